@@ -1,0 +1,20 @@
+/// commands.h: the sketchpose subcommands, one X-macro line each.
+/// Each `cmd_<name>(argc, argv)` lives in cmd_<name>.c, gets argv with the
+/// subcommand name at argv[0], and returns the process exit code:
+/// 0 success, 1 bad input, 2 bad usage (DESIGN.md).
+#ifndef SP_COMMANDS_H
+#define SP_COMMANDS_H
+
+#define SP_COMMANDS(X)                                                                  \
+    X(inspect, "print a rig's joints, parameters, abstractions and warnings as JSON")   \
+    X(render, "render a rig (posed) with an abstraction overlaid to PNG")              \
+    X(export, "write a rig posed by a pose file as .glb")                         \
+    X(train, "train a sketch classifier on a labelled folder")                          \
+    X(eval, "classifier accuracy (top-1/top-3, recall, confusion), cross-validation")   \
+    X(classify, "classify one drawing with a trained model; ranked JSON")
+
+#define SP_DECLARE_CMD(name, help) int cmd_##name(int argc, char** argv);
+SP_COMMANDS(SP_DECLARE_CMD)
+#undef SP_DECLARE_CMD
+
+#endif

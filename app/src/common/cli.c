@@ -1,0 +1,106 @@
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void print_help(const char* cmd, const char* summary, const sp_opt* opts, int nopts)
+{
+    printf("usage: %s", cmd);
+    for (int i = 0; i < nopts; ++i) {
+        const char* a = opts[i].kind == SP_OPT_FLAG ? "" : " ";
+        printf(opts[i].required ? " %s%s%s" : " [%s%s%s]", opts[i].name, a, opts[i].kind == SP_OPT_FLAG ? "" : opts[i].arg);
+    }
+    printf("\n\n%s\n\noptions:\n", summary);
+    for (int i = 0; i < nopts; ++i)
+        printf("  %-12s %-12s %s%s\n", opts[i].name, opts[i].kind == SP_OPT_FLAG ? "" : opts[i].arg, opts[i].help,
+               opts[i].required ? " (required)" : "");
+    printf("  %-12s %-12s %s\n", "--help", "", "show this help");
+}
+
+int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts)
+{
+    bool seen[64] = {0};
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            print_help(cmd, summary, opts, nopts);
+            return 0;
+        }
+    }
+    for (int i = 1; i < argc; ++i) {
+        int k = -1;
+        for (int j = 0; j < nopts; ++j)
+            if (!strcmp(argv[i], opts[j].name)) k = j;
+        if (k < 0) {
+            fprintf(stderr, "%s: unknown option '%s' (see --help)\n", cmd, argv[i]);
+            return 2;
+        }
+        const sp_opt* o = &opts[k];
+        if (k < 64) seen[k] = true;
+        if (o->kind == SP_OPT_FLAG) {
+            *(bool*)o->out = true;
+            continue;
+        }
+        if (o->kind == SP_OPT_LIST) {
+            sp_str_list* l = o->out;
+            while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
+                if (l->count >= 256) {
+                    fprintf(stderr, "%s: too many values for %s (256 at most)\n", cmd, o->name);
+                    return 2;
+                }
+                l->items[l->count++] = argv[++i];
+            }
+            if (l->count == 0) {
+                fprintf(stderr, "%s: %s needs at least one value\n", cmd, o->name);
+                return 2;
+            }
+            continue;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "%s: %s needs a value (%s)\n", cmd, o->name, o->arg);
+            return 2;
+        }
+        const char* v = argv[++i];
+        char* end = NULL;
+        errno = 0;
+        if (o->kind == SP_OPT_STRING) {
+            *(const char**)o->out = v;
+        } else if (o->kind == SP_OPT_INT) {
+            long x = strtol(v, &end, 10);
+            if (errno || end == v || *end || x < -2147483647L || x > 2147483647L) {
+                fprintf(stderr, "%s: %s expects an integer, got '%s'\n", cmd, o->name, v);
+                return 2;
+            }
+            *(int*)o->out = (int)x;
+        } else if (o->kind == SP_OPT_DOUBLE) {
+            double x = strtod(v, &end);
+            if (errno || end == v || *end || !isfinite(x)) {
+                fprintf(stderr, "%s: %s expects a finite number, got '%s'\n", cmd, o->name, v);
+                return 2;
+            }
+            *(double*)o->out = x;
+        }
+    }
+    for (int j = 0; j < nopts && j < 64; ++j)
+        if (opts[j].required && !seen[j]) {
+            fprintf(stderr, "%s: missing %s %s (see --help)\n", cmd, opts[j].name, opts[j].arg);
+            return 2;
+        }
+    return -1;
+}
+
+bool sp_cli_parse_size(const char* s, int* w, int* h)
+{
+    char* end = NULL;
+    long a = strtol(s, &end, 10);
+    if (end == s || (*end != 'x' && *end != 'X')) return false;
+    const char* s2 = end + 1;
+    long b = strtol(s2, &end, 10);
+    if (end == s2 || *end) return false;
+    if (a < 16 || b < 16 || a > 8192 || b > 8192) return false;
+    *w = (int)a;
+    *h = (int)b;
+    return true;
+}

@@ -1,0 +1,46 @@
+/// cli.h: option parsing shared by every sketchpose subcommand and the kiosk.
+///
+///     const char* rig = NULL; int size_w = 0;
+///     sp_opt opts[] = {
+///         {"--rig", SP_OPT_STRING, &rig, "R.gltf", "the rigged character", true},
+///         ...};
+///     int rc = sp_cli_parse(argc, argv, "sketchpose render", "render a rig", opts, n);
+///     if (rc >= 0) return rc;   // --help (0) or bad usage (2), already reported
+#ifndef SP_CLI_H
+#define SP_CLI_H
+
+#include <stdbool.h>
+
+typedef enum sp_opt_kind {
+    SP_OPT_FLAG,   ///< bool*, no value
+    SP_OPT_STRING, ///< const char**
+    SP_OPT_INT,    ///< int*
+    SP_OPT_DOUBLE, ///< double*
+    SP_OPT_LIST,   ///< sp_str_list*: every value up to the next option
+} sp_opt_kind;
+
+typedef struct sp_str_list {
+    int count;
+    const char* items[256];
+} sp_str_list;
+
+typedef struct sp_opt {
+    const char* name;   ///< "--rig"
+    sp_opt_kind kind;
+    void* out;
+    const char* arg;    ///< value placeholder for --help, e.g. "R.gltf"
+    const char* help;
+    bool required;
+} sp_opt;
+
+/// Parses argv[1..) against opts. Returns -1 when the command should run,
+/// 0 after printing --help, 2 after printing a usage error to stderr.
+int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts);
+
+/// Parses "WxH" into two positive ints; false if malformed.
+bool sp_cli_parse_size(const char* s, int* w, int* h);
+
+/// Exit codes (DESIGN.md).
+enum { SP_EXIT_OK = 0, SP_EXIT_INPUT = 1, SP_EXIT_USAGE = 2 };
+
+#endif

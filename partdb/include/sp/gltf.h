@@ -1,0 +1,75 @@
+/// sp/gltf.h: rigged characters and parts in and out of glTF 2.0.
+///
+/// How to use:
+///
+///     sp_character ch = {0};
+///     sp_error err = {0};
+///     if (sp_gltf_load("CesiumMan.glb", &ch, &err) != SP_OK) { fprintf(stderr, "%s\n", err.text); ... }
+///     ... ch.rig is a finalized sp_rig; ch.pose its stored pose ...
+///     sp_gltf_save(&ch, ch.pose, "posed.glb", &err);
+///     sp_character_free(&ch);
+///
+/// The loader reads .gltf (external or data: URI buffers) and .glb, the
+/// sketch-abstraction conventions of DESIGN.md (skinned LINE_STRIP/LINE_LOOP
+/// curves with `sp_abstraction` extras, `sp_dofs` on joints, `sp_part` on the
+/// scene, the scene camera), renormalises skin weights and records a warning,
+/// and for a file without our extras derives a stick-figure abstraction
+/// ("stick", a curve per bone chain, ordered) and default rotation DOFs.
+/// The saver writes a fresh .glb (or .gltf with embedded buffers, by file
+/// extension) from the structs: parameters baked into the joint nodes, the
+/// rest TRS and parameter values kept in extras so that loading the export
+/// gives back the same rig and the same parameters.
+#ifndef SP_GLTF_H
+#define SP_GLTF_H
+
+#include <stdbool.h>
+
+#include "sp/rig.h"
+#include "sp/result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum { SP_WARNING_MAX = 256 };
+
+typedef struct sp_character {
+    sp_rig rig;          ///< finalized
+    double* pose;        ///< rig.param_count values: stored pose (extras `sp_pose`), else defaults
+    float* colors;       ///< rig.vertex_count by 4, linear RGBA base colour per vertex
+    bool has_camera;     ///< a camera came from the file's scene
+    sp_camera camera;    ///< the sketch view: the file's camera, else a front orthographic view of the rest pose
+    char* part_json;     ///< the scene's `extras.sp_part` as compact JSON, or NULL
+    bool derived_abstraction; ///< the stick figure was derived from the skeleton
+    bool derived_dofs;        ///< default rotation DOFs were added
+    int warning_count;
+    char (*warnings)[SP_WARNING_MAX]; ///< one line each
+} sp_character;
+
+/// Loads a .gltf or .glb. On failure err names the file and the problem and
+/// *out is left zeroed.
+sp_result sp_gltf_load(const char* path, sp_character* out, sp_error* err);
+/// Loads from memory (used by the fuzzer and the database); `what` names it in messages.
+sp_result sp_gltf_load_memory(const void* data, size_t size, const char* what, sp_character* out, sp_error* err);
+/// Writes the character posed at `params` (rig.param_count, NULL = ch->pose).
+/// ".glb" writes binary, anything else .gltf with embedded buffers.
+sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err);
+/// Same as sp_gltf_save to a malloc'd GLB in memory (*data freed by the caller with free()).
+sp_result sp_gltf_save_memory(const sp_character* ch, const double* params, void** data, size_t* size, sp_error* err);
+/// Makes a character of a finalized rig, which it takes over (*rig is zeroed):
+/// default pose, light grey vertices, the default front orthographic camera.
+/// For generators and tests that build rigs in code and want to save them.
+sp_result sp_character_from_rig(sp_rig* rig, sp_character* out, sp_error* err);
+/// Frees everything the character owns and zeroes it.
+void sp_character_free(sp_character* ch);
+/// Appends a warning line (printf style).
+void sp_character_warn(sp_character* ch, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,174 @@
+/// sp/math.h: tiny by-value math for rigs and cameras.
+///
+/// Everything is `static inline` on small structs. Matrices are 4x4,
+/// column-major like glTF and OpenGL: m[col*4 + row]. Quaternions are
+/// (x, y, z, w) like glTF. Double precision throughout, because the
+/// Jacobian tests compare against central differences to 1e-6 relative.
+#ifndef SP_MATH_H
+#define SP_MATH_H
+
+#include <math.h>
+#include <stdbool.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sp_vec2 { double x, y; } sp_vec2;
+typedef struct sp_vec3 { double x, y, z; } sp_vec3;
+typedef struct sp_quat { double x, y, z, w; } sp_quat;
+/// Column-major 4x4: m[c*4 + r].
+typedef struct sp_mat4 { double m[16]; } sp_mat4;
+
+static inline sp_vec3 sp_v3(double x, double y, double z) { return (sp_vec3){x, y, z}; }
+static inline sp_vec3 sp_v3_add(sp_vec3 a, sp_vec3 b) { return (sp_vec3){a.x + b.x, a.y + b.y, a.z + b.z}; }
+static inline sp_vec3 sp_v3_sub(sp_vec3 a, sp_vec3 b) { return (sp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline sp_vec3 sp_v3_scale(sp_vec3 a, double s) { return (sp_vec3){a.x * s, a.y * s, a.z * s}; }
+static inline double sp_v3_dot(sp_vec3 a, sp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline sp_vec3 sp_v3_cross(sp_vec3 a, sp_vec3 b)
+{
+    return (sp_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+static inline double sp_v3_len(sp_vec3 a) { return sqrt(sp_v3_dot(a, a)); }
+static inline sp_vec3 sp_v3_norm(sp_vec3 a)
+{
+    double l = sp_v3_len(a);
+    return l > 0.0 ? sp_v3_scale(a, 1.0 / l) : a;
+}
+static inline bool sp_v3_is_valid(sp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+static inline sp_vec2 sp_v2_sub(sp_vec2 a, sp_vec2 b) { return (sp_vec2){a.x - b.x, a.y - b.y}; }
+static inline sp_vec2 sp_v2_add(sp_vec2 a, sp_vec2 b) { return (sp_vec2){a.x + b.x, a.y + b.y}; }
+static inline sp_vec2 sp_v2_scale(sp_vec2 a, double s) { return (sp_vec2){a.x * s, a.y * s}; }
+static inline double sp_v2_dot(sp_vec2 a, sp_vec2 b) { return a.x * b.x + a.y * b.y; }
+static inline double sp_v2_len(sp_vec2 a) { return sqrt(a.x * a.x + a.y * a.y); }
+static inline bool sp_v2_is_valid(sp_vec2 a) { return isfinite(a.x) && isfinite(a.y); }
+
+static inline sp_quat sp_quat_identity(void) { return (sp_quat){0, 0, 0, 1}; }
+static inline sp_quat sp_quat_mul(sp_quat a, sp_quat b)
+{
+    return (sp_quat){a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+                     a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+                     a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+                     a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z};
+}
+static inline sp_quat sp_quat_norm(sp_quat q)
+{
+    double l = sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    if (!(l > 0.0)) return sp_quat_identity();
+    return (sp_quat){q.x / l, q.y / l, q.z / l, q.w / l};
+}
+static inline sp_quat sp_quat_conj(sp_quat q) { return (sp_quat){-q.x, -q.y, -q.z, q.w}; }
+/// Rotation of `angle` radians about unit `axis`.
+static inline sp_quat sp_quat_axis_angle(sp_vec3 axis, double angle)
+{
+    double s = sin(0.5 * angle);
+    return (sp_quat){axis.x * s, axis.y * s, axis.z * s, cos(0.5 * angle)};
+}
+static inline sp_vec3 sp_quat_rotate(sp_quat q, sp_vec3 v)
+{
+    sp_vec3 u = {q.x, q.y, q.z};
+    sp_vec3 t = sp_v3_scale(sp_v3_cross(u, v), 2.0);
+    return sp_v3_add(sp_v3_add(v, sp_v3_scale(t, q.w)), sp_v3_cross(u, t));
+}
+/// Spherical interpolation on the short arc (glTF animation semantics).
+static inline sp_quat sp_quat_slerp(sp_quat a, sp_quat b, double t)
+{
+    double d = a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w;
+    if (d < 0.0) { b = (sp_quat){-b.x, -b.y, -b.z, -b.w}; d = -d; }
+    double wa, wb;
+    if (d > 0.9995) { wa = 1.0 - t; wb = t; }
+    else {
+        double th = acos(d), s = sin(th);
+        wa = sin((1.0 - t) * th) / s;
+        wb = sin(t * th) / s;
+    }
+    return sp_quat_norm((sp_quat){wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z, wa * a.w + wb * b.w});
+}
+
+static inline sp_mat4 sp_mat4_identity(void)
+{
+    sp_mat4 r = {{0}};
+    r.m[0] = r.m[5] = r.m[10] = r.m[15] = 1.0;
+    return r;
+}
+static inline sp_mat4 sp_mat4_mul(const sp_mat4* a, const sp_mat4* b)
+{
+    sp_mat4 r;
+    for (int c = 0; c < 4; ++c)
+        for (int rr = 0; rr < 4; ++rr) {
+            double s = 0.0;
+            for (int k = 0; k < 4; ++k) s += a->m[k * 4 + rr] * b->m[c * 4 + k];
+            r.m[c * 4 + rr] = s;
+        }
+    return r;
+}
+/// Affine point transform (w = 1).
+static inline sp_vec3 sp_mat4_point(const sp_mat4* a, sp_vec3 p)
+{
+    const double* m = a->m;
+    return (sp_vec3){m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+                     m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]};
+}
+/// Direction transform (w = 0).
+static inline sp_vec3 sp_mat4_dir(const sp_mat4* a, sp_vec3 p)
+{
+    const double* m = a->m;
+    return (sp_vec3){m[0] * p.x + m[4] * p.y + m[8] * p.z, m[1] * p.x + m[5] * p.y + m[9] * p.z,
+                     m[2] * p.x + m[6] * p.y + m[10] * p.z};
+}
+/// T * R * S, the glTF node transform.
+static inline sp_mat4 sp_mat4_trs(sp_vec3 t, sp_quat q, sp_vec3 s)
+{
+    double x = q.x, y = q.y, z = q.z, w = q.w;
+    sp_mat4 r = sp_mat4_identity();
+    r.m[0] = (1 - 2 * (y * y + z * z)) * s.x;
+    r.m[1] = (2 * (x * y + z * w)) * s.x;
+    r.m[2] = (2 * (x * z - y * w)) * s.x;
+    r.m[4] = (2 * (x * y - z * w)) * s.y;
+    r.m[5] = (1 - 2 * (x * x + z * z)) * s.y;
+    r.m[6] = (2 * (y * z + x * w)) * s.y;
+    r.m[8] = (2 * (x * z + y * w)) * s.z;
+    r.m[9] = (2 * (y * z - x * w)) * s.z;
+    r.m[10] = (1 - 2 * (x * x + y * y)) * s.z;
+    r.m[12] = t.x;
+    r.m[13] = t.y;
+    r.m[14] = t.z;
+    return r;
+}
+/// General inverse; returns false (and identity) when singular.
+static inline bool sp_mat4_inverse(const sp_mat4* a, sp_mat4* out)
+{
+    const double* m = a->m;
+    double inv[16];
+    inv[0] = m[5] * m[10] * m[15] - m[5] * m[11] * m[14] - m[9] * m[6] * m[15] + m[9] * m[7] * m[14] + m[13] * m[6] * m[11] - m[13] * m[7] * m[10];
+    inv[4] = -m[4] * m[10] * m[15] + m[4] * m[11] * m[14] + m[8] * m[6] * m[15] - m[8] * m[7] * m[14] - m[12] * m[6] * m[11] + m[12] * m[7] * m[10];
+    inv[8] = m[4] * m[9] * m[15] - m[4] * m[11] * m[13] - m[8] * m[5] * m[15] + m[8] * m[7] * m[13] + m[12] * m[5] * m[11] - m[12] * m[7] * m[9];
+    inv[12] = -m[4] * m[9] * m[14] + m[4] * m[10] * m[13] + m[8] * m[5] * m[14] - m[8] * m[6] * m[13] - m[12] * m[5] * m[10] + m[12] * m[6] * m[9];
+    inv[1] = -m[1] * m[10] * m[15] + m[1] * m[11] * m[14] + m[9] * m[2] * m[15] - m[9] * m[3] * m[14] - m[13] * m[2] * m[11] + m[13] * m[3] * m[10];
+    inv[5] = m[0] * m[10] * m[15] - m[0] * m[11] * m[14] - m[8] * m[2] * m[15] + m[8] * m[3] * m[14] + m[12] * m[2] * m[11] - m[12] * m[3] * m[10];
+    inv[9] = -m[0] * m[9] * m[15] + m[0] * m[11] * m[13] + m[8] * m[1] * m[15] - m[8] * m[3] * m[13] - m[12] * m[1] * m[11] + m[12] * m[3] * m[9];
+    inv[13] = m[0] * m[9] * m[14] - m[0] * m[10] * m[13] - m[8] * m[1] * m[14] + m[8] * m[2] * m[13] + m[12] * m[1] * m[10] - m[12] * m[2] * m[9];
+    inv[2] = m[1] * m[6] * m[15] - m[1] * m[7] * m[14] - m[5] * m[2] * m[15] + m[5] * m[3] * m[14] + m[13] * m[2] * m[7] - m[13] * m[3] * m[6];
+    inv[6] = -m[0] * m[6] * m[15] + m[0] * m[7] * m[14] + m[4] * m[2] * m[15] - m[4] * m[3] * m[14] - m[12] * m[2] * m[7] + m[12] * m[3] * m[6];
+    inv[10] = m[0] * m[5] * m[15] - m[0] * m[7] * m[13] - m[4] * m[1] * m[15] + m[4] * m[3] * m[13] + m[12] * m[1] * m[7] - m[12] * m[3] * m[5];
+    inv[14] = -m[0] * m[5] * m[14] + m[0] * m[6] * m[13] + m[4] * m[1] * m[14] - m[4] * m[2] * m[13] - m[12] * m[1] * m[6] + m[12] * m[2] * m[5];
+    inv[3] = -m[1] * m[6] * m[11] + m[1] * m[7] * m[10] + m[5] * m[2] * m[11] - m[5] * m[3] * m[10] - m[9] * m[2] * m[7] + m[9] * m[3] * m[6];
+    inv[7] = m[0] * m[6] * m[11] - m[0] * m[7] * m[10] - m[4] * m[2] * m[11] + m[4] * m[3] * m[10] + m[8] * m[2] * m[7] - m[8] * m[3] * m[6];
+    inv[11] = -m[0] * m[5] * m[11] + m[0] * m[7] * m[9] + m[4] * m[1] * m[11] - m[4] * m[3] * m[9] - m[8] * m[1] * m[7] + m[8] * m[3] * m[5];
+    inv[15] = m[0] * m[5] * m[10] - m[0] * m[6] * m[9] - m[4] * m[1] * m[10] + m[4] * m[2] * m[9] + m[8] * m[1] * m[6] - m[8] * m[2] * m[5];
+    double det = m[0] * inv[0] + m[1] * inv[4] + m[2] * inv[8] + m[3] * inv[12];
+    if (!(fabs(det) > 1e-300) || !isfinite(det)) {
+        *out = sp_mat4_identity();
+        return false;
+    }
+    det = 1.0 / det;
+    for (int i = 0; i < 16; ++i) out->m[i] = inv[i] * det;
+    return true;
+}
+static inline sp_vec3 sp_mat4_translation(const sp_mat4* a) { return (sp_vec3){a->m[12], a->m[13], a->m[14]}; }
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,48 @@
+/// sp/result.h: the result enum and error message shared by every module.
+///
+/// Fallible calls return an `sp_result` and, when they fail, write one line
+/// into an `sp_error` that names the file (if any) and the problem, e.g.
+/// "CesiumMan.glb: accessor 7 reads past the end of buffer 0". Callers print
+/// `err.text` as is. Contract violations (NULL where a pointer is required)
+/// are asserts, not results.
+#ifndef SP_RESULT_H
+#define SP_RESULT_H
+
+#include <stdarg.h>
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sp_result {
+    SP_OK = 0,
+    SP_ERR_IO,          ///< a file could not be opened, read or written
+    SP_ERR_PARSE,       ///< the bytes are not the format they claim to be
+    SP_ERR_INVALID,     ///< well-formed but semantically wrong (bad index, NaN, cycle, ...)
+    SP_ERR_UNSUPPORTED, ///< valid but outside what we handle
+    SP_ERR_NO_MEMORY,   ///< an allocation failed
+    SP_ERR_BUSY,        ///< a resource (database) is held by someone else
+    SP_ERR_INTERNAL,    ///< a bug or an exception from a library
+} sp_result;
+
+/// One-line error message. Zero-initialise before use.
+typedef struct sp_error {
+    char text[512];
+} sp_error;
+
+/// printf into err->text (if err is not NULL) and return `code`, so that
+/// `return sp_fail(err, SP_ERR_PARSE, "%s: bad header", path);` reads well.
+sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/// Short stable name of a result code, e.g. "parse error".
+const char* sp_result_name(sp_result r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

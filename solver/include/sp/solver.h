@@ -1,0 +1,120 @@
+/// sp/solver.h: sketch to pose: the regularized nonlinear ICP of the paper.
+///
+/// How to use:
+///
+///     sp_solver* s = sp_solver_create(&rig, abstraction_index, &camera, &(sp_solve_desc){0});
+///     sp_solve_report rep;
+///     sp_error err = {0};
+///     if (sp_solver_solve(s, &sketch, p_start, p_out, &rep, &err) != SP_OK) ... err.text ...
+///     sp_solver_destroy(s);
+///
+/// The energy (paper eq. 7, coarsened by eq. 12) is
+///     W = W_match + l_pose W_pose + l_plane W_plane + l_dist W_dist
+/// with every term made dimensionless so that the paper's default weights
+/// transfer between characters of any size and canvases of any resolution:
+///   - W_match = mean over correspondence pairs of (|y_i - z_j| / (0.01 L))^2,
+///     L the diagonal in pixels of the abstraction's 2D bounding box at the
+///     start pose: W_match = 1 means the mean error is 1% of the abstraction.
+///   - W_pose = sum_k ((p_k - p0_k) / u_k)^2, u_k = 1 for angles (radians) and
+///     scale factors, D for translations (D = the rest mesh's bounding-box
+///     diagonal in world units).
+///   - W_plane = mean over the k representative vertices of (v . (x_i - x_i0) / (0.01 D))^2.
+///   - W_dist = mean over representatives of d_i / d_max |x_i - x_i0|^2 / (0.01 D)^2,
+///     d_i the 3D distance from x_i0 to the nearest point of the matched curves.
+/// Means instead of the paper's sums keep the balance independent of sample
+/// and vertex counts (the paper's n/k factor is the same idea).
+///
+/// The solve alternates correspondence updates (ICP rounds) with damped
+/// Gauss-Newton steps (Levenberg-Marquardt) on the linearised rig. Bounds
+/// are honoured exactly by a projected step with an active set: a parameter
+/// at a bound whose gradient points outward is held fixed for the step, and
+/// every iterate is clamped, so no returned value is ever out of bounds.
+#ifndef SP_SOLVER_H
+#define SP_SOLVER_H
+
+#include <stdbool.h>
+
+#include "sp/result.h"
+#include "sp/rig.h"
+#include "sp/sketch.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum { SP_REPORT_CURVES = 64 };
+
+/// Options; zero means the default.
+typedef struct sp_solve_desc {
+    double lambda_pose;  ///< 0: 0.5; < 0: term off
+    double lambda_plane; ///< 0: 0.01; < 0: term off
+    double lambda_dist;  ///< 0: 0.001; < 0: term off
+    int representatives; ///< k for the coarsening (eq. 12); 0: 200
+    int samples;         ///< samples per curve after resampling; 0: by length, 24..160
+    int max_iterations;  ///< Gauss-Newton iterations in all; 0: 300
+    int max_icp_rounds;  ///< correspondence updates; 0: 40
+    double time_cap_ms;  ///< wall-clock cap; 0: 3000
+    bool no_root_alignment; ///< skip the first stage that moves only the root's parameters
+    const bool* active;  ///< param_count flags: which parameters may change; NULL: all
+} sp_solve_desc;
+
+typedef enum sp_stop_reason {
+    SP_STOP_CONVERGED,      ///< the energy stalled at a minimum
+    SP_STOP_MAX_ITERATIONS, ///< the iteration or round cap was reached
+    SP_STOP_TIME_CAP,       ///< the time cap was reached
+    SP_STOP_STALLED,        ///< no step could lower the energy further from a non-stationary point
+} sp_stop_reason;
+
+/// "converged", "max_iterations", "time_cap", "stalled" (the report's JSON words).
+const char* sp_stop_reason_name(sp_stop_reason r);
+
+typedef struct sp_energy_terms {
+    double total, match, pose, plane, dist; ///< weighted terms sum to total
+} sp_energy_terms;
+
+typedef struct sp_curve_report {
+    int curve;        ///< index in the abstraction
+    int stroke;       ///< index of the matched stroke, -1 if none
+    bool reversed;    ///< the stroke was drawn against the curve's direction
+    double mean_px, max_px; ///< 2D error after the solve, pixels
+} sp_curve_report;
+
+typedef struct sp_solve_report {
+    int iterations, icp_rounds;
+    sp_stop_reason stopped;
+    double ms;
+    sp_energy_terms before, after;
+    double mean_error_px, max_error_px; ///< over all matched samples, both directions for closest
+    double bbox_diagonal_px;            ///< L, the abstraction's 2D diagonal at the start pose
+    int curve_count;                    ///< entries used in curves
+    sp_curve_report curves[SP_REPORT_CURVES];
+    int unused_strokes;                 ///< strokes left without a curve (more strokes than curves)
+    char note[256];                     ///< why a best-effort result is only that, or empty
+} sp_solve_report;
+
+typedef struct sp_solver sp_solver;
+
+/// Prepares a solver for one rig, abstraction and view: the coarsening
+/// (k-means of the rest vertices with FLANN, cluster centres snapped to the
+/// nearest vertex) and buffers. The rig and camera must outlive the solver.
+/// Returns NULL if out of memory or the abstraction index is invalid.
+sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_solve_desc* desc);
+void sp_solver_destroy(sp_solver* s);
+/// Representative vertex indices chosen by the coarsening (*count of them).
+const int* sp_solver_representatives(const sp_solver* s, int* count);
+
+/// Fits the rig to the strokes from p_start (param_count, NULL: defaults);
+/// writes the result into p_out (may alias p_start). Bad strokes (NaN,
+/// empty, one point) are refused with SP_ERR_INVALID; a target that cannot
+/// be reached gives SP_OK with a best-effort pose and a note in the report.
+sp_result sp_solver_solve(sp_solver* s, const sp_sketch* strokes, const double* p_start, double* p_out, sp_solve_report* rep,
+                          sp_error* err);
+
+/// The abstraction's curves projected at parameters p: xy is point_count by 2,
+/// pixels (the caller sizes it with the abstraction's point_count).
+void sp_solver_project_abstraction(sp_solver* s, const double* p, double* xy);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,209 @@
+// match.c: the correspondence step of the ICP: resample the projected
+// abstraction curves and the strokes to equal counts and pair their samples,
+// ordered (with strokes assigned to curves regardless of drawing order and
+// direction) or by closest points in both directions over all strokes.
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "solver_internal.h"
+#include "sp/curve.h"
+
+sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err);
+
+// Arc-length resampling of curve c of the projected abstraction, as
+// references to its points (so that samples stay linear in the rig's points).
+static void resample_refs(const sp_solver* s, const sp_curve* cv, int m, sample_ref* out)
+{
+    int n = cv->point_count, f = cv->first_point;
+    int segs = cv->closed ? n : n - 1;
+    double total = 0;
+    for (int i = 0; i < segs; ++i) {
+        const double* a = s->z2 + 2 * (f + i);
+        const double* b = s->z2 + 2 * (f + (i + 1) % n);
+        total += hypot(b[0] - a[0], b[1] - a[1]);
+    }
+    int seg = 0;
+    double acc = 0; // arc length at the start of seg
+    for (int k = 0; k < m; ++k) {
+        double target = cv->closed ? total * k / m : (m > 1 ? total * k / (m - 1) : 0);
+        for (;;) {
+            const double* a = s->z2 + 2 * (f + seg);
+            const double* b = s->z2 + 2 * (f + (seg + 1) % n);
+            double len = hypot(b[0] - a[0], b[1] - a[1]);
+            if (acc + len >= target || seg + 1 >= segs) {
+                double t = len > 0 ? (target - acc) / len : 0;
+                out[k] = (sample_ref){f + seg, f + (seg + 1) % n, fmin(fmax(t, 0.0), 1.0)};
+                break;
+            }
+            acc += len;
+            ++seg;
+        }
+    }
+    if (!cv->closed && m > 1) out[m - 1] = (sample_ref){f + n - 2, f + n - 1, 1.0}; // exact end point
+}
+
+static sp_vec2 ref_pos(const sp_solver* s, sample_ref r)
+{
+    const double* a = s->z2 + 2 * r.a;
+    const double* b = s->z2 + 2 * r.b;
+    return (sp_vec2){a[0] + r.t * (b[0] - a[0]), a[1] + r.t * (b[1] - a[1])};
+}
+
+static double curve_length2d(const sp_solver* s, const sp_curve* cv)
+{
+    double len = 0;
+    int segs = cv->closed ? cv->point_count : cv->point_count - 1;
+    for (int i = 0; i < segs; ++i) {
+        const double* a = s->z2 + 2 * (cv->first_point + i);
+        const double* b = s->z2 + 2 * (cv->first_point + (i + 1) % cv->point_count);
+        len += hypot(b[0] - a[0], b[1] - a[1]);
+    }
+    return len;
+}
+
+// Samples per curve: the caller's fixed count, or about 400 over the whole
+// abstraction in proportion to length, 16..160 per curve.
+static int samples_for(const sp_solver* s, const sp_curve* cv, double total_len)
+{
+    if (s->d.samples > 0) return s->d.samples;
+    double share = total_len > 0 ? curve_length2d(s, cv) / total_len : 1.0 / s->ab->curve_count;
+    int m = (int)lround(400.0 * share);
+    return m < 16 ? 16 : (m > 160 ? 160 : m);
+}
+
+static bool grow_pairs(sp_solver* s, int need)
+{
+    if (need <= s->pair_cap) return true;
+    int cap = need + need / 2 + 16;
+    pair* p = realloc(s->pairs, sizeof(pair) * (size_t)cap);
+    if (!p) return false;
+    s->pairs = p;
+    s->pair_cap = cap;
+    return true;
+}
+
+sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err)
+{
+    const sp_abstraction* ab = s->ab;
+    const int C = ab->curve_count;
+    s->pair_count = 0;
+    rep->curve_count = C < SP_REPORT_CURVES ? C : SP_REPORT_CURVES;
+    for (int c = 0; c < rep->curve_count; ++c) rep->curves[c] = (sp_curve_report){c, -1, false, 0, 0};
+    double total_len = 0;
+    for (int c = 0; c < C; ++c) total_len += curve_length2d(s, &ab->curves[c]);
+    int mmax = 1, msum = 0;
+    for (int c = 0; c < C; ++c) {
+        int m = samples_for(s, &ab->curves[c], total_len);
+        mmax = m > mmax ? m : mmax;
+        msum += m;
+    }
+    sp_result res = SP_OK;
+    if (s->mode == SP_CORR_ORDERED) {
+        sp_polyline* lines = malloc(sizeof(sp_polyline) * (size_t)C);
+        sp_vec2* pts = malloc(sizeof(sp_vec2) * (size_t)ab->point_count);
+        sp_stroke_match* sm = malloc(sizeof(sp_stroke_match) * (size_t)sk->stroke_count);
+        int* c2s = malloc(sizeof(int) * (size_t)C);
+        sp_vec2* y = malloc(sizeof(sp_vec2) * (size_t)mmax);
+        sp_vec2* z = malloc(sizeof(sp_vec2) * (size_t)mmax);
+        sample_ref* refs = malloc(sizeof(sample_ref) * (size_t)mmax);
+        int* match = malloc(sizeof(int) * (size_t)mmax);
+        if (!lines || !pts || !sm || !c2s || !y || !z || !refs || !match || !grow_pairs(s, msum)) {
+            res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+            goto ordered_done;
+        }
+        for (int i = 0; i < ab->point_count; ++i) pts[i] = (sp_vec2){s->z2[2 * i], s->z2[2 * i + 1]};
+        for (int c = 0; c < C; ++c)
+            lines[c] = (sp_polyline){pts + ab->curves[c].first_point, ab->curves[c].point_count, ab->curves[c].closed};
+        res = sp_assign_strokes(sk->strokes, sk->stroke_count, lines, C, &(sp_assign_desc){.samples = 64}, sm, c2s, err);
+        if (res != SP_OK) goto ordered_done;
+        rep->unused_strokes = 0;
+        for (int i = 0; i < sk->stroke_count; ++i) rep->unused_strokes += sm[i].curve < 0;
+        for (int c = 0; c < C; ++c) {
+            int st = c2s[c];
+            if (st < 0) continue;
+            const sp_curve* cv = &ab->curves[c];
+            int m = samples_for(s, cv, total_len);
+            res = sp_curve_resample(sk->strokes[st].points, sk->strokes[st].count, cv->closed, m, y);
+            if (res != SP_OK) {
+                sp_fail(err, res, "stroke %d cannot be resampled", st);
+                goto ordered_done;
+            }
+            resample_refs(s, cv, m, refs);
+            for (int k = 0; k < m; ++k) z[k] = ref_pos(s, refs[k]);
+            sp_ordered_info info;
+            res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
+            if (res != SP_OK) {
+                sp_fail(err, res, "stroke %d: no ordered correspondence", st);
+                goto ordered_done;
+            }
+            for (int k = 0; k < m; ++k) s->pairs[s->pair_count++] = (pair){y[k], refs[match[k]], c};
+            if (c < SP_REPORT_CURVES) rep->curves[c].stroke = st, rep->curves[c].reversed = info.reversed;
+        }
+        if (rep->unused_strokes > 0)
+            snprintf(rep->note, sizeof rep->note, "%d stroke(s) more than the abstraction's %d curve(s) were left unused",
+                     rep->unused_strokes, C);
+    ordered_done:
+        free(lines), free(pts), free(sm), free(c2s), free(y), free(z), free(refs), free(match);
+        return res;
+    }
+    // Closest points, both ways, over all strokes and all curves at once:
+    // the strokes get as many samples in all as the curves, by length.
+    double slen_total = 0;
+    for (int i = 0; i < sk->stroke_count; ++i) slen_total += sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false);
+    int* scount = malloc(sizeof(int) * (size_t)sk->stroke_count);
+    int my = 0;
+    for (int i = 0; scount && i < sk->stroke_count; ++i) {
+        double share = slen_total > 0 ? sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false) / slen_total : 0;
+        scount[i] = (int)lround(msum * share);
+        if (scount[i] < 8) scount[i] = 8;
+        my += scount[i];
+    }
+    sp_vec2* y = malloc(sizeof(sp_vec2) * (size_t)(my + 1));
+    int* ystroke = malloc(sizeof(int) * (size_t)(my + 1));
+    sp_vec2* z = malloc(sizeof(sp_vec2) * (size_t)msum);
+    sample_ref* refs = malloc(sizeof(sample_ref) * (size_t)msum);
+    int* zcurve = malloc(sizeof(int) * (size_t)msum);
+    sp_corr_pair* cp = malloc(sizeof(sp_corr_pair) * (size_t)(my + msum));
+    int* votes = calloc((size_t)C * (size_t)sk->stroke_count, sizeof(int));
+    if (!scount || !y || !ystroke || !z || !refs || !zcurve || !cp || !votes || !grow_pairs(s, my + msum)) {
+        res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+        goto closest_done;
+    }
+    int at = 0;
+    for (int i = 0; i < sk->stroke_count; ++i) {
+        res = sp_curve_resample(sk->strokes[i].points, sk->strokes[i].count, false, scount[i], y + at);
+        if (res != SP_OK) {
+            sp_fail(err, res, "stroke %d cannot be resampled", i);
+            goto closest_done;
+        }
+        for (int k = 0; k < scount[i]; ++k) ystroke[at + k] = i;
+        at += scount[i];
+    }
+    at = 0;
+    for (int c = 0; c < C; ++c) {
+        int m = samples_for(s, &ab->curves[c], total_len);
+        resample_refs(s, &ab->curves[c], m, refs + at);
+        for (int k = 0; k < m; ++k) z[at + k] = ref_pos(s, refs[at + k]), zcurve[at + k] = c;
+        at += m;
+    }
+    res = sp_corr_closest(y, my, z, msum, cp, NULL);
+    if (res != SP_OK) {
+        sp_fail(err, res, "closest-point correspondences failed");
+        goto closest_done;
+    }
+    for (int i = 0; i < my + msum; ++i) {
+        int c = zcurve[cp[i].z];
+        s->pairs[s->pair_count++] = (pair){y[cp[i].y], refs[cp[i].z], c};
+        votes[c * sk->stroke_count + ystroke[cp[i].y]]++;
+    }
+    for (int c = 0; c < rep->curve_count; ++c) {
+        int best = -1, bv = 0;
+        for (int i = 0; i < sk->stroke_count; ++i)
+            if (votes[c * sk->stroke_count + i] > bv) bv = votes[c * sk->stroke_count + i], best = i;
+        rep->curves[c].stroke = best;
+    }
+closest_done:
+    free(scount), free(y), free(ystroke), free(z), free(refs), free(zcurve), free(cp), free(votes);
+    return res;
+}

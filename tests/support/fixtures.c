@@ -1,0 +1,136 @@
+#include "fixtures.h"
+
+#include <assert.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+double sp_test_uniform(sp_test_rng* r)
+{
+    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+double sp_test_range(sp_test_rng* r, double lo, double hi) { return lo + (hi - lo) * sp_test_uniform(r); }
+
+void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
+{
+    int nj = d->joint_count > 0 ? d->joint_count : 4;
+    int rings = d->rings_per_bone > 0 ? d->rings_per_bone : 6;
+    int rv = d->ring_vertices > 0 ? d->ring_vertices : 12;
+    sp_test_rng rng = {d->seed * 7919u + 17u};
+    memset(rig, 0, sizeof *rig);
+    rig->joint_count = nj;
+    rig->joints = calloc((size_t)nj, sizeof(sp_joint));
+    sp_mat4* world = malloc(sizeof(sp_mat4) * (size_t)nj);
+    for (int j = 0; j < nj; ++j) {
+        sp_joint* jt = &rig->joints[j];
+        snprintf(jt->name, sizeof jt->name, "j%d", j);
+        jt->parent = j == 0 ? -1 : (d->branching ? (int)(sp_test_uniform(&rng) * j * 0.999) : j - 1);
+        if (d->branching && j > 1 && sp_test_uniform(&rng) < 0.6) jt->parent = j - 1;
+        // Bones point mostly along +Y with a random bend; rest rotations and
+        // scales are not identity so that the tests exercise them.
+        jt->rest_t = j == 0 ? sp_v3(0.1, 0.2, -0.1) : sp_v3(sp_test_range(&rng, -0.2, 0.2), sp_test_range(&rng, 0.6, 1.0), sp_test_range(&rng, -0.2, 0.2));
+        sp_vec3 axis = sp_v3_norm(sp_v3(sp_test_range(&rng, -1, 1), sp_test_range(&rng, -1, 1), sp_test_range(&rng, -1, 1)));
+        jt->rest_r = sp_quat_axis_angle(axis, sp_test_range(&rng, -0.4, 0.4));
+        jt->rest_s = j == 0 ? sp_v3(1.1, 1.1, 1.1) : sp_v3(sp_test_range(&rng, 0.9, 1.1), sp_test_range(&rng, 0.9, 1.1), sp_test_range(&rng, 0.9, 1.1));
+        sp_mat4 local = sp_mat4_trs(jt->rest_t, jt->rest_r, jt->rest_s);
+        world[j] = jt->parent < 0 ? local : sp_mat4_mul(&world[jt->parent], &local);
+        sp_mat4_inverse(&world[j], &jt->inverse_bind);
+    }
+    for (int j = 0; j < nj; ++j) {
+        for (int c = SP_CH_RX; c <= SP_CH_RZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, -2.0, 2.0, SP_GROUP_POSE);
+        if (!d->all_channels) continue;
+        if (j == 0) {
+            for (int c = SP_CH_TX; c <= SP_CH_TZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, -5.0, 5.0, SP_GROUP_POSE);
+            sp_rig_add_param(rig, j, SP_CH_S, 0.25, 4.0, SP_GROUP_SHAPE);
+        } else if (j % 2) {
+            for (int c = SP_CH_SX; c <= SP_CH_SZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, 0.5, 2.0, SP_GROUP_SHAPE);
+        } else {
+            sp_rig_add_param(rig, j, SP_CH_S, 0.5, 2.0, SP_GROUP_SHAPE);
+            sp_rig_add_param(rig, j, SP_CH_TY, -0.3, 0.3, SP_GROUP_SHAPE);
+        }
+    }
+    // Mesh: rings along each bone (parent -> child), blended weights.
+    int bones = nj - 1 > 0 ? nj - 1 : 1;
+    int nv = bones * rings * rv;
+    rig->vertex_count = nv;
+    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
+    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
+    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
+    rig->triangle_count = bones * (rings - 1) * rv * 2;
+    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
+    // Stick abstraction: 8 points per bone, one curve per bone.
+    const int per = 8;
+    sp_abstraction ab = {0};
+    snprintf(ab.name, sizeof ab.name, "stick");
+    ab.correspondence = SP_CORR_ORDERED;
+    ab.curve_count = bones;
+    ab.curves = calloc((size_t)bones, sizeof(sp_curve));
+    ab.point_count = bones * per;
+    ab.rest = malloc(sizeof(double) * 3 * (size_t)ab.point_count);
+    ab.joints = calloc((size_t)ab.point_count * 4, sizeof(uint16_t));
+    ab.weights = calloc((size_t)ab.point_count * 4, sizeof(float));
+    int v = 0, t = 0;
+    for (int b = 0; b < bones; ++b) {
+        int child = nj > 1 ? b + 1 : 0, par = nj > 1 ? rig->joints[child].parent : 0;
+        sp_vec3 a = sp_mat4_translation(&world[par]), c = sp_mat4_translation(&world[child]);
+        if (nj == 1) c = sp_v3_add(a, sp_v3(0, 1, 0));
+        sp_vec3 dir = sp_v3_sub(c, a);
+        sp_vec3 n1 = sp_v3_norm(sp_v3_cross(dir, fabs(dir.x) < 0.9 * sp_v3_len(dir) ? sp_v3(1, 0, 0) : sp_v3(0, 0, 1)));
+        sp_vec3 n2 = sp_v3_norm(sp_v3_cross(dir, n1));
+        double radius = 0.12 * sp_v3_len(dir) + 0.03;
+        int base = v;
+        for (int r = 0; r < rings; ++r) {
+            double u = (double)r / (rings - 1);
+            sp_vec3 center = sp_v3_add(a, sp_v3_scale(dir, u));
+            for (int k = 0; k < rv; ++k) {
+                double ang = 2.0 * 3.14159265358979323846 * k / rv;
+                sp_vec3 p = sp_v3_add(center, sp_v3_add(sp_v3_scale(n1, radius * cos(ang)), sp_v3_scale(n2, radius * sin(ang))));
+                rig->rest[3 * v] = p.x, rig->rest[3 * v + 1] = p.y, rig->rest[3 * v + 2] = p.z;
+                rig->joints4[4 * v] = (uint16_t)par, rig->joints4[4 * v + 1] = (uint16_t)child;
+                rig->weights4[4 * v] = (float)(1.0 - 0.5 * u), rig->weights4[4 * v + 1] = (float)(0.5 * u);
+                ++v;
+            }
+        }
+        for (int r = 0; r + 1 < rings; ++r)
+            for (int k = 0; k < rv; ++k) {
+                uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
+                uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
+                uint32_t* tr = rig->triangles + 3 * t;
+                tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
+                t += 2;
+            }
+        snprintf(ab.curves[b].name, sizeof ab.curves[b].name, "bone%d", b);
+        ab.curves[b].first_point = b * per;
+        ab.curves[b].point_count = per;
+        for (int k = 0; k < per; ++k) {
+            int i = b * per + k;
+            sp_vec3 p = sp_v3_add(a, sp_v3_scale(dir, (double)k / (per - 1)));
+            ab.rest[3 * i] = p.x, ab.rest[3 * i + 1] = p.y, ab.rest[3 * i + 2] = p.z;
+            ab.joints[4 * i] = (uint16_t)par;
+            ab.weights[4 * i] = 1.0f;
+        }
+    }
+    rig->abstraction_count = 1;
+    rig->abstractions = malloc(sizeof(sp_abstraction));
+    rig->abstractions[0] = ab;
+    free(world);
+    sp_error err = {0};
+    sp_result r = sp_rig_finalize(rig, "fixture", NULL, &err);
+    if (r != SP_OK) fprintf(stderr, "fixture: %s\n", err.text);
+    assert(r == SP_OK);
+}
+
+void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p)
+{
+    for (int i = 0; i < rig->param_count; ++i) {
+        const sp_param* q = &rig->params[i];
+        double lo = q->min, hi = q->max;
+        if (sp_channel_is_rotation(q->channel)) lo = fmax(lo, q->def - amplitude), hi = fmin(hi, q->def + amplitude);
+        p[i] = sp_test_range(rng, lo, hi);
+    }
+}

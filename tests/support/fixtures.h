@@ -1,0 +1,32 @@
+/// fixtures.h: reference rigs shared by tests and benchmarks.
+///
+/// sp_fixture_tree_rig builds a tube mesh around any skeleton: rings of
+/// vertices along every bone, skinned smoothly between the bone's two joints,
+/// plus a "stick" abstraction (points along each bone, rigid to its parent).
+#ifndef SP_FIXTURES_H
+#define SP_FIXTURES_H
+
+#include <stdint.h>
+
+#include "sp/rig.h"
+
+/// Deterministic splitmix64 generator for tests.
+typedef struct sp_test_rng { uint64_t s; } sp_test_rng;
+double sp_test_uniform(sp_test_rng* r); ///< [0, 1)
+double sp_test_range(sp_test_rng* r, double lo, double hi);
+
+typedef struct sp_fixture_desc {
+    int joint_count;       ///< 0: 4 (a chain)
+    bool branching;        ///< random tree instead of a chain
+    int rings_per_bone;    ///< 0: 6
+    int ring_vertices;     ///< 0: 12
+    bool all_channels;     ///< root gets tx/ty/tz + s, others sx/sy/sz or s besides rx/ry/rz
+    uint64_t seed;
+} sp_fixture_desc;
+
+/// Builds and finalizes a rig (asserts on failure).
+void sp_fixture_tree_rig(const sp_fixture_desc* desc, sp_rig* out);
+/// Random in-bounds parameters (rotations within +-amplitude of the default).
+void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p);
+
+#endif

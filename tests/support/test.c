@@ -1,0 +1,70 @@
+#include "test.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+int sp_test_failures = 0;
+jmp_buf sp_test_jmp;
+const char* sp_test_skip_reason = NULL;
+
+static char* ring_next(void)
+{
+    static char ring[8][1024];
+    static int at = 0;
+    return ring[at++ & 7];
+}
+
+const char* sp_test_data_dir(void)
+{
+    struct stat st;
+    if (stat(SP_SHARED_DATA, &st) == 0 && S_ISDIR(st.st_mode)) return SP_SHARED_DATA;
+    return NULL;
+}
+
+const char* sp_test_src_path(const char* rel)
+{
+    char* b = ring_next();
+    snprintf(b, 1024, "%s/%s", SP_SOURCE_DIR, rel);
+    return b;
+}
+
+const char* sp_test_tmp_path(const char* name)
+{
+    char* b = ring_next();
+    mkdir(SP_BINARY_DIR "/tmp", 0755);
+    snprintf(b, 1024, "%s/tmp/%d_%s", SP_BINARY_DIR, (int)getpid(), name);
+    return b;
+}
+
+// 0 ok, 1 failed, 2 skipped. The setjmp lives here, apart from the loop's
+// locals, so that longjmp cannot clobber them.
+static int run_one(const sp_test* t)
+{
+    int before = sp_test_failures;
+    sp_test_skip_reason = NULL;
+    if (setjmp(sp_test_jmp) == 0) t->fn();
+    else if (sp_test_skip_reason) return 2;
+    return sp_test_failures > before ? 1 : 0;
+}
+
+int sp_test_run(int argc, char** argv, const sp_test* tests)
+{
+    int ran = 0, failed = 0, skipped = 0;
+    for (const sp_test* t = tests; t->name; ++t) {
+        if (argc > 1 && !strstr(t->name, argv[1])) continue;
+        int rc = run_one(t);
+        ++ran;
+        if (rc == 2) {
+            ++skipped;
+            printf("SKIP %s: %s\n", t->name, sp_test_skip_reason);
+        } else if (rc == 1) {
+            ++failed;
+            printf("FAIL %s\n", t->name);
+        } else {
+            printf("ok   %s\n", t->name);
+        }
+        fflush(stdout);
+    }
+    printf("%d passed, %d failed, %d skipped\n", ran - failed - skipped, failed, skipped);
+    return failed ? 1 : 0;
+}

@@ -1,0 +1,188 @@
+// Solver tests: recovery of random poses from their own projected
+// abstraction, bounds, drawing-order independence, determinism, bad input.
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fixtures.h"
+#include "sp/solver.h"
+#include "test.h"
+
+typedef struct setup {
+    sp_rig rig;
+    sp_camera cam;
+} setup;
+
+static void make_setup(setup* st, const sp_fixture_desc* d)
+{
+    sp_fixture_tree_rig(d, &st->rig);
+    sp_vec3 lo, hi;
+    sp_bounds(st->rig.rest, st->rig.vertex_count, &lo, &hi);
+    st->cam = sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, lo, hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), 640, 480);
+}
+
+// Strokes = the abstraction's curves projected at p (one stroke per curve).
+static void strokes_at(sp_solver* s, const sp_rig* rig, const double* p, sp_sketch* sk)
+{
+    const sp_abstraction* ab = &rig->abstractions[0];
+    double* xy = malloc(sizeof(double) * 2 * ab->point_count);
+    sp_solver_project_abstraction(s, p, xy);
+    memset(sk, 0, sizeof *sk);
+    sk->canvas_w = 640, sk->canvas_h = 480;
+    for (int c = 0; c < ab->curve_count; ++c) {
+        const sp_curve* cv = &ab->curves[c];
+        sp_vec2* pts = malloc(sizeof(sp_vec2) * cv->point_count);
+        for (int i = 0; i < cv->point_count; ++i)
+            pts[i] = (sp_vec2){xy[2 * (cv->first_point + i)], xy[2 * (cv->first_point + i) + 1]};
+        sp_sketch_add_stroke(sk, pts, NULL, cv->point_count);
+        free(pts);
+    }
+    free(xy);
+}
+
+static void test_recovery_chain(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 5, .seed = 3});
+    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    ENSURE(s);
+    int P = st.rig.param_count, ok = 0, cases = 20;
+    double* truth = malloc(sizeof(double) * P);
+    double* out = malloc(sizeof(double) * P);
+    for (int c = 0; c < cases; ++c) {
+        sp_test_rng rng = {100 + c};
+        sp_fixture_random_params(&st.rig, &rng, 0.785, truth);
+        sp_sketch sk;
+        strokes_at(s, &st.rig, truth, &sk);
+        sp_solve_report rep;
+        sp_error err = {0};
+        ENSURE(sp_solver_solve(s, &sk, NULL, out, &rep, &err) == SP_OK);
+        double rel = rep.mean_error_px / rep.bbox_diagonal_px;
+        if (rel <= 0.01) ++ok;
+        else fprintf(stderr, "  case %d: mean error %.2f%% (%s, %d it, %d rounds)\n", c, 100 * rel, sp_stop_reason_name(rep.stopped), rep.iterations, rep.icp_rounds);
+        ENSURE(rep.after.total <= rep.before.total);
+        sp_sketch_free(&sk);
+    }
+    fprintf(stderr, "  recovered %d of %d\n", ok, cases);
+    ENSURE(ok >= cases * 95 / 100);
+    free(truth), free(out);
+    sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
+static void test_bounds_exact(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 4, .all_channels = true, .seed = 4});
+    // Narrow every scale to [0.9, 1.1], then draw the figure shrunk to 40%.
+    for (int q = 0; q < st.rig.param_count; ++q)
+        if (sp_channel_is_scale(st.rig.params[q].channel)) st.rig.params[q].min = 0.9, st.rig.params[q].max = 1.1;
+    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    int P = st.rig.param_count;
+    double* p = malloc(sizeof(double) * P);
+    sp_rig_defaults(&st.rig, p);
+    sp_sketch sk;
+    strokes_at(s, &st.rig, p, &sk);
+    for (int i = 0; i < sk.stroke_count; ++i)
+        for (int j = 0; j < sk.strokes[i].count; ++j) {
+            sp_vec2* q = &sk.strokes[i].points[j];
+            q->x = 320 + 0.4 * (q->x - 320), q->y = 240 + 0.4 * (q->y - 240);
+        }
+    sp_solve_report rep;
+    sp_error err = {0};
+    ENSURE(sp_solver_solve(s, &sk, NULL, p, &rep, &err) == SP_OK);
+    int s_root = sp_rig_find_param(&st.rig, "j0.s");
+    ENSURE(p[s_root] == 0.9); // exactly at the bound, not below
+    for (int q = 0; q < P; ++q) ENSURE(p[q] >= st.rig.params[q].min && p[q] <= st.rig.params[q].max);
+    sp_sketch_free(&sk);
+    free(p);
+    sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
+static uint64_t hash_doubles(const double* v, int n)
+{
+    uint64_t h = 1469598103934665603ull;
+    const unsigned char* b = (const unsigned char*)v;
+    for (size_t i = 0; i < sizeof(double) * (size_t)n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+static void test_order_independence_and_determinism(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 7, .branching = true, .seed = 8});
+    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    int P = st.rig.param_count;
+    double* truth = malloc(sizeof(double) * P);
+    double* a = malloc(sizeof(double) * P);
+    double* b = malloc(sizeof(double) * P);
+    double* c = malloc(sizeof(double) * P);
+    sp_test_rng rng = {77};
+    sp_fixture_random_params(&st.rig, &rng, 0.5, truth);
+    sp_sketch sk, shuffled = {0};
+    strokes_at(s, &st.rig, truth, &sk);
+    sp_solve_report rep;
+    sp_error err = {0};
+    ENSURE(sp_solver_solve(s, &sk, NULL, a, &rep, &err) == SP_OK);
+    // Reverse the stroke order and every stroke's direction.
+    shuffled.canvas_w = 640, shuffled.canvas_h = 480;
+    for (int i = sk.stroke_count - 1; i >= 0; --i) {
+        int n = sk.strokes[i].count;
+        sp_vec2* r = malloc(sizeof(sp_vec2) * n);
+        for (int j = 0; j < n; ++j) r[j] = sk.strokes[i].points[n - 1 - j];
+        sp_sketch_add_stroke(&shuffled, r, NULL, n);
+        free(r);
+    }
+    ENSURE(sp_solver_solve(s, &shuffled, NULL, b, &rep, &err) == SP_OK);
+    for (int q = 0; q < P; ++q) ENSURE_NEAR(a[q], b[q], 1e-6);
+    // Same input, same bits.
+    ENSURE(sp_solver_solve(s, &sk, NULL, c, &rep, &err) == SP_OK);
+    ENSURE(hash_doubles(a, P) == hash_doubles(c, P));
+    sp_sketch_free(&sk), sp_sketch_free(&shuffled);
+    free(truth), free(a), free(b), free(c);
+    sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
+static void test_bad_strokes(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 3, .seed = 1});
+    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    double* p = malloc(sizeof(double) * st.rig.param_count);
+    sp_solve_report rep;
+    sp_error err = {0};
+    sp_sketch empty = {0};
+    ENSURE(sp_solver_solve(s, &empty, NULL, p, &rep, &err) == SP_ERR_INVALID);
+    sp_sketch one = {0};
+    sp_vec2 pt = {10, 10};
+    sp_sketch_add_stroke(&one, &pt, NULL, 1);
+    ENSURE(sp_solver_solve(s, &one, NULL, p, &rep, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "stroke 0"));
+    sp_sketch nan = {0};
+    sp_vec2 pts[3] = {{0, 0}, {NAN, 1}, {2, 2}};
+    sp_sketch_add_stroke(&nan, pts, NULL, 3);
+    ENSURE(sp_solver_solve(s, &nan, NULL, p, &rep, &err) == SP_ERR_INVALID);
+    // Far outside the canvas: a best-effort pose, finite, in bounds, with a note.
+    sp_sketch far = {0};
+    sp_vec2 fp[2] = {{1e6, 1e6}, {1e6 + 50, 1e6 + 80}};
+    sp_sketch_add_stroke(&far, fp, NULL, 2);
+    ENSURE(sp_solver_solve(s, &far, NULL, p, &rep, &err) == SP_OK);
+    for (int q = 0; q < st.rig.param_count; ++q) ENSURE(isfinite(p[q]) && p[q] >= st.rig.params[q].min && p[q] <= st.rig.params[q].max);
+    ENSURE(rep.note[0] != 0);
+    sp_sketch_free(&one), sp_sketch_free(&nan), sp_sketch_free(&far);
+    free(p);
+    sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
+int main(int argc, char** argv)
+{
+    return sp_test_run(argc, argv, (sp_test[]){
+        {"recovery_chain", test_recovery_chain},
+        {"bounds_exact", test_bounds_exact},
+        {"order_independence_and_determinism", test_order_independence_and_determinism},
+        {"bad_strokes", test_bad_strokes},
+        {0}});
+}
