@@ -1,0 +1,253 @@
+// Polylines: arc-length resampling, cleaning, smoothing, and the paper's
+// two correspondence procedures (ordered and closest point).
+#include "sp/curve.h"
+
+#include <assert.h>
+#include <flann/flann.h>
+#include <stdlib.h>
+#include <string.h>
+
+static inline double dist2(sp_vec2 a, sp_vec2 b)
+{
+    double dx = a.x - b.x, dy = a.y - b.y;
+    return dx * dx + dy * dy;
+}
+
+bool sp_curve_is_valid(const sp_vec2* pts, int n)
+{
+    if (n < 1 || !pts) return false;
+    for (int i = 0; i < n; ++i)
+        if (!sp_v2_is_valid(pts[i])) return false;
+    return true;
+}
+
+static inline double seg_len(const sp_vec2* pts, int n, int j)
+{
+    int k = j + 1 == n ? 0 : j + 1;
+    return hypot(pts[k].x - pts[j].x, pts[k].y - pts[j].y);
+}
+
+double sp_curve_length(const sp_vec2* pts, int n, bool closed)
+{
+    if (n <= 1) return 0.0;
+    int nseg = closed ? n : n - 1;
+    double L = 0.0;
+    for (int j = 0; j < nseg; ++j)
+        L += seg_len(pts, n, j);
+    return L;
+}
+
+sp_result sp_curve_resample(const sp_vec2* pts, int n, bool closed, int m, sp_vec2* out)
+{
+    if (n < 1 || m < 1) return SP_ERR_INVALID;
+    assert(pts && out);
+    if (!sp_curve_is_valid(pts, n)) return SP_ERR_INVALID;
+    double L = sp_curve_length(pts, n, closed);
+    if (!isfinite(L)) return SP_ERR_INVALID;
+    if (!(L > 0.0) || m == 1) {
+        // Zero length (one point or all equal): m copies of the first point.
+        for (int k = 0; k < m; ++k)
+            out[k] = pts[0];
+        return SP_OK;
+    }
+    int nseg = closed ? n : n - 1;
+    double denom = closed ? (double)m : (double)(m - 1);
+    // One walk along the segments. s0 accumulates the same terms in the same
+    // order as sp_curve_length, so the last segment ends exactly at L and
+    // every target (<= L) lies on a segment.
+    int j = 0;
+    double s0 = 0.0, lj = seg_len(pts, n, 0);
+    for (int k = 0; k < m; ++k) {
+        // Multiply rather than accumulate a step, so that error does not grow with k.
+        double target = L * ((double)k / denom);
+        while (j < nseg - 1 && s0 + lj < target) {
+            s0 += lj;
+            ++j;
+            lj = seg_len(pts, n, j);
+        }
+        double t = lj > 0.0 ? (target - s0) / lj : 0.0;
+        t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+        sp_vec2 a = pts[j], b = pts[j + 1 == n ? 0 : j + 1];
+        out[k] = (sp_vec2){a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t};
+    }
+    if (!closed) out[m - 1] = pts[n - 1];
+    return SP_OK;
+}
+
+int sp_curve_clean(const sp_vec2* pts, int n, double min_step, sp_vec2* out)
+{
+    if (n <= 0) return 0;
+    assert(pts && out);
+    // fmax also maps a NaN step to 0 (exact duplicates only).
+    double step2 = fmax(min_step, 0.0);
+    step2 *= step2;
+    // In place is safe: we only ever write at k <= i after reading pts[i].
+    int k = 0;
+    out[k++] = pts[0];
+    for (int i = 1; i < n; ++i) {
+        sp_vec2 p = pts[i];
+        double d2 = dist2(p, out[k - 1]);
+        bool keep = step2 > 0.0 ? d2 >= step2 : d2 > 0.0;
+        if (keep)
+            out[k++] = p;
+        else if (i == n - 1 && d2 > 0.0) {
+            // The end of a stroke matters more than the point before it.
+            if (k > 1)
+                out[k - 1] = p;
+            else
+                out[k++] = p;
+        }
+    }
+    return k;
+}
+
+void sp_curve_smooth(const sp_vec2* pts, int n, bool closed, int iterations, sp_vec2* out)
+{
+    if (n <= 0) return;
+    assert(pts && out);
+    if (out != pts) memmove(out, pts, sizeof(sp_vec2) * (size_t)n);
+    if (n < 3) return;
+    for (int it = 0; it < iterations; ++it) {
+        if (closed) {
+            sp_vec2 first = out[0], prev = out[n - 1];
+            for (int i = 0; i < n; ++i) {
+                sp_vec2 cur = out[i], next = i == n - 1 ? first : out[i + 1];
+                out[i] = (sp_vec2){0.25 * prev.x + 0.5 * cur.x + 0.25 * next.x, 0.25 * prev.y + 0.5 * cur.y + 0.25 * next.y};
+                prev = cur;
+            }
+        } else {
+            sp_vec2 prev = out[0];
+            for (int i = 1; i < n - 1; ++i) {
+                sp_vec2 cur = out[i], next = out[i + 1];
+                out[i] = (sp_vec2){0.25 * prev.x + 0.5 * cur.x + 0.25 * next.x, 0.25 * prev.y + 0.5 * cur.y + 0.25 * next.y};
+                prev = cur;
+            }
+        }
+    }
+}
+
+// Cost of one ordered candidate; stops early once it cannot beat `best`
+// (a tie keeps the earlier candidate, so stopping at equality is exact).
+static double ordered_cost(const sp_vec2* y, const sp_vec2* z, int m, bool reversed, int shift, double best)
+{
+    double c = 0.0;
+    for (int i = 0; i < m; ++i) {
+        int j = reversed ? shift - i : shift + i;
+        if (j < 0)
+            j += m;
+        else if (j >= m)
+            j -= m;
+        c += dist2(y[i], z[j]);
+        if (c >= best) return INFINITY;
+    }
+    return c;
+}
+
+sp_result sp_corr_ordered(const sp_vec2* y, const sp_vec2* z, int m, bool closed, int* match, sp_ordered_info* info)
+{
+    if (m < 1) return SP_ERR_INVALID;
+    assert(y && z);
+    if (!sp_curve_is_valid(y, m) || !sp_curve_is_valid(z, m)) return SP_ERR_INVALID;
+    sp_ordered_info best = {false, 0, INFINITY};
+    // Open curves: the reversed candidate is "shift m-1, reversed".
+    int shifts = closed ? m : 1;
+    for (int rev = 0; rev < 2; ++rev)
+        for (int s = 0; s < shifts; ++s) {
+            int shift = closed ? s : (rev ? m - 1 : 0);
+            double c = ordered_cost(y, z, m, rev, shift, best.cost);
+            if (c < best.cost) best = (sp_ordered_info){rev != 0, shift, c};
+        }
+    if (!isfinite(best.cost)) {
+        // Only when every candidate overflowed; recompute the first one in full.
+        best = (sp_ordered_info){false, 0, ordered_cost(y, z, m, false, 0, INFINITY)};
+        if (isnan(best.cost)) return SP_ERR_INVALID;
+    }
+    if (match)
+        for (int i = 0; i < m; ++i) {
+            int j = best.reversed ? best.shift - i : best.shift + i;
+            match[i] = j < 0 ? j + m : (j >= m ? j - m : j);
+        }
+    if (!closed) best.shift = 0;
+    if (info) *info = best;
+    return SP_OK;
+}
+
+// For each query point, the index of its closest data point (lowest index on ties).
+static void closest_brute(const sp_vec2* q, int nq, const sp_vec2* d, int nd, int* idx)
+{
+    for (int i = 0; i < nq; ++i) {
+        int bj = 0;
+        double bd = dist2(q[i], d[0]);
+        for (int j = 1; j < nd; ++j) {
+            double dd = dist2(q[i], d[j]);
+            if (dd < bd) bd = dd, bj = j;
+        }
+        idx[i] = bj;
+    }
+}
+
+// The same through an exact single k-d tree (eps 0, unlimited checks).
+static sp_result closest_kdtree(const sp_vec2* q, int nq, const sp_vec2* d, int nd, int* idx)
+{
+    struct FLANNParameters prm = DEFAULT_FLANN_PARAMETERS;
+    prm.algorithm = FLANN_INDEX_KDTREE_SINGLE;
+    prm.checks = FLANN_CHECKS_UNLIMITED;
+    prm.eps = 0.0f;
+    prm.leaf_max_size = 10;
+    prm.cores = 1;
+    prm.log_level = FLANN_LOG_NONE;
+    prm.random_seed = 1;
+    double* dists = malloc(sizeof(double) * (size_t)nq);
+    if (!dists) return SP_ERR_NO_MEMORY;
+    float speedup = 0.0f;
+    // sp_vec2 arrays are n by 2 doubles; FLANN's C API takes non-const
+    // pointers but does not write through them.
+    flann_index_t index = flann_build_index_double((double*)(void*)d, nd, 2, &speedup, &prm);
+    if (!index) {
+        free(dists);
+        return SP_ERR_INTERNAL;
+    }
+    int rc = flann_find_nearest_neighbors_index_double(index, (double*)(void*)q, nq, idx, dists, 1, &prm);
+    flann_free_index_double(index, &prm);
+    free(dists);
+    if (rc != 0) return SP_ERR_INTERNAL;
+    for (int i = 0; i < nq; ++i)
+        if (idx[i] < 0 || idx[i] >= nd) return SP_ERR_INTERNAL;
+    return SP_OK;
+}
+
+sp_result sp_corr_closest(const sp_vec2* y, int my, const sp_vec2* z, int mz, sp_corr_pair* pairs, double* cost)
+{
+    if (my < 1 || mz < 1) return SP_ERR_INVALID;
+    assert(y && z && pairs);
+    if (!sp_curve_is_valid(y, my) || !sp_curve_is_valid(z, mz)) return SP_ERR_INVALID;
+    // One scratch index array serves both directions and both methods.
+    int* idx = malloc(sizeof(int) * (size_t)(my > mz ? my : mz));
+    if (!idx) return SP_ERR_NO_MEMORY;
+    bool brute = (double)my * (double)mz <= (double)SP_CORR_BRUTE_MAX;
+    sp_result r = SP_OK;
+    if (brute)
+        closest_brute(y, my, z, mz, idx);
+    else
+        r = closest_kdtree(y, my, z, mz, idx);
+    if (r == SP_OK) {
+        for (int i = 0; i < my; ++i)
+            pairs[i] = (sp_corr_pair){i, idx[i]};
+        if (brute)
+            closest_brute(z, mz, y, my, idx);
+        else
+            r = closest_kdtree(z, mz, y, my, idx);
+    }
+    if (r == SP_OK) {
+        for (int j = 0; j < mz; ++j)
+            pairs[my + j] = (sp_corr_pair){idx[j], j};
+        if (cost) {
+            double c = 0.0;
+            for (int k = 0; k < my + mz; ++k)
+                c += dist2(y[pairs[k].y], z[pairs[k].z]);
+            *cost = c;
+        }
+    }
+    free(idx);
+    return r;
+}

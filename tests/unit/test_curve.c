@@ -1,0 +1,655 @@
+// Curve tests: arc-length resampling, cleaning, the ordered and closest-point
+// correspondences, the Hungarian method against brute force, and the
+// stroke-to-curve assignment under shuffling and reversal.
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "fixtures.h"
+#include "sp/curve.h"
+#include "test.h"
+
+static double d2(sp_vec2 a, sp_vec2 b)
+{
+    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+}
+
+static double seg_dist(sp_vec2 q, sp_vec2 a, sp_vec2 b)
+{
+    sp_vec2 ab = sp_v2_sub(b, a);
+    double l2 = sp_v2_dot(ab, ab);
+    double t = l2 > 0 ? sp_v2_dot(sp_v2_sub(q, a), ab) / l2 : 0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    return sp_v2_len(sp_v2_sub(q, sp_v2_add(a, sp_v2_scale(ab, t))));
+}
+
+// Arc-length position of each sample on the polyline, walking forward (the
+// samples are in arc order), so that self-touching polylines are fine. Every
+// sample must lie on the polyline (within tol).
+static void arc_params(const sp_vec2* p, int n, bool closed, const sp_vec2* q, int m, double* s, double tol)
+{
+    int nseg = closed ? n : n - 1, j = 0;
+    double s0 = 0;
+    for (int k = 0; k < m; ++k) {
+        while (j < nseg) {
+            sp_vec2 a = p[j], b = p[(j + 1) % n];
+            if (seg_dist(q[k], a, b) <= tol) break;
+            s0 += sp_v2_len(sp_v2_sub(b, a));
+            ++j;
+        }
+        ENSURE(j < nseg);
+        s[k] = s0 + sp_v2_len(sp_v2_sub(q[k], p[j]));
+    }
+}
+
+// A zigzag with repeated points and zero-length segments.
+static int zigzag(sp_vec2* p)
+{
+    sp_vec2 pts[] = {{0, 0}, {10, 0}, {10, 0}, {10, 5}, {3, 5}, {3, 5}, {3, 5}, {3, 12}, {20, 12}, {20, 30}, {20, 30}};
+    int n = (int)(sizeof pts / sizeof pts[0]);
+    memcpy(p, pts, sizeof pts);
+    return n;
+}
+
+static void test_resample_open_uniform(void)
+{
+    sp_vec2 p[16], q[57];
+    double s[57];
+    int n = zigzag(p), m = 57;
+    double L = sp_curve_length(p, n, false);
+    ENSURE_NEAR(L, 10 + 5 + 7 + 7 + 17 + 18, 1e-12);
+    ENSURE(sp_curve_resample(p, n, false, m, q) == SP_OK);
+    ENSURE(q[0].x == p[0].x && q[0].y == p[0].y);
+    ENSURE(q[m - 1].x == p[n - 1].x && q[m - 1].y == p[n - 1].y);
+    arc_params(p, n, false, q, m, s, 1e-9);
+    for (int k = 0; k < m; ++k)
+        ENSURE_NEAR(s[k], L * k / (m - 1), 1e-9);
+    // m = 2: just the end points.
+    ENSURE(sp_curve_resample(p, n, false, 2, q) == SP_OK);
+    ENSURE(q[0].x == 0 && q[0].y == 0 && q[1].x == 20 && q[1].y == 30);
+}
+
+static void test_resample_closed_uniform(void)
+{
+    sp_vec2 p[16], q[41];
+    double s[41];
+    int n = zigzag(p), m = 41;
+    double L = sp_curve_length(p, n, true);
+    ENSURE_NEAR(L, sp_curve_length(p, n, false) + sqrt(20 * 20 + 30 * 30), 1e-12);
+    ENSURE(sp_curve_resample(p, n, true, m, q) == SP_OK);
+    ENSURE(q[0].x == p[0].x && q[0].y == p[0].y);
+    arc_params(p, n, true, q, m, s, 1e-9);
+    for (int k = 0; k < m; ++k)
+        ENSURE_NEAR(s[k], L * k / m, 1e-9);
+    // Across the seam: the closing gap equals every other spacing.
+    ENSURE_NEAR(L - s[m - 1], L / m, 1e-9);
+    // A square with its start repeated at the end (closing segment of length 0).
+    sp_vec2 sq[5] = {{0, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 0}};
+    sp_vec2 r[8];
+    ENSURE(sp_curve_resample(sq, 5, true, 8, r) == SP_OK);
+    sp_vec2 want[8] = {{0, 0}, {2, 0}, {4, 0}, {4, 2}, {4, 4}, {2, 4}, {0, 4}, {0, 2}};
+    for (int k = 0; k < 8; ++k)
+        ENSURE(d2(r[k], want[k]) < 1e-24);
+}
+
+static void test_resample_degenerate(void)
+{
+    sp_vec2 q[10];
+    sp_vec2 one = {3, 4};
+    ENSURE(sp_curve_resample(&one, 1, false, 10, q) == SP_OK);
+    for (int k = 0; k < 10; ++k)
+        ENSURE(q[k].x == 3 && q[k].y == 4);
+    ENSURE(sp_curve_resample(&one, 1, true, 10, q) == SP_OK);
+    for (int k = 0; k < 10; ++k)
+        ENSURE(q[k].x == 3 && q[k].y == 4);
+    sp_vec2 same[6] = {{1, 2}, {1, 2}, {1, 2}, {1, 2}, {1, 2}, {1, 2}};
+    ENSURE(sp_curve_length(same, 6, true) == 0);
+    ENSURE(sp_curve_resample(same, 6, false, 7, q) == SP_OK);
+    for (int k = 0; k < 7; ++k)
+        ENSURE(q[k].x == 1 && q[k].y == 2);
+    // m = 1: the first point.
+    sp_vec2 line[2] = {{0, 0}, {10, 0}};
+    ENSURE(sp_curve_resample(line, 2, false, 1, q) == SP_OK);
+    ENSURE(q[0].x == 0 && q[0].y == 0);
+    // Errors.
+    ENSURE(sp_curve_resample(line, 0, false, 5, q) == SP_ERR_INVALID);
+    ENSURE(sp_curve_resample(line, 2, false, 0, q) == SP_ERR_INVALID);
+    sp_vec2 bad[3] = {{0, 0}, {NAN, 1}, {2, 2}};
+    ENSURE(!sp_curve_is_valid(bad, 3));
+    ENSURE(sp_curve_resample(bad, 3, false, 5, q) == SP_ERR_INVALID);
+    bad[1] = (sp_vec2){INFINITY, 0};
+    ENSURE(sp_curve_resample(bad, 3, true, 5, q) == SP_ERR_INVALID);
+    // Finite coordinates whose length overflows.
+    sp_vec2 huge[2] = {{-1.7e308, 0}, {1.7e308, 0}};
+    ENSURE(sp_curve_resample(huge, 2, false, 5, q) == SP_ERR_INVALID);
+    ENSURE(sp_curve_clean(bad, 0, 0, q) == 0);
+}
+
+// 10^6 points on a noisy spiral: linear time, and still uniform.
+static void test_resample_million(void)
+{
+    int n = 1000000, m = 1000;
+    sp_vec2* p = malloc(sizeof(sp_vec2) * n);
+    sp_vec2* q = malloc(sizeof(sp_vec2) * m);
+    double* s = malloc(sizeof(double) * m);
+    sp_test_rng rng = {7};
+    for (int i = 0; i < n; ++i) {
+        double t = 20.0 * i / n, r = 10 + 10 * t;
+        p[i] = (sp_vec2){r * cos(t) + sp_test_range(&rng, -0.01, 0.01), r * sin(t)};
+        if (i % 10 == 3) p[i] = p[i - 1]; // duplicates
+    }
+    clock_t t0 = clock();
+    ENSURE(sp_curve_resample(p, n, false, m, q) == SP_OK);
+    ENSURE(sp_curve_resample(p, n, true, m, q) == SP_OK);
+    ENSURE(sp_curve_resample(p, n, false, m, q) == SP_OK);
+    double secs = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    ENSURE(secs < 2.0); // ~30 ms when linear, even under sanitizers well below
+    double L = sp_curve_length(p, n, false);
+    arc_params(p, n, false, q, m, s, 1e-7);
+    for (int k = 0; k < m; ++k)
+        ENSURE_NEAR(s[k], L * k / (m - 1), 1e-6 * L);
+    ENSURE(q[m - 1].x == p[n - 1].x && q[m - 1].y == p[n - 1].y);
+    int kept = sp_curve_clean(p, n, 0, p);
+    ENSURE(kept == n - n / 10);
+    free(p), free(q), free(s);
+}
+
+static void test_clean_smooth(void)
+{
+    sp_vec2 p[8] = {{0, 0}, {0, 0}, {1, 0}, {1, 0}, {1.2, 0}, {3, 0}, {3.1, 0}, {3.1, 0}};
+    sp_vec2 q[8];
+    ENSURE(sp_curve_clean(p, 8, 0, q) == 5);
+    ENSURE(q[4].x == 3.1 && q[3].x == 3 && q[2].x == 1.2);
+    // With a 0.5 px step: 1.2 goes (too close to 1), 3.1 replaces 3 (the end is kept).
+    ENSURE(sp_curve_clean(p, 8, 0.5, q) == 3);
+    ENSURE(q[0].x == 0 && q[1].x == 1 && q[2].x == 3.1);
+    // In place, and a stroke shorter than the step keeps both ends.
+    sp_vec2 tiny[3] = {{0, 0}, {0.1, 0}, {0.2, 0}};
+    ENSURE(sp_curve_clean(tiny, 3, 1.0, tiny) == 2);
+    ENSURE(tiny[0].x == 0 && tiny[1].x == 0.2);
+    sp_vec2 dot[3] = {{5, 5}, {5, 5}, {5, 5}};
+    ENSURE(sp_curve_clean(dot, 3, 1.0, dot) == 1);
+    // Smoothing keeps evenly spaced straight lines and open end points, and pulls in a spike.
+    sp_vec2 l[5] = {{0, 0}, {1, 0}, {2, 3}, {3, 0}, {4, 0}};
+    sp_curve_smooth(l, 5, false, 3, l);
+    ENSURE(l[0].x == 0 && l[0].y == 0 && l[4].x == 4 && l[4].y == 0);
+    ENSURE(l[2].y < 3 && l[2].y > 0);
+    sp_vec2 straight[4] = {{0, 0}, {1, 1}, {2, 2}, {3, 3}}, out[4];
+    sp_curve_smooth(straight, 4, false, 5, out);
+    for (int i = 0; i < 4; ++i) {
+        ENSURE_NEAR(out[i].x, i, 1e-12);
+        ENSURE_NEAR(out[i].y, i, 1e-12);
+    }
+    sp_vec2 sq[4] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+    sp_curve_smooth(sq, 4, true, 1, sq);
+    ENSURE_NEAR(sq[0].x, 0.5, 1e-12);
+    ENSURE_NEAR(sq[0].y, 0.5, 1e-12);
+}
+
+static void circle(sp_vec2* p, int m, double cx, double cy, double r, double phase)
+{
+    for (int i = 0; i < m; ++i) {
+        double a = phase + 2 * M_PI * i / m;
+        p[i] = (sp_vec2){cx + r * cos(a), cy + 0.7 * r * sin(a)};
+    }
+}
+
+static bool is_permutation(const int* match, int m)
+{
+    char seen[1024] = {0};
+    for (int i = 0; i < m; ++i) {
+        if (match[i] < 0 || match[i] >= m || seen[match[i]]) return false;
+        seen[match[i]] = 1;
+    }
+    return true;
+}
+
+static void test_ordered_direction(void)
+{
+    enum { M = 50 };
+    sp_vec2 z[M], y[M];
+    int match[M];
+    sp_test_rng rng = {3};
+    for (int i = 0; i < M; ++i)
+        z[i] = (sp_vec2){100 + 4 * i, 200 + 30 * sin(i * 0.1)};
+    for (int i = 0; i < M; ++i)
+        y[i] = sp_v2_add(z[M - 1 - i], (sp_vec2){sp_test_range(&rng, -1, 1), sp_test_range(&rng, -1, 1)});
+    sp_ordered_info info;
+    ENSURE(sp_corr_ordered(y, z, M, false, match, &info) == SP_OK);
+    ENSURE(info.reversed && info.shift == 0);
+    for (int i = 0; i < M; ++i)
+        ENSURE(match[i] == M - 1 - i);
+    double c = 0;
+    for (int i = 0; i < M; ++i)
+        c += d2(y[i], z[match[i]]);
+    ENSURE_NEAR(info.cost, c, 1e-9);
+    ENSURE(info.cost < 2.0 * M);
+    // Forward.
+    ENSURE(sp_corr_ordered(z, z, M, false, match, &info) == SP_OK);
+    ENSURE(!info.reversed && info.cost == 0);
+    for (int i = 0; i < M; ++i)
+        ENSURE(match[i] == i);
+    // Exact tie (all points equal): forward wins.
+    sp_vec2 same[M];
+    for (int i = 0; i < M; ++i)
+        same[i] = (sp_vec2){1, 1};
+    ENSURE(sp_corr_ordered(same, same, M, true, match, &info) == SP_OK);
+    ENSURE(!info.reversed && info.shift == 0 && info.cost == 0);
+    // m = 1 and invalid input.
+    ENSURE(sp_corr_ordered(z, y, 1, true, match, &info) == SP_OK && match[0] == 0);
+    ENSURE(sp_corr_ordered(z, y, 0, true, match, &info) == SP_ERR_INVALID);
+    y[3].x = NAN;
+    ENSURE(sp_corr_ordered(y, z, M, false, match, &info) == SP_ERR_INVALID);
+}
+
+static void test_ordered_cyclic_shift(void)
+{
+    enum { M = 60 };
+    sp_vec2 z[M], y[M];
+    int match[M];
+    sp_ordered_info info;
+    circle(z, M, 300, 200, 80, 0.3);
+    for (int k = 0; k < M; k += 7) {
+        // Same direction, start at sample k (plus a little noise).
+        for (int i = 0; i < M; ++i)
+            y[i] = sp_v2_add(z[(i + k) % M], (sp_vec2){0.3 * sin(i), 0.2 * cos(3 * i)});
+        ENSURE(sp_corr_ordered(y, z, M, true, match, &info) == SP_OK);
+        ENSURE(!info.reversed && info.shift == k);
+        ENSURE(is_permutation(match, M));
+        for (int i = 0; i < M; ++i)
+            ENSURE(match[i] == (i + k) % M);
+        // Drawn the other way round from sample k.
+        for (int i = 0; i < M; ++i)
+            y[i] = z[((k - i) % M + M) % M];
+        ENSURE(sp_corr_ordered(y, z, M, true, match, &info) == SP_OK);
+        ENSURE(info.reversed && info.shift == k && info.cost < 1e-18);
+        ENSURE(is_permutation(match, M));
+        for (int i = 0; i < M; ++i)
+            ENSURE(match[i] == ((k - i) % M + M) % M);
+    }
+    // From resampling: a closed stroke that starts a quarter of the way around.
+    enum { N = 400 };
+    sp_vec2 dense[N], ys[M], zs[M];
+    circle(dense, N, 0, 0, 100, 0);
+    sp_vec2 rot[N];
+    for (int i = 0; i < N; ++i)
+        rot[i] = dense[(i + N / 4) % N];
+    ENSURE(sp_curve_resample(dense, N, true, M, zs) == SP_OK);
+    ENSURE(sp_curve_resample(rot, N, true, M, ys) == SP_OK);
+    ENSURE(sp_corr_ordered(ys, zs, M, true, NULL, &info) == SP_OK);
+    ENSURE(!info.reversed && info.shift == M / 4);
+}
+
+static void test_closest_both_ways(void)
+{
+    enum { MY = 37, MZ = 53 };
+    sp_vec2 y[MY], z[MZ];
+    sp_corr_pair pairs[MY + MZ];
+    sp_test_rng rng = {9};
+    for (int i = 0; i < MY; ++i)
+        y[i] = (sp_vec2){sp_test_range(&rng, 0, 640), sp_test_range(&rng, 0, 480)};
+    for (int j = 0; j < MZ; ++j)
+        z[j] = (sp_vec2){sp_test_range(&rng, 0, 640), sp_test_range(&rng, 0, 480)};
+    z[10] = z[4]; // an exact tie: the lowest index wins
+    double cost = -1;
+    ENSURE(sp_corr_closest(y, MY, z, MZ, pairs, &cost) == SP_OK);
+    bool ycov[MY] = {0}, zcov[MZ] = {0};
+    double c = 0;
+    for (int k = 0; k < MY + MZ; ++k) {
+        ENSURE(pairs[k].y >= 0 && pairs[k].y < MY && pairs[k].z >= 0 && pairs[k].z < MZ);
+        ycov[pairs[k].y] = zcov[pairs[k].z] = true;
+        c += d2(y[pairs[k].y], z[pairs[k].z]);
+    }
+    for (int i = 0; i < MY; ++i)
+        ENSURE(ycov[i]);
+    for (int j = 0; j < MZ; ++j)
+        ENSURE(zcov[j]);
+    ENSURE_NEAR(cost, c, 1e-9 * c);
+    for (int i = 0; i < MY; ++i) {
+        ENSURE(pairs[i].y == i);
+        ENSURE(pairs[i].z != 10);
+        for (int j = 0; j < MZ; ++j)
+            ENSURE(d2(y[i], z[pairs[i].z]) <= d2(y[i], z[j]));
+    }
+    for (int j = 0; j < MZ; ++j) {
+        ENSURE(pairs[MY + j].z == j);
+        for (int i = 0; i < MY; ++i)
+            ENSURE(d2(z[j], y[pairs[MY + j].y]) <= d2(z[j], y[i]));
+    }
+    ENSURE(sp_corr_closest(y, 0, z, MZ, pairs, NULL) == SP_ERR_INVALID);
+}
+
+// Above SP_CORR_BRUTE_MAX the k-d tree answers; it must be exact.
+static void test_closest_kdtree(void)
+{
+    int my = 1500, mz = 1200;
+    ENSURE((double)my * mz > SP_CORR_BRUTE_MAX);
+    sp_vec2* y = malloc(sizeof(sp_vec2) * my);
+    sp_vec2* z = malloc(sizeof(sp_vec2) * mz);
+    sp_corr_pair* pairs = malloc(sizeof(sp_corr_pair) * (my + mz));
+    sp_test_rng rng = {21};
+    for (int i = 0; i < my; ++i)
+        y[i] = (sp_vec2){sp_test_range(&rng, 0, 1920), sp_test_range(&rng, 0, 1080)};
+    for (int j = 0; j < mz; ++j)
+        z[j] = (sp_vec2){sp_test_range(&rng, 0, 1920), sp_test_range(&rng, 0, 1080)};
+    double cost;
+    ENSURE(sp_corr_closest(y, my, z, mz, pairs, &cost) == SP_OK);
+    for (int i = 0; i < my; ++i) {
+        double best = INFINITY;
+        for (int j = 0; j < mz; ++j)
+            best = fmin(best, d2(y[i], z[j]));
+        ENSURE(pairs[i].y == i);
+        ENSURE(d2(y[i], z[pairs[i].z]) == best);
+    }
+    for (int j = 0; j < mz; ++j) {
+        double best = INFINITY;
+        for (int i = 0; i < my; ++i)
+            best = fmin(best, d2(z[j], y[i]));
+        ENSURE(pairs[my + j].z == j);
+        ENSURE(d2(z[j], y[pairs[my + j].y]) == best);
+    }
+    // A million stroke samples against a small curve: no crash, every sample paired.
+    int big = 1000000;
+    sp_vec2* yy = malloc(sizeof(sp_vec2) * big);
+    sp_corr_pair* pp = malloc(sizeof(sp_corr_pair) * (big + 100));
+    for (int i = 0; i < big; ++i)
+        yy[i] = (sp_vec2){sp_test_range(&rng, 0, 640), sp_test_range(&rng, 0, 480)};
+    ENSURE(sp_corr_closest(yy, big, z, 100, pp, NULL) == SP_OK);
+    for (int i = 0; i < big; i += 9973) {
+        double best = INFINITY;
+        for (int j = 0; j < 100; ++j)
+            best = fmin(best, d2(yy[i], z[j]));
+        ENSURE(d2(yy[i], z[pp[i].z]) == best);
+    }
+    free(yy), free(pp), free(y), free(z), free(pairs);
+}
+
+// Minimum over all injective maps of the smaller side into the larger.
+static double brute_assign(const double* c, int rows, int cols, int depth, bool* used, double acc)
+{
+    bool tr = rows > cols;
+    int n = tr ? cols : rows, m = tr ? rows : cols;
+    if (depth == n) return acc;
+    double best = INFINITY;
+    for (int j = 0; j < m; ++j) {
+        if (used[j]) continue;
+        used[j] = true;
+        double v = tr ? c[j * cols + depth] : c[depth * cols + j];
+        best = fmin(best, brute_assign(c, rows, cols, depth + 1, used, acc + v));
+        used[j] = false;
+    }
+    return best;
+}
+
+static void check_hungarian(int rows, int cols, sp_test_rng* rng)
+{
+    double c[64];
+    int r2c[8], c2r[8];
+    for (int k = 0; k < rows * cols; ++k)
+        c[k] = sp_test_range(rng, -5, 20);
+    double total;
+    ENSURE(sp_assign_hungarian(c, rows, cols, r2c, c2r, &total) == SP_OK);
+    bool used[8] = {0};
+    double sum = 0;
+    int assigned = 0;
+    for (int i = 0; i < rows; ++i) {
+        if (r2c[i] < 0) continue;
+        ENSURE(r2c[i] < cols && !used[r2c[i]] && c2r[r2c[i]] == i);
+        used[r2c[i]] = true;
+        sum += c[i * cols + r2c[i]];
+        ++assigned;
+    }
+    for (int j = 0; j < cols; ++j)
+        ENSURE(c2r[j] == -1 || r2c[c2r[j]] == j);
+    ENSURE(assigned == (rows < cols ? rows : cols));
+    ENSURE_NEAR(total, sum, 1e-12);
+    bool u[8] = {0};
+    ENSURE_NEAR(total, brute_assign(c, rows, cols, 0, u, 0), 1e-9);
+}
+
+static void test_hungarian_vs_brute(void)
+{
+    sp_test_rng rng = {1234};
+    for (int trial = 0; trial < 200; ++trial) {
+        check_hungarian(5, 5, &rng);
+        check_hungarian(4, 6, &rng);
+        check_hungarian(6, 4, &rng);
+        check_hungarian(1, 3, &rng);
+        check_hungarian(3, 1, &rng);
+    }
+    // Integer costs with many ties.
+    for (int trial = 0; trial < 100; ++trial) {
+        double c[25];
+        int r2c[5];
+        for (int k = 0; k < 25; ++k)
+            c[k] = floor(sp_test_range(&rng, 0, 3));
+        double total;
+        ENSURE(sp_assign_hungarian(c, 5, 5, r2c, NULL, &total) == SP_OK);
+        bool u[8] = {0};
+        ENSURE(total == brute_assign(c, 5, 5, 0, u, 0));
+    }
+    // Degenerate sizes and bad input.
+    int r2c[3] = {7, 7, 7};
+    double total = 1;
+    ENSURE(sp_assign_hungarian(NULL, 3, 0, r2c, NULL, &total) == SP_OK);
+    ENSURE(r2c[0] == -1 && r2c[2] == -1 && total == 0);
+    double bad[4] = {1, NAN, 2, 3};
+    ENSURE(sp_assign_hungarian(bad, 2, 2, r2c, NULL, NULL) == SP_ERR_INVALID);
+    // All equal: a valid, reproducible assignment.
+    double flat[12] = {0};
+    int a1[3], a2[3];
+    ENSURE(sp_assign_hungarian(flat, 3, 4, a1, NULL, NULL) == SP_OK);
+    ENSURE(sp_assign_hungarian(flat, 3, 4, a2, NULL, NULL) == SP_OK);
+    ENSURE(memcmp(a1, a2, sizeof a1) == 0);
+    ENSURE(a1[0] != a1[1] && a1[1] != a1[2] && a1[0] != a1[2]);
+}
+
+// A stick figure: head (closed), torso, two arms, one leg; in pixels.
+enum { NC = 5 };
+static sp_vec2 g_curve_pts[NC][40];
+static sp_polyline g_curves[NC];
+
+static void make_curves(void)
+{
+    circle(g_curve_pts[0], 24, 320, 80, 30, 0);
+    g_curves[0] = (sp_polyline){g_curve_pts[0], 24, true};
+    for (int i = 0; i < 10; ++i)
+        g_curve_pts[1][i] = (sp_vec2){320, 115 + 18.0 * i};
+    g_curves[1] = (sp_polyline){g_curve_pts[1], 10, false};
+    for (int i = 0; i < 8; ++i)
+        g_curve_pts[2][i] = (sp_vec2){310 - 14.0 * i, 140 + 6.0 * i};
+    g_curves[2] = (sp_polyline){g_curve_pts[2], 8, false};
+    for (int i = 0; i < 8; ++i)
+        g_curve_pts[3][i] = (sp_vec2){330 + 14.0 * i, 140 + 2.0 * i * i};
+    g_curves[3] = (sp_polyline){g_curve_pts[3], 8, false};
+    for (int i = 0; i < 12; ++i)
+        g_curve_pts[4][i] = (sp_vec2){315 - 6.0 * i, 290 + 15.0 * i};
+    g_curves[4] = (sp_polyline){g_curve_pts[4], 12, false};
+}
+
+// Stroke s traces curve `perm[s]`, densely, with noise, reversed when asked,
+// closed strokes starting at `start`.
+static void make_strokes(sp_sketch* sk, const int* perm, const bool* rev, int count, int start, uint64_t seed)
+{
+    *sk = (sp_sketch){0};
+    sp_test_rng rng = {seed};
+    for (int s = 0; s < count; ++s) {
+        const sp_polyline* c = &g_curves[perm[s]];
+        int n = 30 + 7 * perm[s];
+        sp_vec2 pts[200];
+        sp_curve_resample(c->points, c->count, c->closed, n, pts);
+        sp_vec2 tmp[200];
+        for (int i = 0; i < n; ++i) {
+            int k = c->closed ? (i + start) % n : i;
+            tmp[i] = sp_v2_add(pts[k], (sp_vec2){sp_test_range(&rng, -2, 2), sp_test_range(&rng, -2, 2)});
+        }
+        if (rev[s])
+            for (int i = 0; i < n / 2; ++i) {
+                sp_vec2 t = tmp[i];
+                tmp[i] = tmp[n - 1 - i], tmp[n - 1 - i] = t;
+            }
+        ENSURE(sp_sketch_add_stroke(sk, tmp, NULL, n) == SP_OK);
+    }
+}
+
+static void test_assign_order_independent(void)
+{
+    make_curves();
+    int ident[NC] = {0, 1, 2, 3, 4};
+    bool fwd[NC] = {0};
+    sp_sketch a;
+    make_strokes(&a, ident, fwd, NC, 0, 5);
+    for (int kind = 0; kind < 2; ++kind) {
+        sp_assign_desc desc = {.match = kind ? SP_CORR_CLOSEST : SP_CORR_ORDERED};
+        sp_stroke_match ma[NC], mb[NC];
+        int c2s[NC];
+        sp_error err = {{0}};
+        ENSURE(sp_assign_strokes(a.strokes, NC, g_curves, NC, &desc, ma, c2s, &err) == SP_OK);
+        for (int s = 0; s < NC; ++s) {
+            ENSURE(ma[s].curve == s && c2s[s] == s);
+            // The noisy head's start lands within one sample of the curve's.
+            ENSURE(!ma[s].reversed && (ma[s].shift <= 1 || ma[s].shift == 63));
+            ENSURE(ma[s].cost < 8.0); // noise of +-2 px
+        }
+        // Shuffled, every other stroke reversed, the head started elsewhere.
+        int perm[NC] = {3, 0, 4, 2, 1};
+        bool rev[NC] = {true, false, true, false, true};
+        sp_sketch b;
+        make_strokes(&b, perm, rev, NC, 0, 5);
+        ENSURE(sp_assign_strokes(b.strokes, NC, g_curves, NC, &desc, mb, c2s, &err) == SP_OK);
+        for (int s = 0; s < NC; ++s) {
+            ENSURE(mb[s].curve == perm[s] && c2s[perm[s]] == s);
+            ENSURE(mb[s].reversed == (kind == 0 && rev[s]));
+        }
+        sp_sketch_free(&b);
+        // The same strokes (bit for bit) reversed and shuffled: identical mapping and costs.
+        sp_sketch cpy = {0};
+        for (int k = 0; k < NC; ++k) {
+            int s = perm[k];
+            const sp_stroke* st = &a.strokes[s];
+            sp_vec2 tmp[200];
+            for (int i = 0; i < st->count; ++i)
+                tmp[i] = st->points[rev[k] ? st->count - 1 - i : i];
+            ENSURE(sp_sketch_add_stroke(&cpy, tmp, NULL, st->count) == SP_OK);
+        }
+        ENSURE(sp_assign_strokes(cpy.strokes, NC, g_curves, NC, &desc, mb, NULL, &err) == SP_OK);
+        for (int k = 0; k < NC; ++k) {
+            ENSURE(mb[k].curve == ma[perm[k]].curve);
+            ENSURE(mb[k].reversed == (kind == 0 && rev[k]));
+            ENSURE_NEAR(mb[k].cost, ma[perm[k]].cost, 1e-9 * (1 + ma[perm[k]].cost));
+        }
+        sp_sketch_free(&cpy);
+        // A closed stroke begun a third of the way round, drawn backwards.
+        int head[1] = {0};
+        bool back[1] = {true};
+        sp_sketch h;
+        make_strokes(&h, head, back, 1, 10, 8);
+        sp_stroke_match mh;
+        ENSURE(sp_assign_strokes(h.strokes, 1, g_curves, NC, &desc, &mh, c2s, &err) == SP_OK);
+        ENSURE(mh.curve == 0 && c2s[0] == 0 && c2s[1] == -1);
+        // Backwards from stroke point 10 of 30: its first point is curve point 9 of 30,
+        // 0.3 of the way round, so near sample 19 of 64.
+        if (kind == 0) ENSURE(mh.reversed && abs(mh.shift - 19) <= 1);
+        sp_sketch_free(&h);
+    }
+    sp_sketch_free(&a);
+}
+
+static void test_assign_counts(void)
+{
+    make_curves();
+    // Six strokes, five curves: the extra (a copy of the leg, shifted away) is unassigned.
+    int perm6[6] = {4, 1, 0, 2, 3, 4};
+    bool fwd[6] = {0};
+    sp_sketch sk;
+    make_strokes(&sk, perm6, fwd, 6, 0, 3);
+    for (int i = 0; i < sk.strokes[5].count; ++i)
+        sk.strokes[5].points[i].x += 200;
+    sp_stroke_match mt[6];
+    int c2s[NC];
+    sp_error err = {{0}};
+    ENSURE(sp_assign_strokes(sk.strokes, 6, g_curves, NC, NULL, mt, c2s, &err) == SP_OK);
+    for (int s = 0; s < 5; ++s)
+        ENSURE(mt[s].curve == perm6[s]);
+    ENSURE(mt[5].curve == -1 && mt[5].cost == 0);
+    for (int c = 0; c < NC; ++c)
+        ENSURE(c2s[c] >= 0 && c2s[c] < 5);
+    sp_sketch_free(&sk);
+    // Two strokes, five curves: three curves unmatched.
+    int perm2[2] = {3, 1};
+    make_strokes(&sk, perm2, fwd, 2, 0, 4);
+    ENSURE(sp_assign_strokes(sk.strokes, 2, g_curves, NC, &(sp_assign_desc){.samples = 16}, mt, c2s, &err) == SP_OK);
+    ENSURE(mt[0].curve == 3 && mt[1].curve == 1);
+    int unmatched = 0;
+    for (int c = 0; c < NC; ++c)
+        unmatched += c2s[c] == -1;
+    ENSURE(unmatched == 3);
+    // Determinism: bit-identical on a second run.
+    sp_stroke_match again[2];
+    ENSURE(sp_assign_strokes(sk.strokes, 2, g_curves, NC, &(sp_assign_desc){.samples = 16}, again, NULL, &err) == SP_OK);
+    for (int s = 0; s < 2; ++s)
+        ENSURE(again[s].curve == mt[s].curve && again[s].reversed == mt[s].reversed && again[s].shift == mt[s].shift &&
+               memcmp(&again[s].cost, &mt[s].cost, sizeof(double)) == 0);
+    sp_sketch_free(&sk);
+    // No curves / no strokes.
+    make_strokes(&sk, perm2, fwd, 2, 0, 4);
+    ENSURE(sp_assign_strokes(sk.strokes, 2, g_curves, 0, NULL, mt, NULL, &err) == SP_OK);
+    ENSURE(mt[0].curve == -1 && mt[1].curve == -1);
+    ENSURE(sp_assign_strokes(NULL, 0, g_curves, NC, NULL, NULL, c2s, &err) == SP_OK);
+    ENSURE(c2s[0] == -1 && c2s[4] == -1);
+    sp_sketch_free(&sk);
+}
+
+static void test_assign_degenerate(void)
+{
+    make_curves();
+    sp_sketch sk = {0};
+    sp_vec2 one = {320, 80}, line[2] = {{320, 120}, {320, 280}};
+    sp_vec2 same[4] = {{100, 100}, {100, 100}, {100, 100}, {100, 100}};
+    ENSURE(sp_sketch_add_stroke(&sk, line, NULL, 2) == SP_OK);
+    ENSURE(sp_sketch_add_stroke(&sk, &one, NULL, 1) == SP_OK);
+    ENSURE(sp_sketch_add_stroke(&sk, same, NULL, 4) == SP_OK);
+    sp_stroke_match mt[4];
+    sp_error err = {{0}};
+    ENSURE(sp_assign_strokes(sk.strokes, 3, g_curves, NC, NULL, mt, NULL, &err) == SP_OK);
+    ENSURE(mt[0].curve == 1); // the torso line
+    ENSURE(mt[1].curve >= 0 && mt[2].curve >= 0 && mt[1].curve != mt[2].curve);
+    for (int s = 0; s < 3; ++s)
+        ENSURE(isfinite(mt[s].cost));
+    // An empty stroke and a NaN are reported by index.
+    ENSURE(sp_sketch_add_stroke(&sk, NULL, NULL, 0) == SP_OK);
+    ENSURE(sp_assign_strokes(sk.strokes, 4, g_curves, NC, NULL, mt, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "stroke 3") != NULL);
+    sk.strokes[0].points[1].y = NAN;
+    ENSURE(sp_assign_strokes(sk.strokes, 3, g_curves, NC, NULL, mt, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "stroke 0") != NULL);
+    sp_sketch_free(&sk);
+    // One stroke of 10^6 points (a dense torso line) against the figure.
+    int n = 1000000;
+    sp_vec2* p = malloc(sizeof(sp_vec2) * n);
+    for (int i = 0; i < n; ++i)
+        p[i] = (sp_vec2){320 + 0.5 * sin(i * 0.001), 115 + 162.0 * i / (n - 1)};
+    sp_stroke big = {n, p, NULL};
+    ENSURE(sp_assign_strokes(&big, 1, g_curves, NC, NULL, mt, NULL, &err) == SP_OK);
+    ENSURE(mt[0].curve == 1 && !mt[0].reversed);
+    free(p);
+}
+
+int main(int argc, char** argv)
+{
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"resample_open_uniform", test_resample_open_uniform},
+                                   {"resample_closed_uniform", test_resample_closed_uniform},
+                                   {"resample_degenerate", test_resample_degenerate},
+                                   {"resample_million", test_resample_million},
+                                   {"clean_smooth", test_clean_smooth},
+                                   {"ordered_direction", test_ordered_direction},
+                                   {"ordered_cyclic_shift", test_ordered_cyclic_shift},
+                                   {"closest_both_ways", test_closest_both_ways},
+                                   {"closest_kdtree", test_closest_kdtree},
+                                   {"hungarian_vs_brute", test_hungarian_vs_brute},
+                                   {"assign_order_independent", test_assign_order_independent},
+                                   {"assign_counts", test_assign_counts},
+                                   {"assign_degenerate", test_assign_degenerate},
+                                   {0}});
+}
