@@ -24,8 +24,8 @@
 
 #include <stdbool.h>
 
-#include "sp/rig.h"
 #include "sp/result.h"
+#include "sp/rig.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -34,12 +34,12 @@ extern "C" {
 enum { SP_WARNING_MAX = 256 };
 
 typedef struct sp_character {
-    sp_rig rig;          ///< finalized
-    double* pose;        ///< rig.param_count values: stored pose (extras `sp_pose`), else defaults
-    float* colors;       ///< rig.vertex_count by 4, linear RGBA base colour per vertex
-    bool has_camera;     ///< a camera came from the file's scene
-    sp_camera camera;    ///< the sketch view: the file's camera, else a front orthographic view of the rest pose
-    char* part_json;     ///< the scene's `extras.sp_part` as compact JSON, or NULL
+    sp_rig rig;               ///< finalized
+    double* pose;             ///< rig.param_count values: stored pose (extras `sp_pose`), else defaults
+    float* colors;            ///< rig.vertex_count by 4, linear RGBA base colour per vertex
+    bool has_camera;          ///< a camera came from the file's scene
+    sp_camera camera;         ///< the sketch view: the file's camera, else a front orthographic view of the rest pose
+    char* part_json;          ///< the scene's `extras.sp_part` as compact JSON, or NULL
     bool derived_abstraction; ///< the stick figure was derived from the skeleton
     bool derived_dofs;        ///< default rotation DOFs were added
     int warning_count;

@@ -1,0 +1,102 @@
+// pose_io.c: reading and writing pose files (see pose_io.h).
+#include "pose_io.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+sp_result sp_pose_parse(const char* text, const char* what, const sp_rig* rig, double* p, int* clamped, sp_error* err)
+{
+    if (clamped) *clamped = 0;
+    cJSON* root = cJSON_Parse(text);
+    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: not valid JSON", what);
+    sp_result r = SP_OK;
+    const cJSON* params = cJSON_GetObjectItemCaseSensitive(root, "parameters");
+    if (!cJSON_IsObject(params)) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: expected {\"parameters\": {\"<joint>.<channel>\": value, ...}}", what);
+        goto done;
+    }
+    const cJSON* it;
+    cJSON_ArrayForEach(it, params)
+    {
+        int k = sp_rig_find_param(rig, it->string);
+        if (k < 0) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: unknown parameter '%s' (see `sketchpose inspect`)", what, it->string);
+            goto done;
+        }
+        if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble)) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: parameter '%s' is not a finite number", what, it->string);
+            goto done;
+        }
+        double v = it->valuedouble;
+        const sp_param* q = &rig->params[k];
+        if (v < q->min || v > q->max) {
+            double c = v < q->min ? q->min : q->max;
+            fprintf(stderr, "warning: %s: parameter '%s' = %g is outside [%g, %g], clamped to %g\n", what, it->string, v, q->min,
+                    q->max, c);
+            v = c;
+            if (clamped) ++*clamped;
+        }
+        p[k] = v;
+    }
+done:
+    cJSON_Delete(root);
+    return r;
+}
+
+sp_result sp_pose_read(const char* path, const sp_rig* rig, double* p, int* clamped, sp_error* err)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    size_t cap = 4096, n = 0;
+    char* text = malloc(cap);
+    size_t got;
+    while (text && (got = fread(text + n, 1, cap - n - 1, f)) > 0) {
+        n += got;
+        if (n + 1 == cap) {
+            char* grown = realloc(text, cap * 2);
+            if (!grown) free(text);
+            text = grown;
+            cap *= 2;
+        }
+    }
+    bool bad = ferror(f) != 0;
+    fclose(f);
+    if (!text) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    if (bad) {
+        free(text);
+        return sp_fail(err, SP_ERR_IO, "%s: read error", path);
+    }
+    text[n] = 0;
+    sp_result r = sp_pose_parse(text, path, rig, p, clamped, err);
+    free(text);
+    return r;
+}
+
+cJSON* sp_pose_to_json(const sp_rig* rig, const double* p)
+{
+    cJSON* root = cJSON_CreateObject();
+    cJSON* params = cJSON_AddObjectToObject(root, "parameters");
+    for (int k = 0; params && k < rig->param_count; ++k)
+        cJSON_AddNumberToObject(params, rig->params[k].name, p[k]);
+    return root;
+}
+
+sp_result sp_pose_write(const char* path, const sp_rig* rig, const double* p, sp_error* err)
+{
+    cJSON* root = sp_pose_to_json(rig, p);
+    char* text = root ? cJSON_Print(root) : NULL;
+    cJSON_Delete(root);
+    if (!text) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    FILE* f = fopen(path, "wb");
+    if (!f) {
+        free(text);
+        return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    }
+    bool ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    ok = fclose(f) == 0 && ok;
+    free(text);
+    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write error", path);
+}

@@ -1,0 +1,29 @@
+/// pose_io.h: the pose file that `export --pose`, `synth --truth` and the
+/// reports share: JSON `{"parameters": {"<joint>.<channel>": value, ...}}`.
+///
+///     sp_rig_defaults(rig, p);                       // or a stored pose
+///     if (sp_pose_read("p.json", rig, p, &err) != SP_OK) { fprintf(stderr, "%s\n", err.text); ... }
+///
+/// Reading overwrites only the listed parameters. An unknown name, a value
+/// that is not a finite number or a malformed file is an error naming the
+/// file and the parameter; a value outside its bounds is clamped and reported
+/// on stderr as a one-line warning.
+#ifndef SP_POSE_IO_H
+#define SP_POSE_IO_H
+
+#include <cjson/cJSON.h>
+
+#include "sp/result.h"
+#include "sp/rig.h"
+
+/// Reads `path` into p (rig->param_count values, pre-filled by the caller).
+/// *clamped (may be NULL) receives the number of clamped values.
+sp_result sp_pose_read(const char* path, const sp_rig* rig, double* p, int* clamped, sp_error* err);
+/// Same from JSON text; `what` names the source in messages.
+sp_result sp_pose_parse(const char* text, const char* what, const sp_rig* rig, double* p, int* clamped, sp_error* err);
+/// The pose object {"parameters": {...}} for p (caller deletes it).
+cJSON* sp_pose_to_json(const sp_rig* rig, const double* p);
+/// Writes the pose file.
+sp_result sp_pose_write(const char* path, const sp_rig* rig, const double* p, sp_error* err);
+
+#endif

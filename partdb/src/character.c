@@ -1,0 +1,370 @@
+// character.c: the C half of the glTF import: our extras (sp_dofs, sp_rest,
+// sp_abstraction, sp_pose, sp_part), default DOFs, finalising, warnings,
+// the default camera, and the character's lifetime.
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gltf_internal.h"
+
+void sp_character_free(sp_character* ch)
+{
+    if (!ch) return;
+    sp_rig_free(&ch->rig);
+    free(ch->pose);
+    free(ch->colors);
+    free(ch->part_json);
+    free(ch->warnings);
+    memset(ch, 0, sizeof *ch);
+}
+
+void sp_character_warn(sp_character* ch, const char* fmt, ...)
+{
+    char(*grown)[SP_WARNING_MAX] = realloc(ch->warnings, sizeof *ch->warnings * (size_t)(ch->warning_count + 1));
+    if (!grown) return; // a lost warning is not worth failing a load for
+    ch->warnings = grown;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(ch->warnings[ch->warning_count], SP_WARNING_MAX, fmt, ap);
+    va_end(ap);
+    ++ch->warning_count;
+}
+
+// The front orthographic view framing the skinned vertices (or, without a
+// mesh, the joints) at the default parameters.
+static sp_result default_camera(sp_character* ch)
+{
+    const sp_rig* rig = &ch->rig;
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
+    int n = rig->vertex_count > 0 ? rig->vertex_count : rig->joint_count;
+    double* xyz = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!ev || !p || !xyz) {
+        sp_rig_eval_destroy(ev);
+        free(p), free(xyz);
+        return SP_ERR_NO_MEMORY;
+    }
+    sp_rig_defaults(rig, p);
+    sp_rig_eval_update(ev, p, false);
+    if (rig->vertex_count > 0) {
+        sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
+    } else {
+        const sp_mat4* g = sp_rig_eval_world(ev);
+        for (int j = 0; j < n; ++j) {
+            sp_vec3 t = sp_mat4_translation(&g[j]);
+            xyz[3 * j] = t.x, xyz[3 * j + 1] = t.y, xyz[3 * j + 2] = t.z;
+        }
+    }
+    ch->camera = sp_camera_default_view(xyz, n, SP_GLTF_CANVAS_W, SP_GLTF_CANVAS_H);
+    sp_rig_eval_destroy(ev);
+    free(p), free(xyz);
+    return SP_OK;
+}
+
+sp_result sp_character_from_rig(sp_rig* rig, sp_character* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    out->rig = *rig;
+    memset(rig, 0, sizeof *rig);
+    size_t nv = (size_t)out->rig.vertex_count;
+    out->pose = malloc(sizeof(double) * (size_t)(out->rig.param_count + 1));
+    out->colors = malloc(sizeof(float) * 4 * (nv + 1));
+    if (!out->pose || !out->colors || default_camera(out) != SP_OK) {
+        sp_character_free(out);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "character: out of memory");
+    }
+    sp_rig_defaults(&out->rig, out->pose);
+    for (size_t i = 0; i < 4 * nv; ++i)
+        out->colors[i] = (i % 4 == 3) ? 1.0f : SP_GLTF_TEXTURE_GREY;
+    return SP_OK;
+}
+
+// ---- extras -------------------------------------------------------------
+
+static bool json_number(const cJSON* o, const char* key, double* v)
+{
+    const cJSON* it = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (!cJSON_IsNumber(it)) return false;
+    *v = it->valuedouble;
+    return true;
+}
+
+// Reads n finite numbers from a JSON array.
+static bool json_vec(const cJSON* a, double* v, int n)
+{
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n) return false;
+    int i = 0;
+    const cJSON* it;
+    cJSON_ArrayForEach(it, a)
+    {
+        if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble)) return false;
+        v[i++] = it->valuedouble;
+    }
+    return true;
+}
+
+sp_result sp_gltf_joint_extras(sp_rig* rig, int joint, const char* json, bool* has_dofs, bool* has_rest, const char* what,
+                               sp_error* err)
+{
+    *has_dofs = *has_rest = false;
+    if (!json || !*json) return SP_OK;
+    cJSON* root = cJSON_Parse(json);
+    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: joint '%s': extras are not valid JSON", what, rig->joints[joint].name);
+    sp_result r = SP_OK;
+    const char* jn = rig->joints[joint].name;
+    const cJSON* dofs = cJSON_GetObjectItemCaseSensitive(root, "sp_dofs");
+    if (cJSON_IsNull(dofs)) *has_dofs = true;
+    // Why null counts as empty: JSON writers (tinygltf's among them) may
+    // write an empty list as null.
+    if (dofs && !cJSON_IsNull(dofs)) {
+        *has_dofs = true;
+        if (!cJSON_IsArray(dofs)) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs must be a list", what, jn);
+            goto done;
+        }
+        const cJSON* d;
+        cJSON_ArrayForEach(d, dofs)
+        {
+            const cJSON* chn = cJSON_GetObjectItemCaseSensitive(d, "channel");
+            sp_channel c = cJSON_IsString(chn) ? sp_channel_parse(chn->valuestring) : SP_CH_COUNT;
+            if (c == SP_CH_COUNT) {
+                r = sp_fail(err, SP_ERR_INVALID,
+                            "%s: joint '%s': sp_dofs entry without a known channel (rx|ry|rz|tx|ty|tz|sx|sy|sz|s)", what, jn);
+                goto done;
+            }
+            const char* cn = sp_channel_name(c);
+            double lo, hi;
+            if (!json_number(d, "min", &lo) || !json_number(d, "max", &hi)) {
+                r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s needs numeric min and max", what, jn, cn);
+                goto done;
+            }
+            if (!isfinite(lo) || !isfinite(hi) || !(lo <= hi)) {
+                r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s has invalid bounds [%g, %g]", what, jn, cn,
+                            lo, hi);
+                goto done;
+            }
+            if (sp_channel_is_scale(c) && !(lo > 0.0)) {
+                r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': scale channel %s needs min > 0 (got %g)", what, jn, cn, lo);
+                goto done;
+            }
+            sp_group g = sp_channel_is_scale(c) ? SP_GROUP_SHAPE : SP_GROUP_POSE;
+            const cJSON* grp = cJSON_GetObjectItemCaseSensitive(d, "group");
+            if (grp) {
+                if (cJSON_IsString(grp) && !strcmp(grp->valuestring, "pose"))
+                    g = SP_GROUP_POSE;
+                else if (cJSON_IsString(grp) && !strcmp(grp->valuestring, "shape"))
+                    g = SP_GROUP_SHAPE;
+                else {
+                    r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s: group must be \"pose\" or \"shape\"",
+                                what, jn, cn);
+                    goto done;
+                }
+            }
+            if (sp_rig_add_param(rig, joint, c, lo, hi, g) < 0) {
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+                goto done;
+            }
+        }
+    }
+    const cJSON* rest = cJSON_GetObjectItemCaseSensitive(root, "sp_rest");
+    if (rest) {
+        double t[3], q[4], s[3];
+        if (!json_vec(cJSON_GetObjectItemCaseSensitive(rest, "translation"), t, 3) ||
+            !json_vec(cJSON_GetObjectItemCaseSensitive(rest, "rotation"), q, 4) ||
+            !json_vec(cJSON_GetObjectItemCaseSensitive(rest, "scale"), s, 3)) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_rest needs finite translation[3], rotation[4], scale[3]", what,
+                        jn);
+            goto done;
+        }
+        sp_joint* jt = &rig->joints[joint];
+        jt->rest_t = sp_v3(t[0], t[1], t[2]);
+        jt->rest_r = (sp_quat){q[0], q[1], q[2], q[3]};
+        jt->rest_s = sp_v3(s[0], s[1], s[2]);
+        *has_rest = true;
+    }
+done:
+    cJSON_Delete(root);
+    return r;
+}
+
+sp_result sp_gltf_curve_extras(const char* json, sp_curve_tag* tag, const char* what, sp_error* err)
+{
+    memset(tag, 0, sizeof *tag);
+    if (!json || !*json) return SP_OK;
+    cJSON* root = cJSON_Parse(json);
+    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: node extras are not valid JSON", what);
+    sp_result r = SP_OK;
+    const cJSON* a = cJSON_GetObjectItemCaseSensitive(root, "sp_abstraction");
+    if (a) {
+        if (!cJSON_IsString(a) || !a->valuestring[0] || strlen(a->valuestring) >= SP_NAME_MAX) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: sp_abstraction must be a name of 1 to %d characters", what, SP_NAME_MAX - 1);
+            goto done;
+        }
+        tag->is_curve = true;
+        snprintf(tag->abstraction, sizeof tag->abstraction, "%s", a->valuestring);
+        const cJSON* c = cJSON_GetObjectItemCaseSensitive(root, "sp_curve");
+        if (cJSON_IsString(c)) snprintf(tag->curve, sizeof tag->curve, "%s", c->valuestring);
+        const cJSON* k = cJSON_GetObjectItemCaseSensitive(root, "sp_correspondence");
+        if (k) {
+            if (cJSON_IsString(k) && !strcmp(k->valuestring, "ordered"))
+                tag->correspondence = SP_CORR_ORDERED;
+            else if (cJSON_IsString(k) && !strcmp(k->valuestring, "closest"))
+                tag->correspondence = SP_CORR_CLOSEST;
+            else {
+                r = sp_fail(err, SP_ERR_INVALID, "%s: abstraction '%s': sp_correspondence must be \"ordered\" or \"closest\"",
+                            what, tag->abstraction);
+                goto done;
+            }
+            tag->has_correspondence = true;
+        }
+    }
+done:
+    cJSON_Delete(root);
+    return r;
+}
+
+sp_result sp_gltf_append_curve(sp_rig* rig, const char* abstraction, sp_correspondence corr, const char* curve, bool closed,
+                               int n, const double* rest, const uint16_t* joints, const float* weights)
+{
+    int a = sp_rig_find_abstraction(rig, abstraction);
+    if (a < 0) {
+        sp_abstraction* grown = realloc(rig->abstractions, sizeof(sp_abstraction) * (size_t)(rig->abstraction_count + 1));
+        if (!grown) return SP_ERR_NO_MEMORY;
+        rig->abstractions = grown;
+        a = rig->abstraction_count++;
+        memset(&grown[a], 0, sizeof grown[a]);
+        snprintf(grown[a].name, sizeof grown[a].name, "%s", abstraction);
+        grown[a].correspondence = corr;
+    }
+    sp_abstraction* ab = &rig->abstractions[a];
+    size_t old = (size_t)ab->point_count, total = old + (size_t)n;
+    sp_curve* curves = realloc(ab->curves, sizeof(sp_curve) * (size_t)(ab->curve_count + 1));
+    if (curves) ab->curves = curves;
+    double* r = realloc(ab->rest, sizeof(double) * 3 * total);
+    if (r) ab->rest = r;
+    uint16_t* j = realloc(ab->joints, sizeof(uint16_t) * 4 * total);
+    if (j) ab->joints = j;
+    float* w = realloc(ab->weights, sizeof(float) * 4 * total);
+    if (w) ab->weights = w;
+    if (!curves || !r || !j || !w) return SP_ERR_NO_MEMORY;
+    memcpy(ab->rest + 3 * old, rest, sizeof(double) * 3 * (size_t)n);
+    memcpy(ab->joints + 4 * old, joints, sizeof(uint16_t) * 4 * (size_t)n);
+    memcpy(ab->weights + 4 * old, weights, sizeof(float) * 4 * (size_t)n);
+    sp_curve* cv = &ab->curves[ab->curve_count++];
+    memset(cv, 0, sizeof *cv);
+    if (curve && *curve)
+        snprintf(cv->name, sizeof cv->name, "%s", curve);
+    else
+        snprintf(cv->name, sizeof cv->name, "curve%d", ab->curve_count - 1);
+    cv->first_point = (int)old;
+    cv->point_count = n;
+    cv->closed = closed;
+    ab->point_count = (int)total;
+    return SP_OK;
+}
+
+// ---- pose ---------------------------------------------------------------
+
+void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, double* p)
+{
+    cJSON* root = cJSON_Parse(parameters_json);
+    if (!cJSON_IsObject(root)) {
+        sp_character_warn(ch, "sp_pose.parameters is not a JSON object; using the default pose");
+        cJSON_Delete(root);
+        return;
+    }
+    const cJSON* it;
+    cJSON_ArrayForEach(it, root)
+    {
+        int k = sp_rig_find_param(&ch->rig, it->string);
+        if (k < 0)
+            sp_character_warn(ch, "sp_pose: unknown parameter '%s' ignored", it->string);
+        else if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
+            sp_character_warn(ch, "sp_pose: parameter '%s' is not a finite number; default kept", it->string);
+        else
+            p[k] = it->valuedouble;
+    }
+    cJSON_Delete(root);
+    int clamped = sp_rig_clamp(&ch->rig, p);
+    if (clamped > 0) sp_character_warn(ch, "sp_pose: %d parameters clamped to their bounds", clamped);
+}
+
+// Scene extras: sp_part (kept as compact JSON) and sp_pose (applied to ch->pose).
+static sp_result scene_extras(sp_character* ch, const char* json, const char* what, sp_error* err)
+{
+    if (!json || !*json) return SP_OK;
+    cJSON* root = cJSON_Parse(json);
+    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: scene extras are not valid JSON", what);
+    sp_result r = SP_OK;
+    const cJSON* part = cJSON_GetObjectItemCaseSensitive(root, "sp_part");
+    if (part) {
+        ch->part_json = cJSON_PrintUnformatted(part);
+        if (!ch->part_json) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    }
+    const cJSON* pose = cJSON_GetObjectItemCaseSensitive(root, "sp_pose");
+    if (r == SP_OK && pose) {
+        const cJSON* params = cJSON_GetObjectItemCaseSensitive(pose, "parameters");
+        char* text = params ? cJSON_PrintUnformatted(params) : NULL;
+        if (text)
+            sp_gltf_apply_pose_json(ch, text, ch->pose);
+        else if (!cJSON_IsNull(params) || ch->rig.param_count > 0)
+            sp_character_warn(ch, "sp_pose has no \"parameters\" object; using the default pose");
+        free(text);
+    }
+    cJSON_Delete(root);
+    return r;
+}
+
+// ---- finishing ----------------------------------------------------------
+
+sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err)
+{
+    sp_rig* rig = &ch->rig;
+    const char* what = im->what;
+    // Why only when no joint declares sp_dofs: a file that declares some has
+    // chosen its parameters; an explicit empty list means "this joint is fixed".
+    if (!im->any_dofs) {
+        int added = 0;
+        for (int j = 0; j < rig->joint_count; ++j) {
+            if (!im->is_skin[j]) continue;
+            for (int c = SP_CH_RX; c <= SP_CH_RZ; ++c)
+                if (sp_rig_add_param(rig, j, (sp_channel)c, -SP_GLTF_DEFAULT_ROT_LIMIT, SP_GLTF_DEFAULT_ROT_LIMIT,
+                                     SP_GROUP_POSE) < 0)
+                    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+            ++added;
+        }
+        ch->derived_dofs = added > 0;
+    }
+    int renorm = 0;
+    sp_result r = sp_rig_finalize(rig, what, &renorm, err);
+    if (r != SP_OK) return r;
+    if (renorm > 0) sp_character_warn(ch, "renormalised skin weights of %d vertices", renorm);
+    if (rig->abstraction_count == 0) {
+        r = sp_gltf_derive_stick(rig, im->is_skin, err);
+        if (r != SP_OK) return r;
+        if (rig->abstraction_count > 0) {
+            ch->derived_abstraction = true;
+            r = sp_rig_finalize(rig, what, NULL, err);
+            if (r != SP_OK) return r;
+        } else {
+            sp_character_warn(ch, "the skeleton has no bones to derive a stick figure from");
+        }
+    }
+    ch->pose = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
+    if (!ch->pose) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    sp_rig_defaults(rig, ch->pose);
+    // Our exports bake the pose into the node TRS and keep the rest in
+    // sp_rest: recover the parameters from the node (sp_pose refines them).
+    for (int j = 0; j < rig->joint_count; ++j)
+        if (im->has_rest[j] && rig->joints[j].param_count > 0)
+            sp_rig_params_from_trs(rig, j, im->node_t[j], im->node_r[j], im->node_s[j], ch->pose);
+    r = scene_extras(ch, im->scene_extras, what, err);
+    if (r != SP_OK) return r;
+    if (!ch->has_camera) {
+        if (default_camera(ch) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    }
+    return SP_OK;
+}

@@ -1,0 +1,1528 @@
+// gltf_adapter.cpp: the only file that includes <tiny_gltf.h>. It turns a
+// glTF document into the plain C structs of sp/rig.h and sp/gltf.h (and
+// back, for export); the sketch-abstraction conventions that need no glTF
+// types live in character.c and stickfig.c.
+//
+// Every exported function is an exception firewall: tinygltf and the STL may
+// throw, C callers must not see it. Inside, errors are thrown as `Failure`
+// (code + one-line message) and turned into an sp_result at the boundary.
+#include <tiny_gltf.h>
+
+#include <cjson/cJSON.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+// Why the pragma: sp/math.h is C11 and uses compound literals, which C++
+// accepts only as a GNU extension (-pedantic warns).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#include "gltf_internal.h"
+#pragma GCC diagnostic pop
+
+namespace
+{
+
+struct Failure {
+    sp_result code;
+    std::string text;
+};
+
+[[noreturn]] __attribute__((format(printf, 2, 3))) void fail(sp_result code, const char* fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    throw Failure{code, buf};
+}
+
+// tinygltf reports several lines; we keep the first meaningful one.
+std::string first_line(const std::string& s)
+{
+    size_t i = 0;
+    while (i < s.size()) {
+        size_t e = s.find('\n', i);
+        if (e == std::string::npos) e = s.size();
+        std::string line = s.substr(i, e - i);
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
+            line.pop_back();
+        if (!line.empty()) return line;
+        i = e + 1;
+    }
+    return std::string();
+}
+
+// ---- GLB container check ------------------------------------------------
+
+uint32_t le32(const unsigned char* p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+// Why our own check: tinygltf 2.7 trusts some of the GLB header's lengths.
+// Returns the number of bytes the container declares.
+size_t check_glb(const unsigned char* d, size_t n, const char* what)
+{
+    if (n < 20) fail(SP_ERR_PARSE, "%s: truncated .glb (%zu bytes, the header alone is 20)", what, n);
+    if (le32(d + 4) != 2) fail(SP_ERR_UNSUPPORTED, "%s: .glb version %u (only glTF 2.0 is supported)", what, le32(d + 4));
+    size_t total = le32(d + 8);
+    if (total > n) fail(SP_ERR_PARSE, "%s: truncated .glb (the header says %zu bytes, the file has %zu)", what, total, n);
+    if (total < 20) fail(SP_ERR_PARSE, "%s: corrupt .glb header (total length %zu)", what, total);
+    size_t json_len = le32(d + 12);
+    if (le32(d + 16) != 0x4E4F534Au) fail(SP_ERR_PARSE, "%s: .glb: the first chunk is not JSON", what);
+    if (json_len > total - 20) fail(SP_ERR_PARSE, "%s: truncated .glb (the JSON chunk runs past the end)", what);
+    size_t off = 20 + json_len;
+    if (off < total) {
+        if (total - off < 8) fail(SP_ERR_PARSE, "%s: truncated .glb (incomplete chunk header at byte %zu)", what, off);
+        size_t bin_len = le32(d + off);
+        if (bin_len > total - off - 8) fail(SP_ERR_PARSE, "%s: truncated .glb (the BIN chunk runs past the end)", what);
+    }
+    return total;
+}
+
+// ---- tinygltf callbacks -------------------------------------------------
+
+// Why: we never need pixels (colours come from baseColorFactor), and
+// decoding a JPEG costs time and attack surface.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*)
+{
+    return true;
+}
+
+bool no_file_exists(const std::string&, void*)
+{
+    return false;
+}
+std::string no_expand(const std::string& p, void*)
+{
+    return p;
+}
+bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& p, void*)
+{
+    if (err) *err += "external file '" + p + "' cannot be resolved when loading from memory\n";
+    return false;
+}
+bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*)
+{
+    return false;
+}
+
+void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size, const char* what, const std::string& base_dir,
+                 bool use_fs, sp_character* ch)
+{
+    if (size > 0x7fffffffu) fail(SP_ERR_UNSUPPORTED, "%s: files over 2 GiB are not supported", what);
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(skip_image, nullptr);
+    loader.SetStoreOriginalJSONForExtrasAndExtensions(true);
+    if (!use_fs) loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, no_expand, no_read, no_write, nullptr});
+    std::string terr, twarn;
+    bool ok;
+    if (size >= 4 && !memcmp(data, "glTF", 4)) {
+        size_t total = check_glb(data, size, what);
+        ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, data, (unsigned)total, base_dir);
+    } else {
+        size_t i = 0;
+        while (i < size && (data[i] == ' ' || data[i] == '\n' || data[i] == '\r' || data[i] == '\t'))
+            ++i;
+        if (i == size) fail(SP_ERR_PARSE, "%s: empty file", what);
+        if (data[i] != '{') fail(SP_ERR_PARSE, "%s: neither glTF JSON nor a .glb", what);
+        ok = loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char*>(data), (unsigned)size, base_dir);
+    }
+    if (!ok) {
+        std::string line = first_line(terr);
+        if (line.empty()) line = first_line(twarn);
+        if (line.empty()) line = "not a valid glTF 2.0 file";
+        sp_result code = SP_ERR_PARSE;
+        if (line.find("File not found") != std::string::npos || line.find("Failed to load") != std::string::npos ||
+            line.find("cannot be resolved") != std::string::npos)
+            code = SP_ERR_IO;
+        fail(code, "%s: %s", what, line.c_str());
+    }
+    if (!twarn.empty()) sp_character_warn(ch, "glTF: %s", first_line(twarn).c_str());
+}
+
+// ---- accessors ------------------------------------------------------------
+
+struct View {
+    const unsigned char* base = nullptr;
+    size_t stride = 0, count = 0;
+    int comp = 0, ncomp = 0;
+    bool normalized = false;
+    int index = -1;
+};
+
+View view_accessor(const tinygltf::Model& m, int index, const char* what, const char* usage)
+{
+    if (index < 0 || (size_t)index >= m.accessors.size())
+        fail(SP_ERR_INVALID, "%s: %s refers to accessor %d, but there are %zu", what, usage, index, m.accessors.size());
+    const tinygltf::Accessor& a = m.accessors[(size_t)index];
+    if (a.sparse.isSparse) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d is sparse (not supported)", what, index);
+    if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
+        fail(SP_ERR_INVALID, "%s: accessor %d refers to buffer view %d, but there are %zu", what, index, a.bufferView,
+             m.bufferViews.size());
+    const tinygltf::BufferView& bv = m.bufferViews[(size_t)a.bufferView];
+    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+        fail(SP_ERR_INVALID, "%s: buffer view %d refers to buffer %d, but there are %zu", what, a.bufferView, bv.buffer,
+             m.buffers.size());
+    const std::vector<unsigned char>& buf = m.buffers[(size_t)bv.buffer].data;
+    int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    int ncomp = tinygltf::GetNumComponentsInType((uint32_t)a.type);
+    if (csize <= 0 || ncomp <= 0) fail(SP_ERR_INVALID, "%s: accessor %d has an invalid type or component type", what, index);
+    if (bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset)
+        fail(SP_ERR_INVALID, "%s: buffer view %d reads past the end of buffer %d", what, a.bufferView, bv.buffer);
+    size_t elem = (size_t)csize * (size_t)ncomp;
+    size_t stride = bv.byteStride ? bv.byteStride : elem;
+    if (stride < elem) fail(SP_ERR_INVALID, "%s: accessor %d: byteStride %zu is smaller than an element", what, index, stride);
+    if (a.count > (1u << 28)) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d has %zu elements (too many)", what, index, a.count);
+    if (a.count > 0) {
+        size_t need = stride * (a.count - 1) + elem;
+        if (a.byteOffset > bv.byteLength || need > bv.byteLength - a.byteOffset)
+            fail(SP_ERR_INVALID, "%s: accessor %d reads past the end of buffer view %d", what, index, a.bufferView);
+    }
+    View v;
+    v.base = buf.data() + bv.byteOffset + a.byteOffset;
+    v.stride = stride;
+    v.count = a.count;
+    v.comp = a.componentType;
+    v.ncomp = ncomp;
+    v.normalized = a.normalized;
+    v.index = index;
+    return v;
+}
+
+// One component as a double; normalized integers map to [0, 1] / [-1, 1].
+double read_comp(const View& v, size_t i, int c)
+{
+    const unsigned char* p = v.base + i * v.stride;
+    switch (v.comp) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float f;
+        memcpy(&f, p + 4 * c, 4);
+        return f;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return v.normalized ? p[c] / 255.0 : p[c];
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        double x = (int8_t)p[c];
+        return v.normalized ? std::max(x / 127.0, -1.0) : x;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t s;
+        memcpy(&s, p + 2 * c, 2);
+        return v.normalized ? s / 65535.0 : s;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t s;
+        memcpy(&s, p + 2 * c, 2);
+        return v.normalized ? std::max(s / 32767.0, -1.0) : s;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t u;
+        memcpy(&u, p + 4 * c, 4);
+        return u;
+    }
+    default:
+        return 0.0;
+    }
+}
+
+void expect(const View& v, int type_ncomp, std::initializer_list<int> comps, bool need_normalized_ints, const char* what,
+            const char* usage)
+{
+    bool comp_ok = std::find(comps.begin(), comps.end(), v.comp) != comps.end();
+    if (v.ncomp != type_ncomp || !comp_ok)
+        fail(SP_ERR_INVALID, "%s: %s (accessor %d) has the wrong type or component type", what, usage, v.index);
+    if (need_normalized_ints && v.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && !v.normalized)
+        fail(SP_ERR_INVALID, "%s: %s (accessor %d) must be float or normalized integers", what, usage, v.index);
+}
+
+// ---- node graph -----------------------------------------------------------
+
+struct Trs {
+    sp_vec3 t{0, 0, 0};
+    sp_quat r{0, 0, 0, 1};
+    sp_vec3 s{1, 1, 1};
+};
+
+sp_quat quat_from_rotation(const double m[9]) // column-major 3x3, orthonormal
+{
+    double m00 = m[0], m11 = m[4], m22 = m[8];
+    double tr = m00 + m11 + m22;
+    sp_quat q;
+    if (tr > 0) {
+        double s = std::sqrt(tr + 1.0) * 2;
+        q = {(m[5] - m[7]) / s, (m[6] - m[2]) / s, (m[1] - m[3]) / s, 0.25 * s};
+    } else if (m00 > m11 && m00 > m22) {
+        double s = std::sqrt(1.0 + m00 - m11 - m22) * 2;
+        q = {0.25 * s, (m[3] + m[1]) / s, (m[6] + m[2]) / s, (m[5] - m[7]) / s};
+    } else if (m11 > m22) {
+        double s = std::sqrt(1.0 + m11 - m00 - m22) * 2;
+        q = {(m[3] + m[1]) / s, 0.25 * s, (m[7] + m[5]) / s, (m[6] - m[2]) / s};
+    } else {
+        double s = std::sqrt(1.0 + m22 - m00 - m11) * 2;
+        q = {(m[6] + m[2]) / s, (m[7] + m[5]) / s, 0.25 * s, (m[1] - m[3]) / s};
+    }
+    return sp_quat_norm(q);
+}
+
+Trs decompose(const sp_mat4& a)
+{
+    Trs r;
+    r.t = sp_mat4_translation(&a);
+    sp_vec3 c[3];
+    for (int k = 0; k < 3; ++k)
+        c[k] = sp_v3(a.m[4 * k], a.m[4 * k + 1], a.m[4 * k + 2]);
+    double sx = sp_v3_len(c[0]), sy = sp_v3_len(c[1]), sz = sp_v3_len(c[2]);
+    if (sp_v3_dot(sp_v3_cross(c[0], c[1]), c[2]) < 0) sx = -sx;
+    r.s = sp_v3(sx, sy, sz);
+    double m[9];
+    double sc[3] = {sx, sy, sz};
+    for (int k = 0; k < 3; ++k) {
+        double inv = sc[k] != 0 ? 1.0 / sc[k] : 0.0;
+        m[3 * k] = c[k].x * inv, m[3 * k + 1] = c[k].y * inv, m[3 * k + 2] = c[k].z * inv;
+    }
+    r.r = quat_from_rotation(m);
+    return r;
+}
+
+Trs node_trs(const tinygltf::Node& n, int index, const char* what)
+{
+    Trs r;
+    if (n.matrix.size() == 16) {
+        sp_mat4 a;
+        for (int k = 0; k < 16; ++k) {
+            a.m[k] = n.matrix[(size_t)k];
+            if (!(std::fabs(a.m[k]) < 1e30)) fail(SP_ERR_INVALID, "%s: node %d has a non-finite or huge matrix", what, index);
+        }
+        return decompose(a);
+    }
+    if (!n.matrix.empty()) fail(SP_ERR_INVALID, "%s: node %d: matrix must have 16 numbers", what, index);
+    if (!n.translation.empty() && n.translation.size() != 3)
+        fail(SP_ERR_INVALID, "%s: node %d: translation must have 3 numbers", what, index);
+    if (!n.rotation.empty() && n.rotation.size() != 4)
+        fail(SP_ERR_INVALID, "%s: node %d: rotation must have 4 numbers", what, index);
+    if (!n.scale.empty() && n.scale.size() != 3) fail(SP_ERR_INVALID, "%s: node %d: scale must have 3 numbers", what, index);
+    if (n.translation.size() == 3) r.t = sp_v3(n.translation[0], n.translation[1], n.translation[2]);
+    if (n.rotation.size() == 4) r.r = sp_quat{n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]};
+    if (n.scale.size() == 3) r.s = sp_v3(n.scale[0], n.scale[1], n.scale[2]);
+    // Why: everything else in glTF is float32, and our export writes floats.
+    const double big = 1e30;
+    double all[10] = {r.t.x, r.t.y, r.t.z, r.r.x, r.r.y, r.r.z, r.r.w, r.s.x, r.s.y, r.s.z};
+    for (double x : all)
+        if (!(std::fabs(x) < big)) fail(SP_ERR_INVALID, "%s: node %d has a non-finite or huge transform", what, index);
+    return r;
+}
+
+sp_mat4 node_local(const tinygltf::Node& n, int index, const char* what)
+{
+    if (n.matrix.size() == 16) {
+        sp_mat4 a;
+        for (int k = 0; k < 16; ++k)
+            a.m[k] = n.matrix[(size_t)k];
+        return a;
+    }
+    Trs t = node_trs(n, index, what);
+    return sp_mat4_trs(t.t, sp_quat_norm(t.r), t.s);
+}
+
+std::string joint_name(const tinygltf::Node& n, int index, const std::vector<std::string>& used)
+{
+    std::string base = n.name.empty() ? "node" + std::to_string(index) : n.name;
+    if (base.size() >= SP_NAME_MAX) base.resize(SP_NAME_MAX - 1);
+    std::string name = base;
+    if (std::find(used.begin(), used.end(), name) != used.end()) {
+        std::string suffix = "_" + std::to_string(index);
+        name = base.substr(0, std::min(base.size(), (size_t)SP_NAME_MAX - 1 - suffix.size())) + suffix;
+    }
+    return name;
+}
+
+template <class T> T* c_array(const std::vector<T>& v)
+{
+    T* p = static_cast<T*>(malloc(sizeof(T) * (v.size() ? v.size() : 1)));
+    if (!p) throw std::bad_alloc();
+    if (!v.empty()) memcpy(p, v.data(), sizeof(T) * v.size());
+    return p;
+}
+
+struct Skinned {
+    std::vector<double> rest;
+    std::vector<uint16_t> joints;
+    std::vector<float> weights;
+};
+
+// Reads POSITION/JOINTS_0/WEIGHTS_0 of one primitive, joints remapped to the rig.
+void read_skinned(const tinygltf::Model& m, const tinygltf::Primitive& prim, int mesh, int pi, const std::vector<int>& skin_map,
+                  int skin, const char* what, Skinned& out)
+{
+    char usage[96];
+    auto attr = [&](const char* name) {
+        auto it = prim.attributes.find(name);
+        return it == prim.attributes.end() ? -1 : it->second;
+    };
+    int ipos = attr("POSITION"), ijnt = attr("JOINTS_0"), iwgt = attr("WEIGHTS_0");
+    if (ipos < 0) fail(SP_ERR_INVALID, "%s: mesh %d primitive %d has no POSITION", what, mesh, pi);
+    if (ijnt < 0 || iwgt < 0)
+        fail(SP_ERR_INVALID, "%s: mesh %d primitive %d has no JOINTS_0/WEIGHTS_0 (not skinned)", what, mesh, pi);
+    snprintf(usage, sizeof usage, "mesh %d primitive %d POSITION", mesh, pi);
+    View pos = view_accessor(m, ipos, what, usage);
+    expect(pos, 3, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
+    snprintf(usage, sizeof usage, "mesh %d primitive %d JOINTS_0", mesh, pi);
+    View jnt = view_accessor(m, ijnt, what, usage);
+    expect(jnt, 4, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, false, what, usage);
+    snprintf(usage, sizeof usage, "mesh %d primitive %d WEIGHTS_0", mesh, pi);
+    View wgt = view_accessor(m, iwgt, what, usage);
+    expect(wgt, 4, {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+           true, what, usage);
+    if (jnt.count != pos.count || wgt.count != pos.count)
+        fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: POSITION, JOINTS_0 and WEIGHTS_0 have different counts", what, mesh, pi);
+    size_t n = pos.count;
+    out.rest.resize(3 * n);
+    out.joints.resize(4 * n);
+    out.weights.resize(4 * n);
+    for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) {
+            double x = read_comp(pos, i, c);
+            if (!std::isfinite(x))
+                fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: vertex %zu has a non-finite POSITION", what, mesh, pi, i);
+            out.rest[3 * i + (size_t)c] = x;
+        }
+        double w[4];
+        unsigned j[4];
+        for (int c = 0; c < 4; ++c) {
+            w[c] = read_comp(wgt, i, c);
+            j[c] = (unsigned)read_comp(jnt, i, c);
+            if (!std::isfinite(w[c]) || w[c] < 0)
+                fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: vertex %zu has an invalid weight", what, mesh, pi, i);
+            if (j[c] >= skin_map.size()) {
+                if (w[c] > 0)
+                    fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: vertex %zu uses joint %u, but skin %d has %zu joints", what,
+                         mesh, pi, i, j[c], skin, skin_map.size());
+                j[c] = 0;
+            }
+        }
+        // Merge repeated joints (the validator rejects duplicates with weight).
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b)
+                if (j[a] == j[b] && w[b] > 0) w[a] += w[b], w[b] = 0;
+        if (!(w[0] + w[1] + w[2] + w[3] > 0))
+            fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: vertex %zu has all skin weights zero", what, mesh, pi, i);
+        for (int c = 0; c < 4; ++c) {
+            out.joints[4 * i + (size_t)c] = (uint16_t)skin_map[j[c]];
+            out.weights[4 * i + (size_t)c] = (float)w[c];
+        }
+    }
+}
+
+std::vector<uint32_t> read_indices(const tinygltf::Model& m, const tinygltf::Primitive& prim, int mesh, int pi, size_t nverts,
+                                   const char* what)
+{
+    std::vector<uint32_t> idx;
+    if (prim.indices < 0) {
+        idx.resize(nverts);
+        for (size_t i = 0; i < nverts; ++i)
+            idx[i] = (uint32_t)i;
+        return idx;
+    }
+    char usage[64];
+    snprintf(usage, sizeof usage, "mesh %d primitive %d indices", mesh, pi);
+    View v = view_accessor(m, prim.indices, what, usage);
+    expect(v, 1,
+           {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+           false, what, usage);
+    idx.resize(v.count);
+    for (size_t i = 0; i < v.count; ++i) {
+        double x = read_comp(v, i, 0);
+        if (x >= (double)nverts)
+            fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: index %.0f is out of range (%zu vertices)", what, mesh, pi, x,
+                 nverts);
+        idx[i] = (uint32_t)x;
+    }
+    return idx;
+}
+
+// Base colour of a primitive's material (linear RGBA).
+void material_color(const tinygltf::Model& m, int material, const char* what, float rgba[4])
+{
+    rgba[0] = rgba[1] = rgba[2] = rgba[3] = 1.0f;
+    if (material < 0) return;
+    if ((size_t)material >= m.materials.size())
+        fail(SP_ERR_INVALID, "%s: a primitive refers to material %d, but there are %zu", what, material, m.materials.size());
+    const tinygltf::PbrMetallicRoughness& pbr = m.materials[(size_t)material].pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() == 4)
+        for (int c = 0; c < 4; ++c) {
+            double x = pbr.baseColorFactor[(size_t)c];
+            rgba[c] = std::isfinite(x) ? (float)std::min(1.0, std::max(0.0, x)) : 1.0f;
+        }
+    if (pbr.baseColorTexture.index >= 0)
+        for (int c = 0; c < 3; ++c)
+            rgba[c] *= SP_GLTF_TEXTURE_GREY;
+}
+
+struct Importer {
+    const tinygltf::Model& m;
+    const char* what;
+    sp_character* ch;
+    std::vector<int> parent;                   // node -> parent node
+    std::vector<int> order;                    // reachable nodes, depth first
+    std::vector<int> node2joint;               // node -> rig joint or -1
+    std::map<int, std::vector<int>> skin_maps; // skin -> (skin joint -> rig joint)
+
+    void check_graph()
+    {
+        size_t N = m.nodes.size();
+        parent.assign(N, -1);
+        for (size_t n = 0; n < N; ++n)
+            for (int c : m.nodes[n].children) {
+                if (c < 0 || (size_t)c >= N)
+                    fail(SP_ERR_INVALID, "%s: node %zu has child %d, but there are %zu nodes", what, n, c, N);
+                if ((size_t)c == n || parent[(size_t)c] >= 0)
+                    fail(SP_ERR_INVALID,
+                         "%s: node %d has more than one parent or is its own child (the node graph must be a forest)", what, c);
+                parent[(size_t)c] = (int)n;
+            }
+        // Every node has at most one parent; a cycle is then a parent chain longer than N.
+        for (size_t n = 0; n < N; ++n) {
+            size_t steps = 0;
+            for (int p = parent[n]; p >= 0; p = parent[(size_t)p])
+                if (++steps > N) fail(SP_ERR_INVALID, "%s: the node graph has a cycle through node %zu", what, n);
+        }
+    }
+
+    // Depth-first order of the scene's nodes (children in file order).
+    void walk_scene(std::vector<int>& roots)
+    {
+        std::vector<char> seen(m.nodes.size(), 0);
+        std::vector<int> stack;
+        for (int r : roots) {
+            if (r < 0 || (size_t)r >= m.nodes.size())
+                fail(SP_ERR_INVALID, "%s: the scene refers to node %d, but there are %zu", what, r, m.nodes.size());
+            stack.push_back(r);
+            while (!stack.empty()) {
+                int n = stack.back();
+                stack.pop_back();
+                if (seen[(size_t)n]) continue;
+                seen[(size_t)n] = 1;
+                order.push_back(n);
+                const std::vector<int>& ch2 = m.nodes[(size_t)n].children;
+                for (auto it = ch2.rbegin(); it != ch2.rend(); ++it)
+                    stack.push_back(*it);
+            }
+        }
+    }
+
+    sp_curve_tag tag_of(const std::string& json)
+    {
+        sp_curve_tag tag;
+        sp_error e = {};
+        if (sp_gltf_curve_extras(json.empty() ? nullptr : json.c_str(), &tag, what, &e) != SP_OK)
+            fail(SP_ERR_INVALID, "%s", e.text);
+        return tag;
+    }
+
+    const std::vector<int>& skin_map(int skin)
+    {
+        auto it = skin_maps.find(skin);
+        if (it != skin_maps.end()) return it->second;
+        std::vector<int> map;
+        for (int jn : m.skins[(size_t)skin].joints) {
+            int j = (jn >= 0 && (size_t)jn < node2joint.size()) ? node2joint[(size_t)jn] : -1;
+            if (j < 0)
+                fail(SP_ERR_UNSUPPORTED, "%s: skin %d uses node %d, which is not a joint of the character's skeleton", what, skin,
+                     jn);
+            map.push_back(j);
+        }
+        return skin_maps[skin] = map;
+    }
+
+    void run()
+    {
+        sp_rig* rig = &ch->rig;
+        check_graph();
+        std::vector<int> roots;
+        int scene = -1;
+        if (!m.scenes.empty()) {
+            scene = m.defaultScene >= 0 ? m.defaultScene : 0;
+            if ((size_t)scene >= m.scenes.size()) fail(SP_ERR_INVALID, "%s: default scene %d does not exist", what, scene);
+            roots = m.scenes[(size_t)scene].nodes;
+        } else {
+            for (size_t n = 0; n < m.nodes.size(); ++n)
+                if (parent[n] < 0) roots.push_back((int)n);
+        }
+        walk_scene(roots);
+
+        // The character's skin: the first skinned mesh node that is not a curve.
+        int skin = -1;
+        for (int n : order) {
+            const tinygltf::Node& nd = m.nodes[(size_t)n];
+            if (nd.mesh < 0 || nd.skin < 0) continue;
+            if ((size_t)nd.mesh >= m.meshes.size())
+                fail(SP_ERR_INVALID, "%s: node %d refers to mesh %d, but there are %zu", what, n, nd.mesh, m.meshes.size());
+            if ((size_t)nd.skin >= m.skins.size())
+                fail(SP_ERR_INVALID, "%s: node %d refers to skin %d, but there are %zu", what, n, nd.skin, m.skins.size());
+            if (tag_of(nd.extras_json_string).is_curve) continue;
+            skin = nd.skin;
+            break;
+        }
+        if (skin < 0) fail(SP_ERR_UNSUPPORTED, "%s: no skinned mesh (a node with a mesh and a skin) in the scene", what);
+        const tinygltf::Skin& sk = m.skins[(size_t)skin];
+        if (sk.joints.empty()) fail(SP_ERR_INVALID, "%s: skin %d has no joints", what, skin);
+        size_t N = m.nodes.size();
+        std::vector<int> skin_index(N, -1);
+        for (size_t k = 0; k < sk.joints.size(); ++k) {
+            int jn = sk.joints[k];
+            if (jn < 0 || (size_t)jn >= N)
+                fail(SP_ERR_INVALID, "%s: skin %d uses node %d, but there are %zu nodes", what, skin, jn, N);
+            if (skin_index[(size_t)jn] >= 0) fail(SP_ERR_INVALID, "%s: skin %d lists node %d twice", what, skin, jn);
+            skin_index[(size_t)jn] = (int)k;
+        }
+        if (sk.joints.size() > 65535) fail(SP_ERR_UNSUPPORTED, "%s: skin %d has too many joints", what, skin);
+        std::vector<sp_mat4> ibm(sk.joints.size(), sp_mat4_identity());
+        if (sk.inverseBindMatrices >= 0) {
+            char usage[64];
+            snprintf(usage, sizeof usage, "skin %d inverseBindMatrices", skin);
+            View v = view_accessor(m, sk.inverseBindMatrices, what, usage);
+            expect(v, 16, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
+            if (v.count < sk.joints.size())
+                fail(SP_ERR_INVALID, "%s: skin %d has fewer inverse bind matrices than joints", what, skin);
+            for (size_t k = 0; k < sk.joints.size(); ++k)
+                for (int c = 0; c < 16; ++c)
+                    ibm[k].m[c] = read_comp(v, k, c);
+        }
+
+        // Rig joints: skin joints and their ancestors, depth first from the
+        // topmost ancestors, in the order the scene reaches them.
+        std::vector<char> needed(N, 0);
+        for (int jn : sk.joints)
+            for (int p = jn; p >= 0 && !needed[(size_t)p]; p = parent[(size_t)p])
+                needed[(size_t)p] = 1;
+        auto top_of = [&](int n) {
+            while (parent[(size_t)n] >= 0)
+                n = parent[(size_t)n];
+            return n;
+        };
+        std::vector<int> tops;
+        for (int n : order)
+            if (needed[(size_t)n] && std::find(tops.begin(), tops.end(), top_of(n)) == tops.end()) tops.push_back(top_of(n));
+        size_t in_scene = tops.size();
+        for (int jn : sk.joints)
+            if (std::find(tops.begin(), tops.end(), top_of(jn)) == tops.end()) tops.push_back(top_of(jn));
+        if (tops.size() > in_scene) sp_character_warn(ch, "part of the skeleton of skin %d is not in the scene", skin);
+        node2joint.assign(N, -1);
+        std::vector<int> joint_nodes, stack;
+        for (int t : tops) {
+            stack.push_back(t);
+            while (!stack.empty()) {
+                int n = stack.back();
+                stack.pop_back();
+                if (!needed[(size_t)n] || node2joint[(size_t)n] >= 0) continue;
+                node2joint[(size_t)n] = (int)joint_nodes.size();
+                joint_nodes.push_back(n);
+                const std::vector<int>& kids = m.nodes[(size_t)n].children;
+                for (auto it = kids.rbegin(); it != kids.rend(); ++it)
+                    stack.push_back(*it);
+            }
+        }
+        int J = (int)joint_nodes.size();
+        if (J > 65535) fail(SP_ERR_UNSUPPORTED, "%s: %d joints (65535 at most)", what, J);
+        rig->joints = static_cast<sp_joint*>(calloc((size_t)J, sizeof(sp_joint)));
+        if (!rig->joints) throw std::bad_alloc();
+        rig->joint_count = J;
+        std::unique_ptr<bool[]> is_skin(new bool[(size_t)J]), has_rest(new bool[(size_t)J]);
+        std::vector<sp_vec3> node_t((size_t)J), node_s((size_t)J);
+        std::vector<sp_quat> node_r((size_t)J);
+        std::vector<std::string> names;
+        sp_import im = {};
+        im.what = what;
+        for (int j = 0; j < J; ++j) {
+            int n = joint_nodes[(size_t)j];
+            const tinygltf::Node& nd = m.nodes[(size_t)n];
+            sp_joint* jt = &rig->joints[j];
+            std::string name = joint_name(nd, n, names);
+            names.push_back(name);
+            snprintf(jt->name, sizeof jt->name, "%s", name.c_str());
+            jt->parent = parent[(size_t)n] >= 0 ? node2joint[(size_t)parent[(size_t)n]] : -1;
+            Trs t = node_trs(nd, n, what);
+            jt->rest_t = t.t, jt->rest_r = t.r, jt->rest_s = t.s;
+            node_t[(size_t)j] = t.t, node_r[(size_t)j] = t.r, node_s[(size_t)j] = t.s;
+            is_skin[(size_t)j] = skin_index[(size_t)n] >= 0;
+            jt->inverse_bind = is_skin[(size_t)j] ? ibm[(size_t)skin_index[(size_t)n]] : sp_mat4_identity();
+            bool dofs = false, rest = false;
+            sp_error e = {};
+            if (sp_gltf_joint_extras(rig, j, nd.extras_json_string.empty() ? nullptr : nd.extras_json_string.c_str(), &dofs,
+                                     &rest, what, &e) != SP_OK)
+                fail(SP_ERR_INVALID, "%s", e.text);
+            has_rest[(size_t)j] = rest;
+            im.any_dofs |= dofs;
+        }
+
+        read_meshes(skin);
+        read_animations();
+        read_camera();
+
+        im.is_skin = is_skin.get();
+        im.has_rest = has_rest.get();
+        im.node_t = node_t.data();
+        im.node_r = node_r.data();
+        im.node_s = node_s.data();
+        std::string scene_extras = scene >= 0 ? m.scenes[(size_t)scene].extras_json_string : std::string();
+        im.scene_extras = scene_extras.empty() ? nullptr : scene_extras.c_str();
+        sp_error e = {};
+        sp_result r = sp_gltf_finish(ch, &im, &e);
+        if (r != SP_OK) fail(r, "%s", e.text);
+    }
+
+    void read_meshes(int skin)
+    {
+        sp_rig* rig = &ch->rig;
+        std::vector<double> rest;
+        std::vector<uint16_t> joints;
+        std::vector<float> weights, colors;
+        std::vector<uint32_t> tris;
+        bool warned_unskinned = false, warned_lines = false;
+        for (int n : order) {
+            const tinygltf::Node& nd = m.nodes[(size_t)n];
+            if (nd.mesh < 0) continue;
+            if ((size_t)nd.mesh >= m.meshes.size())
+                fail(SP_ERR_INVALID, "%s: node %d refers to mesh %d, but there are %zu", what, n, nd.mesh, m.meshes.size());
+            if (nd.skin >= 0 && (size_t)nd.skin >= m.skins.size())
+                fail(SP_ERR_INVALID, "%s: node %d refers to skin %d, but there are %zu", what, n, nd.skin, m.skins.size());
+            sp_curve_tag node_tag = tag_of(nd.extras_json_string);
+            const tinygltf::Mesh& mesh = m.meshes[(size_t)nd.mesh];
+            for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+                const tinygltf::Primitive& prim = mesh.primitives[pi];
+                int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+                // POINTS: skinned vertices without faces (what we export for a mesh without triangles).
+                bool triangles = mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+                                 mode == TINYGLTF_MODE_TRIANGLE_FAN || mode == TINYGLTF_MODE_POINTS;
+                bool lines = mode == TINYGLTF_MODE_LINE_STRIP || mode == TINYGLTF_MODE_LINE_LOOP;
+                sp_curve_tag tag = node_tag;
+                sp_curve_tag ptag = tag_of(prim.extras_json_string);
+                if (ptag.is_curve) tag = ptag;
+                if (lines && tag.is_curve) {
+                    read_curve(nd, n, prim, nd.mesh, (int)pi, mode, tag, skin);
+                    continue;
+                }
+                if (!triangles || tag.is_curve) {
+                    if (!warned_lines)
+                        sp_character_warn(ch, "ignored line primitives without sp_abstraction extras (mesh %d)", nd.mesh);
+                    warned_lines = true;
+                    continue;
+                }
+                if (nd.skin != skin) {
+                    if (!warned_unskinned)
+                        sp_character_warn(ch, "ignored mesh %d on node %d: not skinned by the character's skin", nd.mesh, n);
+                    warned_unskinned = true;
+                    continue;
+                }
+                Skinned s;
+                read_skinned(m, prim, nd.mesh, (int)pi, skin_map(skin), skin, what, s);
+                size_t nv = s.rest.size() / 3, base = rest.size() / 3;
+                if (base + nv > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
+                rest.insert(rest.end(), s.rest.begin(), s.rest.end());
+                joints.insert(joints.end(), s.joints.begin(), s.joints.end());
+                weights.insert(weights.end(), s.weights.begin(), s.weights.end());
+                float rgba[4];
+                material_color(m, prim.material, what, rgba);
+                size_t cbase = colors.size();
+                colors.resize(cbase + 4 * nv);
+                for (size_t i = 0; i < nv; ++i)
+                    for (int c = 0; c < 4; ++c)
+                        colors[cbase + 4 * i + (size_t)c] = rgba[c];
+                auto cit = prim.attributes.find("COLOR_0");
+                if (cit != prim.attributes.end()) {
+                    char usage[64];
+                    snprintf(usage, sizeof usage, "mesh %d primitive %zu COLOR_0", nd.mesh, pi);
+                    View cv = view_accessor(m, cit->second, what, usage);
+                    if ((cv.ncomp != 3 && cv.ncomp != 4) || cv.count != nv)
+                        fail(SP_ERR_INVALID, "%s: %s has the wrong type or count", what, usage);
+                    for (size_t i = 0; i < nv; ++i)
+                        for (int c = 0; c < cv.ncomp; ++c) {
+                            double x = read_comp(cv, i, c);
+                            if (!std::isfinite(x)) x = 1.0;
+                            colors[cbase + 4 * i + (size_t)c] *= (float)std::min(1.0, std::max(0.0, x));
+                        }
+                }
+                std::vector<uint32_t> idx = read_indices(m, prim, nd.mesh, (int)pi, nv, what);
+                auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+                    tris.push_back((uint32_t)base + a), tris.push_back((uint32_t)base + b), tris.push_back((uint32_t)base + c);
+                };
+                if (mode == TINYGLTF_MODE_TRIANGLES) {
+                    if (idx.size() % 3)
+                        fail(SP_ERR_INVALID, "%s: mesh %d primitive %zu: %zu indices is not a multiple of 3", what, nd.mesh, pi,
+                             idx.size());
+                    for (size_t i = 0; i + 2 < idx.size(); i += 3)
+                        tri(idx[i], idx[i + 1], idx[i + 2]);
+                } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                    for (size_t i = 0; i + 2 < idx.size(); ++i)
+                        if (i % 2 == 0)
+                            tri(idx[i], idx[i + 1], idx[i + 2]);
+                        else
+                            tri(idx[i + 1], idx[i], idx[i + 2]);
+                } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+                    for (size_t i = 1; i + 1 < idx.size(); ++i)
+                        tri(idx[0], idx[i], idx[i + 1]);
+                }
+            }
+        }
+        if (rest.empty()) fail(SP_ERR_INVALID, "%s: the skinned mesh has no vertices", what);
+        if (tris.size() / 3 > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many triangles", what);
+        rig->rest = c_array(rest);
+        rig->joints4 = c_array(joints);
+        rig->weights4 = c_array(weights);
+        rig->vertex_count = (int)(rest.size() / 3);
+        rig->triangles = c_array(tris);
+        rig->triangle_count = (int)(tris.size() / 3);
+        ch->colors = c_array(colors);
+    }
+
+    void read_curve(const tinygltf::Node& nd, int n, const tinygltf::Primitive& prim, int mesh, int pi, int mode,
+                    const sp_curve_tag& tag, int skin)
+    {
+        int use_skin = skin;
+        if (nd.skin >= 0 && nd.skin != skin) use_skin = nd.skin;
+        if (m.skins[(size_t)use_skin].joints.empty()) fail(SP_ERR_INVALID, "%s: skin %d has no joints", what, use_skin);
+        Skinned s;
+        read_skinned(m, prim, mesh, pi, skin_map(use_skin), use_skin, what, s);
+        size_t nv = s.rest.size() / 3;
+        std::vector<uint32_t> idx = read_indices(m, prim, mesh, pi, nv, what);
+        if (idx.size() < 2)
+            fail(SP_ERR_INVALID, "%s: curve on node %d (mesh %d primitive %d) has fewer than 2 points", what, n, mesh, pi);
+        Skinned c;
+        for (uint32_t i : idx) {
+            c.rest.insert(c.rest.end(), s.rest.begin() + 3 * i, s.rest.begin() + 3 * i + 3);
+            c.joints.insert(c.joints.end(), s.joints.begin() + 4 * i, s.joints.begin() + 4 * i + 4);
+            c.weights.insert(c.weights.end(), s.weights.begin() + 4 * i, s.weights.begin() + 4 * i + 4);
+        }
+        std::string name = tag.curve[0] ? tag.curve : (nd.name.empty() ? "curve" + std::to_string(n) : nd.name);
+        if (pi > 0) name += "_" + std::to_string(pi);
+        if (name.size() >= SP_NAME_MAX) name.resize(SP_NAME_MAX - 1);
+        int a = sp_rig_find_abstraction(&ch->rig, tag.abstraction);
+        sp_correspondence corr = tag.has_correspondence ? tag.correspondence : SP_CORR_ORDERED;
+        if (a >= 0 && tag.has_correspondence && ch->rig.abstractions[a].correspondence != corr)
+            sp_character_warn(ch, "abstraction '%s': curves disagree on sp_correspondence; the first one wins", tag.abstraction);
+        if (sp_gltf_append_curve(&ch->rig, tag.abstraction, corr, name.c_str(), mode == TINYGLTF_MODE_LINE_LOOP, (int)idx.size(),
+                                 c.rest.data(), c.joints.data(), c.weights.data()) != SP_OK)
+            throw std::bad_alloc();
+    }
+
+    void read_animations()
+    {
+        sp_rig* rig = &ch->rig;
+        if (m.animations.empty()) return;
+        rig->animations = static_cast<sp_animation*>(calloc(m.animations.size(), sizeof(sp_animation)));
+        if (!rig->animations) throw std::bad_alloc();
+        for (size_t ai = 0; ai < m.animations.size(); ++ai) {
+            const tinygltf::Animation& an = m.animations[ai];
+            sp_animation* out = &rig->animations[rig->animation_count++];
+            std::string name = an.name.empty() ? "animation" + std::to_string(ai) : an.name;
+            snprintf(out->name, sizeof out->name, "%s", name.c_str());
+            if (an.channels.empty()) continue;
+            out->channels = static_cast<sp_anim_channel*>(calloc(an.channels.size(), sizeof(sp_anim_channel)));
+            if (!out->channels) throw std::bad_alloc();
+            bool warned = false;
+            for (size_t ci = 0; ci < an.channels.size(); ++ci) {
+                const tinygltf::AnimationChannel& c = an.channels[ci];
+                int node = c.target_node;
+                sp_anim_path path;
+                if (c.target_path == "translation")
+                    path = SP_ANIM_TRANSLATION;
+                else if (c.target_path == "rotation")
+                    path = SP_ANIM_ROTATION;
+                else if (c.target_path == "scale")
+                    path = SP_ANIM_SCALE;
+                else
+                    continue; // morph weights: nothing to animate here
+                if (node < 0 || (size_t)node >= m.nodes.size())
+                    fail(SP_ERR_INVALID, "%s: animation %zu channel %zu targets node %d, but there are %zu", what, ai, ci, node,
+                         m.nodes.size());
+                if (node2joint[(size_t)node] < 0) {
+                    if (!warned)
+                        sp_character_warn(ch, "animation '%s': channels on nodes outside the skeleton ignored", out->name);
+                    warned = true;
+                    continue;
+                }
+                if (c.sampler < 0 || (size_t)c.sampler >= an.samplers.size())
+                    fail(SP_ERR_INVALID, "%s: animation %zu channel %zu refers to sampler %d, but there are %zu", what, ai, ci,
+                         c.sampler, an.samplers.size());
+                const tinygltf::AnimationSampler& s = an.samplers[(size_t)c.sampler];
+                sp_interp interp = SP_INTERP_LINEAR;
+                if (s.interpolation == "STEP")
+                    interp = SP_INTERP_STEP;
+                else if (s.interpolation == "CUBICSPLINE")
+                    interp = SP_INTERP_CUBICSPLINE;
+                else if (!s.interpolation.empty() && s.interpolation != "LINEAR")
+                    fail(SP_ERR_INVALID, "%s: animation %zu sampler %d: unknown interpolation '%s'", what, ai, c.sampler,
+                         s.interpolation.c_str());
+                char usage[80];
+                snprintf(usage, sizeof usage, "animation %zu sampler %d input", ai, c.sampler);
+                View in = view_accessor(m, s.input, what, usage);
+                expect(in, 1, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
+                snprintf(usage, sizeof usage, "animation %zu sampler %d output", ai, c.sampler);
+                View ov = view_accessor(m, s.output, what, usage);
+                int comps = path == SP_ANIM_ROTATION ? 4 : 3;
+                if (path == SP_ANIM_ROTATION)
+                    expect(ov, 4,
+                           {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                            TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                           true, what, usage);
+                else
+                    expect(ov, 3, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
+                size_t per = interp == SP_INTERP_CUBICSPLINE ? 3 : 1;
+                if (in.count < 1 || ov.count != in.count * per)
+                    fail(SP_ERR_INVALID, "%s: animation %zu sampler %d: %zu outputs for %zu keys", what, ai, c.sampler, ov.count,
+                         in.count);
+                sp_anim_channel* oc = &out->channels[out->channel_count];
+                oc->joint = node2joint[(size_t)node];
+                oc->path = path;
+                oc->interp = interp;
+                oc->times = static_cast<float*>(malloc(sizeof(float) * in.count));
+                oc->values = static_cast<float*>(malloc(sizeof(float) * ov.count * (size_t)comps));
+                ++out->channel_count; // counted now so that sp_rig_free releases it on failure
+                if (!oc->times || !oc->values) throw std::bad_alloc();
+                oc->key_count = (int)in.count;
+                for (size_t k = 0; k < in.count; ++k)
+                    oc->times[k] = (float)read_comp(in, k, 0);
+                for (size_t k = 0; k < ov.count; ++k)
+                    for (int cc = 0; cc < comps; ++cc)
+                        oc->values[k * (size_t)comps + (size_t)cc] = (float)read_comp(ov, k, cc);
+            }
+        }
+    }
+
+    void read_camera()
+    {
+        for (int n : order) {
+            const tinygltf::Node& nd = m.nodes[(size_t)n];
+            if (nd.camera < 0) continue;
+            if ((size_t)nd.camera >= m.cameras.size())
+                fail(SP_ERR_INVALID, "%s: node %d refers to camera %d, but there are %zu", what, n, nd.camera, m.cameras.size());
+            const tinygltf::Camera& c = m.cameras[(size_t)nd.camera];
+            sp_mat4 world = node_local(nd, n, what);
+            for (int p = parent[(size_t)n]; p >= 0; p = parent[(size_t)p]) {
+                sp_mat4 l = node_local(m.nodes[(size_t)p], p, what);
+                world = sp_mat4_mul(&l, &world);
+            }
+            sp_camera cam = {};
+            if (!sp_mat4_inverse(&world, &cam.view)) fail(SP_ERR_INVALID, "%s: camera node %d has a singular transform", what, n);
+            int w = SP_GLTF_CANVAS_W, h = SP_GLTF_CANVAS_H;
+            double cx = -1, cy = -1;
+            if (!c.extras_json_string.empty()) {
+                cJSON* ex = cJSON_Parse(c.extras_json_string.c_str());
+                const cJSON* cv = cJSON_GetObjectItemCaseSensitive(ex, "sp_canvas");
+                if (cJSON_GetArraySize(cv) == 2 && cJSON_IsNumber(cJSON_GetArrayItem(cv, 0)) &&
+                    cJSON_IsNumber(cJSON_GetArrayItem(cv, 1))) {
+                    double a = cJSON_GetArrayItem(cv, 0)->valuedouble, b = cJSON_GetArrayItem(cv, 1)->valuedouble;
+                    if (a >= 16 && a <= 16384 && b >= 16 && b <= 16384) w = (int)a, h = (int)b;
+                }
+                const cJSON* pp = cJSON_GetObjectItemCaseSensitive(ex, "sp_principal");
+                if (cJSON_GetArraySize(pp) == 2 && cJSON_IsNumber(cJSON_GetArrayItem(pp, 0)) &&
+                    cJSON_IsNumber(cJSON_GetArrayItem(pp, 1))) {
+                    cx = cJSON_GetArrayItem(pp, 0)->valuedouble, cy = cJSON_GetArrayItem(pp, 1)->valuedouble;
+                    if (!std::isfinite(cx) || !std::isfinite(cy)) cx = cy = -1;
+                }
+                cJSON_Delete(ex);
+            }
+            cam.width = w, cam.height = h;
+            cam.cx = cx >= 0 ? cx : 0.5 * w;
+            cam.cy = cy >= 0 ? cy : 0.5 * h;
+            if (c.type == "orthographic") {
+                double xm = std::fabs(c.orthographic.xmag), ym = std::fabs(c.orthographic.ymag);
+                if (!(xm > 0) || !(ym > 0) || !std::isfinite(xm) || !std::isfinite(ym))
+                    fail(SP_ERR_INVALID, "%s: camera %d: xmag and ymag must be non-zero", what, nd.camera);
+                cam.kind = SP_CAMERA_ORTHOGRAPHIC;
+                cam.scale = std::min(0.5 * w / xm, 0.5 * h / ym);
+                cam.zfar = c.orthographic.zfar;
+                cam.znear = c.orthographic.znear > 0 ? c.orthographic.znear : 1e-4 * cam.zfar;
+            } else if (c.type == "perspective") {
+                double f = c.perspective.yfov;
+                if (!(f > 0 && f < 3.14159) || !std::isfinite(f))
+                    fail(SP_ERR_INVALID, "%s: camera %d: yfov must be in (0, pi)", what, nd.camera);
+                cam.kind = SP_CAMERA_PERSPECTIVE;
+                cam.scale = 0.5 * h / std::tan(0.5 * f);
+                cam.znear = c.perspective.znear;
+                cam.zfar = c.perspective.zfar > 0 ? c.perspective.zfar : 1e4 * cam.znear;
+            } else {
+                fail(SP_ERR_INVALID, "%s: camera %d has an unknown type '%s'", what, nd.camera, c.type.c_str());
+            }
+            if (!(cam.znear > 0) || !(cam.zfar > cam.znear) || !std::isfinite(cam.zfar))
+                fail(SP_ERR_INVALID, "%s: camera %d has an invalid clip range", what, nd.camera);
+            ch->camera = cam;
+            ch->has_camera = true;
+            return;
+        }
+    }
+};
+
+void import(tinygltf::Model& model, const char* what, sp_character* ch)
+{
+    Importer im{model, what, ch, {}, {}, {}, {}};
+    im.run();
+}
+
+bool ends_with_ci(const char* s, const char* suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && strcasecmp(s + a - b, suffix) == 0;
+}
+
+} // namespace
+
+extern "C" sp_result sp_gltf_load_memory(const void* data, size_t size, const char* what, sp_character* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    if (!what) what = "glTF";
+    try {
+        tinygltf::Model model;
+        parse_model(model, static_cast<const unsigned char*>(data), size, what, "", false, out);
+        import(model, what, out);
+        return SP_OK;
+    } catch (const Failure& f) {
+        sp_character_free(out);
+        return sp_fail(err, f.code, "%s", f.text.c_str());
+    } catch (const std::bad_alloc&) {
+        sp_character_free(out);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    } catch (...) {
+        sp_character_free(out);
+        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF reader", what);
+    }
+}
+
+extern "C" sp_result sp_gltf_load(const char* path, sp_character* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    try {
+        FILE* f = fopen(path, "rb");
+        if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+        std::vector<unsigned char> bytes;
+        unsigned char buf[65536];
+        size_t got;
+        while ((got = fread(buf, 1, sizeof buf, f)) > 0)
+            bytes.insert(bytes.end(), buf, buf + got);
+        bool bad = ferror(f) != 0;
+        fclose(f);
+        if (bad) return sp_fail(err, SP_ERR_IO, "%s: read error", path);
+        std::string dir = path;
+        size_t slash = dir.rfind('/');
+        dir = slash == std::string::npos ? "." : dir.substr(0, slash == 0 ? 1 : slash);
+        tinygltf::Model model;
+        parse_model(model, bytes.data(), bytes.size(), path, dir, true, out);
+        import(model, path, out);
+        return SP_OK;
+    } catch (const Failure& f) {
+        sp_character_free(out);
+        return sp_fail(err, f.code, "%s", f.text.c_str());
+    } catch (const std::bad_alloc&) {
+        sp_character_free(out);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    } catch (...) {
+        sp_character_free(out);
+        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF reader", path);
+    }
+}
+
+// ---- export ---------------------------------------------------------------
+
+namespace
+{
+
+using tinygltf::Value;
+
+Value num_array(const double* v, int n)
+{
+    Value::Array a;
+    for (int i = 0; i < n; ++i)
+        a.push_back(Value(v[i]));
+    return Value(std::move(a));
+}
+
+// cJSON tree -> tinygltf value (for sp_part, which we keep as JSON text).
+Value from_cjson(const cJSON* j)
+{
+    if (cJSON_IsBool(j)) return Value(cJSON_IsTrue(j) ? true : false);
+    if (cJSON_IsNumber(j)) {
+        double d = j->valuedouble;
+        if (d == std::floor(d) && std::fabs(d) < 2e9) return Value((int)d);
+        return Value(d);
+    }
+    if (cJSON_IsString(j)) return Value(std::string(j->valuestring));
+    if (cJSON_IsArray(j)) {
+        Value::Array a;
+        const cJSON* it;
+        cJSON_ArrayForEach(it, j) a.push_back(from_cjson(it));
+        return Value(std::move(a));
+    }
+    if (cJSON_IsObject(j)) {
+        Value::Object o;
+        const cJSON* it;
+        cJSON_ArrayForEach(it, j) o[it->string] = from_cjson(it);
+        return Value(std::move(o));
+    }
+    return Value();
+}
+
+struct Writer {
+    tinygltf::Model m;
+
+    Writer()
+    {
+        m.asset.version = "2.0";
+        m.asset.generator = "sketchpose";
+        m.buffers.emplace_back();
+    }
+
+    int view(const void* data, size_t bytes, int target)
+    {
+        std::vector<unsigned char>& buf = m.buffers[0].data;
+        // Why 4: every accessor's component size divides 4, and glTF wants
+        // vertex attributes 4-byte aligned.
+        while (buf.size() % 4)
+            buf.push_back(0);
+        tinygltf::BufferView bv;
+        bv.buffer = 0;
+        bv.byteOffset = buf.size();
+        bv.byteLength = bytes;
+        bv.target = target;
+        const unsigned char* p = static_cast<const unsigned char*>(data);
+        buf.insert(buf.end(), p, p + bytes);
+        m.bufferViews.push_back(bv);
+        return (int)m.bufferViews.size() - 1;
+    }
+
+    int accessor(const void* data, size_t count, int comp, int type, int target, bool minmax = false, bool normalized = false)
+    {
+        int ncomp = tinygltf::GetNumComponentsInType((uint32_t)type);
+        int csize = tinygltf::GetComponentSizeInBytes((uint32_t)comp);
+        tinygltf::Accessor a;
+        a.bufferView = view(data, count * (size_t)ncomp * (size_t)csize, target);
+        a.byteOffset = 0;
+        a.componentType = comp;
+        a.type = type;
+        a.count = count;
+        a.normalized = normalized;
+        if (minmax && comp == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+            const float* f = static_cast<const float*>(data);
+            a.minValues.assign((size_t)ncomp, 0.0);
+            a.maxValues.assign((size_t)ncomp, 0.0);
+            for (size_t i = 0; i < count; ++i)
+                for (int c = 0; c < ncomp; ++c) {
+                    double x = f[i * (size_t)ncomp + (size_t)c];
+                    if (i == 0 || x < a.minValues[(size_t)c]) a.minValues[(size_t)c] = x;
+                    if (i == 0 || x > a.maxValues[(size_t)c]) a.maxValues[(size_t)c] = x;
+                }
+        }
+        m.accessors.push_back(a);
+        return (int)m.accessors.size() - 1;
+    }
+
+    // POSITION / JOINTS_0 / WEIGHTS_0 of skinned points.
+    void skinned_attributes(tinygltf::Primitive& prim, int n, const double* rest, const uint16_t* joints, const float* weights)
+    {
+        std::vector<float> pos(3 * (size_t)n), w(4 * (size_t)n);
+        std::vector<uint16_t> j(4 * (size_t)n);
+        for (size_t i = 0; i < 3 * (size_t)n; ++i) {
+            pos[i] = (float)rest[i];
+            if (!std::isfinite(pos[i])) fail(SP_ERR_INVALID, "a point's position is beyond the float range of glTF");
+        }
+        for (size_t i = 0; i < (size_t)n; ++i) {
+            double ww[4];
+            uint16_t jj[4];
+            for (int k = 0; k < 4; ++k)
+                ww[k] = weights[4 * i + (size_t)k], jj[k] = joints[4 * i + (size_t)k];
+            for (int a = 0; a < 4; ++a)
+                for (int b = a + 1; b < 4; ++b)
+                    if (jj[a] == jj[b] && ww[b] > 0) ww[a] += ww[b], ww[b] = 0;
+            double sum = ww[0] + ww[1] + ww[2] + ww[3];
+            int big = 0;
+            for (int k = 0; k < 4; ++k) {
+                ww[k] = sum > 0 ? ww[k] / sum : (k == 0);
+                if (ww[k] == 0) jj[k] = 0; // unused influences point at joint 0
+                if (ww[k] > ww[big]) big = k;
+            }
+            // Why: the validator checks the float sum; put the rounding on the largest weight.
+            float f[4], fs = 0;
+            for (int k = 0; k < 4; ++k)
+                f[k] = (float)ww[k];
+            for (int k = 0; k < 4; ++k)
+                if (k != big) fs += f[k];
+            f[big] = 1.0f - fs;
+            for (int k = 0; k < 4; ++k)
+                w[4 * i + (size_t)k] = f[k], j[4 * i + (size_t)k] = jj[k];
+        }
+        prim.attributes["POSITION"] = accessor(pos.data(), (size_t)n, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                               TINYGLTF_TARGET_ARRAY_BUFFER, true);
+        prim.attributes["JOINTS_0"] = accessor(j.data(), (size_t)n, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4,
+                                               TINYGLTF_TARGET_ARRAY_BUFFER);
+        prim.attributes["WEIGHTS_0"] =
+            accessor(w.data(), (size_t)n, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+};
+
+// An embedded abstraction (points in mesh triangles) becomes skinned points:
+// barycentric rest positions and the four strongest blended joint weights.
+void embedded_to_skinned(const sp_rig* rig, const sp_abstraction* a, std::vector<double>& rest, std::vector<uint16_t>& joints,
+                         std::vector<float>& weights)
+{
+    size_t n = (size_t)a->point_count;
+    rest.assign(3 * n, 0.0);
+    joints.assign(4 * n, 0);
+    weights.assign(4 * n, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+        std::map<int, double> acc;
+        for (int k = 0; k < 3; ++k) {
+            uint32_t v = a->tri_vertices[3 * i + (size_t)k];
+            double b = a->bary[3 * i + (size_t)k];
+            for (int c = 0; c < 3; ++c)
+                rest[3 * i + (size_t)c] += b * rig->rest[3 * (size_t)v + (size_t)c];
+            for (int c = 0; c < 4; ++c)
+                acc[rig->joints4[4 * (size_t)v + (size_t)c]] += b * rig->weights4[4 * (size_t)v + (size_t)c];
+        }
+        std::vector<std::pair<double, int>> best;
+        for (auto& kv : acc)
+            if (kv.second > 0) best.push_back({kv.second, kv.first});
+        std::sort(best.rbegin(), best.rend());
+        for (size_t k = 0; k < best.size() && k < 4; ++k)
+            joints[4 * i + k] = (uint16_t)best[k].second, weights[4 * i + k] = (float)best[k].first;
+        if (best.empty()) weights[4 * i] = 1.0f;
+    }
+}
+
+tinygltf::Model build_model(const sp_character* ch, const double* params_in)
+{
+    const sp_rig* rig = &ch->rig;
+    int J = rig->joint_count;
+    std::vector<double> p((size_t)rig->param_count + 1);
+    if (params_in)
+        std::copy(params_in, params_in + rig->param_count, p.begin());
+    else if (ch->pose)
+        std::copy(ch->pose, ch->pose + rig->param_count, p.begin());
+    else
+        sp_rig_defaults(rig, p.data());
+    sp_rig_clamp(rig, p.data());
+
+    Writer w;
+    tinygltf::Model& m = w.m;
+    // Joint nodes 0..J-1 in rig order, so node index = joint index.
+    for (int j = 0; j < J; ++j) {
+        const sp_joint* jt = &rig->joints[j];
+        tinygltf::Node nd;
+        nd.name = jt->name;
+        sp_vec3 t, s;
+        sp_quat r;
+        sp_rig_local_trs(rig, j, p.data(), &t, &r, &s);
+        r = sp_quat_norm(r);
+        nd.translation = {t.x, t.y, t.z};
+        nd.rotation = {r.x, r.y, r.z, r.w};
+        nd.scale = {s.x, s.y, s.z};
+        Value::Array dofs;
+        for (int k = 0; k < jt->param_count; ++k) {
+            const sp_param* q = &rig->params[jt->first_param + k];
+            Value::Object d;
+            d["channel"] = Value(std::string(sp_channel_name(q->channel)));
+            d["min"] = Value(q->min);
+            d["max"] = Value(q->max);
+            d["group"] = Value(std::string(q->group == SP_GROUP_SHAPE ? "shape" : "pose"));
+            dofs.push_back(Value(std::move(d)));
+        }
+        Value::Object rest;
+        double rt[3] = {jt->rest_t.x, jt->rest_t.y, jt->rest_t.z},
+               rr[4] = {jt->rest_r.x, jt->rest_r.y, jt->rest_r.z, jt->rest_r.w},
+               rs[3] = {jt->rest_s.x, jt->rest_s.y, jt->rest_s.z};
+        rest["translation"] = num_array(rt, 3);
+        rest["rotation"] = num_array(rr, 4);
+        rest["scale"] = num_array(rs, 3);
+        Value::Object ex;
+        ex["sp_dofs"] = Value(std::move(dofs));
+        ex["sp_rest"] = Value(std::move(rest));
+        nd.extras = Value(std::move(ex));
+        if (jt->parent >= 0) m.nodes[(size_t)jt->parent].children.push_back(j);
+        m.nodes.push_back(nd);
+    }
+    tinygltf::Scene scene;
+    for (int j = 0; j < J; ++j)
+        if (rig->joints[j].parent < 0) scene.nodes.push_back(j);
+
+    // Skin.
+    tinygltf::Skin skin;
+    std::vector<float> ibm(16 * (size_t)J);
+    for (int j = 0; j < J; ++j) {
+        skin.joints.push_back(j);
+        for (int k = 0; k < 16; ++k) {
+            ibm[16 * (size_t)j + (size_t)k] = (float)rig->joints[j].inverse_bind.m[k];
+            if (!std::isfinite(ibm[16 * (size_t)j + (size_t)k]))
+                fail(SP_ERR_INVALID, "joint '%s': inverse bind matrix beyond the float range of glTF", rig->joints[j].name);
+        }
+        // The validator insists on an exact affine last row.
+        ibm[16 * (size_t)j + 3] = ibm[16 * (size_t)j + 7] = ibm[16 * (size_t)j + 11] = 0.0f;
+        ibm[16 * (size_t)j + 15] = 1.0f;
+    }
+    skin.inverseBindMatrices = w.accessor(ibm.data(), (size_t)J, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, 0);
+    m.skins.push_back(skin);
+
+    // The skinned mesh.
+    if (rig->vertex_count > 0) {
+        size_t nv = (size_t)rig->vertex_count;
+        tinygltf::Primitive prim;
+        w.skinned_attributes(prim, rig->vertex_count, rig->rest, rig->joints4, rig->weights4);
+        std::vector<double> nrm(3 * nv, 0.0);
+        for (int t = 0; t < rig->triangle_count; ++t) {
+            const uint32_t* tri = rig->triangles + 3 * (size_t)t;
+            sp_vec3 a = sp_v3(rig->rest[3 * tri[0]], rig->rest[3 * tri[0] + 1], rig->rest[3 * tri[0] + 2]);
+            sp_vec3 b = sp_v3(rig->rest[3 * tri[1]], rig->rest[3 * tri[1] + 1], rig->rest[3 * tri[1] + 2]);
+            sp_vec3 c = sp_v3(rig->rest[3 * tri[2]], rig->rest[3 * tri[2] + 1], rig->rest[3 * tri[2] + 2]);
+            sp_vec3 fn = sp_v3_cross(sp_v3_sub(b, a), sp_v3_sub(c, a)); // area weighted
+            for (int k = 0; k < 3; ++k)
+                nrm[3 * tri[k]] += fn.x, nrm[3 * tri[k] + 1] += fn.y, nrm[3 * tri[k] + 2] += fn.z;
+        }
+        std::vector<float> nf(3 * nv);
+        for (size_t i = 0; i < nv; ++i) {
+            sp_vec3 n = sp_v3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+            double l = sp_v3_len(n);
+            n = l > 1e-300 && std::isfinite(l) ? sp_v3_scale(n, 1.0 / l) : sp_v3(0, 0, 1);
+            nf[3 * i] = (float)n.x, nf[3 * i + 1] = (float)n.y, nf[3 * i + 2] = (float)n.z;
+        }
+        prim.attributes["NORMAL"] =
+            w.accessor(nf.data(), nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+        tinygltf::Material mat;
+        mat.name = "sp_vertex_color";
+        mat.pbrMetallicRoughness.metallicFactor = 0.0;
+        mat.pbrMetallicRoughness.roughnessFactor = 0.8;
+        if (ch->colors) {
+            std::vector<float> col(4 * nv);
+            for (size_t i = 0; i < 4 * nv; ++i)
+                col[i] = std::isfinite(ch->colors[i]) ? std::min(1.0f, std::max(0.0f, ch->colors[i])) : 1.0f;
+            prim.attributes["COLOR_0"] =
+                w.accessor(col.data(), nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, TINYGLTF_TARGET_ARRAY_BUFFER);
+        } else {
+            mat.pbrMetallicRoughness.baseColorFactor = {SP_GLTF_TEXTURE_GREY, SP_GLTF_TEXTURE_GREY, SP_GLTF_TEXTURE_GREY, 1.0};
+        }
+        m.materials.push_back(mat);
+        prim.material = 0;
+        if (rig->triangle_count > 0) {
+            prim.mode = TINYGLTF_MODE_TRIANGLES;
+            size_t ni = 3 * (size_t)rig->triangle_count;
+            if (nv <= 65535) {
+                std::vector<uint16_t> idx(ni);
+                for (size_t i = 0; i < ni; ++i)
+                    idx[i] = (uint16_t)rig->triangles[i];
+                prim.indices = w.accessor(idx.data(), ni, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR,
+                                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+            } else {
+                prim.indices = w.accessor(rig->triangles, ni, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+            }
+        } else {
+            prim.mode = TINYGLTF_MODE_POINTS;
+        }
+        tinygltf::Mesh mesh;
+        mesh.name = "character";
+        mesh.primitives.push_back(prim);
+        m.meshes.push_back(mesh);
+        tinygltf::Node nd;
+        nd.name = "character_mesh";
+        nd.mesh = (int)m.meshes.size() - 1;
+        nd.skin = 0;
+        scene.nodes.push_back((int)m.nodes.size());
+        m.nodes.push_back(nd);
+    }
+
+    // Abstractions: a node per curve, skinned by the same skin.
+    for (int a = 0; a < rig->abstraction_count; ++a) {
+        const sp_abstraction* ab = &rig->abstractions[a];
+        std::vector<double> er;
+        std::vector<uint16_t> ej;
+        std::vector<float> ew;
+        const double* rest = ab->rest;
+        const uint16_t* joints = ab->joints;
+        const float* weights = ab->weights;
+        if (!rest) {
+            embedded_to_skinned(rig, ab, er, ej, ew);
+            rest = er.data(), joints = ej.data(), weights = ew.data();
+        }
+        for (int c = 0; c < ab->curve_count; ++c) {
+            const sp_curve* cv = &ab->curves[c];
+            tinygltf::Primitive prim;
+            size_t f = (size_t)cv->first_point;
+            w.skinned_attributes(prim, cv->point_count, rest + 3 * f, joints + 4 * f, weights + 4 * f);
+            prim.mode = cv->closed ? TINYGLTF_MODE_LINE_LOOP : TINYGLTF_MODE_LINE_STRIP;
+            tinygltf::Mesh mesh;
+            mesh.name = std::string(ab->name) + "/" + cv->name;
+            mesh.primitives.push_back(prim);
+            m.meshes.push_back(mesh);
+            tinygltf::Node nd;
+            nd.name = mesh.name;
+            nd.mesh = (int)m.meshes.size() - 1;
+            nd.skin = 0;
+            Value::Object ex;
+            ex["sp_abstraction"] = Value(std::string(ab->name));
+            ex["sp_curve"] = Value(std::string(cv->name));
+            ex["sp_correspondence"] = Value(std::string(ab->correspondence == SP_CORR_CLOSEST ? "closest" : "ordered"));
+            nd.extras = Value(std::move(ex));
+            scene.nodes.push_back((int)m.nodes.size());
+            m.nodes.push_back(nd);
+        }
+    }
+
+    // Animations: one sampler per channel, targets are the joint nodes.
+    for (int a = 0; a < rig->animation_count; ++a) {
+        const sp_animation* an = &rig->animations[a];
+        tinygltf::Animation out;
+        out.name = an->name;
+        for (int c = 0; c < an->channel_count; ++c) {
+            const sp_anim_channel* ac = &an->channels[c];
+            if (ac->key_count < 1) continue;
+            int comps = ac->path == SP_ANIM_ROTATION ? 4 : 3;
+            size_t per = ac->interp == SP_INTERP_CUBICSPLINE ? 3 : 1;
+            size_t nvals = (size_t)ac->key_count * per * (size_t)comps;
+            std::vector<float> vals(ac->values, ac->values + nvals);
+            if (comps == 4 && per == 1)
+                for (size_t k = 0; k < (size_t)ac->key_count; ++k) {
+                    sp_quat q = sp_quat_norm(sp_quat{vals[4 * k], vals[4 * k + 1], vals[4 * k + 2], vals[4 * k + 3]});
+                    vals[4 * k] = (float)q.x, vals[4 * k + 1] = (float)q.y, vals[4 * k + 2] = (float)q.z,
+                             vals[4 * k + 3] = (float)q.w;
+                }
+            tinygltf::AnimationSampler s;
+            s.input = w.accessor(ac->times, (size_t)ac->key_count, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, 0, true);
+            s.output = w.accessor(vals.data(), (size_t)ac->key_count * per, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                  comps == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, 0);
+            s.interpolation = ac->interp == SP_INTERP_STEP          ? "STEP"
+                              : ac->interp == SP_INTERP_CUBICSPLINE ? "CUBICSPLINE"
+                                                                    : "LINEAR";
+            out.samplers.push_back(s);
+            tinygltf::AnimationChannel ch2;
+            ch2.sampler = (int)out.samplers.size() - 1;
+            ch2.target_node = ac->joint;
+            ch2.target_path = ac->path == SP_ANIM_TRANSLATION ? "translation"
+                              : ac->path == SP_ANIM_ROTATION  ? "rotation"
+                                                              : "scale";
+            out.channels.push_back(ch2);
+        }
+        // Why skip: an animation without channels is invalid glTF.
+        if (!out.channels.empty()) m.animations.push_back(out);
+    }
+
+    // Camera: the node's world matrix is the inverse of the view.
+    {
+        const sp_camera& cam = ch->camera;
+        sp_mat4 world;
+        bool ok = cam.scale > 0 && cam.width > 0 && cam.height > 0 && sp_mat4_inverse(&cam.view, &world);
+        for (int k = 0; ok && k < 16; ++k)
+            ok = std::fabs(world.m[k]) < 1e30;
+        // Why the size check: a camera framing float-range coordinates cannot
+        // be written back; the importer then frames the rest pose itself.
+        if (ok) {
+            tinygltf::Camera c;
+            if (cam.kind == SP_CAMERA_ORTHOGRAPHIC) {
+                c.type = "orthographic";
+                c.orthographic.xmag = 0.5 * cam.width / cam.scale;
+                c.orthographic.ymag = 0.5 * cam.height / cam.scale;
+                c.orthographic.znear = cam.znear > 0 ? cam.znear : 0.0;
+                c.orthographic.zfar = cam.zfar > c.orthographic.znear ? cam.zfar : c.orthographic.znear + 1.0;
+            } else {
+                c.type = "perspective";
+                c.perspective.yfov = 2.0 * std::atan(0.5 * cam.height / cam.scale);
+                c.perspective.aspectRatio = (double)cam.width / cam.height;
+                c.perspective.znear = cam.znear > 0 ? cam.znear : 1e-3;
+                c.perspective.zfar = cam.zfar > c.perspective.znear ? cam.zfar : c.perspective.znear * 1e4;
+            }
+            Value::Object ex;
+            double canvas[2] = {(double)cam.width, (double)cam.height}, pp[2] = {cam.cx, cam.cy};
+            ex["sp_canvas"] = num_array(canvas, 2);
+            ex["sp_principal"] = num_array(pp, 2);
+            c.extras = Value(std::move(ex));
+            m.cameras.push_back(c);
+            Trs t = decompose(world);
+            tinygltf::Node nd;
+            nd.name = "sketch_view";
+            nd.camera = 0;
+            nd.translation = {t.t.x, t.t.y, t.t.z};
+            nd.rotation = {t.r.x, t.r.y, t.r.z, t.r.w};
+            scene.nodes.push_back((int)m.nodes.size());
+            m.nodes.push_back(nd);
+        }
+    }
+
+    // Scene extras: the pose (exact values) and the part description.
+    Value::Object params;
+    for (int k = 0; k < rig->param_count; ++k)
+        params[rig->params[k].name] = Value(p[(size_t)k]);
+    Value::Object pose;
+    pose["parameters"] = Value(std::move(params));
+    Value::Object sx;
+    sx["sp_pose"] = Value(std::move(pose));
+    if (ch->part_json) {
+        cJSON* part = cJSON_Parse(ch->part_json);
+        if (part) sx["sp_part"] = from_cjson(part);
+        cJSON_Delete(part);
+    }
+    scene.extras = Value(std::move(sx));
+    scene.name = "sketchpose";
+    m.scenes.push_back(scene);
+    m.defaultScene = 0;
+    return m;
+}
+
+std::string serialize(const sp_character* ch, const double* params, bool binary)
+{
+    tinygltf::Model m = build_model(ch, params);
+    tinygltf::TinyGLTF writer;
+    std::ostringstream os;
+    if (!writer.WriteGltfSceneToStream(&m, os, !binary, binary)) fail(SP_ERR_INTERNAL, "tinygltf could not serialise the model");
+    return os.str();
+}
+
+} // namespace
+
+extern "C" sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err)
+{
+    try {
+        std::string bytes = serialize(ch, params, ends_with_ci(path, ".glb"));
+        FILE* f = fopen(path, "wb");
+        if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+        ok = (fclose(f) == 0) && ok;
+        if (!ok) return sp_fail(err, SP_ERR_IO, "%s: write error: %s", path, strerror(errno));
+        return SP_OK;
+    } catch (const Failure& f) {
+        return sp_fail(err, f.code, "%s: %s", path, f.text.c_str());
+    } catch (const std::bad_alloc&) {
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    } catch (...) {
+        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF writer", path);
+    }
+}
+
+extern "C" sp_result sp_gltf_save_memory(const sp_character* ch, const double* params, void** data, size_t* size, sp_error* err)
+{
+    *data = nullptr;
+    *size = 0;
+    try {
+        std::string bytes = serialize(ch, params, true);
+        void* p = malloc(bytes.size());
+        if (!p) throw std::bad_alloc();
+        memcpy(p, bytes.data(), bytes.size());
+        *data = p;
+        *size = bytes.size();
+        return SP_OK;
+    } catch (const Failure& f) {
+        return sp_fail(err, f.code, "glb: %s", f.text.c_str());
+    } catch (const std::bad_alloc&) {
+        return sp_fail(err, SP_ERR_NO_MEMORY, "glb: out of memory");
+    } catch (...) {
+        return sp_fail(err, SP_ERR_INTERNAL, "glb: internal error in the glTF writer");
+    }
+}

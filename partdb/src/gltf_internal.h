@@ -1,0 +1,76 @@
+// gltf_internal.h: the C side of the glTF import, shared by the tinygltf
+// adapter (gltf_adapter.cpp) and character.c / stickfig.c. The adapter turns
+// the glTF document into plain C (joints, vertices, curves, extras as JSON
+// text); everything that does not need tinygltf happens here, in C.
+#ifndef SP_GLTF_INTERNAL_H
+#define SP_GLTF_INTERNAL_H
+
+#include <stdbool.h>
+
+#include "sp/gltf.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Default canvas for a file camera without `sp_canvas` extras, pixels.
+enum { SP_GLTF_CANVAS_W = 640, SP_GLTF_CANVAS_H = 480 };
+/// Limits of the derived rotation DOFs, radians (120 degrees).
+#define SP_GLTF_DEFAULT_ROT_LIMIT 2.0943951023931957
+/// Colour of vertices whose material has only a texture: a neutral light grey.
+#define SP_GLTF_TEXTURE_GREY 0.8f
+/// Points sampled along each bone of the derived stick figure.
+enum { SP_STICK_POINTS_PER_BONE = 8 };
+
+/// What the adapter learned about the rig's joints besides sp_rig itself.
+typedef struct sp_import {
+    const char* what; ///< file name for messages
+    bool* is_skin;    ///< joint_count: a joint of the skin (not a mere ancestor)
+    bool* has_rest;   ///< joint_count: `sp_rest` extras replaced the rest TRS
+    sp_vec3* node_t;  ///< joint_count: node TRS as written in the file (posed, for our exports)
+    sp_quat* node_r;
+    sp_vec3* node_s;
+    bool any_dofs;            ///< some joint declared `sp_dofs` (then no default DOFs are added)
+    const char* scene_extras; ///< JSON text of the scene's extras or NULL
+} sp_import;
+
+/// Applies one joint node's extras (JSON text, may be NULL): `sp_dofs` adds
+/// parameters (sets *has_dofs), `sp_rest` replaces the rest TRS (sets *has_rest).
+sp_result sp_gltf_joint_extras(sp_rig* rig, int joint, const char* json, bool* has_dofs, bool* has_rest, const char* what,
+                               sp_error* err);
+
+/// Curve identity from a node's (or primitive's) extras. *is_curve is false
+/// when there is no `sp_abstraction`.
+typedef struct sp_curve_tag {
+    bool is_curve;
+    char abstraction[SP_NAME_MAX];
+    char curve[SP_NAME_MAX];
+    bool has_correspondence;
+    sp_correspondence correspondence;
+} sp_curve_tag;
+sp_result sp_gltf_curve_extras(const char* json, sp_curve_tag* tag, const char* what, sp_error* err);
+
+/// Appends one skinned curve (n points, bind space) to the abstraction named
+/// `abstraction` (created if new). Copies the arrays.
+sp_result sp_gltf_append_curve(sp_rig* rig, const char* abstraction, sp_correspondence corr, const char* curve, bool closed,
+                               int n, const double* rest, const uint16_t* joints, const float* weights);
+
+/// Derives the "stick" abstraction from the skeleton (finalized rig, default
+/// parameters): a curve per bone chain between skin joints. Returns SP_OK and
+/// appends nothing when there is no bone.
+sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err);
+
+/// Everything after the adapter filled ch->rig (unfinalized), ch->colors and
+/// perhaps ch->camera: default DOFs, finalize, warnings, the derived stick
+/// figure, the pose (sp_rest node TRS, then `sp_pose`), `sp_part`, the
+/// default camera.
+sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err);
+
+/// Reads a pose object {"<joint>.<channel>": value, ...} (JSON text) into p;
+/// unknown names and non-numbers become warnings on ch; values are clamped.
+void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, double* p);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

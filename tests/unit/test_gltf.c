@@ -1,0 +1,478 @@
+// glTF import/export tests: the Khronos sample characters (skipped without
+// ../shared/data), a hand-made skinned file with our extras, the derived
+// stick figure, export -> import round trips, and bad input that must give a
+// one-line error naming the file.
+//
+// `test_gltf --write-corpus DIR` writes the hand-made seed files (fuzz corpus,
+// CLI fixture) instead of running tests.
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fixtures.h"
+#include "gltf_internal.h"
+#include "mini_gltf.h"
+#include "sp/gltf.h"
+#include "test.h"
+
+// ---- helpers --------------------------------------------------------------
+
+static const char* data_path(const char* rel)
+{
+    static char buf[4][1024];
+    static int at = 0;
+    const char* dir = sp_test_data_dir();
+    if (!dir) return NULL;
+    char* b = buf[at++ & 3];
+    snprintf(b, 1024, "%s/gltf/%s", dir, rel);
+    return b;
+}
+
+static sp_character load_ok(const char* path)
+{
+    sp_character ch = {0};
+    sp_error err = {0};
+    sp_result r = sp_gltf_load(path, &ch, &err);
+    if (r != SP_OK) fprintf(stderr, "  load %s: %s\n", path, err.text);
+    ENSURE(r == SP_OK);
+    return ch;
+}
+
+static bool has_warning(const sp_character* ch, const char* text)
+{
+    for (int i = 0; i < ch->warning_count; ++i)
+        if (strstr(ch->warnings[i], text)) return true;
+    return false;
+}
+
+static const char* write_mini(const char* name, const mini_desc* d)
+{
+    const char* path = sp_test_tmp_path(name);
+    char* text = mini_gltf(d);
+    ENSURE(mini_write(path, text, strlen(text)));
+    free(text);
+    return path;
+}
+
+// Skinned mesh vertices of ch at p (malloc'd, vertex_count by 3).
+static double* skin_mesh(const sp_rig* rig, const double* p)
+{
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    double* x = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), x);
+    sp_rig_eval_destroy(ev);
+    return x;
+}
+
+// Same rig: joints, parameters, mesh, abstractions, animations.
+static void ensure_same_rig(const sp_rig* a, const sp_rig* b, double tol)
+{
+    ENSURE(a->joint_count == b->joint_count);
+    for (int j = 0; j < a->joint_count; ++j) {
+        const sp_joint *x = &a->joints[j], *y = &b->joints[j];
+        ENSURE(!strcmp(x->name, y->name));
+        ENSURE(x->parent == y->parent);
+        ENSURE_NEAR(x->rest_t.x, y->rest_t.x, tol);
+        ENSURE_NEAR(x->rest_t.y, y->rest_t.y, tol);
+        ENSURE_NEAR(x->rest_t.z, y->rest_t.z, tol);
+        ENSURE_NEAR(
+            fabs(x->rest_r.x * y->rest_r.x + x->rest_r.y * y->rest_r.y + x->rest_r.z * y->rest_r.z + x->rest_r.w * y->rest_r.w),
+            1.0, tol);
+        ENSURE_NEAR(x->rest_s.x, y->rest_s.x, tol);
+        ENSURE_NEAR(x->rest_s.y, y->rest_s.y, tol);
+        ENSURE_NEAR(x->rest_s.z, y->rest_s.z, tol);
+        for (int k = 0; k < 16; ++k)
+            ENSURE_NEAR(x->inverse_bind.m[k], y->inverse_bind.m[k], 1e-5 * (1 + fabs(x->inverse_bind.m[k])));
+    }
+    ENSURE(a->param_count == b->param_count);
+    for (int k = 0; k < a->param_count; ++k) {
+        ENSURE(!strcmp(a->params[k].name, b->params[k].name));
+        ENSURE(a->params[k].group == b->params[k].group);
+        ENSURE_NEAR(a->params[k].min, b->params[k].min, 1e-12);
+        ENSURE_NEAR(a->params[k].max, b->params[k].max, 1e-12);
+        ENSURE_NEAR(a->params[k].def, b->params[k].def, 1e-12);
+    }
+    ENSURE(a->vertex_count == b->vertex_count);
+    ENSURE(a->triangle_count == b->triangle_count);
+    ENSURE(!memcmp(a->triangles, b->triangles, sizeof(uint32_t) * 3 * (size_t)a->triangle_count));
+    for (int i = 0; i < 3 * a->vertex_count; ++i)
+        ENSURE_NEAR(a->rest[i], b->rest[i], 1e-6 * (1 + fabs(a->rest[i])));
+    for (int i = 0; i < 4 * a->vertex_count; ++i) {
+        if (a->weights4[i] > 0) ENSURE(a->joints4[i] == b->joints4[i]);
+        ENSURE_NEAR(a->weights4[i], b->weights4[i], 1e-6);
+    }
+    ENSURE(a->abstraction_count == b->abstraction_count);
+    for (int k = 0; k < a->abstraction_count; ++k) {
+        const sp_abstraction *x = &a->abstractions[k], *y = &b->abstractions[k];
+        ENSURE(!strcmp(x->name, y->name));
+        ENSURE(x->correspondence == y->correspondence);
+        ENSURE(x->curve_count == y->curve_count);
+        ENSURE(x->point_count == y->point_count);
+        for (int c = 0; c < x->curve_count; ++c) {
+            ENSURE(!strcmp(x->curves[c].name, y->curves[c].name));
+            ENSURE(x->curves[c].point_count == y->curves[c].point_count);
+            ENSURE(x->curves[c].closed == y->curves[c].closed);
+        }
+        for (int i = 0; i < 3 * x->point_count; ++i)
+            ENSURE_NEAR(x->rest[i], y->rest[i], 1e-6 * (1 + fabs(x->rest[i])));
+    }
+    ENSURE(a->animation_count == b->animation_count);
+    for (int k = 0; k < a->animation_count; ++k) {
+        ENSURE(!strcmp(a->animations[k].name, b->animations[k].name));
+        ENSURE(a->animations[k].channel_count == b->animations[k].channel_count);
+        ENSURE_NEAR(a->animations[k].duration_s, b->animations[k].duration_s, 1e-6);
+    }
+}
+
+// Export at random in-bounds parameters, import, compare rig and pose.
+static void round_trip(sp_character* ch, const char* name, uint64_t seed)
+{
+    sp_test_rng rng = {seed};
+    double* p = malloc(sizeof(double) * (size_t)(ch->rig.param_count + 1));
+    for (int k = 0; k < ch->rig.param_count; ++k)
+        p[k] = sp_test_range(&rng, ch->rig.params[k].min, ch->rig.params[k].max);
+    const char* out = sp_test_tmp_path(name);
+    sp_error err = {0};
+    sp_result r = sp_gltf_save(ch, p, out, &err);
+    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_OK);
+    sp_character back = load_ok(out);
+    ensure_same_rig(&ch->rig, &back.rig, 1e-9);
+    for (int k = 0; k < ch->rig.param_count; ++k)
+        ENSURE_NEAR(back.pose[k], p[k], 1e-6);
+    ENSURE(!back.derived_abstraction && !back.derived_dofs);
+    ENSURE(back.has_camera);
+    ENSURE(back.camera.kind == ch->camera.kind);
+    ENSURE_NEAR(back.camera.scale, ch->camera.scale, 1e-6 * ch->camera.scale);
+    for (int k = 0; k < 16; ++k)
+        ENSURE_NEAR(back.camera.view.m[k], ch->camera.view.m[k], 1e-6 * (1 + fabs(ch->camera.view.m[k])));
+    ENSURE((back.part_json == NULL) == (ch->part_json == NULL));
+    if (ch->part_json) ENSURE(!strcmp(back.part_json, ch->part_json));
+    // The skinned mesh at p is the same through both rigs.
+    double* xa = skin_mesh(&ch->rig, p);
+    double* xb = skin_mesh(&back.rig, back.pose);
+    for (int i = 0; i < 3 * ch->rig.vertex_count; ++i)
+        ENSURE_NEAR(xa[i], xb[i], 1e-5 * (1 + fabs(xa[i])));
+    for (int i = 0; i < 4 * ch->rig.vertex_count; ++i)
+        ENSURE_NEAR(back.colors[i], ch->colors[i], 1e-6);
+    free(xa), free(xb), free(p);
+    sp_character_free(&back);
+}
+
+// Every curve of the stick figure at default parameters starts at its first
+// joint, passes through each bone's joint every SP_STICK_POINTS_PER_BONE
+// points and ends at a child of the joint of its last point.
+static void ensure_stick(const sp_character* ch)
+{
+    const sp_rig* rig = &ch->rig;
+    int a = sp_rig_find_abstraction(rig, "stick");
+    ENSURE(a >= 0);
+    ENSURE(ch->derived_abstraction);
+    const sp_abstraction* ab = &rig->abstractions[a];
+    ENSURE(ab->curve_count > 0 && ab->correspondence == SP_CORR_ORDERED);
+    double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
+    double* z = malloc(sizeof(double) * 3 * (size_t)ab->point_count);
+    sp_rig_defaults(rig, p);
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_abstraction(ev, ab, NULL, z);
+    const sp_mat4* g = sp_rig_eval_world(ev);
+    double scale = 0;
+    for (int j = 0; j < rig->joint_count; ++j)
+        scale = fmax(scale, sp_v3_len(sp_mat4_translation(&g[j])));
+    double tol = 1e-9 * (1 + scale) * 1e3;
+    for (int c = 0; c < ab->curve_count; ++c) {
+        const sp_curve* cv = &ab->curves[c];
+        for (int i = 0; i < cv->point_count; ++i) {
+            int pi = cv->first_point + i;
+            int j = ab->joints[4 * pi];
+            ENSURE(ab->weights[4 * pi] == 1.0f);
+            sp_vec3 jp = sp_mat4_translation(&g[j]);
+            if (i % SP_STICK_POINTS_PER_BONE == 0 && i + 1 < cv->point_count) {
+                ENSURE_NEAR(z[3 * pi], jp.x, tol);
+                ENSURE_NEAR(z[3 * pi + 1], jp.y, tol);
+                ENSURE_NEAR(z[3 * pi + 2], jp.z, tol);
+            }
+        }
+        int last = cv->first_point + cv->point_count - 1, j = ab->joints[4 * last];
+        bool found = false;
+        for (int k = 0; k < rig->joint_count && !found; ++k) {
+            if (rig->joints[k].parent != j) continue;
+            sp_vec3 kp = sp_mat4_translation(&g[k]);
+            found = fabs(kp.x - z[3 * last]) < tol && fabs(kp.y - z[3 * last + 1]) < tol && fabs(kp.z - z[3 * last + 2]) < tol;
+        }
+        ENSURE(found);
+    }
+    sp_rig_eval_destroy(ev);
+    free(p), free(z);
+}
+
+// ---- the shared Khronos samples -------------------------------------------
+
+static void test_cesium_gltf_vs_glb(void)
+{
+    if (!sp_test_data_dir()) SKIP("../shared/data absent");
+    sp_character a = load_ok(data_path("CesiumMan/glTF/CesiumMan.gltf"));
+    sp_character b = load_ok(data_path("CesiumMan/CesiumMan.glb"));
+    ENSURE(a.rig.vertex_count == 3273);
+    ensure_same_rig(&a.rig, &b.rig, 1e-12);
+    ENSURE(!memcmp(a.rig.rest, b.rig.rest, sizeof(double) * 3 * (size_t)a.rig.vertex_count));
+    ENSURE(!memcmp(a.rig.weights4, b.rig.weights4, sizeof(float) * 4 * (size_t)a.rig.vertex_count));
+    ENSURE(!memcmp(a.rig.joints4, b.rig.joints4, sizeof(uint16_t) * 4 * (size_t)a.rig.vertex_count));
+    ENSURE(has_warning(&a, "renormalised skin weights of 210 vertices"));
+    ENSURE(has_warning(&b, "renormalised skin weights of 210 vertices"));
+    ENSURE(a.derived_dofs && a.rig.param_count >= 3 * 19);
+    ENSURE(a.rig.animation_count == 1 && a.rig.animations[0].duration_s > 0);
+    ENSURE(!a.has_camera && a.camera.scale > 0);
+    ensure_stick(&a);
+    sp_character_free(&a);
+    sp_character_free(&b);
+}
+
+static void test_rigged_figure(void)
+{
+    if (!sp_test_data_dir()) SKIP("../shared/data absent");
+    sp_character a = load_ok(data_path("RiggedFigure/glTF/RiggedFigure.gltf"));
+    sp_character b = load_ok(data_path("RiggedFigure/RiggedFigure.glb"));
+    ENSURE(a.rig.vertex_count == 370);
+    ensure_same_rig(&a.rig, &b.rig, 1e-12);
+    ENSURE(has_warning(&a, "renormalised skin weights of 31 vertices"));
+    ensure_stick(&a);
+    sp_character_free(&a);
+    sp_character_free(&b);
+}
+
+static void test_simple_skins(void)
+{
+    if (!sp_test_data_dir()) SKIP("../shared/data absent");
+    sp_character s = load_ok(data_path("SimpleSkin/SimpleSkin.gltf"));
+    ENSURE(s.rig.vertex_count == 10);
+    ENSURE(s.rig.param_count == 6);
+    ENSURE(s.rig.animation_count == 1);
+    // Its only bone has length 0 (the child joint sits on its parent): no stick figure.
+    ENSURE(s.rig.abstraction_count == 0 && has_warning(&s, "no bones"));
+    sp_character_free(&s);
+    sp_character a = load_ok(data_path("RiggedSimple/glTF/RiggedSimple.gltf"));
+    sp_character b = load_ok(data_path("RiggedSimple/RiggedSimple.glb"));
+    ENSURE(a.rig.vertex_count == 96);
+    ensure_same_rig(&a.rig, &b.rig, 1e-12);
+    ensure_stick(&a);
+    sp_character_free(&a);
+    sp_character_free(&b);
+}
+
+static void test_cesium_round_trip(void)
+{
+    if (!sp_test_data_dir()) SKIP("../shared/data absent");
+    sp_character a = load_ok(data_path("CesiumMan/CesiumMan.glb"));
+    round_trip(&a, "cesium_rt.glb", 7);
+    round_trip(&a, "cesium_rt.gltf", 8);
+    sp_character_free(&a);
+}
+
+// ---- the hand-made file -----------------------------------------------------
+
+static void test_mini_plain(void)
+{
+    mini_desc d = {.armature = true, .w1 = 0.5f};
+    sp_character ch = load_ok(write_mini("plain.gltf", &d));
+    ENSURE(ch.rig.vertex_count == 4 && ch.rig.triangle_count == 2);
+    ENSURE(ch.rig.joint_count == 3); // Armature, root, tip
+    ENSURE(!strcmp(ch.rig.joints[0].name, "Armature") && ch.rig.joints[0].parent == -1);
+    ENSURE(!strcmp(ch.rig.joints[1].name, "root") && ch.rig.joints[1].parent == 0);
+    ENSURE(!strcmp(ch.rig.joints[2].name, "tip") && ch.rig.joints[2].parent == 1);
+    ENSURE(ch.rig.joints[0].param_count == 0); // not a skin joint
+    ENSURE(ch.rig.param_count == 6 && ch.derived_dofs);
+    ENSURE(sp_rig_find_param(&ch.rig, "tip.ry") >= 0);
+    ENSURE_NEAR(ch.rig.params[0].max, 2.0943951023931957, 1e-12);
+    ENSURE(has_warning(&ch, "renormalised skin weights of 1 vertices"));
+    ENSURE(ch.rig.joints4[4 * 2] == 2 && ch.rig.joints4[4 * 2 + 1] == 1); // skin joint 1 -> rig joint 2
+    ENSURE_NEAR(ch.colors[0], 0.9, 1e-6);
+    ENSURE_NEAR(ch.colors[1], 0.3, 1e-6);
+    ENSURE(!ch.has_camera && ch.camera.kind == SP_CAMERA_ORTHOGRAPHIC && ch.camera.width == 640);
+    ensure_stick(&ch);
+    ENSURE(ch.rig.abstractions[0].curve_count == 1 && ch.rig.abstractions[0].point_count == SP_STICK_POINTS_PER_BONE + 1);
+    // The default camera frames the rest pose: every vertex projects inside the canvas.
+    double* x = skin_mesh(&ch.rig, ch.pose);
+    for (int i = 0; i < ch.rig.vertex_count; ++i) {
+        sp_vec2 px = sp_camera_project(&ch.camera, sp_v3(x[3 * i], x[3 * i + 1], x[3 * i + 2]));
+        ENSURE(px.x > 0 && px.x < 640 && px.y > 0 && px.y < 480);
+    }
+    free(x);
+    sp_character_free(&ch);
+
+    // Variants the loader must accept: a strip, byte joints.
+    mini_desc s = {.strip = true, .byte_joints = true};
+    ch = load_ok(write_mini("strip.gltf", &s));
+    ENSURE(ch.rig.triangle_count == 2 && ch.rig.joint_count == 2);
+    sp_character_free(&ch);
+}
+
+static void test_mini_extras(void)
+{
+    mini_desc d = {.extras = true};
+    sp_character ch = load_ok(write_mini("extras.gltf", &d));
+    ENSURE(!ch.derived_dofs && !ch.derived_abstraction);
+    ENSURE(ch.rig.param_count == 5);
+    int k = sp_rig_find_param(&ch.rig, "root.s");
+    ENSURE(k >= 0 && ch.rig.params[k].group == SP_GROUP_SHAPE && ch.rig.params[k].def == 1.0 && ch.rig.params[k].min == 0.5);
+    k = sp_rig_find_param(&ch.rig, "tip.rx");
+    ENSURE(k >= 0 && ch.rig.params[k].group == SP_GROUP_POSE && ch.rig.params[k].max == 1.5);
+    ENSURE(ch.rig.abstraction_count == 1);
+    const sp_abstraction* ab = &ch.rig.abstractions[0];
+    ENSURE(!strcmp(ab->name, "outline") && ab->correspondence == SP_CORR_CLOSEST);
+    ENSURE(ab->curve_count == 1 && ab->curves[0].closed && ab->point_count == 4 && !strcmp(ab->curves[0].name, "body"));
+    ENSURE(ch.part_json && strstr(ch.part_json, "\"category\":\"tail\"") && strstr(ch.part_json, "\"attach\":\"back\""));
+    ENSURE(ch.has_camera && ch.camera.kind == SP_CAMERA_PERSPECTIVE);
+    ENSURE_NEAR(ch.camera.scale, 240.0 / tan(0.4), 1e-9);
+    ENSURE_NEAR(ch.camera.view.m[13], -1.0, 1e-12);
+    ENSURE_NEAR(ch.camera.view.m[14], -5.0, 1e-12);
+    round_trip(&ch, "extras_rt.glb", 3);
+    round_trip(&ch, "extras_rt.gltf", 4);
+    sp_character_free(&ch);
+}
+
+// A generated tree rig with every channel kind, built in code.
+static void test_fixture_round_trip(void)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 7, .branching = true, .all_channels = true, .seed = 11}, &rig);
+    sp_character ch;
+    sp_error err = {0};
+    ENSURE(sp_character_from_rig(&rig, &ch, &err) == SP_OK);
+    ch.part_json = strdup("{\"category\":\"wings\",\"n\":2}");
+    round_trip(&ch, "fixture_rt.glb", 21);
+    round_trip(&ch, "fixture_rt.gltf", 22);
+    // In memory too.
+    void* glb = NULL;
+    size_t n = 0;
+    ENSURE(sp_gltf_save_memory(&ch, NULL, &glb, &n, &err) == SP_OK);
+    sp_character back;
+    ENSURE(sp_gltf_load_memory(glb, n, "memory.glb", &back, &err) == SP_OK);
+    ensure_same_rig(&ch.rig, &back.rig, 1e-9);
+    sp_character_free(&back);
+    free(glb);
+    sp_character_free(&ch);
+}
+
+// ---- bad input ---------------------------------------------------------------
+
+static void ensure_fails(const char* path, const char* name, const char* expect)
+{
+    sp_character ch = {0};
+    sp_error err = {0};
+    sp_result r = sp_gltf_load(path, &ch, &err);
+    printf("  %-18s -> %s: %s\n", name, sp_result_name(r), err.text);
+    ENSURE(r != SP_OK);
+    ENSURE(strstr(err.text, name) != NULL);
+    ENSURE(!strchr(err.text, '\n'));
+    if (expect) ENSURE(strstr(err.text, expect) != NULL);
+    ENSURE(ch.rig.joints == NULL && ch.pose == NULL);
+}
+
+static void bad_mini(const char* name, mini_desc d, const char* expect)
+{
+    ensure_fails(write_mini(name, &d), name, expect);
+}
+
+static void test_bad_input(void)
+{
+    bad_mini("accessor_index.gltf", (mini_desc){.pos_accessor = 42}, "accessor 42");
+    bad_mini("past_end.gltf", (mini_desc){.pos_count = 100}, "past the end");
+    bad_mini("missing_bin.gltf", (mini_desc){.uri = "missing.bin"}, "missing.bin");
+    bad_mini("empty_skin.gltf", (mini_desc){.empty_skin = true}, NULL);
+    bad_mini("cycle.gltf", (mini_desc){.cycle = true}, "cycle");
+    bad_mini("cycle2.gltf", (mini_desc){.cycle = true, .armature = true}, "parent");
+    bad_mini("nan.gltf", (mini_desc){.nan_position = true}, "non-finite");
+    bad_mini("zero_weights.gltf", (mini_desc){.zero_weights = true}, "weight");
+    bad_mini("bad_joint.gltf", (mini_desc){.bad_joint = 5}, "joint 5");
+    bad_mini("bad_dofs.gltf", (mini_desc){.bad_dofs = true}, "bounds");
+
+    char* text = mini_gltf(&(mini_desc){0});
+    const char* p = sp_test_tmp_path("invalid_json.gltf");
+    ENSURE(mini_write(p, text, strlen(text) / 2));
+    ensure_fails(p, "invalid_json.gltf", NULL);
+    p = sp_test_tmp_path("empty.gltf");
+    ENSURE(mini_write(p, "", 0));
+    ensure_fails(p, "empty.gltf", NULL);
+    free(text);
+    ensure_fails(sp_test_tmp_path("does_not_exist.glb"), "does_not_exist.glb", NULL);
+
+    // Truncated .glb: a valid export cut at several places.
+    sp_character ch = load_ok(write_mini("ok.gltf", &(mini_desc){.extras = true}));
+    void* glb = NULL;
+    size_t n = 0;
+    sp_error err = {0};
+    ENSURE(sp_gltf_save_memory(&ch, NULL, &glb, &n, &err) == SP_OK);
+    size_t cuts[] = {10, 24, n / 2, n - 4};
+    for (int i = 0; i < 4; ++i) {
+        p = sp_test_tmp_path("truncated.glb");
+        ENSURE(mini_write(p, glb, cuts[i]));
+        ensure_fails(p, "truncated.glb", NULL);
+    }
+    free(glb);
+    sp_character_free(&ch);
+}
+
+// Random byte flips of a valid file must never crash (a tiny in-test fuzz).
+static void test_mutations(void)
+{
+    char* text = mini_gltf(&(mini_desc){.extras = true, .armature = true});
+    size_t n = strlen(text);
+    sp_test_rng rng = {99};
+    int ok = 0;
+    for (int it = 0; it < 400; ++it) {
+        char* m = malloc(n);
+        memcpy(m, text, n);
+        for (int k = 0; k < 3; ++k)
+            m[(size_t)(sp_test_uniform(&rng) * n)] = "0123456789[]{},\"-e."[(int)(sp_test_uniform(&rng) * 19)];
+        sp_character ch;
+        sp_error err = {0};
+        if (sp_gltf_load_memory(m, n, "mutant", &ch, &err) == SP_OK)
+            ++ok, sp_character_free(&ch);
+        else
+            ENSURE(strstr(err.text, "mutant") && !strchr(err.text, '\n'));
+        free(m);
+    }
+    printf("  %d of 400 mutants loaded\n", ok);
+    free(text);
+}
+
+static int write_corpus(const char* dir)
+{
+    struct {
+        const char* name;
+        mini_desc d;
+    } files[] = {{"two_bone.gltf", {0}},
+                 {"two_bone_extras.gltf", {.extras = true}},
+                 {"two_bone_armature.gltf", {.armature = true, .w1 = 0.5f}},
+                 {"two_bone_strip.gltf", {.strip = true, .byte_joints = true}},
+                 {"cycle.gltf", {.cycle = true}},
+                 {"past_end.gltf", {.pos_count = 100}}};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", dir, files[i].name);
+        char* text = mini_gltf(&files[i].d);
+        bool ok = mini_write(path, text, strlen(text));
+        free(text);
+        if (!ok) return 1;
+    }
+    return 0;
+}
+
+int main(int argc, char** argv)
+{
+    if (argc == 3 && !strcmp(argv[1], "--write-corpus")) return write_corpus(argv[2]);
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"cesium_gltf_vs_glb", test_cesium_gltf_vs_glb},
+                                   {"rigged_figure", test_rigged_figure},
+                                   {"simple_skins", test_simple_skins},
+                                   {"cesium_round_trip", test_cesium_round_trip},
+                                   {"mini_plain", test_mini_plain},
+                                   {"mini_extras", test_mini_extras},
+                                   {"fixture_round_trip", test_fixture_round_trip},
+                                   {"bad_input", test_bad_input},
+                                   {"mutations", test_mutations},
+                                   {0}});
+}
