@@ -11,7 +11,11 @@
     X(export, "write a rig posed by a pose file as .glb")                         \
     X(train, "train a sketch classifier on a labelled folder")                          \
     X(eval, "classifier accuracy (top-1/top-3, recall, confusion), cross-validation")   \
-    X(classify, "classify one drawing with a trained model; ranked JSON")
+    X(classify, "classify one drawing with a trained model; ranked JSON")              \
+    X(synth, "strokes of a random pose within bounds (tests, training)")               \
+    X(pose, "redraw posing: fit the rig to strokes; posed .glb, PNG, report")         \
+    X(drawover, "draw-over posing: curves drawn over the character, then redrawn")     \
+    X(animate, "key poses from stroke files, solved in sequence, as one glTF animation")
 
 #define SP_DECLARE_CMD(name, help) int cmd_##name(int argc, char** argv);
 SP_COMMANDS(SP_DECLARE_CMD)

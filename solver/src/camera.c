@@ -46,6 +46,34 @@ sp_vec3 sp_camera_view_dir(const sp_camera* cam, sp_vec3 world)
     return sp_v3_norm(sp_v3_sub(world, sp_mat4_translation(&inv)));
 }
 
+sp_camera sp_camera_default_view(const double* xyz, int n, int width, int height)
+{
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, n, &lo, &hi);
+    double mx = 0, mz = 0, vx = 0, vz = 0;
+    for (int i = 0; i < n; ++i) mx += xyz[3 * i], mz += xyz[3 * i + 2];
+    if (n > 0) mx /= n, mz /= n;
+    for (int i = 0; i < n; ++i) {
+        double dx = xyz[3 * i] - mx, dz = xyz[3 * i + 2] - mz;
+        vx += dx * dx, vz += dz * dz;
+    }
+    sp_vec3 forward = vx >= vz ? sp_v3(0, 0, -1) : sp_v3(-1, 0, 0);
+    return sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, lo, hi, forward, sp_v3(0, 1, 0), width, height);
+}
+
+sp_camera sp_camera_resize(const sp_camera* cam, int width, int height)
+{
+    sp_camera c = *cam;
+    if (cam->width <= 0 || cam->height <= 0 || width <= 0 || height <= 0) return c;
+    double f = fmin((double)width / cam->width, (double)height / cam->height);
+    c.scale = cam->scale * f;
+    c.cx = 0.5 * width + (cam->cx - 0.5 * cam->width) * f;
+    c.cy = 0.5 * height + (cam->cy - 0.5 * cam->height) * f;
+    c.width = width;
+    c.height = height;
+    return c;
+}
+
 void sp_bounds(const double* xyz, int n, sp_vec3* lo, sp_vec3* hi)
 {
     *lo = (sp_vec3){0, 0, 0};

@@ -176,7 +176,7 @@ sp_result sp_rig_finalize(sp_rig* rig, const char* what, int* renormalised, sp_e
     return SP_OK;
 }
 
-static void free_abstraction(sp_abstraction* a)
+void sp_abstraction_free(sp_abstraction* a)
 {
     free(a->curves);
     free(a->rest);
@@ -184,6 +184,7 @@ static void free_abstraction(sp_abstraction* a)
     free(a->weights);
     free(a->tri_vertices);
     free(a->bary);
+    memset(a, 0, sizeof *a);
 }
 
 void sp_rig_free(sp_rig* rig)
@@ -194,7 +195,7 @@ void sp_rig_free(sp_rig* rig)
     free(rig->joints4);
     free(rig->weights4);
     free(rig->triangles);
-    for (int a = 0; a < rig->abstraction_count; ++a) free_abstraction(&rig->abstractions[a]);
+    for (int a = 0; a < rig->abstraction_count; ++a) sp_abstraction_free(&rig->abstractions[a]);
     free(rig->abstractions);
     for (int a = 0; a < rig->animation_count; ++a) {
         for (int c = 0; c < rig->animations[a].channel_count; ++c) {

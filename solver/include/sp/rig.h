@@ -149,6 +149,8 @@ typedef struct sp_skinned_points {
 /// number of renormalised vertices and abstraction points in *renormalised
 /// (may be NULL). `what` names the source in messages (a file path).
 sp_result sp_rig_finalize(sp_rig* rig, const char* what, int* renormalised, sp_error* err);
+/// Frees an abstraction's arrays and zeroes it.
+void sp_abstraction_free(sp_abstraction* a);
 /// Frees every array of the rig and zeroes it.
 void sp_rig_free(sp_rig* rig);
 /// Deep copy.
@@ -230,6 +232,15 @@ sp_vec3 sp_camera_view_dir(const sp_camera* cam, sp_vec3 world);
 /// A camera of the given kind looking along `forward` (world, e.g. -Z for a
 /// front view) with `up`, framing the box [lo, hi] with a margin of 10%.
 sp_camera sp_camera_frame(sp_camera_kind kind, sp_vec3 lo, sp_vec3 hi, sp_vec3 forward, sp_vec3 up, int width, int height);
+/// The default sketch view of a character without a camera: orthographic,
+/// y up, looking along -Z or -X, whichever sees the wider spread of the
+/// points (xyz, n by 3, e.g. the rest-pose vertices), so that a figure
+/// modelled facing +X is still seen from the front with its limbs apart.
+sp_camera sp_camera_default_view(const double* xyz, int n, int width, int height);
+/// The same view on a canvas of another size: the picture is scaled to fit
+/// (aspect kept) and stays centred, so a figure framed on 640x480 keeps its
+/// place on 1280x800.
+sp_camera sp_camera_resize(const sp_camera* cam, int width, int height);
 /// Axis-aligned bounds of n points (n by 3).
 void sp_bounds(const double* xyz, int n, sp_vec3* lo, sp_vec3* hi);
 
