@@ -43,6 +43,7 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
     }
     for (int j = 0; j < nj; ++j) {
         for (int c = SP_CH_RX; c <= SP_CH_RZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, -2.0, 2.0, SP_GROUP_POSE);
+        if (j == 0 && d->root_scale) sp_rig_add_param(rig, j, SP_CH_S, 0.5, 2.0, SP_GROUP_SHAPE);
         if (!d->all_channels) continue;
         if (j == 0) {
             for (int c = SP_CH_TX; c <= SP_CH_TZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, -5.0, 5.0, SP_GROUP_POSE);
@@ -64,10 +65,10 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
     rig->triangle_count = bones * (rings - 1) * rv * 2;
     rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
     // Stick abstraction: 8 points per bone, one curve per bone.
-    const int per = 8;
+    const int per = d->stick_points > 1 ? d->stick_points : 8;
     sp_abstraction ab = {0};
     snprintf(ab.name, sizeof ab.name, "stick");
-    ab.correspondence = SP_CORR_ORDERED;
+    ab.correspondence = d->closest ? SP_CORR_CLOSEST : SP_CORR_ORDERED;
     ab.curve_count = bones;
     ab.curves = calloc((size_t)bones, sizeof(sp_curve));
     ab.point_count = bones * per;

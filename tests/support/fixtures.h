@@ -21,6 +21,9 @@ typedef struct sp_fixture_desc {
     int rings_per_bone;    ///< 0: 6
     int ring_vertices;     ///< 0: 12
     bool all_channels;     ///< root gets tx/ty/tz + s, others sx/sy/sz or s besides rx/ry/rz
+    bool root_scale;       ///< only a uniform scale on the root besides the rotations
+    int stick_points;      ///< abstraction points per bone; 0: 8
+    bool closest;          ///< the abstraction uses closest-point correspondences
     uint64_t seed;
 } sp_fixture_desc;
 

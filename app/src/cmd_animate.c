@@ -1,0 +1,121 @@
+// sketchpose animate: the paper's redraw-posing animations (its Figure 1
+// run cycle, Figure 3 fall). Each key's strokes are solved starting from the
+// previous key's pose; the keys become one glTF animation.
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "posing.h"
+#include "report.h"
+#include "sp/gltf.h"
+#include "sp/solver.h"
+
+// "0,0.5,1.2" -> times; false if malformed or not increasing.
+static bool parse_times(const char* s, double* t, int n)
+{
+    const char* at = s;
+    for (int i = 0; i < n; ++i) {
+        char* end = NULL;
+        t[i] = strtod(at, &end);
+        if (end == at || !isfinite(t[i]) || t[i] < 0 || (i > 0 && !(t[i] > t[i - 1]))) return false;
+        at = end;
+        if (i + 1 < n) {
+            if (*at != ',') return false;
+            ++at;
+        }
+    }
+    return *at == 0;
+}
+
+int cmd_animate(int argc, char** argv)
+{
+    const char *rig_path = NULL, *abs_name = NULL, *times_s = NULL, *out = NULL, *report = NULL;
+    sp_str_list keys = {0};
+    const sp_opt opts[] = {
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
+        {"--strokes", SP_OPT_LIST, &keys, "K1.json K2.json ...", "one stroke file per key pose, in time order", true},
+        {"--times", SP_OPT_STRING, &times_s, "t1,t2,...", "key times in seconds (default 0,1,2,...)", false},
+        {"--out", SP_OPT_STRING, &out, "anim.glb", "the animated character", true},
+        {"--report", SP_OPT_STRING, &report, "report.json", "write the per-key solve reports (also printed on stdout)", false},
+    };
+    int rc = sp_cli_parse(argc, argv, "sketchpose animate", "Key poses from strokes, solved in sequence, as one glTF animation.",
+                          opts, (int)(sizeof opts / sizeof opts[0]));
+    if (rc >= 0) return rc;
+    int n = keys.count;
+    double* times = malloc(sizeof(double) * (size_t)n);
+    if (!times) return SP_EXIT_INPUT;
+    for (int k = 0; k < n; ++k) times[k] = k;
+    if (times_s && !parse_times(times_s, times, n)) {
+        fprintf(stderr, "sketchpose animate: --times needs %d increasing non-negative numbers separated by commas, got '%s'\n", n, times_s);
+        free(times);
+        return SP_EXIT_USAGE;
+    }
+    sp_character ch = {0};
+    sp_error err = {0};
+    sp_solver* solver = NULL;
+    double* kp = NULL;
+    cJSON* all = cJSON_CreateArray();
+    int exit_code = SP_EXIT_INPUT;
+    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) goto fail;
+    int a = sp_pick_abstraction(&ch, rig_path, abs_name, &err);
+    if (a < 0) goto fail;
+    const int P = ch.rig.param_count;
+    kp = malloc(sizeof(double) * (size_t)(P + 1) * (size_t)n);
+    if (!kp) goto oom;
+    sp_camera cam = ch.camera;
+    for (int k = 0; k < n; ++k) {
+        sp_sketch sk = {0};
+        if (sp_read_strokes(keys.items[k], &sk, &err) != SP_OK) goto fail;
+        sp_camera kc = sp_canvas_camera(&ch, &sk);
+        // One solver for all keys when they share a canvas (the coarsening is reused).
+        if (!solver || kc.width != cam.width || kc.height != cam.height) {
+            sp_solver_destroy(solver);
+            cam = kc;
+            solver = sp_solver_create(&ch.rig, a, &cam, &(sp_solve_desc){0});
+            if (!solver) {
+                sp_sketch_free(&sk);
+                goto oom;
+            }
+        }
+        const double* start = k == 0 ? ch.pose : kp + (size_t)(k - 1) * P;
+        sp_solve_report rep;
+        sp_result r = sp_solver_solve(solver, &sk, start, kp + (size_t)k * P, &rep, &err);
+        sp_sketch_free(&sk);
+        if (r != SP_OK) {
+            fprintf(stderr, "sketchpose animate: %s: %s\n", keys.items[k], err.text);
+            goto done;
+        }
+        cJSON* j = sp_report_to_json(&rep, &ch.rig, &ch.rig.abstractions[a], kp + (size_t)k * P);
+        cJSON_AddStringToObject(j, "strokes", keys.items[k]);
+        cJSON_AddNumberToObject(j, "time_s", times[k]);
+        cJSON_AddItemToArray(all, j);
+    }
+    sp_animation anim;
+    sp_result ar = sp_animation_from_keys(&ch.rig, kp, times, n, "sketchpose", &anim, &err);
+    sp_animation* grown = ar == SP_OK ? realloc(ch.rig.animations, sizeof(sp_animation) * (size_t)(ch.rig.animation_count + 1)) : NULL;
+    if (!grown) {
+        for (int c = 0; c < anim.channel_count; ++c) free(anim.channels[c].times), free(anim.channels[c].values);
+        free(anim.channels);
+        if (ar == SP_OK) goto oom;
+        goto fail;
+    }
+    ch.rig.animations = grown;
+    ch.rig.animations[ch.rig.animation_count++] = anim;
+    if (report && sp_json_write_file(report, all, &err) != SP_OK) goto fail;
+    sp_json_print(all);
+    if (sp_gltf_save(&ch, kp, out, &err) != SP_OK) goto fail;
+    exit_code = SP_EXIT_OK;
+    goto done;
+oom:
+    sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
+fail:
+    fprintf(stderr, "sketchpose animate: %s\n", err.text);
+done:
+    cJSON_Delete(all);
+    sp_solver_destroy(solver);
+    free(kp), free(times);
+    sp_character_free(&ch);
+    return exit_code;
+}

@@ -1,0 +1,133 @@
+// sketchpose drawover: the paper's on-the-fly abstraction. Each stroke of
+// --on, drawn over the character in its view, is projected onto the mesh
+// (eq. 2); the strokes of --to are their desired shapes.
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "posing.h"
+#include "report.h"
+#include "snapshot.h"
+#include "sp/embed.h"
+#include "sp/gltf.h"
+#include "sp/solver.h"
+
+// One abstraction with a curve per stroke of `on`, embedded in the mesh.
+static sp_result embed_strokes(const sp_rig* rig, const double* xyz, const sp_camera* cam, const sp_sketch* on, sp_abstraction* out,
+                               sp_error* err)
+{
+    enum { SAMPLES = 48 };
+    int n = on->stroke_count;
+    memset(out, 0, sizeof *out);
+    snprintf(out->name, sizeof out->name, "drawover");
+    out->correspondence = SP_CORR_ORDERED;
+    out->curves = calloc((size_t)n, sizeof(sp_curve));
+    out->tri_vertices = malloc(sizeof(uint32_t) * 3 * SAMPLES * (size_t)n);
+    out->bary = malloc(sizeof(double) * 3 * SAMPLES * (size_t)n);
+    if (!out->curves || !out->tri_vertices || !out->bary) {
+        sp_abstraction_free(out);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    for (int i = 0; i < n; ++i) {
+        sp_abstraction one;
+        char name[32];
+        snprintf(name, sizeof name, "stroke%d", i);
+        sp_result r = sp_embed_curve(rig, xyz, cam, on->strokes[i].points, on->strokes[i].count, SAMPLES, name, &one, err);
+        if (r != SP_OK) {
+            char msg[sizeof err->text];
+            snprintf(msg, sizeof msg, "stroke %d: %.480s", i, err->text);
+            snprintf(err->text, sizeof err->text, "%s", msg);
+            sp_abstraction_free(out);
+            return r;
+        }
+        sp_curve* cv = &out->curves[i];
+        *cv = one.curves[0];
+        cv->first_point = out->point_count;
+        memcpy(out->tri_vertices + 3 * out->point_count, one.tri_vertices, sizeof(uint32_t) * 3 * (size_t)one.point_count);
+        memcpy(out->bary + 3 * out->point_count, one.bary, sizeof(double) * 3 * (size_t)one.point_count);
+        out->point_count += one.point_count;
+        sp_abstraction_free(&one);
+    }
+    out->curve_count = n;
+    return SP_OK;
+}
+
+int cmd_drawover(int argc, char** argv)
+{
+    const char *rig_path = NULL, *on_path = NULL, *to_path = NULL, *out = NULL, *render = NULL, *report = NULL;
+    sp_solve_desc desc = {0};
+    const sp_opt opts[] = {
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--on", SP_OPT_STRING, &on_path, "S1.json", "strokes drawn over the character in its view", true},
+        {"--to", SP_OPT_STRING, &to_path, "S2.json", "the same strokes redrawn in their desired shape", true},
+        {"--out", SP_OPT_STRING, &out, "posed.glb", "write the posed character", false},
+        {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: --on grey, --to blue, the fitted curves yellow", false},
+        {"--report", SP_OPT_STRING, &report, "report.json", "write the solve report (also printed on stdout)", false},
+        {"--lambda-dist", SP_OPT_DOUBLE, &desc.lambda_dist, "L", "weight of W_dist, locality (default 0.001)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &desc.time_cap_ms, "MS", "time cap of the solve (default 3000)", false},
+    };
+    int rc = sp_cli_parse(argc, argv, "sketchpose drawover", "Draw-over posing: redraw curves drawn over the character.", opts,
+                          (int)(sizeof opts / sizeof opts[0]));
+    if (rc >= 0) return rc;
+    sp_character ch = {0};
+    sp_error err = {0};
+    sp_sketch on = {0}, to = {0};
+    sp_solver* solver = NULL;
+    sp_abstraction emb = {0};
+    double *p = NULL, *xyz = NULL;
+    sp_rig_eval* ev = NULL;
+    int exit_code = SP_EXIT_INPUT, a = -1;
+    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) goto fail;
+    if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
+    sp_camera cam = sp_canvas_camera(&ch, &on);
+    p = malloc(sizeof(double) * (size_t)(ch.rig.param_count + 1));
+    xyz = malloc(sizeof(double) * 3 * (size_t)(ch.rig.vertex_count + 1));
+    ev = sp_rig_eval_create(&ch.rig);
+    if (!p || !xyz || !ev) goto oom;
+    memcpy(p, ch.pose, sizeof(double) * (size_t)ch.rig.param_count);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(&ch.rig), xyz);
+    if (embed_strokes(&ch.rig, xyz, &cam, &on, &emb, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose drawover: %s: %s\n", on_path, err.text);
+        goto done;
+    }
+    // The embedded curves join the rig only for the solve (the saver writes skinned abstractions).
+    a = sp_rig_add_abstraction(&ch.rig, &emb);
+    if (a < 0) goto oom;
+    solver = sp_solver_create(&ch.rig, a, &cam, &desc);
+    if (!solver) goto oom;
+    sp_solve_report rep;
+    if (sp_solver_solve(solver, &to, p, p, &rep, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose drawover: %s: %s\n", to_path, err.text);
+        goto done;
+    }
+    cJSON* j = sp_report_to_json(&rep, &ch.rig, &ch.rig.abstractions[a], p);
+    sp_result wr = report ? sp_json_write_file(report, j, &err) : SP_OK;
+    sp_json_print(j);
+    cJSON_Delete(j);
+    if (wr != SP_OK) goto fail;
+    if (render) {
+        sp_snapshot_desc d = {.character = &ch, .params = p, .camera = &cam, .abstraction = a, .strokes = &to, .ghost = &on};
+        if (sp_snapshot_png(&d, render, &err) != SP_OK) goto fail;
+    }
+    sp_solver_destroy(solver);
+    solver = NULL;
+    sp_abstraction_free(&ch.rig.abstractions[--ch.rig.abstraction_count]);
+    if (out && sp_gltf_save(&ch, p, out, &err) != SP_OK) goto fail;
+    if (rep.note[0]) fprintf(stderr, "sketchpose drawover: %s\n", rep.note);
+    exit_code = SP_EXIT_OK;
+    goto done;
+oom:
+    sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
+fail:
+    fprintf(stderr, "sketchpose drawover: %s\n", err.text);
+done:
+    sp_solver_destroy(solver);
+    sp_rig_eval_destroy(ev);
+    sp_abstraction_free(&emb);
+    free(p), free(xyz);
+    sp_sketch_free(&on), sp_sketch_free(&to);
+    sp_character_free(&ch);
+    return exit_code;
+}

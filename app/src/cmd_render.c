@@ -1,0 +1,204 @@
+// cmd_render.c: `sketchpose render`: a rig, posed, with an abstraction overlaid, to PNG.
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "headless.h"
+#include "image.h"
+#include "pose_io.h"
+#include "render.h"
+#include "sp/gltf.h"
+
+// The sketch camera maps the character onto its own canvas; fit that canvas
+// into the output keeping its aspect, centred (letterboxed), so that a
+// stroke file drawn on the canvas overlays the render at the same scale.
+static sp_camera fit_camera(const sp_camera* src, int w, int h)
+{
+    sp_camera c = *src;
+    double cw = src->width > 0 ? src->width : w, chh = src->height > 0 ? src->height : h;
+    double k = fmin(w / cw, h / chh);
+    c.scale = src->scale * k;
+    c.cx = src->cx * k + 0.5 * (w - cw * k);
+    c.cy = src->cy * k + 0.5 * (h - chh * k);
+    c.width = w;
+    c.height = h;
+    return c;
+}
+
+// Orbits the camera about the character's centre c: yaw about world +Y,
+// then pitch about the camera's horizontal axis (positive: from above). The
+// centre keeps its pixel, so the framing stays.
+static void orbit_camera(sp_camera* cam, sp_vec3 c, double yaw, double pitch)
+{
+    sp_mat4 to = sp_mat4_trs(c, sp_quat_identity(), sp_v3(1, 1, 1));
+    sp_mat4 from = sp_mat4_trs(sp_v3_scale(c, -1.0), sp_quat_identity(), sp_v3(1, 1, 1));
+    sp_mat4 ry = sp_mat4_trs(sp_v3(0, 0, 0), sp_quat_axis_angle(sp_v3(0, 1, 0), yaw), sp_v3(1, 1, 1));
+    sp_mat4 world = sp_mat4_mul(&to, &ry);
+    world = sp_mat4_mul(&world, &from);
+    sp_mat4 view = sp_mat4_mul(&cam->view, &world);
+    sp_vec3 cc = sp_mat4_point(&view, c);
+    sp_mat4 cto = sp_mat4_trs(cc, sp_quat_identity(), sp_v3(1, 1, 1));
+    sp_mat4 cfrom = sp_mat4_trs(sp_v3_scale(cc, -1.0), sp_quat_identity(), sp_v3(1, 1, 1));
+    sp_mat4 rx = sp_mat4_trs(sp_v3(0, 0, 0), sp_quat_axis_angle(sp_v3(1, 0, 0), pitch), sp_v3(1, 1, 1));
+    sp_mat4 cam_m = sp_mat4_mul(&cto, &rx);
+    cam_m = sp_mat4_mul(&cam_m, &cfrom);
+    cam->view = sp_mat4_mul(&cam_m, &view);
+}
+
+int cmd_render(int argc, char** argv)
+{
+    const char *rig_path = NULL, *pose_path = NULL, *abs_name = NULL, *out_path = NULL, *size = NULL;
+    double line_width = 0, yaw = 0, pitch = 0;
+    bool no_shadow = false;
+    const sp_opt opts[] = {
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--pose", SP_OPT_STRING, &pose_path, "p.json", "pose file {\"parameters\": {...}} (default: the rig's stored pose)",
+         false},
+        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "abstraction to overlay (default: the first; 'none': no overlay)",
+         false},
+        {"--out", SP_OPT_STRING, &out_path, "X.png", "the PNG to write", true},
+        {"--size", SP_OPT_STRING, &size, "WxH", "image size in pixels (default 640x480)", false},
+        {"--line-width", SP_OPT_DOUBLE, &line_width, "PX", "overlay line width (default: scales with the image)", false},
+        {"--yaw", SP_OPT_DOUBLE, &yaw, "DEG", "orbit the sketch camera about the vertical axis (default 0)", false},
+        {"--pitch", SP_OPT_DOUBLE, &pitch, "DEG", "then tilt it, positive looks from above (default 0)", false},
+        {"--no-shadow", SP_OPT_FLAG, &no_shadow, NULL, "no ground shadow", false},
+    };
+    int rc =
+        sp_cli_parse(argc, argv, "sketchpose render",
+                     "render a rig posed by a pose file (else its stored pose), with an abstraction overlaid in yellow, to PNG",
+                     opts, (int)(sizeof opts / sizeof opts[0]));
+    if (rc >= 0) return rc;
+    int w = 640, h = 480;
+    if (size && !sp_cli_parse_size(size, &w, &h)) {
+        fprintf(stderr, "sketchpose render: --size wants WxH, e.g. 640x480, got '%s'\n", size);
+        return SP_EXIT_USAGE;
+    }
+    if (line_width < 0 || !isfinite(line_width) || !isfinite(yaw) || !isfinite(pitch) || fabs(pitch) > 89.0) {
+        fprintf(stderr, "sketchpose render: --line-width must be positive, --yaw finite, --pitch within +-89\n");
+        return SP_EXIT_USAGE;
+    }
+
+    sp_error err = {0};
+    sp_character ch = {0};
+    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose render: %s\n", err.text);
+        return SP_EXIT_INPUT;
+    }
+    const sp_rig* rig = &ch.rig;
+    const sp_abstraction* ab = NULL;
+    if (abs_name && strcmp(abs_name, "none") != 0) {
+        int ai = sp_rig_find_abstraction(rig, abs_name);
+        if (ai < 0) {
+            char names[256] = "";
+            for (int i = 0; i < rig->abstraction_count; ++i) {
+                size_t n = strlen(names);
+                snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", rig->abstractions[i].name);
+            }
+            fprintf(stderr, "sketchpose render: %s has no abstraction '%s' (it has: %s)\n", rig_path, abs_name,
+                    rig->abstraction_count ? names : "none");
+            sp_character_free(&ch);
+            return SP_EXIT_INPUT;
+        }
+        ab = &rig->abstractions[ai];
+    } else if (!abs_name && rig->abstraction_count > 0) {
+        ab = &rig->abstractions[0];
+    }
+
+    int exit_code = SP_EXIT_INPUT;
+    double* p = malloc(sizeof(double) * (size_t)(rig->param_count ? rig->param_count : 1));
+    double* xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count ? rig->vertex_count : 1));
+    double* zxyz = ab ? malloc(sizeof(double) * 3 * (size_t)(ab->point_count ? ab->point_count : 1)) : NULL;
+    sp_vec2* ends = ab ? malloc(sizeof(sp_vec2) * 2 * (size_t)(ab->curve_count ? ab->curve_count : 1)) : NULL;
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_headless* gl = NULL;
+    sp_renderer* r = NULL;
+    sp_render_target* target = NULL;
+    sp_render_mesh* mesh = NULL;
+    sp_image img = {0};
+    if (!p || !xyz || (ab && (!zxyz || !ends)) || !ev) {
+        fprintf(stderr, "sketchpose render: out of memory\n");
+        goto done;
+    }
+    // Parameters the pose file does not list keep the stored pose.
+    memcpy(p, ch.pose, sizeof(double) * (size_t)rig->param_count);
+    if (pose_path && sp_pose_read(pose_path, rig, p, NULL, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose render: %s\n", err.text);
+        goto done;
+    }
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
+    if (ab) sp_rig_eval_abstraction(ev, ab, xyz, zxyz);
+
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, rig->vertex_count, &lo, &hi);
+    sp_camera cam = fit_camera(&ch.camera, w, h);
+    if (yaw != 0 || pitch != 0)
+        orbit_camera(&cam, sp_v3_scale(sp_v3_add(lo, hi), 0.5), yaw * (3.14159265358979323846 / 180.0),
+                     pitch * (3.14159265358979323846 / 180.0));
+    sp_render_fit_depth(&cam, lo, hi);
+
+    gl = sp_headless_create(&err);
+    if (!gl) {
+        fprintf(stderr, "sketchpose render: %s\n", err.text);
+        goto done;
+    }
+    r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
+    target = r ? sp_render_target_create(w, h, 0, &err) : NULL;
+    mesh = target ? sp_render_mesh_create(r,
+                                          &(sp_mesh_desc){.vertex_count = rig->vertex_count,
+                                                          .positions = xyz,
+                                                          .colors = ch.colors,
+                                                          .triangle_count = rig->triangle_count,
+                                                          .triangles = rig->triangles},
+                                          &err)
+                  : NULL;
+    if (!mesh) {
+        fprintf(stderr, "sketchpose render: %s\n", err.text);
+        goto done;
+    }
+
+    float lw = line_width > 0 ? (float)line_width : (float)fmax(2.0, fmin(w, h) / 150.0);
+    sp_render_target_bind(target);
+    sp_renderer_begin(r, &cam, w, h);
+    sp_renderer_clear(r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
+    if (!no_shadow) sp_renderer_draw_ground_shadow(r, lo, hi, 0.0f);
+    sp_renderer_draw_mesh(r, mesh, NULL);
+    if (ab) {
+        // A dark halo first so that yellow reads on light skin and background.
+        int n_ends = 0;
+        for (int c = 0; c < ab->curve_count; ++c) {
+            const sp_curve* cv = &ab->curves[c];
+            if (cv->point_count < 1 || cv->closed) continue;
+            const double* a = zxyz + 3 * (size_t)cv->first_point;
+            const double* b = zxyz + 3 * (size_t)(cv->first_point + cv->point_count - 1);
+            ends[n_ends++] = sp_camera_project(&cam, sp_v3(a[0], a[1], a[2]));
+            ends[n_ends++] = sp_camera_project(&cam, sp_v3(b[0], b[1], b[2]));
+        }
+        sp_renderer_draw_abstraction(r, ab, zxyz, lw + 2.0f * fmaxf(1.0f, 0.35f * lw), SP_COLOR_OUTLINE);
+        sp_renderer_draw_dots(r, ends, n_ends, 0.5f * lw * 1.6f + fmaxf(1.0f, 0.35f * lw), SP_COLOR_OUTLINE);
+        sp_renderer_draw_abstraction(r, ab, zxyz, lw, SP_COLOR_ABSTRACTION);
+        sp_renderer_draw_dots(r, ends, n_ends, 0.5f * lw * 1.6f, SP_COLOR_ABSTRACTION);
+    }
+    sp_renderer_end(r);
+    if (sp_render_target_read(target, &img, &err) != SP_OK || sp_image_write_png(&img, out_path, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose render: %s\n", err.text);
+        goto done;
+    }
+    exit_code = SP_EXIT_OK;
+done:
+    sp_image_free(&img);
+    sp_render_mesh_destroy(mesh);
+    sp_render_target_destroy(target);
+    sp_renderer_destroy(r);
+    sp_headless_destroy(gl);
+    sp_rig_eval_destroy(ev);
+    free(ends);
+    free(zxyz);
+    free(xyz);
+    free(p);
+    sp_character_free(&ch);
+    return exit_code;
+}

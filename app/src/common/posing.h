@@ -1,0 +1,27 @@
+/// posing.h: what the posing commands (pose, synth, drawover, animate,
+/// dragon) share: choosing an abstraction, the view camera on a stroke
+/// canvas, reading strokes with the file named in errors.
+#ifndef SP_POSING_H
+#define SP_POSING_H
+
+#include "sp/gltf.h"
+#include "sp/sketch.h"
+
+/// Index of the abstraction called `name` (NULL: the first one). -1 and a
+/// message naming the rig and the abstractions it has if there is none.
+int sp_pick_abstraction(const sp_character* ch, const char* rig_path, const char* name, sp_error* err);
+/// The character's sketch view on the sketch's canvas (or the camera's own
+/// canvas when the sketch gives none).
+sp_camera sp_canvas_camera(const sp_character* ch, const sp_sketch* sk);
+/// Reads a stroke file and checks that it has at least one stroke of two
+/// or more points; err names the file.
+sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
+
+/// A glTF-style animation that passes through key poses: keys is nkeys by
+/// rig->param_count, times nkeys seconds (increasing). Every joint with
+/// parameters gets LINEAR channels for the paths its parameters touch
+/// (rotation, translation, scale), sampled from sp_rig_local_trs at each key.
+sp_result sp_animation_from_keys(const sp_rig* rig, const double* keys, const double* times, int nkeys, const char* name,
+                                 sp_animation* out, sp_error* err);
+
+#endif

@@ -1,0 +1,87 @@
+#include "report.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pose_io.h"
+
+static cJSON* terms_json(const sp_energy_terms* e)
+{
+    cJSON* o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "total", e->total);
+    cJSON_AddNumberToObject(o, "match", e->match);
+    cJSON_AddNumberToObject(o, "pose", e->pose);
+    cJSON_AddNumberToObject(o, "plane", e->plane);
+    cJSON_AddNumberToObject(o, "dist", e->dist);
+    return o;
+}
+
+cJSON* sp_report_to_json(const sp_solve_report* rep, const sp_rig* rig, const sp_abstraction* ab, const double* p)
+{
+    cJSON* o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "ms", rep->ms);
+    cJSON_AddNumberToObject(o, "iterations", rep->iterations);
+    cJSON_AddNumberToObject(o, "icp_rounds", rep->icp_rounds);
+    cJSON_AddStringToObject(o, "stopped", sp_stop_reason_name(rep->stopped));
+    cJSON_AddNumberToObject(o, "energy_before", rep->before.total);
+    cJSON_AddNumberToObject(o, "energy_after", rep->after.total);
+    cJSON_AddItemToObject(o, "terms_before", terms_json(&rep->before));
+    cJSON_AddItemToObject(o, "terms_after", terms_json(&rep->after));
+    cJSON_AddNumberToObject(o, "mean_error_px", rep->mean_error_px);
+    cJSON_AddNumberToObject(o, "max_error_px", rep->max_error_px);
+    cJSON_AddNumberToObject(o, "bbox_diagonal_px", rep->bbox_diagonal_px);
+    cJSON* curves = cJSON_AddArrayToObject(o, "curves");
+    for (int c = 0; c < rep->curve_count; ++c) {
+        cJSON* cv = cJSON_CreateObject();
+        cJSON_AddStringToObject(cv, "curve", ab && c < ab->curve_count ? ab->curves[c].name : "");
+        if (rep->curves[c].stroke >= 0) cJSON_AddNumberToObject(cv, "stroke", rep->curves[c].stroke);
+        else cJSON_AddNullToObject(cv, "stroke");
+        cJSON_AddBoolToObject(cv, "reversed", rep->curves[c].reversed);
+        cJSON_AddNumberToObject(cv, "mean_error_px", rep->curves[c].mean_px);
+        cJSON_AddNumberToObject(cv, "max_error_px", rep->curves[c].max_px);
+        cJSON_AddItemToArray(curves, cv);
+    }
+    cJSON_AddNumberToObject(o, "unused_strokes", rep->unused_strokes);
+    cJSON_AddStringToObject(o, "note", rep->note);
+    if (rig && p) {
+        cJSON* pose = sp_pose_to_json(rig, p);
+        cJSON* params = cJSON_DetachItemFromObject(pose, "parameters");
+        cJSON_AddItemToObject(o, "parameters", params ? params : cJSON_CreateObject());
+        cJSON_Delete(pose);
+    }
+    return o;
+}
+
+void sp_json_print(const cJSON* j)
+{
+    char* s = cJSON_Print(j);
+    if (s) {
+        fputs(s, stdout);
+        fputc('\n', stdout);
+        fflush(stdout);
+    }
+    free(s);
+}
+
+sp_result sp_json_write_file(const char* path, const cJSON* j, sp_error* err)
+{
+    if (!strcmp(path, "-")) {
+        sp_json_print(j);
+        return SP_OK;
+    }
+    char* s = cJSON_Print(j);
+    if (!s) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while writing JSON", path);
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp%d", path, (int)getpid());
+    FILE* f = fopen(tmp, "wb");
+    bool ok = f && fputs(s, f) >= 0 && fputc('\n', f) != EOF;
+    if (f && fclose(f) != 0) ok = false;
+    free(s);
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        return sp_fail(err, SP_ERR_IO, "%s: cannot write the file", path);
+    }
+    return SP_OK;
+}

@@ -1,0 +1,163 @@
+// tests/bench/solver: solves to convergence on rigs of the paper's Table 1
+// dimensions, one thread, median of N solves (each a different seeded
+// target pose, amplitude 45 degrees, from the rest pose).
+//   build/tests/bench/solver [--json] [--runs N]
+//   build/tests/bench/solver --recovery [--json] [--cases N]
+// --recovery runs the recovery protocol instead: N seeded targets
+// per rig (chain fixture, CesiumMan and RiggedFigure with derived stick
+// figures when ../shared/data is present) and reports the share within 1%
+// mean 2D error of the abstraction's diagonal, and the median and 95th
+// percentile of that relative error.
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench.h"
+#include "fixtures.h"
+#include "sp/gltf.h"
+#include "sp/solver.h"
+#include "sp/synth.h"
+#include "test.h"
+
+typedef struct bench_case {
+    const char* name;
+    double paper_ms, target_ms;
+    sp_fixture_desc desc;
+} bench_case;
+
+typedef struct outcome {
+    double* ms;
+    double* rel; // mean error / diagonal
+    int n;
+} outcome;
+
+static void run_solves(const sp_rig* rig, const sp_camera* cam, int first_seed, int n, outcome* o)
+{
+    int P = rig->param_count;
+    double* truth = malloc(sizeof(double) * P);
+    double* out = malloc(sizeof(double) * P);
+    sp_solver* s = sp_solver_create(rig, 0, cam, &(sp_solve_desc){0});
+    o->ms = malloc(sizeof(double) * n);
+    o->rel = malloc(sizeof(double) * n);
+    o->n = n;
+    for (int i = 0; i < n; ++i) {
+        sp_synth_params(rig, (uint64_t)(first_seed + i), 0.7853981633974483, truth);
+        sp_sketch sk;
+        sp_synth_sketch(rig, 0, cam, truth, &sk);
+        sp_solve_report rep;
+        sp_error err = {0};
+        if (sp_solver_solve(s, &sk, NULL, out, &rep, &err) != SP_OK) fprintf(stderr, "solve failed: %s\n", err.text);
+        o->ms[i] = rep.ms;
+        o->rel[i] = rep.mean_error_px / rep.bbox_diagonal_px;
+        sp_sketch_free(&sk);
+    }
+    sp_solver_destroy(s);
+    free(truth), free(out);
+}
+
+static int within(const outcome* o, double tol)
+{
+    int k = 0;
+    for (int i = 0; i < o->n; ++i) k += o->rel[i] <= tol;
+    return k;
+}
+
+static sp_bench_row row_for(const char* name, const sp_rig* rig, outcome* o, double paper, double target)
+{
+    sp_bench_row r = {.runs = o->n, .paper_ms = paper, .target_ms = target};
+    snprintf(r.name, sizeof r.name, "%s", name);
+    int ok = within(o, 0.01);
+    sp_bench_stats(o->ms, o->n, &r.ms_median, &r.ms_p90);
+    int coords = 2 * rig->abstractions[0].point_count;
+    snprintf(r.extra, sizeof r.extra, "\"parameters\": %d, \"mesh_coordinates\": %d, \"abstraction_coordinates\": %d, \"within_1pct\": %d",
+             rig->param_count, 3 * rig->vertex_count, coords, ok);
+    return r;
+}
+
+static sp_camera camera_for(const sp_rig* rig)
+{
+    return sp_camera_default_view(rig->rest, rig->vertex_count, 640, 480);
+}
+
+static void recovery(int cases, bool json)
+{
+    sp_bench_row rows[8];
+    int nr = 0;
+    const char* data = sp_test_data_dir();
+    const char* models[3] = {NULL, "CesiumMan/CesiumMan.glb", "RiggedFigure/RiggedFigure.glb"};
+    for (int m = 0; m < 3; ++m) {
+        sp_character ch = {0};
+        sp_rig fixture;
+        const sp_rig* rig = NULL;
+        sp_camera cam;
+        if (m == 0) {
+            sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 6, .seed = 3}, &fixture);
+            rig = &fixture;
+            cam = camera_for(rig);
+        } else {
+            if (!data) continue;
+            char path[1024];
+            sp_error err = {0};
+            snprintf(path, sizeof path, "%s/gltf/%s", data, models[m]);
+            if (sp_gltf_load(path, &ch, &err) != SP_OK) {
+                fprintf(stderr, "%s\n", err.text);
+                continue;
+            }
+            rig = &ch.rig;
+            cam = ch.camera;
+        }
+        outcome o;
+        run_solves(rig, &cam, 1, cases, &o);
+        sp_bench_row r = row_for(m == 0 ? "recovery: chain fixture (6 joints, stick)" : (m == 1 ? "recovery: CesiumMan (derived stick)" : "recovery: RiggedFigure (derived stick)"), rig, &o, -1, -1);
+        double med, p95;
+        double* rel = o.rel;
+        sp_bench_stats(rel, o.n, &med, &p95);
+        int k95 = (int)(0.95 * (o.n - 1) + 0.5);
+        p95 = rel[k95]; // rel is sorted by sp_bench_stats
+        snprintf(r.extra + strlen(r.extra), sizeof r.extra - strlen(r.extra), ", \"error_median_pct\": %.3f, \"error_p95_pct\": %.3f", 100 * med, 100 * p95);
+        if (!json) printf("%-44s within 1%%: %d/%d  error median %.3f%%  p95 %.3f%%  solve median %.1f ms\n", r.name, within(&o, 0.01) , o.n, 100 * med, 100 * p95, r.ms_median);
+        rows[nr++] = r;
+        free(o.ms), free(o.rel);
+        if (m == 0) sp_rig_free(&fixture);
+        sp_character_free(&ch);
+    }
+    if (json) sp_bench_print("", rows, nr, true);
+}
+
+int main(int argc, char** argv)
+{
+    int runs = 20, cases = 100;
+    bool json = sp_bench_json_flag(argc, argv), rec = false;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--runs") && i + 1 < argc) runs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--cases") && i + 1 < argc) cases = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--recovery")) rec = true;
+    }
+    if (runs < 3) runs = 3;
+    if (cases < 1) cases = 1;
+    if (rec) {
+        recovery(cases, json);
+        return 0;
+    }
+    // Synthetic rigs with the dimensions of the paper's Table 1 rows.
+    const bench_case cs[] = {
+        {"dragon-sized (25 p, closest)", 100, 5, {.joint_count = 8, .root_scale = true, .rings_per_bone = 46, .ring_vertices = 48, .stick_points = 14, .closest = true, .seed = 1}},
+        {"humanoid-sized stick (91 p, ordered)", 260, 15, {.joint_count = 30, .branching = true, .root_scale = true, .rings_per_bone = 7, .ring_vertices = 11, .stick_points = 7, .seed = 2}},
+        {"humanoid-sized outline (91 p, closest)", 373, 15, {.joint_count = 30, .branching = true, .root_scale = true, .rings_per_bone = 7, .ring_vertices = 11, .stick_points = 12, .closest = true, .seed = 2}},
+        {"elephant-sized (132 p, ordered)", 304, 20, {.joint_count = 44, .branching = true, .rings_per_bone = 6, .ring_vertices = 8, .stick_points = 3, .seed = 4}},
+    };
+    sp_bench_row rows[8];
+    int n = 0;
+    for (size_t c = 0; c < sizeof cs / sizeof cs[0]; ++c) {
+        sp_rig rig;
+        sp_fixture_tree_rig(&cs[c].desc, &rig);
+        sp_camera cam = camera_for(&rig);
+        outcome o;
+        run_solves(&rig, &cam, 1000, runs, &o);
+        rows[n++] = row_for(cs[c].name, &rig, &o, cs[c].paper_ms, cs[c].target_ms);
+        free(o.ms), free(o.rel);
+        sp_rig_free(&rig);
+    }
+    sp_bench_print("tests/bench/solver: solve to convergence, one thread (synthetic rigs of the paper's Table 1 dimensions)", rows, n, json);
+    return 0;
+}

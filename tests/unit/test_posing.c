@@ -1,0 +1,194 @@
+// Posing uses beyond a single solve: key-pose animations (animate) and
+// draw-over curves embedded in the mesh (drawover), in process and through
+// the command line on CesiumMan when ../shared/data is there.
+#include <cjson/cJSON.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fixtures.h"
+#include "posing.h"
+#include "sp/embed.h"
+#include "sp/gltf.h"
+#include "sp/solver.h"
+#include "sp/synth.h"
+#include "test.h"
+
+static sp_camera front_camera(const sp_rig* rig)
+{
+    return sp_camera_default_view(rig->rest, rig->vertex_count, 640, 480);
+}
+
+// The animation passes through every key: sampled at key times and turned
+// back into parameters it gives each key's parameters.
+static void check_animation_keys(const sp_rig* rig, const sp_animation* an, const double* keys, const double* times, int n, double tol)
+{
+    int P = rig->param_count, J = rig->joint_count;
+    sp_vec3* t = malloc(sizeof(sp_vec3) * J);
+    sp_quat* r = malloc(sizeof(sp_quat) * J);
+    sp_vec3* s = malloc(sizeof(sp_vec3) * J);
+    double* q = malloc(sizeof(double) * P);
+    for (int k = 0; k < n; ++k) {
+        for (int j = 0; j < J; ++j) t[j] = rig->joints[j].rest_t, r[j] = rig->joints[j].rest_r, s[j] = rig->joints[j].rest_s;
+        sp_animation_sample(an, times[k], t, r, s);
+        for (int j = 0; j < J; ++j) sp_rig_params_from_trs(rig, j, t[j], r[j], s[j], q);
+        for (int i = 0; i < P; ++i) ENSURE_NEAR(q[i], keys[(size_t)k * P + i], tol);
+    }
+    free(t), free(r), free(s), free(q);
+}
+
+static void test_animation_from_keys(void)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 6, .all_channels = true, .seed = 21}, &rig);
+    int P = rig.param_count, n = 4;
+    double* keys = malloc(sizeof(double) * P * n);
+    double times[4] = {0.0, 0.4, 1.0, 1.7};
+    for (int k = 0; k < n; ++k) sp_synth_params(&rig, 50 + k, 0.6, keys + (size_t)k * P);
+    sp_animation an;
+    sp_error err = {0};
+    ENSURE(sp_animation_from_keys(&rig, keys, times, n, "keys", &an, &err) == SP_OK);
+    ENSURE(an.channel_count > rig.joint_count);
+    ENSURE_NEAR(an.duration_s, 1.7, 1e-12);
+    check_animation_keys(&rig, &an, keys, times, n, 1e-5); // float storage
+    // Times that do not increase are refused.
+    sp_animation bad;
+    double t2[2] = {1.0, 1.0};
+    ENSURE(sp_animation_from_keys(&rig, keys, t2, 2, "bad", &bad, &err) == SP_ERR_INVALID);
+    rig.animations = malloc(sizeof(sp_animation));
+    rig.animations[0] = an;
+    rig.animation_count = 1;
+    free(keys);
+    sp_rig_free(&rig);
+}
+
+// Draw-over on the project's own chain: a curve along the last bone,
+// redrawn bent, bends it; the first bone stays put (W_dist, locality).
+static void test_drawover_fixture(void)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 5, .seed = 3, .ring_vertices = 16, .rings_per_bone = 8}, &rig);
+    sp_camera cam = front_camera(&rig);
+    int P = rig.param_count;
+    double* p0 = calloc(P, sizeof(double));
+    double* bent = calloc(P, sizeof(double));
+    double* p = calloc(P, sizeof(double));
+    sp_rig_defaults(&rig, p0);
+    memcpy(bent, p0, sizeof(double) * P);
+    bent[sp_rig_find_param(&rig, "j3.rz")] = 0.7;
+    // S1: the last bone's stick curve at rest; S2: the same at the bent pose.
+    sp_sketch s_rest, s_bent;
+    ENSURE(sp_synth_sketch(&rig, 0, &cam, p0, &s_rest) == SP_OK);
+    ENSURE(sp_synth_sketch(&rig, 0, &cam, bent, &s_bent) == SP_OK);
+    const sp_stroke* on = &s_rest.strokes[3];
+    sp_sketch to = {0};
+    sp_sketch_add_stroke(&to, s_bent.strokes[3].points, NULL, s_bent.strokes[3].count);
+    double* xyz = malloc(sizeof(double) * 3 * rig.vertex_count);
+    sp_rig_eval* ev = sp_rig_eval_create(&rig);
+    sp_rig_eval_update(ev, p0, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(&rig), xyz);
+    sp_abstraction emb;
+    sp_error err = {0};
+    ENSURE(sp_embed_curve(&rig, xyz, &cam, on->points, on->count, 32, "drawover", &emb, &err) == SP_OK);
+    int a = sp_rig_add_abstraction(&rig, &emb);
+    ENSURE(a == 1);
+    sp_solver* s = sp_solver_create(&rig, a, &cam, &(sp_solve_desc){0});
+    sp_solve_report rep;
+    ENSURE(sp_solver_solve(s, &to, p0, p, &rep, &err) == SP_OK);
+    ENSURE(rep.mean_error_px <= 0.02 * rep.bbox_diagonal_px);
+    // Vertices of the first bone (rings 0..7 of bone 0) barely move.
+    double* x1 = malloc(sizeof(double) * 3 * rig.vertex_count);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(&rig), x1);
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, rig.vertex_count, &lo, &hi);
+    double D = sp_v3_len(sp_v3_sub(hi, lo)), far = 0;
+    for (int v = 0; v < 8 * 16; ++v) far = fmax(far, sp_v3_len(sp_v3_sub(sp_v3(x1[3 * v], x1[3 * v + 1], x1[3 * v + 2]), sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]))));
+    fprintf(stderr, "  drawover fixture: mean error %.2f px (%.2f%%), far vertices moved %.3f%% of the size\n", rep.mean_error_px,
+            100 * rep.mean_error_px / rep.bbox_diagonal_px, 100 * far / D);
+    ENSURE(far <= 0.01 * D);
+    // A curve drawn beside the character is refused.
+    sp_vec2 off[2] = {{2, 2}, {30, 4}};
+    sp_abstraction none;
+    ENSURE(sp_embed_curve(&rig, xyz, &cam, off, 2, 16, "x", &none, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "not on the character"));
+    sp_solver_destroy(s);
+    sp_rig_eval_destroy(ev);
+    sp_abstraction_free(&emb);
+    sp_sketch_free(&s_rest), sp_sketch_free(&s_bent), sp_sketch_free(&to);
+    free(p0), free(bent), free(p), free(xyz), free(x1);
+    sp_rig_free(&rig);
+}
+
+// Runs a shell command; returns its exit status.
+static int run(const char* cmd)
+{
+    int rc = system(cmd);
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+static cJSON* read_json(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 22];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    return cJSON_Parse(buf);
+}
+
+// `sketchpose animate` with 4 keys on CesiumMan: the .glb's animation,
+// sampled at each key time, reproduces each key's fitted pose.
+static void test_animate_cli_cesiumman(void)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) SKIP("../shared/data absent");
+    char rig[1024], cmd[8192];
+    snprintf(rig, sizeof rig, "%s/gltf/CesiumMan/CesiumMan.glb", data);
+    const char* keys[4] = {sp_test_tmp_path("k0.json"), sp_test_tmp_path("k1.json"), sp_test_tmp_path("k2.json"), sp_test_tmp_path("k3.json")};
+    for (int k = 0; k < 4; ++k) {
+        snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed %d --amplitude 0.4 --out %s", SP_SKETCHPOSE, rig, 10 + k, keys[k]);
+        ENSURE(run(cmd) == 0);
+    }
+    const char* out = sp_test_tmp_path("anim.glb");
+    const char* rep = sp_test_tmp_path("anim_report.json");
+    snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s %s %s %s --times 0,0.5,1.25,2 --out %s --report %s > /dev/null", SP_SKETCHPOSE,
+             rig, keys[0], keys[1], keys[2], keys[3], out, rep);
+    ENSURE(run(cmd) == 0);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(out, &ch, &err) == SP_OK);
+    int an = -1;
+    for (int i = 0; i < ch.rig.animation_count; ++i)
+        if (!strcmp(ch.rig.animations[i].name, "sketchpose")) an = i;
+    ENSURE(an >= 0);
+    cJSON* reports = read_json(rep);
+    ENSURE(reports && cJSON_GetArraySize(reports) == 4);
+    int P = ch.rig.param_count;
+    double* keyp = malloc(sizeof(double) * P * 4);
+    double times[4] = {0, 0.5, 1.25, 2};
+    for (int k = 0; k < 4; ++k) {
+        cJSON* params = cJSON_GetObjectItem(cJSON_GetArrayItem(reports, k), "parameters");
+        for (int i = 0; i < P; ++i) {
+            cJSON* v = cJSON_GetObjectItem(params, ch.rig.params[i].name);
+            ENSURE(cJSON_IsNumber(v));
+            keyp[(size_t)k * P + i] = v->valuedouble;
+        }
+        cJSON* e = cJSON_GetObjectItem(cJSON_GetArrayItem(reports, k), "mean_error_px");
+        cJSON* d = cJSON_GetObjectItem(cJSON_GetArrayItem(reports, k), "bbox_diagonal_px");
+        ENSURE(e->valuedouble <= 0.01 * d->valuedouble);
+    }
+    check_animation_keys(&ch.rig, &ch.rig.animations[an], keyp, times, 4, 1e-4);
+    cJSON_Delete(reports);
+    free(keyp);
+    sp_character_free(&ch);
+}
+
+int main(int argc, char** argv)
+{
+    return sp_test_run(argc, argv, (sp_test[]){
+        {"animation_from_keys", test_animation_from_keys},
+        {"drawover_fixture", test_drawover_fixture},
+        {"animate_cli_cesiumman", test_animate_cli_cesiumman},
+        {0}});
+}
