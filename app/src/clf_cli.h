@@ -1,0 +1,78 @@
+/// clf_cli.h: what the classifier commands (train, eval, classify) share:
+/// training options on the command line, a terminal progress bar, JSON strings.
+/// Header-only so that it needs no build changes; included by cmd_train.c and cmd_eval.c.
+#ifndef SP_CLF_CLI_H
+#define SP_CLF_CLI_H
+
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "sp/classifier.h"
+
+/// Training options as flags; zero values mean the library defaults.
+typedef struct clf_cli_opts {
+    int words, knn, augment, soft, threads, seed;
+    bool no_pyramid, no_tfidf, no_hellinger, no_mirror;
+    double reject_quantile;
+} clf_cli_opts;
+
+#define CLF_CLI_OPTS(o)                                                                                         \
+    {"--words", SP_OPT_INT, &(o).words, "N", "vocabulary size (default 500)", false},                          \
+        {"--knn", SP_OPT_INT, &(o).knn, "K", "neighbours voting (default 8)", false},                          \
+        {"--soft", SP_OPT_INT, &(o).soft, "N", "words per descriptor, soft assignment (default 4)", false},    \
+        {"--augment", SP_OPT_INT, &(o).augment, "N", "jittered copies per training drawing (default 0)", false}, \
+        {"--no-pyramid", SP_OPT_FLAG, &(o).no_pyramid, "", "no 2x2 spatial pyramid", false},                 \
+        {"--no-tfidf", SP_OPT_FLAG, &(o).no_tfidf, "", "no tf-idf word weights", false},                               \
+        {"--no-hellinger", SP_OPT_FLAG, &(o).no_hellinger, "", "plain L2 between histograms", false},        \
+        {"--no-mirror", SP_OPT_FLAG, &(o).no_mirror, "", "do not add mirrored training drawings", false},    \
+        {"--reject-quantile", SP_OPT_DOUBLE, &(o).reject_quantile, "Q", "reject threshold quantile (0.98)", false}, \
+        {"--seed", SP_OPT_INT, &(o).seed, "S", "random seed (default 1)", false},                              \
+        {"--threads", SP_OPT_INT, &(o).threads, "T", "worker threads (default 2)", false}
+
+static inline sp_clf_desc clf_cli_desc(const clf_cli_opts* o)
+{
+    sp_clf_desc d = {0};
+    d.words = o->words;
+    d.knn = o->knn;
+    d.soft_neighbours = o->soft;
+    d.augment = o->augment;
+    d.pyramid = o->no_pyramid ? -1 : 0;
+    d.tfidf = o->no_tfidf ? -1 : 0;
+    d.hellinger = o->no_hellinger ? -1 : 0;
+    d.mirror = o->no_mirror ? -1 : 0;
+    d.reject_quantile = o->reject_quantile;
+    d.seed = (uint32_t)o->seed;
+    d.threads = o->threads;
+    return d;
+}
+
+/// Progress bar on stderr, drawn only when stderr is a terminal (user = const char* prefix).
+static inline void clf_cli_progress(void* user, const char* stage, int done, int total)
+{
+    if (total <= 0) return;
+    int step = total / 50 > 0 ? total / 50 : 1;
+    if (done != total && done % step != 0) return;
+    int fill = (int)(30.0 * done / total);
+    fprintf(stderr, "\r%s%-12s [%.*s%*s] %d/%d", user ? (const char*)user : "", stage, fill,
+            "##############################", 30 - fill, "", done, total);
+    if (done == total) fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static inline bool clf_cli_tty(void) { return isatty(fileno(stderr)) != 0; }
+
+/// Writes s as a JSON string.
+static inline void clf_cli_json_str(FILE* f, const char* s)
+{
+    fputc('"', f);
+    for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
+        if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+        else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
+        else fputc(*p, f);
+    }
+    fputc('"', f);
+}
+
+#endif

@@ -1,0 +1,57 @@
+// cmd_classify.c: sketchpose classify --model M --strokes S.json
+#include <math.h>
+
+#include "clf_cli.h"
+#include "sp/classifier.h"
+#include "sp/sketch_io.h"
+
+int cmd_classify(int argc, char** argv)
+{
+    const char* model = NULL;
+    const char* strokes = NULL;
+    int top = 5;
+    sp_opt opts[] = {
+        {"--model", SP_OPT_STRING, &model, "M", "trained model (sketchpose train)", true},
+        {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the drawing: stroke JSON, SVG, PNG or ndjson (first drawing)", true},
+        {"--top", SP_OPT_INT, &top, "N", "ranked categories to print (default 5, at most 10)", false},
+    };
+    int rc = sp_cli_parse(argc, argv, "sketchpose classify", "classify one drawing; prints ranked categories as JSON", opts,
+                          (int)(sizeof opts / sizeof opts[0]));
+    if (rc >= 0) return rc;
+    if (top < 1 || top > SP_CLF_MAX_RANKED) {
+        fprintf(stderr, "sketchpose classify: --top must be 1..%d\n", SP_CLF_MAX_RANKED);
+        return SP_EXIT_USAGE;
+    }
+    sp_error err = {0};
+    sp_clf* clf = NULL;
+    if (sp_clf_load(model, &clf, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose classify: %s\n", err.text);
+        return SP_EXIT_INPUT;
+    }
+    sp_sketch s;
+    sp_raster r;
+    if (sp_drawing_read(strokes, &s, &r, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose classify: %s\n", err.text);
+        sp_clf_free(clf);
+        return SP_EXIT_INPUT;
+    }
+    sp_clf_answer a;
+    sp_result res = sp_clf_classify(clf, &s, &r, &a, &err);
+    sp_sketch_free(&s);
+    sp_raster_free(&r);
+    if (res != SP_OK) {
+        fprintf(stderr, "sketchpose classify: %s: %s\n", strokes, err.text);
+        sp_clf_free(clf);
+        return SP_EXIT_INPUT;
+    }
+    printf("{\"ranked\": [");
+    for (int i = 0; i < a.count && i < top; ++i) {
+        printf("%s{\"category\": ", i ? ", " : "");
+        clf_cli_json_str(stdout, sp_clf_category(clf, a.ranked[i].category));
+        printf(", \"score\": %.4f}", a.ranked[i].score);
+    }
+    printf("], \"rejected\": %s, \"distance\": %.4f, \"reject_distance\": %.4f}\n", a.rejected ? "true" : "false", a.distance,
+           isfinite(a.reject_distance) ? a.reject_distance : -1.0);
+    sp_clf_free(clf);
+    return SP_EXIT_OK;
+}

@@ -1,0 +1,99 @@
+/// sp/classifier.h: which category did someone draw?
+///
+/// Eitz-style bag of features (Eitz, Hays, Alexa 2012): a drawing is fitted to a
+/// 256x256 frame, rasterised, described by 64-D local orientation descriptors on
+/// a 28x28 grid, soft-assigned to a k-means vocabulary and summarised as an
+/// L1-normalised histogram (optionally with a 1x1+2x2 spatial pyramid, tf-idf,
+/// and Hellinger-mapped). A FLANN k-nearest-neighbour search over the training
+/// histograms votes, weighted by distance, for ranked categories; a drawing
+/// farther from every training drawing than a threshold learned on the training
+/// set is rejected.
+///
+///     sp_dataset ds; sp_dataset_load("data/", &ds, &err);
+///     sp_clf* clf; sp_clf_train(&ds, NULL, &(sp_clf_desc){0}, &clf, &err);
+///     sp_clf_answer a; sp_clf_classify(clf, &sketch, NULL, &a, &err);
+///     printf("%s %.2f\n", sp_clf_category(clf, a.ranked[0].category), a.ranked[0].score);
+///     sp_clf_save(clf, "m.spclf", &err); sp_clf_free(clf);
+///
+/// A trained model is immutable: classification may run on several threads at once.
+#ifndef SP_CLASSIFIER_H
+#define SP_CLASSIFIER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sp/result.h"
+#include "sp/sketch.h"
+#include "sp/sketch_io.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Model file format version written by sp_clf_save; others are refused by sp_clf_load.
+#define SP_CLF_FILE_VERSION 1
+/// Most ranked categories in an answer.
+#define SP_CLF_MAX_RANKED 10
+
+typedef struct sp_clf sp_clf;
+
+/// Training options. Zero means the default; for switches 1 = on, -1 = off.
+typedef struct sp_clf_desc {
+    int words;              ///< vocabulary size (default 500)
+    int vocab_samples;      ///< descriptors sampled for k-means (default 50000)
+    int kmeans_iterations;  ///< Lloyd iterations after k-means++ seeding (default 10)
+    int soft_neighbours;    ///< words each descriptor is soft-assigned to (default 4; 1 = hard assignment)
+    int knn;                ///< neighbours voting at classification (default 8)
+    int pyramid;            ///< 1x1 + 2x2 spatial pyramid histograms (default on)
+    int tfidf;              ///< tf-idf word weighting (default on: +0.8 pt top-1 on quickdraw 5-fold)
+    int hellinger;          ///< square-root (Hellinger) map of the histograms before k-NN (default on)
+    int mirror;             ///< also train on left-right mirrored drawings (default on)
+    int augment;            ///< extra randomly jittered copies of each stroke drawing (default 0; -1 = none)
+    double reject_quantile; ///< reject beyond this quantile of training leave-one-out distances (default 0.98)
+    uint32_t seed;          ///< every random choice derives from it (default 1)
+    int threads;            ///< worker threads (default 2)
+    /// Progress report (may be NULL): stage name, done of total.
+    void (*progress)(void* user, const char* stage, int done, int total);
+    void* progress_user;
+} sp_clf_desc;
+
+/// One ranked category: index into the model's categories, and its vote share in [0, 1].
+typedef struct sp_clf_rank {
+    int category;
+    float score;
+} sp_clf_rank;
+
+/// A classification: categories by decreasing score (scores sum to <= 1).
+typedef struct sp_clf_answer {
+    int count; ///< ranked entries (categories that got votes, at most SP_CLF_MAX_RANKED)
+    sp_clf_rank ranked[SP_CLF_MAX_RANKED];
+    bool rejected;         ///< nothing in the training set is close: ask again
+    float distance;        ///< histogram distance to the nearest training drawing
+    float reject_distance; ///< the model's threshold for `rejected`
+} sp_clf_answer;
+
+/// Trains on the samples of `data` whose `use[i]` is non-zero (`use` NULL: all).
+/// Categories are data's categories (those without samples simply never win).
+sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const sp_clf_desc* desc, sp_clf** out, sp_error* err);
+/// Classifies strokes, or (when `sketch` is NULL or empty) a raster. Bad drawings
+/// (empty, non-finite, too many points) fail with a one-line message.
+sp_result sp_clf_classify(const sp_clf* clf, const sp_sketch* sketch, const sp_raster* raster, sp_clf_answer* out, sp_error* err);
+/// Saves with a version header and a checksum.
+sp_result sp_clf_save(const sp_clf* clf, const char* path, sp_error* err);
+/// Loads a model; a corrupt, truncated or other-version file is refused with a clear message.
+sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err);
+/// Frees the model (NULL is fine).
+void sp_clf_free(sp_clf* clf);
+
+/// Number of categories and the name of one.
+int sp_clf_category_count(const sp_clf* clf);
+const char* sp_clf_category(const sp_clf* clf, int i);
+/// The options the model was trained with, defaults resolved (progress callback NULL).
+sp_clf_desc sp_clf_get_desc(const sp_clf* clf);
+/// The training-time options with defaults resolved (what a zero field means).
+sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* desc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,861 @@
+// classifier.c: vocabulary, soft-assigned histograms, FLANN k-NN voting,
+// rejection, and the model file.
+#include "sp/classifier.h"
+
+#include <errno.h>
+#include <flann/flann.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "feat.h"
+#include "kmeans.h"
+
+struct sp_clf {
+    sp_clf_desc desc; // resolved, progress NULL
+    int category_count;
+    char** categories;
+    int words;    // vocabulary size actually used
+    float* vocab; // words by 64
+    float* vnorm; // words squared norms
+    float sigma;  // soft-assignment kernel width (descriptor distance)
+    int hist_dim; // words * (pyramid ? 5 : 1)
+    float* idf;   // words, or NULL
+    int train_count;
+    float* hists;    // train_count by hist_dim (final, mapped)
+    int* labels;     // train_count
+    float bandwidth; // voting kernel width (histogram distance)
+    float reject;    // reject beyond this nearest distance
+    flann_index_t vocab_index;
+    flann_index_t hist_index;
+    struct FLANNParameters vocab_params;
+    struct FLANNParameters hist_params;
+};
+
+sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
+{
+    sp_clf_desc r = d ? *d : (sp_clf_desc){0};
+    if (r.words <= 0) r.words = 500;
+    if (r.vocab_samples <= 0) r.vocab_samples = 50000;
+    if (r.kmeans_iterations <= 0) r.kmeans_iterations = 10;
+    if (r.soft_neighbours <= 0) r.soft_neighbours = 4;
+    if (r.soft_neighbours > 16) r.soft_neighbours = 16;
+    if (r.knn <= 0) r.knn = 8;
+    if (r.knn > 64) r.knn = 64;
+    if (r.pyramid == 0) r.pyramid = 1;
+    if (r.tfidf == 0) r.tfidf = 1;
+    if (r.hellinger == 0) r.hellinger = 1;
+    if (r.mirror == 0) r.mirror = 1;
+    if (r.augment <= 0) r.augment = 0;
+    if (r.augment > 16) r.augment = 16;
+    if (!(r.reject_quantile > 0.0 && r.reject_quantile <= 1.0)) r.reject_quantile = 0.98;
+    if (r.seed == 0) r.seed = 1;
+    if (r.threads <= 0) r.threads = 2;
+    return r;
+}
+
+int sp_clf_category_count(const sp_clf* clf)
+{
+    return clf->category_count;
+}
+const char* sp_clf_category(const sp_clf* clf, int i)
+{
+    return i >= 0 && i < clf->category_count ? clf->categories[i] : "?";
+}
+sp_clf_desc sp_clf_get_desc(const sp_clf* clf)
+{
+    return clf->desc;
+}
+
+void sp_clf_free(sp_clf* clf)
+{
+    if (!clf) return;
+    if (clf->vocab_index) flann_free_index_float(clf->vocab_index, &clf->vocab_params);
+    if (clf->hist_index) flann_free_index_float(clf->hist_index, &clf->hist_params);
+    for (int i = 0; i < clf->category_count; ++i)
+        free(clf->categories[i]);
+    free(clf->categories);
+    free(clf->vocab);
+    free(clf->vnorm);
+    free(clf->idf);
+    free(clf->hists);
+    free(clf->labels);
+    free(clf);
+}
+
+// ---------------------------------------------------------------------------
+// Indices
+
+static sp_result build_vocab_index(sp_clf* c, sp_error* err)
+{
+    free(c->vnorm);
+    if (!(c->vnorm = malloc(sizeof(float) * (size_t)c->words))) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    for (int w = 0; w < c->words; ++w) {
+        float s = 0.0f;
+        for (int d = 0; d < SP_FEAT_DIM; ++d)
+            s += c->vocab[(size_t)w * SP_FEAT_DIM + d] * c->vocab[(size_t)w * SP_FEAT_DIM + d];
+        c->vnorm[w] = s;
+    }
+    struct FLANNParameters p = DEFAULT_FLANN_PARAMETERS;
+    // Why the single kd-tree: FLANN 1.9's randomised trees shuffle with
+    // std::random_device, so their (approximate) answers differ from run to run.
+    p.algorithm = FLANN_INDEX_KDTREE_SINGLE;
+    p.leaf_max_size = 8;
+    p.checks = 64;
+    p.cores = 1;
+    p.log_level = FLANN_LOG_NONE;
+    p.random_seed = (long)(c->desc.seed & 0x7fffffff) + 7;
+    c->vocab_params = p;
+    float speedup;
+    c->vocab_index = flann_build_index_float(c->vocab, c->words, SP_FEAT_DIM, &speedup, &c->vocab_params);
+    if (!c->vocab_index) return sp_fail(err, SP_ERR_INTERNAL, "FLANN: vocabulary index build failed");
+    return SP_OK;
+}
+
+static sp_result build_hist_index(sp_clf* c, sp_error* err)
+{
+    struct FLANNParameters p = DEFAULT_FLANN_PARAMETERS;
+    // Why exact search: a few thousand histograms are searched in about a
+    // millisecond, and approximate neighbours would make votes (and tests) flaky.
+    p.algorithm = c->train_count > 20000 ? FLANN_INDEX_KDTREE_SINGLE : FLANN_INDEX_LINEAR;
+    p.leaf_max_size = 8;
+    p.checks = 512;
+    p.cores = 1;
+    p.log_level = FLANN_LOG_NONE;
+    p.random_seed = (long)(c->desc.seed & 0x7fffffff) + 11;
+    c->hist_params = p;
+    float speedup;
+    c->hist_index = flann_build_index_float(c->hists, c->train_count, c->hist_dim, &speedup, &c->hist_params);
+    if (!c->hist_index) return sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram index build failed");
+    return SP_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Histograms
+
+// Raw soft-assigned word counts of one drawing: level 0 (words) then, with the
+// pyramid, the 2x2 cells (4 * words). raw: hist_dim floats.
+static sp_result raw_hist(const sp_clf* c, sp_features* f, float* raw, sp_error* err)
+{
+    const int K = c->words;
+    int nn = c->desc.soft_neighbours < K ? c->desc.soft_neighbours : K;
+    memset(raw, 0, sizeof(float) * (size_t)c->hist_dim);
+    int* idx = malloc(sizeof(int) * (size_t)f->count * nn);
+    float* d2 = malloc(sizeof(float) * (size_t)f->count * nn);
+    if (!idx || !d2) {
+        free(idx);
+        free(d2);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    sp_nearest_words(c->vocab, c->vnorm, K, f->desc, f->count, nn, idx, d2);
+    const float inv2s2 = 1.0f / (2.0f * c->sigma * c->sigma);
+    for (int i = 0; i < f->count; ++i) {
+        float w[16], sum = 0.0f;
+        const int* id = idx + (size_t)i * nn;
+        const float* dd = d2 + (size_t)i * nn;
+        // Relative to the nearest word, so that a far-away descriptor still counts once.
+        for (int j = 0; j < nn; ++j) {
+            w[j] = id[j] >= 0 && id[j] < K ? expf(-(dd[j] - dd[0]) * inv2s2) : 0.0f;
+            sum += w[j];
+        }
+        if (!(sum > 0.0f)) continue;
+        int cell = (f->pos[2 * i] >= 0.5f) + 2 * (f->pos[2 * i + 1] >= 0.5f);
+        for (int j = 0; j < nn; ++j) {
+            if (w[j] == 0.0f) continue;
+            float v = w[j] / sum;
+            raw[id[j]] += v;
+            if (c->desc.pyramid > 0) raw[K * (1 + cell) + id[j]] += v;
+        }
+    }
+    free(idx);
+    free(d2);
+    return SP_OK;
+}
+
+// idf weighting, L1 normalisation per pyramid level, Hellinger map.
+static void finish_hist(const sp_clf* c, const float* raw, float* out)
+{
+    const int K = c->words;
+    int levels = c->desc.pyramid > 0 ? 2 : 1;
+    for (int l = 0; l < levels; ++l) {
+        int b = l == 0 ? 0 : K, e = l == 0 ? K : 5 * K;
+        double s = 0.0;
+        for (int i = b; i < e; ++i) {
+            float v = raw[i] * (c->idf ? c->idf[(i - b) % K] : 1.0f);
+            out[i] = v;
+            s += v;
+        }
+        float scale = s > 0.0 ? (float)((levels == 1 ? 1.0 : 0.5) / s) : 0.0f;
+        for (int i = b; i < e; ++i) {
+            out[i] *= scale;
+            if (c->desc.hellinger > 0) out[i] = sqrtf(out[i]);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Voting
+
+static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, sp_clf_answer* a)
+{
+    memset(a, 0, sizeof *a);
+    float* score = calloc((size_t)c->category_count, sizeof(float));
+    a->distance = nn > 0 ? sqrtf(fmaxf(d2[0], 0.0f)) : INFINITY;
+    a->reject_distance = c->reject;
+    a->rejected = !(a->distance <= c->reject);
+    if (!score) return;
+    const float inv = 1.0f / (2.0f * c->bandwidth * c->bandwidth);
+    double total = 0.0;
+    for (int j = 0; j < nn; ++j) {
+        if (idx[j] < 0 || idx[j] >= c->train_count) continue;
+        float w = expf(-(fmaxf(d2[j], 0.0f) - fmaxf(d2[0], 0.0f)) * inv);
+        score[c->labels[idx[j]]] += w;
+        total += w;
+    }
+    for (int r = 0; r < SP_CLF_MAX_RANKED; ++r) {
+        int best = -1;
+        for (int k = 0; k < c->category_count; ++k)
+            if (score[k] > 0.0f && (best < 0 || score[k] > score[best])) best = k;
+        if (best < 0) break;
+        a->ranked[a->count++] = (sp_clf_rank){best, total > 0 ? (float)(score[best] / total) : 0.0f};
+        score[best] = 0.0f;
+    }
+    free(score);
+}
+
+static sp_result classify_hist(const sp_clf* c, float* hist, sp_clf_answer* out, sp_error* err)
+{
+    int nn = c->desc.knn < c->train_count ? c->desc.knn : c->train_count;
+    int idx[64];
+    float d2[64];
+    struct FLANNParameters p = c->hist_params;
+    if (flann_find_nearest_neighbors_index_float(c->hist_index, hist, 1, idx, d2, nn, &p) < 0)
+        return sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram search failed");
+    vote(c, idx, d2, nn, out);
+    return SP_OK;
+}
+
+sp_result sp_clf_classify(const sp_clf* c, const sp_sketch* sketch, const sp_raster* raster, sp_clf_answer* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    sp_features* f = malloc(sizeof *f);
+    float* raw = malloc(sizeof(float) * (size_t)c->hist_dim * 2);
+    sp_result rc = (!f || !raw) ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : SP_OK;
+    if (rc == SP_OK) rc = sp_feat_extract(sketch, raster, f, err);
+    if (rc == SP_OK) rc = raw_hist(c, f, raw, err);
+    if (rc == SP_OK) {
+        finish_hist(c, raw, raw + c->hist_dim);
+        rc = classify_hist(c, raw + c->hist_dim, out, err);
+    }
+    free(f);
+    free(raw);
+    return rc;
+}
+
+// ---------------------------------------------------------------------------
+// Training
+
+typedef struct job {
+    int sample;  // index into the dataset
+    int variant; // 0 original, 1 mirrored, 2.. jittered
+} job;
+
+typedef struct train_ctx {
+    const sp_dataset* data;
+    sp_clf* clf;
+    const job* jobs;
+    int job_count;
+    int per_job;       // pass 1: descriptors kept per drawing
+    float* sample;     // job_count * per_job * 64
+    int* sample_n;     // kept per job
+    float* raw;        // pass 2: job_count * hist_dim
+    sp_result* status; // per job
+    sp_error* errs;    // per job
+    int pass;
+    atomic_int done;
+    pthread_mutex_t lock;
+} train_ctx;
+
+// The drawing a job trains on: the sample itself, mirrored, or a jittered copy.
+static sp_result job_drawing(const train_ctx* t, const job* j, sp_sketch* sk, sp_raster* r, bool* owned)
+{
+    const sp_sample* s = &t->data->samples[j->sample];
+    *owned = false;
+    if (j->variant == 0) {
+        *sk = s->sketch;
+        *r = s->raster;
+        return SP_OK;
+    }
+    *owned = true;
+    memset(r, 0, sizeof *r);
+    memset(sk, 0, sizeof *sk);
+    if (s->sketch.stroke_count == 0) { // raster: only mirroring
+        size_t n = (size_t)s->raster.w * s->raster.h;
+        r->pixels = malloc(n ? n : 1);
+        if (!r->pixels) return SP_ERR_NO_MEMORY;
+        r->w = s->raster.w;
+        r->h = s->raster.h;
+        for (int y = 0; y < r->h; ++y)
+            for (int x = 0; x < r->w; ++x)
+                r->pixels[(size_t)y * r->w + x] = s->raster.pixels[(size_t)y * r->w + (r->w - 1 - x)];
+        return SP_OK;
+    }
+    if (sp_sketch_clone(&s->sketch, sk) != SP_OK) return SP_ERR_NO_MEMORY;
+    double m[4] = {-1, 0, 0, 1}; // mirror
+    if (j->variant >= 2) {
+        uint64_t rng = t->clf->desc.seed * 0x9e3779b97f4a7c15ull ^ ((uint64_t)j->sample << 20) ^ (uint64_t)j->variant;
+        sp_rng_next(&rng);
+        double ang = (sp_rng_uniform(&rng) * 2 - 1) * 12.0 * M_PI / 180.0;
+        double sx = 0.85 + 0.3 * sp_rng_uniform(&rng), sy = 0.85 + 0.3 * sp_rng_uniform(&rng);
+        double sh = (sp_rng_uniform(&rng) * 2 - 1) * 0.1;
+        double flip = (t->clf->desc.mirror > 0 && sp_rng_uniform(&rng) < 0.5) ? -1.0 : 1.0;
+        double cs = cos(ang), sn = sin(ang);
+        // R * Shear * S * Flip
+        double a = sx * flip, b = sh * sy, d = sy;
+        m[0] = cs * a;
+        m[1] = cs * b - sn * d;
+        m[2] = sn * a;
+        m[3] = sn * b + cs * d;
+    }
+    for (int i = 0; i < sk->stroke_count; ++i)
+        for (int k = 0; k < sk->strokes[i].count; ++k) {
+            sp_vec2 p = sk->strokes[i].points[k];
+            sk->strokes[i].points[k] = (sp_vec2){m[0] * p.x + m[1] * p.y, m[2] * p.x + m[3] * p.y};
+        }
+    return SP_OK;
+}
+
+static int train_job(void* user, int i)
+{
+    train_ctx* t = user;
+    const job* j = &t->jobs[i];
+    sp_sketch sk;
+    sp_raster r;
+    bool owned;
+    sp_result rc = job_drawing(t, j, &sk, &r, &owned);
+    sp_features* f = rc == SP_OK ? malloc(sizeof *f) : NULL;
+    if (rc != SP_OK || !f) rc = sp_fail(&t->errs[i], SP_ERR_NO_MEMORY, "out of memory");
+    if (rc == SP_OK) rc = sp_feat_extract(&sk, &r, f, &t->errs[i]);
+    if (rc == SP_OK && t->pass == 1) {
+        // A seeded partial shuffle picks this drawing's share of the vocabulary sample.
+        uint64_t rng = t->clf->desc.seed ^ ((uint64_t)(i + 1) * 0xd1b54a32d192ed03ull);
+        int keep = f->count < t->per_job ? f->count : t->per_job;
+        int order[SP_FEAT_MAX];
+        for (int k = 0; k < f->count; ++k)
+            order[k] = k;
+        for (int k = 0; k < keep; ++k) {
+            int o = k + (int)(sp_rng_next(&rng) % (uint64_t)(f->count - k));
+            int tmp = order[k];
+            order[k] = order[o];
+            order[o] = tmp;
+            memcpy(t->sample + ((size_t)i * t->per_job + k) * SP_FEAT_DIM, f->desc + (size_t)order[k] * SP_FEAT_DIM,
+                   sizeof(float) * SP_FEAT_DIM);
+        }
+        t->sample_n[i] = keep;
+    } else if (rc == SP_OK) {
+        rc = raw_hist(t->clf, f, t->raw + (size_t)i * t->clf->hist_dim, &t->errs[i]);
+    }
+    free(f);
+    if (owned) {
+        sp_sketch_free(&sk);
+        sp_raster_free(&r);
+    }
+    t->status[i] = rc;
+    int done = atomic_fetch_add(&t->done, 1) + 1;
+    if (t->clf->desc.progress) {
+        pthread_mutex_lock(&t->lock);
+        t->clf->desc.progress(t->clf->desc.progress_user, t->pass == 1 ? "descriptors" : "histograms", done, t->job_count);
+        pthread_mutex_unlock(&t->lock);
+    }
+    // Bad drawings (empty, NaN) are skipped; running out of memory or a library failure stops training.
+    return rc == SP_ERR_NO_MEMORY || rc == SP_ERR_INTERNAL ? (int)rc : 0;
+}
+
+typedef struct loo_ctx {
+    const sp_clf* c;
+    const int* src;
+    int q;
+    float* out; // per training histogram: distance to the nearest other drawing, -1 if skipped
+} loo_ctx;
+
+static int loo_one(void* user, int i)
+{
+    loo_ctx* l = user;
+    const sp_clf* c = l->c;
+    l->out[i] = -1.0f;
+    if (i > 0 && l->src[i] == l->src[i - 1]) return 0; // one query per original drawing
+    int idx[64];
+    float d2[64];
+    struct FLANNParameters p = c->hist_params;
+    if (flann_find_nearest_neighbors_index_float(c->hist_index, c->hists + (size_t)i * c->hist_dim, 1, idx, d2, l->q, &p) < 0)
+        return 1;
+    for (int j = 0; j < l->q; ++j)
+        if (idx[j] >= 0 && idx[j] < c->train_count && l->src[idx[j]] != l->src[i]) {
+            l->out[i] = sqrtf(fmaxf(d2[j], 0.0f));
+            break;
+        }
+    return 0;
+}
+
+static int cmp_float(const void* a, const void* b)
+{
+    float x = *(const float*)a, y = *(const float*)b;
+    return (x > y) - (x < y);
+}
+
+sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const sp_clf_desc* desc, sp_clf** out, sp_error* err)
+{
+    *out = NULL;
+    sp_clf* c = calloc(1, sizeof *c);
+    train_ctx t = {.data = data, .clf = c};
+    job* jobs = NULL;
+    sp_result rc = SP_OK;
+    float* sample = NULL;
+    int* src = NULL;
+    float* loo = NULL;
+    if (!c) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    c->desc = sp_clf_desc_defaults(desc);
+    pthread_mutex_init(&t.lock, NULL);
+    c->categories = calloc((size_t)(data->category_count ? data->category_count : 1), sizeof(char*));
+    if (!c->categories) goto oom;
+    for (int i = 0; i < data->category_count; ++i) {
+        if (!(c->categories[i] = strdup(data->categories[i]))) goto oom;
+        c->category_count = i + 1;
+    }
+    int per_sample = 1 + (c->desc.mirror > 0) + c->desc.augment;
+    jobs = malloc(sizeof(job) * (size_t)(data->count ? data->count : 1) * per_sample);
+    if (!jobs) goto oom;
+    int nj = 0;
+    for (int i = 0; i < data->count; ++i) {
+        const sp_sample* s = &data->samples[i];
+        if ((use && !use[i]) || s->label < 0 || s->label >= data->category_count) continue;
+        jobs[nj++] = (job){i, 0};
+        if (c->desc.mirror > 0) jobs[nj++] = (job){i, 1};
+        if (s->sketch.stroke_count > 0)
+            for (int a = 0; a < c->desc.augment; ++a)
+                jobs[nj++] = (job){i, 2 + a};
+    }
+    if (nj == 0) {
+        rc = sp_fail(err, SP_ERR_INVALID, "no training drawings");
+        goto fail;
+    }
+    t.jobs = jobs;
+    t.job_count = nj;
+    t.per_job = (c->desc.vocab_samples + nj - 1) / nj;
+    if (t.per_job > SP_FEAT_MAX) t.per_job = SP_FEAT_MAX;
+    t.sample = malloc(sizeof(float) * (size_t)nj * t.per_job * SP_FEAT_DIM);
+    t.sample_n = calloc((size_t)nj, sizeof(int));
+    t.status = calloc((size_t)nj, sizeof(sp_result));
+    t.errs = calloc((size_t)nj, sizeof(sp_error));
+    if (!t.sample || !t.sample_n || !t.status || !t.errs) goto oom;
+
+    // Pass 1: a sample of descriptors for the vocabulary.
+    t.pass = 1;
+    atomic_init(&t.done, 0);
+    int bad = sp_parallel_for(nj, c->desc.threads, train_job, &t);
+    if (bad) {
+        for (int i = 0; i < nj; ++i)
+            if (t.status[i] == (sp_result)bad) {
+                rc = sp_fail(err, (sp_result)bad, "training drawing %d: %s", jobs[i].sample, t.errs[i].text);
+                break;
+            }
+        goto fail;
+    }
+    int total = 0;
+    for (int i = 0; i < nj; ++i)
+        total += t.status[i] == SP_OK ? t.sample_n[i] : 0;
+    if (total == 0) {
+        rc = sp_fail(err, SP_ERR_INVALID, "no training drawing has any ink (first problem: %s)", t.errs[0].text);
+        goto fail;
+    }
+    sample = malloc(sizeof(float) * (size_t)total * SP_FEAT_DIM);
+    if (!sample) goto oom;
+    int at = 0;
+    for (int i = 0; i < nj; ++i) {
+        if (t.status[i] != SP_OK) continue;
+        memcpy(sample + (size_t)at * SP_FEAT_DIM, t.sample + (size_t)i * t.per_job * SP_FEAT_DIM,
+               sizeof(float) * SP_FEAT_DIM * (size_t)t.sample_n[i]);
+        at += t.sample_n[i];
+    }
+    free(t.sample);
+    t.sample = NULL;
+
+    c->words = c->desc.words < total ? c->desc.words : total;
+    c->vocab = malloc(sizeof(float) * (size_t)c->words * SP_FEAT_DIM);
+    if (!c->vocab) goto oom;
+    if (c->desc.progress) c->desc.progress(c->desc.progress_user, "vocabulary", 0, 1);
+    rc = sp_kmeans(sample, total, SP_FEAT_DIM, c->words, c->desc.seed, c->desc.kmeans_iterations, c->desc.threads, c->vocab, err);
+    if (rc != SP_OK) goto fail;
+    if ((rc = build_vocab_index(c, err)) != SP_OK) goto fail;
+    {
+        // Soft-assignment width: the median distance of a descriptor to its nearest word.
+        int* idx = malloc(sizeof(int) * (size_t)total);
+        float* d2 = malloc(sizeof(float) * (size_t)total);
+        if (!idx || !d2) {
+            free(idx);
+            free(d2);
+            goto oom;
+        }
+        sp_nearest_words(c->vocab, c->vnorm, c->words, sample, total, 1, idx, d2);
+        qsort(d2, (size_t)total, sizeof(float), cmp_float);
+        c->sigma = sqrtf(fmaxf(d2[total / 2], 0.0f));
+        if (!(c->sigma > 1e-3f)) c->sigma = 1e-3f;
+        free(idx);
+        free(d2);
+    }
+    if (c->desc.progress) c->desc.progress(c->desc.progress_user, "vocabulary", 1, 1);
+    free(sample);
+    sample = NULL;
+
+    // Pass 2: histograms.
+    c->hist_dim = c->words * (c->desc.pyramid > 0 ? 5 : 1);
+    t.raw = malloc(sizeof(float) * (size_t)nj * c->hist_dim);
+    if (!t.raw) goto oom;
+    t.pass = 2;
+    atomic_store(&t.done, 0);
+    bad = sp_parallel_for(nj, c->desc.threads, train_job, &t);
+    if (bad) {
+        for (int i = 0; i < nj; ++i)
+            if (t.status[i] == (sp_result)bad) {
+                rc = sp_fail(err, (sp_result)bad, "training drawing %d: %s", jobs[i].sample, t.errs[i].text);
+                break;
+            }
+        goto fail;
+    }
+    int n = 0;
+    for (int i = 0; i < nj; ++i)
+        n += t.status[i] == SP_OK;
+    if (c->desc.tfidf > 0) {
+        c->idf = calloc((size_t)c->words, sizeof(float));
+        if (!c->idf) goto oom;
+        for (int i = 0; i < nj; ++i) {
+            if (t.status[i] != SP_OK) continue;
+            const float* r = t.raw + (size_t)i * c->hist_dim;
+            for (int w = 0; w < c->words; ++w)
+                c->idf[w] += r[w] > 0.5f;
+        }
+        for (int w = 0; w < c->words; ++w)
+            c->idf[w] = fmaxf(logf((float)n / (1.0f + c->idf[w])), 0.05f);
+    }
+    c->hists = malloc(sizeof(float) * (size_t)n * c->hist_dim);
+    c->labels = malloc(sizeof(int) * (size_t)n);
+    src = malloc(sizeof(int) * (size_t)n);
+    if (!c->hists || !c->labels || !src) goto oom;
+    int k = 0;
+    for (int i = 0; i < nj; ++i) {
+        if (t.status[i] != SP_OK) continue;
+        finish_hist(c, t.raw + (size_t)i * c->hist_dim, c->hists + (size_t)k * c->hist_dim);
+        c->labels[k] = data->samples[jobs[i].sample].label;
+        src[k++] = jobs[i].sample;
+    }
+    c->train_count = n;
+    if ((rc = build_hist_index(c, err)) != SP_OK) goto fail;
+
+    // Leave-one-out nearest distances (another drawing, not a variant of the same one)
+    // give the voting bandwidth (median) and the reject threshold (quantile).
+    {
+        int q = per_sample + 1 < n ? per_sample + 1 : n;
+        loo = malloc(sizeof(float) * (size_t)n);
+        if (!loo) goto oom;
+        loo_ctx lc = {c, src, q, loo};
+        if (sp_parallel_for(n, c->desc.threads, loo_one, &lc)) {
+            rc = sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram search failed");
+            goto fail;
+        }
+        int m = 0;
+        for (int i = 0; i < n; ++i)
+            if (loo[i] >= 0.0f) loo[m++] = loo[i];
+        if (m > 0) {
+            qsort(loo, (size_t)m, sizeof(float), cmp_float);
+            c->bandwidth = fmaxf(loo[m / 2], 1e-4f);
+            int qi = (int)ceil(c->desc.reject_quantile * m) - 1;
+            if (qi < 0) qi = 0;
+            if (qi >= m) qi = m - 1;
+            c->reject = c->desc.reject_quantile >= 1.0 ? INFINITY : loo[qi];
+        } else {
+            c->bandwidth = 1.0f;
+            c->reject = INFINITY;
+        }
+    }
+    c->desc.progress = NULL;
+    c->desc.progress_user = NULL;
+    *out = c;
+    c = NULL;
+    goto fail; // shared cleanup
+oom:
+    rc = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while training");
+fail:
+    pthread_mutex_destroy(&t.lock);
+    free(jobs);
+    free(t.sample);
+    free(t.sample_n);
+    free(t.status);
+    free(t.errs);
+    free(t.raw);
+    free(sample);
+    free(src);
+    free(loo);
+    sp_clf_free(c);
+    return rc;
+}
+
+// ---------------------------------------------------------------------------
+// Model file: "SPCLFMDL", u32 version, u32 byte-order mark, u64 payload bytes,
+// payload, u64 FNV-1a of the payload. Host byte order (the mark refuses others).
+
+static const char k_magic[8] = {'S', 'P', 'C', 'L', 'F', 'M', 'D', 'L'};
+#define SP_CLF_BOM 0x01020304u
+
+static uint64_t fnv1a(const unsigned char* p, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ p[i]) * 0x100000001b3ull;
+    return h;
+}
+
+typedef struct wbuf {
+    unsigned char* p;
+    size_t n, cap;
+    bool oom;
+} wbuf;
+
+static void put(wbuf* b, const void* v, size_t n)
+{
+    if (b->oom) return;
+    if (b->n + n > b->cap) {
+        size_t cap = b->cap ? b->cap : 4096;
+        while (cap < b->n + n)
+            cap *= 2;
+        unsigned char* g = realloc(b->p, cap);
+        if (!g) {
+            b->oom = true;
+            return;
+        }
+        b->p = g;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->n, v, n);
+    b->n += n;
+}
+static void put_i32(wbuf* b, int32_t v)
+{
+    put(b, &v, 4);
+}
+static void put_f32(wbuf* b, float v)
+{
+    put(b, &v, 4);
+}
+static void put_f64(wbuf* b, double v)
+{
+    put(b, &v, 8);
+}
+
+sp_result sp_clf_save(const sp_clf* c, const char* path, sp_error* err)
+{
+    wbuf b = {0};
+    const sp_clf_desc* d = &c->desc;
+    int32_t ints[] = {d->words, d->vocab_samples, d->kmeans_iterations, d->soft_neighbours, d->knn, d->pyramid,
+                      d->tfidf, d->hellinger, d->mirror, d->augment, (int32_t)d->seed,
+                      0 /* threads: the model does not depend on them */};
+    put_i32(&b, (int32_t)(sizeof ints / sizeof ints[0]));
+    for (size_t i = 0; i < sizeof ints / sizeof ints[0]; ++i)
+        put_i32(&b, ints[i]);
+    put_f64(&b, d->reject_quantile);
+    put_i32(&b, c->category_count);
+    for (int i = 0; i < c->category_count; ++i) {
+        int32_t l = (int32_t)strlen(c->categories[i]);
+        put_i32(&b, l);
+        put(&b, c->categories[i], (size_t)l);
+    }
+    put_i32(&b, c->words);
+    put_i32(&b, SP_FEAT_DIM);
+    put(&b, c->vocab, sizeof(float) * (size_t)c->words * SP_FEAT_DIM);
+    put_f32(&b, c->sigma);
+    put_i32(&b, c->hist_dim);
+    put_i32(&b, c->idf != NULL);
+    if (c->idf) put(&b, c->idf, sizeof(float) * (size_t)c->words);
+    put_i32(&b, c->train_count);
+    put(&b, c->hists, sizeof(float) * (size_t)c->train_count * c->hist_dim);
+    put(&b, c->labels, sizeof(int32_t) * (size_t)c->train_count);
+    put_f32(&b, c->bandwidth);
+    put_f32(&b, c->reject);
+    if (b.oom) {
+        free(b.p);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    FILE* f = fopen(path, "wb");
+    if (!f) {
+        free(b.p);
+        return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    }
+    uint32_t version = SP_CLF_FILE_VERSION, bom = SP_CLF_BOM;
+    uint64_t len = b.n, sum = fnv1a(b.p, b.n);
+    bool ok = fwrite(k_magic, 8, 1, f) == 1 && fwrite(&version, 4, 1, f) == 1 && fwrite(&bom, 4, 1, f) == 1 &&
+              fwrite(&len, 8, 1, f) == 1 && fwrite(b.p, 1, b.n, f) == b.n && fwrite(&sum, 8, 1, f) == 1;
+    free(b.p);
+    if (fclose(f) != 0 || !ok) return sp_fail(err, SP_ERR_IO, "%s: write failed", path);
+    return SP_OK;
+}
+
+typedef struct rbuf {
+    const unsigned char* p;
+    size_t n, at;
+    bool bad;
+} rbuf;
+
+static void get(rbuf* b, void* v, size_t n)
+{
+    if (b->bad || n > b->n - b->at) {
+        b->bad = true;
+        memset(v, 0, n);
+        return;
+    }
+    memcpy(v, b->p + b->at, n);
+    b->at += n;
+}
+static int32_t get_i32(rbuf* b)
+{
+    int32_t v;
+    get(b, &v, 4);
+    return v;
+}
+static float get_f32(rbuf* b)
+{
+    float v;
+    get(b, &v, 4);
+    return v;
+}
+
+static bool all_finite(const float* v, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
+
+sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
+{
+    *out = NULL;
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    unsigned char hdr[24];
+    size_t got = fread(hdr, 1, sizeof hdr, f);
+    if (got < 8 || memcmp(hdr, k_magic, 8) != 0) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_PARSE, "%s: not a sketchpose classifier model", path);
+    }
+    if (got < sizeof hdr) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_PARSE, "%s: model file truncated (header)", path);
+    }
+    uint32_t version, bom;
+    uint64_t len;
+    memcpy(&version, hdr + 8, 4);
+    memcpy(&bom, hdr + 12, 4);
+    memcpy(&len, hdr + 16, 8);
+    if (bom != SP_CLF_BOM) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model written on a machine of other byte order", path);
+    }
+    if (version != SP_CLF_FILE_VERSION) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model format version %u, this build reads version %d (retrain)", path,
+                       version, SP_CLF_FILE_VERSION);
+    }
+    if (len > (uint64_t)1 << 32) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_PARSE, "%s: model header claims %llu bytes (corrupt)", path, (unsigned long long)len);
+    }
+    unsigned char* p = malloc((size_t)len + 8);
+    if (!p) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    got = fread(p, 1, (size_t)len + 8, f);
+    int extra = fgetc(f);
+    fclose(f);
+    if (got < len + 8) {
+        free(p);
+        return sp_fail(err, SP_ERR_PARSE, "%s: model file truncated (%zu of %llu bytes)", path, got + 24,
+                       (unsigned long long)len + 32);
+    }
+    uint64_t sum;
+    memcpy(&sum, p + len, 8);
+    if (extra != EOF || sum != fnv1a(p, (size_t)len)) {
+        free(p);
+        return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (checksum mismatch)", path);
+    }
+    rbuf b = {p, (size_t)len, 0, false};
+    sp_clf* c = calloc(1, sizeof *c);
+    sp_result rc = SP_OK;
+    if (!c) goto oom;
+    int32_t ni = get_i32(&b);
+    int32_t ints[12] = {0};
+    if (ni != 12) goto corrupt;
+    for (int i = 0; i < 12; ++i)
+        ints[i] = get_i32(&b);
+    sp_clf_desc d = {ints[0],  ints[1], ints[2], ints[3], ints[4], ints[5],
+                     ints[6],  ints[7], ints[8], ints[9], 0,       (uint32_t)ints[10],
+                     ints[11], NULL,    NULL};
+    get(&b, &d.reject_quantile, 8);
+    c->desc = sp_clf_desc_defaults(&d);
+    int32_t nc = get_i32(&b);
+    if (b.bad || nc < 1 || nc > 100000) goto corrupt;
+    c->categories = calloc((size_t)nc, sizeof(char*));
+    if (!c->categories) goto oom;
+    for (int i = 0; i < nc; ++i) {
+        int32_t l = get_i32(&b);
+        if (b.bad || l < 0 || (size_t)l > b.n - b.at) goto corrupt;
+        if (!(c->categories[i] = malloc((size_t)l + 1))) goto oom;
+        c->category_count = i + 1;
+        get(&b, c->categories[i], (size_t)l);
+        c->categories[i][l] = '\0';
+    }
+    c->words = get_i32(&b);
+    if (b.bad || c->words < 1 || c->words > 100000 || get_i32(&b) != SP_FEAT_DIM) goto corrupt;
+    if ((size_t)c->words * SP_FEAT_DIM * 4 > b.n - b.at) goto corrupt;
+    if (!(c->vocab = malloc(sizeof(float) * (size_t)c->words * SP_FEAT_DIM))) goto oom;
+    get(&b, c->vocab, sizeof(float) * (size_t)c->words * SP_FEAT_DIM);
+    c->sigma = get_f32(&b);
+    c->hist_dim = get_i32(&b);
+    if (b.bad || c->hist_dim != c->words * (c->desc.pyramid > 0 ? 5 : 1) || !(c->sigma > 0) || !isfinite(c->sigma)) goto corrupt;
+    if (get_i32(&b)) {
+        if ((size_t)c->words * 4 > b.n - b.at) goto corrupt;
+        if (!(c->idf = malloc(sizeof(float) * (size_t)c->words))) goto oom;
+        get(&b, c->idf, sizeof(float) * (size_t)c->words);
+    }
+    c->train_count = get_i32(&b);
+    if (b.bad || c->train_count < 1 || (size_t)c->train_count * ((size_t)c->hist_dim + 1) * 4 > b.n - b.at) goto corrupt;
+    c->hists = malloc(sizeof(float) * (size_t)c->train_count * c->hist_dim);
+    c->labels = malloc(sizeof(int) * (size_t)c->train_count);
+    if (!c->hists || !c->labels) goto oom;
+    get(&b, c->hists, sizeof(float) * (size_t)c->train_count * c->hist_dim);
+    get(&b, c->labels, sizeof(int32_t) * (size_t)c->train_count);
+    c->bandwidth = get_f32(&b);
+    c->reject = get_f32(&b);
+    if (b.bad || b.at != b.n || !(c->bandwidth > 0) || isnan(c->reject)) goto corrupt;
+    for (int i = 0; i < c->train_count; ++i)
+        if (c->labels[i] < 0 || c->labels[i] >= c->category_count) goto corrupt;
+    if (!all_finite(c->vocab, (size_t)c->words * SP_FEAT_DIM) || !all_finite(c->hists, (size_t)c->train_count * c->hist_dim) ||
+        (c->idf && !all_finite(c->idf, (size_t)c->words)))
+        goto corrupt;
+    free(p);
+    if ((rc = build_vocab_index(c, err)) != SP_OK || (rc = build_hist_index(c, err)) != SP_OK) {
+        sp_clf_free(c);
+        return rc;
+    }
+    *out = c;
+    return SP_OK;
+corrupt:
+    free(p);
+    sp_clf_free(c);
+    return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (inconsistent contents)", path);
+oom:
+    free(p);
+    sp_clf_free(c);
+    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+}

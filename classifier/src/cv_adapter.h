@@ -1,0 +1,43 @@
+/// cv_adapter.h: the classifier's only door to OpenCV (implemented in cv_adapter.cpp).
+///
+/// Pure C; no OpenCV type crosses it. Every function catches every exception
+/// and turns it into an sp_result (cv::Exception -> SP_ERR_INTERNAL with its
+/// message, std::bad_alloc -> SP_ERR_NO_MEMORY).
+#ifndef SP_CV_ADAPTER_H
+#define SP_CV_ADAPTER_H
+
+#include <stddef.h>
+
+#include "sp/result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Draws polylines anti-aliased in white on a black `size` x `size` 8-bit image.
+/// xy: total points by 2 (pixels, already in image coordinates); counts: points per
+/// polyline. thickness in pixels. out: size*size bytes (row-major).
+sp_result sp_cv_draw_polylines(const float* xy, const int* counts, int polylines, int size, int thickness, unsigned char* out,
+                               sp_error* err);
+
+/// Decodes image bytes (PNG) into grey pixels, alpha composited over white.
+/// *pixels is malloc'd (free()), w*h bytes.
+sp_result sp_cv_decode_grey(const unsigned char* bytes, size_t len, const char* name, unsigned char** pixels, int* w, int* h,
+                            sp_error* err);
+
+/// Fits the ink of a grey raster (0 = ink, 255 = paper) into the box [pad, pad+fit) of a
+/// `size` x `size` image keeping aspect, centred, ink white on black (like sp_cv_draw_polylines).
+/// Returns SP_ERR_INVALID when the raster has no ink.
+sp_result sp_cv_fit_raster(const unsigned char* grey, int w, int h, int size, int pad, int fit, unsigned char* out,
+                           sp_error* err);
+
+/// Orientation responses of an ink image (size x size, ink bright): gradient magnitude split
+/// into 4 unsigned orientation bins (0, 45, 90, 135 degrees, linear interpolation between
+/// bins), downsampled by `down` (1 or 2) and Gaussian-smoothed with `sigma` (in output pixels).
+/// maps: 4 planes of (size/down)^2 floats, plane-major.
+sp_result sp_cv_orientation_maps(const unsigned char* img, int size, int down, double sigma, float* maps, sp_error* err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

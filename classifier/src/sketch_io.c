@@ -1,0 +1,1029 @@
+// sketch_io.c: readers for stroke JSON, Quick, Draw! ndjson, SVG, PNG and
+// labelled folders, and the stroke JSON writer.
+#include "sp/sketch_io.h"
+
+#include <cjson/cJSON.h>
+#include <ctype.h>
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cv_adapter.h"
+
+// ---------------------------------------------------------------------------
+// Files
+
+static sp_result read_file(const char* path, char** out, size_t* len, sp_error* err)
+{
+    *out = NULL;
+    *len = 0;
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
+    }
+    if ((unsigned long long)st.st_size > SP_SKETCH_MAX_FILE_BYTES) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: file too large (%lld bytes, at most %u)", path, (long long)st.st_size,
+                       SP_SKETCH_MAX_FILE_BYTES);
+    }
+    size_t n = (size_t)st.st_size;
+    char* buf = malloc(n + 1);
+    if (!buf) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory reading %zu bytes", path, n);
+    }
+    size_t got = fread(buf, 1, n, f);
+    fclose(f);
+    if (got != n) {
+        free(buf);
+        return sp_fail(err, SP_ERR_IO, "%s: short read", path);
+    }
+    buf[n] = '\0';
+    *out = buf;
+    *len = n;
+    return SP_OK;
+}
+
+static const char* ext_of(const char* path)
+{
+    const char* slash = strrchr(path, '/');
+    const char* dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash)) return "";
+    return dot + 1;
+}
+
+static bool ext_is(const char* path, const char* ext)
+{
+    return strcasecmp(ext_of(path), ext) == 0;
+}
+
+// Line number of byte `at` in text (1-based), for parse messages.
+static int line_of(const char* text, size_t len, const char* at)
+{
+    if (!at || at < text || at > text + len) return 0;
+    int line = 1;
+    for (const char* p = text; p < at; ++p)
+        if (*p == '\n') ++line;
+    return line;
+}
+
+// ---------------------------------------------------------------------------
+// Stroke JSON
+
+static bool json_number(const cJSON* j, double* v)
+{
+    if (!cJSON_IsNumber(j)) return false;
+    *v = j->valuedouble;
+    return isfinite(*v);
+}
+
+sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    const char* end = NULL;
+    cJSON* root = cJSON_ParseWithLengthOpts(text, len, &end, false);
+    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d", name, line_of(text, len, end));
+    sp_result rc = SP_OK;
+    sp_sketch s = {0};
+    sp_vec2* pts = NULL;
+    double* ts = NULL;
+    const cJSON* fmt = cJSON_GetObjectItemCaseSensitive(root, "format");
+    const cJSON* ver = cJSON_GetObjectItemCaseSensitive(root, "version");
+    const cJSON* canvas = cJSON_GetObjectItemCaseSensitive(root, "canvas");
+    const cJSON* strokes = cJSON_GetObjectItemCaseSensitive(root, "strokes");
+    if (!cJSON_IsObject(root)) {
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: a stroke file is a JSON object", name);
+        goto done;
+    }
+    if (!cJSON_IsString(fmt) || strcmp(fmt->valuestring, "sketchpose-strokes") != 0) {
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: \"format\" must be \"sketchpose-strokes\"", name);
+        goto done;
+    }
+    double vd = 0.0;
+    if (!json_number(ver, &vd)) {
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: \"version\" missing or not a number", name);
+        goto done;
+    }
+    if (vd != 1.0) {
+        rc = sp_fail(err, SP_ERR_UNSUPPORTED, "%s: stroke file version %g, this build reads version 1", name, vd);
+        goto done;
+    }
+    if (canvas) {
+        double w = 0, h = 0;
+        if (!cJSON_IsArray(canvas) || cJSON_GetArraySize(canvas) != 2 || !json_number(cJSON_GetArrayItem(canvas, 0), &w) ||
+            !json_number(cJSON_GetArrayItem(canvas, 1), &h) || w < 0 || h < 0 || w > 1e6 || h > 1e6) {
+            rc = sp_fail(err, SP_ERR_INVALID, "%s: \"canvas\" must be [width, height] with 0 <= sizes <= 1e6", name);
+            goto done;
+        }
+        s.canvas_w = w;
+        s.canvas_h = h;
+    }
+    if (!cJSON_IsArray(strokes)) {
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: \"strokes\" missing or not an array", name);
+        goto done;
+    }
+    int total = 0, si = 0;
+    const cJSON* st;
+    cJSON_ArrayForEach(st, strokes)
+    {
+        const cJSON* p = cJSON_GetObjectItemCaseSensitive(st, "points");
+        const cJSON* t = cJSON_GetObjectItemCaseSensitive(st, "t");
+        if (!cJSON_IsObject(st) || !cJSON_IsArray(p)) {
+            rc = sp_fail(err, SP_ERR_PARSE, "%s: stroke %d has no \"points\" array", name, si);
+            goto done;
+        }
+        int n = cJSON_GetArraySize(p);
+        if (n > SP_SKETCH_MAX_POINTS - total) {
+            rc = sp_fail(err, SP_ERR_UNSUPPORTED, "%s: more than %d points", name, SP_SKETCH_MAX_POINTS);
+            goto done;
+        }
+        total += n;
+        if (t && !cJSON_IsNull(t) && (!cJSON_IsArray(t) || cJSON_GetArraySize(t) != n)) {
+            rc = sp_fail(err, SP_ERR_INVALID, "%s: stroke %d: \"t\" must be an array as long as \"points\"", name, si);
+            goto done;
+        }
+        bool has_t = t && cJSON_IsArray(t);
+        free(pts);
+        free(ts);
+        pts = malloc(sizeof *pts * (size_t)(n ? n : 1));
+        ts = has_t ? malloc(sizeof *ts * (size_t)(n ? n : 1)) : NULL;
+        if (!pts || (has_t && !ts)) {
+            rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+            goto done;
+        }
+        int k = 0;
+        const cJSON* q;
+        cJSON_ArrayForEach(q, p)
+        {
+            double x, y;
+            if (!cJSON_IsArray(q) || cJSON_GetArraySize(q) != 2 || !cJSON_IsNumber(cJSON_GetArrayItem(q, 0)) ||
+                !cJSON_IsNumber(cJSON_GetArrayItem(q, 1))) {
+                rc = sp_fail(err, SP_ERR_PARSE, "%s: stroke %d point %d is not [x, y]", name, si, k);
+                goto done;
+            }
+            if (!json_number(cJSON_GetArrayItem(q, 0), &x) || !json_number(cJSON_GetArrayItem(q, 1), &y) || fabs(x) > 1e9 ||
+                fabs(y) > 1e9) {
+                rc = sp_fail(err, SP_ERR_INVALID, "%s: stroke %d point %d is not finite (or beyond 1e9)", name, si, k);
+                goto done;
+            }
+            pts[k++] = (sp_vec2){x, y};
+        }
+        if (has_t) {
+            k = 0;
+            cJSON_ArrayForEach(q, t)
+            {
+                if (!json_number(q, &ts[k])) {
+                    rc = sp_fail(err, SP_ERR_INVALID, "%s: stroke %d time %d is not a finite number", name, si, k);
+                    goto done;
+                }
+                ++k;
+            }
+        }
+        if (sp_sketch_add_stroke(&s, pts, ts, n) != SP_OK) {
+            rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+            goto done;
+        }
+        ++si;
+    }
+done:
+    free(pts);
+    free(ts);
+    cJSON_Delete(root);
+    if (rc != SP_OK)
+        sp_sketch_free(&s);
+    else
+        *out = s;
+    return rc;
+}
+
+sp_result sp_sketch_read_json(const char* path, sp_sketch* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    char* text;
+    size_t len;
+    sp_result rc = read_file(path, &text, &len, err);
+    if (rc != SP_OK) return rc;
+    rc = sp_sketch_parse_json(text, len, path, out, err);
+    free(text);
+    return rc;
+}
+
+sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* err)
+{
+    if (!sp_sketch_is_valid(s)) return sp_fail(err, SP_ERR_INVALID, "%s: sketch has non-finite values", path);
+    FILE* f = fopen(path, "wb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    bool all_t = s->stroke_count > 0;
+    for (int i = 0; i < s->stroke_count; ++i)
+        if (!s->strokes[i].t) all_t = false;
+    fprintf(f, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [%.17g, %.17g], \"strokes\": [", s->canvas_w,
+            s->canvas_h);
+    for (int i = 0; i < s->stroke_count; ++i) {
+        const sp_stroke* st = &s->strokes[i];
+        fprintf(f, "%s\n  {\"points\": [", i ? "," : "");
+        for (int j = 0; j < st->count; ++j)
+            fprintf(f, "%s[%.17g, %.17g]", j ? ", " : "", st->points[j].x, st->points[j].y);
+        fprintf(f, "]");
+        if (all_t) {
+            fprintf(f, ", \"t\": [");
+            for (int j = 0; j < st->count; ++j)
+                fprintf(f, "%s%.17g", j ? ", " : "", st->t[j]);
+            fprintf(f, "]");
+        }
+        fprintf(f, "}");
+    }
+    fprintf(f, "%s]}\n", s->stroke_count ? "\n" : "");
+    bool bad = ferror(f) != 0;
+    if (fclose(f) != 0 || bad) return sp_fail(err, SP_ERR_IO, "%s: write failed", path);
+    return SP_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Dataset
+
+int sp_dataset_add_category(sp_dataset* ds, const char* name)
+{
+    for (int i = 0; i < ds->category_count; ++i)
+        if (!strcmp(ds->categories[i], name)) return i;
+    char** grown = realloc(ds->categories, sizeof(char*) * (size_t)(ds->category_count + 1));
+    if (!grown) return -1;
+    ds->categories = grown;
+    char* copy = strdup(name);
+    if (!copy) return -1;
+    ds->categories[ds->category_count] = copy;
+    return ds->category_count++;
+}
+
+static sp_result dataset_push(sp_dataset* ds, sp_sample* smp)
+{
+    // Grow geometrically; the capacity is implied by count (powers of two).
+    int n = ds->count;
+    if ((n & (n - 1)) == 0) {
+        size_t cap = n ? (size_t)n * 2 : 1;
+        sp_sample* grown = realloc(ds->samples, sizeof(sp_sample) * cap);
+        if (!grown) return SP_ERR_NO_MEMORY;
+        ds->samples = grown;
+    }
+    int idx = 0;
+    for (int i = 0; i < n; ++i)
+        if (ds->samples[i].label == smp->label) ++idx;
+    smp->index = idx;
+    ds->samples[ds->count++] = *smp;
+    return SP_OK;
+}
+
+void sp_raster_free(sp_raster* r)
+{
+    free(r->pixels);
+    memset(r, 0, sizeof *r);
+}
+
+void sp_dataset_free(sp_dataset* ds)
+{
+    for (int i = 0; i < ds->count; ++i) {
+        sp_sketch_free(&ds->samples[i].sketch);
+        sp_raster_free(&ds->samples[i].raster);
+    }
+    for (int i = 0; i < ds->category_count; ++i)
+        free(ds->categories[i]);
+    free(ds->samples);
+    free(ds->categories);
+    memset(ds, 0, sizeof *ds);
+}
+
+// ---------------------------------------------------------------------------
+// Quick, Draw! ndjson
+
+// Parses one drawing: [[[x...],[y...](,[t...])], ...].
+static sp_result ndjson_drawing(const cJSON* drawing, const char* name, int line, sp_sketch* out, sp_error* err)
+{
+    sp_sketch s = {0};
+    sp_vec2* pts = NULL;
+    double* ts = NULL;
+    sp_result rc = SP_OK;
+    int total = 0, si = 0;
+    const cJSON* st;
+    cJSON_ArrayForEach(st, drawing)
+    {
+        const cJSON* xs = cJSON_GetArrayItem(st, 0);
+        const cJSON* ys = cJSON_GetArrayItem(st, 1);
+        const cJSON* tt = cJSON_GetArrayItem(st, 2);
+        int n = cJSON_GetArraySize(xs);
+        if (!cJSON_IsArray(st) || !cJSON_IsArray(xs) || !cJSON_IsArray(ys) || cJSON_GetArraySize(ys) != n ||
+            (tt && (!cJSON_IsArray(tt) || cJSON_GetArraySize(tt) != n))) {
+            rc = sp_fail(err, SP_ERR_PARSE, "%s:%d: stroke %d is not [[x...], [y...]] of equal lengths", name, line, si);
+            goto done;
+        }
+        if (n > SP_SKETCH_MAX_POINTS - total) {
+            rc = sp_fail(err, SP_ERR_UNSUPPORTED, "%s:%d: more than %d points in one drawing", name, line, SP_SKETCH_MAX_POINTS);
+            goto done;
+        }
+        total += n;
+        free(pts);
+        free(ts);
+        pts = malloc(sizeof *pts * (size_t)(n ? n : 1));
+        ts = tt ? malloc(sizeof *ts * (size_t)(n ? n : 1)) : NULL;
+        if (!pts || (tt && !ts)) {
+            rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+            goto done;
+        }
+        const cJSON* x = xs->child;
+        const cJSON* y = ys->child;
+        const cJSON* t = tt ? tt->child : NULL;
+        for (int k = 0; k < n; ++k, x = x->next, y = y->next) {
+            double vx, vy;
+            if (!json_number(x, &vx) || !json_number(y, &vy) || fabs(vx) > 1e9 || fabs(vy) > 1e9) {
+                rc = sp_fail(err, SP_ERR_INVALID, "%s:%d: stroke %d point %d is not a finite number pair", name, line, si, k);
+                goto done;
+            }
+            pts[k] = (sp_vec2){vx, vy};
+            if (t) {
+                if (!json_number(t, &ts[k])) {
+                    rc = sp_fail(err, SP_ERR_INVALID, "%s:%d: stroke %d time %d is not finite", name, line, si, k);
+                    goto done;
+                }
+                t = t->next;
+            }
+        }
+        if (sp_sketch_add_stroke(&s, pts, ts, n) != SP_OK) {
+            rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+            goto done;
+        }
+        ++si;
+    }
+done:
+    free(pts);
+    free(ts);
+    if (rc != SP_OK)
+        sp_sketch_free(&s);
+    else
+        *out = s;
+    return rc;
+}
+
+sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, const char* name, int label, sp_error* err)
+{
+    size_t at = 0;
+    int line = 0;
+    while (at < len) {
+        size_t e = at;
+        while (e < len && text[e] != '\n')
+            ++e;
+        ++line;
+        size_t b = at;
+        at = e + 1;
+        while (b < e && isspace((unsigned char)text[b]))
+            ++b;
+        if (b == e) continue; // blank line
+        cJSON* root = cJSON_ParseWithLength(text + b, e - b);
+        if (!root) return sp_fail(err, SP_ERR_PARSE, "%s:%d: malformed JSON", name, line);
+        const cJSON* drawing = cJSON_GetObjectItemCaseSensitive(root, "drawing");
+        if (!cJSON_IsObject(root) || !cJSON_IsArray(drawing)) {
+            cJSON_Delete(root);
+            return sp_fail(err, SP_ERR_PARSE, "%s:%d: no \"drawing\" array", name, line);
+        }
+        sp_sample smp = {.label = label};
+        sp_result rc = ndjson_drawing(drawing, name, line, &smp.sketch, err);
+        cJSON_Delete(root);
+        if (rc != SP_OK) return rc;
+        smp.sketch.canvas_w = smp.sketch.canvas_h = 256.0; // Quick, Draw! simplified drawings are 0..255
+        if (dataset_push(ds, &smp) != SP_OK) {
+            sp_sketch_free(&smp.sketch);
+            return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+        }
+    }
+    return SP_OK;
+}
+
+sp_result sp_dataset_read_ndjson(sp_dataset* ds, const char* path, int label, sp_error* err)
+{
+    char* text;
+    size_t len;
+    sp_result rc = read_file(path, &text, &len, err);
+    if (rc != SP_OK) return rc;
+    rc = sp_dataset_parse_ndjson(ds, text, len, path, label, err);
+    free(text);
+    return rc;
+}
+
+// ---------------------------------------------------------------------------
+// SVG
+
+typedef struct affine {
+    double a, b, c, d, e, f; // x' = a x + c y + e, y' = b x + d y + f (SVG matrix order)
+} affine;
+
+static const affine k_identity = {1, 0, 0, 1, 0, 0};
+
+static affine affine_mul(affine m, affine n) // m * n (apply n first)
+{
+    return (affine){m.a * n.a + m.c * n.b, m.b * n.a + m.d * n.b,       m.a * n.c + m.c * n.d,
+                    m.b * n.c + m.d * n.d, m.a * n.e + m.c * n.f + m.e, m.b * n.e + m.d * n.f + m.f};
+}
+
+static sp_vec2 affine_apply(affine m, double x, double y)
+{
+    return (sp_vec2){m.a * x + m.c * y + m.e, m.b * x + m.d * y + m.f};
+}
+
+typedef struct svg_ctx {
+    const char* name;
+    sp_error* err;
+    sp_sketch* out;
+    sp_vec2* pts; // current stroke, in document coordinates (transformed)
+    int n, cap, total;
+    affine m;
+} svg_ctx;
+
+static sp_result svg_point(svg_ctx* c, double x, double y)
+{
+    if (!isfinite(x) || !isfinite(y) || fabs(x) > 1e9 || fabs(y) > 1e9)
+        return sp_fail(c->err, SP_ERR_INVALID, "%s: coordinate out of range", c->name);
+    if (c->total >= SP_SKETCH_MAX_POINTS)
+        return sp_fail(c->err, SP_ERR_UNSUPPORTED, "%s: more than %d points after flattening", c->name, SP_SKETCH_MAX_POINTS);
+    if (c->n == c->cap) {
+        int cap = c->cap ? c->cap * 2 : 64;
+        sp_vec2* g = realloc(c->pts, sizeof *g * (size_t)cap);
+        if (!g) return sp_fail(c->err, SP_ERR_NO_MEMORY, "%s: out of memory", c->name);
+        c->pts = g;
+        c->cap = cap;
+    }
+    sp_vec2 p = affine_apply(c->m, x, y);
+    if (!sp_v2_is_valid(p) || fabs(p.x) > 1e9 || fabs(p.y) > 1e9)
+        return sp_fail(c->err, SP_ERR_INVALID, "%s: transformed coordinate out of range", c->name);
+    c->pts[c->n++] = p;
+    ++c->total;
+    return SP_OK;
+}
+
+static sp_result svg_flush(svg_ctx* c)
+{
+    sp_result rc = SP_OK;
+    if (c->n > 0 && sp_sketch_add_stroke(c->out, c->pts, NULL, c->n) != SP_OK)
+        rc = sp_fail(c->err, SP_ERR_NO_MEMORY, "%s: out of memory", c->name);
+    c->n = 0;
+    return rc;
+}
+
+// Reads one number at *p (skipping separators). Refuses inf/nan/hex, which strtod would take.
+static bool svg_number(const char** p, const char* end, double* v)
+{
+    const char* s = *p;
+    while (s < end && (isspace((unsigned char)*s) || *s == ','))
+        ++s;
+    if (s >= end) return false;
+    char buf[64];
+    size_t k = 0;
+    const char* q = s;
+    if (q < end && (*q == '+' || *q == '-')) buf[k++] = *q++;
+    bool digits = false, dot = false;
+    while (q < end && k < sizeof buf - 8) {
+        if (isdigit((unsigned char)*q))
+            digits = true;
+        else if (*q == '.' && !dot)
+            dot = true;
+        else
+            break;
+        buf[k++] = *q++;
+    }
+    if (!digits) return false;
+    if (q < end && (*q == 'e' || *q == 'E')) {
+        const char* r = q + 1;
+        char eb[8];
+        size_t ek = 0;
+        eb[ek++] = 'e';
+        if (r < end && (*r == '+' || *r == '-')) eb[ek++] = *r++;
+        bool ed = false;
+        while (r < end && isdigit((unsigned char)*r) && ek < sizeof eb - 1) {
+            eb[ek++] = *r++;
+            ed = true;
+        }
+        if (ed) {
+            memcpy(buf + k, eb, ek);
+            k += ek;
+            q = r;
+        }
+    }
+    buf[k] = '\0';
+    *v = strtod(buf, NULL);
+    if (!isfinite(*v)) return false;
+    *p = q;
+    return true;
+}
+
+static bool svg_numbers(const char** p, const char* end, double* v, int n)
+{
+    for (int i = 0; i < n; ++i)
+        if (!svg_number(p, end, &v[i])) return false;
+    return true;
+}
+
+// Flattening: fixed segments per curve, enough for sketches drawn at <= 1000 px.
+enum { SVG_CURVE_SEGMENTS = 12 };
+
+static sp_result svg_path(svg_ctx* c, const char* d, const char* end)
+{
+    const char* p = d;
+    double cx = 0, cy = 0, sx = 0, sy = 0, lcx = 0, lcy = 0; // current, subpath start, last control
+    char cmd = 0, prev = 0;
+    sp_result rc;
+    for (;;) {
+        while (p < end && (isspace((unsigned char)*p) || *p == ','))
+            ++p;
+        if (p >= end) break;
+        if (isalpha((unsigned char)*p))
+            cmd = *p++;
+        else if (!cmd)
+            return sp_fail(c->err, SP_ERR_PARSE, "%s: path data must start with a command", c->name);
+        else if (cmd == 'M')
+            cmd = 'L'; // implicit lineto after moveto
+        else if (cmd == 'm')
+            cmd = 'l';
+        bool rel = islower((unsigned char)cmd) != 0;
+        double ox = rel ? cx : 0, oy = rel ? cy : 0, v[7];
+        switch (toupper((unsigned char)cmd)) {
+        case 'M':
+            if (!svg_numbers(&p, end, v, 2)) goto bad;
+            if ((rc = svg_flush(c)) != SP_OK) return rc;
+            cx = sx = ox + v[0];
+            cy = sy = oy + v[1];
+            if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            break;
+        case 'L':
+            if (!svg_numbers(&p, end, v, 2)) goto bad;
+            cx = ox + v[0];
+            cy = oy + v[1];
+            if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            break;
+        case 'H':
+            if (!svg_numbers(&p, end, v, 1)) goto bad;
+            cx = ox + v[0];
+            if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            break;
+        case 'V':
+            if (!svg_numbers(&p, end, v, 1)) goto bad;
+            cy = oy + v[0];
+            if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            break;
+        case 'C':
+        case 'S': {
+            double x1, y1, x2, y2, x, y;
+            if (toupper((unsigned char)cmd) == 'C') {
+                if (!svg_numbers(&p, end, v, 6)) goto bad;
+                x1 = ox + v[0], y1 = oy + v[1], x2 = ox + v[2], y2 = oy + v[3], x = ox + v[4], y = oy + v[5];
+            } else {
+                if (!svg_numbers(&p, end, v, 4)) goto bad;
+                bool refl = strchr("CcSs", prev) != NULL;
+                x1 = refl ? 2 * cx - lcx : cx, y1 = refl ? 2 * cy - lcy : cy;
+                x2 = ox + v[0], y2 = oy + v[1], x = ox + v[2], y = oy + v[3];
+            }
+            if (c->n == 0 && (rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            for (int i = 1; i <= SVG_CURVE_SEGMENTS; ++i) {
+                double t = (double)i / SVG_CURVE_SEGMENTS, u = 1 - t;
+                double bx = u * u * u * cx + 3 * u * u * t * x1 + 3 * u * t * t * x2 + t * t * t * x;
+                double by = u * u * u * cy + 3 * u * u * t * y1 + 3 * u * t * t * y2 + t * t * t * y;
+                if ((rc = svg_point(c, bx, by)) != SP_OK) return rc;
+            }
+            lcx = x2, lcy = y2, cx = x, cy = y;
+            break;
+        }
+        case 'Q':
+        case 'T': {
+            double x1, y1, x, y;
+            if (toupper((unsigned char)cmd) == 'Q') {
+                if (!svg_numbers(&p, end, v, 4)) goto bad;
+                x1 = ox + v[0], y1 = oy + v[1], x = ox + v[2], y = oy + v[3];
+            } else {
+                if (!svg_numbers(&p, end, v, 2)) goto bad;
+                bool refl = strchr("QqTt", prev) != NULL;
+                x1 = refl ? 2 * cx - lcx : cx, y1 = refl ? 2 * cy - lcy : cy;
+                x = ox + v[0], y = oy + v[1];
+            }
+            if (c->n == 0 && (rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            for (int i = 1; i <= SVG_CURVE_SEGMENTS; ++i) {
+                double t = (double)i / SVG_CURVE_SEGMENTS, u = 1 - t;
+                if ((rc = svg_point(c, u * u * cx + 2 * u * t * x1 + t * t * x, u * u * cy + 2 * u * t * y1 + t * t * y)) !=
+                    SP_OK)
+                    return rc;
+            }
+            lcx = x1, lcy = y1, cx = x, cy = y;
+            break;
+        }
+        case 'A': // elliptical arcs are rare in line drawings: approximated by their chord
+            if (!svg_numbers(&p, end, v, 7)) goto bad;
+            cx = ox + v[5];
+            cy = oy + v[6];
+            if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            break;
+        case 'Z':
+            if (c->n > 0 && (rc = svg_point(c, sx, sy)) != SP_OK) return rc;
+            cx = sx, cy = sy;
+            if ((rc = svg_flush(c)) != SP_OK) return rc;
+            cmd = 0; // a number right after Z is an error
+            prev = 'Z';
+            continue;
+        default:
+            return sp_fail(c->err, SP_ERR_PARSE, "%s: unknown path command '%c'", c->name, cmd);
+        }
+        prev = cmd;
+    }
+    return svg_flush(c);
+bad:
+    return sp_fail(c->err, SP_ERR_PARSE, "%s: bad numbers after path command '%c'", c->name, cmd);
+}
+
+// Parses a transform list into an affine (SVG order: left to right, each applied to what follows).
+static bool svg_transform(const char* s, const char* end, affine* out)
+{
+    affine m = k_identity;
+    const char* p = s;
+    for (;;) {
+        while (p < end && (isspace((unsigned char)*p) || *p == ','))
+            ++p;
+        if (p >= end) break;
+        const char* nm = p;
+        while (p < end && isalpha((unsigned char)*p))
+            ++p;
+        size_t nl = (size_t)(p - nm);
+        while (p < end && isspace((unsigned char)*p))
+            ++p;
+        if (p >= end || *p != '(' || nl == 0) return false;
+        ++p;
+        double v[6];
+        int n = 0;
+        for (;;) {
+            while (p < end && (isspace((unsigned char)*p) || *p == ','))
+                ++p;
+            if (p < end && *p == ')') {
+                ++p;
+                break;
+            }
+            if (n == 6 || !svg_number(&p, end, &v[n])) return false;
+            ++n;
+        }
+        affine t = k_identity;
+        if (nl == 9 && !strncmp(nm, "translate", 9) && (n == 1 || n == 2))
+            t.e = v[0], t.f = n == 2 ? v[1] : 0;
+        else if (nl == 5 && !strncmp(nm, "scale", 5) && (n == 1 || n == 2))
+            t.a = v[0], t.d = n == 2 ? v[1] : v[0];
+        else if (nl == 6 && !strncmp(nm, "matrix", 6) && n == 6)
+            t = (affine){v[0], v[1], v[2], v[3], v[4], v[5]};
+        else if (nl == 6 && !strncmp(nm, "rotate", 6) && (n == 1 || n == 3)) {
+            double r = v[0] * M_PI / 180.0, cs = cos(r), sn = sin(r);
+            t = (affine){cs, sn, -sn, cs, 0, 0};
+            if (n == 3) {
+                affine a = {1, 0, 0, 1, v[1], v[2]}, b = {1, 0, 0, 1, -v[1], -v[2]};
+                t = affine_mul(affine_mul(a, t), b);
+            }
+        } else if (nl == 5 && !strncmp(nm, "skewX", 5) && n == 1)
+            t.c = tan(v[0] * M_PI / 180.0);
+        else if (nl == 5 && !strncmp(nm, "skewY", 5) && n == 1)
+            t.b = tan(v[0] * M_PI / 180.0);
+        else
+            return false;
+        m = affine_mul(m, t);
+    }
+    *out = m;
+    return true;
+}
+
+// Finds attribute `key` in the tag text [s, e); returns value bounds.
+static bool svg_attr(const char* s, const char* e, const char* key, const char** vb, const char** ve)
+{
+    size_t kl = strlen(key);
+    for (const char* p = s; p + kl < e; ++p) {
+        if (strncmp(p, key, kl) != 0) continue;
+        if (p > s && !isspace((unsigned char)p[-1])) continue;
+        const char* q = p + kl;
+        while (q < e && isspace((unsigned char)*q))
+            ++q;
+        if (q >= e || *q != '=') continue;
+        ++q;
+        while (q < e && isspace((unsigned char)*q))
+            ++q;
+        if (q >= e || (*q != '"' && *q != '\'')) continue;
+        char quote = *q++;
+        const char* r = memchr(q, quote, (size_t)(e - q));
+        if (!r) return false;
+        *vb = q;
+        *ve = r;
+        return true;
+    }
+    return false;
+}
+
+static bool tag_is(const char* s, const char* e, const char* nm)
+{
+    size_t n = strlen(nm);
+    return (size_t)(e - s) >= n && !strncmp(s, nm, n) && (s + n == e || isspace((unsigned char)s[n]) || s[n] == '/');
+}
+
+enum { SVG_MAX_DEPTH = 64 };
+
+sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    svg_ctx c = {.name = name, .err = err, .out = out, .m = k_identity};
+    affine stack[SVG_MAX_DEPTH];
+    int depth = 0;
+    bool saw_svg = false;
+    sp_result rc = SP_OK;
+    const char* p = text;
+    const char* end = text + len;
+    while (p < end) {
+        const char* lt = memchr(p, '<', (size_t)(end - p));
+        if (!lt) break;
+        const char* s = lt + 1;
+        if (end - s >= 3 && !strncmp(s, "!--", 3)) { // comment
+            const char* q = s + 3;
+            while (q + 2 < end && strncmp(q, "-->", 3))
+                ++q;
+            p = q + 3;
+            continue;
+        }
+        const char* gt = memchr(s, '>', (size_t)(end - s));
+        if (!gt) {
+            rc = sp_fail(err, SP_ERR_PARSE, "%s: unterminated tag near line %d", name, line_of(text, len, lt));
+            goto fail;
+        }
+        p = gt + 1;
+        if (*s == '?' || *s == '!') continue;
+        bool closing = *s == '/';
+        bool self_closing = gt[-1] == '/';
+        if (closing) {
+            if (tag_is(s + 1, gt, "g") || tag_is(s + 1, gt, "svg") || tag_is(s + 1, gt, "a")) {
+                if (depth == 0) {
+                    rc = sp_fail(err, SP_ERR_PARSE, "%s: unbalanced </g> near line %d", name, line_of(text, len, lt));
+                    goto fail;
+                }
+                c.m = stack[--depth];
+            }
+            continue;
+        }
+        const char *vb, *ve;
+        affine local = k_identity;
+        if (svg_attr(s, gt, "transform", &vb, &ve) && !svg_transform(vb, ve, &local)) {
+            rc = sp_fail(err, SP_ERR_PARSE, "%s: bad transform near line %d", name, line_of(text, len, lt));
+            goto fail;
+        }
+        bool group = tag_is(s, gt, "g") || tag_is(s, gt, "svg") || tag_is(s, gt, "a");
+        if (tag_is(s, gt, "svg")) {
+            saw_svg = true;
+            if (out->canvas_w == 0 && svg_attr(s, gt, "viewBox", &vb, &ve)) {
+                double v[4];
+                const char* q = vb;
+                if (svg_numbers(&q, ve, v, 4) && v[2] > 0 && v[3] > 0 && v[2] < 1e6 && v[3] < 1e6) {
+                    out->canvas_w = v[2];
+                    out->canvas_h = v[3];
+                }
+            }
+        }
+        if (group) {
+            if (self_closing) continue;
+            if (depth == SVG_MAX_DEPTH) {
+                rc = sp_fail(err, SP_ERR_UNSUPPORTED, "%s: groups nested deeper than %d", name, SVG_MAX_DEPTH);
+                goto fail;
+            }
+            stack[depth++] = c.m;
+            c.m = affine_mul(c.m, local);
+            continue;
+        }
+        affine saved = c.m;
+        c.m = affine_mul(c.m, local);
+        if (tag_is(s, gt, "path")) {
+            if (svg_attr(s, gt, "d", &vb, &ve)) rc = svg_path(&c, vb, ve);
+        } else if (tag_is(s, gt, "line")) {
+            double v[4];
+            const char* keys[4] = {"x1", "y1", "x2", "y2"};
+            for (int i = 0; i < 4; ++i) {
+                const char* q;
+                v[i] = 0;
+                if (svg_attr(s, gt, keys[i], &vb, &ve) && (q = vb, !svg_number(&q, ve, &v[i]))) {
+                    rc = sp_fail(err, SP_ERR_PARSE, "%s: bad <line> near line %d", name, line_of(text, len, lt));
+                    break;
+                }
+            }
+            if (rc == SP_OK && (rc = svg_point(&c, v[0], v[1])) == SP_OK && (rc = svg_point(&c, v[2], v[3])) == SP_OK)
+                rc = svg_flush(&c);
+        } else if (tag_is(s, gt, "polyline") || tag_is(s, gt, "polygon")) {
+            if (svg_attr(s, gt, "points", &vb, &ve)) {
+                const char* q = vb;
+                double xy[2], x0 = 0, y0 = 0;
+                int k = 0;
+                while (rc == SP_OK && svg_numbers(&q, ve, xy, 2)) {
+                    if (k++ == 0) x0 = xy[0], y0 = xy[1];
+                    rc = svg_point(&c, xy[0], xy[1]);
+                }
+                if (rc == SP_OK && k > 0 && tag_is(s, gt, "polygon")) rc = svg_point(&c, x0, y0);
+                if (rc == SP_OK) rc = svg_flush(&c);
+            }
+        }
+        c.m = saved;
+        if (rc != SP_OK) goto fail;
+    }
+    if (!saw_svg) {
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: no <svg> element", name);
+        goto fail;
+    }
+    free(c.pts);
+    return SP_OK;
+fail:
+    free(c.pts);
+    sp_sketch_free(out);
+    return rc;
+}
+
+sp_result sp_sketch_read_svg(const char* path, sp_sketch* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    char* text;
+    size_t len;
+    sp_result rc = read_file(path, &text, &len, err);
+    if (rc != SP_OK) return rc;
+    rc = sp_sketch_parse_svg(text, len, path, out, err);
+    free(text);
+    return rc;
+}
+
+// ---------------------------------------------------------------------------
+// PNG
+
+sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    // Why read the header ourselves: a decoder would allocate the whole image
+    // before we could refuse a 20000x20000 file.
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    unsigned char hdr[24];
+    size_t got = fread(hdr, 1, sizeof hdr, f);
+    fclose(f);
+    if (got < 8 || memcmp(hdr, sig, 8) != 0) return sp_fail(err, SP_ERR_PARSE, "%s: not a PNG file", path);
+    if (got < 24 || memcmp(hdr + 12, "IHDR", 4) != 0) return sp_fail(err, SP_ERR_PARSE, "%s: PNG header truncated", path);
+    uint32_t w = (uint32_t)hdr[16] << 24 | (uint32_t)hdr[17] << 16 | (uint32_t)hdr[18] << 8 | hdr[19];
+    uint32_t h = (uint32_t)hdr[20] << 24 | (uint32_t)hdr[21] << 16 | (uint32_t)hdr[22] << 8 | hdr[23];
+    if (w == 0 || h == 0) return sp_fail(err, SP_ERR_PARSE, "%s: PNG has zero size", path);
+    if (w > SP_RASTER_MAX_SIDE || h > SP_RASTER_MAX_SIDE)
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: PNG is %ux%u, larger than %dx%d", path, w, h, SP_RASTER_MAX_SIDE,
+                       SP_RASTER_MAX_SIDE);
+    char* bytes;
+    size_t len;
+    sp_result rc = read_file(path, &bytes, &len, err);
+    if (rc != SP_OK) return rc;
+    rc = sp_cv_decode_grey((const unsigned char*)bytes, len, path, &out->pixels, &out->w, &out->h, err);
+    free(bytes);
+    if (rc == SP_OK && (out->w != (int)w || out->h != (int)h)) {
+        sp_raster_free(out);
+        return sp_fail(err, SP_ERR_PARSE, "%s: decoded size differs from the PNG header", path);
+    }
+    return rc;
+}
+
+// ---------------------------------------------------------------------------
+// Any drawing, folders
+
+sp_result sp_drawing_read(const char* path, sp_sketch* sketch, sp_raster* raster, sp_error* err)
+{
+    memset(sketch, 0, sizeof *sketch);
+    if (raster) memset(raster, 0, sizeof *raster);
+    if (ext_is(path, "json")) return sp_sketch_read_json(path, sketch, err);
+    if (ext_is(path, "svg")) return sp_sketch_read_svg(path, sketch, err);
+    if (ext_is(path, "png")) {
+        if (!raster) return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: a PNG has no strokes; give a .json or .svg", path);
+        return sp_raster_read_png(path, raster, err);
+    }
+    if (ext_is(path, "ndjson")) {
+        sp_dataset ds = {0};
+        sp_result rc = sp_dataset_read_ndjson(&ds, path, -1, err);
+        if (rc == SP_OK && ds.count == 0) rc = sp_fail(err, SP_ERR_INVALID, "%s: no drawings", path);
+        if (rc == SP_OK) {
+            *sketch = ds.samples[0].sketch;
+            ds.samples[0].sketch = (sp_sketch){0};
+        }
+        sp_dataset_free(&ds);
+        return rc;
+    }
+    return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: unknown drawing type (want .json, .svg, .png or .ndjson)", path);
+}
+
+static int cmp_str(const void* a, const void* b)
+{
+    return strcmp(*(char* const*)a, *(char* const*)b);
+}
+
+// Sorted entry names of a directory (excluding dot files). *names malloc'd.
+static sp_result list_dir(const char* dir, char*** names, int* count, sp_error* err)
+{
+    *names = NULL;
+    *count = 0;
+    DIR* d = opendir(dir);
+    if (!d) return sp_fail(err, SP_ERR_IO, "%s: cannot open folder (%s)", dir, strerror(errno));
+    struct dirent* e;
+    int n = 0, cap = 0;
+    char** v = NULL;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.') continue;
+        if (n == cap) {
+            cap = cap ? cap * 2 : 32;
+            char** g = realloc(v, sizeof(char*) * (size_t)cap);
+            if (!g) goto oom;
+            v = g;
+        }
+        if (!(v[n] = strdup(e->d_name))) goto oom;
+        ++n;
+    }
+    closedir(d);
+    if (n) qsort(v, (size_t)n, sizeof(char*), cmp_str);
+    *names = v;
+    *count = n;
+    return SP_OK;
+oom:
+    closedir(d);
+    for (int i = 0; i < n; ++i)
+        free(v[i]);
+    free(v);
+    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory listing", dir);
+}
+
+static void free_names(char** v, int n)
+{
+    for (int i = 0; i < n; ++i)
+        free(v[i]);
+    free(v);
+}
+
+static bool is_dir(const char* path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    char** names;
+    int n;
+    sp_result rc = list_dir(dir, &names, &n, err);
+    if (rc != SP_OK) return rc;
+    sp_dataset ds = {0};
+    char path[4096];
+    // Categories first (sorted), so labels do not depend on which kind of file came first.
+    for (int i = 0; i < n && rc == SP_OK; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        char cat[1024];
+        if (is_dir(path))
+            snprintf(cat, sizeof cat, "%s", names[i]);
+        else if (ext_is(names[i], "ndjson")) {
+            snprintf(cat, sizeof cat, "%s", names[i]);
+            cat[strlen(cat) - 7] = '\0';
+        } else
+            continue;
+        if (sp_dataset_add_category(&ds, cat) < 0) rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", dir);
+    }
+    if (rc == SP_OK && ds.category_count > 1) qsort(ds.categories, (size_t)ds.category_count, sizeof(char*), cmp_str);
+    for (int i = 0; i < n && rc == SP_OK; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        if (is_dir(path)) {
+            int label = sp_dataset_add_category(&ds, names[i]);
+            char** files;
+            int nf;
+            if ((rc = list_dir(path, &files, &nf, err)) != SP_OK) break;
+            for (int j = 0; j < nf && rc == SP_OK; ++j) {
+                if (!ext_is(files[j], "json") && !ext_is(files[j], "svg") && !ext_is(files[j], "png")) continue;
+                char fp[4096 + 256];
+                snprintf(fp, sizeof fp, "%s/%s", path, files[j]);
+                sp_sample smp = {.label = label};
+                rc = sp_drawing_read(fp, &smp.sketch, &smp.raster, err);
+                if (rc == SP_OK && dataset_push(&ds, &smp) != SP_OK) {
+                    sp_sketch_free(&smp.sketch);
+                    sp_raster_free(&smp.raster);
+                    rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", fp);
+                }
+            }
+            free_names(files, nf);
+        } else if (ext_is(names[i], "ndjson")) {
+            char cat[1024];
+            snprintf(cat, sizeof cat, "%s", names[i]);
+            cat[strlen(cat) - 7] = '\0';
+            rc = sp_dataset_read_ndjson(&ds, path, sp_dataset_add_category(&ds, cat), err);
+        }
+    }
+    free_names(names, n);
+    if (rc == SP_OK && ds.count == 0)
+        rc = sp_fail(err, SP_ERR_INVALID, "%s: no drawings (want <category>/*.json|svg|png or <category>.ndjson)", dir);
+    if (rc != SP_OK) {
+        sp_dataset_free(&ds);
+        return rc;
+    }
+    *out = ds;
+    return SP_OK;
+}

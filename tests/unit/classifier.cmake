@@ -1,0 +1,1 @@
+sp_unit_test(classifier LIBS sp::classifier TIMEOUT 120)

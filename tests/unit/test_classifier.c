@@ -1,0 +1,714 @@
+// test_classifier.c: sketch readers, descriptors, training, model files.
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <sys/stat.h>
+
+#include "sp/classifier.h"
+#include "sp/sketch_io.h"
+#include "test.h"
+
+// Internals (tests may reach into src/, STYLE.md).
+#include "../../classifier/src/feat.h"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#pragma GCC diagnostic pop
+
+// ---------------------------------------------------------------------------
+// helpers
+
+static void write_text(const char* path, const char* text)
+{
+    FILE* f = fopen(path, "wb");
+    ENSURE(f != NULL);
+    fputs(text, f);
+    fclose(f);
+}
+
+static uint64_t g_rng;
+static double urand(void)
+{
+    uint64_t z = (g_rng += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+// Synthetic hand-drawn-ish shapes: 0 circle, 1 straight line, 2 zigzag.
+static void make_shape(int kind, sp_sketch* s)
+{
+    sp_vec2 p[200];
+    int n = 0;
+    double cx = 100 + 40 * urand(), cy = 100 + 40 * urand(), r = 40 + 40 * urand(), rot = urand() * 2 * M_PI;
+    if (kind == 0) {
+        n = 60;
+        for (int i = 0; i < n; ++i) {
+            double a = 2 * M_PI * i / (n - 1) * (1.0 + 0.05 * urand()), rr = r * (1 + 0.06 * (urand() - 0.5));
+            p[i] = (sp_vec2){cx + rr * cos(a), cy + 0.8 * rr * sin(a)};
+        }
+    } else if (kind == 1) {
+        n = 20;
+        for (int i = 0; i < n; ++i) {
+            double t = (double)i / (n - 1) * 2 - 1;
+            p[i] = (sp_vec2){cx + r * t * cos(rot) + 2 * (urand() - 0.5), cy + r * t * sin(rot) + 2 * (urand() - 0.5)};
+        }
+    } else {
+        int teeth = 4 + (int)(3 * urand());
+        n = 2 * teeth + 1;
+        double amp = r * (0.25 + 0.15 * urand());
+        for (int i = 0; i < n; ++i) {
+            double t = (double)i / (n - 1) * 2 - 1, off = (i % 2 ? amp : -amp) * (1 + 0.2 * (urand() - 0.5));
+            double x = r * t, y = off;
+            double a = (urand() - 0.5) * 0.4;
+            p[i] = (sp_vec2){cx + x * cos(a) - y * sin(a), cy + x * sin(a) + y * cos(a)};
+        }
+    }
+    *s = (sp_sketch){256, 256, 0, NULL};
+    ENSURE(sp_sketch_add_stroke(s, p, NULL, n) == SP_OK);
+}
+
+static bool contains(const char* hay, const char* needle)
+{
+    return strstr(hay, needle) != NULL;
+}
+
+// ---------------------------------------------------------------------------
+// stroke JSON
+
+static void test_json_roundtrip(void)
+{
+    sp_sketch s = {640, 480, 0, NULL};
+    sp_vec2 a[3] = {{1.5, 2.25}, {3, 4}, {100.125, -7}};
+    double ta[3] = {0, 16.5, 33};
+    sp_vec2 b[1] = {{5, 6}};
+    double tb[1] = {50};
+    ENSURE(sp_sketch_add_stroke(&s, a, ta, 3) == SP_OK);
+    ENSURE(sp_sketch_add_stroke(&s, b, tb, 1) == SP_OK);
+    const char* path = sp_test_tmp_path("rt.json");
+    sp_error err = {0};
+    ENSURE(sp_sketch_write_json(path, &s, &err) == SP_OK);
+    sp_sketch r;
+    ENSURE(sp_sketch_read_json(path, &r, &err) == SP_OK);
+    ENSURE(r.stroke_count == 2 && r.canvas_w == 640 && r.canvas_h == 480);
+    ENSURE(r.strokes[0].count == 3 && r.strokes[1].count == 1);
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(r.strokes[0].points[i].x == a[i].x && r.strokes[0].points[i].y == a[i].y);
+        ENSURE(r.strokes[0].t && r.strokes[0].t[i] == ta[i]);
+    }
+    ENSURE(r.strokes[1].points[0].x == 5 && r.strokes[1].t[0] == 50);
+    sp_sketch_free(&r);
+    sp_sketch_free(&s);
+}
+
+static void expect_json_error(const char* text, sp_result code, const char* what)
+{
+    sp_sketch s;
+    sp_error err = {0};
+    sp_result rc = sp_sketch_parse_json(text, strlen(text), "x.json", &s, &err);
+    if (rc != code || !contains(err.text, what) || !contains(err.text, "x.json"))
+        fprintf(stderr, "  got %d '%s' for %s\n", rc, err.text, text);
+    ENSURE(rc == code);
+    ENSURE(contains(err.text, "x.json") && contains(err.text, what));
+    ENSURE(s.stroke_count == 0 && s.strokes == NULL);
+}
+
+static void test_json_bad(void)
+{
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [", SP_ERR_PARSE, "malformed");
+    expect_json_error("[1, 2]", SP_ERR_PARSE, "JSON object");
+    expect_json_error("{\"format\": \"other\", \"version\": 1, \"strokes\": []}", SP_ERR_PARSE, "format");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 2, \"strokes\": []}", SP_ERR_UNSUPPORTED, "version 2");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1}", SP_ERR_PARSE, "strokes");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, NaN]]}]}",
+                      SP_ERR_PARSE, "malformed");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 1e999]]}]}",
+                      SP_ERR_INVALID, "finite");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2, 3]]}]}",
+                      SP_ERR_PARSE, "[x, y]");
+    expect_json_error(
+        "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2]], \"t\": [1, 2]}]}",
+        SP_ERR_INVALID, "\"t\"");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [-1, 5], \"strokes\": []}",
+                      SP_ERR_INVALID, "canvas");
+    // 10^6 + 1 points: refused with a clear message, not a crash or a huge allocation spree.
+    size_t n = 1000001, cap = n * 6 + 200;
+    char* big = malloc(cap);
+    ENSURE(big != NULL);
+    size_t at = (size_t)sprintf(big, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [");
+    for (size_t i = 0; i < n; ++i) {
+        memcpy(big + at, i ? ",[0,0]" : "[0,0]", i ? 6 : 5);
+        at += i ? 6 : 5;
+    }
+    strcpy(big + at, "]}]}");
+    sp_sketch s;
+    sp_error err = {0};
+    sp_result rc = sp_sketch_parse_json(big, strlen(big), "big.json", &s, &err);
+    free(big);
+    ENSURE(rc == SP_ERR_UNSUPPORTED && contains(err.text, "1000000"));
+    // Missing file.
+    ENSURE(sp_sketch_read_json(sp_test_tmp_path("does-not-exist.json"), &s, &err) == SP_ERR_IO);
+    ENSURE(contains(err.text, "does-not-exist.json"));
+}
+
+// ---------------------------------------------------------------------------
+// ndjson
+
+static void test_ndjson(void)
+{
+    const char* text = "{\"word\": \"a\", \"drawing\": [[[0, 10, 20], [0, 5, 0]], [[1], [2]]]}\n"
+                       "\n"
+                       "{\"word\": \"a\", \"drawing\": [[[3, 4], [5, 6], [0, 10]]]}\n";
+    sp_dataset ds = {0};
+    sp_error err = {0};
+    int l = sp_dataset_add_category(&ds, "a");
+    ENSURE(sp_dataset_parse_ndjson(&ds, text, strlen(text), "a.ndjson", l, &err) == SP_OK);
+    ENSURE(ds.count == 2);
+    ENSURE(ds.samples[0].sketch.stroke_count == 2 && ds.samples[0].sketch.strokes[0].count == 3);
+    ENSURE(ds.samples[0].sketch.strokes[0].points[1].x == 10 && ds.samples[0].sketch.strokes[0].points[1].y == 5);
+    ENSURE(ds.samples[1].index == 1 && ds.samples[1].sketch.strokes[0].t && ds.samples[1].sketch.strokes[0].t[1] == 10);
+    const char* bad[] = {
+        "{\"drawing\": [[[0, 1], [0]]]}\n",
+        "{\"word\": \"a\"}\n",
+        "{\"drawing\": [[[0, \"x\"], [0, 1]]]}\n",
+        "{\"drawing\": [[[0, 1e999], [0, 1]]]}\n",
+        "{\"drawing\": [[[0, 1], [0, 1]]]}\n{\"drawing\": [[[0, 1], [0 1]]]}\n",
+    };
+    const char* want[] = {":1:", ":1:", ":1:", ":1:", ":2:"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        sp_error e = {0};
+        ENSURE(sp_dataset_parse_ndjson(&ds, bad[i], strlen(bad[i]), "b.ndjson", l, &e) != SP_OK);
+        if (!contains(e.text, want[i])) fprintf(stderr, "  '%s'\n", e.text);
+        ENSURE(contains(e.text, "b.ndjson") && contains(e.text, want[i]));
+    }
+    sp_dataset_free(&ds);
+}
+
+static void test_quickdraw_real(void)
+{
+    const char* dir = sp_test_data_dir();
+    if (!dir) SKIP("../shared/data absent");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/quickdraw", dir);
+    sp_dataset ds;
+    sp_error err = {0};
+    ENSURE(sp_dataset_load(path, &ds, &err) == SP_OK);
+    ENSURE(ds.category_count == 100 && ds.count == 2500);
+    int dragon = -1;
+    for (int i = 0; i < ds.category_count; ++i)
+        if (!strcmp(ds.categories[i], "dragon")) dragon = i;
+    ENSURE(dragon >= 0);
+    for (int i = 0; i < ds.count; ++i) {
+        ENSURE(ds.samples[i].sketch.stroke_count > 0 && sp_sketch_is_valid(&ds.samples[i].sketch));
+        ENSURE(ds.samples[i].index >= 0 && ds.samples[i].index < 25);
+    }
+    sp_dataset_free(&ds);
+}
+
+// ---------------------------------------------------------------------------
+// SVG
+
+static void test_svg(void)
+{
+    const char* text = "<?xml version=\"1.0\"?>\n<!-- a comment <path d=\"M 0 0 L 9 9\"/> -->\n"
+                       "<svg viewBox=\"0 0 800 600\" xmlns=\"http://www.w3.org/2000/svg\">\n"
+                       "<g transform=\"translate(10,20) scale(2)\">\n"
+                       "  <path d=\"M1 2 L3 4 l1 1 H10 v2 Z\"/>\n"
+                       "  <path d='m 0 0 c 0 10 10 10 10 0 q 5 -5 10 0'/>\n"
+                       "  <g transform=\"matrix(1 0 0 1 100 0)\"><path d=\"M0,0L1-1\"/></g>\n"
+                       "</g>\n<line x1=\"1\" y1=\"2\" x2=\"3\" y2=\"4\"/>\n"
+                       "<polyline points=\"0,0 1,1 2,0\"/>\n</svg>\n";
+    sp_sketch s;
+    sp_error err = {0};
+    ENSURE(sp_sketch_parse_svg(text, strlen(text), "t.svg", &s, &err) == SP_OK);
+    ENSURE(s.canvas_w == 800 && s.canvas_h == 600);
+    ENSURE(s.stroke_count == 5);
+    // stroke 0: M1 2 L3 4 l1 1 H10 v2 Z -> (1,2) (3,4) (4,5) (10,5) (10,7) (1,2), through translate(10,20) scale(2)
+    const sp_stroke* a = &s.strokes[0];
+    ENSURE(a->count == 6);
+    ENSURE_NEAR(a->points[0].x, 12, 1e-9);
+    ENSURE_NEAR(a->points[0].y, 24, 1e-9);
+    ENSURE_NEAR(a->points[2].x, 18, 1e-9);
+    ENSURE_NEAR(a->points[2].y, 30, 1e-9);
+    ENSURE_NEAR(a->points[4].x, 30, 1e-9);
+    ENSURE_NEAR(a->points[4].y, 34, 1e-9);
+    ENSURE_NEAR(a->points[5].x, 12, 1e-9);
+    // stroke 1: relative cubic then quadratic, flattened; ends at (20,0) -> (50,20); curve peak y = 7.5 -> 35
+    const sp_stroke* b = &s.strokes[1];
+    ENSURE(b->count == 1 + 2 * 12);
+    ENSURE_NEAR(b->points[b->count - 1].x, 50, 1e-9);
+    ENSURE_NEAR(b->points[b->count - 1].y, 20, 1e-9);
+    ENSURE_NEAR(b->points[6].y, 20 + 2 * 7.5, 1e-9);
+    // stroke 2: nested matrix translate(100,0) inside the outer group
+    ENSURE_NEAR(s.strokes[2].points[0].x, 10 + 2 * 100, 1e-9);
+    ENSURE_NEAR(s.strokes[2].points[1].y, 20 - 2, 1e-9);
+    ENSURE(s.strokes[3].count == 2 && s.strokes[4].count == 3);
+    sp_sketch_free(&s);
+
+    const char* bad[] = {"<svg><path d=\"M 0 0 L 1\"/></svg>",
+                         "<svg><path d=\"X 0 0\"/></svg>",
+                         "<svg><path d=\"0 0\"/></svg>",
+                         "<svg></g></svg>",
+                         "<path d=\"M0 0 L1 1\"/>",
+                         "<svg><path d=\"M 0 0 L nan 1\"/></svg>",
+                         "<svg><path d=\"M 0 0 L 1e999 1\"/></svg>",
+                         "<svg><g transform=\"scale(\"><path d=\"M0 0\"/></g></svg>",
+                         "<svg><path d=\"M0 0"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        sp_error e = {0};
+        sp_result rc = sp_sketch_parse_svg(bad[i], strlen(bad[i]), "b.svg", &s, &e);
+        if (rc == SP_OK) fprintf(stderr, "  accepted: %s\n", bad[i]);
+        ENSURE(rc != SP_OK && contains(e.text, "b.svg"));
+        ENSURE(s.stroke_count == 0);
+    }
+}
+
+static void test_tuberlin_real(void)
+{
+    const char* dir = sp_test_data_dir();
+    if (!dir) SKIP("../shared/data absent");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/tuberlin-svg", dir);
+    sp_dataset ds;
+    sp_error err = {0};
+    ENSURE(sp_dataset_load(path, &ds, &err) == SP_OK);
+    ENSURE(ds.category_count == 3 && ds.count == 15);
+    ENSURE(!strcmp(ds.categories[1], "alarm clock"));
+    for (int i = 0; i < ds.count; ++i) {
+        const sp_sketch* s = &ds.samples[i].sketch;
+        ENSURE(s->stroke_count > 3 && s->canvas_w == 800);
+        sp_vec2 lo, hi;
+        ENSURE(sp_sketch_bounds(s, &lo, &hi));
+        // Group transforms put every drawing inside (or just around) its 800x800 view box.
+        ENSURE(lo.x > -100 && lo.y > -100 && hi.x < 900 && hi.y < 900 && hi.x - lo.x > 100);
+    }
+    sp_dataset_free(&ds);
+}
+
+// ---------------------------------------------------------------------------
+// PNG
+
+static void write_png_sketch(const char* path, int w, int h)
+{
+    unsigned char* px = malloc((size_t)w * h);
+    ENSURE(px != NULL);
+    memset(px, 255, (size_t)w * h);
+    for (int i = 0; i < w; ++i) { // a dark diagonal and a box
+        int y = i * h / w;
+        for (int t = -1; t <= 1; ++t)
+            if (y + t >= 0 && y + t < h) px[(size_t)(y + t) * w + i] = 0;
+    }
+    for (int i = w / 4; i < 3 * w / 4; ++i)
+        px[(size_t)(h / 4) * w + i] = px[(size_t)(3 * h / 4) * w + i] = 10;
+    ENSURE(stbi_write_png(path, w, h, 1, px, w) != 0);
+    free(px);
+}
+
+static void test_png(void)
+{
+    const char* ok = sp_test_tmp_path("ok.png");
+    write_png_sketch(ok, 120, 90);
+    sp_raster r;
+    sp_error err = {0};
+    ENSURE(sp_raster_read_png(ok, &r, &err) == SP_OK);
+    ENSURE(r.w == 120 && r.h == 90 && r.pixels[0] == 0 && r.pixels[119] == 255);
+    sp_features* f = malloc(sizeof *f);
+    ENSURE(f != NULL);
+    ENSURE(sp_feat_extract(NULL, &r, f, &err) == SP_OK);
+    ENSURE(f->count > 50);
+    sp_raster_free(&r);
+
+    // A header claiming 20000x20000 is refused before anything is decoded.
+    FILE* fp = fopen(ok, "rb");
+    unsigned char buf[4096];
+    size_t n = fread(buf, 1, sizeof buf, fp);
+    fclose(fp);
+    buf[16] = 0, buf[17] = 0, buf[18] = 0x4e, buf[19] = 0x20; // 20000
+    buf[20] = 0, buf[21] = 0, buf[22] = 0x4e, buf[23] = 0x20;
+    const char* huge = sp_test_tmp_path("huge.png");
+    fp = fopen(huge, "wb");
+    fwrite(buf, 1, n, fp);
+    fclose(fp);
+    ENSURE(sp_raster_read_png(huge, &r, &err) == SP_ERR_UNSUPPORTED);
+    ENSURE(contains(err.text, "20000x20000") && contains(err.text, "huge.png"));
+
+    const char* fake = sp_test_tmp_path("fake.png");
+    write_text(fake, "this is not a png at all");
+    ENSURE(sp_raster_read_png(fake, &r, &err) == SP_ERR_PARSE);
+    ENSURE(contains(err.text, "not a PNG") && contains(err.text, "fake.png"));
+
+    // Right signature, garbage after: the decoder fails cleanly.
+    memcpy(buf + 30, "garbagegarbagegarbage", 21);
+    buf[18] = 0, buf[19] = 16, buf[22] = 0, buf[23] = 16;
+    const char* broken = sp_test_tmp_path("broken.png");
+    fp = fopen(broken, "wb");
+    fwrite(buf, 1, 60, fp);
+    fclose(fp);
+    ENSURE(sp_raster_read_png(broken, &r, &err) != SP_OK && contains(err.text, "broken.png"));
+
+    // A blank (all white) PNG has nothing to describe.
+    unsigned char white[64 * 64];
+    memset(white, 255, sizeof white);
+    const char* blank = sp_test_tmp_path("blank.png");
+    ENSURE(stbi_write_png(blank, 64, 64, 1, white, 64) != 0);
+    ENSURE(sp_raster_read_png(blank, &r, &err) == SP_OK);
+    ENSURE(sp_feat_extract(NULL, &r, f, &err) == SP_ERR_INVALID);
+    sp_raster_free(&r);
+    free(f);
+}
+
+// ---------------------------------------------------------------------------
+// folders
+
+static void test_folder(void)
+{
+    char dir[1024], sub[1100], p[1200];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("folder"));
+    mkdir(dir, 0755);
+    snprintf(sub, sizeof sub, "%s/circle", dir);
+    mkdir(sub, 0755);
+    snprintf(p, sizeof p, "%s/b.json", sub);
+    write_text(p, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [10, 10], \"strokes\": "
+                  "[{\"points\": [[0, 0], [5, 5]]}]}");
+    snprintf(p, sizeof p, "%s/a.svg", sub);
+    write_text(p, "<svg viewBox=\"0 0 10 10\"><path d=\"M0 0 L 5 5\"/></svg>");
+    snprintf(p, sizeof p, "%s/c.png", sub);
+    write_png_sketch(p, 40, 40);
+    snprintf(p, sizeof p, "%s/notes.txt", sub);
+    write_text(p, "ignored");
+    snprintf(p, sizeof p, "%s/apple.ndjson", dir);
+    write_text(p, "{\"drawing\": [[[0, 10], [0, 10]]]}\n{\"drawing\": [[[0, 10], [10, 0]]]}\n");
+    sp_dataset ds;
+    sp_error err = {0};
+    ENSURE(sp_dataset_load(dir, &ds, &err) == SP_OK);
+    ENSURE(ds.category_count == 2 && !strcmp(ds.categories[0], "apple") && !strcmp(ds.categories[1], "circle"));
+    ENSURE(ds.count == 5);
+    int apples = 0, pngs = 0;
+    for (int i = 0; i < ds.count; ++i) {
+        apples += ds.samples[i].label == 0;
+        pngs += ds.samples[i].raster.pixels != NULL;
+    }
+    ENSURE(apples == 2 && pngs == 1);
+    sp_dataset_free(&ds);
+    // One bad file fails the whole load, naming it.
+    snprintf(p, sizeof p, "%s/d.json", sub);
+    write_text(p, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[0, 0], [5]]}]}");
+    ENSURE(sp_dataset_load(dir, &ds, &err) == SP_ERR_PARSE);
+    ENSURE(contains(err.text, "d.json"));
+    ENSURE(sp_dataset_load(sp_test_tmp_path("no-such-dir"), &ds, &err) == SP_ERR_IO);
+}
+
+// ---------------------------------------------------------------------------
+// descriptors
+
+static void test_descriptors(void)
+{
+    g_rng = 42;
+    sp_sketch s;
+    make_shape(0, &s);
+    sp_features* f = malloc(sizeof *f);
+    sp_error err = {0};
+    ENSURE(f != NULL);
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    ENSURE(f->count > 100 && f->count <= SP_FEAT_MAX);
+    for (int i = 0; i < f->count; ++i) {
+        double n2 = 0;
+        for (int d = 0; d < SP_FEAT_DIM; ++d) {
+            float v = f->desc[i * SP_FEAT_DIM + d];
+            ENSURE(v >= 0.0f && isfinite(v));
+            n2 += (double)v * v;
+        }
+        ENSURE_NEAR(n2, 1.0, 1e-4);
+        ENSURE(f->pos[2 * i] >= 0 && f->pos[2 * i] <= 1 && f->pos[2 * i + 1] >= 0 && f->pos[2 * i + 1] <= 1);
+    }
+    // The circle's interior: the sample point in the middle of the frame has no ink in its patch? Not for a
+    // big circle; but a tiny drawing in one corner leaves most patches empty. Use a dot: only patches
+    // around the centre see it.
+    sp_sketch_free(&s);
+    sp_vec2 dot = {5, 5};
+    s = (sp_sketch){0};
+    ENSURE(sp_sketch_add_stroke(&s, &dot, NULL, 1) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    ENSURE(f->count > 0 && f->count < 150); // empty patches skipped
+    // A horizontal line: its descriptors see (almost) only the horizontal-edge bin (gradient along y = bin 2).
+    sp_sketch_free(&s);
+    sp_vec2 line[2] = {{0, 50}, {100, 50}};
+    ENSURE(sp_sketch_add_stroke(&s, line, NULL, 2) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    double bins[4] = {0};
+    for (int i = 0; i < f->count; ++i)
+        for (int d = 0; d < SP_FEAT_DIM; ++d)
+            bins[d % 4] += f->desc[i * SP_FEAT_DIM + d];
+    ENSURE(bins[2] > 3 * (bins[0] + bins[1] + bins[3]));
+    sp_sketch_free(&s);
+    free(f);
+}
+
+static void test_bad_drawings(void)
+{
+    sp_features* f = malloc(sizeof *f);
+    sp_error err = {0};
+    ENSURE(f != NULL);
+    sp_sketch s = {0};
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
+    sp_vec2 nan_pt[2] = {{0, 0}, {NAN, 1}};
+    ENSURE(sp_sketch_add_stroke(&s, nan_pt, NULL, 2) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_ERR_INVALID && contains(err.text, "finite"));
+    sp_sketch_free(&s);
+    int n = SP_SKETCH_MAX_POINTS + 1;
+    sp_vec2* many = malloc(sizeof(sp_vec2) * (size_t)n);
+    ENSURE(many != NULL);
+    for (int i = 0; i < n; ++i)
+        many[i] = (sp_vec2){i % 1000, i / 1000};
+    ENSURE(sp_sketch_add_stroke(&s, many, NULL, n) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_ERR_UNSUPPORTED && contains(err.text, "1000000"));
+    sp_sketch_free(&s);
+    ENSURE(sp_sketch_add_stroke(&s, many, NULL, n - 1) == SP_OK); // exactly the cap is fine
+    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    sp_sketch_free(&s);
+    free(many);
+    free(f);
+}
+
+// ---------------------------------------------------------------------------
+// training, classification, model files
+
+static sp_dataset shapes(int per_class, uint64_t seed)
+{
+    g_rng = seed;
+    sp_dataset ds = {0};
+    const char* names[3] = {"circle", "line", "zigzag"};
+    for (int c = 0; c < 3; ++c)
+        sp_dataset_add_category(&ds, names[c]);
+    ds.samples = calloc((size_t)per_class * 3, sizeof(sp_sample));
+    for (int i = 0; i < per_class * 3; ++i) {
+        sp_sample* s = &ds.samples[ds.count++];
+        s->label = i % 3;
+        s->index = i / 3;
+        make_shape(s->label, &s->sketch);
+    }
+    return ds;
+}
+
+static sp_clf* g_model; // trained once, shared by the tests below
+
+static sp_clf* shapes_model(void)
+{
+    if (g_model) return g_model;
+    sp_dataset train = shapes(20, 7);
+    sp_error err = {0};
+    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5};
+    sp_result rc = sp_clf_train(&train, NULL, &d, &g_model, &err);
+    if (rc != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    sp_dataset_free(&train);
+    ENSURE(rc == SP_OK);
+    return g_model;
+}
+
+static void test_train_shapes(void)
+{
+    sp_clf* clf = shapes_model();
+    ENSURE(sp_clf_category_count(clf) == 3 && !strcmp(sp_clf_category(clf, 2), "zigzag"));
+    sp_dataset test = shapes(15, 1234); // held out: other seed
+    int right = 0;
+    for (int i = 0; i < test.count; ++i) {
+        sp_clf_answer a;
+        sp_error err = {0};
+        ENSURE(sp_clf_classify(clf, &test.samples[i].sketch, NULL, &a, &err) == SP_OK);
+        ENSURE(a.count >= 1 && a.ranked[0].score > 0 && a.ranked[0].score <= 1.0f + 1e-6f);
+        for (int j = 1; j < a.count; ++j)
+            ENSURE(a.ranked[j].score <= a.ranked[j - 1].score);
+        right += a.ranked[0].category == test.samples[i].label;
+    }
+    printf("  shapes: %d/%d held-out correct\n", right, test.count);
+    ENSURE(right >= test.count * 9 / 10);
+    sp_dataset_free(&test);
+}
+
+static void test_reject(void)
+{
+    sp_clf* clf = shapes_model();
+    // A dense scribble of many crossing strokes looks like none of the shapes.
+    g_rng = 99;
+    sp_sketch s = {0};
+    for (int k = 0; k < 30; ++k) {
+        sp_vec2 p[2] = {{urand() * 200, urand() * 200}, {urand() * 200, urand() * 200}};
+        ENSURE(sp_sketch_add_stroke(&s, p, NULL, 2) == SP_OK);
+    }
+    sp_clf_answer a;
+    sp_error err = {0};
+    ENSURE(sp_clf_classify(clf, &s, NULL, &a, &err) == SP_OK);
+    ENSURE(a.rejected && a.distance > a.reject_distance);
+    sp_sketch_free(&s);
+}
+
+static void test_deterministic(void)
+{
+    sp_dataset train = shapes(6, 3);
+    sp_error err = {0};
+    sp_clf *a = NULL, *b = NULL;
+    sp_clf_desc d1 = {.words = 16, .vocab_samples = 3000, .threads = 1};
+    sp_clf_desc d2 = d1;
+    d2.threads = 2;
+    ENSURE(sp_clf_train(&train, NULL, &d1, &a, &err) == SP_OK);
+    ENSURE(sp_clf_train(&train, NULL, &d2, &b, &err) == SP_OK);
+    const char* pa = sp_test_tmp_path("det_a.spclf");
+    const char* pb = sp_test_tmp_path("det_b.spclf");
+    ENSURE(sp_clf_save(a, pa, &err) == SP_OK && sp_clf_save(b, pb, &err) == SP_OK);
+    FILE* fa = fopen(pa, "rb");
+    FILE* fb = fopen(pb, "rb");
+    int ca, cb, same = 1;
+    do {
+        ca = fgetc(fa);
+        cb = fgetc(fb);
+        if (ca != cb) same = 0;
+    } while (ca != EOF && cb != EOF);
+    fclose(fa);
+    fclose(fb);
+    sp_clf_free(a);
+    sp_clf_free(b);
+    sp_dataset_free(&train);
+    ENSURE(same); // the same model whatever the thread count
+}
+
+static long file_size(const char* p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 ? (long)st.st_size : -1;
+}
+
+static void copy_modified(const char* from, const char* to, long keep, long flip_at)
+{
+    FILE* f = fopen(from, "rb");
+    long n = file_size(from);
+    unsigned char* b = malloc((size_t)n);
+    ENSURE(f && b && fread(b, 1, (size_t)n, f) == (size_t)n);
+    fclose(f);
+    if (flip_at >= 0) b[flip_at] ^= 0x5a;
+    FILE* g = fopen(to, "wb");
+    fwrite(b, 1, (size_t)(keep < n ? keep : n), g);
+    fclose(g);
+    free(b);
+}
+
+static void test_model_files(void)
+{
+    sp_clf* clf = shapes_model();
+    const char* path = sp_test_tmp_path("shapes.spclf");
+    sp_error err = {0};
+    ENSURE(sp_clf_save(clf, path, &err) == SP_OK);
+    sp_clf* back = NULL;
+    ENSURE(sp_clf_load(path, &back, &err) == SP_OK);
+    sp_clf_desc d0 = sp_clf_get_desc(clf), d1 = sp_clf_get_desc(back);
+    ENSURE(d0.words == d1.words && d0.knn == d1.knn && d0.pyramid == d1.pyramid);
+    sp_dataset test = shapes(5, 555);
+    for (int i = 0; i < test.count; ++i) {
+        sp_clf_answer a, b;
+        ENSURE(sp_clf_classify(clf, &test.samples[i].sketch, NULL, &a, &err) == SP_OK);
+        ENSURE(sp_clf_classify(back, &test.samples[i].sketch, NULL, &b, &err) == SP_OK);
+        ENSURE(a.count == b.count && a.rejected == b.rejected);
+        for (int j = 0; j < a.count; ++j)
+            ENSURE(a.ranked[j].category == b.ranked[j].category && a.ranked[j].score == b.ranked[j].score);
+    }
+    sp_dataset_free(&test);
+    sp_clf_free(back);
+
+    long n = file_size(path);
+    const char* bad = sp_test_tmp_path("bad.spclf");
+    copy_modified(path, bad, n, n / 2); // one byte flipped
+    ENSURE(sp_clf_load(bad, &back, &err) == SP_ERR_PARSE && contains(err.text, "corrupt") && contains(err.text, "bad.spclf"));
+    copy_modified(path, bad, n - 100, -1); // truncated
+    ENSURE(sp_clf_load(bad, &back, &err) == SP_ERR_PARSE && contains(err.text, "truncated"));
+    copy_modified(path, bad, 10, -1); // truncated in the header
+    ENSURE(sp_clf_load(bad, &back, &err) == SP_ERR_PARSE && contains(err.text, "truncated"));
+    copy_modified(path, bad, n, 8); // version field changed
+    ENSURE(sp_clf_load(bad, &back, &err) == SP_ERR_UNSUPPORTED && contains(err.text, "version"));
+    write_text(bad, "{\"format\": \"sketchpose-strokes\"}");
+    ENSURE(sp_clf_load(bad, &back, &err) == SP_ERR_PARSE && contains(err.text, "not a sketchpose classifier model"));
+    ENSURE(sp_clf_load(sp_test_tmp_path("none.spclf"), &back, &err) == SP_ERR_IO);
+    ENSURE(back == NULL);
+}
+
+static void test_classify_edge_drawings(void)
+{
+    sp_clf* clf = shapes_model();
+    sp_clf_answer a;
+    sp_error err = {0};
+    sp_sketch s = {0};
+    ENSURE(sp_clf_classify(clf, &s, NULL, &a, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
+    sp_vec2 dot = {3, 3};
+    ENSURE(sp_sketch_add_stroke(&s, &dot, NULL, 1) == SP_OK);
+    ENSURE(sp_clf_classify(clf, &s, NULL, &a, &err) == SP_OK); // a dot is a (strange) drawing
+    sp_sketch_free(&s);
+    sp_vec2 line[2] = {{0, 0}, {100, 100}};
+    ENSURE(sp_sketch_add_stroke(&s, line, NULL, 2) == SP_OK);
+    ENSURE(sp_clf_classify(clf, &s, NULL, &a, &err) == SP_OK);
+    ENSURE(a.count > 0 && a.ranked[0].category == 1); // a straight line is a line
+    sp_sketch_free(&s);
+}
+
+static void test_quickdraw_small(void)
+{
+    const char* dir = sp_test_data_dir();
+    if (!dir) SKIP("../shared/data absent");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/quickdraw", dir);
+    sp_dataset all;
+    sp_error err = {0};
+    ENSURE(sp_dataset_load(path, &all, &err) == SP_OK);
+    // 10 categories, 20 train / 5 test each: far above chance (10%) even with a small vocabulary.
+    unsigned char* use = calloc((size_t)all.count, 1);
+    for (int i = 0; i < all.count; ++i)
+        use[i] = all.samples[i].label < 10 && all.samples[i].index % 5 != 0;
+    sp_clf* clf = NULL;
+    sp_clf_desc d = {.words = 100, .vocab_samples = 20000};
+    ENSURE(sp_clf_train(&all, use, &d, &clf, &err) == SP_OK);
+    int right = 0, n = 0;
+    for (int i = 0; i < all.count; ++i) {
+        if (all.samples[i].label >= 10 || all.samples[i].index % 5 != 0) continue;
+        sp_clf_answer a;
+        ENSURE(sp_clf_classify(clf, &all.samples[i].sketch, NULL, &a, &err) == SP_OK);
+        right += a.count > 0 && a.ranked[0].category == all.samples[i].label;
+        ++n;
+    }
+    printf("  quickdraw 10 classes: %d/%d\n", right, n);
+    ENSURE(n == 50 && right >= 20);
+    sp_clf_free(clf);
+    free(use);
+    sp_dataset_free(&all);
+}
+
+static void test_cleanup(void)
+{
+    sp_clf_free(g_model);
+    g_model = NULL;
+}
+
+int main(int argc, char** argv)
+{
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"json_roundtrip", test_json_roundtrip},
+                                   {"json_bad", test_json_bad},
+                                   {"ndjson", test_ndjson},
+                                   {"quickdraw_real", test_quickdraw_real},
+                                   {"svg", test_svg},
+                                   {"tuberlin_real", test_tuberlin_real},
+                                   {"png", test_png},
+                                   {"folder", test_folder},
+                                   {"descriptors", test_descriptors},
+                                   {"bad_drawings", test_bad_drawings},
+                                   {"train_shapes", test_train_shapes},
+                                   {"reject", test_reject},
+                                   {"deterministic", test_deterministic},
+                                   {"model_files", test_model_files},
+                                   {"classify_edge_drawings", test_classify_edge_drawings},
+                                   {"quickdraw_small", test_quickdraw_small},
+                                   {"zz_cleanup", test_cleanup},
+                                   {0}});
+}
