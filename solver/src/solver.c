@@ -9,6 +9,15 @@
 
 #include "solver_internal.h"
 
+// The reference setup the paper's default weights are tuned for, in the
+// spirit of its Maya scenes: an abstraction 500 pixels across matched with
+// 200 sample pairs, a character 200 units across with 1000 vertices. Every
+// solve measures its residuals in these units (see sp/solver.h).
+#define SP_REF_PIXELS 500.0
+#define SP_REF_PAIRS 200.0
+#define SP_REF_SIZE 200.0
+#define SP_REF_VERTICES 1000.0
+
 // Built in match.c: resamples the projected curves and the strokes and
 // fills s->pairs; writes which stroke each curve got into rep->curves.
 sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err);
@@ -146,7 +155,9 @@ sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera*
     s->reps = malloc(sizeof(int) * (size_t)(s->d.representatives + 1));
     s->k = s->reps && rig->vertex_count > 0 ? coarsen(rig, s->d.representatives, s->reps) : 0;
     // Column lists.
-    int* tmp = malloc(sizeof(int) * (size_t)(P * 3 + 16));
+    // Before deduplication a point lists every ancestor parameter of up to
+    // 12 influences (an embedded point: 3 vertices x 4 joints).
+    int* tmp = malloc(sizeof(int) * (size_t)(P * 12 + 16));
     s->ab_sb = malloc(sizeof(sparse_block) * (size_t)(l > 0 ? l : 1));
     s->rep_sb = malloc(sizeof(sparse_block) * (size_t)(s->k > 0 ? s->k : 1));
     size_t ab_total = 0, rep_total = 0;
@@ -190,12 +201,15 @@ sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera*
     s->p0 = malloc(sizeof(double) * (size_t)P);
     s->unit = malloc(sizeof(double) * (size_t)P);
     s->free_ = malloc(sizeof(bool) * (size_t)P);
+    s->match_aa = malloc(sizeof(double) * ll);
+    s->match_ab = malloc(sizeof(double) * ll);
+    s->match_beta = malloc(sizeof(double) * 2 * ll);
     if ((!s->ab->rest && !s->mesh) || !s->z3 || !s->z2 || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
-        !s->scratch || !s->H || !s->g || !s->p0 || !s->unit || !s->free_)
+        !s->scratch || !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->match_aa || !s->match_ab || !s->match_beta)
         goto fail;
     for (int i = 0; i < s->P; ++i) {
         sp_channel c = rig->params[i].channel;
-        s->unit[i] = (c >= SP_CH_TX && c <= SP_CH_TZ) ? s->D : 1.0;
+        s->unit[i] = (c >= SP_CH_TX && c <= SP_CH_TZ) ? s->D / SP_REF_SIZE : 1.0;
     }
     return s;
 fail:
@@ -211,6 +225,7 @@ void sp_solver_destroy(sp_solver* s)
     free(s->reps), free(s->ab_cols), free(s->ab_sb), free(s->rep_cols), free(s->rep_sb);
     free(s->mesh), free(s->z3), free(s->z2), free(s->G), free(s->x0), free(s->xr), free(s->Jr), free(s->dw), free(s->view);
     free(s->scratch), free(s->H), free(s->g), free(s->p0), free(s->unit), free(s->free_), free(s->pairs);
+    free(s->match_aa), free(s->match_ab), free(s->match_beta);
     free(s);
 }
 
@@ -249,8 +264,16 @@ static sp_vec2 sample_at(const sp_solver* s, sample_ref r)
 
 static double match_weight(const sp_solver* s)
 {
-    double unit = 0.001 * s->L;
-    return 1.0 / ((double)(s->pair_count > 0 ? s->pair_count : 1) * unit * unit);
+    double r = SP_REF_PIXELS / s->L;
+    return SP_REF_PAIRS * r * r / (double)(s->pair_count > 0 ? s->pair_count : 1);
+}
+
+// Weight of one representative's squared displacement (before lambda):
+// reference units, summed as over SP_REF_VERTICES vertices.
+static double vertex_weight(const sp_solver* s)
+{
+    double r = SP_REF_SIZE / s->D;
+    return SP_REF_VERTICES * r * r / (double)(s->k > 0 ? s->k : 1);
 }
 
 // Energy terms at p with the current correspondences (updates the rig state).
@@ -270,7 +293,7 @@ static sp_energy_terms energy(sp_solver* s, const double* p)
     }
     if (s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0)) {
         sp_rig_eval_rows(s->ev, sp_rig_mesh_points(s->rig), s->reps, s->k, s->xr);
-        double unit = 0.01 * s->D, inv = 1.0 / (s->k * unit * unit);
+        double inv = vertex_weight(s);
         for (int i = 0; i < s->k; ++i) {
             sp_vec3 dx = {s->xr[3 * i] - s->x0[3 * i], s->xr[3 * i + 1] - s->x0[3 * i + 1], s->xr[3 * i + 2] - s->x0[3 * i + 2]};
             double vp = sp_v3_dot(s->view[i], dx);
@@ -279,8 +302,8 @@ static sp_energy_terms energy(sp_solver* s, const double* p)
         }
     }
     e.pose *= s->d.lambda_pose * s->pose_boost;
-    e.plane *= s->d.lambda_plane;
-    e.dist *= s->d.lambda_dist;
+    e.plane *= s->d.lambda_plane * s->vertex_boost;
+    e.dist *= s->d.lambda_dist * s->vertex_boost;
     e.total = e.match + e.pose + e.plane + e.dist;
     return e;
 }
@@ -334,19 +357,21 @@ static void jacobian_blocks(sp_solver* s)
     }
 }
 
-// H += w * B^T B, g += w * B^T r over the listed columns; B is rows x n.
-static void accumulate(sp_solver* s, const int* cols, int n, const double* B, int rows, const double* r, double w)
+// H += wh * B^T B, g += wg * B^T r over the listed (sorted) columns; B is
+// rows x n, row-major. Fills the upper triangle of H.
+static void accumulate(sp_solver* s, const int* cols, int n, const double* B, int rows, const double* r, double wg, double wh)
 {
     const int P = s->P;
     for (int a = 0; a < n; ++a) {
         int qa = cols[a];
         double ga = 0;
         for (int k = 0; k < rows; ++k) ga += B[k * n + a] * r[k];
-        s->g[qa] += w * ga;
+        s->g[qa] += wg * ga;
+        if (wh == 0.0) continue;
         for (int b = a; b < n; ++b) {
             double h = 0;
             for (int k = 0; k < rows; ++k) h += B[k * n + a] * B[k * n + b];
-            s->H[qa * P + cols[b]] += w * h;
+            s->H[qa * P + cols[b]] += wh * h;
         }
     }
 }
@@ -365,36 +390,57 @@ static void normal_equations(sp_solver* s, const double* p)
         free(cols), free(B);
         return;
     }
+    // The match term is quadratic in the projected points z: a sample is
+    // (1-t) z_a + t z_b, so summing over pairs first leaves per point a
+    // weight aa and a gradient vector beta, and per segment (a, b) a
+    // coupling ab. H and g then need one product per point and one per
+    // segment instead of one per pair, whatever the sample count.
+    const int l = s->ab->point_count;
+    double* aa = s->match_aa;
+    double* ab = s->match_ab;
+    double* beta = s->match_beta;
+    memset(aa, 0, sizeof(double) * (size_t)l);
+    memset(ab, 0, sizeof(double) * (size_t)l);
+    memset(beta, 0, sizeof(double) * 2 * (size_t)l);
     double wm = match_weight(s);
     for (int i = 0; i < s->pair_count; ++i) {
         const pair* pr = &s->pairs[i];
-        const sparse_block* A = &s->ab_sb[pr->s.a];
-        const sparse_block* Bb = &s->ab_sb[pr->s.b];
-        // Union of the two sorted column lists, blending both blocks.
-        int n = 0, ia = 0, ib = 0;
-        double ta = 1.0 - pr->s.t, tb = pr->s.t;
-        const double* Ga = s->G + 2 * (size_t)A->first;
-        const double* Gb = s->G + 2 * (size_t)Bb->first;
-        double tmp[2][512];
-        int cap = 512;
-        while ((ia < A->count || ib < Bb->count) && n < cap) {
-            int ca = ia < A->count ? s->ab_cols[A->first + ia] : 1 << 30;
-            int cb = ib < Bb->count ? s->ab_cols[Bb->first + ib] : 1 << 30;
-            int c = ca < cb ? ca : cb;
-            double x = 0, y = 0;
-            if (ca == c) x += ta * Ga[ia], y += ta * Ga[A->count + ia], ++ia;
-            if (cb == c && pr->s.b != pr->s.a) x += tb * Gb[ib], y += tb * Gb[Bb->count + ib], ++ib;
-            else if (cb == c) ++ib;
-            cols[n] = c, tmp[0][n] = x, tmp[1][n] = y;
-            ++n;
-        }
-        for (int c = 0; c < n; ++c) B[c] = tmp[0][c], B[n + c] = tmp[1][c];
         sp_vec2 d = sp_v2_sub(sample_at(s, pr->s), pr->y);
-        double r[2] = {d.x, d.y};
-        accumulate(s, cols, n, B, 2, r, wm);
+        double ca = 1.0 - pr->s.t, cb = pr->s.t;
+        int a = pr->s.a, b = pr->s.b;
+        if (a == b) ca += cb, cb = 0;
+        aa[a] += wm * ca * ca;
+        aa[b] += wm * cb * cb;
+        ab[a] += wm * ca * cb; // segment a -> b: b is the point after a
+        beta[2 * a] += wm * ca * d.x, beta[2 * a + 1] += wm * ca * d.y;
+        beta[2 * b] += wm * cb * d.x, beta[2 * b + 1] += wm * cb * d.y;
+    }
+    for (const sp_curve* cv = s->ab->curves; cv < s->ab->curves + s->ab->curve_count; ++cv) {
+        for (int k = 0; k < cv->point_count; ++k) {
+            int a = cv->first_point + k;
+            const sparse_block* A = &s->ab_sb[a];
+            const double* Ga = s->G + 2 * (size_t)A->first;
+            const int* ca = s->ab_cols + A->first;
+            if (aa[a] != 0.0 || beta[2 * a] != 0.0 || beta[2 * a + 1] != 0.0)
+                accumulate(s, ca, A->count, Ga, 2, beta + 2 * a, 1.0, aa[a]);
+            if (ab[a] == 0.0) continue;
+            int b = k + 1 < cv->point_count ? a + 1 : cv->first_point; // closing segment of a loop
+            const sparse_block* Bk = &s->ab_sb[b];
+            const double* Gb = s->G + 2 * (size_t)Bk->first;
+            const int* cb = s->ab_cols + Bk->first;
+            // Cross term ab * (Ga^T Gb + Gb^T Ga), into the upper triangle.
+            for (int i = 0; i < A->count; ++i)
+                for (int j = 0; j < Bk->count; ++j) {
+                    double x = ab[a] * (Ga[i] * Gb[j] + Ga[A->count + i] * Gb[Bk->count + j]);
+                    int qi = ca[i], qj = cb[j];
+                    if (qi == qj) s->H[qi * P + qi] += 2.0 * x;
+                    else if (qi < qj) s->H[qi * P + qj] += x;
+                    else s->H[qj * P + qi] += x;
+                }
+        }
     }
     if (s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0)) {
-        double unit = 0.01 * s->D, inv = 1.0 / (s->k * unit * unit);
+        double inv = vertex_weight(s) * s->vertex_boost;
         for (int i = 0; i < s->k; ++i) {
             const sparse_block* sb = &s->rep_sb[i];
             const double* Jb = s->Jr + 3 * (size_t)sb->first;
@@ -404,9 +450,9 @@ static void normal_equations(sp_solver* s, const double* p)
                 sp_vec3 v = s->view[i];
                 for (int c = 0; c < sb->count; ++c) B[c] = v.x * Jb[c] + v.y * Jb[sb->count + c] + v.z * Jb[2 * sb->count + c];
                 double r = v.x * dx[0] + v.y * dx[1] + v.z * dx[2];
-                accumulate(s, cl, sb->count, B, 1, &r, s->d.lambda_plane * inv);
+                accumulate(s, cl, sb->count, B, 1, &r, s->d.lambda_plane * inv, s->d.lambda_plane * inv);
             }
-            if (s->d.lambda_dist > 0 && s->dw[i] > 0) accumulate(s, cl, sb->count, Jb, 3, dx, s->d.lambda_dist * inv * s->dw[i]);
+            if (s->d.lambda_dist > 0 && s->dw[i] > 0) accumulate(s, cl, sb->count, Jb, 3, dx, s->d.lambda_dist * inv * s->dw[i], s->d.lambda_dist * inv * s->dw[i]);
         }
     }
     for (int q = 0; q < P; ++q) {
@@ -595,7 +641,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     sp_result res = sp__build_pairs(s, sk, rep, err);
     if (res != SP_OK) goto done;
     prepare_start(s, p, rep);
-    s->pose_boost = 1.0;
+    s->pose_boost = s->vertex_boost = 1.0;
     rep->before = energy(s, p);
     sp_energy_terms cur = rep->before;
     rep->stopped = SP_STOP_MAX_ITERATIONS;
@@ -619,11 +665,15 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
                 if (res != SP_OK) goto done;
             }
             ++rep->icp_rounds;
-            // Graduated W_pose: strongly damped early rounds follow the
-            // correspondences in small steps instead of jumping into a
-            // folded local minimum; from the ninth round on the weight is
-            // the configured one, so the result minimises the real W.
-            s->pose_boost = round < 9 ? fmax(1.0, 1e5 / pow(4.0, round)) : 1.0;
+            // Graduated regularisation: strongly damped early rounds follow
+            // the correspondences in small steps instead of jumping into a
+            // folded local minimum; from the ninth round on the weights are
+            // the configured ones, so the result minimises the real W.
+            // Draw-over curves (embedded in the surface) are local edits, so
+            // there W_plane and W_dist are graduated too: the early steps
+            // then move what is near the curve, not the whole figure.
+            s->pose_boost = fmax(1.0, 1e7 / pow(8.0, round));
+            s->vertex_boost = s->ab->rest ? 1.0 : s->pose_boost;
             cur = energy(s, p);
             double round_start = cur.total;
             // Gauss-Newton iterations with these correspondences.
@@ -662,7 +712,9 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
                 if (!accepted) break;
             }
             double drop = (round_start - cur.total) / fmax(round_start, 1e-300);
-            if (drop < 1e-6) {
+            // Converged when a round with fresh correspondences no longer
+            // lowers W by more than 0.01% once the weights are the real ones.
+            if (drop < 1e-6 || (s->pose_boost == 1.0 && drop < 1e-4)) {
                 converged = true;
                 break;
             }
@@ -672,7 +724,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     rep->stopped = time_up ? SP_STOP_TIME_CAP : (converged ? SP_STOP_CONVERGED : SP_STOP_MAX_ITERATIONS);
     // Final errors with fresh correspondences at the result.
     s->mode = s->ab->correspondence;
-    s->pose_boost = 1.0;
+    s->pose_boost = s->vertex_boost = 1.0;
     sp_rig_eval_update(s->ev, p, false);
     project_abstraction(s);
     res = sp__build_pairs(s, sk, rep, err);

@@ -56,12 +56,16 @@ struct sp_solver {
     double* p0;      // P: the start pose (W_pose anchor)
     double* unit;    // P: parameter units
     bool* free_;     // P
+    double* match_aa;   // point_count: summed match weights per point
+    double* match_ab;   // point_count: coupling of the segment starting at each point
+    double* match_beta; // point_count by 2: weighted residual per point
     // Correspondences.
     pair* pairs;
     int pair_count, pair_cap;
     double L;        // abstraction 2D diagonal at the start pose, pixels
     sp_correspondence mode; // how sp__build_pairs pairs samples now
     double pose_boost;      // >= 1: graduated W_pose weight, 1 in the final rounds
+    double vertex_boost;    // >= 1: the same for W_plane and W_dist (draw-over only)
 };
 
 #endif

@@ -26,6 +26,7 @@ typedef struct bench_case {
 } bench_case;
 
 typedef struct outcome {
+    double* its; // iterations
     double* ms;
     double* rel; // mean error / diagonal
     int n;
@@ -39,6 +40,7 @@ static void run_solves(const sp_rig* rig, const sp_camera* cam, int first_seed, 
     sp_solver* s = sp_solver_create(rig, 0, cam, &(sp_solve_desc){0});
     o->ms = malloc(sizeof(double) * n);
     o->rel = malloc(sizeof(double) * n);
+    o->its = malloc(sizeof(double) * n);
     o->n = n;
     for (int i = 0; i < n; ++i) {
         sp_synth_params(rig, (uint64_t)(first_seed + i), 0.7853981633974483, truth);
@@ -49,6 +51,7 @@ static void run_solves(const sp_rig* rig, const sp_camera* cam, int first_seed, 
         if (sp_solver_solve(s, &sk, NULL, out, &rep, &err) != SP_OK) fprintf(stderr, "solve failed: %s\n", err.text);
         o->ms[i] = rep.ms;
         o->rel[i] = rep.mean_error_px / rep.bbox_diagonal_px;
+        o->its[i] = rep.iterations;
         sp_sketch_free(&sk);
     }
     sp_solver_destroy(s);
@@ -69,8 +72,10 @@ static sp_bench_row row_for(const char* name, const sp_rig* rig, outcome* o, dou
     int ok = within(o, 0.01);
     sp_bench_stats(o->ms, o->n, &r.ms_median, &r.ms_p90);
     int coords = 2 * rig->abstractions[0].point_count;
-    snprintf(r.extra, sizeof r.extra, "\"parameters\": %d, \"mesh_coordinates\": %d, \"abstraction_coordinates\": %d, \"within_1pct\": %d",
-             rig->param_count, 3 * rig->vertex_count, coords, ok);
+    double it_med, it_p90;
+    sp_bench_stats(o->its, o->n, &it_med, &it_p90);
+    snprintf(r.extra, sizeof r.extra, "\"parameters\": %d, \"mesh_coordinates\": %d, \"abstraction_coordinates\": %d, \"within_1pct\": %d, \"iterations_median\": %g",
+             rig->param_count, 3 * rig->vertex_count, coords, ok, it_med);
     return r;
 }
 
@@ -117,7 +122,7 @@ static void recovery(int cases, bool json)
         snprintf(r.extra + strlen(r.extra), sizeof r.extra - strlen(r.extra), ", \"error_median_pct\": %.3f, \"error_p95_pct\": %.3f", 100 * med, 100 * p95);
         if (!json) printf("%-44s within 1%%: %d/%d  error median %.3f%%  p95 %.3f%%  solve median %.1f ms\n", r.name, within(&o, 0.01) , o.n, 100 * med, 100 * p95, r.ms_median);
         rows[nr++] = r;
-        free(o.ms), free(o.rel);
+        free(o.ms), free(o.rel), free(o.its);
         if (m == 0) sp_rig_free(&fixture);
         sp_character_free(&ch);
     }
@@ -155,7 +160,7 @@ int main(int argc, char** argv)
         outcome o;
         run_solves(&rig, &cam, 1000, runs, &o);
         rows[n++] = row_for(cs[c].name, &rig, &o, cs[c].paper_ms, cs[c].target_ms);
-        free(o.ms), free(o.rel);
+        free(o.ms), free(o.rel), free(o.its);
         sp_rig_free(&rig);
     }
     sp_bench_print("tests/bench/solver: solve to convergence, one thread (synthetic rigs of the paper's Table 1 dimensions)", rows, n, json);
