@@ -10,19 +10,22 @@
 ///
 /// The energy (paper eq. 7, coarsened by eq. 12) is
 ///     W = W_match + l_pose W_pose + l_plane W_plane + l_dist W_dist
-/// with every term made dimensionless so that the paper's default weights
-/// transfer between characters of any size and canvases of any resolution:
-///   - W_match = mean over correspondence pairs of (|y_i - z_j| / (0.01 L))^2,
-///     L the diagonal in pixels of the abstraction's 2D bounding box at the
-///     start pose: W_match = 1 means the mean error is 1% of the abstraction.
-///   - W_pose = sum_k ((p_k - p0_k) / u_k)^2, u_k = 1 for angles (radians) and
-///     scale factors, D for translations (D = the rest mesh's bounding-box
-///     diagonal in world units).
-///   - W_plane = mean over the k representative vertices of (v . (x_i - x_i0) / (0.01 D))^2.
-///   - W_dist = mean over representatives of d_i / d_max |x_i - x_i0|^2 / (0.01 D)^2,
-///     d_i the 3D distance from x_i0 to the nearest point of the matched curves.
-/// Means instead of the paper's sums keep the balance independent of sample
-/// and vertex counts (the paper's n/k factor is the same idea).
+/// measured in the units of a fixed reference setup, so that the paper's
+/// default weights transfer between characters of any size and canvases of
+/// any resolution (a 2-unit character on 640x480 and a 200-unit one on
+/// 3840x2160 give the same pose for the same drawing):
+///   - 2D: pixels of a view in which the abstraction's bounding-box diagonal
+///     (at the start pose) is 500 px, summed as over 200 correspondence
+///     pairs: W_match = (200 / N) sum_i |(y_i - z_j) * 500 / L|^2.
+///   - 3D: units of a character whose rest mesh diagonal is 200, summed as
+///     over 1000 vertices: W_plane = (1000 / k) sum_reps (v . dx * 200 / D)^2
+///     and W_dist = (1000 / k) sum_reps d_i / d_max |dx * 200 / D|^2, d_i the
+///     3D distance from x_i0 to the nearest point of the matched curves.
+///   - W_pose = sum_k ((p_k - p0_k) / u_k)^2: radians for angles, factors for
+///     scales, reference units (D / 200) for translations.
+/// The reference is the paper's setting (Maya scenes in centimetres, a
+/// character a few hundred pixels tall); fixing the counts keeps the balance
+/// independent of sample and vertex counts, as the paper's n/k factor does.
 ///
 /// The solve alternates correspondence updates (ICP rounds) with damped
 /// Gauss-Newton steps (Levenberg-Marquardt) on the linearised rig. Bounds

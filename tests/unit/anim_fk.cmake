@@ -1,0 +1,1 @@
+sp_unit_test(anim_fk LIBS sp::partdb)
