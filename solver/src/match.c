@@ -83,6 +83,104 @@ static bool grow_pairs(sp_solver* s, int need)
     return true;
 }
 
+// Drawing-order independence for small stick figures, topology first: when
+// strokes and curves are as many and at most 7, every one-to-one assignment
+// is scored by how many joints it breaks (two curves that meet at an end
+// point must get two strokes that meet, and the other way round), then by
+// the ordered shape and length cost. Plain optimal assignment on shape cost alone
+// swaps a spine and an arm that happen to overlap; the joints do not.
+enum { TOPO_MAX = 7 };
+
+static bool ends_meet(sp_vec2 a0, sp_vec2 a1, sp_vec2 b0, sp_vec2 b1, double eps)
+{
+    return sp_v2_len(sp_v2_sub(a0, b0)) < eps || sp_v2_len(sp_v2_sub(a0, b1)) < eps || sp_v2_len(sp_v2_sub(a1, b0)) < eps ||
+           sp_v2_len(sp_v2_sub(a1, b1)) < eps;
+}
+
+typedef struct topo_search {
+    int n;
+    double cost[TOPO_MAX][TOPO_MAX]; // stroke x curve
+    bool sadj[TOPO_MAX][TOPO_MAX], cadj[TOPO_MAX][TOPO_MAX];
+    int perm[TOPO_MAX], best[TOPO_MAX];
+    bool used[TOPO_MAX];
+    int best_breaks;
+    double best_cost;
+} topo_search;
+
+static void topo_visit(topo_search* t, int s, int breaks, double cost)
+{
+    if (breaks > t->best_breaks || (breaks == t->best_breaks && cost >= t->best_cost)) return;
+    if (s == t->n) {
+        t->best_breaks = breaks, t->best_cost = cost;
+        memcpy(t->best, t->perm, sizeof t->perm);
+        return;
+    }
+    for (int c = 0; c < t->n; ++c) {
+        if (t->used[c]) continue;
+        int b = 0;
+        for (int q = 0; q < s; ++q) b += t->sadj[s][q] != t->cadj[c][t->perm[q]];
+        t->used[c] = true, t->perm[s] = c;
+        topo_visit(t, s + 1, breaks + b, cost + t->cost[s][c]);
+        t->used[c] = false;
+    }
+}
+
+// Fills c2s (curve -> stroke) and returns true when the topology search applies.
+static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp_polyline* lines, int C, int* c2s)
+{
+    int n = sk->stroke_count;
+    if (n != C || n < 2 || n > TOPO_MAX) return false;
+    enum { M = 48 };
+    topo_search t = {.n = n, .best_breaks = 1 << 30, .best_cost = INFINITY};
+    sp_vec2 y[M], z[M], se[TOPO_MAX][2], ce[TOPO_MAX][2];
+    double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
+    for (int i = 0; i < n; ++i) {
+        const sp_stroke* st = &sk->strokes[i];
+        se[i][0] = st->points[0], se[i][1] = st->points[st->count - 1];
+        for (int k = 0; k < st->count; ++k) {
+            lo_x = fmin(lo_x, st->points[k].x), hi_x = fmax(hi_x, st->points[k].x);
+            lo_y = fmin(lo_y, st->points[k].y), hi_y = fmax(hi_y, st->points[k].y);
+        }
+    }
+    for (int c = 0; c < C; ++c) ce[c][0] = lines[c].points[0], ce[c][1] = lines[c].points[lines[c].count - 1];
+    double seps = 0.05 * hypot(hi_x - lo_x, hi_y - lo_y), ceps = 0.02 * s->L;
+    bool any = false;
+    for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) {
+            t.sadj[a][b] = a != b && ends_meet(se[a][0], se[a][1], se[b][0], se[b][1], seps);
+            t.cadj[a][b] = a != b && ends_meet(ce[a][0], ce[a][1], ce[b][0], ce[b][1], ceps);
+            any |= t.cadj[a][b];
+        }
+    if (!any) return false;
+    for (int i = 0; i < n; ++i) {
+        const sp_stroke* st = &sk->strokes[i];
+        // Canonical direction, so that a reversed stroke gives the same costs.
+        bool flip = st->points[0].x > st->points[st->count - 1].x ||
+                    (st->points[0].x == st->points[st->count - 1].x && st->points[0].y > st->points[st->count - 1].y);
+        sp_vec2* tmp = malloc(sizeof(sp_vec2) * (size_t)st->count);
+        if (!tmp) return false;
+        for (int k = 0; k < st->count; ++k) tmp[k] = st->points[flip ? st->count - 1 - k : k];
+        for (int c = 0; c < C; ++c) {
+            sp_ordered_info info = {0};
+            if (sp_curve_resample(tmp, st->count, lines[c].closed, M, y) != SP_OK ||
+                sp_curve_resample(lines[c].points, lines[c].count, lines[c].closed, M, z) != SP_OK ||
+                sp_corr_ordered(y, z, M, lines[c].closed, NULL, &info) != SP_OK) {
+                free(tmp);
+                return false;
+            }
+            double dl = sp_curve_length(tmp, st->count, false) - sp_curve_length(lines[c].points, lines[c].count, false);
+            // Plus the squared length difference: projected lengths tell a
+            // short neck from an arm that meets it at the same joint.
+            t.cost[i][c] = info.cost / M + 4.0 * dl * dl;
+        }
+        free(tmp);
+    }
+    topo_visit(&t, 0, 0, 0.0);
+    for (int c = 0; c < C; ++c) c2s[c] = -1;
+    for (int i = 0; i < n; ++i) c2s[t.best[i]] = i;
+    return true;
+}
+
 sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err)
 {
     const sp_abstraction* ab = s->ab;
@@ -115,10 +213,23 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
         for (int i = 0; i < ab->point_count; ++i) pts[i] = (sp_vec2){s->z2[2 * i], s->z2[2 * i + 1]};
         for (int c = 0; c < C; ++c)
             lines[c] = (sp_polyline){pts + ab->curves[c].first_point, ab->curves[c].point_count, ab->curves[c].closed};
-        res = sp_assign_strokes(sk->strokes, sk->stroke_count, lines, C, &(sp_assign_desc){.samples = 64}, sm, c2s, err);
-        if (res != SP_OK) goto ordered_done;
-        rep->unused_strokes = 0;
-        for (int i = 0; i < sk->stroke_count; ++i) rep->unused_strokes += sm[i].curve < 0;
+        if (s->keep_assignment && s->c2s_valid) {
+            memcpy(c2s, s->c2s, sizeof(int) * (size_t)C);
+            rep->unused_strokes = 0;
+            for (int c = 0; c < C; ++c) rep->unused_strokes -= c2s[c] >= 0;
+            rep->unused_strokes += sk->stroke_count;
+        } else if (assign_by_topology(s, sk, lines, C, c2s)) {
+            rep->unused_strokes = 0;
+        } else {
+            res = sp_assign_strokes(sk->strokes, sk->stroke_count, lines, C, &(sp_assign_desc){.samples = 64}, sm, c2s, err);
+            if (res != SP_OK) goto ordered_done;
+            rep->unused_strokes = 0;
+            for (int i = 0; i < sk->stroke_count; ++i) rep->unused_strokes += sm[i].curve < 0;
+        }
+        if (C <= SP_REPORT_CURVES) {
+            memcpy(s->c2s, c2s, sizeof(int) * (size_t)C);
+            s->c2s_valid = true;
+        }
         for (int c = 0; c < C; ++c) {
             int st = c2s[c];
             if (st < 0) continue;

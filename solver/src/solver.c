@@ -638,6 +638,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     int last_stage = 1;
 
     s->mode = first_stage == 0 ? SP_CORR_CLOSEST : s->ab->correspondence;
+    s->c2s_valid = s->keep_assignment = false;
     sp_result res = sp__build_pairs(s, sk, rep, err);
     if (res != SP_OK) goto done;
     prepare_start(s, p, rep);
@@ -665,6 +666,9 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
                 if (res != SP_OK) goto done;
             }
             ++rep->icp_rounds;
+            // The assignment settles in the first rounds; keeping it then
+            // saves the search and stops late flips between look-alikes.
+            s->keep_assignment = round >= 3;
             // Graduated regularisation: strongly damped early rounds follow
             // the correspondences in small steps instead of jumping into a
             // folded local minimum; from the ninth round on the weights are

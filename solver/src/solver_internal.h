@@ -65,7 +65,10 @@ struct sp_solver {
     double L;        // abstraction 2D diagonal at the start pose, pixels
     sp_correspondence mode; // how sp__build_pairs pairs samples now
     double pose_boost;      // >= 1: graduated W_pose weight, 1 in the final rounds
-    double vertex_boost;    // >= 1: the same for W_plane and W_dist (draw-over only)
+    double vertex_boost;
+    int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke)
+    bool c2s_valid;
+    bool keep_assignment;      // reuse c2s instead of assigning again    // >= 1: the same for W_plane and W_dist (draw-over only)
 };
 
 #endif

@@ -1,0 +1,1 @@
+sp_unit_test(recovery LIBS sp::partdb TIMEOUT 900)
