@@ -659,7 +659,11 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
         s->mode = stage == 0 ? SP_CORR_CLOSEST : s->ab->correspondence;
         converged = false;
         for (int round = 0; round < s->d.max_icp_rounds && !time_up; ++round) {
-            if (round > 0 || stage > first_stage) {
+            // Ordered correspondences are kept once the weights are final:
+            // re-resampling a curve that barely moves only slides its samples
+            // along it, which costs many rounds and gains nothing.
+            bool frozen = s->mode == SP_CORR_ORDERED && s->pose_boost == 1.0 && round > 0;
+            if ((round > 0 || stage > first_stage) && !frozen) {
                 sp_rig_eval_update(s->ev, p, false);
                 project_abstraction(s);
                 res = sp__build_pairs(s, sk, rep, err);

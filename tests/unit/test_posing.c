@@ -128,6 +128,75 @@ static void test_drawover_fixture(void)
     sp_rig_free(&rig);
 }
 
+// Draw-over on CesiumMan: a curve drawn along the arm at rest, redrawn bent,
+// bends the arm; the fitted curve matches and the legs barely move.
+static void test_drawover_cesiumman(void)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) SKIP("../shared/data absent");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf/CesiumMan/CesiumMan.glb", data);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(path, &ch, &err) == SP_OK);
+    sp_rig* rig = &ch.rig;
+    int P = rig->param_count, arm = sp_rig_find_param(rig, "node17.rx");
+    ENSURE(arm >= 0);
+    double* bent = malloc(sizeof(double) * P);
+    double* p = malloc(sizeof(double) * P);
+    memcpy(bent, ch.pose, sizeof(double) * P);
+    bent[arm] = 1.0;
+    bent[sp_rig_find_param(rig, "node17.rz")] = 0.6;
+    // The derived stick curve of that arm (node12 -> node16 -> node17 -> node18), from the shoulder on.
+    int c = -1;
+    for (int i = 0; i < rig->abstractions[0].curve_count; ++i)
+        if (!strcmp(rig->abstractions[0].curves[i].name, "node12-node18")) c = i;
+    ENSURE(c >= 0);
+    sp_sketch s_rest, s_bent;
+    ENSURE(sp_synth_sketch(rig, 0, &ch.camera, ch.pose, &s_rest) == SP_OK);
+    ENSURE(sp_synth_sketch(rig, 0, &ch.camera, bent, &s_bent) == SP_OK);
+    int n = s_rest.strokes[c].count, from = n / 3;
+    double* xyz = malloc(sizeof(double) * 3 * rig->vertex_count);
+    double* x1 = malloc(sizeof(double) * 3 * rig->vertex_count);
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval_update(ev, ch.pose, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
+    sp_abstraction emb;
+    ENSURE(sp_embed_curve(rig, xyz, &ch.camera, s_rest.strokes[c].points + from, n - from, 48, "drawover", &emb, &err) == SP_OK);
+    int a = sp_rig_add_abstraction(rig, &emb);
+    // The redrawn stroke: the embedded curve itself at the bent pose, so the
+    // target is reachable by bending the arm alone.
+    sp_sketch to = {0};
+    ENSURE(sp_synth_sketch(rig, a, &ch.camera, bent, &to) == SP_OK);
+    sp_solver* s = sp_solver_create(rig, a, &ch.camera, &(sp_solve_desc){0});
+    sp_solve_report rep;
+    ENSURE(sp_solver_solve(s, &to, ch.pose, p, &rep, &err) == SP_OK);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), x1);
+    // Far from the arm: the vertices below the hips (lowest 40% of the body).
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, rig->vertex_count, &lo, &hi);
+    double D = sp_v3_len(sp_v3_sub(hi, lo)), far = 0, arm_moved = 0;
+    const int up = 1; // y is up in the default view
+    for (int v = 0; v < rig->vertex_count; ++v) {
+        double d = sp_v3_len(sp_v3_sub(sp_v3(x1[3 * v], x1[3 * v + 1], x1[3 * v + 2]), sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2])));
+        double h = xyz[3 * v + up];
+        if (h < lo.y + 0.4 * (hi.y - lo.y)) far = fmax(far, d);
+        arm_moved = fmax(arm_moved, d);
+    }
+    fprintf(stderr, "  drawover CesiumMan: mean error %.2f%% of %.0f px, legs moved %.3f%%, the arm %.1f%% of the size\n",
+            100 * rep.mean_error_px / rep.bbox_diagonal_px, rep.bbox_diagonal_px, 100 * far / D, 100 * arm_moved / D);
+    ENSURE(rep.mean_error_px <= 0.02 * rep.bbox_diagonal_px);
+    ENSURE(arm_moved > 0.05 * D); // the arm did bend
+    ENSURE(far <= 0.01 * D);
+    sp_solver_destroy(s);
+    sp_rig_eval_destroy(ev);
+    sp_abstraction_free(&emb);
+    sp_sketch_free(&s_rest), sp_sketch_free(&s_bent), sp_sketch_free(&to);
+    free(bent), free(p), free(xyz), free(x1);
+    sp_character_free(&ch);
+}
+
 // Runs a shell command; returns its exit status.
 static int run(const char* cmd)
 {
@@ -199,5 +268,6 @@ int main(int argc, char** argv)
         {"animation_from_keys", test_animation_from_keys},
         {"drawover_fixture", test_drawover_fixture},
         {"animate_cli_cesiumman", test_animate_cli_cesiumman},
+        {"drawover_cesiumman", test_drawover_cesiumman},
         {0}});
 }

@@ -1,0 +1,96 @@
+#!/bin/sh
+# posing_cli.sh SKETCHPOSE SRC_DIR WORK_DIR [SHARED_DATA]: the posing
+# commands (synth, pose, animate, drawover) from the command line: exit
+# codes, machine-readable reports, bad strokes, and the Khronos validator on
+# an animate export when node and tests/tools/node_modules are there.
+set -u
+SP="$1"
+SRC="$2"
+WORK="$3/posing_cli.$$"
+SHARED="${4:-}"
+RIG="$SRC/tests/e2e/data/two_bone_extras.gltf"
+mkdir -p "$WORK"
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+expect() { # expect CODE CMD...: stdout/stderr kept in $WORK/out, $WORK/err
+    want="$1"
+    shift
+    "$@" >"$WORK/out" 2>"$WORK/err"
+    got=$?
+    [ "$got" = "$want" ] || fail "exit $got (wanted $want): $* -- $(head -c 300 "$WORK/err")"
+}
+one_line_naming() {
+    [ "$(wc -l <"$WORK/err")" -eq 1 ] || fail "stderr is not one line: $(cat "$WORK/err")"
+    grep -q "$1" "$WORK/err" || fail "stderr does not name $1: $(cat "$WORK/err")"
+}
+strokes() { # strokes FILE POINTS-JSON...: a stroke file with one stroke per argument
+    f="$1"
+    shift
+    printf '{"format": "sketchpose-strokes", "version": 1, "canvas": [640, 480], "strokes": [' >"$f"
+    sep=""
+    for s in "$@"; do
+        printf '%s{"points": %s}' "$sep" "$s" >>"$f"
+        sep=", "
+    done
+    printf ']}\n' >>"$f"
+}
+
+for c in synth pose drawover animate; do
+    expect 0 "$SP" "$c" --help
+    expect 2 "$SP" "$c" --bogus
+done
+expect 0 "$SP" synth --rig "$RIG" --seed 4 --out "$WORK/s.json" --truth "$WORK/t.json"
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/posed.glb" --report "$WORK/r.json"
+for key in '"ms"' '"iterations"' '"icp_rounds"' '"stopped"' '"energy_before"' '"energy_after"' '"mean_error_px"' '"max_error_px"' '"bbox_diagonal_px"' '"curves"' '"parameters"'; do
+    grep -q "$key" "$WORK/r.json" || fail "report lacks $key"
+done
+grep -q '"stopped":' "$WORK/out" || fail "pose prints no report on stdout"
+
+# Bad strokes: one clear line naming the file, exit 1.
+strokes "$WORK/empty.json"
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/empty.json"
+one_line_naming empty.json
+strokes "$WORK/one.json" '[[10, 10]]'
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/one.json"
+one_line_naming one.json
+printf '{"format": "sketchpose-strokes", "version": 1, "strokes": [{"points": [[1, NaN], [2, 3]]}]}\n' >"$WORK/nan.json"
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/nan.json"
+one_line_naming nan.json
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/missing.json"
+one_line_naming missing.json
+expect 1 "$SP" pose --rig "$WORK/missing.glb" --strokes "$WORK/s.json"
+one_line_naming missing.glb
+
+# Hard but valid strokes: a best-effort pose, exit 0, the report says so.
+strokes "$WORK/far.json" '[[100000, 100000], [100040, 100090], [100100, 100100]]'
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/far.json" --report "$WORK/far_r.json"
+grep -q '"note":	"best effort' "$WORK/far_r.json" || fail "far strokes: no best-effort note"
+# two_bone.gltf has no extras: a derived stick figure, ordered correspondences.
+strokes "$WORK/many.json" '[[10, 10], [50, 60]]' '[[300, 300], [320, 310]]' '[[500, 40], [520, 90]]' '[[100, 400], [140, 420]]' '[[600, 460], [610, 470]]'
+expect 0 "$SP" pose --rig "$SRC/tests/e2e/data/two_bone.gltf" --strokes "$WORK/many.json" --report "$WORK/many_r.json"
+grep -q '"unused_strokes":	[1-9]' "$WORK/many_r.json" || fail "more strokes than curves: unused strokes not reported"
+# A million points: resampled, bounded by the time cap, no hang.
+awk 'BEGIN { printf "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [640, 480], \"strokes\": [{\"points\": ["; for (i = 0; i < 1000000; ++i) printf "%s[%.3f, %.3f]", (i ? ", " : ""), 200 + 150 * i / 1000000, 100 + 200 * i / 1000000 + 3 * sin(i); print "]}]}" }' >"$WORK/huge.json"
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/huge.json" --max-ms 5000
+
+# animate: a .glb with the animation; valid for Khronos's validator.
+"$SP" synth --rig "$RIG" --seed 5 --amplitude 0.3 --out "$WORK/k2.json" >/dev/null 2>&1
+expect 0 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" "$WORK/k2.json" --times 0,0.8 --out "$WORK/anim.glb"
+expect 0 "$SP" inspect --rig "$WORK/anim.glb"
+grep -q '"sketchpose"' "$WORK/out" || fail "animate: no 'sketchpose' animation in the export"
+expect 2 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" "$WORK/k2.json" --times 1,0.5 --out "$WORK/x.glb"
+if command -v node >/dev/null 2>&1 && [ -d "$SRC/tests/tools/node_modules/gltf-validator" ]; then
+    node "$SRC/tests/tools/validate.js" "$WORK/anim.glb" >"$WORK/val.json" || fail "animate export does not validate: $(cat "$WORK/val.json")"
+    if [ -n "$SHARED" ] && [ -f "$SHARED/gltf/CesiumMan/CesiumMan.glb" ]; then
+        C="$SHARED/gltf/CesiumMan/CesiumMan.glb"
+        for k in 1 2 3 4; do "$SP" synth --rig "$C" --seed "$k" --amplitude 0.4 --out "$WORK/c$k.json" >/dev/null 2>&1; done
+        expect 0 "$SP" animate --rig "$C" --strokes "$WORK/c1.json" "$WORK/c2.json" "$WORK/c3.json" "$WORK/c4.json" --out "$WORK/canim.glb"
+        node "$SRC/tests/tools/validate.js" "$WORK/canim.glb" >"$WORK/val.json" || fail "CesiumMan animate export does not validate: $(cat "$WORK/val.json")"
+    fi
+else
+    echo "note: node or tests/tools/node_modules missing, the validator step was skipped"
+fi
+
+rm -rf "$WORK"
+[ "$fails" -eq 0 ] || exit 1
+echo "posing_cli: all checks passed"
