@@ -1,0 +1,659 @@
+// cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log
+// The curators' commands over the part database (sp/partdb.h).
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "clf_cli.h"
+#include "cli.h"
+#include "sp/partdb.h"
+
+#ifndef SP_SOURCE_DIR
+#define SP_SOURCE_DIR "."
+#endif
+
+typedef struct db_common {
+    const char* db;
+    double busy_s;
+    const char* by;
+} db_common;
+
+#define DB_COMMON_OPTS(c)                                                                                                \
+    {"--db", SP_OPT_STRING, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},            \
+        {"--busy-timeout", SP_OPT_DOUBLE, &(c).busy_s, "S", "seconds to wait for another writer (default 5)", false}, \
+        {"--by", SP_OPT_STRING, &(c).by, "WHO", "curator's name for the log (default $USER)", false}
+
+static const char* db_path(const db_common* c) { return c->db ? c->db : sp_db_default_path(); }
+
+// Splits argv into options (for sp_cli_parse) and positional values.
+static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char** kept, const char** pos, int* npos, int maxpos)
+{
+    int nk = 0;
+    *npos = 0;
+    kept[nk++] = argv[0];
+    for (int i = 1; i < argc; ++i) {
+        const sp_opt* o = NULL;
+        for (int j = 0; j < nopts; ++j)
+            if (!strcmp(argv[i], opts[j].name)) o = &opts[j];
+        if (strncmp(argv[i], "--", 2) != 0 && strcmp(argv[i], "-h") != 0) {
+            if (*npos >= maxpos) return -1;
+            pos[(*npos)++] = argv[i];
+            continue;
+        }
+        kept[nk++] = argv[i];
+        if (o && o->kind != SP_OPT_FLAG && o->kind != SP_OPT_LIST && i + 1 < argc) kept[nk++] = argv[++i];
+        else if (o && o->kind == SP_OPT_LIST)
+            while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0)
+                kept[nk++] = argv[++i];
+    }
+    return nk;
+}
+
+static int parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts, const char** pos, int* npos,
+                 int minpos, int maxpos, const char* posname)
+{
+    char* kept[512];
+    if (argc > 512) {
+        fprintf(stderr, "%s: too many arguments\n", cmd);
+        return SP_EXIT_USAGE;
+    }
+    int nk = split_args(argc, argv, opts, nopts, kept, pos, npos, maxpos);
+    if (nk < 0) {
+        fprintf(stderr, "%s: too many %s (at most %d)\n", cmd, posname, maxpos);
+        return SP_EXIT_USAGE;
+    }
+    char full[256];
+    snprintf(full, sizeof full, "%s%s%s", cmd, maxpos ? " " : "", maxpos ? posname : "");
+    int rc = sp_cli_parse(nk, kept, full, summary, opts, nopts);
+    if (rc >= 0) return rc;
+    if (*npos < minpos) {
+        fprintf(stderr, "%s: missing %s (see --help)\n", cmd, posname);
+        return SP_EXIT_USAGE;
+    }
+    return -1;
+}
+
+static sp_db* open_db(const char* cmd, const db_common* c, unsigned flags)
+{
+    sp_db* db = NULL;
+    sp_error err = {0};
+    if (sp_db_open(db_path(c), flags, &db, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", cmd, err.text);
+        return NULL;
+    }
+    if (c->busy_s > 0) sp_db_set_busy_timeout(db, (int)(c->busy_s * 1000));
+    return db;
+}
+
+static int fail(const char* cmd, const sp_error* err)
+{
+    fprintf(stderr, "%s: %s\n", cmd, err->text);
+    return SP_EXIT_INPUT;
+}
+
+static void print_part(const sp_db_part_info* p)
+{
+    printf("{\"name\": ");
+    clf_cli_json_str(stdout, p->name);
+    printf(", \"category\": ");
+    clf_cli_json_str(stdout, p->category);
+    printf(", \"abstraction\": ");
+    clf_cli_json_str(stdout, p->abstraction);
+    printf(", \"vertices\": %d, \"triangles\": %d, \"joints\": %d, \"parameters\": %d, \"abstractions\": %d, \"animations\": %d, \"bytes\": %zu, "
+           "\"sha256\": \"%s\"",
+           p->vertices, p->triangles, p->joints, p->parameters, p->abstractions, p->animations, p->bytes, p->sha256);
+    if (p->selftest_error >= 0) printf(", \"selftest_error\": %.5f", p->selftest_error);
+    if (p->sketches >= 0) printf(", \"category_sketches\": %d", p->sketches);
+    printf(", \"added_by\": ");
+    clf_cli_json_str(stdout, p->added_by);
+    printf(", \"added_at\": ");
+    clf_cli_json_str(stdout, p->added_at);
+    printf("}");
+}
+
+// ---- subcommands ---------------------------------------------------------------
+
+static int db_init(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db init";
+    db_common c = {0};
+    const char* from = NULL;
+    const char* assets = NULL;
+    int synth = 0, folds = 0;
+    bool no_train = false;
+    clf_cli_opts o = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c),
+                     {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
+                     {"--assets", SP_OPT_STRING, &assets, "DIR", "parts to build the default database from (default: the source tree's assets/)", false},
+                     {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
+                     {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
+                     {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
+                     CLF_CLI_OPTS(o)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd,
+                   "create a database: the default one from assets/ (parts, synthetic sketches, a trained model), or one rebuilt from an "
+                   "export folder",
+                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    if (rc >= 0) return rc;
+    sp_error err = {0};
+    sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};
+    if (clf_cli_tty()) td.clf.progress = clf_cli_progress;
+    sp_result r;
+    if (from) r = sp_db_create_from_export(db_path(&c), from, no_train ? NULL : &td, c.by, &err);
+    else {
+        char def[1024];
+        snprintf(def, sizeof def, "%s/assets", SP_SOURCE_DIR);
+        r = sp_db_create_default(db_path(&c), assets ? assets : def, &(sp_db_default_desc){.synth_per_part = synth, .train = td}, &err);
+    }
+    if (r != SP_OK) return fail(cmd, &err);
+    sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
+    if (!db) return SP_EXIT_INPUT;
+    sp_db_part_info* parts;
+    int n;
+    char *models = NULL;
+    if (sp_db_list_parts(db, &parts, &n, &err) != SP_OK || sp_db_models_json(db, &models, &err) != SP_OK) {
+        sp_db_close(db);
+        return fail(cmd, &err);
+    }
+    printf("{\"db\": ");
+    clf_cli_json_str(stdout, db_path(&c));
+    printf(", \"parts\": %d, \"models\": %s}\n", n, models);
+    free(parts);
+    free(models);
+    sp_db_close(db);
+    return SP_EXIT_OK;
+}
+
+static int db_add_part(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db add-part";
+    db_common c = {0};
+    sp_db_part_desc d = {0};
+    bool no_selftest = false;
+    sp_opt opts[] = {DB_COMMON_OPTS(c),
+                     {"--category", SP_OPT_STRING, &d.category, "C", "category (default: the part's extras.sp_part.category)", false},
+                     {"--name", SP_OPT_STRING, &d.name, "NAME", "part name (default: the file name without extension)", false},
+                     {"--abstraction", SP_OPT_STRING, &d.abstraction, "A", "abstraction its sketches show (default: sp_part.abstraction, else the first)", false},
+                     {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it (default 60, -1 none)", false},
+                     {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd,
+                   "validate a rigged part (loads, skin, abstraction, bounded parameters, solver self-test) and store it with synthetic "
+                   "sketches; a refused part writes nothing",
+                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
+    if (rc >= 0) return rc;
+    d.added_by = c.by;
+    if (no_selftest) d.selftest_seeds = -1;
+    sp_db* db = open_db(cmd, &c, SP_DB_CREATE);
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    sp_db_part_info info;
+    sp_result r = sp_db_add_part_file(db, pos[0], &d, &info, &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    print_part(&info);
+    printf("\n");
+    return SP_EXIT_OK;
+}
+
+// ---- add-sketch: reading files ------------------------------------------------------
+
+typedef struct sketch_set {
+    sp_dataset ds;
+    sp_db_png* png; // parallel to ds.samples
+    int cap;
+} sketch_set;
+
+static bool has_ext(const char* p, const char* ext)
+{
+    size_t n = strlen(p), e = strlen(ext);
+    return n > e && !strcasecmp(p + n - e, ext);
+}
+
+static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size, sp_error* err)
+{
+    if (s->ds.count == s->cap) {
+        int cap = s->cap ? 2 * s->cap : 64;
+        sp_sample* g = realloc(s->ds.samples, sizeof *g * (size_t)cap);
+        if (g) s->ds.samples = g;
+        sp_db_png* h = realloc(s->png, sizeof *h * (size_t)cap);
+        if (h) s->png = h;
+        if (!g || !h) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        s->cap = cap;
+    }
+    s->png[s->ds.count] = (sp_db_png){png, png_size};
+    s->ds.samples[s->ds.count++] = *smp;
+    return SP_OK;
+}
+
+static sp_result read_bytes(const char* path, void** out, size_t* size, sp_error* err)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open", path);
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    void* b = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    bool ok = b && fread(b, 1, (size_t)n, f) == (size_t)n;
+    fclose(f);
+    if (!ok) {
+        free(b);
+        return sp_fail(err, SP_ERR_IO, "%s: read error", path);
+    }
+    *out = b;
+    *size = (size_t)n;
+    return SP_OK;
+}
+
+static sp_result add_file(sketch_set* s, const char* path, const char* category, sp_error* err)
+{
+    int label = sp_dataset_add_category(&s->ds, category);
+    if (label < 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    if (has_ext(path, ".ndjson")) {
+        sp_dataset tmp = {0};
+        sp_result r = sp_dataset_read_ndjson(&tmp, path, -1, err);
+        if (r == SP_OK && tmp.count == 0) r = sp_fail(err, SP_ERR_INVALID, "%s: no drawings", path);
+        for (int i = 0; r == SP_OK && i < tmp.count; ++i) {
+            sp_sample smp = tmp.samples[i];
+            smp.label = label;
+            if ((r = push(s, &smp, NULL, 0, err)) == SP_OK) memset(&tmp.samples[i], 0, sizeof tmp.samples[i]);
+        }
+        sp_dataset_free(&tmp);
+        return r;
+    }
+    sp_sample smp = {.label = label};
+    sp_result r = sp_drawing_read(path, &smp.sketch, &smp.raster, err);
+    if (r != SP_OK) return r;
+    if (!smp.raster.pixels && sp_sketch_point_count(&smp.sketch) == 0) {
+        sp_sketch_free(&smp.sketch);
+        return sp_fail(err, SP_ERR_INVALID, "%s: empty drawing (no strokes)", path);
+    }
+    void* png = NULL;
+    size_t n = 0;
+    if (smp.raster.pixels && (r = read_bytes(path, &png, &n, err)) != SP_OK) {
+        sp_raster_free(&smp.raster);
+        return r;
+    }
+    if ((r = push(s, &smp, png, n, err)) != SP_OK) {
+        sp_sketch_free(&smp.sketch);
+        sp_raster_free(&smp.raster);
+        free(png);
+    }
+    return r;
+}
+
+static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+// Sorted entries of a directory, no dot files (*names malloc'd).
+static int list_dir(const char* dir, char*** names)
+{
+    DIR* d = opendir(dir);
+    if (!d) return -1;
+    int n = 0, cap = 0;
+    char** out = NULL;
+    struct dirent* e;
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.') continue;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            char** g = realloc(out, sizeof *out * (size_t)cap);
+            if (!g) break;
+            out = g;
+        }
+        if ((out[n] = strdup(e->d_name))) ++n;
+    }
+    closedir(d);
+    if (n) qsort(out, (size_t)n, sizeof *out, cmp_str);
+    *names = out;
+    return n;
+}
+
+static bool is_dir(const char* p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+// A labelled folder: DIR/<category>/*.{json,svg,png} and DIR/<category>.ndjson
+// (`only`: just that category).
+static sp_result add_folder(sketch_set* s, const char* dir, const char* only, sp_error* err)
+{
+    char** names;
+    int n = list_dir(dir, &names);
+    if (n < 0) return sp_fail(err, SP_ERR_IO, "%s: cannot read the folder", dir);
+    sp_result r = SP_OK;
+    int before = s->ds.count;
+    char path[2048];
+    for (int i = 0; r == SP_OK && i < n; ++i) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        if (is_dir(path)) {
+            if (only && strcmp(only, names[i]) != 0) continue;
+            char** files;
+            int m = list_dir(path, &files);
+            for (int j = 0; r == SP_OK && j < m; ++j) {
+                char fp[4096];
+                snprintf(fp, sizeof fp, "%s/%s", path, files[j]);
+                if (has_ext(fp, ".json") || has_ext(fp, ".svg") || has_ext(fp, ".png")) r = add_file(s, fp, names[i], err);
+            }
+            for (int j = 0; j < m; ++j)
+                free(files[j]);
+            free(m > 0 ? files : NULL);
+        } else if (has_ext(names[i], ".ndjson")) {
+            char cat[256];
+            snprintf(cat, sizeof cat, "%.*s", (int)(strlen(names[i]) - 7), names[i]);
+            if (!only || !strcmp(only, cat)) r = add_file(s, path, cat, err);
+        }
+    }
+    for (int i = 0; i < n; ++i)
+        free(names[i]);
+    free(n > 0 ? names : NULL);
+    if (r == SP_OK && s->ds.count == before) r = sp_fail(err, SP_ERR_INVALID, "%s: no drawings found%s%s", dir, only ? " for category " : "", only ? only : "");
+    return r;
+}
+
+static int db_add_sketch(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db add-sketch";
+    db_common c = {0};
+    const char* category = NULL;
+    const char* source = NULL;
+    sp_opt opts[] = {DB_COMMON_OPTS(c),
+                     {"--category", SP_OPT_STRING, &category, "C", "category of the drawings (labelled folders name their own)", false},
+                     {"--source", SP_OPT_STRING, &source, "S", "curated (default) or kiosk", false}};
+    const char* pos[256];
+    int npos;
+    int rc = parse(argc, argv, cmd,
+                   "add example sketches: JSON strokes, Quick, Draw! .ndjson, SVG, PNG, or labelled folders DIR/<category>/...; all or "
+                   "nothing",
+                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 256, "FILES...");
+    if (rc >= 0) return rc;
+    sp_db_source src = SP_DB_SOURCE_CURATED;
+    if (source && !strcmp(source, "kiosk")) src = SP_DB_SOURCE_KIOSK;
+    else if (source && strcmp(source, "curated") != 0) {
+        fprintf(stderr, "%s: --source must be curated or kiosk, got '%s'\n", cmd, source);
+        return SP_EXIT_USAGE;
+    }
+    for (int i = 0; i < npos; ++i)
+        if (!category && !is_dir(pos[i])) {
+            fprintf(stderr, "%s: %s: give --category for drawings outside a labelled folder\n", cmd, pos[i]);
+            return SP_EXIT_USAGE;
+        }
+    sketch_set s = {0};
+    sp_error err = {0};
+    sp_result r = SP_OK;
+    for (int i = 0; r == SP_OK && i < npos; ++i)
+        r = is_dir(pos[i]) ? add_folder(&s, pos[i], category, &err) : add_file(&s, pos[i], category, &err);
+    int added = 0;
+    sp_db* db = NULL;
+    if (r == SP_OK) {
+        db = open_db(cmd, &c, SP_DB_CREATE);
+        if (!db) r = SP_ERR_IO;
+        else r = sp_db_add_sketches(db, &s.ds, s.png, src, c.by, &added, &err);
+    }
+    int exit_code = SP_EXIT_OK;
+    if (r != SP_OK) exit_code = db || err.text[0] ? fail(cmd, &err) : SP_EXIT_INPUT;
+    else {
+        printf("{\"added\": %d, \"categories\": {", added);
+        int* per = calloc((size_t)(s.ds.category_count + 1), sizeof(int));
+        for (int i = 0; per && i < s.ds.count; ++i)
+            per[s.ds.samples[i].label]++;
+        for (int k = 0; per && k < s.ds.category_count; ++k) {
+            printf("%s", k ? ", " : "");
+            clf_cli_json_str(stdout, s.ds.categories[k]);
+            printf(": %d", per[k]);
+        }
+        free(per);
+        printf("}}\n");
+    }
+    sp_db_close(db);
+    for (int i = 0; i < s.ds.count; ++i)
+        free((void*)s.png[i].bytes);
+    free(s.png);
+    sp_dataset_free(&s.ds);
+    return exit_code;
+}
+
+static int db_list(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db list";
+    db_common c = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd, "parts (category, vertex and parameter counts), sketch counts per category and models, as JSON", opts,
+                   (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    sp_db_part_info* parts = NULL;
+    int n = 0, ncat = 0;
+    char** cats = NULL;
+    int* counts = NULL;
+    char* models = NULL;
+    if (sp_db_list_parts(db, &parts, &n, &err) != SP_OK || sp_db_sketch_counts(db, &cats, &counts, &ncat, &err) != SP_OK ||
+        sp_db_models_json(db, &models, &err) != SP_OK) {
+        free(parts);
+        sp_db_free_strings(cats, ncat);
+        free(counts);
+        sp_db_close(db);
+        return fail(cmd, &err);
+    }
+    printf("{\"db\": ");
+    clf_cli_json_str(stdout, sp_db_path(db));
+    printf(", \"schema\": %d, \"generation\": %llu, \"parts\": [", sp_db_schema_version(db), (unsigned long long)sp_db_generation(db));
+    for (int i = 0; i < n; ++i) {
+        printf("%s", i ? ", " : "");
+        print_part(&parts[i]);
+    }
+    printf("], \"sketches\": {");
+    for (int i = 0; i < ncat; ++i) {
+        printf("%s", i ? ", " : "");
+        clf_cli_json_str(stdout, cats[i]);
+        printf(": %d", counts[i]);
+    }
+    printf("}, \"models\": %s}\n", models);
+    free(parts);
+    sp_db_free_strings(cats, ncat);
+    free(counts);
+    free(models);
+    sp_db_close(db);
+    return SP_EXIT_OK;
+}
+
+static int db_show(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db show";
+    db_common c = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd, "one part: summary, parameters, abstractions and its log, as JSON", opts, (int)(sizeof opts / sizeof opts[0]),
+                   pos, &npos, 1, 1, "NAME");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    sp_db_part_info info;
+    char *summary = NULL, *log = NULL;
+    if (sp_db_part(db, pos[0], &info, &err) != SP_OK || sp_db_part_summary_json(db, pos[0], &summary, &err) != SP_OK ||
+        sp_db_log_json(db, pos[0], &log, &err) != SP_OK) {
+        free(summary);
+        sp_db_close(db);
+        return fail(cmd, &err);
+    }
+    printf("{\"part\": ");
+    print_part(&info);
+    printf(", \"summary\": %s, \"log\": %s}\n", summary, log);
+    free(summary);
+    free(log);
+    sp_db_close(db);
+    return SP_EXIT_OK;
+}
+
+static int db_remove(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db remove";
+    db_common c = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd, "remove a part and its synthetic sketches (curated sketches stay)", opts,
+                   (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "NAME");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, 0);
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    sp_result r = sp_db_remove_part(db, pos[0], c.by, &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    printf("{\"removed\": ");
+    clf_cli_json_str(stdout, pos[0]);
+    printf("}\n");
+    return SP_EXIT_OK;
+}
+
+static int db_check(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db check";
+    db_common c = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd,
+                   "SQLite integrity and foreign keys, every part loads and matches its checksum, every sketch parses, the newest model "
+                   "matches the part categories; JSON; exit 1 on any problem",
+                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, 0); // writable: an older schema gets migrated
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    bool ok = false;
+    char* json = NULL;
+    sp_result r = sp_db_check(db, &ok, &json, &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    printf("%s\n", json);
+    free(json);
+    if (!ok) fprintf(stderr, "%s: problems found (see \"problems\")\n", cmd);
+    return ok ? SP_EXIT_OK : SP_EXIT_INPUT;
+}
+
+static int db_train(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db train";
+    db_common c = {0};
+    int folds = 0;
+    clf_cli_opts o = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c),
+                     {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report (default 3, -1 none)", false},
+                     CLF_CLI_OPTS(o)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd, "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
+                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, 0);
+    if (!db) return SP_EXIT_INPUT;
+    sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};
+    if (clf_cli_tty()) td.clf.progress = clf_cli_progress;
+    sp_error err = {0};
+    char* report = NULL;
+    sp_result r = sp_db_train(db, &td, &report, &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    printf("%s\n", report);
+    free(report);
+    return SP_EXIT_OK;
+}
+
+static int db_export(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db export";
+    db_common c = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd, "write DIR/parts/*.glb, DIR/sketches/<category>/* and DIR/manifest.json (what `db init --from DIR` reads)",
+                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "DIR");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    sp_result r = sp_db_export(db, pos[0], &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    printf("{\"exported\": ");
+    clf_cli_json_str(stdout, pos[0]);
+    printf("}\n");
+    return SP_EXIT_OK;
+}
+
+static int db_log(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db log";
+    db_common c = {0};
+    sp_opt opts[] = {DB_COMMON_OPTS(c)};
+    const char* pos[1];
+    int npos;
+    int rc = parse(argc, argv, cmd, "the curator log (append-only), oldest first, as JSON; NAME: only entries about it", opts,
+                   (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 1, "[NAME]");
+    if (rc >= 0) return rc;
+    sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
+    if (!db) return SP_EXIT_INPUT;
+    sp_error err = {0};
+    char* json = NULL;
+    sp_result r = sp_db_log_json(db, npos ? pos[0] : NULL, &json, &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    printf("%s\n", json);
+    free(json);
+    return SP_EXIT_OK;
+}
+
+typedef struct db_sub {
+    const char* name;
+    int (*run)(int, char**);
+    const char* help;
+} db_sub;
+
+static const db_sub k_subs[] = {
+    {"init", db_init, "create the default database from assets/, or rebuild one with --from DIR"},
+    {"add-part", db_add_part, "validate and store a rigged part (PART.glb) with synthetic sketches"},
+    {"add-sketch", db_add_sketch, "store example sketches (JSON, ndjson, SVG, PNG, labelled folders)"},
+    {"list", db_list, "parts, sketch counts and models (JSON)"},
+    {"show", db_show, "one part with its parameters, abstractions and log (JSON)"},
+    {"remove", db_remove, "remove a part"},
+    {"check", db_check, "integrity and consistency checks (JSON; exit 1 on problems)"},
+    {"train", db_train, "retrain the classifier from the stored sketches"},
+    {"export", db_export, "write the parts and sketches to a folder"},
+    {"log", db_log, "the curator log (JSON)"},
+};
+
+static void db_usage(FILE* f)
+{
+    fprintf(f, "usage: sketchpose db <subcommand> [--db PATH] [options]   (sketchpose db <subcommand> --help for details)\n\n"
+               "The curators' part database. PATH defaults to $SP_DB, else ./sketchpose.db.\n\nsubcommands:\n");
+    for (size_t i = 0; i < sizeof k_subs / sizeof k_subs[0]; ++i)
+        fprintf(f, "  %-11s %s\n", k_subs[i].name, k_subs[i].help);
+}
+
+int cmd_db(int argc, char** argv)
+{
+    if (argc < 2) {
+        db_usage(stderr);
+        return SP_EXIT_USAGE;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        db_usage(stdout);
+        return SP_EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof k_subs / sizeof k_subs[0]; ++i)
+        if (!strcmp(argv[1], k_subs[i].name)) return k_subs[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "sketchpose db: unknown subcommand '%s' (try sketchpose db --help)\n", argv[1]);
+    return SP_EXIT_USAGE;
+}

@@ -1,0 +1,228 @@
+/// sp/partdb.h: the part database: rigged parts, example sketches, trained
+/// classifier models and the curators' log, in one SQLite file.
+///
+/// How to use (a curator's tool):
+///
+///     sp_db* db; sp_error err = {0};
+///     if (sp_db_open("sketchpose.db", SP_DB_CREATE, &db, &err) != SP_OK) { fprintf(stderr, "%s\n", err.text); ... }
+///     sp_db_part_info info;
+///     sp_db_add_part_file(db, "wings2.glb", &(sp_db_part_desc){.category = "wings"}, &info, &err);
+///     sp_db_train(db, &(sp_db_train_desc){0}, NULL, &err);
+///     sp_db_close(db);
+///
+/// and a reader that must notice a curator's change (the kiosk):
+///
+///     uint64_t seen = sp_db_generation(db);
+///     ... per stroke: if (sp_db_generation(db) != seen) { reload model and parts; seen = ...; }
+///
+/// Guarantees:
+///   - every write (adding a part with its synthetic sketches, adding sketches,
+///     removing, storing a trained model) is one SQLite transaction: a crash,
+///     SIGKILL or full disk leaves either the old or the new state, never a mix;
+///   - everything expensive (glTF validation, the solver self-test, training)
+///     runs before the write lock is taken, so writers hold it for milliseconds;
+///   - a writer that waits longer than the busy timeout for another writer fails
+///     with SP_ERR_BUSY and "database is busy (held by another writer for more than N s)";
+///   - WAL mode: readers never block the writer nor see a half-written change.
+///
+/// The schema is versioned with `PRAGMA user_version` (SP_DB_SCHEMA_VERSION):
+/// opening for writing migrates an older database forward in one transaction;
+/// a database from a newer schema is refused (read-only opens refuse an older one too,
+/// naming the command that migrates it).
+#ifndef SP_PARTDB_H
+#define SP_PARTDB_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sp/classifier.h"
+#include "sp/gltf.h"
+#include "sp/result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Schema version this build reads and writes (PRAGMA user_version).
+#define SP_DB_SCHEMA_VERSION 2
+/// Default busy timeout: how long a writer waits for another writer.
+#define SP_DB_BUSY_MS_DEFAULT 5000
+/// Synthetic sketches stored with a part by default (per part, random poses).
+#define SP_DB_SYNTH_DEFAULT 60
+
+typedef struct sp_db sp_db;
+
+/// sp_db_open flags.
+enum sp_db_flags {
+    SP_DB_CREATE = 1,   ///< create the file (and schema) if it does not exist
+    SP_DB_READONLY = 2, ///< never write; refuses a database that needs migrating
+};
+
+/// The path used when the user gives none: $SP_DB if set, else "sketchpose.db"
+/// in the current directory.
+const char* sp_db_default_path(void);
+
+/// Opens (and with SP_DB_CREATE creates) a database: WAL mode, foreign keys,
+/// the default busy timeout, schema migrated forward. A missing file without
+/// SP_DB_CREATE, a file that is not an SQLite database, a newer schema, a file
+/// that cannot be written (unless SP_DB_READONLY) are refused with one line.
+sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err);
+/// Closes (NULL is fine). The WAL is checkpointed into the main file.
+void sp_db_close(sp_db* db);
+/// Sets how long a write waits for another writer (milliseconds, >= 0).
+void sp_db_set_busy_timeout(sp_db* db, int ms);
+/// The file's path as opened.
+const char* sp_db_path(const sp_db* db);
+/// The schema version of the open database (== SP_DB_SCHEMA_VERSION once open).
+int sp_db_schema_version(sp_db* db);
+/// A counter that grows with every committed change of parts, sketches or
+/// models, by this or any other connection. Cheap (PRAGMA data_version first;
+/// the counter is read only when some connection committed since the last call).
+/// Returns 0 if the database cannot be read.
+uint64_t sp_db_generation(sp_db* db);
+
+/// What a part is, as stored (summary computed at add time).
+typedef struct sp_db_part_info {
+    char name[SP_NAME_MAX];
+    char category[SP_NAME_MAX];
+    char abstraction[SP_NAME_MAX]; ///< the abstraction its sketches are drawn of
+    int vertices, triangles, joints, parameters, abstractions, animations;
+    size_t bytes;          ///< size of the stored glTF
+    char sha256[65];       ///< hex SHA-256 of the stored glTF bytes
+    double selftest_error; ///< solver self-test: mean error / 2D diagonal over the seeds (0.02 = 2%)
+    int sketches;          ///< example sketches of its category (list/show only)
+    char added_by[64];
+    char added_at[32];     ///< UTC, ISO 8601
+} sp_db_part_info;
+
+/// How to add a part. Zero means the default.
+typedef struct sp_db_part_desc {
+    const char* name;        ///< NULL: the file name without extension (sp_db_add_part: required)
+    const char* category;    ///< NULL: the part's `extras.sp_part.category`
+    const char* abstraction; ///< NULL: `sp_part.abstraction`, else the first abstraction
+    const char* added_by;    ///< NULL: $USER, else "unknown"
+    int synth_sketches;      ///< synthetic sketches stored with it; 0: SP_DB_SYNTH_DEFAULT; -1: none
+    uint64_t seed;           ///< for the synthetic sketches (0: 1)
+    double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: 0.4; see sp/synth.h)
+    int selftest_seeds;      ///< solver self-test seeds; 0: 3; -1: skip the self-test
+    double selftest_tolerance; ///< largest mean error over the seeds, fraction of the 2D diagonal; 0: 0.02
+} sp_db_part_desc;
+
+/// Validates a part without writing anything: the glTF loads, it has a skin
+/// (joints and skinned vertices), triangles, an abstraction with curves, a
+/// category, every parameter has finite bounds, it projects to a visible
+/// non-degenerate picture in its sketch view, and the solver fits its own
+/// synthetic sketches (mean error <= tolerance of the diagonal). On failure err
+/// holds every reason, separated by "; ". `info` (may be NULL) gets the summary.
+sp_result sp_db_validate_part(const void* glb, size_t size, const char* what, const sp_db_part_desc* desc, sp_db_part_info* info,
+                              sp_error* err);
+/// Validates and stores a part (and its synthetic sketches) in one transaction.
+/// A name that exists is refused (remove it first). Nothing is written on failure.
+sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err);
+/// Same from a .gltf/.glb file: the part is re-encoded as one self-contained GLB.
+sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err);
+/// Removes a part and the synthetic sketches stored with it (curated and kiosk
+/// sketches of its category stay: they are the curators' work; training uses
+/// only the categories of current parts). SP_ERR_INVALID when there is no such part.
+sp_result sp_db_remove_part(sp_db* db, const char* name, const char* by, sp_error* err);
+/// Every part, by name (*parts malloc'd, free()).
+sp_result sp_db_list_parts(sp_db* db, sp_db_part_info** parts, int* count, sp_error* err);
+/// One part's summary; SP_ERR_INVALID when there is no such part.
+sp_result sp_db_part(sp_db* db, const char* name, sp_db_part_info* info, sp_error* err);
+/// The stored glTF bytes (*glb malloc'd, free()).
+sp_result sp_db_part_bytes(sp_db* db, const char* name, void** glb, size_t* size, sp_error* err);
+/// Loads a part as a character (checksum verified first).
+sp_result sp_db_load_part(sp_db* db, const char* name, sp_character* out, sp_error* err);
+/// The names of the parts of a category, by name (*names malloc'd array of
+/// malloc'd strings; free with sp_db_free_strings).
+sp_result sp_db_category_parts(sp_db* db, const char* category, char*** names, int* count, sp_error* err);
+/// Distinct categories of the current parts, sorted (free with sp_db_free_strings).
+sp_result sp_db_categories(sp_db* db, char*** names, int* count, sp_error* err);
+void sp_db_free_strings(char** names, int count);
+
+/// Where an example sketch came from.
+typedef enum sp_db_source { SP_DB_SOURCE_SYNTHETIC, SP_DB_SOURCE_CURATED, SP_DB_SOURCE_KIOSK } sp_db_source;
+/// "synthetic", "curated", "kiosk".
+const char* sp_db_source_name(sp_db_source s);
+
+/// Stores drawings of a dataset in one transaction; sample i goes under
+/// `data->categories[label]` (every sample needs strokes or a raster; empty or
+/// non-finite drawings refuse the whole set). `png` (may be NULL) gives the
+/// original PNG bytes of raster samples, kept for export.
+typedef struct sp_db_png {
+    const void* bytes;
+    size_t size;
+} sp_db_png;
+sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png* png, sp_db_source source, const char* by, int* added,
+                             sp_error* err);
+/// Number of sketches per category: parallel arrays (free with sp_db_free_strings / free()).
+sp_result sp_db_sketch_counts(sp_db* db, char*** categories, int** counts, int* count, sp_error* err);
+/// The stored sketches of the current part categories as a dataset (categories
+/// = sp_db_categories); `unused` (may be NULL) counts sketches of other categories.
+sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err);
+
+/// Training. Zero means the default.
+typedef struct sp_db_train_desc {
+    sp_clf_desc clf;    ///< classifier options (progress reported through it)
+    int folds;          ///< cross-validation folds for the report; 0: 3; -1: none
+    const char* by;     ///< curator (NULL: $USER)
+} sp_db_train_desc;
+/// Rebuilds the classifier from the stored sketches of the current part
+/// categories, cross-validates it for the report, and stores the model with
+/// its options and report in one transaction. `report_json` (may be NULL) gets
+/// the report: {"categories", "drawings", "folds", "top1", "per_class": {"<cat>": {"recall", "n"}}, "seconds"}
+/// (malloc'd, free()). Fails when a part category has no sketches.
+sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err);
+/// The newest model; *id (may be NULL) its row id. SP_ERR_INVALID when none is stored.
+sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err);
+
+/// Stored models, newest first, as a JSON array [{"id", "created_at", "created_by",
+/// "bytes", "categories", "options", "report"}] (malloc'd, free()).
+sp_result sp_db_models_json(sp_db* db, char** json, sp_error* err);
+/// A part's parameter and abstraction summary as stored:
+/// {"parameters": [{"name", "min", "max", "default", "group"}], "abstractions": [{"name", "curves", "points", "correspondence"}]}.
+sp_result sp_db_part_summary_json(sp_db* db, const char* name, char** json, sp_error* err);
+
+/// Integrity check: SQLite's integrity and foreign key checks plus ours (every
+/// part loads from its bytes and matches its checksum and size, every sketch
+/// parses, the newest model loads and its categories equal the current part
+/// categories). *ok tells; *json (may be NULL, malloc'd) gets
+/// {"ok", "integrity", "parts", "sketches", "models", "problems": [...]}.
+sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err);
+
+/// Writes DIR/parts/<name>.glb, DIR/sketches/<category>/<source>-<id>.{json,png}
+/// and DIR/manifest.json (names, categories, curators). DIR is created.
+sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err);
+/// Adds every part and sketch of an export folder (parts validated as by
+/// sp_db_add_part, no synthetic sketches added: the folder has them).
+sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err);
+
+/// The default database: every `*.glb`/`*.gltf` part of assets_dir (category
+/// from its sp_part extras), `synth_per_part` synthetic sketches each (0:
+/// SP_DB_SYNTH_DEFAULT) and a trained model. Creates `path`; refuses an existing file.
+typedef struct sp_db_default_desc {
+    int synth_per_part;
+    sp_db_train_desc train;
+} sp_db_default_desc;
+sp_result sp_db_create_default(const char* path, const char* assets_dir, const sp_db_default_desc* desc, sp_error* err);
+/// Creates `path` from an export folder (sp_db_import), then trains when
+/// `train` is not NULL. Built beside `path` and moved into place when complete.
+sp_result sp_db_create_from_export(const char* path, const char* dir, const sp_db_train_desc* train, const char* by, sp_error* err);
+/// Opens `path`, creating it with sp_db_create_default first if it does not exist
+/// (what the kiosk does at start).
+sp_result sp_db_open_or_create_default(const char* path, const char* assets_dir, unsigned flags, sp_db** out, sp_error* err);
+
+/// Appends to the curator log (also done by every write above). `details` is JSON or NULL.
+sp_result sp_db_log(sp_db* db, const char* by, const char* action, const char* subject, const char* details, sp_error* err);
+/// The log, oldest first, as a JSON array [{"id","at","by","action","subject","details"}]
+/// (subject NULL: all entries) (malloc'd, free()).
+sp_result sp_db_log_json(sp_db* db, const char* subject, char** json, sp_error* err);
+
+/// Hex SHA-256 of bytes (hex: 65 chars with the NUL).
+void sp_sha256_hex(const void* data, size_t size, char hex[65]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,496 @@
+// db.c: opening the database, the schema and its migrations, transactions,
+// the busy message, the generation counter and the curator log.
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "db_internal.h"
+
+void (*sp_db_test_hook)(const char* point) = NULL;
+
+// ---- migrations ----------------------------------------------------------
+// Migration i takes the schema from version i to i + 1. Never edit a shipped
+// step: add a new one and bump SP_DB_SCHEMA_VERSION.
+static const char* const k_migrations[SP_DB_SCHEMA_VERSION] = {
+    // 0 -> 1: parts, sketches, models, the append-only log.
+    "CREATE TABLE parts("
+    " id INTEGER PRIMARY KEY,"
+    " name TEXT NOT NULL UNIQUE,"
+    " category TEXT NOT NULL,"
+    " abstraction TEXT NOT NULL,"
+    " gltf BLOB NOT NULL,"
+    " bytes INTEGER NOT NULL,"
+    " sha256 TEXT NOT NULL,"
+    " vertices INTEGER NOT NULL, triangles INTEGER NOT NULL, joints INTEGER NOT NULL,"
+    " parameters INTEGER NOT NULL, abstractions INTEGER NOT NULL, animations INTEGER NOT NULL,"
+    " selftest_error REAL,"
+    " summary TEXT NOT NULL," // JSON: parameters (name, min, max, group) and abstractions (name, curves, points)
+    " added_by TEXT NOT NULL,"
+    " added_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')));"
+    "CREATE INDEX parts_category ON parts(category);"
+    "CREATE TABLE sketches("
+    " id INTEGER PRIMARY KEY,"
+    " category TEXT NOT NULL,"
+    " source TEXT NOT NULL CHECK (source IN ('synthetic', 'curated', 'kiosk')),"
+    " part_id INTEGER REFERENCES parts(id) ON DELETE CASCADE," // synthetic sketches belong to their part
+    " strokes TEXT,"                                          // sketchpose-strokes JSON
+    " raster_w INTEGER, raster_h INTEGER, raster BLOB,"       // grey pixels of a PNG sketch
+    " png BLOB,"                                              // the PNG as given, for export
+    " added_by TEXT NOT NULL,"
+    " added_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),"
+    " CHECK ((strokes IS NULL) <> (raster IS NULL)));"
+    "CREATE INDEX sketches_category ON sketches(category);"
+    "CREATE INDEX sketches_part ON sketches(part_id);"
+    "CREATE TABLE models("
+    " id INTEGER PRIMARY KEY,"
+    " model BLOB NOT NULL," // the classifier's model file (sp_clf_save), as is
+    " sha256 TEXT NOT NULL,"
+    " categories TEXT NOT NULL," // JSON array, the model's categories in order
+    " options TEXT NOT NULL,"    // JSON, sp_clf_desc with defaults resolved
+    " report TEXT NOT NULL,"     // JSON, training and cross-validation report
+    " created_by TEXT NOT NULL,"
+    " created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')));"
+    "CREATE TABLE log("
+    " id INTEGER PRIMARY KEY,"
+    " at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),"
+    " by TEXT NOT NULL, action TEXT NOT NULL, subject TEXT, details TEXT);"
+    "CREATE TRIGGER log_no_update BEFORE UPDATE ON log BEGIN SELECT RAISE(ABORT, 'the curator log is append-only'); END;"
+    "CREATE TRIGGER log_no_delete BEFORE DELETE ON log BEGIN SELECT RAISE(ABORT, 'the curator log is append-only'); END;",
+    // 1 -> 2: a generation counter that every change of parts, sketches or
+    // models bumps in its own transaction, so a reader (the kiosk) can tell
+    // "something changed" from one small row.
+    "CREATE TABLE meta(key TEXT PRIMARY KEY, value INTEGER NOT NULL);"
+    "INSERT INTO meta VALUES ('generation', 1);"
+    "CREATE TRIGGER gen_parts_ins AFTER INSERT ON parts BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
+    "CREATE TRIGGER gen_parts_del AFTER DELETE ON parts BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
+    "CREATE TRIGGER gen_sketches_ins AFTER INSERT ON sketches BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
+    "CREATE TRIGGER gen_sketches_del AFTER DELETE ON sketches BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
+    "CREATE TRIGGER gen_models_ins AFTER INSERT ON models BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
+    "CREATE TRIGGER gen_models_del AFTER DELETE ON models BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;",
+};
+
+// ---- helpers ---------------------------------------------------------------
+
+void db_str_printf(db_str* b, const char* fmt, ...)
+{
+    if (b->oom) return;
+    va_list ap;
+    va_start(ap, fmt);
+    va_list ap2;
+    va_copy(ap2, ap);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+        va_end(ap2);
+        b->oom = true;
+        return;
+    }
+    if (b->len + (size_t)n + 1 > b->cap) {
+        size_t cap = b->cap ? b->cap : 256;
+        while (cap < b->len + (size_t)n + 1)
+            cap *= 2;
+        char* s = realloc(b->s, cap);
+        if (!s) {
+            va_end(ap2);
+            b->oom = true;
+            return;
+        }
+        b->s = s;
+        b->cap = cap;
+    }
+    vsnprintf(b->s + b->len, (size_t)n + 1, fmt, ap2);
+    va_end(ap2);
+    b->len += (size_t)n;
+}
+
+void db_str_json(db_str* b, const char* s)
+{
+    db_str_printf(b, "\"");
+    for (const unsigned char* p = (const unsigned char*)(s ? s : ""); *p; ++p) {
+        if (*p == '"' || *p == '\\') db_str_printf(b, "\\%c", *p);
+        else if (*p < 0x20) db_str_printf(b, "\\u%04x", *p);
+        else db_str_printf(b, "%c", *p);
+    }
+    db_str_printf(b, "\"");
+}
+
+const char* db_who(const char* by)
+{
+    if (by && *by) return by;
+    const char* u = getenv("USER");
+    return u && *u ? u : "unknown";
+}
+
+bool db_name_ok(const char* s)
+{
+    size_t n = s ? strlen(s) : 0;
+    if (n == 0 || n >= SP_NAME_MAX || s[0] == '.') return false;
+    for (size_t i = 0; i < n; ++i) {
+        char c = s[i];
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.'))
+            return false;
+    }
+    return true;
+}
+
+sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err)
+{
+    *data = NULL;
+    *size = 0;
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
+    }
+    if ((unsigned long long)st.st_size > (1ull << 30)) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: larger than 1 GiB", path);
+    }
+    char* buf = malloc((size_t)st.st_size + 1);
+    if (!buf) {
+        fclose(f);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    size_t n = fread(buf, 1, (size_t)st.st_size, f);
+    bool bad = ferror(f);
+    fclose(f);
+    if (bad || n != (size_t)st.st_size) {
+        free(buf);
+        return sp_fail(err, SP_ERR_IO, "%s: read error", path);
+    }
+    buf[n] = 0;
+    *data = buf;
+    *size = n;
+    return SP_OK;
+}
+
+sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err)
+{
+    FILE* f = fopen(path, "wb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
+    bool ok = fwrite(data, 1, size, f) == size;
+    ok = (fclose(f) == 0) && ok;
+    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (disk full?)", path);
+}
+
+sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
+{
+    int prim = rc & 0xff;
+    const char* p = db->path;
+    switch (prim) {
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+        return sp_fail(err, SP_ERR_BUSY, "%s: database is busy (held by another writer for more than %g s) while %s", p,
+                       db->busy_ms / 1000.0, doing);
+    case SQLITE_FULL: return sp_fail(err, SP_ERR_IO, "%s: disk full while %s; nothing was changed", p, doing);
+    case SQLITE_READONLY:
+        return sp_fail(err, SP_ERR_IO, "%s: the database is read-only (file permissions or opened read-only) while %s; nothing was changed",
+                       p, doing);
+    case SQLITE_NOMEM: return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while %s", p, doing);
+    case SQLITE_CORRUPT:
+    case SQLITE_NOTADB: return sp_fail(err, SP_ERR_PARSE, "%s: not a valid sketchpose database (%s) while %s", p, sqlite3_errstr(rc), doing);
+    case SQLITE_IOERR:
+        if (rc == SQLITE_IOERR_WRITE || rc == SQLITE_IOERR_FSYNC || rc == SQLITE_IOERR_TRUNCATE)
+            return sp_fail(err, SP_ERR_IO, "%s: write failed (disk full or file too large?) while %s; nothing was changed", p, doing);
+        return sp_fail(err, SP_ERR_IO, "%s: I/O error (%s) while %s", p, sqlite3_errmsg(db->h), doing);
+    default: return sp_fail(err, SP_ERR_INTERNAL, "%s: %s while %s", p, db->h ? sqlite3_errmsg(db->h) : sqlite3_errstr(rc), doing);
+    }
+}
+
+sp_result db_exec(sp_db* db, const char* sql, sp_error* err)
+{
+    int rc = sqlite3_exec(db->h, sql, NULL, NULL, NULL);
+    return rc == SQLITE_OK ? SP_OK : db_fail(db, rc, "writing", err);
+}
+
+sp_result db_prepare(sp_db* db, const char* sql, sqlite3_stmt** st, sp_error* err)
+{
+    int rc = sqlite3_prepare_v2(db->h, sql, -1, st, NULL);
+    return rc == SQLITE_OK ? SP_OK : db_fail(db, rc, "preparing a query", err);
+}
+
+sp_result db_begin(sp_db* db, sp_error* err)
+{
+    if (db->readonly) return sp_fail(err, SP_ERR_IO, "%s: opened read-only; nothing was changed", db->path);
+    // IMMEDIATE takes the write lock now, so a second writer waits here (up to
+    // the busy timeout) instead of failing halfway through its statements.
+    int rc = sqlite3_exec(db->h, "BEGIN IMMEDIATE", NULL, NULL, NULL);
+    return rc == SQLITE_OK ? SP_OK : db_fail(db, rc, "starting a write", err);
+}
+
+sp_result db_commit(sp_db* db, sp_error* err)
+{
+    DB_HOOK("commit");
+    int rc = sqlite3_exec(db->h, "COMMIT", NULL, NULL, NULL);
+    if (rc != SQLITE_OK) {
+        sp_result r = db_fail(db, rc, "committing", err);
+        db_rollback(db);
+        return r;
+    }
+    db->gen_valid = false; // our own commits do not change data_version
+    return SP_OK;
+}
+
+void db_rollback(sp_db* db)
+{
+    if (!sqlite3_get_autocommit(db->h)) sqlite3_exec(db->h, "ROLLBACK", NULL, NULL, NULL);
+}
+
+static int pragma_int(sp_db* db, const char* sql, int* out)
+{
+    sqlite3_stmt* st = NULL;
+    int rc = sqlite3_prepare_v2(db->h, sql, -1, &st, NULL);
+    if (rc == SQLITE_OK) {
+        rc = sqlite3_step(st);
+        if (rc == SQLITE_ROW) {
+            *out = sqlite3_column_int(st, 0);
+            rc = SQLITE_OK;
+        } else if (rc == SQLITE_DONE) {
+            rc = SQLITE_ERROR;
+        }
+    }
+    sqlite3_finalize(st);
+    return rc;
+}
+
+sp_result db_log_row(sp_db* db, const char* by, const char* action, const char* subject, const char* details, sp_error* err)
+{
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "INSERT INTO log(by, action, subject, details) VALUES (?, ?, ?, ?)", &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, db_who(by), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 2, action, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 3, subject, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 4, details, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    return rc == SQLITE_DONE ? SP_OK : db_fail(db, rc, "writing the log", err);
+}
+
+// ---- public ------------------------------------------------------------------
+
+const char* sp_db_default_path(void)
+{
+    const char* e = getenv("SP_DB");
+    return e && *e ? e : "sketchpose.db";
+}
+
+sp_result db_migrate(sp_db* db, int target, sp_error* err)
+{
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    int v = 0;
+    int rc = pragma_int(db, "PRAGMA user_version", &v); // re-read under the lock: another process may have migrated
+    if (rc != SQLITE_OK) {
+        db_rollback(db);
+        return db_fail(db, rc, "reading the schema version", err);
+    }
+    if (v == 0) {
+        int tables = 0;
+        pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables);
+        if (tables > 0) {
+            db_rollback(db);
+            return sp_fail(err, SP_ERR_INVALID, "%s: an SQLite file but not a sketchpose database (no schema version)", db->path);
+        }
+    }
+    for (; v < target; ++v) {
+        if (sqlite3_exec(db->h, k_migrations[v], NULL, NULL, NULL) != SQLITE_OK) {
+            char what[64];
+            snprintf(what, sizeof what, "migrating the schema from version %d", v);
+            r = db_fail(db, sqlite3_errcode(db->h), what, err);
+            db_rollback(db);
+            return r;
+        }
+        char sql[64];
+        snprintf(sql, sizeof sql, "PRAGMA user_version = %d", v + 1);
+        if ((r = db_exec(db, sql, err)) != SP_OK) {
+            db_rollback(db);
+            return r;
+        }
+    }
+    return db_commit(db, err);
+}
+
+sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err)
+{
+    *out = NULL;
+    bool ro = (flags & SP_DB_READONLY) != 0;
+    struct stat st;
+    bool exists = stat(path, &st) == 0;
+    if (!exists && (ro || !(flags & SP_DB_CREATE)))
+        return sp_fail(err, SP_ERR_IO, "%s: no such database (create one with `sketchpose db init`)", path);
+    if (exists && !S_ISREG(st.st_mode)) return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
+    sp_db* db = calloc(1, sizeof *db);
+    if (!db || !(db->path = strdup(path))) {
+        free(db);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    db->readonly = ro;
+    db->busy_ms = SP_DB_BUSY_MS_DEFAULT;
+    int oflags = ro ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | ((flags & SP_DB_CREATE) ? SQLITE_OPEN_CREATE : 0);
+    int rc = sqlite3_open_v2(path, &db->h, oflags | SQLITE_OPEN_FULLMUTEX, NULL);
+    sp_result r = SP_OK;
+    if (rc != SQLITE_OK) {
+        r = (rc & 0xff) == SQLITE_CANTOPEN ? sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno ? errno : EACCES))
+                                          : db_fail(db, rc, "opening", err);
+        goto fail;
+    }
+    sqlite3_extended_result_codes(db->h, 1);
+    sqlite3_busy_timeout(db->h, db->busy_ms);
+    int v = 0;
+    if ((rc = pragma_int(db, "PRAGMA user_version", &v)) != SQLITE_OK) {
+        r = db_fail(db, rc, "reading the schema version", err);
+        goto fail;
+    }
+    if (!ro && sqlite3_db_readonly(db->h, "main") == 1) {
+        r = sp_fail(err, SP_ERR_IO, "%s: cannot write the database file (read-only file or folder); open it read-only or fix the permissions",
+                    path);
+        goto fail;
+    }
+    if (v > SP_DB_SCHEMA_VERSION) {
+        r = sp_fail(err, SP_ERR_UNSUPPORTED,
+                    "%s: database schema version %d is newer than this sketchpose understands (%d); update sketchpose", path, v,
+                    SP_DB_SCHEMA_VERSION);
+        goto fail;
+    }
+    if (!ro) {
+        // WAL: readers (the kiosk) never block the curator and never see a half-written change.
+        sqlite3_stmt* jm = NULL;
+        rc = sqlite3_prepare_v2(db->h, "PRAGMA journal_mode = WAL", -1, &jm, NULL);
+        if (rc == SQLITE_OK) rc = sqlite3_step(jm);
+        bool wal = rc == SQLITE_ROW && !sqlite3_stricmp((const char*)sqlite3_column_text(jm, 0), "wal");
+        sqlite3_finalize(jm);
+        if (!wal) {
+            r = rc == SQLITE_ROW ? sp_fail(err, SP_ERR_IO, "%s: cannot switch to WAL mode", path) : db_fail(db, rc, "switching to WAL mode", err);
+            goto fail;
+        }
+        // FULL: a committed change survives a power cut too, not only a crash.
+        if ((r = db_exec(db, "PRAGMA synchronous = FULL", err)) != SP_OK) goto fail;
+    }
+    if ((r = db_exec(db, "PRAGMA foreign_keys = ON", err)) != SP_OK) goto fail;
+    if (v < SP_DB_SCHEMA_VERSION) {
+        if (ro && exists && v > 0) {
+            r = sp_fail(err, SP_ERR_UNSUPPORTED,
+                        "%s: database schema version %d is older than %d; open it once for writing (e.g. `sketchpose db check`) to migrate",
+                        path, v, SP_DB_SCHEMA_VERSION);
+            goto fail;
+        }
+        if (ro) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: not a sketchpose database (no schema)", path);
+            goto fail;
+        }
+        if ((r = db_migrate(db, SP_DB_SCHEMA_VERSION, err)) != SP_OK) goto fail;
+    }
+    *out = db;
+    return SP_OK;
+fail:
+    sqlite3_close(db->h);
+    free(db->path);
+    free(db);
+    return r;
+}
+
+void sp_db_close(sp_db* db)
+{
+    if (!db) return;
+    db_rollback(db);
+    sqlite3_close(db->h);
+    free(db->path);
+    free(db);
+}
+
+void sp_db_set_busy_timeout(sp_db* db, int ms)
+{
+    db->busy_ms = ms < 0 ? 0 : ms;
+    sqlite3_busy_timeout(db->h, db->busy_ms);
+}
+
+const char* sp_db_path(const sp_db* db) { return db->path; }
+
+int sp_db_schema_version(sp_db* db)
+{
+    int v = -1;
+    pragma_int(db, "PRAGMA user_version", &v);
+    return v;
+}
+
+uint64_t sp_db_generation(sp_db* db)
+{
+    int dv = 0;
+    if (pragma_int(db, "PRAGMA data_version", &dv) != SQLITE_OK) return 0;
+    if (db->gen_valid && dv == db->dv) return db->gen;
+    sqlite3_stmt* st = NULL;
+    uint64_t g = 0;
+    if (sqlite3_prepare_v2(db->h, "SELECT value FROM meta WHERE key = 'generation'", -1, &st, NULL) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW)
+        g = (uint64_t)sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    if (g) {
+        db->gen = g;
+        db->dv = dv;
+        db->gen_valid = true;
+    }
+    return g;
+}
+
+sp_result sp_db_log(sp_db* db, const char* by, const char* action, const char* subject, const char* details, sp_error* err)
+{
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    if ((r = db_log_row(db, by, action, subject, details, err)) != SP_OK) {
+        db_rollback(db);
+        return r;
+    }
+    return db_commit(db, err);
+}
+
+sp_result sp_db_log_json(sp_db* db, const char* subject, char** json, sp_error* err)
+{
+    *json = NULL;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, subject ? "SELECT id, at, by, action, subject, details FROM log WHERE subject = ? ORDER BY id"
+                                         : "SELECT id, at, by, action, subject, details FROM log ORDER BY id",
+                             &st, err);
+    if (r != SP_OK) return r;
+    if (subject) sqlite3_bind_text(st, 1, subject, -1, SQLITE_TRANSIENT);
+    db_str b = {0};
+    db_str_printf(&b, "[");
+    int rc, n = 0;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        db_str_printf(&b, "%s{\"id\": %lld, \"at\": ", n++ ? ", " : "", (long long)sqlite3_column_int64(st, 0));
+        db_str_json(&b, (const char*)sqlite3_column_text(st, 1));
+        db_str_printf(&b, ", \"by\": ");
+        db_str_json(&b, (const char*)sqlite3_column_text(st, 2));
+        db_str_printf(&b, ", \"action\": ");
+        db_str_json(&b, (const char*)sqlite3_column_text(st, 3));
+        db_str_printf(&b, ", \"subject\": ");
+        db_str_json(&b, (const char*)sqlite3_column_text(st, 4));
+        const char* d = (const char*)sqlite3_column_text(st, 5);
+        db_str_printf(&b, ", \"details\": %s}", d && *d ? d : "null");
+    }
+    sqlite3_finalize(st);
+    db_str_printf(&b, "]");
+    if (rc != SQLITE_DONE) {
+        free(b.s);
+        return db_fail(db, rc, "reading the log", err);
+    }
+    if (b.oom) {
+        free(b.s);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    *json = b.s;
+    return SP_OK;
+}
+
+void sp_db_free_strings(char** names, int count)
+{
+    if (!names) return;
+    for (int i = 0; i < count; ++i)
+        free(names[i]);
+    free(names);
+}

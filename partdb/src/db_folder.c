@@ -1,0 +1,350 @@
+// db_folder.c: export to and import from a folder, and the default database
+// built from assets/.
+#include <cjson/cJSON.h>
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "db_internal.h"
+
+static sp_result make_dir(const char* path, sp_error* err)
+{
+    if (mkdir(path, 0777) == 0 || errno == EEXIST) return SP_OK;
+    return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
+}
+
+sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
+{
+    char path[1024];
+    sp_result r = make_dir(dir, err);
+    if (r != SP_OK) return r;
+    snprintf(path, sizeof path, "%s/parts", dir);
+    if ((r = make_dir(path, err)) != SP_OK) return r;
+    snprintf(path, sizeof path, "%s/sketches", dir);
+    if ((r = make_dir(path, err)) != SP_OK) return r;
+    if ((r = db_exec(db, "BEGIN", err)) != SP_OK) return r; // one snapshot
+    db_str m = {0};
+    db_str_printf(&m, "{\"format\": \"sketchpose-db-export\", \"version\": 1, \"schema\": %d, \"parts\": [", SP_DB_SCHEMA_VERSION);
+    sqlite3_stmt* st;
+    if ((r = db_prepare(db, "SELECT name, category, abstraction, gltf, added_by, added_at FROM parts ORDER BY name", &st, err)) != SP_OK)
+        goto out;
+    int rc, n = 0;
+    while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        const char* name = (const char*)sqlite3_column_text(st, 0);
+        snprintf(path, sizeof path, "%s/parts/%s.glb", dir, name);
+        r = db_write_file(path, sqlite3_column_blob(st, 3), (size_t)sqlite3_column_bytes(st, 3), err);
+        db_str_printf(&m, "%s{\"name\": ", n++ ? ", " : "");
+        db_str_json(&m, name);
+        db_str_printf(&m, ", \"category\": ");
+        db_str_json(&m, (const char*)sqlite3_column_text(st, 1));
+        db_str_printf(&m, ", \"abstraction\": ");
+        db_str_json(&m, (const char*)sqlite3_column_text(st, 2));
+        db_str_printf(&m, ", \"file\": \"parts/%s.glb\", \"added_by\": ", name);
+        db_str_json(&m, (const char*)sqlite3_column_text(st, 4));
+        db_str_printf(&m, ", \"added_at\": ");
+        db_str_json(&m, (const char*)sqlite3_column_text(st, 5));
+        db_str_printf(&m, "}");
+    }
+    sqlite3_finalize(st);
+    if (r != SP_OK) goto out;
+    db_str_printf(&m, "], \"sketches\": [");
+    if ((r = db_prepare(db,
+                        "SELECT s.id, s.category, s.source, p.name, s.strokes, s.png, s.raster_w, s.added_by FROM sketches s"
+                        " LEFT JOIN parts p ON p.id = s.part_id ORDER BY s.category, s.id",
+                        &st, err)) != SP_OK)
+        goto out;
+    n = 0;
+    char last_cat[SP_NAME_MAX] = "";
+    while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        long long id = sqlite3_column_int64(st, 0);
+        const char* cat = (const char*)sqlite3_column_text(st, 1);
+        const char* src = (const char*)sqlite3_column_text(st, 2);
+        if (strcmp(cat, last_cat) != 0) {
+            snprintf(last_cat, sizeof last_cat, "%s", cat);
+            snprintf(path, sizeof path, "%s/sketches/%s", dir, cat);
+            if ((r = make_dir(path, err)) != SP_OK) break;
+        }
+        const char* ext;
+        if (sqlite3_column_type(st, 4) != SQLITE_NULL) {
+            ext = "json";
+            snprintf(path, sizeof path, "%s/sketches/%s/%s-%06lld.json", dir, cat, src, id);
+            r = db_write_file(path, sqlite3_column_text(st, 4), (size_t)sqlite3_column_bytes(st, 4), err);
+        } else if (sqlite3_column_type(st, 5) != SQLITE_NULL) {
+            ext = "png";
+            snprintf(path, sizeof path, "%s/sketches/%s/%s-%06lld.png", dir, cat, src, id);
+            r = db_write_file(path, sqlite3_column_blob(st, 5), (size_t)sqlite3_column_bytes(st, 5), err);
+        } else {
+            continue; // a raster without its PNG (none are stored that way today)
+        }
+        db_str_printf(&m, "%s{\"file\": \"sketches/%s/%s-%06lld.%s\", \"category\": ", n++ ? ", " : "", cat, src, id, ext);
+        db_str_json(&m, cat);
+        db_str_printf(&m, ", \"source\": \"%s\", \"part\": ", src);
+        if (sqlite3_column_type(st, 3) != SQLITE_NULL) db_str_json(&m, (const char*)sqlite3_column_text(st, 3));
+        else db_str_printf(&m, "null");
+        db_str_printf(&m, ", \"added_by\": ");
+        db_str_json(&m, (const char*)sqlite3_column_text(st, 7));
+        db_str_printf(&m, "}");
+    }
+    sqlite3_finalize(st);
+    if (r != SP_OK) goto out;
+    db_str_printf(&m, "]}\n");
+    if (m.oom) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        goto out;
+    }
+    snprintf(path, sizeof path, "%s/manifest.json", dir);
+    r = db_write_file(path, m.s, m.len, err);
+out:
+    free(m.s);
+    db_rollback(db);
+    return r;
+}
+
+static sp_db_source parse_source(const char* s)
+{
+    if (s && !strcmp(s, "synthetic")) return SP_DB_SOURCE_SYNTHETIC;
+    if (s && !strcmp(s, "kiosk")) return SP_DB_SOURCE_KIOSK;
+    return SP_DB_SOURCE_CURATED;
+}
+
+static const char* jstr(const cJSON* o, const char* key)
+{
+    const cJSON* v = cJSON_GetObjectItemCaseSensitive(o, key);
+    return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+// Reads one drawing into a sample (and its PNG bytes for rasters).
+static sp_result read_sample(const char* path, sp_sample* smp, void** png, size_t* png_size, sp_error* err)
+{
+    memset(smp, 0, sizeof *smp);
+    *png = NULL;
+    *png_size = 0;
+    sp_result r = sp_drawing_read(path, &smp->sketch, &smp->raster, err);
+    if (r != SP_OK) return r;
+    if (smp->raster.pixels) r = db_read_file(path, png, png_size, err);
+    if (r == SP_OK) r = db_sample_ok(smp, path, err);
+    if (r != SP_OK) {
+        sp_sketch_free(&smp->sketch);
+        sp_raster_free(&smp->raster);
+        free(*png);
+        *png = NULL;
+    }
+    return r;
+}
+
+static int64_t part_id(sp_db* db, const char* name)
+{
+    sqlite3_stmt* st = NULL;
+    int64_t id = 0;
+    if (name && sqlite3_prepare_v2(db->h, "SELECT id FROM parts WHERE name = ?", -1, &st, NULL) == SQLITE_OK) {
+        sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
+        if (sqlite3_step(st) == SQLITE_ROW) id = sqlite3_column_int64(st, 0);
+    }
+    sqlite3_finalize(st);
+    return id;
+}
+
+sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/manifest.json", dir);
+    void* text;
+    size_t size;
+    sp_result r = db_read_file(path, &text, &size, err);
+    if (r != SP_OK) return r;
+    cJSON* man = cJSON_ParseWithLength(text, size);
+    free(text);
+    const cJSON* parts = cJSON_GetObjectItemCaseSensitive(man, "parts");
+    const cJSON* sketches = cJSON_GetObjectItemCaseSensitive(man, "sketches");
+    if (!man || !cJSON_IsArray(parts) || !cJSON_IsArray(sketches) || !jstr(man, "format") ||
+        strcmp(jstr(man, "format"), "sketchpose-db-export") != 0) {
+        cJSON_Delete(man);
+        return sp_fail(err, SP_ERR_PARSE, "%s: not a sketchpose-db-export manifest", path);
+    }
+    const cJSON* it;
+    cJSON_ArrayForEach(it, parts)
+    {
+        const char *file = jstr(it, "file"), *name = jstr(it, "name");
+        if (!file || !name || strstr(file, "..")) {
+            r = sp_fail(err, SP_ERR_PARSE, "%s: a part entry without name or file", path);
+            break;
+        }
+        snprintf(path, sizeof path, "%s/%s", dir, file);
+        sp_db_part_desc d = {.name = name,
+                             .category = jstr(it, "category"),
+                             .abstraction = jstr(it, "abstraction"),
+                             .added_by = jstr(it, "added_by") ? jstr(it, "added_by") : by,
+                             .synth_sketches = -1};
+        if ((r = sp_db_add_part_file(db, path, &d, NULL, err)) != SP_OK) break;
+    }
+    // Sketches: all of them in one transaction, after reading and checking every file.
+    int n = cJSON_GetArraySize(sketches), read = 0;
+    sp_sample* smp = r == SP_OK ? calloc((size_t)(n > 0 ? n : 1), sizeof *smp) : NULL;
+    sp_db_png* png = r == SP_OK ? calloc((size_t)(n > 0 ? n : 1), sizeof *png) : NULL;
+    if (r == SP_OK && (!smp || !png)) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    if (r == SP_OK) {
+        cJSON_ArrayForEach(it, sketches)
+        {
+            const char *file = jstr(it, "file"), *cat = jstr(it, "category");
+            if (!file || !cat || strstr(file, "..") || !db_name_ok(cat)) {
+                r = sp_fail(err, SP_ERR_PARSE, "%s/manifest.json: a sketch entry without a file or a plain category", dir);
+                break;
+            }
+            snprintf(path, sizeof path, "%s/%s", dir, file);
+            void* bytes;
+            size_t nb;
+            if ((r = read_sample(path, &smp[read], &bytes, &nb, err)) != SP_OK) break;
+            png[read].bytes = bytes;
+            png[read].size = nb;
+            ++read;
+        }
+    }
+    if (r == SP_OK && read > 0 && (r = db_begin(db, err)) == SP_OK) {
+        int i = 0;
+        cJSON_ArrayForEach(it, sketches)
+        {
+            const char* pname = jstr(it, "part");
+            const char* src = jstr(it, "source");
+            sp_db_source s = parse_source(src);
+            if ((r = db_insert_sketch(db, jstr(it, "category"), s, s == SP_DB_SOURCE_SYNTHETIC ? part_id(db, pname) : 0, &smp[i],
+                                      &png[i], jstr(it, "added_by") ? jstr(it, "added_by") : by, err)) != SP_OK)
+                break;
+            ++i;
+        }
+        char details[128];
+        snprintf(details, sizeof details, "{\"sketches\": %d}", read);
+        if (r == SP_OK) r = db_log_row(db, by, "import", dir, details, err);
+        if (r == SP_OK) r = db_commit(db, err);
+        else db_rollback(db);
+    }
+    for (int i = 0; i < read; ++i) {
+        sp_sketch_free(&smp[i].sketch);
+        sp_raster_free(&smp[i].raster);
+        free((void*)png[i].bytes);
+    }
+    free(smp);
+    free(png);
+    cJSON_Delete(man);
+    return r;
+}
+
+// ---- the default database ---------------------------------------------------------
+
+static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+static bool is_part_file(const char* n)
+{
+    size_t l = strlen(n);
+    return n[0] != '.' && ((l > 4 && !strcmp(n + l - 4, ".glb")) || (l > 5 && !strcmp(n + l - 5, ".gltf")));
+}
+
+// Builds a database beside `path` with fill(), then links it into place, so
+// that an interrupted build never leaves a half database at `path`. link()
+// never replaces: a database someone else completed meanwhile wins.
+static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, const void*, sp_error*), const void* ctx, sp_error* err)
+{
+    struct stat st;
+    if (stat(path, &st) == 0) return sp_fail(err, SP_ERR_INVALID, "%s: exists already (remove it, or use another --db)", path);
+    char tmp[1024];
+    snprintf(tmp, sizeof tmp, "%s.building-%ld", path, (long)getpid());
+    sp_db* db = NULL;
+    sp_result r = sp_db_open(tmp, SP_DB_CREATE, &db, err);
+    if (r == SP_OK) r = fill(db, ctx, err);
+    sp_db_close(db);
+    if (r == SP_OK && link(tmp, path) != 0)
+        r = sp_fail(err, errno == EEXIST ? SP_ERR_BUSY : SP_ERR_IO, "%s: %s", path, strerror(errno));
+    unlink(tmp);
+    char side[1100];
+    snprintf(side, sizeof side, "%s-wal", tmp);
+    unlink(side);
+    snprintf(side, sizeof side, "%s-shm", tmp);
+    unlink(side);
+    return r;
+}
+
+typedef struct default_ctx {
+    const char* assets;
+    char** names;
+    int n;
+    sp_db_default_desc d;
+} default_ctx;
+
+static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
+{
+    const default_ctx* c = vctx;
+    sp_result r = SP_OK;
+    for (int i = 0; r == SP_OK && i < c->n; ++i) {
+        char file[1024];
+        snprintf(file, sizeof file, "%s/%s", c->assets, c->names[i]);
+        sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = "assets"};
+        r = sp_db_add_part_file(db, file, &pd, NULL, err);
+    }
+    if (r == SP_OK) {
+        sp_db_train_desc td = c->d.train;
+        if (!td.by) td.by = "assets";
+        r = sp_db_train(db, &td, NULL, err);
+    }
+    return r;
+}
+
+sp_result sp_db_create_default(const char* path, const char* assets_dir, const sp_db_default_desc* desc, sp_error* err)
+{
+    default_ctx c = {.assets = assets_dir, .d = desc ? *desc : (sp_db_default_desc){0}};
+    DIR* dp = opendir(assets_dir);
+    if (!dp) return sp_fail(err, SP_ERR_IO, "%s: %s", assets_dir, strerror(errno));
+    int cap = 0;
+    struct dirent* e;
+    while ((e = readdir(dp))) {
+        if (!is_part_file(e->d_name)) continue;
+        if (c.n == cap) {
+            cap = cap ? 2 * cap : 16;
+            char** g = realloc(c.names, sizeof *c.names * (size_t)cap);
+            if (!g) break;
+            c.names = g;
+        }
+        if ((c.names[c.n] = strdup(e->d_name))) ++c.n;
+    }
+    closedir(dp);
+    if (c.n == 0) {
+        free(c.names);
+        return sp_fail(err, SP_ERR_INVALID, "%s: no parts (*.glb, *.gltf) to build the default database from", assets_dir);
+    }
+    qsort(c.names, (size_t)c.n, sizeof *c.names, cmp_str);
+    sp_result r = build_then_link(path, fill_default, &c, err);
+    sp_db_free_strings(c.names, c.n);
+    return r;
+}
+
+typedef struct export_ctx {
+    const char* dir;
+    const char* by;
+    const sp_db_train_desc* train;
+} export_ctx;
+
+static sp_result fill_export(sp_db* db, const void* vctx, sp_error* err)
+{
+    const export_ctx* c = vctx;
+    sp_result r = sp_db_import(db, c->dir, c->by, err);
+    if (r == SP_OK && c->train) r = sp_db_train(db, c->train, NULL, err);
+    return r;
+}
+
+sp_result sp_db_create_from_export(const char* path, const char* dir, const sp_db_train_desc* train, const char* by, sp_error* err)
+{
+    export_ctx c = {dir, by, train};
+    return build_then_link(path, fill_export, &c, err);
+}
+
+sp_result sp_db_open_or_create_default(const char* path, const char* assets_dir, unsigned flags, sp_db** out, sp_error* err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        sp_result r = sp_db_create_default(path, assets_dir, NULL, err);
+        if (r != SP_OK && !(r == SP_ERR_BUSY && stat(path, &st) == 0)) return r;
+    }
+    return sp_db_open(path, flags & ~(unsigned)SP_DB_CREATE, out, err);
+}

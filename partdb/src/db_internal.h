@@ -1,0 +1,78 @@
+// db_internal.h: what the database's source files share (and tests reach).
+#ifndef SP_DB_INTERNAL_H
+#define SP_DB_INTERNAL_H
+
+#include <sqlite3.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sp/partdb.h"
+
+struct sp_db {
+    sqlite3* h;
+    char* path;
+    int busy_ms;
+    bool readonly;
+    bool gen_valid;   // gen is current as of data_version dv
+    int dv;
+    uint64_t gen;
+};
+
+/// Test hook: called at named points inside write transactions (NULL in
+/// production). The crash test sleeps there so that SIGKILL lands mid-write.
+extern void (*sp_db_test_hook)(const char* point);
+#define DB_HOOK(name)                          \
+    do {                                       \
+        if (sp_db_test_hook) sp_db_test_hook(name); \
+    } while (0)
+
+/// Runs the migrations from the file's version up to `target` (tests build
+/// old-schema files with it). Inside a write transaction taken here.
+sp_result db_migrate(sp_db* db, int target, sp_error* err);
+
+/// Maps an SQLite failure to a result and a one-line message naming the file.
+sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err);
+/// BEGIN IMMEDIATE with the busy message; COMMIT (rolls back on failure); ROLLBACK.
+sp_result db_begin(sp_db* db, sp_error* err);
+sp_result db_commit(sp_db* db, sp_error* err);
+void db_rollback(sp_db* db);
+/// Executes SQL without results.
+sp_result db_exec(sp_db* db, const char* sql, sp_error* err);
+/// Prepares or fails with a message.
+sp_result db_prepare(sp_db* db, const char* sql, sqlite3_stmt** st, sp_error* err);
+/// Appends a log row (inside the caller's transaction).
+sp_result db_log_row(sp_db* db, const char* by, const char* action, const char* subject, const char* details, sp_error* err);
+/// The curator's name: `by` if given, else $USER, else "unknown".
+const char* db_who(const char* by);
+/// True for names that are safe as file and folder names: [A-Za-z0-9_.-], 1..63, not starting with '.'.
+bool db_name_ok(const char* s);
+
+/// Inserts one sketch (strokes or raster) inside the caller's transaction.
+sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source, int64_t part_id, const sp_sample* smp,
+                           const sp_db_png* png, const char* by, sp_error* err);
+/// Checks a sample is storable (strokes with finite points, or a raster).
+sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err);
+/// Serialises strokes as a sketchpose-strokes JSON document (malloc'd).
+char* db_sketch_json(const sp_sketch* s);
+/// Reads a whole file (malloc'd, NUL-terminated beyond size).
+sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err);
+/// Writes a whole file.
+sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err);
+/// Synthetic sketches of a part (amplitude 0: the default), label 0 in a one-category dataset.
+sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out, sp_error* err);
+
+/// A growable string.
+typedef struct db_str {
+    char* s;
+    size_t len, cap;
+    bool oom;
+} db_str;
+void db_str_printf(db_str* b, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+void db_str_json(db_str* b, const char* s); // a JSON string literal
+
+#endif

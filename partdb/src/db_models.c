@@ -1,0 +1,421 @@
+// db_models.c: training and storing classifier models, loading the newest,
+// and the integrity check.
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "db_internal.h"
+
+// The classifier reads and writes model files; the database keeps the file's
+// bytes as they are (its own version header and checksum included), going
+// through a private temporary file.
+static sp_result temp_path(char* buf, size_t cap, int* fd, sp_error* err)
+{
+    const char* dir = getenv("TMPDIR");
+    snprintf(buf, cap, "%s/sp-model-XXXXXX", dir && *dir ? dir : "/tmp");
+    *fd = mkstemp(buf);
+    return *fd >= 0 ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: cannot create a temporary file", buf);
+}
+
+static sp_result model_to_bytes(const sp_clf* clf, void** bytes, size_t* size, sp_error* err)
+{
+    char path[512];
+    int fd;
+    sp_result r = temp_path(path, sizeof path, &fd, err);
+    if (r != SP_OK) return r;
+    close(fd);
+    r = sp_clf_save(clf, path, err);
+    if (r == SP_OK) r = db_read_file(path, bytes, size, err);
+    unlink(path);
+    return r;
+}
+
+static sp_result model_from_bytes(const void* bytes, size_t size, const char* what, sp_clf** out, sp_error* err)
+{
+    char path[512];
+    int fd;
+    sp_result r = temp_path(path, sizeof path, &fd, err);
+    if (r != SP_OK) return r;
+    close(fd);
+    r = db_write_file(path, bytes, size, err);
+    if (r == SP_OK) {
+        sp_error e = {0};
+        r = sp_clf_load(path, out, &e);
+        if (r != SP_OK) sp_fail(err, r, "%s: stored model: %s", what, e.text);
+    }
+    unlink(path);
+    return r;
+}
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static bool classify_ok(const sp_clf* clf, const sp_sample* s)
+{
+    sp_clf_answer a;
+    sp_error e = {0};
+    bool strokes = s->sketch.stroke_count > 0;
+    if (sp_clf_classify(clf, strokes ? &s->sketch : NULL, strokes ? NULL : &s->raster, &a, &e) != SP_OK) return false;
+    return a.count > 0 && a.ranked[0].category == s->label;
+}
+
+static char* desc_json(const sp_clf_desc* d)
+{
+    db_str b = {0};
+    db_str_printf(&b,
+                  "{\"words\": %d, \"vocab_samples\": %d, \"kmeans_iterations\": %d, \"soft_neighbours\": %d, \"knn\": %d,"
+                  " \"pyramid\": %d, \"tfidf\": %d, \"hellinger\": %d, \"mirror\": %d, \"augment\": %d, \"reject_quantile\": %.6g,"
+                  " \"seed\": %u, \"threads\": %d}",
+                  d->words, d->vocab_samples, d->kmeans_iterations, d->soft_neighbours, d->knn, d->pyramid, d->tfidf, d->hellinger,
+                  d->mirror, d->augment, d->reject_quantile, (unsigned)d->seed, d->threads);
+    return b.oom ? (free(b.s), NULL) : b.s;
+}
+
+static void cats_json(db_str* b, char** cats, int n)
+{
+    db_str_printf(b, "[");
+    for (int i = 0; i < n; ++i) {
+        db_str_printf(b, "%s", i ? ", " : "");
+        db_str_json(b, cats[i]);
+    }
+    db_str_printf(b, "]");
+}
+
+sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err)
+{
+    if (report_json) *report_json = NULL;
+    sp_db_train_desc d = desc ? *desc : (sp_db_train_desc){0};
+    int folds = d.folds == 0 ? 3 : d.folds < 0 ? 0 : d.folds;
+    double t0 = now_s();
+    sp_dataset ds;
+    int unused = 0;
+    sp_result r = sp_db_load_dataset(db, &ds, &unused, err);
+    if (r != SP_OK) return r;
+    sp_clf* clf = NULL;
+    void* bytes = NULL;
+    size_t size = 0;
+    char *opts = NULL, *cats_s = NULL;
+    db_str rep = {0};
+    int* n_cls = calloc((size_t)(ds.category_count > 0 ? ds.category_count : 1), sizeof(int));
+    int* ok_cls = calloc((size_t)(ds.category_count > 0 ? ds.category_count : 1), sizeof(int));
+    unsigned char* use = malloc((size_t)(ds.count > 0 ? ds.count : 1));
+    if (!n_cls || !ok_cls || !use) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    if (ds.category_count == 0) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: no parts, so nothing to train (add parts first)", db->path);
+        goto done;
+    }
+    for (int i = 0; i < ds.count; ++i)
+        n_cls[ds.samples[i].label]++;
+    for (int c = 0; c < ds.category_count; ++c)
+        if (n_cls[c] == 0) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: category '%s' has parts but no sketches (add-sketch --category %s ...)", db->path,
+                        ds.categories[c], ds.categories[c]);
+            goto done;
+        }
+    // Cross-validation for the report: fold f holds out the drawings whose
+    // index within their category is f modulo the fold count.
+    int cv_n = 0, cv_ok = 0;
+    double t_cv = now_s();
+    for (int f = 0; f < folds; ++f) {
+        for (int i = 0; i < ds.count; ++i)
+            use[i] = (unsigned char)(ds.samples[i].index % folds != f);
+        sp_clf* m = NULL;
+        if ((r = sp_clf_train(&ds, use, &d.clf, &m, err)) != SP_OK) goto done;
+        for (int i = 0; i < ds.count; ++i) {
+            if (use[i]) continue;
+            bool ok = classify_ok(m, &ds.samples[i]);
+            ok_cls[ds.samples[i].label] += ok;
+            cv_ok += ok;
+            ++cv_n;
+        }
+        sp_clf_free(m);
+    }
+    t_cv = now_s() - t_cv;
+    double t_train = now_s();
+    if ((r = sp_clf_train(&ds, NULL, &d.clf, &clf, err)) != SP_OK) goto done;
+    t_train = now_s() - t_train;
+    if ((r = model_to_bytes(clf, &bytes, &size, err)) != SP_OK) goto done;
+    sp_clf_desc resolved = sp_clf_get_desc(clf);
+    opts = desc_json(&resolved);
+    db_str cb = {0};
+    cats_json(&cb, ds.categories, ds.category_count);
+    cats_s = cb.s;
+    db_str_printf(&rep, "{\"categories\": %s, \"drawings\": %d, \"unused_drawings\": %d, \"folds\": %d", cats_s ? cats_s : "[]", ds.count,
+                  unused, folds);
+    if (folds > 0) {
+        db_str_printf(&rep, ", \"top1\": %.4f, \"per_class\": {", cv_n ? (double)cv_ok / cv_n : 0.0);
+        for (int c = 0; c < ds.category_count; ++c) {
+            db_str_printf(&rep, "%s", c ? ", " : "");
+            db_str_json(&rep, ds.categories[c]);
+            db_str_printf(&rep, ": {\"recall\": %.4f, \"n\": %d}", (double)ok_cls[c] / n_cls[c], n_cls[c]);
+        }
+        db_str_printf(&rep, "}");
+    }
+    db_str_printf(&rep, ", \"seconds_train\": %.3f, \"seconds_cv\": %.3f}", t_train, t_cv);
+    if (!opts || !cats_s || cb.oom || rep.oom) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
+    char sha[65];
+    sp_sha256_hex(bytes, size, sha);
+    // Store, unless the parts changed while we trained (the model would not match them).
+    if ((r = db_begin(db, err)) != SP_OK) goto done;
+    {
+        char** now;
+        int nnow;
+        if ((r = sp_db_categories(db, &now, &nnow, err)) != SP_OK) goto rollback;
+        bool same = nnow == ds.category_count;
+        for (int c = 0; same && c < nnow; ++c)
+            same = !strcmp(now[c], ds.categories[c]);
+        sp_db_free_strings(now, nnow);
+        if (!same) {
+            r = sp_fail(err, SP_ERR_BUSY, "%s: the part categories changed while training; train again", db->path);
+            goto rollback;
+        }
+        sqlite3_stmt* st;
+        if ((r = db_prepare(db, "INSERT INTO models(model, sha256, categories, options, report, created_by) VALUES (?,?,?,?,?,?)", &st,
+                            err)) != SP_OK)
+            goto rollback;
+        sqlite3_bind_blob64(st, 1, bytes, size, SQLITE_STATIC);
+        sqlite3_bind_text(st, 2, sha, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 3, cats_s, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 4, opts, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 5, rep.s, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 6, db_who(d.by), -1, SQLITE_TRANSIENT);
+        int rc = sqlite3_step(st);
+        sqlite3_finalize(st);
+        if (rc != SQLITE_DONE) {
+            r = db_fail(db, rc, "storing the model", err);
+            goto rollback;
+        }
+        DB_HOOK("model");
+        char subject[32];
+        snprintf(subject, sizeof subject, "model %lld", (long long)sqlite3_last_insert_rowid(db->h));
+        if ((r = db_log_row(db, d.by, "train", subject, rep.s, err)) != SP_OK) goto rollback;
+        r = db_commit(db, err);
+        goto done;
+    }
+rollback:
+    db_rollback(db);
+done:
+    (void)t0;
+    if (r == SP_OK && report_json) {
+        *report_json = rep.s;
+        rep.s = NULL;
+    }
+    free(rep.s);
+    free(opts);
+    free(cats_s);
+    free(bytes);
+    free(use);
+    free(n_cls);
+    free(ok_cls);
+    sp_clf_free(clf);
+    sp_dataset_free(&ds);
+    return r;
+}
+
+sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err)
+{
+    *out = NULL;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT id, model, sha256 FROM models ORDER BY id DESC LIMIT 1", &st, err);
+    if (r != SP_OK) return r;
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) {
+        const void* b = sqlite3_column_blob(st, 1);
+        size_t n = (size_t)sqlite3_column_bytes(st, 1);
+        char sha[65], what[600];
+        sp_sha256_hex(b, n, sha);
+        snprintf(what, sizeof what, "%s: model %lld", db->path, (long long)sqlite3_column_int64(st, 0));
+        if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0)
+            r = sp_fail(err, SP_ERR_PARSE, "%s: stored bytes do not match the checksum", what);
+        else r = model_from_bytes(b, n, what, out, err);
+        if (r == SP_OK && id) *id = sqlite3_column_int64(st, 0);
+    } else if (rc == SQLITE_DONE) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: no trained model (run `sketchpose db train`)", db->path);
+    } else {
+        r = db_fail(db, rc, "reading the model", err);
+    }
+    sqlite3_finalize(st);
+    return r;
+}
+
+// ---- check -------------------------------------------------------------------
+
+static void problem(db_str* b, int* n, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void problem(db_str* b, int* n, const char* fmt, ...)
+{
+    char line[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    db_str_printf(b, "%s", (*n)++ ? ", " : "");
+    db_str_json(b, line);
+}
+
+static int count_rows(sp_db* db, const char* table)
+{
+    char sql[64];
+    snprintf(sql, sizeof sql, "SELECT count(*) FROM %s", table);
+    sqlite3_stmt* st = NULL;
+    int n = -1;
+    if (sqlite3_prepare_v2(db->h, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW) n = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    return n;
+}
+
+sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err)
+{
+    *ok = false;
+    if (json) *json = NULL;
+    db_str pb = {0};
+    int np = 0;
+    sp_result r = db_exec(db, "BEGIN", err); // one snapshot for every check
+    if (r != SP_OK) return r;
+    char integrity[256] = "";
+    sqlite3_stmt* st;
+    if ((r = db_prepare(db, "PRAGMA integrity_check", &st, err)) != SP_OK) goto out;
+    int rc;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        const char* line = (const char*)sqlite3_column_text(st, 0);
+        if (!integrity[0]) snprintf(integrity, sizeof integrity, "%s", line);
+        if (strcmp(line, "ok") != 0) problem(&pb, &np, "integrity: %s", line);
+    }
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) problem(&pb, &np, "integrity check failed: %s", sqlite3_errstr(rc));
+    if ((r = db_prepare(db, "PRAGMA foreign_key_check", &st, err)) != SP_OK) goto out;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW)
+        problem(&pb, &np, "foreign key: %s row %lld refers to a missing %s", sqlite3_column_text(st, 0),
+                (long long)sqlite3_column_int64(st, 1), sqlite3_column_text(st, 2));
+    sqlite3_finalize(st);
+    // Every part loads from its bytes and matches its checksum and size.
+    if ((r = db_prepare(db, "SELECT name, gltf, sha256, bytes FROM parts ORDER BY name", &st, err)) != SP_OK) goto out;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        const char* name = (const char*)sqlite3_column_text(st, 0);
+        const void* b = sqlite3_column_blob(st, 1);
+        size_t n = (size_t)sqlite3_column_bytes(st, 1);
+        char sha[65];
+        sp_sha256_hex(b, n, sha);
+        if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0) problem(&pb, &np, "part %s: checksum mismatch", name);
+        if ((sqlite3_int64)n != sqlite3_column_int64(st, 3)) problem(&pb, &np, "part %s: size mismatch", name);
+        sp_character ch = {0};
+        sp_error e = {0};
+        if (sp_gltf_load_memory(b, n, name, &ch, &e) != SP_OK) problem(&pb, &np, "part %s does not load: %s", name, e.text);
+        sp_character_free(&ch);
+    }
+    sqlite3_finalize(st);
+    // Every sketch parses.
+    if ((r = db_prepare(db, "SELECT id, strokes, raster_w, raster_h, length(raster) FROM sketches", &st, err)) != SP_OK) goto out;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        long long id = sqlite3_column_int64(st, 0);
+        if (sqlite3_column_type(st, 1) != SQLITE_NULL) {
+            sp_sketch s = {0};
+            sp_error e = {0};
+            if (sp_sketch_parse_json((const char*)sqlite3_column_text(st, 1), (size_t)sqlite3_column_bytes(st, 1), "sketch", &s, &e) != SP_OK)
+                problem(&pb, &np, "sketch %lld does not parse: %s", id, e.text);
+            sp_sketch_free(&s);
+        } else if ((long long)sqlite3_column_int(st, 2) * sqlite3_column_int(st, 3) != sqlite3_column_int64(st, 4)) {
+            problem(&pb, &np, "sketch %lld: raster size does not match its pixels", id);
+        }
+    }
+    sqlite3_finalize(st);
+    // The newest model loads and knows exactly the current part categories.
+    int models = count_rows(db, "models");
+    if (models > 0) {
+        sp_clf* clf = NULL;
+        sp_error e = {0};
+        if (sp_db_load_model(db, &clf, NULL, &e) != SP_OK) problem(&pb, &np, "newest model: %s", e.text);
+        else {
+            char** cats;
+            int n;
+            if ((r = sp_db_categories(db, &cats, &n, err)) != SP_OK) {
+                sp_clf_free(clf);
+                goto out;
+            }
+            bool same = n == sp_clf_category_count(clf);
+            for (int i = 0; same && i < n; ++i)
+                same = !strcmp(cats[i], sp_clf_category(clf, i));
+            if (!same) {
+                db_str a = {0}, b = {0};
+                cats_json(&a, cats, n);
+                db_str_printf(&b, "[");
+                for (int i = 0; i < sp_clf_category_count(clf); ++i) {
+                    db_str_printf(&b, "%s", i ? ", " : "");
+                    db_str_json(&b, sp_clf_category(clf, i));
+                }
+                db_str_printf(&b, "]");
+                problem(&pb, &np, "newest model's categories %s differ from the parts' %s: run `sketchpose db train`", b.s ? b.s : "",
+                        a.s ? a.s : "");
+                free(a.s);
+                free(b.s);
+            }
+            sp_db_free_strings(cats, n);
+            sp_clf_free(clf);
+        }
+    } else if (count_rows(db, "parts") > 0) {
+        problem(&pb, &np, "no trained model: run `sketchpose db train`");
+    }
+    *ok = np == 0;
+    if (json) {
+        db_str b = {0};
+        db_str_printf(&b, "{\"ok\": %s, \"integrity\": ", *ok ? "true" : "false");
+        db_str_json(&b, integrity);
+        db_str_printf(&b, ", \"schema\": %d, \"generation\": %llu, \"parts\": %d, \"sketches\": %d, \"models\": %d, \"problems\": [%s]}",
+                      sp_db_schema_version(db), (unsigned long long)sp_db_generation(db), count_rows(db, "parts"),
+                      count_rows(db, "sketches"), models, pb.s ? pb.s : "");
+        if (b.oom || pb.oom) {
+            free(b.s);
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        } else {
+            *json = b.s;
+        }
+    }
+out:
+    free(pb.s);
+    db_rollback(db);
+    return r;
+}
+
+sp_result sp_db_models_json(sp_db* db, char** json, sp_error* err)
+{
+    *json = NULL;
+    sqlite3_stmt* st;
+    sp_result r =
+        db_prepare(db, "SELECT id, created_at, created_by, length(model), categories, options, report FROM models ORDER BY id DESC", &st, err);
+    if (r != SP_OK) return r;
+    db_str b = {0};
+    db_str_printf(&b, "[");
+    int rc, n = 0;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        db_str_printf(&b, "%s{\"id\": %lld, \"created_at\": ", n++ ? ", " : "", (long long)sqlite3_column_int64(st, 0));
+        db_str_json(&b, (const char*)sqlite3_column_text(st, 1));
+        db_str_printf(&b, ", \"created_by\": ");
+        db_str_json(&b, (const char*)sqlite3_column_text(st, 2));
+        db_str_printf(&b, ", \"bytes\": %lld, \"categories\": %s, \"options\": %s, \"report\": %s}", (long long)sqlite3_column_int64(st, 3),
+                      sqlite3_column_text(st, 4), sqlite3_column_text(st, 5), sqlite3_column_text(st, 6));
+    }
+    sqlite3_finalize(st);
+    db_str_printf(&b, "]");
+    if (rc != SQLITE_DONE || b.oom) {
+        free(b.s);
+        return rc != SQLITE_DONE ? db_fail(db, rc, "listing models", err) : sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    *json = b.s;
+    return SP_OK;
+}

@@ -1,0 +1,566 @@
+// db_parts.c: validating, storing, listing and loading rigged parts.
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "db_internal.h"
+#include "sp/solver.h"
+#include "sp/synth.h"
+
+// Rotation amplitude of the self-test poses and of synthetic training
+// sketches (radians): visibly posed, yet within reach of a rest-pose start.
+#define SELFTEST_AMPLITUDE 0.5
+#define SYNTH_AMPLITUDE 0.4
+
+static void add_reason(char* buf, size_t cap, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void add_reason(char* buf, size_t cap, const char* fmt, ...)
+{
+    size_t n = strlen(buf);
+    if (n + 3 >= cap) return;
+    if (n) {
+        strcat(buf, "; ");
+        n += 2;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf + n, cap - n, fmt, ap);
+    va_end(ap);
+}
+
+static void copy_name(char* dst, size_t cap, const char* src)
+{
+    snprintf(dst, cap, "%s", src ? src : "");
+}
+
+// The part's `sp_part` extras field `key` as a string (static buffer), or NULL.
+static const char* part_extra(const sp_character* ch, const char* key, char* buf, size_t cap)
+{
+    if (!ch->part_json) return NULL;
+    cJSON* j = cJSON_Parse(ch->part_json);
+    const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, key);
+    const char* out = NULL;
+    if (cJSON_IsString(v) && v->valuestring) {
+        copy_name(buf, cap, v->valuestring);
+        out = buf;
+    }
+    cJSON_Delete(j);
+    return out;
+}
+
+static int pick_abstraction(const sp_character* ch, const sp_db_part_desc* d)
+{
+    char buf[SP_NAME_MAX];
+    const char* want = d && d->abstraction ? d->abstraction : part_extra(ch, "abstraction", buf, sizeof buf);
+    if (want) return sp_rig_find_abstraction(&ch->rig, want);
+    return ch->rig.abstraction_count > 0 ? 0 : -1;
+}
+
+sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    if (sp_dataset_add_category(out, "part") < 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    out->samples = calloc((size_t)(n > 0 ? n : 1), sizeof(sp_sample));
+    double* p = malloc(sizeof(double) * (size_t)(ch->rig.param_count > 0 ? ch->rig.param_count : 1));
+    if (!out->samples || !p) {
+        free(p);
+        sp_dataset_free(out);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    for (int i = 0; i < n; ++i) {
+        sp_synth_params(&ch->rig, seed * 1000003u + (uint64_t)i, amplitude > 0 ? amplitude : SYNTH_AMPLITUDE, p);
+        sp_result r = sp_synth_sketch(&ch->rig, abstraction, &ch->camera, p, &out->samples[i].sketch);
+        if (r != SP_OK) {
+            free(p);
+            sp_dataset_free(out);
+            return sp_fail(err, r, "synthetic sketch %d: %s", i, sp_result_name(r));
+        }
+        out->samples[i].label = 0;
+        out->samples[i].index = i;
+        out->count = i + 1;
+    }
+    free(p);
+    return SP_OK;
+}
+
+// The solver fits the part's own synthetic sketches from the rest pose.
+static double self_test(const sp_character* ch, int abstraction, int seeds, char* reasons, size_t cap)
+{
+    const sp_rig* rig = &ch->rig;
+    double* p = malloc(sizeof(double) * (size_t)rig->param_count);
+    double* q = malloc(sizeof(double) * (size_t)rig->param_count);
+    sp_solver* s = sp_solver_create(rig, abstraction, &ch->camera, &(sp_solve_desc){.time_cap_ms = 2000});
+    double sum = 0;
+    int done = 0;
+    if (!p || !q || !s) {
+        add_reason(reasons, cap, "self-test: out of memory");
+        goto out;
+    }
+    for (int k = 0; k < seeds; ++k) {
+        sp_sketch sk = {0};
+        sp_synth_params(rig, 1000u + (uint64_t)k, SELFTEST_AMPLITUDE, p);
+        if (sp_synth_sketch(rig, abstraction, &ch->camera, p, &sk) != SP_OK) {
+            add_reason(reasons, cap, "self-test: cannot draw the abstraction's synthetic sketch (seed %d)", k);
+            goto out;
+        }
+        sp_solve_report rep;
+        sp_error e = {0};
+        sp_result r = sp_solver_solve(s, &sk, NULL, q, &rep, &e);
+        sp_sketch_free(&sk);
+        if (r != SP_OK) {
+            add_reason(reasons, cap, "self-test: the solver failed on its own sketch (seed %d): %s", k, e.text);
+            goto out;
+        }
+        sum += rep.bbox_diagonal_px > 0 ? rep.mean_error_px / rep.bbox_diagonal_px : INFINITY;
+        ++done;
+    }
+out:
+    sp_solver_destroy(s);
+    free(p);
+    free(q);
+    return done == seeds && seeds > 0 ? sum / seeds : INFINITY;
+}
+
+static sp_result validate(const void* glb, size_t size, const char* what, const sp_db_part_desc* d, sp_db_part_info* info,
+                          sp_character* keep, int* abstraction_out, sp_error* err)
+{
+    sp_db_part_info tmp;
+    if (!info) info = &tmp;
+    memset(info, 0, sizeof *info);
+    sp_character ch = {0};
+    sp_result r = sp_gltf_load_memory(glb, size, what, &ch, err);
+    if (r != SP_OK) return r;
+    const sp_rig* rig = &ch.rig;
+    char reasons[sizeof err->text] = "";
+    if (rig->joint_count == 0 || !rig->weights4 || !rig->joints4) add_reason(reasons, sizeof reasons, "no skin");
+    if (rig->vertex_count == 0 || rig->triangle_count == 0) add_reason(reasons, sizeof reasons, "no triangle mesh");
+    char cat[SP_NAME_MAX];
+    const char* category = d && d->category ? d->category : part_extra(&ch, "category", cat, sizeof cat);
+    if (!category) add_reason(reasons, sizeof reasons, "no category (give --category or the scene's extras.sp_part.category)");
+    else if (!db_name_ok(category)) add_reason(reasons, sizeof reasons, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", category);
+    int a = pick_abstraction(&ch, d);
+    if (a < 0) add_reason(reasons, sizeof reasons, "no sketch abstraction%s%s", d && d->abstraction ? " named " : "",
+                          d && d->abstraction ? d->abstraction : "");
+    else if (rig->abstractions[a].curve_count == 0 || rig->abstractions[a].point_count < 2)
+        add_reason(reasons, sizeof reasons, "abstraction '%s' has no curve", rig->abstractions[a].name);
+    if (rig->param_count == 0) add_reason(reasons, sizeof reasons, "no rig parameters");
+    for (int i = 0; i < rig->param_count; ++i) {
+        const sp_param* pm = &rig->params[i];
+        if (!isfinite(pm->min) || !isfinite(pm->max) || pm->min > pm->max ||
+            (sp_channel_is_rotation(pm->channel) && pm->max - pm->min > 4 * 3.14159265358979323846)) {
+            add_reason(reasons, sizeof reasons, "parameter %s is not bounded ([%g, %g])", pm->name, pm->min, pm->max);
+            break;
+        }
+    }
+    // "Renders": the mesh and the abstraction project to a non-degenerate picture that overlaps the canvas.
+    if (!reasons[0]) {
+        double* xy = malloc(sizeof(double) * 2 * (size_t)rig->abstractions[a].point_count);
+        double* p = malloc(sizeof(double) * (size_t)rig->param_count);
+        if (!xy || !p) add_reason(reasons, sizeof reasons, "out of memory");
+        else {
+            sp_rig_defaults(rig, p);
+            sp_abstraction_project(rig, a, &ch.camera, p, xy);
+            double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+            for (int i = 0; i < rig->abstractions[a].point_count; ++i)
+                for (int c = 0; c < 2; ++c) {
+                    lo[c] = fmin(lo[c], xy[2 * i + c]);
+                    hi[c] = fmax(hi[c], xy[2 * i + c]);
+                }
+            double diag = hypot(hi[0] - lo[0], hi[1] - lo[1]);
+            if (!isfinite(diag) || diag < 8) add_reason(reasons, sizeof reasons, "the abstraction is invisible in the sketch view (%.1f px)", diag);
+            else if (hi[0] < 0 || hi[1] < 0 || lo[0] > ch.camera.width || lo[1] > ch.camera.height)
+                add_reason(reasons, sizeof reasons, "the abstraction lies outside the sketch view");
+        }
+        free(xy);
+        free(p);
+    }
+    int seeds = d && d->selftest_seeds ? d->selftest_seeds : 3;
+    double tol = d && d->selftest_tolerance > 0 ? d->selftest_tolerance : 0.02;
+    info->selftest_error = -1;
+    if (!reasons[0] && seeds > 0) {
+        info->selftest_error = self_test(&ch, a, seeds, reasons, sizeof reasons);
+        if (!reasons[0] && !(info->selftest_error <= tol))
+            add_reason(reasons, sizeof reasons, "self-test: the solver fits its own synthetic sketches with %.2f%% mean error (> %.2f%% of the diagonal)",
+                       100 * info->selftest_error, 100 * tol);
+    }
+    if (reasons[0]) {
+        sp_character_free(&ch);
+        return sp_fail(err, SP_ERR_INVALID, "%s: refused: %s", what, reasons);
+    }
+    copy_name(info->category, sizeof info->category, category);
+    copy_name(info->abstraction, sizeof info->abstraction, rig->abstractions[a].name);
+    info->vertices = rig->vertex_count;
+    info->triangles = rig->triangle_count;
+    info->joints = rig->joint_count;
+    info->parameters = rig->param_count;
+    info->abstractions = rig->abstraction_count;
+    info->animations = rig->animation_count;
+    info->bytes = size;
+    sp_sha256_hex(glb, size, info->sha256);
+    if (abstraction_out) *abstraction_out = a;
+    if (keep) *keep = ch;
+    else sp_character_free(&ch);
+    return SP_OK;
+}
+
+sp_result sp_db_validate_part(const void* glb, size_t size, const char* what, const sp_db_part_desc* desc, sp_db_part_info* info,
+                              sp_error* err)
+{
+    return validate(glb, size, what, desc, info, NULL, NULL, err);
+}
+
+static char* summary_json(const sp_rig* rig)
+{
+    db_str b = {0};
+    db_str_printf(&b, "{\"parameters\": [");
+    for (int i = 0; i < rig->param_count; ++i) {
+        const sp_param* p = &rig->params[i];
+        db_str_printf(&b, "%s{\"name\": ", i ? ", " : "");
+        db_str_json(&b, p->name);
+        db_str_printf(&b, ", \"min\": %.9g, \"max\": %.9g, \"default\": %.9g, \"group\": \"%s\"}", p->min, p->max, p->def,
+                      p->group == SP_GROUP_SHAPE ? "shape" : "pose");
+    }
+    db_str_printf(&b, "], \"abstractions\": [");
+    for (int i = 0; i < rig->abstraction_count; ++i) {
+        const sp_abstraction* a = &rig->abstractions[i];
+        db_str_printf(&b, "%s{\"name\": ", i ? ", " : "");
+        db_str_json(&b, a->name);
+        db_str_printf(&b, ", \"curves\": %d, \"points\": %d, \"correspondence\": \"%s\"}", a->curve_count, a->point_count,
+                      a->correspondence == SP_CORR_CLOSEST ? "closest" : "ordered");
+    }
+    db_str_printf(&b, "]}");
+    if (b.oom) {
+        free(b.s);
+        return NULL;
+    }
+    return b.s;
+}
+
+sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info_out, sp_error* err)
+{
+    sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
+    if (!d.name || !db_name_ok(d.name))
+        return sp_fail(err, SP_ERR_INVALID, "part name '%s' is not a plain name ([A-Za-z0-9_.-], < 64 chars)", d.name ? d.name : "");
+    sp_db_part_info info;
+    sp_character ch = {0};
+    int a = -1;
+    // Everything slow happens before the write lock.
+    sp_result r = validate(glb, size, d.name, &d, &info, &ch, &a, err);
+    if (r != SP_OK) return r;
+    copy_name(info.name, sizeof info.name, d.name);
+    int nsynth = d.synth_sketches == 0 ? SP_DB_SYNTH_DEFAULT : d.synth_sketches < 0 ? 0 : d.synth_sketches;
+    sp_dataset synth = {0};
+    if (nsynth > 0 && (r = db_synth_sketches(&ch, a, nsynth, d.seed ? d.seed : 1, d.synth_amplitude, &synth, err)) != SP_OK) {
+        sp_character_free(&ch);
+        return r;
+    }
+    char* summary = summary_json(&ch.rig);
+    sp_character_free(&ch);
+    if (!summary) {
+        sp_dataset_free(&synth);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    const char* by = db_who(d.added_by);
+    sqlite3_stmt* st = NULL;
+    if ((r = db_begin(db, err)) != SP_OK) goto done;
+    if ((r = db_prepare(db,
+                        "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, parameters,"
+                        " abstractions, animations, selftest_error, summary, added_by) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
+                        &st, err)) != SP_OK)
+        goto rollback;
+    sqlite3_bind_text(st, 1, info.name, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 2, info.category, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 3, info.abstraction, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_blob64(st, 4, glb, size, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 5, (sqlite3_int64)size);
+    sqlite3_bind_text(st, 6, info.sha256, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int(st, 7, info.vertices);
+    sqlite3_bind_int(st, 8, info.triangles);
+    sqlite3_bind_int(st, 9, info.joints);
+    sqlite3_bind_int(st, 10, info.parameters);
+    sqlite3_bind_int(st, 11, info.abstractions);
+    sqlite3_bind_int(st, 12, info.animations);
+    if (info.selftest_error >= 0) sqlite3_bind_double(st, 13, info.selftest_error);
+    sqlite3_bind_text(st, 14, summary, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 15, by, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        if (rc == SQLITE_CONSTRAINT_UNIQUE)
+            r = sp_fail(err, SP_ERR_INVALID, "%s: a part named '%s' exists (remove it first)", db->path, info.name);
+        else r = db_fail(db, rc, "storing the part", err);
+        goto rollback;
+    }
+    int64_t part_id = sqlite3_last_insert_rowid(db->h);
+    DB_HOOK("part");
+    for (int i = 0; i < synth.count; ++i) {
+        if ((r = db_insert_sketch(db, info.category, SP_DB_SOURCE_SYNTHETIC, part_id, &synth.samples[i], NULL, by, err)) != SP_OK)
+            goto rollback;
+        if (i == synth.count / 2) DB_HOOK("sketches");
+    }
+    char details[256];
+    snprintf(details, sizeof details, "{\"category\": \"%s\", \"sha256\": \"%s\", \"bytes\": %zu, \"synthetic_sketches\": %d}", info.category,
+             info.sha256, size, synth.count);
+    if ((r = db_log_row(db, by, "add-part", info.name, details, err)) != SP_OK) goto rollback;
+    r = db_commit(db, err);
+    goto done;
+rollback:
+    db_rollback(db);
+done:
+    free(summary);
+    sp_dataset_free(&synth);
+    if (r == SP_OK && info_out) {
+        *info_out = info;
+        sp_error e2 = {0};
+        if (sp_db_part(db, info.name, info_out, &e2) != SP_OK) copy_name(info_out->added_by, sizeof info_out->added_by, by);
+        info_out->selftest_error = info.selftest_error;
+    }
+    return r;
+}
+
+sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err)
+{
+    // Load from the path first: its messages are the loader's, and a .gltf
+    // with external buffers only loads there.
+    sp_character ch = {0};
+    sp_result r = sp_gltf_load(path, &ch, err);
+    if (r != SP_OK) return r;
+    void* bytes = NULL;
+    size_t size = 0;
+    if ((r = db_read_file(path, &bytes, &size, err)) != SP_OK) {
+        sp_character_free(&ch);
+        return r;
+    }
+    sp_character probe = {0};
+    sp_error e2 = {0};
+    if (sp_gltf_load_memory(bytes, size, path, &probe, &e2) == SP_OK) {
+        sp_character_free(&probe);
+    } else {
+        // Not self-contained (external .bin): store it re-encoded as one GLB.
+        free(bytes);
+        bytes = NULL;
+        if ((r = sp_gltf_save_memory(&ch, NULL, &bytes, &size, err)) != SP_OK) {
+            sp_character_free(&ch);
+            return r;
+        }
+    }
+    sp_character_free(&ch);
+    sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
+    char name[SP_NAME_MAX];
+    if (!d.name) {
+        const char* base = strrchr(path, '/');
+        base = base ? base + 1 : path;
+        snprintf(name, sizeof name, "%s", base);
+        char* dot = strrchr(name, '.');
+        if (dot && dot != name) *dot = 0;
+        d.name = name;
+    }
+    r = sp_db_add_part(db, bytes, size, &d, info, err);
+    free(bytes);
+    return r;
+}
+
+sp_result sp_db_remove_part(sp_db* db, const char* name, const char* by, sp_error* err)
+{
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    sqlite3_stmt* st;
+    if ((r = db_prepare(db, "DELETE FROM parts WHERE name = ?", &st, err)) != SP_OK) goto rollback;
+    sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        r = db_fail(db, rc, "removing the part", err);
+        goto rollback;
+    }
+    if (sqlite3_changes(db->h) == 0) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
+        goto rollback;
+    }
+    DB_HOOK("remove");
+    if ((r = db_log_row(db, by, "remove-part", name, NULL, err)) != SP_OK) goto rollback;
+    return db_commit(db, err);
+rollback:
+    db_rollback(db);
+    return r;
+}
+
+#define PART_COLS                                                                                                             \
+    "p.name, p.category, p.abstraction, p.vertices, p.triangles, p.joints, p.parameters, p.abstractions, p.animations, p.bytes," \
+    " p.sha256, p.selftest_error, p.added_by, p.added_at, (SELECT count(*) FROM sketches s WHERE s.category = p.category)"
+
+static void read_info(sqlite3_stmt* st, sp_db_part_info* o)
+{
+    memset(o, 0, sizeof *o);
+    copy_name(o->name, sizeof o->name, (const char*)sqlite3_column_text(st, 0));
+    copy_name(o->category, sizeof o->category, (const char*)sqlite3_column_text(st, 1));
+    copy_name(o->abstraction, sizeof o->abstraction, (const char*)sqlite3_column_text(st, 2));
+    o->vertices = sqlite3_column_int(st, 3);
+    o->triangles = sqlite3_column_int(st, 4);
+    o->joints = sqlite3_column_int(st, 5);
+    o->parameters = sqlite3_column_int(st, 6);
+    o->abstractions = sqlite3_column_int(st, 7);
+    o->animations = sqlite3_column_int(st, 8);
+    o->bytes = (size_t)sqlite3_column_int64(st, 9);
+    copy_name(o->sha256, sizeof o->sha256, (const char*)sqlite3_column_text(st, 10));
+    o->selftest_error = sqlite3_column_type(st, 11) == SQLITE_NULL ? -1 : sqlite3_column_double(st, 11);
+    copy_name(o->added_by, sizeof o->added_by, (const char*)sqlite3_column_text(st, 12));
+    copy_name(o->added_at, sizeof o->added_at, (const char*)sqlite3_column_text(st, 13));
+    o->sketches = sqlite3_column_int(st, 14);
+}
+
+sp_result sp_db_list_parts(sp_db* db, sp_db_part_info** parts, int* count, sp_error* err)
+{
+    *parts = NULL;
+    *count = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT " PART_COLS " FROM parts p ORDER BY p.name", &st, err);
+    if (r != SP_OK) return r;
+    int rc, n = 0, cap = 0;
+    sp_db_part_info* out = NULL;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 8;
+            sp_db_part_info* g = realloc(out, sizeof *out * (size_t)cap);
+            if (!g) {
+                free(out);
+                sqlite3_finalize(st);
+                return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+            }
+            out = g;
+        }
+        read_info(st, &out[n++]);
+    }
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        free(out);
+        return db_fail(db, rc, "listing parts", err);
+    }
+    *parts = out;
+    *count = n;
+    return SP_OK;
+}
+
+sp_result sp_db_part(sp_db* db, const char* name, sp_db_part_info* info, sp_error* err)
+{
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT " PART_COLS " FROM parts p WHERE p.name = ?", &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) read_info(st, info);
+    sqlite3_finalize(st);
+    if (rc == SQLITE_DONE) return sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
+    return rc == SQLITE_ROW ? SP_OK : db_fail(db, rc, "reading a part", err);
+}
+
+sp_result sp_db_part_bytes(sp_db* db, const char* name, void** glb, size_t* size, sp_error* err)
+{
+    *glb = NULL;
+    *size = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT gltf, sha256 FROM parts WHERE name = ?", &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) {
+        size_t n = (size_t)sqlite3_column_bytes(st, 0);
+        const void* src = sqlite3_column_blob(st, 0);
+        char want[65], got[65];
+        copy_name(want, sizeof want, (const char*)sqlite3_column_text(st, 1));
+        sp_sha256_hex(src, n, got);
+        void* buf = malloc(n ? n : 1);
+        if (!buf) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        else if (strcmp(want, got) != 0) {
+            free(buf);
+            r = sp_fail(err, SP_ERR_PARSE, "%s: part '%s': stored glTF does not match its checksum", db->path, name);
+        } else {
+            memcpy(buf, src, n);
+            *glb = buf;
+            *size = n;
+        }
+    } else if (rc == SQLITE_DONE) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
+    } else {
+        r = db_fail(db, rc, "reading a part", err);
+    }
+    sqlite3_finalize(st);
+    return r;
+}
+
+sp_result sp_db_load_part(sp_db* db, const char* name, sp_character* out, sp_error* err)
+{
+    void* glb;
+    size_t size;
+    sp_result r = sp_db_part_bytes(db, name, &glb, &size, err);
+    if (r != SP_OK) return r;
+    char what[256];
+    snprintf(what, sizeof what, "%s:%s", db->path, name);
+    r = sp_gltf_load_memory(glb, size, what, out, err);
+    free(glb);
+    return r;
+}
+
+static sp_result strings_query(sp_db* db, const char* sql, const char* arg, char*** names, int* count, sp_error* err)
+{
+    *names = NULL;
+    *count = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, sql, &st, err);
+    if (r != SP_OK) return r;
+    if (arg) sqlite3_bind_text(st, 1, arg, -1, SQLITE_TRANSIENT);
+    int rc, n = 0, cap = 0;
+    char** out = NULL;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 8;
+            char** g = realloc(out, sizeof *out * (size_t)cap);
+            if (!g) break;
+            out = g;
+        }
+        if (!(out[n] = strdup((const char*)sqlite3_column_text(st, 0)))) break;
+        ++n;
+    }
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        sp_db_free_strings(out, n);
+        return rc == SQLITE_ROW ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : db_fail(db, rc, "reading", err);
+    }
+    *names = out;
+    *count = n;
+    return SP_OK;
+}
+
+sp_result sp_db_category_parts(sp_db* db, const char* category, char*** names, int* count, sp_error* err)
+{
+    return strings_query(db, "SELECT name FROM parts WHERE category = ? ORDER BY name", category, names, count, err);
+}
+
+sp_result sp_db_categories(sp_db* db, char*** names, int* count, sp_error* err)
+{
+    return strings_query(db, "SELECT DISTINCT category FROM parts ORDER BY category", NULL, names, count, err);
+}
+
+sp_result sp_db_part_summary_json(sp_db* db, const char* name, char** json, sp_error* err)
+{
+    *json = NULL;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT summary FROM parts WHERE name = ?", &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) {
+        if (!(*json = strdup((const char*)sqlite3_column_text(st, 0)))) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    } else if (rc == SQLITE_DONE) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
+    } else {
+        r = db_fail(db, rc, "reading a part", err);
+    }
+    sqlite3_finalize(st);
+    return r;
+}

@@ -1,0 +1,260 @@
+// db_sketches.c: example sketches: stored as sketchpose-strokes JSON (or a
+// PNG's grey pixels), read back as a classifier dataset.
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "db_internal.h"
+
+const char* sp_db_source_name(sp_db_source s)
+{
+    switch (s) {
+    case SP_DB_SOURCE_SYNTHETIC: return "synthetic";
+    case SP_DB_SOURCE_CURATED: return "curated";
+    case SP_DB_SOURCE_KIOSK: return "kiosk";
+    }
+    return "curated";
+}
+
+char* db_sketch_json(const sp_sketch* s)
+{
+    db_str b = {0};
+    db_str_printf(&b, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [%.9g, %.9g], \"strokes\": [", s->canvas_w,
+                  s->canvas_h);
+    bool times = s->stroke_count > 0;
+    for (int i = 0; i < s->stroke_count; ++i)
+        if (!s->strokes[i].t) times = false;
+    for (int i = 0; i < s->stroke_count; ++i) {
+        const sp_stroke* k = &s->strokes[i];
+        db_str_printf(&b, "%s{\"points\": [", i ? ", " : "");
+        for (int j = 0; j < k->count; ++j)
+            db_str_printf(&b, "%s[%.9g, %.9g]", j ? ", " : "", k->points[j].x, k->points[j].y);
+        db_str_printf(&b, "]");
+        if (times) {
+            db_str_printf(&b, ", \"t\": [");
+            for (int j = 0; j < k->count; ++j)
+                db_str_printf(&b, "%s%.9g", j ? ", " : "", k->t[j]);
+            db_str_printf(&b, "]");
+        }
+        db_str_printf(&b, "}");
+    }
+    db_str_printf(&b, "]}");
+    if (b.oom) {
+        free(b.s);
+        return NULL;
+    }
+    return b.s;
+}
+
+sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err)
+{
+    if (smp->raster.pixels) {
+        if (smp->raster.w <= 0 || smp->raster.h <= 0) return sp_fail(err, SP_ERR_INVALID, "%s: empty image", what);
+        return SP_OK;
+    }
+    if (smp->sketch.stroke_count == 0 || sp_sketch_point_count(&smp->sketch) == 0)
+        return sp_fail(err, SP_ERR_INVALID, "%s: empty drawing (no strokes)", what);
+    if (!sp_sketch_is_valid(&smp->sketch)) return sp_fail(err, SP_ERR_INVALID, "%s: non-finite coordinates", what);
+    for (int i = 0; i < smp->sketch.stroke_count; ++i)
+        if (smp->sketch.strokes[i].count < 1) return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d is empty", what, i);
+    return SP_OK;
+}
+
+sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source, int64_t part_id, const sp_sample* smp,
+                           const sp_db_png* png, const char* by, sp_error* err)
+{
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db,
+                             "INSERT INTO sketches(category, source, part_id, strokes, raster_w, raster_h, raster, png, added_by)"
+                             " VALUES (?,?,?,?,?,?,?,?,?)",
+                             &st, err);
+    if (r != SP_OK) return r;
+    char* json = NULL;
+    sqlite3_bind_text(st, 1, category, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 2, sp_db_source_name(source), -1, SQLITE_STATIC);
+    if (part_id > 0) sqlite3_bind_int64(st, 3, part_id);
+    if (smp->raster.pixels) {
+        sqlite3_bind_int(st, 5, smp->raster.w);
+        sqlite3_bind_int(st, 6, smp->raster.h);
+        sqlite3_bind_blob64(st, 7, smp->raster.pixels, (sqlite3_uint64)smp->raster.w * (sqlite3_uint64)smp->raster.h, SQLITE_STATIC);
+        if (png && png->bytes) sqlite3_bind_blob64(st, 8, png->bytes, png->size, SQLITE_STATIC);
+    } else {
+        if (!(json = db_sketch_json(&smp->sketch))) {
+            sqlite3_finalize(st);
+            return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        }
+        sqlite3_bind_text(st, 4, json, -1, SQLITE_STATIC);
+    }
+    sqlite3_bind_text(st, 9, db_who(by), -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    free(json);
+    return rc == SQLITE_DONE ? SP_OK : db_fail(db, rc, "storing a sketch", err);
+}
+
+sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png* png, sp_db_source source, const char* by, int* added,
+                             sp_error* err)
+{
+    if (added) *added = 0;
+    // Validate everything first: a bad drawing refuses the whole set.
+    for (int i = 0; i < data->count; ++i) {
+        const sp_sample* s = &data->samples[i];
+        char what[96];
+        snprintf(what, sizeof what, "drawing %d", i);
+        if (s->label < 0 || s->label >= data->category_count) return sp_fail(err, SP_ERR_INVALID, "%s: no category", what);
+        if (!db_name_ok(data->categories[s->label]))
+            return sp_fail(err, SP_ERR_INVALID, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", data->categories[s->label]);
+        sp_result r = db_sample_ok(s, what, err);
+        if (r != SP_OK) return r;
+    }
+    if (data->count == 0) return sp_fail(err, SP_ERR_INVALID, "no drawings to add");
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    for (int i = 0; i < data->count; ++i) {
+        const sp_sample* s = &data->samples[i];
+        if ((r = db_insert_sketch(db, data->categories[s->label], source, 0, s, png ? &png[i] : NULL, by, err)) != SP_OK) {
+            db_rollback(db);
+            return r;
+        }
+        if (i == data->count / 2) DB_HOOK("sketches");
+    }
+    db_str b = {0};
+    db_str_printf(&b, "{\"source\": \"%s\", \"count\": %d, \"categories\": [", sp_db_source_name(source), data->count);
+    for (int c = 0; c < data->category_count; ++c) {
+        db_str_printf(&b, "%s", c ? ", " : "");
+        db_str_json(&b, data->categories[c]);
+    }
+    db_str_printf(&b, "]}");
+    r = b.oom ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory")
+              : db_log_row(db, by, "add-sketches", data->category_count == 1 ? data->categories[0] : NULL, b.s, err);
+    free(b.s);
+    if (r != SP_OK) {
+        db_rollback(db);
+        return r;
+    }
+    if ((r = db_commit(db, err)) == SP_OK && added) *added = data->count;
+    return r;
+}
+
+sp_result sp_db_sketch_counts(sp_db* db, char*** categories, int** counts, int* count, sp_error* err)
+{
+    *categories = NULL;
+    *counts = NULL;
+    *count = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT category, count(*) FROM sketches GROUP BY category ORDER BY category", &st, err);
+    if (r != SP_OK) return r;
+    int rc, n = 0, cap = 0;
+    char** names = NULL;
+    int* cnt = NULL;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 8;
+            char** g = realloc(names, sizeof *names * (size_t)cap);
+            if (g) names = g;
+            int* h = realloc(cnt, sizeof *cnt * (size_t)cap);
+            if (h) cnt = h;
+            if (!g || !h) break;
+        }
+        if (!(names[n] = strdup((const char*)sqlite3_column_text(st, 0)))) break;
+        cnt[n++] = sqlite3_column_int(st, 1);
+    }
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        sp_db_free_strings(names, n);
+        free(cnt);
+        return rc == SQLITE_ROW ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : db_fail(db, rc, "counting sketches", err);
+    }
+    *categories = names;
+    *counts = cnt;
+    *count = n;
+    return SP_OK;
+}
+
+static int find_cat(char** cats, int n, const char* c)
+{
+    int lo = 0, hi = n - 1;
+    while (lo <= hi) {
+        int mid = (lo + hi) / 2, k = strcmp(cats[mid], c);
+        if (k == 0) return mid;
+        if (k < 0) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    if (unused) *unused = 0;
+    // One read transaction: categories and sketches are one consistent snapshot.
+    sp_result r = db_exec(db, "BEGIN", err);
+    if (r != SP_OK) return r;
+    char** cats;
+    int ncat;
+    if ((r = sp_db_categories(db, &cats, &ncat, err)) != SP_OK) {
+        db_rollback(db);
+        return r;
+    }
+    out->categories = cats;
+    out->category_count = ncat;
+    sqlite3_stmt* st;
+    if ((r = db_prepare(db, "SELECT id, category, strokes, raster_w, raster_h, raster FROM sketches ORDER BY category, id", &st, err)) !=
+        SP_OK) {
+        db_rollback(db);
+        sp_dataset_free(out);
+        return r;
+    }
+    int rc, cap = 0;
+    int* per_cat = calloc((size_t)(ncat > 0 ? ncat : 1), sizeof(int));
+    if (!per_cat) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        int label = find_cat(cats, ncat, (const char*)sqlite3_column_text(st, 1));
+        if (label < 0) {
+            if (unused) ++*unused;
+            continue;
+        }
+        if (out->count == cap) {
+            cap = cap ? 2 * cap : 64;
+            sp_sample* g = realloc(out->samples, sizeof(sp_sample) * (size_t)cap);
+            if (!g) {
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+                break;
+            }
+            out->samples = g;
+        }
+        sp_sample* s = &out->samples[out->count];
+        memset(s, 0, sizeof *s);
+        s->label = label;
+        s->index = per_cat[label]++;
+        char what[96];
+        snprintf(what, sizeof what, "%s: sketch %lld", db->path, (long long)sqlite3_column_int64(st, 0));
+        if (sqlite3_column_type(st, 2) != SQLITE_NULL) {
+            r = sp_sketch_parse_json((const char*)sqlite3_column_text(st, 2), (size_t)sqlite3_column_bytes(st, 2), what, &s->sketch, err);
+        } else {
+            int w = sqlite3_column_int(st, 3), h = sqlite3_column_int(st, 4);
+            const void* px = sqlite3_column_blob(st, 5);
+            if (w <= 0 || h <= 0 || !px || (size_t)sqlite3_column_bytes(st, 5) != (size_t)w * (size_t)h)
+                r = sp_fail(err, SP_ERR_PARSE, "%s: raster size does not match its pixels", what);
+            else if (!(s->raster.pixels = malloc((size_t)w * (size_t)h)))
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+            else {
+                memcpy(s->raster.pixels, px, (size_t)w * (size_t)h);
+                s->raster.w = w;
+                s->raster.h = h;
+            }
+        }
+        if (r == SP_OK) ++out->count;
+        else {
+            sp_sketch_free(&s->sketch);
+            sp_raster_free(&s->raster);
+        }
+    }
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading sketches", err);
+    sqlite3_finalize(st);
+    db_rollback(db);
+    free(per_cat);
+    if (r != SP_OK) sp_dataset_free(out);
+    return r;
+}

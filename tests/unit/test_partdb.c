@@ -1,0 +1,767 @@
+// Part database tests: round trips (add, list, remove, retrain, export and
+// rebuild), a curator-added category recognised after training, crash safety
+// (SIGKILL during add-part and train, many times), two writers, read-only
+// files and a full disk, schema migrations, malformed input that must leave
+// the file untouched, and the generation counter a kiosk polls.
+//
+// The parts are fixture rigs (tests/support/fixtures.h) saved as GLB with an
+// sp_part category, so the test does not depend on assets/.
+// `test_partdb --write-parts DIR` writes them for trying the CLI by hand.
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "db_internal.h"
+#include "fixtures.h"
+#include "mini_gltf.h"
+#include "sp/partdb.h"
+#include "sp/synth.h"
+#include "test.h"
+
+// ---- helpers -----------------------------------------------------------------
+
+typedef struct fixture_part {
+    const char* name;
+    const char* category;
+    int joints;
+    bool branching;
+    uint64_t seed;
+} fixture_part;
+
+static const fixture_part k_parts[] = {
+    {"tail_a", "tail", 5, false, 1},
+    {"wings_a", "wings", 6, true, 2},
+    {"horns_a", "horns", 8, true, 5},
+    {"tail_b", "tail", 5, false, 7},
+};
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+static void write_part(const fixture_part* fp, const char* path)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = fp->joints, .branching = fp->branching, .seed = fp->seed, .rings_per_bone = 4,
+                                           .ring_vertices = 8},
+                        &rig);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_character_from_rig(&rig, &ch, &err) == SP_OK);
+    char json[128];
+    snprintf(json, sizeof json, "{\"category\": \"%s\"}", fp->category);
+    ch.part_json = strdup(json);
+    sp_result r = sp_gltf_save(&ch, NULL, path, &err);
+    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_OK);
+    sp_character_free(&ch);
+}
+
+// Fixture part i as a file in the build's tmp folder (written once).
+static const char* part_file(int i)
+{
+    static char paths[4][1024];
+    if (!paths[i][0]) {
+        char name[64];
+        snprintf(name, sizeof name, "%s.glb", k_parts[i].name);
+        snprintf(paths[i], sizeof paths[i], "%s", sp_test_tmp_path(name));
+        write_part(&k_parts[i], paths[i]);
+    }
+    return paths[i];
+}
+
+static void remove_db(const char* path)
+{
+    char side[1100];
+    unlink(path);
+    snprintf(side, sizeof side, "%s-wal", path);
+    unlink(side);
+    snprintf(side, sizeof side, "%s-shm", path);
+    unlink(side);
+}
+
+static sp_db* open_ok(const char* path, unsigned flags)
+{
+    sp_db* db = NULL;
+    sp_error err = {0};
+    sp_result r = sp_db_open(path, flags, &db, &err);
+    if (r != SP_OK) fprintf(stderr, "  open: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    return db;
+}
+
+static void add_ok(sp_db* db, int i, int synth)
+{
+    sp_error err = {0};
+    sp_db_part_info info;
+    sp_result r = sp_db_add_part_file(db, part_file(i), &(sp_db_part_desc){.name = k_parts[i].name, .synth_sketches = synth, .seed = (uint64_t)i + 1}, &info, &err);
+    if (r != SP_OK) fprintf(stderr, "  add-part: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    ENSURE(!strcmp(info.category, k_parts[i].category));
+}
+
+// Small vocabulary: training in well under a second on the test's few hundred drawings.
+static sp_db_train_desc quick_train(int folds)
+{
+    return (sp_db_train_desc){.clf = {.words = 64, .vocab_samples = 6000, .threads = 2}, .folds = folds, .by = "test"};
+}
+
+static void train_ok(sp_db* db, int folds, char** report)
+{
+    sp_error err = {0};
+    sp_db_train_desc td = quick_train(folds);
+    sp_result r = sp_db_train(db, &td, report, &err);
+    if (r != SP_OK) fprintf(stderr, "  train: %s\n", err.text);
+    ENSURE(r == SP_OK);
+}
+
+static void check_ok(sp_db* db)
+{
+    bool ok = false;
+    char* json = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_check(db, &ok, &json, &err) == SP_OK);
+    if (!ok) fprintf(stderr, "  check: %s\n", json);
+    free(json);
+    ENSURE(ok);
+}
+
+static int scalar(const char* path, const char* sql)
+{
+    sqlite3* h;
+    ENSURE(sqlite3_open_v2(path, &h, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK);
+    sqlite3_stmt* st;
+    ENSURE(sqlite3_prepare_v2(h, sql, -1, &st, NULL) == SQLITE_OK);
+    ENSURE(sqlite3_step(st) == SQLITE_ROW);
+    int v = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(h);
+    return v;
+}
+
+static void file_sha(const char* path, char hex[65])
+{
+    void* b;
+    size_t n;
+    sp_error err = {0};
+    ENSURE(db_read_file(path, &b, &n, &err) == SP_OK);
+    sp_sha256_hex(b, n, hex);
+    free(b);
+}
+
+// A database with tail_a and wings_a (30 synthetic sketches each), trained.
+static const char* base_db(const char* name)
+{
+    const char* path = sp_test_tmp_path(name);
+    remove_db(path);
+    sp_db* db = open_ok(path, SP_DB_CREATE);
+    add_ok(db, 0, 30);
+    add_ok(db, 1, 30);
+    train_ok(db, -1, NULL);
+    sp_db_close(db);
+    return path;
+}
+
+static const char* sketchpose_bin(void)
+{
+    static char b[1024];
+    snprintf(b, sizeof b, "%s/app/sketchpose", SP_BINARY_DIR);
+    return access(b, X_OK) == 0 ? b : NULL;
+}
+
+// ---- tests ---------------------------------------------------------------------------
+
+static void test_sha256(void)
+{
+    char h[65];
+    sp_sha256_hex("", 0, h);
+    ENSURE(!strcmp(h, "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"));
+    sp_sha256_hex("abc", 3, h);
+    ENSURE(!strcmp(h, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"));
+    const char* m = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"; // 56 bytes: two padding blocks
+    sp_sha256_hex(m, strlen(m), h);
+    ENSURE(!strcmp(h, "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"));
+}
+
+static void test_round_trip(void)
+{
+    const char* path = sp_test_tmp_path("rt.db");
+    char p[1024];
+    snprintf(p, sizeof p, "%s", path);
+    remove_db(p);
+    sp_error err = {0};
+    sp_db* db = NULL;
+    ENSURE(sp_db_open(p, 0, &db, &err) == SP_ERR_IO && strstr(err.text, "no such database")); // no CREATE
+    db = open_ok(p, SP_DB_CREATE);
+    ENSURE(sp_db_schema_version(db) == SP_DB_SCHEMA_VERSION);
+    add_ok(db, 0, 20);
+    add_ok(db, 1, 20);
+    // A name that exists is refused.
+    err = (sp_error){0};
+    ENSURE(sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "tail_a", .synth_sketches = -1}, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "exists"));
+    sp_db_part_info* parts;
+    int n;
+    ENSURE(sp_db_list_parts(db, &parts, &n, &err) == SP_OK && n == 2);
+    fprintf(stderr, "  %s %s %d sketches, %d vertices, self-test %.4f\n", parts[0].name, parts[0].category, parts[0].sketches, parts[0].vertices, parts[0].selftest_error);
+    ENSURE(!strcmp(parts[0].name, "tail_a") && !strcmp(parts[0].category, "tail") && parts[0].sketches == 20);
+    ENSURE(parts[0].vertices > 0 && parts[0].parameters > 0 && parts[0].selftest_error >= 0 && parts[0].selftest_error <= 0.02);
+    free(parts);
+    // Curated sketches: strokes of a wings pose, stored and read back.
+    sp_dataset ds = {0};
+    sp_character ch = {0};
+    ENSURE(sp_db_load_part(db, "wings_a", &ch, &err) == SP_OK);
+    ENSURE(db_synth_sketches(&ch, 0, 5, 77, 0, &ds, &err) == SP_OK);
+    free(ds.categories[0]);
+    ds.categories[0] = strdup("wings");
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", &n, &err) == SP_OK && n == 5);
+    sp_dataset_free(&ds);
+    sp_character_free(&ch);
+    ENSURE(sp_db_load_dataset(db, &ds, NULL, &err) == SP_OK);
+    ENSURE(ds.count == 45 && ds.category_count == 2 && !strcmp(ds.categories[1], "wings"));
+    sp_dataset_free(&ds);
+    // No model yet: check says so.
+    bool ok = true;
+    ENSURE(sp_db_check(db, &ok, NULL, &err) == SP_OK && !ok);
+    char* report = NULL;
+    train_ok(db, 2, &report);
+    ENSURE(strstr(report, "\"per_class\"") && strstr(report, "\"top1\""));
+    free(report);
+    check_ok(db);
+    // Remove: its synthetic sketches go, the model no longer matches, retrain fixes it.
+    ENSURE(sp_db_remove_part(db, "tail_a", "test", &err) == SP_OK);
+    ENSURE(sp_db_remove_part(db, "tail_a", "test", &err) == SP_ERR_INVALID && strstr(err.text, "no part named"));
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == 25);
+    ENSURE(sp_db_check(db, &ok, NULL, &err) == SP_OK && !ok);
+    train_ok(db, -1, NULL);
+    check_ok(db);
+    sp_clf* clf;
+    ENSURE(sp_db_load_model(db, &clf, NULL, &err) == SP_OK);
+    ENSURE(sp_clf_category_count(clf) == 1 && !strcmp(sp_clf_category(clf, 0), "wings"));
+    sp_clf_free(clf);
+    add_ok(db, 0, 20);
+    train_ok(db, -1, NULL);
+    check_ok(db);
+    // The log is append-only.
+    ENSURE(sqlite3_exec(((struct sp_db*)db)->h, "DELETE FROM log", NULL, NULL, NULL) != SQLITE_OK);
+    char* log;
+    ENSURE(sp_db_log_json(db, NULL, &log, &err) == SP_OK);
+    ENSURE(strstr(log, "remove-part") && strstr(log, "add-part") && strstr(log, "train") && strstr(log, "add-sketches"));
+    free(log);
+    // Export and rebuild: the same parts, sketches and a model that matches.
+    char dir[1024], p2[1024];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("export"));
+    snprintf(p2, sizeof p2, "%s", sp_test_tmp_path("rebuilt.db"));
+    ENSURE(system("true") == 0);
+    char cmd[2200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ENSURE(system(cmd) == 0);
+    remove_db(p2);
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
+    sp_db_close(db);
+    sp_db_train_desc td = quick_train(-1);
+    sp_result r = sp_db_create_from_export(p2, dir, &td, "test", &err);
+    if (r != SP_OK) fprintf(stderr, "  rebuild: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    ENSURE(scalar(p2, "SELECT count(*) FROM parts") == 2);
+    ENSURE(scalar(p2, "SELECT count(*) FROM sketches") == scalar(p, "SELECT count(*) FROM sketches"));
+    ENSURE(scalar(p2, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 5);
+    ENSURE(scalar(p2, "SELECT count(*) FROM sketches WHERE part_id IS NOT NULL") == 40);
+    ENSURE(scalar(p2, "SELECT count(*) FROM parts a WHERE sha256 = 'x'") == 0);
+    db = open_ok(p2, 0);
+    check_ok(db);
+    sp_db_close(db);
+    // Existing targets are never overwritten.
+    ENSURE(sp_db_create_from_export(p2, dir, NULL, "test", &err) == SP_ERR_INVALID && strstr(err.text, "exists"));
+}
+
+static void test_curator_category(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("cur.db"));
+    sp_db* db = open_ok(p, 0);
+    sp_error err = {0};
+    add_ok(db, 2, 60); // horns: a category the model has never seen
+    bool ok = true;
+    ENSURE(sp_db_check(db, &ok, NULL, &err) == SP_OK && !ok);
+    train_ok(db, -1, NULL);
+    check_ok(db);
+    sp_clf* clf;
+    ENSURE(sp_db_load_model(db, &clf, NULL, &err) == SP_OK);
+    sp_character ch = {0};
+    ENSURE(sp_db_load_part(db, "horns_a", &ch, &err) == SP_OK);
+    int right = 0, n = 30;
+    for (int i = 0; i < n; ++i) { // fresh poses, never stored
+        double* q = malloc(sizeof(double) * (size_t)ch.rig.param_count);
+        sp_synth_params(&ch.rig, 900 + (uint64_t)i, 0.4, q);
+        sp_sketch sk = {0};
+        ENSURE(sp_synth_sketch(&ch.rig, 0, &ch.camera, q, &sk) == SP_OK);
+        sp_clf_answer a;
+        ENSURE(sp_clf_classify(clf, &sk, NULL, &a, &err) == SP_OK);
+        right += a.count > 0 && !strcmp(sp_clf_category(clf, a.ranked[0].category), "horns");
+        if (getenv("SP_VERBOSE")) fprintf(stderr, "  -> %s %.2f rejected %d\n", a.count ? sp_clf_category(clf, a.ranked[0].category) : "-", a.count ? a.ranked[0].score : 0, a.rejected);
+        sp_sketch_free(&sk);
+        free(q);
+    }
+    fprintf(stderr, "  horns recognised %d/%d after train\n", right, n);
+    ENSURE(right >= 21); // 70%; chance is 33%
+    sp_character_free(&ch);
+    sp_clf_free(clf);
+    sp_db_close(db);
+}
+
+// ---- crash safety ------------------------------------------------------------------------
+
+static int g_hook_ms = 0;
+static void sleep_hook(const char* point)
+{
+    (void)point;
+    usleep((useconds_t)g_hook_ms * 1000);
+}
+
+typedef enum { OP_ADD_PART, OP_TRAIN } crash_op;
+
+static void run_op(const char* path, crash_op op)
+{
+    sp_db* db = NULL;
+    sp_error err = {0};
+    if (sp_db_open(path, 0, &db, &err) != SP_OK) _exit(3);
+    sp_result r;
+    if (op == OP_ADD_PART) {
+        r = sp_db_add_part_file(db, part_file(3), &(sp_db_part_desc){.name = "tail_b", .synth_sketches = 30, .selftest_seeds = 1}, NULL, &err);
+    } else {
+        sp_db_train_desc td = quick_train(-1);
+        r = sp_db_train(db, &td, NULL, &err);
+    }
+    sp_db_close(db);
+    if (r != SP_OK) fprintf(stderr, "  child: %s\n", err.text);
+    _exit(r == SP_OK ? 0 : 4);
+}
+
+static void crash_loop(crash_op op, int runs, uint64_t seed)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db(op == OP_ADD_PART ? "crash_add.db" : "crash_train.db"));
+    part_file(3);
+    // One uninterrupted run measures how long the operation takes (hook included).
+    g_hook_ms = 15;
+    int parts0 = scalar(p, "SELECT count(*) FROM parts"), sk0 = scalar(p, "SELECT count(*) FROM sketches");
+    double t0 = now_ms();
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        sp_db_test_hook = sleep_hook;
+        run_op(p, op);
+    }
+    int status;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    double span = now_ms() - t0;
+    sp_error err = {0};
+    if (op == OP_ADD_PART) {
+        sp_db* db = open_ok(p, 0);
+        ENSURE(sp_db_remove_part(db, "tail_b", "test", &err) == SP_OK);
+        sp_db_close(db);
+    }
+    sp_test_rng rng = {seed};
+    int olds = 0, news = 0;
+    for (int k = 0; k < runs; ++k) {
+        int models = scalar(p, "SELECT count(*) FROM models");
+        double at = sp_test_range(&rng, 0.0, 1.1 * span);
+        pid = fork();
+        ENSURE(pid >= 0);
+        if (pid == 0) {
+            sp_db_test_hook = sleep_hook;
+            run_op(p, op);
+        }
+        usleep((useconds_t)(at * 1000));
+        kill(pid, SIGKILL);
+        ENSURE(waitpid(pid, &status, 0) == pid);
+        // After the kill: integrity holds and the state is the old or the new one.
+        sp_db* db = open_ok(p, 0);
+        check_ok(db);
+        sp_db_close(db);
+        int parts = scalar(p, "SELECT count(*) FROM parts"), sk = scalar(p, "SELECT count(*) FROM sketches");
+        if (op == OP_ADD_PART) {
+            bool old = parts == parts0 && sk == sk0, nu = parts == parts0 + 1 && sk == sk0 + 30;
+            if (!old && !nu) fprintf(stderr, "  mixed state: %d parts, %d sketches\n", parts, sk);
+            ENSURE(old || nu);
+            olds += old;
+            news += nu;
+            if (nu) {
+                db = open_ok(p, 0);
+                ENSURE(sp_db_remove_part(db, "tail_b", "test", &err) == SP_OK);
+                sp_db_close(db);
+            }
+        } else {
+            int m = scalar(p, "SELECT count(*) FROM models");
+            ENSURE(m == models || m == models + 1);
+            ENSURE(scalar(p, "SELECT count(*) FROM log WHERE action = 'train'") == m); // model and its log row together
+            olds += m == models;
+            news += m == models + 1;
+        }
+    }
+    fprintf(stderr, "  %s: %d kills over %.0f ms: %d old, %d new, never mixed\n", op == OP_ADD_PART ? "add-part" : "train", runs, span,
+            olds, news);
+}
+
+static void test_crash_add_part(void) { crash_loop(OP_ADD_PART, 30, 12345); }
+static void test_crash_train(void) { crash_loop(OP_TRAIN, 30, 777); }
+
+// ---- concurrency, permissions, full disk ----------------------------------------------------
+
+static sp_dataset one_sketch(const char* cat)
+{
+    sp_dataset ds = {0};
+    sp_dataset_add_category(&ds, cat);
+    ds.samples = calloc(1, sizeof(sp_sample));
+    sp_vec2 pts[3] = {{10, 10}, {50, 80}, {90, 20}};
+    sp_sketch_add_stroke(&ds.samples[0].sketch, pts, NULL, 3);
+    ds.samples[0].sketch.canvas_w = ds.samples[0].sketch.canvas_h = 100;
+    ds.count = 1;
+    return ds;
+}
+
+static void test_two_writers(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("busy.db"));
+    remove_db(p);
+    sp_db_close(open_ok(p, SP_DB_CREATE));
+    // Another writer holds the lock: we wait our timeout, then fail with the message.
+    sqlite3* other;
+    ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
+    ENSURE(sqlite3_exec(other, "BEGIN IMMEDIATE; INSERT INTO log(by, action) VALUES ('other', 'hold')", NULL, NULL, NULL) == SQLITE_OK);
+    sp_db* db = open_ok(p, 0);
+    sp_db_set_busy_timeout(db, 300);
+    sp_dataset ds = one_sketch("tail");
+    sp_error err = {0};
+    double t0 = now_ms();
+    sp_result r = sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err);
+    double waited = now_ms() - t0;
+    fprintf(stderr, "  busy after %.0f ms: %s\n", waited, err.text);
+    ENSURE(r == SP_ERR_BUSY);
+    ENSURE(strstr(err.text, "database is busy (held by another writer for more than 0.3 s)"));
+    ENSURE(waited >= 250 && waited < 2000);
+    sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
+    sqlite3_close(other);
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err) == SP_OK);
+    sp_db_close(db);
+    // Two processes writing at once are serialised: every write lands.
+    pid_t kids[2];
+    for (int k = 0; k < 2; ++k) {
+        kids[k] = fork();
+        ENSURE(kids[k] >= 0);
+        if (kids[k] == 0) {
+            sp_db* d = NULL;
+            sp_error e = {0};
+            if (sp_db_open(p, 0, &d, &e) != SP_OK) _exit(3);
+            for (int i = 0; i < 25; ++i)
+                if (sp_db_add_sketches(d, &ds, NULL, SP_DB_SOURCE_CURATED, k ? "b" : "a", NULL, &e) != SP_OK) _exit(4);
+            sp_db_close(d);
+            _exit(0);
+        }
+    }
+    for (int k = 0; k < 2; ++k) {
+        int st;
+        ENSURE(waitpid(kids[k], &st, 0) == kids[k] && WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    }
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == 51);
+    sp_dataset_free(&ds);
+}
+
+static void test_read_only_and_full(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("ro.db"));
+    char before[65], after[65];
+    file_sha(p, before);
+    // Opened read-only: reads work, writes are refused clearly.
+    sp_db* db = open_ok(p, SP_DB_READONLY);
+    sp_error err = {0};
+    sp_dataset ds = one_sketch("tail");
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err) == SP_ERR_IO);
+    ENSURE(strstr(err.text, "read-only"));
+    check_ok(db);
+    sp_db_close(db);
+    // A file the user may not write (a non-root child, as root ignores permissions).
+    ENSURE(chmod(p, 0444) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
+        sp_db* d = NULL;
+        sp_error e = {0};
+        sp_result r = sp_db_open(p, 0, &d, &e);
+        fprintf(stderr, "  read-only file: %s\n", e.text);
+        _exit(r == SP_ERR_IO && strstr(e.text, "read-only") ? 0 : 6);
+    }
+    int st;
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+    ENSURE(WEXITSTATUS(st) == 0);
+    ENSURE(chmod(p, 0644) == 0);
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+    // Full disk: a child whose files may not grow past their size now.
+    struct stat fs;
+    ENSURE(stat(p, &fs) == 0);
+    pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        sp_db* d = NULL;
+        sp_error e = {0};
+        if (sp_db_open(p, 0, &d, &e) != SP_OK) _exit(3);
+        struct rlimit rl = {(rlim_t)fs.st_size, (rlim_t)fs.st_size};
+        setrlimit(RLIMIT_FSIZE, &rl);
+        sp_result r = sp_db_add_part_file(d, part_file(2), &(sp_db_part_desc){.synth_sketches = 200, .selftest_seeds = -1}, NULL, &e);
+        fprintf(stderr, "  disk full: %s\n", e.text);
+        sp_db_close(d);
+        _exit(r == SP_ERR_IO ? 0 : 6);
+    }
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    db = open_ok(p, 0);
+    check_ok(db);
+    sp_db_close(db);
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 2);
+    sp_dataset_free(&ds);
+}
+
+static void test_schema_versions(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("schema.db"));
+    sp_error err = {0};
+    // Newer: refused, untouched.
+    sqlite3* h;
+    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
+    ENSURE(sqlite3_exec(h, "PRAGMA user_version = 99", NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(h);
+    char before[65], after[65];
+    file_sha(p, before);
+    sp_db* db = NULL;
+    ENSURE(sp_db_open(p, 0, &db, &err) == SP_ERR_UNSUPPORTED);
+    fprintf(stderr, "  newer: %s\n", err.text);
+    ENSURE(strstr(err.text, "newer") && strstr(err.text, "99"));
+    ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED);
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+    // Older (version 1: no generation counter): read-only refuses, writable migrates and keeps the data.
+    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
+    ENSURE(sqlite3_exec(h,
+                        "DROP TRIGGER gen_parts_ins; DROP TRIGGER gen_parts_del; DROP TRIGGER gen_sketches_ins; DROP TRIGGER gen_sketches_del;"
+                        "DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta; PRAGMA user_version = 1",
+                        NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(h);
+    ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED && strstr(err.text, "older"));
+    db = open_ok(p, 0);
+    ENSURE(sp_db_schema_version(db) == SP_DB_SCHEMA_VERSION);
+    uint64_t g = sp_db_generation(db);
+    ENSURE(g >= 1);
+    check_ok(db);
+    add_ok(db, 3, 5);
+    ENSURE(sp_db_generation(db) > g);
+    sp_db_close(db);
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 3);
+    // Not a database / someone else's database.
+    char q[1024];
+    snprintf(q, sizeof q, "%s", sp_test_tmp_path("notdb.db"));
+    ENSURE(db_write_file(q, "hello, this is not sqlite at all..............................................................", 90, &err) ==
+           SP_OK);
+    ENSURE(sp_db_open(q, 0, &db, &err) != SP_OK);
+    fprintf(stderr, "  not a database: %s\n", err.text);
+    remove_db(q);
+    ENSURE(sqlite3_open(q, &h) == SQLITE_OK);
+    ENSURE(sqlite3_exec(h, "CREATE TABLE foo(x)", NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(h);
+    ENSURE(sp_db_open(q, 0, &db, &err) == SP_ERR_INVALID && strstr(err.text, "not a sketchpose database"));
+}
+
+static void test_bad_input(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("bad.db"));
+    char before[65], after[65];
+    file_sha(p, before);
+    sp_db* db = open_ok(p, 0);
+    struct {
+        const char* name;
+        mini_desc d;
+    } cases[] = {
+        {"b_accessor.gltf", {.pos_accessor = 42}}, {"b_past_end.gltf", {.pos_count = 100}}, {"b_missing_bin.gltf", {.uri = "missing.bin"}},
+        {"b_empty_skin.gltf", {.empty_skin = true}}, {"b_cycle.gltf", {.cycle = true}},       {"b_nan.gltf", {.nan_position = true}},
+        {"b_zero_weights.gltf", {.zero_weights = true}}, {"b_bad_joint.gltf", {.bad_joint = 5}}, {"b_bad_dofs.gltf", {.bad_dofs = true}},
+        {"b_no_category.gltf", {0}}, // loads, but has no category
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        const char* f = sp_test_tmp_path(cases[i].name);
+        char* text = mini_gltf(&cases[i].d);
+        ENSURE(mini_write(f, text, strlen(text)));
+        free(text);
+        sp_error err = {0};
+        sp_result r = sp_db_add_part_file(db, f, NULL, NULL, &err);
+        fprintf(stderr, "  %-22s -> %s\n", cases[i].name, err.text);
+        ENSURE(r != SP_OK && err.text[0]);
+    }
+    // Garbage and truncated GLBs straight into sp_db_add_part.
+    void* glb;
+    size_t n;
+    sp_error err = {0};
+    ENSURE(db_read_file(part_file(0), &glb, &n, &err) == SP_OK);
+    size_t cuts[] = {0, 11, 20, n / 2, n - 1};
+    for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; ++i) {
+        err = (sp_error){0};
+        ENSURE(sp_db_add_part(db, glb, cuts[i], &(sp_db_part_desc){.name = "cut"}, NULL, &err) != SP_OK && err.text[0]);
+    }
+    memset((char*)glb + 20, 'x', 40);
+    ENSURE(sp_db_add_part(db, glb, n, &(sp_db_part_desc){.name = "garbled"}, NULL, &err) != SP_OK);
+    free(glb);
+    // An unfittable or badly named part.
+    ENSURE(sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "../evil"}, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "x", .category = "a b"}, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "x", .abstraction = "nope"}, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "no sketch abstraction named nope"));
+    // Bad drawings refuse the whole set.
+    sp_dataset ds = one_sketch("tail");
+    ds.samples[0].sketch.strokes[0].points[1].x = NAN;
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "t", NULL, &err) == SP_ERR_INVALID);
+    sp_dataset_free(&ds);
+    ds = one_sketch("no/slash");
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "t", NULL, &err) == SP_ERR_INVALID);
+    sp_dataset_free(&ds);
+    sp_db_close(db);
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+    // The same through the command line, sketches included.
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    struct {
+        const char* name;
+        const char* text;
+    } sk[] = {
+        {"s_empty.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [100, 100], \"strokes\": []}"},
+        {"s_trunc.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], [3"},
+        {"s_nan.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": [[1, 2], [NaN, 3]]}]}"},
+        {"s_version.json", "{\"format\": \"sketchpose-strokes\", \"version\": 7, \"canvas\": [9, 9], \"strokes\": [{\"points\": [[1, 2], [2, 3]]}]}"},
+        {"s_bad.svg", "<svg><path d=\"M 10 10 L zz\"/></svg>"},
+        {"s_notpng.png", "this is not a png"},
+        {"s_bad.ndjson", "{\"word\": \"cat\", \"drawing\": [[[1, 2], [3]]]}\n"},
+        {"s_unknown.txt", "hello"},
+    };
+    for (size_t i = 0; i < sizeof sk / sizeof sk[0]; ++i) {
+        const char* f = sp_test_tmp_path(sk[i].name);
+        ENSURE(db_write_file(f, sk[i].text, strlen(sk[i].text), &err) == SP_OK);
+        char cmd[4096];
+        snprintf(cmd, sizeof cmd, "'%s' db add-sketch --db '%s' --category tail '%s' 2>&1 >/dev/null", bin, p, f);
+        FILE* pp = popen(cmd, "r");
+        char line[600] = "";
+        if (!fgets(line, sizeof line, pp)) line[0] = 0;
+        int st = pclose(pp);
+        fprintf(stderr, "  %-15s -> exit %d: %s", sk[i].name, WEXITSTATUS(st), line);
+        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && strstr(line, "sketchpose db add-sketch: "));
+    }
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' 2>/dev/null >/dev/null", bin, p, sp_test_tmp_path("b_cycle.gltf"));
+    int st = system(cmd);
+    ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1);
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+}
+
+static void test_generation(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("gen.db"));
+    sp_db* reader = open_ok(p, SP_DB_READONLY);
+    sp_db* writer = open_ok(p, 0);
+    uint64_t g0 = sp_db_generation(reader);
+    ENSURE(g0 > 0 && sp_db_generation(reader) == g0);
+    // A cheap poll: a thousand calls with nothing changed.
+    double t0 = now_ms();
+    for (int i = 0; i < 1000; ++i)
+        ENSURE(sp_db_generation(reader) == g0);
+    double per = (now_ms() - t0) / 1000;
+    fprintf(stderr, "  sp_db_generation: %.2f us per unchanged poll\n", per * 1000);
+    int64_t id0 = 0, id1 = 0;
+    sp_clf* clf;
+    sp_error err = {0};
+    ENSURE(sp_db_load_model(reader, &clf, &id0, &err) == SP_OK);
+    sp_clf_free(clf);
+    train_ok(writer, -1, NULL);
+    uint64_t g1 = sp_db_generation(reader);
+    ENSURE(g1 > g0);
+    ENSURE(sp_db_generation(writer) == g1);
+    ENSURE(sp_db_load_model(reader, &clf, &id1, &err) == SP_OK && id1 > id0);
+    sp_clf_free(clf);
+    ENSURE(sp_db_remove_part(writer, "wings_a", "t", &err) == SP_OK);
+    ENSURE(sp_db_generation(reader) > g1);
+    sp_db_close(writer);
+    sp_db_close(reader);
+}
+
+static void test_default_db(void)
+{
+    // The default database from an assets folder of fixture parts.
+    char dir[1024], p[1024], cmd[2200];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("assets"));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
+    ENSURE(system(cmd) == 0);
+    for (int i = 0; i < 3; ++i) {
+        char f[1100];
+        snprintf(f, sizeof f, "%s/%s.glb", dir, k_parts[i].name);
+        write_part(&k_parts[i], f);
+    }
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("default.db"));
+    remove_db(p);
+    sp_db* db = NULL;
+    sp_error err = {0};
+    sp_db_default_desc dd = {.synth_per_part = 20, .train = quick_train(-1)};
+    double t0 = now_ms();
+    sp_result r = sp_db_create_default(p, dir, &dd, &err);
+    if (r != SP_OK) fprintf(stderr, "  default: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    fprintf(stderr, "  default database of 3 parts x 20 sketches in %.0f ms\n", now_ms() - t0);
+    ENSURE(sp_db_open_or_create_default(p, dir, SP_DB_READONLY, &db, &err) == SP_OK);
+    check_ok(db);
+    char** cats;
+    int n;
+    ENSURE(sp_db_categories(db, &cats, &n, &err) == SP_OK && n == 3);
+    sp_db_free_strings(cats, n);
+    sp_db_close(db);
+    ENSURE(sp_db_create_default(p, dir, &dd, &err) == SP_ERR_INVALID);
+}
+
+int main(int argc, char** argv)
+{
+    if (argc == 3 && !strcmp(argv[1], "--write-parts")) {
+        for (int i = 0; i < 4; ++i) {
+            char f[1100];
+            snprintf(f, sizeof f, "%s/%s.glb", argv[2], k_parts[i].name);
+            write_part(&k_parts[i], f);
+        }
+        return 0;
+    }
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"sha256", test_sha256},
+                                   {"round_trip", test_round_trip},
+                                   {"curator_category", test_curator_category},
+                                   {"crash_add_part", test_crash_add_part},
+                                   {"crash_train", test_crash_train},
+                                   {"two_writers", test_two_writers},
+                                   {"read_only_and_full", test_read_only_and_full},
+                                   {"schema_versions", test_schema_versions},
+                                   {"bad_input", test_bad_input},
+                                   {"generation", test_generation},
+                                   {"default_db", test_default_db},
+                                   {0}});
+}
