@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "plugin_rig.h"
 #include "sp/gltf.h"
 
 static cJSON* inspect_json(const sp_character* ch)
@@ -71,11 +72,12 @@ static cJSON* inspect_json(const sp_character* ch)
 int cmd_inspect(int argc, char** argv)
 {
     const char* rig_path = NULL;
-    sp_opt opts[] = {{"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true}};
+    sp_opt opts[] = {{"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true}};
     int rc = sp_cli_parse(argc, argv, "sketchpose inspect",
                           "Print a rig's joints, parameters, abstractions, animations and load warnings as JSON.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (sp_is_plugin_path(rig_path)) return sp_plugin_inspect(rig_path);
     sp_character ch = {0};
     sp_error err = {0};
     if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) {

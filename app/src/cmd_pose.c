@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "cli.h"
+#include "plugin_rig.h"
 #include "pose_io.h"
 #include "posing.h"
 #include "report.h"
@@ -16,7 +17,7 @@ int cmd_pose(int argc, char** argv)
     const char *rig_path = NULL, *abs_name = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *start = NULL;
     sp_solve_desc desc = {0};
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
         {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the strokes (sketchpose-strokes JSON)", true},
         {"--start", SP_OPT_STRING, &start, "p.json", "start pose (default: the rig's stored pose)", false},
@@ -33,6 +34,7 @@ int cmd_pose(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, "sketchpose pose", "Redraw posing: fits the rig's abstraction to the strokes.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (sp_is_plugin_path(rig_path)) return sp_plugin_pose(rig_path, abs_name, strokes, start, out, render, report, &desc);
     sp_character ch = {0};
     sp_error err = {0};
     sp_sketch sk = {0};

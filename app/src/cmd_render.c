@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "headless.h"
 #include "image.h"
+#include "plugin_rig.h"
 #include "pose_io.h"
 #include "render.h"
 #include "sp/gltf.h"
@@ -54,7 +55,7 @@ int cmd_render(int argc, char** argv)
     double line_width = 0, yaw = 0, pitch = 0;
     bool no_shadow = false;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
         {"--pose", SP_OPT_STRING, &pose_path, "p.json", "pose file {\"parameters\": {...}} (default: the rig's stored pose)",
          false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "abstraction to overlay (default: the first; 'none': no overlay)",
@@ -83,7 +84,9 @@ int cmd_render(int argc, char** argv)
 
     sp_error err = {0};
     sp_character ch = {0};
-    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) {
+    // A plugin comes baked at the pose (a static character with no parameters).
+    bool plugin = sp_is_plugin_path(rig_path);
+    if (plugin ? sp_plugin_load_posed(rig_path, pose_path, &ch, &err) != SP_OK : sp_gltf_load(rig_path, &ch, &err) != SP_OK) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         return SP_EXIT_INPUT;
     }
@@ -124,7 +127,7 @@ int cmd_render(int argc, char** argv)
     }
     // Parameters the pose file does not list keep the stored pose.
     memcpy(p, ch.pose, sizeof(double) * (size_t)rig->param_count);
-    if (pose_path && sp_pose_read(pose_path, rig, p, NULL, &err) != SP_OK) {
+    if (pose_path && !plugin && sp_pose_read(pose_path, rig, p, NULL, &err) != SP_OK) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         goto done;
     }

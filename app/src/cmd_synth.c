@@ -1,36 +1,218 @@
-// sketchpose synth: strokes of a random pose within bounds (tests, training).
+// sketchpose synth: strokes of a random pose within bounds (tests, training);
+// with --style, passed through the hand-drawing model; with --parts DIR, a
+// labelled folder of hand-drawn sketches of every part in DIR.
+#include <cjson/cJSON.h>
+#include <dirent.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
+#include "plugin_rig.h"
 #include "pose_io.h"
 #include "posing.h"
 #include "sp/gltf.h"
+#include "sp/handdraw.h"
 #include "sp/sketch_io.h"
 #include "sp/synth.h"
+
+static bool has_opt(int argc, char** argv, const char* name)
+{
+    for (int i = 1; i < argc; ++i)
+        if (!strcmp(argv[i], name)) return true;
+    return false;
+}
+
+static int cmp_str(const void* a, const void* b)
+{
+    return strcmp(*(char* const*)a, *(char* const*)b);
+}
+
+// The part's extras.sp_part string field `key` into buf, or false.
+static bool part_field(const sp_character* ch, const char* key, char* buf, size_t cap)
+{
+    cJSON* j = ch->part_json ? cJSON_Parse(ch->part_json) : NULL;
+    const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, key);
+    bool ok = cJSON_IsString(v) && v->valuestring && v->valuestring[0] && strlen(v->valuestring) < cap;
+    if (ok) snprintf(buf, cap, "%s", v->valuestring);
+    cJSON_Delete(j);
+    return ok;
+}
+
+static bool make_dir(const char* path, sp_error* err)
+{
+    if (mkdir(path, 0777) == 0 || errno == EEXIST) {
+        struct stat st;
+        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return true;
+    }
+    sp_fail(err, SP_ERR_IO, "%s: cannot create the folder (%s)", path, strerror(errno == EEXIST ? ENOTDIR : errno));
+    return false;
+}
+
+static void json_str(const char* s)
+{
+    putchar('"');
+    for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
+        if (*p == '"' || *p == '\\') printf("\\%c", *p);
+        else if (*p < 0x20) printf("\\u%04x", *p);
+        else putchar(*p);
+    }
+    putchar('"');
+}
+
+// --parts DIR: every .glb/.gltf part of DIR (category from extras.sp_part),
+// `per_part` hand-drawn sketches each, into OUT/<category>/<part>-<style>-<family>-<i>.json.
+static int synth_parts(const char* dir, const char* abs_name, int per_part, uint64_t family, sp_handdraw_style style, double amplitude,
+                       const char* out_dir)
+{
+    sp_error err = {0};
+    DIR* d = opendir(dir);
+    if (!d) {
+        fprintf(stderr, "sketchpose synth: %s: cannot open the parts folder (%s)\n", dir, strerror(errno));
+        return SP_EXIT_INPUT;
+    }
+    char** names = NULL;
+    int n = 0, cap = 0;
+    for (struct dirent* e; (e = readdir(d));) {
+        size_t l = strlen(e->d_name);
+        bool glb = l > 4 && !strcmp(e->d_name + l - 4, ".glb"), gltf = l > 5 && !strcmp(e->d_name + l - 5, ".gltf");
+        if (!glb && !gltf) continue;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            char** g = realloc(names, sizeof *g * (size_t)cap);
+            if (!g) break;
+            names = g;
+        }
+        if (!(names[n] = strdup(e->d_name))) break;
+        ++n;
+    }
+    closedir(d);
+    int code = SP_EXIT_INPUT;
+    if (n == 0) {
+        fprintf(stderr, "sketchpose synth: %s: no .glb or .gltf parts in the folder\n", dir);
+        free(names);
+        return SP_EXIT_INPUT;
+    }
+    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    if (!make_dir(out_dir, &err)) goto fail;
+    sp_handdraw_desc desc = {.style = style, .amplitude = amplitude};
+    int total = 0;
+    printf("{\"out_dir\": ");
+    json_str(out_dir);
+    printf(", \"style\": \"%s\", \"seed\": %llu, \"parts\": [", sp_handdraw_style_name(style), (unsigned long long)family);
+    for (int k = 0; k < n; ++k) {
+        char path[4096], stem[256], category[SP_NAME_MAX], want[SP_NAME_MAX];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        snprintf(stem, sizeof stem, "%s", names[k]);
+        *strrchr(stem, '.') = 0;
+        sp_character ch = {0};
+        if (sp_gltf_load(path, &ch, &err) != SP_OK) goto fail_open;
+        if (!part_field(&ch, "category", category, sizeof category)) {
+            sp_fail(&err, SP_ERR_INVALID, "%s: no extras.sp_part.category (every part in --parts needs one)", path);
+            sp_character_free(&ch);
+            goto fail_open;
+        }
+        // The abstraction: --abstraction, else the part's own choice, else its outline, else the first.
+        const char* an = abs_name;
+        if (!an && part_field(&ch, "abstraction", want, sizeof want)) an = want;
+        if (!an && sp_rig_find_abstraction(&ch.rig, "outline") >= 0) an = "outline";
+        int a = sp_pick_abstraction(&ch, path, an, &err);
+        char cdir[4096];
+        snprintf(cdir, sizeof cdir, "%s/%s", out_dir, category);
+        if (a < 0 || !make_dir(cdir, &err)) {
+            sp_character_free(&ch);
+            goto fail_open;
+        }
+        uint64_t pf = sp_handdraw_part_family(family, stem);
+        for (int i = 0; i < per_part; ++i) {
+            sp_sketch sk = {0};
+            if (sp_handdraw_part(&ch.rig, a, &ch.camera, &desc, sp_handdraw_seed(pf, i), &sk, NULL, &err) != SP_OK) {
+                sp_character_free(&ch);
+                goto fail_open;
+            }
+            char file[4400];
+            snprintf(file, sizeof file, "%s/%s-%s-s%llu-%04d.json", cdir, stem, sp_handdraw_style_name(style), (unsigned long long)family, i);
+            sp_result r = sp_sketch_write_json(file, &sk, &err);
+            sp_sketch_free(&sk);
+            if (r != SP_OK) {
+                sp_character_free(&ch);
+                goto fail_open;
+            }
+        }
+        total += per_part;
+        printf("%s{\"name\": ", k ? ", " : "");
+        json_str(stem);
+        printf(", \"category\": ");
+        json_str(category);
+        printf(", \"abstraction\": ");
+        json_str(ch.rig.abstractions[a].name);
+        printf(", \"sketches\": %d}", per_part);
+        sp_character_free(&ch);
+    }
+    printf("], \"sketches\": %d}\n", total);
+    code = SP_EXIT_OK;
+    goto done;
+fail_open:
+    printf("]}\n");
+fail:
+    fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
+done:
+    for (int k = 0; k < n; ++k)
+        free(names[k]);
+    free(names);
+    return code;
+}
 
 int cmd_synth(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *out = NULL, *truth = NULL, *size = NULL, *pose = NULL;
-    int seed = 0;
+    const char *parts = NULL, *out_dir = NULL, *style_name = NULL;
+    int seed = 0, per_part = 60;
     double amplitude = 0.7853981633974483, noise = 0;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
         {"--seed", SP_OPT_INT, &seed, "N", "random seed (required unless --pose)", false},
         {"--pose", SP_OPT_STRING, &pose, "p.json", "draw this pose instead of a random one", false},
         {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A", "largest change per rotation from rest, radians (default 0.785)", false},
-        {"--out", SP_OPT_STRING, &out, "S.json", "stroke file to write", true},
+        {"--out", SP_OPT_STRING, &out, "S.json", "stroke file to write (required unless --parts)", false},
         {"--truth", SP_OPT_STRING, &truth, "p.json", "also write the pose's parameters", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "canvas size (default: the rig's sketch view)", false},
         {"--noise", SP_OPT_DOUBLE, &noise, "PX", "Gaussian jitter of the stroke points, pixels (default 0)", false},
+        {"--style", SP_OPT_STRING, &style_name, "S", "hand-drawing model: normal, harsh or clean (default: none; with --parts: normal)", false},
+        {"--parts", SP_OPT_STRING, &parts, "DIR", "every .glb/.gltf part in DIR (category from extras.sp_part): a labelled folder", false},
+        {"--per-part", SP_OPT_INT, &per_part, "N", "with --parts: hand-drawn sketches per part (default 60)", false},
+        {"--out-dir", SP_OPT_STRING, &out_dir, "D", "with --parts: folder to write D/<category>/<part>-<style>-s<seed>-<i>.json", false},
     };
-    int rc = sp_cli_parse(argc, argv, "sketchpose synth", "Writes the strokes of a random pose of the rig's abstraction.", opts,
-                          (int)(sizeof opts / sizeof opts[0]));
+    int rc = sp_cli_parse(argc, argv, "sketchpose synth",
+                          "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "
+                          "with --parts DIR --out-dir D, a labelled folder of hand-drawn sketches of every part (seed family --seed).",
+                          opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    bool seeded = false;
-    for (int i = 1; i < argc; ++i) seeded |= !strcmp(argv[i], "--seed");
+    bool seeded = has_opt(argc, argv, "--seed");
+    sp_handdraw_style style = SP_HANDDRAW_STYLE_COUNT;
+    if (style_name && (style = sp_handdraw_style_parse(style_name)) == SP_HANDDRAW_STYLE_COUNT) {
+        fprintf(stderr, "sketchpose synth: --style must be normal, harsh or clean, got '%s'\n", style_name);
+        return SP_EXIT_USAGE;
+    }
+    if (parts) {
+        if (!out_dir || rig_path || out || pose || truth || size) {
+            fprintf(stderr, "sketchpose synth: --parts DIR needs --out-dir D and takes none of --rig, --out, --pose, --truth, --size\n");
+            return SP_EXIT_USAGE;
+        }
+        if (per_part < 1 || per_part > 100000 || seed < 0 || amplitude < 0 || noise != 0) {
+            fprintf(stderr, "sketchpose synth: --per-part must be 1..100000, --seed and --amplitude not negative; --noise does not apply to --parts\n");
+            return SP_EXIT_USAGE;
+        }
+        return synth_parts(parts, abs_name, per_part, (uint64_t)(seeded ? seed : 1), style == SP_HANDDRAW_STYLE_COUNT ? SP_HANDDRAW_NORMAL : style,
+                           has_opt(argc, argv, "--amplitude") ? amplitude : 0.0, out_dir);
+    }
+    if (!rig_path || !out || out_dir) {
+        fprintf(stderr, "sketchpose synth: missing --rig R.gltf and --out S.json (or use --parts DIR --out-dir D; see --help)\n");
+        return SP_EXIT_USAGE;
+    }
     if (!seeded && !pose) {
         fprintf(stderr, "sketchpose synth: missing --seed N or --pose p.json (see --help)\n");
         return SP_EXIT_USAGE;
@@ -43,6 +225,13 @@ int cmd_synth(int argc, char** argv)
     if (amplitude < 0 || noise < 0) {
         fprintf(stderr, "sketchpose synth: --amplitude and --noise must not be negative\n");
         return SP_EXIT_USAGE;
+    }
+    if (sp_is_plugin_path(rig_path)) {
+        if (style != SP_HANDDRAW_STYLE_COUNT) {
+            fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
+            return SP_EXIT_USAGE;
+        }
+        return sp_plugin_synth(rig_path, abs_name, seed, pose, amplitude, out, truth, w, h, noise);
     }
     sp_character ch = {0};
     sp_error err = {0};
@@ -64,6 +253,13 @@ int cmd_synth(int argc, char** argv)
     if (sp_synth_sketch(&ch.rig, a, &cam, p, &sk) != SP_OK) {
         sp_fail(&err, SP_ERR_INTERNAL, "%s: cannot project abstraction '%s'", rig_path, ch.rig.abstractions[a].name);
         goto fail;
+    }
+    if (style != SP_HANDDRAW_STYLE_COUNT) {
+        sp_handdraw_params hp = sp_handdraw_preset(style);
+        sp_sketch drawn;
+        if (sp_handdraw_apply(&sk, &hp, sp_handdraw_seed((uint64_t)(unsigned)seed, 0), &drawn, NULL, &err) != SP_OK) goto fail;
+        sp_sketch_free(&sk);
+        sk = drawn;
     }
     if (noise > 0) {
         sp_rng rng = {(uint64_t)(unsigned)seed ^ 0xA5A5A5A5ull};

@@ -1,4 +1,5 @@
 // cmd_train.c: sketchpose train --data DIR --model M
+#include <math.h>
 #include <time.h>
 
 #include "clf_cli.h"
@@ -9,15 +10,24 @@ int cmd_train(int argc, char** argv)
 {
     const char* data = NULL;
     const char* model = NULL;
+    const char* calibrate = NULL;
+    double cal_q = 0.97;
     clf_cli_opts o = {0};
     sp_opt opts[] = {
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder: DIR/<category>/*.{json,svg,png}, DIR/<category>.ndjson", true},
         {"--model", SP_OPT_STRING, &model, "M", "model file to write", true},
+        {"--calibrate", SP_OPT_STRING, &calibrate, "DIR",
+         "held-out labelled folder (e.g. `synth --parts P --style harsh --seed 3`): set the reject threshold from its distances", false},
+        {"--calibrate-quantile", SP_OPT_DOUBLE, &cal_q, "Q", "with --calibrate: share of its drawings accepted (default 0.97)", false},
         CLF_CLI_OPTS(o),
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose train", "train a sketch classifier on a labelled folder", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!(cal_q > 0 && cal_q <= 1)) {
+        fprintf(stderr, "sketchpose train: --calibrate-quantile must be in (0, 1]\n");
+        return SP_EXIT_USAGE;
+    }
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     sp_error err = {0};
@@ -34,6 +44,20 @@ int cmd_train(int argc, char** argv)
         sp_dataset_free(&ds);
         return SP_EXIT_INPUT;
     }
+    if (calibrate) {
+        sp_dataset cal;
+        sp_result r = sp_dataset_load(calibrate, &cal, &err);
+        if (r == SP_OK) {
+            r = sp_clf_calibrate_reject(clf, &cal, NULL, cal_q, 1.0, NULL, NULL, &err);
+            sp_dataset_free(&cal);
+        }
+        if (r != SP_OK) {
+            fprintf(stderr, "sketchpose train: --calibrate: %s\n", err.text);
+            sp_clf_free(clf);
+            sp_dataset_free(&ds);
+            return SP_EXIT_INPUT;
+        }
+    }
     if (sp_clf_save(clf, model, &err) != SP_OK) {
         fprintf(stderr, "sketchpose train: %s\n", err.text);
         sp_clf_free(clf);
@@ -43,8 +67,9 @@ int cmd_train(int argc, char** argv)
     clock_gettime(CLOCK_MONOTONIC, &t1);
     printf("{\"model\": ");
     clf_cli_json_str(stdout, model);
-    printf(", \"categories\": %d, \"drawings\": %d, \"seconds\": %.3f}\n", ds.category_count, ds.count,
-           (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+    float rd = sp_clf_reject_distance(clf);
+    printf(", \"categories\": %d, \"drawings\": %d, \"seconds\": %.3f, \"reject_distance\": %.4f}\n", ds.category_count, ds.count,
+           (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec), isfinite(rd) ? rd : -1.0);
     sp_clf_free(clf);
     sp_dataset_free(&ds);
     return SP_EXIT_OK;

@@ -17,6 +17,7 @@
     X(drawover, "draw-over posing: curves drawn over the character, then redrawn")     \
     X(animate, "key poses from stroke files, solved in sequence, as one glTF animation") \
     X(demo, "headless demo: strokes of a pose in, a render and a posed .glb out")          \
+    X(dragon, "the kiosk pipeline without a window: one part per stroke; animated .glb, PNG, report") \
     X(db, "the curators' part database: init, add-part, add-sketch, list, show, remove, check, train, export")
 
 #define SP_DECLARE_CMD(name, help) int cmd_##name(int argc, char** argv);

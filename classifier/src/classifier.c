@@ -22,7 +22,7 @@ struct sp_clf {
     float* vocab; // words by 64
     float* vnorm; // words squared norms
     float sigma;  // soft-assignment kernel width (descriptor distance)
-    int hist_dim; // words * (pyramid ? 5 : 1)
+    int hist_dim; // words * pyramid_cells(pyramid)
     float* idf;   // words, or NULL
     int train_count;
     float* hists;    // train_count by hist_dim (final, mapped)
@@ -46,6 +46,7 @@ sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
     if (r.knn <= 0) r.knn = 8;
     if (r.knn > 64) r.knn = 64;
     if (r.pyramid == 0) r.pyramid = 1;
+    if (r.pyramid > 2) r.pyramid = 2;
     if (r.tfidf == 0) r.tfidf = 1;
     if (r.hellinger == 0) r.hellinger = 1;
     if (r.mirror == 0) r.mirror = 1;
@@ -136,8 +137,18 @@ static sp_result build_hist_index(sp_clf* c, sp_error* err)
 // ---------------------------------------------------------------------------
 // Histograms
 
+// Histogram cells of the spatial pyramid: 1x1, then 2x2 (pyramid 1), then 4x4 (pyramid 2).
+static int pyramid_levels(int pyramid)
+{
+    return pyramid > 0 ? 1 + pyramid : 1;
+}
+static int pyramid_cells(int pyramid)
+{
+    return pyramid >= 2 ? 21 : pyramid == 1 ? 5 : 1;
+}
+
 // Raw soft-assigned word counts of one drawing: level 0 (words) then, with the
-// pyramid, the 2x2 cells (4 * words). raw: hist_dim floats.
+// pyramid, the 2x2 cells (4 * words) and the 4x4 cells (16 * words). raw: hist_dim floats.
 static sp_result raw_hist(const sp_clf* c, sp_features* f, float* raw, sp_error* err)
 {
     const int K = c->words;
@@ -163,11 +174,14 @@ static sp_result raw_hist(const sp_clf* c, sp_features* f, float* raw, sp_error*
         }
         if (!(sum > 0.0f)) continue;
         int cell = (f->pos[2 * i] >= 0.5f) + 2 * (f->pos[2 * i + 1] >= 0.5f);
+        int cx4 = (int)(f->pos[2 * i] * 4.0f), cy4 = (int)(f->pos[2 * i + 1] * 4.0f);
+        int cell4 = (cx4 < 0 ? 0 : cx4 > 3 ? 3 : cx4) + 4 * (cy4 < 0 ? 0 : cy4 > 3 ? 3 : cy4);
         for (int j = 0; j < nn; ++j) {
             if (w[j] == 0.0f) continue;
             float v = w[j] / sum;
             raw[id[j]] += v;
             if (c->desc.pyramid > 0) raw[K * (1 + cell) + id[j]] += v;
+            if (c->desc.pyramid > 1) raw[K * (5 + cell4) + id[j]] += v;
         }
     }
     free(idx);
@@ -179,16 +193,17 @@ static sp_result raw_hist(const sp_clf* c, sp_features* f, float* raw, sp_error*
 static void finish_hist(const sp_clf* c, const float* raw, float* out)
 {
     const int K = c->words;
-    int levels = c->desc.pyramid > 0 ? 2 : 1;
+    const int levels = pyramid_levels(c->desc.pyramid);
+    static const int first_cell[4] = {0, 1, 5, 21};
     for (int l = 0; l < levels; ++l) {
-        int b = l == 0 ? 0 : K, e = l == 0 ? K : 5 * K;
+        int b = K * first_cell[l], e = K * first_cell[l + 1];
         double s = 0.0;
         for (int i = b; i < e; ++i) {
             float v = raw[i] * (c->idf ? c->idf[(i - b) % K] : 1.0f);
             out[i] = v;
             s += v;
         }
-        float scale = s > 0.0 ? (float)((levels == 1 ? 1.0 : 0.5) / s) : 0.0f;
+        float scale = s > 0.0 ? (float)(1.0 / (levels * s)) : 0.0f; // each level weighs the same
         for (int i = b; i < e; ++i) {
             out[i] *= scale;
             if (c->desc.hellinger > 0) out[i] = sqrtf(out[i]);
@@ -511,7 +526,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     sample = NULL;
 
     // Pass 2: histograms.
-    c->hist_dim = c->words * (c->desc.pyramid > 0 ? 5 : 1);
+    c->hist_dim = c->words * pyramid_cells(c->desc.pyramid);
     t.raw = malloc(sizeof(float) * (size_t)nj * c->hist_dim);
     if (!t.raw) goto oom;
     t.pass = 2;
@@ -600,6 +615,67 @@ fail:
     free(loo);
     sp_clf_free(c);
     return rc;
+}
+
+// ---------------------------------------------------------------------------
+// Reject threshold calibration on held-out drawings
+
+typedef struct calib_ctx {
+    const sp_clf* c;
+    const sp_dataset* data;
+    const unsigned char* use;
+    float* dist; // per sample, -1 when skipped or not drawable
+} calib_ctx;
+
+static int calib_one(void* user, int i)
+{
+    calib_ctx* k = user;
+    k->dist[i] = -1.0f;
+    if (k->use && !k->use[i]) return 0;
+    const sp_sample* s = &k->data->samples[i];
+    sp_clf_answer a;
+    sp_error e = {0};
+    sp_result r = sp_clf_classify(k->c, &s->sketch, &s->raster, &a, &e);
+    if (r == SP_OK) k->dist[i] = a.distance;
+    return r == SP_ERR_NO_MEMORY || r == SP_ERR_INTERNAL ? (int)r : 0; // a bad drawing is only skipped
+}
+
+float sp_clf_reject_distance(const sp_clf* clf)
+{
+    return clf->reject;
+}
+
+sp_result sp_clf_calibrate_reject(sp_clf* c, const sp_dataset* held_out, const unsigned char* use, double quantile, double margin,
+                                  float* distances, int* count, sp_error* err)
+{
+    if (count) *count = 0;
+    if (!(quantile > 0.0 && quantile <= 1.0)) return sp_fail(err, SP_ERR_INVALID, "calibration quantile %g is not in (0, 1]", quantile);
+    if (margin == 0.0) margin = 1.0;
+    if (!(margin >= 1.0 && isfinite(margin))) return sp_fail(err, SP_ERR_INVALID, "calibration margin %g is not >= 1", margin);
+    float* d = malloc(sizeof(float) * (size_t)(held_out->count > 0 ? held_out->count : 1));
+    if (!d) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    calib_ctx k = {c, held_out, use, d};
+    int bad = sp_parallel_for(held_out->count, c->desc.threads, calib_one, &k);
+    if (bad) {
+        free(d);
+        return sp_fail(err, (sp_result)bad, "calibration: %s", sp_result_name((sp_result)bad));
+    }
+    int m = 0;
+    for (int i = 0; i < held_out->count; ++i)
+        if (d[i] >= 0.0f && isfinite(d[i])) d[m++] = d[i];
+    if (m == 0) {
+        free(d);
+        return sp_fail(err, SP_ERR_INVALID, "calibration: no usable held-out drawing");
+    }
+    qsort(d, (size_t)m, sizeof(float), cmp_float);
+    int qi = (int)ceil(quantile * m) - 1;
+    if (qi < 0) qi = 0;
+    if (qi >= m) qi = m - 1;
+    c->reject = (float)(d[qi] * margin);
+    if (distances) memcpy(distances, d, sizeof(float) * (size_t)m);
+    if (count) *count = m;
+    free(d);
+    return SP_OK;
 }
 
 // ---------------------------------------------------------------------------
@@ -822,7 +898,7 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
     get(&b, c->vocab, sizeof(float) * (size_t)c->words * SP_FEAT_DIM);
     c->sigma = get_f32(&b);
     c->hist_dim = get_i32(&b);
-    if (b.bad || c->hist_dim != c->words * (c->desc.pyramid > 0 ? 5 : 1) || !(c->sigma > 0) || !isfinite(c->sigma)) goto corrupt;
+    if (b.bad || c->hist_dim != c->words * pyramid_cells(c->desc.pyramid) || !(c->sigma > 0) || !isfinite(c->sigma)) goto corrupt;
     if (get_i32(&b)) {
         if ((size_t)c->words * 4 > b.n - b.at) goto corrupt;
         if (!(c->idf = malloc(sizeof(float) * (size_t)c->words))) goto oom;

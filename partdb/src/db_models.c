@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "db_internal.h"
+#include "sp/handdraw.h"
 
 // The classifier reads and writes model files; the database keeps the file's
 // bytes as they are (its own version header and checksum included), going
@@ -88,6 +89,36 @@ static void cats_json(db_str* b, char** cats, int n)
     db_str_printf(b, "]");
 }
 
+// Harsh hand-drawn sketches of every current part (labels: the dataset's
+// categories), for the reject threshold. Their seed family is their own: the
+// stored synthetic sketches never share a pose or a perturbation with them.
+static sp_result calibration_set(sp_db* db, const sp_dataset* like, int per_part, sp_dataset* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    for (int c = 0; c < like->category_count; ++c)
+        if (sp_dataset_add_category(out, like->categories[c]) < 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    sp_db_part_info* parts = NULL;
+    int n = 0;
+    sp_result r = sp_db_list_parts(db, &parts, &n, err);
+    for (int i = 0; r == SP_OK && i < n; ++i) {
+        int label = -1;
+        for (int c = 0; c < out->category_count; ++c)
+            if (!strcmp(out->categories[c], parts[i].category)) label = c;
+        if (label < 0) continue;
+        sp_character ch = {0};
+        if ((r = sp_db_load_part(db, parts[i].name, &ch, err)) != SP_OK) break;
+        int a = sp_rig_find_abstraction(&ch.rig, parts[i].abstraction);
+        if (a < 0) a = 0;
+        sp_handdraw_desc hd = {.style = SP_HANDDRAW_HARSH};
+        r = sp_handdraw_dataset(&ch.rig, a, &ch.camera, &hd, sp_handdraw_part_family(0xCA1B4A7Eu, parts[i].name), per_part, label, out->count,
+                                out, err);
+        sp_character_free(&ch);
+    }
+    free(parts);
+    if (r != SP_OK) sp_dataset_free(out);
+    return r;
+}
+
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err)
 {
     if (report_json) *report_json = NULL;
@@ -143,6 +174,16 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     t_cv = now_s() - t_cv;
     double t_train = now_s();
     if ((r = sp_clf_train(&ds, NULL, &d.clf, &clf, err)) != SP_OK) goto done;
+    int n_cal = d.calibrate == 0 ? 50 : d.calibrate < 0 ? 0 : d.calibrate;
+    double q_cal = d.calibrate_quantile > 0 && d.calibrate_quantile <= 1 ? d.calibrate_quantile : 0.97;
+    if (n_cal > 0) {
+        sp_dataset cal;
+        if ((r = calibration_set(db, &ds, n_cal, &cal, err)) != SP_OK) goto done;
+        r = sp_clf_calibrate_reject(clf, &cal, NULL, q_cal, 1.0, NULL, NULL, err);
+        n_cal = cal.count;
+        sp_dataset_free(&cal);
+        if (r != SP_OK) goto done;
+    }
     t_train = now_s() - t_train;
     if ((r = model_to_bytes(clf, &bytes, &size, err)) != SP_OK) goto done;
     sp_clf_desc resolved = sp_clf_get_desc(clf);
@@ -161,7 +202,11 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
         }
         db_str_printf(&rep, "}");
     }
-    db_str_printf(&rep, ", \"seconds_train\": %.3f, \"seconds_cv\": %.3f}", t_train, t_cv);
+    float reject = sp_clf_reject_distance(clf);
+    db_str_printf(&rep, ", \"seconds_train\": %.3f, \"seconds_cv\": %.3f, \"reject_distance\": %.4f", t_train, t_cv,
+                  isfinite(reject) ? reject : -1.0);
+    if (n_cal > 0) db_str_printf(&rep, ", \"calibration\": {\"sketches\": %d, \"quantile\": %.4g}", n_cal, q_cal);
+    db_str_printf(&rep, "}");
     if (!opts || !cats_s || cb.oom || rep.oom) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         goto done;

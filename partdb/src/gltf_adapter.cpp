@@ -1201,29 +1201,19 @@ void embedded_to_skinned(const sp_rig* rig, const sp_abstraction* a, std::vector
     }
 }
 
-tinygltf::Model build_model(const sp_character* ch, const double* params_in)
+// A rig's joint nodes at parameters p, appended in rig order (node index =
+// first index + joint index), named prefix + joint name.
+void write_joint_nodes(Writer& w, const sp_rig* rig, const double* p, const std::string& prefix)
 {
-    const sp_rig* rig = &ch->rig;
-    int J = rig->joint_count;
-    std::vector<double> p((size_t)rig->param_count + 1);
-    if (params_in)
-        std::copy(params_in, params_in + rig->param_count, p.begin());
-    else if (ch->pose)
-        std::copy(ch->pose, ch->pose + rig->param_count, p.begin());
-    else
-        sp_rig_defaults(rig, p.data());
-    sp_rig_clamp(rig, p.data());
-
-    Writer w;
     tinygltf::Model& m = w.m;
-    // Joint nodes 0..J-1 in rig order, so node index = joint index.
-    for (int j = 0; j < J; ++j) {
+    int base = (int)m.nodes.size();
+    for (int j = 0; j < rig->joint_count; ++j) {
         const sp_joint* jt = &rig->joints[j];
         tinygltf::Node nd;
-        nd.name = jt->name;
+        nd.name = prefix + jt->name;
         sp_vec3 t, s;
         sp_quat r;
-        sp_rig_local_trs(rig, j, p.data(), &t, &r, &s);
+        sp_rig_local_trs(rig, j, p, &t, &r, &s);
         r = sp_quat_norm(r);
         nd.translation = {t.x, t.y, t.z};
         nd.rotation = {r.x, r.y, r.z, r.w};
@@ -1249,18 +1239,20 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
         ex["sp_dofs"] = Value(std::move(dofs));
         ex["sp_rest"] = Value(std::move(rest));
         nd.extras = Value(std::move(ex));
-        if (jt->parent >= 0) m.nodes[(size_t)jt->parent].children.push_back(j);
+        if (jt->parent >= 0) m.nodes[(size_t)(base + jt->parent)].children.push_back(base + j);
         m.nodes.push_back(nd);
     }
-    tinygltf::Scene scene;
-    for (int j = 0; j < J; ++j)
-        if (rig->joints[j].parent < 0) scene.nodes.push_back(j);
+}
 
-    // Skin.
+// The skin of a rig whose joint nodes start at `base`; returns its index.
+int write_skin(Writer& w, const sp_rig* rig, int base, const std::string& name)
+{
+    int J = rig->joint_count;
     tinygltf::Skin skin;
+    skin.name = name;
     std::vector<float> ibm(16 * (size_t)J);
     for (int j = 0; j < J; ++j) {
-        skin.joints.push_back(j);
+        skin.joints.push_back(base + j);
         for (int k = 0; k < 16; ++k) {
             ibm[16 * (size_t)j + (size_t)k] = (float)rig->joints[j].inverse_bind.m[k];
             if (!std::isfinite(ibm[16 * (size_t)j + (size_t)k]))
@@ -1271,76 +1263,86 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
         ibm[16 * (size_t)j + 15] = 1.0f;
     }
     skin.inverseBindMatrices = w.accessor(ibm.data(), (size_t)J, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, 0);
-    m.skins.push_back(skin);
+    w.m.skins.push_back(skin);
+    return (int)w.m.skins.size() - 1;
+}
 
-    // The skinned mesh.
-    if (rig->vertex_count > 0) {
-        size_t nv = (size_t)rig->vertex_count;
-        tinygltf::Primitive prim;
-        w.skinned_attributes(prim, rig->vertex_count, rig->rest, rig->joints4, rig->weights4);
-        std::vector<double> nrm(3 * nv, 0.0);
-        for (int t = 0; t < rig->triangle_count; ++t) {
-            const uint32_t* tri = rig->triangles + 3 * (size_t)t;
-            sp_vec3 a = sp_v3(rig->rest[3 * tri[0]], rig->rest[3 * tri[0] + 1], rig->rest[3 * tri[0] + 2]);
-            sp_vec3 b = sp_v3(rig->rest[3 * tri[1]], rig->rest[3 * tri[1] + 1], rig->rest[3 * tri[1] + 2]);
-            sp_vec3 c = sp_v3(rig->rest[3 * tri[2]], rig->rest[3 * tri[2] + 1], rig->rest[3 * tri[2] + 2]);
-            sp_vec3 fn = sp_v3_cross(sp_v3_sub(b, a), sp_v3_sub(c, a)); // area weighted
-            for (int k = 0; k < 3; ++k)
-                nrm[3 * tri[k]] += fn.x, nrm[3 * tri[k] + 1] += fn.y, nrm[3 * tri[k] + 2] += fn.z;
-        }
-        std::vector<float> nf(3 * nv);
-        for (size_t i = 0; i < nv; ++i) {
-            sp_vec3 n = sp_v3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
-            double l = sp_v3_len(n);
-            n = l > 1e-300 && std::isfinite(l) ? sp_v3_scale(n, 1.0 / l) : sp_v3(0, 0, 1);
-            nf[3 * i] = (float)n.x, nf[3 * i + 1] = (float)n.y, nf[3 * i + 2] = (float)n.z;
-        }
-        prim.attributes["NORMAL"] =
-            w.accessor(nf.data(), nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
-        tinygltf::Material mat;
-        mat.name = "sp_vertex_color";
-        mat.pbrMetallicRoughness.metallicFactor = 0.0;
-        mat.pbrMetallicRoughness.roughnessFactor = 0.8;
-        if (ch->colors) {
-            std::vector<float> col(4 * nv);
-            for (size_t i = 0; i < 4 * nv; ++i)
-                col[i] = std::isfinite(ch->colors[i]) ? std::min(1.0f, std::max(0.0f, ch->colors[i])) : 1.0f;
-            prim.attributes["COLOR_0"] =
-                w.accessor(col.data(), nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, TINYGLTF_TARGET_ARRAY_BUFFER);
-        } else {
-            mat.pbrMetallicRoughness.baseColorFactor = {SP_GLTF_TEXTURE_GREY, SP_GLTF_TEXTURE_GREY, SP_GLTF_TEXTURE_GREY, 1.0};
-        }
-        m.materials.push_back(mat);
-        prim.material = 0;
-        if (rig->triangle_count > 0) {
-            prim.mode = TINYGLTF_MODE_TRIANGLES;
-            size_t ni = 3 * (size_t)rig->triangle_count;
-            if (nv <= 65535) {
-                std::vector<uint16_t> idx(ni);
-                for (size_t i = 0; i < ni; ++i)
-                    idx[i] = (uint16_t)rig->triangles[i];
-                prim.indices = w.accessor(idx.data(), ni, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR,
-                                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-            } else {
-                prim.indices = w.accessor(rig->triangles, ni, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-            }
-        } else {
-            prim.mode = TINYGLTF_MODE_POINTS;
-        }
-        tinygltf::Mesh mesh;
-        mesh.name = "character";
-        mesh.primitives.push_back(prim);
-        m.meshes.push_back(mesh);
-        tinygltf::Node nd;
-        nd.name = "character_mesh";
-        nd.mesh = (int)m.meshes.size() - 1;
-        nd.skin = 0;
-        scene.nodes.push_back((int)m.nodes.size());
-        m.nodes.push_back(nd);
+// The skinned triangle mesh of a character (with its material) on a new root node.
+void write_mesh(Writer& w, tinygltf::Scene& scene, const sp_character* ch, int skin_index, const std::string& mesh_name,
+                const std::string& node_name)
+{
+    tinygltf::Model& m = w.m;
+    const sp_rig* rig = &ch->rig;
+    if (rig->vertex_count <= 0) return;
+    size_t nv = (size_t)rig->vertex_count;
+    tinygltf::Primitive prim;
+    w.skinned_attributes(prim, rig->vertex_count, rig->rest, rig->joints4, rig->weights4);
+    std::vector<double> nrm(3 * nv, 0.0);
+    for (int t = 0; t < rig->triangle_count; ++t) {
+        const uint32_t* tri = rig->triangles + 3 * (size_t)t;
+        sp_vec3 a = sp_v3(rig->rest[3 * tri[0]], rig->rest[3 * tri[0] + 1], rig->rest[3 * tri[0] + 2]);
+        sp_vec3 b = sp_v3(rig->rest[3 * tri[1]], rig->rest[3 * tri[1] + 1], rig->rest[3 * tri[1] + 2]);
+        sp_vec3 c = sp_v3(rig->rest[3 * tri[2]], rig->rest[3 * tri[2] + 1], rig->rest[3 * tri[2] + 2]);
+        sp_vec3 fn = sp_v3_cross(sp_v3_sub(b, a), sp_v3_sub(c, a)); // area weighted
+        for (int k = 0; k < 3; ++k)
+            nrm[3 * tri[k]] += fn.x, nrm[3 * tri[k] + 1] += fn.y, nrm[3 * tri[k] + 2] += fn.z;
     }
+    std::vector<float> nf(3 * nv);
+    for (size_t i = 0; i < nv; ++i) {
+        sp_vec3 n = sp_v3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+        double l = sp_v3_len(n);
+        n = l > 1e-300 && std::isfinite(l) ? sp_v3_scale(n, 1.0 / l) : sp_v3(0, 0, 1);
+        nf[3 * i] = (float)n.x, nf[3 * i + 1] = (float)n.y, nf[3 * i + 2] = (float)n.z;
+    }
+    prim.attributes["NORMAL"] =
+        w.accessor(nf.data(), nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    tinygltf::Material mat;
+    mat.name = "sp_vertex_color";
+    mat.pbrMetallicRoughness.metallicFactor = 0.0;
+    mat.pbrMetallicRoughness.roughnessFactor = 0.8;
+    if (ch->colors) {
+        std::vector<float> col(4 * nv);
+        for (size_t i = 0; i < 4 * nv; ++i)
+            col[i] = std::isfinite(ch->colors[i]) ? std::min(1.0f, std::max(0.0f, ch->colors[i])) : 1.0f;
+        prim.attributes["COLOR_0"] =
+            w.accessor(col.data(), nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    } else {
+        mat.pbrMetallicRoughness.baseColorFactor = {SP_GLTF_TEXTURE_GREY, SP_GLTF_TEXTURE_GREY, SP_GLTF_TEXTURE_GREY, 1.0};
+    }
+    m.materials.push_back(mat);
+    prim.material = (int)m.materials.size() - 1;
+    if (rig->triangle_count > 0) {
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        size_t ni = 3 * (size_t)rig->triangle_count;
+        if (nv <= 65535) {
+            std::vector<uint16_t> idx(ni);
+            for (size_t i = 0; i < ni; ++i)
+                idx[i] = (uint16_t)rig->triangles[i];
+            prim.indices = w.accessor(idx.data(), ni, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR,
+                                      TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        } else {
+            prim.indices = w.accessor(rig->triangles, ni, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                      TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        }
+    } else {
+        prim.mode = TINYGLTF_MODE_POINTS;
+    }
+    tinygltf::Mesh mesh;
+    mesh.name = mesh_name;
+    mesh.primitives.push_back(prim);
+    m.meshes.push_back(mesh);
+    tinygltf::Node nd;
+    nd.name = node_name;
+    nd.mesh = (int)m.meshes.size() - 1;
+    nd.skin = skin_index;
+    scene.nodes.push_back((int)m.nodes.size());
+    m.nodes.push_back(nd);
+}
 
-    // Abstractions: a node per curve, skinned by the same skin.
+// Abstractions: a node per curve, skinned by the rig's skin.
+void write_abstractions(Writer& w, tinygltf::Scene& scene, const sp_rig* rig, int skin_index, const std::string& prefix)
+{
+    tinygltf::Model& m = w.m;
     for (int a = 0; a < rig->abstraction_count; ++a) {
         const sp_abstraction* ab = &rig->abstractions[a];
         std::vector<double> er;
@@ -1360,13 +1362,13 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
             w.skinned_attributes(prim, cv->point_count, rest + 3 * f, joints + 4 * f, weights + 4 * f);
             prim.mode = cv->closed ? TINYGLTF_MODE_LINE_LOOP : TINYGLTF_MODE_LINE_STRIP;
             tinygltf::Mesh mesh;
-            mesh.name = std::string(ab->name) + "/" + cv->name;
+            mesh.name = prefix + ab->name + "/" + cv->name;
             mesh.primitives.push_back(prim);
             m.meshes.push_back(mesh);
             tinygltf::Node nd;
             nd.name = mesh.name;
             nd.mesh = (int)m.meshes.size() - 1;
-            nd.skin = 0;
+            nd.skin = skin_index;
             Value::Object ex;
             ex["sp_abstraction"] = Value(std::string(ab->name));
             ex["sp_curve"] = Value(std::string(cv->name));
@@ -1376,41 +1378,68 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
             m.nodes.push_back(nd);
         }
     }
+}
+
+// One sampler and channel per animation channel; targets are joint nodes `base + joint`.
+void write_channels(Writer& w, const sp_animation* an, int base, tinygltf::Animation& out)
+{
+    for (int c = 0; c < an->channel_count; ++c) {
+        const sp_anim_channel* ac = &an->channels[c];
+        if (ac->key_count < 1) continue;
+        int comps = ac->path == SP_ANIM_ROTATION ? 4 : 3;
+        size_t per = ac->interp == SP_INTERP_CUBICSPLINE ? 3 : 1;
+        size_t nvals = (size_t)ac->key_count * per * (size_t)comps;
+        std::vector<float> vals(ac->values, ac->values + nvals);
+        if (comps == 4 && per == 1)
+            for (size_t k = 0; k < (size_t)ac->key_count; ++k) {
+                sp_quat q = sp_quat_norm(sp_quat{vals[4 * k], vals[4 * k + 1], vals[4 * k + 2], vals[4 * k + 3]});
+                vals[4 * k] = (float)q.x, vals[4 * k + 1] = (float)q.y, vals[4 * k + 2] = (float)q.z,
+                         vals[4 * k + 3] = (float)q.w;
+            }
+        tinygltf::AnimationSampler s;
+        s.input = w.accessor(ac->times, (size_t)ac->key_count, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, 0, true);
+        s.output = w.accessor(vals.data(), (size_t)ac->key_count * per, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                              comps == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, 0);
+        s.interpolation = ac->interp == SP_INTERP_STEP ? "STEP" : ac->interp == SP_INTERP_CUBICSPLINE ? "CUBICSPLINE" : "LINEAR";
+        out.samplers.push_back(s);
+        tinygltf::AnimationChannel ch2;
+        ch2.sampler = (int)out.samplers.size() - 1;
+        ch2.target_node = base + ac->joint;
+        ch2.target_path = ac->path == SP_ANIM_TRANSLATION ? "translation" : ac->path == SP_ANIM_ROTATION ? "rotation" : "scale";
+        out.channels.push_back(ch2);
+    }
+}
+
+tinygltf::Model build_model(const sp_character* ch, const double* params_in)
+{
+    const sp_rig* rig = &ch->rig;
+    int J = rig->joint_count;
+    std::vector<double> p((size_t)rig->param_count + 1);
+    if (params_in)
+        std::copy(params_in, params_in + rig->param_count, p.begin());
+    else if (ch->pose)
+        std::copy(ch->pose, ch->pose + rig->param_count, p.begin());
+    else
+        sp_rig_defaults(rig, p.data());
+    sp_rig_clamp(rig, p.data());
+
+    Writer w;
+    tinygltf::Model& m = w.m;
+    // Joint nodes 0..J-1 in rig order, so node index = joint index.
+    write_joint_nodes(w, rig, p.data(), "");
+    tinygltf::Scene scene;
+    for (int j = 0; j < J; ++j)
+        if (rig->joints[j].parent < 0) scene.nodes.push_back(j);
+    write_skin(w, rig, 0, "");
+    write_mesh(w, scene, ch, 0, "character", "character_mesh");
+    write_abstractions(w, scene, rig, 0, "");
 
     // Animations: one sampler per channel, targets are the joint nodes.
     for (int a = 0; a < rig->animation_count; ++a) {
         const sp_animation* an = &rig->animations[a];
         tinygltf::Animation out;
         out.name = an->name;
-        for (int c = 0; c < an->channel_count; ++c) {
-            const sp_anim_channel* ac = &an->channels[c];
-            if (ac->key_count < 1) continue;
-            int comps = ac->path == SP_ANIM_ROTATION ? 4 : 3;
-            size_t per = ac->interp == SP_INTERP_CUBICSPLINE ? 3 : 1;
-            size_t nvals = (size_t)ac->key_count * per * (size_t)comps;
-            std::vector<float> vals(ac->values, ac->values + nvals);
-            if (comps == 4 && per == 1)
-                for (size_t k = 0; k < (size_t)ac->key_count; ++k) {
-                    sp_quat q = sp_quat_norm(sp_quat{vals[4 * k], vals[4 * k + 1], vals[4 * k + 2], vals[4 * k + 3]});
-                    vals[4 * k] = (float)q.x, vals[4 * k + 1] = (float)q.y, vals[4 * k + 2] = (float)q.z,
-                             vals[4 * k + 3] = (float)q.w;
-                }
-            tinygltf::AnimationSampler s;
-            s.input = w.accessor(ac->times, (size_t)ac->key_count, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, 0, true);
-            s.output = w.accessor(vals.data(), (size_t)ac->key_count * per, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                  comps == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, 0);
-            s.interpolation = ac->interp == SP_INTERP_STEP          ? "STEP"
-                              : ac->interp == SP_INTERP_CUBICSPLINE ? "CUBICSPLINE"
-                                                                    : "LINEAR";
-            out.samplers.push_back(s);
-            tinygltf::AnimationChannel ch2;
-            ch2.sampler = (int)out.samplers.size() - 1;
-            ch2.target_node = ac->joint;
-            ch2.target_path = ac->path == SP_ANIM_TRANSLATION ? "translation"
-                              : ac->path == SP_ANIM_ROTATION  ? "rotation"
-                                                              : "scale";
-            out.channels.push_back(ch2);
-        }
+        write_channels(w, an, 0, out);
         // Why skip: an animation without channels is invalid glTF.
         if (!out.channels.empty()) m.animations.push_back(out);
     }
@@ -1476,6 +1505,110 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
     return m;
 }
 
+// Several parts in one scene (sp_gltf_save_scene): per part a placement
+// node over its joints, its own skin and mesh; one animation for everything.
+tinygltf::Model build_scene(const sp_gltf_scene_desc* d)
+{
+    if (!d || d->part_count <= 0 || !d->parts) fail(SP_ERR_INVALID, "a scene needs at least one part");
+    Writer w;
+    tinygltf::Model& m = w.m;
+    tinygltf::Scene scene;
+    tinygltf::Animation anim;
+    anim.name = d->animation_name ? d->animation_name : "animation";
+    for (int i = 0; i < d->part_count; ++i) {
+        const sp_gltf_scene_part* part = &d->parts[i];
+        const sp_character* ch = part->character;
+        if (!ch) fail(SP_ERR_INVALID, "part %d has no character", i);
+        const sp_rig* rig = &ch->rig;
+        std::string name = part->name ? std::string(part->name) : "part" + std::to_string(i);
+        std::vector<double> p((size_t)rig->param_count + 1);
+        if (part->params)
+            std::copy(part->params, part->params + rig->param_count, p.begin());
+        else if (ch->pose)
+            std::copy(ch->pose, ch->pose + rig->param_count, p.begin());
+        else
+            sp_rig_defaults(rig, p.data());
+        sp_rig_clamp(rig, p.data());
+        // The placement node: a similarity, so that it is exactly a glTF TRS.
+        Trs t = decompose(part->placement);
+        double s = t.s.x;
+        if (!(s > 0) || std::fabs(t.s.y - s) > 1e-6 * s || std::fabs(t.s.z - s) > 1e-6 * s)
+            fail(SP_ERR_INVALID, "part %d (%s): the placement is not a rotation, uniform scale and translation", i, name.c_str());
+        double all[10] = {t.t.x, t.t.y, t.t.z, t.r.x, t.r.y, t.r.z, t.r.w, s, s, s};
+        for (double x : all)
+            if (!(std::fabs(x) < 1e30)) fail(SP_ERR_INVALID, "part %d (%s): non-finite or huge placement", i, name.c_str());
+        int place = (int)m.nodes.size();
+        {
+            tinygltf::Node nd;
+            nd.name = name;
+            nd.translation = {t.t.x, t.t.y, t.t.z};
+            nd.rotation = {t.r.x, t.r.y, t.r.z, t.r.w};
+            nd.scale = {s, s, s};
+            m.nodes.push_back(nd);
+            scene.nodes.push_back(place);
+        }
+        int base = (int)m.nodes.size();
+        write_joint_nodes(w, rig, p.data(), name + "/");
+        for (int j = 0; j < rig->joint_count; ++j)
+            if (rig->joints[j].parent < 0) m.nodes[(size_t)place].children.push_back(base + j);
+        int skin = write_skin(w, rig, base, name);
+        m.skins[(size_t)skin].skeleton = place;
+        write_mesh(w, scene, ch, skin, name + "/mesh", name + "/mesh");
+        if (d->abstractions) write_abstractions(w, scene, rig, skin, name + "/");
+        if (part->animation) write_channels(w, part->animation, base, anim);
+        int nk = part->placement_key_count;
+        if (nk > 0) {
+            if (!part->placement_times || !part->placement_trs)
+                fail(SP_ERR_INVALID, "part %d (%s): placement keys missing", i, name.c_str());
+            std::vector<float> tt(3 * (size_t)nk), rr(4 * (size_t)nk), ss(3 * (size_t)nk);
+            for (int k = 0; k < nk; ++k) {
+                const float* v = part->placement_trs + 8 * (size_t)k;
+                for (int c = 0; c < 8; ++c)
+                    if (!std::isfinite(v[c])) fail(SP_ERR_INVALID, "part %d (%s): non-finite placement key", i, name.c_str());
+                if (k > 0 && !(part->placement_times[k] > part->placement_times[k - 1]))
+                    fail(SP_ERR_INVALID, "part %d (%s): placement key times must increase", i, name.c_str());
+                sp_quat q = sp_quat_norm(sp_quat{v[3], v[4], v[5], v[6]});
+                for (int c = 0; c < 3; ++c)
+                    tt[3 * (size_t)k + (size_t)c] = v[c], ss[3 * (size_t)k + (size_t)c] = v[7];
+                rr[4 * (size_t)k] = (float)q.x, rr[4 * (size_t)k + 1] = (float)q.y, rr[4 * (size_t)k + 2] = (float)q.z,
+                       rr[4 * (size_t)k + 3] = (float)q.w;
+            }
+            int input =
+                w.accessor(part->placement_times, (size_t)nk, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, 0, true);
+            const std::vector<float>* outs[3] = {&tt, &rr, &ss};
+            const char* paths[3] = {"translation", "rotation", "scale"};
+            for (int c = 0; c < 3; ++c) {
+                tinygltf::AnimationSampler smp;
+                smp.input = input;
+                smp.output = w.accessor(outs[c]->data(), (size_t)nk, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                        c == 1 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, 0);
+                smp.interpolation = "LINEAR";
+                anim.samplers.push_back(smp);
+                tinygltf::AnimationChannel chn;
+                chn.sampler = (int)anim.samplers.size() - 1;
+                chn.target_node = place;
+                chn.target_path = paths[c];
+                anim.channels.push_back(chn);
+            }
+        }
+    }
+    // Why skip: an animation without channels is invalid glTF.
+    if (!anim.channels.empty()) m.animations.push_back(anim);
+    if (d->extras_json) {
+        cJSON* ex = cJSON_Parse(d->extras_json);
+        if (!ex || !cJSON_IsObject(ex)) {
+            cJSON_Delete(ex);
+            fail(SP_ERR_INVALID, "the scene extras are not a JSON object");
+        }
+        scene.extras = from_cjson(ex);
+        cJSON_Delete(ex);
+    }
+    scene.name = "sketchpose";
+    m.scenes.push_back(scene);
+    m.defaultScene = 0;
+    return m;
+}
+
 std::string serialize(const sp_character* ch, const double* params, bool binary)
 {
     tinygltf::Model m = build_model(ch, params);
@@ -1524,5 +1657,30 @@ extern "C" sp_result sp_gltf_save_memory(const sp_character* ch, const double* p
         return sp_fail(err, SP_ERR_NO_MEMORY, "glb: out of memory");
     } catch (...) {
         return sp_fail(err, SP_ERR_INTERNAL, "glb: internal error in the glTF writer");
+    }
+}
+
+extern "C" sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const char* path, sp_error* err)
+{
+    try {
+        tinygltf::Model m = build_scene(desc);
+        tinygltf::TinyGLTF writer;
+        std::ostringstream os;
+        bool binary = ends_with_ci(path, ".glb");
+        if (!writer.WriteGltfSceneToStream(&m, os, !binary, binary))
+            fail(SP_ERR_INTERNAL, "tinygltf could not serialise the scene");
+        std::string bytes = os.str();
+        FILE* f = fopen(path, "wb");
+        if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+        ok = (fclose(f) == 0) && ok;
+        if (!ok) return sp_fail(err, SP_ERR_IO, "%s: write error: %s", path, strerror(errno));
+        return SP_OK;
+    } catch (const Failure& f) {
+        return sp_fail(err, f.code, "%s: %s", path, f.text.c_str());
+    } catch (const std::bad_alloc&) {
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    } catch (...) {
+        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF writer", path);
     }
 }

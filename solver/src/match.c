@@ -13,6 +13,18 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
 
 // Arc-length resampling of curve c of the projected abstraction, as
 // references to its points (so that samples stay linear in the rig's points).
+// Unit normal of a resampled stroke at sample k (central difference within
+// its stroke), (0, 0) where the stroke has no length there.
+static sp_vec2 stroke_normal(const sp_vec2* y, const int* ystroke, int my, int k)
+{
+    int a = k > 0 && ystroke[k - 1] == ystroke[k] ? k - 1 : k;
+    int b = k + 1 < my && ystroke[k + 1] == ystroke[k] ? k + 1 : k;
+    sp_vec2 t = sp_v2_sub(y[b], y[a]);
+    double len = sqrt(t.x * t.x + t.y * t.y);
+    if (!(len > 1e-12)) return (sp_vec2){0, 0};
+    return (sp_vec2){-t.y / len, t.x / len};
+}
+
 static void resample_refs(const sp_solver* s, const sp_curve* cv, int m, sample_ref* out)
 {
     int n = cv->point_count, f = cv->first_point;
@@ -303,9 +315,23 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
         sp_fail(err, res, "closest-point correspondences failed");
         goto closest_done;
     }
+    if (my > s->ypoly_cap) {
+        sp_vec2* yp = realloc(s->ypoly, sizeof(sp_vec2) * (size_t)my);
+        if (yp) s->ypoly = yp;
+        int* ys = realloc(s->ypoly_stroke, sizeof(int) * (size_t)my);
+        if (ys) s->ypoly_stroke = ys;
+        if (!yp || !ys) {
+            res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+            goto closest_done;
+        }
+        s->ypoly_cap = my;
+    }
+    memcpy(s->ypoly, y, sizeof(sp_vec2) * (size_t)my);
+    memcpy(s->ypoly_stroke, ystroke, sizeof(int) * (size_t)my);
+    s->ypoly_count = my;
     for (int i = 0; i < my + msum; ++i) {
         int c = zcurve[cp[i].z];
-        s->pairs[s->pair_count++] = (pair){y[cp[i].y], refs[cp[i].z], c};
+        s->pairs[s->pair_count++] = (pair){y[cp[i].y], refs[cp[i].z], c, stroke_normal(y, ystroke, my, cp[i].y), i >= my};
         votes[c * sk->stroke_count + ystroke[cp[i].y]]++;
     }
     for (int c = 0; c < rep->curve_count; ++c) {

@@ -1,5 +1,7 @@
 // solver.c: setup (coarsening, sparsity), the energy, and the bounded
 // Levenberg-Marquardt / ICP loop. Correspondences are built in match.c.
+#include <assert.h>
+#include <cblas.h>
 #include <flann/flann.h>
 #include <lapacke.h>
 #include <stdio.h>
@@ -44,43 +46,29 @@ const char* sp_stop_reason_name(sp_stop_reason r)
 
 static int cmp_int(const void* a, const void* b) { return *(const int*)a - *(const int*)b; }
 
-// Parameters that move a point skinned to `joints`/`weights`: those of
-// every influence joint and its ancestors, sorted, unique. Returns the count.
-static int point_columns(const sp_rig* rig, const uint16_t* joints, const float* weights, int ninf, int* out)
+// The model's calls (model.h), and bounds as sp_rig_clamp has them.
+static inline void model_update(sp_solver* s, const double* p, bool derivatives) { s->model->ops->update(s->model, p, derivatives); }
+static inline void model_rows(sp_solver* s, double* xyz) { s->model->ops->rows(s->model, s->reps, s->k, xyz); }
+static void model_defaults(const sp_solver* s, double* p)
 {
-    int n = 0;
-    for (int k = 0; k < ninf; ++k) {
-        if (weights[k] == 0.0f) continue;
-        for (int a = joints[k]; a >= 0; a = rig->joints[a].parent)
-            for (int q = 0; q < rig->joints[a].param_count; ++q) out[n++] = rig->joints[a].first_param + q;
-    }
-    qsort(out, (size_t)n, sizeof(int), cmp_int);
-    int u = 0;
-    for (int i = 0; i < n; ++i)
-        if (u == 0 || out[u - 1] != out[i]) out[u++] = out[i];
-    return u;
+    for (int i = 0; i < s->P; ++i) p[i] = s->model->params[i].def;
 }
-
-// Column list of an abstraction point (skinned, or embedded in 3 vertices).
-static int abstraction_point_columns(const sp_rig* rig, const sp_abstraction* ab, int i, int* out)
+static void model_clamp(const sp_solver* s, double* p)
 {
-    if (ab->rest) return point_columns(rig, ab->joints + 4 * i, ab->weights + 4 * i, 4, out);
-    uint16_t j[12];
-    float w[12];
-    for (int v = 0; v < 3; ++v) {
-        uint32_t vi = ab->tri_vertices[3 * i + v];
-        for (int k = 0; k < 4; ++k) {
-            j[4 * v + k] = rig->joints4[4 * vi + k];
-            w[4 * v + k] = ab->bary[3 * i + v] != 0.0 ? rig->weights4[4 * vi + k] : 0.0f;
-        }
+    for (int i = 0; i < s->P; ++i) {
+        const sp_model_param* q = &s->model->params[i];
+        double v = p[i];
+        if (!isfinite(v)) v = q->def;
+        if (v < q->min) v = q->min;
+        if (v > q->max) v = q->max;
+        p[i] = v;
     }
-    return point_columns(rig, j, w, 12, out);
 }
 
 // k-means of the rest vertices (FLANN), centres snapped to the nearest vertex.
-static int coarsen(const sp_rig* rig, int k, int* reps)
+static int coarsen(const double* rest_in, int n, int k, int* reps)
 {
-    int n = rig->vertex_count;
+    double* rest = (double*)rest_in; // FLANN's C API only reads it but is not const-correct
     if (n <= k) {
         for (int i = 0; i < n; ++i) reps[i] = i;
         return n;
@@ -95,7 +83,7 @@ static int coarsen(const sp_rig* rig, int k, int* reps)
     fp.random_seed = 12345; // deterministic coarsening
     fp.log_level = FLANN_LOG_NONE;
     // FLANN's hierarchical k-means returns (branching-1)*m+1 <= k clusters.
-    int got = flann_compute_cluster_centers_double(rig->rest, n, 3, k, centers, &fp);
+    int got = flann_compute_cluster_centers_double(rest, n, 3, k, centers, &fp);
     if (got <= 0) {
         // Fallback: evenly spaced vertices.
         for (int i = 0; i < k; ++i) reps[i] = (int)((long long)i * n / k);
@@ -108,7 +96,7 @@ static int coarsen(const sp_rig* rig, int k, int* reps)
     ip.log_level = FLANN_LOG_NONE;
     ip.random_seed = 12345;
     float speedup = 0;
-    flann_index_t idx = flann_build_index_double(rig->rest, n, 3, &speedup, &ip);
+    flann_index_t idx = flann_build_index_double(rest, n, 3, &speedup, &ip);
     double* dist = malloc(sizeof(double) * (size_t)got);
     int m = 0;
     if (idx && dist && flann_find_nearest_neighbors_index_double(idx, centers, got, reps, dist, 1, &ip) == 0) {
@@ -126,13 +114,75 @@ static int coarsen(const sp_rig* rig, int k, int* reps)
     return m;
 }
 
+// OpenBLAS threads its small kernels by default and then spends most of a
+// solve in sched_yield (perf: 40% on the Table 1 rigs): our systems have at
+// most a few hundred unknowns, so one BLAS thread is faster, and the solver's
+// own parallel work (finite differences) must not be oversubscribed. Weak, so
+// that any other CBLAS/LAPACKE implementation links too.
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+
 sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_solve_desc* desc)
 {
     if (abstraction < 0 || abstraction >= rig->abstraction_count) return NULL;
+    return sp__solver_create_model(sp__model_lbs_create(rig, abstraction), cam, desc);
+}
+
+static int find_group(sp_solver* s, const int* cols, int n)
+{
+    for (int g = 0; g < s->group_count; ++g)
+        if (s->groups[g].n == n && (n == 0 || !memcmp(s->groups[g].cols, cols, sizeof(int) * (size_t)n))) return g;
+    s->groups[s->group_count] = (row_group){.cols = cols, .n = n};
+    return s->group_count++;
+}
+
+// Groups the abstraction points and representatives by column list and
+// reserves their rows: 2 per point, 2 per segment inside a group, 4 per
+// representative (W_plane and W_dist).
+static bool make_groups(sp_solver* s)
+{
+    const int l = s->ab->point_count;
+    s->groups = malloc(sizeof(row_group) * (size_t)(l + s->k + 1));
+    s->ab_grp = malloc(sizeof(int) * (size_t)(l + 1));
+    s->rep_grp = malloc(sizeof(int) * (size_t)(s->k + 1));
+    if (!s->groups || !s->ab_grp || !s->rep_grp) return false;
+    s->group_count = 0;
+    for (int i = 0; i < l; ++i) {
+        int g = s->ab_grp[i] = find_group(s, s->ab_cols + s->ab_sb[i].first, s->ab_sb[i].count);
+        s->groups[g].cap += 2;
+    }
+    for (const sp_curve* cv = s->ab->curves; cv < s->ab->curves + s->ab->curve_count; ++cv)
+        for (int k = 0; k < cv->point_count; ++k) {
+            int a = cv->first_point + k, b = k + 1 < cv->point_count ? a + 1 : cv->first_point;
+            if (b != a && s->ab_grp[a] == s->ab_grp[b]) s->groups[s->ab_grp[a]].cap += 2;
+        }
+    for (int i = 0; i < s->k; ++i) {
+        int g = s->rep_grp[i] = find_group(s, s->rep_cols + s->rep_sb[i].first, s->rep_sb[i].count);
+        s->groups[g].cap += 4;
+    }
+    size_t total = 0;
+    for (int g = 0; g < s->group_count; ++g) total += 2 * (size_t)s->groups[g].cap * (size_t)s->groups[g].n;
+    s->group_pool = malloc(sizeof(double) * (total + 1));
+    if (!s->group_pool) return false;
+    double* at = s->group_pool;
+    for (int g = 0; g < s->group_count; ++g) {
+        row_group* gr = &s->groups[g];
+        gr->U = at, at += (size_t)gr->cap * (size_t)gr->n;
+        gr->V = at, at += (size_t)gr->cap * (size_t)gr->n;
+    }
+    return true;
+}
+
+sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_solve_desc* desc)
+{
+    if (openblas_set_num_threads) openblas_set_num_threads(1);
+    if (!m) return NULL;
     sp_solver* s = calloc(1, sizeof *s);
-    if (!s) return NULL;
-    s->rig = rig;
-    s->ab = &rig->abstractions[abstraction];
+    if (!s) {
+        m->ops->destroy(m);
+        return NULL;
+    }
+    s->model = m;
+    s->ab = m->ab;
     s->cam = cam;
     s->d = desc ? *desc : (sp_solve_desc){0};
     if (s->d.lambda_pose == 0) s->d.lambda_pose = 0.5;
@@ -145,15 +195,14 @@ sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera*
     if (s->d.max_iterations <= 0) s->d.max_iterations = 300;
     if (s->d.max_icp_rounds <= 0) s->d.max_icp_rounds = 40;
     if (!(s->d.time_cap_ms > 0)) s->d.time_cap_ms = 3000;
-    s->P = rig->param_count;
+    s->P = m->P;
     int P = s->P > 0 ? s->P : 1, l = s->ab->point_count;
-    s->ev = sp_rig_eval_create(rig);
     sp_vec3 lo, hi;
-    sp_bounds(rig->rest, rig->vertex_count, &lo, &hi);
+    sp_bounds(m->rest, m->vertex_count, &lo, &hi);
     s->D = sp_v3_len(sp_v3_sub(hi, lo));
     if (!(s->D > 0)) s->D = 1.0;
     s->reps = malloc(sizeof(int) * (size_t)(s->d.representatives + 1));
-    s->k = s->reps && rig->vertex_count > 0 ? coarsen(rig, s->d.representatives, s->reps) : 0;
+    s->k = s->reps && m->vertex_count > 0 ? coarsen(m->rest, m->vertex_count, s->d.representatives, s->reps) : 0;
     // Column lists.
     // Before deduplication a point lists every ancestor parameter of up to
     // 12 influences (an embedded point: 3 vertices x 4 joints).
@@ -161,18 +210,17 @@ sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera*
     s->ab_sb = malloc(sizeof(sparse_block) * (size_t)(l > 0 ? l : 1));
     s->rep_sb = malloc(sizeof(sparse_block) * (size_t)(s->k > 0 ? s->k : 1));
     size_t ab_total = 0, rep_total = 0;
-    if (!s->ev || !tmp || !s->ab_sb || !s->rep_sb || !s->reps) goto fail;
+    if (!tmp || !s->ab_sb || !s->rep_sb || !s->reps || !m->ops->prepare(m, s->reps, s->k)) goto fail;
     for (int pass = 0; pass < 2; ++pass) {
         ab_total = rep_total = 0;
         for (int i = 0; i < l; ++i) {
-            int n = abstraction_point_columns(rig, s->ab, i, tmp);
+            int n = m->ops->columns(m, true, i, tmp);
             if (pass) memcpy(s->ab_cols + ab_total, tmp, sizeof(int) * (size_t)n);
             s->ab_sb[i] = (sparse_block){(int)ab_total, n};
             ab_total += (size_t)n;
         }
         for (int i = 0; i < s->k; ++i) {
-            int v = s->reps[i];
-            int n = point_columns(rig, rig->joints4 + 4 * v, rig->weights4 + 4 * v, 4, tmp);
+            int n = m->ops->columns(m, false, s->reps[i], tmp);
             if (pass) memcpy(s->rep_cols + rep_total, tmp, sizeof(int) * (size_t)n);
             s->rep_sb[i] = (sparse_block){(int)rep_total, n};
             rep_total += (size_t)n;
@@ -185,32 +233,30 @@ sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera*
     }
     free(tmp);
     tmp = NULL;
+    if (!make_groups(s)) goto fail;
     size_t kk = (size_t)(s->k > 0 ? s->k : 1), ll = (size_t)(l > 0 ? l : 1);
-    s->mesh = s->ab->rest ? NULL : malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
     s->z3 = malloc(sizeof(double) * 3 * ll);
     s->z2 = malloc(sizeof(double) * 2 * ll);
+    s->Jz = malloc(sizeof(double) * 3 * (ab_total + 1));
     s->G = malloc(sizeof(double) * 2 * (ab_total + 1));
     s->x0 = malloc(sizeof(double) * 3 * kk);
     s->xr = malloc(sizeof(double) * 3 * kk);
     s->Jr = malloc(sizeof(double) * 3 * (rep_total + 1));
     s->dw = malloc(sizeof(double) * kk);
     s->view = malloc(sizeof(sp_vec3) * kk);
-    s->scratch = malloc(sizeof(double) * 9 * (size_t)P);
     s->H = malloc(sizeof(double) * (size_t)P * (size_t)P);
     s->g = malloc(sizeof(double) * (size_t)P);
     s->p0 = malloc(sizeof(double) * (size_t)P);
     s->unit = malloc(sizeof(double) * (size_t)P);
     s->free_ = malloc(sizeof(bool) * (size_t)P);
-    s->match_aa = malloc(sizeof(double) * ll);
-    s->match_ab = malloc(sizeof(double) * ll);
+    s->Hl = malloc(sizeof(double) * (size_t)P * (size_t)P);
+    s->match_aa = malloc(sizeof(double) * 3 * ll);
+    s->match_ab = malloc(sizeof(double) * 3 * ll);
     s->match_beta = malloc(sizeof(double) * 2 * ll);
-    if ((!s->ab->rest && !s->mesh) || !s->z3 || !s->z2 || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
-        !s->scratch || !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->match_aa || !s->match_ab || !s->match_beta)
+    if (!s->z3 || !s->z2 || !s->Jz || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
+        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->match_aa || !s->match_ab || !s->match_beta)
         goto fail;
-    for (int i = 0; i < s->P; ++i) {
-        sp_channel c = rig->params[i].channel;
-        s->unit[i] = (c >= SP_CH_TX && c <= SP_CH_TZ) ? s->D / SP_REF_SIZE : 1.0;
-    }
+    for (int i = 0; i < s->P; ++i) s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
     return s;
 fail:
     free(tmp);
@@ -221,11 +267,13 @@ fail:
 void sp_solver_destroy(sp_solver* s)
 {
     if (!s) return;
-    sp_rig_eval_destroy(s->ev);
+    if (s->model) s->model->ops->destroy(s->model);
     free(s->reps), free(s->ab_cols), free(s->ab_sb), free(s->rep_cols), free(s->rep_sb);
-    free(s->mesh), free(s->z3), free(s->z2), free(s->G), free(s->x0), free(s->xr), free(s->Jr), free(s->dw), free(s->view);
-    free(s->scratch), free(s->H), free(s->g), free(s->p0), free(s->unit), free(s->free_), free(s->pairs);
-    free(s->match_aa), free(s->match_ab), free(s->match_beta);
+    free(s->Jz), free(s->z3), free(s->z2), free(s->G), free(s->x0), free(s->xr), free(s->Jr), free(s->dw), free(s->view);
+    free(s->H), free(s->g), free(s->p0), free(s->unit), free(s->free_), free(s->pairs);
+    free(s->ypoly), free(s->ypoly_stroke);
+    free(s->Hl), free(s->match_aa), free(s->match_ab), free(s->match_beta);
+    free(s->groups), free(s->ab_grp), free(s->rep_grp), free(s->group_pool);
     free(s);
 }
 
@@ -240,8 +288,7 @@ const int* sp_solver_representatives(const sp_solver* s, int* count)
 // Projects the abstraction at the current rig state into s->z2.
 static void project_abstraction(sp_solver* s)
 {
-    if (!s->ab->rest) sp_rig_eval_points(s->ev, sp_rig_mesh_points(s->rig), s->mesh);
-    sp_rig_eval_abstraction(s->ev, s->ab, s->mesh, s->z3);
+    s->model->ops->abstraction(s->model, s->z3);
     for (int i = 0; i < s->ab->point_count; ++i) {
         sp_vec2 q = sp_camera_project(s->cam, (sp_vec3){s->z3[3 * i], s->z3[3 * i + 1], s->z3[3 * i + 2]});
         s->z2[2 * i] = q.x, s->z2[2 * i + 1] = q.y;
@@ -250,7 +297,7 @@ static void project_abstraction(sp_solver* s)
 
 void sp_solver_project_abstraction(sp_solver* s, const double* p, double* xy)
 {
-    sp_rig_eval_update(s->ev, p, false);
+    model_update(s, p, false);
     project_abstraction(s);
     memcpy(xy, s->z2, sizeof(double) * 2 * (size_t)s->ab->point_count);
 }
@@ -260,6 +307,28 @@ static sp_vec2 sample_at(const sp_solver* s, sample_ref r)
     const double* a = s->z2 + 2 * r.a;
     const double* b = s->z2 + 2 * r.b;
     return (sp_vec2){a[0] + r.t * (b[0] - a[0]), a[1] + r.t * (b[1] - a[1])};
+}
+
+// Closest-point pairs measure the residual mostly across the stroke
+// (point-to-line, as in Chen and Medioni's ICP): a curve may then slide along
+// the stroke within a round instead of being dragged to the sample that was
+// closest at the round's start, which is what makes point-to-point ICP crawl
+// (the Table 1 benchmark rigs needed 3x the iterations). The small tangential
+// weight keeps the energy positive definite on straight strokes.
+#define SP_TANGENT_WEIGHT 0.1
+
+// The pair's symmetric 2x2 metric (xx, xy, yy): identity for ordered pairs,
+// n n^T + SP_TANGENT_WEIGHT (I - n n^T) for closest ones.
+static void pair_metric(const pair* pr, double m[3])
+{
+    if (pr->n.x == 0.0 && pr->n.y == 0.0) {
+        m[0] = 1, m[1] = 0, m[2] = 1;
+        return;
+    }
+    const double t = SP_TANGENT_WEIGHT, nx = pr->n.x, ny = pr->n.y;
+    m[0] = t + (1 - t) * nx * nx;
+    m[1] = (1 - t) * nx * ny;
+    m[2] = t + (1 - t) * ny * ny;
 }
 
 static double match_weight(const sp_solver* s)
@@ -280,19 +349,21 @@ static double vertex_weight(const sp_solver* s)
 static sp_energy_terms energy(sp_solver* s, const double* p)
 {
     sp_energy_terms e = {0};
-    sp_rig_eval_update(s->ev, p, false);
+    model_update(s, p, false);
     project_abstraction(s);
     double wm = match_weight(s);
     for (int i = 0; i < s->pair_count; ++i) {
         sp_vec2 d = sp_v2_sub(sample_at(s, s->pairs[i].s), s->pairs[i].y);
-        e.match += wm * sp_v2_dot(d, d);
+        double m[3];
+        pair_metric(&s->pairs[i], m);
+        e.match += wm * (m[0] * d.x * d.x + 2 * m[1] * d.x * d.y + m[2] * d.y * d.y);
     }
     for (int i = 0; i < s->P; ++i) {
         double u = (p[i] - s->p0[i]) / s->unit[i];
         e.pose += u * u;
     }
     if (s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0)) {
-        sp_rig_eval_rows(s->ev, sp_rig_mesh_points(s->rig), s->reps, s->k, s->xr);
+        model_rows(s, s->xr);
         double inv = vertex_weight(s);
         for (int i = 0; i < s->k; ++i) {
             sp_vec3 dx = {s->xr[3 * i] - s->x0[3 * i], s->xr[3 * i + 1] - s->x0[3 * i + 1], s->xr[3 * i + 2] - s->x0[3 * i + 2]};
@@ -305,6 +376,8 @@ static sp_energy_terms energy(sp_solver* s, const double* p)
     e.plane *= s->d.lambda_plane * s->vertex_boost;
     e.dist *= s->d.lambda_dist * s->vertex_boost;
     e.total = e.match + e.pose + e.plane + e.dist;
+    // A black-box rig that failed to evaluate here makes this state unusable.
+    if (s->model->failed) e.total = INFINITY;
     return e;
 }
 
@@ -314,65 +387,54 @@ static sp_energy_terms energy(sp_solver* s, const double* p)
 // the 3D blocks of the representatives (s->Jr) at the current rig state.
 static void jacobian_blocks(sp_solver* s)
 {
-    const sp_rig* rig = s->rig;
-    const int P = s->P;
-    double* J = s->scratch; // 3 x P
-    double* Jv = s->scratch + 3 * P;
+    s->model->ops->jacobians(s->model, s->reps, s->k, s->ab_sb, s->ab_cols, s->Jz, s->rep_sb, s->rep_cols, s->Jr);
     for (int i = 0; i < s->ab->point_count; ++i) {
         const sparse_block* sb = &s->ab_sb[i];
-        if (s->ab->rest) {
-            sp_skinned_points pts = {s->ab->point_count, s->ab->rest, s->ab->joints, s->ab->weights};
-            sp_rig_eval_jacobian(s->ev, pts, &i, 1, J);
-        } else {
-            memset(J, 0, sizeof(double) * 3 * (size_t)P);
-            for (int v = 0; v < 3; ++v) {
-                int vi = (int)s->ab->tri_vertices[3 * i + v];
-                double b = s->ab->bary[3 * i + v];
-                if (b == 0.0) continue;
-                sp_rig_eval_jacobian(s->ev, sp_rig_mesh_points(rig), &vi, 1, Jv);
-                for (int c = 0; c < sb->count; ++c) {
-                    int q = s->ab_cols[sb->first + c];
-                    for (int r = 0; r < 3; ++r) J[r * P + q] += b * Jv[r * P + q];
-                }
-            }
-        }
         double C[6];
         sp_camera_jacobian(s->cam, (sp_vec3){s->z3[3 * i], s->z3[3 * i + 1], s->z3[3 * i + 2]}, C);
+        const double* Jb = s->Jz + 3 * (size_t)sb->first;
         double* Gb = s->G + 2 * (size_t)sb->first;
         for (int c = 0; c < sb->count; ++c) {
-            int q = s->ab_cols[sb->first + c];
-            double jx = J[q], jy = J[P + q], jz = J[2 * P + q];
+            double jx = Jb[c], jy = Jb[sb->count + c], jz = Jb[2 * sb->count + c];
             Gb[c] = C[0] * jx + C[1] * jy + C[2] * jz;
             Gb[sb->count + c] = C[3] * jx + C[4] * jy + C[5] * jz;
         }
     }
-    for (int i = 0; i < s->k; ++i) {
-        const sparse_block* sb = &s->rep_sb[i];
-        sp_rig_eval_jacobian(s->ev, sp_rig_mesh_points(rig), &s->reps[i], 1, J);
-        double* Jb = s->Jr + 3 * (size_t)sb->first;
-        for (int c = 0; c < sb->count; ++c) {
-            int q = s->rep_cols[sb->first + c];
-            Jb[c] = J[q], Jb[sb->count + c] = J[P + q], Jb[2 * sb->count + c] = J[2 * P + q];
-        }
-    }
 }
 
-// H += wh * B^T B, g += wg * B^T r over the listed (sorted) columns; B is
-// rows x n, row-major. Fills the upper triangle of H.
-static void accumulate(sp_solver* s, const int* cols, int n, const double* B, int rows, const double* r, double wg, double wh)
+// Least-squares rows B (rows x n over group g's columns, residuals r):
+// g += B^T r now, H += B^T B when the group is flushed.
+static void push_rows(sp_solver* s, int g, const double* B, int rows, const double* r)
+{
+    row_group* gr = &s->groups[g];
+    const int n = gr->n;
+    for (int k = 0; k < rows; ++k) {
+        const double* Bk = B + (size_t)k * (size_t)n;
+        for (int a = 0; a < n; ++a) s->g[gr->cols[a]] += Bk[a] * r[k];
+    }
+    assert(gr->rows + rows <= gr->cap);
+    double* U = gr->U + (size_t)gr->rows * (size_t)n;
+    double* V = gr->V + (size_t)gr->rows * (size_t)n;
+    for (size_t q = 0; q < (size_t)rows * (size_t)n; ++q) U[q] = B[q], V[q] = 0.5 * B[q];
+    gr->rows += rows;
+}
+
+// H += U^T V + V^T U of every group, into the upper triangle (columns are
+// sorted, so the local upper triangle lands in the global one).
+static void flush_groups(sp_solver* s)
 {
     const int P = s->P;
-    for (int a = 0; a < n; ++a) {
-        int qa = cols[a];
-        double ga = 0;
-        for (int k = 0; k < rows; ++k) ga += B[k * n + a] * r[k];
-        s->g[qa] += wg * ga;
-        if (wh == 0.0) continue;
-        for (int b = a; b < n; ++b) {
-            double h = 0;
-            for (int k = 0; k < rows; ++k) h += B[k * n + a] * B[k * n + b];
-            s->H[qa * P + cols[b]] += wh * h;
+    for (int g = 0; g < s->group_count; ++g) {
+        row_group* gr = &s->groups[g];
+        const int n = gr->n;
+        if (gr->rows == 0 || n == 0) continue;
+        cblas_dsyr2k(CblasRowMajor, CblasUpper, CblasTrans, n, gr->rows, 1.0, gr->U, n, gr->V, n, 0.0, s->Hl, n);
+        for (int a = 0; a < n; ++a) {
+            double* Hrow = s->H + (size_t)gr->cols[a] * (size_t)P;
+            const double* L = s->Hl + (size_t)a * (size_t)n;
+            for (int b = a; b < n; ++b) Hrow[gr->cols[b]] += L[b];
         }
+        gr->rows = 0;
     }
 }
 
@@ -399,21 +461,26 @@ static void normal_equations(sp_solver* s, const double* p)
     double* aa = s->match_aa;
     double* ab = s->match_ab;
     double* beta = s->match_beta;
-    memset(aa, 0, sizeof(double) * (size_t)l);
-    memset(ab, 0, sizeof(double) * (size_t)l);
+    memset(aa, 0, sizeof(double) * 3 * (size_t)l);
+    memset(ab, 0, sizeof(double) * 3 * (size_t)l);
     memset(beta, 0, sizeof(double) * 2 * (size_t)l);
     double wm = match_weight(s);
     for (int i = 0; i < s->pair_count; ++i) {
         const pair* pr = &s->pairs[i];
         sp_vec2 d = sp_v2_sub(sample_at(s, pr->s), pr->y);
+        double m[3];
+        pair_metric(pr, m);
+        sp_vec2 md = {m[0] * d.x + m[1] * d.y, m[1] * d.x + m[2] * d.y};
         double ca = 1.0 - pr->s.t, cb = pr->s.t;
         int a = pr->s.a, b = pr->s.b;
         if (a == b) ca += cb, cb = 0;
-        aa[a] += wm * ca * ca;
-        aa[b] += wm * cb * cb;
-        ab[a] += wm * ca * cb; // segment a -> b: b is the point after a
-        beta[2 * a] += wm * ca * d.x, beta[2 * a + 1] += wm * ca * d.y;
-        beta[2 * b] += wm * cb * d.x, beta[2 * b + 1] += wm * cb * d.y;
+        for (int c = 0; c < 3; ++c) {
+            aa[3 * a + c] += wm * ca * ca * m[c];
+            aa[3 * b + c] += wm * cb * cb * m[c];
+            ab[3 * a + c] += wm * ca * cb * m[c]; // segment a -> b: b is the point after a
+        }
+        beta[2 * a] += wm * ca * md.x, beta[2 * a + 1] += wm * ca * md.y;
+        beta[2 * b] += wm * cb * md.x, beta[2 * b + 1] += wm * cb * md.y;
     }
     for (const sp_curve* cv = s->ab->curves; cv < s->ab->curves + s->ab->curve_count; ++cv) {
         for (int k = 0; k < cv->point_count; ++k) {
@@ -421,22 +488,57 @@ static void normal_equations(sp_solver* s, const double* p)
             const sparse_block* A = &s->ab_sb[a];
             const double* Ga = s->G + 2 * (size_t)A->first;
             const int* ca = s->ab_cols + A->first;
-            if (aa[a] != 0.0 || beta[2 * a] != 0.0 || beta[2 * a + 1] != 0.0)
-                accumulate(s, ca, A->count, Ga, 2, beta + 2 * a, 1.0, aa[a]);
-            if (ab[a] == 0.0) continue;
+            const double* M = aa + 3 * a;
+            if (M[0] != 0.0 || M[2] != 0.0 || beta[2 * a] != 0.0 || beta[2 * a + 1] != 0.0) {
+                // H += Ga^T M Ga and g += Ga^T beta through M = L L^T:
+                // rows L^T Ga and residual L^-1 beta (M is positive definite
+                // whenever a pair touches the point; a tiny floor otherwise).
+                double l00 = sqrt(fmax(M[0], 1e-300)), l10 = M[1] / l00;
+                double l11 = sqrt(fmax(M[2] - l10 * l10, 1e-300 * (1.0 + M[2])));
+                int n = A->count;
+                for (int c = 0; c < n; ++c) {
+                    double gx = Ga[c], gy = Ga[n + c];
+                    B[c] = l00 * gx + l10 * gy;
+                    B[n + c] = l11 * gy;
+                }
+                double r2[2];
+                r2[0] = beta[2 * a] / l00;
+                r2[1] = (beta[2 * a + 1] - l10 * r2[0]) / l11;
+                push_rows(s, s->ab_grp[a], B, 2, r2);
+            }
+            const double* X = ab + 3 * a;
+            if (X[0] == 0.0 && X[1] == 0.0 && X[2] == 0.0) continue;
             int b = k + 1 < cv->point_count ? a + 1 : cv->first_point; // closing segment of a loop
             const sparse_block* Bk = &s->ab_sb[b];
             const double* Gb = s->G + 2 * (size_t)Bk->first;
             const int* cb = s->ab_cols + Bk->first;
-            // Cross term ab * (Ga^T Gb + Gb^T Ga), into the upper triangle.
-            for (int i = 0; i < A->count; ++i)
-                for (int j = 0; j < Bk->count; ++j) {
-                    double x = ab[a] * (Ga[i] * Gb[j] + Ga[A->count + i] * Gb[Bk->count + j]);
+            // Cross term Ga^T X Gb + Gb^T X Ga (X symmetric): inside a group
+            // as rows U = Ga, V = X Gb; across groups straight into H.
+            if (s->ab_grp[a] == s->ab_grp[b] && a != b) {
+                row_group* gr = &s->groups[s->ab_grp[a]];
+                const int n = gr->n;
+                assert(gr->rows + 2 <= gr->cap);
+                double* U = gr->U + (size_t)gr->rows * (size_t)n;
+                double* V = gr->V + (size_t)gr->rows * (size_t)n;
+                for (int c = 0; c < n; ++c) {
+                    U[c] = Ga[c], U[n + c] = Ga[n + c];
+                    V[c] = X[0] * Gb[c] + X[1] * Gb[n + c];
+                    V[n + c] = X[1] * Gb[c] + X[2] * Gb[n + c];
+                }
+                gr->rows += 2;
+                continue;
+            }
+            for (int j = 0; j < Bk->count; ++j) {
+                double bx = X[0] * Gb[j] + X[1] * Gb[Bk->count + j];
+                double by = X[1] * Gb[j] + X[2] * Gb[Bk->count + j];
+                for (int i = 0; i < A->count; ++i) {
+                    double x = Ga[i] * bx + Ga[A->count + i] * by;
                     int qi = ca[i], qj = cb[j];
                     if (qi == qj) s->H[qi * P + qi] += 2.0 * x;
                     else if (qi < qj) s->H[qi * P + qj] += x;
                     else s->H[qj * P + qi] += x;
                 }
+            }
         }
     }
     if (s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0)) {
@@ -444,17 +546,29 @@ static void normal_equations(sp_solver* s, const double* p)
         for (int i = 0; i < s->k; ++i) {
             const sparse_block* sb = &s->rep_sb[i];
             const double* Jb = s->Jr + 3 * (size_t)sb->first;
-            const int* cl = s->rep_cols + sb->first;
             double dx[3] = {s->xr[3 * i] - s->x0[3 * i], s->xr[3 * i + 1] - s->x0[3 * i + 1], s->xr[3 * i + 2] - s->x0[3 * i + 2]};
-            if (s->d.lambda_plane > 0) {
+            // W_plane and W_dist of this representative as four rows of one
+            // least-squares block, each scaled by the square root of its weight.
+            int n = sb->count, rows = 0;
+            double r4[4];
+            double wp = s->d.lambda_plane * inv, wd = s->d.lambda_dist * inv * s->dw[i];
+            if (wp > 0) {
                 sp_vec3 v = s->view[i];
-                for (int c = 0; c < sb->count; ++c) B[c] = v.x * Jb[c] + v.y * Jb[sb->count + c] + v.z * Jb[2 * sb->count + c];
-                double r = v.x * dx[0] + v.y * dx[1] + v.z * dx[2];
-                accumulate(s, cl, sb->count, B, 1, &r, s->d.lambda_plane * inv, s->d.lambda_plane * inv);
+                double sw = sqrt(wp);
+                for (int c = 0; c < n; ++c) B[c] = sw * (v.x * Jb[c] + v.y * Jb[n + c] + v.z * Jb[2 * n + c]);
+                r4[rows++] = sw * (v.x * dx[0] + v.y * dx[1] + v.z * dx[2]);
             }
-            if (s->d.lambda_dist > 0 && s->dw[i] > 0) accumulate(s, cl, sb->count, Jb, 3, dx, s->d.lambda_dist * inv * s->dw[i], s->d.lambda_dist * inv * s->dw[i]);
+            if (wd > 0) {
+                double sw = sqrt(wd);
+                for (int d = 0; d < 3; ++d) {
+                    for (int c = 0; c < n; ++c) B[rows * n + c] = sw * Jb[d * n + c];
+                    r4[rows++] = sw * dx[d];
+                }
+            }
+            if (rows) push_rows(s, s->rep_grp[i], B, rows, r4);
         }
     }
+    flush_groups(s);
     for (int q = 0; q < P; ++q) {
         double w = s->d.lambda_pose * s->pose_boost / (s->unit[q] * s->unit[q]);
         s->H[q * P + q] += w;
@@ -504,7 +618,7 @@ static bool lm_step(sp_solver* s, double mu, double* delta)
 static void choose_free(sp_solver* s, const double* p, const bool* stage_active)
 {
     for (int q = 0; q < s->P; ++q) {
-        const sp_param* pr = &s->rig->params[q];
+        const sp_model_param* pr = &s->model->params[q];
         bool f = stage_active[q];
         double eps = 1e-12 * (1.0 + fabs(pr->max - pr->min));
         if (p[q] <= pr->min + eps && s->g[q] > 0) f = false;
@@ -518,8 +632,8 @@ static void choose_free(sp_solver* s, const double* p, const bool* stage_active)
 // the representatives, and d_i / d_max from the curves that got a stroke.
 static void prepare_start(sp_solver* s, const double* p, const sp_solve_report* rep)
 {
-    sp_rig_eval_update(s->ev, p, false);
-    sp_rig_eval_rows(s->ev, sp_rig_mesh_points(s->rig), s->reps, s->k, s->x0);
+    model_update(s, p, false);
+    model_rows(s, s->x0);
     project_abstraction(s);
     double dmax = 0;
     for (int i = 0; i < s->k; ++i) {
@@ -544,13 +658,55 @@ static void prepare_start(sp_solver* s, const double* p, const sp_solve_report* 
 }
 
 // Per-curve and overall 2D errors from the current pairs at the current state.
+static double segment_distance(sp_vec2 x, sp_vec2 a, sp_vec2 b)
+{
+    sp_vec2 ab = sp_v2_sub(b, a), ax = sp_v2_sub(x, a);
+    double l2 = sp_v2_dot(ab, ab);
+    double t = l2 > 0 ? fmin(1.0, fmax(0.0, sp_v2_dot(ax, ab) / l2)) : 0.0;
+    return sp_v2_len(sp_v2_sub(ax, (sp_vec2){t * ab.x, t * ab.y}));
+}
+
+// Distance of x to projected curve c (its polyline through the points).
+static double curve_distance(const sp_solver* s, int c, sp_vec2 x)
+{
+    const sp_curve* cv = &s->ab->curves[c];
+    const double* z = s->z2 + 2 * (size_t)cv->first_point;
+    double best = INFINITY;
+    int n = cv->point_count, segs = cv->closed ? n : n - 1;
+    if (n == 1) return sp_v2_len(sp_v2_sub(x, (sp_vec2){z[0], z[1]}));
+    for (int k = 0; k < segs; ++k) {
+        int k2 = (k + 1) % n;
+        best = fmin(best, segment_distance(x, (sp_vec2){z[2 * k], z[2 * k + 1]}, (sp_vec2){z[2 * k2], z[2 * k2 + 1]}));
+    }
+    return best;
+}
+
+// Distance of x to the resampled strokes of the last closest-point matching.
+static double stroke_distance(const sp_solver* s, sp_vec2 x)
+{
+    double best = INFINITY;
+    for (int k = 0; k < s->ypoly_count; ++k) {
+        bool joined = k + 1 < s->ypoly_count && s->ypoly_stroke[k + 1] == s->ypoly_stroke[k];
+        best = fmin(best, joined ? segment_distance(x, s->ypoly[k], s->ypoly[k + 1]) : sp_v2_len(sp_v2_sub(x, s->ypoly[k])));
+    }
+    return best;
+}
+
+// The report's 2D errors. Ordered pairs: the distance between corresponding
+// samples. Closest pairs: the distance of each sample to the other side's
+// polyline, not to its nearest sample: two samplings of the same curve are
+// up to half a spacing apart, which would put a floor of about 0.7% of the
+// diagonal under every closest-point fit (seen on the dragon outlines).
 static void fill_errors(sp_solver* s, sp_solve_report* rep)
 {
     double sum = 0, mx = 0;
     double csum[SP_REPORT_CURVES] = {0}, cmax[SP_REPORT_CURVES] = {0};
     int cn[SP_REPORT_CURVES] = {0};
     for (int i = 0; i < s->pair_count; ++i) {
-        double d = sp_v2_len(sp_v2_sub(sample_at(s, s->pairs[i].s), s->pairs[i].y));
+        const pair* pr = &s->pairs[i];
+        double d = sp_v2_len(sp_v2_sub(sample_at(s, pr->s), pr->y));
+        if (s->mode == SP_CORR_CLOSEST)
+            d = fmin(d, pr->dir == 0 ? curve_distance(s, pr->curve, pr->y) : stroke_distance(s, sample_at(s, pr->s)));
         sum += d;
         if (d > mx) mx = d;
         int c = s->pairs[i].curve;
@@ -591,10 +747,27 @@ static bool sketch_ok(const sp_sketch* sk, sp_error* err)
     return true;
 }
 
-sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep,
-                          sp_error* err)
+// A stroke whose ends meet within a fifth of its bounding-box diagonal: a
+// person drawing a closed outline (gaps at closure are common, see the
+// hand-drawing model of the classifier's training data).
+static bool stroke_is_loop(const sp_stroke* st)
+{
+    if (st->count < 8) return false;
+    double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
+    for (int i = 0; i < st->count; ++i) {
+        lx = fmin(lx, st->points[i].x), hx = fmax(hx, st->points[i].x);
+        ly = fmin(ly, st->points[i].y), hy = fmax(hy, st->points[i].y);
+    }
+    double diag = hypot(hx - lx, hy - ly);
+    sp_vec2 gap = sp_v2_sub(st->points[st->count - 1], st->points[0]);
+    return diag > 0 && sp_v2_len(gap) <= 0.2 * diag;
+}
+
+static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep, bool allow_loop,
+                            double time_cap_ms, sp_error* err)
 {
     double t0 = now_ms();
+    s->used_loop = false;
     memset(rep, 0, sizeof *rep);
     if (!sketch_ok(sk, err)) return SP_ERR_INVALID;
     const int P = s->P;
@@ -607,12 +780,13 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory in the solver");
     }
     if (p_start) memcpy(p, p_start, sizeof(double) * (size_t)P);
-    else sp_rig_defaults(s->rig, p);
-    sp_rig_clamp(s->rig, p);
+    else model_defaults(s, p);
+    model_clamp(s, p);
     memcpy(s->p0, p, sizeof(double) * (size_t)P);
+    s->model->failed = false;
 
     // L: the abstraction's diagonal in pixels at the start pose.
-    sp_rig_eval_update(s->ev, p, false);
+    model_update(s, p, false);
     project_abstraction(s);
     {
         double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
@@ -627,19 +801,25 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
 
     // Stages: (0) only the root's placement moves, when it has translation
     // or scale parameters, so that a part drawn anywhere on the canvas is
-    // first brought to the stroke; (1) everything moves. (A closest-point
+    // first brought to the stroke; (1) everything moves; (2) for an outline
+    // drawn as a loop, closest-point refinement after stage 1 in order. (A closest-point
     // stage before ordered matching was tried and lost: it folds stick
     // figures into local minima, 17% vs 97% recovery on the test chain.)
-    int root_joint = P > 0 ? s->rig->params[0].joint : -1;
-    bool has_placement = false;
-    for (int q = 0; q < P && s->rig->params[q].joint == root_joint; ++q)
-        has_placement |= !sp_channel_is_rotation(s->rig->params[q].channel);
-    int first_stage = (!s->d.no_root_alignment && has_placement) ? 0 : 1;
+    int first_stage = (!s->d.no_root_alignment && s->model->placement_count > 0) ? 0 : 1;
     int last_stage = 1;
+    // An outline (one closed curve, closest points) drawn as one closed
+    // stroke is matched in order first (arc length, best cyclic shift and
+    // direction), then refined with closest points: closest-point ICP from
+    // the rest pose snags in local minima where limbs cross (dragon parts:
+    // 16-79% of random targets recovered; in order first: 95-100%).
+    bool loop_first = s->ab->correspondence == SP_CORR_CLOSEST && s->ab->curve_count == 1 && s->ab->curves[0].closed &&
+                      sk->stroke_count == 1 && stroke_is_loop(&sk->strokes[0]) && allow_loop;
+    s->used_loop = loop_first;
+    if (loop_first) last_stage = 2;
 
     s->mode = first_stage == 0 ? SP_CORR_CLOSEST : s->ab->correspondence;
     s->c2s_valid = s->keep_assignment = false;
-    sp_result res = sp__build_pairs(s, sk, rep, err);
+    sp_result res = s->model->failed ? sp_fail(err, SP_ERR_INVALID, "%s", s->model->error.text) : sp__build_pairs(s, sk, rep, err);
     if (res != SP_OK) goto done;
     prepare_start(s, p, rep);
     s->pose_boost = s->vertex_boost = 1.0;
@@ -651,20 +831,22 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     for (int stage = first_stage; stage <= last_stage && !time_up; ++stage) {
         for (int q = 0; q < P; ++q) {
             bool a = s->d.active ? s->d.active[q] : true;
-            if (stage == 0) a = a && s->rig->params[q].joint == root_joint;
+            if (stage == 0) a = a && q < s->model->placement_count;
             stage_active[q] = a;
         }
         // Placement is found with closest points (no assignment needed);
         // the full solve uses the abstraction's own procedure.
         s->mode = stage == 0 ? SP_CORR_CLOSEST : s->ab->correspondence;
+        if (loop_first) s->mode = stage == 1 ? SP_CORR_ORDERED : SP_CORR_CLOSEST;
+        s->c2s_valid = s->keep_assignment = false;
         converged = false;
-        for (int round = 0; round < s->d.max_icp_rounds && !time_up; ++round) {
+        for (int round = 0; round < s->d.max_icp_rounds && !time_up && !s->model->failed; ++round) {
             // Ordered correspondences are kept once the weights are final:
             // re-resampling a curve that barely moves only slides its samples
             // along it, which costs many rounds and gains nothing.
             bool frozen = s->mode == SP_CORR_ORDERED && s->pose_boost == 1.0 && round > 0;
             if ((round > 0 || stage > first_stage) && !frozen) {
-                sp_rig_eval_update(s->ev, p, false);
+                model_update(s, p, false);
                 project_abstraction(s);
                 res = sp__build_pairs(s, sk, rep, err);
                 if (res != SP_OK) goto done;
@@ -680,21 +862,25 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
             // Draw-over curves (embedded in the surface) are local edits, so
             // there W_plane and W_dist are graduated too: the early steps
             // then move what is near the curve, not the whole figure.
-            s->pose_boost = fmax(1.0, 1e7 / pow(8.0, round));
-            s->vertex_boost = s->ab->rest ? 1.0 : s->pose_boost;
+            s->pose_boost = stage != 1 ? 1.0 : fmax(1.0, 1e7 / pow(8.0, round));
+            s->vertex_boost = s->model->embedded ? s->pose_boost : 1.0;
             cur = energy(s, p);
             double round_start = cur.total;
-            // Gauss-Newton iterations with these correspondences.
-            for (int it = 0; it < 8; ++it) {
+            // Few Gauss-Newton iterations per round: correspondences from
+            // the previous pose go stale quickly, and while the weights are
+            // graduated a round only has to follow them part of the way.
+            // Frozen ordered pairs do not go stale, so they get more.
+            int max_it = s->pose_boost > 1.0 ? 2 : (frozen ? 8 : 3);
+            for (int it = 0; it < max_it; ++it) {
                 if (rep->iterations >= s->d.max_iterations) break;
-                if (now_ms() - t0 > s->d.time_cap_ms) {
+                if (now_ms() - t0 > time_cap_ms) {
                     time_up = true;
                     break;
                 }
                 ++rep->iterations;
-                sp_rig_eval_update(s->ev, p, true);
+                model_update(s, p, true);
                 project_abstraction(s);
-                if (s->k > 0) sp_rig_eval_rows(s->ev, sp_rig_mesh_points(s->rig), s->reps, s->k, s->xr);
+                if (s->k > 0) model_rows(s, s->xr);
                 normal_equations(s, p);
                 choose_free(s, p, stage_active);
                 bool accepted = false;
@@ -704,7 +890,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
                         continue;
                     }
                     for (int q = 0; q < P; ++q) pn[q] = p[q] + delta[q];
-                    sp_rig_clamp(s->rig, pn);
+                    model_clamp(s, pn);
                     sp_energy_terms e = energy(s, pn);
                     if (e.total < cur.total) {
                         accepted = true;
@@ -712,7 +898,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
                         memcpy(p, pn, sizeof(double) * (size_t)P);
                         cur = e;
                         mu = fmax(mu / 3, 1e-7);
-                        if (gain < 1e-9) it = 8; // this linearisation is exhausted
+                        if (gain < 1e-9) it = max_it; // this linearisation is exhausted
                     } else {
                         mu *= 4;
                     }
@@ -720,20 +906,31 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
                 if (!accepted) break;
             }
             double drop = (round_start - cur.total) / fmax(round_start, 1e-300);
-            // Converged when a round with fresh correspondences no longer
-            // lowers W by more than 0.01% once the weights are the real ones.
-            if (drop < 1e-6 || (s->pose_boost == 1.0 && drop < 1e-4)) {
+            // Converged when a round no longer lowers W by more than 0.1% once
+            // the weights are the real ones (1% while only placing the root).
+            // The regularisers keep a large residual at the optimum, where
+            // Gauss-Newton converges only linearly; the recovery benchmark
+            // gives the same errors with this tolerance as with 0.01% in a
+            // third of the iterations.
+            double tol = stage == 0 ? 1e-2 : 1e-3;
+            if (drop < 1e-6 || (s->pose_boost == 1.0 && drop < tol)) {
                 converged = true;
                 break;
             }
             if (rep->iterations >= s->d.max_iterations) break;
         }
     }
+    if (s->model->failed) {
+        // A black-box rig that cannot evaluate inside its bounds is broken:
+        // say so instead of returning a pose fitted around the hole.
+        res = sp_fail(err, SP_ERR_INVALID, "%s", s->model->error.text);
+        goto done;
+    }
     rep->stopped = time_up ? SP_STOP_TIME_CAP : (converged ? SP_STOP_CONVERGED : SP_STOP_MAX_ITERATIONS);
     // Final errors with fresh correspondences at the result.
     s->mode = s->ab->correspondence;
     s->pose_boost = s->vertex_boost = 1.0;
-    sp_rig_eval_update(s->ev, p, false);
+    model_update(s, p, false);
     project_abstraction(s);
     res = sp__build_pairs(s, sk, rep, err);
     if (res != SP_OK) goto done;
@@ -746,5 +943,34 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
 done:
     rep->ms = now_ms() - t0;
     free(p), free(pn), free(delta), free(stage_active);
+    return res;
+}
+
+sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep,
+                          sp_error* err)
+{
+    sp_result res = solve_once(s, sk, p_start, p_out, rep, true, s->d.time_cap_ms, err);
+    // An outline matched in order can lock onto the wrong cyclic shift or
+    // direction when the target is far from the start (a thin tail's two
+    // edges look alike); when that leaves more than 1% error, the plain
+    // closest-point solve gets a turn and the better fit is kept. Both
+    // attempts count in the report's work and time.
+    double left = s->d.time_cap_ms - rep->ms;
+    if (res != SP_OK || !s->used_loop || rep->mean_error_px <= 0.01 * rep->bbox_diagonal_px || left <= 0) return res;
+    double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
+    sp_solve_report* r2 = malloc(sizeof *r2);
+    if (!p2 || !r2) {
+        free(p2), free(r2);
+        return res;
+    }
+    sp_error e2 = {0};
+    if (solve_once(s, sk, p_start, p2, r2, false, left, &e2) == SP_OK && r2->mean_error_px < rep->mean_error_px) {
+        r2->iterations += rep->iterations, r2->icp_rounds += rep->icp_rounds, r2->ms += rep->ms;
+        *rep = *r2;
+        memcpy(p_out, p2, sizeof(double) * (size_t)s->P);
+    } else {
+        rep->iterations += r2->iterations, rep->icp_rounds += r2->icp_rounds, rep->ms += r2->ms;
+    }
+    free(p2), free(r2);
     return res;
 }

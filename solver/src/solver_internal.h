@@ -2,6 +2,7 @@
 #ifndef SP_SOLVER_INTERNAL_H
 #define SP_SOLVER_INTERNAL_H
 
+#include "model.h"
 #include "sp/solver.h"
 
 // A sample on a projected curve: (1 - t) * point a + t * point b.
@@ -15,21 +16,34 @@ typedef struct pair {
     sp_vec2 y;
     sample_ref s;
     int curve; // for the per-curve report
+    // Unit normal of the stroke at y for closest-point pairs, (0, 0) for
+    // ordered ones: a closest pair weighs the residual across the stroke
+    // fully and along it by SP_TANGENT_WEIGHT (see solver.c).
+    sp_vec2 n;
+    // Closest-point pairs: 0 when y was the stroke sample looking for the
+    // curve, 1 when the curve sample looked for the stroke (the final error
+    // then measures to the other side's polyline, see fill_errors).
+    int dir;
 } pair;
 
-// Sparse rows: a point's Jacobian touches only the parameters of its
-// influences' ancestors; `cols` lists them (sorted), `block` holds the
-// projected 2 x ncols values (row-major).
-typedef struct sparse_block {
-    int first, count; // into solver->cols / solver->blocks
-} sparse_block;
+// Rows of the normal equations that share one column list: H gets
+// U^T V + V^T U of the stacked rows with one BLAS call (dsyr2k) and one
+// scattered add per entry, instead of one per row (points and
+// representatives on the same bones have the same columns; a black-box rig
+// has one group of all parameters).
+typedef struct row_group {
+    const int* cols; // n sorted parameter indices
+    int n;
+    int cap, rows;   // rows reserved, rows filled this iteration
+    double* U;       // cap by n, row-major
+    double* V;       // cap by n
+} row_group;
 
 struct sp_solver {
-    const sp_rig* rig;
+    sp_model* model; // the rig: LBS (analytic Jacobians) or black box (finite differences)
     const sp_abstraction* ab;
     const sp_camera* cam;
     sp_solve_desc d;
-    sp_rig_eval* ev;
     int P;
     double D; // rest mesh bounding-box diagonal, world units
     // Coarsening.
@@ -41,26 +55,36 @@ struct sp_solver {
     int* rep_cols;       // pool
     sparse_block* rep_sb;// k
     // Buffers.
-    double* mesh;    // vertex_count * 3 (only for embedded abstractions)
     double* z3;      // point_count * 3
     double* z2;      // point_count * 2
+    double* Jz;      // 3D Jacobian blocks of the abstraction points, pool aligned with ab_cols: 3 values per column
     double* G;       // projected Jacobian blocks, pool aligned with ab_cols: 2 values per column
     double* x0;      // k * 3 representatives at the start pose
     double* xr;      // k * 3 representatives now
     double* Jr;      // pool aligned with rep_cols: 3 values per column
     double* dw;      // k: d_i / d_max
     sp_vec3* view;   // k: viewing direction at x0
-    double* scratch; // 3 * P * 3
     double* H;       // P * P
+    double* Hl;      // P * P scratch: one block's local normal matrix
     double* g;       // P
     double* p0;      // P: the start pose (W_pose anchor)
     double* unit;    // P: parameter units
     bool* free_;     // P
-    double* match_aa;   // point_count: summed match weights per point
-    double* match_ab;   // point_count: coupling of the segment starting at each point
+    double* match_aa;   // point_count by 3: summed 2x2 match weights per point (xx, xy, yy)
+    double* match_ab;   // point_count by 3: coupling of the segment starting at each point
     double* match_beta; // point_count by 2: weighted residual per point
+    row_group* groups;
+    int group_count;
+    int* ab_grp;        // point_count: group of each abstraction point
+    int* rep_grp;       // k: group of each representative
+    double* group_pool; // U and V of every group
     // Correspondences.
     pair* pairs;
+    // The resampled strokes of the last closest-point matching (polylines,
+    // stroke index per sample), for the report's errors.
+    sp_vec2* ypoly;
+    int* ypoly_stroke;
+    int ypoly_count, ypoly_cap;
     int pair_count, pair_cap;
     double L;        // abstraction 2D diagonal at the start pose, pixels
     sp_correspondence mode; // how sp__build_pairs pairs samples now
@@ -68,6 +92,7 @@ struct sp_solver {
     double vertex_boost;
     int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke)
     bool c2s_valid;
+    bool used_loop;            // the last attempt matched an outline in order first
     bool keep_assignment;      // reuse c2s instead of assigning again    // >= 1: the same for W_plane and W_dist (draw-over only)
 };
 

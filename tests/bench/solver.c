@@ -1,7 +1,7 @@
 // tests/bench/solver: solves to convergence on rigs of the paper's Table 1
 // dimensions, one thread, median of N solves (each a different seeded
 // target pose, amplitude 45 degrees, from the rest pose).
-//   build/tests/bench/solver [--json] [--runs N]
+//   build/tests/bench/solver [--json] [--runs N] [--only NAME]
 //   build/tests/bench/solver --recovery [--json] [--cases N]
 // --recovery runs the recovery protocol instead: N seeded targets
 // per rig (chain fixture, CesiumMan and RiggedFigure with derived stick
@@ -14,6 +14,7 @@
 
 #include "bench.h"
 #include "fixtures.h"
+#include "sp/blackbox.h"
 #include "sp/gltf.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
@@ -129,12 +130,57 @@ static void recovery(int cases, bool json)
     if (json) sp_bench_print("", rows, nr, true);
 }
 
+// The paper's black-box row: the `face` plugin (44 parameters, blendshapes
+// and bend/twist deformers, no analytic Jacobian), posed through finite
+// differences on both cores, each run a different seeded target within the
+// same amplitude rule as the synthetic rows.
+static bool face_row(int runs, sp_bench_row* row)
+{
+    sp_blackbox* bb = NULL;
+    sp_error err = {0};
+    if (sp_blackbox_load_plugin(SP_FACE_PLUGIN, &bb, &err) != SP_OK) {
+        fprintf(stderr, "%s\n", err.text);
+        return false;
+    }
+    const sp_blackbox_rig* r = sp_blackbox_desc(bb);
+    sp_camera cam = sp_blackbox_camera(bb, 640, 480);
+    sp_solver* s = sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){0});
+    outcome o = {malloc(sizeof(double) * runs), malloc(sizeof(double) * runs), malloc(sizeof(double) * runs), runs};
+    double* truth = malloc(sizeof(double) * r->param_count);
+    double* out = malloc(sizeof(double) * r->param_count);
+    for (int i = 0; i < runs; ++i) {
+        sp_blackbox_synth_params(bb, (uint64_t)(1000 + i), 0.7853981633974483, truth);
+        sp_sketch sk;
+        sp_solve_report rep = {0};
+        if (sp_blackbox_synth_sketch(bb, 0, &cam, truth, &sk, &err) != SP_OK || sp_solver_solve(s, &sk, NULL, out, &rep, &err) != SP_OK)
+            fprintf(stderr, "face: %s\n", err.text);
+        o.ms[i] = rep.ms;
+        o.rel[i] = rep.bbox_diagonal_px > 0 ? rep.mean_error_px / rep.bbox_diagonal_px : 1;
+        o.its[i] = rep.iterations;
+        sp_sketch_free(&sk);
+    }
+    *row = (sp_bench_row){.runs = runs, .paper_ms = 8922, .target_ms = 250};
+    snprintf(row->name, sizeof row->name, "face (black box, 44 p, FD on %d threads)", 2);
+    int ok = within(&o, 0.01);
+    sp_bench_stats(o.ms, o.n, &row->ms_median, &row->ms_p90);
+    double it_med, it_p90;
+    sp_bench_stats(o.its, o.n, &it_med, &it_p90);
+    snprintf(row->extra, sizeof row->extra, "\"parameters\": %d, \"mesh_coordinates\": %d, \"abstraction_coordinates\": %d, \"within_1pct\": %d, \"iterations_median\": %g",
+             r->param_count, 3 * r->vertex_count, 2 * sp_blackbox_abstraction_points(bb, 0), ok, it_med);
+    free(truth), free(out), free(o.ms), free(o.rel), free(o.its);
+    sp_solver_destroy(s);
+    sp_blackbox_free(bb);
+    return true;
+}
+
 int main(int argc, char** argv)
 {
     int runs = 20, cases = 100;
+    const char* only = NULL;
     bool json = sp_bench_json_flag(argc, argv), rec = false;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--runs") && i + 1 < argc) runs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
         else if (!strcmp(argv[i], "--cases") && i + 1 < argc) cases = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--recovery")) rec = true;
     }
@@ -154,6 +200,7 @@ int main(int argc, char** argv)
     sp_bench_row rows[8];
     int n = 0;
     for (size_t c = 0; c < sizeof cs / sizeof cs[0]; ++c) {
+        if (only && !strstr(cs[c].name, only)) continue;
         sp_rig rig;
         sp_fixture_tree_rig(&cs[c].desc, &rig);
         sp_camera cam = camera_for(&rig);
@@ -163,6 +210,7 @@ int main(int argc, char** argv)
         free(o.ms), free(o.rel), free(o.its);
         sp_rig_free(&rig);
     }
+    if ((!only || strstr("face", only)) && face_row(runs, &rows[n])) ++n;
     sp_bench_print("tests/bench/solver: solve to convergence, one thread (synthetic rigs of the paper's Table 1 dimensions)", rows, n, json);
     return 0;
 }

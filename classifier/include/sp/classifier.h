@@ -3,7 +3,7 @@
 /// Eitz-style bag of features (Eitz, Hays, Alexa 2012): a drawing is fitted to a
 /// 256x256 frame, rasterised, described by 64-D local orientation descriptors on
 /// a 28x28 grid, soft-assigned to a k-means vocabulary and summarised as an
-/// L1-normalised histogram (optionally with a 1x1+2x2 spatial pyramid, tf-idf,
+/// L1-normalised histogram (optionally with a 1x1+2x2(+4x4) spatial pyramid, tf-idf,
 /// and Hellinger-mapped). A FLANN k-nearest-neighbour search over the training
 /// histograms votes, weighted by distance, for ranked categories; a drawing
 /// farther from every training drawing than a threshold learned on the training
@@ -44,7 +44,7 @@ typedef struct sp_clf_desc {
     int kmeans_iterations;  ///< Lloyd iterations after k-means++ seeding (default 10)
     int soft_neighbours;    ///< words each descriptor is soft-assigned to (default 4; 1 = hard assignment)
     int knn;                ///< neighbours voting at classification (default 8)
-    int pyramid;            ///< 1x1 + 2x2 spatial pyramid histograms (default on)
+    int pyramid;            ///< spatial pyramid: 1 = 1x1 + 2x2 cells (default), 2 = also 4x4; -1 = whole drawing only
     int tfidf;              ///< tf-idf word weighting (default on: +0.8 pt top-1 on quickdraw 5-fold)
     int hellinger;          ///< square-root (Hellinger) map of the histograms before k-NN (default on)
     int mirror;             ///< also train on left-right mirrored drawings (default on)
@@ -78,6 +78,18 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
 /// Classifies strokes, or (when `sketch` is NULL or empty) a raster. Bad drawings
 /// (empty, non-finite, too many points) fail with a one-line message.
 sp_result sp_clf_classify(const sp_clf* clf, const sp_sketch* sketch, const sp_raster* raster, sp_clf_answer* out, sp_error* err);
+/// Recalibrates the reject threshold on drawings the model was not trained on
+/// (held out; `use` NULL: all of `held_out`): the `quantile` (in (0, 1]) of
+/// their nearest-neighbour distances, times `margin` (>= 1; 0 means 1).
+/// Training sets the threshold from leave-one-out distances among training
+/// drawings, which are closer to one another than new drawings are; held-out
+/// drawings of the kind the model will see give a threshold that rejects few
+/// of them. `distances` (may be NULL) receives the sorted distances, *count of
+/// them. Call before sharing the model between threads.
+sp_result sp_clf_calibrate_reject(sp_clf* clf, const sp_dataset* held_out, const unsigned char* use, double quantile, double margin,
+                                  float* distances, int* count, sp_error* err);
+/// The reject threshold (histogram distance; INFINITY: never rejects).
+float sp_clf_reject_distance(const sp_clf* clf);
 /// Saves with a version header and a checksum.
 sp_result sp_clf_save(const sp_clf* clf, const char* path, sp_error* err);
 /// Loads a model; a corrupt, truncated or other-version file is refused with a clear message.

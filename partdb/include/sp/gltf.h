@@ -56,6 +56,35 @@ sp_result sp_gltf_load_memory(const void* data, size_t size, const char* what, s
 sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err);
 /// Same as sp_gltf_save to a malloc'd GLB in memory (*data freed by the caller with free()).
 sp_result sp_gltf_save_memory(const sp_character* ch, const double* params, void** data, size_t* size, sp_error* err);
+/// One part of a scene written by sp_gltf_save_scene.
+typedef struct sp_gltf_scene_part {
+    const sp_character* character; ///< its rig, mesh and colours (written as its own skin)
+    const double* params;          ///< the pose baked into its joint nodes (rig.param_count); NULL: character->pose
+    const char* name;              ///< prefix of its node, mesh and skin names ("<name>/<joint>"); NULL: "part<i>"
+    sp_mat4 placement;             ///< its placement node, parent of the part's root joints: model space -> scene;
+                                   ///< must be a similarity (rotation, uniform positive scale, translation)
+    const sp_animation* animation; ///< channels on the part's joints (channel.joint = rig joint index); NULL: none
+    int placement_key_count;       ///< keys of an animated placement (0: static), LINEAR
+    const float* placement_times;  ///< placement_key_count seconds, increasing
+    const float* placement_trs;    ///< placement_key_count by 8: tx ty tz, qx qy qz qw, uniform scale
+} sp_gltf_scene_part;
+
+/// A scene of several rigged parts (e.g. the kiosk's dragon).
+typedef struct sp_gltf_scene_desc {
+    int part_count;
+    const sp_gltf_scene_part* parts;
+    const char* animation_name; ///< the ONE animation holding every part's channels; NULL: "animation"
+    const char* extras_json;    ///< the scene's extras as a JSON object text, or NULL
+    bool abstractions;          ///< also write each part's abstraction curves (off: viewers draw them as lines)
+} sp_gltf_scene_desc;
+
+/// Writes several parts into one glTF (".glb" binary, else .gltf with
+/// embedded buffers): per part a placement node, its joint nodes under it,
+/// its own skin and skinned mesh; every part's channels (joints and
+/// placement) in one animation. SP_ERR_INVALID for no parts, a placement that
+/// is not a similarity, or non-finite values.
+sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const char* path, sp_error* err);
+
 /// Makes a character of a finalized rig, which it takes over (*rig is zeroed):
 /// default pose, light grey vertices, the default front orthographic camera.
 /// For generators and tests that build rigs in code and want to save them.

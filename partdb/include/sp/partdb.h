@@ -48,7 +48,8 @@ extern "C" {
 #define SP_DB_SCHEMA_VERSION 2
 /// Default busy timeout: how long a writer waits for another writer.
 #define SP_DB_BUSY_MS_DEFAULT 5000
-/// Synthetic sketches stored with a part by default (per part, random poses).
+/// Synthetic sketches stored with a part by default (per part: random shape and
+/// pose, drawn by the hand-drawing model of sp/handdraw.h, normal style).
 #define SP_DB_SYNTH_DEFAULT 60
 
 typedef struct sp_db sp_db;
@@ -103,7 +104,7 @@ typedef struct sp_db_part_desc {
     const char* abstraction; ///< NULL: `sp_part.abstraction`, else the first abstraction
     const char* added_by;    ///< NULL: $USER, else "unknown"
     int synth_sketches;      ///< synthetic sketches stored with it; 0: SP_DB_SYNTH_DEFAULT; -1: none
-    uint64_t seed;           ///< for the synthetic sketches (0: 1)
+    uint64_t seed;           ///< seed family of the synthetic sketches (0: one of the part's own, from its name; sp/handdraw.h)
     double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: 0.4; see sp/synth.h)
     int selftest_seeds;      ///< solver self-test seeds; 0: 3; -1: skip the self-test
     double selftest_tolerance; ///< largest mean error over the seeds, fraction of the 2D diagonal; 0: 0.02
@@ -167,11 +168,19 @@ typedef struct sp_db_train_desc {
     sp_clf_desc clf;    ///< classifier options (progress reported through it)
     int folds;          ///< cross-validation folds for the report; 0: 3; -1: none
     const char* by;     ///< curator (NULL: $USER)
+    /// Reject threshold calibration: this many hand-drawn sketches per part, in
+    /// the harsh style and a seed family of their own (never stored, never
+    /// trained on), set the threshold (sp_clf_calibrate_reject). 0: 50; -1: keep
+    /// the training set's leave-one-out threshold.
+    int calibrate;
+    double calibrate_quantile; ///< share of the calibration sketches accepted; 0: 0.97
 } sp_db_train_desc;
 /// Rebuilds the classifier from the stored sketches of the current part
-/// categories, cross-validates it for the report, and stores the model with
+/// categories, cross-validates it for the report, calibrates its reject
+/// threshold on fresh hand-drawn sketches of the parts, and stores the model with
 /// its options and report in one transaction. `report_json` (may be NULL) gets
-/// the report: {"categories", "drawings", "folds", "top1", "per_class": {"<cat>": {"recall", "n"}}, "seconds"}
+/// the report: {"categories", "drawings", "folds", "top1", "per_class": {"<cat>": {"recall", "n"}}, "seconds_train",
+/// "seconds_cv", "reject_distance", "calibration": {"sketches", "quantile"} (absent without calibration)}
 /// (malloc'd, free()). Fails when a part category has no sketches.
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err);
 /// The newest model; *id (may be NULL) its row id. SP_ERR_INVALID when none is stored.

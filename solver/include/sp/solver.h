@@ -59,6 +59,7 @@ typedef struct sp_solve_desc {
     double time_cap_ms;  ///< wall-clock cap; 0: 3000
     bool no_root_alignment; ///< skip the first stage that moves only the root's parameters
     const bool* active;  ///< param_count flags: which parameters may change; NULL: all
+    int threads;         ///< black-box rigs (sp/blackbox.h): finite-difference threads; 0: the online cores (at most 8)
 } sp_solve_desc;
 
 typedef enum sp_stop_reason {

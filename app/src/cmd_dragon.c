@@ -1,0 +1,117 @@
+// sketchpose dragon: the kiosk pipeline without a window. Every stroke of the
+// file is one part, in order: classified, instantiated, fitted where it was
+// drawn, attached to the nearest torso socket; the dragon is written as one
+// animated .glb, a PNG and the report (DESIGN.md "dragon --report").
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "cli.h"
+#include "dragon.h"
+#include "dragon_snapshot.h"
+#include "posing.h"
+#include "report.h"
+
+#ifndef SP_SOURCE_DIR
+#define SP_SOURCE_DIR "."
+#endif
+
+int cmd_dragon(int argc, char** argv)
+{
+    const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = SP_SOURCE_DIR "/assets";
+    double max_ms = 0, at = 0;
+    const sp_opt opts[] = {
+        {"--db", SP_OPT_STRING, &db_path, "DB", "the part database (created from --assets when missing)", true},
+        {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the strokes, one per part, in drawing order (sketchpose-strokes JSON)",
+         true},
+        {"--out", SP_OPT_STRING, &out, "dragon.glb", "write the animated dragon (.glb, or .gltf)", false},
+        {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: parts, strokes blue, fitted outlines yellow", false},
+        {"--report", SP_OPT_STRING, &report, "report.json", "write the report (also printed on stdout)", false},
+        {"--assets", SP_OPT_STRING, &assets, "DIR",
+         "parts for a database that does not exist yet (default: the source tree's assets/)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve (default 250)", false},
+        {"--time", SP_OPT_DOUBLE, &at, "S", "animation time of the render, seconds (default 0: as fitted)", false},
+    };
+    int rc = sp_cli_parse(argc, argv, "sketchpose dragon",
+                          "The kiosk pipeline without a window: one part per stroke, one animated dragon.", opts,
+                          (int)(sizeof opts / sizeof opts[0]));
+    if (rc >= 0) return rc;
+    sp_error err = {0};
+    sp_sketch sk = {0};
+    if (sp_sketch_read_json(strokes, &sk, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose dragon: %s\n", err.text);
+        return SP_EXIT_INPUT;
+    }
+    if (sk.stroke_count == 0) {
+        fprintf(stderr, "sketchpose dragon: %s: the file has no strokes\n", strokes);
+        sp_sketch_free(&sk);
+        return SP_EXIT_INPUT;
+    }
+    int w = sk.canvas_w >= 1 && sk.canvas_w <= 16384 ? (int)sk.canvas_w : 0,
+        h = sk.canvas_h >= 1 && sk.canvas_h <= 16384 ? (int)sk.canvas_h : 0;
+    sp_dragon* d = sp_dragon_create(
+        &(sp_dragon_desc){
+            .db_path = db_path, .assets_dir = assets, .canvas_w = w, .canvas_h = h, .solve = {.time_cap_ms = max_ms}},
+        &err);
+    if (!d) {
+        fprintf(stderr, "sketchpose dragon: %s\n", err.text);
+        sp_sketch_free(&sk);
+        return SP_EXIT_INPUT;
+    }
+    int exit_code = SP_EXIT_INPUT;
+    cJSON* j = NULL;
+    cJSON* list = cJSON_CreateArray();
+    for (int i = 0; i < sk.stroke_count; ++i) {
+        sp_dragon_result res;
+        cJSON* s = cJSON_CreateObject();
+        cJSON_AddItemToArray(list, s);
+        cJSON_AddNumberToObject(s, "stroke", i);
+        if (sp_dragon_add_stroke(d, &sk.strokes[i], NULL, &res, &err) != SP_OK) {
+            fprintf(stderr, "sketchpose dragon: %s: stroke %d: %s\n", strokes, i, err.text);
+            goto done;
+        }
+        cJSON_AddBoolToObject(s, "rejected", res.rejected);
+        cJSON_AddStringToObject(s, "reason", sp_dragon_reject_name(res.reason));
+        if (res.part >= 0)
+            cJSON_AddNumberToObject(s, "part", res.part);
+        else
+            cJSON_AddNullToObject(s, "part");
+        cJSON* g = cJSON_AddArrayToObject(s, "ranked");
+        for (int k = 0; k < res.guess_count; ++k) {
+            cJSON* o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "category", res.guesses[k].category);
+            cJSON_AddNumberToObject(o, "score", res.guesses[k].confidence);
+            cJSON_AddItemToArray(g, o);
+        }
+        cJSON_AddNumberToObject(s, "ms", res.ms_total);
+        if (res.rejected)
+            fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (%s)\n", strokes, i, sp_dragon_reject_name(res.reason));
+    }
+    j = sp_dragon_report_json(d);
+    cJSON_AddItemToObject(j, "strokes", list);
+    list = NULL;
+    if (sp_dragon_part_count(d) == 0) {
+        sp_json_print(j);
+        fprintf(stderr, "sketchpose dragon: %s: no stroke became a part\n", strokes);
+        goto done;
+    }
+    if (report && sp_json_write_file(report, j, &err) != SP_OK) goto fail;
+    sp_json_print(j);
+    if (out && sp_dragon_export(d, out, &err) != SP_OK) goto fail;
+    if (render) {
+        sp_dragon_snapshot_desc sd = {.t = at, .strokes = true, .outlines = true};
+        if (sp_dragon_snapshot_png(d, &sd, render, &err) != SP_OK) goto fail;
+    }
+    exit_code = SP_EXIT_OK;
+    goto done;
+fail:
+    fprintf(stderr, "sketchpose dragon: %s\n", err.text);
+done:
+    cJSON_Delete(list);
+    cJSON_Delete(j);
+    sp_dragon_destroy(d);
+    sp_sketch_free(&sk);
+    return exit_code;
+}

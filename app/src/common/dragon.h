@@ -1,0 +1,250 @@
+/// dragon.h: the kiosk pipeline without a window: strokes in, a growing,
+/// animated dragon of rigged parts out.
+///
+/// How to use (the kiosk window, `sketchpose dragon`, tests):
+///
+///     sp_error err = {0};
+///     sp_dragon* d = sp_dragon_create(&(sp_dragon_desc){.db_path = "sketchpose.db", .canvas_w = 1280, .canvas_h = 800}, &err);
+///     if (!d) { fprintf(stderr, "%s\n", err.text); ... }
+///     sp_dragon_result res;
+///     if (sp_dragon_add_stroke(d, &stroke, NULL, &res, &err) != SP_OK) ... bad numbers: err.text ...
+///     else if (res.rejected) ... a friendly hint (res.reason); nothing changed ...
+///     else ... res.guesses[0..2] are the chips, res.part the new part ...
+///     sp_dragon_pose_at(d, t_seconds);                      // every part, animated and attached
+///     for (int i = 0; i < sp_dragon_part_count(d); ++i) {
+///         const sp_dragon_part* p = sp_dragon_part_get(d, i);  // p->character->rig.triangles, ->colors
+///         draw(sp_dragon_part_xyz(d, i), ...);                // world space, vertex_count by 3
+///     }
+///     sp_dragon_export_glb(d, "dragon.glb", &err);
+///     sp_dragon_destroy(d);
+///
+/// The shared world (one for the whole dragon, so that parts drawn in
+/// different places end up in those places): right-handed, y up, z towards
+/// the viewer. The drawing canvas (canvas_w x canvas_h pixels, origin top
+/// left, y down) is the front orthographic view of the plane z = 0 looking
+/// along -Z, centred on the origin, the canvas height spanning 2 world units:
+///     x = (u - canvas_w / 2) / s,  y = (canvas_h / 2 - v) / s,  s = canvas_h / 2 pixels per unit.
+/// sp_dragon_camera gives that camera (sp_camera_project maps world to
+/// canvas pixels exactly), so rendering with it puts each part under its
+/// stroke; the kiosk's Turn orbits a copy of it.
+///
+/// Placement: a part is fitted in its own sketch view (the glTF's camera, or
+/// the default front view), zoomed and panned so that its rest-pose
+/// abstraction covers the stroke's bounding box (same centre, same
+/// diagonal); the solver then fits shape and pose (with the root's own
+/// placement parameters if the part has them). Because both views are
+/// orthographic, the part's model space maps into the world by a
+/// similarity (rotation, uniform scale, translation) that makes the two
+/// projections agree: the 3D part lands exactly where its fitted outline
+/// was drawn, with its rest-pose centre at depth z = 0. A perspective
+/// part camera is replaced by its weak-perspective (orthographic) equivalent
+/// at the depth of the rest-pose centre.
+///
+/// Attachment: a part whose category is not a torso attaches to the nearest
+/// socket (in canvas pixels, at the fitted poses) of any torso part (one
+/// whose `sp_part` has sockets, or category "torso"); the socket's joint
+/// then carries it, so the dragon moves as one. Its depth goes to the
+/// socket's; in the picture plane it moves onto the socket only when its
+/// attachment point is within `snap_fraction` of the canvas diagonal (a
+/// part drawn touching the body joins it, one drawn far away stays where
+/// it was drawn and still follows the body). Attachments are recomputed
+/// after every change, so a torso drawn last still collects the parts
+/// drawn before it, and undoing it frees them.
+///
+/// Animation: each part's first glTF animation clip, applied as offsets on
+/// its fitted parameters: p(t) = clamp(p_fit + clip(t') - rest) for
+/// angles and translations, p_fit * clip(t') / rest for scales, rest being
+/// the rig's default parameters (the clips are keyed as offsets from rest),
+/// so a part moves about its fitted pose (at t = 0 it is off the fit by
+/// the clip's first offsets). Clips loop together with one
+/// period T (the longest clip): a clip of duration c repeats n = round(T / c)
+/// times in T, slightly retimed, so the whole dragon loops seamlessly and
+/// the export holds ONE animation of length T.
+///
+/// Live update: before each stroke (and on sp_dragon_reload_if_changed) the
+/// database generation is polled; a new model or part is used for the next
+/// stroke. A database file replaced on disk (a new inode) is reopened. Parts
+/// already on the canvas keep the rig they were fitted with. A failed reload
+/// keeps the previous model and parts (the kiosk keeps running).
+///
+/// Not thread-safe: one sp_dragon is used by one thread at a time.
+#ifndef SP_DRAGON_H
+#define SP_DRAGON_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sp/classifier.h"
+#include "sp/gltf.h"
+#include "sp/partdb.h"
+#include "sp/solver.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Ranked guesses kept per stroke (the label chip and two alternatives).
+enum { SP_DRAGON_GUESSES = 3 };
+/// Strokes longer than this are resampled to it (arc length) before classifying and fitting.
+enum { SP_DRAGON_MAX_STROKE_POINTS = 4096 };
+
+typedef struct sp_dragon sp_dragon;
+
+/// Options. Zero means the default.
+typedef struct sp_dragon_desc {
+    sp_db* db;              ///< an open database to use (not owned, must outlive the dragon); NULL: open db_path
+    const char* db_path;    ///< NULL: sp_db_default_path(); created from assets_dir when missing
+    const char* assets_dir; ///< parts for a missing default database; NULL: $SP_ASSETS, else "assets"
+    int canvas_w, canvas_h; ///< drawing canvas, pixels; 0: 1280 x 800
+    sp_solve_desc solve; ///< solver options; zero: the solver's defaults except time_cap_ms 250, representatives 100, samples 48
+    double min_confidence; ///< a top guess scoring below this is rejected too; 0: 0.0 (only the classifier's own rejection)
+    double snap_fraction;  ///< attachment snap distance, fraction of the canvas diagonal; 0: 0.15; < 0: never snap in 2D
+    int max_variants;      ///< parts of one category fitted per stroke, best kept; 0: 4
+    double fps;            ///< key rate of the exported animation, per second; 0: 30
+    int max_parts;         ///< a stroke beyond this many parts is rejected (a kiosk runs all day); 0: 48
+} sp_dragon_desc;
+
+/// Why a stroke left the dragon unchanged.
+typedef enum sp_dragon_reject {
+    SP_DRAGON_ACCEPTED = 0,
+    SP_DRAGON_TOO_SHORT,        ///< fewer than 2 points, or smaller than 1% of the canvas (a tap)
+    SP_DRAGON_UNRECOGNISED,     ///< the classifier rejected it (or the top score < min_confidence)
+    SP_DRAGON_NO_PART,          ///< the category has no part in the database (or none loads)
+    SP_DRAGON_NO_MODEL,         ///< the database has no trained model and no category was forced
+    SP_DRAGON_FIT_FAILED,       ///< every part of the category refused the stroke
+    SP_DRAGON_NOTHING_TO_REFIT, ///< sp_dragon_refit_last with no stroke kept
+    SP_DRAGON_FULL,             ///< max_parts parts already (Redraw, refit, undo and clear still work)
+} sp_dragon_reject;
+
+/// "accepted", "too_short", "unrecognised", "no_part", "no_model", "fit_failed", "nothing_to_refit", "full".
+const char* sp_dragon_reject_name(sp_dragon_reject r);
+
+/// A ranked category.
+typedef struct sp_dragon_guess {
+    char category[SP_NAME_MAX];
+    float confidence; ///< the classifier's vote share in [0, 1]; 1 when forced
+} sp_dragon_guess;
+
+/// One part of the dragon (read only; valid until the next change).
+typedef struct sp_dragon_part {
+    uint64_t id;            ///< unique for the dragon's lifetime (cache render meshes by it)
+    char name[SP_NAME_MAX]; ///< the database part
+    char category[SP_NAME_MAX];
+    float confidence;              ///< of the category (1 when forced)
+    const sp_character* character; ///< the rig, triangles, colours (shared by parts of the same database part)
+    int abstraction;               ///< index of the abstraction fitted
+    const double* params;          ///< fitted parameters (rig.param_count)
+    sp_solve_report report;        ///< the fit
+    sp_camera view;                ///< the part's own zoomed sketch view on the canvas (fitting happened in it)
+    sp_mat4 placement;             ///< part model space -> world at the fit (the similarity above), before attachment
+    bool is_torso;                 ///< offers sockets
+    int attached_to;               ///< index of the torso part it hangs on, -1: free
+    char socket[SP_NAME_MAX];      ///< the socket's name when attached
+    int socket_joint;              ///< the torso's joint carrying it, when attached
+    int stroke_points;             ///< the stroke as fitted (after cleaning): stroke_points by 2 in stroke_xy
+    const sp_vec2* stroke_xy;
+} sp_dragon_part;
+
+/// What one stroke did.
+typedef struct sp_dragon_result {
+    bool rejected; ///< nothing changed (see reason)
+    sp_dragon_reject reason;
+    int guess_count; ///< ranked categories (0..SP_DRAGON_GUESSES), also when rejected by the classifier
+    sp_dragon_guess guesses[SP_DRAGON_GUESSES];
+    int part;                             ///< index of the new (or replaced) part, -1 when rejected
+    double ms_classify, ms_fit, ms_total; ///< wall-clock, milliseconds
+} sp_dragon_result;
+
+/// How to treat one stroke. Zero (or a NULL pointer) means: classify, append.
+typedef struct sp_dragon_stroke_opts {
+    const char* category; ///< use this category instead of classifying (the guesses are still filled)
+    bool replace_last;    ///< the stroke replaces the last part (Redraw); a rejected stroke keeps it
+} sp_dragon_stroke_opts;
+
+/// Opens the database (creating the default one when missing), loads the
+/// newest model. NULL and one line in err on failure. A database without a
+/// model still opens (strokes then need a forced category).
+sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err);
+/// Frees everything (NULL is fine). Does not close a caller's database.
+void sp_dragon_destroy(sp_dragon* d);
+
+/// Classifies one stroke (pixels on the canvas), instantiates the part of
+/// that category and fits it (shape and pose), attaches it. Points outside
+/// the canvas are clamped onto its edge; more than SP_DRAGON_MAX_STROKE_POINTS
+/// are resampled. Returns SP_ERR_INVALID (nothing changed) for non-finite
+/// coordinates; every other unusable stroke is SP_OK with out->rejected.
+sp_result sp_dragon_add_stroke(sp_dragon* d, const sp_stroke* stroke, const sp_dragon_stroke_opts* opts, sp_dragon_result* out,
+                               sp_error* err);
+/// Same from a point array (xy: count by 2, pixels).
+sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
+                               sp_dragon_result* out, sp_error* err);
+/// A chip tap: re-fits the last part's stroke as `category` (replacing that
+/// part). Rejected (nothing changed) when there is no part or no part of that category.
+sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_result* out, sp_error* err);
+/// Removes the last part; false when there was none.
+bool sp_dragon_undo(sp_dragon* d);
+/// Removes every part.
+void sp_dragon_clear(sp_dragon* d);
+
+/// Number of parts, in drawing order.
+int sp_dragon_part_count(const sp_dragon* d);
+/// Part i (0 <= i < count).
+const sp_dragon_part* sp_dragon_part_get(const sp_dragon* d, int i);
+/// The world camera on the canvas (see the top of this file).
+sp_camera sp_dragon_camera(const sp_dragon* d);
+/// The loop period in seconds (0 when no part has an animation).
+double sp_dragon_period(const sp_dragon* d);
+
+/// Evaluates every part at time t (seconds, wrapped into the loop): its
+/// animated parameters, its attachment, its skinned vertices and abstraction
+/// in world space, readable with the calls below until the next pose_at,
+/// change or export (then NULL). SP_ERR_NO_MEMORY is the only failure.
+sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err);
+/// Part i's vertices at the last pose_at, world, rig.vertex_count by 3.
+const double* sp_dragon_part_xyz(const sp_dragon* d, int i);
+/// Part i's fitted abstraction at the last pose_at, world, point_count by 3
+/// (draw with sp_renderer_draw_abstraction and the part's abstraction).
+const double* sp_dragon_part_outline(const sp_dragon* d, int i);
+/// Part i's fitted abstraction where it was fitted, before attachment moved
+/// it: canvas pixels (xy: point_count entries, the part's abstraction's
+/// point order), for the yellow overlay shown over the stroke right after
+/// the fit. Returns the point count (xy NULL: only the count), 0 for a bad i.
+int sp_dragon_part_fitted_outline(const sp_dragon* d, int i, sp_vec2* xy);
+/// Part i's parameters at the last pose_at (rig.param_count).
+const double* sp_dragon_part_params(const sp_dragon* d, int i);
+/// Part i's model -> world transform at the last pose_at (placement, attachment
+/// and the torso's motion), or NULL. Vertices above are already transformed.
+const sp_mat4* sp_dragon_part_transform(const sp_dragon* d, int i);
+/// World bounds of every vertex at the last pose_at; false when there are no parts.
+bool sp_dragon_bounds(const sp_dragon* d, sp_vec3* lo, sp_vec3* hi);
+
+/// Writes one glTF (.glb, or .gltf with embedded buffers by extension) with
+/// every part (each its own skin) in the world above, attachments as node
+/// parents, and ONE looped animation of length sp_dragon_period holding the
+/// offsets (none when no part animates). Fails with SP_ERR_INVALID when there
+/// are no parts.
+sp_result sp_dragon_export(const sp_dragon* d, const char* path, sp_error* err);
+
+/// Polls the database: when another connection committed a change (or the
+/// file was replaced), reloads the model and forgets the loaded parts that
+/// were removed or changed (a part whose stored bytes are the same is kept). *reloaded
+/// (may be NULL) tells whether anything was reloaded. On failure the previous
+/// state is kept and err says why.
+sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err);
+/// Loads every part of the database now (parsing, checksum, the solver's
+/// coarsening), so that the first stroke of each category costs no more than
+/// the others; otherwise each part is loaded by the first stroke that needs it.
+/// Parts that do not load are skipped (err says the last reason, SP_OK still).
+sp_result sp_dragon_preload(sp_dragon* d, sp_error* err);
+/// The categories the current model knows (for hints); NULL when there is no model.
+const sp_clf* sp_dragon_model(const sp_dragon* d);
+
+/// The solve report of the whole dragon as JSON (DESIGN.md: the last part's
+/// solve report keys, plus "parts": [{"category", "confidence", "name",
+/// "attached_to", "socket", "report": {...}}]). Caller deletes (cJSON_Delete).
+struct cJSON* sp_dragon_report_json(const sp_dragon* d);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,486 @@
+// dragon_kiosk.c: the kiosk window. GLFW turns touches (pointer events) into
+// sp_kiosk_events; kiosk.h does the rest. With --script the session file is
+// replayed on a virtual clock (its own timestamps, 60 updates a second, every
+// third one drawn), so a run is deterministic whatever the machine's speed.
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include "cli.h"
+#include "dragon.h"
+#include "kiosk/draw2d.h"
+#include "kiosk/kiosk.h"
+#include "kiosk/session.h"
+
+static const char* const k_cmd = "dragon-kiosk";
+
+typedef struct app {
+    sp_kiosk* k;
+    GLFWwindow* win;
+    bool scripted;
+    double t0;
+    sp_kiosk_session rec;
+    bool recording;
+    int fb_w, fb_h;
+    double ppm;             // measured (or the script's)
+    double ppm_override;    // from the script, 0: none
+    // Stats.
+    double up_wall[8];      // wall times of pen-ups whose strokes wait for the pipeline (ring)
+    int up_head, up_count;
+    int seen_fits, seen_dropped, seen_finished;
+    double* latency;        // pen-up -> fitted outline on screen, ms
+    int latency_n, latency_cap;
+    double frame_ms[8192], update_ms[8192], draw_ms[8192], swap_ms[8192];
+    int frames;
+    long rss_kb[512];
+    int rss_n, rss_next_stroke;
+} app;
+
+static volatile sig_atomic_t g_quit = 0;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    g_quit = 1;
+}
+
+static double wall_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static long rss_kb(void)
+{
+    FILE* f = fopen("/proc/self/statm", "r");
+    long pages = 0, res = 0;
+    if (!f) return 0;
+    if (fscanf(f, "%ld %ld", &pages, &res) != 2) res = 0;
+    fclose(f);
+    return res * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+// Pixels per millimetre of the framebuffer: the monitor's physical size
+// when it reports a plausible one, else 96 dpi times the content scale.
+static double measure_ppm(GLFWwindow* win, int fb_w)
+{
+    GLFWmonitor* mon = glfwGetWindowMonitor(win);
+    if (!mon) mon = glfwGetPrimaryMonitor();
+    int win_w = 0, win_h = 0;
+    glfwGetWindowSize(win, &win_w, &win_h);
+    double fb_per_screen = win_w > 0 ? (double)fb_w / win_w : 1.0;
+    int mm_w = 0, mm_h = 0;
+    const GLFWvidmode* mode = mon ? glfwGetVideoMode(mon) : NULL;
+    if (mon) glfwGetMonitorPhysicalSize(mon, &mm_w, &mm_h);
+    if (mode && mm_w >= 50 && mode->width > 0) {
+        double ppm = mode->width / (double)mm_w;
+        // 40..600 dpi: anything else is a made-up EDID.
+        if (ppm >= 40 / 25.4 && ppm <= 600 / 25.4) return ppm * fb_per_screen;
+    }
+    float sx = 1, sy = 1;
+    glfwGetWindowContentScale(win, &sx, &sy);
+    if (!(sx > 0.25f && sx < 8.0f)) sx = 1;
+    return 96.0 / 25.4 * sx * fb_per_screen;
+}
+
+static void push_event(app* a, const sp_kiosk_event* ev)
+{
+    int before = sp_kiosk_ui_of(a->k)->strokes_finished;
+    sp_kiosk_input(a->k, ev);
+    if (a->recording && ev->type != SP_KEV_FRAME && sp_kiosk_session_append(&a->rec, ev) != SP_OK) {
+        fprintf(stderr, "%s: recording full or out of memory; recording stops here\n", k_cmd);
+        a->recording = false;
+    }
+    if (sp_kiosk_ui_of(a->k)->strokes_finished > before) {
+        a->up_wall[(a->up_head + a->up_count) % 8] = wall_ms();
+        if (a->up_count < 8) ++a->up_count;
+        else a->up_head = (a->up_head + 1) % 8;
+    }
+}
+
+static double live_t(const app* a)
+{
+    return (glfwGetTime() - a->t0) * 1000.0;
+}
+
+static void cb_button(GLFWwindow* w, int button, int action, int mods)
+{
+    (void)mods;
+    app* a = glfwGetWindowUserPointer(w);
+    if (a->scripted) return;
+    double x = 0, y = 0;
+    glfwGetCursorPos(w, &x, &y);
+    int ww = 1, wh = 1;
+    glfwGetWindowSize(w, &ww, &wh);
+    double sx = ww > 0 ? (double)a->fb_w / ww : 1, sy = wh > 0 ? (double)a->fb_h / wh : 1;
+    sp_kiosk_event ev = {action == GLFW_PRESS ? SP_KEV_DOWN : SP_KEV_UP, live_t(a), (float)(x * sx), (float)(y * sy), button};
+    push_event(a, &ev);
+}
+
+static void cb_cursor(GLFWwindow* w, double x, double y)
+{
+    app* a = glfwGetWindowUserPointer(w);
+    if (a->scripted) return;
+    int ww = 1, wh = 1;
+    glfwGetWindowSize(w, &ww, &wh);
+    double sx = ww > 0 ? (double)a->fb_w / ww : 1, sy = wh > 0 ? (double)a->fb_h / wh : 1;
+    sp_kiosk_event ev = {SP_KEV_MOVE, live_t(a), (float)(x * sx), (float)(y * sy), 0};
+    push_event(a, &ev);
+}
+
+static void cb_focus(GLFWwindow* w, int focused)
+{
+    app* a = glfwGetWindowUserPointer(w);
+    if (a->scripted || focused) return;
+    sp_kiosk_event ev = {SP_KEV_CANCEL, live_t(a), 0, 0, 0};
+    push_event(a, &ev);
+}
+
+static void relayout(app* a)
+{
+    glfwGetFramebufferSize(a->win, &a->fb_w, &a->fb_h);
+    a->ppm = a->ppm_override > 0 ? a->ppm_override : measure_ppm(a->win, a->fb_w);
+    sp_kiosk_resize(a->k, a->fb_w, a->fb_h, a->ppm);
+}
+
+static void cb_resize(GLFWwindow* w, int fw, int fh)
+{
+    (void)fw, (void)fh;
+    relayout(glfwGetWindowUserPointer(w));
+}
+
+static void cb_scale(GLFWwindow* w, float sx, float sy)
+{
+    (void)sx, (void)sy;
+    relayout(glfwGetWindowUserPointer(w));
+}
+
+static void cb_key(GLFWwindow* w, int key, int scancode, int action, int mods)
+{
+    (void)scancode;
+    // Staff only: Ctrl+Shift+Q closes the kiosk (visitors need no keyboard).
+    if (key == GLFW_KEY_Q && action == GLFW_PRESS && (mods & GLFW_MOD_CONTROL) && (mods & GLFW_MOD_SHIFT)) glfwSetWindowShouldClose(w, 1);
+}
+
+static void cb_error(int code, const char* text)
+{
+    fprintf(stderr, "%s: GLFW error 0x%x: %s\n", k_cmd, code, text);
+}
+
+// One frame: update at t, draw, swap; the pen-up latency of strokes whose fit just landed.
+static void frame(app* a, double t, bool render)
+{
+    double w0 = wall_ms();
+    sp_kiosk_update(a->k, t);
+    double wu = wall_ms(), wd = wu;
+    const sp_kiosk_ui* ui = sp_kiosk_ui_of(a->k);
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(a->k);
+    int fits = st->fit_count, dropped = ui->dropped_strokes;
+    if (render) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        sp_kiosk_draw(a->k);
+        if (a->scripted) glFinish(); // frame times mean finished frames, not queued ones
+        wd = wall_ms();
+        glfwSwapBuffers(a->win);
+    }
+    double w1 = wall_ms();
+    for (; a->seen_dropped < dropped && a->up_count > 0; ++a->seen_dropped)
+        a->up_head = (a->up_head + 1) % 8, --a->up_count;
+    a->seen_dropped = dropped;
+    for (; a->seen_fits < fits; ++a->seen_fits) {
+        if (a->up_count == 0) continue;
+        double up = a->up_wall[a->up_head];
+        a->up_head = (a->up_head + 1) % 8, --a->up_count;
+        if (a->latency_n == a->latency_cap) {
+            int cap = a->latency_cap ? 2 * a->latency_cap : 1024;
+            double* l = realloc(a->latency, sizeof *l * (size_t)cap);
+            if (!l) continue;
+            a->latency = l, a->latency_cap = cap;
+        }
+        a->latency[a->latency_n++] = w1 - up;
+    }
+    if (render) {
+        int f = a->frames++ % 8192;
+        a->frame_ms[f] = w1 - w0, a->update_ms[f] = wu - w0, a->draw_ms[f] = wd - wu, a->swap_ms[f] = w1 - wd;
+    }
+    if (st->strokes >= a->rss_next_stroke && a->rss_n < 512) {
+        a->rss_kb[a->rss_n++] = rss_kb();
+        a->rss_next_stroke += 100;
+    }
+}
+
+static int cmp_double(const void* x, const void* y)
+{
+    double a = *(const double*)x, b = *(const double*)y;
+    return a < b ? -1 : a > b;
+}
+
+static double quantile(const double* v, int n, double q)
+{
+    if (n <= 0) return 0;
+    double* s = malloc(sizeof *s * (size_t)n);
+    if (!s) return 0;
+    memcpy(s, v, sizeof *s * (size_t)n);
+    qsort(s, (size_t)n, sizeof *s, cmp_double);
+    double r = s[(int)fmin(n - 1, floor(q * (n - 1) + 0.5))];
+    free(s);
+    return r;
+}
+
+static void print_stats(const app* a, double start_ms)
+{
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(a->k);
+    const sp_kiosk_ui* ui = sp_kiosk_ui_of(a->k);
+    int nf = a->frames < 8192 ? a->frames : 8192, nfit = st->fit_count < 4096 ? st->fit_count : 4096;
+    printf("{\"parts\": %d, \"strokes\": %d, \"parts_added\": %d, \"rejected\": %d, \"refits\": %d, \"undos\": %d, \"clears\": %d, "
+           "\"saves\": %d, \"save_failures\": %d, \"pipeline_errors\": %d, \"reloads\": %d, \"taps\": %d, \"dropped_strokes\": %d, "
+           "\"dropped_jobs\": %d, \"resets\": %d, \"mode\": \"%s\", \"code\": \"%s\", \"last_save\": \"%s\",\n",
+           st->parts, st->strokes, st->parts_added, st->rejected, st->refits, st->undos, st->clears, st->saves, st->save_failures,
+           st->pipeline_errors, st->reloads, ui->taps, ui->dropped_strokes, ui->dropped_jobs, ui->resets,
+           ui->mode == SP_KM_ATTRACT ? "attract" : ui->mode == SP_KM_TURN ? "turn" : "draw", ui->code, sp_kiosk_last_save(a->k));
+    printf(" \"framebuffer\": [%d, %d], \"px_per_mm\": %.4f, \"gl_renderer\": \"%s\", \"start_ms\": %.1f, \"frames\": %d, "
+           "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"fit_ms_median\": %.2f, \"fit_ms_p90\": %.2f, "
+           "\"latency_ms_median\": %.2f, \"latency_ms_p90\": %.2f, \"latency_n\": %d, \"update_ms_median\": %.2f, "
+           "\"draw_ms_median\": %.2f, \"swap_ms_median\": %.2f,\n \"rss_kb\": [",
+           a->fb_w, a->fb_h, a->ppm, (const char*)glGetString(GL_RENDERER), start_ms, a->frames, quantile(a->frame_ms, nf, 0.5),
+           quantile(a->frame_ms, nf, 0.9), quantile(st->fit_ms, nfit, 0.5), quantile(st->fit_ms, nfit, 0.9),
+           quantile(a->latency, a->latency_n, 0.5), quantile(a->latency, a->latency_n, 0.9), a->latency_n, quantile(a->update_ms, nf, 0.5),
+           quantile(a->draw_ms, nf, 0.5), quantile(a->swap_ms, nf, 0.5));
+    for (int i = 0; i < a->rss_n; ++i)
+        printf("%s%ld", i ? ", " : "", a->rss_kb[i]);
+    printf("],\n \"categories\": [");
+    const sp_dragon* d = sp_kiosk_dragon(a->k);
+    for (int i = 0; i < sp_dragon_part_count(d); ++i)
+        printf("%s\"%s\"", i ? ", " : "", sp_dragon_part_get(d, i)->category);
+    printf("]}\n");
+}
+
+// Building the default database (parts, synthetic sketches, training) takes
+// a while the first time: say so on screen instead of showing nothing.
+static void loading_screen(GLFWwindow* win, const char* font_path)
+{
+    sp_error err = {0};
+    sp_font* font = sp_font_load(font_path, &err);
+    sp_draw2d* d = font ? sp_draw2d_create(font, &err) : NULL;
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(win, &w, &h);
+    glViewport(0, 0, w, h);
+    glClearColor(0.81f, 0.83f, 0.875f, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    if (d) {
+        sp_draw2d_begin(d, w, h);
+        sp_draw2d_text_fit(d, "Getting the dragon parts ready...", 0.5f * w, 0.5f * h, 0.06f * h, 0.9f * w, SP_ALIGN_CENTER,
+                           (const float[4]){0.06f, 0.07f, 0.1f, 1});
+        sp_draw2d_end(d);
+    }
+    glfwSwapBuffers(win);
+    glfwPollEvents();
+    sp_draw2d_destroy(d);
+    sp_font_free(font);
+}
+
+// Writes <screenshot stem>-<mark>.png.
+static void mark_path(const char* shot, const char* name, char* out, size_t cap)
+{
+    const char* dot = strrchr(shot, '.');
+    const char* slash = strrchr(shot, '/');
+    size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - shot) : strlen(shot);
+    snprintf(out, cap, "%.*s-%s.png", (int)stem, shot, name);
+}
+
+int main(int argc, char** argv)
+{
+    double start = wall_ms();
+    const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL, *size = NULL;
+    const char* font = NULL;
+    bool fullscreen = false, stats = false;
+    double idle_s = 0;
+    int lod = 0, msaa = -1;
+    sp_opt opts[] = {
+        {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)", false},
+        {"--assets", SP_OPT_STRING, &assets, "DIR", "parts for a missing database (default: $SP_ASSETS or assets)", false},
+        {"--fullscreen", SP_OPT_FLAG, &fullscreen, "", "full screen on the primary monitor", false},
+        {"--size", SP_OPT_STRING, &size, "WxH", "window size (default 1280x800, or the script's canvas)", false},
+        {"--script", SP_OPT_STRING, &script, "S.json", "replay a session (virtual clock), then exit", false},
+        {"--record", SP_OPT_STRING, &record, "R.json", "record the input events to a session file", false},
+        {"--screenshot", SP_OPT_STRING, &shot, "out.png", "PNG of the last frame (and of every script mark)", false},
+        {"--export", SP_OPT_STRING, &out_glb, "out.glb", "glTF of the dragon at the end", false},
+        {"--export-dir", SP_OPT_STRING, &export_dir, "DIR", "where Save writes (default: dragon-exports)", false},
+        {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen (default 90; < 0: never)", false},
+        {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
+        {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling (default: 4 on a GPU, 0 on software GL)", false},
+        {"--lod", SP_OPT_INT, &lod, "N", "display triangles per part (default: 4000 on software GL, all on a GPU; -1: all)", false},
+        {"--stats", SP_OPT_FLAG, &stats, "", "print counters and timings as JSON at the end", false},
+    };
+    int rc = sp_cli_parse(argc, argv, k_cmd, "The dragon kiosk: draw a part in one line, see it come alive.", opts,
+                          (int)(sizeof opts / sizeof opts[0]));
+    if (rc >= 0) return rc;
+    int win_w = 1280, win_h = 800;
+    if (size && !sp_cli_parse_size(size, &win_w, &win_h)) {
+        fprintf(stderr, "%s: --size expects WxH, got '%s'\n", k_cmd, size);
+        return SP_EXIT_USAGE;
+    }
+    sp_kiosk_session session = {0};
+    sp_error err = {0};
+    if (script) {
+        if (sp_kiosk_session_read(script, &session, &err) != SP_OK) {
+            fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+            return SP_EXIT_INPUT;
+        }
+        if (!size && session.canvas_w > 0 && !session.unit_coords) win_w = session.canvas_w, win_h = session.canvas_h;
+    }
+    glfwSetErrorCallback(cb_error);
+    if (!glfwInit()) {
+        fprintf(stderr, "%s: cannot open a window (no display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n", k_cmd);
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_SAMPLES, msaa >= 0 ? msaa : 4);
+    glfwWindowHint(GLFW_STENCIL_BITS, 8);
+    glfwWindowHint(GLFW_SCALE_TO_MONITOR, script ? GLFW_FALSE : GLFW_TRUE);
+    GLFWmonitor* mon = fullscreen ? glfwGetPrimaryMonitor() : NULL;
+    if (mon) {
+        const GLFWvidmode* mode = glfwGetVideoMode(mon);
+        if (mode) win_w = mode->width, win_h = mode->height;
+    }
+    GLFWwindow* win = glfwCreateWindow(win_w, win_h, "Dragon kiosk", mon, NULL);
+    if (!win) {
+        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
+        glfwTerminate();
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
+    }
+    glfwMakeContextCurrent(win);
+    // A software rasteriser clears and shades every sample: without --msaa,
+    // its window gets one sample a pixel (the 2D layers are anti-aliased
+    // analytically anyway; screenshots still render with 4 samples).
+    const char* gl_name = (const char*)glGetString(GL_RENDERER);
+    if (msaa < 0 && gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast"))) {
+        glfwMakeContextCurrent(NULL);
+        glfwDestroyWindow(win);
+        glfwWindowHint(GLFW_SAMPLES, 0);
+        win = glfwCreateWindow(win_w, win_h, "Dragon kiosk", mon, NULL);
+        if (!win) {
+            fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
+            glfwTerminate();
+            sp_kiosk_session_free(&session);
+            return SP_EXIT_INPUT;
+        }
+        glfwMakeContextCurrent(win);
+    }
+    glfwSwapInterval(script ? 0 : 1);
+    if (mon) glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
+    static app a; // large (frame ring): not on the stack
+    a.win = win;
+    a.scripted = script != NULL;
+    a.ppm_override = script ? session.px_per_mm : 0;
+    glfwGetFramebufferSize(win, &a.fb_w, &a.fb_h);
+    sp_kiosk_desc kd = {.db_path = db, .assets_dir = assets, .export_dir = export_dir, .font_path = font, .canvas_w = a.fb_w,
+                        .canvas_h = a.fb_h, .ui = {.idle_ms = idle_s > 0 ? idle_s * 1000.0 : idle_s < 0 ? -1 : 0},
+                        .code_seed = script ? 1 : (uint64_t)time(NULL), .lod_triangles = lod};
+    if (access(db ? db : sp_db_default_path(), F_OK) != 0) loading_screen(win, font);
+    a.k = sp_kiosk_create(&kd, &err);
+    if (!a.k) {
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
+    }
+    glfwSetWindowUserPointer(win, &a);
+    relayout(&a);
+    glfwSetMouseButtonCallback(win, cb_button);
+    glfwSetCursorPosCallback(win, cb_cursor);
+    glfwSetWindowFocusCallback(win, cb_focus);
+    glfwSetFramebufferSizeCallback(win, cb_resize);
+    glfwSetWindowContentScaleCallback(win, cb_scale);
+    glfwSetKeyCallback(win, cb_key);
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    if (record) {
+        a.recording = true;
+        a.rec.canvas_w = a.fb_w, a.rec.canvas_h = a.fb_h, a.rec.px_per_mm = a.ppm;
+    }
+    double first_frame_ms = 0;
+    int exit_code = SP_EXIT_OK;
+    if (script) {
+        // Virtual clock: events at their own times, 60 frames a second of
+        // session time, marks and the end hit exactly.
+        const double step = 1000.0 / 60.0;
+        double t = 0;
+        int ei = 0, mi = 0;
+        long n = 0;
+        for (;;) {
+            double target = fmin(t + step, session.end_ms);
+            if (mi < session.mark_count && session.marks[mi].t_ms < target) target = session.marks[mi].t_ms;
+            if (target < t) target = t;
+            for (; ei < session.count && session.events[ei].t_ms <= target; ++ei) {
+                sp_kiosk_event ev = sp_kiosk_session_map(&session, &session.events[ei], a.fb_w, a.fb_h);
+                push_event(&a, &ev);
+            }
+            bool at_end = target >= session.end_ms && ei >= session.count;
+            // On screen at 20 frames a second of session time: what a replay
+            // decides depends only on the clock, and marks and the end render
+            // their own screenshots offscreen.
+            frame(&a, target, n % 3 == 0 || at_end);
+            if (n++ == 0) first_frame_ms = wall_ms() - start;
+            glfwPollEvents();
+            for (; mi < session.mark_count && session.marks[mi].t_ms <= target; ++mi) {
+                if (!shot) continue;
+                char path[2048];
+                mark_path(shot, session.marks[mi].name, path, sizeof path);
+                if (sp_kiosk_screenshot(a.k, path, &err) != SP_OK) {
+                    fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+                    exit_code = SP_EXIT_INPUT;
+                }
+            }
+            t = target;
+            if (at_end || g_quit) break;
+        }
+    } else {
+        a.t0 = glfwGetTime();
+        long n = 0;
+        while (!glfwWindowShouldClose(win) && !g_quit) {
+            glfwPollEvents();
+            frame(&a, live_t(&a), true);
+            if (n++ == 0) first_frame_ms = wall_ms() - start;
+        }
+    }
+    if (shot && sp_kiosk_screenshot(a.k, shot, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+        exit_code = SP_EXIT_INPUT;
+    }
+    if (out_glb && sp_kiosk_export(a.k, out_glb, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+        exit_code = SP_EXIT_INPUT;
+    }
+    if (record) {
+        a.rec.end_ms = script ? session.end_ms : live_t(&a);
+        if (sp_kiosk_session_write(record, &a.rec, &err) != SP_OK) {
+            fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+            exit_code = SP_EXIT_INPUT;
+        }
+    }
+    if (stats) print_stats(&a, first_frame_ms);
+    sp_kiosk_destroy(a.k);
+    glfwDestroyWindow(win);
+    glfwTerminate();
+    sp_kiosk_session_free(&session);
+    sp_kiosk_session_free(&a.rec);
+    free(a.latency);
+    return exit_code;
+}

@@ -1,0 +1,596 @@
+// kiosk.c: the kiosk's core: the UI's jobs against the pipeline, saving,
+// the mesh cache, the canvas <-> framebuffer mapping.
+#include "kiosk_internal.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+// ------------------------------------------------------------------ mapping
+
+static double fit_factor(const sp_kiosk* k)
+{
+    return fmin((double)k->fb_w / k->canvas_w, (double)k->fb_h / k->canvas_h);
+}
+
+sp_vec2 kiosk_canvas_to_fb(const sp_kiosk* k, sp_vec2 c)
+{
+    double f = fit_factor(k);
+    return (sp_vec2){0.5 * k->fb_w + (c.x - 0.5 * k->canvas_w) * f, 0.5 * k->fb_h + (c.y - 0.5 * k->canvas_h) * f};
+}
+
+sp_vec2 kiosk_fb_to_canvas(const sp_kiosk* k, sp_vec2 p)
+{
+    double f = fit_factor(k);
+    return (sp_vec2){0.5 * k->canvas_w + (p.x - 0.5 * k->fb_w) / f, 0.5 * k->canvas_h + (p.y - 0.5 * k->fb_h) / f};
+}
+
+sp_camera kiosk_fb_camera(const sp_kiosk* k)
+{
+    return sp_camera_resize(&k->canvas_cam, k->fb_w, k->fb_h);
+}
+
+void kiosk_pretty(const char* category, char* out, size_t cap)
+{
+    snprintf(out, cap, "%s", category ? category : "");
+    for (char* c = out; *c; ++c)
+        if (*c == '_' || *c == '-') *c = ' ';
+    if (out[0] >= 'a' && out[0] <= 'z') out[0] = (char)(out[0] - 'a' + 'A');
+}
+
+int kiosk_fitted_outline(const sp_dragon_part* p, float** out, int* cap, int* breaks, int max_breaks, int* nbreaks)
+{
+    *nbreaks = 0;
+    const sp_rig* rig = &p->character->rig;
+    if (p->abstraction < 0 || p->abstraction >= rig->abstraction_count) return 0;
+    const sp_abstraction* ab = &rig->abstractions[p->abstraction];
+    int need = ab->point_count + ab->curve_count;
+    if (need > *cap) {
+        float* o = realloc(*out, sizeof(float) * 2 * (size_t)need);
+        if (!o) return 0;
+        *out = o, *cap = need;
+    }
+    // The abstraction at the fitted parameters, seen in the part's own view:
+    // exactly what the solver matched to the stroke (before any attachment).
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    double* z = malloc(sizeof(double) * 3 * (size_t)(ab->point_count + 1));
+    double* mesh = ab->rest ? NULL : malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
+    int n = 0;
+    if (ev && z && (ab->rest || mesh)) {
+        sp_rig_eval_update(ev, p->params, false);
+        if (mesh) sp_rig_eval_points(ev, sp_rig_mesh_points(rig), mesh);
+        sp_rig_eval_abstraction(ev, ab, mesh, z);
+        for (int c = 0; c < ab->curve_count; ++c) {
+            const sp_curve* cv = &ab->curves[c];
+            if (cv->point_count <= 0) continue;
+            if (n > 0 && *nbreaks < max_breaks) breaks[(*nbreaks)++] = n;
+            for (int j = 0; j <= cv->point_count; ++j) {
+                if (j == cv->point_count && !cv->closed) break;
+                int q = cv->first_point + (j % cv->point_count);
+                sp_vec2 px = sp_camera_project(&p->view, (sp_vec3){z[3 * q], z[3 * q + 1], z[3 * q + 2]});
+                (*out)[2 * n] = (float)px.x, (*out)[2 * n + 1] = (float)px.y;
+                ++n;
+            }
+        }
+    }
+    free(mesh);
+    free(z);
+    sp_rig_eval_destroy(ev);
+    return n;
+}
+
+// ------------------------------------------------------------------ meshes
+
+sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id)
+{
+    for (int i = 0; i < c->count; ++i)
+        if (c->items[i].id == id) return c->items[i].mesh;
+    return NULL;
+}
+
+void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions)
+{
+    for (int i = 0; i < c->count; ++i)
+        c->items[i].seen = false;
+    int n = d ? sp_dragon_part_count(d) : 0;
+    for (int i = 0; i < n; ++i) {
+        const sp_dragon_part* p = sp_dragon_part_get(d, i);
+        const sp_rig* rig = &p->character->rig;
+        const double* xyz = sp_dragon_part_xyz(d, i);
+        if (!xyz || rig->vertex_count <= 0 || rig->triangle_count <= 0) continue;
+        int at = -1;
+        for (int j = 0; j < c->count; ++j)
+            if (c->items[j].id == p->id) at = j;
+        if (at >= 0) {
+            struct cached_mesh* it = &c->items[at];
+            it->seen = true;
+            if (update_positions) {
+                if (it->coarse) {
+                    sp_lod_positions(&it->lod, xyz, c->scratch);
+                    sp_render_mesh_update(it->mesh, c->scratch, NULL);
+                } else {
+                    sp_render_mesh_update(it->mesh, xyz, NULL);
+                }
+            }
+            continue;
+        }
+        if (c->count == c->cap) {
+            int cap = c->cap ? 2 * c->cap : 16;
+            struct cached_mesh* it = realloc(c->items, sizeof *it * (size_t)cap);
+            if (!it) continue; // not drawn this frame; tried again next frame
+            c->items = it, c->cap = cap;
+        }
+        sp_error err = {0};
+        struct cached_mesh it = {p->id, NULL, true, false, {0}};
+        sp_mesh_desc md = {.vertex_count = rig->vertex_count, .positions = xyz, .colors = p->character->colors,
+                           .triangle_count = rig->triangle_count, .triangles = rig->triangles};
+        if (c->lod_triangles > 0 && rig->triangle_count > c->lod_triangles &&
+            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, c->lod_triangles, &it.lod) == SP_OK) {
+            if (it.lod.cluster_count > c->scratch_cap) {
+                double* s = realloc(c->scratch, sizeof(double) * 3 * (size_t)it.lod.cluster_count);
+                if (s) c->scratch = s, c->scratch_cap = it.lod.cluster_count;
+            }
+            if (it.lod.cluster_count <= c->scratch_cap) {
+                sp_lod_positions(&it.lod, xyz, c->scratch);
+                md = (sp_mesh_desc){.vertex_count = it.lod.cluster_count, .positions = c->scratch, .colors = it.lod.colors,
+                                    .triangle_count = it.lod.tri_count, .triangles = it.lod.tris};
+                it.coarse = true;
+            }
+        }
+        it.mesh = sp_render_mesh_create(r, &md, &err);
+        if (!it.mesh) {
+            fprintf(stderr, "dragon-kiosk: part %s: %s\n", p->name, err.text);
+            sp_lod_free(&it.lod);
+            continue;
+        }
+        c->items[c->count++] = it;
+    }
+    // Parts that are gone (undo, clear, redraw) free their meshes.
+    int w = 0;
+    for (int i = 0; i < c->count; ++i) {
+        if (c->items[i].seen) {
+            c->items[w++] = c->items[i];
+        } else {
+            sp_render_mesh_destroy(c->items[i].mesh);
+            sp_lod_free(&c->items[i].lod);
+        }
+    }
+    c->count = w;
+}
+
+void mesh_cache_free(mesh_cache* c)
+{
+    for (int i = 0; i < c->count; ++i) {
+        sp_render_mesh_destroy(c->items[i].mesh);
+        sp_lod_free(&c->items[i].lod);
+    }
+    free(c->items);
+    free(c->scratch);
+    memset(c, 0, sizeof *c);
+}
+
+// ------------------------------------------------------------------ create
+
+sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
+{
+    sp_kiosk* k = calloc(1, sizeof *k);
+    if (!k) {
+        sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory");
+        return NULL;
+    }
+    k->desc = desc ? *desc : (sp_kiosk_desc){0};
+    snprintf(k->db_path, sizeof k->db_path, "%s", k->desc.db_path ? k->desc.db_path : sp_db_default_path());
+    snprintf(k->export_dir, sizeof k->export_dir, "%s", k->desc.export_dir ? k->desc.export_dir : "dragon-exports");
+    k->desc.db_path = k->db_path;
+    k->desc.export_dir = k->export_dir;
+    k->canvas_w = k->desc.canvas_w > 0 ? k->desc.canvas_w : 1280;
+    k->canvas_h = k->desc.canvas_h > 0 ? k->desc.canvas_h : 800;
+    k->fb_w = k->canvas_w, k->fb_h = k->canvas_h;
+    k->code_state = k->desc.code_seed ? k->desc.code_seed : 1;
+    for (int i = 0; i < DEMO_MAX; ++i)
+        k->demo_parts[i].part = -1;
+    if (!(k->font = sp_font_load(k->desc.font_path, err))) goto fail;
+    if (!(k->ui = sp_kiosk_ui_create(&k->desc.ui))) {
+        sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory");
+        goto fail;
+    }
+    k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path, .assets_dir = k->desc.assets_dir, .canvas_w = k->canvas_w,
+                                                   .canvas_h = k->canvas_h}, err);
+    if (!k->dragon) goto fail;
+    k->canvas_cam = sp_dragon_camera(k->dragon);
+    if (!(k->r = sp_renderer_create(&(sp_renderer_desc){0}, err))) goto fail;
+    // Software rasterisers pay per triangle: coarser display meshes there.
+    const char* gl_name = (const char*)glGetString(GL_RENDERER);
+    k->software = gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast") || strstr(gl_name, "SWR"));
+    int lod = k->desc.lod_triangles < 0 ? 0 : k->desc.lod_triangles > 0 ? k->desc.lod_triangles : k->software ? 4000 : 0;
+    k->meshes.lod_triangles = k->demo_meshes.lod_triangles = lod;
+    if (!(k->d2 = sp_draw2d_create(k->font, err))) goto fail;
+    sp_kiosk_resize(k, k->canvas_w, k->canvas_h, 0);
+    return k;
+fail:
+    sp_kiosk_destroy(k);
+    return NULL;
+}
+
+void sp_kiosk_destroy(sp_kiosk* k)
+{
+    if (!k) return;
+    kiosk_attract_free(k);
+    mesh_cache_free(&k->meshes);
+    sp_draw2d_destroy(k->d2);
+    sp_renderer_destroy(k->r);
+    sp_dragon_destroy(k->dragon);
+    sp_kiosk_ui_destroy(k->ui);
+    sp_font_free(k->font);
+    free(k->guesses);
+    free(k->scratch);
+    free(k->outline_px);
+    free(k);
+}
+
+void sp_kiosk_resize(sp_kiosk* k, int fb_w, int fb_h, double px_per_mm)
+{
+    k->fb_w = fb_w > 0 ? fb_w : 1;
+    k->fb_h = fb_h > 0 ? fb_h : 1;
+    if (px_per_mm > 0) k->ppm = px_per_mm;
+    sp_kiosk_ui_resize(k->ui, k->fb_w, k->fb_h, k->ppm);
+    k->ppm = k->ui->px_per_mm;
+}
+
+void sp_kiosk_input(sp_kiosk* k, const sp_kiosk_event* ev)
+{
+    sp_kiosk_ui_event(k->ui, ev);
+}
+
+const sp_kiosk_ui* sp_kiosk_ui_of(const sp_kiosk* k)
+{
+    return k->ui;
+}
+
+const sp_kiosk_stats* sp_kiosk_stats_of(const sp_kiosk* k)
+{
+    return &k->stats;
+}
+
+const sp_dragon* sp_kiosk_dragon(const sp_kiosk* k)
+{
+    return k->dragon;
+}
+
+const char* sp_kiosk_last_save(const sp_kiosk* k)
+{
+    return k->last_save;
+}
+
+// ------------------------------------------------------------------ guesses per part
+
+static part_guesses* guesses_of(sp_kiosk* k, uint64_t id, bool create)
+{
+    for (int i = 0; i < k->guess_count; ++i)
+        if (k->guesses[i].id == id) return &k->guesses[i];
+    if (!create) return NULL;
+    // Forget parts that are gone first: the list stays as long as the dragon.
+    int w = 0;
+    for (int i = 0; i < k->guess_count; ++i) {
+        bool alive = false;
+        for (int j = 0; j < sp_dragon_part_count(k->dragon) && !alive; ++j)
+            alive = sp_dragon_part_get(k->dragon, j)->id == k->guesses[i].id;
+        if (alive) k->guesses[w++] = k->guesses[i];
+    }
+    k->guess_count = w;
+    if (k->guess_count == k->guess_cap) {
+        int cap = k->guess_cap ? 2 * k->guess_cap : 16;
+        part_guesses* g = realloc(k->guesses, sizeof *g * (size_t)cap);
+        if (!g) return NULL;
+        k->guesses = g, k->guess_cap = cap;
+    }
+    part_guesses* g = &k->guesses[k->guess_count++];
+    memset(g, 0, sizeof *g);
+    g->id = id;
+    return g;
+}
+
+// The label chip and the next two guesses of the last part, for the UI.
+static void last_label(sp_kiosk* k, sp_kiosk_part_label* l)
+{
+    *l = (sp_kiosk_part_label){0};
+    int n = sp_dragon_part_count(k->dragon);
+    if (n == 0) return;
+    const sp_dragon_part* p = sp_dragon_part_get(k->dragon, n - 1);
+    l->category = p->category;
+    const part_guesses* g = guesses_of(k, p->id, false);
+    if (g) l->guesses[0] = g->guess[0], l->guesses[1] = g->guess[1];
+}
+
+// ------------------------------------------------------------------ jobs
+
+static const char* reject_hint(sp_dragon_reject r)
+{
+    switch (r) {
+    case SP_DRAGON_TOO_SHORT:
+        return "A bit bigger please: draw one long line";
+    case SP_DRAGON_NO_PART:
+    case SP_DRAGON_NO_MODEL:
+        return "This kiosk is not ready yet. Please ask a guide";
+    case SP_DRAGON_FIT_FAILED:
+        return "That one was tricky. Try drawing it again";
+    case SP_DRAGON_NOTHING_TO_REFIT:
+        return "Draw a part first";
+    case SP_DRAGON_FULL:
+        return "What a dragon! Save it, or tap Undo or Start over";
+    default:
+        return "Hmm, what is that? Try a head, wings, a tail, legs or a body";
+    }
+}
+
+static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const sp_error* err, bool refit)
+{
+    if (rc != SP_OK || res->rejected || res->part < 0 || res->part >= sp_dragon_part_count(k->dragon)) {
+        if (rc != SP_OK) {
+            ++k->stats.pipeline_errors;
+            fprintf(stderr, "dragon-kiosk: %s\n", err->text);
+        }
+        ++k->stats.rejected;
+        sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = false, .hint = rc != SP_OK ? reject_hint(SP_DRAGON_UNRECOGNISED)
+                                                                                            : reject_hint(res->reason)});
+        return;
+    }
+    ++k->rev;
+    const sp_dragon_part* p = sp_dragon_part_get(k->dragon, res->part);
+    // The chips: the fitted category, then the classifier's next guesses.
+    part_guesses* g = guesses_of(k, p->id, true);
+    int ng = 0;
+    for (int i = 0; g && i < res->guess_count && ng < 2; ++i)
+        if (strcmp(res->guesses[i].category, p->category) != 0) snprintf(g->guess[ng++], SP_NAME_MAX, "%s", res->guesses[i].category);
+    // A sure classifier votes for one category only; the visitor still gets
+    // two other parts to choose from (the model's other categories, in order).
+    const sp_clf* clf = sp_dragon_model(k->dragon);
+    for (int c = 0; g && clf && c < sp_clf_category_count(clf) && ng < 2; ++c) {
+        const char* name = sp_clf_category(clf, c);
+        bool used = !strcmp(name, p->category);
+        for (int q = 0; q < ng; ++q)
+            used = used || !strcmp(name, g->guess[q]);
+        if (!used) snprintf(g->guess[ng++], SP_NAME_MAX, "%s", name);
+    }
+    // The outline as fitted, in yellow over the stroke.
+    int nb = 0;
+    int n = kiosk_fitted_outline(p, &k->outline_px, &k->outline_cap, k->breaks, 64, &nb);
+    for (int i = 0; i < n; ++i) {
+        sp_vec2 q = kiosk_canvas_to_fb(k, (sp_vec2){k->outline_px[2 * i], k->outline_px[2 * i + 1]});
+        k->outline_px[2 * i] = (float)q.x, k->outline_px[2 * i + 1] = (float)q.y;
+    }
+    if (p->stroke_points > k->scratch_cap) {
+        sp_vec2* s = realloc(k->scratch, sizeof *s * (size_t)p->stroke_points);
+        if (s) k->scratch = s, k->scratch_cap = p->stroke_points;
+    }
+    float* stroke = NULL;
+    int sn = 0;
+    if (refit && p->stroke_points <= k->scratch_cap) {
+        // The part's stored stroke, in fb pixels (packed as floats in the scratch buffer).
+        stroke = (float*)k->scratch;
+        for (int i = 0; i < p->stroke_points; ++i) {
+            sp_vec2 q = kiosk_canvas_to_fb(k, p->stroke_xy[i]);
+            stroke[2 * i] = (float)q.x, stroke[2 * i + 1] = (float)q.y;
+        }
+        sn = p->stroke_points;
+    }
+    sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true, .category = p->category,
+                                                      .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
+                                                      .part_count = sp_dragon_part_count(k->dragon), .outline = k->outline_px,
+                                                      .outline_count = n, .outline_breaks = k->breaks, .outline_break_count = nb,
+                                                      .stroke = stroke, .stroke_count = sn});
+    if (refit) ++k->stats.refits;
+    else ++k->stats.parts_added;
+}
+
+static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
+{
+    const sp_kiosk_line* s = j->stroke;
+    ++k->stats.strokes;
+    if (s->count > k->scratch_cap) {
+        sp_vec2* p = realloc(k->scratch, sizeof *p * (size_t)s->count);
+        if (!p) {
+            sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = false});
+            return;
+        }
+        k->scratch = p, k->scratch_cap = s->count;
+    }
+    for (int i = 0; i < s->count; ++i)
+        k->scratch[i] = kiosk_fb_to_canvas(k, (sp_vec2){s->xy[2 * i], s->xy[2 * i + 1]});
+    sp_dragon_result res;
+    memset(&res, 0, sizeof res);
+    sp_error err = {0};
+    double t0 = now_ms();
+    sp_result rc = sp_dragon_add_points(k->dragon, k->scratch, s->count, &(sp_dragon_stroke_opts){.replace_last = j->replace}, &res, &err);
+    double ms = now_ms() - t0;
+    k->stats.last_fit_ms = ms;
+    k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
+    answer_fit(k, rc, &res, &err, false);
+}
+
+static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
+{
+    sp_dragon_result res;
+    memset(&res, 0, sizeof res);
+    sp_error err = {0};
+    sp_result rc = sp_dragon_refit_last(k->dragon, j->category, &res, &err);
+    answer_fit(k, rc, &res, &err, true);
+}
+
+// A four-character code that reads aloud unambiguously (no 0/O, 1/I, 2/Z, 5/S, 8/B).
+static void next_code(sp_kiosk* k, char code[8])
+{
+    static const char alphabet[] = "ACEFHJKLMNPRTUVWXY3479";
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+        uint64_t z = (k->code_state += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        for (int i = 0; i < 4; ++i, z /= (sizeof alphabet - 1))
+            code[i] = alphabet[z % (sizeof alphabet - 1)];
+        code[4] = 0;
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s.glb", k->export_dir, code);
+        if (access(path, F_OK) != 0) return;
+    }
+}
+
+static sp_result make_dirs(const char* dir, sp_error* err)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (char* p = buf + 1; *p; ++p) {
+        if (*p != '/') continue;
+        *p = 0;
+        if (mkdir(buf, 0755) != 0 && errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
+        *p = '/';
+    }
+    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
+    return SP_OK;
+}
+
+static void run_save(sp_kiosk* k)
+{
+    sp_error err = {0};
+    char code[8];
+    next_code(k, code);
+    char glb[1200], png[1200], tmp[1300];
+    snprintf(glb, sizeof glb, "%s/%s.glb", k->export_dir, code);
+    snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
+    sp_image img = {0};
+    // Written beside and renamed into place: a visitor's code never names half a file.
+    sp_result r = make_dirs(k->export_dir, &err);
+    if (r == SP_OK) {
+        snprintf(tmp, sizeof tmp, "%s/.%s.tmp.glb", k->export_dir, code);
+        r = sp_dragon_export(k->dragon, tmp, &err);
+        if (r == SP_OK && rename(tmp, glb) != 0) r = sp_fail(&err, SP_ERR_IO, "%s: cannot rename (%s)", glb, strerror(errno));
+        if (r != SP_OK) unlink(tmp);
+    }
+    if (r == SP_OK) {
+        // The export evaluates poses of its own: pose the dragon again for the picture.
+        r = sp_dragon_pose_at(k->dragon, k->ui->anim_ms / 1000.0, &err);
+        k->posed = false;
+        if (r == SP_OK) r = kiosk_postcard(k, code, &img, &err);
+        snprintf(tmp, sizeof tmp, "%s/.%s.tmp.png", k->export_dir, code);
+        if (r == SP_OK) r = sp_image_write_png(&img, tmp, &err);
+        if (r == SP_OK && rename(tmp, png) != 0) r = sp_fail(&err, SP_ERR_IO, "%s: cannot rename (%s)", png, strerror(errno));
+        if (r != SP_OK) unlink(tmp);
+    }
+    sp_image_free(&img);
+    if (r == SP_OK) {
+        ++k->stats.saves;
+        snprintf(k->last_save, sizeof k->last_save, "%s/%s", k->export_dir, code);
+        sp_kiosk_ui_saved(k->ui, true, code);
+    } else {
+        ++k->stats.save_failures;
+        fprintf(stderr, "dragon-kiosk: save: %s\n", err.text);
+        sp_kiosk_ui_saved(k->ui, false, NULL);
+    }
+}
+
+static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
+{
+    switch (j->kind) {
+    case SP_KJOB_FIT:
+        run_fit(k, j);
+        break;
+    case SP_KJOB_REFIT:
+        run_refit(k, j);
+        break;
+    case SP_KJOB_UNDO: {
+        if (sp_dragon_undo(k->dragon)) ++k->rev, ++k->stats.undos;
+        sp_kiosk_part_label l;
+        last_label(k, &l);
+        sp_kiosk_ui_parts_changed(k->ui, sp_dragon_part_count(k->dragon), &l);
+        break;
+    }
+    case SP_KJOB_CLEAR:
+        sp_dragon_clear(k->dragon);
+        ++k->rev, ++k->stats.clears;
+        k->guess_count = 0;
+        sp_kiosk_ui_parts_changed(k->ui, 0, NULL);
+        break;
+    case SP_KJOB_SAVE:
+        run_save(k);
+        break;
+    default:
+        break;
+    }
+}
+
+void sp_kiosk_update(sp_kiosk* k, double t_ms)
+{
+    ++k->updates;
+    sp_kiosk_ui_event(k->ui, &(sp_kiosk_event){SP_KEV_FRAME, t_ms, 0, 0, 0});
+    k->heavy_done = false;
+    sp_kiosk_job j;
+    while (!k->heavy_done && sp_kiosk_ui_next_job(k->ui, &j)) {
+        run_job(k, &j);
+        k->heavy_done = j.heavy;
+    }
+    // A curator's change (or a replaced database file) is picked up between
+    // strokes; add_stroke polls too, this only keeps idle kiosks current.
+    if (!k->heavy_done && k->ui->capture == SP_KCAP_NONE && t_ms - k->last_reload_check >= 2000) {
+        k->last_reload_check = t_ms;
+        bool reloaded = false;
+        sp_error err = {0};
+        if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK) fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
+        if (reloaded) ++k->stats.reloads;
+    }
+    if (k->ui->mode == SP_KM_ATTRACT) kiosk_attract_update(k);
+    // Pose the dragon at the animation clock (only when something moves).
+    double t = k->ui->anim_ms / 1000.0;
+    if (!k->posed || k->posed_rev != k->rev || k->posed_t != t) {
+        double t0 = now_ms();
+        sp_error err = {0};
+        if (sp_dragon_pose_at(k->dragon, t, &err) == SP_OK) {
+            mesh_cache_sync(&k->meshes, k->r, k->dragon, true);
+            k->posed = true, k->posed_rev = k->rev, k->posed_t = t;
+        } else {
+            fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+        }
+        k->stats.pose_ms = now_ms() - t0;
+    }
+    k->stats.parts = sp_dragon_part_count(k->dragon);
+}
+
+void sp_kiosk_draw(sp_kiosk* k)
+{
+    kiosk_draw_frame(k, k->fb_w, k->fb_h);
+}
+
+sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err)
+{
+    sp_render_target* t = sp_render_target_create(k->fb_w, k->fb_h, 0, err);
+    if (!t) return SP_ERR_INTERNAL;
+    sp_render_target_bind(t);
+    kiosk_draw_frame(k, k->fb_w, k->fb_h);
+    sp_image img = {0};
+    sp_result r = sp_render_target_read(t, &img, err);
+    sp_render_target_destroy(t);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (r == SP_OK) r = sp_image_write_png(&img, path, err);
+    sp_image_free(&img);
+    return r;
+}
+
+sp_result sp_kiosk_export(sp_kiosk* k, const char* path, sp_error* err)
+{
+    if (sp_dragon_part_count(k->dragon) == 0) return sp_fail(err, SP_ERR_INVALID, "%s: nothing to export: the dragon has no parts", path);
+    return sp_dragon_export(k->dragon, path, err);
+}

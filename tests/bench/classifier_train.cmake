@@ -1,0 +1,4 @@
+# Classifier training time on 10k drawings (Quick, Draw! + hand-drawn variants):
+# built with the tests, run on demand.
+add_executable(bench_classifier_train bench/classifier_train.c)
+target_link_libraries(bench_classifier_train PRIVATE sp_test_support sp::partdb sp::classifier)

@@ -1,0 +1,331 @@
+// tests/bench/kiosk: the kiosk's speed on a headless OpenGL context (Mesa
+// llvmpipe in CI): the same code as the window (sp_kiosk), drawing into a
+// 1280 x 800 offscreen framebuffer and waiting for each frame (glFinish).
+//   build/tests/bench/kiosk [--json] [--runs N] [--db DB] [--lod N (triangles per part, -1: all)] [--png last.png]
+//   build/tests/bench/kiosk --soak N [--json]   N strokes in one session (undo, start over and
+//   save now and then); resident memory after 200 strokes (warm-up) and at the end.
+// Cases: start to first frame, pen-up to the fitted part on screen (the
+// paper's solve alone took 100 ms; target 50 ms), frames of the attract
+// screen, of an empty canvas and of six animated parts (target 33 ms).
+// Without --db it builds the test database of tests/support/kiosk_parts.h.
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include "bench.h"
+#include "fixtures.h"
+#include "headless.h"
+#include "kiosk.h"
+#include "kiosk_parts.h"
+#include "render.h"
+
+enum { W = 1280, H = 800 };
+
+static void ev(sp_kiosk* k, sp_kiosk_event_type type, double t, double x, double y)
+{
+    sp_kiosk_input(k, &(sp_kiosk_event){type, t, (float)x, (float)y, 0});
+}
+
+// Process CPU time (every thread, llvmpipe's too): on a busy machine a
+// steadier figure than the wall clock.
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static double g_cpu[4096];
+static int g_ncpu;
+
+static double g_upd_cpu[4096];
+
+static GLuint g_fbo;
+static sp_render_target* g_target;
+
+static double frame(sp_kiosk* k, double t)
+{
+    // Screenshots and postcards bind their own framebuffers.
+    if (g_target) sp_render_target_bind(g_target);
+    else glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
+    double t0 = sp_bench_now_ms(), c0 = cpu_ms();
+    sp_kiosk_update(k, t);
+    if (g_ncpu < 4096) g_upd_cpu[g_ncpu] = cpu_ms() - c0;
+    sp_kiosk_draw(k);
+    glFinish();
+    if (g_ncpu < 4096) g_cpu[g_ncpu++] = cpu_ms() - c0;
+    return sp_bench_now_ms() - t0;
+}
+
+// The CPU time of the frames since the last call, as an extra JSON member.
+static void cpu_extra(sp_bench_row* r)
+{
+    double med = 0, p90 = 0, umed = 0;
+    if (g_ncpu > 0) sp_bench_stats(g_cpu, g_ncpu, &med, &p90);
+    if (g_ncpu > 0) sp_bench_stats(g_upd_cpu, g_ncpu, &umed, &p90);
+    size_t n = strlen(r->extra);
+    snprintf(r->extra + n, sizeof r->extra - n, "%s\"cpu_ms_median\": %.2f, \"update_cpu_ms_median\": %.2f", n ? ", " : "", med, umed);
+    g_ncpu = 0;
+}
+
+static void press(sp_kiosk* k, double t, sp_kiosk_target target)
+{
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, target});
+}
+
+static long rss_kb(void)
+{
+    FILE* f = fopen("/proc/self/statm", "r");
+    long pages = 0, res = 0;
+    if (!f) return 0;
+    if (fscanf(f, "%ld %ld", &pages, &res) != 2) res = 0;
+    fclose(f);
+    return res * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+// n strokes in one session: the six parts drawn again and again, shifted a
+// little each time, with Undo, Start over and Save mixed in.
+static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row* row)
+{
+    double t = 1e6, step = 1000.0 / 60.0;
+    sp_test_rng rng = {77};
+    long warm = 0, peak = 0;
+    double t0 = sp_bench_now_ms();
+    sp_vec2* xy = NULL;
+    int cap = 0;
+    for (int i = 0; i < n; ++i) {
+        const kp_stroke* s = &strokes[i % DRAGON_PART_COUNT];
+        if (s->n > cap) {
+            xy = realloc(xy, sizeof *xy * (size_t)s->n);
+            cap = s->n;
+        }
+        double dx = sp_test_range(&rng, -40, 40), dy = sp_test_range(&rng, -30, 30);
+        for (int p = 0; p < s->n; ++p)
+            xy[p] = (sp_vec2){s->xy[p].x + dx, s->xy[p].y + dy};
+        ev(k, SP_KEV_DOWN, t, xy[0].x, xy[0].y);
+        for (int p = 1; p < s->n; ++p)
+            ev(k, SP_KEV_MOVE, t + 0.01 * p, xy[p].x, xy[p].y);
+        t += 0.01 * s->n;
+        ev(k, SP_KEV_UP, t, xy[s->n - 1].x, xy[s->n - 1].y);
+        for (int f = 0; f < 3; ++f)
+            frame(k, t += step);
+        if (i % 7 == 6) press(k, t += step, SP_KT_UNDO);
+        if (i % 97 == 96) press(k, t += step, SP_KT_SAVE);
+        if (i % 40 == 39) {
+            press(k, t += step, SP_KT_START_OVER);
+            press(k, t += step, SP_KT_START_OVER);
+        }
+        frame(k, t += step);
+        long r = rss_kb();
+        if (i + 1 == 200 || (n < 200 && i == 0)) warm = r;
+        if (i + 1 >= 200 && r > peak) peak = r;
+    }
+    free(xy);
+    long end = rss_kb();
+    if (peak < end) peak = end;
+    double ms = (sp_bench_now_ms() - t0) / n;
+    *row = (sp_bench_row){"soak: ms per stroke", ms, ms, n, -1, -1, ""};
+    snprintf(row->extra, sizeof row->extra, "\"rss_kb_warm\": %ld, \"rss_kb_peak\": %ld, \"rss_kb_end\": %ld, \"growth_pct\": %.2f, \"parts\": %d, \"saves\": %d",
+             warm, peak, end, warm > 0 ? 100.0 * (double)(peak - warm) / (double)warm : 0.0, sp_kiosk_stats_of(k)->parts,
+             sp_kiosk_stats_of(k)->saves);
+}
+
+int main(int argc, char** argv)
+{
+    bool json = sp_bench_json_flag(argc, argv);
+    int runs = 60;
+    const char* db = NULL;
+    const char* png = NULL;
+    int lod = 0, soak = 0;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--runs") && i + 1 < argc) runs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--lod") && i + 1 < argc) lod = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--png") && i + 1 < argc) png = argv[++i];
+        else if (!strcmp(argv[i], "--soak") && i + 1 < argc) soak = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--db") && i + 1 < argc) db = argv[++i];
+    }
+    if (runs < 3) runs = 3;
+    sp_error err = {0};
+    char db_path[1100], dir[1024];
+    bool real = false;
+    if (!db) {
+        snprintf(dir, sizeof dir, "%s/tmp", SP_BINARY_DIR);
+        mkdir(dir, 0755);
+        snprintf(db_path, sizeof db_path, "%.1024s/bench_kiosk.db", dir);
+        if (!kp_build_db(db_path, SP_SOURCE_DIR "/assets", dir, &real, &err)) {
+            fprintf(stderr, "bench kiosk: %s\n", err.text);
+            return 1;
+        }
+        db = db_path;
+    }
+    kp_stroke strokes[DRAGON_PART_COUNT];
+    memset(strokes, 0, sizeof strokes);
+    if (!kp_six_strokes(db, strokes, &err)) {
+        fprintf(stderr, "bench kiosk: %s\n", err.text);
+        return 1;
+    }
+    sp_headless* gl = sp_headless_create(&err);
+    if (!gl) {
+        fprintf(stderr, "bench kiosk: %s\n", err.text);
+        return 1;
+    }
+    // The framebuffer the window would have: one sample a pixel on software
+    // GL (dragon-kiosk's default there), 4 on a GPU.
+    const char* gl_name = sp_headless_renderer_name(gl);
+    bool software = strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast");
+    sp_render_target* target = NULL;
+    GLuint fbo = 0, rb[2] = {0, 0};
+    if (software) {
+        glGenFramebuffers(1, &fbo);
+        glGenRenderbuffers(2, rb);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+        g_fbo = fbo;
+    } else {
+        if (!(target = sp_render_target_create(W, H, 4, &err))) {
+            fprintf(stderr, "bench kiosk: %s\n", err.text);
+            return 1;
+        }
+        sp_render_target_bind(target);
+        g_target = target;
+    }
+    sp_bench_row rows[8];
+    int nr = 0;
+    if (soak > 0) {
+        sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod,
+                                                       .no_attract_demo = true}, &err);
+        if (!k) {
+            fprintf(stderr, "bench kiosk: %s\n", err.text);
+            return 1;
+        }
+        sp_kiosk_resize(k, W, H, 96 / 25.4);
+        frame(k, 0);
+        ev(k, SP_KEV_DOWN, 10, 640, 400);
+        ev(k, SP_KEV_UP, 20, 640, 400);
+        soak_run(k, strokes, soak, &rows[nr++]);
+        sp_bench_print("kiosk soak (headless, 1280x800)", rows, nr, json);
+        sp_kiosk_destroy(k);
+        for (int i = 0; i < DRAGON_PART_COUNT; ++i)
+            free(strokes[i].xy);
+        sp_render_target_destroy(target);
+        if (fbo) glDeleteFramebuffers(1, &fbo);
+        if (rb[0]) glDeleteRenderbuffers(2, rb);
+        sp_headless_destroy(gl);
+        return 0;
+    }
+
+    // Start to first frame (the database exists, as in a museum after install).
+    double t0 = sp_bench_now_ms();
+    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod}, &err);
+    if (!k) {
+        fprintf(stderr, "bench kiosk: %s\n", err.text);
+        return 1;
+    }
+    sp_kiosk_resize(k, W, H, 96 / 25.4);
+    frame(k, 0);
+    double start = sp_bench_now_ms() - t0;
+    rows[nr++] = (sp_bench_row){"start to first frame", start, start, 1, -1, 2000, ""};
+    snprintf(rows[nr - 1].extra, sizeof rows[nr - 1].extra, "\"database\": \"%s\"", real ? "assets" : "stand-ins");
+
+    // The attract screen (its demo dragon fits itself over the first frames).
+    double t = 0, step = 1000.0 / 60.0;
+    double* ms = malloc(sizeof(double) * (size_t)(runs + 64));
+    for (int i = 0; i < 30; ++i)
+        frame(k, t += step);
+    g_ncpu = 0;
+    for (int i = 0; i < runs; ++i)
+        ms[i] = frame(k, t += step);
+    sp_bench_row r = {"frame: attract screen 1280x800", 0, 0, runs, -1, 33, ""};
+    sp_bench_stats(ms, runs, &r.ms_median, &r.ms_p90);
+    cpu_extra(&r);
+    rows[nr++] = r;
+
+    // An empty canvas.
+    ev(k, SP_KEV_DOWN, t += step, 640, 400);
+    ev(k, SP_KEV_UP, t += 10, 640, 400);
+    g_ncpu = 0;
+    for (int i = 0; i < runs; ++i)
+        ms[i] = frame(k, t += step);
+    r = (sp_bench_row){"frame: empty canvas 1280x800", 0, 0, runs, -1, 33, ""};
+    sp_bench_stats(ms, runs, &r.ms_median, &r.ms_p90);
+    cpu_extra(&r);
+    rows[nr++] = r;
+
+    // Pen-up to the fitted part on screen: the stroke's events, then one
+    // update + draw. Rounds of six strokes, cleared in between.
+    int rounds = runs / 6 < 2 ? 2 : runs / 6, n = 0;
+    double* lat = malloc(sizeof(double) * (size_t)(rounds * DRAGON_PART_COUNT));
+    for (int round = 0; round < rounds; ++round) {
+        for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+            const kp_stroke* s = &strokes[i];
+            ev(k, SP_KEV_DOWN, t, s->xy[0].x, s->xy[0].y);
+            for (int p = 1; p < s->n; ++p)
+                ev(k, SP_KEV_MOVE, t + 0.01 * p, s->xy[p].x, s->xy[p].y);
+            t += 0.01 * s->n;
+            double up = sp_bench_now_ms();
+            ev(k, SP_KEV_UP, t, s->xy[s->n - 1].x, s->xy[s->n - 1].y);
+            frame(k, t += step);
+            lat[n++] = sp_bench_now_ms() - up;
+            for (int f = 0; f < 60; ++f) // the flash ends, the part shows
+                frame(k, t += step);
+        }
+        if (round + 1 < rounds) {
+            press(k, t += step, SP_KT_START_OVER);
+            press(k, t += step, SP_KT_START_OVER);
+            frame(k, t += step);
+        }
+    }
+    r = (sp_bench_row){"pen-up to fitted part on screen", 0, 0, n, 100, 50, ""};
+    sp_bench_stats(lat, n, &r.ms_median, &r.ms_p90);
+    snprintf(r.extra, sizeof r.extra, "\"parts\": %d", sp_kiosk_stats_of(k)->parts);
+    rows[nr++] = r;
+
+    // Six animated parts.
+    press(k, t += step, SP_KT_PLAY);
+    g_ncpu = 0;
+    for (int i = 0; i < runs; ++i)
+        ms[i] = frame(k, t += step);
+    r = (sp_bench_row){"frame: six animated parts 1280x800", 0, 0, runs, -1, 33, ""};
+    sp_bench_stats(ms, runs, &r.ms_median, &r.ms_p90);
+    snprintf(r.extra, sizeof r.extra, "\"parts\": %d, \"playing\": %s, \"renderer\": \"%s\"", sp_kiosk_stats_of(k)->parts,
+             sp_kiosk_ui_of(k)->playing ? "true" : "false", sp_headless_renderer_name(gl));
+    cpu_extra(&r);
+    rows[nr++] = r;
+
+    if (png) { // the last frame, to look at what was timed
+        sp_image img = {0};
+        if (sp_image_alloc(&img, W, H) == SP_OK) {
+            if (g_target) {
+                sp_render_target_read(g_target, &img, &err);
+            } else {
+                glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
+                glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, img.rgba);
+                sp_image_flip_rows(&img);
+            }
+            if (sp_image_write_png(&img, png, &err) != SP_OK) fprintf(stderr, "bench kiosk: %s\n", err.text);
+        }
+        sp_image_free(&img);
+    }
+    sp_bench_print("kiosk (headless, 1280x800)", rows, nr, json);
+    free(ms);
+    free(lat);
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i)
+        free(strokes[i].xy);
+    sp_kiosk_destroy(k);
+    sp_render_target_destroy(target);
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (rb[0]) glDeleteRenderbuffers(2, rb);
+    sp_headless_destroy(gl);
+    return 0;
+}

@@ -1,0 +1,537 @@
+// Dragon-part classes: the hand-drawing model (determinism, each effect
+// measured on the drawn geometry with the others switched off, the presets'
+// ranges), the part database's synthetic sketches going through it, the
+// `sketchpose synth --parts` folder, and the dragon-part classifier criteria
+// of issue 5 on a smaller set (train on normal sketches of seed family 1, test
+// on harsh sketches of family 2, reject Quick, Draw! drawings of objects).
+// Parts: assets/*.glb when all six are there, else stand-ins built in code
+// (tests/support/dragon_parts.h); `test_dragon_classes --write-standins DIR`
+// writes the stand-ins as .glb for trying the command line by hand.
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "db_internal.h"
+#include "dragon_parts.h"
+#include "sp/classifier.h"
+#include "sp/curve.h"
+#include "sp/handdraw.h"
+#include "sp/synth.h"
+#include "test.h"
+
+#define PI 3.14159265358979323846
+
+static dragon_part g_parts[DRAGON_PART_COUNT];
+static bool g_loaded, g_assets;
+
+static dragon_part* parts(void)
+{
+    if (!g_loaded) {
+        g_assets = dragon_parts_load(sp_test_src_path("assets"), g_parts);
+        g_loaded = true;
+        printf("  parts: %s\n", g_assets ? "assets/*.glb" : "code-built stand-ins (assets/ incomplete)");
+    }
+    return g_parts;
+}
+
+// The clean sketch of part i at its rest pose.
+static sp_sketch clean_sketch(int i)
+{
+    dragon_part* p = &parts()[i];
+    double* q = malloc(sizeof(double) * (size_t)p->ch.rig.param_count);
+    sp_rig_defaults(&p->ch.rig, q);
+    sp_sketch sk = {0};
+    ENSURE(sp_synth_sketch(&p->ch.rig, p->abstraction, &p->ch.camera, q, &sk) == SP_OK);
+    free(q);
+    return sk;
+}
+
+static double diag(const sp_sketch* s)
+{
+    sp_vec2 lo, hi;
+    ENSURE(sp_sketch_bounds(s, &lo, &hi));
+    return hypot(hi.x - lo.x, hi.y - lo.y);
+}
+
+static double poly_length(const sp_stroke* s)
+{
+    return sp_curve_length(s->points, s->count, false);
+}
+
+// Distance from p to the polyline pts[0..n).
+static double dist_to_poly(sp_vec2 p, const sp_vec2* pts, int n)
+{
+    double best = INFINITY;
+    for (int i = 0; i + 1 < n; ++i) {
+        sp_vec2 a = pts[i], d = sp_v2_sub(pts[i + 1], a);
+        double l2 = sp_v2_dot(d, d), t = l2 > 0 ? sp_v2_dot(sp_v2_sub(p, a), d) / l2 : 0;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        best = fmin(best, sp_v2_len(sp_v2_sub(p, sp_v2_add(a, sp_v2_scale(d, t)))));
+    }
+    return best;
+}
+
+// Signed area (shoelace) of a stroke taken as closed; y down, so > 0 is clockwise on screen.
+static double signed_area(const sp_stroke* s)
+{
+    double a = 0;
+    for (int i = 0; i < s->count; ++i) {
+        sp_vec2 p = s->points[i], q = s->points[(i + 1) % s->count];
+        a += p.x * q.y - q.x * p.y;
+    }
+    return 0.5 * a;
+}
+
+// Every effect off: a resampled copy of the clean sketch.
+static sp_handdraw_params only(void)
+{
+    return sp_handdraw_preset(SP_HANDDRAW_CLEAN);
+}
+
+static bool same_sketch(const sp_sketch* a, const sp_sketch* b)
+{
+    if (a->stroke_count != b->stroke_count) return false;
+    for (int s = 0; s < a->stroke_count; ++s) {
+        if (a->strokes[s].count != b->strokes[s].count) return false;
+        if (memcmp(a->strokes[s].points, b->strokes[s].points, sizeof(sp_vec2) * (size_t)a->strokes[s].count)) return false;
+        if (memcmp(a->strokes[s].t, b->strokes[s].t, sizeof(double) * (size_t)a->strokes[s].count)) return false;
+    }
+    return true;
+}
+
+// ---- the hand-drawing model ----------------------------------------------------
+
+static void test_handdraw_deterministic(void)
+{
+    dragon_part* p = &parts()[5];
+    sp_error err = {0};
+    for (int st = SP_HANDDRAW_NORMAL; st <= SP_HANDDRAW_HARSH; ++st) {
+        sp_handdraw_desc d = {.style = (sp_handdraw_style)st};
+        sp_sketch a, b, c;
+        ENSURE(sp_handdraw_part(&p->ch.rig, p->abstraction, &p->ch.camera, &d, 42, &a, NULL, &err) == SP_OK);
+        ENSURE(sp_handdraw_part(&p->ch.rig, p->abstraction, &p->ch.camera, &d, 42, &b, NULL, &err) == SP_OK);
+        ENSURE(sp_handdraw_part(&p->ch.rig, p->abstraction, &p->ch.camera, &d, 43, &c, NULL, &err) == SP_OK);
+        ENSURE(same_sketch(&a, &b));
+        ENSURE(!same_sketch(&a, &c));
+        ENSURE(sp_sketch_is_valid(&a) && a.canvas_w == p->ch.camera.width && a.canvas_h == p->ch.camera.height);
+        sp_sketch_free(&a);
+        sp_sketch_free(&b);
+        sp_sketch_free(&c);
+    }
+    // A whole labelled set, twice; families and parts give distinct seeds.
+    sp_dataset x, y;
+    ENSURE(dragon_set(parts(), 4, 9, &(sp_handdraw_desc){0}, &x, &err) == SP_OK);
+    ENSURE(dragon_set(parts(), 4, 9, &(sp_handdraw_desc){0}, &y, &err) == SP_OK);
+    ENSURE(x.count == 4 * DRAGON_PART_COUNT && y.count == x.count);
+    for (int i = 0; i < x.count; ++i)
+        ENSURE(same_sketch(&x.samples[i].sketch, &y.samples[i].sketch) && x.samples[i].label == y.samples[i].label);
+    sp_dataset_free(&x);
+    sp_dataset_free(&y);
+    ENSURE(sp_handdraw_seed(1, 0) != sp_handdraw_seed(2, 0) && sp_handdraw_seed(1, 0) != sp_handdraw_seed(1, 1));
+    ENSURE(sp_handdraw_part_family(1, "wings") != sp_handdraw_part_family(1, "tail"));
+    ENSURE(sp_handdraw_part_family(1, "wings") == sp_handdraw_part_family(1, "wings"));
+}
+
+static void test_handdraw_bad_input(void)
+{
+    sp_error err = {0};
+    sp_sketch out;
+    sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
+    sp_sketch empty = {0};
+    ENSURE(sp_handdraw_apply(&empty, &hp, 1, &out, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "empty"));
+    sp_vec2 nan_pts[2] = {{0, 0}, {NAN, 1}};
+    sp_sketch bad = {0};
+    ENSURE(sp_sketch_add_stroke(&bad, nan_pts, NULL, 2) == SP_OK);
+    ENSURE(sp_handdraw_apply(&bad, &hp, 1, &out, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "finite"));
+    sp_sketch_free(&bad);
+    sp_vec2 dot[2] = {{5, 5}, {5, 5}};
+    ENSURE(sp_sketch_add_stroke(&bad, dot, NULL, 2) == SP_OK);
+    ENSURE(sp_handdraw_apply(&bad, &hp, 1, &out, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "single point"));
+    sp_sketch_free(&bad);
+    sp_sketch sk = clean_sketch(0);
+    hp.gap = -0.1;
+    ENSURE(sp_handdraw_apply(&sk, &hp, 1, &out, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "out of range"));
+    hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
+    hp.spacing_max = hp.spacing_min / 2;
+    ENSURE(!sp_handdraw_params_valid(&hp));
+    sp_sketch_free(&sk);
+    dragon_part* p = &parts()[0];
+    ENSURE(sp_handdraw_part(&p->ch.rig, 7, &p->ch.camera, NULL, 1, &out, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(sp_handdraw_style_parse("harsh") == SP_HANDDRAW_HARSH && sp_handdraw_style_parse("x") == SP_HANDDRAW_STYLE_COUNT);
+}
+
+// Rotation alone: every drawn point, turned back by info.rotation about the
+// clean drawing's centre, lies on the clean curve; the angle stays within
+// +-20 degrees in the harsh preset (+-15 normal) and uses the range.
+static void test_handdraw_rotation(void)
+{
+    sp_sketch sk = clean_sketch(4);
+    const sp_stroke* cs = &sk.strokes[0];
+    sp_vec2 lo, hi;
+    sp_sketch_bounds(&sk, &lo, &hi);
+    sp_vec2 c = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y)};
+    double D = diag(&sk);
+    sp_handdraw_params hp = only();
+    hp.rotation_deg = 20;
+    sp_error err = {0};
+    for (uint64_t seed = 1; seed <= 10; ++seed) {
+        sp_sketch out;
+        sp_handdraw_info info;
+        ENSURE(sp_handdraw_apply(&sk, &hp, seed, &out, &info, &err) == SP_OK);
+        ENSURE(out.stroke_count == 1 && fabs(info.rotation) <= 20 * PI / 180 + 1e-12);
+        double worst = 0, worst_unrotated = 0, cs_ = cos(info.rotation), sn = sin(info.rotation);
+        for (int i = 0; i < out.strokes[0].count; ++i) {
+            sp_vec2 p = sp_v2_sub(out.strokes[0].points[i], c);
+            sp_vec2 back = {c.x + cs_ * p.x - sn * p.y, c.y + sn * p.x + cs_ * p.y};
+            worst = fmax(worst, dist_to_poly(back, cs->points, cs->count));
+            worst_unrotated = fmax(worst_unrotated, dist_to_poly(out.strokes[0].points[i], cs->points, cs->count));
+        }
+        ENSURE(worst < 0.002 * D); // the pen's points lie on chords of the dense resampling
+        if (fabs(info.rotation) > 2 * PI / 180) ENSURE(worst_unrotated > 0.005 * D); // the rotation is real
+        sp_sketch_free(&out);
+    }
+    for (int st = SP_HANDDRAW_NORMAL; st <= SP_HANDDRAW_HARSH; ++st) {
+        sp_handdraw_params pp = sp_handdraw_preset((sp_handdraw_style)st);
+        double limit = st == SP_HANDDRAW_HARSH ? 20 : 15, most = 0;
+        for (uint64_t seed = 1; seed <= 300; ++seed) {
+            sp_sketch out;
+            sp_handdraw_info info;
+            ENSURE(sp_handdraw_apply(&sk, &pp, seed, &out, &info, &err) == SP_OK);
+            ENSURE(fabs(info.rotation) * 180 / PI <= limit + 1e-9);
+            most = fmax(most, fabs(info.rotation) * 180 / PI);
+            ENSURE(info.aspect >= 1 / pp.aspect - 1e-12 && info.aspect <= pp.aspect + 1e-12);
+            sp_sketch_free(&out);
+        }
+        ENSURE(most > 0.9 * limit);
+    }
+    sp_sketch_free(&sk);
+}
+
+// Closure alone: the traced length is (1 + closure) of the curve's (gaps < 0,
+// overshoots > 0), the ends stay apart by about the gap; the harsh preset has
+// both gaps and overshoots, larger than the normal one's.
+static void test_handdraw_closure(void)
+{
+    sp_sketch sk = clean_sketch(4);
+    double L = poly_length(&sk.strokes[0]), D = diag(&sk);
+    sp_error err = {0};
+    for (int kind = 0; kind < 2; ++kind) {
+        sp_handdraw_params hp = only();
+        hp.random_start = true;
+        hp.gap = 0.1;
+        hp.overshoot = 0.1;
+        hp.gap_probability = kind == 0 ? 1.0 : 0.0;
+        int seen = 0;
+        for (uint64_t seed = 1; seed <= 40; ++seed) {
+            sp_sketch out;
+            sp_handdraw_info info;
+            ENSURE(sp_handdraw_apply(&sk, &hp, seed, &out, &info, &err) == SP_OK);
+            ENSURE(out.stroke_count == 1 && info.closed_curves == 1);
+            double c = info.closure_min, drawn = poly_length(&out.strokes[0]);
+            ENSURE(kind == 0 ? (c <= 0 && c >= -0.1) : (c >= 0 && c <= 0.1));
+            ENSURE_NEAR(drawn / L, 1 + c, 0.01);
+            double ends = sp_v2_len(sp_v2_sub(out.strokes[0].points[0], out.strokes[0].points[out.strokes[0].count - 1]));
+            if (kind == 0 && c < -0.03) {
+                ENSURE(ends > 0.3 * (-c) * L); // a chord of the missing arc
+                ++seen;
+            }
+            if (kind == 1 && c > 0.03) {
+                // The pen passed its start: the start lies on the stroke's last stretch.
+                const sp_stroke* s = &out.strokes[0];
+                int from = s->count - 1;
+                for (double back = 0; from > 0 && back < 1.2 * c * L; --from)
+                    back += sp_v2_len(sp_v2_sub(s->points[from], s->points[from - 1]));
+                ENSURE(dist_to_poly(s->points[0], s->points + from, s->count - from) < 0.01 * D);
+                ++seen;
+            }
+            sp_sketch_free(&out);
+        }
+        ENSURE(seen >= 10);
+    }
+    // The presets: over many sketches, harsh has both kinds and larger ones.
+    double extreme[2][2] = {{0}};
+    for (int st = 0; st < 2; ++st) {
+        sp_handdraw_params pp = sp_handdraw_preset(st ? SP_HANDDRAW_HARSH : SP_HANDDRAW_NORMAL);
+        int gaps = 0, overs = 0;
+        for (uint64_t seed = 1; seed <= 200; ++seed) {
+            sp_sketch out;
+            sp_handdraw_info info;
+            ENSURE(sp_handdraw_apply(&sk, &pp, seed, &out, &info, &err) == SP_OK);
+            gaps += info.gaps;
+            overs += info.overshoots;
+            extreme[st][0] = fmin(extreme[st][0], info.closure_min);
+            extreme[st][1] = fmax(extreme[st][1], info.closure_max);
+            sp_sketch_free(&out);
+        }
+        printf("  %s: %d gaps, %d overshoots in 200; closure %.3f .. %.3f\n", st ? "harsh" : "normal", gaps, overs, extreme[st][0],
+               extreme[st][1]);
+        ENSURE(gaps >= 50 && overs >= 50);
+    }
+    ENSURE(extreme[1][0] < -0.07 && extreme[1][1] > 0.1);
+    ENSURE(extreme[1][0] < extreme[0][0] && extreme[1][1] > extreme[0][1]);
+    sp_sketch_free(&sk);
+}
+
+// Partial strokes, splits and direction.
+static void test_handdraw_partial_split_direction(void)
+{
+    sp_sketch sk = clean_sketch(3);
+    double L = poly_length(&sk.strokes[0]);
+    sp_error err = {0};
+    sp_handdraw_params hp = only();
+    hp.partial_probability = 1;
+    hp.partial = 0.3;
+    for (uint64_t seed = 1; seed <= 30; ++seed) {
+        sp_sketch out;
+        sp_handdraw_info info;
+        ENSURE(sp_handdraw_apply(&sk, &hp, seed, &out, &info, &err) == SP_OK);
+        double f = poly_length(&out.strokes[0]) / L;
+        ENSURE(info.partial == 1 && f >= 0.7 - 0.01 && f <= 1 - 0.105 + 0.01);
+        ENSURE_NEAR(f, info.covered_min, 0.01);
+        sp_sketch_free(&out);
+    }
+    // Harsh: some curves drawn in part, some in several strokes, both directions.
+    sp_handdraw_params pp = sp_handdraw_preset(SP_HANDDRAW_HARSH);
+    int partial = 0, split = 0, multi = 0, cw = 0, ccw = 0, reversed = 0;
+    for (uint64_t seed = 1; seed <= 200; ++seed) {
+        sp_sketch out;
+        sp_handdraw_info info;
+        ENSURE(sp_handdraw_apply(&sk, &pp, seed, &out, &info, &err) == SP_OK);
+        partial += info.partial;
+        split += info.split;
+        reversed += info.reversed;
+        multi += out.stroke_count > 1;
+        ENSURE((out.stroke_count > 1) == (info.split > 0));
+        if (out.stroke_count == 1 && info.covered_min > 0.9) {
+            if (signed_area(&out.strokes[0]) > 0) ++cw;
+            else ++ccw;
+        }
+        sp_sketch_free(&out);
+    }
+    printf("  harsh: %d partial, %d split, %d reversed; closed single strokes %d clockwise, %d counter-clockwise\n", partial, split,
+           reversed, cw, ccw);
+    ENSURE(partial >= 20 && partial <= 60); // 20% of 200
+    ENSURE(split >= 35 && split <= 85 && multi == split);
+    ENSURE(reversed >= 70 && reversed <= 130 && cw >= 30 && ccw >= 30);
+    sp_sketch_free(&sk);
+}
+
+// Uneven sampling with timestamps; rounded corners; wobble.
+static void test_handdraw_sampling_corners_wobble(void)
+{
+    sp_sketch sk = clean_sketch(5);
+    double D = diag(&sk);
+    sp_error err = {0};
+    double cv[2] = {0};
+    for (int st = 0; st < 2; ++st) {
+        sp_handdraw_params hp = st ? sp_handdraw_preset(SP_HANDDRAW_NORMAL) : only();
+        sp_sketch out;
+        ENSURE(sp_handdraw_apply(&sk, &hp, 5, &out, NULL, &err) == SP_OK);
+        double s1 = 0, s2 = 0;
+        int n = 0;
+        double t_prev = -1;
+        for (int s = 0; s < out.stroke_count; ++s) {
+            const sp_stroke* k = &out.strokes[s];
+            ENSURE(k->t != NULL && k->t[0] > t_prev);
+            for (int i = 1; i < k->count; ++i) {
+                ENSURE(k->t[i] > k->t[i - 1]);
+                double d = sp_v2_len(sp_v2_sub(k->points[i], k->points[i - 1]));
+                s1 += d, s2 += d * d, ++n;
+            }
+            t_prev = k->t[k->count - 1];
+        }
+        double mean = s1 / n;
+        cv[st] = sqrt(fmax(0, s2 / n - mean * mean)) / mean;
+        sp_sketch_free(&out);
+    }
+    printf("  point spacing, coefficient of variation: clean %.3f, normal %.3f\n", cv[0], cv[1]);
+    ENSURE(cv[0] < 0.1 && cv[1] > 0.4);
+    // Corners: with rounding the drawn curve cuts the wing's sharp tips.
+    sp_handdraw_params hp = only();
+    hp.corner = 0.025;
+    sp_sketch out;
+    ENSURE(sp_handdraw_apply(&sk, &hp, 3, &out, NULL, &err) == SP_OK);
+    double cut = 0;
+    const sp_stroke* cs = &sk.strokes[0];
+    for (int i = 0; i < cs->count; ++i)
+        cut = fmax(cut, dist_to_poly(cs->points[i], out.strokes[0].points, out.strokes[0].count));
+    printf("  rounded corners: a tip is cut by %.3f D\n", cut / D);
+    ENSURE(cut > 0.005 * D && cut < 0.05 * D);
+    sp_sketch_free(&out);
+    // Wobble: the drawn curve strays from the clean one by about its amplitude, smoothly.
+    hp = only();
+    hp.wobble = 0.02;
+    ENSURE(sp_handdraw_apply(&sk, &hp, 3, &out, NULL, &err) == SP_OK);
+    double stray = 0;
+    for (int i = 0; i < out.strokes[0].count; ++i)
+        stray = fmax(stray, dist_to_poly(out.strokes[0].points[i], cs->points, cs->count));
+    printf("  wobble: strays up to %.4f D\n", stray / D);
+    ENSURE(stray > 0.003 * D && stray <= 0.02 * D + 1e-9);
+    sp_sketch_free(&out);
+    sp_sketch_free(&sk);
+}
+
+// The part database stores hand-drawn sketches (normal style) with each part.
+static void test_db_synthetic_sketches(void)
+{
+    dragon_part* p = &parts()[1];
+    sp_dataset a, b;
+    sp_error err = {0};
+    ENSURE(db_synth_sketches(&p->ch, p->abstraction, 5, 3, 0, &a, &err) == SP_OK);
+    ENSURE(db_synth_sketches(&p->ch, p->abstraction, 5, 3, 0, &b, &err) == SP_OK);
+    ENSURE(a.count == 5);
+    for (int i = 0; i < a.count; ++i) {
+        ENSURE(same_sketch(&a.samples[i].sketch, &b.samples[i].sketch));
+        ENSURE(a.samples[i].sketch.strokes[0].t != NULL); // drawn by the model: timed pen samples
+    }
+    // Not the clean projection: closed curves do not end exactly where they start.
+    int open_ends = 0;
+    for (int i = 0; i < a.count; ++i) {
+        const sp_stroke* s = &a.samples[i].sketch.strokes[0];
+        open_ends += sp_v2_len(sp_v2_sub(s->points[0], s->points[s->count - 1])) > 1e-3;
+    }
+    ENSURE(open_ends >= 4);
+    sp_dataset_free(&a);
+    sp_dataset_free(&b);
+}
+
+// ---- the command line ------------------------------------------------------------
+
+static const char* sketchpose_bin(void)
+{
+    static char b[1024];
+    snprintf(b, sizeof b, "%s/app/sketchpose", SP_BINARY_DIR);
+    return access(b, X_OK) == 0 ? b : NULL;
+}
+
+static bool write_standins(const char* dir)
+{
+    mkdir(dir, 0777);
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+        dragon_part p;
+        dragon_standin(i, &p);
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s.glb", dir, p.name);
+        sp_error err = {0};
+        sp_result r = sp_gltf_save(&p.ch, NULL, path, &err);
+        sp_character_free(&p.ch);
+        if (r != SP_OK) {
+            fprintf(stderr, "%s\n", err.text);
+            return false;
+        }
+    }
+    return true;
+}
+
+static void test_cli_synth_parts(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char dir[1024], out[1024], cmd[8192];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("standins"));
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("synth_out"));
+    ENSURE(write_standins(dir));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && '%s' synth --parts '%s' --per-part 3 --seed 5 --style harsh --out-dir '%s' > '%s.json'", out,
+             bin, dir, out, out);
+    ENSURE(system(cmd) == 0);
+    sp_dataset ds;
+    sp_error err = {0};
+    ENSURE(sp_dataset_load(out, &ds, &err) == SP_OK);
+    ENSURE(ds.count == 3 * DRAGON_PART_COUNT && ds.category_count == DRAGON_PART_COUNT);
+    ENSURE(!strcmp(ds.categories[0], "front_legs") && !strcmp(ds.categories[5], "wings"));
+    // The same as the library's sketches of that family and style.
+    dragon_part p;
+    dragon_standin(3, &p);
+    sp_sketch want;
+    ENSURE(sp_handdraw_part(&p.ch.rig, 0, &p.ch.camera, &(sp_handdraw_desc){.style = SP_HANDDRAW_HARSH},
+                            sp_handdraw_seed(sp_handdraw_part_family(5, "tail"), 1), &want, NULL, &err) == SP_OK);
+    const sp_sample* got = NULL;
+    for (int i = 0; i < ds.count; ++i)
+        if (ds.samples[i].label == 3 && ds.samples[i].index == 1) got = &ds.samples[i];
+    ENSURE(got && got->sketch.stroke_count == want.stroke_count);
+    for (int s = 0; s < want.stroke_count; ++s) {
+        ENSURE(got->sketch.strokes[s].count == want.strokes[s].count);
+        for (int i = 0; i < want.strokes[s].count; ++i)
+            ENSURE_NEAR(got->sketch.strokes[s].points[i].x, want.strokes[s].points[i].x, 1e-3); // the .glb stores float32
+    }
+    sp_sketch_free(&want);
+    sp_character_free(&p.ch);
+    sp_dataset_free(&ds);
+    // Bad usage and bad input: exit 2 and 1 with one line.
+    snprintf(cmd, sizeof cmd, "'%s' synth --parts '%s' --per-part 3 --style wild --out-dir '%s' 2>/dev/null", bin, dir, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' synth --parts '%s' --per-part 3 2>/dev/null", bin, dir);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' synth --parts '%s/none' --out-dir '%s' 2>/dev/null", bin, dir, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 1);
+    // Single drawing with a style.
+    snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s/wings.glb' --seed 2 --style normal --out '%s/w.json'", bin, dir, out);
+    ENSURE(system(cmd) == 0);
+    sp_sketch one;
+    snprintf(cmd, sizeof cmd, "%s/w.json", out);
+    ENSURE(sp_sketch_read_json(cmd, &one, &err) == SP_OK && one.stroke_count >= 1 && one.strokes[0].t);
+    sp_sketch_free(&one);
+}
+
+// ---- the dragon-part classifier --------------------------------------------------
+
+// Issue 5's criteria on a smaller set: 6 x 80 training (normal, family 1),
+// 6 x 40 held out (harsh, family 2), 80 scribbles (8 object categories x 10).
+static void test_dragon_accuracy_and_rejection(void)
+{
+    sp_error err = {0};
+    sp_dataset train, test, scrib;
+    ENSURE(dragon_set(parts(), 80, 1, &(sp_handdraw_desc){.style = SP_HANDDRAW_NORMAL}, &train, &err) == SP_OK);
+    ENSURE(dragon_set(parts(), 40, 2, &(sp_handdraw_desc){.style = SP_HANDDRAW_HARSH}, &test, &err) == SP_OK);
+    bool have_scribbles = dragon_scribbles(sp_test_data_dir(), 10, &scrib, &err) == SP_OK;
+    sp_clf* clf = NULL;
+    sp_result r = sp_clf_train(&train, NULL, &(sp_clf_desc){0}, &clf, &err);
+    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_OK);
+    dragon_scores s;
+    dragon_score(clf, &test, have_scribbles ? &scrib : NULL, &s);
+    printf("  held-out harsh: top-1 %d/%d, top-3 %d/%d, wrongly rejected %d; scribbles rejected %d/%d\n", s.right, s.n, s.top3, s.n,
+           s.rejected, s.scribbles_rejected, s.scribbles);
+    for (int i = 0; i < train.category_count; ++i) {
+        printf("    %-12s", train.categories[i]);
+        for (int j = 0; j < train.category_count; ++j)
+            printf(" %3d", s.confusion[i][j]);
+        printf("\n");
+    }
+    ENSURE(s.n == 240 && s.failed == 0);
+    ENSURE(s.right >= 0.97 * s.n);
+    ENSURE(s.rejected <= 0.03 * s.n);
+    if (have_scribbles) ENSURE(s.scribbles == 80 && s.scribbles_rejected >= 0.8 * s.scribbles);
+    sp_clf_free(clf);
+    sp_dataset_free(&train);
+    sp_dataset_free(&test);
+    if (have_scribbles) sp_dataset_free(&scrib);
+    if (!have_scribbles) SKIP("../shared/data absent: rejection of non-dragon drawings not measured (accuracy was)");
+}
+
+static void test_cleanup(void)
+{
+    if (g_loaded) dragon_parts_free(g_parts);
+    g_loaded = false;
+}
+
+int main(int argc, char** argv)
+{
+    if (argc == 3 && !strcmp(argv[1], "--write-standins")) {
+        return write_standins(argv[2]) ? 0 : 1;
+    }
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"handdraw_deterministic", test_handdraw_deterministic},
+                                   {"handdraw_bad_input", test_handdraw_bad_input},
+                                   {"handdraw_rotation", test_handdraw_rotation},
+                                   {"handdraw_closure", test_handdraw_closure},
+                                   {"handdraw_partial_split_direction", test_handdraw_partial_split_direction},
+                                   {"handdraw_sampling_corners_wobble", test_handdraw_sampling_corners_wobble},
+                                   {"db_synthetic_sketches", test_db_synthetic_sketches},
+                                   {"cli_synth_parts", test_cli_synth_parts},
+                                   {"dragon_accuracy_and_rejection", test_dragon_accuracy_and_rejection},
+                                   {"zz_cleanup", test_cleanup},
+                                   {0}});
+}

@@ -1,0 +1,630 @@
+// The dragon kiosk window end to end, under Xvfb: scripted sessions (the
+// --script replay on its virtual clock) draw a whole dragon, play, turn and
+// save; storms of bad input leave it running; a recorded session replays to
+// the same dragon. The screenshots and the exported glTF are checked.
+//
+// Parts: assets/*.glb when all six are there, else the stand-ins of
+// tests/support/dragon_parts.h (coloured here, each given a looping clip),
+// in a temporary database with a quickly trained model. Strokes are the
+// parts' synthetic sketches at random poses, placed like a dragon; a seed is
+// taken only when the model ranks the right category in its top three, and
+// when it is not first the script taps its chip, as a visitor would.
+//
+// Skipped when xvfb-run is missing.
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "fixtures.h"
+#include "image.h"
+#include "kiosk_parts.h"
+#include "test.h"
+
+static double hue_of(const uint8_t* p, double* sat, double* val)
+{
+    double r = p[0] / 255.0, g = p[1] / 255.0, b = p[2] / 255.0;
+    double mx = fmax(r, fmax(g, b)), mn = fmin(r, fmin(g, b)), d = mx - mn;
+    *val = mx;
+    *sat = mx > 0 ? d / mx : 0;
+    if (d <= 1e-9) return 0;
+    double h = mx == r ? fmod((g - b) / d, 6.0) : mx == g ? (b - r) / d + 2 : (r - g) / d + 4;
+    h *= 60;
+    return h < 0 ? h + 360 : h;
+}
+
+static double hue_dist(double a, double b)
+{
+    double d = fabs(a - b);
+    return d > 180 ? 360 - d : d;
+}
+
+static bool g_real_assets;
+
+// The test database, built once per run.
+static const char* e2e_db(void)
+{
+    static char path[1024];
+    if (path[0]) return path;
+    snprintf(path, sizeof path, "%s", sp_test_tmp_path("kiosk_e2e.db"));
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("kiosk_parts"));
+    mkdir(dir, 0755);
+    sp_error err = {0};
+    bool ok = kp_build_db(path, sp_test_src_path("assets"), dir, &g_real_assets, &err);
+    if (!ok) fprintf(stderr, "  database: %s\n", err.text);
+    ENSURE(ok);
+    return path;
+}
+
+typedef kp_stroke stroke;
+// The six strokes (found once).
+static stroke g_strokes[DRAGON_PART_COUNT];
+
+static void six_strokes(void)
+{
+    if (g_strokes[0].xy) return;
+    sp_error err = {0};
+    bool ok = kp_six_strokes(e2e_db(), g_strokes, &err);
+    if (!ok) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(ok);
+}
+
+// ------------------------------------------------------------ scripts and runs
+
+typedef struct script {
+    FILE* f;
+    bool first;
+} script;
+
+static script script_open(const char* path, double end_ms)
+{
+    script s = {fopen(path, "w"), true};
+    ENSURE(s.f);
+    fprintf(s.f, "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"px_per_mm\": 3.7795, \"end_ms\": %.0f,\n \"events\": [", end_ms);
+    return s;
+}
+
+static void script_raw(script* s, const char* json)
+{
+    fprintf(s->f, "%s\n  %s", s->first ? "" : ",", json);
+    s->first = false;
+}
+
+static void script_event(script* s, double t, const char* type, double x, double y)
+{
+    char buf[160];
+    snprintf(buf, sizeof buf, "{\"t\": %.3f, \"type\": \"%s\", \"x\": %.2f, \"y\": %.2f}", t, type, x, y);
+    script_raw(s, buf);
+}
+
+static void script_press(script* s, double t, const char* target)
+{
+    char buf[160];
+    snprintf(buf, sizeof buf, "{\"t\": %.3f, \"type\": \"press\", \"target\": \"%s\"}", t, target);
+    script_raw(s, buf);
+}
+
+static void script_mark(script* s, double t, const char* name)
+{
+    char buf[160];
+    snprintf(buf, sizeof buf, "{\"t\": %.3f, \"type\": \"mark\", \"name\": \"%s\"}", t, name);
+    script_raw(s, buf);
+}
+
+// The stroke as "stroke" shorthand, dt ms between points; returns the pen-up time.
+static double script_stroke(script* s, double t, const sp_vec2* xy, int n, double dt)
+{
+    fprintf(s->f, "%s\n  {\"t\": %.3f, \"type\": \"stroke\", \"dt\": %g, \"points\": [", s->first ? "" : ",", t, dt);
+    for (int i = 0; i < n; ++i)
+        fprintf(s->f, "%s[%.2f, %.2f]", i ? ", " : "", xy[i].x, xy[i].y);
+    fprintf(s->f, "]}");
+    s->first = false;
+    return t + dt * (n - 1);
+}
+
+static void script_close(script* s)
+{
+    fprintf(s->f, "\n ]}\n");
+    ENSURE(fclose(s->f) == 0);
+}
+
+static bool have_xvfb(void)
+{
+    return system("command -v xvfb-run >/dev/null 2>&1") == 0;
+}
+
+// Runs the kiosk under Xvfb; returns its exit code; stats JSON in *stats (may be NULL).
+static int run_kiosk(const char* args, cJSON** stats)
+{
+    const char* out = sp_test_tmp_path("kiosk_stats.json");
+    const char* errf = sp_test_tmp_path("kiosk_stderr.txt");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --stats %s > '%s' 2> '%s'", SP_DRAGON_KIOSK, e2e_db(), args,
+             out, errf);
+    int rc = system(cmd);
+    rc = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+    char show[2200];
+    snprintf(show, sizeof show, "sed -e 's/^/  kiosk: /' '%s' >&2", errf);
+    if (system(show) != 0) fprintf(stderr, "  (no stderr)\n");
+    if (stats) {
+        *stats = NULL;
+        FILE* f = fopen(out, "rb");
+        if (f) {
+            static char buf[1 << 16];
+            size_t n = fread(buf, 1, sizeof buf - 1, f);
+            buf[n] = 0;
+            fclose(f);
+            *stats = cJSON_Parse(buf);
+            if (!*stats) fprintf(stderr, "  stats are not JSON: %s\n", buf);
+        }
+    }
+    return rc;
+}
+
+static double num(const cJSON* j, const char* key)
+{
+    const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, key);
+    return cJSON_IsNumber(v) ? v->valuedouble : NAN;
+}
+
+// The Khronos validator: 1 pass, 0 fail, -1 when it is not installed.
+static int validate(const char* file)
+{
+    char tool[1100], cmd[3000];
+    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
+    struct stat st;
+    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
+    const char* rep = sp_test_tmp_path("kiosk_validator.json");
+    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
+    int rc = system(cmd);
+    if (rc != 0) {
+        snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);
+        if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
+    }
+    return rc == 0;
+}
+
+static cJSON* glb_json(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    ENSURE(f);
+    unsigned char h[20];
+    ENSURE(fread(h, 1, 20, f) == 20);
+    ENSURE(!memcmp(h, "glTF", 4));
+    uint32_t len = (uint32_t)h[12] | (uint32_t)h[13] << 8 | (uint32_t)h[14] << 16 | (uint32_t)h[15] << 24;
+    char* text = malloc(len + 1);
+    ENSURE(fread(text, 1, len, f) == len);
+    text[len] = 0;
+    fclose(f);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    ENSURE(j);
+    return j;
+}
+
+// ------------------------------------------------------------ picture checks
+
+static bool is_yellow(const uint8_t* p)
+{
+    return p[0] > 215 && p[1] > 165 && p[1] < 235 && p[2] < 90;
+}
+
+static bool is_blue(const uint8_t* p)
+{
+    return p[2] > 190 && p[0] < 90 && p[1] > 50 && p[1] < 140;
+}
+
+static double dist_to_polyline(const sp_vec2* xy, int n, double x, double y)
+{
+    double best = INFINITY;
+    for (int i = 0; i + 1 < n; ++i) {
+        double ax = xy[i].x, ay = xy[i].y, dx = xy[i + 1].x - ax, dy = xy[i + 1].y - ay;
+        double l2 = dx * dx + dy * dy, t = l2 > 0 ? ((x - ax) * dx + (y - ay) * dy) / l2 : 0;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        best = fmin(best, hypot(ax + t * dx - x, ay + t * dy - y));
+    }
+    return best;
+}
+
+static int cmp_d(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : x > y;
+}
+
+// Yellow (outline) and blue (stroke) pixels of a screenshot near a stroke:
+// how many there are and the median distance of the yellow ones to it.
+static void overlay_match(const sp_image* img, const stroke* s, int* yellow, int* blue_near, double* median)
+{
+    int cap = 1 << 16, n = 0;
+    double* d = malloc(sizeof(double) * (size_t)cap);
+    *blue_near = 0;
+    for (int y = 0; y < img->height; ++y)
+        for (int x = 0; x < img->width; ++x) {
+            const uint8_t* p = sp_image_at(img, x, y);
+            if (is_yellow(p) && n < cap) d[n++] = dist_to_polyline(s->xy, s->n, x + 0.5, y + 0.5);
+            if (is_blue(p) && dist_to_polyline(s->xy, s->n, x + 0.5, y + 0.5) < 8) ++*blue_near;
+        }
+    qsort(d, (size_t)n, sizeof *d, cmp_d);
+    *yellow = n;
+    *median = n ? d[n / 2] : INFINITY;
+    free(d);
+}
+
+// Pixels of each part hue (saturated, not too dark) in the canvas above the toolbar.
+static void hue_coverage(const sp_image* img, int counts[DRAGON_PART_COUNT], int* saturated)
+{
+    memset(counts, 0, sizeof(int) * DRAGON_PART_COUNT);
+    *saturated = 0;
+    for (int y = 0; y < img->height * 82 / 100; ++y)
+        for (int x = 0; x < img->width; ++x) {
+            double s, v, h = hue_of(sp_image_at(img, x, y), &s, &v);
+            if (s < 0.45 || v < 0.2) continue;
+            ++*saturated;
+            for (int i = 0; i < DRAGON_PART_COUNT; ++i)
+                if (hue_dist(h, kp_hue[i]) < 12) ++counts[i];
+        }
+}
+
+static double image_difference(const sp_image* a, const sp_image* b)
+{
+    if (a->width != b->width || a->height != b->height) return 1;
+    long diff = 0;
+    for (int y = 0; y < a->height; ++y)
+        for (int x = 0; x < a->width; ++x) {
+            const uint8_t *p = sp_image_at(a, x, y), *q = sp_image_at(b, x, y);
+            if (abs(p[0] - q[0]) + abs(p[1] - q[1]) + abs(p[2] - q[2]) > 24) ++diff;
+        }
+    return (double)diff / ((double)a->width * a->height);
+}
+
+static void load_png(const char* path, sp_image* img)
+{
+    sp_error err = {0};
+    sp_result r = sp_image_read_png(path, img, &err);
+    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_OK);
+}
+
+// ------------------------------------------------------------ tests
+
+#define NEED_XVFB()                                               \
+    do {                                                          \
+        if (!have_xvfb()) SKIP("xvfb-run is not installed (apt-get install xvfb xauth)"); \
+    } while (0)
+
+// The whole dragon: six strokes (chips tapped where the model's first guess
+// is wrong), play, turn, back, save.
+static double write_dragon_script(const char* path, double* t_flash, double* t_end)
+{
+    six_strokes();
+    double end = 0;
+    script s = script_open(path, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = 500;
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+        const stroke* st = &g_strokes[i];
+        double up = script_stroke(&s, t, st->xy, st->n, 4);
+        double settled = up;
+        if (st->rank > 0) {
+            script_press(&s, up + 250, st->rank == 1 ? "guess1" : "guess2");
+            settled = up + 250;
+        }
+        if (i == DRAGON_PART_COUNT - 1) {
+            *t_flash = settled + 300; // inside the 0.8 s flash
+            script_mark(&s, *t_flash, "flash");
+        }
+        t = settled + 1200;
+    }
+    script_mark(&s, t, "drawn");
+    script_press(&s, t + 100, "play");
+    script_mark(&s, t + 1500, "playing");
+    script_press(&s, t + 1600, "turn");
+    script_event(&s, t + 1800, "down", 500, 400);
+    for (int k = 1; k <= 10; ++k)
+        script_event(&s, t + 1800 + 40 * k, "move", 500 + 30 * k, 400 - 4 * k);
+    script_event(&s, t + 2250, "up", 800, 360);
+    script_mark(&s, t + 2400, "turned");
+    script_press(&s, t + 2600, "turn");
+    script_press(&s, t + 3400, "save");
+    end = t + 5000;
+    script_close(&s);
+    // end_ms goes in the header: rewrite it (the file is small).
+    FILE* f = fopen(path, "rb");
+    ENSURE(f);
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char* text = malloc((size_t)n + 1);
+    ENSURE(fread(text, 1, (size_t)n, f) == (size_t)n);
+    text[n] = 0;
+    fclose(f);
+    char head[64];
+    snprintf(head, sizeof head, "\"end_ms\": %.0f,", end);
+    char* at = strstr(text, "\"end_ms\": 0,");
+    ENSURE(at);
+    f = fopen(path, "wb");
+    fwrite(text, 1, (size_t)(at - text), f);
+    fputs(head, f);
+    fputs(at + strlen("\"end_ms\": 0,"), f);
+    fclose(f);
+    free(text);
+    *t_end = end;
+    return end;
+}
+
+static void test_dragon_session(void)
+{
+    NEED_XVFB();
+    double t_flash, t_end;
+    const char* sc = sp_test_tmp_path("kiosk_dragon.json");
+    write_dragon_script(sc, &t_flash, &t_end);
+    const char* shot = sp_test_tmp_path("kiosk_dragon.png");
+    const char* glb = sp_test_tmp_path("kiosk_dragon.glb");
+    const char* exports = sp_test_tmp_path("kiosk_exports");
+    char args[4096];
+    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export '%s' --export-dir '%s'", sc, shot, glb, exports);
+    cJSON* st = NULL;
+    ENSURE(run_kiosk(args, &st) == 0);
+    ENSURE(st);
+    char* txt = cJSON_PrintUnformatted(st);
+    fprintf(stderr, "  stats: %s\n", txt);
+    free(txt);
+    ENSURE(num(st, "parts") == DRAGON_PART_COUNT && num(st, "pipeline_errors") == 0 && num(st, "saves") == 1);
+    // Every category once.
+    const cJSON* cats = cJSON_GetObjectItemCaseSensitive(st, "categories");
+    ENSURE(cJSON_GetArraySize(cats) == DRAGON_PART_COUNT);
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+        int found = 0;
+        const cJSON* c;
+        cJSON_ArrayForEach(c, cats) found += cJSON_IsString(c) && !strcmp(c->valuestring, g_strokes[i].category);
+        if (found != 1) fprintf(stderr, "  category %s appears %d times\n", g_strokes[i].category, found);
+        ENSURE(found == 1);
+    }
+    // The flash: the fitted outline (yellow) lies on the last stroke (blue).
+    char path[2048];
+    snprintf(path, sizeof path, "%.*s-flash.png", (int)(strlen(shot) - 4), shot);
+    sp_image img = {0};
+    load_png(path, &img);
+    ENSURE(img.width == 1280 && img.height == 800);
+    int yellow, blue;
+    double med;
+    overlay_match(&img, &g_strokes[DRAGON_PART_COUNT - 1], &yellow, &blue, &med);
+    fprintf(stderr, "  flash: %d yellow px (median %.2f px from the stroke), %d blue px on it\n", yellow, med, blue);
+    ENSURE(yellow > 300 && blue > 300 && med < 4.0);
+    // The dragon: every part's colour shows (stand-ins: their hues).
+    sp_image fin = {0}, turned = {0}, playing = {0};
+    load_png(shot, &fin);
+    int counts[DRAGON_PART_COUNT], sat;
+    hue_coverage(&fin, counts, &sat);
+    fprintf(stderr, "  final: %d saturated px; per part:", sat);
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i)
+        fprintf(stderr, " %s %d", k_dragon_part_names[i], counts[i]);
+    fprintf(stderr, "\n");
+    ENSURE(sat > 0.04 * fin.width * fin.height);
+    if (!g_real_assets)
+        for (int i = 0; i < DRAGON_PART_COUNT; ++i)
+            ENSURE(counts[i] > 400);
+    // No overlay is left once the flash is over; the turn changed the view.
+    overlay_match(&fin, &g_strokes[DRAGON_PART_COUNT - 1], &yellow, &blue, &med);
+    ENSURE(yellow < 50);
+    snprintf(path, sizeof path, "%.*s-playing.png", (int)(strlen(shot) - 4), shot);
+    load_png(path, &playing);
+    snprintf(path, sizeof path, "%.*s-turned.png", (int)(strlen(shot) - 4), shot);
+    load_png(path, &turned);
+    double dturn = image_difference(&playing, &turned);
+    fprintf(stderr, "  turned vs playing: %.1f%% of the pixels differ\n", 100 * dturn);
+    ENSURE(dturn > 0.02);
+    // The export: six skinned parts, one animation, 0 validator errors.
+    cJSON* g = glb_json(glb);
+    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "skins")) == DRAGON_PART_COUNT);
+    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "animations")) == 1);
+    cJSON_Delete(g);
+    int v = validate(glb);
+    if (v < 0) fprintf(stderr, "  note: gltf-validator not installed (tests/tools: npm ci); validation skipped\n");
+    ENSURE(v != 0);
+    // Save wrote <code>.glb and a postcard.
+    const cJSON* code = cJSON_GetObjectItemCaseSensitive(st, "code");
+    ENSURE(cJSON_IsString(code) && strlen(code->valuestring) == 4);
+    snprintf(path, sizeof path, "%s/%s.glb", exports, code->valuestring);
+    ENSURE(access(path, R_OK) == 0);
+    if (v > 0) ENSURE(validate(path) == 1);
+    sp_image card = {0};
+    snprintf(path, sizeof path, "%s/%s.png", exports, code->valuestring);
+    load_png(path, &card);
+    ENSURE(card.width == 1200 && card.height == 800);
+    sp_image_free(&card);
+    sp_image_free(&img);
+    sp_image_free(&fin);
+    sp_image_free(&turned);
+    sp_image_free(&playing);
+    cJSON_Delete(st);
+}
+
+// Bad input of every kind, then one good stroke that must still become a part.
+static void test_storms(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const char* sc = sp_test_tmp_path("kiosk_storm.json");
+    sp_test_rng rng = {5};
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    // One point; a stroke that leaves the window on both sides; a scribble.
+    script_event(&s, 300, "down", 700, 300);
+    script_event(&s, 310, "up", 700, 300);
+    const sp_vec2 out[] = {{1100, 600}, {1250, 700}, {1400, 900}, {2000, 1500}, {-300, -200}, {40, 40}};
+    double t = script_stroke(&s, 500, out, 6, 30) + 300;
+    sp_vec2 scrib[200];
+    scrib[0] = (sp_vec2){600, 400};
+    for (int i = 1; i < 200; ++i)
+        scrib[i] = (sp_vec2){scrib[i - 1].x + sp_test_range(&rng, -40, 40), scrib[i - 1].y + sp_test_range(&rng, -40, 40)};
+    t = script_stroke(&s, t, scrib, 200, 3) + 500;
+    // A tap storm on every button, 5 ms apart.
+    static const char* const targets[] = {"undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2"};
+    for (int r = 0; r < 30; ++r)
+        for (int k = 0; k < 9; ++k, t += 5)
+            script_press(&s, t, targets[k]);
+    for (int r = 0; r < 300; ++r, t += 4) {
+        double x = sp_test_range(&rng, 0, 1280), y = sp_test_range(&rng, 0, 800);
+        script_event(&s, t, "down", x, y);
+        script_event(&s, t + 2, "up", x, y);
+    }
+    script_press(&s, t + 100, "turn"); // leave Turn mode if the storm ended there (toggling is harmless otherwise)
+    t += 400;
+    // 10^4 strokes a minute: 1000 strokes in 6 s.
+    for (int r = 0; r < 1000; ++r, t += 6) {
+        sp_vec2 p[3];
+        p[0] = (sp_vec2){sp_test_range(&rng, 50, 1230), sp_test_range(&rng, 50, 650)};
+        for (int q = 1; q < 3; ++q)
+            p[q] = (sp_vec2){p[q - 1].x + sp_test_range(&rng, -150, 150), p[q - 1].y + sp_test_range(&rng, -150, 150)};
+        script_stroke(&s, t, p, 3, 2);
+    }
+    t += 4000;
+    script_mark(&s, t, "after");
+    // Still responsive: Start over, then the torso.
+    script_press(&s, t, "start_over");
+    script_press(&s, t + 200, "start_over");
+    double up = script_stroke(&s, t + 600, g_strokes[0].xy, g_strokes[0].n, 4);
+    if (g_strokes[0].rank > 0) script_press(&s, up + 250, g_strokes[0].rank == 1 ? "guess1" : "guess2");
+    double end = up + 2000;
+    script_close(&s);
+    // Patch end_ms in.
+    char cmd[2300];
+    snprintf(cmd, sizeof cmd, "sed -i 's/\"end_ms\": 0,/\"end_ms\": %.0f,/' '%s'", end, sc);
+    ENSURE(system(cmd) == 0);
+    const char* shot = sp_test_tmp_path("kiosk_storm.png");
+    char args[4096];
+    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export-dir '%s'", sc, shot, sp_test_tmp_path("kiosk_storm_exports"));
+    cJSON* st = NULL;
+    ENSURE(run_kiosk(args, &st) == 0);
+    ENSURE(st);
+    char* txt = cJSON_PrintUnformatted(st);
+    fprintf(stderr, "  stats: %s\n", txt);
+    free(txt);
+    ENSURE(num(st, "pipeline_errors") == 0);
+    ENSURE(num(st, "parts") == 1);
+    const cJSON* cats = cJSON_GetObjectItemCaseSensitive(st, "categories");
+    ENSURE(cJSON_IsString(cJSON_GetArrayItem(cats, 0)) && !strcmp(cJSON_GetArrayItem(cats, 0)->valuestring, g_strokes[0].category));
+    ENSURE(num(st, "taps") >= 1 && num(st, "strokes") > 100);
+    cJSON_Delete(st);
+}
+
+// A session recorded while a script plays replays to the same dragon and the same picture.
+static void test_record_replay(void)
+{
+    NEED_XVFB();
+    double t_flash, t_end;
+    const char* sc = sp_test_tmp_path("kiosk_rec_src.json");
+    write_dragon_script(sc, &t_flash, &t_end);
+    const char* rec = sp_test_tmp_path("kiosk_rec.json");
+    const char* a_png = sp_test_tmp_path("kiosk_rec_a.png");
+    const char* b_png = sp_test_tmp_path("kiosk_rec_b.png");
+    char args[4096];
+    snprintf(args, sizeof args, "--script '%s' --record '%s' --screenshot '%s' --export-dir '%s'", sc, rec, a_png, sp_test_tmp_path("kiosk_rec_ex"));
+    cJSON *sa = NULL, *sb = NULL;
+    ENSURE(run_kiosk(args, &sa) == 0 && sa);
+    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export-dir '%s'", rec, b_png, sp_test_tmp_path("kiosk_rec_ex2"));
+    ENSURE(run_kiosk(args, &sb) == 0 && sb);
+    char* ca = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(sa, "categories"));
+    char* cb = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(sb, "categories"));
+    fprintf(stderr, "  recorded %s, replayed %s\n", ca, cb);
+    ENSURE(!strcmp(ca, cb) && num(sa, "parts") == DRAGON_PART_COUNT);
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(sa, "code")->valuestring, cJSON_GetObjectItemCaseSensitive(sb, "code")->valuestring));
+    free(ca);
+    free(cb);
+    sp_image a = {0}, b = {0};
+    load_png(a_png, &a);
+    load_png(b_png, &b);
+    double d = image_difference(&a, &b);
+    fprintf(stderr, "  replayed picture differs in %.3f%% of its pixels\n", 100 * d);
+    ENSURE(d < 0.002);
+    sp_image_free(&a);
+    sp_image_free(&b);
+    cJSON_Delete(sa);
+    cJSON_Delete(sb);
+}
+
+// The database file is replaced (a new inode) while the kiosk draws: it keeps going.
+static void test_db_replaced(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const char* db = e2e_db();
+    char live[1100], spare[1100];
+    snprintf(live, sizeof live, "%s", sp_test_tmp_path("kiosk_live.db"));
+    snprintf(spare, sizeof spare, "%s", sp_test_tmp_path("kiosk_spare.db"));
+    kp_remove_db(live);
+    char cmd[16384];
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s' && cp '%s' '%s'", db, live, db, spare);
+    ENSURE(system(cmd) == 0);
+    const char* sc = sp_test_tmp_path("kiosk_dbswap.json");
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = 300;
+    for (int r = 0; r < 5; ++r)
+        for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+            t = script_stroke(&s, t, g_strokes[i].xy, g_strokes[i].n, 2) + 600;
+            if (i == DRAGON_PART_COUNT - 1) script_press(&s, t, "undo");
+        }
+    double end = t + 1000;
+    script_close(&s);
+    snprintf(cmd, sizeof cmd, "sed -i 's/\"end_ms\": 0,/\"end_ms\": %.0f,/' '%s'", end, sc);
+    ENSURE(system(cmd) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        // Replace the file a little later, twice, while the session runs.
+        for (int k = 0; k < 2; ++k) {
+            sleep(2);
+            char tmp[1200], c2[8192];
+            snprintf(tmp, sizeof tmp, "%s.new", live);
+            snprintf(c2, sizeof c2, "cp '%s' '%s' && mv '%s' '%s' && rm -f '%s-wal' '%s-shm'", spare, tmp, tmp, live, live, live);
+            if (system(c2) != 0) _exit(1);
+        }
+        _exit(0);
+    }
+    char args[4096];
+    snprintf(args, sizeof args, "--script '%s' --export-dir '%s'", sc, sp_test_tmp_path("kiosk_swap_ex"));
+
+    // run_kiosk uses e2e_db(): point it at the live copy through SP_DB-style override.
+    const char* out = sp_test_tmp_path("kiosk_swap_stats.json");
+    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --stats %s > '%s'", SP_DRAGON_KIOSK, live, args, out);
+    int rc = system(cmd);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ENSURE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0);
+    FILE* f = fopen(out, "rb");
+    ENSURE(f);
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    cJSON* st = cJSON_Parse(buf);
+    ENSURE(st);
+    fprintf(stderr, "  parts %g, strokes %g, added %g, reloads %g, errors %g\n", num(st, "parts"), num(st, "strokes"), num(st, "parts_added"),
+            num(st, "reloads"), num(st, "pipeline_errors"));
+    ENSURE(num(st, "strokes") == 5 * DRAGON_PART_COUNT && num(st, "parts_added") >= 20);
+    cJSON_Delete(st);
+}
+
+int main(int argc, char** argv)
+{
+    signal(SIGPIPE, SIG_IGN);
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"dragon_session", test_dragon_session},
+                                   {"storms", test_storms},
+                                   {"record_replay", test_record_replay},
+                                   {"db_replaced", test_db_replaced},
+                                   {0}});
+}
