@@ -98,7 +98,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     qsort(names, (size_t)n, sizeof *names, cmp_str);
     if (!make_dir(out_dir, &err)) goto fail;
     sp_handdraw_desc desc = {.style = style, .amplitude = amplitude};
-    int total = 0;
+    int total = 0, written = 0;
     printf("{\"out_dir\": ");
     json_str(out_dir);
     printf(", \"style\": \"%s\", \"seed\": %llu, \"parts\": [", sp_handdraw_style_name(style), (unsigned long long)family);
@@ -110,9 +110,10 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         sp_character ch = {0};
         if (sp_gltf_load(path, &ch, &err) != SP_OK) goto fail_open;
         if (!part_field(&ch, "category", category, sizeof category)) {
-            sp_fail(&err, SP_ERR_INVALID, "%s: no extras.sp_part.category (every part in --parts needs one)", path);
+            // A character beside the parts (assets/ holds both): not a part, left out.
+            fprintf(stderr, "sketchpose synth: %s: skipped (no extras.sp_part.category: not a part)\n", path);
             sp_character_free(&ch);
-            goto fail_open;
+            continue;
         }
         // The abstraction: --abstraction, else the part's own choice, else its outline, else the first.
         const char* an = abs_name;
@@ -142,7 +143,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
             }
         }
         total += per_part;
-        printf("%s{\"name\": ", k ? ", " : "");
+        printf("%s{\"name\": ", written++ ? ", " : "");
         json_str(stem);
         printf(", \"category\": ");
         json_str(category);
@@ -152,6 +153,10 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         sp_character_free(&ch);
     }
     printf("], \"sketches\": %d}\n", total);
+    if (written == 0) {
+        sp_fail(&err, SP_ERR_INVALID, "%s: no part (a .glb/.gltf with extras.sp_part.category) in the folder", dir);
+        goto fail;
+    }
     code = SP_EXIT_OK;
     goto done;
 fail_open:

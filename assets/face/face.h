@@ -66,9 +66,9 @@ enum {
 };
 
 // Rotation-type deformers weight each point by a level 0..F_LEVELS (weight
-// level / F_LEVELS): a deformer then costs one sine and cosine per level
-// used, not per point. 1/64 steps of a 0.3 rad twist are 0.005 rad, far
-// below what shows.
+// level / F_LEVELS): an evaluation builds one transform per level used, not
+// per point. 1/64 steps of a 0.3 rad twist are 0.005 rad, far below what
+// shows.
 enum { F_LEVELS = 64 };
 
 // The lid grids: LID_ACROSS columns at angles beta_j across the eye, LID_ROWS
@@ -77,15 +77,14 @@ enum { FACE_LID_ACROSS = 17, FACE_LID_ROWS = 5 };
 
 typedef enum face_kind { FK_SKIN, FK_EYEBALL, FK_LID_UPPER, FK_LID_LOWER } face_kind;
 
-// One deformed point: a mesh vertex or an abstraction-only point. 64 bytes:
-// an evaluation streams through all of them for every finite difference.
+// One vertex as the builder sees it: where it is and how much each
+// deformer moves it. compile_plan turns these into the evaluator's lists.
 typedef struct face_point {
     double rest[3];
     float w_eye;         // eye_size: scaling about the eye's centre
     float w_mouth;       // mouth_width: x scaling
     float w_low;         // jaw_width: x scaling of the lower face
     float w_brow;        // brow_height: y translation
-    float w_spare;       // unused (keeps the struct at 64 bytes)
     float w_nose;        // nose_size: scaling about the nose root
     int32_t delta_first; // blendshape deltas of this point
     uint8_t delta_count;
@@ -96,6 +95,7 @@ typedef struct face_point {
     int8_t lip;                                 // +1 upper lip, -1 lower lip, 0 elsewhere
 } face_point;
 
+// A blendshape delta of one point, as the builder computes them.
 typedef struct face_delta {
     int32_t shape; // parameter index
     float d[3];
@@ -120,11 +120,15 @@ typedef struct face_entry {
     int32_t i;
     float d[3];
 } face_entry;
-enum { FACE_MAX_VIRTUAL = 32 }; // abstraction-only points at most
+// A run of consecutive points at one neck level (the grid's rows).
+typedef struct face_run {
+    int32_t first, count;
+    uint8_t lv;
+} face_run;
 
 typedef struct face_rig {
     sp_blackbox_rig desc;          // first: release() gets the desc's user pointer, which is this struct
-    int vertex_count, point_count; // points: the vertices, then abstraction-only points
+    int vertex_count, point_count; // the same: abstraction points are vertices too (the nose's base is not in a triangle)
     face_point* points;
     face_delta* deltas;
     int delta_count;
@@ -143,9 +147,8 @@ typedef struct face_rig {
     face_list lists[FL_COUNT];
     face_entry* entries;           // blendshape deltas by shape
     int shape_first[F_PARAMS + 1]; // shape s: entries[shape_first[s] .. shape_first[s+1])
-    uint8_t* neck_lv;              // point_count
-    uint8_t* simple;               // point_count: 1 when only the neck moves it (one pass from rest)
-    double* virtual_rest;          // (point_count - vertex_count) by 3
+    face_run* neck_runs;           // the neck's pass, level by level (level 0 skipped)
+    int neck_run_count;
 } face_rig;
 
 // Geometry constants shared by the generator and the evaluator.

@@ -636,7 +636,7 @@ void face_free(face_rig* f)
     free(f->points), free(f->deltas), free(f->rest), free(f->triangles), free(f->colors), free(f->abs_index);
     for (int l = 0; l < FL_COUNT; ++l)
         free(f->lists[l].items);
-    free(f->entries), free(f->neck_lv), free(f->simple), free(f->virtual_rest);
+    free(f->entries), free(f->neck_runs);
     free(f);
 }
 
@@ -654,19 +654,21 @@ static bool push(face_list* l, face_item it)
 // The evaluator's plan from the points (face_item in face.h).
 static bool compile_plan(face_rig* f)
 {
-    int nvirt = f->point_count - f->vertex_count;
-    f->neck_lv = malloc((size_t)f->point_count);
-    f->simple = malloc((size_t)f->point_count);
-    f->virtual_rest = malloc(sizeof(double) * 3 * (size_t)(nvirt + 1));
     f->entries = malloc(sizeof(face_entry) * (size_t)(f->delta_count + 1));
-    if (!f->neck_lv || !f->simple || !f->virtual_rest || !f->entries || nvirt > FACE_MAX_VIRTUAL) return false;
+    f->neck_runs = malloc(sizeof(face_run) * (size_t)(f->point_count + 1));
+    if (!f->entries || !f->neck_runs) return false;
     bool ok = true;
+    for (int i = 0; i < f->point_count; ++i) {
+        uint8_t lv = f->points[i].lv_neck;
+        face_run* last = f->neck_run_count ? &f->neck_runs[f->neck_run_count - 1] : NULL;
+        if (lv == 0) continue;
+        if (last && last->lv == lv && last->first + last->count == i)
+            ++last->count;
+        else
+            f->neck_runs[f->neck_run_count++] = (face_run){i, 1, lv};
+    }
     for (int i = 0; ok && i < f->point_count; ++i) {
         const face_point* pt = &f->points[i];
-        f->neck_lv[i] = pt->lv_neck;
-        f->simple[i] = i < f->vertex_count && pt->kind == FK_SKIN && pt->delta_count == 0 && pt->w_eye == 0 && pt->w_nose == 0 &&
-                       pt->w_brow == 0 && pt->w_mouth == 0 && pt->w_low == 0 && !pt->lv_nose && !pt->lv_mouth && !pt->lv_jaw;
-        if (i >= f->vertex_count) memcpy(f->virtual_rest + 3 * (i - f->vertex_count), pt->rest, sizeof(double) * 3);
         face_item it = {.i = i, .side = pt->side, .upper = pt->kind == FK_LID_UPPER, .col = pt->col, .row = pt->row};
         if (pt->kind == FK_EYEBALL) ok = ok && push(&f->lists[FL_EYEBALL], it);
         if (pt->kind == FK_LID_UPPER || pt->kind == FK_LID_LOWER) ok = ok && push(&f->lists[FL_LID], it);
@@ -711,13 +713,15 @@ face_rig* face_build(void)
         ok = (lip[u] = build_lip(&b, u == 0)) >= 0;
     for (int s = 0; ok && s < 2; ++s)
         ok = (brow[s] = build_brow(&b, s)) >= 0;
-    f->vertex_count = f->point_count;
-    // Abstraction-only points: the base of the nose, on the sculpted surface.
+    // The base of the nose, on the sculpted surface: abstraction points
+    // that no triangle uses (vertices all the same, so that every point
+    // the rig moves is written straight to the caller's buffer).
     int nose_first = f->point_count;
     for (int i = 0; ok && i < NOSE_POINTS; ++i) {
         double u = -1 + 2.0 * i / (NOSE_POINTS - 1), x = 0.08 * u, y = -0.12 - 0.025 * (1 - u * u);
         ok = add_point(&b, FK_SKIN, x > 0 ? 0 : 1, x, y, surface_z(x, y), SKIN) >= 0;
     }
+    f->vertex_count = f->point_count;
     f->triangle_count = b.ntri;
     for (int i = 0; ok && i < f->point_count; ++i)
         set_weights(f, &f->points[i]);

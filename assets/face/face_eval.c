@@ -150,24 +150,8 @@ static int evaluate(void* user, const double* params, double* vertices, double* 
         if (!isfinite(p[k])) return 1;
     eval_ctx c;
     prepare(f, p, &c);
-    const int n = f->vertex_count, nv = f->point_count - n;
-    double virt[3 * FACE_MAX_VIRTUAL];
-    // Points that only the neck moves (the back of the head, the neck) get
-    // their final place in one pass from rest; the others start at rest.
-    for (int i = 0; i < n; ++i) {
-        const double* r = f->rest + 3 * (size_t)i;
-        double* x = vertices + 3 * (size_t)i;
-        if (f->simple[i] && f->neck_lv[i]) {
-            const aff* a = &c.neck[f->neck_lv[i]];
-            x[0] = a->m[0] * r[0] + a->m[1] * r[1] + a->m[2] * r[2] + a->m[3];
-            x[1] = a->m[4] * r[0] + a->m[5] * r[1] + a->m[6] * r[2] + a->m[7];
-            x[2] = a->m[8] * r[0] + a->m[9] * r[1] + a->m[10] * r[2] + a->m[11];
-        } else {
-            x[0] = r[0], x[1] = r[1], x[2] = r[2];
-        }
-    }
-    memcpy(virt, f->virtual_rest, sizeof(double) * 3 * (size_t)nv);
-#define PT(i) ((i) < n ? vertices + 3 * (size_t)(i) : virt + 3 * (size_t)((i)-n))
+    memcpy(vertices, f->rest, sizeof(double) * 3 * (size_t)f->vertex_count);
+#define PT(i) (vertices + 3 * (size_t)(i))
     // 1. Eyeballs turn; lids are placed by their angles.
     const face_list* L = f->lists;
     for (const face_item* it = L[FL_EYEBALL].items; it < L[FL_EYEBALL].items + L[FL_EYEBALL].count; ++it)
@@ -213,10 +197,16 @@ static int evaluate(void* user, const double* params, double* vertices, double* 
         aff_apply(&c.mouth[it->lv], PT(it->i));
     for (const face_item* it = L[FL_JAW_ROT].items; it < L[FL_JAW_ROT].items + L[FL_JAW_ROT].count; ++it)
         aff_apply(&c.jaw[it->lv], PT(it->i));
-    for (int i = 0; i < n; ++i)
-        if (f->neck_lv[i] && !f->simple[i]) aff_apply(&c.neck[f->neck_lv[i]], vertices + 3 * (size_t)i);
-    for (int i = 0; i < nv; ++i)
-        if (f->neck_lv[n + i]) aff_apply(&c.neck[f->neck_lv[n + i]], virt + 3 * (size_t)i);
+    // The neck level by level: a run's transform stays in registers.
+    for (const face_run* run = f->neck_runs; run < f->neck_runs + f->neck_run_count; ++run) {
+        const aff a = c.neck[run->lv];
+        for (double* x = PT(run->first); x < PT(run->first + run->count); x += 3) {
+            double px = x[0], py = x[1], pz = x[2];
+            x[0] = a.m[0] * px + a.m[1] * py + a.m[2] * pz + a.m[3];
+            x[1] = a.m[4] * px + a.m[5] * py + a.m[6] * pz + a.m[7];
+            x[2] = a.m[8] * px + a.m[9] * py + a.m[10] * pz + a.m[11];
+        }
+    }
     if (abstraction)
         for (int a = 0; a < f->abs_count; ++a)
             memcpy(abstraction + 3 * a, PT(f->abs_index[a]), sizeof(double) * 3);

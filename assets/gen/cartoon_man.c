@@ -81,8 +81,8 @@ static arm_pts arm_points(int side)
     a.thumb_1 = sp_v3_add(a.wrist, sp_v3_add(sp_v3_scale(a.dir, 0.045), sp_v3_scale(a.out, 0.042)));
     a.thumb_2 = sp_v3_add(a.thumb_1, sp_v3_scale(a.thumb_dir, 0.05));
     a.thumb_tip = sp_v3_add(a.thumb_2, sp_v3_scale(a.thumb_dir, 0.045));
-    sp_vec3* p[] = {&a.clav, &a.shoulder, &a.elbow, &a.wrist, &a.knuckles, &a.fingers_2, &a.tip, &a.dir, &a.out,
-                    &a.thumb_1, &a.thumb_2, &a.thumb_tip, &a.thumb_dir};
+    sp_vec3* p[] = {&a.clav, &a.shoulder, &a.elbow,   &a.wrist,   &a.knuckles,  &a.fingers_2, &a.tip,
+                    &a.dir,  &a.out,      &a.thumb_1, &a.thumb_2, &a.thumb_tip, &a.thumb_dir};
     for (size_t k = 0; k < sizeof p / sizeof p[0]; ++k)
         *p[k] = mirror(*p[k], side);
     return a;
@@ -207,8 +207,8 @@ static sp_gen_section torso_profile(double u, void* user)
     // shoulders' top), a neck.
     static const double w[][2] = {{0.745, 0.12}, {0.80, 0.165}, {0.88, 0.175}, {0.98, 0.165}, {1.06, 0.17},
                                   {1.14, 0.185}, {1.20, 0.185}, {1.245, 0.14}, {1.28, 0.068}, {1.36, 0.062}};
-    static const double f[][2] = {{0.745, 0.09}, {0.80, 0.11}, {0.88, 0.115}, {0.98, 0.125}, {1.06, 0.13},
-                                  {1.14, 0.12},  {1.20, 0.105}, {1.245, 0.08}, {1.28, 0.06}, {1.36, 0.058}};
+    static const double f[][2] = {{0.745, 0.09}, {0.80, 0.11},  {0.88, 0.115}, {0.98, 0.125}, {1.06, 0.13},
+                                  {1.14, 0.12},  {1.20, 0.105}, {1.245, 0.08}, {1.28, 0.06},  {1.36, 0.058}};
     static const double b[][2] = {{0.745, 0.10}, {0.80, 0.12}, {0.88, 0.125}, {0.98, 0.11}, {1.06, 0.105},
                                   {1.14, 0.105}, {1.20, 0.1},  {1.245, 0.08}, {1.28, 0.06}, {1.36, 0.058}};
     return (sp_gen_section){sp_gen_interp(f, 10, y), sp_gen_interp(b, 10, y), sp_gen_interp(w, 10, y)};
@@ -225,8 +225,14 @@ static sp_gen_section arm_profile(double u, void* user)
     const limb_ctx* c = user;
     double sS = c->s[1], sE = c->s[2], sW = c->s[3];
     double sleeve = sS + 0.62 * (sE - sS);
-    double k[][2] = {{0.0, 0.05},          {sS, 0.072},      {sS + 0.4 * (sE - sS), 0.066}, {sleeve - 0.004, 0.067},
-                     {sleeve + 0.012, 0.05}, {sE, 0.046},   {sE + 0.4 * (sW - sE), 0.049}, {sW, 0.04},
+    double k[][2] = {{0.0, 0.05},
+                     {sS, 0.072},
+                     {sS + 0.4 * (sE - sS), 0.066},
+                     {sleeve - 0.004, 0.067},
+                     {sleeve + 0.012, 0.05},
+                     {sE, 0.046},
+                     {sE + 0.4 * (sW - sE), 0.049},
+                     {sW, 0.04},
                      {c->len, 0.038}};
     double r = keyed(k, 9, c->len, u);
     return (sp_gen_section){r, r, r};
@@ -244,8 +250,9 @@ static sp_gen_section leg_profile(double u, void* user)
 {
     const limb_ctx* c = user;
     double sH = c->s[1], sK = c->s[2], sA = c->s[3];
-    double k[][2] = {{0.0, 0.08}, {sH, 0.095}, {sH + 0.45 * (sK - sH), 0.086}, {sK, 0.068},
-                     {sK + 0.35 * (sA - sK), 0.067}, {sA - 0.05, 0.064}, {c->len, 0.066}};
+    double k[][2] = {
+        {0.0, 0.08},        {sH, 0.095},    {sH + 0.45 * (sK - sH), 0.086}, {sK, 0.068}, {sK + 0.35 * (sA - sK), 0.067},
+        {sA - 0.05, 0.064}, {c->len, 0.066}};
     double r = keyed(k, 7, c->len, u);
     return (sp_gen_section){r, r, r};
 }
@@ -308,7 +315,8 @@ static void build_joints(man* w)
     w->pelvis = sp_gen_joint(g, "pelvis", w->root, k_pelvis, 0.5 * k_pi);
     static const char* names[5] = {"spine_1", "spine_2", "chest", "neck", "head"};
     for (int k = 0; k < 5; ++k)
-        w->spine[k] = sp_gen_joint(g, names[k], k ? w->spine[k - 1] : w->pelvis, sp_v3(0, k_spine_y[k], k_spine_z[k]), 0.5 * k_pi);
+        w->spine[k] =
+            sp_gen_joint(g, names[k], k ? w->spine[k - 1] : w->pelvis, sp_v3(0, k_spine_y[k], k_spine_z[k]), 0.5 * k_pi);
     int head = w->spine[4], chest = w->spine[2];
     for (int s = 0; s < 2; ++s)
         w->brow[s] = sp_gen_joint(g, s == LEFT ? "brow_l" : "brow_r", head, mirror(sp_v3(0.072, 1.66, 0.19), s), 0.5 * k_pi);
@@ -318,8 +326,8 @@ static void build_joints(man* w)
         const char* sf = s == LEFT ? "l" : "r";
         arm_pts a = arm_points(s);
         char name[64];
-#define JOINT(var, nm, parent, at, to)                                                                                     \
-    snprintf(name, sizeof name, "%s_%s", nm, sf);                                                                        \
+#define JOINT(var, nm, parent, at, to)                                                                                           \
+    snprintf(name, sizeof name, "%s_%s", nm, sf);                                                                                \
     var[s] = sp_gen_joint(g, name, parent, at, angle_of(at, to))
         JOINT(w->clav, "clavicle", chest, a.clav, a.shoulder);
         JOINT(w->upper, "upper_arm", w->clav[s], a.shoulder, a.elbow);
@@ -373,15 +381,18 @@ static void build_params(man* w)
     sp_gen_param(g, w->root, SP_CH_TY, -0.6, 0.6, SP_GROUP_POSE);
     sp_gen_param(g, w->root, SP_CH_RZ, -0.8, 0.8, SP_GROUP_POSE);
     sp_gen_param(g, w->root, SP_CH_S, 0.8, 1.25, SP_GROUP_SHAPE);
-    // Vertical joints: rx turns about the spine, ry leans (+ backwards), rz bends sideways.
+    // Vertical joints: rx turns about the spine, ry leans (+ backwards), rz
+    // bends sideways. Human ranges: the back turns about 35 degrees, the
+    // neck and head about 60 more (an outline of a head turned further than
+    // that would show the back of his head).
     sp_gen_param(g, w->pelvis, SP_CH_RX, -0.8, 0.8, SP_GROUP_POSE);
     sp_gen_param(g, w->pelvis, SP_CH_RY, -0.5, 0.4, SP_GROUP_POSE);
     static const double lim[5][3][2] = {
-        {{-0.35, 0.35}, {-0.4, 0.3}, {-0.3, 0.3}},   // spine_1
-        {{-0.35, 0.35}, {-0.35, 0.25}, {-0.25, 0.25}}, // spine_2
-        {{-0.35, 0.35}, {-0.3, 0.25}, {-0.25, 0.25}},  // chest
-        {{-0.5, 0.5}, {-0.5, 0.4}, {-0.4, 0.4}},   // neck
-        {{-0.9, 0.9}, {-0.5, 0.5}, {-0.5, 0.5}},   // head
+        {{-0.2, 0.2}, {-0.4, 0.3}, {-0.3, 0.3}},     // spine_1
+        {{-0.2, 0.2}, {-0.35, 0.25}, {-0.25, 0.25}}, // spine_2
+        {{-0.2, 0.2}, {-0.3, 0.25}, {-0.25, 0.25}},  // chest
+        {{-0.4, 0.4}, {-0.5, 0.4}, {-0.4, 0.4}},     // neck
+        {{-0.6, 0.6}, {-0.5, 0.5}, {-0.4, 0.4}},     // head
     };
     for (int k = 0; k < 5; ++k)
         for (int c = 0; c < 3; ++c)
@@ -402,15 +413,15 @@ static void build_params(man* w)
     param_lr(g, w->upper, SP_CH_RX, -1.0, 1.0);
     param_lr(g, w->upper, SP_CH_RY, -1.5, 1.0);
     param_lr(g, w->upper, SP_CH_RZ, -0.6, 1.9);
-    scale_lr(g, w->upper, 0.8, 1.25);
+    scale_lr(g, w->upper, 0.85, 1.2);
     param_lr(g, w->fore, SP_CH_RX, -1.0, 1.0);
     param_lr(g, w->fore, SP_CH_RY, -1.9, 0.1);
     param_lr(g, w->fore, SP_CH_RZ, -0.3, 1.5);
-    scale_lr(g, w->fore, 0.85, 1.2);
+    scale_lr(g, w->fore, 0.9, 1.15);
     param_lr(g, w->hand, SP_CH_RX, -1.0, 1.0);
     param_lr(g, w->hand, SP_CH_RY, -1.2, 0.9);
     param_lr(g, w->hand, SP_CH_RZ, -0.6, 0.6);
-    scale_lr(g, w->hand, 0.8, 1.3);
+    scale_lr(g, w->hand, 0.85, 1.25);
     param_lr(g, w->fing1, SP_CH_RY, -1.1, 0.2);
     param_lr(g, w->fing2, SP_CH_RY, -1.0, 0.2);
     param_lr(g, w->thumb1, SP_CH_RY, -1.0, 0.3);
@@ -420,7 +431,7 @@ static void build_params(man* w)
     param_lr(g, w->thigh, SP_CH_RX, -0.7, 0.7);
     param_lr(g, w->thigh, SP_CH_RY, -1.4, 0.5);
     param_lr(g, w->thigh, SP_CH_RZ, -0.35, 0.9);
-    scale_lr(g, w->thigh, 0.85, 1.2);
+    scale_lr(g, w->thigh, 0.9, 1.15);
     param_lr(g, w->shin, SP_CH_RX, -0.3, 0.3);
     param_lr(g, w->shin, SP_CH_RY, 0.0, 1.9);
     param_lr(g, w->shin, SP_CH_RZ, -0.25, 0.25);
@@ -428,7 +439,7 @@ static void build_params(man* w)
     param_lr(g, w->foot, SP_CH_RX, -0.6, 0.6);
     param_lr(g, w->foot, SP_CH_RY, -0.6, 0.8);
     param_lr(g, w->foot, SP_CH_RZ, -0.3, 0.3);
-    scale_lr(g, w->foot, 0.8, 1.3);
+    scale_lr(g, w->foot, 0.85, 1.2);
     param_lr(g, w->toes, SP_CH_RY, -0.6, 0.4);
 }
 
@@ -720,7 +731,8 @@ static sp_result build_outline(const sp_gen_mesh* m, sp_abstraction* out, sp_err
     double* z = sp_gen_check_alloc(malloc(sizeof(double) * (size_t)n));
     for (int pass = 0; pass < 8; ++pass) {
         for (int i = 0; i < n; ++i)
-            z[i] = 0.25 * out->rest[3 * ((i + n - 1) % n) + 2] + 0.5 * out->rest[3 * i + 2] + 0.25 * out->rest[3 * ((i + 1) % n) + 2];
+            z[i] = 0.25 * out->rest[3 * ((i + n - 1) % n) + 2] + 0.5 * out->rest[3 * i + 2] +
+                   0.25 * out->rest[3 * ((i + 1) % n) + 2];
         for (int i = 0; i < n; ++i)
             out->rest[3 * i + 2] = z[i];
     }
@@ -741,8 +753,8 @@ static void build_clip(man* w)
         double t = (double)k / (KEYS - 1);
         double env = sp_gen_smoothstep(0.0, 0.2, t) * (1.0 - sp_gen_smoothstep(0.8, 1.0, t));
         double wave = sin(2.0 * k_pi * 3.0 * (t - 0.2) / 0.6);
-        up[k] = 1.75 * env;
-        fore[k] = env * (0.9 + 0.45 * wave);
+        up[k] = 1.6 * env;
+        fore[k] = env * (0.75 + 0.35 * wave);
         hand[k] = env * 0.25 * sin(2.0 * k_pi * 3.0 * (t - 0.2) / 0.6 + 0.6);
         head[k] = 0.12 * env;
         chest[k] = -0.06 * env;
@@ -773,9 +785,10 @@ sp_result sp_character_cartoon_man(const char* path, sp_error* err)
     sp_abstraction abs[2] = {stick, {{0}}};
     sp_result r = build_outline(&w.m, &abs[1], err);
     if (r == SP_OK)
-        r = sp_gen_save(&w.g, &w.m,
-                        &(sp_gen_save_desc){.name = "cartoon_man", .abstractions = abs, .abstraction_count = 2, .no_outline = true},
-                        path, err);
+        r = sp_gen_save(
+            &w.g, &w.m,
+            &(sp_gen_save_desc){.name = "cartoon_man", .abstractions = abs, .abstraction_count = 2, .no_outline = true}, path,
+            err);
     sp_abstraction_free(&abs[0]);
     sp_abstraction_free(&abs[1]);
     sp_gen_mesh_free(&w.m);

@@ -46,10 +46,12 @@ typedef struct leg_desc {
     double radius[5]; ///< at the top, first bend, second bend, wrist/ankle, pad
 } leg_desc;
 
-static const leg_desc k_front = {.pt = {{0.42, 1.62, 0}, {0.48, 1.12, 0}, {0.45, 0.68, 0}, {0.5, 0.26, 0}, {0.6, 0.06, 0}, {0.68, 0.03, 0}},
-                                 .radius = {0.2, 0.2, 0.155, 0.14, 0.165}};
-static const leg_desc k_hind = {.pt = {{-0.72, 1.42, 0}, {-0.68, 1.1, 0}, {-0.6, 0.64, 0}, {-0.66, 0.26, 0}, {-0.56, 0.06, 0}, {-0.48, 0.03, 0}},
-                                .radius = {0.24, 0.23, 0.16, 0.14, 0.165}};
+static const leg_desc k_front = {
+    .pt = {{0.42, 1.62, 0}, {0.48, 1.12, 0}, {0.45, 0.68, 0}, {0.5, 0.26, 0}, {0.6, 0.06, 0}, {0.68, 0.03, 0}},
+    .radius = {0.2, 0.2, 0.155, 0.14, 0.165}};
+static const leg_desc k_hind = {
+    .pt = {{-0.72, 1.42, 0}, {-0.68, 1.1, 0}, {-0.6, 0.64, 0}, {-0.66, 0.26, 0}, {-0.56, 0.06, 0}, {-0.48, 0.03, 0}},
+    .radius = {0.24, 0.23, 0.16, 0.14, 0.165}};
 
 typedef struct elephant {
     sp_gen_rig g;
@@ -194,8 +196,9 @@ static sp_gen_section leg_profile(double u, void* user)
 {
     const leg_ctx* c = user;
     const double* R = c->d->radius;
-    double k[][2] = {{0.0, R[0] * 0.8}, {c->s[0], R[0]}, {c->s[1], R[1]}, {c->s[1] + 0.5 * (c->s[2] - c->s[1]), 0.5 * (R[1] + R[2])},
-                     {c->s[2], R[2]}, {c->s[3], R[3]}, {c->len, R[4]}};
+    double k[][2] = {
+        {0.0, R[0] * 0.8}, {c->s[0], R[0]}, {c->s[1], R[1]}, {c->s[1] + 0.5 * (c->s[2] - c->s[1]), 0.5 * (R[1] + R[2])},
+        {c->s[2], R[2]},   {c->s[3], R[3]}, {c->len, R[4]}};
     for (int i = 0; i < 7; ++i)
         k[i][0] /= c->len;
     double r = sp_gen_interp((const double(*)[2])k, 7, u);
@@ -216,7 +219,8 @@ static void build_joints(elephant* e)
     e->hips = sp_gen_joint(g, "hips", -1, k_hips, angle_of(k_hips, k_spine[0]));
     static const char* sn[3] = {"spine_1", "spine_2", "spine_3"};
     for (int k = 0; k < 3; ++k)
-        e->spine[k] = sp_gen_joint(g, sn[k], k ? e->spine[k - 1] : e->hips, k_spine[k], angle_of(k_spine[k], k < 2 ? k_spine[k + 1] : k_neck));
+        e->spine[k] = sp_gen_joint(g, sn[k], k ? e->spine[k - 1] : e->hips, k_spine[k],
+                                   angle_of(k_spine[k], k < 2 ? k_spine[k + 1] : k_neck));
     e->neck = sp_gen_joint(g, "neck", e->spine[2], k_neck, angle_of(k_neck, k_head));
     // The trunk hangs from the lower front of the head, curling forward at the tip.
     const sp_vec3 tc[] = {{1.38, 1.22, 0}, {1.47, 0.95, 0}, {1.52, 0.68, 0}, {1.52, 0.42, 0}, {1.51, 0.2, 0}, {1.6, 0.07, 0}};
@@ -228,16 +232,19 @@ static void build_joints(elephant* e)
     char name[64];
     for (int k = 0; k < TRUNK; ++k) {
         snprintf(name, sizeof name, "trunk_%d", k + 1);
-        e->trunk[k] = sp_gen_joint(g, name, k ? e->trunk[k - 1] : e->head, e->trunk_at[k], angle_of(e->trunk_at[k], e->trunk_at[k + 1]));
+        e->trunk[k] =
+            sp_gen_joint(g, name, k ? e->trunk[k - 1] : e->head, e->trunk_at[k], angle_of(e->trunk_at[k], e->trunk_at[k + 1]));
     }
     for (int s = 0; s < 2; ++s) {
         const char* sf = s == NEAR ? "l" : "r";
         snprintf(name, sizeof name, "ear_%s_1", sf);
         e->ear1[s] = sp_gen_joint(g, name, e->head, side_z(sp_v3(1.02, 1.5, 0.37), s), k_pi);
         snprintf(name, sizeof name, "ear_%s_2", sf);
-        e->ear2[s] = sp_gen_joint(g, name, e->ear1[s], side_z(sp_v3(0.76, 1.45, 0.5), s), angle_of(sp_v3(0.76, 1.45, 0), sp_v3(0.45, 1.2, 0)));
+        e->ear2[s] = sp_gen_joint(g, name, e->ear1[s], side_z(sp_v3(0.76, 1.45, 0.5), s),
+                                  angle_of(sp_v3(0.76, 1.45, 0), sp_v3(0.45, 1.2, 0)));
         snprintf(name, sizeof name, "tusk_%s", sf);
-        e->tusk[s] = sp_gen_joint(g, name, e->head, side_z(sp_v3(1.26, 1.2, 0.14), s), angle_of(sp_v3(1.26, 1.2, 0), sp_v3(1.66, 1.12, 0)));
+        e->tusk[s] = sp_gen_joint(g, name, e->head, side_z(sp_v3(1.26, 1.2, 0.14), s),
+                                  angle_of(sp_v3(1.26, 1.2, 0), sp_v3(1.66, 1.12, 0)));
     }
     const sp_vec3 lc[] = {{-1.1, 1.6, 0}, {-1.18, 1.38, 0}, {-1.21, 1.1, 0}, {-1.19, 0.84, 0}};
     sp_gen_path_catmull(&e->tail_path, lc, 4, 16);
@@ -245,7 +252,8 @@ static void build_joints(elephant* e)
         e->tail_at[k] = sp_gen_path_at(&e->tail_path, e->tail_path.length * k / TAIL, NULL);
     for (int k = 0; k < TAIL; ++k) {
         snprintf(name, sizeof name, "tail_%d", k + 1);
-        e->tail[k] = sp_gen_joint(g, name, k ? e->tail[k - 1] : e->hips, e->tail_at[k], angle_of(e->tail_at[k], e->tail_at[k + 1]));
+        e->tail[k] =
+            sp_gen_joint(g, name, k ? e->tail[k - 1] : e->hips, e->tail_at[k], angle_of(e->tail_at[k], e->tail_at[k + 1]));
     }
     // Legs: near front forward, far front back; near hind back, far hind forward.
     static const char* fn[5] = {"scapula", "upper_arm", "forearm", "front_foot", "front_toes"};
@@ -335,8 +343,9 @@ static void build_params(elephant* e)
         if (k == 0) scale(g, e->tail[k], 0.8, 1.3);
     }
     // Legs (X down): rz swings fore (+) and aft in the picture, ry outwards
-    // or inwards, rx twists. Elbows fold forwards, wrists and knees back,
-    // hocks forwards.
+    // or inwards, rx twists. An elephant's legs are columns: the elbow
+    // barely moves, the wrist (front_foot) folds back when the foot lifts,
+    // the knee (shin) folds back a little and the hock (hind_foot) forwards.
     for (int pair = 0; pair < 2; ++pair)
         for (int s = 0; s < 2; ++s) {
             const int* j = pair == 0 ? e->front[s] : e->hind[s];
@@ -344,14 +353,14 @@ static void build_params(elephant* e)
             sp_gen_param(g, j[0], SP_CH_RZ, -0.25, 0.25, SP_GROUP_POSE);
             sp_gen_param(g, j[1], SP_CH_RX, -0.3, 0.3, SP_GROUP_POSE);
             sp_gen_param(g, j[1], SP_CH_RY, -0.35, 0.35, SP_GROUP_POSE);
-            sp_gen_param(g, j[1], SP_CH_RZ, -0.6, 0.7, SP_GROUP_POSE);
+            sp_gen_param(g, j[1], SP_CH_RZ, -0.5, 0.55, SP_GROUP_POSE);
             scale(g, j[1], 0.85, 1.2);
             sp_gen_param(g, j[2], SP_CH_RY, -0.2, 0.2, SP_GROUP_POSE);
-            sp_gen_param(g, j[2], SP_CH_RZ, pair == 0 ? -0.3 : -0.75, pair == 0 ? 0.9 : 0.3, SP_GROUP_POSE);
+            sp_gen_param(g, j[2], SP_CH_RZ, pair == 0 ? -0.2 : -0.7, pair == 0 ? 0.35 : 0.2, SP_GROUP_POSE);
             scale(g, j[2], 0.85, 1.2);
             sp_gen_param(g, j[3], SP_CH_RX, -0.3, 0.3, SP_GROUP_POSE);
             sp_gen_param(g, j[3], SP_CH_RY, -0.3, 0.3, SP_GROUP_POSE);
-            sp_gen_param(g, j[3], SP_CH_RZ, pair == 0 ? -0.75 : -0.3, pair == 0 ? 0.3 : 0.65, SP_GROUP_POSE);
+            sp_gen_param(g, j[3], SP_CH_RZ, pair == 0 ? -0.9 : -0.2, pair == 0 ? 0.2 : 0.6, SP_GROUP_POSE);
             scale(g, j[3], 0.85, 1.2);
             sp_gen_param(g, j[4], SP_CH_RZ, -0.3, 0.3, SP_GROUP_POSE);
         }
@@ -476,7 +485,8 @@ static void build_body(elephant* e)
                                            .tip_color = k_ivory_tip,
                                            .skin = sp_gen_skin_one(e->tusk[s])});
         double ex = 1.24, ey = 1.64;
-        double ez = k_head_r.z * sqrt(1.0 - pow((ex - k_head_c.x) / k_head_r.x, 2) - pow((ey - k_head_c.y) / k_head_r.y, 2)) - 0.008;
+        double ez =
+            k_head_r.z * sqrt(1.0 - pow((ex - k_head_c.x) / k_head_r.x, 2) - pow((ey - k_head_c.y) / k_head_r.y, 2)) - 0.008;
         sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = side_z(sp_v3(ex, ey, ez), s),
                                                      .ax = {0.035, 0, 0},
                                                      .ay = {0, 0.026, 0},
@@ -587,8 +597,8 @@ static void build_clip(elephant* e)
                 double ph = 2.0 * k_pi * q / (KEYS - 1) + ph0;
                 double lift = fmax(0.0, sin(ph + 0.5 * k_pi)); // the forward swing
                 a[0][q] = 0.22 * sin(ph);
-                a[1][q] = (pair == 0 ? 0.35 : -0.35) * lift * lift;
-                a[2][q] = (pair == 0 ? -0.3 : 0.25) * lift * lift;
+                a[1][q] = (pair == 0 ? 0.15 : -0.3) * lift * lift;
+                a[2][q] = (pair == 0 ? -0.5 : 0.3) * lift * lift;
             }
             for (int k = 0; k < 3; ++k)
                 sp_gen_clip_rz(g, j[k + 1], a[k]);
@@ -620,9 +630,9 @@ sp_result sp_character_elephant(const char* path, sp_error* err)
             build_leg(&e, pair, s);
     sp_abstraction stick = build_stick(&e);
     build_clip(&e);
-    sp_result r = sp_gen_save(&e.g, &e.m,
-                              &(sp_gen_save_desc){.name = "elephant", .abstractions = &stick, .abstraction_count = 1, .no_outline = true},
-                              path, err);
+    sp_result r = sp_gen_save(
+        &e.g, &e.m, &(sp_gen_save_desc){.name = "elephant", .abstractions = &stick, .abstraction_count = 1, .no_outline = true},
+        path, err);
     sp_abstraction_free(&stick);
     sp_gen_path_free(&e.trunk_path);
     sp_gen_path_free(&e.tail_path);

@@ -273,6 +273,12 @@ sp_result sp_clf_classify(const sp_clf* c, const sp_sketch* sketch, const sp_ras
 // ---------------------------------------------------------------------------
 // Training
 
+// Training drawings described for the vocabulary sample, and leave-one-out
+// queries for the voting bandwidth and reject threshold, at most (larger sets
+// are sampled; below these sizes every drawing is used, as before).
+#define PASS1_MAX_JOBS 4000
+#define LOO_MAX_QUERIES 4000
+
 typedef struct job {
     int sample;  // index into the dataset
     int variant; // 0 original, 1 mirrored, 2.. jittered
@@ -284,7 +290,8 @@ typedef struct train_ctx {
     const job* jobs;
     int job_count;
     int per_job;       // pass 1: descriptors kept per drawing
-    float* sample;     // job_count * per_job * 64
+    int stride;        // pass 1 describes every stride-th job only
+    float* sample;     // pass 1: (job_count / stride, rounded up) * per_job * 64
     int* sample_n;     // kept per job
     float* raw;        // pass 2: job_count * hist_dim
     sp_result* status; // per job
@@ -343,9 +350,10 @@ static sp_result job_drawing(const train_ctx* t, const job* j, sp_sketch* sk, sp
     return SP_OK;
 }
 
-static int train_job(void* user, int i)
+static int train_job(void* user, int k)
 {
     train_ctx* t = user;
+    const int i = t->pass == 1 ? k * t->stride : k; // the job; pass 1 keeps its sample at k
     const job* j = &t->jobs[i];
     sp_sketch sk;
     sp_raster r;
@@ -366,7 +374,7 @@ static int train_job(void* user, int i)
             int tmp = order[k];
             order[k] = order[o];
             order[o] = tmp;
-            memcpy(t->sample + ((size_t)i * t->per_job + k) * SP_FEAT_DIM, f->desc + (size_t)order[k] * SP_FEAT_DIM,
+            memcpy(t->sample + ((size_t)i / (size_t)t->stride * t->per_job + k) * SP_FEAT_DIM, f->desc + (size_t)order[k] * SP_FEAT_DIM,
                    sizeof(float) * SP_FEAT_DIM);
         }
         t->sample_n[i] = keep;
@@ -382,7 +390,8 @@ static int train_job(void* user, int i)
     int done = atomic_fetch_add(&t->done, 1) + 1;
     if (t->clf->desc.progress) {
         pthread_mutex_lock(&t->lock);
-        t->clf->desc.progress(t->clf->desc.progress_user, t->pass == 1 ? "descriptors" : "histograms", done, t->job_count);
+        t->clf->desc.progress(t->clf->desc.progress_user, t->pass == 1 ? "descriptors" : "histograms", done,
+                              t->pass == 1 ? (t->job_count + t->stride - 1) / t->stride : t->job_count);
         pthread_mutex_unlock(&t->lock);
     }
     // Bad drawings (empty, NaN) are skipped; running out of memory or a library failure stops training.
@@ -393,6 +402,7 @@ typedef struct loo_ctx {
     const sp_clf* c;
     const int* src;
     int q;
+    int stride; // one query per `stride` original drawings (seeded choice)
     float* out; // per training histogram: distance to the nearest other drawing, -1 if skipped
 } loo_ctx;
 
@@ -402,6 +412,10 @@ static int loo_one(void* user, int i)
     const sp_clf* c = l->c;
     l->out[i] = -1.0f;
     if (i > 0 && l->src[i] == l->src[i - 1]) return 0; // one query per original drawing
+    if (l->stride > 1) {
+        uint64_t h = (uint64_t)l->src[i] ^ ((uint64_t)c->desc.seed << 32);
+        if (sp_rng_next(&h) % (uint64_t)l->stride != 0) return 0;
+    }
     int idx[64];
     float d2[64];
     struct FLANNParameters p = c->hist_params;
@@ -459,9 +473,14 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     }
     t.jobs = jobs;
     t.job_count = nj;
-    t.per_job = (c->desc.vocab_samples + nj - 1) / nj;
+    // Why a stride: the vocabulary needs vocab_samples descriptors, which a few
+    // thousand drawings give; describing every drawing of a large set twice
+    // (here and for the histograms) doubled the training time for nothing.
+    t.stride = (nj + PASS1_MAX_JOBS - 1) / PASS1_MAX_JOBS;
+    const int n1 = (nj + t.stride - 1) / t.stride;
+    t.per_job = (c->desc.vocab_samples + n1 - 1) / n1;
     if (t.per_job > SP_FEAT_MAX) t.per_job = SP_FEAT_MAX;
-    t.sample = malloc(sizeof(float) * (size_t)nj * t.per_job * SP_FEAT_DIM);
+    t.sample = malloc(sizeof(float) * (size_t)n1 * t.per_job * SP_FEAT_DIM);
     t.sample_n = calloc((size_t)nj, sizeof(int));
     t.status = calloc((size_t)nj, sizeof(sp_result));
     t.errs = calloc((size_t)nj, sizeof(sp_error));
@@ -470,7 +489,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     // Pass 1: a sample of descriptors for the vocabulary.
     t.pass = 1;
     atomic_init(&t.done, 0);
-    int bad = sp_parallel_for(nj, c->desc.threads, train_job, &t);
+    int bad = sp_parallel_for(n1, c->desc.threads, train_job, &t);
     if (bad) {
         for (int i = 0; i < nj; ++i)
             if (t.status[i] == (sp_result)bad) {
@@ -489,9 +508,10 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     sample = malloc(sizeof(float) * (size_t)total * SP_FEAT_DIM);
     if (!sample) goto oom;
     int at = 0;
-    for (int i = 0; i < nj; ++i) {
+    for (int k = 0; k < n1; ++k) {
+        int i = k * t.stride;
         if (t.status[i] != SP_OK) continue;
-        memcpy(sample + (size_t)at * SP_FEAT_DIM, t.sample + (size_t)i * t.per_job * SP_FEAT_DIM,
+        memcpy(sample + (size_t)at * SP_FEAT_DIM, t.sample + (size_t)k * t.per_job * SP_FEAT_DIM,
                sizeof(float) * SP_FEAT_DIM * (size_t)t.sample_n[i]);
         at += t.sample_n[i];
     }
@@ -575,7 +595,13 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
         int q = per_sample + 1 < n ? per_sample + 1 : n;
         loo = malloc(sizeof(float) * (size_t)n);
         if (!loo) goto oom;
-        loo_ctx lc = {c, src, q, loo};
+        // Why a sample: exact leave-one-out over n drawings costs n^2 histogram
+        // distances (20000 drawings: minutes); a few thousand queries give the
+        // median and the reject quantile just as well.
+        int originals = 0;
+        for (int i = 0; i < n; ++i)
+            originals += i == 0 || src[i] != src[i - 1];
+        loo_ctx lc = {c, src, q, (originals + LOO_MAX_QUERIES - 1) / LOO_MAX_QUERIES, loo};
         if (sp_parallel_for(n, c->desc.threads, loo_one, &lc)) {
             rc = sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram search failed");
             goto fail;

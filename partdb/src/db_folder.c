@@ -266,6 +266,22 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     return r;
 }
 
+// assets/ also holds the paper's characters (cartoon_man, elephant): only
+// files whose scene names a part category (`extras.sp_part.category`) are
+// kiosk parts. A file that does not load is left to sp_db_add_part_file,
+// which refuses it with its reason.
+static bool is_kiosk_part(const char* file)
+{
+    sp_character ch = {0};
+    sp_error err = {0};
+    if (sp_gltf_load(file, &ch, &err) != SP_OK) return true;
+    cJSON* j = ch.part_json ? cJSON_Parse(ch.part_json) : NULL;
+    bool part = cJSON_IsString(cJSON_GetObjectItem(j, "category"));
+    cJSON_Delete(j);
+    sp_character_free(&ch);
+    return part;
+}
+
 typedef struct default_ctx {
     const char* assets;
     char** names;
@@ -280,6 +296,7 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
     for (int i = 0; r == SP_OK && i < c->n; ++i) {
         char file[1024];
         snprintf(file, sizeof file, "%s/%s", c->assets, c->names[i]);
+        if (!is_kiosk_part(file)) continue;
         sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = "assets"};
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
     }

@@ -175,7 +175,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     double t_train = now_s();
     if ((r = sp_clf_train(&ds, NULL, &d.clf, &clf, err)) != SP_OK) goto done;
     int n_cal = d.calibrate == 0 ? 50 : d.calibrate < 0 ? 0 : d.calibrate;
-    double q_cal = d.calibrate_quantile > 0 && d.calibrate_quantile <= 1 ? d.calibrate_quantile : 0.97;
+    double q_cal = d.calibrate_quantile > 0 && d.calibrate_quantile <= 1 ? d.calibrate_quantile : 0.96;
     if (n_cal > 0) {
         sp_dataset cal;
         if ((r = calibration_set(db, &ds, n_cal, &cal, err)) != SP_OK) goto done;

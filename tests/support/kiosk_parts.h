@@ -1,8 +1,8 @@
 /// kiosk_parts.h: a part database and dragon strokes for the kiosk's end-to-end
 /// test and benchmark (header-only; needs sp::partdb).
 ///
-/// kp_build_db() fills a new database with the six dragon parts: assets/*.glb
-/// when all six are there (the shipped default database, a quickly trained
+/// kp_build_db() fills a new database with the six dragon parts: assets/<part>.glb
+/// when all six are there and pass the database's checks (a quickly trained
 /// model), else the stand-ins of dragon_parts.h, each given its own colour
 /// (kp_hue) and a looping clip. kp_six_strokes() gives one stroke per part,
 /// placed like a dragon on a 1280 x 800 canvas: the part's synthetic sketch
@@ -99,15 +99,25 @@ static inline bool kp_build_db(const char* path, const char* assets_dir, const c
     dragon_part parts[DRAGON_PART_COUNT];
     *real = dragon_parts_load(assets_dir, parts);
     dragon_parts_free(parts);
+    sp_db* db = NULL;
     if (*real) {
-        sp_db_default_desc dd = {.synth_per_part = 40, .train = kp_quick_train()};
-        if (sp_db_create_default(path, assets_dir, &dd, err) == SP_OK) return true;
+        // The six part files only (assets/ holds other characters too).
+        bool ok = sp_db_open(path, SP_DB_CREATE, &db, err) == SP_OK;
+        for (int i = 0; ok && i < DRAGON_PART_COUNT; ++i) {
+            char glb[1200];
+            snprintf(glb, sizeof glb, "%.1000s/%s.glb", assets_dir, k_dragon_part_names[i]);
+            ok = sp_db_add_part_file(db, glb, &(sp_db_part_desc){.synth_sketches = 40}, NULL, err) == SP_OK;
+        }
+        sp_db_train_desc td = kp_quick_train();
+        ok = ok && sp_db_train(db, &td, NULL, err) == SP_OK;
+        sp_db_close(db);
+        db = NULL;
+        if (ok) return true;
         // The assets are checked by their own tests; the kiosk's go on with the stand-ins.
         fprintf(stderr, "  note: no database from assets/ (%s); using the stand-in parts\n", err->text);
         *real = false;
         kp_remove_db(path);
     }
-    sp_db* db = NULL;
     if (sp_db_open(path, SP_DB_CREATE, &db, err) != SP_OK) return false;
     bool ok = true;
     for (int i = 0; ok && i < DRAGON_PART_COUNT; ++i) {

@@ -81,8 +81,16 @@ const sp_blackbox_rig* some_other_function(void)
 #if defined(SP_TEST_PLUGIN_null)
     return NULL;
 #endif
+#if defined(SP_TEST_PLUGIN_badversion) || defined(SP_TEST_PLUGIN_badsize)
+    // A host cannot call release() of a layout it does not know, so these
+    // rigs live in static storage (a real plugin of another version would
+    // leak its heap copy, once).
+    static sheet one;
+    sheet* s = &one;
+#else
     sheet* s = calloc(1, sizeof *s);
     if (!s) return NULL;
+#endif
     double p0[4] = {0, 0, 0, 0};
     for (int j = 0; j < N; ++j)
         for (int i = 0; i < N; ++i)
@@ -116,8 +124,10 @@ const sp_blackbox_rig* some_other_function(void)
     };
 #if defined(SP_TEST_PLUGIN_badversion)
     s->desc.abi_version = 99;
+    s->desc.release = NULL;
 #elif defined(SP_TEST_PLUGIN_badsize)
     s->desc.struct_size = sizeof(sp_blackbox_rig) + 16;
+    s->desc.release = NULL;
 #endif
     return &s->desc;
 }

@@ -2,7 +2,11 @@
 // byte-identical; each loads without warnings with the promised counts,
 // bounds, outline, camera, clip and sp_part extras; random poses within
 // bounds neither fold the surface nor mirror it; the Khronos validator
-// reports no errors.
+// reports no errors. The paper's characters (cartoon_man, elephant) go
+// through the same regeneration, fold and validator checks, and their own
+// contents check (`characters`: counts near the paper's Table 1, the stick
+// and outline abstractions, a connected stick figure, elbows and knees bent
+// 60 and 90 degrees without folds or collapse).
 //
 // Inverted triangle (the definition the 0.5% budget counts): a face whose
 // skinned normal points against the normal that the blended skinning
@@ -12,6 +16,7 @@
 // (collapse at a bend, candy wrapper) flips. Negative scale: det(A) <= 0 at
 // a vertex, or a joint whose world transform has det <= 0.
 #include <cjson/cJSON.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -25,6 +30,49 @@
 static const char* const k_parts[] = {"torso", "tail", "head", "wings", "front_legs", "hind_legs"};
 enum { PART_COUNT = sizeof k_parts / sizeof k_parts[0] };
 static const char* const k_sockets[] = {"head", "tail", "wings", "front_legs", "hind_legs"};
+
+// The paper's characters: counts within about 20% of its Table 1 (Cartoon
+// Man: 91 parameters, 6708 mesh coordinates, stick 380 and outline 706
+// coordinates; Elephant: 49 joints, 132 parameters, 6162 mesh and 200 stick
+// coordinates), and the bends that must not collapse (joint, channel, two
+// angles: 60 and 90 degrees in the joint's bending sense).
+typedef struct abstraction_spec {
+    const char* name;
+    sp_correspondence correspondence;
+    int curves;
+    bool closed;
+    int coords_min, coords_max;
+} abstraction_spec;
+typedef struct bend_spec {
+    const char* param;
+    double sign;
+} bend_spec;
+typedef struct character_spec {
+    const char* name;
+    int vertices[2], params[2], joints[2]; ///< min, max
+    abstraction_spec ab[2];
+    bend_spec bends[4];
+} character_spec;
+static const character_spec k_characters[] = {
+    {.name = "cartoon_man",
+     .vertices = {1800, 2700},
+     .params = {85, 97},
+     .joints = {25, 40},
+     .ab = {{"stick", SP_CORR_ORDERED, 5, false, 340, 420}, {"outline", SP_CORR_CLOSEST, 1, true, 640, 760}},
+     .bends = {{"forearm_l.ry", -1}, {"forearm_r.ry", -1}, {"shin_l.ry", 1}, {"shin_r.ry", 1}}},
+    {.name = "elephant",
+     .vertices = {1700, 2500},
+     .params = {120, 140},
+     .joints = {45, 53},
+     .ab = {{"stick", SP_CORR_ORDERED, 7, false, 160, 240}}},
+};
+enum { CHARACTER_COUNT = sizeof k_characters / sizeof k_characters[0], ASSET_COUNT = PART_COUNT + CHARACTER_COUNT };
+
+// Every generated asset: the dragon parts, then the characters.
+static const char* asset_name(int i)
+{
+    return i < PART_COUNT ? k_parts[i] : k_characters[i - PART_COUNT].name;
+}
 
 static bool read_file(const char* path, unsigned char** data, size_t* size)
 {
@@ -56,8 +104,11 @@ static void load_part(const char* name, sp_character* ch)
 // committed assets/<name>, and the six dragon parts must be among them.
 static void test_regenerate_identical(void)
 {
-    const char* dir = sp_test_tmp_path("assetgen");
-    const char* list = sp_test_tmp_path("assetgen.txt");
+    // Copies: sp_test_*_path return a small ring of buffers that the loop's
+    // calls reuse (unlink(list) once removed a committed asset that way).
+    char dir[1024], list[1024];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("assetgen"));
+    snprintf(list, sizeof list, "%s", sp_test_tmp_path("assetgen.txt"));
     mkdir(dir, 0755);
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "'%s' --out '%s' >'%s'", SP_ASSETGEN, dir, list);
@@ -67,7 +118,7 @@ static void test_regenerate_identical(void)
     clock_gettime(CLOCK_MONOTONIC, &t1);
     FILE* f = fopen(list, "r");
     ENSURE(f != NULL);
-    int differ = 0, files = 0, parts_seen = 0;
+    int differ = 0, files = 0, parts_seen = 0, characters_seen = 0;
     char line[2048];
     while (fgets(line, sizeof line, f)) {
         line[strcspn(line, "\r\n")] = 0;
@@ -79,6 +130,11 @@ static void test_regenerate_identical(void)
             char want[64];
             snprintf(want, sizeof want, "%s.glb", k_parts[i]);
             parts_seen += strcmp(base, want) == 0;
+        }
+        for (int i = 0; i < CHARACTER_COUNT; ++i) {
+            char want[64];
+            snprintf(want, sizeof want, "%s.glb", k_characters[i].name);
+            characters_seen += strcmp(base, want) == 0;
         }
         unsigned char *x = NULL, *y = NULL;
         size_t nx = 0, ny = 0;
@@ -97,6 +153,7 @@ static void test_regenerate_identical(void)
     rmdir(dir);
     fprintf(stderr, "  generated %d files in %.2f s\n", files, (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec));
     ENSURE(parts_seen == PART_COUNT);
+    ENSURE(characters_seen == CHARACTER_COUNT);
     ENSURE(differ == 0);
 }
 
@@ -234,9 +291,9 @@ static sp_vec3 tri_normal(const double* x, const uint32_t* t)
 
 static void test_random_poses(void)
 {
-    for (int i = 0; i < PART_COUNT; ++i) {
+    for (int i = 0; i < ASSET_COUNT; ++i) {
         sp_character ch = {0};
-        load_part(k_parts[i], &ch);
+        load_part(asset_name(i), &ch);
         const sp_rig* rig = &ch.rig;
         int nv = rig->vertex_count, nt = rig->triangle_count;
         double* p = malloc(sizeof(double) * (size_t)rig->param_count);
@@ -292,8 +349,8 @@ static void test_random_poses(void)
             total += inverted;
             if (inverted > worst) worst = inverted, worst_seed = seed;
         }
-        fprintf(stderr, "  %-10s inverted faces: worst %d of %d (%.3f%%, seed %d), mean %.2f; negative scales %d\n", k_parts[i],
-                worst, nt, 100.0 * worst / nt, worst_seed, total / 200.0, negative);
+        fprintf(stderr, "  %-10s inverted faces: worst %d of %d (%.3f%%, seed %d), mean %.2f; negative scales %d\n",
+                asset_name(i), worst, nt, 100.0 * worst / nt, worst_seed, total / 200.0, negative);
         ENSURE(worst <= nt / 200);
         ENSURE(negative == 0);
         sp_rig_eval_destroy(ev);
@@ -302,21 +359,190 @@ static void test_random_poses(void)
     }
 }
 
+// ---- the paper's characters ---------------------------------------------------
+
+// Distance from q to the polyline pts[0..n) (n by 3).
+static double polyline_distance(const double* pts, int n, sp_vec3 q)
+{
+    double best = INFINITY;
+    for (int k = 0; k + 1 < n || (n == 1 && k == 0); ++k) {
+        sp_vec3 a = {pts[3 * k], pts[3 * k + 1], pts[3 * k + 2]};
+        sp_vec3 b = n == 1 ? a : (sp_vec3){pts[3 * k + 3], pts[3 * k + 4], pts[3 * k + 5]};
+        sp_vec3 ab = sp_v3_sub(b, a);
+        double len2 = sp_v3_dot(ab, ab);
+        double t = len2 > 0 ? sp_v3_dot(sp_v3_sub(q, a), ab) / len2 : 0.0;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        double d = sp_v3_len(sp_v3_sub(q, sp_v3_add(a, sp_v3_scale(ab, t))));
+        if (d < best) best = d;
+    }
+    return best;
+}
+
+// At parameters p: the faces folded over (the random-pose test's
+// definition) and, over the vertices that blend `joint` with its parent
+// (weight 0.25..0.75), the smallest ratio of their posed to their rest
+// distance from the joint's pivot. Linear blend skinning keeps cos(a/2) of
+// it in the middle of a blend bent by a (71% at 90 degrees); skin pinching
+// onto the bone (a collapse, weights on the wrong joints) drives it towards 0.
+static int bend_check(const sp_rig* rig, sp_rig_eval* ev, const double* p, int joint, double* min_ratio)
+{
+    int nv = rig->vertex_count;
+    double* x = malloc(sizeof(double) * 3 * (size_t)nv);
+    double* A = malloc(sizeof(double) * 9 * (size_t)nv);
+    ENSURE(x && A);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), x);
+    const sp_mat4* M = sp_rig_eval_skin(ev);
+    sp_vec3 pivot = sp_mat4_translation(&sp_rig_eval_world(ev)[joint]), pivot0;
+    sp_mat4 bind;
+    ENSURE(sp_mat4_inverse(&rig->joints[joint].inverse_bind, &bind));
+    pivot0 = sp_mat4_translation(&bind);
+    *min_ratio = INFINITY;
+    for (int v = 0; v < nv; ++v) {
+        double* a = A + 9 * (size_t)v;
+        double wj = 0;
+        for (int k = 0; k < 9; ++k)
+            a[k] = 0;
+        for (int k = 0; k < 4; ++k) {
+            double w = rig->weights4[4 * (size_t)v + (size_t)k];
+            int j = rig->joints4[4 * (size_t)v + (size_t)k];
+            if (w == 0) continue;
+            if (j == joint) wj += w;
+            for (int c = 0; c < 3; ++c)
+                for (int r = 0; r < 3; ++r)
+                    a[3 * c + r] += w * M[j].m[4 * c + r];
+        }
+        if (wj < 0.25 || wj > 0.75) continue;
+        sp_vec3 x0 = {rig->rest[3 * v], rig->rest[3 * v + 1], rig->rest[3 * v + 2]};
+        sp_vec3 x1 = {x[3 * v], x[3 * v + 1], x[3 * v + 2]};
+        double r0 = sp_v3_len(sp_v3_sub(x0, pivot0));
+        if (r0 > 0) *min_ratio = fmin(*min_ratio, sp_v3_len(sp_v3_sub(x1, pivot)) / r0);
+    }
+    int inverted = 0;
+    for (int t = 0; t < rig->triangle_count; ++t) {
+        const uint32_t* tri = rig->triangles + 3 * (size_t)t;
+        sp_vec3 n0 = tri_normal(rig->rest, tri);
+        if (!(sp_v3_len(n0) > 1e-14)) continue;
+        double ac[9];
+        for (int k = 0; k < 9; ++k)
+            ac[k] = (A[9 * (size_t)tri[0] + k] + A[9 * (size_t)tri[1] + k] + A[9 * (size_t)tri[2] + k]) / 3.0;
+        inverted += sp_v3_dot(tri_normal(x, tri), cof_apply(ac, n0)) < 0;
+    }
+    free(x), free(A);
+    return inverted;
+}
+
+static void check_character_abstraction(const sp_rig* rig, const abstraction_spec* s, const char* who)
+{
+    int ai = sp_rig_find_abstraction(rig, s->name);
+    if (ai < 0) fprintf(stderr, "  %s: no abstraction '%s'\n", who, s->name);
+    ENSURE(ai >= 0);
+    const sp_abstraction* a = &rig->abstractions[ai];
+    fprintf(stderr, "  %-11s %-8s %d curves, %d points (%d coordinates), %s\n", who, s->name, a->curve_count, a->point_count,
+            2 * a->point_count, a->correspondence == SP_CORR_ORDERED ? "ordered" : "closest");
+    ENSURE(a->correspondence == s->correspondence && a->curve_count == s->curves);
+    ENSURE(2 * a->point_count >= s->coords_min && 2 * a->point_count <= s->coords_max);
+    ENSURE(a->rest != NULL); // skinned like the mesh, not embedded
+    for (int c = 0; c < a->curve_count; ++c)
+        ENSURE(a->curves[c].closed == s->closed);
+    if (s->closed || a->curve_count < 2) return;
+    // One connected figure: every curve starts on another curve (within 2%
+    // of the figure's size), as a stick figure is drawn.
+    sp_vec3 lo, hi;
+    sp_bounds(a->rest, a->point_count, &lo, &hi);
+    double size = sp_v3_len(sp_v3_sub(hi, lo));
+    for (int c = 0; c < a->curve_count; ++c) {
+        const double* first = a->rest + 3 * (size_t)a->curves[c].first_point;
+        double best = INFINITY;
+        for (int d = 0; d < a->curve_count; ++d)
+            if (d != c)
+                best = fmin(best, polyline_distance(a->rest + 3 * (size_t)a->curves[d].first_point, a->curves[d].point_count,
+                                                    (sp_vec3){first[0], first[1], first[2]}));
+        if (!(best <= 0.02 * size))
+            fprintf(stderr, "  %s: curve '%s' starts %.3f away from the others\n", who, a->curves[c].name, best);
+        ENSURE(best <= 0.02 * size);
+    }
+}
+
+static void test_characters(void)
+{
+    for (int i = 0; i < CHARACTER_COUNT; ++i) {
+        const character_spec* cs = &k_characters[i];
+        sp_character ch = {0};
+        load_part(cs->name, &ch);
+        const sp_rig* rig = &ch.rig;
+        for (int w = 0; w < ch.warning_count; ++w)
+            fprintf(stderr, "  %s: warning: %s\n", cs->name, ch.warnings[w]);
+        int shape = 0, pose = 0, placement = 0;
+        for (int q = 0; q < rig->param_count; ++q) {
+            const sp_param* p = &rig->params[q];
+            ENSURE(isfinite(p->min) && isfinite(p->max) && p->min < p->max);
+            if (sp_channel_is_scale(p->channel)) ENSURE(p->min > 0.0);
+            shape += p->group == SP_GROUP_SHAPE;
+            pose += p->group == SP_GROUP_POSE;
+            placement += p->joint == 0 && (p->channel == SP_CH_TX || p->channel == SP_CH_TY);
+        }
+        fprintf(stderr, "  %-11s %5d vertices (%d mesh coordinates) %3d parameters (%d pose, %d shape) %2d joints\n", cs->name,
+                rig->vertex_count, 3 * rig->vertex_count, rig->param_count, pose, shape, rig->joint_count);
+        ENSURE(ch.warning_count == 0);
+        ENSURE(!ch.derived_abstraction && !ch.derived_dofs);
+        ENSURE(ch.part_json == NULL); // a character, not a kiosk part
+        ENSURE(rig->vertex_count >= cs->vertices[0] && rig->vertex_count <= cs->vertices[1]);
+        ENSURE(rig->param_count >= cs->params[0] && rig->param_count <= cs->params[1]);
+        ENSURE(rig->joint_count >= cs->joints[0] && rig->joint_count <= cs->joints[1]);
+        ENSURE(placement == 2 && shape >= 5);
+        int abstractions = cs->ab[1].name ? 2 : 1;
+        ENSURE(rig->abstraction_count == abstractions);
+        for (int a = 0; a < abstractions; ++a)
+            check_character_abstraction(rig, &cs->ab[a], cs->name);
+        // The first abstraction is the stick figure (what `pose` uses by default).
+        ENSURE(strcmp(rig->abstractions[0].name, "stick") == 0);
+        ENSURE(ch.has_camera && ch.camera.kind == SP_CAMERA_ORTHOGRAPHIC);
+        ENSURE_NEAR(ch.camera.view.m[10], 1.0, 1e-6); // looking along -Z
+        check_clip(rig);
+        // Elbows and knees bent 60 and 90 degrees: no folded face, no collapse.
+        sp_rig_eval* ev = sp_rig_eval_create(rig);
+        double* p = malloc(sizeof(double) * (size_t)rig->param_count);
+        ENSURE(ev && p);
+        for (int b = 0; b < 4 && cs->bends[b].param; ++b) {
+            int q = sp_rig_find_param(rig, cs->bends[b].param);
+            ENSURE(q >= 0);
+            for (int deg = 60; deg <= 90; deg += 30) {
+                sp_rig_defaults(rig, p);
+                p[q] = cs->bends[b].sign * deg * 3.14159265358979323846 / 180.0;
+                ENSURE(p[q] >= rig->params[q].min && p[q] <= rig->params[q].max);
+                double ratio = 0;
+                int inverted = bend_check(rig, ev, p, rig->params[q].joint, &ratio);
+                fprintf(stderr, "  %-11s %s bent %d degrees: %d folded faces, blend zone keeps %.0f%% of its radius\n", cs->name,
+                        cs->bends[b].param, deg, inverted, 100 * ratio);
+                ENSURE(inverted == 0);
+                ENSURE(ratio >= 0.6);
+            }
+        }
+        free(p);
+        sp_rig_eval_destroy(ev);
+        sp_character_free(&ch);
+    }
+}
+
 // ---- Khronos validator -----------------------------------------------------
 
 static void test_validator(void)
 {
-    const char* tools = sp_test_src_path("tests/tools");
+    // Copies: sp_test_*_path return a small ring of buffers that the loop's
+    // calls reuse (the report path once became a committed asset's that way).
+    char tools[1024], report[1024];
+    snprintf(tools, sizeof tools, "%s", sp_test_src_path("tests/tools"));
+    snprintf(report, sizeof report, "%s", sp_test_tmp_path("validator.json"));
     char probe[1200];
     snprintf(probe, sizeof probe, "%s/node_modules/gltf-validator", tools);
     struct stat st;
     if (system("command -v node >/dev/null 2>&1") != 0) SKIP("node is not installed");
     if (stat(probe, &st) != 0) SKIP("tests/tools/node_modules is missing (run: cd tests/tools && npm ci)");
-    const char* report = sp_test_tmp_path("validator.json");
     int failed = 0;
-    for (int i = 0; i < PART_COUNT; ++i) {
+    for (int i = 0; i < ASSET_COUNT; ++i) {
         char rel[256], cmd[4096];
-        snprintf(rel, sizeof rel, "assets/%s.glb", k_parts[i]);
+        snprintf(rel, sizeof rel, "assets/%s.glb", asset_name(i));
         snprintf(cmd, sizeof cmd, "node '%s/validate.js' '%s' >'%s'", tools, sp_test_src_path(rel), report);
         int rc = system(cmd);
         unsigned char* text = NULL;
@@ -325,7 +551,7 @@ static void test_validator(void)
         const cJSON* ne = cJSON_GetObjectItemCaseSensitive(j, "numErrors");
         const cJSON* nw = cJSON_GetObjectItemCaseSensitive(j, "numWarnings");
         bool ok = rc == 0 && cJSON_IsNumber(ne) && ne->valueint == 0;
-        fprintf(stderr, "  %-10s validator: %d errors, %d warnings\n", k_parts[i], cJSON_IsNumber(ne) ? ne->valueint : -1,
+        fprintf(stderr, "  %-10s validator: %d errors, %d warnings\n", asset_name(i), cJSON_IsNumber(ne) ? ne->valueint : -1,
                 cJSON_IsNumber(nw) ? nw->valueint : -1);
         if (!ok) fprintf(stderr, "%s\n", text ? (const char*)text : "(no report)");
         failed += !ok;
@@ -341,6 +567,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"regenerate_identical", test_regenerate_identical},
                                    {"contents", test_contents},
+                                   {"characters", test_characters},
                                    {"random_poses", test_random_poses},
                                    {"validator", test_validator},
                                    {0}});

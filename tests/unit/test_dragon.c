@@ -1235,6 +1235,38 @@ static void test_command(void)
 
 // The shipped parts (assets/*.glb), once they exist: a default database built
 // from them, one stroke per part from its own synthetic sketch, the whole pipeline.
+// `sketchpose demo` (the README's run command without a display) on the
+// shipped parts' database: six parts placed, the files it names written, the
+// .glb valid.
+static void check_demo(const char* db_path)
+{
+    char dir[1024], cmd[4000], glb[1200], png[1200], strokes[1200], log[1200];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("dragon_demo"));
+    snprintf(glb, sizeof glb, "%s/dragon.glb", dir);
+    snprintf(png, sizeof png, "%s/dragon.png", dir);
+    snprintf(strokes, sizeof strokes, "%s/strokes.json", dir);
+    snprintf(log, sizeof log, "%s", sp_test_tmp_path("dragon_demo.txt"));
+    unlink(glb), unlink(png), unlink(strokes);
+    snprintf(cmd, sizeof cmd, "'%s' demo --db '%s' --out '%s' > '%s' 2>&1", SP_SKETCHPOSE, db_path, dir, log);
+    ENSURE(system(cmd) == 0);
+    FILE* f = fopen(log, "rb");
+    ENSURE(f);
+    char text[8192] = {0};
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    (void)n;
+    fprintf(stderr, "%s", text);
+    ENSURE(strstr(text, "a dragon of 6 parts") && strstr(text, glb) && strstr(text, png));
+    struct stat st;
+    ENSURE(stat(png, &st) == 0 && st.st_size > 10000);
+    sp_sketch sk = {0};
+    sp_error err = {0};
+    ENSURE(sp_sketch_read_json(strokes, &sk, &err) == SP_OK && sk.stroke_count == 6);
+    sp_sketch_free(&sk);
+    int v = validate(glb);
+    if (v >= 0) ENSURE(v == 1);
+}
+
 static void test_six_real_parts(void)
 {
     char assets[1024];
@@ -1343,6 +1375,7 @@ static void test_six_real_parts(void)
     free(infos);
     sp_dragon_destroy(d);
     sp_db_close(db);
+    if (r == SP_OK) check_demo(path);
 }
 
 int main(int argc, char** argv)

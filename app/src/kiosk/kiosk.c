@@ -210,7 +210,7 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
         goto fail;
     }
     k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path, .assets_dir = k->desc.assets_dir, .canvas_w = k->canvas_w,
-                                                   .canvas_h = k->canvas_h}, err);
+                                                   .canvas_h = k->canvas_h, .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}}, err);
     if (!k->dragon) goto fail;
     k->canvas_cam = sp_dragon_camera(k->dragon);
     if (!(k->r = sp_renderer_create(&(sp_renderer_desc){0}, err))) goto fail;
@@ -576,6 +576,8 @@ void sp_kiosk_draw(sp_kiosk* k)
 
 sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err)
 {
+    GLint bound = 0; // restored after: the caller's framebuffer need not be the window's
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
     sp_render_target* t = sp_render_target_create(k->fb_w, k->fb_h, 0, err);
     if (!t) return SP_ERR_INTERNAL;
     sp_render_target_bind(t);
@@ -583,7 +585,7 @@ sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err)
     sp_image img = {0};
     sp_result r = sp_render_target_read(t, &img, err);
     sp_render_target_destroy(t);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)bound);
     if (r == SP_OK) r = sp_image_write_png(&img, path, err);
     sp_image_free(&img);
     return r;

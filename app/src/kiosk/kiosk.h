@@ -36,6 +36,7 @@ typedef struct sp_kiosk_desc {
     sp_kiosk_ui_desc ui;     ///< UI timings and sizes
     uint64_t code_seed;      ///< first save code's seed (0: 1); a live kiosk passes the clock
     bool no_attract_demo;    ///< skip fitting the attract screen's demo dragon (tests of other things)
+    double fit_time_cap_ms;  ///< the solver's wall-clock cap per part; 0: the pipeline's (250 ms). A replay raises it so results never depend on the machine's speed
     int lod_triangles;       ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full meshes
 } sp_kiosk_desc;
 

@@ -347,6 +347,8 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
     cam.height = H;
     cam.cy += 0.02 * H;
     sp_render_fit_depth(&cam, lo, hi);
+    GLint bound = 0; // restored after: the caller's framebuffer need not be the window's
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
     sp_render_target* t = sp_render_target_create(W, H, 0, err);
     if (!t) return SP_ERR_INTERNAL;
     sp_render_target_bind(t);
@@ -364,6 +366,6 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
     sp_draw2d_end(k->d2);
     sp_result r = sp_render_target_read(t, img, err);
     sp_render_target_destroy(t);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)bound);
     return r;
 }

@@ -173,7 +173,7 @@ typedef struct sp_db_train_desc {
     /// trained on), set the threshold (sp_clf_calibrate_reject). 0: 50; -1: keep
     /// the training set's leave-one-out threshold.
     int calibrate;
-    double calibrate_quantile; ///< share of the calibration sketches accepted; 0: 0.97
+    double calibrate_quantile; ///< share of the calibration sketches accepted; 0: 0.96
 } sp_db_train_desc;
 /// Rebuilds the classifier from the stored sketches of the current part
 /// categories, cross-validates it for the report, calibrates its reject
@@ -208,7 +208,7 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err);
 sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err);
 
 /// The default database: every `*.glb`/`*.gltf` part of assets_dir (category
-/// from its sp_part extras), `synth_per_part` synthetic sketches each (0:
+/// from its sp_part extras; files without one, such as the paper's characters, are skipped), `synth_per_part` synthetic sketches each (0:
 /// SP_DB_SYNTH_DEFAULT) and a trained model. Creates `path`; refuses an existing file.
 typedef struct sp_db_default_desc {
     int synth_per_part;
