@@ -1,7 +1,7 @@
 // dragon_kiosk.c: the kiosk window. GLFW turns touches (pointer events) into
 // sp_kiosk_events; kiosk.h does the rest. With --script the session file is
 // replayed on a virtual clock (its own timestamps, 60 updates a second, every
-// third one drawn), so a run is deterministic whatever the machine's speed.
+// tenth one drawn), so a run is deterministic whatever the machine's speed.
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -31,13 +31,13 @@ typedef struct app {
     sp_kiosk_session rec;
     bool recording;
     int fb_w, fb_h;
-    double ppm;             // measured (or the script's)
-    double ppm_override;    // from the script, 0: none
+    double ppm;          // measured (or the script's)
+    double ppm_override; // from the script, 0: none
     // Stats.
-    double up_wall[8];      // wall times of pen-ups whose strokes wait for the pipeline (ring)
+    double up_wall[8]; // wall times of pen-ups whose strokes wait for the pipeline (ring)
     int up_head, up_count;
     int seen_fits, seen_dropped, seen_finished;
-    double* latency;        // pen-up -> fitted outline on screen, ms
+    double* latency; // pen-up -> fitted outline on screen, ms
     int latency_n, latency_cap;
     double frame_ms[8192], update_ms[8192], draw_ms[8192], swap_ms[8192];
     int frames;
@@ -103,8 +103,10 @@ static void push_event(app* a, const sp_kiosk_event* ev)
     }
     if (sp_kiosk_ui_of(a->k)->strokes_finished > before) {
         a->up_wall[(a->up_head + a->up_count) % 8] = wall_ms();
-        if (a->up_count < 8) ++a->up_count;
-        else a->up_head = (a->up_head + 1) % 8;
+        if (a->up_count < 8)
+            ++a->up_count;
+        else
+            a->up_head = (a->up_head + 1) % 8;
     }
 }
 
@@ -169,7 +171,8 @@ static void cb_key(GLFWwindow* w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
     // Staff only: Ctrl+Shift+Q closes the kiosk (visitors need no keyboard).
-    if (key == GLFW_KEY_Q && action == GLFW_PRESS && (mods & GLFW_MOD_CONTROL) && (mods & GLFW_MOD_SHIFT)) glfwSetWindowShouldClose(w, 1);
+    if (key == GLFW_KEY_Q && action == GLFW_PRESS && (mods & GLFW_MOD_CONTROL) && (mods & GLFW_MOD_SHIFT))
+        glfwSetWindowShouldClose(w, 1);
 }
 
 static void cb_error(int code, const char* text)
@@ -242,20 +245,24 @@ static void print_stats(const app* a, double start_ms)
     const sp_kiosk_stats* st = sp_kiosk_stats_of(a->k);
     const sp_kiosk_ui* ui = sp_kiosk_ui_of(a->k);
     int nf = a->frames < 8192 ? a->frames : 8192, nfit = st->fit_count < 4096 ? st->fit_count : 4096;
-    printf("{\"parts\": %d, \"strokes\": %d, \"parts_added\": %d, \"rejected\": %d, \"refits\": %d, \"undos\": %d, \"clears\": %d, "
-           "\"saves\": %d, \"save_failures\": %d, \"pipeline_errors\": %d, \"reloads\": %d, \"taps\": %d, \"dropped_strokes\": %d, "
-           "\"dropped_jobs\": %d, \"resets\": %d, \"mode\": \"%s\", \"code\": \"%s\", \"last_save\": \"%s\",\n",
-           st->parts, st->strokes, st->parts_added, st->rejected, st->refits, st->undos, st->clears, st->saves, st->save_failures,
-           st->pipeline_errors, st->reloads, ui->taps, ui->dropped_strokes, ui->dropped_jobs, ui->resets,
-           ui->mode == SP_KM_ATTRACT ? "attract" : ui->mode == SP_KM_TURN ? "turn" : "draw", ui->code, sp_kiosk_last_save(a->k));
+    printf(
+        "{\"parts\": %d, \"strokes\": %d, \"parts_added\": %d, \"rejected\": %d, \"refits\": %d, \"undos\": %d, \"clears\": %d, "
+        "\"saves\": %d, \"save_failures\": %d, \"pipeline_errors\": %d, \"reloads\": %d, \"taps\": %d, \"dropped_strokes\": %d, "
+        "\"dropped_jobs\": %d, \"resets\": %d, \"mode\": \"%s\", \"code\": \"%s\", \"last_save\": \"%s\",\n",
+        st->parts, st->strokes, st->parts_added, st->rejected, st->refits, st->undos, st->clears, st->saves, st->save_failures,
+        st->pipeline_errors, st->reloads, ui->taps, ui->dropped_strokes, ui->dropped_jobs, ui->resets,
+        ui->mode == SP_KM_ATTRACT ? "attract"
+        : ui->mode == SP_KM_TURN  ? "turn"
+                                  : "draw",
+        ui->code, sp_kiosk_last_save(a->k));
     printf(" \"framebuffer\": [%d, %d], \"px_per_mm\": %.4f, \"gl_renderer\": \"%s\", \"start_ms\": %.1f, \"frames\": %d, "
            "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"fit_ms_median\": %.2f, \"fit_ms_p90\": %.2f, "
            "\"latency_ms_median\": %.2f, \"latency_ms_p90\": %.2f, \"latency_n\": %d, \"update_ms_median\": %.2f, "
            "\"draw_ms_median\": %.2f, \"swap_ms_median\": %.2f,\n \"rss_kb\": [",
            a->fb_w, a->fb_h, a->ppm, (const char*)glGetString(GL_RENDERER), start_ms, a->frames, quantile(a->frame_ms, nf, 0.5),
            quantile(a->frame_ms, nf, 0.9), quantile(st->fit_ms, nfit, 0.5), quantile(st->fit_ms, nfit, 0.9),
-           quantile(a->latency, a->latency_n, 0.5), quantile(a->latency, a->latency_n, 0.9), a->latency_n, quantile(a->update_ms, nf, 0.5),
-           quantile(a->draw_ms, nf, 0.5), quantile(a->swap_ms, nf, 0.5));
+           quantile(a->latency, a->latency_n, 0.5), quantile(a->latency, a->latency_n, 0.9), a->latency_n,
+           quantile(a->update_ms, nf, 0.5), quantile(a->draw_ms, nf, 0.5), quantile(a->swap_ms, nf, 0.5));
     for (int i = 0; i < a->rss_n; ++i)
         printf("%s%ld", i ? ", " : "", a->rss_kb[i]);
     printf("],\n \"categories\": [");
@@ -315,13 +322,15 @@ static void mark_path(const char* shot, const char* name, char* out, size_t cap)
 int main(int argc, char** argv)
 {
     double start = wall_ms();
-    const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL, *size = NULL;
+    const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL,
+               *size = NULL;
     const char* font = NULL;
     bool fullscreen = false, stats = false;
     double idle_s = 0;
     int lod = 0, msaa = -1;
     sp_opt opts[] = {
-        {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)", false},
+        {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)",
+         false},
         {"--assets", SP_OPT_STRING, &assets, "DIR", "parts for a missing database (default: $SP_ASSETS or assets)", false},
         {"--fullscreen", SP_OPT_FLAG, &fullscreen, "", "full screen on the primary monitor", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "window size (default 1280x800, or the script's canvas)", false},
@@ -330,10 +339,12 @@ int main(int argc, char** argv)
         {"--screenshot", SP_OPT_STRING, &shot, "out.png", "PNG of the last frame (and of every script mark)", false},
         {"--export", SP_OPT_STRING, &out_glb, "out.glb", "glTF of the dragon at the end", false},
         {"--export-dir", SP_OPT_STRING, &export_dir, "DIR", "where Save writes (default: dragon-exports)", false},
-        {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen (default 90; < 0: never)", false},
+        {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen (default 90; < 0: never)",
+         false},
         {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
         {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling (default: 4 on a GPU, 0 on software GL)", false},
-        {"--lod", SP_OPT_INT, &lod, "N", "display triangles per part (default: 4000 on software GL, all on a GPU; -1: all)", false},
+        {"--lod", SP_OPT_INT, &lod, "N", "display triangles per part (default: 4000 on software GL, all on a GPU; -1: all)",
+         false},
         {"--stats", SP_OPT_FLAG, &stats, "", "print counters and timings as JSON at the end", false},
     };
     int rc = sp_cli_parse(argc, argv, k_cmd, "The dragon kiosk: draw a part in one line, see it come alive.", opts,
@@ -355,7 +366,9 @@ int main(int argc, char** argv)
     }
     glfwSetErrorCallback(cb_error);
     if (!glfwInit()) {
-        fprintf(stderr, "%s: cannot open a window (no display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n", k_cmd);
+        fprintf(stderr,
+                "%s: cannot open a window (no display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n",
+                k_cmd);
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
@@ -398,14 +411,22 @@ int main(int argc, char** argv)
     }
     glfwSwapInterval(script ? 0 : 1);
     if (mon) glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
-    static app a; // large (frame ring): not on the stack
+    static app a;                                                    // large (frame ring): not on the stack
     a.win = win;
     a.scripted = script != NULL;
     a.ppm_override = script ? session.px_per_mm : 0;
     glfwGetFramebufferSize(win, &a.fb_w, &a.fb_h);
-    sp_kiosk_desc kd = {.db_path = db, .assets_dir = assets, .export_dir = export_dir, .font_path = font, .canvas_w = a.fb_w,
-                        .canvas_h = a.fb_h, .ui = {.idle_ms = idle_s > 0 ? idle_s * 1000.0 : idle_s < 0 ? -1 : 0},
-                        .code_seed = script ? 1 : (uint64_t)time(NULL), .lod_triangles = lod,
+    sp_kiosk_desc kd = {.db_path = db,
+                        .assets_dir = assets,
+                        .export_dir = export_dir,
+                        .font_path = font,
+                        .canvas_w = a.fb_w,
+                        .canvas_h = a.fb_h,
+                        .ui = {.idle_ms = idle_s > 0   ? idle_s * 1000.0
+                                          : idle_s < 0 ? -1
+                                                       : 0},
+                        .code_seed = script ? 1 : (uint64_t)time(NULL),
+                        .lod_triangles = lod,
                         // A replay must not depend on the machine's speed: the solver's
                         // wall-clock cap (a visitor's safety net) is lifted; its
                         // iteration caps still bound every fit.
@@ -451,10 +472,10 @@ int main(int argc, char** argv)
                 push_event(&a, &ev);
             }
             bool at_end = target >= session.end_ms && ei >= session.count;
-            // On screen at 20 frames a second of session time: what a replay
+            // On screen at 6 frames a second of session time: what a replay
             // decides depends only on the clock, and marks and the end render
             // their own screenshots offscreen.
-            frame(&a, target, n % 3 == 0 || at_end);
+            frame(&a, target, n % 10 == 0 || at_end);
             if (n++ == 0) first_frame_ms = wall_ms() - start;
             glfwPollEvents();
             for (; mi < session.mark_count && session.marks[mi].t_ms <= target; ++mi) {

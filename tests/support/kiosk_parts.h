@@ -32,12 +32,18 @@ static inline void kp_hsv_rgb(double h, double s, double v, double rgb[3])
 {
     double c = v * s, hp = fmod(h, 360.0) / 60.0, x = c * (1 - fabs(fmod(hp, 2.0) - 1)), m = v - c;
     double r = 0, g = 0, b = 0;
-    if (hp < 1) r = c, g = x;
-    else if (hp < 2) r = x, g = c;
-    else if (hp < 3) g = c, b = x;
-    else if (hp < 4) g = x, b = c;
-    else if (hp < 5) r = x, b = c;
-    else r = c, b = x;
+    if (hp < 1)
+        r = c, g = x;
+    else if (hp < 2)
+        r = x, g = c;
+    else if (hp < 3)
+        g = c, b = x;
+    else if (hp < 4)
+        g = x, b = c;
+    else if (hp < 5)
+        r = x, b = c;
+    else
+        r = c, b = x;
     rgb[0] = r + m, rgb[1] = g + m, rgb[2] = b + m;
 }
 
@@ -106,7 +112,8 @@ static inline bool kp_build_db(const char* path, const char* assets_dir, const c
         for (int i = 0; ok && i < DRAGON_PART_COUNT; ++i) {
             char glb[1200];
             snprintf(glb, sizeof glb, "%.1000s/%s.glb", assets_dir, k_dragon_part_names[i]);
-            ok = sp_db_add_part_file(db, glb, &(sp_db_part_desc){.synth_sketches = 40}, NULL, err) == SP_OK;
+            // The assets' solver self-test is their own tests' business: skipped here for speed.
+            ok = sp_db_add_part_file(db, glb, &(sp_db_part_desc){.synth_sketches = 40, .selftest_seeds = -1}, NULL, err) == SP_OK;
         }
         sp_db_train_desc td = kp_quick_train();
         ok = ok && sp_db_train(db, &td, NULL, err) == SP_OK;
@@ -125,10 +132,11 @@ static inline bool kp_build_db(const char* path, const char* assets_dir, const c
         snprintf(glb, sizeof glb, "%.1000s/kiosk_%s.glb", glb_dir, k_dragon_part_names[i]);
         ok = kp_write_standin(i, glb, err) &&
              // The stand-ins are fixtures of the kiosk, not parts to certify: no solver self-test.
-             sp_db_add_part_file(db, glb,
-                                 &(sp_db_part_desc){.name = k_dragon_part_names[i], .synth_sketches = 40, .seed = (uint64_t)i + 1,
-                                                    .selftest_seeds = -1},
-                                 NULL, err) == SP_OK;
+             sp_db_add_part_file(
+                 db, glb,
+                 &(sp_db_part_desc){
+                     .name = k_dragon_part_names[i], .synth_sketches = 40, .seed = (uint64_t)i + 1, .selftest_seeds = -1},
+                 NULL, err) == SP_OK;
     }
     sp_db_train_desc td = kp_quick_train();
     ok = ok && sp_db_train(db, &td, NULL, err) == SP_OK;
@@ -148,7 +156,7 @@ static const struct {
 typedef struct kp_stroke {
     sp_vec2* xy; ///< n points, canvas pixels
     int n;
-    int rank;    ///< of the right category in the model's ranking (0..2)
+    int rank; ///< of the right category in the model's ranking (0..2)
     char category[64];
 } kp_stroke;
 
@@ -179,7 +187,8 @@ static inline bool kp_part_stroke(sp_db* db, const sp_clf* clf, int li, uint64_t
     sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
     for (int s = 0; s < sk.stroke_count; ++s)
         for (int i = 0; i < sk.strokes[s].count; ++i, ++k)
-            xy[k] = (sp_vec2){kp_layout[li].cx + f * (sk.strokes[s].points[i].x - c.x), kp_layout[li].cy + f * (sk.strokes[s].points[i].y - c.y)};
+            xy[k] = (sp_vec2){kp_layout[li].cx + f * (sk.strokes[s].points[i].x - c.x),
+                              kp_layout[li].cy + f * (sk.strokes[s].points[i].y - c.y)};
     sp_clf_answer ans;
     if (sp_sketch_add_stroke(&one, xy, NULL, n) != SP_OK || sp_clf_classify(clf, &one, NULL, &ans, &err) != SP_OK) goto done;
     int rank = -1;

@@ -17,10 +17,10 @@ static const char* const k_cats[6] = {"head", "wings", "tail", "torso", "front_l
 
 typedef struct fake {
     int parts;
-    int cat[256];       // category index per part
+    int cat[256]; // category index per part
     int fits, refits, undos, clears, saves, rejects;
     int heavy_per_frame; // heavy jobs answered per drain (0: all)
-    char log[8192];     // one letter per job, for replay comparisons
+    char log[8192];      // one letter per job, for replay comparisons
     int log_n;
 } fake;
 
@@ -76,9 +76,12 @@ static void fake_drain(sp_kiosk_ui* ui, fake* f)
                 int k = (int)((long)i * (j.stroke->count - 1) / (n > 1 ? n - 1 : 1));
                 outline[2 * i] = j.stroke->xy[2 * k] + 2, outline[2 * i + 1] = j.stroke->xy[2 * k + 1] - 1;
             }
-            sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = k_cats[c],
-                                                          .guesses = {k_cats[(c + 1) % 6], k_cats[(c + 2) % 6]},
-                                                          .part_count = f->parts, .outline = outline, .outline_count = n});
+            sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true,
+                                                            .category = k_cats[c],
+                                                            .guesses = {k_cats[(c + 1) % 6], k_cats[(c + 2) % 6]},
+                                                            .part_count = f->parts,
+                                                            .outline = outline,
+                                                            .outline_count = n});
             break;
         }
         case SP_KJOB_REFIT: {
@@ -93,9 +96,14 @@ static void fake_drain(sp_kiosk_ui* ui, fake* f)
             }
             f->cat[f->parts - 1] = c;
             float xy[4] = {10, 10, 200, 200};
-            sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = k_cats[c], .guesses = {k_cats[(c + 1) % 6]},
-                                                          .part_count = f->parts, .outline = xy, .outline_count = 2, .stroke = xy,
-                                                          .stroke_count = 2});
+            sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true,
+                                                            .category = k_cats[c],
+                                                            .guesses = {k_cats[(c + 1) % 6]},
+                                                            .part_count = f->parts,
+                                                            .outline = xy,
+                                                            .outline_count = 2,
+                                                            .stroke = xy,
+                                                            .stroke_count = 2});
             break;
         }
         case SP_KJOB_UNDO: {
@@ -201,15 +209,20 @@ static void test_flow(void)
     ENSURE_NEAR(j.stroke->t[j.stroke->count - 1], 1300, 1e-9);
     ENSURE(!sp_kiosk_ui_next_job(ui, &j));
     float outline[6] = {300, 300, 480, 330, 660, 310};
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "wings", .guesses = {"tail", "head"}, .part_count = 1,
-                                                  .outline = outline, .outline_count = 3});
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true,
+                                                    .category = "wings",
+                                                    .guesses = {"tail", "head"},
+                                                    .part_count = 1,
+                                                    .outline = outline,
+                                                    .outline_count = 3});
     // The outline flashes for 0.8 s, then the part is there with its chips.
     ENSURE(sp_kiosk_ui_flashing(ui) && ui->flash_outline.count == 3 && ui->flash_stroke.count >= 30);
     frame(ui, &f, 1300 + 790);
     ENSURE(sp_kiosk_ui_flashing(ui));
     frame(ui, &f, 1300 + 810);
     ENSURE(!sp_kiosk_ui_flashing(ui));
-    ENSURE(ui->part_count == 1 && strcmp(ui->chip[0], "wings") == 0 && strcmp(ui->chip[1], "tail") == 0 && strcmp(ui->chip[2], "head") == 0);
+    ENSURE(ui->part_count == 1 && strcmp(ui->chip[0], "wings") == 0 && strcmp(ui->chip[1], "tail") == 0 &&
+           strcmp(ui->chip[2], "head") == 0);
     for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_GUESS2; ++t)
         ENSURE(sp_kiosk_ui_target_enabled(ui, (sp_kiosk_target)t));
     // A guess chip re-fits as that category.
@@ -217,7 +230,8 @@ static void test_flow(void)
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT && strcmp(j.category, "head") == 0);
     tap(ui, 2600, SP_KT_CHIP_GUESS1); // ignored while the re-fit runs
     ENSURE(!sp_kiosk_ui_next_job(ui, &j));
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"wings", "tail"}, .part_count = 1});
+    sp_kiosk_ui_fit_done(ui,
+                         &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"wings", "tail"}, .part_count = 1});
     ENSURE(strcmp(ui->chip[0], "head") == 0 && strcmp(ui->chip[1], "wings") == 0);
     // A rejected stroke: hint, fading stroke, nothing else changes.
     double t = stroke(ui, 4000, 100, 500, 20, 10);
@@ -287,8 +301,8 @@ static void check_rect_mm(const sp_kiosk_ui* ui, const sp_kiosk_rect* r, const c
 {
     double min_px = min_mm * ui->px_per_mm - 1e-3;
     if (!(r->w >= min_px && r->h >= min_px))
-        fprintf(stderr, "  %s at %dx%d, %.2f px/mm: %.1f x %.1f px (%.1f x %.1f mm)\n", what, ui->width, ui->height, ui->px_per_mm, r->w, r->h,
-                r->w / ui->px_per_mm, r->h / ui->px_per_mm);
+        fprintf(stderr, "  %s at %dx%d, %.2f px/mm: %.1f x %.1f px (%.1f x %.1f mm)\n", what, ui->width, ui->height,
+                ui->px_per_mm, r->w, r->h, r->w / ui->px_per_mm, r->h / ui->px_per_mm);
     ENSURE(r->w >= min_px && r->h >= min_px);
     ENSURE(r->x >= -1e-3 && r->y >= -1e-3 && r->x + r->w <= ui->width + 1e-3 && r->y + r->h <= ui->height + 1e-3);
 }
@@ -297,9 +311,13 @@ static void test_layout(void)
 {
     // Screens: desktop, the e2e window, a 10" tablet, HiDPI laptop (content
     // scale 2), 4K on 27", portrait tablet, a small window on a dense screen.
-    const struct { int w, h; double ppm; } screens[] = {
-        {1280, 800, 96 / 25.4}, {1920, 1080, 3.6}, {1280, 800, 149 / 25.4}, {2560, 1600, 2 * 96 / 25.4},
-        {3840, 2160, 163 / 25.4}, {800, 1280, 216 / 25.4}, {640, 480, 96 / 25.4}, {1024, 600, 150 / 25.4}, {480, 800, 96 / 25.4},
+    const struct {
+        int w, h;
+        double ppm;
+    } screens[] = {
+        {1280, 800, 96 / 25.4},      {1920, 1080, 3.6},        {1280, 800, 149 / 25.4},
+        {2560, 1600, 2 * 96 / 25.4}, {3840, 2160, 163 / 25.4}, {800, 1280, 216 / 25.4},
+        {640, 480, 96 / 25.4},       {1024, 600, 150 / 25.4},  {480, 800, 96 / 25.4},
     };
     fake f;
     for (size_t s = 0; s < sizeof screens / sizeof screens[0]; ++s) {
@@ -309,20 +327,25 @@ static void test_layout(void)
         stroke(ui, 1000, 0.2f * (float)screens[s].w, 0.3f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
         sp_kiosk_job j;
         ENSURE(sp_kiosk_ui_next_job(ui, &j));
-        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "front_legs", .guesses = {"hind_legs", "wings"}, .part_count = 1});
+        sp_kiosk_ui_fit_done(
+            ui, &(sp_kiosk_fit_result){.ok = true, .category = "front_legs", .guesses = {"hind_legs", "wings"}, .part_count = 1});
         for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t) {
             const sp_kiosk_rect* r = &ui->target[t];
             check_rect_mm(ui, r, sp_kiosk_target_name((sp_kiosk_target)t), 15.0);
             // The centre and every point 1 mm inside the edge hit this target.
             float in = (float)ui->px_per_mm;
-            float pts[5][2] = {{r->x + 0.5f * r->w, r->y + 0.5f * r->h}, {r->x + in, r->y + in}, {r->x + r->w - in, r->y + in},
-                               {r->x + in, r->y + r->h - in}, {r->x + r->w - in, r->y + r->h - in}};
+            float pts[5][2] = {{r->x + 0.5f * r->w, r->y + 0.5f * r->h},
+                               {r->x + in, r->y + in},
+                               {r->x + r->w - in, r->y + in},
+                               {r->x + in, r->y + r->h - in},
+                               {r->x + r->w - in, r->y + r->h - in}};
             for (int k = 0; k < 5; ++k)
                 ENSURE(sp_kiosk_ui_hit(ui, pts[k][0], pts[k][1]) == (sp_kiosk_target)t);
             // No two targets overlap (at least 2 mm apart), and toolbar buttons stay off the canvas.
             for (int u = SP_KT_UNDO; u < t; ++u) {
                 const sp_kiosk_rect* q = &ui->target[u];
-                double gap = fmax(fmax(q->x - (r->x + r->w), r->x - (q->x + q->w)), fmax(q->y - (r->y + r->h), r->y - (q->y + q->h)));
+                double gap =
+                    fmax(fmax(q->x - (r->x + r->w), r->x - (q->x + q->w)), fmax(q->y - (r->y + r->h), r->y - (q->y + q->h)));
                 ENSURE(gap >= 2.0 * ui->px_per_mm - 1e-3);
             }
             if (t <= SP_KT_SAVE) {
@@ -394,13 +417,18 @@ static void test_tap_storm(void)
         sp_kiosk_target tg = (sp_kiosk_target)(1 + (int)(sp_test_uniform(&rng) * (SP_KT_COUNT - 1)));
         const sp_kiosk_rect* r = &ui->target[tg];
         float x = r->x + (float)sp_test_uniform(&rng) * r->w, y = r->y + (float)sp_test_uniform(&rng) * r->h;
-        if (u < 0.1) x = (float)sp_test_range(&rng, -500, 2000), y = (float)sp_test_range(&rng, -500, 1500); // anywhere, off-screen too
-        sp_kiosk_event_type ty = u < 0.4 ? SP_KEV_DOWN : u < 0.75 ? SP_KEV_UP : u < 0.9 ? SP_KEV_MOVE : u < 0.93 ? SP_KEV_CANCEL : SP_KEV_PRESS;
+        if (u < 0.1)
+            x = (float)sp_test_range(&rng, -500, 2000), y = (float)sp_test_range(&rng, -500, 1500); // anywhere, off-screen too
+        sp_kiosk_event_type ty = u < 0.4    ? SP_KEV_DOWN
+                                 : u < 0.75 ? SP_KEV_UP
+                                 : u < 0.9  ? SP_KEV_MOVE
+                                 : u < 0.93 ? SP_KEV_CANCEL
+                                            : SP_KEV_PRESS;
         int button = sp_test_uniform(&rng) < 0.05 ? 1 : 0;
         if (ty == SP_KEV_PRESS) button = (int)sp_test_range(&rng, -2, SP_KT_COUNT + 2);
         if (sp_test_uniform(&rng) < 0.01) x = NAN;
         double tt = sp_test_uniform(&rng) < 0.01 ? t - 1000 : t; // late events count as now
-        if (sp_test_uniform(&rng) < 0.6) { // a quick tap on the target
+        if (sp_test_uniform(&rng) < 0.6) {                       // a quick tap on the target
             sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_DOWN, tt, x, y, 0});
             ty = SP_KEV_UP, button = 0, tt += sp_test_range(&rng, 0, 6);
         }
@@ -496,7 +524,8 @@ static void test_long_stroke(void)
 // A session of strokes, taps and drags, fed with irregular frames and
 // recorded; the file replayed with other frame times makes the same jobs
 // and ends in the same state.
-static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t seed, fake* f, sp_kiosk_ui** out, sp_kiosk_session* rec)
+static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t seed, fake* f, sp_kiosk_ui** out,
+                        sp_kiosk_session* rec)
 {
     memset(f, 0, sizeof *f);
     sp_kiosk_ui* ui = sp_kiosk_ui_create(NULL);
@@ -524,8 +553,10 @@ static void test_record_replay(void)
     const char* script = sp_test_tmp_path("script.json");
     FILE* fp = fopen(script, "w");
     ENSURE(fp);
-    fprintf(fp, "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [640, 400], \"coords\": \"pixels\", \"end_ms\": 30000,\n"
-                " \"events\": [{\"t\": 0, \"type\": \"down\", \"x\": 320, \"y\": 200}, {\"t\": 50, \"type\": \"up\", \"x\": 320, \"y\": 200},\n");
+    fprintf(fp, "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [640, 400], \"coords\": \"pixels\", "
+                "\"end_ms\": 30000,\n"
+                " \"events\": [{\"t\": 0, \"type\": \"down\", \"x\": 320, \"y\": 200}, {\"t\": 50, \"type\": \"up\", \"x\": 320, "
+                "\"y\": 200},\n");
     double t = 500;
     for (int s = 0; s < 6; ++s, t += 1500) {
         fprintf(fp, "  {\"t\": %g, \"type\": \"stroke\", \"dt\": 9, \"points\": [", t);
@@ -547,7 +578,8 @@ static void test_record_replay(void)
     sp_kiosk_session s = {0};
     sp_error err = {0};
     ENSURE(sp_kiosk_session_read(script, &s, &err) == SP_OK);
-    ENSURE(s.canvas_w == 640 && s.canvas_h == 400 && s.end_ms == 30000 && s.mark_count == 1 && strcmp(s.marks[0].name, "mid-1") == 0);
+    ENSURE(s.canvas_w == 640 && s.canvas_h == 400 && s.end_ms == 30000 && s.mark_count == 1 &&
+           strcmp(s.marks[0].name, "mid-1") == 0);
     ENSURE(s.count == 2 + 6 * 26 + 4 + 4 + 1 + 1 + 1 + 4);
     // Live-like run with irregular frames, recorded in window pixels.
     fake f1, f2;
@@ -564,7 +596,8 @@ static void test_record_replay(void)
     ENSURE(back.count == rec.count && back.canvas_w == 1280);
     for (int i = 0; i < back.count; ++i) {
         ENSURE(back.events[i].type == rec.events[i].type && back.events[i].t_ms == rec.events[i].t_ms);
-        ENSURE(back.events[i].x == rec.events[i].x && back.events[i].y == rec.events[i].y && back.events[i].button == rec.events[i].button);
+        ENSURE(back.events[i].x == rec.events[i].x && back.events[i].y == rec.events[i].y &&
+               back.events[i].button == rec.events[i].button);
     }
     // Replay at a fixed 60 Hz (the scripted kiosk's clock).
     back.end_ms = s.end_ms;
@@ -583,23 +616,36 @@ static void test_record_replay(void)
 
 static void test_session_errors(void)
 {
-    const struct { const char* text; const char* expect; } bad[] = {
+    const struct {
+        const char* text;
+        const char* expect;
+    } bad[] = {
         {"{", "not valid JSON"},
         {"{\"format\": \"x\", \"version\": 1, \"events\": []}", "not a kiosk session"},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 2, \"events\": []}", "version"},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1}", "\"events\" must be an array"},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"type\": \"down\", \"x\": 1, \"y\": 2}]}", "events[0]: \"t\""},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 5, \"type\": \"up\", \"x\": 1, \"y\": 2}, "
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"type\": \"down\", \"x\": 1, \"y\": 2}]}",
+         "events[0]: \"t\""},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 5, \"type\": \"up\", \"x\": 1, \"y\": "
+         "2}, "
          "{\"t\": 4, \"type\": \"down\", \"x\": 1, \"y\": 2}]}",
          "events[1]: t = 4 goes back"},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"tap\"}]}", "unknown type \"tap\""},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"press\", \"target\": \"x\"}]}",
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"tap\"}]}",
+         "unknown type \"tap\""},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"press\", \"target\": "
+         "\"x\"}]}",
          "\"press\" needs \"target\""},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"down\", \"x\": 1}]}", "finite \"x\" and \"y\""},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"stroke\", \"points\": []}]}", "a stroke needs"},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"stroke\", \"points\": [[1, \"a\"]]}]}",
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"down\", \"x\": 1}]}",
+         "finite \"x\" and \"y\""},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"stroke\", \"points\": "
+         "[]}]}",
+         "a stroke needs"},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"stroke\", \"points\": "
+         "[[1, \"a\"]]}]}",
          "points[0]"},
-        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"mark\", \"name\": \"../x\"}]}", "a mark needs"},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"mark\", \"name\": "
+         "\"../x\"}]}",
+         "a mark needs"},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [0, 5], \"events\": []}", "\"canvas\""},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"coords\": \"mm\", \"events\": []}", "\"coords\""},
     };
@@ -641,7 +687,8 @@ static void sphere(int rings, int segs, double** xyz, int* nv, uint32_t** tris, 
     int k = 0;
     for (int r = 0; r < rings; ++r)
         for (int s = 0; s < segs; ++s) {
-            uint32_t a = (uint32_t)(r * segs + s), b = (uint32_t)(r * segs + (s + 1) % segs), c = a + (uint32_t)segs, d = b + (uint32_t)segs;
+            uint32_t a = (uint32_t)(r * segs + s), b = (uint32_t)(r * segs + (s + 1) % segs), c = a + (uint32_t)segs,
+                     d = b + (uint32_t)segs;
             uint32_t t[6] = {a, c, b, b, c, d};
             memcpy(*tris + 3 * k, t, sizeof t);
             k += 2;
@@ -672,7 +719,8 @@ static void test_lod(void)
     // No degenerate and no duplicate triangles (either winding).
     for (int i = 0; i < lod.tri_count; ++i) {
         uint32_t* t = lod.tris + 3 * i;
-        ENSURE(t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && t[0] < (uint32_t)lod.cluster_count && t[2] < (uint32_t)lod.cluster_count);
+        ENSURE(t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && t[0] < (uint32_t)lod.cluster_count &&
+               t[2] < (uint32_t)lod.cluster_count);
     }
     // Moving every vertex moves the clusters the same way (they follow the skinning).
     for (int v = 0; v < 3 * nv; v += 3)

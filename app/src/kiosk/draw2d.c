@@ -157,7 +157,8 @@ sp_draw2d* sp_draw2d_create(const sp_font* font, sp_error* err)
     glBindVertexArray(d->vao);
     glBindBuffer(GL_ARRAY_BUFFER, d->vbo);
     const GLsizei stride = (GLsizei)sizeof(vertex);
-    const size_t off[5] = {offsetof(vertex, px), offsetof(vertex, uv), offsetof(vertex, col), offsetof(vertex, a), offsetof(vertex, b)};
+    const size_t off[5] = {offsetof(vertex, px), offsetof(vertex, uv), offsetof(vertex, col), offsetof(vertex, a),
+                           offsetof(vertex, b)};
     const int size[5] = {2, 2, 4, 4, 4};
     for (int i = 0; i < 5; ++i) {
         glEnableVertexAttribArray((GLuint)i);
@@ -296,8 +297,10 @@ void sp_draw2d_arc(sp_draw2d* d, float cx, float cy, float r, float width, float
     if (!(a1 > a0)) return;
     const float tau = 6.28318530718f;
     if (a1 - a0 >= tau) a0 = 0, a1 = tau;
-    while (a0 < 0) a0 += tau, a1 += tau;
-    while (a0 >= tau) a0 -= tau, a1 -= tau;
+    while (a0 < 0)
+        a0 += tau, a1 += tau;
+    while (a0 >= tau)
+        a0 -= tau, a1 -= tau;
     if (a1 > tau) { // the shader's angles run 0..2pi: split at the top
         sp_draw2d_arc(d, cx, cy, r, width, a0, tau, rgba);
         sp_draw2d_arc(d, cx, cy, r, width, 0, a1 - tau, rgba);
@@ -311,8 +314,8 @@ void sp_draw2d_arc(sp_draw2d* d, float cx, float cy, float r, float width, float
 void sp_draw2d_triangle(sp_draw2d* d, float x0, float y0, float x1, float y1, float x2, float y2, const float rgba[4])
 {
     const float a[4] = {x0, y0, x1, y1}, b[4] = {x2, y2, 0, 5};
-    quad(d, fminf(x0, fminf(x1, x2)) - 1.5f, fminf(y0, fminf(y1, y2)) - 1.5f, fmaxf(x0, fmaxf(x1, x2)) + 1.5f, fmaxf(y0, fmaxf(y1, y2)) + 1.5f,
-         NULL, rgba, a, b);
+    quad(d, fminf(x0, fminf(x1, x2)) - 1.5f, fminf(y0, fminf(y1, y2)) - 1.5f, fmaxf(x0, fmaxf(x1, x2)) + 1.5f,
+         fmaxf(y0, fmaxf(y1, y2)) + 1.5f, NULL, rgba, a, b);
 }
 
 float sp_draw2d_text(sp_draw2d* d, const char* text, float x, float y, float px, sp_align align, const float rgba[4])
@@ -337,7 +340,8 @@ float sp_draw2d_text(sp_draw2d* d, const char* text, float x, float y, float px,
     return w;
 }
 
-float sp_draw2d_text_fit(sp_draw2d* d, const char* text, float x, float y, float px, float max_w, sp_align align, const float rgba[4])
+float sp_draw2d_text_fit(sp_draw2d* d, const char* text, float x, float y, float px, float max_w, sp_align align,
+                         const float rgba[4])
 {
     float w = sp_font_width(d->font, text, px);
     if (w > max_w && w > 0) px *= max_w / w;

@@ -47,7 +47,8 @@ void sp_draw2d_triangle(sp_draw2d* d, float x0, float y0, float x1, float y1, fl
 /// (cap height), aligned on x. Returns the width drawn.
 float sp_draw2d_text(sp_draw2d* d, const char* text, float x, float y, float px, sp_align align, const float rgba[4]);
 /// Text shrunk (never grown) to fit max_w. Returns the em size used.
-float sp_draw2d_text_fit(sp_draw2d* d, const char* text, float x, float y, float px, float max_w, sp_align align, const float rgba[4]);
+float sp_draw2d_text_fit(sp_draw2d* d, const char* text, float x, float y, float px, float max_w, sp_align align,
+                         const float rgba[4]);
 /// The font (for measuring).
 const sp_font* sp_draw2d_font(const sp_draw2d* d);
 

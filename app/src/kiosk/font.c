@@ -37,10 +37,14 @@ int sp_utf8_next(const char** s)
 {
     const unsigned char* p = (const unsigned char*)*s;
     int c = p[0], n = 0;
-    if (c < 0x80) n = 0;
-    else if ((c & 0xE0) == 0xC0) c &= 0x1F, n = 1;
-    else if ((c & 0xF0) == 0xE0) c &= 0x0F, n = 2;
-    else if ((c & 0xF8) == 0xF0) c &= 0x07, n = 3;
+    if (c < 0x80)
+        n = 0;
+    else if ((c & 0xE0) == 0xC0)
+        c &= 0x1F, n = 1;
+    else if ((c & 0xF0) == 0xE0)
+        c &= 0x0F, n = 2;
+    else if ((c & 0xF8) == 0xF0)
+        c &= 0x07, n = 3;
     else {
         *s += 1;
         return '?';
@@ -197,8 +201,10 @@ const sp_font_glyph* sp_font_glyph_for(const sp_font* f, int cp)
         while (lo <= hi) {
             int mid = (lo + hi) / 2;
             if (f->glyphs[mid].codepoint == cp) return &f->glyphs[mid];
-            if (f->glyphs[mid].codepoint < cp) lo = mid + 1;
-            else hi = mid - 1;
+            if (f->glyphs[mid].codepoint < cp)
+                lo = mid + 1;
+            else
+                hi = mid - 1;
         }
     }
     return &f->glyphs[0];

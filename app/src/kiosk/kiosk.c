@@ -137,18 +137,25 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         }
         sp_error err = {0};
         struct cached_mesh it = {p->id, NULL, true, false, {0}};
-        sp_mesh_desc md = {.vertex_count = rig->vertex_count, .positions = xyz, .colors = p->character->colors,
-                           .triangle_count = rig->triangle_count, .triangles = rig->triangles};
+        sp_mesh_desc md = {.vertex_count = rig->vertex_count,
+                           .positions = xyz,
+                           .colors = p->character->colors,
+                           .triangle_count = rig->triangle_count,
+                           .triangles = rig->triangles};
         if (c->lod_triangles > 0 && rig->triangle_count > c->lod_triangles &&
-            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, c->lod_triangles, &it.lod) == SP_OK) {
+            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, c->lod_triangles,
+                         &it.lod) == SP_OK) {
             if (it.lod.cluster_count > c->scratch_cap) {
                 double* s = realloc(c->scratch, sizeof(double) * 3 * (size_t)it.lod.cluster_count);
                 if (s) c->scratch = s, c->scratch_cap = it.lod.cluster_count;
             }
             if (it.lod.cluster_count <= c->scratch_cap) {
                 sp_lod_positions(&it.lod, xyz, c->scratch);
-                md = (sp_mesh_desc){.vertex_count = it.lod.cluster_count, .positions = c->scratch, .colors = it.lod.colors,
-                                    .triangle_count = it.lod.tri_count, .triangles = it.lod.tris};
+                md = (sp_mesh_desc){.vertex_count = it.lod.cluster_count,
+                                    .positions = c->scratch,
+                                    .colors = it.lod.colors,
+                                    .triangle_count = it.lod.tri_count,
+                                    .triangles = it.lod.tris};
                 it.coarse = true;
             }
         }
@@ -209,14 +216,19 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
         sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory");
         goto fail;
     }
-    k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path, .assets_dir = k->desc.assets_dir, .canvas_w = k->canvas_w,
-                                                   .canvas_h = k->canvas_h, .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}}, err);
+    k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
+                                                   .assets_dir = k->desc.assets_dir,
+                                                   .canvas_w = k->canvas_w,
+                                                   .canvas_h = k->canvas_h,
+                                                   .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
+                                 err);
     if (!k->dragon) goto fail;
     k->canvas_cam = sp_dragon_camera(k->dragon);
     if (!(k->r = sp_renderer_create(&(sp_renderer_desc){0}, err))) goto fail;
     // Software rasterisers pay per triangle: coarser display meshes there.
     const char* gl_name = (const char*)glGetString(GL_RENDERER);
-    k->software = gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast") || strstr(gl_name, "SWR"));
+    k->software = gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast") ||
+                              strstr(gl_name, "SWR"));
     int lod = k->desc.lod_triangles < 0 ? 0 : k->desc.lod_triangles > 0 ? k->desc.lod_triangles : k->software ? 4000 : 0;
     k->meshes.lod_triangles = k->demo_meshes.lod_triangles = lod;
     if (!(k->d2 = sp_draw2d_create(k->font, err))) goto fail;
@@ -346,8 +358,9 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
             fprintf(stderr, "dragon-kiosk: %s\n", err->text);
         }
         ++k->stats.rejected;
-        sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = false, .hint = rc != SP_OK ? reject_hint(SP_DRAGON_UNRECOGNISED)
-                                                                                            : reject_hint(res->reason)});
+        sp_kiosk_ui_fit_done(
+            k->ui, &(sp_kiosk_fit_result){.ok = false,
+                                          .hint = rc != SP_OK ? reject_hint(SP_DRAGON_UNRECOGNISED) : reject_hint(res->reason)});
         return;
     }
     ++k->rev;
@@ -356,7 +369,8 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
     part_guesses* g = guesses_of(k, p->id, true);
     int ng = 0;
     for (int i = 0; g && i < res->guess_count && ng < 2; ++i)
-        if (strcmp(res->guesses[i].category, p->category) != 0) snprintf(g->guess[ng++], SP_NAME_MAX, "%s", res->guesses[i].category);
+        if (strcmp(res->guesses[i].category, p->category) != 0)
+            snprintf(g->guess[ng++], SP_NAME_MAX, "%s", res->guesses[i].category);
     // A sure classifier votes for one category only; the visitor still gets
     // two other parts to choose from (the model's other categories, in order).
     const sp_clf* clf = sp_dragon_model(k->dragon);
@@ -389,13 +403,20 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
         }
         sn = p->stroke_points;
     }
-    sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true, .category = p->category,
-                                                      .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
-                                                      .part_count = sp_dragon_part_count(k->dragon), .outline = k->outline_px,
-                                                      .outline_count = n, .outline_breaks = k->breaks, .outline_break_count = nb,
-                                                      .stroke = stroke, .stroke_count = sn});
-    if (refit) ++k->stats.refits;
-    else ++k->stats.parts_added;
+    sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true,
+                                                       .category = p->category,
+                                                       .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
+                                                       .part_count = sp_dragon_part_count(k->dragon),
+                                                       .outline = k->outline_px,
+                                                       .outline_count = n,
+                                                       .outline_breaks = k->breaks,
+                                                       .outline_break_count = nb,
+                                                       .stroke = stroke,
+                                                       .stroke_count = sn});
+    if (refit)
+        ++k->stats.refits;
+    else
+        ++k->stats.parts_added;
 }
 
 static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
@@ -416,7 +437,8 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     memset(&res, 0, sizeof res);
     sp_error err = {0};
     double t0 = now_ms();
-    sp_result rc = sp_dragon_add_points(k->dragon, k->scratch, s->count, &(sp_dragon_stroke_opts){.replace_last = j->replace}, &res, &err);
+    sp_result rc =
+        sp_dragon_add_points(k->dragon, k->scratch, s->count, &(sp_dragon_stroke_opts){.replace_last = j->replace}, &res, &err);
     double ms = now_ms() - t0;
     k->stats.last_fit_ms = ms;
     k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
@@ -457,7 +479,8 @@ static sp_result make_dirs(const char* dir, sp_error* err)
     for (char* p = buf + 1; *p; ++p) {
         if (*p != '/') continue;
         *p = 0;
-        if (mkdir(buf, 0755) != 0 && errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
+        if (mkdir(buf, 0755) != 0 && errno != EEXIST)
+            return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
         *p = '/';
     }
     if (mkdir(buf, 0755) != 0 && errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
@@ -549,7 +572,8 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         k->last_reload_check = t_ms;
         bool reloaded = false;
         sp_error err = {0};
-        if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK) fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
+        if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK)
+            fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
         if (reloaded) ++k->stats.reloads;
     }
     if (k->ui->mode == SP_KM_ATTRACT) kiosk_attract_update(k);
@@ -593,6 +617,7 @@ sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err)
 
 sp_result sp_kiosk_export(sp_kiosk* k, const char* path, sp_error* err)
 {
-    if (sp_dragon_part_count(k->dragon) == 0) return sp_fail(err, SP_ERR_INVALID, "%s: nothing to export: the dragon has no parts", path);
+    if (sp_dragon_part_count(k->dragon) == 0)
+        return sp_fail(err, SP_ERR_INVALID, "%s: nothing to export: the dragon has no parts", path);
     return sp_dragon_export(k->dragon, path, err);
 }

@@ -28,26 +28,28 @@ typedef struct sp_dragon sp_dragon; // dragon.h
 
 /// Zero means the default.
 typedef struct sp_kiosk_desc {
-    const char* db_path;     ///< NULL: sp_db_default_path(); created from assets_dir when missing
-    const char* assets_dir;  ///< NULL: the pipeline's default ($SP_ASSETS, else "assets")
-    const char* export_dir;  ///< where Save writes; NULL: "dragon-exports" (created when needed)
-    const char* font_path;   ///< NULL: DejaVu Sans Bold
-    int canvas_w, canvas_h;  ///< the drawing canvas in pixels (the first framebuffer size); 0: 1280 x 800
-    sp_kiosk_ui_desc ui;     ///< UI timings and sizes
-    uint64_t code_seed;      ///< first save code's seed (0: 1); a live kiosk passes the clock
-    bool no_attract_demo;    ///< skip fitting the attract screen's demo dragon (tests of other things)
-    double fit_time_cap_ms;  ///< the solver's wall-clock cap per part; 0: the pipeline's (250 ms). A replay raises it so results never depend on the machine's speed
-    int lod_triangles;       ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full meshes
+    const char* db_path;    ///< NULL: sp_db_default_path(); created from assets_dir when missing
+    const char* assets_dir; ///< NULL: the pipeline's default ($SP_ASSETS, else "assets")
+    const char* export_dir; ///< where Save writes; NULL: "dragon-exports" (created when needed)
+    const char* font_path;  ///< NULL: DejaVu Sans Bold
+    int canvas_w, canvas_h; ///< the drawing canvas in pixels (the first framebuffer size); 0: 1280 x 800
+    sp_kiosk_ui_desc ui;    ///< UI timings and sizes
+    uint64_t code_seed;     ///< first save code's seed (0: 1); a live kiosk passes the clock
+    bool no_attract_demo;   ///< skip fitting the attract screen's demo dragon (tests of other things)
+    double fit_time_cap_ms; ///< the solver's wall-clock cap per part; 0: the pipeline's (250 ms). A replay raises it so results
+                            ///< never depend on the machine's speed
+    int lod_triangles; ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full
+                       ///< meshes
 } sp_kiosk_desc;
 
 /// Measurements for logs and benchmarks.
 typedef struct sp_kiosk_stats {
     int strokes, parts_added, rejected, refits, undos, clears, saves, save_failures, pipeline_errors, reloads;
-    double last_fit_ms;      ///< wall time of the last classify+fit (the pipeline's)
+    double last_fit_ms; ///< wall time of the last classify+fit (the pipeline's)
     int fit_count;
-    double fit_ms[4096];     ///< the last 4096 classify+fit wall times (ring)
-    double pose_ms;          ///< last pose_at + mesh update
-    int parts;               ///< parts now
+    double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
+    double pose_ms;      ///< last pose_at + mesh update
+    int parts;           ///< parts now
 } sp_kiosk_stats;
 
 /// Opens the database (creating the default one when missing), loads the font,

@@ -19,7 +19,7 @@ static const struct {
     const char* category;
     double cx, cy, size;
 } k_layout[] = {
-    {"torso", 0.50, 0.55, 0.46}, {"head", 0.72, 0.40, 0.24},      {"wings", 0.50, 0.34, 0.34},     {"tail", 0.27, 0.58, 0.36},
+    {"torso", 0.50, 0.55, 0.46},      {"head", 0.72, 0.40, 0.24},      {"wings", 0.50, 0.34, 0.34}, {"tail", 0.27, 0.58, 0.36},
     {"front_legs", 0.60, 0.74, 0.22}, {"hind_legs", 0.40, 0.74, 0.24}, {"legs", 0.50, 0.74, 0.22},
 };
 enum { LAYOUT_N = sizeof k_layout / sizeof k_layout[0] };
@@ -84,8 +84,11 @@ static void prepare(sp_kiosk* k)
         demo_stroke(k, db, li);
     sp_db_close(db);
     if (k->demo_count == 0) return;
-    k->demo = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path, .canvas_w = k->canvas_w, .canvas_h = k->canvas_h,
-                                                 .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}}, &err);
+    k->demo = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
+                                                 .canvas_w = k->canvas_w,
+                                                 .canvas_h = k->canvas_h,
+                                                 .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
+                               &err);
     if (!k->demo) fprintf(stderr, "dragon-kiosk: attract screen without its demo: %s\n", err.text);
 }
 
@@ -123,10 +126,12 @@ void kiosk_attract_update(sp_kiosk* k)
             k->heavy_done = true;
             sp_dragon_result res;
             sp_error err = {0};
-            sp_result rc = sp_dragon_add_points(k->demo, d->xy, d->n, &(sp_dragon_stroke_opts){.category = d->category}, &res, &err);
+            sp_result rc =
+                sp_dragon_add_points(k->demo, d->xy, d->n, &(sp_dragon_stroke_opts){.category = d->category}, &res, &err);
             if (rc == SP_OK && !res.rejected && res.part >= 0) {
                 d->part = res.part;
-                d->outline_n = kiosk_fitted_outline(sp_dragon_part_get(k->demo, res.part), &d->outline, &d->outline_cap, d->breaks, 16, &d->break_n);
+                d->outline_n = kiosk_fitted_outline(sp_dragon_part_get(k->demo, res.part), &d->outline, &d->outline_cap,
+                                                    d->breaks, 16, &d->break_n);
             }
             k->demo_posed_parts = -1;
             break;

@@ -131,14 +131,16 @@ static void icon(sp_draw2d* d, sp_kiosk_target t, bool alt, float cx, float cy, 
             }
             sp_draw2d_polyline(d, pts, n, false, lw, c);
             float ex = pts[2 * n - 2], ey = pts[2 * n - 1];
-            sp_draw2d_triangle(d, ex - 0.05f * s, ey - 0.2f * s, ex - 0.05f * s, ey + 0.2f * s, ex + 0.25f * s, ey + 0.05f * s, c);
+            sp_draw2d_triangle(d, ex - 0.05f * s, ey - 0.2f * s, ex - 0.05f * s, ey + 0.2f * s, ex + 0.25f * s, ey + 0.05f * s,
+                               c);
             sp_draw2d_disc(d, cx, cy, 0.11f * s, c);
         }
         break;
     case SP_KT_SAVE: { // an arrow into a tray
         sp_draw2d_line(d, cx, cy - 0.42f * s, cx, cy + 0.02f * s, lw, c);
         sp_draw2d_triangle(d, cx - 0.22f * s, cy - 0.04f * s, cx + 0.22f * s, cy - 0.04f * s, cx, cy + 0.2f * s, c);
-        float tray[8] = {cx - 0.4f * s, cy + 0.08f * s, cx - 0.4f * s, cy + 0.38f * s, cx + 0.4f * s, cy + 0.38f * s, cx + 0.4f * s, cy + 0.08f * s};
+        float tray[8] = {cx - 0.4f * s, cy + 0.08f * s, cx - 0.4f * s, cy + 0.38f * s,
+                         cx + 0.4f * s, cy + 0.38f * s, cx + 0.4f * s, cy + 0.08f * s};
         sp_draw2d_polyline(d, tray, 4, false, lw, c);
         break;
     }
@@ -162,7 +164,8 @@ static void draw_button(sp_kiosk* k, sp_kiosk_target t)
     float rad = 0.16f * fminf(r->w, r->h);
     sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0, bg);
     // A white rim keeps dark buttons apart from a dark dragon behind them.
-    sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.025f * r->h), (const float[4]){1, 1, 1, enabled ? 0.9f : 0.5f});
+    sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.025f * r->h),
+                   (const float[4]){1, 1, 1, enabled ? 0.9f : 0.5f});
     bool alt = (t == SP_KT_PLAY && ui->playing) || (t == SP_KT_TURN && ui->mode == SP_KM_TURN);
     const char* label = "";
     switch (t) {
@@ -212,8 +215,8 @@ static void draw_chips(sp_kiosk* k)
             float tick[6] = {ix - 0.5f * s, iy, ix - 0.1f * s, iy + 0.4f * s, ix + 0.6f * s, iy - 0.45f * s};
             sp_draw2d_polyline(k->d2, tick, 3, false, fmaxf(2.0f, 0.09f * r->h), k_green);
             float left = r->x + 0.8f * r->h;
-            sp_draw2d_text_fit(k->d2, text, 0.5f * (left + r->x + r->w - 0.3f * r->h), r->y + 0.5f * r->h, px, r->x + r->w - left - 0.3f * r->h,
-                               SP_ALIGN_CENTER, k_ink);
+            sp_draw2d_text_fit(k->d2, text, 0.5f * (left + r->x + r->w - 0.3f * r->h), r->y + 0.5f * r->h, px,
+                               r->x + r->w - left - 0.3f * r->h, SP_ALIGN_CENTER, k_ink);
         } else {
             snprintf(text, sizeof text, "%s?", pretty);
             sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0, pressed ? k_yellow : enabled ? k_navy : k_grey);
@@ -245,7 +248,8 @@ static void draw_countdown(sp_kiosk* k, double left_s)
     char num[16];
     snprintf(num, sizeof num, "%d", (int)ceil(left_s));
     sp_draw2d_text(k->d2, num, cx, cy, 0.8f * R, SP_ALIGN_CENTER, k_white);
-    sp_kiosk_rect box = {ui->canvas.x + 0.05f * ui->canvas.w, cy + R + 0.6f * ui->text_px, 0.9f * ui->canvas.w, 2.2f * ui->text_px};
+    sp_kiosk_rect box = {ui->canvas.x + 0.05f * ui->canvas.w, cy + R + 0.6f * ui->text_px, 0.9f * ui->canvas.w,
+                         2.2f * ui->text_px};
     draw_message(k, &box, "Still drawing? Touch the screen", ui->text_px, k_panel, k_white);
 }
 
@@ -259,12 +263,13 @@ static void draw_attract_ui(sp_kiosk* k)
                        ui->text_px, 0.92f * W, SP_ALIGN_CENTER, (const float[4]){0.15f, 0.18f, 0.25f, 1});
     // "Touch to start" breathes gently so that it reads as alive, not as a hover.
     double a = 0.8 + 0.2 * sin(ui->now / 1000.0 * 2.4);
-    float bh = (float)(ui->px_per_mm * (ui->desc.min_target_mm + 3)), bw = fminf(0.9f * W, sp_font_width(k->font, "Touch to start", ui->text_px * 1.3f) + 3 * bh);
+    float bh = (float)(ui->px_per_mm * (ui->desc.min_target_mm + 3)),
+          bw = fminf(0.9f * W, sp_font_width(k->font, "Touch to start", ui->text_px * 1.3f) + 3 * bh);
     float bx = 0.5f * (W - bw), by = H - bh - (float)(ui->px_per_mm * 8);
     sp_draw2d_rect(k->d2, bx, by, bw, bh, 0.5f * bh, 0, (const float[4]){k_navy[0], k_navy[1], k_navy[2], (float)a});
     icon(k->d2, SP_KT_REDRAW, false, bx + 0.6f * bh, by + 0.5f * bh, 0.55f * bh, k_yellow);
-    sp_draw2d_text_fit(k->d2, "Touch to start", bx + 0.5f * bw + 0.3f * bh, by + 0.5f * bh, ui->text_px * 1.3f, bw - 1.6f * bh, SP_ALIGN_CENTER,
-                       k_white);
+    sp_draw2d_text_fit(k->d2, "Touch to start", bx + 0.5f * bw + 0.3f * bh, by + 0.5f * bh, ui->text_px * 1.3f, bw - 1.6f * bh,
+                       SP_ALIGN_CENTER, k_white);
 }
 
 static void draw_ui(sp_kiosk* k, int w, int h)
@@ -285,8 +290,8 @@ static void draw_ui(sp_kiosk* k, int w, int h)
             char text[64];
             snprintf(text, sizeof text, "Saved! Your code: %s", ui->code);
             float bh = 2.0f * ui->big_text_px * 0.75f;
-            sp_kiosk_rect box = {ui->canvas.x + 0.04f * ui->canvas.w, ui->canvas.y + ui->canvas.h - bh - (float)(3 * ui->px_per_mm),
-                                 0.92f * ui->canvas.w, bh};
+            sp_kiosk_rect box = {ui->canvas.x + 0.04f * ui->canvas.w,
+                                 ui->canvas.y + ui->canvas.h - bh - (float)(3 * ui->px_per_mm), 0.92f * ui->canvas.w, bh};
             draw_message(k, &box, text, 0.75f * ui->big_text_px, k_green, k_white);
         }
         double left = sp_kiosk_ui_countdown_s(ui);
@@ -308,8 +313,10 @@ void kiosk_draw_frame(sp_kiosk* k, int w, int h)
     // A software rasteriser spends as long on the gradient's full-screen pass
     // as on a part: a flat background there (the gradient's middle tone).
     static const float k_flat[4] = {0.81f, 0.83f, 0.875f, 1};
-    if (k->software) sp_renderer_clear(k->r, k_flat, NULL);
-    else sp_renderer_clear(k->r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
+    if (k->software)
+        sp_renderer_clear(k->r, k_flat, NULL);
+    else
+        sp_renderer_clear(k->r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
     if (attract) {
         kiosk_attract_draw_scene(k);
     } else {
@@ -320,13 +327,14 @@ void kiosk_draw_frame(sp_kiosk* k, int w, int h)
             float lw = ui->line_px;
             double fade = sp_kiosk_ui_fade(ui);
             if (fade > 0)
-                draw_line(k, &ui->fade_stroke, lw, (const float[4]){SP_COLOR_STROKE[0], SP_COLOR_STROKE[1], SP_COLOR_STROKE[2], (float)fade});
+                draw_line(k, &ui->fade_stroke, lw,
+                          (const float[4]){SP_COLOR_STROKE[0], SP_COLOR_STROKE[1], SP_COLOR_STROKE[2], (float)fade});
             for (int i = 0; i < ui->pending_count; ++i)
                 draw_line(k, &ui->pending[(ui->pending_head + i) % SP_KIOSK_PENDING_MAX], lw, SP_COLOR_STROKE);
             if (sp_kiosk_ui_flashing(ui)) {
                 draw_line(k, &ui->flash_stroke, lw, SP_COLOR_STROKE);
-                draw_outline(k, ui->flash_outline.xy, ui->flash_outline.count, ui->flash_breaks, ui->flash_break_count, 0.75f * lw,
-                             SP_COLOR_ABSTRACTION);
+                draw_outline(k, ui->flash_outline.xy, ui->flash_outline.count, ui->flash_breaks, ui->flash_break_count,
+                             0.75f * lw, SP_COLOR_ABSTRACTION);
             }
             if (ui->capture == SP_KCAP_STROKE) draw_line(k, &ui->stroke, lw, SP_COLOR_STROKE);
         }

@@ -36,7 +36,7 @@ typedef struct demo_part {
     char category[SP_NAME_MAX];
     sp_vec2* xy; // canvas pixels
     int n;
-    int part;    // index in the demo dragon, -1 until fitted (or when it failed)
+    int part; // index in the demo dragon, -1 until fitted (or when it failed)
     bool tried;
     float* outline; // canvas pixels at the fit (outline_n by 2), with curve breaks
     int outline_n, outline_cap, breaks[16], break_n;
@@ -59,8 +59,8 @@ struct sp_kiosk {
     mesh_cache meshes;
     part_guesses* guesses;
     int guess_count, guess_cap;
-    uint64_t rev;         // grows with every change of the dragon
-    uint64_t posed_rev;   // rev and time of the last pose_at
+    uint64_t rev;       // grows with every change of the dragon
+    uint64_t posed_rev; // rev and time of the last pose_at
     double posed_t;
     bool posed;
     // The attract screen's demo dragon.
@@ -69,8 +69,8 @@ struct sp_kiosk {
     demo_part demo_parts[DEMO_MAX];
     int demo_count;
     bool demo_prepared;
-    int updates;          // sp_kiosk_update calls (the demo waits for the first frame)
-    bool software;        // a software rasteriser (llvmpipe): cheaper background, coarser meshes
+    int updates;   // sp_kiosk_update calls (the demo waits for the first frame)
+    bool software; // a software rasteriser (llvmpipe): cheaper background, coarser meshes
     double demo_posed_t;
     int demo_posed_parts;
     // Bookkeeping.

@@ -77,7 +77,8 @@ static int map_triangles(const uint32_t* tris, int nt, const int* cluster, table
     table_clear(t);
     int m = 0;
     for (int i = 0; i < nt; ++i) {
-        uint32_t a = (uint32_t)cluster[tris[3 * i]], b = (uint32_t)cluster[tris[3 * i + 1]], c = (uint32_t)cluster[tris[3 * i + 2]];
+        uint32_t a = (uint32_t)cluster[tris[3 * i]], b = (uint32_t)cluster[tris[3 * i + 1]],
+                 c = (uint32_t)cluster[tris[3 * i + 2]];
         if (a == b || b == c || a == c) continue;
         uint32_t s[3] = {a, b, c}, tmp;
         if (s[0] > s[1]) tmp = s[0], s[0] = s[1], s[1] = tmp;
@@ -135,8 +136,10 @@ sp_result sp_lod_build(const double* xyz, int nv, const uint32_t* tris, int nt, 
         for (int it = 0; it < 14; ++it) {
             double mid = sqrt(a * b);
             cluster_grid(xyz, nv, lo, mid, &t, out->cluster);
-            if (map_triangles(tris, nt, out->cluster, &tt, NULL) > max_tris) a = mid;
-            else b = mid;
+            if (map_triangles(tris, nt, out->cluster, &tt, NULL) > max_tris)
+                a = mid;
+            else
+                b = mid;
         }
         nc = cluster_grid(xyz, nv, lo, b, &t, out->cluster);
     }

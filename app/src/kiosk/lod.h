@@ -27,8 +27,8 @@ typedef struct sp_lod {
     int* cluster;      ///< vertex_count: the cluster of each source vertex
     float* inv_size;   ///< cluster_count: 1 / members
     int tri_count;
-    uint32_t* tris;    ///< tri_count by 3, cluster indices
-    float* colors;     ///< cluster_count by 4 (mean of the members'), or NULL
+    uint32_t* tris; ///< tri_count by 3, cluster indices
+    float* colors;  ///< cluster_count by 4 (mean of the members'), or NULL
 } sp_lod;
 
 /// Clusters a mesh (xyz: nv by 3; tris: nt by 3; colors: nv by 4 or NULL)

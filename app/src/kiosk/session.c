@@ -54,7 +54,8 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
 {
     if (!cJSON_IsObject(e)) return sp_fail(err, SP_ERR_PARSE, "%s: events[%d] is not an object", name, i);
     double t;
-    if (!num(e, "t", &t) || t < 0) return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: \"t\" must be a number >= 0 (ms)", name, i);
+    if (!num(e, "t", &t) || t < 0)
+        return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: \"t\" must be a number >= 0 (ms)", name, i);
     if (t < *last_t)
         return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: t = %g goes back in time (previous %g)", name, i, t, *last_t);
     *last_t = t;
@@ -74,7 +75,8 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
         {
             const cJSON* x = cJSON_GetArrayItem(p, 0);
             const cJSON* y = cJSON_GetArrayItem(p, 1);
-            if (!cJSON_IsArray(p) || !cJSON_IsNumber(x) || !cJSON_IsNumber(y) || !isfinite(x->valuedouble) || !isfinite(y->valuedouble))
+            if (!cJSON_IsArray(p) || !cJSON_IsNumber(x) || !cJSON_IsNumber(y) || !isfinite(x->valuedouble) ||
+                !isfinite(y->valuedouble))
                 return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: points[%d] is not [x, y] with finite numbers", name, i, k);
             sp_kiosk_event ev = {k == 0 ? SP_KEV_DOWN : SP_KEV_MOVE, t + dt * k, (float)x->valuedouble, (float)y->valuedouble, 0};
             sp_result r = add(s, &ev, name, i, err);
@@ -94,7 +96,8 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
         size_t n = strlen(v);
         bool ok = n >= 1 && n <= 32;
         for (size_t k = 0; ok && k < n; ++k)
-            ok = (v[k] >= 'a' && v[k] <= 'z') || (v[k] >= 'A' && v[k] <= 'Z') || (v[k] >= '0' && v[k] <= '9') || v[k] == '_' || v[k] == '-';
+            ok = (v[k] >= 'a' && v[k] <= 'z') || (v[k] >= 'A' && v[k] <= 'Z') || (v[k] >= '0' && v[k] <= '9') || v[k] == '_' ||
+                 v[k] == '-';
         if (!ok) return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: a mark needs \"name\": 1-32 of A-Z a-z 0-9 _ -", name, i);
         if (s->mark_count >= 1000) return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: more than 1000 marks", name, i);
         sp_kiosk_mark* m = realloc(s->marks, sizeof *m * (size_t)(s->mark_count + 1));
@@ -123,7 +126,8 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
         sp_kiosk_target k = cJSON_IsString(tg) ? sp_kiosk_target_parse(tg->valuestring) : SP_KT_NONE;
         if (k == SP_KT_NONE)
             return sp_fail(err, SP_ERR_INVALID,
-                           "%s: events[%d]: \"press\" needs \"target\": one of undo, redraw, start_over, play, turn, save, label, guess1, guess2",
+                           "%s: events[%d]: \"press\" needs \"target\": one of undo, redraw, start_over, play, turn, save, "
+                           "label, guess1, guess2",
                            name, i);
         ev.button = k;
         break;
@@ -132,7 +136,8 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
     case SP_KEV_FRAME:
         break;
     default:
-        return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: unknown type \"%.40s\" (down, move, up, cancel, press, stroke, mark, frame)", name, i,
+        return sp_fail(err, SP_ERR_INVALID,
+                       "%s: events[%d]: unknown type \"%.40s\" (down, move, up, cancel, press, stroke, mark, frame)", name, i,
                        tname);
     }
     return add(s, &ev, name, i, err);
@@ -159,20 +164,22 @@ sp_result sp_kiosk_session_parse(const char* text, size_t len, const char* name,
     if (canvas) {
         const cJSON* w = cJSON_GetArrayItem(canvas, 0);
         const cJSON* h = cJSON_GetArrayItem(canvas, 1);
-        if (!cJSON_IsArray(canvas) || !cJSON_IsNumber(w) || !cJSON_IsNumber(h) || !(w->valuedouble >= 1 && w->valuedouble <= 65536) ||
-            !(h->valuedouble >= 1 && h->valuedouble <= 65536)) {
+        if (!cJSON_IsArray(canvas) || !cJSON_IsNumber(w) || !cJSON_IsNumber(h) ||
+            !(w->valuedouble >= 1 && w->valuedouble <= 65536) || !(h->valuedouble >= 1 && h->valuedouble <= 65536)) {
             r = sp_fail(err, SP_ERR_INVALID, "%s: \"canvas\" must be [width, height] in pixels (1..65536)", name);
             goto done;
         }
         s.canvas_w = (int)w->valuedouble, s.canvas_h = (int)h->valuedouble;
     }
-    if (cJSON_GetObjectItemCaseSensitive(root, "px_per_mm") && (!num(root, "px_per_mm", &s.px_per_mm) || s.px_per_mm < 0 || s.px_per_mm > 1000)) {
+    if (cJSON_GetObjectItemCaseSensitive(root, "px_per_mm") &&
+        (!num(root, "px_per_mm", &s.px_per_mm) || s.px_per_mm < 0 || s.px_per_mm > 1000)) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: \"px_per_mm\" must be a number in [0, 1000]", name);
         goto done;
     }
     const cJSON* coords = cJSON_GetObjectItemCaseSensitive(root, "coords");
     if (coords) {
-        if (cJSON_IsString(coords) && strcmp(coords->valuestring, "unit") == 0) s.unit_coords = true;
+        if (cJSON_IsString(coords) && strcmp(coords->valuestring, "unit") == 0)
+            s.unit_coords = true;
         else if (!cJSON_IsString(coords) || strcmp(coords->valuestring, "pixels") != 0) {
             r = sp_fail(err, SP_ERR_INVALID, "%s: \"coords\" must be \"pixels\" or \"unit\"", name);
             goto done;
@@ -200,8 +207,10 @@ sp_result sp_kiosk_session_parse(const char* text, size_t len, const char* name,
     }
 done:
     cJSON_Delete(root);
-    if (r != SP_OK) sp_kiosk_session_free(&s);
-    else *out = s;
+    if (r != SP_OK)
+        sp_kiosk_session_free(&s);
+    else
+        *out = s;
     return r;
 }
 
@@ -245,8 +254,11 @@ sp_result sp_kiosk_session_write(const char* path, const sp_kiosk_session* s, sp
     FILE* f = fopen(path, "wb");
     if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
     double end = s->end_ms;
-    fprintf(f, "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [%d, %d], \"px_per_mm\": %.6g, \"coords\": \"%s\",\n",
-            s->canvas_w > 0 ? s->canvas_w : 1, s->canvas_h > 0 ? s->canvas_h : 1, s->px_per_mm, s->unit_coords ? "unit" : "pixels");
+    fprintf(f,
+            "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [%d, %d], \"px_per_mm\": %.6g, \"coords\": "
+            "\"%s\",\n",
+            s->canvas_w > 0 ? s->canvas_w : 1, s->canvas_h > 0 ? s->canvas_h : 1, s->px_per_mm,
+            s->unit_coords ? "unit" : "pixels");
     fprintf(f, " \"events\": [");
     bool first = true;
     for (int i = 0; i < s->count; ++i) {

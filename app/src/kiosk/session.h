@@ -47,7 +47,7 @@ typedef struct sp_kiosk_session {
     int count, cap;
     sp_kiosk_event* events; ///< count events, t non-decreasing
     int mark_count;
-    sp_kiosk_mark* marks;   ///< mark_count, t non-decreasing (scripts only; never recorded)
+    sp_kiosk_mark* marks; ///< mark_count, t non-decreasing (scripts only; never recorded)
 } sp_kiosk_session;
 
 /// Parses a session document of `len` bytes; `name` is used in messages.

@@ -103,7 +103,8 @@ sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc)
     if (!ui) return NULL;
     ui->desc = with_defaults(desc);
     bool ok = line_alloc(&ui->stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->job_stroke, SP_KIOSK_STROKE_MAX, true) &&
-              line_alloc(&ui->flash_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->fade_stroke, SP_KIOSK_STROKE_MAX, true) &&
+              line_alloc(&ui->flash_stroke, SP_KIOSK_STROKE_MAX, true) &&
+              line_alloc(&ui->fade_stroke, SP_KIOSK_STROKE_MAX, true) &&
               line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
         ok = ok && line_alloc(&ui->pending[i], SP_KIOSK_STROKE_MAX, true);
@@ -396,7 +397,6 @@ static void finish_stroke(sp_kiosk_ui* ui)
     }
     int slot = (ui->pending_head + ui->pending_count++) % SP_KIOSK_PENDING_MAX;
     line_copy(&ui->pending[slot], s);
-    ui->pending_replace[slot] = ui->redraw_armed;
     j->replace = ui->redraw_armed;
     ui->redraw_armed = false;
     s->count = 0;
@@ -493,8 +493,10 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         break;
     case SP_KT_REDRAW:
         ui->redraw_armed = !ui->redraw_armed;
-        if (ui->redraw_armed) set_hint(ui, "Draw the new part: it replaces the last one");
-        else ui->hint_until = -1;
+        if (ui->redraw_armed)
+            set_hint(ui, "Draw the new part: it replaces the last one");
+        else
+            ui->hint_until = -1;
         break;
     case SP_KT_START_OVER:
         if (sp_kiosk_ui_clear_armed(ui)) {
@@ -517,8 +519,10 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     case SP_KT_TURN:
         ui->mode = ui->mode == SP_KM_TURN ? SP_KM_DRAW : SP_KM_TURN;
         ui->mode_since = ui->now;
-        if (ui->mode == SP_KM_TURN) set_hint(ui, "Drag to turn your dragon");
-        else ui->hint_until = -1;
+        if (ui->mode == SP_KM_TURN)
+            set_hint(ui, "Drag to turn your dragon");
+        else
+            ui->hint_until = -1;
         break;
     case SP_KT_SAVE:
         if (ui->code[0] && ui->saved_revision == ui->revision) {
@@ -704,7 +708,9 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
             ui->fade_until = ui->now + ui->desc.fade_ms;
             if (ui->inflight_replace) ui->redraw_armed = true; // still waiting for the replacement
         }
-        set_hint(ui, r->hint ? r->hint : refit ? "That shape did not fit there" : "Hmm, what is that? Try one big line for a head, wings or a tail");
+        set_hint(ui, r->hint ? r->hint
+                     : refit ? "That shape did not fit there"
+                             : "Hmm, what is that? Try one big line for a head, wings or a tail");
         return;
     }
     ui->part_count = r->part_count;
@@ -721,7 +727,8 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
     ui->flash_break_count = 0;
     bool thinned = r->outline_count > SP_KIOSK_OUTLINE_MAX;
     for (int i = 0; !thinned && r->outline_breaks && i < r->outline_break_count && ui->flash_break_count < 64; ++i)
-        if (r->outline_breaks[i] > 0 && r->outline_breaks[i] < ui->flash_outline.count) ui->flash_breaks[ui->flash_break_count++] = r->outline_breaks[i];
+        if (r->outline_breaks[i] > 0 && r->outline_breaks[i] < ui->flash_outline.count)
+            ui->flash_breaks[ui->flash_break_count++] = r->outline_breaks[i];
     ui->flash_until = ui->now + ui->desc.flash_ms;
     ui->fade_until = -1;
     ui->hint_until = -1;

@@ -34,15 +34,15 @@
 /// Touch targets (the order of the toolbar).
 typedef enum sp_kiosk_target {
     SP_KT_NONE = 0,
-    SP_KT_UNDO,       ///< remove the last part
-    SP_KT_REDRAW,     ///< the next stroke replaces the last part (toggles)
-    SP_KT_START_OVER, ///< two taps within clear_confirm_ms: remove every part
-    SP_KT_PLAY,       ///< play / pause the animation
-    SP_KT_TURN,       ///< orbit mode (drag turns the dragon) / back to the drawing view
-    SP_KT_SAVE,       ///< export .glb + postcard, show the code
-    SP_KT_CHIP_LABEL, ///< the last part's category (informative)
-    SP_KT_CHIP_GUESS1,///< next guess: re-fit the last stroke as this category
-    SP_KT_CHIP_GUESS2,///< the guess after that
+    SP_KT_UNDO,        ///< remove the last part
+    SP_KT_REDRAW,      ///< the next stroke replaces the last part (toggles)
+    SP_KT_START_OVER,  ///< two taps within clear_confirm_ms: remove every part
+    SP_KT_PLAY,        ///< play / pause the animation
+    SP_KT_TURN,        ///< orbit mode (drag turns the dragon) / back to the drawing view
+    SP_KT_SAVE,        ///< export .glb + postcard, show the code
+    SP_KT_CHIP_LABEL,  ///< the last part's category (informative)
+    SP_KT_CHIP_GUESS1, ///< next guess: re-fit the last stroke as this category
+    SP_KT_CHIP_GUESS2, ///< the guess after that
     SP_KT_COUNT
 } sp_kiosk_target;
 
@@ -69,17 +69,17 @@ enum {
 
 /// Zero means the default.
 typedef struct sp_kiosk_ui_desc {
-    double min_target_mm;    ///< smallest side of any touch target; 0: 15
-    double button_mm;        ///< preferred toolbar button height; 0: 18 (never below min_target_mm)
-    double idle_ms;          ///< no input for this long returns to the attract screen; 0: 90000; < 0: never
-    double countdown_ms;     ///< the last part of idle_ms, shown as a countdown; 0: 10000
-    double flash_ms;         ///< fitted outline shown over the stroke; 0: 800
-    double fade_ms;          ///< a rejected stroke fades out; 0: 1200
-    double hint_ms;          ///< hints stay this long; 0: 4000
-    double banner_ms;        ///< the save code stays this long; 0: 15000
-    double confirm_ms;       ///< Start over needs a second tap within this; 0: 3000
-    double tap_mm;           ///< a stroke whose box diagonal is smaller is a tap, not a part; 0: 4
-    bool start_playing;      ///< animation on from the start (default: paused until Play)
+    double min_target_mm; ///< smallest side of any touch target; 0: 15
+    double button_mm;     ///< preferred toolbar button height; 0: 18 (never below min_target_mm)
+    double idle_ms;       ///< no input for this long returns to the attract screen; 0: 90000; < 0: never
+    double countdown_ms;  ///< the last part of idle_ms, shown as a countdown; 0: 10000
+    double flash_ms;      ///< fitted outline shown over the stroke; 0: 800
+    double fade_ms;       ///< a rejected stroke fades out; 0: 1200
+    double hint_ms;       ///< hints stay this long; 0: 4000
+    double banner_ms;     ///< the save code stays this long; 0: 15000
+    double confirm_ms;    ///< Start over needs a second tap within this; 0: 3000
+    double tap_mm;        ///< a stroke whose box diagonal is smaller is a tap, not a part; 0: 4
+    bool start_playing;   ///< animation on from the start (default: paused until Play)
 } sp_kiosk_ui_desc;
 
 typedef struct sp_kiosk_rect {
@@ -96,35 +96,35 @@ typedef struct sp_kiosk_line {
 /// What the caller has to do next.
 typedef enum sp_kiosk_job_kind {
     SP_KJOB_NONE = 0,
-    SP_KJOB_FIT,     ///< classify + fit `stroke`; replace: it replaces the last part (Redraw)
-    SP_KJOB_REFIT,   ///< re-fit the last part's stroke as `category`
-    SP_KJOB_UNDO,    ///< remove the last part
-    SP_KJOB_CLEAR,   ///< remove every part (Start over, idle timeout)
-    SP_KJOB_SAVE,    ///< export the dragon (.glb + PNG postcard)
+    SP_KJOB_FIT,   ///< classify + fit `stroke`; replace: it replaces the last part (Redraw)
+    SP_KJOB_REFIT, ///< re-fit the last part's stroke as `category`
+    SP_KJOB_UNDO,  ///< remove the last part
+    SP_KJOB_CLEAR, ///< remove every part (Start over, idle timeout)
+    SP_KJOB_SAVE,  ///< export the dragon (.glb + PNG postcard)
 } sp_kiosk_job_kind;
 
 /// One job. Pointers stay valid until the next sp_kiosk_ui_next_job call.
 typedef struct sp_kiosk_job {
     sp_kiosk_job_kind kind;
-    bool heavy;                 ///< FIT, REFIT, SAVE: do one per frame
-    bool replace;               ///< FIT: replace the last part
-    const sp_kiosk_line* stroke;///< FIT: the stroke (pixels, with times)
+    bool heavy;                        ///< FIT, REFIT, SAVE: do one per frame
+    bool replace;                      ///< FIT: replace the last part
+    const sp_kiosk_line* stroke;       ///< FIT: the stroke (pixels, with times)
     char category[SP_KIOSK_LABEL_MAX]; ///< REFIT
-    double t_ms;                ///< when it was asked for
+    double t_ms;                       ///< when it was asked for
 } sp_kiosk_job;
 
 /// The answer to a FIT or REFIT job.
 typedef struct sp_kiosk_fit_result {
-    bool ok;                       ///< false: rejected (hint shown, stroke fades, nothing else changes)
-    const char* hint;              ///< shown when rejected (NULL: a default)
-    const char* category;          ///< the fitted part's category
-    const char* guesses[2];        ///< next two guesses (NULL or "" when none)
-    int part_count;                ///< parts after the job
-    const float* outline;          ///< outline_count by 2: the fitted abstraction in pixels (flashed in yellow)
+    bool ok;                ///< false: rejected (hint shown, stroke fades, nothing else changes)
+    const char* hint;       ///< shown when rejected (NULL: a default)
+    const char* category;   ///< the fitted part's category
+    const char* guesses[2]; ///< next two guesses (NULL or "" when none)
+    int part_count;         ///< parts after the job
+    const float* outline;   ///< outline_count by 2: the fitted abstraction in pixels (flashed in yellow)
     int outline_count;
-    const int* outline_breaks;     ///< indices where a new curve of the outline starts (may be NULL)
+    const int* outline_breaks; ///< indices where a new curve of the outline starts (may be NULL)
     int outline_break_count;
-    const float* stroke;           ///< stroke_count by 2: the stroke that was fitted (REFIT: the part's; NULL: the job's)
+    const float* stroke; ///< stroke_count by 2: the stroke that was fitted (REFIT: the part's; NULL: the job's)
     int stroke_count;
 } sp_kiosk_fit_result;
 
@@ -138,36 +138,35 @@ typedef struct sp_kiosk_part_label {
 typedef struct sp_kiosk_ui {
     sp_kiosk_ui_desc desc; ///< with defaults filled in
     // Layout (sp_kiosk_ui_resize).
-    int width, height;     ///< framebuffer pixels
+    int width, height; ///< framebuffer pixels
     double px_per_mm;
-    sp_kiosk_rect canvas;  ///< where strokes start (the window minus the toolbar)
+    sp_kiosk_rect canvas;              ///< where strokes start (the window minus the toolbar)
     sp_kiosk_rect target[SP_KT_COUNT]; ///< drawn rectangles (w = 0: not shown)
-    sp_kiosk_rect hint_box;           ///< where hints and the save code go
-    float text_px;         ///< body text height
-    float big_text_px;     ///< titles, the countdown
-    float line_px;         ///< stroke width
+    sp_kiosk_rect hint_box;            ///< where hints and the save code go
+    float text_px;                     ///< body text height
+    float big_text_px;                 ///< titles, the countdown
+    float line_px;                     ///< stroke width
     // Time.
-    double now;            ///< t_ms of the last event
-    double last_input;     ///< t_ms of the last pointer event (idle timer)
-    double mode_since;     ///< when the current mode began
+    double now;        ///< t_ms of the last event
+    double last_input; ///< t_ms of the last pointer event (idle timer)
+    double mode_since; ///< when the current mode began
     sp_kiosk_mode mode;
     // The finger.
     enum { SP_KCAP_NONE, SP_KCAP_STROKE, SP_KCAP_TARGET, SP_KCAP_ORBIT, SP_KCAP_ATTRACT, SP_KCAP_SWALLOW } capture;
     sp_kiosk_target pressed; ///< the target under the finger (drawn pressed)
     float last_x, last_y;
-    sp_kiosk_line stroke;    ///< the stroke being drawn (blue)
-    double stroke_spacing;   ///< current thinning distance, pixels
+    sp_kiosk_line stroke;  ///< the stroke being drawn (blue)
+    double stroke_spacing; ///< current thinning distance, pixels
     // Finished strokes waiting for FIT jobs (ring).
     sp_kiosk_line pending[SP_KIOSK_PENDING_MAX];
-    bool pending_replace[SP_KIOSK_PENDING_MAX];
     int pending_head, pending_count;
-    int dropped_strokes;     ///< strokes dropped because the pipeline fell behind
+    int dropped_strokes; ///< strokes dropped because the pipeline fell behind
     // Jobs (ring).
     sp_kiosk_job jobs[SP_KIOSK_JOBS_MAX];
     int job_head, job_count;
     int dropped_jobs;
     sp_kiosk_line job_stroke; ///< the stroke of the FIT job last handed out
-    bool fit_in_flight;      ///< a FIT/REFIT handed out and not answered yet
+    bool fit_in_flight;       ///< a FIT/REFIT handed out and not answered yet
     sp_kiosk_job_kind inflight_kind;
     bool inflight_replace;
     bool refit_queued, save_queued;
@@ -180,20 +179,20 @@ typedef struct sp_kiosk_ui {
     double fade_until;
     char hint[SP_KIOSK_TEXT_MAX];
     double hint_until;
-    char code[16];             ///< the last save code
+    char code[16]; ///< the last save code
     double banner_until;
     bool save_failed;
     // Parts as the caller reported them.
     int part_count;
     char chip[3][SP_KIOSK_LABEL_MAX]; ///< label, guess 1, guess 2 ("" = hidden)
-    uint64_t revision;       ///< grows with every change of the dragon
-    uint64_t saved_revision; ///< revision at the last successful save (0: never)
+    uint64_t revision;                ///< grows with every change of the dragon
+    uint64_t saved_revision;          ///< revision at the last successful save (0: never)
     bool redraw_armed;
     double clear_armed_until;
     // Animation and view.
     bool playing;
-    double anim_ms;          ///< animation clock, advances only while playing
-    double yaw, pitch;       ///< orbit, radians (0, 0: the drawing view)
+    double anim_ms;    ///< animation clock, advances only while playing
+    double yaw, pitch; ///< orbit, radians (0, 0: the drawing view)
     // Counters (tests, logs).
     int strokes_finished, taps, activations[SP_KT_COUNT], resets;
 } sp_kiosk_ui;
