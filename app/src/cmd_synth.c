@@ -181,7 +181,7 @@ int cmd_synth(int argc, char** argv)
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
         {"--seed", SP_OPT_INT, &seed, "N", "random seed (required unless --pose)", false},
         {"--pose", SP_OPT_STRING, &pose, "p.json", "draw this pose instead of a random one", false},
-        {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A", "largest change per rotation from rest, radians (default 0.785)", false},
+        {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A", "largest change per rotation from rest, radians (default 0.785; with --parts 0.4)", false},
         {"--out", SP_OPT_STRING, &out, "S.json", "stroke file to write (required unless --parts)", false},
         {"--truth", SP_OPT_STRING, &truth, "p.json", "also write the pose's parameters", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "canvas size (default: the rig's sketch view)", false},

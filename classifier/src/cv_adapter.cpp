@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <new>
 #include <vector>
 
@@ -188,4 +189,22 @@ extern "C" sp_result sp_cv_orientation_maps(const unsigned char* img, int size, 
         return SP_OK;
     }
     SP_CV_FIREWALL(err, "orientation")
+}
+
+extern "C" sp_result sp_cv_dot_rows(const float* a, int n, const float* b, int k, int dim, float* out, sp_error* err)
+{
+    try {
+        // Why one OpenCV thread: the classifier already runs one job per
+        // drawing on each of its own threads; OpenCV's pool on top of that only
+        // oversubscribed the cores (a third of training time went to the kernel).
+        static std::once_flag once;
+        std::call_once(once, [] { cv::setNumThreads(1); });
+        const cv::Mat A(n, dim, CV_32F, const_cast<float*>(a));
+        const cv::Mat B(k, dim, CV_32F, const_cast<float*>(b));
+        cv::Mat C(n, k, CV_32F, out); // written in place: gemm keeps a destination of the right size and type
+        cv::gemm(A, B, 1.0, cv::noArray(), 0.0, C, cv::GEMM_2_T);
+        if (C.data != reinterpret_cast<unsigned char*>(out)) return sp_fail(err, SP_ERR_INTERNAL, "dot products: OpenCV reallocated the output");
+        return SP_OK;
+    }
+    SP_CV_FIREWALL(err, "dot products")
 }

@@ -37,6 +37,11 @@ sp_result sp_cv_fit_raster(const unsigned char* grey, int w, int h, int size, in
 /// maps: 4 planes of (size/down)^2 floats, plane-major.
 sp_result sp_cv_orientation_maps(const unsigned char* img, int size, int down, double sigma, float* maps, sp_error* err);
 
+/// Dot products of every row of `a` (n by dim) with every row of `b` (k by dim):
+/// out is n by k, row-major (OpenCV's gemm: several times faster than a
+/// hand-vectorised scan on this machine, 1.3 vs 9 ms for 784 x 500 x 64).
+sp_result sp_cv_dot_rows(const float* a, int n, const float* b, int k, int dim, float* out, sp_error* err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,6 +1,8 @@
 // kmeans.c: k-means++ seeding and Lloyd iterations; nearest centres through FLANN.
 #include "kmeans.h"
 
+#include "cv_adapter.h"
+
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdbool.h>
@@ -197,8 +199,61 @@ done:
 
 typedef float v4f __attribute__((vector_size(16)));
 
+// Keeps the nn smallest (d, w) in bd/bi, sorted; exact ties keep the lower index.
+static inline void keep_nearest(float d, int w, int nn, int* bi, float* bd)
+{
+    if (d >= bd[nn - 1]) return;
+    int j = nn - 1;
+    while (j > 0 && bd[j - 1] > d) {
+        bd[j] = bd[j - 1];
+        bi[j] = bi[j - 1];
+        --j;
+    }
+    bd[j] = d;
+    bi[j] = w;
+}
+
+// The same through dot products in blocks of rows (OpenCV's gemm); false when
+// the scratch or the adapter fails (the caller falls back to the scan).
+static bool nearest_words_gemm(const float* words, const float* wnorm, int K, const float* x, int n, int nn, int* idx, float* d2)
+{
+    int rows = (1 << 20) / (K > 0 ? K : 1); // about 4 MB of scratch
+    if (rows < 1) rows = 1;
+    if (rows > 256) rows = 256;
+    float* dots = malloc(sizeof(float) * (size_t)rows * (size_t)K);
+    if (!dots) return false;
+    for (int b = 0; b < n; b += rows) {
+        int m = n - b < rows ? n - b : rows;
+        sp_error e = {0};
+        if (sp_cv_dot_rows(x + (size_t)b * 64, m, words, K, 64, dots, &e) != SP_OK) {
+            free(dots);
+            return false;
+        }
+        for (int i = 0; i < m; ++i) {
+            const float* q = x + (size_t)(b + i) * 64;
+            float qn = 0.0f;
+            for (int d = 0; d < 64; ++d)
+                qn += q[d] * q[d];
+            int* bi = idx + (size_t)(b + i) * nn;
+            float* bd = d2 + (size_t)(b + i) * nn;
+            for (int j = 0; j < nn; ++j) {
+                bi[j] = -1;
+                bd[j] = 3.4e38f;
+            }
+            const float* row = dots + (size_t)i * K;
+            for (int w = 0; w < K; ++w) {
+                float d = qn + wnorm[w] - 2.0f * row[w];
+                keep_nearest(d < 0.0f ? 0.0f : d, w, nn, bi, bd);
+            }
+        }
+    }
+    free(dots);
+    return true;
+}
+
 void sp_nearest_words(const float* words, const float* wnorm, int K, const float* x, int n, int nn, int* idx, float* d2)
 {
+    if (n > 0 && nearest_words_gemm(words, wnorm, K, x, n, nn, idx, d2)) return;
     for (int i = 0; i < n; ++i) {
         const float* q = x + (size_t)i * 64;
         v4f qv[16];
@@ -226,16 +281,7 @@ void sp_nearest_words(const float* words, const float* wnorm, int K, const float
             }
             v4f s = a0 + a1 + a2 + a3;
             float d = qn + wnorm[w] - 2.0f * (s[0] + s[1] + s[2] + s[3]);
-            if (d < 0.0f) d = 0.0f;
-            if (d >= bd[nn - 1]) continue;
-            int j = nn - 1;
-            while (j > 0 && bd[j - 1] > d) {
-                bd[j] = bd[j - 1];
-                bi[j] = bi[j - 1];
-                --j;
-            }
-            bd[j] = d;
-            bi[j] = w;
+            keep_nearest(d < 0.0f ? 0.0f : d, w, nn, bi, bd);
         }
     }
 }

@@ -63,7 +63,8 @@ sp_handdraw_params sp_handdraw_preset(sp_handdraw_style s)
                                     .scale_max = 1.2,
                                     .shift = 0.1};
     case SP_HANDDRAW_CLEAN:
-        return (sp_handdraw_params){.aspect = 1, .wobble_waves = 1, .spacing_min = 0.01, .spacing_max = 0.01, .scale_min = 1, .scale_max = 1};
+        return (sp_handdraw_params){
+            .aspect = 1, .wobble_waves = 1, .spacing_min = 0.01, .spacing_max = 0.01, .scale_min = 1, .scale_max = 1};
     case SP_HANDDRAW_NORMAL:
     default:
         return (sp_handdraw_params){.rotation_deg = 15,
@@ -182,8 +183,10 @@ static void smooth(const sp_vec2* in, int m, bool closed, double sigma, sp_vec2*
         double sx = 0, sy = 0, sw = 0;
         for (int k = -r; k <= r; ++k) {
             int j = i + k;
-            if (closed) j = ((j % m) + m) % m;
-            else if (j < 0 || j >= m) continue; // truncated and renormalised: the ends round off too
+            if (closed)
+                j = ((j % m) + m) % m;
+            else if (j < 0 || j >= m)
+                continue; // truncated and renormalised: the ends round off too
             double w = exp(-0.5 * k * k / (sigma * sigma));
             sx += w * in[j].x;
             sy += w * in[j].y;
@@ -225,8 +228,8 @@ static double wave_at(const wave3* w, double x)
 typedef struct draw_ctx {
     const sp_handdraw_params* hp;
     sp_rng* rng;
-    double D;      // clean drawing's bbox diagonal
-    double t;      // pen clock, ms
+    double D; // clean drawing's bbox diagonal
+    double t; // pen clock, ms
     sp_sketch* out;
     sp_handdraw_info* info;
 } draw_ctx;
@@ -264,14 +267,19 @@ static sp_result draw_curve(draw_ctx* c, const sp_vec2* pts, int n, bool closed)
     if (closed) {
         s0 = hp->random_start ? sp_rng_range(rng, 0, L) : 0.0;
         double closure;
-        if (partial) closure = -q;
-        else if (sp_rng_uniform(rng) < hp->gap_probability) closure = -sp_rng_uniform(rng) * hp->gap;
-        else closure = sp_rng_uniform(rng) * hp->overshoot;
+        if (partial)
+            closure = -q;
+        else if (sp_rng_uniform(rng) < hp->gap_probability)
+            closure = -sp_rng_uniform(rng) * hp->gap;
+        else
+            closure = sp_rng_uniform(rng) * hp->overshoot;
         total = L * (1 + closure);
         covered = fmin(1.0, 1 + closure);
         c->info->closed_curves++;
-        if (closure < 0) c->info->gaps++;
-        else if (closure > 0) c->info->overshoots++;
+        if (closure < 0)
+            c->info->gaps++;
+        else if (closure > 0)
+            c->info->overshoots++;
         c->info->closure_min = fmin(c->info->closure_min, closure);
         c->info->closure_max = fmax(c->info->closure_max, closure);
     } else {
@@ -361,7 +369,8 @@ static sp_result draw_curve(draw_ctx* c, const sp_vec2* pts, int n, bool closed)
     int pieces = 1, cut[3] = {0, pen.n, pen.n};
     if (pen.n >= 12 && sp_rng_uniform(rng) < hp->split_probability) {
         pieces = sp_rng_uniform(rng) < 0.7 ? 2 : 3;
-        if (pieces == 2) cut[1] = (int)(pen.n * sp_rng_range(rng, 0.3, 0.7));
+        if (pieces == 2)
+            cut[1] = (int)(pen.n * sp_rng_range(rng, 0.3, 0.7));
         else {
             cut[1] = (int)(pen.n * sp_rng_range(rng, 0.2, 0.4));
             cut[2] = (int)(pen.n * sp_rng_range(rng, 0.6, 0.8));
@@ -404,8 +413,8 @@ done:
     return r;
 }
 
-sp_result sp_handdraw_apply(const sp_sketch* clean, const sp_handdraw_params* hp, uint64_t seed, sp_sketch* out, sp_handdraw_info* info,
-                            sp_error* err)
+sp_result sp_handdraw_apply(const sp_sketch* clean, const sp_handdraw_params* hp, uint64_t seed, sp_sketch* out,
+                            sp_handdraw_info* info, sp_error* err)
 {
     memset(out, 0, sizeof *out);
     sp_handdraw_info dummy;
@@ -415,7 +424,8 @@ sp_result sp_handdraw_apply(const sp_sketch* clean, const sp_handdraw_params* hp
     info->closure_max = -INFINITY;
     info->covered_min = 1.0;
     if (!sp_handdraw_params_valid(hp)) return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: a parameter is out of range");
-    if (!sp_sketch_is_valid(clean)) return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: the sketch has non-finite coordinates");
+    if (!sp_sketch_is_valid(clean))
+        return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: the sketch has non-finite coordinates");
     sp_vec2 lo, hi;
     if (!sp_sketch_bounds(clean, &lo, &hi)) return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: the sketch is empty");
     const double D = hypot(hi.x - lo.x, hi.y - lo.y);
@@ -507,7 +517,8 @@ sp_result sp_handdraw_part(const sp_rig* rig, int abstraction, const sp_camera* 
     sp_handdraw_desc d = desc ? *desc : (sp_handdraw_desc){0};
     if (abstraction < 0 || abstraction >= rig->abstraction_count)
         return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: no abstraction %d", abstraction);
-    if (d.style < 0 || d.style >= SP_HANDDRAW_STYLE_COUNT) return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: unknown style");
+    if (d.style < 0 || d.style >= SP_HANDDRAW_STYLE_COUNT)
+        return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: unknown style");
     sp_handdraw_params hp = d.params ? *d.params : sp_handdraw_preset(d.style);
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count > 0 ? rig->param_count : 1));
     if (!p) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
@@ -515,21 +526,24 @@ sp_result sp_handdraw_part(const sp_rig* rig, int abstraction, const sp_camera* 
     sp_sketch clean = {0};
     sp_result r = sp_synth_sketch(rig, abstraction, cam, p, &clean);
     free(p);
-    if (r != SP_OK) return sp_fail(err, r, "hand-drawing model: cannot project abstraction '%s' (%s)", rig->abstractions[abstraction].name,
-                                   sp_result_name(r));
+    if (r != SP_OK)
+        return sp_fail(err, r, "hand-drawing model: cannot project abstraction '%s' (%s)", rig->abstractions[abstraction].name,
+                       sp_result_name(r));
     // The perturbation's stream is independent of the pose's.
     r = sp_handdraw_apply(&clean, &hp, seed * 0xC2B2AE3D27D4EB4Full + 0x165667B19E3779F9ull, out, info, err);
     sp_sketch_free(&clean);
     return r;
 }
 
-sp_result sp_handdraw_dataset(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_handdraw_desc* desc, uint64_t family,
-                              int n, int label, int first_index, sp_dataset* ds, sp_error* err)
+sp_result sp_handdraw_dataset(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_handdraw_desc* desc,
+                              uint64_t family, int n, int label, int first_index, sp_dataset* ds, sp_error* err)
 {
     if (n <= 0) return SP_OK;
-    if (label < -1 || label >= ds->category_count) return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: label %d out of range", label);
+    if (label < -1 || label >= ds->category_count)
+        return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: label %d out of range", label);
     double share = desc ? desc->clean_share : 0.0;
-    if (!(share >= 0.0 && share <= 1.0)) return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: clean share %g is not in [0, 1]", share);
+    if (!(share >= 0.0 && share <= 1.0))
+        return sp_fail(err, SP_ERR_INVALID, "hand-drawing model: clean share %g is not in [0, 1]", share);
     sp_handdraw_desc clean = desc ? *desc : (sp_handdraw_desc){0};
     clean.params = NULL;
     clean.style = SP_HANDDRAW_CLEAN;
@@ -540,7 +554,8 @@ sp_result sp_handdraw_dataset(const sp_rig* rig, int abstraction, const sp_camer
         sp_sample* s = &ds->samples[ds->count + i];
         memset(s, 0, sizeof *s);
         bool is_clean = floor((i + 1) * share) > floor(i * share);
-        sp_result r = sp_handdraw_part(rig, abstraction, cam, is_clean ? &clean : desc, sp_handdraw_seed(family, i), &s->sketch, NULL, err);
+        sp_result r =
+            sp_handdraw_part(rig, abstraction, cam, is_clean ? &clean : desc, sp_handdraw_seed(family, i), &s->sketch, NULL, err);
         if (r != SP_OK) {
             for (int j = 0; j < i; ++j)
                 sp_sketch_free(&ds->samples[ds->count + j].sketch);

@@ -33,9 +33,12 @@ static void on_progress(void* user, const char* stage, int done, int total)
 {
     stages* s = user;
     double t = now_ms() - s->t0;
-    if (!strcmp(stage, "descriptors") && done == total) s->descriptors = t;
-    else if (!strcmp(stage, "vocabulary") && done == total) s->vocabulary = t;
-    else if (!strcmp(stage, "histograms") && done == total) s->histograms = t;
+    if (!strcmp(stage, "descriptors") && done == total)
+        s->descriptors = t;
+    else if (!strcmp(stage, "vocabulary") && done == total)
+        s->vocabulary = t;
+    else if (!strcmp(stage, "histograms") && done == total)
+        s->histograms = t;
 }
 
 int main(int argc, char** argv)
@@ -43,10 +46,14 @@ int main(int argc, char** argv)
     bool json = false, no_mirror_row = true;
     int threads = 2, copies = 3;
     for (int i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--json")) json = true;
-        else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--copies") && i + 1 < argc) copies = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--no-mirror-row")) no_mirror_row = false;
+        if (!strcmp(argv[i], "--json"))
+            json = true;
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
+            threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--copies") && i + 1 < argc)
+            copies = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--no-mirror-row"))
+            no_mirror_row = false;
         else {
             fprintf(stderr, "usage: bench_classifier_train [--json] [--threads T] [--copies N] [--no-mirror-row]\n");
             return 2;
@@ -82,7 +89,8 @@ int main(int argc, char** argv)
         for (int i = 0; i < orig; ++i) {
             sp_sample* s = &ds.samples[ds.count];
             memset(s, 0, sizeof *s);
-            if (sp_handdraw_apply(&ds.samples[i].sketch, &hp, sp_handdraw_seed((uint64_t)k + 1, i), &s->sketch, NULL, &err) != SP_OK) {
+            if (sp_handdraw_apply(&ds.samples[i].sketch, &hp, sp_handdraw_seed((uint64_t)k + 1, i), &s->sketch, NULL, &err) !=
+                SP_OK) {
                 fprintf(stderr, "bench_classifier_train: drawing %d: %s\n", i, err.text);
                 return 1;
             }
@@ -115,21 +123,23 @@ int main(int argc, char** argv)
         printf("[");
         for (int r = 0; r < nr; ++r) {
             const stages* s = &rows[r].st;
-            printf("%s\n {\"case\": \"%s\", \"ms_median\": %.1f, \"ms_p90\": %.1f, \"runs\": 1, \"target_ms\": 120000, \"drawings\": %d, "
-                   "\"threads\": %d, \"descriptors_ms\": %.1f, \"vocabulary_ms\": %.1f, \"histograms_ms\": %.1f, \"reject_calibration_ms\": %.1f}",
-                   r ? "," : "", rows[r].name, rows[r].ms, rows[r].ms, ds.count, threads, s->descriptors, s->vocabulary - s->descriptors,
-                   s->histograms - s->vocabulary, rows[r].ms - s->histograms);
+            printf("%s\n {\"case\": \"%s\", \"ms_median\": %.1f, \"ms_p90\": %.1f, \"runs\": 1, \"target_ms\": 120000, "
+                   "\"drawings\": %d, "
+                   "\"threads\": %d, \"descriptors_ms\": %.1f, \"vocabulary_ms\": %.1f, \"histograms_ms\": %.1f, "
+                   "\"reject_calibration_ms\": %.1f}",
+                   r ? "," : "", rows[r].name, rows[r].ms, rows[r].ms, ds.count, threads, s->descriptors,
+                   s->vocabulary - s->descriptors, s->histograms - s->vocabulary, rows[r].ms - s->histograms);
         }
         printf("\n]\n");
     } else {
-        printf("%d drawings (%d Quick, Draw! + %d hand-drawn variants), %d categories, %d threads\n", ds.count, orig, ds.count - orig,
-               ds.category_count, threads);
-        printf("%-36s %10s %12s %12s %12s %12s %10s\n", "case", "total ms", "descriptors", "vocabulary", "histograms", "leave-1-out",
-               "target ms");
+        printf("%d drawings (%d Quick, Draw! + %d hand-drawn variants), %d categories, %d threads\n", ds.count, orig,
+               ds.count - orig, ds.category_count, threads);
+        printf("%-36s %10s %12s %12s %12s %12s %10s\n", "case", "total ms", "descriptors", "vocabulary", "histograms",
+               "leave-1-out", "target ms");
         for (int r = 0; r < nr; ++r) {
             const stages* s = &rows[r].st;
-            printf("%-36s %10.0f %12.0f %12.0f %12.0f %12.0f %10d\n", rows[r].name, rows[r].ms, s->descriptors, s->vocabulary - s->descriptors,
-                   s->histograms - s->vocabulary, rows[r].ms - s->histograms, 120000);
+            printf("%-36s %10.0f %12.0f %12.0f %12.0f %12.0f %10d\n", rows[r].name, rows[r].ms, s->descriptors,
+                   s->vocabulary - s->descriptors, s->histograms - s->vocabulary, rows[r].ms - s->histograms, 120000);
         }
     }
     sp_dataset_free(&ds);

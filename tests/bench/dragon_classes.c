@@ -74,15 +74,24 @@ int main(int argc, char** argv)
     bool json = false, sweep = false;
     int ntrain = 300, ntest = 100, ncal = 100, nscrib = 25, words = 1000;
     for (int i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--json")) json = true;
-        else if (!strcmp(argv[i], "--sweep")) sweep = true;
-        else if (!strcmp(argv[i], "--train") && i + 1 < argc) ntrain = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--test") && i + 1 < argc) ntest = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--cal") && i + 1 < argc) ncal = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--scribbles") && i + 1 < argc) nscrib = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--words") && i + 1 < argc) words = atoi(argv[++i]);
+        if (!strcmp(argv[i], "--json"))
+            json = true;
+        else if (!strcmp(argv[i], "--sweep"))
+            sweep = true;
+        else if (!strcmp(argv[i], "--train") && i + 1 < argc)
+            ntrain = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--test") && i + 1 < argc)
+            ntest = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--cal") && i + 1 < argc)
+            ncal = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--scribbles") && i + 1 < argc)
+            nscrib = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--words") && i + 1 < argc)
+            words = atoi(argv[++i]);
         else {
-            fprintf(stderr, "usage: bench_dragon_classes [--json] [--train N] [--test N] [--cal N] [--scribbles N] [--words W] [--sweep]\n");
+            fprintf(
+                stderr,
+                "usage: bench_dragon_classes [--json] [--train N] [--test N] [--cal N] [--scribbles N] [--words W] [--sweep]\n");
             return 2;
         }
     }
@@ -95,7 +104,8 @@ int main(int argc, char** argv)
     sp_error err = {0};
     sp_dataset train, test, cal, scrib = {0};
     double t0 = now_ms();
-    if (dragon_set(parts, ntrain, 1, &(sp_handdraw_desc){.style = SP_HANDDRAW_NORMAL, .clean_share = 0.25}, &train, &err) != SP_OK ||
+    if (dragon_set(parts, ntrain, 1, &(sp_handdraw_desc){.style = SP_HANDDRAW_NORMAL, .clean_share = 0.25}, &train, &err) !=
+            SP_OK ||
         dragon_set(parts, ntest, 2, &(sp_handdraw_desc){.style = SP_HANDDRAW_HARSH}, &test, &err) != SP_OK ||
         dragon_set(parts, ncal, 3, &(sp_handdraw_desc){.style = SP_HANDDRAW_HARSH}, &cal, &err) != SP_OK) {
         fprintf(stderr, "bench_dragon_classes: %s\n", err.text);
@@ -104,9 +114,11 @@ int main(int argc, char** argv)
     double gen_ms = now_ms() - t0;
     if (nscrib > 0 && dragon_scribbles(sp_test_data_dir(), nscrib, &scrib, &err) != SP_OK)
         fprintf(stderr, "bench_dragon_classes: no scribbles (%s)\n", err.text);
-    fprintf(stderr, "parts: %s; %d training (normal, 1/4 clean, family 1), %d held-out (harsh, family 2), %d calibration (harsh, family 3), "
-                    "%d scribbles; generated in %.0f ms\n",
-            assets ? "assets/*.glb" : "stand-ins (assets/ incomplete)", train.count, test.count, cal.count, scrib.count, gen_ms);
+    fprintf(
+        stderr,
+        "parts: %s; %d training (normal, 1/4 clean, family 1), %d held-out (harsh, family 2), %d calibration (harsh, family 3), "
+        "%d scribbles; generated in %.0f ms\n",
+        assets ? "assets/*.glb" : "stand-ins (assets/ incomplete)", train.count, test.count, cal.count, scrib.count, gen_ms);
 
     variant vs[32];
     int nv = 0;
@@ -126,10 +138,11 @@ int main(int argc, char** argv)
     }
     static const double qs[] = {0, 0.95, 0.96, 0.97, 0.98, 0.99}; // 0: the training set's threshold
     int rows = 0;
-    if (json) printf("[");
+    if (json)
+        printf("[");
     else
-        printf("%-18s %-12s %7s %7s %9s %9s %9s %10s %8s %8s\n", "variant", "threshold", "top1", "top3", "dragon", "scribbles", "reject", "train ms",
-               "ms med", "ms p90");
+        printf("%-18s %-12s %7s %7s %9s %9s %9s %10s %8s %8s\n", "variant", "threshold", "top1", "top3", "dragon", "scribbles",
+               "reject", "train ms", "ms med", "ms p90");
     for (int v = 0; v < nv; ++v) {
         sp_clf* clf = NULL;
         double a0 = now_ms();
@@ -169,20 +182,24 @@ int main(int argc, char** argv)
             for (int i = 0; i < scrib.count; ++i)
                 sr += !(as[i].distance <= thr);
             char tname[32];
-            if (qs[k] > 0) snprintf(tname, sizeof tname, "cal q%.2f", qs[k]);
-            else snprintf(tname, sizeof tname, "train LOO q%.2f", sp_clf_get_desc(clf).reject_quantile);
+            if (qs[k] > 0)
+                snprintf(tname, sizeof tname, "cal q%.2f", qs[k]);
+            else
+                snprintf(tname, sizeof tname, "train LOO q%.2f", sp_clf_get_desc(clf).reject_quantile);
             double top1 = (double)right / test.count, t3 = (double)top3 / test.count, frr = (double)fr / test.count;
             double srr = scrib.count ? (double)sr / scrib.count : 0.0;
             if (json) {
-                printf("%s\n {\"case\": \"dragon parts: %s, %s\", \"ms_median\": %.3f, \"ms_p90\": %.3f, \"runs\": %d, \"top1\": %.4f, "
-                       "\"top3\": %.4f, \"dragon_rejected\": %.4f, \"scribbles_rejected\": %.4f, \"reject_distance\": %.4f, \"train_ms\": %.0f, "
+                printf("%s\n {\"case\": \"dragon parts: %s, %s\", \"ms_median\": %.3f, \"ms_p90\": %.3f, \"runs\": %d, \"top1\": "
+                       "%.4f, "
+                       "\"top3\": %.4f, \"dragon_rejected\": %.4f, \"scribbles_rejected\": %.4f, \"reject_distance\": %.4f, "
+                       "\"train_ms\": %.0f, "
                        "\"train\": %d, \"n\": %d, \"scribbles\": %d, \"assets\": %s, \"target_top1\": 0.97, "
                        "\"target_scribbles_rejected\": 0.8, \"target_dragon_rejected\": 0.03}",
-                       rows++ ? "," : "", vs[v].name, tname, med, p90, test.count, top1, t3, frr, srr, thr, train_ms, train.count, test.count,
-                       scrib.count, assets ? "true" : "false");
+                       rows++ ? "," : "", vs[v].name, tname, med, p90, test.count, top1, t3, frr, srr, thr, train_ms, train.count,
+                       test.count, scrib.count, assets ? "true" : "false");
             } else {
-                printf("%-18s %-12s %6.1f%% %6.1f%% %8.1f%% %8.1f%% %9.4f %10.0f %8.2f %8.2f\n", vs[v].name, tname, 100 * top1, 100 * t3,
-                       100 * frr, 100 * srr, thr, train_ms, med, p90);
+                printf("%-18s %-12s %6.1f%% %6.1f%% %8.1f%% %8.1f%% %9.4f %10.0f %8.2f %8.2f\n", vs[v].name, tname, 100 * top1,
+                       100 * t3, 100 * frr, 100 * srr, thr, train_ms, med, p90);
             }
         }
         if (v == 0 && !json) {

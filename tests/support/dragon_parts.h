@@ -28,19 +28,19 @@
 #define DRAGON_PART_COUNT 6
 
 // Benchmarks use this header too, where ENSURE has nowhere to jump: fail loudly instead.
-#define DRAGON_CHECK(c)                                                                  \
-    do {                                                                                 \
-        if (!(c)) {                                                                      \
-            fprintf(stderr, "%s:%d: %s failed: %s\n", __FILE__, __LINE__, #c, err.text); \
-            abort();                                                                     \
-        }                                                                                \
+#define DRAGON_CHECK(c)                                                                                                          \
+    do {                                                                                                                         \
+        if (!(c)) {                                                                                                              \
+            fprintf(stderr, "%s:%d: %s failed: %s\n", __FILE__, __LINE__, #c, err.text);                                         \
+            abort();                                                                                                             \
+        }                                                                                                                        \
     } while (0)
 
 typedef struct dragon_part {
     char name[64];     ///< file stem (torso, wings, ...)
     char category[64]; ///< classifier category
     sp_character ch;
-    int abstraction;   ///< index of `outline` (else the first)
+    int abstraction; ///< index of `outline` (else the first)
 } dragon_part;
 
 static const char* const k_dragon_part_names[DRAGON_PART_COUNT] = {"front_legs", "head", "hind_legs", "tail", "torso", "wings"};
@@ -53,31 +53,39 @@ typedef struct standin_shape {
     const double (*jt)[2];
 } standin_shape;
 
-static const double k_front_legs_xy[][2] = {{-0.25, 0.1}, {0.25, 0.1},  {0.25, -0.6}, {0.1, -1.25},  {0.45, -1.35}, {0.55, -1.52},
-                                            {0.3, -1.45}, {0.35, -1.62}, {0.1, -1.5}, {0.08, -1.65}, {-0.15, -1.45}, {-0.2, -1.25},
-                                            {-0.1, -0.7}, {-0.25, -0.6}};
+static const double k_front_legs_xy[][2] = {{-0.25, 0.1},   {0.25, 0.1},   {0.25, -0.6},  {0.1, -1.25}, {0.45, -1.35},
+                                            {0.55, -1.52},  {0.3, -1.45},  {0.35, -1.62}, {0.1, -1.5},  {0.08, -1.65},
+                                            {-0.15, -1.45}, {-0.2, -1.25}, {-0.1, -0.7},  {-0.25, -0.6}};
 static const double k_front_legs_jt[][2] = {{0, 0}, {0.05, -0.65}, {-0.05, -1.3}, {0.3, -1.45}};
-static const double k_head_xy[][2] = {{-0.9, -0.3}, {-0.9, 0.3}, {-0.55, 0.45}, {-0.45, 0.95}, {-0.2, 0.5}, {0.2, 0.45}, {0.6, 0.3},
-                                      {1.1, 0.15},  {1.2, 0.0},  {1.1, -0.1},   {0.6, -0.15},  {0.9, -0.35}, {0.3, -0.45}, {-0.3, -0.45}};
+static const double k_head_xy[][2] = {{-0.9, -0.3}, {-0.9, 0.3},  {-0.55, 0.45}, {-0.45, 0.95}, {-0.2, 0.5},
+                                      {0.2, 0.45},  {0.6, 0.3},   {1.1, 0.15},   {1.2, 0.0},    {1.1, -0.1},
+                                      {0.6, -0.15}, {0.9, -0.35}, {0.3, -0.45},  {-0.3, -0.45}};
 static const double k_head_jt[][2] = {{-0.8, 0}, {0, 0}, {0.8, -0.05}};
-static const double k_hind_legs_xy[][2] = {{-0.4, 0.15}, {0.3, 0.2},  {0.55, -0.4}, {0.5, -0.7},  {0.0, -1.1},  {0.1, -1.35},
-                                           {0.45, -1.4}, {0.5, -1.55}, {0.3, -1.5}, {0.35, -1.66}, {0.1, -1.58}, {0.1, -1.72},
+static const double k_hind_legs_xy[][2] = {{-0.4, 0.15}, {0.3, 0.2},   {0.55, -0.4},  {0.5, -0.7},   {0.0, -1.1},  {0.1, -1.35},
+                                           {0.45, -1.4}, {0.5, -1.55}, {0.3, -1.5},   {0.35, -1.66}, {0.1, -1.58}, {0.1, -1.72},
                                            {-0.2, -1.5}, {-0.3, -1.1}, {0.15, -0.65}, {-0.45, -0.3}};
 static const double k_hind_legs_jt[][2] = {{0, 0}, {0.35, -0.6}, {-0.1, -1.1}, {0.2, -1.5}};
-static const double k_tail_xy[][2] = {{0, 0.25},    {0.6, 0.2},    {1.2, 0.13},  {1.8, 0.08},  {2.1, 0.05},   {2.15, 0.28}, {2.65, 0},
-                                      {2.15, -0.28}, {2.1, -0.05}, {1.8, -0.08}, {1.2, -0.13}, {0.6, -0.2},   {0, -0.25}};
+static const double k_tail_xy[][2] = {{0, 0.25},    {0.6, 0.2},  {1.2, 0.13},   {1.8, 0.08},  {2.1, 0.05},
+                                      {2.15, 0.28}, {2.65, 0},   {2.15, -0.28}, {2.1, -0.05}, {1.8, -0.08},
+                                      {1.2, -0.13}, {0.6, -0.2}, {0, -0.25}};
 static const double k_tail_jt[][2] = {{0, 0}, {0.6, 0}, {1.2, 0}, {1.8, 0}, {2.3, 0}};
-static const double k_torso_xy[][2] = {{-1.3, 0.15}, {-0.9, 0.35}, {-0.3, 0.5},  {0.3, 0.5}, {0.8, 0.4},    {1.2, 0.3},  {1.5, 0.25},
-                                       {1.5, 0.05},  {1.1, -0.15}, {0.6, -0.45}, {0, -0.55}, {-0.6, -0.45}, {-1.0, -0.2}, {-1.3, -0.05}};
+static const double k_torso_xy[][2] = {{-1.3, 0.15}, {-0.9, 0.35},  {-0.3, 0.5},  {0.3, 0.5},   {0.8, 0.4},
+                                       {1.2, 0.3},   {1.5, 0.25},   {1.5, 0.05},  {1.1, -0.15}, {0.6, -0.45},
+                                       {0, -0.55},   {-0.6, -0.45}, {-1.0, -0.2}, {-1.3, -0.05}};
 static const double k_torso_jt[][2] = {{-1.0, 0}, {0, 0}, {1.0, 0.1}};
-static const double k_wings_xy[][2] = {{0, 0},      {0.4, 0.45},  {0.8, 0.7},   {1.2, 0.95}, {1.7, 1.1},  {1.55, 0.6}, {1.8, 0.2},
-                                       {1.3, 0.25}, {1.35, -0.3}, {0.9, -0.05}, {0.7, -0.5}, {0.35, -0.1}, {0.1, -0.3}};
+static const double k_wings_xy[][2] = {{0, 0},      {0.4, 0.45},  {0.8, 0.7},  {1.2, 0.95},  {1.7, 1.1},
+                                       {1.55, 0.6}, {1.8, 0.2},   {1.3, 0.25}, {1.35, -0.3}, {0.9, -0.05},
+                                       {0.7, -0.5}, {0.35, -0.1}, {0.1, -0.3}};
 static const double k_wings_jt[][2] = {{0, 0}, {0.8, 0.6}, {1.5, 0.9}};
 
-#define STANDIN(a, b) {(int)(sizeof a / sizeof a[0]), a, (int)(sizeof b / sizeof b[0]), b}
+#define STANDIN(a, b)                                                                                                            \
+    {                                                                                                                            \
+        (int)(sizeof a / sizeof a[0]), a, (int)(sizeof b / sizeof b[0]), b                                                       \
+    }
 static const standin_shape k_standins[DRAGON_PART_COUNT] = {
-    STANDIN(k_front_legs_xy, k_front_legs_jt), STANDIN(k_head_xy, k_head_jt),   STANDIN(k_hind_legs_xy, k_hind_legs_jt),
-    STANDIN(k_tail_xy, k_tail_jt),             STANDIN(k_torso_xy, k_torso_jt), STANDIN(k_wings_xy, k_wings_jt)};
+    STANDIN(k_front_legs_xy, k_front_legs_jt), STANDIN(k_head_xy, k_head_jt),
+    STANDIN(k_hind_legs_xy, k_hind_legs_jt),   STANDIN(k_tail_xy, k_tail_jt),
+    STANDIN(k_torso_xy, k_torso_jt),           STANDIN(k_wings_xy, k_wings_jt)};
 #undef STANDIN
 
 // The bone (segment jt[b] -> jt[b+1]) nearest to p.
@@ -232,14 +240,14 @@ static inline void dragon_parts_free(dragon_part parts[DRAGON_PART_COUNT])
 /// Quick, Draw! categories used as non-dragon scribbles: objects, none of them
 /// an animal or a body part (chosen before any measurement; 8 x 25 = 200).
 #define DRAGON_SCRIBBLE_CATEGORIES 8
-static const char* const k_scribble_categories[DRAGON_SCRIBBLE_CATEGORIES] = {"house", "guitar", "key", "stop sign",
+static const char* const k_scribble_categories[DRAGON_SCRIBBLE_CATEGORIES] = {"house", "guitar", "key",      "stop sign",
                                                                               "chair", "hammer", "sailboat", "suitcase"};
 
 /// A labelled set of `per_part` hand-drawn sketches of every part; categories are
 /// the parts' (sorted, shared when parts share one). Part k uses its own family
 /// derived from `family` and its name (sp_handdraw_part_family).
-static inline sp_result dragon_set(const dragon_part parts[DRAGON_PART_COUNT], int per_part, uint64_t family, const sp_handdraw_desc* hd,
-                            sp_dataset* ds, sp_error* err)
+static inline sp_result dragon_set(const dragon_part parts[DRAGON_PART_COUNT], int per_part, uint64_t family,
+                                   const sp_handdraw_desc* hd, sp_dataset* ds, sp_error* err)
 {
     memset(ds, 0, sizeof *ds);
     const char* cats[DRAGON_PART_COUNT];
@@ -305,11 +313,11 @@ static inline sp_result dragon_scribbles(const char* data_dir, int per_category,
 }
 
 typedef struct dragon_scores {
-    int n, right, top3, rejected, failed;  ///< held-out dragon sketches
+    int n, right, top3, rejected, failed; ///< held-out dragon sketches
     int scribbles, scribbles_rejected;    ///< non-dragon drawings
     int confusion[DRAGON_PART_COUNT][DRAGON_PART_COUNT];
-    float dragon_dist_max;     ///< largest nearest distance of a dragon sketch
-    float scribble_dist_min;   ///< smallest nearest distance of a scribble
+    float dragon_dist_max;   ///< largest nearest distance of a dragon sketch
+    float scribble_dist_min; ///< smallest nearest distance of a scribble
 } dragon_scores;
 
 /// Classifies `test` (labels = clf categories by name) and `scribbles` (may be NULL).

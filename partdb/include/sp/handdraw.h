@@ -52,25 +52,25 @@ sp_handdraw_style sp_handdraw_style_parse(const char* name);
 /// The perturbation model's magnitudes. Each random quantity is drawn
 /// uniformly up to its maximum unless said otherwise; 0 switches an effect off.
 typedef struct sp_handdraw_params {
-    double rotation_deg;     ///< whole drawing rotated by up to +-this, degrees (<= 180)
-    double aspect;           ///< width:height changed by a factor in [1/aspect, aspect] (>= 1; 1 = off)
-    double shear;            ///< horizontal shear up to +-this (dx per dy)
-    double wobble;           ///< low-frequency sideways drift, largest amplitude, fraction of D
-    double wobble_waves;     ///< wobble cycles over one curve's length, at most (>= 1)
-    double tremor;           ///< high-frequency jitter (standard deviation), fraction of D
-    double corner;           ///< corner rounding: Gaussian smoothing width along the curve, fraction of D
-    double gap;              ///< closed curves: largest gap left at closure, fraction of the curve length
-    double overshoot;        ///< closed curves: largest overshoot past the start, fraction of the curve length
-    double gap_probability;  ///< closed curves: chance of ending short (a gap) rather than beyond the start
-    double miss;             ///< closed curves: sideways miss of the end point at closure, fraction of D
-    double partial_probability; ///< chance a curve is drawn only in part
-    double partial;          ///< largest share of such a curve left out
-    double split_probability; ///< chance a curve is drawn as 2 or 3 strokes (restarts overlap or leave small gaps)
-    double reverse_probability; ///< chance a curve is drawn against the abstraction's direction
-    bool random_start;       ///< closed curves start anywhere (people rarely start where the abstraction does)
+    double rotation_deg;             ///< whole drawing rotated by up to +-this, degrees (<= 180)
+    double aspect;                   ///< width:height changed by a factor in [1/aspect, aspect] (>= 1; 1 = off)
+    double shear;                    ///< horizontal shear up to +-this (dx per dy)
+    double wobble;                   ///< low-frequency sideways drift, largest amplitude, fraction of D
+    double wobble_waves;             ///< wobble cycles over one curve's length, at most (>= 1)
+    double tremor;                   ///< high-frequency jitter (standard deviation), fraction of D
+    double corner;                   ///< corner rounding: Gaussian smoothing width along the curve, fraction of D
+    double gap;                      ///< closed curves: largest gap left at closure, fraction of the curve length
+    double overshoot;                ///< closed curves: largest overshoot past the start, fraction of the curve length
+    double gap_probability;          ///< closed curves: chance of ending short (a gap) rather than beyond the start
+    double miss;                     ///< closed curves: sideways miss of the end point at closure, fraction of D
+    double partial_probability;      ///< chance a curve is drawn only in part
+    double partial;                  ///< largest share of such a curve left out
+    double split_probability;        ///< chance a curve is drawn as 2 or 3 strokes (restarts overlap or leave small gaps)
+    double reverse_probability;      ///< chance a curve is drawn against the abstraction's direction
+    bool random_start;               ///< closed curves start anywhere (people rarely start where the abstraction does)
     double spacing_min, spacing_max; ///< point spacing (pen speed x sample interval), fraction of D; uneven between these
     double scale_min, scale_max;     ///< size on the canvas relative to the clean drawing
-    double shift;            ///< largest move of the drawing's centre, fraction of the canvas side
+    double shift;                    ///< largest move of the drawing's centre, fraction of the canvas side
 } sp_handdraw_params;
 
 /// The settings of a named style.
@@ -80,18 +80,18 @@ bool sp_handdraw_params_valid(const sp_handdraw_params* p);
 
 /// What one perturbed sketch got (for tests and curators' sanity checks).
 typedef struct sp_handdraw_info {
-    double rotation;     ///< radians, counter-clockwise as seen on screen (y down)
-    double aspect;       ///< width factor / height factor actually applied
-    double scale;        ///< size factor actually applied
-    int curves;          ///< curves of the abstraction drawn
-    int closed_curves;   ///< of which closed
-    int gaps;            ///< closed curves ending short of their start
-    int overshoots;      ///< closed curves ending past their start
+    double rotation;                 ///< radians, counter-clockwise as seen on screen (y down)
+    double aspect;                   ///< width factor / height factor actually applied
+    double scale;                    ///< size factor actually applied
+    int curves;                      ///< curves of the abstraction drawn
+    int closed_curves;               ///< of which closed
+    int gaps;                        ///< closed curves ending short of their start
+    int overshoots;                  ///< closed curves ending past their start
     double closure_min, closure_max; ///< signed closure over closed curves, fraction of curve length (< 0 gap, > 0 overshoot)
-    int partial;         ///< curves drawn only in part
-    double covered_min;  ///< smallest share of a curve's length traced (1 = all of it)
-    int split;           ///< curves drawn as several strokes
-    int reversed;        ///< curves drawn against the abstraction's direction
+    int partial;                     ///< curves drawn only in part
+    double covered_min;              ///< smallest share of a curve's length traced (1 = all of it)
+    int split;                       ///< curves drawn as several strokes
+    int reversed;                    ///< curves drawn against the abstraction's direction
 } sp_handdraw_info;
 
 /// Perturbs a clean sketch (one stroke per curve; a stroke whose last point
@@ -134,8 +134,8 @@ sp_result sp_handdraw_part(const sp_rig* rig, int abstraction, const sp_camera* 
 /// `ds` with label `label` (< ds->category_count); sample indices continue
 /// from `first_index`. Sketch i is clean when floor((i+1)*clean_share) >
 /// floor(i*clean_share). On failure `ds` is unchanged.
-sp_result sp_handdraw_dataset(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_handdraw_desc* desc, uint64_t family,
-                              int n, int label, int first_index, sp_dataset* ds, sp_error* err);
+sp_result sp_handdraw_dataset(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_handdraw_desc* desc,
+                              uint64_t family, int n, int label, int first_index, sp_dataset* ds, sp_error* err);
 
 #ifdef __cplusplus
 }
