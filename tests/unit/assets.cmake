@@ -1,6 +1,7 @@
 # The generated assets (assets/*.glb, issue 4): byte-identical regeneration
 # with sp-assetgen, contents, folds under random poses, the Khronos
-# validator (skipped without tests/tools/node_modules), and the solver's
+# validator and a real glTF client, glTF Transform (both skipped without
+# tests/tools/node_modules), and the solver's
 # recovery rate on every dragon part and per abstraction of the characters
 # (cartoon_man stick and outline, elephant stick). One CTest entry per check and per part
 # so that they run in parallel (the sanitizer build runs the first 10 seeds
@@ -9,7 +10,7 @@ add_executable(test_assets unit/test_assets.c)
 target_link_libraries(test_assets PRIVATE sp_test_support sp::partdb PkgConfig::CJSON)
 target_compile_definitions(test_assets PRIVATE SP_ASSETGEN="$<TARGET_FILE:sp-assetgen>")
 add_dependencies(test_assets sp-assetgen)
-foreach(check regenerate_identical contents characters random_poses validator)
+foreach(check regenerate_identical contents characters random_poses validator gltf_client)
   add_test(NAME assets_${check} COMMAND test_assets ${check})
   set_tests_properties(assets_${check} PROPERTIES TIMEOUT 300 ENVIRONMENT "SP_BUILD_DIR=${PROJECT_BINARY_DIR}")
 endforeach()

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -562,6 +563,101 @@ static void test_validator(void)
     ENSURE(failed == 0);
 }
 
+// ---- a real glTF client -----------------------------------------------------
+
+// Runs `cmd`, parses its stdout as one JSON object; NULL when it printed none.
+static cJSON* run_json(const char* cmd, const char* out, int* rc)
+{
+    char full[4096];
+    snprintf(full, sizeof full, "%s >'%s'", cmd, out);
+    int st = system(full);
+    *rc = st == -1 || !WIFEXITED(st) ? -1 : WEXITSTATUS(st);
+    unsigned char* text = NULL;
+    size_t n = 0;
+    cJSON* j = read_file(out, &text, &n) ? (text[n] = 0, cJSON_Parse((const char*)text)) : NULL;
+    free(text);
+    unlink(out);
+    return j;
+}
+
+// Each asset loaded by glTF Transform (npm @gltf-transform, tests/tools):
+// its SDK reads the file as a player would (tests/tools/inspect.js reports
+// skins, skinned primitives and animations, and anything that would keep them
+// from playing), and the `gltf-transform inspect` command must read it too.
+// What it sees must agree with our own loader: the same joints in the skin,
+// the same clip. A truncated copy must be refused (the check can fail).
+static void test_gltf_client(void)
+{
+    char tools[1024], out[1024], cli[1200], probe[1200];
+    snprintf(tools, sizeof tools, "%s", sp_test_src_path("tests/tools"));
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("client.json"));
+    snprintf(cli, sizeof cli, "%s/node_modules/@gltf-transform/cli/bin/cli.js", tools);
+    snprintf(probe, sizeof probe, "%s/node_modules/@gltf-transform/core", tools);
+    struct stat st;
+    if (system("command -v node >/dev/null 2>&1") != 0) SKIP("node is not installed");
+    if (stat(probe, &st) != 0 || stat(cli, &st) != 0) SKIP("tests/tools/node_modules has no @gltf-transform (run: cd tests/tools && npm ci)");
+    int failed = 0;
+    for (int i = 0; i < ASSET_COUNT; ++i) {
+        char rel[256], path[1024], cmd[4096];
+        snprintf(rel, sizeof rel, "assets/%s.glb", asset_name(i));
+        snprintf(path, sizeof path, "%s", sp_test_src_path(rel));
+        sp_character ch = {0};
+        load_part(asset_name(i), &ch);
+        const sp_rig* rig = &ch.rig;
+
+        int rc;
+        snprintf(cmd, sizeof cmd, "node '%s/inspect.js' '%s'", tools, path);
+        cJSON* j = run_json(cmd, out, &rc);
+        const cJSON* skins = cJSON_GetObjectItemCaseSensitive(j, "skins");
+        const cJSON* anims = cJSON_GetObjectItemCaseSensitive(j, "animations");
+        const cJSON* prims = cJSON_GetObjectItemCaseSensitive(j, "skinnedPrimitives");
+        const cJSON* problems = cJSON_GetObjectItemCaseSensitive(j, "problems");
+        const cJSON* joints = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(skins, 0), "joints");
+        const cJSON* anim = cJSON_GetArrayItem(anims, 0);
+        const cJSON* name = cJSON_GetObjectItemCaseSensitive(anim, "name");
+        const cJSON* chans = cJSON_GetObjectItemCaseSensitive(anim, "channels");
+        const cJSON* dur = cJSON_GetObjectItemCaseSensitive(anim, "duration");
+        bool ok = rc == 0 && cJSON_GetArraySize(skins) == 1 && cJSON_IsNumber(joints) && joints->valueint == rig->joint_count &&
+                  cJSON_IsNumber(prims) && prims->valueint >= 1 && cJSON_GetArraySize(problems) == 0 &&
+                  cJSON_GetArraySize(anims) == rig->animation_count && rig->animation_count == 1 && cJSON_IsString(name) &&
+                  strcmp(name->valuestring, rig->animations[0].name) == 0 && cJSON_IsNumber(chans) &&
+                  chans->valueint == rig->animations[0].channel_count && cJSON_IsNumber(dur) &&
+                  fabs(dur->valuedouble - rig->animations[0].duration_s) < 1e-4;
+        char* text = j ? cJSON_PrintUnformatted(j) : NULL;
+        fprintf(stderr, "  %-11s glTF Transform: %s\n", asset_name(i), text ? text : "(no report)");
+        free(text);
+        cJSON_Delete(j);
+
+        // The command-line tool itself: it must read the file and list the clip.
+        snprintf(cmd, sizeof cmd, "node '%s' inspect '%s' --format csv >'%s' 2>&1", cli, path, out);
+        int st_cli = system(cmd);
+        unsigned char* csv = NULL;
+        size_t n = 0;
+        bool cli_ok = st_cli == 0 && read_file(out, &csv, &n) && (csv[n] = 0, strstr((const char*)csv, rig->animations[0].name) != NULL);
+        if (!cli_ok) fprintf(stderr, "  %-11s gltf-transform inspect failed (exit %d): %.300s\n", asset_name(i), st_cli, csv ? (const char*)csv : "");
+        free(csv);
+        unlink(out);
+        failed += !(ok && cli_ok);
+        sp_character_free(&ch);
+    }
+    ENSURE(failed == 0);
+
+    // A file cut in half does not load: inspect.js says so and exits 2.
+    unsigned char* glb = NULL;
+    size_t n = 0;
+    ENSURE(read_file(sp_test_src_path("assets/torso.glb"), &glb, &n));
+    char cut[1024], cmd[4096];
+    snprintf(cut, sizeof cut, "%s", sp_test_tmp_path("cut.glb"));
+    FILE* f = fopen(cut, "wb");
+    ENSURE(f && fwrite(glb, 1, n / 2, f) == n / 2 && fclose(f) == 0);
+    free(glb);
+    int rc;
+    snprintf(cmd, sizeof cmd, "node '%s/inspect.js' '%s' 2>/dev/null", tools, cut);
+    cJSON* j = run_json(cmd, out, &rc);
+    ENSURE(rc == 2 && j == NULL);
+    unlink(cut);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -570,5 +666,6 @@ int main(int argc, char** argv)
                                    {"characters", test_characters},
                                    {"random_poses", test_random_poses},
                                    {"validator", test_validator},
+                                   {"gltf_client", test_gltf_client},
                                    {0}});
 }
