@@ -34,8 +34,18 @@ enum { RATE_ASSERTED = 0 };
 enum { RATE_ASSERTED = 1 };
 #endif
 
+// Measurements beyond the test: SP_RECOVERY_CASES=N runs N seeds instead
+// (the rate is still asserted on them).
+static int case_count(int cases)
+{
+    const char* env = getenv("SP_RECOVERY_CASES");
+    int n = env ? atoi(env) : 0;
+    return n > 0 ? n : cases;
+}
+
 static void recover_abstraction_at(const char* name, const char* abstraction, int cases, double rate)
 {
+    cases = case_count(cases);
     char rel[256];
     snprintf(rel, sizeof rel, "assets/%s.glb", name);
     sp_character ch = {0};
@@ -63,6 +73,7 @@ static void recover_abstraction_at(const char* name, const char* abstraction, in
             ENSURE(out[q] >= rig->params[q].min && out[q] <= rig->params[q].max);
         double rel_err = rep.mean_error_px / rep.bbox_diagonal_px;
         ok += rel_err <= 0.01;
+        if (rel_err > 0.01) fprintf(stderr, "    %s %s seed %d: %.2f%% (%d iterations)\n", name, abstraction, seed, 100 * rel_err, rep.iterations);
         err_sum += rel_err;
         ms += rep.ms;
         if (rel_err > worst) worst = rel_err, worst_seed = seed;
