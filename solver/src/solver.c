@@ -314,8 +314,11 @@ static sp_vec2 sample_at(const sp_solver* s, sample_ref r)
 // the stroke within a round instead of being dragged to the sample that was
 // closest at the round's start, which is what makes point-to-point ICP crawl
 // (the Table 1 benchmark rigs needed 3x the iterations). The small tangential
-// weight keeps the energy positive definite on straight strokes.
-#define SP_TANGENT_WEIGHT 0.1
+// weight keeps the energy positive definite on straight strokes; 0.01 rather
+// than 0.1: dragon parts' closest-point refinement takes 20-40% fewer
+// iterations and ends at half the mean error, recovery unchanged (200
+// targets a part); 0 leaves the per-point metric singular on straight runs.
+#define SP_TANGENT_WEIGHT 0.01
 
 // The pair's symmetric 2x2 metric (xx, xy, yy): identity for ordered pairs,
 // n n^T + SP_TANGENT_WEIGHT (I - n n^T) for closest ones.
