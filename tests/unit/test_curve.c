@@ -320,6 +320,33 @@ static void test_closest_both_ways(void)
 }
 
 // Above SP_CORR_BRUTE_MAX the k-d tree answers; it must be exact.
+// Both directions against a plain scan on integer points with many exact
+// ties (equal x, equal distances): the same partner, lowest index on ties.
+static void test_closest_exact_ties(void)
+{
+    enum { MY = 90, MZ = 70 };
+    sp_vec2 y[MY], z[MZ];
+    sp_corr_pair pairs[MY + MZ];
+    sp_test_rng rng = {33};
+    for (int i = 0; i < MY; ++i)
+        y[i] = (sp_vec2){(double)(int)sp_test_range(&rng, 0, 8), (double)(int)sp_test_range(&rng, 0, 8)};
+    for (int j = 0; j < MZ; ++j)
+        z[j] = (sp_vec2){(double)(int)sp_test_range(&rng, 0, 8), (double)(int)sp_test_range(&rng, 0, 8)};
+    ENSURE(sp_corr_closest(y, MY, z, MZ, pairs, NULL) == SP_OK);
+    for (int i = 0; i < MY; ++i) {
+        int bj = 0;
+        for (int j = 1; j < MZ; ++j)
+            if (d2(y[i], z[j]) < d2(y[i], z[bj])) bj = j;
+        ENSURE(pairs[i].y == i && pairs[i].z == bj);
+    }
+    for (int j = 0; j < MZ; ++j) {
+        int bi = 0;
+        for (int i = 1; i < MY; ++i)
+            if (d2(z[j], y[i]) < d2(z[j], y[bi])) bi = i;
+        ENSURE(pairs[MY + j].z == j && pairs[MY + j].y == bi);
+    }
+}
+
 static void test_closest_kdtree(void)
 {
     int my = 1500, mz = 1200;
@@ -648,6 +675,7 @@ int main(int argc, char** argv)
                                    {"closest_both_ways", test_closest_both_ways},
                                    {"closest_kdtree", test_closest_kdtree},
                                    {"hungarian_vs_brute", test_hungarian_vs_brute},
+                                   {"closest_exact_ties", test_closest_exact_ties},
                                    {"assign_order_independent", test_assign_order_independent},
                                    {"assign_counts", test_assign_counts},
                                    {"assign_degenerate", test_assign_degenerate},
