@@ -10,11 +10,12 @@
 
 #include "cli.h"
 #include "sp/classifier.h"
+#include "sp/handdraw.h"
 
 /// Training options as flags; zero values mean the library defaults.
 typedef struct clf_cli_opts {
-    int words, knn, augment, soft, threads, seed;
-    bool no_pyramid, no_tfidf, no_hellinger, no_mirror;
+    int words, knn, augment, soft, threads, seed, pyramid;
+    bool no_pyramid, no_tfidf, no_hellinger, no_mirror, handdraw;
     double reject_quantile;
 } clf_cli_opts;
 
@@ -23,13 +24,24 @@ typedef struct clf_cli_opts {
         {"--knn", SP_OPT_INT, &(o).knn, "K", "neighbours voting (default 8)", false},                          \
         {"--soft", SP_OPT_INT, &(o).soft, "N", "words per descriptor, soft assignment (default 4)", false},    \
         {"--augment", SP_OPT_INT, &(o).augment, "N", "jittered copies per training drawing (default 0)", false}, \
+        {"--handdraw", SP_OPT_FLAG, &(o).handdraw, "", "--augment copies from the hand-drawing model instead of affine jitter", false}, \
         {"--no-pyramid", SP_OPT_FLAG, &(o).no_pyramid, "", "no 2x2 spatial pyramid", false},                 \
+        {"--pyramid", SP_OPT_INT, &(o).pyramid, "L", "pyramid levels past the whole drawing: 1 = 2x2 (default), 2 = also 4x4", false}, \
         {"--no-tfidf", SP_OPT_FLAG, &(o).no_tfidf, "", "no tf-idf word weights", false},                               \
         {"--no-hellinger", SP_OPT_FLAG, &(o).no_hellinger, "", "plain L2 between histograms", false},        \
         {"--no-mirror", SP_OPT_FLAG, &(o).no_mirror, "", "do not add mirrored training drawings", false},    \
         {"--reject-quantile", SP_OPT_DOUBLE, &(o).reject_quantile, "Q", "reject threshold quantile (0.98)", false}, \
         {"--seed", SP_OPT_INT, &(o).seed, "S", "random seed (default 1)", false},                              \
         {"--threads", SP_OPT_INT, &(o).threads, "T", "worker threads (default 2)", false}
+
+/// Augmented copy k of a training drawing drawn again through the hand-drawing
+/// model (normal style), seeded by the copy and the sample: reproducible.
+static inline sp_result clf_cli_handdraw(void* user, const sp_sketch* in, int sample, int k, sp_sketch* out)
+{
+    (void)user;
+    sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
+    return sp_handdraw_apply(in, &hp, sp_handdraw_seed((uint64_t)k + 1, sample), out, NULL, NULL);
+}
 
 static inline sp_clf_desc clf_cli_desc(const clf_cli_opts* o)
 {
@@ -38,13 +50,14 @@ static inline sp_clf_desc clf_cli_desc(const clf_cli_opts* o)
     d.knn = o->knn;
     d.soft_neighbours = o->soft;
     d.augment = o->augment;
-    d.pyramid = o->no_pyramid ? -1 : 0;
+    d.pyramid = o->no_pyramid ? -1 : o->pyramid;
     d.tfidf = o->no_tfidf ? -1 : 0;
     d.hellinger = o->no_hellinger ? -1 : 0;
     d.mirror = o->no_mirror ? -1 : 0;
     d.reject_quantile = o->reject_quantile;
     d.seed = (uint32_t)o->seed;
     d.threads = o->threads;
+    if (o->handdraw) d.augment_fn = clf_cli_handdraw;
     return d;
 }
 

@@ -95,6 +95,7 @@ int cmd_eval(int argc, char** argv)
         return SP_EXIT_INPUT;
     }
     int top1 = 0, top3 = 0, n = 0, rejected = 0, failed = 0, nms = 0;
+    int fold_n[100] = {0}, fold_top1[100] = {0}, fold_top3[100] = {0};
     sp_clf_desc desc = clf_cli_desc(&o);
     sp_clf* clf = NULL;
     if (model) {
@@ -103,7 +104,8 @@ int cmd_eval(int argc, char** argv)
             sp_dataset_free(&ds);
             return SP_EXIT_INPUT;
         }
-        desc = sp_clf_get_desc(clf); // cross-validation reuses the model's options
+        desc = sp_clf_get_desc(clf);                            // cross-validation reuses the model's options
+        desc.augment_fn = o.handdraw ? clf_cli_handdraw : NULL; // not stored in the model
     }
     if (folds == 0) {
         run(clf, &ds, NULL, confusion, &top1, &top3, &n, &rejected, &failed, ms, &nms);
@@ -124,15 +126,28 @@ int cmd_eval(int argc, char** argv)
             }
             for (int i = 0; i < ds.count; ++i)
                 mask[i] = !mask[i];
+            int n0 = n, top10 = top1, top30 = top3;
             run(fc, &ds, mask, confusion, &top1, &top3, &n, &rejected, &failed, ms, &nms);
             sp_clf_free(fc);
+            fold_n[f] = n - n0;
+            fold_top1[f] = top1 - top10;
+            fold_top3[f] = top3 - top30;
         }
     }
     qsort(ms, (size_t)nms, sizeof(double), cmp_double);
     printf("{\"top1\": %.4f, \"top3\": %.4f, \"n\": %d, \"ms_median\": %.3f, \"ms_p90\": %.3f, \"rejected\": %d, "
-           "\"failed\": %d, \"folds\": %d,\n \"per_class\": {",
+           "\"failed\": %d, \"folds\": %d,\n",
            n ? (double)top1 / n : 0.0, n ? (double)top3 / n : 0.0, n, nms ? ms[nms / 2] : 0.0,
            nms ? ms[(int)(0.9 * (nms - 1))] : 0.0, rejected, failed, folds);
+    if (folds > 0) {
+        printf(" \"per_fold\": [");
+        for (int f = 0; f < folds; ++f)
+            printf("%s{\"top1\": %.4f, \"top3\": %.4f, \"n\": %d}", f ? ", " : "",
+                   fold_n[f] ? (double)fold_top1[f] / fold_n[f] : 0.0, fold_n[f] ? (double)fold_top3[f] / fold_n[f] : 0.0,
+                   fold_n[f]);
+        printf("],\n");
+    }
+    printf(" \"per_class\": {");
     for (int c = 0; c < nc; ++c) {
         int row = 0, total = 0;
         for (int i = 0; i < ds.count; ++i)

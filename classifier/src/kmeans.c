@@ -198,6 +198,7 @@ done:
 }
 
 typedef float v4f __attribute__((vector_size(16)));
+typedef int v4si __attribute__((vector_size(16)));
 
 // Keeps the nn smallest (d, w) in bd/bi, sorted; exact ties keep the lower index.
 static inline void keep_nearest(float d, int w, int nn, int* bi, float* bd)
@@ -240,10 +241,34 @@ static bool nearest_words_gemm(const float* words, const float* wnorm, int K, co
                 bi[j] = -1;
                 bd[j] = 3.4e38f;
             }
+            // Why four words at a time: one vector comparison rules out all four
+            // in almost every step (a word-by-word insertion scan took as long
+            // as the products).
             const float* row = dots + (size_t)i * K;
-            for (int w = 0; w < K; ++w) {
+            float worst = bd[nn - 1];
+            const v4f qv = {qn, qn, qn, qn};
+            v4f wv = {worst, worst, worst, worst};
+            int w = 0;
+            for (; w + 4 <= K; w += 4) {
+                v4f r, wn;
+                memcpy(&r, row + w, sizeof r);
+                memcpy(&wn, wnorm + w, sizeof wn);
+                v4f d = qv + wn - (r + r);
+                v4si lt = d < wv;
+                if (!(lt[0] | lt[1] | lt[2] | lt[3])) continue;
+                for (int l = 0; l < 4; ++l)
+                    if (d[l] < worst) {
+                        keep_nearest(d[l] < 0.0f ? 0.0f : d[l], w + l, nn, bi, bd);
+                        worst = bd[nn - 1];
+                    }
+                wv = (v4f){worst, worst, worst, worst};
+            }
+            for (; w < K; ++w) {
                 float d = qn + wnorm[w] - 2.0f * row[w];
-                keep_nearest(d < 0.0f ? 0.0f : d, w, nn, bi, bd);
+                if (d < worst) {
+                    keep_nearest(d < 0.0f ? 0.0f : d, w, nn, bi, bd);
+                    worst = bd[nn - 1];
+                }
             }
         }
     }

@@ -1,5 +1,5 @@
 // bench/dragon_classes.c: the dragon-part classifier (issue 5, "What it must show").
-//   bench_dragon_classes [--json] [--train N] [--test N] [--cal N] [--scribbles N] [--words W] [--sweep]
+//   bench_dragon_classes [--json] [--train N] [--test N] [--cal N] [--scribbles N] [--words W] [--sweep] [--db PATH]
 // Trains on N hand-drawn sketches per part of seed family 1 (normal style, one
 // in four clean: the part database's recipe), tests on --test harsh sketches per
 // part of family 2 (600 by default) and on Quick, Draw! drawings of non-dragon
@@ -8,7 +8,9 @@
 // threshold of the training set (leave-one-out quantile 0.98) and for thresholds
 // calibrated on --cal harsh sketches per part of family 3 at several quantiles.
 // --sweep also trains with each classifier option switched the other way
-// (calibrated at quantile 0.96). Parts: assets/*.glb when all six are there,
+// (calibrated at quantile 0.96). --db evaluates the newest model of a part
+// database instead (e.g. the default one of `sketchpose db init`), with its
+// own reject threshold, on the same held-out sets. Parts: assets/*.glb when all six are there,
 // else the code-built stand-ins (tests/support/dragon_parts.h).
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +19,7 @@
 #include "dragon_parts.h"
 #include "sp/classifier.h"
 #include "sp/handdraw.h"
+#include "sp/partdb.h"
 #include "test.h"
 
 static double now_ms(void)
@@ -73,6 +76,7 @@ int main(int argc, char** argv)
 {
     bool json = false, sweep = false;
     int ntrain = 300, ntest = 100, ncal = 100, nscrib = 25, words = 1000;
+    const char* db_path = NULL;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--json"))
             json = true;
@@ -88,10 +92,11 @@ int main(int argc, char** argv)
             nscrib = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--words") && i + 1 < argc)
             words = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--db") && i + 1 < argc)
+            db_path = argv[++i];
         else {
-            fprintf(
-                stderr,
-                "usage: bench_dragon_classes [--json] [--train N] [--test N] [--cal N] [--scribbles N] [--words W] [--sweep]\n");
+            fprintf(stderr, "usage: bench_dragon_classes [--json] [--train N] [--test N] [--cal N] [--scribbles N] [--words W] "
+                            "[--sweep] [--db PATH]\n");
             return 2;
         }
     }
@@ -120,6 +125,55 @@ int main(int argc, char** argv)
         "%d scribbles; generated in %.0f ms\n",
         assets ? "assets/*.glb" : "stand-ins (assets/ incomplete)", train.count, test.count, cal.count, scrib.count, gen_ms);
 
+    if (db_path) { // the database's model, its own threshold
+        sp_db* db = NULL;
+        sp_clf* clf = NULL;
+        if (sp_db_open(db_path, SP_DB_READONLY, &db, &err) != SP_OK || sp_db_load_model(db, &clf, NULL, &err) != SP_OK) {
+            fprintf(stderr, "bench_dragon_classes: %s\n", err.text);
+            return 1;
+        }
+        sp_db_close(db);
+        double med, p90;
+        answer* at = classify_all(clf, &test, &med, &p90);
+        answer* as = classify_all(clf, &scrib, NULL, NULL);
+        float thr = sp_clf_reject_distance(clf);
+        int right = 0, top3 = 0, fr = 0, sr = 0;
+        for (int i = 0; i < test.count; ++i) {
+            right += at[i].pred == at[i].label;
+            top3 += at[i].top3;
+            fr += !(at[i].distance <= thr);
+        }
+        for (int i = 0; i < scrib.count; ++i)
+            sr += !(as[i].distance <= thr);
+        sp_clf_desc d = sp_clf_get_desc(clf);
+        printf("%s: %d words; top1 %.1f%%, top3 %.1f%%, dragon rejected %.1f%%, scribbles rejected %.1f%% (reject %.4f); ms "
+               "median %.2f, "
+               "p90 %.2f\n",
+               db_path, d.words, 100.0 * right / test.count, 100.0 * top3 / test.count, 100.0 * fr / test.count,
+               scrib.count ? 100.0 * sr / scrib.count : 0.0, thr, med, p90);
+        // The same model with the bench's calibration (--cal harsh sketches per part of family 3, quantile 0.96).
+        if (sp_clf_calibrate_reject(clf, &cal, NULL, 0.96, 1.0, NULL, NULL, &err) == SP_OK) {
+            thr = sp_clf_reject_distance(clf);
+            fr = sr = 0;
+            for (int i = 0; i < test.count; ++i)
+                fr += !(at[i].distance <= thr);
+            for (int i = 0; i < scrib.count; ++i)
+                sr += !(as[i].distance <= thr);
+            printf("  recalibrated on %d harsh sketches of family 3 (q0.96): dragon rejected %.1f%%, scribbles rejected %.1f%% "
+                   "(reject "
+                   "%.4f)\n",
+                   cal.count, 100.0 * fr / test.count, scrib.count ? 100.0 * sr / scrib.count : 0.0, thr);
+        }
+        free(at);
+        free(as);
+        sp_clf_free(clf);
+        sp_dataset_free(&train);
+        sp_dataset_free(&test);
+        sp_dataset_free(&cal);
+        sp_dataset_free(&scrib);
+        dragon_parts_free(parts);
+        return 0;
+    }
     variant vs[32];
     int nv = 0;
     vs[nv++] = (variant){"recipe", {.words = words}};

@@ -4,8 +4,10 @@
 /// 256x256 frame, rasterised, described by 64-D local orientation descriptors on
 /// a 28x28 grid, soft-assigned to a k-means vocabulary and summarised as an
 /// L1-normalised histogram (optionally with a 1x1+2x2(+4x4) spatial pyramid, tf-idf,
-/// and Hellinger-mapped). A FLANN k-nearest-neighbour search over the training
-/// histograms votes, weighted by distance, for ranked categories; a drawing
+/// and Hellinger-mapped). A k-nearest-neighbour search over the training
+/// histograms (full distances for a shortlist of candidates nearest on the
+/// whole-drawing level; FLANN's kd-tree beyond 20000 training histograms)
+/// votes, weighted by distance, for ranked categories; a drawing
 /// farther from every training drawing than a threshold learned on the training
 /// set is rejected.
 ///
@@ -55,6 +57,13 @@ typedef struct sp_clf_desc {
     /// Progress report (may be NULL): stage name, done of total.
     void (*progress)(void* user, const char* stage, int done, int total);
     void* progress_user;
+    /// Makes augmented copy `k` (0 <= k < augment) of the stroke drawing `in` (dataset sample
+    /// `sample`) into `out` (freed by the classifier with sp_sketch_free) instead of the
+    /// built-in random affine jitter; may be NULL. E.g. the hand-drawing model
+    /// (sp_handdraw_apply, partdb), which the classifier cannot link. Must be deterministic
+    /// and thread-safe (called from the training threads). Not stored in the model.
+    sp_result (*augment_fn)(void* user, const sp_sketch* in, int sample, int k, sp_sketch* out);
+    void* augment_user;
 } sp_clf_desc;
 
 /// One ranked category: index into the model's categories, and its vote share in [0, 1].

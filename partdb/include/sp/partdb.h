@@ -50,6 +50,7 @@ extern "C" {
 #define SP_DB_BUSY_MS_DEFAULT 5000
 /// Synthetic sketches stored with a part by default (per part: random shape and
 /// pose, drawn by the hand-drawing model of sp/handdraw.h, normal style).
+/// Why not 300 (the dragon bench's recipe): see docs/DESIGN.md (cost 4.5x, no bar gained in full).
 #define SP_DB_SYNTH_DEFAULT 60
 
 typedef struct sp_db sp_db;
