@@ -18,7 +18,7 @@ typedef struct pair {
     int curve; // for the per-curve report
     // Unit normal of the stroke at y for closest-point pairs, (0, 0) for
     // ordered ones: a closest pair weighs the residual across the stroke
-    // fully and along it by SP_TANGENT_WEIGHT (see solver.c).
+    // fully and along it by its curve's tangential weight (see solver.c).
     sp_vec2 n;
     // Closest-point pairs: 0 when y was the stroke sample looking for the
     // curve, 1 when the curve sample looked for the stroke (the final error
