@@ -133,11 +133,13 @@ static void test_cartoon_man_stick(void)
 }
 static void test_cartoon_man_outline(void)
 {
-    // NOT the issue's 95%: this outline recovers 27 of these 30 (92 of 100 in
-    // the benchmark); the misses are tangled targets (a posed rest silhouette
-    // crossing itself) where the fit stops at 1.0-1.7%. The floor guards
-    // against regressions while the solver issue stays open on this row.
-    recover_abstraction_at("cartoon_man", "outline", SP_ASSETS_RECOVERY_CASES < 30 ? SP_ASSETS_RECOVERY_CASES : 30, 0.85);
+    // NOT the issue's 95%: this outline recovers 26 of these 30 (89 of 100,
+    // 182 of 200 with SP_RECOVERY_CASES); the misses are tangled targets (a
+    // posed rest silhouette crossing itself) where the fit stops at 1.0-1.7%.
+    // The floor (24 of 30) guards against regressions while the solver issue
+    // stays open on this row, with two cases of slack for BLAS kernels that
+    // round differently on another CPU.
+    recover_abstraction_at("cartoon_man", "outline", SP_ASSETS_RECOVERY_CASES < 30 ? SP_ASSETS_RECOVERY_CASES : 30, 0.80);
 }
 static void test_elephant_stick(void)
 {
