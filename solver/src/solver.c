@@ -695,8 +695,7 @@ static void prepare_start(sp_solver* s, const double* p, const sp_solve_report* 
 
 // Per-curve and overall 2D errors from the current pairs at the current state.
 // Squared distance of x to segment ab (the report's errors take one square
-// root per sample, not one per segment: hypot per segment was a tenth of a
-// dragon part's solve).
+// root per sample, not a hypot per segment).
 static double segment_distance2(sp_vec2 x, sp_vec2 a, sp_vec2 b)
 {
     sp_vec2 ab = sp_v2_sub(b, a), ax = sp_v2_sub(x, a);
