@@ -1,7 +1,7 @@
 #!/usr/bin/env node
 // inspect.js FILE.(glb|gltf): loads a file with glTF Transform (npm
-// @gltf-transform/core, a real glTF client, the SDK behind
-// `gltf-transform inspect`) and prints what a player would get from it:
+// @gltf-transform/core, a real glTF client, the SDK behind the
+// `gltf-transform inspect` command) and prints what a player would get from it:
 // {"file", "meshes", "skinnedPrimitives", "skins": [{"name", "joints"}],
 //  "animations": [{"name", "channels", "duration"}], "problems": [...]}.
 // A problem is anything that would keep the skin or the animation from
@@ -12,12 +12,20 @@
 // with problems, 2 when it does not load or on bad usage.
 'use strict';
 const path = require('path');
-const { NodeIO } = require('@gltf-transform/core');
 
 async function main() {
     const file = process.argv[2];
     if (!file || process.argv.length > 3) {
         console.error('usage: inspect.js FILE.glb|FILE.gltf');
+        return 2;
+    }
+    // An ESM import: the package's CommonJS build require()s an ES module,
+    // which Node 18 (Debian 12's nodejs) cannot do.
+    let NodeIO;
+    try {
+        ({ NodeIO } = await import('@gltf-transform/core'));
+    } catch (e) {
+        console.error(`inspect.js: cannot load @gltf-transform/core (run npm ci in tests/tools): ${e.message}`);
         return 2;
     }
     let doc;
