@@ -266,14 +266,7 @@ int cmd_synth(int argc, char** argv)
         sp_sketch_free(&sk);
         sk = drawn;
     }
-    if (noise > 0) {
-        sp_rng rng = {(uint64_t)(unsigned)seed ^ 0xA5A5A5A5ull};
-        for (int i = 0; i < sk.stroke_count; ++i)
-            for (int j = 0; j < sk.strokes[i].count; ++j) {
-                sk.strokes[i].points[j].x += noise * sp_rng_normal(&rng);
-                sk.strokes[i].points[j].y += noise * sp_rng_normal(&rng);
-            }
-    }
+    if (noise > 0) sp_synth_jitter(&sk, noise, (uint64_t)(unsigned)seed);
     if (sp_sketch_write_json(out, &sk, &err) != SP_OK) goto fail;
     if (truth && sp_pose_write(truth, &ch.rig, p, &err) != SP_OK) goto fail;
     exit_code = SP_EXIT_OK;

@@ -1620,16 +1620,22 @@ std::string serialize(const sp_character* ch, const double* params, bool binary)
 
 } // namespace
 
+// The serialised file to disk, with a one-line error naming it.
+static sp_result write_file(const char* path, const std::string& bytes, sp_error* err)
+{
+    FILE* f = fopen(path, "wb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    ok = (fclose(f) == 0) && ok;
+    if (!ok) return sp_fail(err, SP_ERR_IO, "%s: write error: %s", path, strerror(errno));
+    return SP_OK;
+}
+
 extern "C" sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err)
 {
     try {
         std::string bytes = serialize(ch, params, ends_with_ci(path, ".glb"));
-        FILE* f = fopen(path, "wb");
-        if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-        bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-        ok = (fclose(f) == 0) && ok;
-        if (!ok) return sp_fail(err, SP_ERR_IO, "%s: write error: %s", path, strerror(errno));
-        return SP_OK;
+        return write_file(path, bytes, err);
     } catch (const Failure& f) {
         return sp_fail(err, f.code, "%s: %s", path, f.text.c_str());
     } catch (const std::bad_alloc&) {
@@ -1670,12 +1676,7 @@ extern "C" sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const ch
         if (!writer.WriteGltfSceneToStream(&m, os, !binary, binary))
             fail(SP_ERR_INTERNAL, "tinygltf could not serialise the scene");
         std::string bytes = os.str();
-        FILE* f = fopen(path, "wb");
-        if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-        bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-        ok = (fclose(f) == 0) && ok;
-        if (!ok) return sp_fail(err, SP_ERR_IO, "%s: write error: %s", path, strerror(errno));
-        return SP_OK;
+        return write_file(path, bytes, err);
     } catch (const Failure& f) {
         return sp_fail(err, f.code, "%s: %s", path, f.text.c_str());
     } catch (const std::bad_alloc&) {

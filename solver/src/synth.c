@@ -22,6 +22,16 @@ double sp_rng_normal(sp_rng* r)
     return sqrt(-2.0 * log(u)) * cos(2.0 * 3.14159265358979323846 * v);
 }
 
+void sp_synth_jitter(sp_sketch* sk, double noise_px, uint64_t seed)
+{
+    sp_rng rng = {seed ^ 0xA5A5A5A5ull};
+    for (int i = 0; i < sk->stroke_count; ++i)
+        for (int j = 0; j < sk->strokes[i].count; ++j) {
+            sk->strokes[i].points[j].x += noise_px * sp_rng_normal(&rng);
+            sk->strokes[i].points[j].y += noise_px * sp_rng_normal(&rng);
+        }
+}
+
 void sp_synth_params(const sp_rig* rig, uint64_t seed, double amplitude, double* p)
 {
     sp_rng rng = {seed * 0x2545F4914F6CDD1Dull + 1};

@@ -2,6 +2,7 @@
 // draw-over curves embedded in the mesh (drawover), in process and through
 // the command line on CesiumMan when ../shared/data is there.
 #include <cjson/cJSON.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -262,6 +263,32 @@ static void test_animate_cli_cesiumman(void)
     sp_character_free(&ch);
 }
 
+// `synth --noise`: every coordinate moved by seeded Gaussian noise of the
+// given deviation; the same seed, the same drawing.
+static void test_synth_jitter(void)
+{
+    enum { N = 4000 };
+    sp_vec2* pts = calloc(N, sizeof(sp_vec2));
+    ENSURE(pts);
+    sp_sketch a = {0}, b = {0};
+    ENSURE(sp_sketch_add_stroke(&a, pts, NULL, N) == SP_OK && sp_sketch_add_stroke(&b, pts, NULL, N) == SP_OK);
+    sp_synth_jitter(&a, 2.0, 7);
+    sp_synth_jitter(&b, 2.0, 7);
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < N; ++i) {
+        const sp_vec2 p = a.strokes[0].points[i];
+        ENSURE(p.x == b.strokes[0].points[i].x && p.y == b.strokes[0].points[i].y);
+        sum += p.x + p.y;
+        sum2 += p.x * p.x + p.y * p.y;
+    }
+    double mean = sum / (2 * N), sd = sqrt(sum2 / (2 * N) - mean * mean);
+    ENSURE(fabs(mean) < 0.1 && fabs(sd - 2.0) < 0.1);
+    sp_synth_jitter(&b, 2.0, 8); // another seed moves the points differently
+    ENSURE(b.strokes[0].points[0].x != 2 * a.strokes[0].points[0].x);
+    sp_sketch_free(&a), sp_sketch_free(&b);
+    free(pts);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv, (sp_test[]){
@@ -269,5 +296,6 @@ int main(int argc, char** argv)
         {"drawover_fixture", test_drawover_fixture},
         {"animate_cli_cesiumman", test_animate_cli_cesiumman},
         {"drawover_cesiumman", test_drawover_cesiumman},
+        {"synth_jitter", test_synth_jitter},
         {0}});
 }

@@ -283,14 +283,7 @@ int sp_plugin_synth(const char* rig_path, const char* abs_name, int seed, const 
         sp_blackbox_synth_params(bb, (uint64_t)(unsigned)seed, amplitude, p);
     }
     if (sp_blackbox_synth_sketch(bb, a, &cam, p, &sk, &err) != SP_OK) goto fail;
-    if (noise > 0) {
-        sp_rng rng = {(uint64_t)(unsigned)seed ^ 0xA5A5A5A5ull};
-        for (int i = 0; i < sk.stroke_count; ++i)
-            for (int j = 0; j < sk.strokes[i].count; ++j) {
-                sk.strokes[i].points[j].x += noise * sp_rng_normal(&rng);
-                sk.strokes[i].points[j].y += noise * sp_rng_normal(&rng);
-            }
-    }
+    if (noise > 0) sp_synth_jitter(&sk, noise, (uint64_t)(unsigned)seed);
     if (sp_sketch_write_json(out, &sk, &err) != SP_OK) goto fail;
     if (truth) {
         cJSON* j = sp_plugin_pose_json(bb, p);

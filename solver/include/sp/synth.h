@@ -34,6 +34,10 @@ double sp_rng_normal(sp_rng* r);
 /// A random parameter vector within bounds (see the amplitude rule above).
 void sp_synth_params(const sp_rig* rig, uint64_t seed, double amplitude, double* p);
 
+/// Adds Gaussian noise (standard deviation noise_px, per coordinate) to every
+/// point of sk, from its own seeded stream (`synth --noise`).
+void sp_synth_jitter(sp_sketch* sk, double noise_px, uint64_t seed);
+
 /// The abstraction's curves at p, projected by cam, as strokes (one per
 /// curve, in curve order, closed curves repeat their first point at the end)
 /// on the camera's canvas. mesh_xyz scratch is allocated internally.
