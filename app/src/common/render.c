@@ -193,7 +193,7 @@ static GLuint compile(GLenum type, const char* src, const char* what, sp_error* 
     return s;
 }
 
-static GLuint link_program(const char* vs_src, const char* fs_src, const char* what, sp_error* err)
+unsigned sp_gl_program(const char* vs_src, const char* fs_src, const char* what, sp_error* err)
 {
     GLuint vs = compile(GL_VERTEX_SHADER, vs_src, what, err);
     if (!vs) return 0;
@@ -288,9 +288,9 @@ sp_renderer* sp_renderer_create(const sp_renderer_desc* desc, sp_error* err)
     r->exposure = d.exposure > 0 ? d.exposure : 1.0f;
     r->ambient = d.ambient > 0 ? d.ambient : 0.35f;
     r->rim = d.no_rim ? 0.0f : 0.45f;
-    r->mesh_prog = link_program(k_mesh_vs, k_mesh_fs, "mesh", err);
+    r->mesh_prog = sp_gl_program(k_mesh_vs, k_mesh_fs, "mesh", err);
     if (!r->mesh_prog) goto fail;
-    r->overlay_prog = link_program(k_overlay_vs, k_overlay_fs, "overlay", err);
+    r->overlay_prog = sp_gl_program(k_overlay_vs, k_overlay_fs, "overlay", err);
     if (!r->overlay_prog) goto fail;
     r->u_model_view = glGetUniformLocation(r->mesh_prog, "u_model_view");
     r->u_proj = glGetUniformLocation(r->mesh_prog, "u_proj");

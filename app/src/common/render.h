@@ -158,6 +158,12 @@ sp_result sp_render_target_read(const sp_render_target* t, sp_image* img, sp_err
 /// Its size in pixels.
 void sp_render_target_size(const sp_render_target* t, int* width, int* height);
 
+/// Compiles and links a GLSL program from a vertex and a fragment shader (a
+/// GL context must be current): 0 and a one-line error naming `what` and the
+/// compiler's log when it fails. For other GL drawing code (the kiosk's 2D
+/// layer) beside the renderer's own programs.
+unsigned sp_gl_program(const char* vs_src, const char* fs_src, const char* what, sp_error* err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,6 +10,8 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
+#include "render.h"
+
 // clang-format off
 static const char* k_vs =
     "#version 330 core\n"
@@ -100,25 +102,6 @@ struct sp_draw2d {
     int w, h;
 };
 
-static GLuint shader(GLenum type, const char* src, sp_error* err)
-{
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[400] = {0};
-        glGetShaderInfoLog(s, sizeof log - 1, NULL, log);
-        for (char* c = log; *c; ++c)
-            if (*c == '\n') *c = ' ';
-        sp_fail(err, SP_ERR_INTERNAL, "draw2d: shader: %s", log);
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
 sp_draw2d* sp_draw2d_create(const sp_font* font, sp_error* err)
 {
     sp_draw2d* d = calloc(1, sizeof *d);
@@ -130,24 +113,9 @@ sp_draw2d* sp_draw2d_create(const sp_font* font, sp_error* err)
     const sp_font_glyph* H = sp_font_glyph_for(font, 'H');
     d->cap = -(H->y0 + font->sdf_spread);
     if (!(d->cap > 0.3f && d->cap < 1.2f)) d->cap = 0.72f;
-    GLuint vs = shader(GL_VERTEX_SHADER, k_vs, err);
-    GLuint fs = vs ? shader(GL_FRAGMENT_SHADER, k_fs, err) : 0;
-    if (!vs || !fs) {
-        if (vs) glDeleteShader(vs);
+    d->prog = sp_gl_program(k_vs, k_fs, "draw2d", err);
+    if (!d->prog) {
         free(d);
-        return NULL;
-    }
-    d->prog = glCreateProgram();
-    glAttachShader(d->prog, vs);
-    glAttachShader(d->prog, fs);
-    glLinkProgram(d->prog);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(d->prog, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        sp_fail(err, SP_ERR_INTERNAL, "draw2d: the shader does not link");
-        sp_draw2d_destroy(d);
         return NULL;
     }
     d->u_size = glGetUniformLocation(d->prog, "u_size");
