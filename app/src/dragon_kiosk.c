@@ -385,29 +385,23 @@ int main(int argc, char** argv)
         if (mode) win_w = mode->width, win_h = mode->height;
     }
     GLFWwindow* win = glfwCreateWindow(win_w, win_h, "Dragon kiosk", mon, NULL);
-    if (!win) {
-        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
-        glfwTerminate();
-        sp_kiosk_session_free(&session);
-        return SP_EXIT_INPUT;
-    }
-    glfwMakeContextCurrent(win);
+    if (win) glfwMakeContextCurrent(win);
     // A software rasteriser clears and shades every sample: without --msaa,
     // its window gets one sample a pixel (the 2D layers are anti-aliased
     // analytically anyway; screenshots still render with 4 samples).
-    const char* gl_name = (const char*)glGetString(GL_RENDERER);
+    const char* gl_name = win ? (const char*)glGetString(GL_RENDERER) : NULL;
     if (msaa < 0 && gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast"))) {
         glfwMakeContextCurrent(NULL);
         glfwDestroyWindow(win);
         glfwWindowHint(GLFW_SAMPLES, 0);
         win = glfwCreateWindow(win_w, win_h, "Dragon kiosk", mon, NULL);
-        if (!win) {
-            fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
-            glfwTerminate();
-            sp_kiosk_session_free(&session);
-            return SP_EXIT_INPUT;
-        }
-        glfwMakeContextCurrent(win);
+        if (win) glfwMakeContextCurrent(win);
+    }
+    if (!win) {
+        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
+        glfwTerminate();
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
     }
     glfwSwapInterval(script ? 0 : 1);
     if (mon) glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
