@@ -757,7 +757,8 @@ static void bbm_destroy(sp_model* m)
     free(B);
 }
 
-static const sp_model_ops bb_ops = {bbm_columns, bbm_prepare, bbm_update, bbm_abstraction, bbm_rows, bbm_jacobians, bbm_destroy};
+// No closed-form regularisers: the solver sums the representatives' rows.
+static const sp_model_ops bb_ops = {bbm_columns, bbm_prepare, bbm_update, bbm_abstraction, bbm_rows, bbm_jacobians, bbm_destroy, NULL, NULL, NULL};
 
 sp_solver* sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, const sp_camera* cam, const sp_solve_desc* desc)
 {

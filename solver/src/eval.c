@@ -59,6 +59,7 @@ void sp_rig_eval_destroy(sp_rig_eval* ev)
 
 const sp_mat4* sp_rig_eval_world(const sp_rig_eval* ev) { return ev->world; }
 const sp_mat4* sp_rig_eval_skin(const sp_rig_eval* ev) { return ev->skin; }
+const sp_mat4* sp_rig_eval_derivatives(const sp_rig_eval* ev) { return ev->deriv; }
 
 // Skew matrix [a]x with translation c, as an affine 4x4 with zero bottom row.
 static sp_mat4 affine_skew(sp_vec3 a, sp_vec3 c)
@@ -163,35 +164,38 @@ void sp_rig_eval_rows(const sp_rig_eval* ev, sp_skinned_points pts, const int* r
     for (int r = 0; r < nrows; ++r) skin_one(ev, pts, rows ? rows[r] : r, out + 3 * r);
 }
 
-void sp_rig_eval_jacobian(const sp_rig_eval* ev, sp_skinned_points pts, const int* rows, int nrows, double* J)
+void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int i, double scale, double* J)
 {
     const sp_rig* rig = ev->rig;
     const int P = rig->param_count;
-    memset(J, 0, sizeof(double) * 3 * (size_t)nrows * (size_t)P);
     if (P == 0 || !ev->has_deriv) return;
-    for (int r = 0; r < nrows; ++r) {
-        int i = rows ? rows[r] : r;
-        sp_vec3 x0 = {pts.rest[3 * i], pts.rest[3 * i + 1], pts.rest[3 * i + 2]};
-        double* jx = J + (size_t)(3 * r) * P;
-        double* jy = jx + P;
-        double* jz = jy + P;
-        for (int k = 0; k < SP_INFLUENCES; ++k) {
-            double w = pts.weights[4 * i + k];
-            if (w == 0.0) continue;
-            int j = pts.joints[4 * i + k];
-            sp_vec3 y = sp_v3_scale(sp_mat4_point(&ev->skin[j], x0), w);
-            // Every parameter on j and its ancestors moves this influence.
-            for (int a = j; a >= 0; a = rig->joints[a].parent) {
-                const sp_joint* ja = &rig->joints[a];
-                for (int q = ja->first_param; q < ja->first_param + ja->param_count; ++q) {
-                    const double* d = ev->deriv[q].m;
-                    jx[q] += d[0] * y.x + d[4] * y.y + d[8] * y.z + d[12] * w;
-                    jy[q] += d[1] * y.x + d[5] * y.y + d[9] * y.z + d[13] * w;
-                    jz[q] += d[2] * y.x + d[6] * y.y + d[10] * y.z + d[14] * w;
-                }
+    sp_vec3 x0 = {pts.rest[3 * i], pts.rest[3 * i + 1], pts.rest[3 * i + 2]};
+    double* jx = J;
+    double* jy = jx + P;
+    double* jz = jy + P;
+    for (int k = 0; k < SP_INFLUENCES; ++k) {
+        double w = scale * pts.weights[4 * i + k];
+        if (w == 0.0) continue;
+        int j = pts.joints[4 * i + k];
+        sp_vec3 y = sp_v3_scale(sp_mat4_point(&ev->skin[j], x0), w);
+        // Every parameter on j and its ancestors moves this influence.
+        for (int a = j; a >= 0; a = rig->joints[a].parent) {
+            const sp_joint* ja = &rig->joints[a];
+            for (int q = ja->first_param; q < ja->first_param + ja->param_count; ++q) {
+                const double* d = ev->deriv[q].m;
+                jx[q] += d[0] * y.x + d[4] * y.y + d[8] * y.z + d[12] * w;
+                jy[q] += d[1] * y.x + d[5] * y.y + d[9] * y.z + d[13] * w;
+                jz[q] += d[2] * y.x + d[6] * y.y + d[10] * y.z + d[14] * w;
             }
         }
     }
+}
+
+void sp_rig_eval_jacobian(const sp_rig_eval* ev, sp_skinned_points pts, const int* rows, int nrows, double* J)
+{
+    const int P = ev->rig->param_count;
+    memset(J, 0, sizeof(double) * 3 * (size_t)nrows * (size_t)P);
+    for (int r = 0; r < nrows; ++r) sp_rig_eval_jacobian_add(ev, pts, rows ? rows[r] : r, 1.0, J + (size_t)(3 * r) * P);
 }
 
 void sp_rig_eval_abstraction(const sp_rig_eval* ev, const sp_abstraction* a, const double* mesh_xyz, double* out)

@@ -47,6 +47,17 @@ typedef struct sp_model_ops {
     void (*jacobians)(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, double* Jz,
                       const sparse_block* rep_sb, const int* rep_cols, double* Jr);
     void (*destroy)(sp_model* m);
+    // W_plane and W_dist in closed form, used when prepare sets closed_reg
+    // (else the solver sums rows of the representatives' Jacobians, and these
+    // may be NULL). With r_i the displacement of representative reps[i] from
+    // the state at reg_prepare, v_i its viewing direction and d_i its
+    // distance weight, reg_energy gives
+    // sum_i (v_i . r_i)^2 and sum_i d_i |r_i|^2 at the state, and reg_normal
+    // adds the Gauss-Newton H (upper triangle, P x P row-major) and g of
+    // wp * W_plane + wd * W_dist at the last update with derivatives.
+    void (*reg_prepare)(sp_model* m, const int* reps, int k, const sp_vec3* view, const double* d);
+    void (*reg_energy)(sp_model* m, double* plane, double* dist);
+    void (*reg_normal)(sp_model* m, double wp, double wd, double* H, double* g);
 } sp_model_ops;
 
 struct sp_model {
@@ -58,6 +69,7 @@ struct sp_model {
     const sp_abstraction* ab; // curves, correspondence, point_count (other fields by implementation)
     bool embedded;            // a draw-over curve embedded in the surface: local edits
     int placement_count;      // the first n parameters place the root (first solve stage); 0: no such stage
+    bool closed_reg;          // prepare chose the reg_* calls for W_plane and W_dist (see sp_model_ops)
     bool failed;              // an evaluation failed (black-box rigs); `error` says why
     sp_error error;
 };

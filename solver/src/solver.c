@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include "solver_internal.h"
+#include "sp/curve.h"
 
 // The reference setup the paper's default weights are tuned for, in the
 // spirit of its Maya scenes: an abstraction 500 pixels across matched with
@@ -49,6 +50,10 @@ static int cmp_int(const void* a, const void* b) { return *(const int*)a - *(con
 // The model's calls (model.h), and bounds as sp_rig_clamp has them.
 static inline void model_update(sp_solver* s, const double* p, bool derivatives) { s->model->ops->update(s->model, p, derivatives); }
 static inline void model_rows(sp_solver* s, double* xyz) { s->model->ops->rows(s->model, s->reps, s->k, xyz); }
+// W_plane and W_dist are computed in closed form by the model (LBS rigs
+// where that is cheaper), or from the representatives' rows.
+static inline bool closed_form_reg(const sp_solver* s) { return s->model->closed_reg; }
+static inline bool has_reg(const sp_solver* s) { return s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0); }
 static void model_defaults(const sp_solver* s, double* p)
 {
     for (int i = 0; i < s->P; ++i) p[i] = s->model->params[i].def;
@@ -370,7 +375,12 @@ static sp_energy_terms energy(sp_solver* s, const double* p)
         double u = (p[i] - s->p0[i]) / s->unit[i];
         e.pose += u * u;
     }
-    if (s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0)) {
+    if (has_reg(s) && closed_form_reg(s)) {
+        double ep, ed;
+        s->model->ops->reg_energy(s->model, &ep, &ed);
+        e.plane = vertex_weight(s) * ep;
+        e.dist = vertex_weight(s) * ed;
+    } else if (has_reg(s)) {
         model_rows(s, s->xr);
         double inv = vertex_weight(s);
         for (int i = 0; i < s->k; ++i) {
@@ -395,7 +405,7 @@ static sp_energy_terms energy(sp_solver* s, const double* p)
 // the 3D blocks of the representatives (s->Jr) at the current rig state.
 static void jacobian_blocks(sp_solver* s)
 {
-    s->model->ops->jacobians(s->model, s->reps, s->k, s->ab_sb, s->ab_cols, s->Jz, s->rep_sb, s->rep_cols, s->Jr);
+    s->model->ops->jacobians(s->model, s->reps, closed_form_reg(s) ? 0 : s->k, s->ab_sb, s->ab_cols, s->Jz, s->rep_sb, s->rep_cols, s->Jr);
     for (int i = 0; i < s->ab->point_count; ++i) {
         const sparse_block* sb = &s->ab_sb[i];
         double C[6];
@@ -549,7 +559,10 @@ static void normal_equations(sp_solver* s, const double* p)
             }
         }
     }
-    if (s->k > 0 && (s->d.lambda_plane > 0 || s->d.lambda_dist > 0)) {
+    if (has_reg(s) && closed_form_reg(s)) {
+        double inv = vertex_weight(s) * s->vertex_boost;
+        s->model->ops->reg_normal(s->model, s->d.lambda_plane * inv, s->d.lambda_dist * inv, s->H, s->g);
+    } else if (has_reg(s)) {
         double inv = vertex_weight(s) * s->vertex_boost;
         for (int i = 0; i < s->k; ++i) {
             const sparse_block* sb = &s->rep_sb[i];
@@ -624,7 +637,8 @@ static bool lm_step(sp_solver* s, const double* p, double mu, double* delta)
             b[i] = r;
         }
         // A is symmetric: column-major saves LAPACKE's transposed copy.
-        ok = LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', nf, 1, A, nf, b, nf) == 0;
+        // The _work form skips LAPACKE's NaN scan of A (the result is checked below).
+        ok = LAPACKE_dposv_work(LAPACK_COL_MAJOR, 'U', nf, 1, A, nf, b, nf) == 0;
         bool inside = true;
         for (int i = 0; ok && i < nf; ++i) {
             const int q = idx[i];
@@ -691,45 +705,28 @@ static void prepare_start(sp_solver* s, const double* p, const sp_solve_report* 
     }
     for (int i = 0; i < s->k; ++i) s->dw[i] = dmax > 0 ? s->dw[i] / dmax : 0;
     memcpy(s->xr, s->x0, sizeof(double) * 3 * (size_t)s->k);
+    if (closed_form_reg(s)) s->model->ops->reg_prepare(s->model, s->reps, s->k, s->view, s->dw); // the state is p
 }
 
-// Per-curve and overall 2D errors from the current pairs at the current state.
-// Squared distance of x to segment ab (the report's errors take one square
-// root per sample, not a hypot per segment).
-static double segment_distance2(sp_vec2 x, sp_vec2 a, sp_vec2 b)
+// The polyline distances of closest pairs (see fill_errors): queries of
+// direction `dir` (and curve `curve` for dir 0) against polylines p/next.
+// Leaves d[] alone for other pairs or when out of memory (d is then the
+// sample-to-sample distance, an upper bound).
+static void polyline_errors(const sp_solver* s, int dir, int curve, const sp_vec2* p, const int* next, int n, double* d)
 {
-    sp_vec2 ab = sp_v2_sub(b, a), ax = sp_v2_sub(x, a);
-    double l2 = sp_v2_dot(ab, ab);
-    double t = l2 > 0 ? fmin(1.0, fmax(0.0, sp_v2_dot(ax, ab) / l2)) : 0.0;
-    sp_vec2 d = sp_v2_sub(ax, (sp_vec2){t * ab.x, t * ab.y});
-    return sp_v2_dot(d, d);
-}
-
-// Distance of x to projected curve c (its polyline through the points).
-static double curve_distance(const sp_solver* s, int c, sp_vec2 x)
-{
-    const sp_curve* cv = &s->ab->curves[c];
-    const double* z = s->z2 + 2 * (size_t)cv->first_point;
-    double best = INFINITY;
-    int n = cv->point_count, segs = cv->closed ? n : n - 1;
-    if (n == 1) return sp_v2_len(sp_v2_sub(x, (sp_vec2){z[0], z[1]}));
-    for (int k = 0; k < segs; ++k) {
-        int k2 = k + 1 < n ? k + 1 : 0;
-        best = fmin(best, segment_distance2(x, (sp_vec2){z[2 * k], z[2 * k + 1]}, (sp_vec2){z[2 * k2], z[2 * k2 + 1]}));
+    sp_vec2* q = malloc(sizeof(sp_vec2) * (size_t)(s->pair_count + 1));
+    int* which = malloc(sizeof(int) * (size_t)(s->pair_count + 1));
+    double* out = malloc(sizeof(double) * (size_t)(s->pair_count + 1));
+    int nq = 0;
+    for (int i = 0; q && which && out && i < s->pair_count; ++i) {
+        const pair* pr = &s->pairs[i];
+        if (pr->dir != dir || (dir == 0 && pr->curve != curve)) continue;
+        which[nq] = i;
+        q[nq++] = dir == 0 ? pr->y : sample_at(s, pr->s);
     }
-    return sqrt(best);
-}
-
-// Distance of x to the resampled strokes of the last closest-point matching.
-static double stroke_distance(const sp_solver* s, sp_vec2 x)
-{
-    double best = INFINITY;
-    for (int k = 0; k < s->ypoly_count; ++k) {
-        bool joined = k + 1 < s->ypoly_count && s->ypoly_stroke[k + 1] == s->ypoly_stroke[k];
-        sp_vec2 d = sp_v2_sub(x, s->ypoly[k]);
-        best = fmin(best, joined ? segment_distance2(x, s->ypoly[k], s->ypoly[k + 1]) : sp_v2_dot(d, d));
-    }
-    return sqrt(best);
+    if (nq > 0 && sp_polyline_distances(p, next, n, q, nq, out) == SP_OK)
+        for (int k = 0; k < nq; ++k) d[which[k]] = fmin(d[which[k]], out[k]);
+    free(q), free(which), free(out);
 }
 
 // The report's 2D errors. Ordered pairs: the distance between corresponding
@@ -742,19 +739,38 @@ static void fill_errors(sp_solver* s, sp_solve_report* rep)
     double sum = 0, mx = 0;
     double csum[SP_REPORT_CURVES] = {0}, cmax[SP_REPORT_CURVES] = {0};
     int cn[SP_REPORT_CURVES] = {0};
+    // Out of memory, d stays NULL and every pair keeps its sample distance.
+    double* d = malloc(sizeof(double) * (size_t)(s->pair_count + 1));
+    for (int i = 0; d && i < s->pair_count; ++i) d[i] = sp_v2_len(sp_v2_sub(sample_at(s, s->pairs[i].s), s->pairs[i].y));
+    const int l = s->ab->point_count, ny = s->ypoly_count;
+    int* next = d && s->mode == SP_CORR_CLOSEST ? malloc(sizeof(int) * (size_t)(l > ny ? l + 1 : ny + 1)) : NULL;
+    sp_vec2* z = next ? malloc(sizeof(sp_vec2) * (size_t)(l + 1)) : NULL;
+    if (next && z) {
+        // Stroke samples to their curve's projected polyline.
+        for (int c = 0; c < s->ab->curve_count; ++c) {
+            const sp_curve* cv = &s->ab->curves[c];
+            for (int k = 0; k < cv->point_count; ++k) {
+                next[k] = k + 1 < cv->point_count ? k + 1 : (cv->closed && k > 0 ? 0 : -1);
+                z[k] = (sp_vec2){s->z2[2 * (cv->first_point + k)], s->z2[2 * (cv->first_point + k) + 1]};
+            }
+            polyline_errors(s, 0, c, z, next, cv->point_count, d);
+        }
+        // Curve samples to the resampled strokes (consecutive samples of one stroke are joined).
+        for (int k = 0; k < ny; ++k) next[k] = k + 1 < ny && s->ypoly_stroke[k + 1] == s->ypoly_stroke[k] ? k + 1 : -1;
+        if (ny > 0) polyline_errors(s, 1, -1, s->ypoly, next, ny, d);
+    }
+    free(next), free(z);
     for (int i = 0; i < s->pair_count; ++i) {
-        const pair* pr = &s->pairs[i];
-        double d = sp_v2_len(sp_v2_sub(sample_at(s, pr->s), pr->y));
-        if (s->mode == SP_CORR_CLOSEST)
-            d = fmin(d, pr->dir == 0 ? curve_distance(s, pr->curve, pr->y) : stroke_distance(s, sample_at(s, pr->s)));
-        sum += d;
-        if (d > mx) mx = d;
+        double di = d ? d[i] : sp_v2_len(sp_v2_sub(sample_at(s, s->pairs[i].s), s->pairs[i].y));
+        sum += di;
+        if (di > mx) mx = di;
         int c = s->pairs[i].curve;
         if (c >= 0 && c < SP_REPORT_CURVES) {
-            csum[c] += d, cn[c]++;
-            if (d > cmax[c]) cmax[c] = d;
+            csum[c] += di, cn[c]++;
+            if (di > cmax[c]) cmax[c] = di;
         }
     }
+    free(d);
     rep->mean_error_px = s->pair_count ? sum / s->pair_count : 0;
     rep->max_error_px = mx;
     for (int c = 0; c < rep->curve_count; ++c) {
@@ -961,7 +977,7 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
                 ++rep->iterations;
                 model_update(s, p, true);
                 project_abstraction(s);
-                if (s->k > 0) model_rows(s, s->xr);
+                if (s->k > 0 && !closed_form_reg(s)) model_rows(s, s->xr);
                 normal_equations(s, p);
                 choose_free(s, p, stage_active);
                 bool accepted = false;

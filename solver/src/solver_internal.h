@@ -89,11 +89,11 @@ struct sp_solver {
     double L;        // abstraction 2D diagonal at the start pose, pixels
     sp_correspondence mode; // how sp__build_pairs pairs samples now
     double pose_boost;      // >= 1: graduated W_pose weight, 1 in the final rounds
-    double vertex_boost;
+    double vertex_boost;    // >= 1: the same for W_plane and W_dist (draw-over only)
     int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke)
     bool c2s_valid;
     bool used_loop;            // the last attempt matched an outline in order first
-    bool keep_assignment;      // reuse c2s instead of assigning again    // >= 1: the same for W_plane and W_dist (draw-over only)
+    bool keep_assignment;      // reuse c2s instead of assigning again
 };
 
 #endif

@@ -347,6 +347,50 @@ static void test_closest_exact_ties(void)
     }
 }
 
+// Polyline distances by the sweep against every segment: a closed curve,
+// an open one with a long segment (the sweep's reach must cover it), a lone
+// point and a zero-length segment; queries around and far off; bad next[].
+static void test_polyline_distances(void)
+{
+    enum { N = 60, NQ = 400 };
+    sp_vec2 p[N], q[NQ];
+    int next[N];
+    double out[NQ];
+    sp_test_rng rng = {8};
+    for (int v = 0; v < 30; ++v) { // closed: a wobbly circle
+        double a = 2 * 3.14159265358979 * v / 30, r = sp_test_range(&rng, 80, 120);
+        p[v] = (sp_vec2){200 + r * cos(a), 200 + r * sin(a)};
+        next[v] = v + 1 < 30 ? v + 1 : 0;
+    }
+    for (int v = 30; v < 58; ++v) { // open, one segment 300 px long
+        p[v] = (sp_vec2){400 + 7 * (v - 30) + (v == 45 ? 300 : 0), 50 + sp_test_range(&rng, -20, 20)};
+        next[v] = v + 1 < 58 ? v + 1 : -1;
+    }
+    p[58] = (sp_vec2){650, 200}, next[58] = -1; // alone, above the long segment
+    p[59] = p[57], next[57] = 59, next[59] = -1;  // zero length
+    for (int i = 0; i < NQ; ++i) q[i] = (sp_vec2){sp_test_range(&rng, -300, 1100), sp_test_range(&rng, -300, 700)};
+    q[0] = (sp_vec2){650, 60}; // over the long segment, far from its ends
+    ENSURE(sp_polyline_distances(p, next, N, q, NQ, out) == SP_OK);
+    for (int i = 0; i < NQ; ++i) {
+        double best = INFINITY;
+        for (int v = 0; v < N; ++v) {
+            bool lone = next[v] < 0;
+            for (int u = 0; u < N && lone; ++u) lone = next[u] != v;
+            if (lone) best = fmin(best, sqrt(d2(q[i], p[v])));
+            if (next[v] < 0) continue;
+            sp_vec2 a = p[v], b = p[next[v]];
+            double l2 = d2(a, b), t = l2 > 0 ? ((q[i].x - a.x) * (b.x - a.x) + (q[i].y - a.y) * (b.y - a.y)) / l2 : 0;
+            t = fmin(1, fmax(0, t));
+            best = fmin(best, sqrt(d2(q[i], (sp_vec2){a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)})));
+        }
+        ENSURE_NEAR(out[i], best, 1e-9);
+    }
+    ENSURE(out[0] < 20);
+    next[3] = N;
+    ENSURE(sp_polyline_distances(p, next, N, q, NQ, out) == SP_ERR_INVALID);
+    ENSURE(sp_polyline_distances(p, next, 0, q, NQ, out) == SP_ERR_INVALID);
+}
+
 static void test_closest_kdtree(void)
 {
     int my = 1500, mz = 1200;
@@ -676,6 +720,7 @@ int main(int argc, char** argv)
                                    {"closest_kdtree", test_closest_kdtree},
                                    {"hungarian_vs_brute", test_hungarian_vs_brute},
                                    {"closest_exact_ties", test_closest_exact_ties},
+                                   {"polyline_distances", test_polyline_distances},
                                    {"assign_order_independent", test_assign_order_independent},
                                    {"assign_counts", test_assign_counts},
                                    {"assign_degenerate", test_assign_degenerate},

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "fixtures.h"
+#include "../../solver/src/model.h" // the LBS model's closed-form regularisers
 #include "sp/rig.h"
 #include "test.h"
 
@@ -310,6 +311,101 @@ static void test_animation_sampling(void)
     ENSURE_NEAR(t[0].y, 0.0, 1e-9);
 }
 
+// The LBS model's closed-form W_plane and W_dist (model_lbs.c: moments per
+// pair of joints) against the sums over representatives they replace, built
+// from the rig's own rows and Jacobian: energies, H (upper triangle) and g.
+// Skin weights are scrambled to four influences with repeated joints and
+// zeros, on a branching rig with translations and scales; viewing
+// directions per representative (perspective) or one for all (orthographic,
+// which the model stores factored).
+static void check_regularisers(bool one_view)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 14, .branching = true, .all_channels = true, .seed = 5, .ring_vertices = 5, .rings_per_bone = 3}, &rig);
+    sp_test_rng rng = {77};
+    for (int v = 0; v < rig.vertex_count; v += 2) {
+        for (int a = 0; a < 4; ++a) {
+            rig.joints4[4 * v + a] = (uint16_t)(sp_test_uniform(&rng) * rig.joint_count);
+            rig.weights4[4 * v + a] = sp_test_uniform(&rng) < 0.2 ? 0.0f : (float)sp_test_range(&rng, 0.1, 1.0);
+        }
+        if (v % 6 == 0) rig.joints4[4 * v + 1] = rig.joints4[4 * v]; // a joint listed twice
+    }
+    const int P = rig.param_count, k = rig.vertex_count / 3;
+    int* reps = malloc(sizeof(int) * k);
+    for (int i = 0; i < k; ++i) reps[i] = 3 * i;
+    sp_model* m = sp__model_lbs_create(&rig, 0);
+    ENSURE(m && m->ops->reg_normal && m->ops->prepare(m, reps, k));
+    double* p0 = malloc(sizeof(double) * P);
+    double* p1 = malloc(sizeof(double) * P);
+    double* d = malloc(sizeof(double) * k);
+    sp_vec3* view = malloc(sizeof(sp_vec3) * k);
+    sp_fixture_random_params(&rig, &rng, 0.8, p0);
+    sp_fixture_random_params(&rig, &rng, 0.8, p1);
+    for (int i = 0; i < k; ++i) {
+        view[i] = one_view && i > 0 ? view[0] : sp_v3_norm((sp_vec3){sp_test_range(&rng, -1, 1), sp_test_range(&rng, -1, 1), sp_test_range(&rng, 0.5, 1)});
+        d[i] = sp_test_uniform(&rng);
+    }
+    m->ops->update(m, p0, false);
+    m->ops->reg_prepare(m, reps, k, view, d);
+    m->ops->update(m, p1, true);
+    const double wp = 0.7, wd = 1.3;
+    double ep, ed;
+    m->ops->reg_energy(m, &ep, &ed);
+    double* H = calloc((size_t)P * P, sizeof(double));
+    double* g = calloc(P, sizeof(double));
+    m->ops->reg_normal(m, wp, wd, H, g);
+
+    // The reference: per representative, from rows and the dense Jacobian.
+    sp_rig_eval* ev = sp_rig_eval_create(&rig);
+    double* x0 = malloc(sizeof(double) * 3 * k);
+    double* x1 = malloc(sizeof(double) * 3 * k);
+    double* J = malloc(sizeof(double) * 3 * k * P);
+    sp_rig_eval_update(ev, p0, false);
+    sp_rig_eval_rows(ev, sp_rig_mesh_points(&rig), reps, k, x0);
+    sp_rig_eval_update(ev, p1, true);
+    sp_rig_eval_rows(ev, sp_rig_mesh_points(&rig), reps, k, x1);
+    sp_rig_eval_jacobian(ev, sp_rig_mesh_points(&rig), reps, k, J);
+    double* Hr = calloc((size_t)P * P, sizeof(double));
+    double* gr = calloc(P, sizeof(double));
+    double epr = 0, edr = 0;
+    for (int i = 0; i < k; ++i) {
+        double r[3], v[3] = {view[i].x, view[i].y, view[i].z}, vr = 0;
+        for (int c = 0; c < 3; ++c) r[c] = x1[3 * i + c] - x0[3 * i + c], vr += v[c] * r[c];
+        epr += vr * vr;
+        edr += d[i] * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        double W[3][3];
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) W[a][b] = wp * v[a] * v[b] + (a == b ? wd * d[i] : 0);
+        const double* Ji = J + (size_t)3 * i * P;
+        for (int q = 0; q < P; ++q)
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) {
+                    gr[q] += Ji[a * P + q] * W[a][b] * r[b];
+                    for (int s = q; s < P; ++s) Hr[q * P + s] += Ji[a * P + q] * W[a][b] * Ji[b * P + s];
+                }
+    }
+    ENSURE(epr > 1e-3 && edr > 1e-3); // the poses differ
+    ENSURE_NEAR(ep, epr, 1e-9 * epr);
+    ENSURE_NEAR(ed, edr, 1e-9 * edr);
+    double hmax = 0, gmax = 0;
+    for (int q = 0; q < P * P; ++q) hmax = fmax(hmax, fabs(Hr[q]));
+    for (int q = 0; q < P; ++q) gmax = fmax(gmax, fabs(gr[q]));
+    for (int q = 0; q < P; ++q) {
+        ENSURE_NEAR(g[q], gr[q], 1e-9 * gmax);
+        for (int s = q; s < P; ++s) ENSURE_NEAR(H[q * P + s], Hr[q * P + s], 1e-9 * hmax);
+    }
+    free(H), free(g), free(Hr), free(gr), free(x0), free(x1), free(J), free(p0), free(p1), free(d), free(view), free(reps);
+    sp_rig_eval_destroy(ev);
+    m->ops->destroy(m);
+    sp_rig_free(&rig);
+}
+
+static void test_regularisers_closed_form(void)
+{
+    check_regularisers(false);
+    check_regularisers(true);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv, (sp_test[]){
@@ -322,5 +418,6 @@ int main(int argc, char** argv)
         {"clamp", test_clamp},
         {"cameras", test_cameras},
         {"animation_sampling", test_animation_sampling},
+        {"regularisers_closed_form", test_regularisers_closed_form},
         {0}});
 }

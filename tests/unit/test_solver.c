@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../../solver/src/solver_internal.h" // the model's choice of regulariser path
 #include "fixtures.h"
 #include "sp/solver.h"
 #include "test.h"
@@ -177,6 +178,44 @@ static void test_bad_strokes(void)
     sp_rig_free(&st.rig);
 }
 
+// W_plane and W_dist from the LBS model's closed form or from rows of the
+// representatives' Jacobians (the model picks the cheaper per rig): the same
+// normal equations, so the same solve. Both forced on one rig and sketch.
+static void test_regulariser_paths_agree(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 8, .branching = true, .root_scale = true, .seed = 12});
+    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.time_cap_ms = 1e9});
+    ENSURE(s);
+    const int P = st.rig.param_count;
+    double* truth = malloc(sizeof(double) * P);
+    double* out[2] = {malloc(sizeof(double) * P), malloc(sizeof(double) * P)};
+    sp_test_rng rng = {5};
+    sp_fixture_random_params(&st.rig, &rng, 0.6, truth);
+    sp_sketch sk;
+    strokes_at(s, &st.rig, truth, &sk);
+    sp_solve_report rep[2];
+    for (int path = 0; path < 2; ++path) {
+        s->model->closed_reg = path == 1;
+        sp_error err = {0};
+        ENSURE(sp_solver_solve(s, &sk, NULL, out[path], &rep[path], &err) == SP_OK);
+    }
+    fprintf(stderr, "  rows: %d it, W %.9g; closed form: %d it, W %.9g\n", rep[0].iterations, rep[0].after.total, rep[1].iterations,
+            rep[1].after.total);
+    double dmax = 0;
+    for (int q = 0; q < P; ++q) dmax = fmax(dmax, fabs(out[1][q] - out[0][q]) / (1 + st.rig.params[q].max - st.rig.params[q].min));
+    fprintf(stderr, "  max parameter difference %.3g, errors %.4f %.4f px\n", dmax, rep[0].mean_error_px, rep[1].mean_error_px);
+    ENSURE(rep[0].iterations == rep[1].iterations && rep[0].iterations > 3);
+    ENSURE(rep[0].after.plane > 0 && rep[0].after.dist > 0);
+    ENSURE_NEAR(rep[1].after.plane, rep[0].after.plane, 1e-6 * rep[0].after.plane);
+    ENSURE_NEAR(rep[1].after.dist, rep[0].after.dist, 1e-6 * rep[0].after.dist);
+    for (int q = 0; q < P; ++q) ENSURE_NEAR(out[1][q], out[0][q], 1e-6 * (1 + st.rig.params[q].max - st.rig.params[q].min));
+    sp_sketch_free(&sk);
+    free(truth), free(out[0]), free(out[1]);
+    sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv, (sp_test[]){
@@ -184,5 +223,6 @@ int main(int argc, char** argv)
         {"bounds_exact", test_bounds_exact},
         {"order_independence_and_determinism", test_order_independence_and_determinism},
         {"bad_strokes", test_bad_strokes},
+        {"regulariser_paths_agree", test_regulariser_paths_agree},
         {0}});
 }

@@ -131,6 +131,15 @@ sp_result sp_corr_closest(const sp_vec2* y, int my, const sp_vec2* z, int mz, sp
 /// Above this many distance evaluations sp_corr_closest uses a k-d tree.
 enum { SP_CORR_BRUTE_MAX = 1 << 20 };
 
+/// Distance from each query q[i] to a set of polylines through p[0..n): the
+/// segments (v, next[v]) for every v with next[v] >= 0 (a closed curve links
+/// its last point to its first); a point in no segment counts on its own.
+/// Exact, by a sweep over the points sorted by x (a query stops where the x
+/// gap exceeds its best distance plus half the longest segment). out: nq
+/// distances. Returns SP_ERR_INVALID for n < 1 or a next[] index out of
+/// range; falls back to scanning every segment when out of memory.
+sp_result sp_polyline_distances(const sp_vec2* p, const int* next, int n, const sp_vec2* q, int nq, double* out);
+
 // ---------------------------------------------------------------------------
 // Assignment (drawing-order independence)
 

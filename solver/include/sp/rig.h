@@ -197,6 +197,10 @@ void sp_rig_eval_update(sp_rig_eval* ev, const double* p, bool derivatives);
 const sp_mat4* sp_rig_eval_world(const sp_rig_eval* ev);
 /// Skin matrices G_j * IBM_j after the last update (joint_count).
 const sp_mat4* sp_rig_eval_skin(const sp_rig_eval* ev);
+/// Derivative operators D_k after the last update with derivatives (param_count;
+/// affine, rows 0..2 used): dG_j/dp_k = D_k * G_j for every joint j at or below
+/// parameter k's joint.
+const sp_mat4* sp_rig_eval_derivatives(const sp_rig_eval* ev);
 /// Skins every point: out is pts.count by 3.
 void sp_rig_eval_points(const sp_rig_eval* ev, sp_skinned_points pts, double* out);
 /// Skins only rows[0..nrows): out is nrows by 3.
@@ -205,6 +209,10 @@ void sp_rig_eval_rows(const sp_rig_eval* ev, sp_skinned_points pts, const int* r
 /// 0..nrows-1): J is (3*nrows) by param_count, row-major, overwritten.
 /// Requires an update with derivatives.
 void sp_rig_eval_jacobian(const sp_rig_eval* ev, sp_skinned_points pts, const int* rows, int nrows, double* J);
+/// Adds point i's Jacobian times `scale` into J (3 by param_count,
+/// row-major) without clearing it: a caller that gathers a few columns per
+/// point clears just those instead of all 3 * param_count entries.
+void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int i, double scale, double* J);
 /// Abstraction points in world space (a->point_count by 3), skinned or
 /// embedded. `mesh_xyz` (vertex_count by 3, current pose) is needed only for
 /// embedded abstractions and may be NULL otherwise.
