@@ -718,11 +718,12 @@ static void bbm_rows(sp_model* m, const int* rows, int n, double* xyz)
         memcpy(xyz + 3 * i, B->x + 3 * (size_t)rows[i], sizeof(double) * 3);
 }
 
-static void bbm_jacobians(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, double* Jz,
-                          const sparse_block* rep_sb, const int* rep_cols, double* Jr)
+static void bbm_jacobians(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, const bool* ab_used,
+                          double* Jz, const sparse_block* rep_sb, const int* rep_cols, double* Jr)
 {
     bb_model* B = (bb_model*)m;
-    (void)reps, (void)k, (void)ab_cols, (void)rep_cols, (void)ab_sb, (void)rep_sb;
+    // Finite differences give every point at once: ab_used saves nothing here.
+    (void)reps, (void)k, (void)ab_cols, (void)rep_cols, (void)ab_sb, (void)rep_sb, (void)ab_used;
     // Dense blocks one after the other are exactly the engine's row-major
     // (3 * points) x P layout (bbm_columns lists every parameter).
     size_t P = (size_t)m->P, nr = 3 * (size_t)k * P, nz = 3 * (size_t)m->ab->point_count * P;

@@ -173,20 +173,46 @@ void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int 
     double* jx = J;
     double* jy = jx + P;
     double* jz = jy + P;
+    // dx/dp_q = D_q (sum of w_j (y_j, 1) over the influences j at or below
+    // q's joint): the influences' sums are carried up the skeleton together,
+    // deepest joint first (parents precede children), so that an ancestor
+    // shared by several influences is applied once, not once per influence.
+    int joint[SP_INFLUENCES], n = 0;
+    double acc[SP_INFLUENCES][4];
     for (int k = 0; k < SP_INFLUENCES; ++k) {
         double w = scale * pts.weights[4 * i + k];
         if (w == 0.0) continue;
-        int j = pts.joints[4 * i + k];
-        sp_vec3 y = sp_v3_scale(sp_mat4_point(&ev->skin[j], x0), w);
-        // Every parameter on j and its ancestors moves this influence.
-        for (int a = j; a >= 0; a = rig->joints[a].parent) {
-            const sp_joint* ja = &rig->joints[a];
-            for (int q = ja->first_param; q < ja->first_param + ja->param_count; ++q) {
-                const double* d = ev->deriv[q].m;
-                jx[q] += d[0] * y.x + d[4] * y.y + d[8] * y.z + d[12] * w;
-                jy[q] += d[1] * y.x + d[5] * y.y + d[9] * y.z + d[13] * w;
-                jz[q] += d[2] * y.x + d[6] * y.y + d[10] * y.z + d[14] * w;
+        sp_vec3 y = sp_mat4_point(&ev->skin[pts.joints[4 * i + k]], x0);
+        joint[n] = pts.joints[4 * i + k];
+        acc[n][0] = w * y.x, acc[n][1] = w * y.y, acc[n][2] = w * y.z, acc[n][3] = w;
+        ++n;
+    }
+    while (n > 0) {
+        int a = joint[0];
+        for (int k = 1; k < n; ++k)
+            if (joint[k] > a) a = joint[k];
+        double Y[4] = {0, 0, 0, 0};
+        for (int k = 0; k < n;) {
+            if (joint[k] != a) {
+                ++k;
+                continue;
             }
+            for (int c = 0; c < 4; ++c) Y[c] += acc[k][c];
+            --n;
+            joint[k] = joint[n];
+            memcpy(acc[k], acc[n], sizeof acc[k]);
+        }
+        const sp_joint* ja = &rig->joints[a];
+        for (int q = ja->first_param; q < ja->first_param + ja->param_count; ++q) {
+            const double* d = ev->deriv[q].m;
+            jx[q] += d[0] * Y[0] + d[4] * Y[1] + d[8] * Y[2] + d[12] * Y[3];
+            jy[q] += d[1] * Y[0] + d[5] * Y[1] + d[9] * Y[2] + d[13] * Y[3];
+            jz[q] += d[2] * Y[0] + d[6] * Y[1] + d[10] * Y[2] + d[14] * Y[3];
+        }
+        if (ja->parent >= 0) {
+            joint[n] = ja->parent;
+            memcpy(acc[n], Y, sizeof Y);
+            ++n;
         }
     }
 }

@@ -43,9 +43,10 @@ typedef struct sp_model_ops {
     // 3D Jacobian blocks at the state of the last update with derivatives:
     // per abstraction point (Jz) and per representative (Jr) a 3 x count
     // row-major block over that point's column list, at 3 * first in the
-    // pool.
-    void (*jacobians)(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, double* Jz,
-                      const sparse_block* rep_sb, const int* rep_cols, double* Jr);
+    // pool. ab_used (point_count flags, NULL: all): only these points' blocks
+    // are needed (others may be left as they are).
+    void (*jacobians)(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, const bool* ab_used,
+                      double* Jz, const sparse_block* rep_sb, const int* rep_cols, double* Jr);
     void (*destroy)(sp_model* m);
     // W_plane and W_dist in closed form, used when prepare sets closed_reg
     // (else the solver sums rows of the representatives' Jacobians, and these

@@ -224,6 +224,7 @@ static bool lbs_prepare(sp_model* m, const int* reps, int k)
         R->reach_first[nj] = total;
         if (!pass) ok = (R->reach = malloc(sizeof(int) * ((size_t)total + 1))) != NULL;
     }
+    free(tmp);
     // Closed form or rows, by their multiply-adds per Gauss-Newton H: about
     // 100 per partner-parameter product K E (with one view direction; about
     // 200 with a perspective camera, which this does not know) and 12 per
@@ -473,8 +474,8 @@ static void gather_clear(double* J, int P, const int* cols, int n, double* Jb)
     }
 }
 
-static void lbs_jacobians(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, double* Jz,
-                          const sparse_block* rep_sb, const int* rep_cols, double* Jr)
+static void lbs_jacobians(sp_model* m, const int* reps, int k, const sparse_block* ab_sb, const int* ab_cols, const bool* ab_used,
+                          double* Jz, const sparse_block* rep_sb, const int* rep_cols, double* Jr)
 {
     lbs_model* L = (lbs_model*)m;
     const sp_rig* rig = L->rig;
@@ -483,6 +484,7 @@ static void lbs_jacobians(sp_model* m, const int* reps, int k, const sparse_bloc
     double* J = L->scratch; // 3 x P, all zero between points
     for (int i = 0; i < ab->point_count; ++i) {
         const sparse_block* sb = &ab_sb[i];
+        if (ab_used && !ab_used[i]) continue;
         if (ab->rest) {
             sp_skinned_points pts = {ab->point_count, ab->rest, ab->joints, ab->weights};
             sp_rig_eval_jacobian_add(L->ev, pts, i, 1.0, J);

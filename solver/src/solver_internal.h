@@ -73,6 +73,7 @@ struct sp_solver {
     double* match_aa;   // point_count by 3: summed 2x2 match weights per point (xx, xy, yy)
     double* match_ab;   // point_count by 3: coupling of the segment starting at each point
     double* match_beta; // point_count by 2: weighted residual per point
+    bool* ab_used;      // point_count: a pair's sample lies on the point (jacobian_blocks)
     row_group* groups;
     int group_count;
     int* ab_grp;        // point_count: group of each abstraction point
