@@ -132,7 +132,7 @@ typedef struct topo_search {
 static void topo_visit(topo_search* t, int s, int breaks, double cost)
 {
     if (breaks > t->best_breaks || (breaks == t->best_breaks && cost >= t->best_cost)) return;
-    if (s == t->n) {
+    if (s >= t->n || s >= TOPO_MAX) { // n <= TOPO_MAX; the second test tells the compiler so
         t->best_breaks = breaks, t->best_cost = cost;
         memcpy(t->best, t->perm, sizeof t->perm);
         return;
