@@ -143,6 +143,35 @@ static double ordered_cost(const sp_vec2* y, const sp_vec2* z, int m, bool rever
     return c;
 }
 
+int sp_corr_ordered_candidates(const sp_vec2* y, const sp_vec2* z, int m, sp_ordered_info* out, int k)
+{
+    if (m < 3 || k < 1 || !sp_curve_is_valid(y, m) || !sp_curve_is_valid(z, m)) return 0;
+    double* cost = malloc(sizeof(double) * 2 * (size_t)m);
+    if (!cost) return 0;
+    for (int rev = 0; rev < 2; ++rev)
+        for (int s = 0; s < m; ++s) cost[rev * m + s] = ordered_cost(y, z, m, rev, s, INFINITY);
+    int n = 0, sep = m / 20 > 1 ? m / 20 : 1;
+    while (n < k) {
+        // The cheapest local minimum not near one already taken.
+        int bi = -1;
+        for (int i = 0; i < 2 * m; ++i) {
+            int rev = i / m, s = i % m;
+            double c = cost[i];
+            if (!isfinite(c) || c > cost[rev * m + (s + 1) % m] || c > cost[rev * m + (s + m - 1) % m]) continue;
+            bool near = false;
+            for (int t = 0; t < n && !near; ++t) {
+                int d = abs(out[t].shift - s);
+                near = out[t].reversed == (rev != 0) && (d < sep || m - d < sep);
+            }
+            if (!near && (bi < 0 || c < cost[bi])) bi = i;
+        }
+        if (bi < 0) break;
+        out[n++] = (sp_ordered_info){bi >= m, bi % m, cost[bi]};
+    }
+    free(cost);
+    return n;
+}
+
 sp_result sp_corr_ordered(const sp_vec2* y, const sp_vec2* z, int m, bool closed, int* match, sp_ordered_info* info)
 {
     if (m < 1) return SP_ERR_INVALID;

@@ -203,6 +203,25 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
     return true;
 }
 
+// The loop's best shifts at the current projection, for sp_solver_solve's
+// second hypotheses (declared there).
+int sp__loop_candidates(sp_solver* s, const sp_sketch* sk, sp_ordered_info* out, int k, int* m)
+{
+    const sp_curve* cv = &s->ab->curves[0];
+    *m = samples_for(s, cv, curve_length2d(s, cv));
+    sp_vec2* y = malloc(sizeof(sp_vec2) * (size_t)*m);
+    sp_vec2* z = malloc(sizeof(sp_vec2) * (size_t)*m);
+    sample_ref* refs = malloc(sizeof(sample_ref) * (size_t)*m);
+    int n = 0;
+    if (y && z && refs && sp_curve_resample(sk->strokes[0].points, sk->strokes[0].count, true, *m, y) == SP_OK) {
+        resample_refs(s, cv, *m, refs);
+        for (int i = 0; i < *m; ++i) z[i] = ref_pos(s, refs[i]);
+        n = sp_corr_ordered_candidates(y, z, *m, out, k);
+    }
+    free(y), free(z), free(refs);
+    return n;
+}
+
 sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err)
 {
     const sp_abstraction* ab = s->ab;
@@ -265,7 +284,16 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
             resample_refs(s, cv, m, refs);
             for (int k = 0; k < m; ++k) z[k] = ref_pos(s, refs[k]);
             sp_ordered_info info;
-            res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
+            if (s->loop_forced && cv->closed && C == 1) {
+                // A hypothesis of sp_solver_solve: the loop's shift and direction held.
+                info = s->loop_hypothesis;
+                for (int k = 0; k < m; ++k) {
+                    int j = (info.reversed ? info.shift - k : info.shift + k) % m;
+                    match[k] = j < 0 ? j + m : j;
+                }
+            } else {
+                res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
+            }
             if (res != SP_OK) {
                 sp_fail(err, res, "stroke %d: no ordered correspondence", st);
                 goto ordered_done;

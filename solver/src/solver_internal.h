@@ -3,6 +3,7 @@
 #define SP_SOLVER_INTERNAL_H
 
 #include "model.h"
+#include "sp/curve.h"
 #include "sp/solver.h"
 
 // A sample on a projected curve: (1 - t) * point a + t * point b.
@@ -94,6 +95,8 @@ struct sp_solver {
     int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke)
     bool c2s_valid;
     bool used_loop;            // the last attempt matched an outline in order first
+    bool loop_forced;          // a loop's ordered pairs use loop_hypothesis instead of the best shift
+    sp_ordered_info loop_hypothesis;
     bool keep_assignment;      // reuse c2s instead of assigning again
 };
 

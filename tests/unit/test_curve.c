@@ -391,6 +391,53 @@ static void test_polyline_distances(void)
     ENSURE(sp_polyline_distances(p, next, 0, q, NQ, out) == SP_ERR_INVALID);
 }
 
+static double ordered_cost_ref(const sp_vec2* y, const sp_vec2* z, int m, bool rev, int shift)
+{
+    double c = 0;
+    for (int i = 0; i < m; ++i) c += d2(y[i], z[(((rev ? shift - i : shift + i) % m) + m) % m]);
+    return c;
+}
+
+// The candidates of the ordered matching on a closed curve: a stroke that is
+// the curve started 17 samples on puts shift 17 first at zero cost, drawn
+// backwards the reversed direction; the list holds local minima of the cost
+// only, best first, none within m / 20 of a better one of its direction, at
+// most k.
+static void test_ordered_candidates(void)
+{
+    enum { M = 80 };
+    sp_vec2 z[M], y[M], yr[M];
+    for (int i = 0; i < M; ++i) {
+        double a = 2 * 3.14159265358979 * i / M;
+        z[i] = (sp_vec2){300 + (100 + 40 * cos(3 * a)) * cos(a), 200 + (100 + 40 * cos(3 * a)) * sin(a)}; // three lobes
+    }
+    for (int i = 0; i < M; ++i) y[i] = z[(i + 17) % M], yr[i] = z[((17 - i) % M + M) % M];
+    sp_ordered_info c[6];
+    int n = sp_corr_ordered_candidates(y, z, M, c, 6);
+    ENSURE(n >= 3); // a three-lobed outline has more than one local minimum
+    ENSURE(!c[0].reversed && c[0].shift == 17 && c[0].cost < 1e-9);
+    for (int t = 1; t < n; ++t) {
+        ENSURE(c[t].cost >= c[t - 1].cost);
+        for (int u = 0; u < t; ++u) {
+            int d = abs(c[t].shift - c[u].shift);
+            ENSURE(c[t].reversed != c[u].reversed || (d >= M / 20 && M - d >= M / 20));
+        }
+    }
+    for (int t = 0; t < n; ++t) { // each is its cost, no higher than its neighbours'
+        double here = ordered_cost_ref(y, z, M, c[t].reversed, c[t].shift);
+        ENSURE_NEAR(c[t].cost, here, 1e-9 * (1 + here));
+        ENSURE(here <= ordered_cost_ref(y, z, M, c[t].reversed, (c[t].shift + 1) % M));
+        ENSURE(here <= ordered_cost_ref(y, z, M, c[t].reversed, (c[t].shift + M - 1) % M));
+    }
+    sp_ordered_info info;
+    ENSURE(sp_corr_ordered(y, z, M, true, NULL, &info) == SP_OK && info.shift == c[0].shift && !info.reversed);
+    ENSURE(sp_corr_ordered_candidates(yr, z, M, c, 2) == 2 && c[0].reversed && c[0].shift == 17 && c[0].cost < 1e-9);
+    ENSURE(sp_corr_ordered_candidates(y, z, M, c, 1) == 1);
+    ENSURE(sp_corr_ordered_candidates(y, z, 2, c, 4) == 0);
+    y[5].x = NAN;
+    ENSURE(sp_corr_ordered_candidates(y, z, M, c, 4) == 0);
+}
+
 static void test_closest_kdtree(void)
 {
     int my = 1500, mz = 1200;
@@ -721,6 +768,7 @@ int main(int argc, char** argv)
                                    {"hungarian_vs_brute", test_hungarian_vs_brute},
                                    {"closest_exact_ties", test_closest_exact_ties},
                                    {"polyline_distances", test_polyline_distances},
+                                   {"ordered_candidates", test_ordered_candidates},
                                    {"assign_order_independent", test_assign_order_independent},
                                    {"assign_counts", test_assign_counts},
                                    {"assign_degenerate", test_assign_degenerate},

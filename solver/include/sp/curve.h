@@ -106,6 +106,13 @@ typedef struct sp_ordered_info {
 /// info: may be NULL. Returns SP_ERR_INVALID for m < 1 or non-finite input.
 sp_result sp_corr_ordered(const sp_vec2* y, const sp_vec2* z, int m, bool closed, int* match, sp_ordered_info* info);
 
+/// The alternatives sp_corr_ordered chooses from on a closed curve, best
+/// first: the local minima of its cost over the cyclic shifts of each
+/// direction, at most k, no two of one direction within m / 20 shifts of
+/// each other. Returns how many were written to out (0 for m < 3, k < 1,
+/// non-finite input or no memory).
+int sp_corr_ordered_candidates(const sp_vec2* y, const sp_vec2* z, int m, sp_ordered_info* out, int k);
+
 /// One correspondence: y[y] <-> z[z].
 typedef struct sp_corr_pair {
     int y; ///< index into the stroke samples
