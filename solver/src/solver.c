@@ -971,6 +971,7 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
             s->pose_boost = stage != 1 ? 1.0 : fmax(1.0, 1e7 / pow(loop_first ? 6.0 : 4.0, round));
             s->vertex_boost = s->model->embedded ? s->pose_boost : 1.0;
             cur = energy(s, p);
+            bool z_at_p = true; // the abstraction was last projected at p (by energy)
             double round_start = cur.total;
             // Few Gauss-Newton iterations per round: correspondences from
             // the previous pose go stale quickly, and while the weights are
@@ -989,7 +990,7 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
                 }
                 ++rep->iterations;
                 model_update(s, p, true);
-                project_abstraction(s);
+                if (!z_at_p) project_abstraction(s); // else the accepted step's energy did it (same values)
                 if (s->k > 0 && !closed_form_reg(s)) model_rows(s, s->xr);
                 normal_equations(s, p);
                 choose_free(s, p, stage_active);
@@ -1007,10 +1008,12 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
                         double gain = (cur.total - e.total) / fmax(cur.total, 1e-300);
                         memcpy(p, pn, sizeof(double) * (size_t)P);
                         cur = e;
+                        z_at_p = true;
                         mu = fmax(mu / 3, 1e-7);
                         if (gain < 1e-9) it = max_it; // this linearisation is exhausted
                     } else {
                         mu *= 4;
+                        z_at_p = false;
                     }
                 }
                 if (!accepted) break;
