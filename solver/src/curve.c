@@ -143,6 +143,14 @@ static double ordered_cost(const sp_vec2* y, const sp_vec2* z, int m, bool rever
     return c;
 }
 
+void sp_corr_ordered_match(const sp_ordered_info* c, int m, int* match)
+{
+    for (int i = 0; i < m; ++i) {
+        int j = (c->reversed ? c->shift - i : c->shift + i) % m;
+        match[i] = j < 0 ? j + m : j;
+    }
+}
+
 int sp_corr_ordered_candidates(const sp_vec2* y, const sp_vec2* z, int m, sp_ordered_info* out, int k)
 {
     if (m < 3 || k < 1 || !sp_curve_is_valid(y, m) || !sp_curve_is_valid(z, m)) return 0;
@@ -191,11 +199,7 @@ sp_result sp_corr_ordered(const sp_vec2* y, const sp_vec2* z, int m, bool closed
         best = (sp_ordered_info){false, 0, ordered_cost(y, z, m, false, 0, INFINITY)};
         if (isnan(best.cost)) return SP_ERR_INVALID;
     }
-    if (match)
-        for (int i = 0; i < m; ++i) {
-            int j = best.reversed ? best.shift - i : best.shift + i;
-            match[i] = j < 0 ? j + m : (j >= m ? j - m : j);
-        }
+    if (match) sp_corr_ordered_match(&best, m, match);
     if (!closed) best.shift = 0;
     if (info) *info = best;
     return SP_OK;

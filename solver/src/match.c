@@ -287,10 +287,7 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
             if (s->loop_forced && cv->closed && C == 1) {
                 // A hypothesis of sp_solver_solve: the loop's shift and direction held.
                 info = s->loop_hypothesis;
-                for (int k = 0; k < m; ++k) {
-                    int j = (info.reversed ? info.shift - k : info.shift + k) % m;
-                    match[k] = j < 0 ? j + m : j;
-                }
+                sp_corr_ordered_match(&info, m, match);
             } else {
                 res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
             }

@@ -74,6 +74,14 @@ static void model_clamp(const sp_solver* s, double* p)
     }
 }
 
+// The pose a solve starts from: p_start (NULL: the defaults) inside the bounds.
+static void start_pose(const sp_solver* s, const double* p_start, double* p)
+{
+    if (p_start) memcpy(p, p_start, sizeof(double) * (size_t)s->P);
+    else model_defaults(s, p);
+    model_clamp(s, p);
+}
+
 // k-means of the rest vertices (FLANN), centres snapped to the nearest vertex.
 static int coarsen(const double* rest_in, int n, int k, int* reps)
 {
@@ -848,9 +856,7 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
         free(p), free(pn), free(delta), free(stage_active);
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory in the solver");
     }
-    if (p_start) memcpy(p, p_start, sizeof(double) * (size_t)P);
-    else model_defaults(s, p);
-    model_clamp(s, p);
+    start_pose(s, p_start, p);
     memcpy(s->p0, p, sizeof(double) * (size_t)P);
     s->model->failed = false;
 
@@ -1113,9 +1119,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     }
     sp_ordered_info cand[2], hyp[3];
     int m = 0, nh = 0;
-    if (p_start) memcpy(p2, p_start, sizeof(double) * (size_t)s->P);
-    else model_defaults(s, p2);
-    model_clamp(s, p2);
+    start_pose(s, p_start, p2);
     model_update(s, p2, false);
     project_abstraction(s);
     int nc = s->model->failed ? 0 : sp__loop_candidates(s, sk, cand, 2, &m);

@@ -654,35 +654,47 @@ static void test_classify_edge_drawings(void)
     sp_sketch_free(&s);
 }
 
-static void test_quickdraw_small(void)
+// Quick, Draw! fold 0 of the 5-fold protocol (drawing index mod 5) over the
+// first `categories` categories: trains with d on the other folds, counts
+// top-1 and top-3 hits on fold 0. Returns the test count (0: data absent).
+static int quickdraw_fold0(int categories, const sp_clf_desc* d, int* top1, int* top3)
 {
     const char* dir = sp_test_data_dir();
-    if (!dir) SKIP("../shared/data absent");
+    if (!dir) return 0;
     char path[1024];
     snprintf(path, sizeof path, "%s/quickdraw", dir);
     sp_dataset all;
     sp_error err = {0};
     ENSURE(sp_dataset_load(path, &all, &err) == SP_OK);
-    // 10 categories, 20 train / 5 test each: far above chance (10%) even with a small vocabulary.
     unsigned char* use = calloc((size_t)all.count, 1);
     for (int i = 0; i < all.count; ++i)
-        use[i] = all.samples[i].label < 10 && all.samples[i].index % 5 != 0;
+        use[i] = all.samples[i].label < categories && all.samples[i].index % 5 != 0;
     sp_clf* clf = NULL;
-    sp_clf_desc d = {.words = 100, .vocab_samples = 20000};
-    ENSURE(sp_clf_train(&all, use, &d, &clf, &err) == SP_OK);
-    int right = 0, n = 0;
+    ENSURE(sp_clf_train(&all, use, d, &clf, &err) == SP_OK);
+    int n = 0;
+    *top1 = *top3 = 0;
     for (int i = 0; i < all.count; ++i) {
-        if (all.samples[i].label >= 10 || all.samples[i].index % 5 != 0) continue;
+        if (all.samples[i].label >= categories || all.samples[i].index % 5 != 0) continue;
         sp_clf_answer a;
         ENSURE(sp_clf_classify(clf, &all.samples[i].sketch, NULL, &a, &err) == SP_OK);
-        right += a.count > 0 && a.ranked[0].category == all.samples[i].label;
+        *top1 += a.count > 0 && a.ranked[0].category == all.samples[i].label;
+        for (int k = 0; k < a.count && k < 3; ++k)
+            *top3 += a.ranked[k].category == all.samples[i].label;
         ++n;
     }
-    printf("  quickdraw 10 classes: %d/%d\n", right, n);
-    ENSURE(n == 50 && right >= 20);
     sp_clf_free(clf);
     free(use);
     sp_dataset_free(&all);
+    return n;
+}
+
+static void test_quickdraw_small(void)
+{
+    // 10 categories, 20 train / 5 test each: far above chance (10%) even with a small vocabulary.
+    int right, top3, n = quickdraw_fold0(10, &(sp_clf_desc){.words = 100, .vocab_samples = 20000}, &right, &top3);
+    if (n == 0) SKIP("../shared/data absent");
+    printf("  quickdraw 10 classes: %d/%d\n", right, n);
+    ENSURE(n == 50 && right >= 20);
 }
 
 // The augmentation hook: called once per copy and sample with the sample's own
@@ -735,33 +747,10 @@ static void test_augment_hook(void)
 // far above chance. About 8 s of CPU (release).
 static void test_quickdraw_fold(void)
 {
-    const char* dir = sp_test_data_dir();
-    if (!dir) SKIP("../shared/data absent");
-    char path[1024];
-    snprintf(path, sizeof path, "%s/quickdraw", dir);
-    sp_dataset all;
-    sp_error err = {0};
-    ENSURE(sp_dataset_load(path, &all, &err) == SP_OK);
-    unsigned char* use = calloc((size_t)all.count, 1);
-    for (int i = 0; i < all.count; ++i)
-        use[i] = all.samples[i].label < 20 && all.samples[i].index % 5 != 0;
-    sp_clf* clf = NULL;
-    ENSURE(sp_clf_train(&all, use, &(sp_clf_desc){0}, &clf, &err) == SP_OK);
-    int right = 0, top3 = 0, n = 0;
-    for (int i = 0; i < all.count; ++i) {
-        if (all.samples[i].label >= 20 || all.samples[i].index % 5 != 0) continue;
-        sp_clf_answer a;
-        ENSURE(sp_clf_classify(clf, &all.samples[i].sketch, NULL, &a, &err) == SP_OK);
-        right += a.count > 0 && a.ranked[0].category == all.samples[i].label;
-        for (int j = 0; j < a.count && j < 3; ++j)
-            top3 += a.ranked[j].category == all.samples[i].label;
-        ++n;
-    }
+    int right, top3, n = quickdraw_fold0(20, &(sp_clf_desc){0}, &right, &top3);
+    if (n == 0) SKIP("../shared/data absent");
     printf("  quickdraw 20 classes, fold 0: top-1 %d/%d, top-3 %d/%d\n", right, n, top3, n);
     ENSURE(n == 100 && right >= 40 && top3 >= 60 && top3 >= right);
-    sp_clf_free(clf);
-    free(use);
-    sp_dataset_free(&all);
 }
 
 static void test_cleanup(void)

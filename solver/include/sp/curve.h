@@ -106,6 +106,10 @@ typedef struct sp_ordered_info {
 /// info: may be NULL. Returns SP_ERR_INVALID for m < 1 or non-finite input.
 sp_result sp_corr_ordered(const sp_vec2* y, const sp_vec2* z, int m, bool closed, int* match, sp_ordered_info* info);
 
+/// The pairing of one candidate: match[i] = (shift + i) mod m, or
+/// (shift - i) mod m when reversed (what sp_corr_ordered writes for its best).
+void sp_corr_ordered_match(const sp_ordered_info* c, int m, int* match);
+
 /// The alternatives sp_corr_ordered chooses from on a closed curve, best
 /// first: the local minima of its cost over the cyclic shifts of each
 /// direction, at most k, no two of one direction within m / 20 shifts of
