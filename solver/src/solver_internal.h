@@ -100,4 +100,13 @@ struct sp_solver {
     bool keep_assignment;      // reuse c2s instead of assigning again
 };
 
+// The bounded Levenberg-Marquardt step of solver.c (exposed for its test):
+// (H_ff + mu diag(H_ff)) delta_f = -g_f over the free parameters (H: P x P,
+// row-major, symmetric), parameters that would leave [min, max] held on the
+// bound they cross and the rest solved again until the step stays inside.
+// delta is zero outside the free set. False if the system cannot be solved
+// or the step is zero.
+bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p, double mu,
+                      double* delta);
+
 #endif
