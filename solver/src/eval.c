@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "sp/rig.h"
+#include "v4d.h"
 
 struct sp_rig_eval {
     const sp_rig* rig;
@@ -141,17 +142,19 @@ void sp_rig_eval_update(sp_rig_eval* ev, const double* p, bool derivatives)
 
 static inline void skin_one(const sp_rig_eval* ev, sp_skinned_points pts, int i, double* out)
 {
-    sp_vec3 x0 = {pts.rest[3 * i], pts.rest[3 * i + 1], pts.rest[3 * i + 2]};
-    double x = 0, y = 0, z = 0;
+    const double* x0 = pts.rest + 3 * (size_t)i;
+    sp_v4d acc = SP_V4D_SPLAT(0.0);
     for (int k = 0; k < SP_INFLUENCES; ++k) {
         float w = pts.weights[4 * i + k];
         if (w == 0.0f) continue;
+        // S (x0, 1) a column at a time, all rows at once (the same sums in
+        // the same order).
         const double* m = ev->skin[pts.joints[4 * i + k]].m;
-        x += w * (m[0] * x0.x + m[4] * x0.y + m[8] * x0.z + m[12]);
-        y += w * (m[1] * x0.x + m[5] * x0.y + m[9] * x0.z + m[13]);
-        z += w * (m[2] * x0.x + m[6] * x0.y + m[10] * x0.z + m[14]);
+        sp_v4d c0, c1, c2, c3;
+        SP_V4D_LOAD(c0, m), SP_V4D_LOAD(c1, m + 4), SP_V4D_LOAD(c2, m + 8), SP_V4D_LOAD(c3, m + 12);
+        acc += (double)w * (c0 * x0[0] + c1 * x0[1] + c2 * x0[2] + c3);
     }
-    out[0] = x, out[1] = y, out[2] = z;
+    out[0] = acc[0], out[1] = acc[1], out[2] = acc[2];
 }
 
 void sp_rig_eval_points(const sp_rig_eval* ev, sp_skinned_points pts, double* out)
@@ -203,11 +206,16 @@ void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int 
             memcpy(acc[k], acc[n], sizeof acc[k]);
         }
         const sp_joint* ja = &rig->joints[a];
+        const sp_v4d y0 = SP_V4D_SPLAT(Y[0]), y1 = SP_V4D_SPLAT(Y[1]), y2 = SP_V4D_SPLAT(Y[2]), y3 = SP_V4D_SPLAT(Y[3]);
         for (int q = ja->first_param; q < ja->first_param + ja->param_count; ++q) {
-            const double* d = ev->deriv[q].m;
-            jx[q] += d[0] * Y[0] + d[4] * Y[1] + d[8] * Y[2] + d[12] * Y[3];
-            jy[q] += d[1] * Y[0] + d[5] * Y[1] + d[9] * Y[2] + d[13] * Y[3];
-            jz[q] += d[2] * Y[0] + d[6] * Y[1] + d[10] * Y[2] + d[14] * Y[3];
+            // D_q Y as D_q's four columns (column-major) times Y's entries:
+            // the same sums in the same order as row by row, all rows at
+            // once (the fourth is zero).
+            sp_v4d c0, c1, c2, c3;
+            SP_V4D_LOAD(c0, ev->deriv[q].m), SP_V4D_LOAD(c1, ev->deriv[q].m + 4);
+            SP_V4D_LOAD(c2, ev->deriv[q].m + 8), SP_V4D_LOAD(c3, ev->deriv[q].m + 12);
+            sp_v4d v = c0 * y0 + c1 * y1 + c2 * y2 + c3 * y3;
+            jx[q] += v[0], jy[q] += v[1], jz[q] += v[2];
         }
         if (ja->parent >= 0) {
             joint[n] = ja->parent;

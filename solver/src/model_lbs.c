@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "model.h"
+#include "v4d.h"
 
 // The regularisers in closed form (model.h's reg_* calls). A
 // representative's displacement is r_i = sum_j w_ij (S_j - S0_j) x_i, with
@@ -309,13 +310,22 @@ static void reg_deltas(lbs_model* L)
 static inline void apply_ortho(const double* restrict X, const double* restrict A, const double* restrict v, double wp, double wd,
                                const double* restrict e, double* restrict y)
 {
-    double sv[4], t[4], out[12];
-    for (int c = 0; c < 4; ++c) sv[c] = v[0] * e[c] + v[1] * e[4 + c] + v[2] * e[8 + c];
-    for (int c = 0; c < 4; ++c) t[c] = wp * (X[c] * sv[0] + X[4 + c] * sv[1] + X[8 + c] * sv[2] + X[12 + c] * sv[3]); // X symmetric
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c)
-            out[4 * r + c] = v[r] * t[c] + wd * (A[c] * e[4 * r] + A[4 + c] * e[4 * r + 1] + A[8 + c] * e[4 * r + 2] + A[12 + c] * e[4 * r + 3]);
-    for (int a = 0; a < 12; ++a) y[a] += out[a];
+    // Four lanes c = 0..3 at a time; X and A are symmetric (their columns
+    // are their rows).
+    sp_v4d e0, e1, e2, x0, x1, x2, x3, a0, a1, a2, a3;
+    SP_V4D_LOAD(e0, e), SP_V4D_LOAD(e1, e + 4), SP_V4D_LOAD(e2, e + 8);
+    SP_V4D_LOAD(x0, X), SP_V4D_LOAD(x1, X + 4), SP_V4D_LOAD(x2, X + 8), SP_V4D_LOAD(x3, X + 12);
+    SP_V4D_LOAD(a0, A), SP_V4D_LOAD(a1, A + 4), SP_V4D_LOAD(a2, A + 8), SP_V4D_LOAD(a3, A + 12);
+    sp_v4d sv = v[0] * e0 + v[1] * e1 + v[2] * e2;
+    sp_v4d t = wp * (x0 * sv[0] + x1 * sv[1] + x2 * sv[2] + x3 * sv[3]);
+    for (int r = 0; r < 3; ++r) {
+        const double* er = e + 4 * r;
+        sp_v4d out = v[r] * t + wd * (a0 * er[0] + a1 * er[1] + a2 * er[2] + a3 * er[3]);
+        sp_v4d yr;
+        SP_V4D_LOAD(yr, y + 4 * r);
+        yr += out;
+        memcpy(y + 4 * r, &yr, sizeof yr);
+    }
 }
 
 static inline void apply_full(const double* restrict K, const double* restrict A, double wp, double wd, const double* restrict e,
@@ -403,9 +413,14 @@ static void lbs_reg_normal(sp_model* m, double wp, double wd, double* H, double*
         for (int t = R->anc_first[j]; t < R->anc_first[j + 1]; ++t) {
             const double* Dq = D[R->anc[t]].m;
             double* E = R->E + 12 * (size_t)t;
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 4; ++c)
-                    E[4 * r + c] = Dq[r] * Sj[4 * c] + Dq[4 + r] * Sj[4 * c + 1] + Dq[8 + r] * Sj[4 * c + 2] + Dq[12 + r] * Sj[4 * c + 3];
+            // Column c of D_q S_j from D_q's columns (rows 0..3 at once, the
+            // same sums in the same order), stored row-major.
+            sp_v4d d0, d1, d2, d3;
+            SP_V4D_LOAD(d0, Dq), SP_V4D_LOAD(d1, Dq + 4), SP_V4D_LOAD(d2, Dq + 8), SP_V4D_LOAD(d3, Dq + 12);
+            for (int c = 0; c < 4; ++c) {
+                sp_v4d col = d0 * Sj[4 * c] + d1 * Sj[4 * c + 1] + d2 * Sj[4 * c + 2] + d3 * Sj[4 * c + 3];
+                E[c] = col[0], E[4 + c] = col[1], E[8 + c] = col[2];
+            }
         }
     }
     for (int j = 0; j < R->nj; ++j) {
