@@ -222,6 +222,48 @@ int sp__loop_candidates(sp_solver* s, const sp_sketch* sk, sp_ordered_info* out,
     return n;
 }
 
+// The strokes resampled for closest points, msum samples in all shared by
+// length (at least 8 a stroke), into s->ypoly with each sample's stroke.
+static sp_result resample_strokes(sp_solver* s, const sp_sketch* sk, int msum, sp_error* err)
+{
+    s->ypoly_valid = false;
+    double slen_total = 0;
+    double* slen = malloc(sizeof(double) * (size_t)sk->stroke_count);
+    int* scount = malloc(sizeof(int) * (size_t)sk->stroke_count);
+    if (!slen || !scount) {
+        free(slen), free(scount);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+    }
+    for (int i = 0; i < sk->stroke_count; ++i) slen_total += slen[i] = sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false);
+    int my = 0;
+    for (int i = 0; i < sk->stroke_count; ++i) {
+        double share = slen_total > 0 ? slen[i] / slen_total : 0;
+        scount[i] = (int)lround(msum * share);
+        if (scount[i] < 8) scount[i] = 8;
+        my += scount[i];
+    }
+    sp_result res = SP_OK;
+    if (my > s->ypoly_cap) {
+        sp_vec2* yp = realloc(s->ypoly, sizeof(sp_vec2) * (size_t)my);
+        if (yp) s->ypoly = yp;
+        int* ys = realloc(s->ypoly_stroke, sizeof(int) * (size_t)my);
+        if (ys) s->ypoly_stroke = ys;
+        if (!yp || !ys) res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+        else s->ypoly_cap = my;
+    }
+    for (int i = 0, at = 0; res == SP_OK && i < sk->stroke_count; ++i) {
+        res = sp_curve_resample(sk->strokes[i].points, sk->strokes[i].count, false, scount[i], s->ypoly + at);
+        if (res != SP_OK) sp_fail(err, res, "stroke %d cannot be resampled", i);
+        for (int k = 0; k < scount[i]; ++k) s->ypoly_stroke[at + k] = i;
+        at += scount[i];
+    }
+    free(slen), free(scount);
+    s->ypoly_count = res == SP_OK ? my : 0;
+    s->ypoly_total = msum;
+    s->ypoly_valid = res == SP_OK;
+    return res;
+}
+
 sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err)
 {
     const sp_abstraction* ab = s->ab;
@@ -306,39 +348,27 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
         return res;
     }
     // Closest points, both ways, over all strokes and all curves at once:
-    // the strokes get as many samples in all as the curves, by length.
-    double slen_total = 0;
-    for (int i = 0; i < sk->stroke_count; ++i) slen_total += sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false);
-    int* scount = malloc(sizeof(int) * (size_t)sk->stroke_count);
-    int my = 0;
-    for (int i = 0; scount && i < sk->stroke_count; ++i) {
-        double share = slen_total > 0 ? sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false) / slen_total : 0;
-        scount[i] = (int)lround(msum * share);
-        if (scount[i] < 8) scount[i] = 8;
-        my += scount[i];
+    // the strokes get as many samples in all as the curves, by length. They
+    // do not move during a solve, so their samples are kept (s->ypoly) and
+    // made again only for a new solve or another total count.
+    res = SP_OK;
+    if (!s->ypoly_valid || s->ypoly_total != msum) {
+        res = resample_strokes(s, sk, msum, err);
+        if (res != SP_OK) return res;
     }
-    sp_vec2* y = malloc(sizeof(sp_vec2) * (size_t)(my + 1));
-    int* ystroke = malloc(sizeof(int) * (size_t)(my + 1));
+    const sp_vec2* y = s->ypoly;
+    const int* ystroke = s->ypoly_stroke;
+    const int my = s->ypoly_count;
     sp_vec2* z = malloc(sizeof(sp_vec2) * (size_t)msum);
     sample_ref* refs = malloc(sizeof(sample_ref) * (size_t)msum);
     int* zcurve = malloc(sizeof(int) * (size_t)msum);
     sp_corr_pair* cp = malloc(sizeof(sp_corr_pair) * (size_t)(my + msum));
     int* votes = calloc((size_t)C * (size_t)sk->stroke_count, sizeof(int));
-    if (!scount || !y || !ystroke || !z || !refs || !zcurve || !cp || !votes || !grow_pairs(s, my + msum)) {
+    if (!z || !refs || !zcurve || !cp || !votes || !grow_pairs(s, my + msum)) {
         res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
         goto closest_done;
     }
     int at = 0;
-    for (int i = 0; i < sk->stroke_count; ++i) {
-        res = sp_curve_resample(sk->strokes[i].points, sk->strokes[i].count, false, scount[i], y + at);
-        if (res != SP_OK) {
-            sp_fail(err, res, "stroke %d cannot be resampled", i);
-            goto closest_done;
-        }
-        for (int k = 0; k < scount[i]; ++k) ystroke[at + k] = i;
-        at += scount[i];
-    }
-    at = 0;
     for (int c = 0; c < C; ++c) {
         int m = samples_for(s, &ab->curves[c], total_len);
         resample_refs(s, &ab->curves[c], m, refs + at);
@@ -350,20 +380,6 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
         sp_fail(err, res, "closest-point correspondences failed");
         goto closest_done;
     }
-    if (my > s->ypoly_cap) {
-        sp_vec2* yp = realloc(s->ypoly, sizeof(sp_vec2) * (size_t)my);
-        if (yp) s->ypoly = yp;
-        int* ys = realloc(s->ypoly_stroke, sizeof(int) * (size_t)my);
-        if (ys) s->ypoly_stroke = ys;
-        if (!yp || !ys) {
-            res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
-            goto closest_done;
-        }
-        s->ypoly_cap = my;
-    }
-    memcpy(s->ypoly, y, sizeof(sp_vec2) * (size_t)my);
-    memcpy(s->ypoly_stroke, ystroke, sizeof(int) * (size_t)my);
-    s->ypoly_count = my;
     for (int i = 0; i < my + msum; ++i) {
         int c = zcurve[cp[i].z];
         s->pairs[s->pair_count++] = (pair){y[cp[i].y], refs[cp[i].z], c, stroke_normal(y, ystroke, my, cp[i].y), i >= my};
@@ -376,6 +392,6 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
         rep->curves[c].stroke = best;
     }
 closest_done:
-    free(scount), free(y), free(ystroke), free(z), free(refs), free(zcurve), free(cp), free(votes);
+    free(z), free(refs), free(zcurve), free(cp), free(votes);
     return res;
 }

@@ -903,6 +903,7 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
 {
     double t0 = now_ms();
     s->used_loop = false;
+    s->ypoly_valid = false; // the strokes may be new
     memset(rep, 0, sizeof *rep);
     if (!sketch_ok(sk, err)) return SP_ERR_INVALID;
     const int P = s->P;

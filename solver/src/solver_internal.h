@@ -87,6 +87,8 @@ struct sp_solver {
     sp_vec2* ypoly;
     int* ypoly_stroke;
     int ypoly_count, ypoly_cap;
+    int ypoly_total;  // the sample count they were made for
+    bool ypoly_valid; // made for this solve's strokes (solve_once clears it)
     int pair_count, pair_cap;
     double L;        // abstraction 2D diagonal at the start pose, pixels
     sp_correspondence mode; // how sp__build_pairs pairs samples now
