@@ -4,7 +4,6 @@
 #include <cblas.h>
 #include <flann/flann.h>
 #include <lapacke.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -190,25 +189,8 @@ static bool make_groups(sp_solver* s)
     return true;
 }
 
-#ifdef SP_HAVE_OPENBLAS_THREADS
-void openblas_set_num_threads(int num_threads); // OpenBLAS's own call, not CBLAS's
-#endif
-
-// BLAS on one thread: the solver's systems (at most a few hundred wide) only
-// lose by being split, and OpenBLAS's helper threads spin between calls
-// (the cartoon man: 12% more wall time, 30% more CPU, with them). The setting
-// is the process's; everything here that calls BLAS calls it small.
-static void blas_one_thread(void)
-{
-#ifdef SP_HAVE_OPENBLAS_THREADS
-    openblas_set_num_threads(1);
-#endif
-}
-
 sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_solve_desc* desc)
 {
-    static pthread_once_t blas_once = PTHREAD_ONCE_INIT;
-    pthread_once(&blas_once, blas_one_thread);
     if (openblas_set_num_threads) openblas_set_num_threads(1);
     if (!m) return NULL;
     sp_solver* s = calloc(1, sizeof *s);
