@@ -152,39 +152,65 @@ static int find_group(sp_solver* s, const int* cols, int n)
     return s->group_count++;
 }
 
-// Groups the abstraction points and representatives by column list and
-// reserves their rows: 2 per point, 2 per segment inside a group, 4 per
-// representative (W_plane and W_dist).
+// Groups the abstraction points, their segments and the representatives by
+// column list. A pair's sample lies on a segment (a, b), so its two rows span
+// the union of a's and b's columns: the segment's group. Rows reserved: 2 per
+// point and per segment (about a pair each; a group that fills up is flushed
+// early, so this only sizes the common case) and 4 per representative
+// (W_plane and W_dist).
 static bool make_groups(sp_solver* s)
 {
     const int l = s->ab->point_count;
-    s->groups = malloc(sizeof(row_group) * (size_t)(l + s->k + 1));
+    size_t total_cols = 0;
+    for (int i = 0; i < l; ++i) total_cols += (size_t)s->ab_sb[i].count;
+    s->groups = malloc(sizeof(row_group) * (size_t)(2 * l + s->k + 1));
     s->ab_grp = malloc(sizeof(int) * (size_t)(l + 1));
     s->rep_grp = malloc(sizeof(int) * (size_t)(s->k + 1));
-    if (!s->groups || !s->ab_grp || !s->rep_grp) return false;
+    s->seg_grp = malloc(sizeof(int) * (size_t)(l + 1));
+    s->seg_first = malloc(sizeof(int) * (size_t)(l + 1));
+    s->seg_cols = malloc(sizeof(int) * (2 * total_cols + 1)); // a union holds at most a's and b's columns
+    s->seg_map = malloc(sizeof(int) * (2 * total_cols + 1));
+    if (!s->groups || !s->ab_grp || !s->rep_grp || !s->seg_grp || !s->seg_first || !s->seg_cols || !s->seg_map) return false;
     s->group_count = 0;
     for (int i = 0; i < l; ++i) {
         int g = s->ab_grp[i] = find_group(s, s->ab_cols + s->ab_sb[i].first, s->ab_sb[i].count);
         s->groups[g].cap += 2;
     }
+    int at = 0, uat = 0;
     for (const sp_curve* cv = s->ab->curves; cv < s->ab->curves + s->ab->curve_count; ++cv)
         for (int k = 0; k < cv->point_count; ++k) {
-            int a = cv->first_point + k, b = k + 1 < cv->point_count ? a + 1 : cv->first_point;
-            if (b != a && s->ab_grp[a] == s->ab_grp[b]) s->groups[s->ab_grp[a]].cap += 2;
+            const int a = cv->first_point + k;
+            const int b = k + 1 < cv->point_count ? a + 1 : (cv->closed ? cv->first_point : -1);
+            s->seg_first[a] = at;
+            s->seg_grp[a] = -1;
+            if (b < 0 || b == a) continue; // no segment after an open curve's last point (nor in a one-point curve)
+            const int *ca = s->ab_cols + s->ab_sb[a].first, *cb = s->ab_cols + s->ab_sb[b].first;
+            const int na = s->ab_sb[a].count, nb = s->ab_sb[b].count;
+            int* u = s->seg_cols + uat;
+            int nu = 0;
+            for (int i = 0, j = 0; i < na || j < nb;) { // sorted union; each side's positions in it
+                int c = j >= nb || (i < na && ca[i] <= cb[j]) ? ca[i] : cb[j];
+                if (i < na && ca[i] == c) s->seg_map[at + i++] = nu;
+                if (j < nb && cb[j] == c) s->seg_map[at + na + j++] = nu;
+                u[nu++] = c;
+            }
+            int g = s->seg_grp[a] = find_group(s, u, nu);
+            if (s->groups[g].cols == u) uat += nu; // a new group keeps this copy
+            s->groups[g].cap += 4;
+            at += na + nb;
         }
     for (int i = 0; i < s->k; ++i) {
         int g = s->rep_grp[i] = find_group(s, s->rep_cols + s->rep_sb[i].first, s->rep_sb[i].count);
         s->groups[g].cap += 4;
     }
     size_t total = 0;
-    for (int g = 0; g < s->group_count; ++g) total += 2 * (size_t)s->groups[g].cap * (size_t)s->groups[g].n;
+    for (int g = 0; g < s->group_count; ++g) total += (size_t)s->groups[g].cap * (size_t)s->groups[g].n;
     s->group_pool = malloc(sizeof(double) * (total + 1));
     if (!s->group_pool) return false;
-    double* at = s->group_pool;
+    double* pool = s->group_pool;
     for (int g = 0; g < s->group_count; ++g) {
         row_group* gr = &s->groups[g];
-        gr->U = at, at += (size_t)gr->cap * (size_t)gr->n;
-        gr->V = at, at += (size_t)gr->cap * (size_t)gr->n;
+        gr->U = pool, pool += (size_t)gr->cap * (size_t)gr->n;
     }
     return true;
 }
@@ -267,12 +293,10 @@ sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_s
     s->unit = malloc(sizeof(double) * (size_t)P);
     s->free_ = malloc(sizeof(bool) * (size_t)P);
     s->Hl = malloc(sizeof(double) * (size_t)P * (size_t)P);
-    s->match_aa = malloc(sizeof(double) * 3 * ll);
-    s->match_ab = malloc(sizeof(double) * 3 * ll);
-    s->match_beta = malloc(sizeof(double) * 2 * ll);
+    s->pair_rows = malloc(sizeof(double) * 2 * (size_t)(P + 1));
     s->ab_used = malloc(sizeof(bool) * ll);
     if (!s->z3 || !s->z2 || !s->Jz || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
-        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->match_aa || !s->match_ab || !s->match_beta || !s->ab_used)
+        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->pair_rows || !s->ab_used)
         goto fail;
     for (int i = 0; i < s->P; ++i) s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
     return s;
@@ -290,8 +314,9 @@ void sp_solver_destroy(sp_solver* s)
     free(s->Jz), free(s->z3), free(s->z2), free(s->G), free(s->x0), free(s->xr), free(s->Jr), free(s->dw), free(s->view);
     free(s->H), free(s->g), free(s->p0), free(s->unit), free(s->free_), free(s->pairs);
     free(s->ypoly), free(s->ypoly_stroke);
-    free(s->Hl), free(s->match_aa), free(s->match_ab), free(s->match_beta), free(s->ab_used);
+    free(s->Hl), free(s->pair_rows), free(s->ab_used);
     free(s->groups), free(s->ab_grp), free(s->rep_grp), free(s->group_pool);
+    free(s->seg_grp), free(s->seg_first), free(s->seg_cols), free(s->seg_map);
     free(s);
 }
 
@@ -441,8 +466,29 @@ static void jacobian_blocks(sp_solver* s)
     }
 }
 
+// H += U^T U of group g's rows so far, into the upper triangle (columns are
+// sorted, so the local upper triangle lands in the global one).
+static void flush_group(sp_solver* s, int g)
+{
+    row_group* gr = &s->groups[g];
+    const int n = gr->n, P = s->P;
+    if (gr->rows == 0 || n == 0) return;
+    cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, n, gr->rows, 1.0, gr->U, n, 0.0, s->Hl, n);
+    for (int a = 0; a < n; ++a) {
+        double* Hrow = s->H + (size_t)gr->cols[a] * (size_t)P;
+        const double* L = s->Hl + (size_t)a * (size_t)n;
+        for (int b = a; b < n; ++b) Hrow[gr->cols[b]] += L[b];
+    }
+    gr->rows = 0;
+}
+
+static void flush_groups(sp_solver* s)
+{
+    for (int g = 0; g < s->group_count; ++g) flush_group(s, g);
+}
+
 // Least-squares rows B (rows x n over group g's columns, residuals r):
-// g += B^T r now, H += B^T B when the group is flushed.
+// g += B^T r now, H += B^T B when the group is flushed (early if it is full).
 static void push_rows(sp_solver* s, int g, const double* B, int rows, const double* r)
 {
     row_group* gr = &s->groups[g];
@@ -451,30 +497,10 @@ static void push_rows(sp_solver* s, int g, const double* B, int rows, const doub
         const double* Bk = B + (size_t)k * (size_t)n;
         for (int a = 0; a < n; ++a) s->g[gr->cols[a]] += Bk[a] * r[k];
     }
-    assert(gr->rows + rows <= gr->cap);
-    double* U = gr->U + (size_t)gr->rows * (size_t)n;
-    double* V = gr->V + (size_t)gr->rows * (size_t)n;
-    for (size_t q = 0; q < (size_t)rows * (size_t)n; ++q) U[q] = B[q], V[q] = 0.5 * B[q];
+    if (gr->rows + rows > gr->cap) flush_group(s, g);
+    assert(rows <= gr->cap);
+    memcpy(gr->U + (size_t)gr->rows * (size_t)n, B, sizeof(double) * (size_t)rows * (size_t)n);
     gr->rows += rows;
-}
-
-// H += U^T V + V^T U of every group, into the upper triangle (columns are
-// sorted, so the local upper triangle lands in the global one).
-static void flush_groups(sp_solver* s)
-{
-    const int P = s->P;
-    for (int g = 0; g < s->group_count; ++g) {
-        row_group* gr = &s->groups[g];
-        const int n = gr->n;
-        if (gr->rows == 0 || n == 0) continue;
-        cblas_dsyr2k(CblasRowMajor, CblasUpper, CblasTrans, n, gr->rows, 1.0, gr->U, n, gr->V, n, 0.0, s->Hl, n);
-        for (int a = 0; a < n; ++a) {
-            double* Hrow = s->H + (size_t)gr->cols[a] * (size_t)P;
-            const double* L = s->Hl + (size_t)a * (size_t)n;
-            for (int b = a; b < n; ++b) Hrow[gr->cols[b]] += L[b];
-        }
-        gr->rows = 0;
-    }
 }
 
 // Gauss-Newton normal equations of W at the current state (upper triangle
@@ -485,100 +511,58 @@ static void normal_equations(sp_solver* s, const double* p)
     memset(s->H, 0, sizeof(double) * (size_t)P * (size_t)P);
     memset(s->g, 0, sizeof(double) * (size_t)P);
     jacobian_blocks(s);
-    int* cols = malloc(sizeof(int) * (size_t)(2 * P + 1));
     double* B = malloc(sizeof(double) * (size_t)(6 * P + 3));
-    if (!cols || !B) {
-        free(cols), free(B);
-        return;
-    }
-    // The match term is quadratic in the projected points z: a sample is
-    // (1-t) z_a + t z_b, so summing over pairs first leaves per point a
-    // weight aa and a gradient vector beta, and per segment (a, b) a
-    // coupling ab. H and g then need one product per point and one per
-    // segment instead of one per pair, whatever the sample count.
-    const int l = s->ab->point_count;
-    double* aa = s->match_aa;
-    double* ab = s->match_ab;
-    double* beta = s->match_beta;
-    memset(aa, 0, sizeof(double) * 3 * (size_t)l);
-    memset(ab, 0, sizeof(double) * 3 * (size_t)l);
-    memset(beta, 0, sizeof(double) * 2 * (size_t)l);
-    double wm = match_weight(s);
+    if (!B) return;
+    // The match term: a pair's sample is (1-t) z_a + t z_b on the segment
+    // (a, b), its residual d = sample - y weighted by wm m (pair_metric). With
+    // wm m = L L^T its two least-squares rows are L^T J over the segment's
+    // columns (J = (1-t) G_a + t G_b) with residuals L^T d, and H += rows^T
+    // rows is one symmetric rank-k update per group. (Summing the pairs per
+    // point and per segment first, as before, left a cross term per segment
+    // that needed twice the flops in syr2k and loops straight into H across
+    // groups: the cartoon man's outline spent 4x the flops there.)
+    const double wm = match_weight(s);
+    double* rows = s->pair_rows;
     for (int i = 0; i < s->pair_count; ++i) {
         const pair* pr = &s->pairs[i];
         sp_vec2 d = sp_v2_sub(sample_at(s, pr->s), pr->y);
         double m[3];
         pair_metric(s, pr, m);
-        sp_vec2 md = {m[0] * d.x + m[1] * d.y, m[1] * d.x + m[2] * d.y};
-        double ca = 1.0 - pr->s.t, cb = pr->s.t;
-        int a = pr->s.a, b = pr->s.b;
-        if (a == b) ca += cb, cb = 0;
-        for (int c = 0; c < 3; ++c) {
-            aa[3 * a + c] += wm * ca * ca * m[c];
-            aa[3 * b + c] += wm * cb * cb * m[c];
-            ab[3 * a + c] += wm * ca * cb * m[c]; // segment a -> b: b is the point after a
+        double M0 = wm * m[0], M1 = wm * m[1], M2 = wm * m[2];
+        double l00 = sqrt(fmax(M0, 1e-300)), l10 = M1 / l00;
+        double l11 = sqrt(fmax(M2 - l10 * l10, 1e-300 * (1.0 + M2)));
+        double r2[2] = {l00 * d.x + l10 * d.y, l11 * d.y};
+        const int a = pr->s.a, b = pr->s.b;
+        const double ta = 1.0 - pr->s.t, tb = pr->s.t;
+        const sparse_block* A = &s->ab_sb[a];
+        const double* Ga = s->G + 2 * (size_t)A->first;
+        if (a == b || s->seg_grp[a] < 0) { // on a point: its own columns
+            const int n = A->count;
+            for (int c = 0; c < n; ++c) {
+                double gx = Ga[c], gy = Ga[n + c];
+                rows[c] = l00 * gx + l10 * gy;
+                rows[n + c] = l11 * gy;
+            }
+            push_rows(s, s->ab_grp[a], rows, 2, r2);
+            continue;
         }
-        beta[2 * a] += wm * ca * md.x, beta[2 * a + 1] += wm * ca * md.y;
-        beta[2 * b] += wm * cb * md.x, beta[2 * b + 1] += wm * cb * md.y;
-    }
-    for (const sp_curve* cv = s->ab->curves; cv < s->ab->curves + s->ab->curve_count; ++cv) {
-        for (int k = 0; k < cv->point_count; ++k) {
-            int a = cv->first_point + k;
-            const sparse_block* A = &s->ab_sb[a];
-            const double* Ga = s->G + 2 * (size_t)A->first;
-            const int* ca = s->ab_cols + A->first;
-            const double* M = aa + 3 * a;
-            if (M[0] != 0.0 || M[2] != 0.0 || beta[2 * a] != 0.0 || beta[2 * a + 1] != 0.0) {
-                // H += Ga^T M Ga and g += Ga^T beta through M = L L^T:
-                // rows L^T Ga and residual L^-1 beta (M is positive definite
-                // whenever a pair touches the point; a tiny floor otherwise).
-                double l00 = sqrt(fmax(M[0], 1e-300)), l10 = M[1] / l00;
-                double l11 = sqrt(fmax(M[2] - l10 * l10, 1e-300 * (1.0 + M[2])));
-                int n = A->count;
-                for (int c = 0; c < n; ++c) {
-                    double gx = Ga[c], gy = Ga[n + c];
-                    B[c] = l00 * gx + l10 * gy;
-                    B[n + c] = l11 * gy;
-                }
-                double r2[2];
-                r2[0] = beta[2 * a] / l00;
-                r2[1] = (beta[2 * a + 1] - l10 * r2[0]) / l11;
-                push_rows(s, s->ab_grp[a], B, 2, r2);
-            }
-            const double* X = ab + 3 * a;
-            if (X[0] == 0.0 && X[1] == 0.0 && X[2] == 0.0) continue;
-            int b = k + 1 < cv->point_count ? a + 1 : cv->first_point; // closing segment of a loop
-            const sparse_block* Bk = &s->ab_sb[b];
-            const double* Gb = s->G + 2 * (size_t)Bk->first;
-            const int* cb = s->ab_cols + Bk->first;
-            // Cross term Ga^T X Gb + Gb^T X Ga (X symmetric): inside a group
-            // as rows U = Ga, V = X Gb; across groups straight into H.
-            if (s->ab_grp[a] == s->ab_grp[b] && a != b) {
-                row_group* gr = &s->groups[s->ab_grp[a]];
-                const int n = gr->n;
-                assert(gr->rows + 2 <= gr->cap);
-                double* U = gr->U + (size_t)gr->rows * (size_t)n;
-                double* V = gr->V + (size_t)gr->rows * (size_t)n;
-                for (int c = 0; c < n; ++c) {
-                    U[c] = Ga[c], U[n + c] = Ga[n + c];
-                    V[c] = X[0] * Gb[c] + X[1] * Gb[n + c];
-                    V[n + c] = X[1] * Gb[c] + X[2] * Gb[n + c];
-                }
-                gr->rows += 2;
-                continue;
-            }
-            for (int j = 0; j < Bk->count; ++j) {
-                double bx = X[0] * Gb[j] + X[1] * Gb[Bk->count + j];
-                double by = X[1] * Gb[j] + X[2] * Gb[Bk->count + j];
-                for (int i = 0; i < A->count; ++i) {
-                    double x = Ga[i] * bx + Ga[A->count + i] * by;
-                    int qi = ca[i], qj = cb[j];
-                    if (qi == qj) s->H[qi * P + qi] += 2.0 * x;
-                    else if (qi < qj) s->H[qi * P + qj] += x;
-                    else s->H[qj * P + qi] += x;
-                }
-            }
+        const int g = s->seg_grp[a], n = s->groups[g].n;
+        const sparse_block* Bb = &s->ab_sb[b];
+        const double* Gb = s->G + 2 * (size_t)Bb->first;
+        const int* map = s->seg_map + s->seg_first[a]; // a's columns, then b's
+        memset(rows, 0, sizeof(double) * 2 * (size_t)n);
+        for (int c = 0; c < A->count; ++c) {
+            double gx = ta * Ga[c], gy = ta * Ga[A->count + c];
+            rows[map[c]] += l00 * gx + l10 * gy;
+            rows[n + map[c]] += l11 * gy;
         }
+        map += A->count;
+        for (int c = 0; c < Bb->count; ++c) {
+            double gx = tb * Gb[c], gy = tb * Gb[Bb->count + c];
+            rows[map[c]] += l00 * gx + l10 * gy;
+            rows[n + map[c]] += l11 * gy;
+        }
+        push_rows(s, g, rows, 2, r2);
     }
     if (has_reg(s) && closed_form_reg(s)) {
         double inv = vertex_weight(s) * s->vertex_boost;
@@ -618,7 +602,7 @@ static void normal_equations(sp_solver* s, const double* p)
     }
     for (int a = 0; a < P; ++a)
         for (int b = a + 1; b < P; ++b) s->H[b * P + a] = s->H[a * P + b];
-    free(cols), free(B);
+    free(B);
 }
 
 // Solves (H_ff + mu diag) delta_f = -g_f over the free parameters, within
@@ -1126,6 +1110,36 @@ done:
     rep->ms = now_ms() - t0;
     free(p), free(pn), free(delta), free(stage_active);
     return res;
+}
+
+// Test hook (solver_internal.h): W and its Gauss-Newton g and H at p with
+// the pairs and the regularisers' reference made at p_ref (final weights).
+sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double* W, double* g, double* H,
+                              sp_error* err)
+{
+    if (!sketch_ok(sk, err)) return SP_ERR_INVALID;
+    sp_solve_report rep;
+    memset(&rep, 0, sizeof rep);
+    memcpy(s->p0, p_ref, sizeof(double) * (size_t)s->P);
+    s->pose_boost = s->vertex_boost = 1.0;
+    s->mode = s->ab->correspondence;
+    s->c2s_valid = s->keep_assignment = false;
+    s->ypoly_valid = false;
+    s->model->failed = false;
+    model_update(s, p_ref, false);
+    project_abstraction(s);
+    s->L = 1.0; // the weights' pixel scale: any fixed value will do here
+    sp_result res = sp__build_pairs(s, sk, &rep, err);
+    if (res != SP_OK) return res;
+    prepare_start(s, p_ref, &rep);
+    *W = energy(s, p).total;
+    model_update(s, p, true);
+    project_abstraction(s);
+    if (s->k > 0 && !closed_form_reg(s)) model_rows(s, s->xr);
+    normal_equations(s, p);
+    memcpy(g, s->g, sizeof(double) * (size_t)s->P);
+    if (H) memcpy(H, s->H, sizeof(double) * (size_t)s->P * (size_t)s->P);
+    return SP_OK;
 }
 
 // Keeps attempt r2 (parameters p2) when it fits better than rep; the work of

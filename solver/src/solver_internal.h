@@ -35,9 +35,8 @@ typedef struct pair {
 typedef struct row_group {
     const int* cols; // n sorted parameter indices
     int n;
-    int cap, rows;   // rows reserved, rows filled this iteration
-    double* U;       // cap by n, row-major
-    double* V;       // cap by n
+    int cap, rows;   // rows reserved, rows filled since the last flush
+    double* U;       // cap by n, row-major: least-squares rows, H += U^T U
 } row_group;
 
 struct sp_solver {
@@ -71,15 +70,19 @@ struct sp_solver {
     double* p0;      // P: the start pose (W_pose anchor)
     double* unit;    // P: parameter units
     bool* free_;     // P
-    double* match_aa;   // point_count by 3: summed 2x2 match weights per point (xx, xy, yy)
-    double* match_ab;   // point_count by 3: coupling of the segment starting at each point
-    double* match_beta; // point_count by 2: weighted residual per point
+    // Segments (a, the point after a): the group of the union of both
+    // points' columns and where each point's columns sit in it.
+    int* seg_grp;       // point_count: -1 for a curve's last point when open
+    int* seg_map;       // positions: a's columns, then b's, from seg_first[a]
+    int* seg_first;     // point_count
+    int* seg_cols;      // the unions' column lists (groups point into it)
+    double* pair_rows;  // 2 * P: one pair's two rows
     bool* ab_used;      // point_count: a pair's sample lies on the point (jacobian_blocks)
     row_group* groups;
     int group_count;
     int* ab_grp;        // point_count: group of each abstraction point
     int* rep_grp;       // k: group of each representative
-    double* group_pool; // U and V of every group
+    double* group_pool; // U of every group
     // Correspondences.
     pair* pairs;
     // The resampled strokes of the last closest-point matching (polylines,
@@ -108,6 +111,12 @@ struct sp_solver {
 // bound they cross and the rest solved again until the step stays inside.
 // delta is zero outside the free set. False if the system cannot be solved
 // or the step is zero.
+// Test hook: W at p and its Gauss-Newton g (half W's gradient) and H (H may
+// be NULL) with the pairs for sk and the regularisers' reference made at
+// p_ref, at the final weights.
+sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double* W, double* g, double* H,
+                              sp_error* err);
+
 bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p, double mu,
                       double* delta);
 

@@ -217,6 +217,80 @@ static void test_regulariser_paths_agree(void)
     sp_rig_free(&st.rig);
 }
 
+// The normal equations against W itself, on a branching rig with scales and
+// translations, for ordered and closest-point pairs (segments spanning two
+// bones' columns): g must be half W's gradient (central differences, pairs
+// held), and at a zero-residual state (strokes drawn from the reference pose,
+// regularisers at rest) H must be the derivative of g (H v against central
+// differences of g along random v).
+static void test_gauss_newton_consistent(void)
+{
+    for (int closest = 0; closest < 2; ++closest) {
+        setup st;
+        make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .branching = true, .all_channels = true, .closest = closest, .seed = 5});
+        sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+        ENSURE(s);
+        const int P = st.rig.param_count;
+        double* ref = malloc(sizeof(double) * P);
+        double* p = malloc(sizeof(double) * P);
+        double* q = malloc(sizeof(double) * P);
+        double* g = malloc(sizeof(double) * P);
+        double* g1 = malloc(sizeof(double) * P);
+        double* g2 = malloc(sizeof(double) * P);
+        double* H = malloc(sizeof(double) * P * P);
+        double W, W1, W2;
+        sp_error err = {0};
+        sp_test_rng rng = {11 + closest};
+        sp_fixture_random_params(&st.rig, &rng, 0.5, ref);
+        sp_fixture_random_params(&st.rig, &rng, 0.3, p);
+        sp_sketch sk;
+        double* target = malloc(sizeof(double) * P);
+        sp_fixture_random_params(&st.rig, &rng, 0.5, target);
+        strokes_at(s, &st.rig, target, &sk);
+        // g = half the gradient of W at p (pairs and reference made at ref).
+        ENSURE(sp__gauss_newton_at(s, &sk, ref, p, &W, g, NULL, &err) == SP_OK);
+        double gmax = 0;
+        for (int k = 0; k < P; ++k) gmax = fmax(gmax, fabs(g[k]));
+        ENSURE(gmax > 0);
+        for (int k = 0; k < P; ++k) {
+            const double h = 1e-6 * (st.rig.params[k].max - st.rig.params[k].min);
+            memcpy(q, p, sizeof(double) * P);
+            q[k] = p[k] + h;
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W1, g1, NULL, &err) == SP_OK);
+            q[k] = p[k] - h;
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W2, g1, NULL, &err) == SP_OK);
+            ENSURE_NEAR((W1 - W2) / (2 * h), 2 * g[k], 1e-5 * (2 * gmax));
+        }
+        sp_sketch_free(&sk);
+        // H: strokes drawn at ref, evaluated at ref (every residual ~0).
+        strokes_at(s, &st.rig, ref, &sk);
+        ENSURE(sp__gauss_newton_at(s, &sk, ref, ref, &W, g, H, &err) == SP_OK);
+        for (int trial = 0; trial < 6; ++trial) {
+            double v[64];
+            ENSURE(P <= 64);
+            for (int k = 0; k < P; ++k) v[k] = sp_test_range(&rng, -1, 1) * (st.rig.params[k].max - st.rig.params[k].min);
+            const double h = 1e-6;
+            for (int k = 0; k < P; ++k) q[k] = ref[k] + h * v[k];
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W1, g1, NULL, &err) == SP_OK);
+            for (int k = 0; k < P; ++k) q[k] = ref[k] - h * v[k];
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W2, g2, NULL, &err) == SP_OK);
+            double hmax = 0;
+            double* Hv = q;
+            for (int a = 0; a < P; ++a) {
+                Hv[a] = 0;
+                for (int b = 0; b < P; ++b) Hv[a] += H[a * P + b] * v[b];
+                hmax = fmax(hmax, fabs(Hv[a]));
+            }
+            ENSURE(hmax > 0);
+            for (int a = 0; a < P; ++a) ENSURE_NEAR((g1[a] - g2[a]) / (2 * h), Hv[a], 1e-4 * hmax);
+        }
+        sp_sketch_free(&sk);
+        sp_solver_destroy(s);
+        free(ref), free(p), free(q), free(g), free(g1), free(g2), free(H), free(target);
+        sp_rig_free(&st.rig);
+    }
+}
+
 // Reference for the bounded step: the reduced system over the parameters not
 // yet held, solved afresh each pass (plain Cholesky), as the solver did before
 // it shared one factor between passes.
@@ -334,5 +408,6 @@ int main(int argc, char** argv)
         {"bad_strokes", test_bad_strokes},
         {"regulariser_paths_agree", test_regulariser_paths_agree},
         {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
+        {"gauss_newton_consistent", test_gauss_newton_consistent},
         {0}});
 }
