@@ -168,9 +168,10 @@ static bool make_groups(sp_solver* s)
     s->rep_grp = malloc(sizeof(int) * (size_t)(s->k + 1));
     s->seg_grp = malloc(sizeof(int) * (size_t)(l + 1));
     s->seg_first = malloc(sizeof(int) * (size_t)(l + 1));
+    s->seg_next = malloc(sizeof(int) * (size_t)(l + 1));
     s->seg_cols = malloc(sizeof(int) * (2 * total_cols + 1)); // a union holds at most a's and b's columns
     s->seg_map = malloc(sizeof(int) * (2 * total_cols + 1));
-    if (!s->groups || !s->ab_grp || !s->rep_grp || !s->seg_grp || !s->seg_first || !s->seg_cols || !s->seg_map) return false;
+    if (!s->groups || !s->ab_grp || !s->rep_grp || !s->seg_grp || !s->seg_first || !s->seg_next || !s->seg_cols || !s->seg_map) return false;
     s->group_count = 0;
     for (int i = 0; i < l; ++i) {
         int g = s->ab_grp[i] = find_group(s, s->ab_cols + s->ab_sb[i].first, s->ab_sb[i].count);
@@ -183,6 +184,7 @@ static bool make_groups(sp_solver* s)
             const int b = k + 1 < cv->point_count ? a + 1 : (cv->closed ? cv->first_point : -1);
             s->seg_first[a] = at;
             s->seg_grp[a] = -1;
+            s->seg_next[a] = b;
             if (b < 0 || b == a) continue; // no segment after an open curve's last point (nor in a one-point curve)
             const int *ca = s->ab_cols + s->ab_sb[a].first, *cb = s->ab_cols + s->ab_sb[b].first;
             const int na = s->ab_sb[a].count, nb = s->ab_sb[b].count;
@@ -293,10 +295,13 @@ sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_s
     s->unit = malloc(sizeof(double) * (size_t)P);
     s->free_ = malloc(sizeof(bool) * (size_t)P);
     s->Hl = malloc(sizeof(double) * (size_t)P * (size_t)P);
-    s->pair_rows = malloc(sizeof(double) * 2 * (size_t)(P + 1));
+    s->pair_rows = malloc(sizeof(double) * 4 * (size_t)(P + 1));
+    s->seg_mom = calloc(14 * ll, sizeof(double));
+    s->seg_pairs = calloc(ll, sizeof(int));
+    s->seg_list = malloc(sizeof(int) * ll);
     s->ab_used = malloc(sizeof(bool) * ll);
     if (!s->z3 || !s->z2 || !s->Jz || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
-        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->pair_rows || !s->ab_used)
+        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->pair_rows || !s->seg_mom || !s->seg_pairs || !s->seg_list || !s->ab_used)
         goto fail;
     for (int i = 0; i < s->P; ++i) s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
     return s;
@@ -316,7 +321,8 @@ void sp_solver_destroy(sp_solver* s)
     free(s->ypoly), free(s->ypoly_stroke);
     free(s->Hl), free(s->pair_rows), free(s->ab_used);
     free(s->groups), free(s->ab_grp), free(s->rep_grp), free(s->group_pool);
-    free(s->seg_grp), free(s->seg_first), free(s->seg_cols), free(s->seg_map);
+    free(s->seg_grp), free(s->seg_first), free(s->seg_cols), free(s->seg_map), free(s->seg_next);
+    free(s->seg_mom), free(s->seg_pairs), free(s->seg_list);
     free(s);
 }
 
@@ -514,55 +520,99 @@ static void normal_equations(sp_solver* s, const double* p)
     double* B = malloc(sizeof(double) * (size_t)(6 * P + 3));
     if (!B) return;
     // The match term: a pair's sample is (1-t) z_a + t z_b on the segment
-    // (a, b), its residual d = sample - y weighted by wm m (pair_metric). With
-    // wm m = L L^T its two least-squares rows are L^T J over the segment's
-    // columns (J = (1-t) G_a + t G_b) with residuals L^T d, and H += rows^T
-    // rows is one symmetric rank-k update per group. (Summing the pairs per
-    // point and per segment first, as before, left a cross term per segment
-    // that needed twice the flops in syr2k and loops straight into H across
-    // groups: the cartoon man's outline spent 4x the flops there.)
+    // (a, b), its residual d = sample - y weighted by wm m (pair_metric), so
+    // its Gauss-Newton terms are J^T wm m J and J^T wm m d with
+    // J = (1-t) G_a + t G_b. Summed over a segment's pairs they are
+    // G^T S G and G^T beta with G = [G_a; G_b] (4 rows: a's x and y, b's x
+    // and y), S = sum [(1-t) I; t I] wm m [(1-t) I, t I] (4 x 4) and
+    // beta = sum [(1-t) I; t I] wm m d. With S = L L^T the segment becomes at
+    // most four least-squares rows L^T G over the union of a's and b's
+    // columns with residuals L^-1 beta (a pivot that is zero, as when all of
+    // a segment's pairs share one t, drops its row: S is positive
+    // semidefinite, beta in its range), and H += rows^T rows is one
+    // symmetric rank-k update per group. So a segment costs at most 4 rows
+    // however many pairs it has (the dragon-sized rig: 8 a segment), and 2
+    // with one pair (the cartoon man's outline: 320 pairs on 353 segments).
+    // (Per-point sums with a cross term per segment, as before, took
+    // syr2k at twice the flops and loops into H across groups.)
     const double wm = match_weight(s);
-    double* rows = s->pair_rows;
+    double* mom = s->seg_mom; // 14 per segment: S's upper triangle (10), beta (4); zero between calls
+    int nseg = 0;
     for (int i = 0; i < s->pair_count; ++i) {
         const pair* pr = &s->pairs[i];
         sp_vec2 d = sp_v2_sub(sample_at(s, pr->s), pr->y);
         double m[3];
         pair_metric(s, pr, m);
-        double M0 = wm * m[0], M1 = wm * m[1], M2 = wm * m[2];
-        double l00 = sqrt(fmax(M0, 1e-300)), l10 = M1 / l00;
-        double l11 = sqrt(fmax(M2 - l10 * l10, 1e-300 * (1.0 + M2)));
-        double r2[2] = {l00 * d.x + l10 * d.y, l11 * d.y};
-        const int a = pr->s.a, b = pr->s.b;
-        const double ta = 1.0 - pr->s.t, tb = pr->s.t;
+        const int a = pr->s.a;
+        double ta = 1.0 - pr->s.t, tb = pr->s.t;
+        if (pr->s.b == a || s->seg_grp[a] < 0) ta += tb, tb = 0; // on a point: its own columns only
+        const double c[4][2] = {{ta, 0}, {0, ta}, {tb, 0}, {0, tb}}; // [(1-t) I; t I]
+        const double M[2][2] = {{wm * m[0], wm * m[1]}, {wm * m[1], wm * m[2]}};
+        const double Md[2] = {M[0][0] * d.x + M[0][1] * d.y, M[1][0] * d.x + M[1][1] * d.y};
+        double* S = mom + 14 * (size_t)a;
+        if (s->seg_pairs[a]++ == 0) s->seg_list[nseg++] = a;
+        for (int r = 0, e = 0; r < 4; ++r) {
+            double cm[2] = {c[r][0] * M[0][0] + c[r][1] * M[1][0], c[r][0] * M[0][1] + c[r][1] * M[1][1]};
+            for (int q = r; q < 4; ++q) S[e++] += cm[0] * c[q][0] + cm[1] * c[q][1];
+            S[10 + r] += c[r][0] * Md[0] + c[r][1] * Md[1];
+        }
+    }
+    double* rows = s->pair_rows;
+    for (int k = 0; k < nseg; ++k) {
+        const int a = s->seg_list[k];
+        double* S = mom + 14 * (size_t)a;
+        const bool seg = s->seg_grp[a] >= 0;
+        double L[4][4] = {{0}}, r[4];
+        bool live[4];
+        for (int j = 0, e = 0; j < 4; ++j) // unpack the upper triangle into L's lower one
+            for (int q = j; q < 4; ++q) L[q][j] = S[e++];
+        for (int j = 0; j < 4; ++j) {
+            double piv = L[j][j];
+            for (int i = 0; i < j; ++i)
+                if (live[i]) piv -= L[j][i] * L[j][i];
+            live[j] = piv > 1e-12 * L[j][j] && piv > 0;
+            if (!live[j]) continue;
+            double ljj = sqrt(piv);
+            for (int q = j + 1; q < 4; ++q) {
+                double v = L[q][j];
+                for (int i = 0; i < j; ++i)
+                    if (live[i]) v -= L[q][i] * L[j][i];
+                L[q][j] = v / ljj;
+            }
+            L[j][j] = ljj;
+            double v = S[10 + j];
+            for (int i = 0; i < j; ++i)
+                if (live[i]) v -= L[j][i] * r[i];
+            r[j] = v / ljj;
+        }
+        const int g = seg ? s->seg_grp[a] : s->ab_grp[a], n = s->groups[g].n;
         const sparse_block* A = &s->ab_sb[a];
         const double* Ga = s->G + 2 * (size_t)A->first;
-        if (a == b || s->seg_grp[a] < 0) { // on a point: its own columns
-            const int n = A->count;
-            for (int c = 0; c < n; ++c) {
-                double gx = Ga[c], gy = Ga[n + c];
-                rows[c] = l00 * gx + l10 * gy;
-                rows[n + c] = l11 * gy;
+        const int* map = seg ? s->seg_map + s->seg_first[a] : NULL; // a's columns, then b's; NULL: a's own
+        int nr = 0;
+        double rr[4];
+        for (int j = 0; j < 4; ++j) {
+            if (!live[j]) continue;
+            double* row = rows + (size_t)nr * (size_t)n;
+            memset(row, 0, sizeof(double) * (size_t)n);
+            // Row j = column j of L (rows >= j) against G's four rows.
+            double ax = L[0][j], ay = L[1][j], bx = L[2][j], by = L[3][j];
+            if (j > 0) ax = 0;
+            if (j > 1) ay = 0;
+            if (j > 2) bx = 0;
+            for (int c = 0; c < A->count; ++c) row[map ? map[c] : c] += ax * Ga[c] + ay * Ga[A->count + c];
+            if (seg && (bx != 0 || by != 0)) {
+                const int bpt = s->seg_next[a];
+                const sparse_block* Bb = &s->ab_sb[bpt];
+                const double* Gb = s->G + 2 * (size_t)Bb->first;
+                const int* mb = map + A->count;
+                for (int c = 0; c < Bb->count; ++c) row[mb[c]] += bx * Gb[c] + by * Gb[Bb->count + c];
             }
-            push_rows(s, s->ab_grp[a], rows, 2, r2);
-            continue;
+            rr[nr++] = r[j];
         }
-        const int g = s->seg_grp[a], n = s->groups[g].n;
-        const sparse_block* Bb = &s->ab_sb[b];
-        const double* Gb = s->G + 2 * (size_t)Bb->first;
-        const int* map = s->seg_map + s->seg_first[a]; // a's columns, then b's
-        memset(rows, 0, sizeof(double) * 2 * (size_t)n);
-        for (int c = 0; c < A->count; ++c) {
-            double gx = ta * Ga[c], gy = ta * Ga[A->count + c];
-            rows[map[c]] += l00 * gx + l10 * gy;
-            rows[n + map[c]] += l11 * gy;
-        }
-        map += A->count;
-        for (int c = 0; c < Bb->count; ++c) {
-            double gx = tb * Gb[c], gy = tb * Gb[Bb->count + c];
-            rows[map[c]] += l00 * gx + l10 * gy;
-            rows[n + map[c]] += l11 * gy;
-        }
-        push_rows(s, g, rows, 2, r2);
+        if (nr) push_rows(s, g, rows, nr, rr);
+        memset(S, 0, sizeof(double) * 14);
+        s->seg_pairs[a] = 0;
     }
     if (has_reg(s) && closed_form_reg(s)) {
         double inv = vertex_weight(s) * s->vertex_boost;

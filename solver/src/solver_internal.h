@@ -75,8 +75,12 @@ struct sp_solver {
     int* seg_grp;       // point_count: -1 for a curve's last point when open
     int* seg_map;       // positions: a's columns, then b's, from seg_first[a]
     int* seg_first;     // point_count
+    int* seg_next;      // point_count: b
     int* seg_cols;      // the unions' column lists (groups point into it)
-    double* pair_rows;  // 2 * P: one pair's two rows
+    double* seg_mom;    // point_count by 14: a segment's summed pairs (normal_equations; zero between calls)
+    int* seg_pairs;     // point_count: pairs summed into it (zero between calls)
+    int* seg_list;      // point_count: the segments touched
+    double* pair_rows;  // 4 * P: one segment's rows
     bool* ab_used;      // point_count: a pair's sample lies on the point (jacobian_blocks)
     row_group* groups;
     int group_count;
