@@ -153,11 +153,10 @@ static int find_group(sp_solver* s, const int* cols, int n)
 }
 
 // Groups the abstraction points, their segments and the representatives by
-// column list. A pair's sample lies on a segment (a, b), so its two rows span
-// the union of a's and b's columns: the segment's group. Rows reserved: 2 per
-// point and per segment (about a pair each; a group that fills up is flushed
-// early, so this only sizes the common case) and 4 per representative
-// (W_plane and W_dist).
+// column list. A pair's sample lies on a segment (a, b), so a segment's rows
+// span the union of a's and b's columns: the segment's group. Rows reserved:
+// 2 per point (a one-point curve's), 4 per segment and 4 per representative
+// (W_plane and W_dist): what one normal-equation build pushes at most.
 static bool make_groups(sp_solver* s)
 {
     const int l = s->ab->point_count;
@@ -295,13 +294,13 @@ sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_s
     s->unit = malloc(sizeof(double) * (size_t)P);
     s->free_ = malloc(sizeof(bool) * (size_t)P);
     s->Hl = malloc(sizeof(double) * (size_t)P * (size_t)P);
-    s->pair_rows = malloc(sizeof(double) * 4 * (size_t)(P + 1));
+    s->seg_rows = malloc(sizeof(double) * 4 * (size_t)(P + 1));
     s->seg_mom = calloc(14 * ll, sizeof(double));
     s->seg_pairs = calloc(ll, sizeof(int));
     s->seg_list = malloc(sizeof(int) * ll);
     s->ab_used = malloc(sizeof(bool) * ll);
     if (!s->z3 || !s->z2 || !s->Jz || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
-        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->pair_rows || !s->seg_mom || !s->seg_pairs || !s->seg_list || !s->ab_used)
+        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->seg_rows || !s->seg_mom || !s->seg_pairs || !s->seg_list || !s->ab_used)
         goto fail;
     for (int i = 0; i < s->P; ++i) s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
     return s;
@@ -319,7 +318,7 @@ void sp_solver_destroy(sp_solver* s)
     free(s->Jz), free(s->z3), free(s->z2), free(s->G), free(s->x0), free(s->xr), free(s->Jr), free(s->dw), free(s->view);
     free(s->H), free(s->g), free(s->p0), free(s->unit), free(s->free_), free(s->pairs);
     free(s->ypoly), free(s->ypoly_stroke);
-    free(s->Hl), free(s->pair_rows), free(s->ab_used);
+    free(s->Hl), free(s->seg_rows), free(s->ab_used);
     free(s->groups), free(s->ab_grp), free(s->rep_grp), free(s->group_pool);
     free(s->seg_grp), free(s->seg_first), free(s->seg_cols), free(s->seg_map), free(s->seg_next);
     free(s->seg_mom), free(s->seg_pairs), free(s->seg_list);
@@ -557,7 +556,7 @@ static void normal_equations(sp_solver* s, const double* p)
             S[10 + r] += c[r][0] * Md[0] + c[r][1] * Md[1];
         }
     }
-    double* rows = s->pair_rows;
+    double* rows = s->seg_rows;
     for (int k = 0; k < nseg; ++k) {
         const int a = s->seg_list[k];
         double* S = mom + 14 * (size_t)a;

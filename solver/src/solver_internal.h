@@ -80,7 +80,7 @@ struct sp_solver {
     double* seg_mom;    // point_count by 14: a segment's summed pairs (normal_equations; zero between calls)
     int* seg_pairs;     // point_count: pairs summed into it (zero between calls)
     int* seg_list;      // point_count: the segments touched
-    double* pair_rows;  // 4 * P: one segment's rows
+    double* seg_rows;   // 4 * P: one segment's rows
     bool* ab_used;      // point_count: a pair's sample lies on the point (jacobian_blocks)
     row_group* groups;
     int group_count;
