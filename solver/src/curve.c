@@ -253,10 +253,15 @@ static void sort_x_index(x_index* a, int n)
 }
 
 // For each query point, the index of its closest data point (lowest index on
-// ties). The data sorted by x, each query searches outwards from its own x
-// and stops where the x gap alone exceeds the best distance: exact, and a
-// fraction of the all-pairs scan on curves of a few hundred samples (the
-// scan was a tenth of a dragon part's solve).
+// ties). The data sorted along their longer extent (x or y), each query
+// searches outwards from its own coordinate and stops where that gap alone
+// exceeds the best distance: exact, and a fraction of the all-pairs scan on
+// curves of a few hundred samples (the scan was a tenth of a dragon part's
+// solve). Each search starts from the previous query's answer: consecutive
+// queries are neighbours along a curve, so the bound is tight from the start
+// and the sweep short (a vertical stroke swept along x visited most of the
+// data). Still exact: a point that beats or ties the start lies within the
+// start's distance, so inside the swept band.
 static void closest_brute(const sp_vec2* q, int nq, const sp_vec2* d, int nd, int* idx)
 {
     x_index* xs = malloc(sizeof(x_index) * (size_t)nd);
@@ -272,26 +277,27 @@ static void closest_brute(const sp_vec2* q, int nq, const sp_vec2* d, int nd, in
         }
         return;
     }
-    for (int j = 0; j < nd; ++j) xs[j] = (x_index){d[j].x, j};
+    double lx = INFINITY, hx = -INFINITY, ly = INFINITY, hy = -INFINITY;
+    for (int j = 0; j < nd; ++j) lx = fmin(lx, d[j].x), hx = fmax(hx, d[j].x), ly = fmin(ly, d[j].y), hy = fmax(hy, d[j].y);
+    const bool along_y = hy - ly > hx - lx;
+    for (int j = 0; j < nd; ++j) xs[j] = (x_index){along_y ? d[j].y : d[j].x, j};
     sort_x_index(xs, nd);
+    int bj = 0, lo = 0; // the previous query's answer and sorted position
     for (int i = 0; i < nq; ++i) {
         const sp_vec2 p = q[i];
-        int lo = 0, hi = nd; // first sorted entry with x >= p.x
-        while (lo < hi) {
-            int mid = (lo + hi) / 2;
-            if (xs[mid].x < p.x) lo = mid + 1;
-            else hi = mid;
-        }
-        int bj = -1;
-        double bd = INFINITY;
+        const double px = along_y ? p.y : p.x;
+        // lo: the first sorted entry with key >= px, walked from the last one's.
+        while (lo > 0 && xs[lo - 1].x >= px) --lo;
+        while (lo < nd && xs[lo].x < px) ++lo;
+        double bd = dist2(p, d[bj]);
         for (int k = lo; k < nd; ++k) {
-            double dx = xs[k].x - p.x;
+            double dx = xs[k].x - px;
             if (dx * dx > bd) break;
             double dd = dist2(p, d[xs[k].i]);
             if (dd < bd || (dd == bd && xs[k].i < bj)) bd = dd, bj = xs[k].i;
         }
         for (int k = lo - 1; k >= 0; --k) {
-            double dx = p.x - xs[k].x;
+            double dx = px - xs[k].x;
             if (dx * dx > bd) break;
             double dd = dist2(p, d[xs[k].i]);
             if (dd < bd || (dd == bd && xs[k].i < bj)) bd = dd, bj = xs[k].i;

@@ -319,31 +319,57 @@ static void test_closest_both_ways(void)
     ENSURE(sp_corr_closest(y, 0, z, MZ, pairs, NULL) == SP_ERR_INVALID);
 }
 
-// Above SP_CORR_BRUTE_MAX the k-d tree answers; it must be exact.
-// Both directions against a plain scan on integer points with many exact
-// ties (equal x, equal distances): the same partner, lowest index on ties.
+// Both directions against a plain scan: the same partner, lowest index on ties.
+static void check_closest_exact(const sp_vec2* y, int my, const sp_vec2* z, int mz)
+{
+    sp_corr_pair* pairs = malloc(sizeof(sp_corr_pair) * (size_t)(my + mz));
+    ENSURE(sp_corr_closest(y, my, z, mz, pairs, NULL) == SP_OK);
+    for (int i = 0; i < my; ++i) {
+        int bj = 0;
+        for (int j = 1; j < mz; ++j)
+            if (d2(y[i], z[j]) < d2(y[i], z[bj])) bj = j;
+        ENSURE(pairs[i].y == i && pairs[i].z == bj);
+    }
+    for (int j = 0; j < mz; ++j) {
+        int bi = 0;
+        for (int i = 1; i < my; ++i)
+            if (d2(z[j], y[i]) < d2(z[j], y[bi])) bi = i;
+        ENSURE(pairs[my + j].z == j && pairs[my + j].y == bi);
+    }
+    free(pairs);
+}
+
+// The sweep (below SP_CORR_BRUTE_MAX) is exact: integer points with many
+// exact ties (equal coordinates, equal distances) in a square, a tall and a
+// wide box (the sweep runs along the longer side), and curves, where each
+// search starts from the previous answer, one of them queried backwards.
 static void test_closest_exact_ties(void)
 {
     enum { MY = 90, MZ = 70 };
     sp_vec2 y[MY], z[MZ];
-    sp_corr_pair pairs[MY + MZ];
     sp_test_rng rng = {33};
-    for (int i = 0; i < MY; ++i)
-        y[i] = (sp_vec2){(double)(int)sp_test_range(&rng, 0, 8), (double)(int)sp_test_range(&rng, 0, 8)};
-    for (int j = 0; j < MZ; ++j)
-        z[j] = (sp_vec2){(double)(int)sp_test_range(&rng, 0, 8), (double)(int)sp_test_range(&rng, 0, 8)};
-    ENSURE(sp_corr_closest(y, MY, z, MZ, pairs, NULL) == SP_OK);
-    for (int i = 0; i < MY; ++i) {
-        int bj = 0;
-        for (int j = 1; j < MZ; ++j)
-            if (d2(y[i], z[j]) < d2(y[i], z[bj])) bj = j;
-        ENSURE(pairs[i].y == i && pairs[i].z == bj);
+    // Integer grids (many ties): square, tall (swept along y) and wide.
+    const double ext[3][2] = {{8, 8}, {3, 30}, {30, 3}};
+    for (int e = 0; e < 3; ++e) {
+        for (int i = 0; i < MY; ++i)
+            y[i] = (sp_vec2){(double)(int)sp_test_range(&rng, 0, ext[e][0]), (double)(int)sp_test_range(&rng, 0, ext[e][1])};
+        for (int j = 0; j < MZ; ++j)
+            z[j] = (sp_vec2){(double)(int)sp_test_range(&rng, 0, ext[e][0]), (double)(int)sp_test_range(&rng, 0, ext[e][1])};
+        check_closest_exact(y, MY, z, MZ);
     }
-    for (int j = 0; j < MZ; ++j) {
-        int bi = 0;
-        for (int i = 1; i < MY; ++i)
-            if (d2(z[j], y[i]) < d2(z[j], y[bi])) bi = i;
-        ENSURE(pairs[MY + j].z == j && pairs[MY + j].y == bi);
+    // Curves (each search starts from the last answer): random walks, tall
+    // and wide, one of them queried backwards, crossing each other.
+    for (int e = 0; e < 2; ++e) {
+        sp_vec2 a = {0, 0}, b = {5, 0};
+        for (int i = 0; i < MY; ++i) {
+            a = (sp_vec2){a.x + sp_test_range(&rng, -1, 1) * (e ? 4 : 1), a.y + sp_test_range(&rng, -1, 1) * (e ? 1 : 4)};
+            y[e ? i : MY - 1 - i] = a;
+        }
+        for (int j = 0; j < MZ; ++j) {
+            b = (sp_vec2){b.x + sp_test_range(&rng, -1, 1) * (e ? 4 : 1), b.y + sp_test_range(&rng, -1, 1) * (e ? 1 : 4)};
+            z[j] = b;
+        }
+        check_closest_exact(y, MY, z, MZ);
     }
 }
 
@@ -438,6 +464,7 @@ static void test_ordered_candidates(void)
     ENSURE(sp_corr_ordered_candidates(y, z, M, c, 4) == 0);
 }
 
+// Above SP_CORR_BRUTE_MAX the k-d tree answers; it must be exact.
 static void test_closest_kdtree(void)
 {
     int my = 1500, mz = 1200;
