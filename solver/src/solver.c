@@ -294,13 +294,15 @@ sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_s
     s->unit = malloc(sizeof(double) * (size_t)P);
     s->free_ = malloc(sizeof(bool) * (size_t)P);
     s->Hl = malloc(sizeof(double) * (size_t)P * (size_t)P);
-    s->seg_rows = malloc(sizeof(double) * 4 * (size_t)(P + 1));
+    s->rows = malloc(sizeof(double) * 4 * (size_t)(P + 1));
+    s->step_work = malloc(sizeof(double) * sp__bounded_step_work(P));
+    s->step_iwork = malloc(sizeof(int) * 3 * (size_t)(P + 1));
     s->seg_mom = calloc(14 * ll, sizeof(double));
     s->seg_pairs = calloc(ll, sizeof(int));
     s->seg_list = malloc(sizeof(int) * ll);
     s->ab_used = malloc(sizeof(bool) * ll);
     if (!s->z3 || !s->z2 || !s->Jz || !s->G || !s->x0 || !s->xr || !s->Jr || !s->dw || !s->view ||
-        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->seg_rows || !s->seg_mom || !s->seg_pairs || !s->seg_list || !s->ab_used)
+        !s->H || !s->g || !s->p0 || !s->unit || !s->free_ || !s->Hl || !s->rows || !s->step_work || !s->step_iwork || !s->seg_mom || !s->seg_pairs || !s->seg_list || !s->ab_used)
         goto fail;
     for (int i = 0; i < s->P; ++i) s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
     return s;
@@ -318,7 +320,7 @@ void sp_solver_destroy(sp_solver* s)
     free(s->Jz), free(s->z3), free(s->z2), free(s->G), free(s->x0), free(s->xr), free(s->Jr), free(s->dw), free(s->view);
     free(s->H), free(s->g), free(s->p0), free(s->unit), free(s->free_), free(s->pairs);
     free(s->ypoly), free(s->ypoly_stroke);
-    free(s->Hl), free(s->seg_rows), free(s->ab_used);
+    free(s->Hl), free(s->rows), free(s->step_work), free(s->step_iwork), free(s->ab_used);
     free(s->groups), free(s->ab_grp), free(s->rep_grp), free(s->group_pool);
     free(s->seg_grp), free(s->seg_first), free(s->seg_cols), free(s->seg_map), free(s->seg_next);
     free(s->seg_mom), free(s->seg_pairs), free(s->seg_list);
@@ -493,7 +495,8 @@ static void flush_groups(sp_solver* s)
 }
 
 // Least-squares rows B (rows x n over group g's columns, residuals r):
-// g += B^T r now, H += B^T B when the group is flushed (early if it is full).
+// g += B^T r now, H += B^T B when the group is flushed (make_groups reserved
+// what one build pushes).
 static void push_rows(sp_solver* s, int g, const double* B, int rows, const double* r)
 {
     row_group* gr = &s->groups[g];
@@ -502,8 +505,7 @@ static void push_rows(sp_solver* s, int g, const double* B, int rows, const doub
         const double* Bk = B + (size_t)k * (size_t)n;
         for (int a = 0; a < n; ++a) s->g[gr->cols[a]] += Bk[a] * r[k];
     }
-    if (gr->rows + rows > gr->cap) flush_group(s, g);
-    assert(rows <= gr->cap);
+    assert(gr->rows + rows <= gr->cap);
     memcpy(gr->U + (size_t)gr->rows * (size_t)n, B, sizeof(double) * (size_t)rows * (size_t)n);
     gr->rows += rows;
 }
@@ -516,8 +518,6 @@ static void normal_equations(sp_solver* s, const double* p)
     memset(s->H, 0, sizeof(double) * (size_t)P * (size_t)P);
     memset(s->g, 0, sizeof(double) * (size_t)P);
     jacobian_blocks(s);
-    double* B = malloc(sizeof(double) * (size_t)(6 * P + 3));
-    if (!B) return;
     // The match term: a pair's sample is (1-t) z_a + t z_b on the segment
     // (a, b), its residual d = sample - y weighted by wm m (pair_metric), so
     // its Gauss-Newton terms are J^T wm m J and J^T wm m d with
@@ -556,7 +556,7 @@ static void normal_equations(sp_solver* s, const double* p)
             S[10 + r] += c[r][0] * Md[0] + c[r][1] * Md[1];
         }
     }
-    double* rows = s->seg_rows;
+    double* rows = s->rows;
     for (int k = 0; k < nseg; ++k) {
         const int a = s->seg_list[k];
         double* S = mom + 14 * (size_t)a;
@@ -618,6 +618,7 @@ static void normal_equations(sp_solver* s, const double* p)
         s->model->ops->reg_normal(s->model, s->d.lambda_plane * inv, s->d.lambda_dist * inv, s->H, s->g);
     } else if (has_reg(s)) {
         double inv = vertex_weight(s) * s->vertex_boost;
+        double* B = s->rows;
         for (int i = 0; i < s->k; ++i) {
             const sparse_block* sb = &s->rep_sb[i];
             const double* Jb = s->Jr + 3 * (size_t)sb->first;
@@ -651,7 +652,17 @@ static void normal_equations(sp_solver* s, const double* p)
     }
     for (int a = 0; a < P; ++a)
         for (int b = a + 1; b < P; ++b) s->H[b * P + a] = s->H[a * P + b];
-    free(B);
+}
+
+// The rig linearised at p: state with derivatives, projection (unless the
+// caller's last energy left it at p), representatives' rows when the
+// regularisers use them, then the normal equations.
+static void linearise(sp_solver* s, const double* p, bool project)
+{
+    model_update(s, p, true);
+    if (project) project_abstraction(s);
+    if (s->k > 0 && !closed_form_reg(s)) model_rows(s, s->xr);
+    normal_equations(s, p);
 }
 
 // Solves (H_ff + mu diag) delta_f = -g_f over the free parameters, within
@@ -674,23 +685,24 @@ static void normal_equations(sp_solver* s, const double* p)
 // (Tried once before, when the representatives' rows dominated, and dropped
 // for no gain.)
 // Returns false if the system could not be solved.
+size_t sp__bounded_step_work(int P)
+{
+    return 3 * (size_t)P * (size_t)P + 5 * (size_t)P + 5;
+}
+
 bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p, double mu,
-                      double* delta)
+                      double* delta, double* work, int* iwork)
 {
     const size_t PP = (size_t)P * (size_t)P;
-    int* idx = malloc(sizeof(int) * (size_t)(2 * P + 2));
-    int* rpos = idx + P + 1; // positions in idx of the held parameters, in the order they were held
-    bool* held = malloc(sizeof(bool) * (size_t)(P + 1));
-    double* A = malloc(sizeof(double) * (3 * PP + 5 * (size_t)P + 5));
-    bool ok = idx && held && A;
+    int* idx = iwork;           // the free parameters
+    int* rpos = idx + P + 1;    // positions in idx of the held parameters, in the order they were held
+    int* held = rpos + P + 1;   // by position in idx
+    double* A = work;
     memset(delta, 0, sizeof(double) * (size_t)P);
     int nf = 0;
-    for (int q = 0; ok && q < P; ++q)
+    for (int q = 0; q < P; ++q)
         if (free_[q]) idx[nf++] = q;
-    if (!ok || nf == 0) {
-        free(A), free(idx), free(held);
-        return false;
-    }
+    if (nf == 0) return false;
     double* V = A + PP;     // nf x nr, column-major: column j = U^-T e_rpos[j] (A = U'U)
     double* S = V + PP;     // nr x nr: V'V = E_R' A^-1 E_R, factored in place
     double* x0 = S + PP;    // A^-1 b
@@ -703,11 +715,11 @@ bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_
         // Marquardt scaling plus a floor so that flat directions stay solvable.
         A[i * nf + i] += mu * (Hi[idx[i]] + 1e-9);
         x0[i] = -g[idx[i]];
-        held[i] = false;
+        held[i] = 0;
     }
     // A is symmetric: column-major saves LAPACKE's transposed copy. The _work
     // forms skip LAPACKE's NaN scans (the result is checked below).
-    ok = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'U', nf, A, nf) == 0 && LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'U', nf, 1, A, nf, x0, nf) == 0;
+    bool ok = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'U', nf, A, nf) == 0 && LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'U', nf, 1, A, nf, x0, nf) == 0;
     memcpy(x, x0, sizeof(double) * (size_t)nf);
     int nr = 0;
     for (int pass = 0; ok && pass <= nf; ++pass) {
@@ -721,7 +733,7 @@ bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_
             const sp_model_param* pr = &params[idx[i]];
             double v = p[idx[i]] + x[i];
             if (v < pr->min || v > pr->max) {
-                held[i] = true;
+                held[i] = 1;
                 dR[nr] = (v < pr->min ? pr->min : pr->max) - p[idx[i]];
                 rpos[nr++] = i;
             }
@@ -748,13 +760,12 @@ bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_
         any |= x[i] != 0.0;
     }
     if (!ok) memset(delta, 0, sizeof(double) * (size_t)P);
-    free(A), free(idx), free(held);
     return ok && any;
 }
 
 static bool lm_step(sp_solver* s, const double* p, double mu, double* delta)
 {
-    return sp__bounded_step(s->P, s->H, s->g, s->free_, s->model->params, p, mu, delta);
+    return sp__bounded_step(s->P, s->H, s->g, s->free_, s->model->params, p, mu, delta, s->step_work, s->step_iwork);
 }
 
 // Active set: a parameter at a bound whose descent direction leaves the box
@@ -1080,10 +1091,7 @@ static sp_result solve_once(sp_solver* s, const sp_sketch* sk, const double* p_s
                     break;
                 }
                 ++rep->iterations;
-                model_update(s, p, true);
-                if (!z_at_p) project_abstraction(s); // else the accepted step's energy did it (same values)
-                if (s->k > 0 && !closed_form_reg(s)) model_rows(s, s->xr);
-                normal_equations(s, p);
+                linearise(s, p, !z_at_p); // else the accepted step's energy projected at p (same values)
                 choose_free(s, p, stage_active);
                 bool accepted = false;
                 for (int tries = 0; tries < 12 && !accepted; ++tries) {
@@ -1182,10 +1190,7 @@ sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p
     if (res != SP_OK) return res;
     prepare_start(s, p_ref, &rep);
     *W = energy(s, p).total;
-    model_update(s, p, true);
-    project_abstraction(s);
-    if (s->k > 0 && !closed_form_reg(s)) model_rows(s, s->xr);
-    normal_equations(s, p);
+    linearise(s, p, false); // energy projected at p
     memcpy(g, s->g, sizeof(double) * (size_t)s->P);
     if (H) memcpy(H, s->H, sizeof(double) * (size_t)s->P * (size_t)s->P);
     return SP_OK;

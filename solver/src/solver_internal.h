@@ -80,7 +80,9 @@ struct sp_solver {
     double* seg_mom;    // point_count by 14: a segment's summed pairs (normal_equations; zero between calls)
     int* seg_pairs;     // point_count: pairs summed into it (zero between calls)
     int* seg_list;      // point_count: the segments touched
-    double* seg_rows;   // 4 * P: one segment's rows
+    double* rows;       // 4 * P: one segment's or representative's rows (normal_equations)
+    double* step_work;  // the bounded step's scratch (sp__bounded_step_work)
+    int* step_iwork;    // 3 (P + 1)
     bool* ab_used;      // point_count: a pair's sample lies on the point (jacobian_blocks)
     row_group* groups;
     int group_count;
@@ -121,7 +123,9 @@ struct sp_solver {
 sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double* W, double* g, double* H,
                               sp_error* err);
 
+// work: sp__bounded_step_work(P) doubles; iwork: 3 (P + 1) ints (the caller's).
 bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p, double mu,
-                      double* delta);
+                      double* delta, double* work, int* iwork);
+size_t sp__bounded_step_work(int P);
 
 #endif

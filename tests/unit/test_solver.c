@@ -355,6 +355,8 @@ static void test_bounded_step_matches_reduced_solves(void)
     sp_test_rng rng = {7};
     double* H = malloc(sizeof(double) * P * P);
     double* M = malloc(sizeof(double) * P * P);
+    double* work = malloc(sizeof(double) * sp__bounded_step_work(P));
+    int iwork[3 * (P + 1)];
     double g[P], p[P], d[P], ref[P];
     bool free_[P];
     sp_model_param pr[P];
@@ -376,7 +378,7 @@ static void test_bounded_step_matches_reduced_solves(void)
             free_[q] = sp_test_uniform(&rng) > 0.1;
         }
         double mu = trial % 3 == 0 ? 0.0 : 1e-3 * trial;
-        ENSURE(sp__bounded_step(P, H, g, free_, pr, p, mu, d));
+        ENSURE(sp__bounded_step(P, H, g, free_, pr, p, mu, d, work, iwork));
         ENSURE(reference_bounded_step(P, H, g, free_, pr, p, mu, ref));
         double scale = 0;
         for (int q = 0; q < P; ++q) scale = fmax(scale, fabs(ref[q]));
@@ -395,8 +397,8 @@ static void test_bounded_step_matches_reduced_solves(void)
     ENSURE(multi_pass > 30 && held_total > 200);
     // Nothing free: no step.
     for (int q = 0; q < P; ++q) free_[q] = false;
-    ENSURE(!sp__bounded_step(P, H, g, free_, pr, p, 1e-3, d));
-    free(H), free(M);
+    ENSURE(!sp__bounded_step(P, H, g, free_, pr, p, 1e-3, d, work, iwork));
+    free(H), free(M), free(work);
 }
 
 int main(int argc, char** argv)
