@@ -102,14 +102,23 @@ struct sp_solver {
     double L;        // abstraction 2D diagonal at the start pose, pixels
     sp_correspondence mode; // how sp__build_pairs pairs samples now
     double pose_boost;      // >= 1: graduated W_pose weight, 1 in the final rounds
+    int boost_from;         // parameters before it (the placement) keep W_pose unboosted
     double vertex_boost;    // >= 1: the same for W_plane and W_dist (draw-over only)
     int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke)
     bool c2s_valid;
     bool used_loop;            // the last attempt matched an outline in order first
+    bool placed_free;          // the last attempt placed the root without the boost (boost_from > 0)
     bool loop_forced;          // a loop's ordered pairs use loop_hypothesis instead of the best shift
     sp_ordered_info loop_hypothesis;
     bool keep_assignment;      // reuse c2s instead of assigning again
 };
+
+// Test hook: W at p and its Gauss-Newton g (half W's gradient) and H (H may
+// be NULL) with the pairs for sk and the regularisers' reference made at
+// p_ref, W_pose boosted by pose_boost on the parameters from boost_from on
+// (the graduated rounds' weights; 1 and 0: the final ones).
+sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double pose_boost, int boost_from,
+                              double* W, double* g, double* H, sp_error* err);
 
 // The bounded Levenberg-Marquardt step of solver.c (exposed for its test):
 // (H_ff + mu diag(H_ff)) delta_f = -g_f over the free parameters (H: P x P,
@@ -117,12 +126,6 @@ struct sp_solver {
 // bound they cross and the rest solved again until the step stays inside.
 // delta is zero outside the free set. False if the system cannot be solved
 // or the step is zero.
-// Test hook: W at p and its Gauss-Newton g (half W's gradient) and H (H may
-// be NULL) with the pairs for sk and the regularisers' reference made at
-// p_ref, at the final weights.
-sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double* W, double* g, double* H,
-                              sp_error* err);
-
 // work: sp__bounded_step_work(P) doubles; iwork: 3 (P + 1) ints (the caller's).
 bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p, double mu,
                       double* delta, double* work, int* iwork);

@@ -225,7 +225,15 @@ static void test_regulariser_paths_agree(void)
 // differences of g along random v).
 static void test_gauss_newton_consistent(void)
 {
-    for (int closest = 0; closest < 2; ++closest) {
+    // Variants: ordered pairs, closest pairs, ordered pairs with W_pose
+    // boosted as in the graduated rounds except on the first three
+    // parameters (a loop's free placement, solve_once). The boost is far
+    // above the rounds' 1e7 so that W_pose's share of g is not lost under
+    // the match term's (~1e11 at the hook's pixel scale): with 1e3-1e5 a
+    // normal-equations weight that boosted the first three too passed.
+    for (int variant = 0; variant < 3; ++variant) {
+        const int closest = variant == 1, from = variant == 2 ? 3 : 0;
+        const double boost = variant == 2 ? 1e10 : 1.0;
         setup st;
         make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .branching = true, .all_channels = true, .closest = closest, .seed = 5});
         sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
@@ -240,7 +248,7 @@ static void test_gauss_newton_consistent(void)
         double* H = malloc(sizeof(double) * P * P);
         double W, W1, W2;
         sp_error err = {0};
-        sp_test_rng rng = {11 + closest};
+        sp_test_rng rng = {11 + variant};
         sp_fixture_random_params(&st.rig, &rng, 0.5, ref);
         sp_fixture_random_params(&st.rig, &rng, 0.3, p);
         sp_sketch sk;
@@ -248,7 +256,7 @@ static void test_gauss_newton_consistent(void)
         sp_fixture_random_params(&st.rig, &rng, 0.5, target);
         strokes_at(s, &st.rig, target, &sk);
         // g = half the gradient of W at p (pairs and reference made at ref).
-        ENSURE(sp__gauss_newton_at(s, &sk, ref, p, &W, g, NULL, &err) == SP_OK);
+        ENSURE(sp__gauss_newton_at(s, &sk, ref, p, boost, from, &W, g, NULL, &err) == SP_OK);
         double gmax = 0;
         for (int k = 0; k < P; ++k) gmax = fmax(gmax, fabs(g[k]));
         ENSURE(gmax > 0);
@@ -256,24 +264,24 @@ static void test_gauss_newton_consistent(void)
             const double h = 1e-6 * (st.rig.params[k].max - st.rig.params[k].min);
             memcpy(q, p, sizeof(double) * P);
             q[k] = p[k] + h;
-            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W1, g1, NULL, &err) == SP_OK);
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, boost, from, &W1, g1, NULL, &err) == SP_OK);
             q[k] = p[k] - h;
-            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W2, g1, NULL, &err) == SP_OK);
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, boost, from, &W2, g1, NULL, &err) == SP_OK);
             ENSURE_NEAR((W1 - W2) / (2 * h), 2 * g[k], 1e-5 * (2 * gmax));
         }
         sp_sketch_free(&sk);
         // H: strokes drawn at ref, evaluated at ref (every residual ~0).
         strokes_at(s, &st.rig, ref, &sk);
-        ENSURE(sp__gauss_newton_at(s, &sk, ref, ref, &W, g, H, &err) == SP_OK);
+        ENSURE(sp__gauss_newton_at(s, &sk, ref, ref, boost, from, &W, g, H, &err) == SP_OK);
         for (int trial = 0; trial < 6; ++trial) {
             double v[64];
             ENSURE(P <= 64);
             for (int k = 0; k < P; ++k) v[k] = sp_test_range(&rng, -1, 1) * (st.rig.params[k].max - st.rig.params[k].min);
             const double h = 1e-6;
             for (int k = 0; k < P; ++k) q[k] = ref[k] + h * v[k];
-            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W1, g1, NULL, &err) == SP_OK);
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, boost, from, &W1, g1, NULL, &err) == SP_OK);
             for (int k = 0; k < P; ++k) q[k] = ref[k] - h * v[k];
-            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, &W2, g2, NULL, &err) == SP_OK);
+            ENSURE(sp__gauss_newton_at(s, &sk, ref, q, boost, from, &W2, g2, NULL, &err) == SP_OK);
             double hmax = 0;
             double* Hv = q;
             for (int a = 0; a < P; ++a) {
