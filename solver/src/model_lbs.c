@@ -2,7 +2,6 @@
 // eq. 13): evaluation through sp_rig_eval and analytic Jacobians whose
 // sparsity follows the skeleton (a point moves with the parameters of its
 // influences and their ancestors).
-#include <cblas.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,7 +41,6 @@ typedef struct reg_lbs {
     double* E;                      // 12 per entry of anc: E_qj at the last update
     double* delta;                  // 12 per joint: S_j - S0_j
     double* u;                      // 12 per entry of a joint's reach: sum over partners of K E_rk
-    double* Hb;                     // P x P: one joint's block E_j u^T
     int* pos;                       // P: a parameter's position in the current joint's reach
     int* to;                        // P: positions of a partner's parameters in that reach
 } reg_lbs;
@@ -166,10 +164,9 @@ static bool lbs_prepare(sp_model* m, const int* reps, int k)
     R->skin0 = malloc(sizeof(sp_mat4) * ((size_t)nj + 1));
     R->delta = malloc(sizeof(double) * 12 * ((size_t)nj + 1));
     R->u = malloc(sizeof(double) * 12 * (size_t)P);
-    R->Hb = malloc(sizeof(double) * (size_t)P * (size_t)P);
     R->pos = malloc(sizeof(int) * (size_t)P);
     R->to = malloc(sizeof(int) * (size_t)P);
-    bool ok = pairs && mark && R->anc_first && R->adj_first && R->reach_first && R->anc && R->skin0 && R->delta && R->u && R->Hb && R->pos && R->to;
+    bool ok = pairs && mark && R->anc_first && R->adj_first && R->reach_first && R->anc && R->skin0 && R->delta && R->u && R->pos && R->to;
     if (!ok) goto done;
     int na = 0;
     for (int j = 0; j < nj; ++j) {
@@ -438,10 +435,12 @@ static void lbs_reg_normal(sp_model* m, double wp, double wd, double* H, double*
             for (int t = 0; t < nk; ++t) to[t] = R->pos[R->anc[a0 + t]];
             reg_apply(R, pair, wp, wd, R->E + 12 * (size_t)a0, nk, to, R->u);
         }
-        // This joint's rows: g_q += E_qj . h and H_qr += E_qj . u_r (r >= q),
-        // the latter as one product E_j u^T.
+        // This joint's rows: g_q += E_qj . h and H_qr += E_qj . u_r (r >= q).
+        // Only the upper triangle is needed, 12 products a dot: written out
+        // as three four-lane products. (One dgemm E_j u^T for the whole block
+        // computed both triangles, and its per-call setup and zeroing were
+        // most of its cost at these sizes: ~11k instructions a call.)
         const double* Ej = R->E + 12 * (size_t)R->anc_first[j];
-        cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, na, nr, 12, 1.0, Ej, 12, R->u, 12, 0.0, R->Hb, nr);
         int s0 = 0;
         for (int t = 0; t < na; ++t) {
             const int q = R->anc[R->anc_first[j] + t];
@@ -451,8 +450,15 @@ static void lbs_reg_normal(sp_model* m, double wp, double wd, double* H, double*
             g[q] += gq;
             while (s0 < nr && reach[s0] < q) ++s0; // anc is sorted too
             double* Hq = H + (size_t)q * (size_t)P;
-            const double* Hbt = R->Hb + (size_t)t * (size_t)nr;
-            for (int s = s0; s < nr; ++s) Hq[reach[s]] += Hbt[s];
+            sp_v4d e0, e1, e2;
+            SP_V4D_LOAD(e0, E), SP_V4D_LOAD(e1, E + 4), SP_V4D_LOAD(e2, E + 8);
+            for (int s = s0; s < nr; ++s) {
+                const double* us = R->u + 12 * (size_t)s;
+                sp_v4d u0, u1, u2;
+                SP_V4D_LOAD(u0, us), SP_V4D_LOAD(u1, us + 4), SP_V4D_LOAD(u2, us + 8);
+                sp_v4d m = e0 * u0 + e1 * u1 + e2 * u2;
+                Hq[reach[s]] += (m[0] + m[1]) + (m[2] + m[3]);
+            }
         }
     }
 }
@@ -527,7 +533,7 @@ static void lbs_destroy(sp_model* m)
     free(L->params), free(L->mesh), free(L->scratch);
     reg_lbs* R = &L->reg;
     free(R->anc_first), free(R->anc), free(R->adj_first), free(R->adj_joint), free(R->adj_pair), free(R->reach_first), free(R->reach);
-    free(R->Kp), free(R->Ad), free(R->skin0), free(R->E), free(R->delta), free(R->u), free(R->Hb), free(R->pos), free(R->to);
+    free(R->Kp), free(R->Ad), free(R->skin0), free(R->E), free(R->delta), free(R->u), free(R->pos), free(R->to);
     free(L);
 }
 
