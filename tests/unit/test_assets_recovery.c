@@ -35,11 +35,17 @@ enum { RATE_ASSERTED = 0 };
 enum { RATE_ASSERTED = 1 };
 #endif
 
-// Measurements beyond the test: SP_RECOVERY_CASES=N runs N seeds instead
-// (the rate is still asserted on them); SP_RECOVERY_SEED=K then solves seed
-// K alone (to look at one failure).
-static int case_count(int cases)
+// Measurements beyond the test: SP_RECOVERY_CASES=N runs seeds 1..N instead
+// (the rate is still asserted on them); SP_RECOVERY_SEED=K solves seed K
+// alone (to look at one failure; its row then describes that one solve).
+static int case_count(int cases, int* first_seed)
 {
+    const char* one = getenv("SP_RECOVERY_SEED");
+    if (one && atoi(one) > 0) {
+        *first_seed = atoi(one);
+        return 1;
+    }
+    *first_seed = 1;
     const char* env = getenv("SP_RECOVERY_CASES");
     int n = env ? atoi(env) : 0;
     return n > 0 ? n : cases;
@@ -47,7 +53,8 @@ static int case_count(int cases)
 
 static void recover_abstraction(const char* name, const char* abstraction, int cases, int iteration_budget)
 {
-    cases = case_count(cases);
+    int first_seed;
+    cases = case_count(cases, &first_seed);
     char rel[256];
     snprintf(rel, sizeof rel, "assets/%s.glb", name);
     sp_character ch = {0};
@@ -67,9 +74,7 @@ static void recover_abstraction(const char* name, const char* abstraction, int c
     int ok = 0;
     double worst = 0, ms = 0, err_sum = 0;
     int worst_seed = 0;
-    const char* only = getenv("SP_RECOVERY_SEED");
-    for (int seed = 1; seed <= cases; ++seed) {
-        if (only && atoi(only) != seed) continue;
+    for (int seed = first_seed; seed < first_seed + cases; ++seed) {
         sp_synth_params(rig, (uint64_t)seed, 0.7853981633974483, truth);
         sp_sketch sk;
         ENSURE(sp_synth_sketch(rig, ab, &ch.camera, truth, &sk) == SP_OK);
@@ -81,8 +86,8 @@ static void recover_abstraction(const char* name, const char* abstraction, int c
         ok += rel_err <= 0.01;
         if (rel_err > 0.01) fprintf(stderr, "    %s %s seed %d: %.2f%% (%d iterations)\n", name, abstraction, seed, 100 * rel_err, rep.iterations);
         err_sum += rel_err;
-        errs[seed - 1] = rel_err;
-        its[seed - 1] = rep.iterations;
+        errs[seed - first_seed] = rel_err;
+        its[seed - first_seed] = rep.iterations;
         ms += rep.ms;
         if (rel_err > worst) worst = rel_err, worst_seed = seed;
         sp_sketch_free(&sk);
