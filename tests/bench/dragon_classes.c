@@ -72,6 +72,56 @@ static answer* classify_all(const sp_clf* clf, const sp_dataset* ds, double* ms_
     return a;
 }
 
+// --db: the database's model with its own threshold, then recalibrated as
+// the bench does.
+static int report_db_model(const char* db_path, const sp_dataset* test, const sp_dataset* scrib, const sp_dataset* cal)
+{
+    sp_db* db = NULL;
+    sp_clf* clf = NULL;
+    sp_error err = {0};
+    if (sp_db_open(db_path, SP_DB_READONLY, &db, &err) != SP_OK || sp_db_load_model(db, &clf, NULL, &err) != SP_OK) {
+        fprintf(stderr, "bench_dragon_classes: %s\n", err.text);
+        sp_db_close(db);
+        return 1;
+    }
+    sp_db_close(db);
+    double med, p90;
+    answer* at = classify_all(clf, test, &med, &p90);
+    answer* as = classify_all(clf, scrib, NULL, NULL);
+    float thr = sp_clf_reject_distance(clf);
+    int right = 0, top3 = 0, fr = 0, sr = 0;
+    for (int i = 0; i < test->count; ++i) {
+        right += at[i].pred == at[i].label;
+        top3 += at[i].top3;
+        fr += !(at[i].distance <= thr);
+    }
+    for (int i = 0; i < scrib->count; ++i)
+        sr += !(as[i].distance <= thr);
+    sp_clf_desc d = sp_clf_get_desc(clf);
+    printf("%s: %d words; top1 %.1f%%, top3 %.1f%%, dragon rejected %.1f%%, scribbles rejected %.1f%% (reject %.4f); ms "
+           "median %.2f, "
+           "p90 %.2f\n",
+           db_path, d.words, 100.0 * right / test->count, 100.0 * top3 / test->count, 100.0 * fr / test->count,
+           scrib->count ? 100.0 * sr / scrib->count : 0.0, thr, med, p90);
+    // The same model with the bench's calibration (--cal harsh sketches per part of family 3, quantile 0.96).
+    if (sp_clf_calibrate_reject(clf, cal, NULL, 0.96, 1.0, NULL, NULL, &err) == SP_OK) {
+        thr = sp_clf_reject_distance(clf);
+        fr = sr = 0;
+        for (int i = 0; i < test->count; ++i)
+            fr += !(at[i].distance <= thr);
+        for (int i = 0; i < scrib->count; ++i)
+            sr += !(as[i].distance <= thr);
+        printf("  recalibrated on %d harsh sketches of family 3 (q0.96): dragon rejected %.1f%%, scribbles rejected %.1f%% "
+               "(reject "
+               "%.4f)\n",
+               cal->count, 100.0 * fr / test->count, scrib->count ? 100.0 * sr / scrib->count : 0.0, thr);
+    }
+    free(at);
+    free(as);
+    sp_clf_free(clf);
+    return 0;
+}
+
 int main(int argc, char** argv)
 {
     bool json = false, sweep = false;
@@ -125,54 +175,10 @@ int main(int argc, char** argv)
         "%d scribbles; generated in %.0f ms\n",
         assets ? "assets/*.glb" : "stand-ins (assets/ incomplete)", train.count, test.count, cal.count, scrib.count, gen_ms);
 
+    int rc = 0;
     if (db_path) { // the database's model, its own threshold
-        sp_db* db = NULL;
-        sp_clf* clf = NULL;
-        if (sp_db_open(db_path, SP_DB_READONLY, &db, &err) != SP_OK || sp_db_load_model(db, &clf, NULL, &err) != SP_OK) {
-            fprintf(stderr, "bench_dragon_classes: %s\n", err.text);
-            return 1;
-        }
-        sp_db_close(db);
-        double med, p90;
-        answer* at = classify_all(clf, &test, &med, &p90);
-        answer* as = classify_all(clf, &scrib, NULL, NULL);
-        float thr = sp_clf_reject_distance(clf);
-        int right = 0, top3 = 0, fr = 0, sr = 0;
-        for (int i = 0; i < test.count; ++i) {
-            right += at[i].pred == at[i].label;
-            top3 += at[i].top3;
-            fr += !(at[i].distance <= thr);
-        }
-        for (int i = 0; i < scrib.count; ++i)
-            sr += !(as[i].distance <= thr);
-        sp_clf_desc d = sp_clf_get_desc(clf);
-        printf("%s: %d words; top1 %.1f%%, top3 %.1f%%, dragon rejected %.1f%%, scribbles rejected %.1f%% (reject %.4f); ms "
-               "median %.2f, "
-               "p90 %.2f\n",
-               db_path, d.words, 100.0 * right / test.count, 100.0 * top3 / test.count, 100.0 * fr / test.count,
-               scrib.count ? 100.0 * sr / scrib.count : 0.0, thr, med, p90);
-        // The same model with the bench's calibration (--cal harsh sketches per part of family 3, quantile 0.96).
-        if (sp_clf_calibrate_reject(clf, &cal, NULL, 0.96, 1.0, NULL, NULL, &err) == SP_OK) {
-            thr = sp_clf_reject_distance(clf);
-            fr = sr = 0;
-            for (int i = 0; i < test.count; ++i)
-                fr += !(at[i].distance <= thr);
-            for (int i = 0; i < scrib.count; ++i)
-                sr += !(as[i].distance <= thr);
-            printf("  recalibrated on %d harsh sketches of family 3 (q0.96): dragon rejected %.1f%%, scribbles rejected %.1f%% "
-                   "(reject "
-                   "%.4f)\n",
-                   cal.count, 100.0 * fr / test.count, scrib.count ? 100.0 * sr / scrib.count : 0.0, thr);
-        }
-        free(at);
-        free(as);
-        sp_clf_free(clf);
-        sp_dataset_free(&train);
-        sp_dataset_free(&test);
-        sp_dataset_free(&cal);
-        sp_dataset_free(&scrib);
-        dragon_parts_free(parts);
-        return 0;
+        rc = report_db_model(db_path, &test, &scrib, &cal);
+        goto done;
     }
     variant vs[32];
     int nv = 0;
@@ -272,10 +278,11 @@ int main(int argc, char** argv)
         sp_clf_free(clf);
     }
     if (json) printf("\n]\n");
+done:
     sp_dataset_free(&train);
     sp_dataset_free(&test);
     sp_dataset_free(&cal);
     sp_dataset_free(&scrib);
     dragon_parts_free(parts);
-    return 0;
+    return rc;
 }
