@@ -598,11 +598,9 @@ static void normal_equations(sp_solver* s, const double* p)
             if (!live[j]) continue;
             double* row = rows + (size_t)nr * (size_t)n;
             memset(row, 0, sizeof(double) * (size_t)n);
-            // Row j = column j of L (rows >= j) against G's four rows.
-            double ax = L[0][j], ay = L[1][j], bx = L[2][j], by = L[3][j];
-            if (j > 0) ax = 0;
-            if (j > 1) ay = 0;
-            if (j > 2) bx = 0;
+            // Row j = column j of L against G's four rows (L's entries above
+            // its diagonal are the zeros it was made with).
+            const double ax = L[0][j], ay = L[1][j], bx = L[2][j], by = L[3][j];
             for (int c = 0; c < A->count; ++c) row[map ? map[c] : c] += ax * Ga[c] + ay * Ga[A->count + c];
             if (seg && (bx != 0 || by != 0)) {
                 const int bpt = s->seg_next[a];

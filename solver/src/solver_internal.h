@@ -27,9 +27,9 @@ typedef struct pair {
     int dir;
 } pair;
 
-// Rows of the normal equations that share one column list: H gets
-// U^T V + V^T U of the stacked rows with one BLAS call (dsyr2k) and one
-// scattered add per entry, instead of one per row (points and
+// Least-squares rows of the normal equations that share one column list: H
+// gets U^T U of the stacked rows with one BLAS call (dsyrk) and one
+// scattered add per entry, instead of one per row (segments and
 // representatives on the same bones have the same columns; a black-box rig
 // has one group of all parameters).
 typedef struct row_group {
