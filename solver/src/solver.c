@@ -1234,62 +1234,70 @@ static void keep_better(const sp_solver* s, sp_solve_report* rep, double* p_out,
 
 static bool fit_ok(const sp_solve_report* rep) { return rep->mean_error_px <= 0.01 * rep->bbox_diagonal_px; }
 
+// One more attempt at a loop that a first fit left above 1% (sp_solver_solve).
+typedef struct attempt {
+    bool allow_loop, place_free;
+    bool forced; // hold hyp's shift and direction through the ordered stage
+    sp_ordered_info hyp;
+} attempt;
+
 sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep,
                           sp_error* err)
 {
     s->loop_forced = false;
     sp_result res = solve_once(s, sk, p_start, p_out, rep, true, true, s->d.time_cap_ms, err);
     if (res != SP_OK || fit_ok(rep) || !s->used_loop) return res;
+    // The attempts that follow a loop's failed fit, in order, until one ends
+    // within 1% or the time cap is reached; the best fit is kept and every
+    // attempt counts in the report's work and time (a fit that succeeds the
+    // first time pays nothing).
+    // - A root placed without the boost (solve_once) can settle where the
+    //   joints cannot finish the fit (the wings' wide span, now and then):
+    //   the placement held back with the joints, as the graduated rounds did
+    //   before (dragon parts 2381 -> 2395 of 2400 within 1%; the wings 394 ->
+    //   399 of 400).
+    // - An outline matched in order can lock onto the wrong cyclic shift or
+    //   direction when the drawing is far from the start pose: the best
+    //   shift against the rest outline is not the drawing's, and the fit
+    //   then bends the outline round to agree with it (the cartoon man's
+    //   posed outlines: that shift is often a sixth of the way round;
+    //   forcing the drawing's own start recovered 98 of 100 instead of 89).
+    //   So other shifts get a turn, each held through the ordered stage: the
+    //   best shift moved a sixth of the way round either way (an eighth or a
+    //   tenth: 96 and 94 of 100), then the runner-up shift (the cost's next
+    //   local minimum, either direction; alone: 93-94 of 100).
+    // - Last the plain closest-point solve (a thin tail's two edges look
+    //   alike).
+    // Cartoon man's outline 89 -> 100 of 100 (398 of 400), wings 194 -> 200
+    // and tail 198 -> 200 of 200.
+    attempt at[5];
+    int na = 0;
+    if (s->placed_free) at[na++] = (attempt){.allow_loop = true};
     double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
     sp_solve_report* r2 = malloc(sizeof *r2);
     if (!p2 || !r2) {
         free(p2), free(r2);
         return res;
     }
-    sp_error e2 = {0};
-    // A loop's root placed without the boost (solve_once) can settle where
-    // the joints cannot finish the fit (the wings' wide span, now and then).
-    // Its second attempt holds the placement back with the joints, as the
-    // graduated rounds did before: dragon parts 2381 -> 2395 of 2400 within
-    // 1% (the wings 394 -> 399 of 400); the other hypotheses below follow.
-    if (s->placed_free && s->d.time_cap_ms - rep->ms > 0 && solve_once(s, sk, p_start, p2, r2, true, false, s->d.time_cap_ms - rep->ms, &e2) == SP_OK)
-        keep_better(s, rep, p_out, r2, p2);
-    if (fit_ok(rep)) {
-        free(p2), free(r2);
-        return res;
-    }
-    // An outline matched in order can lock onto the wrong cyclic shift or
-    // direction when the drawing is far from the start pose: the best shift
-    // against the rest outline is not the drawing's, and the fit then bends
-    // the outline round to agree with it (the cartoon man's posed outlines:
-    // that shift is often a sixth of the way round; forcing the drawing's own
-    // start recovered 98 of 100 instead of 89). When the fit ends above 1%,
-    // other hypotheses get a turn, each held through the ordered stage: the
-    // best shift moved a sixth of the way round either way (an eighth or a
-    // tenth: 96 and 94 of 100), then the runner-up shift (the cost's next
-    // local minimum, either direction; alone: 93-94 of 100); last the plain
-    // closest-point solve (a thin tail's two edges look alike). The best fit
-    // is kept; every attempt counts in the report's work and time. Cartoon
-    // man's outline 89 -> 100 of 100 (398 of 400), wings 194 -> 200 and tail
-    // 198 -> 200 of 200; a fit that succeeds the first time pays nothing.
-    sp_ordered_info cand[2], hyp[3];
-    int m = 0, nh = 0;
+    sp_ordered_info cand[2];
+    int m = 0;
     start_pose(s, p_start, p2);
     model_update(s, p2, false);
     project_abstraction(s);
     int nc = s->model->failed ? 0 : sp__loop_candidates(s, sk, cand, 2, &m);
     if (nc > 0 && m >= 6) {
-        hyp[nh] = cand[0], hyp[nh++].shift = (cand[0].shift + m / 6) % m;
-        hyp[nh] = cand[0], hyp[nh++].shift = (cand[0].shift + m - m / 6) % m;
+        at[na] = (attempt){.allow_loop = true, .forced = true, .hyp = cand[0]}, at[na++].hyp.shift = (cand[0].shift + m / 6) % m;
+        at[na] = (attempt){.allow_loop = true, .forced = true, .hyp = cand[0]}, at[na++].hyp.shift = (cand[0].shift + m - m / 6) % m;
     }
-    if (nc > 1) hyp[nh++] = cand[1];
-    for (int h = 0; h < nh && !fit_ok(rep) && s->d.time_cap_ms - rep->ms > 0; ++h) {
-        s->loop_forced = true, s->loop_hypothesis = hyp[h];
-        if (solve_once(s, sk, p_start, p2, r2, true, false, s->d.time_cap_ms - rep->ms, &e2) == SP_OK) keep_better(s, rep, p_out, r2, p2);
-        s->loop_forced = false;
+    if (nc > 1) at[na++] = (attempt){.allow_loop = true, .forced = true, .hyp = cand[1]};
+    at[na++] = (attempt){.allow_loop = false};
+    sp_error e2 = {0};
+    for (int i = 0; i < na && !fit_ok(rep) && s->d.time_cap_ms - rep->ms > 0; ++i) {
+        s->loop_forced = at[i].forced, s->loop_hypothesis = at[i].hyp;
+        if (solve_once(s, sk, p_start, p2, r2, at[i].allow_loop, at[i].place_free, s->d.time_cap_ms - rep->ms, &e2) == SP_OK)
+            keep_better(s, rep, p_out, r2, p2);
     }
-    if (!fit_ok(rep) && s->d.time_cap_ms - rep->ms > 0 && solve_once(s, sk, p_start, p2, r2, false, false, s->d.time_cap_ms - rep->ms, &e2) == SP_OK)
-        keep_better(s, rep, p_out, r2, p2);
+    s->loop_forced = false;
     free(p2), free(r2);
     return res;
 }
