@@ -147,12 +147,9 @@ static inline void skin_one(const sp_rig_eval* ev, sp_skinned_points pts, int i,
     for (int k = 0; k < SP_INFLUENCES; ++k) {
         float w = pts.weights[4 * i + k];
         if (w == 0.0f) continue;
-        // S (x0, 1) a column at a time, all rows at once (the same sums in
-        // the same order).
-        const double* m = ev->skin[pts.joints[4 * i + k]].m;
-        sp_v4d c0, c1, c2, c3;
-        SP_V4D_LOAD(c0, m), SP_V4D_LOAD(c1, m + 4), SP_V4D_LOAD(c2, m + 8), SP_V4D_LOAD(c3, m + 12);
-        acc += (double)w * (c0 * x0[0] + c1 * x0[1] + c2 * x0[2] + c3);
+        sp_v4d y;
+        SP_V4D_MAT4_POINT(y, ev->skin[pts.joints[4 * i + k]].m, x0);
+        acc += (double)w * y;
     }
     out[0] = acc[0], out[1] = acc[1], out[2] = acc[2];
 }
@@ -172,7 +169,7 @@ void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int 
     const sp_rig* rig = ev->rig;
     const int P = rig->param_count;
     if (P == 0 || !ev->has_deriv) return;
-    sp_vec3 x0 = {pts.rest[3 * i], pts.rest[3 * i + 1], pts.rest[3 * i + 2]};
+    const double* x0 = pts.rest + 3 * (size_t)i;
     double* jx = J;
     double* jy = jx + P;
     double* jz = jy + P;
@@ -185,9 +182,10 @@ void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int 
     for (int k = 0; k < SP_INFLUENCES; ++k) {
         double w = scale * pts.weights[4 * i + k];
         if (w == 0.0) continue;
-        sp_vec3 y = sp_mat4_point(&ev->skin[pts.joints[4 * i + k]], x0);
+        sp_v4d y; // as skin_one
+        SP_V4D_MAT4_POINT(y, ev->skin[pts.joints[4 * i + k]].m, x0);
         joint[n] = pts.joints[4 * i + k];
-        acc[n][0] = w * y.x, acc[n][1] = w * y.y, acc[n][2] = w * y.z, acc[n][3] = w;
+        acc[n][0] = w * y[0], acc[n][1] = w * y[1], acc[n][2] = w * y[2], acc[n][3] = w;
         ++n;
     }
     while (n > 0) {
@@ -211,10 +209,9 @@ void sp_rig_eval_jacobian_add(const sp_rig_eval* ev, sp_skinned_points pts, int 
             // D_q Y as D_q's four columns (column-major) times Y's entries:
             // the same sums in the same order as row by row, all rows at
             // once (the fourth is zero).
-            sp_v4d c0, c1, c2, c3;
-            SP_V4D_LOAD(c0, ev->deriv[q].m), SP_V4D_LOAD(c1, ev->deriv[q].m + 4);
-            SP_V4D_LOAD(c2, ev->deriv[q].m + 8), SP_V4D_LOAD(c3, ev->deriv[q].m + 12);
-            sp_v4d v = c0 * y0 + c1 * y1 + c2 * y2 + c3 * y3;
+            sp_v4d c[4];
+            SP_V4D_LOAD_COLS(c, ev->deriv[q].m);
+            sp_v4d v = c[0] * y0 + c[1] * y1 + c[2] * y2 + c[3] * y3;
             jx[q] += v[0], jy[q] += v[1], jz[q] += v[2];
         }
         if (ja->parent >= 0) {

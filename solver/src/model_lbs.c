@@ -309,15 +309,15 @@ static inline void apply_ortho(const double* restrict X, const double* restrict 
 {
     // Four lanes c = 0..3 at a time; X and A are symmetric (their columns
     // are their rows).
-    sp_v4d e0, e1, e2, x0, x1, x2, x3, a0, a1, a2, a3;
+    sp_v4d e0, e1, e2, x[4], a[4];
     SP_V4D_LOAD(e0, e), SP_V4D_LOAD(e1, e + 4), SP_V4D_LOAD(e2, e + 8);
-    SP_V4D_LOAD(x0, X), SP_V4D_LOAD(x1, X + 4), SP_V4D_LOAD(x2, X + 8), SP_V4D_LOAD(x3, X + 12);
-    SP_V4D_LOAD(a0, A), SP_V4D_LOAD(a1, A + 4), SP_V4D_LOAD(a2, A + 8), SP_V4D_LOAD(a3, A + 12);
+    SP_V4D_LOAD_COLS(x, X);
+    SP_V4D_LOAD_COLS(a, A);
     sp_v4d sv = v[0] * e0 + v[1] * e1 + v[2] * e2;
-    sp_v4d t = wp * (x0 * sv[0] + x1 * sv[1] + x2 * sv[2] + x3 * sv[3]);
+    sp_v4d t = wp * (x[0] * sv[0] + x[1] * sv[1] + x[2] * sv[2] + x[3] * sv[3]);
     for (int r = 0; r < 3; ++r) {
         const double* er = e + 4 * r;
-        sp_v4d out = v[r] * t + wd * (a0 * er[0] + a1 * er[1] + a2 * er[2] + a3 * er[3]);
+        sp_v4d out = v[r] * t + wd * (a[0] * er[0] + a[1] * er[1] + a[2] * er[2] + a[3] * er[3]);
         sp_v4d yr;
         SP_V4D_LOAD(yr, y + 4 * r);
         yr += out;
@@ -412,10 +412,10 @@ static void lbs_reg_normal(sp_model* m, double wp, double wd, double* H, double*
             double* E = R->E + 12 * (size_t)t;
             // Column c of D_q S_j from D_q's columns (rows 0..3 at once, the
             // same sums in the same order), stored row-major.
-            sp_v4d d0, d1, d2, d3;
-            SP_V4D_LOAD(d0, Dq), SP_V4D_LOAD(d1, Dq + 4), SP_V4D_LOAD(d2, Dq + 8), SP_V4D_LOAD(d3, Dq + 12);
+            sp_v4d d[4];
+            SP_V4D_LOAD_COLS(d, Dq);
             for (int c = 0; c < 4; ++c) {
-                sp_v4d col = d0 * Sj[4 * c] + d1 * Sj[4 * c + 1] + d2 * Sj[4 * c + 2] + d3 * Sj[4 * c + 3];
+                sp_v4d col = d[0] * Sj[4 * c] + d[1] * Sj[4 * c + 1] + d[2] * Sj[4 * c + 2] + d[3] * Sj[4 * c + 3];
                 E[c] = col[0], E[4 + c] = col[1], E[8 + c] = col[2];
             }
         }
