@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "image.h"
+#include "sp/image.h"
 
 int main(int argc, char** argv)
 {

@@ -41,7 +41,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "image.h"
+#include "sp/image.h"
 #include "sp/result.h"
 #include "sp/rig.h"
 

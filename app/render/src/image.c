@@ -1,5 +1,5 @@
 // image.c: PNG in and out through stb_image / stb_image_write (Debian libstb-dev).
-#include "image.h"
+#include "sp/image.h"
 
 #include <assert.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 // headless.c: EGL on the surfaceless Mesa platform, OpenGL 3.3 core, no surface.
-#include "headless.h"
+#include "sp/headless.h"
 
 #include <stdbool.h>
 #include <stdio.h>

@@ -27,7 +27,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "event.h"
+#include "sp/kiosk_event.h"
 #include "sp/result.h"
 
 /// Most events one session may hold (after expanding "stroke" shorthands).

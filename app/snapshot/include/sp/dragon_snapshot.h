@@ -6,8 +6,8 @@
 #ifndef SP_DRAGON_SNAPSHOT_H
 #define SP_DRAGON_SNAPSHOT_H
 
-#include "dragon.h"
-#include "image.h"
+#include "sp/dragon.h"
+#include "sp/image.h"
 
 typedef struct sp_dragon_snapshot_desc {
     double t;                ///< animation time, seconds (0: as fitted)

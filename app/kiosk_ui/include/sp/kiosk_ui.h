@@ -29,7 +29,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "event.h"
+#include "sp/kiosk_event.h"
 
 /// Touch targets (the order of the toolbar).
 typedef enum sp_kiosk_target {

@@ -10,7 +10,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
-#include "render.h"
+#include "sp/render.h"
 
 // clang-format off
 static const char* k_vs =

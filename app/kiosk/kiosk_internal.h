@@ -3,12 +3,12 @@
 #ifndef SP_KIOSK_INTERNAL_H
 #define SP_KIOSK_INTERNAL_H
 
-#include "dragon.h"
 #include "draw2d.h"
 #include "font.h"
 #include "kiosk.h"
-#include "lod.h"
-#include "render.h"
+#include "sp/dragon.h"
+#include "sp/kiosk_lod.h"
+#include "sp/render.h"
 
 /// Render meshes of one dragon's parts, by part id (coarsened when lod_triangles > 0).
 typedef struct mesh_cache {

@@ -1,10 +1,10 @@
-#include "dragon_snapshot.h"
+#include "sp/dragon_snapshot.h"
 
 #include <math.h>
 #include <stdlib.h>
 
-#include "headless.h"
-#include "render.h"
+#include "sp/headless.h"
+#include "sp/render.h"
 
 sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc* desc, sp_image* img, sp_error* err)
 {

@@ -10,8 +10,8 @@
 #ifndef SP_SNAPSHOT_H
 #define SP_SNAPSHOT_H
 
-#include "image.h"
 #include "sp/gltf.h"
+#include "sp/image.h"
 #include "sp/sketch.h"
 
 typedef struct sp_snapshot_desc {

@@ -1,7 +1,7 @@
 // ui.c: the kiosk's pure UI state machine (see ui.h). No GL, no clock, no
 // allocation after create: a tap storm or 10^4 strokes a minute only ever
 // touch fixed buffers.
-#include "ui.h"
+#include "sp/kiosk_ui.h"
 
 #include <math.h>
 #include <stdio.h>

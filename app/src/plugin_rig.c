@@ -7,8 +7,8 @@
 #include "cli.h"
 #include "posing.h"
 #include "report.h"
-#include "snapshot.h"
 #include "sp/sketch_io.h"
+#include "sp/snapshot.h"
 #include "sp/synth.h"
 
 bool sp_is_plugin_path(const char* path)

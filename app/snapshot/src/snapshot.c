@@ -1,10 +1,10 @@
-#include "snapshot.h"
+#include "sp/snapshot.h"
 
 #include <stdlib.h>
 
-#include "headless.h"
-#include "image.h"
-#include "render.h"
+#include "sp/headless.h"
+#include "sp/image.h"
+#include "sp/render.h"
 
 static void draw_sketch(sp_renderer* r, const sp_sketch* s, float width, const float rgba[4])
 {

@@ -20,8 +20,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sp/kiosk_ui.h"
 #include "sp/result.h"
-#include "ui.h"
 
 typedef struct sp_kiosk sp_kiosk;
 typedef struct sp_dragon sp_dragon; // dragon.h

@@ -1,6 +1,6 @@
 // render.c: meshes (smooth-shaded, CPU normals), 2D overlays (capsule
 // coverage), the sp_camera -> GL projection, offscreen targets.
-#include "render.h"
+#include "sp/render.h"
 
 #include <assert.h>
 #include <math.h>

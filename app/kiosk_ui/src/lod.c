@@ -1,6 +1,6 @@
 // lod.c: vertex clustering on a cubic grid (see lod.h), with a binary search
 // on the cell size for a triangle budget.
-#include "lod.h"
+#include "sp/kiosk_lod.h"
 
 #include <math.h>
 #include <stdbool.h>

@@ -1,6 +1,6 @@
 // session.c: kiosk sessions as JSON (cJSON to read, plain stdio to write:
 // a 2,000-stroke soak session is ~100k events, one line each).
-#include "session.h"
+#include "sp/kiosk_session.h"
 
 #include <errno.h>
 #include <math.h>
@@ -10,7 +10,7 @@
 
 #include <cjson/cJSON.h>
 
-#include "ui.h"
+#include "sp/kiosk_ui.h"
 
 sp_result sp_kiosk_session_append(sp_kiosk_session* s, const sp_kiosk_event* ev)
 {
