@@ -220,7 +220,8 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
                                                    .assets_dir = k->desc.assets_dir,
                                                    .canvas_w = k->canvas_w,
                                                    .canvas_h = k->canvas_h,
-                                                   .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
+                                                   .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
+                                                   .max_parts = k->desc.max_parts},
                                  err);
     if (!k->dragon) goto fail;
     k->canvas_cam = sp_dragon_camera(k->dragon);
@@ -350,6 +351,12 @@ static const char* reject_hint(sp_dragon_reject r)
     }
 }
 
+// What to tell about an accepted part (NULL: nothing).
+static const char* note_hint(sp_dragon_note n)
+{
+    return n == SP_DRAGON_NOTE_NO_SURFACE ? "That body cannot hold parts: this one stays where you drew it" : NULL;
+}
+
 static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const sp_error* err, bool refit)
 {
     if (rc != SP_OK || res->rejected || res->part < 0 || res->part >= sp_dragon_part_count(k->dragon)) {
@@ -404,6 +411,7 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
         sn = p->stroke_points;
     }
     sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true,
+                                                       .hint = note_hint(res->note),
                                                        .category = p->category,
                                                        .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
                                                        .part_count = sp_dragon_part_count(k->dragon),

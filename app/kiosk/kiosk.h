@@ -40,6 +40,7 @@ typedef struct sp_kiosk_desc {
                             ///< never depend on the machine's speed
     int lod_triangles; ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full
                        ///< meshes
+    int max_parts;     ///< parts a dragon may have (sp_dragon_desc.max_parts); 0: the pipeline's (48)
 } sp_kiosk_desc;
 
 /// Measurements for logs and benchmarks.

@@ -21,6 +21,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "dragon_internal.h" // fault injection: sp_dragon.fit_hook
 #include "sp/curve.h"
 #include "sp/dragon.h"
 #include "sp/dragon_snapshot.h"
@@ -1837,6 +1838,104 @@ static void test_body_last_and_undo(void)
     sp_db_close(db);
 }
 
+static void put_nan(double* p, int n)
+{
+    if (n > 0) p[n / 2] = NAN;
+}
+
+// What could break the kiosk on a visitor's stroke: a part drawn at a body
+// whose triangles have no area, a fit that comes back with NaN, 48 parts
+// already placed. The pipeline keeps going and says why (the kiosk shows
+// it: tests/unit/test_kiosk_ui.c, test_kiosk_e2e.c).
+static void test_robustness(void)
+{
+    // A body of zero-area triangles (its outline is fine: it can be drawn and fitted).
+    char path[1024];
+    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_flat.db"));
+    remove_db(path);
+    sp_db* db = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(path, SP_DB_CREATE, &db, &err) == SP_OK);
+    spec flat = k_specs[0];
+    flat.name = "flat_t";
+    flat.flat = true;
+    add_spec_sketches(db, &flat, 1, -1);
+    add_spec_sketches(db, &k_specs[4], 2, -1);
+    sp_dragon* d = new_dragon(path);
+    sp_vec2* xy;
+    int n = part_stroke(db, "flat_t", 5, 0.3, 640, 420, 440, &xy);
+    sp_dragon_result res;
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK && !res.rejected);
+    free(xy);
+    const sp_rig* frig = &sp_dragon_part_get(d, 0)->character->rig;
+    sp_vec2* fpx = fitted_px(d, 0);
+    n = part_stroke_ex(db, "legs_t", 6, 0.3, (sp_vec2){640, edge_at(frig, fpx, 640, false)}, 170, true, false, &xy);
+    free(fpx);
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "legs"}, &res, &err) == SP_OK);
+    free(xy);
+    fprintf(stderr, "  legs drawn at a body without area: %s, note %s, attached to %d\n", sp_dragon_reject_name(res.reason),
+            sp_dragon_note_name(res.note), sp_dragon_part_get(d, 1)->attached_to);
+    ENSURE(!res.rejected && res.note == SP_DRAGON_NOTE_NO_SURFACE && sp_dragon_part_get(d, 1)->attached_to == -1);
+    ENSURE(sp_dragon_pose_at(d, 0.4, &err) == SP_OK);
+    cJSON* rep = sp_dragon_report_json(d);
+    ENSURE(!strcmp(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(rep, "parts"), 1), "note")->valuestring,
+                   "no_surface"));
+    cJSON_Delete(rep);
+    ENSURE(sp_dragon_export(d, sp_test_tmp_path("dragon_flat.glb"), &err) == SP_OK);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+
+    // NaN in the fitted pose (injected after the solve): refused, nothing changed, and why.
+    const char* tpath = test_db();
+    ENSURE(sp_db_open(tpath, SP_DB_READONLY, &db, &err) == SP_OK);
+    d = new_dragon(tpath);
+    d->fit_hook = put_nan;
+    n = part_stroke(db, "legs_t", 7, 0.3, 640, 400, 170, &xy);
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "legs"}, &res, &err) == SP_OK);
+    fprintf(stderr, "  NaN in the fit: %s, note %s\n", sp_dragon_reject_name(res.reason), sp_dragon_note_name(res.note));
+    ENSURE(res.rejected && res.reason == SP_DRAGON_FIT_FAILED && res.note == SP_DRAGON_NOTE_NOT_FINITE);
+    ENSURE(sp_dragon_part_count(d) == 0);
+    d->fit_hook = NULL;
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "legs"}, &res, &err) == SP_OK && !res.rejected);
+    ENSURE(sp_dragon_undo(d));
+
+    // 48 parts placed (the default limit): the next is refused as full; the
+    // dragon poses, reports and exports.
+    int torso_n;
+    sp_vec2* torso;
+    torso_n = part_stroke(db, "torso_t", 8, 0.3, 640, 400, 460, &torso);
+    ENSURE(sp_dragon_add_points(d, torso, torso_n, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK &&
+           !res.rejected);
+    free(torso);
+    double worst_ms = 0;
+    for (int k = 1; k < 48; ++k) {
+        // Legs all over the canvas: along the body (attached), above and below it (free).
+        sp_vec2* lxy;
+        int ln = part_stroke(db, "legs_t", 100 + (uint64_t)k, 0.3, 120 + 1040.0 * (k % 16) / 15, 150 + 250.0 * (k / 16), 120, &lxy);
+        ENSURE(sp_dragon_add_points(d, lxy, ln, &(sp_dragon_stroke_opts){.category = "legs"}, &res, &err) == SP_OK &&
+               !res.rejected);
+        free(lxy);
+        worst_ms = fmax(worst_ms, res.ms_total);
+    }
+    int attached = 0;
+    for (int k = 1; k < 48; ++k)
+        attached += sp_dragon_part_get(d, k)->attached_to == 0;
+    fprintf(stderr, "  48 parts: %d legs attached to the body, %d free\n", attached, 47 - attached);
+    ENSURE(attached > 0 && attached < 47);
+    ENSURE(sp_dragon_part_count(d) == 48);
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "legs"}, &res, &err) == SP_OK);
+    fprintf(stderr, "  stroke 49: %s (the slowest of the 47 before: %.0f ms)\n", sp_dragon_reject_name(res.reason), worst_ms);
+    ENSURE(res.rejected && res.reason == SP_DRAGON_FULL && sp_dragon_part_count(d) == 48);
+    ENSURE(sp_dragon_pose_at(d, 0.7, &err) == SP_OK);
+    rep = sp_dragon_report_json(d);
+    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItem(rep, "parts")) == 48);
+    cJSON_Delete(rep);
+    ENSURE(sp_dragon_export(d, sp_test_tmp_path("dragon_48.glb"), &err) == SP_OK);
+    free(xy);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -1850,5 +1949,6 @@ int main(int argc, char** argv)
                                    {"six_real_parts", test_six_real_parts},
                                    {"many_parts", test_many_parts},
                                    {"body_last_and_undo", test_body_last_and_undo},
+                                   {"robustness", test_robustness},
                                    {0}});
 }
