@@ -103,6 +103,24 @@ sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id)
     return NULL;
 }
 
+// Display triangles for a part (0: all): one per LOD_PX_PER_TRIANGLE px^2 of
+// its box on the canvas, LOD_MIN_TRIANGLES to c->lod_triangles. Why by
+// size: llvmpipe pays per triangle and per fragment, and a small part needs
+// fewer triangles than a big one to look the same.
+#define LOD_PX_PER_TRIANGLE 24.0
+#define LOD_MIN_TRIANGLES 400
+static int lod_budget(const mesh_cache* c, const sp_dragon* d, const double* xyz, int n)
+{
+    if (c->lod_triangles <= 0) return 0;
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, n, &lo, &hi);
+    sp_camera cam = sp_dragon_camera(d);
+    sp_vec2 a = sp_camera_project(&cam, lo), b = sp_camera_project(&cam, hi);
+    double area = fabs((b.x - a.x) * (b.y - a.y)), want = area / LOD_PX_PER_TRIANGLE;
+    if (!(want < c->lod_triangles)) return c->lod_triangles;
+    return want > LOD_MIN_TRIANGLES ? (int)want : LOD_MIN_TRIANGLES;
+}
+
 void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions)
 {
     for (int i = 0; i < c->count; ++i)
@@ -136,15 +154,20 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
             c->items = it, c->cap = cap;
         }
         sp_error err = {0};
-        struct cached_mesh it = {p->id, NULL, true, false, {0}};
+        struct cached_mesh it = {p->id, NULL, true, false, {0}, rig->triangle_count};
+        // Coarse meshes (software GL) are drawn without their back faces: the
+        // parts are closed, and llvmpipe shades every fragment it rasterises.
+        bool cull = c->lod_triangles > 0;
         sp_mesh_desc md = {.vertex_count = rig->vertex_count,
                            .positions = xyz,
                            .colors = p->character->colors,
                            .triangle_count = rig->triangle_count,
-                           .triangles = rig->triangles};
-        if (c->lod_triangles > 0 && rig->triangle_count > c->lod_triangles &&
-            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, c->lod_triangles,
-                         &it.lod) == SP_OK) {
+                           .triangles = rig->triangles,
+                           .cull_back_faces = cull};
+        int budget = lod_budget(c, d, xyz, rig->vertex_count);
+        if (budget > 0 && rig->triangle_count > budget &&
+            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, budget, &it.lod) ==
+                SP_OK) {
             if (it.lod.cluster_count > c->scratch_cap) {
                 double* s = realloc(c->scratch, sizeof(double) * 3 * (size_t)it.lod.cluster_count);
                 if (s) c->scratch = s, c->scratch_cap = it.lod.cluster_count;
@@ -155,8 +178,10 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
                                     .positions = c->scratch,
                                     .colors = it.lod.colors,
                                     .triangle_count = it.lod.tri_count,
-                                    .triangles = it.lod.tris};
+                                    .triangles = it.lod.tris,
+                                    .cull_back_faces = cull};
                 it.coarse = true;
+                it.triangles = it.lod.tri_count;
             }
         }
         it.mesh = sp_render_mesh_create(r, &md, &err);
@@ -178,6 +203,14 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         }
     }
     c->count = w;
+}
+
+int mesh_cache_triangles(const mesh_cache* c)
+{
+    int n = 0;
+    for (int i = 0; i < c->count; ++i)
+        n += c->items[i].triangles;
+    return n;
 }
 
 void mesh_cache_free(mesh_cache* c)
@@ -597,6 +630,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
             fprintf(stderr, "dragon-kiosk: %s\n", err.text);
         }
         k->stats.pose_ms = now_ms() - t0;
+        k->stats.triangles = mesh_cache_triangles(&k->meshes);
     }
     k->stats.parts = sp_dragon_part_count(k->dragon);
 }

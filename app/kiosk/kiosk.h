@@ -51,6 +51,7 @@ typedef struct sp_kiosk_stats {
     double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
     double pose_ms;      ///< last pose_at + mesh update
     int parts;           ///< parts now
+    int triangles;       ///< display triangles of the parts' meshes (after LOD)
 } sp_kiosk_stats;
 
 /// Opens the database (creating the default one when missing), loads the font,

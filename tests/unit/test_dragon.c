@@ -1624,13 +1624,38 @@ static void check_demo(const char* db_path)
     fclose(f);
     (void)n;
     fprintf(stderr, "%s", text);
-    ENSURE(strstr(text, "a dragon of 6 parts") && strstr(text, glb) && strstr(text, png));
+    ENSURE(strstr(text, "a dragon of 8 parts") && strstr(text, glb) && strstr(text, png));
     struct stat st;
     ENSURE(stat(png, &st) == 0 && st.st_size > 10000);
     sp_sketch sk = {0};
     sp_error err = {0};
-    ENSURE(sp_sketch_read_json(strokes, &sk, &err) == SP_OK && sk.stroke_count == 6);
+    ENSURE(sp_sketch_read_json(strokes, &sk, &err) == SP_OK && sk.stroke_count == 8);
     sp_sketch_free(&sk);
+    // Its strokes are on the body: every part but the torso attached, lying on its stroke.
+    char rep[1200];
+    snprintf(rep, sizeof rep, "%s/report.json", dir);
+    f = fopen(rep, "rb");
+    ENSURE(f);
+    char* json = calloc(1, 1 << 22);
+    ENSURE(fread(json, 1, (1 << 22) - 1, f) > 0);
+    fclose(f);
+    cJSON* j = cJSON_Parse(json);
+    free(json);
+    ENSURE(j);
+    const cJSON* pj;
+    double worst = 1;
+    cJSON_ArrayForEach(pj, cJSON_GetObjectItem(j, "parts"))
+    {
+        double ob[4], sb[4];
+        json_box(cJSON_GetObjectItem(pj, "outline_bbox_px"), ob);
+        json_box(cJSON_GetObjectItem(pj, "stroke_bbox_px"), sb);
+        bool torso = !strcmp(cJSON_GetObjectItem(pj, "category")->valuestring, "torso");
+        ENSURE(cJSON_GetObjectItem(pj, "attached_to")->valueint == (torso ? -1 : 0));
+        worst = fmin(worst, iou(ob, sb));
+    }
+    fprintf(stderr, "  demo: every part on the body, outline/stroke IoU >= %.2f\n", worst);
+    ENSURE(worst >= 0.6);
+    cJSON_Delete(j);
     int v = validate(glb);
     if (v >= 0) ENSURE(v == 1);
 }

@@ -147,7 +147,8 @@ sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* v
 sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world);
 /// Which way template t should face for a stroke in the box [lo, hi]: +1 as
 /// modelled, -1 mirrored (drawn on the other side of the nearest body than
-/// its socket, or its own reach, puts a part of its kind). +1 without a body.
+/// its socket, or its own reach, puts a part of its kind); 0: no hint (no
+/// body, or drawn over its middle).
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);

@@ -357,10 +357,10 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
         double dist = box_distance(c, a, b);
         if (dist < bd) bd = dist, body = q, blo = a, bhi = b;
     }
-    if (!body) return 1;
+    if (!body) return 0;
     double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x);
     double side = c.x - mid;
-    if (!(fabs(side) > 0.25 * half)) return 1; // over the body's middle: no side to face away from
+    if (!(fabs(side) > 0.25 * half)) return 0; // over the body's middle: no side to face away from
     // The side a part of its kind takes facing as modelled: its socket's,
     // else the way it reaches.
     int natural = t->outward;
@@ -397,9 +397,10 @@ static void layout_part(sp_dragon* d, int i)
     p->pub.carrier_joint = -1;
     p->pub.anchor = (sp_vec2){NAN, NAN};
     p->note = SP_DRAGON_NOTE_NONE;
-    if (p->t->is_torso) return;
     sp_vec3 a = fitted_point(p, &p->pub.placement, p->t->attach_joint, p->t->attach_local);
     sp_vec2 a2 = sp_camera_project(&d->world, a);
+    p->pub.attach_end = a2;
+    if (p->t->is_torso) return;
     double snap = d->desc.snap_fraction > 0 ? d->desc.snap_fraction * hypot(d->desc.canvas_w, d->desc.canvas_h) : 0;
     int bk = -1;
     surface_hit best = {.dist = INFINITY};

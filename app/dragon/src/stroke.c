@@ -144,19 +144,25 @@ static bool fit_one(sp_dragon* d, tpl* t, const sp_sketch* sk, sp_vec2 lo, sp_ve
     return true;
 }
 
-// Fits every candidate part; a part that reaches sideways (a head, a tail)
-// in both facings: the one the bodies' sockets hint at is kept unless the
-// other fits clearly better. The best candidate goes to *best.
+// A fit in the hinted facing worse than this (mean error over the stroke's
+// diagonal; good fits of hand-drawn parts are 0.1-0.3%) also tries the other.
+#define OTHER_FACING_SCORE 0.004
+
+// Fits every candidate part. A part that reaches sideways (a head, a tail)
+// is fitted in the facing the bodies' sockets hint at and, when there is no
+// hint or that fit is poor, in the other too: the hinted one is kept unless
+// the other fits clearly better. The best candidate goes to *best.
 static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, fit_choice* best,
                          int* not_finite)
 {
     bool any = false;
     for (int c = 0; c < nc; ++c) {
         tpl* t = cands[c];
-        bool prefer_mirrored = t->lengthwise && dragon_facing_hint(d, t, lo, hi) < 0;
+        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi) : 1;
         fit_choice a, b;
-        bool got = fit_one(d, t, sk, lo, hi, prefer_mirrored, &a, not_finite);
-        if (t->lengthwise && fit_one(d, t, sk, lo, hi, !prefer_mirrored, &b, not_finite)) {
+        bool got = fit_one(d, t, sk, lo, hi, hint < 0, &a, not_finite);
+        bool other = t->lengthwise && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
+        if (other && fit_one(d, t, sk, lo, hi, !(hint < 0), &b, not_finite)) {
             if (!got || b.score < 0.8 * a.score) {
                 if (got) free(a.p);
                 a = b, got = true;

@@ -165,6 +165,7 @@ typedef struct sp_dragon_part {
     bool mirrored;                 ///< fitted facing the other way (the stroke mirrored left-right)
     sp_mat4 placement;             ///< part model space -> world at the fit (the similarity above), before attachment
     bool is_torso;                 ///< a body (carries other parts)
+    sp_vec2 attach_end;            ///< its attachment end (sp_part.attach) on the canvas as fitted, pixels
     int attached_to;               ///< index of the body it hangs on, -1: free
     sp_vec2 anchor;                ///< where it attaches: the body's surface point on the canvas, pixels (NaN when free)
     bool far_side;                 ///< attached on the body's far side
