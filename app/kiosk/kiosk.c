@@ -105,9 +105,10 @@ sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id)
 
 // Display triangles for a part (0: all): one per LOD_PX_PER_TRIANGLE px^2 of
 // its box on the canvas, LOD_MIN_TRIANGLES to c->lod_triangles. Why by
-// size: llvmpipe pays per triangle and per fragment, and a small part needs
-// fewer triangles than a big one to look the same.
-#define LOD_PX_PER_TRIANGLE 24.0
+// size: llvmpipe pays per triangle (and per fragment: what a part costs
+// beyond its triangles), and a small part needs fewer triangles than a big
+// one to look the same.
+#define LOD_PX_PER_TRIANGLE 16.0
 #define LOD_MIN_TRIANGLES 400
 static int lod_budget(const mesh_cache* c, const sp_dragon* d, const double* xyz, int n)
 {
@@ -155,15 +156,11 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         }
         sp_error err = {0};
         struct cached_mesh it = {p->id, NULL, true, false, {0}, rig->triangle_count};
-        // Coarse meshes (software GL) are drawn without their back faces: the
-        // parts are closed, and llvmpipe shades every fragment it rasterises.
-        bool cull = c->lod_triangles > 0;
         sp_mesh_desc md = {.vertex_count = rig->vertex_count,
                            .positions = xyz,
                            .colors = p->character->colors,
                            .triangle_count = rig->triangle_count,
-                           .triangles = rig->triangles,
-                           .cull_back_faces = cull};
+                           .triangles = rig->triangles};
         int budget = lod_budget(c, d, xyz, rig->vertex_count);
         if (budget > 0 && rig->triangle_count > budget &&
             sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, budget, &it.lod) ==
@@ -178,8 +175,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
                                     .positions = c->scratch,
                                     .colors = it.lod.colors,
                                     .triangle_count = it.lod.tri_count,
-                                    .triangles = it.lod.tris,
-                                    .cull_back_faces = cull};
+                                    .triangles = it.lod.tris};
                 it.coarse = true;
                 it.triangles = it.lod.tri_count;
             }

@@ -163,7 +163,6 @@ struct sp_render_mesh {
     float* nrm;     // nv by 3
     double* acc;    // nv by 3, normal accumulator
     sp_vec3 lo, hi;
-    bool cull_back_faces;
     GLuint vao, vbo_pos, vbo_nrm, vbo_col, ebo;
 };
 
@@ -717,7 +716,6 @@ sp_render_mesh* sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* d, sp_
         m->r = r;
         m->nv = d->vertex_count;
         m->nt = d->triangle_count;
-        m->cull_back_faces = d->cull_back_faces;
         m->tris = malloc(sizeof(uint32_t) * 3 * (nt ? nt : 1));
         m->weld = malloc(sizeof(int) * (nv ? nv : 1));
         m->pos = malloc(sizeof(float) * 3 * (nv ? nv : 1));
@@ -851,10 +849,8 @@ void sp_renderer_draw_mesh(sp_renderer* r, const sp_render_mesh* m, const sp_mat
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
-    if (m->cull_back_faces) glEnable(GL_CULL_FACE); // counter-clockwise fronts, as in glTF
     glBindVertexArray(m->vao);
     glDrawElements(GL_TRIANGLES, 3 * m->nt, GL_UNSIGNED_INT, NULL);
-    glDisable(GL_CULL_FACE);
     glBindVertexArray(0);
 }
 

@@ -105,7 +105,6 @@ typedef struct sp_mesh_desc {
     float base_color[4];     ///< linear RGBA; all zero: a light clay grey
     int triangle_count;
     const uint32_t* triangles; ///< triangle_count by 3, indices < vertex_count
-    bool cull_back_faces;      ///< a closed mesh: triangles facing away (clockwise on screen) are not drawn
 } sp_mesh_desc;
 
 /// Uploads a mesh (copies everything it needs). NULL and err on failure
