@@ -77,7 +77,7 @@ bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
 
 // ---- the dragon --------------------------------------------------------------------
 
-enum { CARRIER_MAX = 12 };
+enum { CARRIER_MAX = 12 }; // a surface point's joints: 3 corners x 4 weights
 
 typedef struct part {
     sp_dragon_part pub;

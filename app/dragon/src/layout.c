@@ -311,8 +311,7 @@ static void attach(sp_dragon* d, int i, int k, const surface_hit* h, sp_vec3 a)
             int e = 0;
             while (e < p->carrier_n && p->carrier_joint[e] != j)
                 ++e;
-            if (e == p->carrier_n) {
-                if (e == CARRIER_MAX) continue; // more joints than any skin gives a point: the weakest go
+            if (e == p->carrier_n) { // at most 3 corners x 4 weights = CARRIER_MAX joints
                 p->carrier_joint[e] = j, p->carrier_w[e] = 0, ++p->carrier_n;
             }
             p->carrier_w[e] += w;
