@@ -1807,6 +1807,28 @@ static void test_many_parts(void)
     sp_result r = sp_dragon_snapshot_png(d, &(sp_dragon_snapshot_desc){.strokes = true, .outlines = true},
                                          sp_test_tmp_path("dragon_many.png"), &rerr);
     ENSURE(r == SP_OK || r == SP_ERR_UNSUPPORTED);
+    // With eleven parts, the last one's chip (refit as legs), Redraw (a leg
+    // pair along the belly instead) and Undo touch only the last part.
+    sp_vec2 anchors[MANY + 1];
+    for (int i = 0; i < MANY; ++i)
+        anchors[i] = sp_dragon_part_get(d, i)->anchor;
+    sp_dragon_result res;
+    ENSURE(sp_dragon_refit_last(d, "legs", &res, &err) == SP_OK && !res.rejected && res.part == MANY);
+    ENSURE(!strcmp(sp_dragon_part_get(d, MANY)->category, "legs") && sp_dragon_part_count(d) == MANY + 1);
+    sp_vec2* xy;
+    sp_vec2 between = sp_v2_scale(sp_v2_add(lay[4].at, lay[5].at), 0.5);
+    int n = part_stroke_ex(db, "legs_t", 790, 0.3, between, 150, true, false, &xy);
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "legs", .replace_last = true}, &res, &err) ==
+               SP_OK &&
+           !res.rejected && res.part == MANY);
+    free(xy);
+    ENSURE(sp_dragon_part_count(d) == MANY + 1 && sp_dragon_part_get(d, MANY)->attached_to == 0);
+    for (int i = 0; i < MANY; ++i) {
+        const sp_dragon_part* p = sp_dragon_part_get(d, i);
+        ENSURE(p->attached_to < 0 ? isnan(p->anchor.x) : p->anchor.x == anchors[i].x && p->anchor.y == anchors[i].y);
+    }
+    ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == MANY);
+    ENSURE(sp_dragon_pose_at(d, 0.5, &err) == SP_OK);
     free(torso);
     sp_dragon_destroy(d);
     sp_db_close(db);
