@@ -274,37 +274,61 @@ static double triangle_nearest(const double* xy, const uint32_t* q, double px, d
     return best;
 }
 
-// Binds a contour point (px, py) to the surface under it: the nearest point
-// of the nearest triangle whose (interpolated) normal faces out of the
-// silhouette along (ox, oy), within `slack` pixels of the nearest triangle
-// of all (the fallback). Writes the world point (the contour, at the
-// surface's depth) into w and returns the interpolated skin.
-static sp_skin8 surface_bind(const sp_outline_desc* d, const double* xy, const double* nrm, double px, double py, double ox,
-                             double oy, double slack, double* w)
+typedef struct candidate {
+    int t;
+    double d, b[3];
+} candidate;
+
+// Binds a contour point (px, py) to the surface under it: among the
+// triangles whose (interpolated) normal faces out of the silhouette along
+// (ox, oy) and whose nearest point lies within `front` pixels of the nearest
+// such one, the one nearest the camera (where a near and a far leg share a
+// stretch of contour, the visible one, so neighbouring points agree); the
+// nearest triangle of all when no outward one is within `slack` pixels of
+// it. Writes the world point (the contour at the surface's depth) into w and
+// returns the interpolated skin. `zv`: the vertices' depths in the view.
+static sp_skin8 surface_bind(const sp_outline_desc* d, const double* xy, const double* nrm, const double* zv, double px,
+                             double py, double ox, double oy, double slack, double front, candidate** list, int* cap, double* w)
 {
-    int best_t = -1, near_t = -1;
-    double best_d = INFINITY, near_d = INFINITY, best_b[3] = {1, 0, 0}, near_b[3] = {1, 0, 0};
+    int near_t = -1, n = 0;
+    double near_d = INFINITY, out_d = INFINITY, near_b[3] = {1, 0, 0};
     for (int t = 0; t < d->triangle_count; ++t) {
         if (skipped(d->skip_triangle, t)) continue;
         const uint32_t* q = d->triangles + 3 * (size_t)t;
         double b[3];
-        double dd = triangle_nearest(xy, q, px, py, b);
-        if (dd > near_d && dd > best_d) continue;
+        double dd = sqrt(triangle_nearest(xy, q, px, py, b));
+        if (dd > near_d + slack && dd > out_d + front) continue;
         if (dd < near_d) near_d = dd, near_t = t, memcpy(near_b, b, sizeof b);
         double nx = 0, ny = 0;
         for (int k = 0; k < 3; ++k)
             nx += b[k] * nrm[2 * q[k]], ny += b[k] * nrm[2 * q[k] + 1];
         double nl = hypot(nx, ny);
-        if (nl > 0 && nx * ox + ny * oy > 0.5 * nl && dd < best_d) best_d = dd, best_t = t, memcpy(best_b, b, sizeof b);
+        if (!(nl > 0 && nx * ox + ny * oy > 0.5 * nl) || dd > out_d + front) continue;
+        out_d = fmin(out_d, dd);
+        if (n == *cap) {
+            int c = *cap ? 2 * *cap : 64;
+            candidate* g = realloc(*list, sizeof(candidate) * (size_t)c);
+            if (!g) continue; // keeps the candidates so far: a slightly worse choice, not a failure
+            *list = g, *cap = c;
+        }
+        (*list)[n++] = (candidate){t, dd, {b[0], b[1], b[2]}};
     }
-    if (best_t < 0 || !(sqrt(best_d) <= sqrt(near_d) + slack)) best_t = near_t, memcpy(best_b, near_b, sizeof best_b);
+    int best_t = near_t;
+    double best_b[3] = {near_b[0], near_b[1], near_b[2]}, best_z = -INFINITY;
+    if (n > 0 && out_d <= near_d + slack)
+        for (int i = 0; i < n; ++i) {
+            const candidate* c = &(*list)[i];
+            if (c->d > out_d + front) continue;
+            const uint32_t* q = d->triangles + 3 * (size_t)c->t;
+            double z = c->b[0] * zv[q[0]] + c->b[1] * zv[q[1]] + c->b[2] * zv[q[2]];
+            if (z > best_z) best_z = z, best_t = c->t, memcpy(best_b, c->b, sizeof best_b);
+        }
     const uint32_t* q = d->triangles + 3 * (size_t)best_t;
     const sp_camera* cam = d->camera;
     double z = 0;
     sp_skin8 s = {0};
     for (int k = 0; k < 3; ++k) {
-        const double* p = d->positions + 3 * (size_t)q[k];
-        z += best_b[k] * sp_mat4_point(&cam->view, sp_v3(p[0], p[1], p[2])).z;
+        z += best_b[k] * zv[q[k]];
         sp_skin8 v = vertex_skin(d, (int)q[k]);
         for (int e = 0; e < v.n; ++e)
             sp_skin8_add(&s, v.joint[e], best_b[k] * v.w[e]);
@@ -330,7 +354,9 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     int points = d->points > 0 ? d->points : 150;
     int nv = d->vertex_count;
     sp_result res = SP_OK;
-    double *xy = NULL, *cell = NULL, *acc = NULL, *nrm = NULL;
+    double *xy = NULL, *cell = NULL, *acc = NULL, *nrm = NULL, *zv = NULL;
+    candidate* cands = NULL;
+    int ncand = 0;
     int *lab = NULL, *sizes = NULL;
     pt *poly = NULL, *tmp = NULL;
     sp_skin8 *bound = NULL, *tmp_skin = NULL;
@@ -433,9 +459,15 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     // silhouette point is made by a surface whose normal points out of the
     // silhouette, which tells the two legs of a pair apart where they overlap.
     nrm = calloc(2 * (size_t)(nv + 1), sizeof(double));
+    if (d->surface && (zv = malloc(sizeof(double) * (size_t)nv)))
+        for (int v = 0; v < nv; ++v) {
+            const double* p = d->positions + 3 * (size_t)v;
+            zv[v] = sp_mat4_point(&cam->view, sp_v3(p[0], p[1], p[2])).z;
+        }
     bound = malloc(sizeof(sp_skin8) * (size_t)points);
     tmp_skin = malloc(sizeof(sp_skin8) * (size_t)points);
-    if (!acc || !out->rest || !out->joints || !out->weights || !out->curves || !nrm || !bound || !tmp_skin) goto oom;
+    if (!acc || !out->rest || !out->joints || !out->weights || !out->curves || !nrm || !bound || !tmp_skin || (d->surface && !zv))
+        goto oom;
     acc[0] = 0;
     for (int i = 0; i < n; ++i) {
         pt a = poly[i], b = poly[(i + 1) % n];
@@ -479,7 +511,8 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
         double ox = tl > 0 ? ty / tl : 0.0, oy = tl > 0 ? -tx / tl : 0.0;
         double cell_px = 1.0 / k;
         if (d->surface) {
-            bound[i] = surface_bind(d, xy, nrm, px, py, ox, oy, 4.0 * cell_px, &out->rest[3 * i]);
+            bound[i] =
+                surface_bind(d, xy, nrm, zv, px, py, ox, oy, 4.0 * cell_px, 2.0 * cell_px, &cands, &ncand, &out->rest[3 * i]);
             continue;
         }
         // The nearest vertex facing outwards (within a few cells of the
@@ -538,6 +571,7 @@ oom:
     res = sp_fail(err, SP_ERR_NO_MEMORY, "outline: out of memory");
 done:
     if (res != SP_OK) sp_abstraction_free(out);
+    free(cands), free(zv);
     free(tmp_skin), free(bound), free(nrm), free(acc), free(tmp), free(poly), free(cell), free(xy), free(lab), free(sizes),
         free(g.c);
     return res;
