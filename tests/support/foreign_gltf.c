@@ -275,8 +275,8 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
     s.to_model = d->z_up ? sp_quat_axis_angle(sp_v3(1, 0, 0), k_pi / 2) : sp_quat_identity();
     int want = d->vertices > 0 ? d->vertices : 3000;
     s.segments = (int)fmax(6.0, round(sqrt(want / 10.0)));
-    // Measured: about 10 S^2 vertices at this spacing; scaled to the request.
-    s.rings_per_unit = s.segments / 0.75 * (want / (10.0 * s.segments * s.segments));
+    // Measured: about 13 S^2 vertices at this spacing; scaled to the request.
+    s.rings_per_unit = s.segments / 0.75 * (want / (13.0 * s.segments * s.segments));
 
     // Joint frames in the stored data: +Y along the bone, rolled about it.
     sp_vec3 pm[SP_FOREIGN_JOINTS];
@@ -290,8 +290,8 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
         qm[j] = sp_quat_norm(sp_quat_mul(arc, sp_quat_axis_angle(sp_v3(0, 1, 0), 0.35 * j - 1.0)));
     }
 
-    prim body = {0}, tail = {0}, legs = {0}, head = {0};
-    bool ok = add_tube(&s, &body, &k_body) && add_tube(&s, &tail, &k_tail) && add_tube(&s, &tail, &k_tail_end) &&
+    prim body = {0}, tail = {0}, tip = {0}, legs = {0}, head = {0};
+    bool ok = add_tube(&s, &body, &k_body) && add_tube(&s, &tail, &k_tail) && add_tube(&s, &tip, &k_tail_end) &&
               add_tube(&s, &head, &k_head);
     for (int leg = 6; ok && leg < SP_FOREIGN_JOINTS; leg += 2) {
         tube t = {4, {{k_joints[leg].p[0], 0.0, k_joints[leg].p[2]}}, {0, leg, leg + 1}, 2, {{0, 0.075}, {1, 0.045}}};
@@ -300,7 +300,7 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
         memcpy(t.p[3], k_joints[leg + 1].to, sizeof t.p[3]);
         ok = add_tube(&s, &legs, &t);
     }
-    int nv = body.nv + tail.nv + legs.nv + head.nv;
+    int nv = body.nv + tail.nv + tip.ni + legs.nv + head.nv; // the tip is not indexed: a vertex per corner
     cJSON* root = cJSON_CreateObject();
     bytes b = {0};
     if (!ok || !root) {
@@ -381,7 +381,7 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
         cJSON_AddNumberToObject(tex, "source", 0);
         cJSON_AddItemToArray(cJSON_AddArrayToObject(root, "textures"), tex);
     }
-    // Meshes: body (body and tail: two primitives), legs, head (not indexed).
+    // Meshes: body (body, tail, and the tail's tip not indexed: three primitives), legs, head.
     cJSON* meshes = cJSON_AddArrayToObject(root, "meshes");
     const char* names[3] = {"body", "legs", "head"};
     for (int m = 0; m < 3; ++m) {
@@ -391,8 +391,9 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
         if (m == 0) {
             cJSON_AddItemToArray(ps, write_prim(root, &b, &body, true, skinned, 0));
             cJSON_AddItemToArray(ps, write_prim(root, &b, &tail, true, skinned, 0));
+            cJSON_AddItemToArray(ps, write_prim(root, &b, &tip, false, skinned, 0));
         } else {
-            cJSON_AddItemToArray(ps, write_prim(root, &b, m == 1 ? &legs : &head, m == 1, skinned, m == 1 ? 1 : 0));
+            cJSON_AddItemToArray(ps, write_prim(root, &b, m == 1 ? &legs : &head, true, skinned, m == 1 ? 1 : 0));
         }
         cJSON_AddItemToArray(meshes, mesh);
         cJSON* n = cJSON_CreateObject();
@@ -487,6 +488,6 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
 done:
     cJSON_Delete(root);
     free(b.d);
-    prim_free(&body), prim_free(&tail), prim_free(&legs), prim_free(&head);
+    prim_free(&body), prim_free(&tail), prim_free(&tip), prim_free(&legs), prim_free(&head);
     return nv;
 }
