@@ -10,7 +10,6 @@
 #include "cli.h"
 #include "headless.h"
 #include "part_preview.h"
-#include "sp/derive.h"
 #include "sp/partdb.h"
 
 #ifndef SP_SOURCE_DIR
@@ -208,12 +207,10 @@ static int db_add_part(int argc, char** argv)
         "writes nothing",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
-    sp_derive_view v = SP_DERIVE_VIEW_AUTO;
-    if (view && !sp_derive_view_parse(view, &v)) {
+    if (view && !sp_derive_view_parse(view, &d.view)) {
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
     }
-    d.view = (int)v;
     d.added_by = c.by;
     if (no_selftest) d.selftest_seeds = -1;
     sp_error err = {0};

@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "db_internal.h"
-#include "sp/derive.h"
 #include "sp/handdraw.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
@@ -242,7 +241,7 @@ static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, c
     sp_derive_info info;
     sp_error e = {0};
     sp_derive_desc dd = {
-        .category = d->category, .abstraction = d->abstraction, .attach_joint = d->attach_joint, .view = (sp_derive_view)d->view};
+        .category = d->category, .abstraction = d->abstraction, .attach_joint = d->attach_joint, .view = d->view};
     sp_result r = sp_part_derive(ch, &dd, &part, &info, &e);
     if (r != SP_OK) return sp_fail(err, r, "%s: refused: %s", what, e.text);
     r = sp_gltf_save_memory(&part, NULL, glb, size, err);

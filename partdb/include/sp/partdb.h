@@ -37,6 +37,7 @@
 #include <stdint.h>
 
 #include "sp/classifier.h"
+#include "sp/derive.h"
 #include "sp/gltf.h"
 #include "sp/result.h"
 
@@ -105,7 +106,7 @@ typedef struct sp_db_part_desc {
     const char* category;    ///< NULL: the part's `extras.sp_part.category`
     const char* abstraction; ///< NULL: `sp_part.abstraction`, else the first abstraction (a derived part: "outline")
     const char* attach_joint; ///< a derived part's attachment joint (NULL: its root)
-    int view;                 ///< a derived part's sketch view (sp_derive_view; 0: auto)
+    sp_derive_view view;      ///< a derived part's sketch view (0: auto)
     const char* added_by;    ///< NULL: $USER, else "unknown"
     int synth_sketches;      ///< synthetic sketches stored with it; 0: SP_DB_SYNTH_DEFAULT; -1: none
     uint64_t seed;           ///< seed family of the synthetic sketches (0: one of the part's own, from its name; sp/handdraw.h)
