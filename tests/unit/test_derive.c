@@ -500,16 +500,12 @@ typedef struct silhouette {
 // silhouette's edge (covered pixels with an uncovered 4-neighbour) and measures.
 static silhouette measure(const sp_character* part)
 {
-    static sp_headless* gl;
-    static sp_renderer* r;
     sp_error err = {0};
-    if (!gl) {
-        gl = sp_headless_create(&err);
-        if (!gl) fprintf(stderr, "  cannot create a headless OpenGL context: %s\n", err.text);
-        ENSURE(gl);
-        r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
-        ENSURE(r);
-    }
+    sp_headless* gl = sp_headless_create(&err);
+    if (!gl) fprintf(stderr, "  cannot create a headless OpenGL context: %s\n", err.text);
+    ENSURE(gl);
+    sp_renderer* r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
+    ENSURE(r);
     const sp_rig* rig = &part->rig;
     sp_camera cam = part->camera;
     int W = cam.width, H = cam.height;
@@ -625,6 +621,8 @@ static silhouette measure(const sp_character* part)
     sp_image_free(&img);
     sp_render_mesh_destroy(m);
     sp_render_target_destroy(t);
+    sp_renderer_destroy(r);
+    sp_headless_destroy(gl);
     return s;
 }
 
