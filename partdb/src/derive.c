@@ -696,8 +696,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         attach = w.to_derived[sj];
     }
     if (w.clip && (r = add_clip(&w, &R, info, err)) != SP_OK) goto done;
-    char what[SP_NAME_MAX + 16];
-    snprintf(what, sizeof what, "derived part");
+    const char* what = "the derived part";
     if ((r = sp_rig_finalize(&R, what, NULL, err)) != SP_OK) goto done;
 
     // The side view of the rest pose, the root's reach, the abstractions.
