@@ -583,7 +583,6 @@ static silhouette measure(const sp_character* part)
     ENSURE(ne > 100);
     // Outline points to edge pixels.
     const sp_abstraction* a = &rig->abstractions[sp_rig_find_abstraction(rig, "outline")];
-    double* z = malloc(sizeof(double) * 3 * (size_t)a->point_count);
     double* pts = malloc(sizeof(double) * 2 * (size_t)a->point_count);
     double* p = malloc(sizeof(double) * (size_t)rig->param_count);
     sp_rig_defaults(rig, p);
@@ -617,7 +616,7 @@ static silhouette measure(const sp_character* part)
             d[k] = d[k - 1], d[k - 1] = tmp;
         }
     s.cover_p95 = nd ? d[(int)(0.95 * (nd - 1))] : INFINITY;
-    free(d), free(z), free(pts), free(p), free(ex), free(outer), free(stack), free(outside), free(in), free(xyz);
+    free(d), free(pts), free(p), free(ex), free(outer), free(stack), free(outside), free(in), free(xyz);
     sp_image_free(&img);
     sp_render_mesh_destroy(m);
     sp_render_target_destroy(t);
