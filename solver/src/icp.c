@@ -208,10 +208,9 @@ typedef enum stage_end {
 // 1-3% a round after a bad one.)
 static stage_end judge_round(const stage* st, double drop, bool configured_weights, bool step_failed, int stall_rounds)
 {
-    (void)step_failed;
-    if (drop < 1e-6) return STAGE_CONVERGED;
+    if (drop < 1e-6) return step_failed ? STAGE_STALLED : STAGE_CONVERGED;
     if (configured_weights && drop < st->tol) return STAGE_CONVERGED;
-    if (stall_rounds >= 2) return STAGE_CONVERGED;
+    if (stall_rounds >= 2) return STAGE_STALLED;
     return STAGE_GOES_ON;
 }
 
