@@ -43,6 +43,19 @@ static void strokes_at(sp_solver* s, const sp_rig* rig, const double* p, sp_sket
     free(xy);
 }
 
+// Solves the strokes of a seeded random pose (rotations within 45 degrees of
+// rest) from the rest pose; truth gets the pose, out the result.
+static void solve_random_pose(sp_solver* s, const sp_rig* rig, uint64_t seed, double* truth, double* out, sp_solve_report* rep)
+{
+    sp_test_rng rng = {seed};
+    sp_fixture_random_params(rig, &rng, 0.785, truth);
+    sp_sketch sk;
+    strokes_at(s, rig, truth, &sk);
+    sp_error err = {0};
+    ENSURE(sp_solver_solve(s, &sk, NULL, out, rep, &err) == SP_OK);
+    sp_sketch_free(&sk);
+}
+
 static void test_recovery_chain(void)
 {
     setup st;
@@ -53,18 +66,12 @@ static void test_recovery_chain(void)
     double* truth = malloc(sizeof(double) * P);
     double* out = malloc(sizeof(double) * P);
     for (int c = 0; c < cases; ++c) {
-        sp_test_rng rng = {100 + c};
-        sp_fixture_random_params(&st.rig, &rng, 0.785, truth);
-        sp_sketch sk;
-        strokes_at(s, &st.rig, truth, &sk);
         sp_solve_report rep;
-        sp_error err = {0};
-        ENSURE(sp_solver_solve(s, &sk, NULL, out, &rep, &err) == SP_OK);
+        solve_random_pose(s, &st.rig, (uint64_t)(100 + c), truth, out, &rep);
         double rel = rep.mean_error_px / rep.bbox_diagonal_px;
         if (rel <= 0.01) ++ok;
         else fprintf(stderr, "  case %d: mean error %.2f%% (%s, %d it, %d rounds)\n", c, 100 * rel, sp_stop_reason_name(rep.stopped), rep.iterations, rep.icp_rounds);
         ENSURE(rep.after.total <= rep.before.total);
-        sp_sketch_free(&sk);
     }
     fprintf(stderr, "  recovered %d of %d\n", ok, cases);
     ENSURE(ok >= cases * 95 / 100);
@@ -525,16 +532,10 @@ static void test_stop_reasons_of_closest_point_solves(void)
     double* truth = malloc(sizeof(double) * P);
     double* out = malloc(sizeof(double) * P);
     for (int c = 0; c < 20; ++c) {
-        sp_test_rng rng = {300 + c};
-        sp_fixture_random_params(&st.rig, &rng, 0.785, truth);
-        sp_sketch sk;
-        strokes_at(s, &st.rig, truth, &sk);
         sp_solve_report rep;
-        sp_error err = {0};
-        ENSURE(sp_solver_solve(s, &sk, NULL, out, &rep, &err) == SP_OK);
+        solve_random_pose(s, &st.rig, (uint64_t)(300 + c), truth, out, &rep);
         ENSURE(rep.stopped >= 0 && rep.stopped < 4);
         n[rep.stopped]++;
-        sp_sketch_free(&sk);
     }
     fprintf(stderr, "  converged %d, stalled %d, max_iterations %d, time_cap %d\n", n[SP_STOP_CONVERGED], n[SP_STOP_STALLED],
             n[SP_STOP_MAX_ITERATIONS], n[SP_STOP_TIME_CAP]);
