@@ -356,7 +356,7 @@ static sp_result ordered_pairs(sp_solver* s, const sp_sketch* sk, const sp_pairi
             break;
         }
         for (int k = 0; k < m; ++k)
-            s->pairs[s->pair_count++] = (pair){y[k], refs[match[k]], c};
+            s->pairs[s->pair_count++] = (pair){.y = y[k], .s = refs[match[k]], .curve = c}; // ordered: no normal
         if (c < SP_REPORT_CURVES) rep->curves[c].stroke = st, rep->curves[c].reversed = info.reversed;
     }
     if (res == SP_OK && rep->unused_strokes > 0)
