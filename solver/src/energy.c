@@ -347,10 +347,13 @@ static void normal_equations(sp_solver* s, const double* p, const sp_weights* w)
     segment_rows(s, match_moments(s));
     if (has_reg(s)) regulariser_rows(s, w);
     flush_groups(s);
+    const double lambda = s->d.lambda_pose, boost = w->pose_boost;
+    const int from = w->boost_from;
+    double *H = s->H, *g = s->g;
     for (int q = 0; q < P; ++q) {
-        double wq = s->d.lambda_pose * (q < w->boost_from ? 1.0 : w->pose_boost) / (s->unit[q] * s->unit[q]);
-        s->H[q * P + q] += wq;
-        s->g[q] += wq * (p[q] - s->p0[q]);
+        double wq = lambda * (q < from ? 1.0 : boost) / (s->unit[q] * s->unit[q]);
+        H[q * P + q] += wq;
+        g[q] += wq * (p[q] - s->p0[q]);
     }
     for (int a = 0; a < P; ++a)
         for (int b = a + 1; b < P; ++b)

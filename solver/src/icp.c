@@ -38,7 +38,6 @@ const char* sp_stop_reason_name(sp_stop_reason r)
 
 // One stage of an attempt: a row of its plan.
 typedef struct stage {
-    const char* name;          // for reading and debugging
     sp_correspondence pairing; // how its rounds pair samples
     bool placement_only;       // only the root's placement parameters move (else every active one)
     // The weights' schedule: round r boosts W_pose (and, for draw-over
@@ -63,12 +62,13 @@ typedef struct stage {
 // placement moves, so that a part drawn anywhere on the canvas is brought
 // to the stroke before anything bends. Closest points need no stroke
 // assignment; 1% a round is close enough for a start.
-static const stage k_place = {"placement", SP_CORR_CLOSEST, true, 0, 3, 0, 1e-2, 0};
+static const stage k_place = {.pairing = SP_CORR_CLOSEST, .placement_only = true, .its_fresh = 3, .tol = 1e-2};
 // A loop is placed in order too: the best cyclic shift and direction of a
 // closed curve do not depend on where the stroke is or how big (both only
 // add a term common to every shift), and fixed pairs place the root in a
 // few iterations where closest points crawl.
-static const stage k_place_in_order = {"placement in order", SP_CORR_ORDERED, true, 0, 3, 2, 1e-2, 0};
+static const stage k_place_in_order = {
+    .pairing = SP_CORR_ORDERED, .placement_only = true, .its_fresh = 3, .its_frozen = 2, .tol = 1e-2};
 // Everything moves, with the abstraction's own pairing. Graduated
 // regularisation: strongly damped early rounds follow the correspondences
 // in small steps instead of jumping into a folded local minimum, one
@@ -81,8 +81,8 @@ static const stage k_place_in_order = {"placement in order", SP_CORR_ORDERED, tr
 // iteration: more crept the last fraction of W down at Gauss-Newton's
 // linear rate without moving the fit. (A closest-point stage before ordered
 // matching folds stick figures into local minima.)
-static const stage k_fit_ordered = {"fit", SP_CORR_ORDERED, false, 4.0, 3, 2, 1e-3, 0};
-static const stage k_fit_closest = {"fit", SP_CORR_CLOSEST, false, 4.0, 3, 0, 1e-3, 0};
+static const stage k_fit_ordered = {.pairing = SP_CORR_ORDERED, .relax = 4, .its_fresh = 3, .its_frozen = 2, .tol = 1e-3};
+static const stage k_fit_closest = {.pairing = SP_CORR_CLOSEST, .relax = 4, .its_fresh = 3, .tol = 1e-3};
 // An outline (one closed curve, closest points) drawn as one closed stroke
 // is matched in order first (arc length, best cyclic shift and direction):
 // closest-point ICP from the rest pose snags in local minima where limbs
@@ -90,10 +90,11 @@ static const stage k_fit_closest = {"fit", SP_CORR_CLOSEST, false, 4.0, 3, 0, 1e
 // configured ones from the tenth round). The stage only has to bring the
 // outline near the stroke: it ends after its first round at the configured
 // weights, one iteration, and closest points take over.
-static const stage k_loop_in_order = {"loop in order", SP_CORR_ORDERED, false, 6.0, 1, 2, 1e-3, 1};
+static const stage k_loop_in_order = {
+    .pairing = SP_CORR_ORDERED, .relax = 6, .its_fresh = 1, .its_frozen = 2, .tol = 1e-3, .final_rounds = 1};
 // ... refined with closest points made again after every iteration: near
 // the stroke fresh pairs beat more iterations on old ones.
-static const stage k_loop_closest = {"loop closest", SP_CORR_CLOSEST, false, 0, 1, 0, 1e-3, 0};
+static const stage k_loop_closest = {.pairing = SP_CORR_CLOSEST, .its_fresh = 1, .tol = 1e-3};
 
 enum { MAX_STAGES = 3 };
 
