@@ -300,6 +300,17 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
         sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = "assets"};
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
     }
+    // People's own strokes of the parts (assets/sketches/<category>.ndjson,
+    // picked from Quick, Draw!; assets/sketches/README.md), when the folder has them.
+    char dir[1024];
+    struct stat st;
+    snprintf(dir, sizeof dir, "%s/sketches", c->assets);
+    if (r == SP_OK && stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) {
+        sp_dataset human;
+        if ((r = sp_dataset_load(dir, &human, err)) == SP_OK && human.count > 0)
+            r = sp_db_add_sketches(db, &human, NULL, SP_DB_SOURCE_CURATED, "assets", NULL, err);
+        sp_dataset_free(&human);
+    }
     if (r == SP_OK) {
         sp_db_train_desc td = c->d.train;
         if (!td.by) td.by = "assets";
