@@ -864,6 +864,42 @@ static void fill_guesses(const sp_clf* clf, const sp_clf_answer* a, sp_dragon_re
     }
 }
 
+// The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
+// that looks anything like a part becomes the best guess; refused are only
+// scribbles (checked before the fit, `fit` < 0) and strokes far from every
+// part, where "far" weighs the classifier's nearest-drawing distance (in
+// units of the model's calibrated reject distance) together with how badly
+// the best guess's part takes the stroke (`fit`: the fit's mean error over
+// the stroke's diagonal). Taps and tiny strokes never get here.
+// Constants tuned on the tune half of tests/data/visitors (BENCHMARKS.md,
+// "Visitors' drawings").
+static bool kiosk_refuses(const sp_vec2* pts, int n, const sp_clf_answer* a, double fit)
+{
+    if (fit < 0) {
+        // A scribble: far more ink than its size, or crossing itself over and over.
+        enum { M = 64 };
+        sp_vec2 r[M], lo = pts[0], hi = pts[0];
+#define CROSS(a, b) ((a).x * (b).y - (a).y * (b).x)
+        for (int i = 1; i < n; ++i)
+            lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
+        double diag = sp_v2_len(sp_v2_sub(hi, lo));
+        if (sp_curve_length(pts, n, false) > 6.0 * diag) return true;
+        if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return false;
+        int crossings = 0;
+        for (int i = 0; i + 1 < M; ++i)
+            for (int j = i + 2; j + 1 < M; ++j) {
+                sp_vec2 p = r[i], q = r[i + 1], u = r[j], v = r[j + 1];
+                double d1 = CROSS(sp_v2_sub(q, p), sp_v2_sub(u, p)), d2 = CROSS(sp_v2_sub(q, p), sp_v2_sub(v, p));
+                double d3 = CROSS(sp_v2_sub(v, u), sp_v2_sub(p, u)), d4 = CROSS(sp_v2_sub(v, u), sp_v2_sub(q, u));
+                crossings += d1 * d2 < 0 && d3 * d4 < 0;
+            }
+#undef CROSS
+        return crossings > 12;
+    }
+    double near = isfinite(a->reject_distance) && a->reject_distance > 0 ? a->distance / a->reject_distance : 0.0;
+    return near + 8.0 * fit > 1.37;
+}
+
 static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
 {
     out->rejected = true;
@@ -904,14 +940,14 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // Classify (also when forced: the chips still show the classifier's guesses).
     char category[SP_NAME_MAX] = "";
     float confidence = 1.0f;
+    sp_clf_answer a = {0};
     if (d->clf) {
-        sp_clf_answer a;
         sp_error cerr = {0};
         double tc = now_ms();
         if (sp_clf_classify(d->clf, &sk, NULL, &a, &cerr) == SP_OK) {
             fill_guesses(d->clf, &a, out);
             if (!o.category) {
-                if (a.rejected || a.count == 0 || a.ranked[0].score < d->desc.min_confidence) {
+                if (a.count == 0 || a.ranked[0].score < d->desc.min_confidence || kiosk_refuses(pts, n, &a, -1.0)) {
                     free(pts);
                     out->ms_classify = now_ms() - tc;
                     return reject(out, SP_DRAGON_UNRECOGNISED, t0);
@@ -970,6 +1006,11 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     if (best < 0) {
         free(pts);
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
+    }
+    if (!o.category && d->clf && kiosk_refuses(pts, n, &a, best_score)) {
+        free(pts);
+        free(best_p);
+        return reject(out, SP_DRAGON_UNRECOGNISED, t0);
     }
     part* q = NULL;
     sp_result r = new_part(d, cands[best], best_p, &best_rep, &best_view, pts, n, confidence, &q, err);
