@@ -8,8 +8,10 @@
 
 #include "clf_cli.h"
 #include "cli.h"
-#include "sketch_sheet.h"
+#include "sp/headless.h"
+#include "sp/part_preview.h"
 #include "sp/partdb.h"
+#include "sp/sketch_sheet.h"
 
 #ifndef SP_SOURCE_DIR
 #define SP_SOURCE_DIR "."
@@ -94,7 +96,8 @@ static int fail(const char* cmd, const sp_error* err)
     return SP_EXIT_INPUT;
 }
 
-static void print_part(const sp_db_part_info* p)
+// One part as JSON; `derived` adds what add-part derived.
+static void print_part(const sp_db_part_info* p, bool derived)
 {
     printf("{\"name\": ");
     clf_cli_json_str(stdout, p->name);
@@ -111,6 +114,12 @@ static void print_part(const sp_db_part_info* p)
     clf_cli_json_str(stdout, p->added_by);
     printf(", \"added_at\": ");
     clf_cli_json_str(stdout, p->added_at);
+    if (derived) {
+        printf(", \"derived\": [");
+        for (int b = 0, n = 0; b < SP_DERIVED_COUNT; ++b)
+            if (p->derived & (1u << b)) printf("%s\"%s\"", n++ ? ", " : "", sp_derived_name(b));
+        printf("]");
+    }
     printf("}");
 }
 
@@ -174,29 +183,55 @@ static int db_add_part(int argc, char** argv)
     db_common c = {0};
     sp_db_part_desc d = {0};
     bool no_selftest = false;
-    sp_opt opts[] = {DB_COMMON_OPTS(c),
-                     {"--category", SP_OPT_STRING, &d.category, "C", "category (default: the part's extras.sp_part.category)", false},
-                     {"--name", SP_OPT_STRING, &d.name, "NAME", "part name (default: the file name without extension)", false},
-                     {"--abstraction", SP_OPT_STRING, &d.abstraction, "A", "abstraction its sketches show (default: sp_part.abstraction, else the first)", false},
-                     {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it (default 60, -1 none)", false},
-                     {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
+    const char *view = NULL, *preview = NULL;
+    sp_opt opts[] = {
+        DB_COMMON_OPTS(c),
+        {"--category", SP_OPT_STRING, &d.category, "C", "category (default: the part's extras.sp_part.category)", false},
+        {"--name", SP_OPT_STRING, &d.name, "NAME", "part name (default: the file name without extension)", false},
+        {"--abstraction", SP_OPT_STRING, &d.abstraction, "A",
+         "abstraction its sketches show (default: sp_part.abstraction, else the first; a derived part: outline, or stick)",
+         false},
+        {"--attach-joint", SP_OPT_STRING, &d.attach_joint, "NAME",
+         "a derived part attaches by this joint (default: its root's end)", false},
+        {"--view", SP_OPT_STRING, &view, "V",
+         "a derived part's sketch view: auto (default), -z, +z, -x, +x (see `sketchpose derive --help`)", false},
+        {"--preview", SP_OPT_STRING, &preview, "out.png",
+         "render the stored part at rest and in three random poses, its abstraction overlaid", false},
+        {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it (default 60, -1 none)", false},
+        {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "validate a rigged part (loads, skin, abstraction, bounded parameters, solver self-test) and store it with synthetic "
-                   "sketches; a refused part writes nothing",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
+    int rc = parse(
+        argc, argv, cmd,
+        "validate a rigged part (loads, skin, abstraction, bounded parameters, solver self-test) and store it with synthetic "
+        "sketches; a rigged glTF without sketchpose extras first gets them derived (as `sketchpose derive`); a refused part "
+        "writes nothing",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
+    if (view && !sp_derive_view_parse(view, &d.view)) {
+        fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
+        return SP_EXIT_USAGE;
+    }
     d.added_by = c.by;
     if (no_selftest) d.selftest_seeds = -1;
+    sp_error err = {0};
+    if (preview) {
+        // A renderer first: without one nothing is stored.
+        sp_headless* gl = sp_headless_create(&err);
+        if (!gl) return fail(cmd, &err);
+        sp_headless_destroy(gl);
+    }
     sp_db* db = open_db(cmd, &c, SP_DB_CREATE);
     if (!db) return SP_EXIT_INPUT;
-    sp_error err = {0};
     sp_db_part_info info;
     sp_result r = sp_db_add_part_file(db, pos[0], &d, &info, &err);
+    sp_character part = {0};
+    if (r == SP_OK && preview && (r = sp_db_load_part(db, info.name, &part, &err)) == SP_OK)
+        r = sp_part_preview_png(&part, sp_rig_find_abstraction(&part.rig, info.abstraction), preview, &err);
+    sp_character_free(&part);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);
-    print_part(&info);
+    print_part(&info, true);
     printf("\n");
     return SP_EXIT_OK;
 }
@@ -449,7 +484,7 @@ static int db_list(int argc, char** argv)
     printf(", \"schema\": %d, \"generation\": %llu, \"parts\": [", sp_db_schema_version(db), (unsigned long long)sp_db_generation(db));
     for (int i = 0; i < n; ++i) {
         printf("%s", i ? ", " : "");
-        print_part(&parts[i]);
+        print_part(&parts[i], false);
     }
     printf("], \"sketches\": {");
     for (int i = 0; i < ncat; ++i) {
@@ -488,7 +523,7 @@ static int db_show(int argc, char** argv)
         return fail(cmd, &err);
     }
     printf("{\"part\": ");
-    print_part(&info);
+    print_part(&info, false);
     printf(", \"summary\": %s, \"log\": %s}\n", summary, log);
     free(summary);
     free(log);

@@ -13,9 +13,9 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
-#include "dragon.h"
-#include "dragon_snapshot.h"
 #include "report.h"
+#include "sp/dragon.h"
+#include "sp/dragon_snapshot.h"
 #include "sp/handdraw.h"
 #include "sp/sketch_io.h"
 

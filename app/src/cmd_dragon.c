@@ -9,10 +9,10 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
-#include "dragon.h"
-#include "dragon_snapshot.h"
 #include "posing.h"
 #include "report.h"
+#include "sp/dragon.h"
+#include "sp/dragon_snapshot.h"
 
 #ifndef SP_SOURCE_DIR
 #define SP_SOURCE_DIR "."

@@ -8,9 +8,9 @@
 #include "cli.h"
 #include "posing.h"
 #include "report.h"
-#include "snapshot.h"
 #include "sp/embed.h"
 #include "sp/gltf.h"
+#include "sp/snapshot.h"
 #include "sp/solver.h"
 
 // One abstraction with a curve per stroke of `on`, embedded in the mesh.

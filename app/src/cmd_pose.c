@@ -8,8 +8,8 @@
 #include "pose_io.h"
 #include "posing.h"
 #include "report.h"
-#include "snapshot.h"
 #include "sp/gltf.h"
+#include "sp/snapshot.h"
 #include "sp/solver.h"
 
 int cmd_pose(int argc, char** argv)

@@ -6,12 +6,12 @@
 
 #include "cli.h"
 #include "commands.h"
-#include "headless.h"
-#include "image.h"
 #include "plugin_rig.h"
 #include "pose_io.h"
-#include "render.h"
 #include "sp/gltf.h"
+#include "sp/headless.h"
+#include "sp/image.h"
+#include "sp/render.h"
 
 // The sketch camera maps the character onto its own canvas; fit that canvas
 // into the output keeping its aspect, centred (letterboxed), so that a

@@ -16,10 +16,10 @@
 #include <GL/glcorearb.h>
 
 #include "cli.h"
-#include "dragon.h"
-#include "kiosk/draw2d.h"
-#include "kiosk/kiosk.h"
-#include "kiosk/session.h"
+#include "draw2d.h"
+#include "kiosk.h"
+#include "sp/dragon.h"
+#include "sp/kiosk_session.h"
 
 static const char* const k_cmd = "dragon-kiosk";
 

@@ -335,6 +335,12 @@ sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* er
     bool ro = (flags & SP_DB_READONLY) != 0;
     struct stat st;
     bool exists = stat(path, &st) == 0;
+    int why = exists ? 0 : errno;
+    // Only a missing file is "no such database": a folder on the way that
+    // this user may not enter hides the file without it being absent.
+    if (!exists && why == EACCES)
+        return sp_fail(err, SP_ERR_IO, "%s: permission denied (this user may not reach the file or a folder above it)", path);
+    if (!exists && why != ENOENT) return sp_fail(err, SP_ERR_IO, "%s: cannot reach the database file (%s)", path, strerror(why));
     if (!exists && (ro || !(flags & SP_DB_CREATE)))
         return sp_fail(err, SP_ERR_IO, "%s: no such database (create one with `sketchpose db init`)", path);
     if (exists && !S_ISREG(st.st_mode)) return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);

@@ -65,6 +65,12 @@ sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint
                                .details = slot.details,
                                .spikes = slot.spikes};
         r = sp_handdraw_part(&ch->rig, abstraction, &ch->camera, &hd, sp_handdraw_seed(seed, i), &s[i].sketch, NULL, err);
+        // A part whose view or mesh the other shapes cannot use (a perspective
+        // camera, no skinned triangles) is drawn as its abstraction.
+        if (r != SP_OK && (hd.shape != SP_HANDDRAW_SHAPE_OUTLINE || hd.details || hd.spikes > 0)) {
+            hd.shape = SP_HANDDRAW_SHAPE_OUTLINE, hd.details = false, hd.spikes = 0;
+            r = sp_handdraw_part(&ch->rig, abstraction, &ch->camera, &hd, sp_handdraw_seed(seed, i), &s[i].sketch, NULL, err);
+        }
         s[i].label = 0;
         s[i].index = i;
         out->count = i + (r == SP_OK);

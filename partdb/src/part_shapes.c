@@ -1,222 +1,76 @@
 // part_shapes.c: what of a part a synthetic sketch shows (sp/handdraw.h,
 // sp_handdraw_shape): the mesh's silhouette with its decorations, the upper
 // or lower side of a closed outline, a single line through a chain-shaped
-// skeleton, and spikes or teeth added along a stretch of a curve. These are
-// clean drawings; the hand-drawing model perturbs them afterwards.
+// skeleton, a piece of the part, and spikes or teeth added along a stretch of
+// a curve. These are clean drawings; the hand-drawing model perturbs them
+// afterwards.
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "sp/curve.h"
 #include "sp/handdraw.h"
+#include "sp/outline.h"
 #include "sp/synth.h"
 
 #define PI 3.14159265358979323846
-// Silhouette raster: cells across the larger side. Spikes and claws a few
-// percent of the part wide keep several cells; the sketch's own precision is coarser.
-#define GRID 240
 // Points of a traced silhouette (the abstractions have 150).
 #define SIL_POINTS 200
 
 // ---- silhouette -----------------------------------------------------------
 
-typedef struct mask {
-    int w, h;
-    unsigned char* px;
-} mask;
-
-static int mget(const mask* m, int x, int y)
-{
-    return x >= 0 && y >= 0 && x < m->w && y < m->h ? m->px[(size_t)y * m->w + x] : 0;
-}
-
-static void fill_triangle(mask* m, const double* a, const double* b, const double* c)
-{
-    int x0 = (int)floor(fmin(a[0], fmin(b[0], c[0]))), x1 = (int)ceil(fmax(a[0], fmax(b[0], c[0])));
-    int y0 = (int)floor(fmin(a[1], fmin(b[1], c[1]))), y1 = (int)ceil(fmax(a[1], fmax(b[1], c[1])));
-    if (x0 < 0) x0 = 0;
-    if (y0 < 0) y0 = 0;
-    if (x1 > m->w - 1) x1 = m->w - 1;
-    if (y1 > m->h - 1) y1 = m->h - 1;
-    double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    if (fabs(area) < 1e-12) return;
-    for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) {
-            double px = x + 0.5, py = y + 0.5;
-            double w0 = (b[0] - px) * (c[1] - py) - (b[1] - py) * (c[0] - px);
-            double w1 = (c[0] - px) * (a[1] - py) - (c[1] - py) * (a[0] - px);
-            double w2 = (a[0] - px) * (b[1] - py) - (a[1] - py) * (b[0] - px);
-            if ((w0 >= 0 && w1 >= 0 && w2 >= 0) || (w0 <= 0 && w1 <= 0 && w2 <= 0)) m->px[(size_t)y * m->w + x] = 1;
-        }
-}
-
-// One step of dilation (grow) or erosion over the 8-neighbourhood.
-static void morph(mask* m, unsigned char* tmp, bool grow)
-{
-    for (int y = 0; y < m->h; ++y)
-        for (int x = 0; x < m->w; ++x) {
-            int v = mget(m, x, y);
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx)
-                    v = grow ? (v | mget(m, x + dx, y + dy))
-                             : (v & (x + dx >= 0 && y + dy >= 0 && x + dx < m->w && y + dy < m->h ? mget(m, x + dx, y + dy) : 1));
-            tmp[(size_t)y * m->w + x] = (unsigned char)v;
-        }
-    memcpy(m->px, tmp, (size_t)m->w * m->h);
-}
-
-// Keeps only the largest 4-connected region.
-static bool keep_largest(mask* m, int* lab, int* stack)
-{
-    size_t n = (size_t)m->w * m->h;
-    memset(lab, 0, n * sizeof *lab);
-    int best = 0, best_size = 0, next = 0;
-    for (size_t s = 0; s < n; ++s) {
-        if (!m->px[s] || lab[s]) continue;
-        int top = 0, size = 0;
-        lab[s] = ++next;
-        stack[top++] = (int)s;
-        while (top) {
-            int q = stack[--top], x = q % m->w, y = q / m->w;
-            ++size;
-            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-            for (int k = 0; k < 4; ++k) {
-                if (!mget(m, nx[k], ny[k])) continue;
-                size_t r = (size_t)ny[k] * m->w + nx[k];
-                if (lab[r]) continue;
-                lab[r] = next;
-                stack[top++] = (int)r;
-            }
-        }
-        if (size > best_size) best_size = size, best = next;
-    }
-    for (size_t s = 0; s < n; ++s)
-        m->px[s] = lab[s] == best && best > 0;
-    return best_size >= 16;
-}
-
-// Moore-neighbour tracing of the region's outer boundary (clockwise on
-// screen) from its first cell in row order, with Jacob's stopping rule.
-// Returns the number of boundary cells written to out.
-static int trace(const mask* m, sp_vec2* out, int cap)
-{
-    int sx = -1, sy = -1;
-    for (int y = 0; y < m->h && sx < 0; ++y)
-        for (int x = 0; x < m->w; ++x)
-            if (mget(m, x, y)) {
-                sx = x, sy = y;
-                break;
-            }
-    if (sx < 0) return 0;
-    // Neighbours clockwise on screen (y down), starting west.
-    static const int dx[8] = {-1, -1, 0, 1, 1, 1, 0, -1}, dy[8] = {0, -1, -1, -1, 0, 1, 1, 1};
-    int x = sx, y = sy, back = 0; // the start's west neighbour is empty: the scan begins there
-    int x1 = -1, y1 = -1, b1 = -1, n = 0;
-    out[n++] = (sp_vec2){x + 0.5, y + 0.5};
-    for (int guard = 0; guard < 4 * m->w * m->h + 8 && n < cap; ++guard) {
-        int found = -1;
-        for (int k = 1; k <= 8 && found < 0; ++k)
-            if (mget(m, x + dx[(back + k) % 8], y + dy[(back + k) % 8])) found = (back + k) % 8;
-        if (found < 0) break; // a single cell
-        // The empty cell scanned just before the found one becomes the backtrack, seen from the new cell.
-        int e = (found + 7) % 8, bx = x + dx[e], by = y + dy[e];
-        x += dx[found], y += dy[found];
-        for (int d = 0; d < 8; ++d)
-            if (dx[d] == bx - x && dy[d] == by - y) back = d;
-        // The walk repeats from here on: the cell before this one was the start, written twice.
-        if (x == x1 && y == y1 && back == b1) {
-            --n;
-            break;
-        }
-        if (b1 < 0) x1 = x, y1 = y, b1 = back;
-        out[n++] = (sp_vec2){x + 0.5, y + 0.5};
-    }
-    return n;
-}
-
-// The silhouette of the posed mesh, or with `keep` (vertex_count flags) of the
-// triangles whose three vertices are kept.
+// The silhouette of the posed mesh (sp_outline_trace on the skinned
+// vertices), or with `keep` (vertex_count flags) of the triangles whose
+// three vertices are kept.
 static sp_result silhouette(const sp_rig* rig, const sp_camera* cam, const double* p, const unsigned char* keep, sp_sketch* out)
 {
-    sp_result r = SP_OK;
-    double* xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
-    double* uv = malloc(sizeof(double) * 2 * (size_t)(rig->vertex_count + 1));
+    int V = rig->vertex_count, T = rig->triangle_count;
+    if (V < 3 || T < 1 || !rig->joints4 || !rig->weights4) return SP_ERR_INVALID;
+    double* xyz = malloc(sizeof(double) * 3 * (size_t)V);
+    double* w = malloc(sizeof(double) * 4 * (size_t)V);
+    unsigned char *skip_v = keep ? malloc((size_t)V) : NULL, *skip_t = keep ? malloc((size_t)T) : NULL;
+    sp_vec2* pts = malloc(sizeof(sp_vec2) * (SIL_POINTS + 1));
     sp_rig_eval* ev = sp_rig_eval_create(rig);
-    mask m = {0};
-    unsigned char* tmp = NULL;
-    int *lab = NULL, *stack = NULL;
-    sp_vec2 *cells = NULL, *res = NULL;
-    if (!xyz || !uv || !ev) {
-        r = SP_ERR_NO_MEMORY;
-        goto done;
-    }
-    if (rig->vertex_count < 3 || rig->triangle_count < 1) {
-        r = SP_ERR_INVALID;
-        goto done;
-    }
+    sp_abstraction ab = {0};
+    sp_result r = SP_ERR_NO_MEMORY;
+    if (!xyz || !w || (keep && (!skip_v || !skip_t)) || !pts || !ev) goto done;
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
-    double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
-    for (int i = 0; i < rig->vertex_count; ++i) {
-        sp_vec2 q = sp_camera_project(cam, (sp_vec3){xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]});
-        uv[2 * i] = q.x, uv[2 * i + 1] = q.y;
-        if (!keep || keep[i]) lx = fmin(lx, q.x), hx = fmax(hx, q.x), ly = fmin(ly, q.y), hy = fmax(hy, q.y);
+    for (int i = 0; i < 4 * V; ++i)
+        w[i] = rig->weights4[i];
+    for (int i = 0; keep && i < V; ++i)
+        skip_v[i] = !keep[i];
+    for (int t = 0; keep && t < T; ++t) {
+        const uint32_t* q = &rig->triangles[3 * t];
+        skip_t[t] = !(keep[q[0]] && keep[q[1]] && keep[q[2]]);
     }
-    double span = fmax(hx - lx, hy - ly);
-    if (!(span > 1e-9) || !isfinite(span)) {
-        r = SP_ERR_INVALID;
-        goto done;
-    }
-    double k = (GRID - 1) / span, pad = 4;
-    m.w = (int)ceil((hx - lx) * k + 2 * pad), m.h = (int)ceil((hy - ly) * k + 2 * pad);
-    size_t n = (size_t)m.w * m.h;
-    m.px = calloc(n, 1);
-    tmp = malloc(n);
-    lab = malloc(n * sizeof *lab);
-    stack = malloc(n * sizeof *stack);
-    cells = malloc(sizeof *cells * 8 * n / 4 + 16);
-    res = malloc(sizeof *res * (SIL_POINTS + 1));
-    if (!m.px || !tmp || !lab || !stack || !cells || !res) {
-        r = SP_ERR_NO_MEMORY;
-        goto done;
-    }
-    for (int i = 0; i < rig->vertex_count; ++i)
-        uv[2 * i] = (uv[2 * i] - lx) * k + pad, uv[2 * i + 1] = (uv[2 * i + 1] - ly) * k + pad;
-    for (int t = 0; t < rig->triangle_count; ++t) {
-        const uint32_t* v = &rig->triangles[3 * t];
-        if (keep && !(keep[v[0]] && keep[v[1]] && keep[v[2]])) continue;
-        fill_triangle(&m, &uv[2 * v[0]], &uv[2 * v[1]], &uv[2 * v[2]]);
-    }
-    // Closing: a claw or a tooth just off the surface joins it; one-cell gaps close.
-    morph(&m, tmp, true);
-    morph(&m, tmp, false);
-    if (!keep_largest(&m, lab, stack)) {
-        r = SP_ERR_INVALID;
-        goto done;
-    }
-    int nc = trace(&m, cells, (int)(8 * n / 4 + 16));
-    if (nc < 8) {
-        r = SP_ERR_INVALID;
-        goto done;
-    }
-    for (int i = 0; i < nc; ++i)
-        cells[i] = (sp_vec2){lx + (cells[i].x - pad) / k, ly + (cells[i].y - pad) / k};
-    // The raster staircase is far below a sketch's precision: smooth it away.
-    sp_curve_smooth(cells, nc, true, 2, cells);
-    if ((r = sp_curve_resample(cells, nc, true, SIL_POINTS, res)) != SP_OK) goto done;
-    res[SIL_POINTS] = res[0];
+    sp_outline_desc od = {.vertex_count = V,
+                          .positions = xyz,
+                          .influences = 4,
+                          .joints = rig->joints4,
+                          .weights = w,
+                          .triangle_count = T,
+                          .triangles = rig->triangles,
+                          .skip_vertex = skip_v,
+                          .skip_triangle = skip_t,
+                          .camera = cam,
+                          .points = SIL_POINTS,
+                          .keep_largest = true};
+    sp_error e = {0};
+    if ((r = sp_outline_trace(&od, &ab, NULL, &e)) != SP_OK) goto done;
+    for (int i = 0; i < SIL_POINTS; ++i)
+        pts[i] = sp_camera_project(cam, (sp_vec3){ab.rest[3 * i], ab.rest[3 * i + 1], ab.rest[3 * i + 2]});
+    pts[SIL_POINTS] = pts[0];
     out->canvas_w = cam->width, out->canvas_h = cam->height;
-    r = sp_sketch_add_stroke(out, res, NULL, SIL_POINTS + 1);
+    r = sp_sketch_add_stroke(out, pts, NULL, SIL_POINTS + 1);
 done:
-    free(xyz);
-    free(uv);
+    sp_abstraction_free(&ab);
     sp_rig_eval_destroy(ev);
-    free(m.px);
-    free(tmp);
-    free(lab);
-    free(stack);
-    free(cells);
-    free(res);
+    free(xyz);
+    free(w);
+    free(skip_v);
+    free(skip_t);
+    free(pts);
     return r;
 }
 

@@ -21,10 +21,10 @@
 
 #include "bench.h"
 #include "fixtures.h"
-#include "headless.h"
 #include "kiosk.h"
 #include "kiosk_parts.h"
-#include "render.h"
+#include "sp/headless.h"
+#include "sp/render.h"
 
 enum { W = 1280, H = 800 };
 

@@ -25,12 +25,10 @@
 #include <unistd.h>
 
 #include "bench.h"
-#include "sketch_sheet.h"
+#include "sp/dragon.h"
 #include "sp/partdb.h"
 #include "sp/sketch_io.h"
-
-// The kiosk pipeline's API (moving to <sp/dragon.h>): included here only.
-#include "dragon.h"
+#include "sp/sketch_sheet.h"
 
 #define NOT_A_PART "not_a_part"
 

@@ -46,8 +46,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "sketch_sheet.h"
 #include "sp/sketch_io.h"
+#include "sp/sketch_sheet.h"
 #include "sp/synth.h"
 
 #define PI 3.14159265358979323846

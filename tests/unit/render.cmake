@@ -1,4 +1,6 @@
-sp_unit_test(render LIBS sp_app)
+if(TARGET sp_render)
+  sp_unit_test(render LIBS sp_render)
+endif()
 
 # `sketchpose render` on CesiumMan: the PNG exists and has the asked size.
 # Skipped (exit 77) when ../shared/data is absent.

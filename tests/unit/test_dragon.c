@@ -1,4 +1,4 @@
-// The headless kiosk pipeline (app/src/common/dragon.h) and `sketchpose dragon`:
+// The headless kiosk pipeline (sp_dragon, app/dragon/include/sp/dragon.h) and `sketchpose dragon`:
 // a dragon drawn from synthetic strokes of several parts is classified,
 // fitted where it was drawn, attached, animated and exported (one .glb, a skin
 // per part, one animation, 0 validator errors); rejected and broken strokes
@@ -21,9 +21,9 @@
 
 #include <cjson/cJSON.h>
 
-#include "dragon.h"
-#include "dragon_snapshot.h"
 #include "sp/curve.h"
+#include "sp/dragon.h"
+#include "sp/dragon_snapshot.h"
 #include "sp/partdb.h"
 #include "sp/sketch_io.h"
 #include "sp/synth.h"

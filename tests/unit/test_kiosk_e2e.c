@@ -24,8 +24,8 @@
 #include <cjson/cJSON.h>
 
 #include "fixtures.h"
-#include "image.h"
 #include "kiosk_parts.h"
+#include "sp/image.h"
 #include "test.h"
 
 static double hue_of(const uint8_t* p, double* sat, double* val)

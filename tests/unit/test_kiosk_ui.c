@@ -6,10 +6,10 @@
 #include <string.h>
 
 #include "fixtures.h"
-#include "lod.h"
-#include "session.h"
+#include "sp/kiosk_lod.h"
+#include "sp/kiosk_session.h"
+#include "sp/kiosk_ui.h"
 #include "test.h"
-#include "ui.h"
 
 // ------------------------------------------------------------ fake pipeline
 

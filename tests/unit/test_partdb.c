@@ -174,6 +174,51 @@ static const char* base_db(const char* name)
     return path;
 }
 
+// True when every folder from / down to dir lets other users pass (o+x).
+static bool others_may_enter(const char* dir)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (;;) {
+        struct stat st;
+        if (stat(buf[0] ? buf : "/", &st) != 0 || !(st.st_mode & S_IXOTH)) return false;
+        char* slash = strrchr(buf, '/');
+        if (!slash) return true;
+        *slash = 0;
+        if (!buf[0]) return stat("/", &st) == 0 && (st.st_mode & S_IXOTH);
+    }
+}
+
+// A fresh folder (mode 0755) that any user can reach, for the cases run as
+// another user: the build folder may lie under one that only its owner may
+// enter (a clone in a fresh `mktemp -d`). NULL when there is none.
+static const char* reachable_dir(void)
+{
+    static char dir[1000];
+    const char* tmpdir = getenv("TMPDIR");
+    const char* candidates[] = {SP_BINARY_DIR "/tmp", tmpdir && tmpdir[0] ? tmpdir : P_tmpdir, P_tmpdir};
+    for (size_t i = 0; i < sizeof candidates / sizeof candidates[0]; ++i) {
+        mkdir(candidates[i], 0755);
+        if (!others_may_enter(candidates[i])) continue;
+        if (snprintf(dir, sizeof dir, "%s/sp_partdb_XXXXXX", candidates[i]) >= 1000) continue;
+        if (mkdtemp(dir) && chmod(dir, 0755) == 0) return dir;
+    }
+    return NULL;
+}
+
+static void copy_file(const char* from, const char* to)
+{
+    FILE* a = fopen(from, "rb");
+    FILE* b = fopen(to, "wb");
+    ENSURE(a && b);
+    char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, a)) > 0)
+        ENSURE(fwrite(buf, 1, n, b) == n);
+    fclose(a);
+    ENSURE(fclose(b) == 0);
+}
+
 static const char* sketchpose_bin(void)
 {
     static char b[1024];
@@ -533,22 +578,31 @@ static void test_read_only_and_full(void)
     ENSURE(strstr(err.text, "read-only"));
     check_ok(db);
     sp_db_close(db);
-    // A file the user may not write (a non-root child, as root ignores permissions).
-    ENSURE(chmod(p, 0444) == 0);
+    // A file the user may not write (a non-root child, as root ignores
+    // permissions), in a folder that child can reach wherever the clone lives.
+    const char* dir = reachable_dir();
+    ENSURE(dir);
+    char ro[1024];
+    snprintf(ro, sizeof ro, "%s/ro.db", dir);
+    copy_file(p, ro);
+    ENSURE(chmod(ro, 0444) == 0);
     pid_t pid = fork();
     ENSURE(pid >= 0);
     if (pid == 0) {
         if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
         sp_db* d = NULL;
         sp_error e = {0};
-        sp_result r = sp_db_open(p, 0, &d, &e);
+        sp_result r = sp_db_open(ro, 0, &d, &e);
         fprintf(stderr, "  read-only file: %s\n", e.text);
         _exit(r == SP_ERR_IO && strstr(e.text, "read-only") ? 0 : 6);
     }
     int st;
     ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
     ENSURE(WEXITSTATUS(st) == 0);
-    ENSURE(chmod(p, 0644) == 0);
+    file_sha(ro, after);
+    ENSURE(!strcmp(before, after));
+    remove_db(ro);
+    ENSURE(rmdir(dir) == 0);
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     ENSURE(on_full_disk(p, add_big_part));
@@ -557,6 +611,42 @@ static void test_read_only_and_full(void)
     sp_db_close(db);
     ENSURE(scalar(p, "SELECT count(*) FROM parts") == 2);
     sp_dataset_free(&ds);
+}
+
+// A database behind a folder the user may not enter: "permission denied",
+// not "no such database" (root ignores permissions: its child drops them).
+static void test_unreachable(void)
+{
+    const char* dir = reachable_dir();
+    ENSURE(dir);
+    char p[1024];
+    snprintf(p, sizeof p, "%s/x.db", dir);
+    copy_file(base_db("unreachable.db"), p);
+    ENSURE(chmod(dir, geteuid() == 0 ? 0700 : 0) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
+        int code = 0;
+        for (int k = 0; k < 2; ++k) {
+            sp_db* d = NULL;
+            sp_error e = {0};
+            sp_result r = sp_db_open(p, k ? SP_DB_READONLY : SP_DB_CREATE, &d, &e);
+            fprintf(stderr, "  unreachable (%s): %s\n", k ? "read-only" : "create", e.text);
+            if (r != SP_ERR_IO || !strstr(e.text, "permission denied") || strstr(e.text, "no such")) code = 6;
+        }
+        _exit(code);
+    }
+    int st;
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+    ENSURE(chmod(dir, 0755) == 0);
+    ENSURE(WEXITSTATUS(st) == 0);
+    remove_db(p);
+    ENSURE(rmdir(dir) == 0);
+    // A file that is really missing still says so.
+    sp_db* d = NULL;
+    sp_error e = {0};
+    ENSURE(sp_db_open(p, SP_DB_READONLY, &d, &e) == SP_ERR_IO && strstr(e.text, "no such database"));
 }
 
 static void test_schema_versions(void)
@@ -578,11 +668,12 @@ static void test_schema_versions(void)
     ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED);
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
-    // Older (version 1: no generation counter): read-only refuses, writable migrates and keeps the data.
+    // Older (version 1: no generation counter, no review status): read-only refuses, writable migrates and keeps the data.
     ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
     ENSURE(sqlite3_exec(h,
                         "DROP TRIGGER gen_parts_ins; DROP TRIGGER gen_parts_del; DROP TRIGGER gen_sketches_ins; DROP TRIGGER gen_sketches_del;"
-                        "DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta; PRAGMA user_version = 1",
+                        "DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta;"
+                        "DROP INDEX sketches_review; ALTER TABLE sketches DROP COLUMN status; PRAGMA user_version = 1",
                         NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(h);
     ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED && strstr(err.text, "older"));
@@ -1037,6 +1128,7 @@ int main(int argc, char** argv)
                                    {"crash_train", test_crash_train},
                                    {"two_writers", test_two_writers},
                                    {"read_only_and_full", test_read_only_and_full},
+                                   {"unreachable", test_unreachable},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},

@@ -7,9 +7,9 @@
 #include <stdint.h>
 
 #include "fixtures.h"
-#include "headless.h"
-#include "image.h"
-#include "render.h"
+#include "sp/headless.h"
+#include "sp/image.h"
+#include "sp/render.h"
 #include "test.h"
 
 enum { W = 320, H = 240 };

@@ -37,6 +37,7 @@
 #include <stdint.h>
 
 #include "sp/classifier.h"
+#include "sp/derive.h"
 #include "sp/gltf.h"
 #include "sp/result.h"
 
@@ -93,6 +94,7 @@ typedef struct sp_db_part_info {
     size_t bytes;          ///< size of the stored glTF
     char sha256[65];       ///< hex SHA-256 of the stored glTF bytes
     double selftest_error; ///< solver self-test: mean error / 2D diagonal over the seeds (0.02 = 2%)
+    unsigned derived;      ///< what add-part derived (sp_derived flags of sp/derive.h); 0: stored as given (list/show: 0)
     int sketches;          ///< example sketches of its category (list/show only)
     char added_by[64];
     char added_at[32];     ///< UTC, ISO 8601
@@ -102,7 +104,9 @@ typedef struct sp_db_part_info {
 typedef struct sp_db_part_desc {
     const char* name;        ///< NULL: the file name without extension (sp_db_add_part: required)
     const char* category;    ///< NULL: the part's `extras.sp_part.category`
-    const char* abstraction; ///< NULL: `sp_part.abstraction`, else the first abstraction
+    const char* abstraction; ///< NULL: `sp_part.abstraction`, else the first abstraction (a derived part: "outline")
+    const char* attach_joint; ///< a derived part's attachment joint (NULL: its root)
+    sp_derive_view view;      ///< a derived part's sketch view (0: auto)
     const char* added_by;    ///< NULL: $USER, else "unknown"
     int synth_sketches;      ///< synthetic sketches stored with it; 0: SP_DB_SYNTH_DEFAULT; -1: none
     uint64_t seed;           ///< seed family of the synthetic sketches (0: one of the part's own, from its name; sp/handdraw.h)
@@ -120,9 +124,14 @@ typedef struct sp_db_part_desc {
 sp_result sp_db_validate_part(const void* glb, size_t size, const char* what, const sp_db_part_desc* desc, sp_db_part_info* info,
                               sp_error* err);
 /// Validates and stores a part (and its synthetic sketches) in one transaction.
+/// A part without sketch abstractions of its own (a rigged glTF made
+/// elsewhere) is first given what the kiosk needs by sp_part_derive
+/// (sp/derive.h: outline, stick, parameters, attachment, clip) and stored
+/// derived; info->derived says what was derived.
 /// A name that exists is refused (remove it first). Nothing is written on failure.
 sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err);
-/// Same from a .gltf/.glb file: the part is re-encoded as one self-contained GLB.
+/// Same from a .gltf/.glb file: the part is re-encoded as one self-contained GLB
+/// (derived, as above, when it has no sketch abstraction of its own).
 sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err);
 /// Removes a part and the synthetic sketches stored with it (curated and kiosk
 /// sketches of its category stay: they are the curators' work; training uses

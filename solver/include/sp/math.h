@@ -167,6 +167,71 @@ static inline bool sp_mat4_inverse(const sp_mat4* a, sp_mat4* out)
     return true;
 }
 static inline sp_vec3 sp_mat4_translation(const sp_mat4* a) { return (sp_vec3){a->m[12], a->m[13], a->m[14]}; }
+/// The translation by t.
+static inline sp_mat4 sp_mat4_translate(sp_vec3 t)
+{
+    sp_mat4 m = sp_mat4_identity();
+    m.m[12] = t.x, m.m[13] = t.y, m.m[14] = t.z;
+    return m;
+}
+/// Transforms n points in place (xyz: n by 3).
+static inline void sp_mat4_points(const sp_mat4* a, double* xyz, int n)
+{
+    for (int i = 0; i < n; ++i) {
+        sp_vec3 p = sp_mat4_point(a, (sp_vec3){xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]});
+        xyz[3 * i] = p.x, xyz[3 * i + 1] = p.y, xyz[3 * i + 2] = p.z;
+    }
+}
+
+/// Unit quaternion of the rotation whose matrix has the orthonormal columns
+/// c0, c1, c2 (Shepperd's method: the largest diagonal term divides).
+static inline sp_quat sp_quat_from_columns(sp_vec3 c0, sp_vec3 c1, sp_vec3 c2)
+{
+    double m00 = c0.x, m10 = c0.y, m20 = c0.z, m01 = c1.x, m11 = c1.y, m21 = c1.z, m02 = c2.x, m12 = c2.y, m22 = c2.z;
+    double tr = m00 + m11 + m22;
+    sp_quat q;
+    if (tr > 0) {
+        double s = sqrt(tr + 1.0) * 2;
+        q = (sp_quat){(m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s};
+    } else if (m00 > m11 && m00 > m22) {
+        double s = sqrt(1.0 + m00 - m11 - m22) * 2;
+        q = (sp_quat){0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s};
+    } else if (m11 > m22) {
+        double s = sqrt(1.0 + m11 - m00 - m22) * 2;
+        q = (sp_quat){(m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s};
+    } else {
+        double s = sqrt(1.0 + m22 - m00 - m11) * 2;
+        q = (sp_quat){(m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s};
+    }
+    return sp_quat_norm(q);
+}
+
+/// A similarity: x -> t + s R(r) x (uniform scale s > 0). What a glTF node's
+/// TRS can hold without shearing whatever hangs below it.
+typedef struct sp_sim3 {
+    sp_vec3 t;
+    sp_quat r;
+    double s;
+} sp_sim3;
+/// The similarity's matrix.
+static inline sp_mat4 sp_sim3_mat4(sp_sim3 a) { return sp_mat4_trs(a.t, a.r, (sp_vec3){a.s, a.s, a.s}); }
+/// The similarity nearest an affine matrix with a positive determinant: its
+/// translation, the cube root of |det| as scale, and the rotation of the
+/// first axis and the Gram-Schmidt of the second (good for the
+/// near-conformal frames of skinned joints; a degenerate matrix gives the
+/// identity rotation and scale 1).
+static inline sp_sim3 sp_sim3_from_mat4(const sp_mat4* m)
+{
+    sp_vec3 c0 = {m->m[0], m->m[1], m->m[2]}, c1 = {m->m[4], m->m[5], m->m[6]}, c2 = {m->m[8], m->m[9], m->m[10]};
+    double det = sp_v3_dot(c0, sp_v3_cross(c1, c2));
+    double s = cbrt(fabs(det));
+    if (!(s > 1e-300) || !isfinite(s)) s = 1.0;
+    sp_vec3 x = sp_v3_norm(c0);
+    sp_vec3 y = sp_v3_norm(sp_v3_sub(c1, sp_v3_scale(x, sp_v3_dot(x, c1))));
+    sp_vec3 z = sp_v3_cross(x, y);
+    if (sp_v3_len(x) < 0.5 || sp_v3_len(y) < 0.5) x = sp_v3(1, 0, 0), y = sp_v3(0, 1, 0), z = sp_v3(0, 0, 1);
+    return (sp_sim3){sp_mat4_translation(m), sp_quat_from_columns(x, y, z), s};
+}
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,122 @@
+// dragon_internal.h: what the pipeline's files share (see sp/dragon.h for the
+// world, placement, attachment and animation conventions):
+//   parts.c    parts as stored (templates: loading, sp_part hints, the
+//              cache) and the database (polling, reopening, preloading);
+//   stroke.c   the stroke path: cleaning, classifying and deciding, fitting,
+//              the parts list (add, redraw, refit, undo, clear);
+//   layout.c   where a part goes: its view on the canvas, its placement in
+//              the world, attachment to a body;
+//   animate.c  the clips as offsets, posing the dragon at a time;
+//   report.c   the report JSON;  export.c  the glTF export;
+//   dragon.c   create, destroy and the small accessors.
+#ifndef SP_DRAGON_INTERNAL_H
+#define SP_DRAGON_INTERNAL_H
+
+#include <stdio.h>
+#include <sys/types.h>
+#include <time.h>
+
+#include "sp/dragon.h"
+
+static inline double dragon_now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+static inline void dragon_copy_name(char* dst, size_t cap, const char* src)
+{
+    snprintf(dst, cap, "%s", src ? src : "");
+}
+
+// ---- parts as stored (templates), parts.c ------------------------------------------
+
+typedef struct dsocket {
+    char name[SP_NAME_MAX];
+    int joint;
+    sp_vec3 local;     // in the joint's frame at the rest pose
+    char accepts[256]; // ",head,neck," or empty: anything
+} dsocket;
+
+typedef struct tpl {
+    int refs; // the cache and every placed part hold one
+    char name[SP_NAME_MAX], category[SP_NAME_MAX], sha256[65];
+    sp_character ch;
+    int abstraction;
+    sp_camera base;           // the part's sketch view on the dragon canvas, orthographic
+    double depth0;            // camera z of the rest-pose centre in `base`
+    sp_vec2 rest_lo, rest_hi; // the rest abstraction's bounding box in `base`, pixels
+    bool is_torso;
+    int socket_count;
+    dsocket* sockets;
+    int attach_joint;
+    sp_vec3 attach_local;
+    char prefer[SP_NAME_MAX]; // preferred socket name
+    const sp_animation* clip;
+    double clip_start, clip_len; // seconds
+    double* clip0;               // the rest parameters: the clip's offsets are keyed relative to them
+    double* scratch_p;           // param_count
+    sp_vec3 *tr, *sc;            // joint_count scratch for sampling the clip
+    sp_quat* rot;
+    sp_solver* solver;
+    sp_camera solver_cam; // the solver reads the camera through this pointer at every solve
+    sp_rig_eval* ev;
+} tpl;
+
+/// Drops one reference (the last frees it). NULL is fine.
+void dragon_tpl_release(tpl* t);
+/// The loaded templates of `category` (loaded and cached on first use), at most cap.
+int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int cap, sp_error* err);
+/// Releases every cached template.
+void dragon_cache_clear(sp_dragon* d);
+/// The file's device and inode (a database replaced on disk is a new inode); false when it does not exist.
+bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
+
+// ---- the dragon --------------------------------------------------------------------
+
+typedef struct part {
+    sp_dragon_part pub;
+    tpl* t;
+    double* p_fit;
+    sp_vec2* stroke;
+    int stroke_n;
+    sp_mat4 world_fit; // model -> world at t = 0, after attachment
+    sp_sim3 socket0;   // the socket's frame at the torso's fitted pose (attached parts)
+    double *p_t, *xyz, *outline;
+    sp_mat4 world_t;
+    sp_rig_eval* ev;
+} part;
+
+struct sp_dragon {
+    sp_dragon_desc desc;
+    sp_db* db;
+    bool own_db;
+    char db_path[1024], assets_dir[1024];
+    dev_t dev;
+    ino_t ino;
+    uint64_t gen;
+    sp_clf* clf;
+    tpl** cache;
+    int cache_n;
+    part** parts;
+    int part_n, part_cap;
+    uint64_t next_id;
+    sp_camera world;
+    double period;
+    bool posed;
+};
+
+/// Frees a placed part and its reference to its template. NULL is fine.
+void dragon_part_free(part* p);
+
+// ---- layout.c ----------------------------------------------------------------------
+
+/// The part's sketch view zoomed and panned so its rest abstraction covers the stroke's box [lo, hi].
+sp_camera dragon_zoomed_view(const tpl* t, sp_vec2 lo, sp_vec2 hi);
+/// Part model space -> world, making the part's view and the world camera agree.
+sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* view);
+/// Recomputes every attachment and the loop period (after any change of the parts).
+void dragon_relayout(sp_dragon* d);
+
+#endif

@@ -1,0 +1,174 @@
+// export.c: the dragon as one glTF: every part with its own skin, one looped
+// animation of the joints' offsets and the attached parts' placements.
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dragon_internal.h"
+#include "posing.h"
+
+static void animation_free(sp_animation* a)
+{
+    for (int c = 0; c < a->channel_count; ++c)
+        free(a->channels[c].times), free(a->channels[c].values);
+    free(a->channels);
+    memset(a, 0, sizeof *a);
+}
+
+static int cmp_double(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : x > y;
+}
+
+// The export's key times over one period [0, T] (*out malloc'd; returns the
+// count, 0 when out of memory): a grid at desc.fps, plus every key of every
+// part's clip as retimed into the loop, so that LINEAR keys do not cut the
+// corners of the clips' own keys. The last key is T (pose_at wraps it to 0).
+static int key_times(const sp_dragon* d, double** out)
+{
+    double T = d->period;
+    int grid = (int)ceil(T * d->desc.fps);
+    if (grid < 2) grid = 2;
+    size_t cap = (size_t)grid + 1;
+    for (int i = 0; i < d->part_n; ++i) {
+        const tpl* t = d->parts[i]->t;
+        if (!t->clip) continue;
+        size_t reps = (size_t)fmax(1.0, round(T / t->clip_len));
+        for (int c = 0; c < t->clip->channel_count; ++c)
+            cap += reps * (size_t)t->clip->channels[c].key_count;
+    }
+    double* k = malloc(sizeof(double) * cap);
+    if (!k) return 0;
+    size_t n = 0;
+    for (int g = 0; g <= grid; ++g)
+        k[n++] = T * g / grid;
+    for (int i = 0; i < d->part_n; ++i) {
+        const tpl* t = d->parts[i]->t;
+        if (!t->clip) continue;
+        double reps = fmax(1.0, round(T / t->clip_len)), per = T / reps;
+        for (int r = 0; r < (int)reps; ++r)
+            for (int c = 0; c < t->clip->channel_count; ++c)
+                for (int q = 0; q < t->clip->channels[c].key_count; ++q) {
+                    double u = (t->clip->channels[c].times[q] - t->clip_start) / t->clip_len;
+                    if (u > 0 && u < 1) k[n++] = (r + u) * per;
+                }
+    }
+    qsort(k, n, sizeof *k, cmp_double);
+    // Keys closer than a millisecond are one key (float times must increase).
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (m == 0 || k[i] - k[m - 1] > 1e-3) k[m++] = k[i];
+    k[m - 1] = T;
+    *out = k;
+    return (int)m;
+}
+
+sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
+{
+    // Why the cast: posing at the key times reuses the parts' evaluation
+    // buffers; the visible state is restored at the end (posed = false).
+    sp_dragon* d = (sp_dragon*)dc;
+    if (d->part_n == 0) return sp_fail(err, SP_ERR_INVALID, "%s: the dragon has no parts to export", path);
+    int n = d->part_n;
+    bool animated = d->period > 0;
+    // Keys: K intervals over one period; the last key repeats the first, so the loop closes.
+    double* times = NULL;
+    int K = animated ? key_times(d, &times) - 1 : 0;
+    if (animated && K < 1) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    sp_result res = SP_OK;
+    sp_gltf_scene_part* parts = calloc((size_t)n, sizeof *parts);
+    sp_animation* anims = calloc((size_t)n, sizeof *anims);
+    double** keys = calloc((size_t)n, sizeof *keys);
+    float* place_trs = animated ? malloc(sizeof(float) * 8 * (size_t)n * (size_t)(K + 1)) : NULL;
+    float* ftimes = animated ? malloc(sizeof(float) * (size_t)(K + 1)) : NULL;
+    char(*names)[SP_NAME_MAX + 16] = calloc((size_t)n, sizeof *names);
+    if (!parts || !anims || !keys || !names || (animated && (!place_trs || !ftimes || !times))) {
+        res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+        goto done;
+    }
+    for (int i = 0; i < n; ++i) {
+        const part* p = d->parts[i];
+        snprintf(names[i], sizeof names[i], "%02d_%s", i, p->pub.category);
+        parts[i] = (sp_gltf_scene_part){.character = &p->t->ch, .params = p->p_fit, .name = names[i], .placement = p->world_fit};
+        if (animated) {
+            keys[i] = malloc(sizeof(double) * ((size_t)p->t->ch.rig.param_count + 1) * (size_t)(K + 1));
+            if (!keys[i]) {
+                res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+                goto done;
+            }
+        }
+    }
+    if (animated) {
+        for (int k = 0; k <= K; ++k) {
+            ftimes[k] = (float)times[k];
+            sp_dragon_pose_at(d, times[k], err);
+            for (int i = 0; i < n; ++i) {
+                const part* p = d->parts[i];
+                size_t P = (size_t)p->t->ch.rig.param_count;
+                memcpy(keys[i] + P * (size_t)k, p->p_t, sizeof(double) * P);
+                sp_sim3 s = sp_sim3_from_mat4(&p->world_t);
+                float* v = place_trs + 8 * ((size_t)i * (size_t)(K + 1) + (size_t)k);
+                v[0] = (float)s.t.x, v[1] = (float)s.t.y, v[2] = (float)s.t.z;
+                v[3] = (float)s.r.x, v[4] = (float)s.r.y, v[5] = (float)s.r.z, v[6] = (float)s.r.w;
+                v[7] = (float)s.s;
+                // Keep neighbouring keys on the same hemisphere so slerp takes the short way.
+                if (k > 0 && v[3] * v[-5] + v[4] * v[-4] + v[5] * v[-3] + v[6] * v[-2] < 0)
+                    v[3] = -v[3], v[4] = -v[4], v[5] = -v[5], v[6] = -v[6];
+            }
+        }
+        for (int i = 0; i < n; ++i) {
+            const part* p = d->parts[i];
+            if (p->t->clip && p->t->ch.rig.param_count > 0) {
+                res = sp_animation_from_keys(&p->t->ch.rig, keys[i], times, K + 1, "dragon", &anims[i], err);
+                if (res != SP_OK) goto done;
+                parts[i].animation = &anims[i];
+            }
+            if (p->pub.attached_to >= 0 && d->parts[p->pub.attached_to]->t->clip) {
+                parts[i].placement_key_count = K + 1;
+                parts[i].placement_times = ftimes;
+                parts[i].placement_trs = place_trs + 8 * (size_t)i * (size_t)(K + 1);
+            }
+        }
+    }
+    {
+        // The scene's extras say what the parts are (for people and tests reading the file).
+        cJSON* ex = cJSON_CreateObject();
+        cJSON* dj = cJSON_AddObjectToObject(ex, "sp_dragon");
+        cJSON* canvas = cJSON_AddArrayToObject(dj, "canvas");
+        cJSON_AddItemToArray(canvas, cJSON_CreateNumber(d->desc.canvas_w));
+        cJSON_AddItemToArray(canvas, cJSON_CreateNumber(d->desc.canvas_h));
+        cJSON_AddNumberToObject(dj, "period_s", d->period);
+        cJSON* pj = cJSON_AddArrayToObject(dj, "parts");
+        for (int i = 0; i < n; ++i) {
+            const part* p = d->parts[i];
+            cJSON* o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "node", names[i]);
+            cJSON_AddStringToObject(o, "name", p->pub.name);
+            cJSON_AddStringToObject(o, "category", p->pub.category);
+            if (p->pub.attached_to >= 0) {
+                cJSON_AddNumberToObject(o, "attached_to", p->pub.attached_to);
+                cJSON_AddStringToObject(o, "socket", p->pub.socket);
+            }
+            cJSON_AddItemToArray(pj, o);
+        }
+        char* text = cJSON_PrintUnformatted(ex);
+        cJSON_Delete(ex);
+        if (!text) {
+            res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+            goto done;
+        }
+        sp_gltf_scene_desc sd = {.part_count = n, .parts = parts, .animation_name = "dragon", .extras_json = text};
+        res = sp_gltf_save_scene(&sd, path, err);
+        free(text);
+    }
+done:
+    for (int i = 0; i < n; ++i) {
+        if (anims) animation_free(&anims[i]);
+        if (keys) free(keys[i]);
+    }
+    free(parts), free(anims), free(keys), free(place_trs), free(ftimes), free(times), free(names);
+    d->posed = false;
+    return res;
+}

@@ -1,0 +1,402 @@
+// parts.c: parts as stored (templates: the rig, its sketch view on the
+// canvas, its sp_part hints, its clip, its prepared solver), cached by name,
+// and the database behind them (polled for changes, reopened when replaced).
+#include <cjson/cJSON.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "dragon_internal.h"
+#include "sp/synth.h"
+
+void dragon_tpl_release(tpl* t)
+{
+    if (!t || --t->refs > 0) return;
+    sp_solver_destroy(t->solver);
+    sp_rig_eval_destroy(t->ev);
+    free(t->sockets);
+    free(t->clip0);
+    free(t->scratch_p);
+    free(t->tr);
+    free(t->sc);
+    free(t->rot);
+    sp_character_free(&t->ch);
+    free(t);
+}
+
+static bool read_vec3(const cJSON* a, sp_vec3* out)
+{
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != 3) return false;
+    double v[3];
+    for (int i = 0; i < 3; ++i) {
+        const cJSON* e = cJSON_GetArrayItem(a, i);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) return false;
+        v[i] = e->valuedouble;
+    }
+    *out = (sp_vec3){v[0], v[1], v[2]};
+    return true;
+}
+
+// A point given in model space at the rest pose, as an offset in `joint`'s frame.
+static sp_vec3 to_joint_local(tpl* t, int joint, sp_vec3 model)
+{
+    const sp_mat4* G = &sp_rig_eval_world(t->ev)[joint];
+    sp_mat4 inv;
+    if (!sp_mat4_inverse(G, &inv)) return (sp_vec3){0, 0, 0};
+    return sp_mat4_point(&inv, model);
+}
+
+// Reads the sockets / attach hints of the part's sp_part extras (DESIGN.md;
+// every key optional). t->ev must hold the rest pose.
+static void read_part_extras(tpl* t)
+{
+    const sp_rig* rig = &t->ch.rig;
+    t->attach_joint = 0;
+    for (int j = 0; j < rig->joint_count; ++j)
+        if (rig->joints[j].parent < 0) {
+            t->attach_joint = j;
+            break;
+        }
+    t->attach_local = (sp_vec3){0, 0, 0};
+    t->is_torso = !strcmp(t->category, "torso");
+    cJSON* part = t->ch.part_json ? cJSON_Parse(t->ch.part_json) : NULL;
+    if (!part) return;
+    const cJSON* sockets = cJSON_GetObjectItemCaseSensitive(part, "sockets");
+    int n = cJSON_IsArray(sockets) ? cJSON_GetArraySize(sockets) : 0;
+    if (n > 0) t->sockets = calloc((size_t)n, sizeof(dsocket));
+    const cJSON* s;
+    if (t->sockets) cJSON_ArrayForEach(s, sockets)
+        {
+            dsocket* d = &t->sockets[t->socket_count];
+            const cJSON* name = cJSON_GetObjectItemCaseSensitive(s, "name");
+            const cJSON* joint = cJSON_GetObjectItemCaseSensitive(s, "joint");
+            const cJSON* pos = cJSON_GetObjectItemCaseSensitive(s, "position");
+            const cJSON* acc = cJSON_GetObjectItemCaseSensitive(s, "accepts");
+            d->joint = cJSON_IsString(joint) ? sp_rig_find_joint(rig, joint->valuestring) : t->attach_joint;
+            if (d->joint < 0) continue; // a socket on a joint the part does not have: ignore it
+            snprintf(d->name, sizeof d->name, "%s", cJSON_IsString(name) ? name->valuestring : "socket");
+            sp_vec3 p;
+            d->local = read_vec3(pos, &p) ? to_joint_local(t, d->joint, p) : (sp_vec3){0, 0, 0};
+            if (cJSON_IsArray(acc)) {
+                const cJSON* c;
+                size_t len = 0;
+                d->accepts[len++] = ',';
+                cJSON_ArrayForEach(c, acc) if (cJSON_IsString(c) && len + strlen(c->valuestring) + 2 < sizeof d->accepts)
+                {
+                    len += (size_t)snprintf(d->accepts + len, sizeof d->accepts - len, "%s,", c->valuestring);
+                }
+                if (len == 1) d->accepts[0] = 0;
+            } else if (cJSON_IsString(acc)) {
+                snprintf(d->accepts, sizeof d->accepts, ",%s,", acc->valuestring);
+            }
+            ++t->socket_count;
+        }
+    if (t->socket_count > 0) t->is_torso = true;
+    const cJSON* at = cJSON_GetObjectItemCaseSensitive(part, "attach");
+    if (cJSON_IsString(at)) {
+        int j = sp_rig_find_joint(rig, at->valuestring);
+        if (j >= 0) t->attach_joint = j;
+    } else if (cJSON_IsObject(at)) {
+        const cJSON* joint = cJSON_GetObjectItemCaseSensitive(at, "joint");
+        const cJSON* pos = cJSON_GetObjectItemCaseSensitive(at, "position");
+        const cJSON* sock = cJSON_GetObjectItemCaseSensitive(at, "socket");
+        int j = cJSON_IsString(joint) ? sp_rig_find_joint(rig, joint->valuestring) : -1;
+        if (j >= 0) t->attach_joint = j;
+        sp_vec3 p;
+        if (read_vec3(pos, &p)) t->attach_local = to_joint_local(t, t->attach_joint, p);
+        if (cJSON_IsString(sock)) dragon_copy_name(t->prefer, sizeof t->prefer, sock->valuestring);
+    }
+    cJSON_Delete(part);
+}
+
+static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve, sp_error* err)
+{
+    tpl* t = calloc(1, sizeof *t);
+    if (!t) {
+        sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        return NULL;
+    }
+    t->refs = 1;
+    sp_db_part_info info;
+    if (sp_db_part(db, name, &info, err) != SP_OK || sp_db_load_part(db, name, &t->ch, err) != SP_OK) {
+        free(t);
+        return NULL;
+    }
+    dragon_copy_name(t->name, sizeof t->name, name);
+    dragon_copy_name(t->category, sizeof t->category, info.category);
+    dragon_copy_name(t->sha256, sizeof t->sha256, info.sha256);
+    const sp_rig* rig = &t->ch.rig;
+    t->abstraction = info.abstraction[0] ? sp_rig_find_abstraction(rig, info.abstraction) : -1;
+    if (t->abstraction < 0) t->abstraction = rig->abstraction_count > 0 ? 0 : -1;
+    size_t P = (size_t)rig->param_count + 1, J = (size_t)rig->joint_count + 1;
+    t->ev = sp_rig_eval_create(rig);
+    t->scratch_p = malloc(sizeof(double) * P);
+    t->tr = malloc(sizeof(sp_vec3) * J);
+    t->sc = malloc(sizeof(sp_vec3) * J);
+    t->rot = malloc(sizeof(sp_quat) * J);
+    double* xyz = malloc(sizeof(double) * 3 * ((size_t)rig->vertex_count + 1));
+    double* xy =
+        t->abstraction >= 0 ? malloc(sizeof(double) * 2 * ((size_t)rig->abstractions[t->abstraction].point_count + 1)) : NULL;
+    if (!t->ev || !t->scratch_p || !t->tr || !t->sc || !t->rot || !xyz || (t->abstraction >= 0 && !xy)) {
+        sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+        goto fail;
+    }
+    if (t->abstraction < 0 || rig->abstractions[t->abstraction].point_count < 2) {
+        sp_fail(err, SP_ERR_INVALID, "part %s: no sketch abstraction to fit", name);
+        goto fail;
+    }
+    // The rest pose: where sockets and attach points are given, and the depth reference.
+    sp_rig_defaults(rig, t->scratch_p);
+    sp_rig_eval_update(t->ev, t->scratch_p, false);
+    read_part_extras(t);
+    sp_rig_eval_update(t->ev, t->ch.pose, false);
+    sp_rig_eval_points(t->ev, sp_rig_mesh_points(rig), xyz);
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, rig->vertex_count, &lo, &hi);
+    sp_vec3 centre = sp_v3_scale(sp_v3_add(lo, hi), 0.5);
+    t->base = sp_camera_resize(&t->ch.camera, canvas_w, canvas_h);
+    sp_vec3 c = sp_mat4_point(&t->base.view, centre);
+    if (t->base.kind == SP_CAMERA_PERSPECTIVE) {
+        // Weak perspective at the part's centre: the world is orthographic (dragon.h).
+        double d = -c.z > 1e-9 ? -c.z : 1.0;
+        t->base.kind = SP_CAMERA_ORTHOGRAPHIC;
+        t->base.scale /= d;
+    }
+    t->depth0 = c.z;
+    sp_abstraction_project(rig, t->abstraction, &t->base, t->ch.pose, xy);
+    int n = rig->abstractions[t->abstraction].point_count;
+    t->rest_lo = t->rest_hi = (sp_vec2){xy[0], xy[1]};
+    for (int i = 1; i < n; ++i) {
+        t->rest_lo.x = fmin(t->rest_lo.x, xy[2 * i]), t->rest_lo.y = fmin(t->rest_lo.y, xy[2 * i + 1]);
+        t->rest_hi.x = fmax(t->rest_hi.x, xy[2 * i]), t->rest_hi.y = fmax(t->rest_hi.y, xy[2 * i + 1]);
+    }
+    double diag = sp_v2_len(sp_v2_sub(t->rest_hi, t->rest_lo));
+    if (!(diag > 1e-6) || !isfinite(diag)) {
+        sp_fail(err, SP_ERR_INVALID, "part %s: its abstraction is invisible in its sketch view", name);
+        goto fail;
+    }
+    // The clip: the first animation with channels.
+    for (int a = 0; a < rig->animation_count && !t->clip; ++a) {
+        const sp_animation* an = &rig->animations[a];
+        double start = INFINITY, end = -INFINITY;
+        for (int k = 0; k < an->channel_count; ++k)
+            if (an->channels[k].key_count > 0) {
+                start = fmin(start, an->channels[k].times[0]);
+                end = fmax(end, an->channels[k].times[an->channels[k].key_count - 1]);
+            }
+        if (end - start > 1e-3 && isfinite(end - start)) {
+            t->clip = an;
+            t->clip_start = start;
+            t->clip_len = end - start;
+        }
+    }
+    if (t->clip) {
+        t->clip0 = malloc(sizeof(double) * P);
+        if (!t->clip0) {
+            sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+            goto fail;
+        }
+        // Offsets relative to rest (docs/DESIGN.md, "Animation clips as
+        // offsets"), not to the clip's first frame: the clips have phase lags
+        // along their chains, and subtracting a first frame would make a flap
+        // or a sway lopsided about the drawn pose.
+        sp_rig_defaults(rig, t->clip0);
+    }
+    t->solver_cam = t->base;
+    t->solver = sp_solver_create(rig, t->abstraction, &t->solver_cam, solve);
+    if (!t->solver) {
+        sp_fail(err, SP_ERR_NO_MEMORY, "part %s: cannot prepare the solver (out of memory)", name);
+        goto fail;
+    }
+    free(xyz);
+    free(xy);
+    return t;
+fail:
+    free(xyz);
+    free(xy);
+    dragon_tpl_release(t);
+    return NULL;
+}
+
+void dragon_part_free(part* p)
+{
+    if (!p) return;
+    dragon_tpl_release(p->t);
+    free(p->p_fit);
+    free(p->stroke);
+    free(p->p_t);
+    free(p->xyz);
+    free(p->outline);
+    sp_rig_eval_destroy(p->ev);
+    free(p);
+}
+
+void dragon_cache_clear(sp_dragon* d)
+{
+    for (int i = 0; i < d->cache_n; ++i)
+        dragon_tpl_release(d->cache[i]);
+    free(d->cache);
+    d->cache = NULL;
+    d->cache_n = 0;
+}
+
+// After a change of the database: keeps the loaded parts whose stored bytes
+// are unchanged (same name, category and SHA-256), so a curator's edit does
+// not make every next stroke pay for loading and preparing its part again.
+static void cache_prune(sp_dragon* d)
+{
+    int kept = 0;
+    for (int i = 0; i < d->cache_n; ++i) {
+        tpl* t = d->cache[i];
+        sp_db_part_info info;
+        sp_error e = {0};
+        bool same = d->db && sp_db_part(d->db, t->name, &info, &e) == SP_OK && !strcmp(info.sha256, t->sha256) &&
+                    !strcmp(info.category, t->category);
+        if (same)
+            d->cache[kept++] = t;
+        else
+            dragon_tpl_release(t);
+    }
+    d->cache_n = kept;
+}
+
+bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return false;
+    *dev = st.st_dev, *ino = st.st_ino;
+    return true;
+}
+
+// After the database file was replaced by a rename, its -wal/-shm beside it
+// still belong to the old file (SQLite does not remove them when the file it
+// had open has moved), and a new connection would read the new file through
+// the old file's WAL. They are removed when no process holds a lock on the
+// -shm (nobody uses them) and the WAL was not written since the new file
+// arrived (its ctime: rename sets it).
+static void drop_stale_sidecars(const char* path)
+{
+    char wal[1100], shm[1100];
+    snprintf(wal, sizeof wal, "%s-wal", path);
+    snprintf(shm, sizeof shm, "%s-shm", path);
+    struct stat db, w;
+    if (stat(path, &db) != 0) return;
+    if (stat(wal, &w) == 0 && w.st_mtime > db.st_ctime) return;
+    int fd = open(shm, O_RDWR);
+    if (fd >= 0) {
+        // SQLite's unix VFS locks bytes 120..128 of the -shm (the lock slots and the dead man switch).
+        struct flock fl = {.l_type = F_WRLCK, .l_whence = SEEK_SET, .l_start = 120, .l_len = 9};
+        bool used = fcntl(fd, F_GETLK, &fl) != 0 || fl.l_type != F_UNLCK;
+        close(fd);
+        if (used) return;
+    }
+    unlink(wal);
+    unlink(shm);
+}
+
+// Opens our own connection, read-only: the kiosk never writes.
+static sp_result open_own(sp_dragon* d, sp_error* err)
+{
+    sp_db* db = NULL;
+    sp_result r = sp_db_open(d->db_path, SP_DB_READONLY, &db, err);
+    if (r != SP_OK) return r;
+    d->db = db;
+    dragon_file_id(d->db_path, &d->dev, &d->ino);
+    return SP_OK;
+}
+
+// Takes the newest model of the (re)opened database; keeps the old one when it cannot be read.
+static void reload_model(sp_dragon* d)
+{
+    sp_clf* clf = NULL;
+    sp_error merr = {0};
+    sp_result r = sp_db_load_model(d->db, &clf, NULL, &merr);
+    if (r == SP_OK || r == SP_ERR_INVALID) {
+        // SP_ERR_INVALID: no model stored (strokes then need a forced category).
+        sp_clf_free(d->clf);
+        d->clf = r == SP_OK ? clf : NULL;
+    }
+}
+
+sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err)
+{
+    if (reloaded) *reloaded = false;
+    if (d->own_db) {
+        // A database replaced on disk (a new file renamed over it) is a new
+        // inode: the open connection still reads the old one. A deleted file
+        // keeps being read through the open connection until a new one appears.
+        dev_t dev;
+        ino_t ino;
+        bool replaced = d->db && dragon_file_id(d->db_path, &dev, &ino) && (dev != d->dev || ino != d->ino);
+        if (replaced || !d->db) {
+            if (d->db) sp_db_close(d->db); // first: then nothing of ours holds the old file's sidecars
+            if (replaced) drop_stale_sidecars(d->db_path);
+            d->db = NULL;
+            if (open_own(d, err) != SP_OK) return SP_ERR_IO; // parts already loaded and the model stay usable
+            reload_model(d);
+            d->gen = sp_db_generation(d->db);
+            cache_prune(d);
+            if (reloaded) *reloaded = true;
+            return SP_OK;
+        }
+    }
+    uint64_t g = sp_db_generation(d->db);
+    if (g == 0) return sp_fail(err, SP_ERR_IO, "%s: the database cannot be read", d->db_path);
+    if (g == d->gen) return SP_OK;
+    reload_model(d);
+    d->gen = g;
+    cache_prune(d);
+    if (reloaded) *reloaded = true;
+    return SP_OK;
+}
+
+// The templates of a category (loaded and cached), up to max_variants.
+int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int cap, sp_error* err)
+{
+    char** names = NULL;
+    int n = 0, got = 0;
+    if (!d->db) {
+        // The database is gone for now: the parts already loaded still serve.
+        for (int k = 0; k < d->cache_n && got < cap; ++k)
+            if (!strcmp(d->cache[k]->category, category)) out[got++] = d->cache[k];
+        return got;
+    }
+    if (sp_db_category_parts(d->db, category, &names, &n, err) != SP_OK) return 0;
+    for (int i = 0; i < n && got < cap; ++i) {
+        tpl* t = NULL;
+        for (int k = 0; k < d->cache_n && !t; ++k)
+            if (!strcmp(d->cache[k]->name, names[i])) t = d->cache[k];
+        if (!t) {
+            t = tpl_load(d->db, names[i], d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, err);
+            if (!t) continue; // a part that does not load is skipped; err keeps why
+            tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
+            if (!c) {
+                dragon_tpl_release(t);
+                continue;
+            }
+            d->cache = c;
+            d->cache[d->cache_n++] = t;
+        }
+        out[got++] = t;
+    }
+    sp_db_free_strings(names, n);
+    return got;
+}
+
+sp_result sp_dragon_preload(sp_dragon* d, sp_error* err)
+{
+    if (!d->db) return SP_OK;
+    char** cats = NULL;
+    int n = 0;
+    sp_result r = sp_db_categories(d->db, &cats, &n, err);
+    if (r != SP_OK) return r;
+    for (int i = 0; i < n; ++i) {
+        tpl* got[16];
+        dragon_category_templates(d, cats[i], got, d->desc.max_variants < 16 ? d->desc.max_variants : 16, err);
+    }
+    sp_db_free_strings(cats, n);
+    return SP_OK;
+}

@@ -1,0 +1,312 @@
+// stroke.c: the stroke path: a stroke is cleaned, classified, decided on
+// (accepted as a category or refused), fitted by every part of its category
+// (the best fit is kept) and becomes a part; Redraw, refit, undo and clear.
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dragon_internal.h"
+#include "sp/curve.h"
+
+// Cleans a stroke: clamps onto the canvas, drops repeated points, resamples
+// very long strokes. *out malloc'd. Returns the point count (0 on no memory).
+static int clean_stroke(const sp_dragon* d, const sp_vec2* xy, int n, sp_vec2** out)
+{
+    double W = d->desc.canvas_w, H = d->desc.canvas_h;
+    sp_vec2* tmp = malloc(sizeof(sp_vec2) * (size_t)(n > 0 ? n : 1));
+    if (!tmp) return 0;
+    for (int i = 0; i < n; ++i)
+        tmp[i] = (sp_vec2){fmin(fmax(xy[i].x, 0.0), W), fmin(fmax(xy[i].y, 0.0), H)};
+    int m = sp_curve_clean(tmp, n, 0.0, tmp);
+    if (m > SP_DRAGON_MAX_STROKE_POINTS) {
+        sp_vec2* r = malloc(sizeof(sp_vec2) * SP_DRAGON_MAX_STROKE_POINTS);
+        if (!r || sp_curve_resample(tmp, m, false, SP_DRAGON_MAX_STROKE_POINTS, r) != SP_OK) {
+            free(r);
+            free(tmp);
+            return 0;
+        }
+        free(tmp);
+        tmp = r;
+        m = SP_DRAGON_MAX_STROKE_POINTS;
+    }
+    *out = tmp;
+    return m;
+}
+
+static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_report* rep, const sp_camera* view,
+                          const sp_vec2* xy, int n, float confidence, part** out, sp_error* err)
+{
+    const sp_rig* rig = &t->ch.rig;
+    part* q = calloc(1, sizeof *q);
+    if (!q) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    size_t P = (size_t)rig->param_count + 1;
+    q->p_fit = malloc(sizeof(double) * P);
+    q->p_t = malloc(sizeof(double) * P);
+    q->xyz = malloc(sizeof(double) * 3 * ((size_t)rig->vertex_count + 1));
+    q->outline = malloc(sizeof(double) * 3 * ((size_t)rig->abstractions[t->abstraction].point_count + 1));
+    q->stroke = malloc(sizeof(sp_vec2) * (size_t)(n > 0 ? n : 1));
+    q->ev = sp_rig_eval_create(rig);
+    if (!q->p_fit || !q->p_t || !q->xyz || !q->outline || !q->stroke || !q->ev) {
+        q->t = NULL;
+        dragon_part_free(q);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    memcpy(q->p_fit, p, sizeof(double) * (size_t)rig->param_count);
+    memcpy(q->stroke, xy, sizeof(sp_vec2) * (size_t)n);
+    q->stroke_n = n;
+    q->t = t;
+    ++t->refs;
+    sp_dragon_part* pub = &q->pub;
+    pub->id = d->next_id++;
+    dragon_copy_name(pub->name, sizeof pub->name, t->name);
+    dragon_copy_name(pub->category, sizeof pub->category, t->category);
+    pub->confidence = confidence;
+    pub->character = &t->ch;
+    pub->abstraction = t->abstraction;
+    pub->params = q->p_fit;
+    pub->report = *rep;
+    pub->view = *view;
+    pub->placement = dragon_placement_of(d, t, view);
+    pub->is_torso = t->is_torso;
+    pub->attached_to = -1;
+    pub->socket_joint = -1;
+    pub->stroke_points = n;
+    pub->stroke_xy = q->stroke;
+    *out = q;
+    return SP_OK;
+}
+
+static void fill_guesses(const sp_clf* clf, const sp_clf_answer* a, sp_dragon_result* out)
+{
+    out->guess_count = 0;
+    for (int i = 0; i < a->count && out->guess_count < SP_DRAGON_GUESSES; ++i) {
+        sp_dragon_guess* g = &out->guesses[out->guess_count++];
+        dragon_copy_name(g->category, sizeof g->category, sp_clf_category(clf, a->ranked[i].category));
+        g->confidence = a->ranked[i].score;
+    }
+}
+
+static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
+{
+    out->rejected = true;
+    out->reason = why;
+    out->part = -1;
+    out->ms_total = dragon_now_ms() - t0;
+    return SP_OK;
+}
+
+// The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
+// that looks anything like a part becomes the best guess; refused are only
+// scribbles (checked before the fit, `fit` < 0) and strokes far from every
+// part, where "far" weighs `near`, the classifier's nearest-drawing distance
+// in units of the model's calibrated reject distance, together with how
+// badly the best guess's part takes the stroke (`fit`: the fit's mean error
+// over the stroke's diagonal). Taps and tiny strokes never get here.
+// Constants tuned on the tune half of tests/data/visitors (BENCHMARKS.md,
+// "Visitors' drawings").
+static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit)
+{
+    if (fit < 0) {
+        // A scribble: far more ink than its size, or crossing itself over and over.
+        enum { M = 64 };
+        sp_vec2 r[M], lo = pts[0], hi = pts[0];
+        for (int i = 1; i < n; ++i)
+            lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
+        if (sp_curve_length(pts, n, false) > 6.0 * sp_v2_len(sp_v2_sub(hi, lo))) return true;
+        if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return false;
+#define CROSS(a, b) ((a).x * (b).y - (a).y * (b).x)
+        int crossings = 0;
+        for (int i = 0; i + 1 < M; ++i)
+            for (int j = i + 2; j + 1 < M; ++j) {
+                sp_vec2 p = r[i], q = r[i + 1], u = r[j], v = r[j + 1];
+                double d1 = CROSS(sp_v2_sub(q, p), sp_v2_sub(u, p)), d2 = CROSS(sp_v2_sub(q, p), sp_v2_sub(v, p));
+                double d3 = CROSS(sp_v2_sub(v, u), sp_v2_sub(p, u)), d4 = CROSS(sp_v2_sub(v, u), sp_v2_sub(q, u));
+                crossings += d1 * d2 < 0 && d3 * d4 < 0;
+            }
+#undef CROSS
+        return crossings > 12;
+    }
+    return near + 8.0 * fit > 1.37;
+}
+
+// The stroke path's decision: the classifier's answer becomes a category
+// (accepted) or a refusal. Classifies also when the category is forced, so
+// the chips still show the classifier's guesses (out->guesses); a forced
+// category is taken as is; otherwise the top guess, unless the kiosk's
+// refusal policy calls the stroke a scribble or the top guess scores under
+// min_confidence (the policy's other half waits for the fit: *near, the
+// classifier's nearest distance in units of its reject distance). Sets
+// out->ms_classify. Returns SP_DRAGON_ACCEPTED with category and *confidence
+// filled, or why the stroke is refused.
+static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, const char* forced, sp_dragon_result* out,
+                                            char category[SP_NAME_MAX], float* confidence, double* near)
+{
+    *confidence = 1.0f;
+    *near = 0.0;
+    if (forced) dragon_copy_name(category, SP_NAME_MAX, forced);
+    if (!d->clf) return forced ? SP_DRAGON_ACCEPTED : SP_DRAGON_NO_MODEL;
+    sp_clf_answer a;
+    sp_error cerr = {0};
+    double tc = dragon_now_ms();
+    sp_result r = sp_clf_classify(d->clf, sk, NULL, &a, &cerr);
+    if (r == SP_OK) fill_guesses(d->clf, &a, out);
+    if (r != SP_OK && !forced) return SP_DRAGON_UNRECOGNISED;
+    out->ms_classify = dragon_now_ms() - tc;
+    if (forced) return SP_DRAGON_ACCEPTED;
+    if (isfinite(a.reject_distance) && a.reject_distance > 0) *near = a.distance / a.reject_distance;
+    if (a.count == 0 || a.ranked[0].score < d->desc.min_confidence ||
+        kiosk_refuses(sk->strokes[0].points, sk->strokes[0].count, *near, -1.0))
+        return SP_DRAGON_UNRECOGNISED;
+    dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a.ranked[0].category));
+    *confidence = a.ranked[0].score;
+    return SP_DRAGON_ACCEPTED;
+}
+
+sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
+                               sp_dragon_result* out, sp_error* err)
+{
+    double t0 = dragon_now_ms();
+    memset(out, 0, sizeof *out);
+    out->part = -1;
+    sp_dragon_stroke_opts o = opts ? *opts : (sp_dragon_stroke_opts){0};
+    if (count < 0 || (count > 0 && !xy)) return sp_fail(err, SP_ERR_INVALID, "stroke: %d points", count);
+    if (count > 0 && !sp_curve_is_valid(xy, count))
+        return sp_fail(err, SP_ERR_INVALID, "stroke: a coordinate is not a finite number");
+    sp_error rerr = {0};
+    sp_dragon_reload_if_changed(d, NULL, &rerr); // a failed poll keeps the current model: the kiosk goes on
+    if (count < 2) return reject(out, SP_DRAGON_TOO_SHORT, t0);
+    if (!(o.replace_last && d->part_n > 0) && d->part_n >= d->desc.max_parts) return reject(out, SP_DRAGON_FULL, t0);
+    sp_vec2* pts = NULL;
+    int n = clean_stroke(d, xy, count, &pts);
+    if (n == 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    sp_vec2 lo = pts[0], hi = pts[0];
+    for (int i = 1; i < n; ++i)
+        lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
+    if (n < 2 || sp_v2_len(sp_v2_sub(hi, lo)) < 0.01 * hypot(d->desc.canvas_w, d->desc.canvas_h)) {
+        free(pts);
+        return reject(out, SP_DRAGON_TOO_SHORT, t0);
+    }
+    sp_sketch sk = {.canvas_w = d->desc.canvas_w,
+                    .canvas_h = d->desc.canvas_h,
+                    .stroke_count = 1,
+                    .strokes = &(sp_stroke){.count = n, .points = pts}};
+    char category[SP_NAME_MAX] = "";
+    float confidence = 1.0f;
+    double near = 0.0;
+    sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence, &near);
+    if (why != SP_DRAGON_ACCEPTED) {
+        free(pts);
+        return reject(out, why, t0);
+    }
+    // Fit every variant of the category; keep the one that matches best.
+    double tf = dragon_now_ms();
+    tpl* cands[16];
+    int cap = d->desc.max_variants < 16 ? d->desc.max_variants : 16;
+    sp_error lerr = {0};
+    int nc = dragon_category_templates(d, category, cands, cap, &lerr);
+    if (nc == 0) {
+        free(pts);
+        return reject(out, SP_DRAGON_NO_PART, t0);
+    }
+    int best = -1;
+    double best_score = INFINITY;
+    double* best_p = NULL;
+    sp_solve_report best_rep;
+    sp_camera best_view = {0};
+    for (int c = 0; c < nc; ++c) {
+        tpl* t = cands[c];
+        const sp_rig* rig = &t->ch.rig;
+        double* p = malloc(sizeof(double) * ((size_t)rig->param_count + 1));
+        if (!p) continue;
+        memcpy(p, t->ch.pose, sizeof(double) * (size_t)rig->param_count);
+        t->solver_cam = dragon_zoomed_view(t, lo, hi);
+        sp_solve_report rep;
+        sp_error serr = {0};
+        if (sp_solver_solve(t->solver, &sk, p, p, &rep, &serr) != SP_OK) {
+            free(p);
+            continue;
+        }
+        double score = rep.mean_error_px / fmax(rep.bbox_diagonal_px, 1.0);
+        if (!isfinite(score)) score = 1e300;
+        if (best < 0 || score < best_score) {
+            free(best_p);
+            best = c, best_score = score, best_p = p, best_rep = rep, best_view = t->solver_cam;
+        } else {
+            free(p);
+        }
+    }
+    out->ms_fit = dragon_now_ms() - tf;
+    if (best < 0) {
+        free(pts);
+        return reject(out, SP_DRAGON_FIT_FAILED, t0);
+    }
+    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best_score)) {
+        free(pts);
+        free(best_p);
+        return reject(out, SP_DRAGON_UNRECOGNISED, t0);
+    }
+    part* q = NULL;
+    sp_result r = new_part(d, cands[best], best_p, &best_rep, &best_view, pts, n, confidence, &q, err);
+    free(best_p);
+    free(pts);
+    if (r != SP_OK) return r;
+    if (o.replace_last && d->part_n > 0) {
+        dragon_part_free(d->parts[d->part_n - 1]);
+        d->parts[d->part_n - 1] = q;
+    } else {
+        if (d->part_n == d->part_cap) {
+            int cap2 = d->part_cap ? 2 * d->part_cap : 8;
+            part** np = realloc(d->parts, sizeof(part*) * (size_t)cap2);
+            if (!np) {
+                dragon_part_free(q);
+                return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+            }
+            d->parts = np, d->part_cap = cap2;
+        }
+        d->parts[d->part_n++] = q;
+    }
+    dragon_relayout(d);
+    out->part = d->part_n - 1;
+    out->rejected = false;
+    out->reason = SP_DRAGON_ACCEPTED;
+    out->ms_total = dragon_now_ms() - t0;
+    return SP_OK;
+}
+
+sp_result sp_dragon_add_stroke(sp_dragon* d, const sp_stroke* stroke, const sp_dragon_stroke_opts* opts, sp_dragon_result* out,
+                               sp_error* err)
+{
+    return sp_dragon_add_points(d, stroke ? stroke->points : NULL, stroke ? stroke->count : 0, opts, out, err);
+}
+
+sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_result* out, sp_error* err)
+{
+    if (d->part_n == 0 || !category) {
+        memset(out, 0, sizeof *out);
+        return reject(out, SP_DRAGON_NOTHING_TO_REFIT, dragon_now_ms());
+    }
+    part* last = d->parts[d->part_n - 1];
+    // A copy: the part (and its stroke) is freed when replaced.
+    int n = last->stroke_n;
+    sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)n);
+    if (!xy) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    memcpy(xy, last->stroke, sizeof(sp_vec2) * (size_t)n);
+    sp_result r = sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = category, .replace_last = true}, out, err);
+    free(xy);
+    return r;
+}
+
+bool sp_dragon_undo(sp_dragon* d)
+{
+    if (d->part_n == 0) return false;
+    dragon_part_free(d->parts[--d->part_n]);
+    dragon_relayout(d);
+    return true;
+}
+
+void sp_dragon_clear(sp_dragon* d)
+{
+    while (d->part_n > 0)
+        dragon_part_free(d->parts[--d->part_n]);
+    dragon_relayout(d);
+}

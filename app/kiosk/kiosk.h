@@ -1,0 +1,80 @@
+/// kiosk.h: the dragon kiosk without its window: UI state machine + pipeline + drawing.
+///
+/// How to use (dragon_kiosk.c's main loop; a GL 3.3 core context is current):
+///
+///     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db, .canvas_w = fb_w, .canvas_h = fb_h}, &err);
+///     sp_kiosk_resize(k, fb_w, fb_h, px_per_mm);
+///     ... input: sp_kiosk_input(k, &ev);  (pointer events, t_ms on the session clock)
+///     ... per frame: sp_kiosk_update(k, now_ms); sp_kiosk_draw(k); swap buffers;
+///     sp_kiosk_screenshot(k, "out.png", &err); sp_kiosk_export(k, "out.glb", &err);
+///     sp_kiosk_destroy(k);
+///
+/// sp_kiosk_update runs the UI's jobs against the pipeline (dragon.h): at
+/// most one classify+fit, re-fit or save a frame, so a frame never waits for
+/// more than one of them. Saving writes <code>.glb and <code>.png (a
+/// postcard) into the export folder; <code> is four characters that are
+/// easy to read aloud and not already used there.
+#ifndef SP_KIOSK_H
+#define SP_KIOSK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sp/kiosk_ui.h"
+#include "sp/result.h"
+
+typedef struct sp_kiosk sp_kiosk;
+typedef struct sp_dragon sp_dragon; // dragon.h
+
+/// Zero means the default.
+typedef struct sp_kiosk_desc {
+    const char* db_path;    ///< NULL: sp_db_default_path(); created from assets_dir when missing
+    const char* assets_dir; ///< NULL: the pipeline's default ($SP_ASSETS, else "assets")
+    const char* export_dir; ///< where Save writes; NULL: "dragon-exports" (created when needed)
+    const char* font_path;  ///< NULL: DejaVu Sans Bold
+    int canvas_w, canvas_h; ///< the drawing canvas in pixels (the first framebuffer size); 0: 1280 x 800
+    sp_kiosk_ui_desc ui;    ///< UI timings and sizes
+    uint64_t code_seed;     ///< first save code's seed (0: 1); a live kiosk passes the clock
+    bool no_attract_demo;   ///< skip fitting the attract screen's demo dragon (tests of other things)
+    double fit_time_cap_ms; ///< the solver's wall-clock cap per part; 0: the pipeline's (250 ms). A replay raises it so results
+                            ///< never depend on the machine's speed
+    int lod_triangles; ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full
+                       ///< meshes
+} sp_kiosk_desc;
+
+/// Measurements for logs and benchmarks.
+typedef struct sp_kiosk_stats {
+    int strokes, parts_added, rejected, refits, undos, clears, saves, save_failures, pipeline_errors, reloads;
+    double last_fit_ms; ///< wall time of the last classify+fit (the pipeline's)
+    int fit_count;
+    double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
+    double pose_ms;      ///< last pose_at + mesh update
+    int parts;           ///< parts now
+} sp_kiosk_stats;
+
+/// Opens the database (creating the default one when missing), loads the font,
+/// compiles the shaders. NULL and one line in err on failure.
+sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err);
+void sp_kiosk_destroy(sp_kiosk* k);
+/// The framebuffer size and density changed.
+void sp_kiosk_resize(sp_kiosk* k, int fb_w, int fb_h, double px_per_mm);
+/// One input event (framebuffer pixels; t_ms on the session clock).
+void sp_kiosk_input(sp_kiosk* k, const sp_kiosk_event* ev);
+/// Advances to t_ms: timers, animation, at most one heavy job, the pose.
+void sp_kiosk_update(sp_kiosk* k, double t_ms);
+/// Draws the frame into the bound framebuffer (fb_w x fb_h).
+void sp_kiosk_draw(sp_kiosk* k);
+/// Draws the frame offscreen and writes it as a PNG.
+sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err);
+/// Writes the dragon as glTF (.glb or .gltf); SP_ERR_INVALID when it has no part.
+sp_result sp_kiosk_export(sp_kiosk* k, const char* path, sp_error* err);
+/// The UI state (read only).
+const sp_kiosk_ui* sp_kiosk_ui_of(const sp_kiosk* k);
+/// Counters and timings.
+const sp_kiosk_stats* sp_kiosk_stats_of(const sp_kiosk* k);
+/// The pipeline (read only: parts, categories).
+const sp_dragon* sp_kiosk_dragon(const sp_kiosk* k);
+/// The path of the last save (without extension), "" before any.
+const char* sp_kiosk_last_save(const sp_kiosk* k);
+
+#endif

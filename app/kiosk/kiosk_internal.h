@@ -1,0 +1,120 @@
+// kiosk_internal.h: the sp_kiosk struct, shared by kiosk.c (jobs, saving),
+// kiosk_draw.c (the frame) and kiosk_attract.c (the attract screen's demo).
+#ifndef SP_KIOSK_INTERNAL_H
+#define SP_KIOSK_INTERNAL_H
+
+#include "draw2d.h"
+#include "font.h"
+#include "kiosk.h"
+#include "sp/dragon.h"
+#include "sp/kiosk_lod.h"
+#include "sp/render.h"
+
+/// Render meshes of one dragon's parts, by part id (coarsened when lod_triangles > 0).
+typedef struct mesh_cache {
+    struct cached_mesh {
+        uint64_t id;
+        sp_render_mesh* mesh;
+        bool seen;
+        bool coarse;
+        sp_lod lod;
+    } * items;
+    int count, cap;
+    int lod_triangles; ///< triangle budget per part; 0: full meshes
+    double* scratch;   ///< coarse positions
+    int scratch_cap;
+} mesh_cache;
+
+/// The chips of each part (the pipeline keeps its stroke, not its guesses).
+typedef struct part_guesses {
+    uint64_t id;
+    char guess[2][SP_NAME_MAX];
+} part_guesses;
+
+/// One stroke of the attract screen's demo dragon.
+typedef struct demo_part {
+    char category[SP_NAME_MAX];
+    sp_vec2* xy; // canvas pixels
+    int n;
+    int part; // index in the demo dragon, -1 until fitted (or when it failed)
+    bool tried;
+    float* outline; // canvas pixels at the fit (outline_n by 2), with curve breaks
+    int outline_n, outline_cap, breaks[16], break_n;
+} demo_part;
+
+enum { DEMO_MAX = 8 };
+
+struct sp_kiosk {
+    sp_kiosk_desc desc;
+    char db_path[1024], export_dir[1024];
+    sp_kiosk_ui* ui;
+    sp_dragon* dragon;
+    sp_renderer* r;
+    sp_font* font;
+    sp_draw2d* d2;
+    int fb_w, fb_h;
+    double ppm;
+    int canvas_w, canvas_h;
+    sp_camera canvas_cam; // the pipeline's world camera on its canvas
+    mesh_cache meshes;
+    part_guesses* guesses;
+    int guess_count, guess_cap;
+    uint64_t rev;       // grows with every change of the dragon
+    uint64_t posed_rev; // rev and time of the last pose_at
+    double posed_t;
+    bool posed;
+    // The attract screen's demo dragon.
+    sp_dragon* demo;
+    mesh_cache demo_meshes;
+    demo_part demo_parts[DEMO_MAX];
+    int demo_count;
+    bool demo_prepared;
+    int updates;   // sp_kiosk_update calls (the demo waits for the first frame)
+    bool software; // a software rasteriser (llvmpipe): cheaper background, coarser meshes
+    double demo_posed_t;
+    int demo_posed_parts;
+    // Bookkeeping.
+    sp_kiosk_stats stats;
+    uint64_t code_state;
+    char last_save[1100];
+    double last_reload_check;
+    bool heavy_done; // a heavy job ran in this update
+    sp_vec2* scratch;
+    int scratch_cap;
+    float* outline_px;
+    int outline_cap;
+    int breaks[64];
+};
+
+// kiosk.c
+/// Canvas pixels -> framebuffer pixels and back (the canvas is scaled to fit, centred).
+sp_vec2 kiosk_canvas_to_fb(const sp_kiosk* k, sp_vec2 c);
+sp_vec2 kiosk_fb_to_canvas(const sp_kiosk* k, sp_vec2 p);
+/// The pipeline camera on the current framebuffer.
+sp_camera kiosk_fb_camera(const sp_kiosk* k);
+/// A part's abstraction as fitted (its parameters, its own view), in canvas
+/// pixels: out (grown as needed) gets n points, breaks[] the curve starts. Returns n.
+int kiosk_fitted_outline(const sp_dragon_part* p, float** out, int* cap, int* breaks, int max_breaks, int* nbreaks);
+/// "front_legs" -> "Front legs".
+void kiosk_pretty(const char* category, char* out, size_t cap);
+/// Brings the cached meshes in step with d's parts at its last pose_at.
+void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions);
+void mesh_cache_free(mesh_cache* c);
+sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id);
+
+// kiosk_draw.c
+/// Draws the frame into the bound framebuffer of w x h pixels.
+void kiosk_draw_frame(sp_kiosk* k, int w, int h);
+/// Renders the postcard (the dragon framed, a title and the code) into img.
+sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error* err);
+
+// kiosk_attract.c
+/// Builds the demo strokes (once) and fits at most one demo part (when no heavy job ran).
+void kiosk_attract_update(sp_kiosk* k);
+/// The camera of the attract screen (the canvas, depth fitted to the demo dragon).
+sp_camera kiosk_attract_camera(sp_kiosk* k);
+/// Draws the attract screen's demo: strokes being drawn, outlines, parts coming alive.
+void kiosk_attract_draw_scene(sp_kiosk* k);
+void kiosk_attract_free(sp_kiosk* k);
+
+#endif

@@ -1,0 +1,237 @@
+/// ui.h: the kiosk's UI as a pure state machine: events in, jobs out, no GL.
+///
+/// How to use (the window's main loop; a test does the same with a fake pipeline):
+///
+///     sp_kiosk_ui* ui = sp_kiosk_ui_create(&(sp_kiosk_ui_desc){0});
+///     sp_kiosk_ui_resize(ui, fb_w, fb_h, px_per_mm);   // and on every resize
+///     ... per GLFW callback: sp_kiosk_ui_event(ui, &ev);
+///     ... per frame: sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_FRAME, now_ms});
+///         sp_kiosk_job job;
+///         while (sp_kiosk_ui_next_job(ui, &job)) {        // in order
+///             switch (job.kind) { case SP_KJOB_FIT: ... sp_kiosk_ui_fit_done(ui, &result); ... }
+///             if (job.heavy) break;                       // one fit or save a frame keeps frames short
+///         }
+///         ... draw from the read-only fields of *ui (mode, stroke, flash, chips, rects, ...) ...
+///     sp_kiosk_ui_destroy(ui);
+///
+/// The UI decides everything a visitor sees and when (attract screen, the
+/// live stroke, the fitted outline's flash, chips, hints, the idle
+/// countdown); the caller only executes jobs (classify and fit a stroke,
+/// undo, save...) and reports their results. Time is the events' t_ms only
+/// (never a clock), so a replayed session makes the same decisions.
+///
+/// Coordinates are framebuffer pixels, y down; sizes come from px_per_mm so
+/// that every touch target is at least desc.min_target_mm (15 mm) on any
+/// screen.
+#ifndef SP_KIOSK_UI_H
+#define SP_KIOSK_UI_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sp/kiosk_event.h"
+
+/// Touch targets (the order of the toolbar).
+typedef enum sp_kiosk_target {
+    SP_KT_NONE = 0,
+    SP_KT_UNDO,        ///< remove the last part
+    SP_KT_REDRAW,      ///< the next stroke replaces the last part (toggles)
+    SP_KT_START_OVER,  ///< two taps within clear_confirm_ms: remove every part
+    SP_KT_PLAY,        ///< play / pause the animation
+    SP_KT_TURN,        ///< orbit mode (drag turns the dragon) / back to the drawing view
+    SP_KT_SAVE,        ///< export .glb + postcard, show the code
+    SP_KT_CHIP_LABEL,  ///< the last part's category (informative)
+    SP_KT_CHIP_GUESS1, ///< next guess: re-fit the last stroke as this category
+    SP_KT_CHIP_GUESS2, ///< the guess after that
+    SP_KT_COUNT
+} sp_kiosk_target;
+
+/// "undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2"; NULL otherwise.
+const char* sp_kiosk_target_name(sp_kiosk_target t);
+/// Parses a target name; SP_KT_NONE when unknown.
+sp_kiosk_target sp_kiosk_target_parse(const char* s);
+
+/// Which screen.
+typedef enum sp_kiosk_mode {
+    SP_KM_ATTRACT, ///< "draw a dragon": an animation shows how; a tap starts
+    SP_KM_DRAW,    ///< strokes become parts
+    SP_KM_TURN,    ///< drags orbit the view
+} sp_kiosk_mode;
+
+enum {
+    SP_KIOSK_STROKE_MAX = 2048,  ///< points kept per stroke (longer strokes are thinned, never cut)
+    SP_KIOSK_OUTLINE_MAX = 4096, ///< points of a fitted outline kept for the flash
+    SP_KIOSK_PENDING_MAX = 2,    ///< finished strokes waiting for the pipeline; a third drops the oldest
+    SP_KIOSK_JOBS_MAX = 32,      ///< queued jobs; more are dropped (tap storms)
+    SP_KIOSK_LABEL_MAX = 48,
+    SP_KIOSK_TEXT_MAX = 160,
+};
+
+/// Zero means the default.
+typedef struct sp_kiosk_ui_desc {
+    double min_target_mm; ///< smallest side of any touch target; 0: 15
+    double button_mm;     ///< preferred toolbar button height; 0: 18 (never below min_target_mm)
+    double idle_ms;       ///< no input for this long returns to the attract screen; 0: 90000; < 0: never
+    double countdown_ms;  ///< the last part of idle_ms, shown as a countdown; 0: 10000
+    double flash_ms;      ///< fitted outline shown over the stroke; 0: 800
+    double fade_ms;       ///< a rejected stroke fades out; 0: 1200
+    double hint_ms;       ///< hints stay this long; 0: 4000
+    double banner_ms;     ///< the save code stays this long; 0: 15000
+    double confirm_ms;    ///< Start over needs a second tap within this; 0: 3000
+    double tap_mm;        ///< a stroke whose box diagonal is smaller is a tap, not a part; 0: 4
+    bool start_playing;   ///< animation on from the start (default: paused until Play)
+} sp_kiosk_ui_desc;
+
+typedef struct sp_kiosk_rect {
+    float x, y, w, h; ///< pixels, top-left corner and size
+} sp_kiosk_rect;
+
+/// A polyline owned by the UI (pixels).
+typedef struct sp_kiosk_line {
+    int count;
+    float* xy; ///< count by 2 (capacity fixed at create)
+    double* t; ///< count timestamps (ms) for strokes; NULL for outlines
+} sp_kiosk_line;
+
+/// What the caller has to do next.
+typedef enum sp_kiosk_job_kind {
+    SP_KJOB_NONE = 0,
+    SP_KJOB_FIT,   ///< classify + fit `stroke`; replace: it replaces the last part (Redraw)
+    SP_KJOB_REFIT, ///< re-fit the last part's stroke as `category`
+    SP_KJOB_UNDO,  ///< remove the last part
+    SP_KJOB_CLEAR, ///< remove every part (Start over, idle timeout)
+    SP_KJOB_SAVE,  ///< export the dragon (.glb + PNG postcard)
+} sp_kiosk_job_kind;
+
+/// One job. Pointers stay valid until the next sp_kiosk_ui_next_job call.
+typedef struct sp_kiosk_job {
+    sp_kiosk_job_kind kind;
+    bool heavy;                        ///< FIT, REFIT, SAVE: do one per frame
+    bool replace;                      ///< FIT: replace the last part
+    const sp_kiosk_line* stroke;       ///< FIT: the stroke (pixels, with times)
+    char category[SP_KIOSK_LABEL_MAX]; ///< REFIT
+    double t_ms;                       ///< when it was asked for
+} sp_kiosk_job;
+
+/// The answer to a FIT or REFIT job.
+typedef struct sp_kiosk_fit_result {
+    bool ok;                ///< false: rejected (hint shown, stroke fades, nothing else changes)
+    const char* hint;       ///< shown when rejected (NULL: a default)
+    const char* category;   ///< the fitted part's category
+    const char* guesses[2]; ///< next two guesses (NULL or "" when none)
+    int part_count;         ///< parts after the job
+    const float* outline;   ///< outline_count by 2: the fitted abstraction in pixels (flashed in yellow)
+    int outline_count;
+    const int* outline_breaks; ///< indices where a new curve of the outline starts (may be NULL)
+    int outline_break_count;
+    const float* stroke; ///< stroke_count by 2: the stroke that was fitted (REFIT: the part's; NULL: the job's)
+    int stroke_count;
+} sp_kiosk_fit_result;
+
+/// The last part's chips after an undo / clear, or NULL labels when there is no part.
+typedef struct sp_kiosk_part_label {
+    const char* category;
+    const char* guesses[2];
+} sp_kiosk_part_label;
+
+/// The state. Read-only outside ui.c (the renderer and tests read it).
+typedef struct sp_kiosk_ui {
+    sp_kiosk_ui_desc desc; ///< with defaults filled in
+    // Layout (sp_kiosk_ui_resize).
+    int width, height; ///< framebuffer pixels
+    double px_per_mm;
+    sp_kiosk_rect canvas;              ///< where strokes start (the window minus the toolbar)
+    sp_kiosk_rect target[SP_KT_COUNT]; ///< drawn rectangles (w = 0: not shown)
+    sp_kiosk_rect hint_box;            ///< where hints and the save code go
+    float text_px;                     ///< body text height
+    float big_text_px;                 ///< titles, the countdown
+    float line_px;                     ///< stroke width
+    // Time.
+    double now;        ///< t_ms of the last event
+    double last_input; ///< t_ms of the last pointer event (idle timer)
+    double mode_since; ///< when the current mode began
+    sp_kiosk_mode mode;
+    // The finger.
+    enum { SP_KCAP_NONE, SP_KCAP_STROKE, SP_KCAP_TARGET, SP_KCAP_ORBIT, SP_KCAP_ATTRACT, SP_KCAP_SWALLOW } capture;
+    sp_kiosk_target pressed; ///< the target under the finger (drawn pressed)
+    float last_x, last_y;
+    sp_kiosk_line stroke;  ///< the stroke being drawn (blue)
+    double stroke_spacing; ///< current thinning distance, pixels
+    // Finished strokes waiting for FIT jobs (ring).
+    sp_kiosk_line pending[SP_KIOSK_PENDING_MAX];
+    int pending_head, pending_count;
+    int dropped_strokes; ///< strokes dropped because the pipeline fell behind
+    // Jobs (ring).
+    sp_kiosk_job jobs[SP_KIOSK_JOBS_MAX];
+    int job_head, job_count;
+    int dropped_jobs;
+    sp_kiosk_line job_stroke; ///< the stroke of the FIT job last handed out
+    bool fit_in_flight;       ///< a FIT/REFIT handed out and not answered yet
+    sp_kiosk_job_kind inflight_kind;
+    bool inflight_replace;
+    bool refit_queued, save_queued;
+    // Results on screen.
+    sp_kiosk_line flash_stroke, flash_outline; ///< shown until flash_until
+    int flash_breaks[64];
+    int flash_break_count;
+    double flash_until;
+    sp_kiosk_line fade_stroke; ///< a rejected stroke, fading until fade_until
+    double fade_until;
+    char hint[SP_KIOSK_TEXT_MAX];
+    double hint_until;
+    char code[16]; ///< the last save code
+    double banner_until;
+    bool save_failed;
+    // Parts as the caller reported them.
+    int part_count;
+    char chip[3][SP_KIOSK_LABEL_MAX]; ///< label, guess 1, guess 2 ("" = hidden)
+    uint64_t revision;                ///< grows with every change of the dragon
+    uint64_t saved_revision;          ///< revision at the last successful save (0: never)
+    bool redraw_armed;
+    double clear_armed_until;
+    // Animation and view.
+    bool playing;
+    double anim_ms;    ///< animation clock, advances only while playing
+    double yaw, pitch; ///< orbit, radians (0, 0: the drawing view)
+    // Counters (tests, logs).
+    int strokes_finished, taps, activations[SP_KT_COUNT], resets;
+} sp_kiosk_ui;
+
+/// A fresh UI on the attract screen (NULL when out of memory). desc may be NULL.
+sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc);
+void sp_kiosk_ui_destroy(sp_kiosk_ui* ui);
+
+/// Lays the screen out for a width x height framebuffer with px_per_mm pixels
+/// per millimetre (<= 0 or NaN: 96 dpi). Every target's sides are at least
+/// min_target_mm whenever the window is large enough to hold them at all.
+void sp_kiosk_ui_resize(sp_kiosk_ui* ui, int width, int height, double px_per_mm);
+
+/// Feeds one event. Times before ui->now are taken as now. Never fails.
+void sp_kiosk_ui_event(sp_kiosk_ui* ui, const sp_kiosk_event* ev);
+/// The next job in order; false when there is none.
+bool sp_kiosk_ui_next_job(sp_kiosk_ui* ui, sp_kiosk_job* job);
+/// Reports a FIT or REFIT job's result.
+void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r);
+/// Reports the parts after UNDO or CLEAR (label NULL or label->category NULL: no part left).
+void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label);
+/// Reports a SAVE job: ok with the code to show, or a failure (a friendly message is shown).
+void sp_kiosk_ui_saved(sp_kiosk_ui* ui, bool ok, const char* code);
+
+/// The target whose touch area contains (x, y) (slightly larger than its
+/// drawn rectangle), SP_KT_NONE when none. Only visible targets count.
+sp_kiosk_target sp_kiosk_ui_hit(const sp_kiosk_ui* ui, float x, float y);
+/// Whether a target is shown and does something now (e.g. Undo needs a part).
+bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t);
+/// Seconds left on the idle countdown, or 0 when it is not showing.
+double sp_kiosk_ui_countdown_s(const sp_kiosk_ui* ui);
+/// Whether the fitted outline is being flashed (the new part is not drawn yet).
+bool sp_kiosk_ui_flashing(const sp_kiosk_ui* ui);
+/// Opacity 0..1 of the fading rejected stroke.
+double sp_kiosk_ui_fade(const sp_kiosk_ui* ui);
+/// Whether the hint / the save banner is showing.
+bool sp_kiosk_ui_hint_visible(const sp_kiosk_ui* ui);
+bool sp_kiosk_ui_banner_visible(const sp_kiosk_ui* ui);
+/// Whether Start over is armed (its button asks "Sure?").
+bool sp_kiosk_ui_clear_armed(const sp_kiosk_ui* ui);
+
+#endif

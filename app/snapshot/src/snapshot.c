@@ -1,0 +1,96 @@
+#include "sp/snapshot.h"
+
+#include <stdlib.h>
+
+#include "sp/headless.h"
+#include "sp/image.h"
+#include "sp/render.h"
+
+static void draw_sketch(sp_renderer* r, const sp_sketch* s, float width, const float rgba[4])
+{
+    if (!s) return;
+    for (int i = 0; i < s->stroke_count; ++i)
+        if (s->strokes[i].count > 0) sp_renderer_draw_polyline(r, s->strokes[i].points, s->strokes[i].count, false, width, rgba);
+}
+
+sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error* err)
+{
+    const sp_character* ch = d->character;
+    const sp_rig* rig = &ch->rig;
+    sp_camera fitted = *d->camera;
+    const sp_camera* cam = &fitted;
+    sp_headless* gl = sp_headless_create(err);
+    if (!gl) return SP_ERR_UNSUPPORTED;
+    sp_result res = SP_OK;
+    sp_renderer* r = sp_renderer_create(&(sp_renderer_desc){0}, err);
+    sp_render_target* t = r ? sp_render_target_create(cam->width, cam->height, 0, err) : NULL;
+    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    double* xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
+    if (!r || !t) {
+        res = SP_ERR_INTERNAL;
+        goto done;
+    }
+    if (!ev || !xyz) {
+        res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while rendering");
+        goto done;
+    }
+    sp_rig_eval_update(ev, d->params ? d->params : ch->pose, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
+    sp_render_mesh* m = NULL;
+    if (rig->vertex_count > 0) {
+        // A strongly posed mesh may leave the rest pose's depth range.
+        sp_vec3 lo, hi;
+        sp_bounds(xyz, rig->vertex_count, &lo, &hi);
+        sp_render_fit_depth(&fitted, lo, hi);
+    }
+    if (rig->vertex_count > 0 && rig->triangle_count > 0) {
+        m = sp_render_mesh_create(r, &(sp_mesh_desc){.vertex_count = rig->vertex_count, .positions = xyz, .colors = ch->colors,
+                                                     .triangle_count = rig->triangle_count, .triangles = rig->triangles}, err);
+        if (!m) {
+            res = SP_ERR_INTERNAL;
+            goto done;
+        }
+    }
+    sp_render_target_bind(t);
+    sp_renderer_begin(r, cam, cam->width, cam->height);
+    sp_renderer_clear(r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
+    if (m) {
+        sp_vec3 lo, hi;
+        sp_render_mesh_bounds(m, &lo, &hi);
+        sp_renderer_draw_ground_shadow(r, lo, hi, 0);
+        sp_renderer_draw_mesh(r, m, NULL);
+    }
+    float line = (float)fmax(2.0, cam->height / 160.0);
+    draw_sketch(r, d->ghost, line, (const float[4]){0.45f, 0.45f, 0.5f, 0.9f});
+    draw_sketch(r, d->strokes, line * 1.2f, SP_COLOR_STROKE);
+    const sp_abstraction* abs[2] = {d->abstraction >= 0 && d->abstraction < rig->abstraction_count ? &rig->abstractions[d->abstraction] : NULL,
+                                    d->extra_abstraction};
+    for (int k = 0; k < 2; ++k) {
+        const sp_abstraction* a = abs[k];
+        if (!a) continue;
+        double* z = malloc(sizeof(double) * 3 * (size_t)(a->point_count + 1));
+        if (!z) continue;
+        sp_rig_eval_abstraction(ev, a, xyz, z);
+        sp_renderer_draw_abstraction(r, a, z, line, SP_COLOR_ABSTRACTION);
+        free(z);
+    }
+    sp_renderer_end(r);
+    res = sp_render_target_read(t, img, err);
+    sp_render_mesh_destroy(m);
+done:
+    free(xyz);
+    sp_rig_eval_destroy(ev);
+    sp_render_target_destroy(t);
+    sp_renderer_destroy(r);
+    sp_headless_destroy(gl);
+    return res;
+}
+
+sp_result sp_snapshot_png(const sp_snapshot_desc* d, const char* path, sp_error* err)
+{
+    sp_image img = {0};
+    sp_result r = sp_snapshot_render(d, &img, err);
+    if (r == SP_OK) r = sp_image_write_png(&img, path, err);
+    sp_image_free(&img);
+    return r;
+}
