@@ -772,7 +772,9 @@ static int db_review(int argc, char** argv)
         char(*notes)[96] = calloc((size_t)(n > 0 ? n : 1), sizeof *notes);
         for (int i = 0; items && labels && notes && i < n; ++i) {
             snprintf(labels[i], sizeof labels[i], "%lld %s", (long long)ks[i].id, ks[i].category);
-            snprintf(notes[i], sizeof notes[i], "%s %.16s", sp_db_status_name(ks[i].status), ks[i].created_at);
+            // "pending 12-02 04:44": month, day and time of the UTC created_at, to fit the cell.
+            const char* at = strlen(ks[i].created_at) >= 16 ? ks[i].created_at : "0000-00-00T00:00";
+            snprintf(notes[i], sizeof notes[i], "%s %.5s %.5s", sp_db_status_name(ks[i].status), at + 5, at + 11);
             items[i] = (sp_sheet_item){.sketch = &ks[i].sketch, .label = labels[i], .note = notes[i]};
         }
         char title[160];
@@ -780,7 +782,7 @@ static int db_review(int argc, char** argv)
         if (!items || !labels || !notes)
             code = fail(cmd, &(sp_error){.text = "out of memory"});
         else if (n == 0)
-            code = fail(cmd, &(sp_error){.text = "no kiosk sketches to draw"});
+            fprintf(stderr, "%s: no kiosk sketches listed (--status %s): no sheet written\n", cmd, status);
         else if (sp_sheet_write_png(items, n, &(sp_sheet_desc){.title = title}, sheet, &err) != SP_OK)
             code = fail(cmd, &err);
         free(items);

@@ -13,7 +13,6 @@
 #include "sp/outline.h"
 #include "sp/synth.h"
 
-#define PI 3.14159265358979323846
 // Points of a traced silhouette (the abstractions have 150).
 #define SIL_POINTS 200
 
@@ -105,7 +104,7 @@ static bool piece_vertices(const sp_rig* rig, uint64_t seed, unsigned char* keep
     sp_rng rng = {seed ^ 0x2545F4914F6CDD1Dull};
     int pick = cand[(int)(sp_rng_uniform(&rng) * nc)];
     for (int v = 0; v < V; ++v) {
-        int j = strongest[v];
+        int j = strongest[v] < J ? strongest[v] : -1;
         while (j >= 0 && j != pick)
             j = rig->joints[j].parent;
         keep[v] = j == pick;
@@ -284,7 +283,7 @@ static sp_result add_spikes(sp_sketch* sk, sp_rng* rng)
     int start = closed ? (int)(sp_rng_uniform(rng) * M) : (int)(sp_rng_uniform(rng) * (M - run - 1));
     int teeth = 3 + (int)(sp_rng_uniform(rng) * 6);
     double height = sp_rng_range(rng, 0.025, 0.07) * L / (closed ? 2.5 : 1.5);
-    sp_vec2* outp = malloc(sizeof(sp_vec2) * (M + 2 * 16 + 2));
+    sp_vec2* outp = malloc(sizeof(sp_vec2) * (M + 1)); // at most one point per sample, and the closing one
     if (!outp) return SP_ERR_NO_MEMORY;
     int k = 0;
     for (int i = 0; i < M; ++i) {
