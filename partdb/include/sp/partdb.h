@@ -50,8 +50,10 @@ extern "C" {
 /// Default busy timeout: how long a writer waits for another writer.
 #define SP_DB_BUSY_MS_DEFAULT 5000
 /// Synthetic sketches stored with a part by default (per part: random shape and
-/// pose, drawn by the hand-drawing model of sp/handdraw.h, normal style).
-/// Why not 300 (the dragon bench's recipe): see docs/DESIGN.md (cost 4.5x, no bar gained in full).
+/// pose, the shapes of the default recipe, drawn by the hand-drawing model of
+/// sp/handdraw.h; docs/DESIGN.md "Part database training data"). Why not 300:
+/// see docs/DESIGN.md (cost 4.5x, no bar gained in full; 120 and 200 gained
+/// nothing on the visitors' drawings either).
 #define SP_DB_SYNTH_DEFAULT 60
 
 typedef struct sp_db sp_db;
@@ -110,7 +112,7 @@ typedef struct sp_db_part_desc {
     const char* added_by;    ///< NULL: $USER, else "unknown"
     int synth_sketches;      ///< synthetic sketches stored with it; 0: SP_DB_SYNTH_DEFAULT; -1: none
     uint64_t seed;           ///< seed family of the synthetic sketches (0: one of the part's own, from its name; sp/handdraw.h)
-    double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: 0.4; see sp/synth.h)
+    double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: the recipe's, 0.4 and the whole bounds by turns; see sp/synth.h)
     int selftest_seeds;      ///< solver self-test seeds; 0: 3; -1: skip the self-test
     double selftest_tolerance; ///< largest mean error over the seeds, fraction of the 2D diagonal; 0: 0.02
 } sp_db_part_desc;
