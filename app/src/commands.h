@@ -5,19 +5,20 @@
 #ifndef SP_COMMANDS_H
 #define SP_COMMANDS_H
 
-#define SP_COMMANDS(X)                                                                  \
-    X(inspect, "print a rig's joints, parameters, abstractions and warnings as JSON")   \
-    X(render, "render a rig (posed) with an abstraction overlaid to PNG")              \
-    X(export, "write a rig posed by a pose file as .glb")                         \
-    X(train, "train a sketch classifier on a labelled folder")                          \
-    X(eval, "classifier accuracy (top-1/top-3, recall, confusion), cross-validation")   \
-    X(classify, "classify one drawing with a trained model; ranked JSON")              \
-    X(synth, "strokes of a random pose within bounds (tests, training)")               \
-    X(pose, "redraw posing: fit the rig to strokes; posed .glb, PNG, report")         \
-    X(drawover, "draw-over posing: curves drawn over the character, then redrawn")     \
-    X(animate, "key poses from stroke files, solved in sequence, as one glTF animation") \
-    X(demo, "headless demo: strokes of a pose in, a render and a posed .glb out")          \
-    X(dragon, "the kiosk pipeline without a window: one part per stroke; animated .glb, PNG, report") \
+#define SP_COMMANDS(X)                                                                                                           \
+    X(inspect, "print a rig's joints, parameters, abstractions and warnings as JSON")                                            \
+    X(render, "render a rig (posed) with an abstraction overlaid to PNG")                                                        \
+    X(export, "write a rig posed by a pose file as .glb")                                                                        \
+    X(train, "train a sketch classifier on a labelled folder")                                                                   \
+    X(eval, "classifier accuracy (top-1/top-3, recall, confusion), cross-validation")                                            \
+    X(classify, "classify one drawing with a trained model; ranked JSON")                                                        \
+    X(synth, "strokes of a random pose within bounds (tests, training)")                                                         \
+    X(pose, "redraw posing: fit the rig to strokes; posed .glb, PNG, report")                                                    \
+    X(drawover, "draw-over posing: curves drawn over the character, then redrawn")                                               \
+    X(animate, "key poses from stroke files, solved in sequence, as one glTF animation")                                         \
+    X(demo, "headless demo: strokes of a pose in, a render and a posed .glb out")                                                \
+    X(dragon, "the kiosk pipeline without a window: one part per stroke; animated .glb, PNG, report")                            \
+    X(derive, "a kiosk part (outline, parameters, attachment, clip) from any rigged glTF; .glb, preview PNG")                    \
     X(db, "the curators' part database: init, add-part, add-sketch, list, show, remove, check, train, export")
 
 #define SP_DECLARE_CMD(name, help) int cmd_##name(int argc, char** argv);

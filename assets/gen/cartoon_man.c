@@ -21,7 +21,6 @@
 
 #include "characters.h"
 #include "gen_mesh.h"
-#include "gen_outline.h"
 #include "gen_rig.h"
 #include "gen_stick.h"
 
@@ -714,29 +713,20 @@ static sp_abstraction build_stick(const man* w)
     return st;
 }
 
-// The outline: the front silhouette (gen_outline), 353 points as in the
+// The outline: the front silhouette (sp_outline_trace), 353 points as in the
 // paper (706 coordinates), each bound to the surface under it. Its depths
-// are then smoothed along the curve: a limb's silhouette runs between the
-// rings of a coarse tube, so the nearest vertex alternates between the front
-// and the back of the limb, and a limb swinging or twisting out of the
-// picture would move neighbouring points apart (a zigzag outline).
+// are then smoothed along the curve (8 passes): a limb's silhouette runs
+// between the rings of a coarse tube, so the nearest vertex alternates
+// between the front and the back of the limb, and a limb swinging or
+// twisting out of the picture would move neighbouring points apart (a zigzag
+// outline).
 static sp_result build_outline(const sp_gen_mesh* m, sp_abstraction* out, sp_error* err)
 {
     sp_vec3 lo, hi;
     sp_bounds(m->pos, m->vertex_count, &lo, &hi);
     sp_camera cam = sp_gen_side_camera(lo, hi, 1.35); // what sp_gen_save frames
-    char why[256];
-    if (!sp_gen_outline(m, &cam, 353, out, why, sizeof why)) return sp_fail(err, SP_ERR_INVALID, "cartoon_man: %s", why);
-    int n = out->point_count;
-    double* z = sp_gen_check_alloc(malloc(sizeof(double) * (size_t)n));
-    for (int pass = 0; pass < 8; ++pass) {
-        for (int i = 0; i < n; ++i)
-            z[i] = 0.25 * out->rest[3 * ((i + n - 1) % n) + 2] + 0.5 * out->rest[3 * i + 2] +
-                   0.25 * out->rest[3 * ((i + 1) % n) + 2];
-        for (int i = 0; i < n; ++i)
-            out->rest[3 * i + 2] = z[i];
-    }
-    free(z);
+    sp_error e = {0};
+    if (sp_gen_outline(m, &cam, 353, 8, out, &e) != SP_OK) return sp_fail(err, SP_ERR_INVALID, "cartoon_man: %s", e.text);
     return SP_OK;
 }
 

@@ -79,24 +79,6 @@ void sp_gen_mesh_shear_z(sp_gen_mesh* m, int first_vertex, double k, double z_of
 
 // ---- skin ----------------------------------------------------------------
 
-void sp_gen_skin_add(sp_gen_skin* s, int joint, double w)
-{
-    if (!(w > 0.0)) return;
-    for (int i = 0; i < s->n; ++i)
-        if (s->joint[i] == joint) {
-            s->w[i] += w;
-            return;
-        }
-    if (s->n < SP_GEN_SKIN_MAX) {
-        s->joint[s->n] = joint, s->w[s->n] = w, ++s->n;
-        return;
-    }
-    int weakest = 0;
-    for (int i = 1; i < s->n; ++i)
-        if (s->w[i] < s->w[weakest]) weakest = i;
-    if (w > s->w[weakest]) s->joint[weakest] = joint, s->w[weakest] = w;
-}
-
 sp_gen_skin sp_gen_skin_lerp(const sp_gen_skin* a, const sp_gen_skin* b, double t)
 {
     sp_gen_skin r = {0};
@@ -105,39 +87,6 @@ sp_gen_skin sp_gen_skin_lerp(const sp_gen_skin* a, const sp_gen_skin* b, double 
     for (int i = 0; i < b->n; ++i)
         sp_gen_skin_add(&r, b->joint[i], t * b->w[i]);
     return r;
-}
-
-void sp_gen_skin_pack(const sp_gen_skin* s, uint16_t joints[4], float weights[4])
-{
-    int idx[SP_GEN_SKIN_MAX];
-    int n = s->n;
-    for (int i = 0; i < n; ++i)
-        idx[i] = i;
-    // Insertion sort: strongest first, lower joint first on ties.
-    for (int i = 1; i < n; ++i) {
-        int v = idx[i], k = i;
-        while (k > 0) {
-            int u = idx[k - 1];
-            bool before = s->w[v] > s->w[u] || (s->w[v] == s->w[u] && s->joint[v] < s->joint[u]);
-            if (!before) break;
-            idx[k] = u, --k;
-        }
-        idx[k] = v;
-    }
-    double sum = 0.0;
-    int keep = n < 4 ? n : 4;
-    for (int i = 0; i < keep; ++i)
-        sum += s->w[idx[i]];
-    for (int i = 0; i < 4; ++i)
-        joints[i] = 0, weights[i] = 0.0f;
-    if (!(sum > 0.0)) {
-        weights[0] = 1.0f;
-        return;
-    }
-    for (int i = 0; i < keep; ++i) {
-        joints[i] = (uint16_t)s->joint[idx[i]];
-        weights[i] = (float)(s->w[idx[i]] / sum);
-    }
 }
 
 // ---- scalar helpers ------------------------------------------------------

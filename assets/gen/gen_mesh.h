@@ -28,8 +28,9 @@
 #include <stdint.h>
 
 #include "sp/math.h"
+#include "sp/outline.h"
 
-enum { SP_GEN_SKIN_MAX = 8 };
+enum { SP_GEN_SKIN_MAX = SP_OUTLINE_INFLUENCES_MAX };
 
 /// A colour, sRGB-encoded components in [0, 1] (converted to linear on save).
 typedef struct sp_gen_rgb {
@@ -37,12 +38,9 @@ typedef struct sp_gen_rgb {
 } sp_gen_rgb;
 
 /// Skin weights while building: up to 8 (joint, weight) pairs; packing
-/// keeps the 4 strongest and renormalises.
-typedef struct sp_gen_skin {
-    int n;
-    int joint[SP_GEN_SKIN_MAX];
-    double w[SP_GEN_SKIN_MAX];
-} sp_gen_skin;
+/// keeps the 4 strongest and renormalises (partdb's sp_skin8, which the
+/// outline tracer smooths with).
+typedef sp_skin8 sp_gen_skin;
 
 /// A growing triangle mesh with per-vertex colour and skin.
 typedef struct sp_gen_mesh {
@@ -78,12 +76,18 @@ static inline sp_gen_skin sp_gen_skin_one(int joint)
     return (sp_gen_skin){1, {joint}, {1.0}};
 }
 /// Adds w to joint's weight (merging), dropping the weakest entry when full.
-void sp_gen_skin_add(sp_gen_skin* s, int joint, double w);
+static inline void sp_gen_skin_add(sp_gen_skin* s, int joint, double w)
+{
+    sp_skin8_add(s, joint, w);
+}
 /// (1 - t) a + t b.
 sp_gen_skin sp_gen_skin_lerp(const sp_gen_skin* a, const sp_gen_skin* b, double t);
 /// The 4 strongest influences, renormalised to sum 1 (ties: lower joint
 /// first, for determinism); unused slots are joint 0, weight 0.
-void sp_gen_skin_pack(const sp_gen_skin* s, uint16_t joints[4], float weights[4]);
+static inline void sp_gen_skin_pack(const sp_gen_skin* s, uint16_t joints[4], float weights[4])
+{
+    sp_skin8_pack(s, joints, weights);
+}
 
 // ---- scalar helpers ------------------------------------------------------
 

@@ -6,7 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gen_outline.h"
+#include "sp/derive.h"
+#include "sp/outline.h"
 
 void sp_gen_rig_init(sp_gen_rig* g)
 {
@@ -129,8 +130,35 @@ void sp_gen_clip_translate(sp_gen_rig* g, int joint, const sp_vec3* offsets)
 
 sp_camera sp_gen_side_camera(sp_vec3 lo, sp_vec3 hi, double margin)
 {
-    sp_vec3 c = sp_v3_scale(sp_v3_add(lo, hi), 0.5), h = sp_v3_scale(sp_v3_sub(hi, lo), 0.5 * margin);
-    return sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, sp_v3_sub(c, h), sp_v3_add(c, h), sp_v3(0, 0, -1), sp_v3(0, 1, 0), 640, 480);
+    return sp_part_side_camera(lo, hi, margin);
+}
+
+sp_result sp_gen_outline(const sp_gen_mesh* mesh, const sp_camera* cam, int points, int depth_passes, sp_abstraction* out,
+                         sp_error* err)
+{
+    size_t nv = (size_t)mesh->vertex_count;
+    uint16_t* joints = sp_gen_check_alloc(calloc(SP_GEN_SKIN_MAX * nv + 1, sizeof(uint16_t)));
+    double* weights = sp_gen_check_alloc(calloc(SP_GEN_SKIN_MAX * nv + 1, sizeof(double)));
+    for (size_t i = 0; i < nv; ++i)
+        for (int k = 0; k < mesh->skin[i].n; ++k) {
+            joints[SP_GEN_SKIN_MAX * i + (size_t)k] = (uint16_t)mesh->skin[i].joint[k];
+            weights[SP_GEN_SKIN_MAX * i + (size_t)k] = mesh->skin[i].w[k];
+        }
+    sp_outline_desc d = {.vertex_count = mesh->vertex_count,
+                         .positions = mesh->pos,
+                         .influences = SP_GEN_SKIN_MAX,
+                         .joints = joints,
+                         .weights = weights,
+                         .triangle_count = mesh->tri_count,
+                         .triangles = mesh->tris,
+                         .skip_vertex = mesh->deco_vertex,
+                         .skip_triangle = mesh->deco_tri,
+                         .camera = cam,
+                         .points = points,
+                         .depth_passes = depth_passes};
+    sp_result r = sp_outline_trace(&d, out, NULL, err);
+    free(joints), free(weights);
+    return r;
 }
 
 // sRGB to linear (the glTF COLOR_0 convention).
@@ -173,9 +201,9 @@ sp_result sp_gen_save(sp_gen_rig* g, const sp_gen_mesh* mesh, const sp_gen_save_
     }
     if (!d->no_outline) {
         sp_abstraction ab;
-        char why[256];
-        if (!sp_gen_outline(mesh, &cam, d->outline_points > 0 ? d->outline_points : 150, &ab, why, sizeof why))
-            return sp_fail(err, SP_ERR_INVALID, "%s: %s", what, why);
+        sp_error e = {0};
+        if (sp_gen_outline(mesh, &cam, d->outline_points > 0 ? d->outline_points : 150, 0, &ab, &e) != SP_OK)
+            return sp_fail(err, SP_ERR_INVALID, "%s: %s", what, e.text);
         r->abstractions[r->abstraction_count++] = ab;
     }
 

@@ -78,7 +78,14 @@ typedef struct sp_gen_save_desc {
 sp_result sp_gen_save(sp_gen_rig* g, const sp_gen_mesh* mesh, const sp_gen_save_desc* d, const char* path, sp_error* err);
 
 /// The side view used for every part: orthographic, looking along -Z, +Y up,
-/// framing the box [lo, hi] grown by `margin`, on 640x480.
+/// framing the box [lo, hi] grown by `margin`, on 640x480 (sp_part_side_camera).
 sp_camera sp_gen_side_camera(sp_vec3 lo, sp_vec3 hi, double margin);
+
+/// The outline abstraction of the mesh without its decorations, traced in the
+/// view `cam` by partdb's sp_outline_trace (sp/outline.h) with `points`
+/// points and `depth_passes` passes of depth smoothing. Its points are bind
+/// space: the generator's rest space.
+sp_result sp_gen_outline(const sp_gen_mesh* mesh, const sp_camera* cam, int points, int depth_passes, sp_abstraction* out,
+                         sp_error* err);
 
 #endif

@@ -82,6 +82,48 @@ sp_result sp_character_from_rig(sp_rig* rig, sp_character* out, sp_error* err)
     return SP_OK;
 }
 
+// ---- transforms ---------------------------------------------------------
+
+// Column-major 3x3, orthonormal.
+static sp_quat quat_from_rotation(const double m[9])
+{
+    double m00 = m[0], m11 = m[4], m22 = m[8];
+    double tr = m00 + m11 + m22;
+    sp_quat q;
+    if (tr > 0) {
+        double s = sqrt(tr + 1.0) * 2;
+        q = (sp_quat){(m[5] - m[7]) / s, (m[6] - m[2]) / s, (m[1] - m[3]) / s, 0.25 * s};
+    } else if (m00 > m11 && m00 > m22) {
+        double s = sqrt(1.0 + m00 - m11 - m22) * 2;
+        q = (sp_quat){0.25 * s, (m[3] + m[1]) / s, (m[6] + m[2]) / s, (m[5] - m[7]) / s};
+    } else if (m11 > m22) {
+        double s = sqrt(1.0 + m11 - m00 - m22) * 2;
+        q = (sp_quat){(m[3] + m[1]) / s, 0.25 * s, (m[7] + m[5]) / s, (m[6] - m[2]) / s};
+    } else {
+        double s = sqrt(1.0 + m22 - m00 - m11) * 2;
+        q = (sp_quat){(m[6] + m[2]) / s, (m[7] + m[5]) / s, 0.25 * s, (m[1] - m[3]) / s};
+    }
+    return sp_quat_norm(q);
+}
+
+void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s)
+{
+    *t = sp_mat4_translation(a);
+    sp_vec3 c[3];
+    for (int k = 0; k < 3; ++k)
+        c[k] = sp_v3(a->m[4 * k], a->m[4 * k + 1], a->m[4 * k + 2]);
+    double sx = sp_v3_len(c[0]), sy = sp_v3_len(c[1]), sz = sp_v3_len(c[2]);
+    if (sp_v3_dot(sp_v3_cross(c[0], c[1]), c[2]) < 0) sx = -sx;
+    *s = sp_v3(sx, sy, sz);
+    double m[9];
+    double sc[3] = {sx, sy, sz};
+    for (int k = 0; k < 3; ++k) {
+        double inv = sc[k] != 0 ? 1.0 / sc[k] : 0.0;
+        m[3 * k] = c[k].x * inv, m[3 * k + 1] = c[k].y * inv, m[3 * k + 2] = c[k].z * inv;
+    }
+    *r = quat_from_rotation(m);
+}
+
 // ---- extras -------------------------------------------------------------
 
 static bool json_number(const cJSON* o, const char* key, double* v)

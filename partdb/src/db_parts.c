@@ -10,10 +10,9 @@
 #include "sp/solver.h"
 #include "sp/synth.h"
 
-// Rotation amplitude of the self-test poses and of synthetic training
-// sketches (radians): visibly posed, yet within reach of a rest-pose start.
+// Rotation amplitude of the self-test poses (radians): visibly posed, yet
+// within reach of a rest-pose start.
 #define SELFTEST_AMPLITUDE 0.5
-#define SYNTH_AMPLITUDE 0.4
 
 static void add_reason(char* buf, size_t cap, const char* fmt, ...)
 #if defined(__GNUC__)
@@ -60,20 +59,6 @@ static int pick_abstraction(const sp_character* ch, const sp_db_part_desc* d)
     const char* want = d && d->abstraction ? d->abstraction : part_extra(ch, "abstraction", buf, sizeof buf);
     if (want) return sp_rig_find_abstraction(&ch->rig, want);
     return ch->rig.abstraction_count > 0 ? 0 : -1;
-}
-
-sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out, sp_error* err)
-{
-    memset(out, 0, sizeof *out);
-    if (sp_dataset_add_category(out, "part") < 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-    // Random shape and pose within bounds, drawn as by a careful visitor
-    // (sp/handdraw.h); one in four exactly, which anchors small training sets
-    // on the part's shape (a stick-figure category added by a curator is
-    // recognised from 60 sketches about as well as from clean ones).
-    sp_handdraw_desc hd = {.style = SP_HANDDRAW_NORMAL, .amplitude = amplitude > 0 ? amplitude : SYNTH_AMPLITUDE, .clean_share = 0.25};
-    sp_result r = sp_handdraw_dataset(&ch->rig, abstraction, &ch->camera, &hd, seed, n, 0, 0, out, err);
-    if (r != SP_OK) sp_dataset_free(out);
-    return r;
 }
 
 // The solver fits the part's own synthetic sketches from the rest pose.
@@ -229,7 +214,51 @@ static char* summary_json(const sp_rig* rig)
     return b.s;
 }
 
+// A part without sketch abstractions of its own, derived (sp/derive.h) and
+// encoded as GLB (*glb malloc'd); *glb stays NULL when ch has its own.
+static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, const char* what, void** glb, size_t* size,
+                             unsigned* derived, sp_error* err)
+{
+    *glb = NULL;
+    *derived = 0;
+    if (!sp_part_needs_derivation(ch)) return SP_OK;
+    sp_character part = {0};
+    sp_derive_info info;
+    sp_error e = {0};
+    sp_derive_desc dd = {
+        .category = d->category, .abstraction = d->abstraction, .attach_joint = d->attach_joint, .view = d->view};
+    sp_result r = sp_part_derive(ch, &dd, &part, &info, &e);
+    if (r != SP_OK) return sp_fail(err, r, "%s: refused: %s", what, e.text);
+    r = sp_gltf_save_memory(&part, NULL, glb, size, err);
+    sp_character_free(&part);
+    if (r == SP_OK) *derived = info.derived;
+    return r;
+}
+
+static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, unsigned derived,
+                          sp_db_part_info* info_out, sp_error* err);
+
 sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info_out, sp_error* err)
+{
+    sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
+    const char* what = d.name ? d.name : "part";
+    sp_character ch = {0};
+    sp_result r = sp_gltf_load_memory(glb, size, what, &ch, err);
+    if (r != SP_OK) return r;
+    void* derived_glb = NULL;
+    size_t derived_size = 0;
+    unsigned derived = 0;
+    r = derive_part(&ch, &d, what, &derived_glb, &derived_size, &derived, err);
+    sp_character_free(&ch);
+    if (r == SP_OK)
+        r = derived_glb ? add_part(db, derived_glb, derived_size, &d, derived, info_out, err)
+                        : add_part(db, glb, size, &d, 0, info_out, err);
+    free(derived_glb);
+    return r;
+}
+
+static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, unsigned derived,
+                          sp_db_part_info* info_out, sp_error* err)
 {
     sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
     if (!d.name || !db_name_ok(d.name))
@@ -309,6 +338,7 @@ done:
         sp_error e2 = {0};
         if (sp_db_part(db, info.name, info_out, &e2) != SP_OK) copy_name(info_out->added_by, sizeof info_out->added_by, by);
         info_out->selftest_error = info.selftest_error;
+        info_out->derived = derived;
     }
     return r;
 }
@@ -320,15 +350,23 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
     sp_character ch = {0};
     sp_result r = sp_gltf_load(path, &ch, err);
     if (r != SP_OK) return r;
+    sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
     void* bytes = NULL;
     size_t size = 0;
-    if ((r = db_read_file(path, &bytes, &size, err)) != SP_OK) {
+    unsigned derived = 0;
+    // Derived from what the path loads (a .gltf's external buffers, a missing
+    // texture only a warning), before any re-encoding would add our extras.
+    if ((r = derive_part(&ch, &d, path, &bytes, &size, &derived, err)) != SP_OK) {
         sp_character_free(&ch);
         return r;
     }
     sp_character probe = {0};
     sp_error e2 = {0};
-    if (sp_gltf_load_memory(bytes, size, path, &probe, &e2) == SP_OK) {
+    if (!bytes && (r = db_read_file(path, &bytes, &size, err)) != SP_OK) {
+        sp_character_free(&ch);
+        return r;
+    }
+    if (derived || sp_gltf_load_memory(bytes, size, path, &probe, &e2) == SP_OK) {
         sp_character_free(&probe);
     } else {
         // Not self-contained (external .bin): store it re-encoded as one GLB.
@@ -340,7 +378,6 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
         }
     }
     sp_character_free(&ch);
-    sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
     char name[SP_NAME_MAX];
     if (!d.name) {
         const char* base = strrchr(path, '/');
@@ -350,7 +387,7 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
         if (dot && dot != name) *dot = 0;
         d.name = name;
     }
-    r = sp_db_add_part(db, bytes, size, &d, info, err);
+    r = add_part(db, bytes, size, &d, derived, info, err);
     free(bytes);
     return r;
 }

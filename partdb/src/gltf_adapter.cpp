@@ -257,44 +257,10 @@ struct Trs {
     sp_vec3 s{1, 1, 1};
 };
 
-sp_quat quat_from_rotation(const double m[9]) // column-major 3x3, orthonormal
-{
-    double m00 = m[0], m11 = m[4], m22 = m[8];
-    double tr = m00 + m11 + m22;
-    sp_quat q;
-    if (tr > 0) {
-        double s = std::sqrt(tr + 1.0) * 2;
-        q = {(m[5] - m[7]) / s, (m[6] - m[2]) / s, (m[1] - m[3]) / s, 0.25 * s};
-    } else if (m00 > m11 && m00 > m22) {
-        double s = std::sqrt(1.0 + m00 - m11 - m22) * 2;
-        q = {0.25 * s, (m[3] + m[1]) / s, (m[6] + m[2]) / s, (m[5] - m[7]) / s};
-    } else if (m11 > m22) {
-        double s = std::sqrt(1.0 + m11 - m00 - m22) * 2;
-        q = {(m[3] + m[1]) / s, 0.25 * s, (m[7] + m[5]) / s, (m[6] - m[2]) / s};
-    } else {
-        double s = std::sqrt(1.0 + m22 - m00 - m11) * 2;
-        q = {(m[6] + m[2]) / s, (m[7] + m[5]) / s, 0.25 * s, (m[1] - m[3]) / s};
-    }
-    return sp_quat_norm(q);
-}
-
 Trs decompose(const sp_mat4& a)
 {
     Trs r;
-    r.t = sp_mat4_translation(&a);
-    sp_vec3 c[3];
-    for (int k = 0; k < 3; ++k)
-        c[k] = sp_v3(a.m[4 * k], a.m[4 * k + 1], a.m[4 * k + 2]);
-    double sx = sp_v3_len(c[0]), sy = sp_v3_len(c[1]), sz = sp_v3_len(c[2]);
-    if (sp_v3_dot(sp_v3_cross(c[0], c[1]), c[2]) < 0) sx = -sx;
-    r.s = sp_v3(sx, sy, sz);
-    double m[9];
-    double sc[3] = {sx, sy, sz};
-    for (int k = 0; k < 3; ++k) {
-        double inv = sc[k] != 0 ? 1.0 / sc[k] : 0.0;
-        m[3 * k] = c[k].x * inv, m[3 * k + 1] = c[k].y * inv, m[3 * k + 2] = c[k].z * inv;
-    }
-    r.r = quat_from_rotation(m);
+    sp_gltf_decompose(&a, &r.t, &r.r, &r.s);
     return r;
 }
 
@@ -566,6 +532,7 @@ struct Importer {
 
         // The character's skin: the first skinned mesh node that is not a curve.
         int skin = -1;
+        std::vector<int> mesh_skins;
         for (int n : order) {
             const tinygltf::Node& nd = m.nodes[(size_t)n];
             if (nd.mesh < 0 || nd.skin < 0) continue;
@@ -574,9 +541,10 @@ struct Importer {
             if ((size_t)nd.skin >= m.skins.size())
                 fail(SP_ERR_INVALID, "%s: node %d refers to skin %d, but there are %zu", what, n, nd.skin, m.skins.size());
             if (tag_of(nd.extras_json_string).is_curve) continue;
-            skin = nd.skin;
-            break;
+            if (skin < 0) skin = nd.skin;
+            if (std::find(mesh_skins.begin(), mesh_skins.end(), nd.skin) == mesh_skins.end()) mesh_skins.push_back(nd.skin);
         }
+        ch->mesh_skins = (int)mesh_skins.size();
         if (skin < 0) fail(SP_ERR_UNSUPPORTED, "%s: no skinned mesh (a node with a mesh and a skin) in the scene", what);
         const tinygltf::Skin& sk = m.skins[(size_t)skin];
         if (sk.joints.empty()) fail(SP_ERR_INVALID, "%s: skin %d has no joints", what, skin);

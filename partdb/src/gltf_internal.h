@@ -66,6 +66,10 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err);
 /// default camera.
 sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err);
 
+/// Splits an affine matrix into translation, rotation and scale (a negative
+/// determinant goes into the x scale; shear is lost), as glTF nodes hold it.
+void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s);
+
 /// Reads a pose object {"<joint>.<channel>": value, ...} (JSON text) into p;
 /// unknown names and non-numbers become warnings on ch; values are clamped.
 void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, double* p);

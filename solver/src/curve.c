@@ -259,8 +259,7 @@ static void sort_x_index(x_index* a, int n)
 // curves of a few hundred samples (the scan was a tenth of a dragon part's
 // solve). Each search starts from the previous query's answer and sorted
 // position: consecutive queries are neighbours along a curve, so the bound is
-// tight from the start and no binary search is needed (the tail's search:
-// 8.8 -> 5.4% of its wall time, about as many instructions; the cost had been
+// tight from the start and no binary search is needed (the cost had been
 // unpredictable branches). Still exact: a point that beats or ties the start
 // lies within the start's distance, so inside the swept band.
 static void closest_brute(const sp_vec2* q, int nq, const sp_vec2* d, int nd, int* idx)

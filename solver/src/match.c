@@ -9,8 +9,6 @@
 #include "solver_internal.h"
 #include "sp/curve.h"
 
-sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err);
-
 // Arc-length resampling of curve c of the projected abstraction, as
 // references to its points (so that samples stay linear in the rig's points).
 // Unit normal of a resampled stroke at sample k (central difference within
@@ -203,8 +201,8 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
     return true;
 }
 
-// The loop's best shifts at the current projection, for sp_solver_solve's
-// second hypotheses (declared there).
+// The loop's best shifts at the current projection, for the further
+// attempts of sp_solver_solve (icp.c).
 int sp__loop_candidates(sp_solver* s, const sp_sketch* sk, sp_ordered_info* out, int k, int* m)
 {
     const sp_curve* cv = &s->ab->curves[0];
@@ -264,94 +262,122 @@ static sp_result resample_strokes(sp_solver* s, const sp_sketch* sk, int msum, s
     return res;
 }
 
-sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* rep, sp_error* err)
+// The curves' sample counts (samples_for) over the whole abstraction: their
+// total and the largest.
+static void sample_counts(const sp_solver* s, double total_len, int* msum, int* mmax)
+{
+    *mmax = 1, *msum = 0;
+    for (int c = 0; c < s->ab->curve_count; ++c) {
+        int m = samples_for(s, &s->ab->curves[c], total_len);
+        *mmax = m > *mmax ? m : *mmax;
+        *msum += m;
+    }
+}
+
+// Which stroke each curve gets (c2s, curve -> stroke or -1): the last
+// assignment when `keep` asks for it, else by topology when that applies,
+// else by shape (sp_assign_strokes). Sets rep->unused_strokes.
+static sp_result assign_curves(sp_solver* s, const sp_sketch* sk, const sp_polyline* lines, bool keep, int* c2s,
+                               sp_solve_report* rep, sp_error* err)
+{
+    const int C = s->ab->curve_count;
+    rep->unused_strokes = 0;
+    if (keep && s->c2s_valid) {
+        memcpy(c2s, s->c2s, sizeof(int) * (size_t)C);
+        for (int c = 0; c < C; ++c)
+            rep->unused_strokes -= c2s[c] >= 0;
+        rep->unused_strokes += sk->stroke_count;
+    } else if (!assign_by_topology(s, sk, lines, C, c2s)) {
+        sp_stroke_match* sm = malloc(sizeof(sp_stroke_match) * (size_t)sk->stroke_count);
+        if (!sm) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+        sp_result res =
+            sp_assign_strokes(sk->strokes, sk->stroke_count, lines, C, &(sp_assign_desc){.samples = 64}, sm, c2s, err);
+        for (int i = 0; res == SP_OK && i < sk->stroke_count; ++i)
+            rep->unused_strokes += sm[i].curve < 0;
+        free(sm);
+        if (res != SP_OK) return res;
+    }
+    if (C <= SP_REPORT_CURVES) {
+        memcpy(s->c2s, c2s, sizeof(int) * (size_t)C);
+        s->c2s_valid = true;
+    }
+    return SP_OK;
+}
+
+// Ordered pairs: strokes assigned to curves, each pair of stroke and curve
+// resampled to the curve's count and paired in order (direction detected,
+// best cyclic shift for closed curves, or how->loop_shift held).
+static sp_result ordered_pairs(sp_solver* s, const sp_sketch* sk, const sp_pairing* how, double total_len, sp_solve_report* rep,
+                               sp_error* err)
 {
     const sp_abstraction* ab = s->ab;
     const int C = ab->curve_count;
-    s->pair_count = 0;
-    rep->curve_count = C < SP_REPORT_CURVES ? C : SP_REPORT_CURVES;
-    for (int c = 0; c < rep->curve_count; ++c) rep->curves[c] = (sp_curve_report){c, -1, false, 0, 0};
-    double total_len = 0;
-    for (int c = 0; c < C; ++c) total_len += curve_length2d(s, &ab->curves[c]);
-    int mmax = 1, msum = 0;
-    for (int c = 0; c < C; ++c) {
-        int m = samples_for(s, &ab->curves[c], total_len);
-        mmax = m > mmax ? m : mmax;
-        msum += m;
-    }
+    int mmax, msum;
+    sample_counts(s, total_len, &msum, &mmax);
+    sp_polyline* lines = malloc(sizeof(sp_polyline) * (size_t)C);
+    sp_vec2* pts = malloc(sizeof(sp_vec2) * (size_t)ab->point_count);
+    int* c2s = malloc(sizeof(int) * (size_t)C);
+    sp_vec2* y = malloc(sizeof(sp_vec2) * (size_t)mmax);
+    sp_vec2* z = malloc(sizeof(sp_vec2) * (size_t)mmax);
+    sample_ref* refs = malloc(sizeof(sample_ref) * (size_t)mmax);
+    int* match = malloc(sizeof(int) * (size_t)mmax);
     sp_result res = SP_OK;
-    if (s->mode == SP_CORR_ORDERED) {
-        sp_polyline* lines = malloc(sizeof(sp_polyline) * (size_t)C);
-        sp_vec2* pts = malloc(sizeof(sp_vec2) * (size_t)ab->point_count);
-        sp_stroke_match* sm = malloc(sizeof(sp_stroke_match) * (size_t)sk->stroke_count);
-        int* c2s = malloc(sizeof(int) * (size_t)C);
-        sp_vec2* y = malloc(sizeof(sp_vec2) * (size_t)mmax);
-        sp_vec2* z = malloc(sizeof(sp_vec2) * (size_t)mmax);
-        sample_ref* refs = malloc(sizeof(sample_ref) * (size_t)mmax);
-        int* match = malloc(sizeof(int) * (size_t)mmax);
-        if (!lines || !pts || !sm || !c2s || !y || !z || !refs || !match || !grow_pairs(s, msum)) {
-            res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
-            goto ordered_done;
-        }
-        for (int i = 0; i < ab->point_count; ++i) pts[i] = (sp_vec2){s->z2[2 * i], s->z2[2 * i + 1]};
-        for (int c = 0; c < C; ++c)
-            lines[c] = (sp_polyline){pts + ab->curves[c].first_point, ab->curves[c].point_count, ab->curves[c].closed};
-        if (s->keep_assignment && s->c2s_valid) {
-            memcpy(c2s, s->c2s, sizeof(int) * (size_t)C);
-            rep->unused_strokes = 0;
-            for (int c = 0; c < C; ++c) rep->unused_strokes -= c2s[c] >= 0;
-            rep->unused_strokes += sk->stroke_count;
-        } else if (assign_by_topology(s, sk, lines, C, c2s)) {
-            rep->unused_strokes = 0;
-        } else {
-            res = sp_assign_strokes(sk->strokes, sk->stroke_count, lines, C, &(sp_assign_desc){.samples = 64}, sm, c2s, err);
-            if (res != SP_OK) goto ordered_done;
-            rep->unused_strokes = 0;
-            for (int i = 0; i < sk->stroke_count; ++i) rep->unused_strokes += sm[i].curve < 0;
-        }
-        if (C <= SP_REPORT_CURVES) {
-            memcpy(s->c2s, c2s, sizeof(int) * (size_t)C);
-            s->c2s_valid = true;
-        }
-        for (int c = 0; c < C; ++c) {
-            int st = c2s[c];
-            if (st < 0) continue;
-            const sp_curve* cv = &ab->curves[c];
-            int m = samples_for(s, cv, total_len);
-            res = sp_curve_resample(sk->strokes[st].points, sk->strokes[st].count, cv->closed, m, y);
-            if (res != SP_OK) {
-                sp_fail(err, res, "stroke %d cannot be resampled", st);
-                goto ordered_done;
-            }
-            resample_refs(s, cv, m, refs);
-            for (int k = 0; k < m; ++k) z[k] = ref_pos(s, refs[k]);
-            sp_ordered_info info;
-            if (s->loop_forced && cv->closed && C == 1) {
-                // A hypothesis of sp_solver_solve: the loop's shift and direction held.
-                info = s->loop_hypothesis;
-                sp_corr_ordered_match(&info, m, match);
-            } else {
-                res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
-            }
-            if (res != SP_OK) {
-                sp_fail(err, res, "stroke %d: no ordered correspondence", st);
-                goto ordered_done;
-            }
-            for (int k = 0; k < m; ++k) s->pairs[s->pair_count++] = (pair){y[k], refs[match[k]], c};
-            if (c < SP_REPORT_CURVES) rep->curves[c].stroke = st, rep->curves[c].reversed = info.reversed;
-        }
-        if (rep->unused_strokes > 0)
-            snprintf(rep->note, sizeof rep->note, "%d stroke(s) more than the abstraction's %d curve(s) were left unused",
-                     rep->unused_strokes, C);
-    ordered_done:
-        free(lines), free(pts), free(sm), free(c2s), free(y), free(z), free(refs), free(match);
-        return res;
+    if (!lines || !pts || !c2s || !y || !z || !refs || !match || !grow_pairs(s, msum)) {
+        res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
+        goto done;
     }
-    // Closest points, both ways, over all strokes and all curves at once:
-    // the strokes get as many samples in all as the curves, by length. They
-    // do not move during a solve, so their samples are kept (s->ypoly) and
-    // made again only for a new solve or another total count.
-    res = SP_OK;
+    for (int i = 0; i < ab->point_count; ++i)
+        pts[i] = (sp_vec2){s->z2[2 * i], s->z2[2 * i + 1]};
+    for (int c = 0; c < C; ++c)
+        lines[c] = (sp_polyline){pts + ab->curves[c].first_point, ab->curves[c].point_count, ab->curves[c].closed};
+    res = assign_curves(s, sk, lines, how->keep_assignment, c2s, rep, err);
+    for (int c = 0; res == SP_OK && c < C; ++c) {
+        int st = c2s[c];
+        if (st < 0) continue;
+        const sp_curve* cv = &ab->curves[c];
+        int m = samples_for(s, cv, total_len);
+        res = sp_curve_resample(sk->strokes[st].points, sk->strokes[st].count, cv->closed, m, y);
+        if (res != SP_OK) {
+            sp_fail(err, res, "stroke %d cannot be resampled", st);
+            break;
+        }
+        resample_refs(s, cv, m, refs);
+        for (int k = 0; k < m; ++k)
+            z[k] = ref_pos(s, refs[k]);
+        sp_ordered_info info;
+        if (how->loop_shift && cv->closed && C == 1) {
+            info = *how->loop_shift;
+            sp_corr_ordered_match(&info, m, match);
+        } else {
+            res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
+        }
+        if (res != SP_OK) {
+            sp_fail(err, res, "stroke %d: no ordered correspondence", st);
+            break;
+        }
+        for (int k = 0; k < m; ++k)
+            s->pairs[s->pair_count++] = (pair){.y = y[k], .s = refs[match[k]], .curve = c}; // ordered: no normal
+        if (c < SP_REPORT_CURVES) rep->curves[c].stroke = st, rep->curves[c].reversed = info.reversed;
+    }
+    if (res == SP_OK && rep->unused_strokes > 0)
+        snprintf(rep->note, sizeof rep->note, "%d stroke(s) more than the abstraction's %d curve(s) were left unused",
+                 rep->unused_strokes, C);
+done:
+    free(lines), free(pts), free(c2s), free(y), free(z), free(refs), free(match);
+    return res;
+}
+
+// Closest points, both ways, over all strokes and all curves at once: the
+// strokes get as many samples in all as the curves, by length. They do not
+// move during a solve, so their samples are kept (s->ypoly) and made again
+// only for a new solve or another total count.
+static sp_result closest_pairs(sp_solver* s, const sp_sketch* sk, double total_len, sp_solve_report* rep, sp_error* err)
+{
+    const sp_abstraction* ab = s->ab;
+    const int C = ab->curve_count;
+    int mmax, msum;
+    sample_counts(s, total_len, &msum, &mmax);
+    sp_result res = SP_OK;
     if (!s->ypoly_valid || s->ypoly_total != msum) {
         res = resample_strokes(s, sk, msum, err);
         if (res != SP_OK) return res;
@@ -366,19 +392,20 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
     int* votes = calloc((size_t)C * (size_t)sk->stroke_count, sizeof(int));
     if (!z || !refs || !zcurve || !cp || !votes || !grow_pairs(s, my + msum)) {
         res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while matching strokes");
-        goto closest_done;
+        goto done;
     }
     int at = 0;
     for (int c = 0; c < C; ++c) {
         int m = samples_for(s, &ab->curves[c], total_len);
         resample_refs(s, &ab->curves[c], m, refs + at);
-        for (int k = 0; k < m; ++k) z[at + k] = ref_pos(s, refs[at + k]), zcurve[at + k] = c;
+        for (int k = 0; k < m; ++k)
+            z[at + k] = ref_pos(s, refs[at + k]), zcurve[at + k] = c;
         at += m;
     }
     res = sp_corr_closest(y, my, z, msum, cp, NULL);
     if (res != SP_OK) {
         sp_fail(err, res, "closest-point correspondences failed");
-        goto closest_done;
+        goto done;
     }
     for (int i = 0; i < my + msum; ++i) {
         int c = zcurve[cp[i].z];
@@ -391,7 +418,22 @@ sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, sp_solve_report* re
             if (votes[c * sk->stroke_count + i] > bv) bv = votes[c * sk->stroke_count + i], best = i;
         rep->curves[c].stroke = best;
     }
-closest_done:
+done:
     free(z), free(refs), free(zcurve), free(cp), free(votes);
     return res;
+}
+
+sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, const sp_pairing* how, sp_solve_report* rep, sp_error* err)
+{
+    const sp_abstraction* ab = s->ab;
+    const int C = ab->curve_count;
+    s->pair_count = 0;
+    rep->curve_count = C < SP_REPORT_CURVES ? C : SP_REPORT_CURVES;
+    for (int c = 0; c < rep->curve_count; ++c)
+        rep->curves[c] = (sp_curve_report){c, -1, false, 0, 0};
+    double total_len = 0;
+    for (int c = 0; c < C; ++c)
+        total_len += curve_length2d(s, &ab->curves[c]);
+    return how->mode == SP_CORR_ORDERED ? ordered_pairs(s, sk, how, total_len, rep, err)
+                                        : closest_pairs(s, sk, total_len, rep, err);
 }

@@ -1,10 +1,29 @@
-// solver_internal.h: the solver's state, shared by its source files.
+// solver_internal.h: the solver's state and the calls its source files make
+// to each other. The solve is split by concern:
+//   setup.c   the solver's lifetime: coarsening, column lists, row groups, buffers
+//   match.c   correspondences: resampling and pairing (ordered, closest points)
+//   energy.c  W at p, its Gauss-Newton normal equations, the regularisers' reference
+//   step.c    the damped step: the bounded Levenberg-Marquardt step and its tries
+//   icp.c     the ICP loop: the plan of an attempt (a table of stages), the
+//             stage runner, the attempts of sp_solver_solve
+//   report.c  the report's 2D errors
 #ifndef SP_SOLVER_INTERNAL_H
 #define SP_SOLVER_INTERNAL_H
+
+#include <string.h>
 
 #include "model.h"
 #include "sp/curve.h"
 #include "sp/solver.h"
+
+// The reference setup the paper's default weights are tuned for, in the
+// spirit of its Maya scenes: an abstraction 500 pixels across matched with
+// 200 sample pairs, a character 200 units across with 1000 vertices. Every
+// solve measures its residuals in these units (see sp/solver.h).
+#define SP_REF_PIXELS 500.0
+#define SP_REF_PAIRS 200.0
+#define SP_REF_SIZE 200.0
+#define SP_REF_VERTICES 1000.0
 
 // A sample on a projected curve: (1 - t) * point a + t * point b.
 typedef struct sample_ref {
@@ -19,7 +38,7 @@ typedef struct pair {
     int curve; // for the per-curve report
     // Unit normal of the stroke at y for closest-point pairs, (0, 0) for
     // ordered ones: a closest pair weighs the residual across the stroke
-    // fully and along it by its curve's tangential weight (see solver.c).
+    // fully and along it by its curve's tangential weight (see energy.c).
     sp_vec2 n;
     // Closest-point pairs: 0 when y was the stroke sample looking for the
     // curve, 1 when the curve sample looked for the stroke (the final error
@@ -97,38 +116,129 @@ struct sp_solver {
     int* ypoly_stroke;
     int ypoly_count, ypoly_cap;
     int ypoly_total;  // the sample count they were made for
-    bool ypoly_valid; // made for this solve's strokes (solve_once clears it)
+    bool ypoly_valid; // made for this solve's strokes (an attempt clears it)
     int pair_count, pair_cap;
-    double L;        // abstraction 2D diagonal at the start pose, pixels
-    sp_correspondence mode; // how sp__build_pairs pairs samples now
-    double pose_boost;      // >= 1: graduated W_pose weight, 1 in the final rounds
-    int boost_from;         // parameters before it (the placement) keep W_pose unboosted
-    double vertex_boost;    // >= 1: the same for W_plane and W_dist (draw-over only)
-    int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke)
+    double L;                  // abstraction 2D diagonal at the start pose, pixels
+    int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke), for sp_pairing.keep_assignment
     bool c2s_valid;
-    bool used_loop;            // the last attempt matched an outline in order first
-    bool placed_free;          // the last attempt placed the root without the boost (boost_from > 0)
-    bool loop_forced;          // a loop's ordered pairs use loop_hypothesis instead of the best shift
-    sp_ordered_info loop_hypothesis;
-    bool keep_assignment;      // reuse c2s instead of assigning again
 };
+
+// The energy's weights in one round (the graduated schedule of icp.c):
+// W_pose of the parameters from boost_from on times pose_boost (>= 1), the
+// parameters before it (a loop's root placement, placed free) at the
+// configured weight, W_plane and W_dist times vertex_boost (>= 1).
+// {1, 0, 1}: the configured weights.
+typedef struct sp_weights {
+    double pose_boost;
+    int boost_from;
+    double vertex_boost;
+} sp_weights;
+
+// How sp__build_pairs pairs samples.
+typedef struct sp_pairing {
+    sp_correspondence mode;
+    bool keep_assignment;              // ordered: reuse the last stroke assignment (c2s) when there is one
+    const sp_ordered_info* loop_shift; // ordered, one closed curve: hold this shift and direction (NULL: the best each time)
+} sp_pairing;
+
+// The model's calls (model.h), and bounds as sp_rig_clamp has them.
+static inline void sp__model_update(sp_solver* s, const double* p, bool derivatives)
+{
+    s->model->ops->update(s->model, p, derivatives);
+}
+static inline void sp__model_rows(sp_solver* s, double* xyz)
+{
+    s->model->ops->rows(s->model, s->reps, s->k, xyz);
+}
+static inline void sp__model_clamp(const sp_solver* s, double* p)
+{
+    for (int i = 0; i < s->P; ++i) {
+        const sp_model_param* q = &s->model->params[i];
+        double v = p[i];
+        if (!isfinite(v)) v = q->def;
+        if (v < q->min) v = q->min;
+        if (v > q->max) v = q->max;
+        p[i] = v;
+    }
+}
+// The pose a solve starts from: p_start (NULL: the defaults) inside the bounds.
+static inline void sp__start_pose(const sp_solver* s, const double* p_start, double* p)
+{
+    if (p_start)
+        memcpy(p, p_start, sizeof(double) * (size_t)s->P);
+    else
+        for (int i = 0; i < s->P; ++i)
+            p[i] = s->model->params[i].def;
+    sp__model_clamp(s, p);
+}
+
+// A sample of the projected abstraction (s->z2).
+static inline sp_vec2 sp__sample_at(const sp_solver* s, sample_ref r)
+{
+    const double* a = s->z2 + 2 * r.a;
+    const double* b = s->z2 + 2 * r.b;
+    return (sp_vec2){a[0] + r.t * (b[0] - a[0]), a[1] + r.t * (b[1] - a[1])};
+}
+
+// match.c: resamples the projected curves (s->z2) and the strokes and fills
+// s->pairs; writes which stroke each curve got into rep->curves.
+sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, const sp_pairing* how, sp_solve_report* rep, sp_error* err);
+// match.c: the best k shifts and directions of the one loop stroke against
+// the one closed curve at the current projection
+// (sp_corr_ordered_candidates over *m samples each).
+int sp__loop_candidates(sp_solver* s, const sp_sketch* sk, sp_ordered_info* out, int k, int* m);
+
+// energy.c: projects the abstraction at the model's state into s->z2.
+void sp__project_abstraction(sp_solver* s);
+// energy.c: W's terms at p with the current pairs (sets the model's state to p, projects).
+sp_energy_terms sp__energy(sp_solver* s, const double* p, const sp_weights* w);
+// energy.c: the rig linearised at p and W's normal equations there (s->H,
+// s->g); `project` false when the last sp__energy call was at p.
+void sp__linearise(sp_solver* s, const double* p, bool project, const sp_weights* w);
+// energy.c: what depends on the start pose p: the representatives' start
+// positions, viewing directions and distance weights to the matched curves.
+void sp__prepare_start(sp_solver* s, const double* p, const sp_solve_report* rep);
+
+// icp.c: bad strokes (none, NaN, one point, no length) refused with a message.
+bool sp__sketch_ok(const sp_sketch* sk, sp_error* err);
+
+// report.c: the report's 2D errors of the current pairs (made by `mode`).
+void sp__fill_errors(sp_solver* s, sp_correspondence mode, sp_solve_report* rep);
 
 // Test hook: W at p and its Gauss-Newton g (half W's gradient) and H (H may
 // be NULL) with the pairs for sk and the regularisers' reference made at
 // p_ref, W_pose boosted by pose_boost on the parameters from boost_from on
 // (the graduated rounds' weights; 1 and 0: the final ones).
-sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double pose_boost, int boost_from,
-                              double* W, double* g, double* H, sp_error* err);
+sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p_ref, const double* p, double pose_boost,
+                              int boost_from, double* W, double* g, double* H, sp_error* err);
 
-// The bounded Levenberg-Marquardt step of solver.c (exposed for its test):
+// The bounded Levenberg-Marquardt step of step.c (exposed for its test):
 // (H_ff + mu diag(H_ff)) delta_f = -g_f over the free parameters (H: P x P,
 // row-major, symmetric), parameters that would leave [min, max] held on the
 // bound they cross and the rest solved again until the step stays inside.
 // delta is zero outside the free set. False if the system cannot be solved
 // or the step is zero.
 // work: sp__bounded_step_work(P) doubles; iwork: 3 (P + 1) ints (the caller's).
-bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p, double mu,
-                      double* delta, double* work, int* iwork);
+bool sp__bounded_step(int P, const double* H, const double* g, const bool* free_, const sp_model_param* params, const double* p,
+                      double mu, double* delta, double* work, int* iwork);
 size_t sp__bounded_step_work(int P);
+
+// step.c: one damped Gauss-Newton iteration (see there).
+typedef enum sp_step_result {
+    SP_STEP_TAKEN,     // a try lowered W
+    SP_STEP_EXHAUSTED, // a try lowered W, by less than 1e-9 of it: this linearisation has no more to give
+    SP_STEP_FAILED,    // no try lowered W although the linearisation promised more than 1e-9 of it (a stall)
+    SP_STEP_NONE,      // no try lowered W, and the linearisation promised nothing (a stationary point)
+} sp_step_result;
+// The iterate a stage's rounds move, and the damping carried between iterations.
+typedef struct sp_iterate {
+    double* p;           // P: the pose, moved by an accepted try
+    double* trial;       // P: scratch, a try's pose
+    double* delta;       // P: scratch, a try's step
+    sp_energy_terms cur; // W at p under the round's weights
+    bool z_at_p;         // the abstraction was last projected at p
+    double mu;           // the Levenberg-Marquardt damping
+} sp_iterate;
+sp_step_result sp__gauss_newton_iteration(sp_solver* s, sp_iterate* it, const bool* moves, const sp_weights* w);
 
 #endif

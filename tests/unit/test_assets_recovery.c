@@ -108,7 +108,7 @@ static void recover_abstraction(const char* name, const char* abstraction, int c
         ENSURE(ok >= (int)ceil(0.95 * cases));
         // Iterations are deterministic, so their median is a fair guard on
         // the solver's convergence where time is not: each row's budget is
-        // its median when set, plus a fifth (solver.c's round lengths).
+        // its median when set, plus a fifth (solver/src/icp.c's round lengths).
         ENSURE(it_med <= iteration_budget);
     }
     else
@@ -151,7 +151,7 @@ static void test_cartoon_man_stick(void)
 static void test_cartoon_man_outline(void)
 {
     // The bar like every row since the runner-up shifts of a loop
-    // get a turn (solver.c, sp_solver_solve): 100 of 100, 200 of 200 and
+    // get a turn (solver/src/icp.c, further_attempts): 100 of 100, 200 of 200 and
     // 398 of 400 with SP_RECOVERY_CASES (89 of 100 before).
     recover_abstraction("cartoon_man", "outline", SP_ASSETS_RECOVERY_CASES, 29);
 }

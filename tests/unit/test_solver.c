@@ -7,6 +7,7 @@
 
 #include "../../solver/src/solver_internal.h" // the model's choice of regulariser path
 #include "fixtures.h"
+#include "sp/blackbox.h"
 #include "sp/solver.h"
 #include "test.h"
 
@@ -42,6 +43,19 @@ static void strokes_at(sp_solver* s, const sp_rig* rig, const double* p, sp_sket
     free(xy);
 }
 
+// Solves the strokes of a seeded random pose (rotations within 45 degrees of
+// rest) from the rest pose; truth gets the pose, out the result.
+static void solve_random_pose(sp_solver* s, const sp_rig* rig, uint64_t seed, double* truth, double* out, sp_solve_report* rep)
+{
+    sp_test_rng rng = {seed};
+    sp_fixture_random_params(rig, &rng, 0.785, truth);
+    sp_sketch sk;
+    strokes_at(s, rig, truth, &sk);
+    sp_error err = {0};
+    ENSURE(sp_solver_solve(s, &sk, NULL, out, rep, &err) == SP_OK);
+    sp_sketch_free(&sk);
+}
+
 static void test_recovery_chain(void)
 {
     setup st;
@@ -52,18 +66,12 @@ static void test_recovery_chain(void)
     double* truth = malloc(sizeof(double) * P);
     double* out = malloc(sizeof(double) * P);
     for (int c = 0; c < cases; ++c) {
-        sp_test_rng rng = {100 + c};
-        sp_fixture_random_params(&st.rig, &rng, 0.785, truth);
-        sp_sketch sk;
-        strokes_at(s, &st.rig, truth, &sk);
         sp_solve_report rep;
-        sp_error err = {0};
-        ENSURE(sp_solver_solve(s, &sk, NULL, out, &rep, &err) == SP_OK);
+        solve_random_pose(s, &st.rig, (uint64_t)(100 + c), truth, out, &rep);
         double rel = rep.mean_error_px / rep.bbox_diagonal_px;
         if (rel <= 0.01) ++ok;
         else fprintf(stderr, "  case %d: mean error %.2f%% (%s, %d it, %d rounds)\n", c, 100 * rel, sp_stop_reason_name(rep.stopped), rep.iterations, rep.icp_rounds);
         ENSURE(rep.after.total <= rep.before.total);
-        sp_sketch_free(&sk);
     }
     fprintf(stderr, "  recovered %d of %d\n", ok, cases);
     ENSURE(ok >= cases * 95 / 100);
@@ -409,6 +417,134 @@ static void test_bounded_step_matches_reduced_solves(void)
     free(H), free(M), free(work);
 }
 
+// ---- stop reasons (sp_stop_reason)
+
+// A one-parameter black-box rig: a line of 8 ordered points and a quad,
+// moved along x by the parameter. With `jump` the line also jumps 0.5 up
+// wherever the parameter is not exactly its default: central differences
+// (taken at +-h, both jumped) see only the smooth slope, so at the default
+// the linearisation promises a decrease that no step can deliver.
+typedef struct line_rig {
+    sp_blackbox_rig desc;
+    double rest[12];
+    bool jump;
+} line_rig;
+
+static int line_evaluate(void* user, const double* p, double* x, double* z)
+{
+    const line_rig* r = user;
+    for (int v = 0; v < 4; ++v) {
+        x[3 * v] = (v & 1 ? 1.0 : -1.0) + p[0];
+        x[3 * v + 1] = v & 2 ? 0.2 : -0.2;
+        x[3 * v + 2] = 0;
+    }
+    const double up = r->jump && p[0] != 0.0 ? 0.5 : 0.0;
+    for (int k = 0; z && k < 8; ++k) {
+        z[3 * k] = -1.0 + 2.0 * k / 7 + p[0];
+        z[3 * k + 1] = up;
+        z[3 * k + 2] = 0;
+    }
+    return 0;
+}
+
+static sp_blackbox* open_line_rig(line_rig* r, bool jump)
+{
+    static const sp_blackbox_param param = {"move_x", -1, 1, 0, SP_GROUP_POSE, SP_BB_UNIT_LENGTH};
+    static const sp_blackbox_curve curve = {"line", 8, 0};
+    static const sp_blackbox_abstraction ab = {"line", SP_CORR_ORDERED, 1, &curve};
+    static const uint32_t tris[6] = {0, 1, 3, 0, 3, 2};
+    memset(r, 0, sizeof *r);
+    r->jump = jump;
+    const double p0 = 0;
+    line_evaluate(r, &p0, r->rest, NULL);
+    r->desc = (sp_blackbox_rig){.abi_version = SP_BLACKBOX_ABI_VERSION,
+                                .struct_size = sizeof(sp_blackbox_rig),
+                                .name = "line",
+                                .param_count = 1,
+                                .params = &param,
+                                .vertex_count = 4,
+                                .rest = r->rest,
+                                .triangle_count = 2,
+                                .triangles = tris,
+                                .abstraction_count = 1,
+                                .abstractions = &ab,
+                                .user = r,
+                                .evaluate = line_evaluate};
+    sp_blackbox* bb = NULL;
+    sp_error err = {0};
+    if (sp_blackbox_open(&r->desc, "line rig", &bb, &err) != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(bb);
+    return bb;
+}
+
+// Stalled (a): no damped step lowers W although the linearisation promised
+// a decrease (the jumping line, from its default); the smooth line, drawn
+// the same, converges. Only the match term, so that the promise is the
+// match's (W_pose's graduated weight would make any step tiny).
+static void test_stalled_when_no_step_lowers_w(void)
+{
+    line_rig smooth_rig, jump_rig;
+    sp_blackbox* smooth = open_line_rig(&smooth_rig, false);
+    sp_blackbox* jumpy = open_line_rig(&jump_rig, true);
+    sp_camera cam = sp_blackbox_camera(smooth, 640, 480);
+    // The line at move_x 0.02, drawn 3 px low (a residual no pose removes, so W stays well above rounding).
+    const double target = 0.02;
+    sp_sketch sk;
+    sp_error err = {0};
+    ENSURE(sp_blackbox_synth_sketch(smooth, 0, &cam, &target, &sk, &err) == SP_OK);
+    for (int i = 0; i < sk.strokes[0].count; ++i)
+        sk.strokes[0].points[i].y += 3;
+    const sp_solve_desc d = {.lambda_pose = -1, .lambda_plane = -1, .lambda_dist = -1, .threads = 1, .time_cap_ms = 1e9};
+    sp_blackbox* rigs[2] = {smooth, jumpy};
+    for (int k = 0; k < 2; ++k) {
+        sp_solver* s = sp_solver_create_blackbox(rigs[k], 0, &cam, &d);
+        ENSURE(s);
+        double p = 0;
+        sp_solve_report rep;
+        ENSURE(sp_solver_solve(s, &sk, NULL, &p, &rep, &err) == SP_OK);
+        fprintf(stderr, "  %s line: %s after %d iterations, move_x %.4f, mean error %.2f px\n", k ? "jumping" : "smooth",
+                sp_stop_reason_name(rep.stopped), rep.iterations, p, rep.mean_error_px);
+        if (k == 0) {
+            ENSURE(rep.stopped == SP_STOP_CONVERGED);
+            ENSURE_NEAR(p, target, 1e-6);
+        } else {
+            ENSURE(rep.stopped == SP_STOP_STALLED);
+            ENSURE(p == 0.0 && rep.iterations == 1); // no step was taken
+        }
+        sp_solver_destroy(s);
+    }
+    sp_sketch_free(&sk);
+    sp_blackbox_free(smooth);
+    sp_blackbox_free(jumpy);
+}
+
+// Stalled (b): closest-point rounds at the configured weights that end no
+// lower than the best round twice in a row. Closed outlines of a
+// synthetic tree drawn at seeded poses end both ways: settled (converged)
+// and cycling (stalled), besides some that use up the 300 iterations.
+static void test_stop_reasons_of_closest_point_solves(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .root_scale = true, .stick_points = 10, .closest = true, .seed = 1});
+    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.time_cap_ms = 1e9});
+    ENSURE(s);
+    int P = st.rig.param_count, n[4] = {0};
+    double* truth = malloc(sizeof(double) * P);
+    double* out = malloc(sizeof(double) * P);
+    for (int c = 0; c < 20; ++c) {
+        sp_solve_report rep;
+        solve_random_pose(s, &st.rig, (uint64_t)(300 + c), truth, out, &rep);
+        ENSURE(rep.stopped >= 0 && rep.stopped < 4);
+        n[rep.stopped]++;
+    }
+    fprintf(stderr, "  converged %d, stalled %d, max_iterations %d, time_cap %d\n", n[SP_STOP_CONVERGED], n[SP_STOP_STALLED],
+            n[SP_STOP_MAX_ITERATIONS], n[SP_STOP_TIME_CAP]);
+    ENSURE(n[SP_STOP_CONVERGED] > 0 && n[SP_STOP_STALLED] > 0 && n[SP_STOP_TIME_CAP] == 0);
+    free(truth), free(out);
+    sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv, (sp_test[]){
@@ -419,5 +555,7 @@ int main(int argc, char** argv)
         {"regulariser_paths_agree", test_regulariser_paths_agree},
         {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
         {"gauss_newton_consistent", test_gauss_newton_consistent},
+        {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
+        {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
         {0}});
 }

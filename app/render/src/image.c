@@ -91,3 +91,21 @@ sp_result sp_image_read_png(const char* path, sp_image* img, sp_error* err)
     img->height = h;
     return SP_OK;
 }
+
+sp_result sp_image_sheet(const sp_image* images, int n, int cols, int gap, sp_image* out)
+{
+    if (n < 1 || cols < 1 || gap < 0) return SP_ERR_INVALID;
+    int w = images[0].width, h = images[0].height, rows = (n + cols - 1) / cols;
+    for (int i = 1; i < n; ++i)
+        if (images[i].width != w || images[i].height != h) return SP_ERR_INVALID;
+    int sw = cols * w + (cols + 1) * gap, sh = rows * h + (rows + 1) * gap;
+    if (sp_image_alloc(out, sw, sh) != SP_OK) return SP_ERR_NO_MEMORY;
+    for (size_t k = 0; k < (size_t)sw * (size_t)sh; ++k)
+        memcpy(out->rgba + 4 * k, (const uint8_t[4]){250, 250, 250, 255}, 4);
+    for (int i = 0; i < n; ++i) {
+        int ox = gap + (i % cols) * (w + gap), oy = gap + (i / cols) * (h + gap);
+        for (int y = 0; y < h; ++y)
+            memcpy(sp_image_at(out, ox, oy + y), sp_image_at(&images[i], 0, y), 4 * (size_t)w);
+    }
+    return SP_OK;
+}

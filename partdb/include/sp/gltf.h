@@ -42,6 +42,7 @@ typedef struct sp_character {
     char* part_json;          ///< the scene's `extras.sp_part` as compact JSON, or NULL
     bool derived_abstraction; ///< the stick figure was derived from the skeleton
     bool derived_dofs;        ///< default rotation DOFs were added
+    int mesh_skins;           ///< distinct skins of the scene's skinned meshes (the rig is the first one's)
     int warning_count;
     char (*warnings)[SP_WARNING_MAX]; ///< one line each
 } sp_character;

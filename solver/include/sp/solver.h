@@ -62,11 +62,29 @@ typedef struct sp_solve_desc {
     int threads;         ///< black-box rigs (sp/blackbox.h): finite-difference threads; 0: the online cores (at most 8)
 } sp_solve_desc;
 
+/// Why a solve stopped: how the last stage of the attempt kept ended. A
+/// stage runs rounds (new correspondences, then a few damped Gauss-Newton
+/// iterations with them held; docs/DESIGN.md, "The solver's structure").
+/// The reason says how the loop ended, not how good the fit is: read
+/// mean_error_px and note for that (a stalled outline often fits well).
 typedef enum sp_stop_reason {
-    SP_STOP_CONVERGED,      ///< the energy stalled at a minimum
+    /// W settled: a round lowered it by less than 0.1% at the configured
+    /// weights (1% in a stage that only places the root), or by less than
+    /// 1e-6 of it at any weights with no failed step.
+    SP_STOP_CONVERGED,
     SP_STOP_MAX_ITERATIONS, ///< the iteration or round cap was reached
     SP_STOP_TIME_CAP,       ///< the time cap was reached
-    SP_STOP_STALLED,        ///< no step could lower the energy further from a non-stationary point
+    /// W stopped going down without settling, either (a) a round ended on a
+    /// failed step, no Levenberg-Marquardt try (12, the damping raised after
+    /// each) lowering W although the linearised rig promised a decrease of
+    /// more than 1e-9 of W, and the round lowered W by less than 1e-6 of it
+    /// (a rig whose Jacobian does not describe it, such as a black box
+    /// with a jump); or (b) with correspondences made afresh every round
+    /// (closest points) at the configured weights, two rounds in a row
+    /// ended no lower than 0.1% below the lowest end of an earlier round,
+    /// though each still lowered W against its own pairs by 0.1% or more:
+    /// ICP cycling between pairings instead of settling.
+    SP_STOP_STALLED,
 } sp_stop_reason;
 
 /// "converged", "max_iterations", "time_cap", "stalled" (the report's JSON words).

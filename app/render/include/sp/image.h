@@ -32,6 +32,10 @@ void sp_image_free(sp_image* img);
 void sp_image_flip_rows(sp_image* img);
 /// Pointer to pixel (x, y), y from the top; asserts the pixel is inside.
 uint8_t* sp_image_at(const sp_image* img, int x, int y);
+/// Lays n equally sized images out in a grid of `cols` columns, row by row,
+/// `gap` pixels apart and around, on a near-white sheet (*out allocated).
+/// SP_ERR_INVALID when the sizes differ or n or cols is not positive.
+sp_result sp_image_sheet(const sp_image* images, int n, int cols, int gap, sp_image* out);
 /// Writes an 8-bit RGBA PNG. err names the path on failure.
 sp_result sp_image_write_png(const sp_image* img, const char* path, sp_error* err);
 /// Reads any PNG (grey, RGB, palette, 16-bit) as RGBA8 into *img (freed first).

@@ -1,0 +1,21 @@
+# Structure checks that CI runs with the tests (issue 18): no function in
+# solver/src is longer than 120 lines (tests/lint/function_length.c says how
+# a function is measured). The check is checked too: a generated function
+# of 121 lines fails it and one of 120 lines, beside a longer initialiser,
+# passes.
+add_executable(function_length lint/function_length.c)
+target_link_libraries(function_length PRIVATE sp_flags)
+file(GLOB SP_SOLVER_C CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/solver/src/*.c)
+add_test(NAME function_length_solver COMMAND function_length 120 ${SP_SOLVER_C})
+
+set(sp_lint_dir ${CMAKE_CURRENT_BINARY_DIR}/lint)
+foreach(n 120 121)
+  math(EXPR body "${n} - 2")
+  string(REPEAT "    x += 1; /* { */\n" ${body} lines)
+  string(REPEAT "    1,\n" 200 table)
+  file(WRITE ${sp_lint_dir}/f${n}.c
+    "static const int table[] = {\n${table}};\n// a comment with a { brace\nstatic int f(int x)\n{\n${lines}}\n")
+endforeach()
+add_test(NAME function_length_passes_120 COMMAND function_length 120 ${sp_lint_dir}/f120.c)
+add_test(NAME function_length_fails_121 COMMAND function_length 120 ${sp_lint_dir}/f121.c)
+set_tests_properties(function_length_fails_121 PROPERTIES PASS_REGULAR_EXPRESSION "f121.c:205: f is 121 lines, limit 120")
