@@ -103,6 +103,25 @@ sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id)
     return NULL;
 }
 
+// Display triangles for a part (0: all): one per LOD_PX_PER_TRIANGLE px^2 of
+// its box on the canvas, LOD_MIN_TRIANGLES to c->lod_triangles. Why by
+// size: llvmpipe pays per triangle (and per fragment: what a part costs
+// beyond its triangles), and a small part needs fewer triangles than a big
+// one to look the same.
+#define LOD_PX_PER_TRIANGLE 16.0
+#define LOD_MIN_TRIANGLES 400
+static int lod_budget(const mesh_cache* c, const sp_dragon* d, const double* xyz, int n)
+{
+    if (c->lod_triangles <= 0) return 0;
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, n, &lo, &hi);
+    sp_camera cam = sp_dragon_camera(d);
+    sp_vec2 a = sp_camera_project(&cam, lo), b = sp_camera_project(&cam, hi);
+    double area = fabs((b.x - a.x) * (b.y - a.y)), want = area / LOD_PX_PER_TRIANGLE;
+    if (!(want < c->lod_triangles)) return c->lod_triangles;
+    return want > LOD_MIN_TRIANGLES ? (int)want : LOD_MIN_TRIANGLES;
+}
+
 void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions)
 {
     for (int i = 0; i < c->count; ++i)
@@ -136,15 +155,16 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
             c->items = it, c->cap = cap;
         }
         sp_error err = {0};
-        struct cached_mesh it = {p->id, NULL, true, false, {0}};
+        struct cached_mesh it = {p->id, NULL, true, false, {0}, rig->triangle_count};
         sp_mesh_desc md = {.vertex_count = rig->vertex_count,
                            .positions = xyz,
                            .colors = p->character->colors,
                            .triangle_count = rig->triangle_count,
                            .triangles = rig->triangles};
-        if (c->lod_triangles > 0 && rig->triangle_count > c->lod_triangles &&
-            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, c->lod_triangles,
-                         &it.lod) == SP_OK) {
+        int budget = lod_budget(c, d, xyz, rig->vertex_count);
+        if (budget > 0 && rig->triangle_count > budget &&
+            sp_lod_build(xyz, rig->vertex_count, rig->triangles, rig->triangle_count, p->character->colors, budget, &it.lod) ==
+                SP_OK) {
             if (it.lod.cluster_count > c->scratch_cap) {
                 double* s = realloc(c->scratch, sizeof(double) * 3 * (size_t)it.lod.cluster_count);
                 if (s) c->scratch = s, c->scratch_cap = it.lod.cluster_count;
@@ -157,6 +177,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
                                     .triangle_count = it.lod.tri_count,
                                     .triangles = it.lod.tris};
                 it.coarse = true;
+                it.triangles = it.lod.tri_count;
             }
         }
         it.mesh = sp_render_mesh_create(r, &md, &err);
@@ -178,6 +199,14 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         }
     }
     c->count = w;
+}
+
+int mesh_cache_triangles(const mesh_cache* c)
+{
+    int n = 0;
+    for (int i = 0; i < c->count; ++i)
+        n += c->items[i].triangles;
+    return n;
 }
 
 void mesh_cache_free(mesh_cache* c)
@@ -220,7 +249,8 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
                                                    .assets_dir = k->desc.assets_dir,
                                                    .canvas_w = k->canvas_w,
                                                    .canvas_h = k->canvas_h,
-                                                   .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
+                                                   .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
+                                                   .max_parts = k->desc.max_parts},
                                  err);
     if (!k->dragon) goto fail;
     k->canvas_cam = sp_dragon_camera(k->dragon);
@@ -350,6 +380,12 @@ static const char* reject_hint(sp_dragon_reject r)
     }
 }
 
+// What to tell about an accepted part (NULL: nothing).
+static const char* note_hint(sp_dragon_note n)
+{
+    return n == SP_DRAGON_NOTE_NO_SURFACE ? "That body cannot hold parts: this one stays where you drew it" : NULL;
+}
+
 static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const sp_error* err, bool refit)
 {
     if (rc != SP_OK || res->rejected || res->part < 0 || res->part >= sp_dragon_part_count(k->dragon)) {
@@ -404,6 +440,7 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
         sn = p->stroke_points;
     }
     sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true,
+                                                       .hint = note_hint(res->note),
                                                        .category = p->category,
                                                        .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
                                                        .part_count = sp_dragon_part_count(k->dragon),
@@ -589,6 +626,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
             fprintf(stderr, "dragon-kiosk: %s\n", err.text);
         }
         k->stats.pose_ms = now_ms() - t0;
+        k->stats.triangles = mesh_cache_triangles(&k->meshes);
     }
     k->stats.parts = sp_dragon_part_count(k->dragon);
 }

@@ -40,6 +40,7 @@ typedef struct sp_kiosk_desc {
                             ///< never depend on the machine's speed
     int lod_triangles; ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full
                        ///< meshes
+    int max_parts;     ///< parts a dragon may have (sp_dragon_desc.max_parts); 0: the pipeline's (48)
 } sp_kiosk_desc;
 
 /// Measurements for logs and benchmarks.
@@ -50,6 +51,7 @@ typedef struct sp_kiosk_stats {
     double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
     double pose_ms;      ///< last pose_at + mesh update
     int parts;           ///< parts now
+    int triangles;       ///< display triangles of the parts' meshes (after LOD)
 } sp_kiosk_stats;
 
 /// Opens the database (creating the default one when missing), loads the font,

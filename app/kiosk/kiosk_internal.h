@@ -18,6 +18,7 @@ typedef struct mesh_cache {
         bool seen;
         bool coarse;
         sp_lod lod;
+        int triangles; ///< drawn
     } * items;
     int count, cap;
     int lod_triangles; ///< triangle budget per part; 0: full meshes
@@ -97,6 +98,8 @@ sp_camera kiosk_fb_camera(const sp_kiosk* k);
 int kiosk_fitted_outline(const sp_dragon_part* p, float** out, int* cap, int* breaks, int max_breaks, int* nbreaks);
 /// "front_legs" -> "Front legs".
 void kiosk_pretty(const char* category, char* out, size_t cap);
+/// Triangles the cached meshes draw.
+int mesh_cache_triangles(const mesh_cache* c);
 /// Brings the cached meshes in step with d's parts at its last pose_at.
 void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions);
 void mesh_cache_free(mesh_cache* c);

@@ -1,6 +1,6 @@
 // sketchpose dragon: the kiosk pipeline without a window. Every stroke of the
 // file is one part, in order: classified, instantiated, fitted where it was
-// drawn, attached to the nearest torso socket; the dragon is written as one
+// drawn, attached where it touches a body; the dragon is written as one
 // animated .glb, a PNG and the report (DESIGN.md "dragon --report").
 #include <stdio.h>
 #include <stdlib.h>
@@ -74,6 +74,7 @@ int cmd_dragon(int argc, char** argv)
         }
         cJSON_AddBoolToObject(s, "rejected", res.rejected);
         cJSON_AddStringToObject(s, "reason", sp_dragon_reject_name(res.reason));
+        cJSON_AddStringToObject(s, "note", sp_dragon_note_name(res.note));
         if (res.part >= 0)
             cJSON_AddNumberToObject(s, "part", res.part);
         else

@@ -12,6 +12,7 @@
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
+#include <cjson/cJSON.h>
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
@@ -255,6 +256,12 @@ static void print_stats(const app* a, double start_ms)
         : ui->mode == SP_KM_TURN  ? "turn"
                                   : "draw",
         ui->code, sp_kiosk_last_save(a->k));
+    // What a visitor reads on screen now (JSON-escaped).
+    cJSON* hint = cJSON_CreateString(sp_kiosk_ui_hint_visible(ui) ? ui->hint : "");
+    char* hint_text = hint ? cJSON_PrintUnformatted(hint) : NULL;
+    printf(" \"hint\": %s,\n", hint_text ? hint_text : "\"\"");
+    free(hint_text);
+    cJSON_Delete(hint);
     printf(" \"framebuffer\": [%d, %d], \"px_per_mm\": %.4f, \"gl_renderer\": \"%s\", \"start_ms\": %.1f, \"frames\": %d, "
            "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"fit_ms_median\": %.2f, \"fit_ms_p90\": %.2f, "
            "\"latency_ms_median\": %.2f, \"latency_ms_p90\": %.2f, \"latency_n\": %d, \"update_ms_median\": %.2f, "
@@ -327,7 +334,7 @@ int main(int argc, char** argv)
     const char* font = NULL;
     bool fullscreen = false, stats = false;
     double idle_s = 0;
-    int lod = 0, msaa = -1;
+    int lod = 0, msaa = -1, max_parts = 0;
     sp_opt opts[] = {
         {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)",
          false},
@@ -344,6 +351,8 @@ int main(int argc, char** argv)
         {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
         {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling (default: 4 on a GPU, 0 on software GL)", false},
         {"--lod", SP_OPT_INT, &lod, "N", "display triangles per part (default: 4000 on software GL, all on a GPU; -1: all)",
+         false},
+        {"--max-parts", SP_OPT_INT, &max_parts, "N", "parts a dragon may have before new strokes are refused (default 48)",
          false},
         {"--stats", SP_OPT_FLAG, &stats, "", "print counters and timings as JSON at the end", false},
     };
@@ -421,6 +430,7 @@ int main(int argc, char** argv)
                                                        : 0},
                         .code_seed = script ? 1 : (uint64_t)time(NULL),
                         .lod_triangles = lod,
+                        .max_parts = max_parts,
                         // A replay must not depend on the machine's speed: the solver's
                         // wall-clock cap (a visitor's safety net) is lifted; its
                         // iteration caps still bound every fit.

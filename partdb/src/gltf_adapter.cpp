@@ -1378,6 +1378,47 @@ void write_channels(Writer& w, const sp_animation* an, int base, tinygltf::Anima
     }
 }
 
+// A camera node in the scene (its world matrix is the inverse of the view),
+// with the canvas and principal point as extras. Why the size check: a
+// camera framing float-range coordinates cannot be written back; nothing
+// is written then (an importer frames the rest pose itself).
+void write_camera(tinygltf::Model& m, tinygltf::Scene& scene, const sp_camera& cam, const char* node_name)
+{
+    sp_mat4 world;
+    bool ok = cam.scale > 0 && cam.width > 0 && cam.height > 0 && sp_mat4_inverse(&cam.view, &world);
+    for (int k = 0; ok && k < 16; ++k)
+        ok = std::fabs(world.m[k]) < 1e30;
+    if (!ok) return;
+    tinygltf::Camera c;
+    if (cam.kind == SP_CAMERA_ORTHOGRAPHIC) {
+        c.type = "orthographic";
+        c.orthographic.xmag = 0.5 * cam.width / cam.scale;
+        c.orthographic.ymag = 0.5 * cam.height / cam.scale;
+        c.orthographic.znear = cam.znear > 0 ? cam.znear : 0.0;
+        c.orthographic.zfar = cam.zfar > c.orthographic.znear ? cam.zfar : c.orthographic.znear + 1.0;
+    } else {
+        c.type = "perspective";
+        c.perspective.yfov = 2.0 * std::atan(0.5 * cam.height / cam.scale);
+        c.perspective.aspectRatio = (double)cam.width / cam.height;
+        c.perspective.znear = cam.znear > 0 ? cam.znear : 1e-3;
+        c.perspective.zfar = cam.zfar > c.perspective.znear ? cam.zfar : c.perspective.znear * 1e4;
+    }
+    Value::Object ex;
+    double canvas[2] = {(double)cam.width, (double)cam.height}, pp[2] = {cam.cx, cam.cy};
+    ex["sp_canvas"] = num_array(canvas, 2);
+    ex["sp_principal"] = num_array(pp, 2);
+    c.extras = Value(std::move(ex));
+    m.cameras.push_back(c);
+    Trs t = decompose(world);
+    tinygltf::Node nd;
+    nd.name = node_name;
+    nd.camera = (int)m.cameras.size() - 1;
+    nd.translation = {t.t.x, t.t.y, t.t.z};
+    nd.rotation = {t.r.x, t.r.y, t.r.z, t.r.w};
+    scene.nodes.push_back((int)m.nodes.size());
+    m.nodes.push_back(nd);
+}
+
 tinygltf::Model build_model(const sp_character* ch, const double* params_in)
 {
     const sp_rig* rig = &ch->rig;
@@ -1412,46 +1453,7 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
         if (!out.channels.empty()) m.animations.push_back(out);
     }
 
-    // Camera: the node's world matrix is the inverse of the view.
-    {
-        const sp_camera& cam = ch->camera;
-        sp_mat4 world;
-        bool ok = cam.scale > 0 && cam.width > 0 && cam.height > 0 && sp_mat4_inverse(&cam.view, &world);
-        for (int k = 0; ok && k < 16; ++k)
-            ok = std::fabs(world.m[k]) < 1e30;
-        // Why the size check: a camera framing float-range coordinates cannot
-        // be written back; the importer then frames the rest pose itself.
-        if (ok) {
-            tinygltf::Camera c;
-            if (cam.kind == SP_CAMERA_ORTHOGRAPHIC) {
-                c.type = "orthographic";
-                c.orthographic.xmag = 0.5 * cam.width / cam.scale;
-                c.orthographic.ymag = 0.5 * cam.height / cam.scale;
-                c.orthographic.znear = cam.znear > 0 ? cam.znear : 0.0;
-                c.orthographic.zfar = cam.zfar > c.orthographic.znear ? cam.zfar : c.orthographic.znear + 1.0;
-            } else {
-                c.type = "perspective";
-                c.perspective.yfov = 2.0 * std::atan(0.5 * cam.height / cam.scale);
-                c.perspective.aspectRatio = (double)cam.width / cam.height;
-                c.perspective.znear = cam.znear > 0 ? cam.znear : 1e-3;
-                c.perspective.zfar = cam.zfar > c.perspective.znear ? cam.zfar : c.perspective.znear * 1e4;
-            }
-            Value::Object ex;
-            double canvas[2] = {(double)cam.width, (double)cam.height}, pp[2] = {cam.cx, cam.cy};
-            ex["sp_canvas"] = num_array(canvas, 2);
-            ex["sp_principal"] = num_array(pp, 2);
-            c.extras = Value(std::move(ex));
-            m.cameras.push_back(c);
-            Trs t = decompose(world);
-            tinygltf::Node nd;
-            nd.name = "sketch_view";
-            nd.camera = 0;
-            nd.translation = {t.t.x, t.t.y, t.t.z};
-            nd.rotation = {t.r.x, t.r.y, t.r.z, t.r.w};
-            scene.nodes.push_back((int)m.nodes.size());
-            m.nodes.push_back(nd);
-        }
-    }
+    write_camera(m, scene, ch->camera, "sketch_view");
 
     // Scene extras: the pose (exact values) and the part description.
     Value::Object params;
@@ -1562,6 +1564,7 @@ tinygltf::Model build_scene(const sp_gltf_scene_desc* d)
     }
     // Why skip: an animation without channels is invalid glTF.
     if (!anim.channels.empty()) m.animations.push_back(anim);
+    if (d->camera) write_camera(m, scene, *d->camera, "view");
     if (d->extras_json) {
         cJSON* ex = cJSON_Parse(d->extras_json);
         if (!ex || !cJSON_IsObject(ex)) {

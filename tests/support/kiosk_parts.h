@@ -144,13 +144,14 @@ static inline bool kp_build_db(const char* path, const char* assets_dir, const c
     return ok;
 }
 
-/// Where each part goes on the 1280 x 800 canvas: centre and box diagonal (px), in drawing order.
+/// Where each part goes on the 1280 x 800 canvas: centre and box diagonal (px), in drawing order;
+/// the legs touch the body (the parts hang where they are drawn).
 static const struct {
     const char* category;
     double cx, cy, size;
 } kp_layout[DRAGON_PART_COUNT] = {
     {"torso", 640, 430, 400}, {"head", 910, 290, 200},       {"wings", 610, 220, 270},
-    {"tail", 320, 450, 300},  {"front_legs", 770, 610, 190}, {"hind_legs", 500, 620, 200},
+    {"tail", 320, 450, 300},  {"front_legs", 770, 580, 190}, {"hind_legs", 510, 580, 200},
 };
 
 typedef struct kp_stroke {

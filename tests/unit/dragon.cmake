@@ -6,4 +6,6 @@ if(TARGET sp_dragon)
   sp_unit_test(dragon LIBS sp_dragon sp_snapshot TIMEOUT 600)
   target_compile_definitions(test_dragon PRIVATE SP_SKETCHPOSE="$<TARGET_FILE:sketchpose>")
   add_dependencies(test_dragon sketchpose)
+  # The pipeline's internals, for fault injection (a NaN in a fit).
+  target_include_directories(test_dragon PRIVATE ${PROJECT_SOURCE_DIR}/app/dragon/src)
 endif()

@@ -670,6 +670,37 @@ static void test_db_replaced(void)
     cJSON_Delete(st);
 }
 
+// A full dragon (here --max-parts 2; the pipeline's own test places the
+// default 48): the next stroke is refused, the visitor reads why on screen,
+// and the kiosk goes on.
+static void test_full_dragon(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const char* sc = sp_test_tmp_path("kiosk_full.json");
+    double end = 500;
+    for (int i = 0; i < 3; ++i)
+        end += 4 * (g_strokes[i].n - 1) + 1500;
+    script s = script_open(sc, end); // ends 1.5 s after the last stroke: its hint is still up
+    script_event(&s, 0, "down", 640, 400); // leaves the attract screen
+    script_event(&s, 60, "up", 640, 400);
+    double t = 500;
+    for (int i = 0; i < 3; ++i)
+        t = script_stroke(&s, t, g_strokes[i].xy, g_strokes[i].n, 4) + 1500;
+    script_close(&s);
+    char args[2048];
+    snprintf(args, sizeof args, "--script '%s' --max-parts 2", sc);
+    cJSON* st = NULL;
+    ENSURE(run_kiosk(args, &st) == 0);
+    ENSURE(st);
+    const cJSON* hint = cJSON_GetObjectItemCaseSensitive(st, "hint");
+    fprintf(stderr, "  parts %.0f, rejected %.0f, on screen: \"%s\"\n", num(st, "parts"), num(st, "rejected"),
+            cJSON_IsString(hint) ? hint->valuestring : "?");
+    ENSURE(num(st, "parts") == 2 && num(st, "rejected") == 1 && num(st, "pipeline_errors") == 0);
+    ENSURE(cJSON_IsString(hint) && strstr(hint->valuestring, "What a dragon!"));
+    cJSON_Delete(st);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -678,5 +709,6 @@ int main(int argc, char** argv)
                                    {"storms", test_storms},
                                    {"record_replay", test_record_replay},
                                    {"db_replaced", test_db_replaced},
+                                   {"full_dragon", test_full_dragon},
                                    {0}});
 }

@@ -233,6 +233,17 @@ static void test_flow(void)
     sp_kiosk_ui_fit_done(ui,
                          &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"wings", "tail"}, .part_count = 1});
     ENSURE(strcmp(ui->chip[0], "head") == 0 && strcmp(ui->chip[1], "wings") == 0);
+    ENSURE(!sp_kiosk_ui_hint_visible(ui));
+    // An accepted part with a note (e.g. the body it touches cannot hold
+    // it): the part is there and the note shows.
+    tap(ui, 2700, SP_KT_CHIP_GUESS1);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true,
+                                                    .hint = "It stays where you drew it",
+                                                    .category = "head",
+                                                    .guesses = {"wings", "tail"},
+                                                    .part_count = 1});
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_hint_visible(ui) && strcmp(ui->hint, "It stays where you drew it") == 0);
     // A rejected stroke: hint, fading stroke, nothing else changes.
     double t = stroke(ui, 4000, 100, 500, 20, 10);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);

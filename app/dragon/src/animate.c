@@ -42,16 +42,29 @@ static void animated_params(const sp_dragon* d, part* p, double t, double* out)
     sp_rig_clamp(rig, out);
 }
 
-// The world transform of part i at its current p_t (torsos must be evaluated first).
+// The world transform of part p at its current p_t (bodies must be posed
+// first): an attached part follows its anchor, the body's skinned surface
+// point, and turns and scales with its carrier (the blended skin matrix
+// there, relative to the body's fit, as its nearest similarity).
 static sp_mat4 part_world_at(const sp_dragon* d, const part* p)
 {
     if (p->pub.attached_to < 0) return p->world_fit;
     const part* q = d->parts[p->pub.attached_to];
-    sp_mat4 f = sp_mat4_mul(&q->pub.placement, &sp_rig_eval_world(q->ev)[p->pub.socket_joint]);
-    sp_mat4 ft = sp_sim3_mat4(sp_sim3_from_mat4(&f)), f0 = sp_sim3_mat4(p->socket0), f0inv;
-    sp_mat4_inverse(&f0, &f0inv);
-    sp_mat4 rel = sp_mat4_mul(&ft, &f0inv);
-    return sp_mat4_mul(&rel, &p->world_fit);
+    const sp_rig* rig = &q->t->ch.rig;
+    int rows[3] = {(int)p->tri[0], (int)p->tri[1], (int)p->tri[2]};
+    double x[9];
+    sp_rig_eval_rows(q->ev, sp_rig_mesh_points(rig), rows, 3, x);
+    sp_vec3 s = {0, 0, 0};
+    for (int c = 0; c < 3; ++c)
+        s = sp_v3_add(s, sp_v3_scale((sp_vec3){x[3 * c], x[3 * c + 1], x[3 * c + 2]}, p->bary[c]));
+    s = sp_mat4_point(&q->world_t, s);
+    sp_mat4 m = dragon_carrier_matrix(p, sp_rig_eval_skin(q->ev), &q->world_t);
+    sp_mat4 rel = sp_mat4_mul(&m, &p->carrier0_inv);
+    sp_sim3 r = sp_sim3_from_mat4(&rel);
+    // Pinned at the anchor: anchor0 goes exactly to where the surface point is now.
+    r.t = sp_v3_sub(s, sp_v3_scale(sp_quat_rotate(r.r, p->anchor0), r.s));
+    sp_mat4 f = sp_sim3_mat4(r);
+    return sp_mat4_mul(&f, &p->world_fit);
 }
 
 sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err)

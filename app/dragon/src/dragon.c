@@ -28,6 +28,19 @@ const char* sp_dragon_reject_name(sp_dragon_reject r)
     return "unknown";
 }
 
+const char* sp_dragon_note_name(sp_dragon_note n)
+{
+    switch (n) {
+    case SP_DRAGON_NOTE_NONE:
+        return "none";
+    case SP_DRAGON_NOTE_NO_SURFACE:
+        return "no_surface";
+    case SP_DRAGON_NOTE_NOT_FINITE:
+        return "not_finite";
+    }
+    return "unknown";
+}
+
 sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err)
 {
     sp_dragon* d = calloc(1, sizeof *d);
@@ -44,7 +57,7 @@ sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err)
     if (!(o->solve.time_cap_ms > 0)) o->solve.time_cap_ms = 250;
     if (o->solve.representatives <= 0) o->solve.representatives = 100;
     if (o->solve.samples <= 0) o->solve.samples = 48;
-    if (o->snap_fraction == 0) o->snap_fraction = 0.15;
+    if (o->snap_fraction == 0) o->snap_fraction = 0.06;
     if (o->max_variants <= 0) o->max_variants = 4;
     if (!(o->fps > 0)) o->fps = 30;
     if (o->max_parts <= 0) o->max_parts = 48;

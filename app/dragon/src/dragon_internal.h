@@ -45,7 +45,9 @@ typedef struct tpl {
     sp_character ch;
     int abstraction;
     sp_camera base;           // the part's sketch view on the dragon canvas, orthographic
-    double depth0;            // camera z of the rest-pose centre in `base`
+    sp_vec3 centre0;          // the rest pose's centre, model space (placed at world depth 0)
+    bool lengthwise;          // from its attachment end it reaches sideways on the canvas (a head, a tail)
+    int outward;              // and which way: +1 right, -1 left, as modelled
     sp_vec2 rest_lo, rest_hi; // the rest abstraction's bounding box in `base`, pixels
     bool is_torso;
     int socket_count;
@@ -75,14 +77,33 @@ bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
 
 // ---- the dragon --------------------------------------------------------------------
 
+enum { CARRIER_MAX = 12 }; // a surface point's joints: 3 corners x 4 weights
+
 typedef struct part {
     sp_dragon_part pub;
     tpl* t;
     double* p_fit;
     sp_vec2* stroke;
     int stroke_n;
-    sp_mat4 world_fit; // model -> world at t = 0, after attachment
-    sp_sim3 socket0;   // the socket's frame at the torso's fitted pose (attached parts)
+    double stroke_box[4]; // x0 y0 x1 y1, canvas pixels
+    sp_mat4 world_fit;    // model -> world at the fit, after attachment
+    // Attachment (layout.c), when pub.attached_to >= 0: the anchor is a
+    // point of the body's surface, barycentric in one of its triangles; the
+    // body's joints that skin it (the carrier) carry the part.
+    uint64_t layout_key; // the bodies it was laid out against (0: not yet)
+    sp_dragon_note note; // why it is free although drawn at a body
+    uint32_t tri[3];
+    double bary[3];
+    sp_vec3 anchor0;      // the anchor at the body's fit, world
+    sp_mat4 carrier0_inv; // inverse of the carrier's blended skin matrix at the body's fit, world
+    int carrier_n;
+    int carrier_joint[CARRIER_MAX];
+    double carrier_w[CARRIER_MAX]; // sum 1
+    // Bodies: vertices at the fit, world and canvas (for attaching; NULL until needed).
+    double* body_xyz;
+    sp_vec2* body_px;
+    bool body_has_surface;
+    // Posed at the last pose_at.
     double *p_t, *xyz, *outline;
     sp_mat4 world_t;
     sp_rig_eval* ev;
@@ -105,6 +126,9 @@ struct sp_dragon {
     sp_camera world;
     double period;
     bool posed;
+    // Fault injection for tests (NULL in use): called on every fit's
+    // parameters before they are checked, e.g. to put a NaN there.
+    void (*fit_hook)(double* p, int n);
 };
 
 /// Frees a placed part and its reference to its template. NULL is fine.
@@ -114,8 +138,18 @@ void dragon_part_free(part* p);
 
 /// The part's sketch view zoomed and panned so its rest abstraction covers the stroke's box [lo, hi].
 sp_camera dragon_zoomed_view(const tpl* t, sp_vec2 lo, sp_vec2 hi);
+/// The view turned to face the other way: what projected to u' = x now projects to 2u - x.
+sp_camera dragon_mirrored_view(const sp_camera* view, double u);
 /// Part model space -> world, making the part's view and the world camera agree.
 sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* view);
+/// Part p's carrier in the world: its joints' skin matrices (skin, the body's
+/// evaluation) blended by its weights, then the body's model -> world.
+sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world);
+/// Which way template t should face for a stroke in the box [lo, hi]: +1 as
+/// modelled, -1 mirrored (drawn on the other side of the nearest body than
+/// its socket, or its own reach, puts a part of its kind); 0: no hint (no
+/// body, or drawn over its middle).
+int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
 

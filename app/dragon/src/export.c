@@ -65,6 +65,24 @@ static int key_times(const sp_dragon* d, double** out)
     return (int)m;
 }
 
+// An orthographic camera looking along -Z (as the canvas does) on the
+// canvas's aspect, framing the box [lo, hi] (already centred) with a margin.
+static sp_camera framing_camera(const sp_dragon* d, sp_vec3 lo, sp_vec3 hi)
+{
+    double aspect = (double)d->desc.canvas_w / d->desc.canvas_h;
+    double hx = fmax(fabs(lo.x), fabs(hi.x)), hy = fmax(fabs(lo.y), fabs(hi.y)), hz = fmax(fabs(lo.z), fabs(hi.z));
+    double xmag = 1.1 * fmax(fmax(hx, hy * aspect), 1e-3);
+    sp_camera c = {0};
+    c.kind = SP_CAMERA_ORTHOGRAPHIC;
+    c.width = d->desc.canvas_w, c.height = d->desc.canvas_h;
+    c.scale = 0.5 * c.width / xmag;
+    c.cx = 0.5 * c.width, c.cy = 0.5 * c.height;
+    double eye = hz + 0.5 * xmag + 1e-3; // in front of everything
+    c.view = sp_mat4_translate((sp_vec3){0, 0, -eye});
+    c.znear = 0.01 * eye, c.zfar = eye + hz + 0.5 * xmag;
+    return c;
+}
+
 sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
 {
     // Why the cast: posing at the key times reuses the parts' evaluation
@@ -88,10 +106,20 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
         res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
         goto done;
     }
+    // Centred: the dragon's box at t = 0 goes to the origin (a viewer's
+    // default camera looks there); the camera in the file frames the box of
+    // the whole loop.
+    sp_vec3 lo, hi, alo, ahi;
+    sp_dragon_pose_at(d, 0, err);
+    if (!sp_dragon_bounds(d, &lo, &hi)) lo = hi = (sp_vec3){0, 0, 0};
+    alo = lo, ahi = hi;
+    sp_vec3 offset = sp_v3_scale(sp_v3_add(lo, hi), -0.5);
+    sp_mat4 shift = sp_mat4_translate(offset);
     for (int i = 0; i < n; ++i) {
         const part* p = d->parts[i];
         snprintf(names[i], sizeof names[i], "%02d_%s", i, p->pub.category);
-        parts[i] = (sp_gltf_scene_part){.character = &p->t->ch, .params = p->p_fit, .name = names[i], .placement = p->world_fit};
+        parts[i] = (sp_gltf_scene_part){
+            .character = &p->t->ch, .params = p->p_fit, .name = names[i], .placement = sp_mat4_mul(&shift, &p->world_fit)};
         if (animated) {
             keys[i] = malloc(sizeof(double) * ((size_t)p->t->ch.rig.param_count + 1) * (size_t)(K + 1));
             if (!keys[i]) {
@@ -104,11 +132,17 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
         for (int k = 0; k <= K; ++k) {
             ftimes[k] = (float)times[k];
             sp_dragon_pose_at(d, times[k], err);
+            sp_vec3 klo, khi;
+            if (sp_dragon_bounds(d, &klo, &khi)) {
+                alo = (sp_vec3){fmin(alo.x, klo.x), fmin(alo.y, klo.y), fmin(alo.z, klo.z)};
+                ahi = (sp_vec3){fmax(ahi.x, khi.x), fmax(ahi.y, khi.y), fmax(ahi.z, khi.z)};
+            }
             for (int i = 0; i < n; ++i) {
                 const part* p = d->parts[i];
                 size_t P = (size_t)p->t->ch.rig.param_count;
                 memcpy(keys[i] + P * (size_t)k, p->p_t, sizeof(double) * P);
-                sp_sim3 s = sp_sim3_from_mat4(&p->world_t);
+                sp_mat4 w = sp_mat4_mul(&shift, &p->world_t);
+                sp_sim3 s = sp_sim3_from_mat4(&w);
                 float* v = place_trs + 8 * ((size_t)i * (size_t)(K + 1) + (size_t)k);
                 v[0] = (float)s.t.x, v[1] = (float)s.t.y, v[2] = (float)s.t.z;
                 v[3] = (float)s.r.x, v[4] = (float)s.r.y, v[5] = (float)s.r.z, v[6] = (float)s.r.w;
@@ -140,6 +174,8 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
         cJSON_AddItemToArray(canvas, cJSON_CreateNumber(d->desc.canvas_w));
         cJSON_AddItemToArray(canvas, cJSON_CreateNumber(d->desc.canvas_h));
         cJSON_AddNumberToObject(dj, "period_s", d->period);
+        // Where the kiosk's world went: file = world + offset.
+        cJSON_AddItemToObject(dj, "world_offset", cJSON_CreateDoubleArray((const double[3]){offset.x, offset.y, offset.z}, 3));
         cJSON* pj = cJSON_AddArrayToObject(dj, "parts");
         for (int i = 0; i < n; ++i) {
             const part* p = d->parts[i];
@@ -159,7 +195,9 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
             res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
             goto done;
         }
-        sp_gltf_scene_desc sd = {.part_count = n, .parts = parts, .animation_name = "dragon", .extras_json = text};
+        sp_camera view = framing_camera(d, sp_v3_add(alo, offset), sp_v3_add(ahi, offset));
+        sp_gltf_scene_desc sd = {
+            .part_count = n, .parts = parts, .animation_name = "dragon", .extras_json = text, .camera = &view};
         res = sp_gltf_save_scene(&sd, path, err);
         free(text);
     }

@@ -1,10 +1,21 @@
 // layout.c: where a part goes: its zoomed sketch view on the canvas, the
-// similarity that places it in the world, and its attachment to a body.
+// similarity that places it in the world, and its attachment to a body at
+// the point of the body's surface, in the view, nearest to where it was
+// drawn (sp/dragon.h, "Attachment").
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "dragon_internal.h"
+
+// Pixels within which two candidate surface points count as equally near
+// the attachment end (the near and the far side of a silhouette edge).
+#define SAME_DISTANCE_PX 0.5
+// Two parts of a kind whose anchors are closer than this fraction of the
+// smaller one's stroke (its box's diagonal) are "at the same place": the
+// second goes on the body's other side.
+#define SAME_PLACE 0.15
 
 // World point of a joint-local offset of part p at its fitted pose.
 static sp_vec3 fitted_point(const part* p, const sp_mat4* model_to_world, int joint, sp_vec3 local)
@@ -38,7 +49,20 @@ sp_camera dragon_zoomed_view(const tpl* t, sp_vec2 lo, sp_vec2 hi)
     return c;
 }
 
-// Part model space -> world, making the part's view and the world camera agree (dragon.h).
+sp_camera dragon_mirrored_view(const sp_camera* view, double u)
+{
+    // Turned half round the view's vertical axis (a rotation, not a
+    // reflection: the placement stays a similarity), then shifted so that
+    // camera x lands at 2u - (what it was).
+    sp_mat4 ry = sp_mat4_identity();
+    ry.m[0] = ry.m[10] = -1;
+    sp_camera c = *view;
+    c.view = sp_mat4_mul(&ry, &view->view);
+    c.cx = 2 * u - view->cx;
+    return c;
+}
+
+// Part model space -> world, making the part's view and the world camera agree (sp/dragon.h).
 sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* view)
 {
     const sp_camera* w = &d->world;
@@ -47,7 +71,8 @@ sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* v
     a.m[0] = a.m[5] = a.m[10] = k;
     a.m[12] = (view->cx - w->cx) / w->scale;
     a.m[13] = (w->cy - view->cy) / w->scale;
-    a.m[14] = -k * t->depth0;
+    // The rest centre goes to world depth 0: the depth of the world's origin in its camera.
+    a.m[14] = -k * sp_mat4_point(&view->view, t->centre0).z + w->view.m[14];
     // World camera coordinates -> world (its view is a translation).
     sp_mat4 winv;
     sp_mat4_inverse(&w->view, &winv);
@@ -56,62 +81,353 @@ sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* v
     return sp_sim3_mat4(sp_sim3_from_mat4(&m));
 }
 
-// Recomputes every attachment and the loop period (after any change).
+// ---- bodies as seen on the canvas ------------------------------------------------------
+
+// A body's vertices at its fit, in the world and on the canvas, and the
+// area of its surface (kept: a body's fit never changes).
+static bool body_prepare(const sp_dragon* d, part* q)
+{
+    if (q->body_px) return true;
+    const sp_rig* rig = &q->t->ch.rig;
+    size_t n = (size_t)rig->vertex_count;
+    q->body_xyz = malloc(sizeof(double) * 3 * (n + 1));
+    q->body_px = malloc(sizeof(sp_vec2) * (n + 1));
+    if (!q->body_xyz || !q->body_px) {
+        free(q->body_xyz), free(q->body_px);
+        q->body_xyz = NULL, q->body_px = NULL;
+        return false;
+    }
+    sp_rig_eval_update(q->t->ev, q->p_fit, false);
+    sp_rig_eval_points(q->t->ev, sp_rig_mesh_points(rig), q->body_xyz);
+    sp_mat4_points(&q->pub.placement, q->body_xyz, (int)n);
+    for (size_t v = 0; v < n; ++v) {
+        const double* x = q->body_xyz + 3 * v;
+        q->body_px[v] = sp_camera_project(&d->world, (sp_vec3){x[0], x[1], x[2]});
+    }
+    // Its surface: the triangles' area in the world. None (every triangle of
+    // zero area, or nothing finite) means there is nothing to hold a part.
+    double area = 0;
+    for (int f = 0; f < rig->triangle_count; ++f) {
+        const uint32_t* tr = rig->triangles + 3 * f;
+        const double *a = q->body_xyz + 3 * tr[0], *b = q->body_xyz + 3 * tr[1], *c = q->body_xyz + 3 * tr[2];
+        sp_vec3 e1 = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2 = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double fa = 0.5 * sp_v3_len(sp_v3_cross(e1, e2));
+        if (isfinite(fa)) area += fa;
+    }
+    sp_vec3 lo, hi;
+    sp_bounds(q->body_xyz, (int)n, &lo, &hi);
+    double size = sp_v3_len(sp_v3_sub(hi, lo));
+    q->body_has_surface = isfinite(size) && size > 0 && area > 1e-9 * size * size;
+    return true;
+}
+
+// The point of triangle (a, b, c) nearest p, all on the canvas, with its
+// barycentric coordinates (Ericson's regions; a degenerate triangle is its
+// longest edge).
+static sp_vec2 closest_on_triangle(sp_vec2 p, sp_vec2 a, sp_vec2 b, sp_vec2 c, double bary[3])
+{
+    sp_vec2 ab = sp_v2_sub(b, a), ac = sp_v2_sub(c, a), ap = sp_v2_sub(p, a);
+    double area2 = ab.x * ac.y - ab.y * ac.x;
+    if (fabs(area2) <= 1e-12 * (sp_v2_dot(ab, ab) + sp_v2_dot(ac, ac))) {
+        // No interior: the nearest of the three edges.
+        sp_vec2 v[3] = {a, b, c};
+        double best = INFINITY;
+        sp_vec2 out = a;
+        for (int e = 0; e < 3; ++e) {
+            sp_vec2 s = v[e], t = v[(e + 1) % 3], st = sp_v2_sub(t, s);
+            double len2 = sp_v2_dot(st, st);
+            double u = len2 > 0 ? fmin(fmax(sp_v2_dot(sp_v2_sub(p, s), st) / len2, 0.0), 1.0) : 0.0;
+            sp_vec2 q = sp_v2_add(s, sp_v2_scale(st, u));
+            double dd = sp_v2_len(sp_v2_sub(p, q));
+            if (dd < best) {
+                best = dd, out = q;
+                bary[e] = 1 - u, bary[(e + 1) % 3] = u, bary[(e + 2) % 3] = 0;
+            }
+        }
+        return out;
+    }
+    double d1 = sp_v2_dot(ab, ap), d2 = sp_v2_dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return bary[0] = 1, bary[1] = bary[2] = 0, a;
+    sp_vec2 bp = sp_v2_sub(p, b);
+    double d3 = sp_v2_dot(ab, bp), d4 = sp_v2_dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return bary[1] = 1, bary[0] = bary[2] = 0, b;
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        double v = d1 / (d1 - d3);
+        bary[0] = 1 - v, bary[1] = v, bary[2] = 0;
+        return sp_v2_add(a, sp_v2_scale(ab, v));
+    }
+    sp_vec2 cp = sp_v2_sub(p, c);
+    double d5 = sp_v2_dot(ab, cp), d6 = sp_v2_dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return bary[2] = 1, bary[0] = bary[1] = 0, c;
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        double w = d2 / (d2 - d6);
+        bary[0] = 1 - w, bary[1] = 0, bary[2] = w;
+        return sp_v2_add(a, sp_v2_scale(ac, w));
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        bary[0] = 0, bary[1] = 1 - w, bary[2] = w;
+        return sp_v2_add(b, sp_v2_scale(sp_v2_sub(c, b), w));
+    }
+    double den = 1 / (va + vb + vc), v = vb * den, w = vc * den;
+    bary[0] = 1 - v - w, bary[1] = v, bary[2] = w;
+    return sp_v2_add(a, sp_v2_add(sp_v2_scale(ab, v), sp_v2_scale(ac, w)));
+}
+
+// The body's surface nearest a canvas point, in the view.
+typedef struct surface_hit {
+    double dist;       // pixels from the query point
+    sp_vec2 px;        // the nearest point of the body's projected mesh
+    int tri[2];        // [0] the near side (towards the viewer), [1] the far side
+    double bary[2][3]; // the surface point's barycentric coordinates in tri
+    double z[2];       // its world depth
+} surface_hit;
+
+// Distance from p to the box [lo, hi] (0 inside).
+static double box_distance(sp_vec2 p, sp_vec2 lo, sp_vec2 hi)
+{
+    double dx = fmax(fmax(lo.x - p.x, p.x - hi.x), 0.0), dy = fmax(fmax(lo.y - p.y, p.y - hi.y), 0.0);
+    return hypot(dx, dy);
+}
+
+// Two passes over the body's triangles: the nearest distance, then among
+// the points that near (a point inside the silhouette is covered by a front
+// and a back triangle; a silhouette edge by the triangles meeting there) the
+// nearest to the viewer and the farthest.
+static bool nearest_surface(const part* q, sp_vec2 p, surface_hit* h)
+{
+    const sp_rig* rig = &q->t->ch.rig;
+    const sp_vec2* px = q->body_px;
+    double best = INFINITY;
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) {
+            if (!isfinite(best)) return false;
+            h->dist = best;
+            h->tri[0] = h->tri[1] = -1;
+            h->z[0] = -INFINITY, h->z[1] = INFINITY;
+        }
+        double limit = pass == 0 ? INFINITY : best + SAME_DISTANCE_PX;
+        for (int f = 0; f < rig->triangle_count; ++f) {
+            const uint32_t* tr = rig->triangles + 3 * f;
+            sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
+            sp_vec2 lo = {fmin(a.x, fmin(b.x, c.x)), fmin(a.y, fmin(b.y, c.y))};
+            sp_vec2 hi = {fmax(a.x, fmax(b.x, c.x)), fmax(a.y, fmax(b.y, c.y))};
+            double bound = box_distance(p, lo, hi);
+            if (!(bound <= (pass == 0 ? best : limit))) continue; // also skips non-finite corners
+            double bary[3];
+            sp_vec2 cp = closest_on_triangle(p, a, b, c, bary);
+            double dist = sp_v2_len(sp_v2_sub(p, cp));
+            if (pass == 0) {
+                if (dist < best) best = dist, h->px = cp;
+                continue;
+            }
+            if (!(dist <= limit)) continue;
+            double z = 0;
+            for (int k = 0; k < 3; ++k)
+                z += bary[k] * q->body_xyz[3 * tr[k] + 2];
+            for (int side = 0; side < 2; ++side)
+                if (side == 0 ? z > h->z[0] : z < h->z[1]) {
+                    h->z[side] = z, h->tri[side] = f;
+                    memcpy(h->bary[side], bary, sizeof bary);
+                }
+        }
+    }
+    return h->tri[0] >= 0;
+}
+
+// ---- attaching -------------------------------------------------------------------------
+
+// The body's socket for this part (its category's, or the one the part
+// prefers), nearest the anchor: a hint of the side the part goes on.
+static const dsocket* socket_hint(const part* q, const part* p, sp_vec3 anchor, sp_vec3* where)
+{
+    const dsocket* best = NULL;
+    double bd = INFINITY;
+    for (int s = 0; s < q->t->socket_count; ++s) {
+        const dsocket* so = &q->t->sockets[s];
+        if (!socket_accepts(so, p->pub.category, p->t->prefer)) continue;
+        sp_vec3 w = fitted_point(q, &q->pub.placement, so->joint, so->local);
+        double dd = sp_v3_len(sp_v3_sub(w, anchor));
+        if (dd < bd) bd = dd, best = so, *where = w;
+    }
+    return best;
+}
+
+sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world)
+{
+    sp_mat4 m = {{0}};
+    for (int e = 0; e < p->carrier_n; ++e)
+        for (int c = 0; c < 16; ++c)
+            m.m[c] += p->carrier_w[e] * skin[p->carrier_joint[e]].m[c];
+    return sp_mat4_mul(body_world, &m);
+}
+
+// Attaches part i to body k at the surface point h: moves it there, and
+// records the body's joints that skin that point (its carrier).
+static void attach(sp_dragon* d, int i, int k, const surface_hit* h, sp_vec3 a)
+{
+    part* p = d->parts[i];
+    part* q = d->parts[k];
+    const sp_rig* rig = &q->t->ch.rig;
+    // Near or far: the socket says which side the first part of its kind
+    // goes on (its depth against the body's middle); a part of the same
+    // kind already at the same place sends the next one to the other side.
+    sp_vec3 sw = {0, 0, 0};
+    const dsocket* so = socket_hint(q, p, a, &sw);
+    bool far = false;
+    if (so) {
+        sp_vec3 lo, hi;
+        sp_bounds(q->body_xyz, rig->vertex_count, &lo, &hi);
+        far = sw.z < 0.5 * (lo.z + hi.z) - 1e-6 * sp_v3_len(sp_v3_sub(hi, lo));
+    }
+    sp_vec2 here = h->px;
+    for (int j = 0; j < i; ++j) {
+        const part* o = d->parts[j];
+        double size = fmin(hypot(o->stroke_box[2] - o->stroke_box[0], o->stroke_box[3] - o->stroke_box[1]),
+                           hypot(p->stroke_box[2] - p->stroke_box[0], p->stroke_box[3] - p->stroke_box[1]));
+        if (o->pub.attached_to == k && !strcmp(o->pub.category, p->pub.category) &&
+            sp_v2_len(sp_v2_sub(o->pub.anchor, here)) < SAME_PLACE * size)
+            far = !far;
+    }
+    int side = far ? 1 : 0;
+    const uint32_t* tr = rig->triangles + 3 * h->tri[side];
+    sp_vec3 s = {0, 0, 0};
+    for (int c = 0; c < 3; ++c)
+        s = sp_v3_add(s, sp_v3_scale((sp_vec3){q->body_xyz[3 * tr[c]], q->body_xyz[3 * tr[c] + 1], q->body_xyz[3 * tr[c] + 2]},
+                                     h->bary[side][c]));
+    sp_mat4 move = sp_mat4_translate(sp_v3_sub(s, a));
+    p->world_fit = sp_mat4_mul(&move, &p->pub.placement);
+    // The carrier: the three corners' skin weights blended by the point's
+    // barycentric coordinates.
+    p->carrier_n = 0;
+    for (int c = 0; c < 3; ++c)
+        for (int m = 0; m < 4; ++m) {
+            double w = h->bary[side][c] * rig->weights4[4 * tr[c] + m];
+            int j = rig->joints4[4 * tr[c] + m];
+            if (!(w > 0)) continue;
+            int e = 0;
+            while (e < p->carrier_n && p->carrier_joint[e] != j)
+                ++e;
+            if (e == p->carrier_n) { // at most 3 corners x 4 weights = CARRIER_MAX joints
+                p->carrier_joint[e] = j, p->carrier_w[e] = 0, ++p->carrier_n;
+            }
+            p->carrier_w[e] += w;
+        }
+    double sum = 0;
+    int strongest = 0;
+    for (int e = 0; e < p->carrier_n; ++e) {
+        sum += p->carrier_w[e];
+        if (p->carrier_w[e] > p->carrier_w[strongest]) strongest = e;
+    }
+    for (int e = 0; e < p->carrier_n; ++e)
+        p->carrier_w[e] /= sum > 0 ? sum : 1;
+    if (p->carrier_n == 0) p->carrier_joint[0] = q->t->attach_joint, p->carrier_w[0] = 1, p->carrier_n = 1;
+    sp_rig_eval_update(q->t->ev, q->p_fit, false);
+    sp_mat4 m0 = dragon_carrier_matrix(p, sp_rig_eval_skin(q->t->ev), &q->pub.placement);
+    sp_mat4_inverse(&m0, &p->carrier0_inv);
+    memcpy(p->tri, tr, sizeof p->tri);
+    memcpy(p->bary, h->bary[side], sizeof p->bary);
+    p->anchor0 = s;
+    p->pub.attached_to = k;
+    p->pub.far_side = far;
+    p->pub.anchor = sp_camera_project(&d->world, s);
+    p->pub.carrier_joint = p->carrier_joint[strongest];
+    dragon_copy_name(p->pub.socket, sizeof p->pub.socket, so ? so->name : "");
+}
+
+int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
+{
+    sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
+    const part* body = NULL;
+    double bd = INFINITY;
+    sp_vec2 blo = {0, 0}, bhi = {0, 0};
+    for (int k = 0; k < d->part_n; ++k) {
+        part* q = d->parts[k];
+        if (!q->t->is_torso || !body_prepare(d, q)) continue;
+        int n = q->t->ch.rig.vertex_count;
+        if (n <= 0) continue;
+        sp_vec2 a = q->body_px[0], b = q->body_px[0];
+        for (int v = 1; v < n; ++v)
+            a.x = fmin(a.x, q->body_px[v].x), a.y = fmin(a.y, q->body_px[v].y), b.x = fmax(b.x, q->body_px[v].x),
+            b.y = fmax(b.y, q->body_px[v].y);
+        double dist = box_distance(c, a, b);
+        if (dist < bd) bd = dist, body = q, blo = a, bhi = b;
+    }
+    if (!body) return 0;
+    double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x);
+    double side = c.x - mid;
+    if (!(fabs(side) > 0.25 * half)) return 0; // over the body's middle: no side to face away from
+    // The side a part of its kind takes facing as modelled: its socket's,
+    // else the way it reaches.
+    int natural = t->outward;
+    for (int s = 0; s < body->t->socket_count; ++s) {
+        const dsocket* so = &body->t->sockets[s];
+        if (!socket_accepts(so, t->category, t->prefer)) continue;
+        sp_vec3 w = fitted_point(body, &body->pub.placement, so->joint, so->local);
+        double su = sp_camera_project(&d->world, w).x - mid;
+        if (fabs(su) > 0.25 * half) natural = su > 0 ? 1 : -1;
+        break;
+    }
+    return (side > 0 ? 1 : -1) == natural ? 1 : -1;
+}
+
+// A key for the set of bodies a layout was made against (their ids in order).
+static uint64_t bodies_key(const sp_dragon* d)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (int i = 0; i < d->part_n; ++i)
+        if (d->parts[i]->t->is_torso) h = (h ^ d->parts[i]->pub.id) * 1099511628211ull;
+    return h;
+}
+
+// Lays part i out against the bodies: attached at the nearest body's
+// surface when its attachment end is within the snap distance of one, else
+// free where it was drawn.
+static void layout_part(sp_dragon* d, int i)
+{
+    part* p = d->parts[i];
+    p->world_fit = p->pub.placement;
+    p->pub.attached_to = -1;
+    p->pub.far_side = false;
+    p->pub.socket[0] = 0;
+    p->pub.carrier_joint = -1;
+    p->pub.anchor = (sp_vec2){NAN, NAN};
+    p->note = SP_DRAGON_NOTE_NONE;
+    sp_vec3 a = fitted_point(p, &p->pub.placement, p->t->attach_joint, p->t->attach_local);
+    sp_vec2 a2 = sp_camera_project(&d->world, a);
+    p->pub.attach_end = a2;
+    if (p->t->is_torso) return;
+    double snap = d->desc.snap_fraction > 0 ? d->desc.snap_fraction * hypot(d->desc.canvas_w, d->desc.canvas_h) : 0;
+    int bk = -1;
+    surface_hit best = {.dist = INFINITY};
+    for (int k = 0; k < d->part_n; ++k) {
+        part* q = d->parts[k];
+        if (k == i || !q->t->is_torso || !body_prepare(d, q)) continue;
+        surface_hit h;
+        if (nearest_surface(q, a2, &h) && h.dist < best.dist) best = h, bk = k;
+    }
+    if (bk < 0 || !(best.dist <= snap)) return; // far from every body: free, where it was drawn
+    if (!d->parts[bk]->body_has_surface) {
+        p->note = SP_DRAGON_NOTE_NO_SURFACE; // drawn at a body that cannot hold it: free
+        return;
+    }
+    attach(d, i, bk, &best, a);
+}
+
 void dragon_relayout(sp_dragon* d)
 {
-    double diag = hypot(d->desc.canvas_w, d->desc.canvas_h);
+    uint64_t key = bodies_key(d);
     d->period = 0;
     for (int i = 0; i < d->part_n; ++i) {
         part* p = d->parts[i];
-        p->world_fit = p->pub.placement;
-        p->pub.attached_to = -1;
-        p->pub.socket[0] = 0;
-        p->pub.socket_joint = -1;
         if (p->t->clip) d->period = fmax(d->period, p->t->clip_len);
-    }
-    for (int i = 0; i < d->part_n; ++i) {
-        part* p = d->parts[i];
-        if (p->t->is_torso) continue;
-        sp_vec3 a = fitted_point(p, &p->pub.placement, p->t->attach_joint, p->t->attach_local);
-        sp_vec2 a2 = sp_camera_project(&d->world, a);
-        // Two rounds: sockets that want this part (by category or name), then any socket.
-        for (int round = 0; round < 2 && p->pub.attached_to < 0; ++round) {
-            double best = INFINITY;
-            int bk = -1, bs = -1;
-            sp_vec3 bpos = {0, 0, 0};
-            for (int k = 0; k < d->part_n; ++k) {
-                const part* q = d->parts[k];
-                if (k == i || !q->t->is_torso) continue;
-                for (int s = 0; s < q->t->socket_count; ++s) {
-                    const dsocket* so = &q->t->sockets[s];
-                    if (round == 0 && !socket_accepts(so, p->pub.category, p->t->prefer)) continue;
-                    sp_vec3 w = fitted_point(q, &q->pub.placement, so->joint, so->local);
-                    double dist = sp_v2_len(sp_v2_sub(sp_camera_project(&d->world, w), a2));
-                    if (dist < best) best = dist, bk = k, bs = s, bpos = w;
-                }
-                if (q->t->socket_count == 0 && round == 1) {
-                    // A torso without declared sockets: its root joint is the socket.
-                    sp_vec3 w = fitted_point(q, &q->pub.placement, q->t->attach_joint, (sp_vec3){0, 0, 0});
-                    double dist = sp_v2_len(sp_v2_sub(sp_camera_project(&d->world, w), a2));
-                    if (dist < best) best = dist, bk = k, bs = -1, bpos = w;
-                }
-            }
-            if (bk < 0) continue;
-            const part* q = d->parts[bk];
-            int joint = bs >= 0 ? q->t->sockets[bs].joint : q->t->attach_joint;
-            sp_vec3 delta = sp_v3_sub(bpos, a);
-            bool snap = d->desc.snap_fraction > 0 && best <= d->desc.snap_fraction * diag;
-            if (!snap) delta.x = delta.y = 0;
-            sp_mat4 tr = sp_mat4_translate(delta);
-            p->world_fit = sp_mat4_mul(&tr, &p->pub.placement);
-            sp_rig_eval_update(q->t->ev, q->p_fit, false);
-            sp_mat4 f0 = sp_mat4_mul(&q->pub.placement, &sp_rig_eval_world(q->t->ev)[joint]);
-            p->socket0 = sp_sim3_from_mat4(&f0);
-            p->pub.attached_to = bk;
-            p->pub.socket_joint = joint;
-            dragon_copy_name(p->pub.socket, sizeof p->pub.socket,
-                             bs >= 0 ? q->t->sockets[bs].name : q->t->ch.rig.joints[joint].name);
-        }
+        // A part keeps its layout while the bodies stay the same (parts
+        // drawn before it do not change it; those after it cannot).
+        if (p->layout_key != key) layout_part(d, i);
+        p->layout_key = key;
     }
     d->posed = false;
 }

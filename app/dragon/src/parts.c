@@ -165,7 +165,7 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
         t->base.kind = SP_CAMERA_ORTHOGRAPHIC;
         t->base.scale /= d;
     }
-    t->depth0 = c.z;
+    t->centre0 = centre;
     sp_abstraction_project(rig, t->abstraction, &t->base, t->ch.pose, xy);
     int n = rig->abstractions[t->abstraction].point_count;
     t->rest_lo = t->rest_hi = (sp_vec2){xy[0], xy[1]};
@@ -178,6 +178,12 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
         sp_fail(err, SP_ERR_INVALID, "part %s: its abstraction is invisible in its sketch view", name);
         goto fail;
     }
+    // Which way it reaches from its attachment end, as modelled: sideways
+    // (a head, a tail) parts may be fitted facing the other way (stroke.c).
+    sp_vec2 at = sp_camera_project(&t->base, sp_mat4_point(&sp_rig_eval_world(t->ev)[t->attach_joint], t->attach_local));
+    sp_vec2 reach = sp_v2_sub(sp_v2_scale(sp_v2_add(t->rest_lo, t->rest_hi), 0.5), at);
+    t->lengthwise = !t->is_torso && fabs(reach.x) > fabs(reach.y);
+    t->outward = reach.x >= 0 ? 1 : -1;
     // The clip: the first animation with channels.
     for (int a = 0; a < rig->animation_count && !t->clip; ++a) {
         const sp_animation* an = &rig->animations[a];
@@ -230,6 +236,8 @@ void dragon_part_free(part* p)
     free(p->p_t);
     free(p->xyz);
     free(p->outline);
+    free(p->body_xyz);
+    free(p->body_px);
     sp_rig_eval_destroy(p->ev);
     free(p);
 }

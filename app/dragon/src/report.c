@@ -7,8 +7,30 @@
 #include "dragon_internal.h"
 #include "report.h"
 
-struct cJSON* sp_dragon_report_json(const sp_dragon* d)
+static cJSON* box_json(const double b[4])
 {
+    return cJSON_CreateDoubleArray(b, 4);
+}
+
+// Part i's abstraction at the last pose, on the canvas: its box (x0 y0 x1 y1).
+static void outline_box(const sp_dragon* d, const part* p, double b[4])
+{
+    int n = p->t->ch.rig.abstractions[p->t->abstraction].point_count;
+    b[0] = b[1] = INFINITY, b[2] = b[3] = -INFINITY;
+    for (int k = 0; k < n; ++k) {
+        sp_vec2 u = sp_camera_project(&d->world, (sp_vec3){p->outline[3 * k], p->outline[3 * k + 1], p->outline[3 * k + 2]});
+        b[0] = fmin(b[0], u.x), b[1] = fmin(b[1], u.y), b[2] = fmax(b[2], u.x), b[3] = fmax(b[3], u.y);
+    }
+}
+
+struct cJSON* sp_dragon_report_json(const sp_dragon* dc)
+{
+    // Why the cast: the outlines' boxes at t = 0 are read from a pose, which
+    // reuses the parts' evaluation buffers (sp/dragon.h says a report ends
+    // the last pose).
+    sp_dragon* d = (sp_dragon*)dc;
+    sp_error perr = {0};
+    bool posed = sp_dragon_pose_at(d, 0, &perr) == SP_OK;
     cJSON* o = cJSON_CreateObject();
     double ms = 0, eb = 0, ea = 0, mean = 0, mx = 0;
     int it = 0, rounds = 0, unused = 0;
@@ -58,13 +80,28 @@ struct cJSON* sp_dragon_report_json(const sp_dragon* d)
         cJSON_AddStringToObject(pj, "category", p->pub.category);
         cJSON_AddNumberToObject(pj, "confidence", p->pub.confidence);
         cJSON_AddStringToObject(pj, "name", p->pub.name);
-        if (p->pub.attached_to >= 0) {
-            cJSON_AddNumberToObject(pj, "attached_to", p->pub.attached_to);
+        cJSON_AddNumberToObject(pj, "attached_to", p->pub.attached_to);
+        if (p->pub.socket[0])
             cJSON_AddStringToObject(pj, "socket", p->pub.socket);
-        } else {
-            cJSON_AddNullToObject(pj, "attached_to");
+        else
             cJSON_AddNullToObject(pj, "socket");
+        if (p->pub.attached_to >= 0) {
+            double a[2] = {p->pub.anchor.x, p->pub.anchor.y};
+            cJSON_AddItemToObject(pj, "anchor_px", cJSON_CreateDoubleArray(a, 2));
+        } else {
+            cJSON_AddNullToObject(pj, "anchor_px");
         }
+        cJSON_AddBoolToObject(pj, "far_side", p->pub.far_side);
+        cJSON_AddBoolToObject(pj, "mirrored", p->pub.mirrored);
+        double box[4];
+        if (posed) {
+            outline_box(d, p, box);
+            cJSON_AddItemToObject(pj, "outline_bbox_px", box_json(box));
+        } else {
+            cJSON_AddNullToObject(pj, "outline_bbox_px");
+        }
+        cJSON_AddItemToObject(pj, "stroke_bbox_px", box_json(p->stroke_box));
+        cJSON_AddStringToObject(pj, "note", p->note ? sp_dragon_note_name(p->note) : "");
         cJSON_AddItemToObject(pj, "report", sp_report_to_json(r, rig, ab, p->p_fit));
         cJSON_AddItemToArray(parts, pj);
     }
@@ -83,5 +120,6 @@ struct cJSON* sp_dragon_report_json(const sp_dragon* d)
     cJSON_AddItemToObject(o, "parameters", params);
     cJSON_AddNumberToObject(o, "period_s", d->period);
     cJSON_AddItemToObject(o, "parts", parts);
+    d->posed = false;
     return o;
 }

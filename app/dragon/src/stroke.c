@@ -33,7 +33,7 @@ static int clean_stroke(const sp_dragon* d, const sp_vec2* xy, int n, sp_vec2** 
     return m;
 }
 
-static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_report* rep, const sp_camera* view,
+static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_report* rep, const sp_camera* view, bool mirrored,
                           const sp_vec2* xy, int n, float confidence, part** out, sp_error* err)
 {
     const sp_rig* rig = &t->ch.rig;
@@ -54,6 +54,11 @@ static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_
     memcpy(q->p_fit, p, sizeof(double) * (size_t)rig->param_count);
     memcpy(q->stroke, xy, sizeof(sp_vec2) * (size_t)n);
     q->stroke_n = n;
+    q->stroke_box[0] = q->stroke_box[2] = xy[0].x, q->stroke_box[1] = q->stroke_box[3] = xy[0].y;
+    for (int i = 1; i < n; ++i) {
+        q->stroke_box[0] = fmin(q->stroke_box[0], xy[i].x), q->stroke_box[1] = fmin(q->stroke_box[1], xy[i].y);
+        q->stroke_box[2] = fmax(q->stroke_box[2], xy[i].x), q->stroke_box[3] = fmax(q->stroke_box[3], xy[i].y);
+    }
     q->t = t;
     ++t->refs;
     sp_dragon_part* pub = &q->pub;
@@ -66,14 +71,114 @@ static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_
     pub->params = q->p_fit;
     pub->report = *rep;
     pub->view = *view;
+    pub->mirrored = mirrored;
     pub->placement = dragon_placement_of(d, t, view);
     pub->is_torso = t->is_torso;
     pub->attached_to = -1;
-    pub->socket_joint = -1;
+    pub->carrier_joint = -1;
+    pub->anchor = (sp_vec2){NAN, NAN};
     pub->stroke_points = n;
     pub->stroke_xy = q->stroke;
     *out = q;
     return SP_OK;
+}
+
+// One fitted candidate: a part of the category in one facing.
+typedef struct fit_choice {
+    tpl* t;
+    bool mirrored;
+    double score; // mean error over the stroke's diagonal
+    double* p;    // malloc'd, rig.param_count
+    sp_solve_report rep;
+    sp_camera view; // the view it was fitted in (turned when mirrored)
+} fit_choice;
+
+// Whether a fit can become a part: every number finite (a solver that
+// produced NaN from a broken rig must not put it on the canvas).
+static bool fit_is_finite(const sp_dragon* d, const tpl* t, const double* p, const sp_solve_report* rep, const sp_camera* view)
+{
+    for (int k = 0; k < t->ch.rig.param_count; ++k)
+        if (!isfinite(p[k])) return false;
+    sp_mat4 m = dragon_placement_of(d, t, view);
+    for (int k = 0; k < 16; ++k)
+        if (!isfinite(m.m[k])) return false;
+    return isfinite(rep->mean_error_px) && isfinite(rep->max_error_px);
+}
+
+// Fits the stroke (its box [lo, hi]) with template t in one facing: the
+// mirrored facing fits the stroke mirrored left-right about its box's centre.
+static bool fit_one(sp_dragon* d, tpl* t, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, bool mirrored, fit_choice* out,
+                    int* not_finite)
+{
+    const sp_rig* rig = &t->ch.rig;
+    int n = sk->strokes[0].count;
+    double u = 0.5 * (lo.x + hi.x);
+    sp_vec2* flipped = mirrored ? malloc(sizeof(sp_vec2) * (size_t)n) : NULL;
+    double* p = malloc(sizeof(double) * ((size_t)rig->param_count + 1));
+    if (!p || (mirrored && !flipped)) {
+        free(p), free(flipped);
+        return false;
+    }
+    sp_sketch msk = *sk;
+    sp_stroke ms = {.count = n, .points = flipped};
+    if (mirrored) {
+        for (int i = 0; i < n; ++i)
+            flipped[i] = (sp_vec2){2 * u - sk->strokes[0].points[i].x, sk->strokes[0].points[i].y};
+        msk.strokes = &ms;
+    }
+    memcpy(p, t->ch.pose, sizeof(double) * (size_t)rig->param_count);
+    t->solver_cam = dragon_zoomed_view(t, lo, hi);
+    sp_solve_report rep;
+    sp_error serr = {0};
+    bool ok = sp_solver_solve(t->solver, &msk, p, p, &rep, &serr) == SP_OK;
+    free(flipped);
+    if (ok && d->fit_hook) d->fit_hook(p, rig->param_count);
+    sp_camera view = mirrored ? dragon_mirrored_view(&t->solver_cam, u) : t->solver_cam;
+    if (ok && !fit_is_finite(d, t, p, &rep, &view)) ok = false, ++*not_finite;
+    if (!ok) {
+        free(p);
+        return false;
+    }
+    double score = rep.mean_error_px / fmax(rep.bbox_diagonal_px, 1.0);
+    *out = (fit_choice){t, mirrored, score, p, rep, view};
+    return true;
+}
+
+// A fit in the hinted facing worse than this (mean error over the stroke's
+// diagonal; good fits of hand-drawn parts are 0.1-0.3%) also tries the other.
+#define OTHER_FACING_SCORE 0.004
+
+// Fits every candidate part. A part that reaches sideways (a head, a tail)
+// is fitted in the facing the bodies' sockets hint at and, when there is no
+// hint or that fit is poor, in the other too: the hinted one is kept unless
+// the other fits clearly better. The best candidate goes to *best.
+static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, fit_choice* best,
+                         int* not_finite)
+{
+    bool any = false;
+    for (int c = 0; c < nc; ++c) {
+        tpl* t = cands[c];
+        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi) : 1;
+        fit_choice a, b;
+        bool got = fit_one(d, t, sk, lo, hi, hint < 0, &a, not_finite);
+        bool other = t->lengthwise && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
+        if (other && fit_one(d, t, sk, lo, hi, !(hint < 0), &b, not_finite)) {
+            if (!got || b.score < 0.8 * a.score) {
+                if (got) free(a.p);
+                a = b, got = true;
+            } else {
+                free(b.p);
+            }
+        }
+        if (!got) continue;
+        if (!any || a.score < best->score) {
+            if (any) free(best->p);
+            *best = a, any = true;
+        } else {
+            free(a.p);
+        }
+    }
+    return any;
 }
 
 static void fill_guesses(const sp_clf* clf, const sp_clf_answer* a, sp_dragon_result* out)
@@ -198,7 +303,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         free(pts);
         return reject(out, why, t0);
     }
-    // Fit every variant of the category; keep the one that matches best.
+    // Fit every variant of the category (and facing); keep the one that matches best.
     double tf = dragon_now_ms();
     tpl* cands[16];
     int cap = d->desc.max_variants < 16 ? d->desc.max_variants : 16;
@@ -208,46 +313,23 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         free(pts);
         return reject(out, SP_DRAGON_NO_PART, t0);
     }
-    int best = -1;
-    double best_score = INFINITY;
-    double* best_p = NULL;
-    sp_solve_report best_rep;
-    sp_camera best_view = {0};
-    for (int c = 0; c < nc; ++c) {
-        tpl* t = cands[c];
-        const sp_rig* rig = &t->ch.rig;
-        double* p = malloc(sizeof(double) * ((size_t)rig->param_count + 1));
-        if (!p) continue;
-        memcpy(p, t->ch.pose, sizeof(double) * (size_t)rig->param_count);
-        t->solver_cam = dragon_zoomed_view(t, lo, hi);
-        sp_solve_report rep;
-        sp_error serr = {0};
-        if (sp_solver_solve(t->solver, &sk, p, p, &rep, &serr) != SP_OK) {
-            free(p);
-            continue;
-        }
-        double score = rep.mean_error_px / fmax(rep.bbox_diagonal_px, 1.0);
-        if (!isfinite(score)) score = 1e300;
-        if (best < 0 || score < best_score) {
-            free(best_p);
-            best = c, best_score = score, best_p = p, best_rep = rep, best_view = t->solver_cam;
-        } else {
-            free(p);
-        }
-    }
+    fit_choice best;
+    int not_finite = 0;
+    bool fitted = fit_variants(d, cands, nc, &sk, lo, hi, &best, &not_finite);
     out->ms_fit = dragon_now_ms() - tf;
-    if (best < 0) {
+    if (!fitted) {
         free(pts);
+        if (not_finite > 0) out->note = SP_DRAGON_NOTE_NOT_FINITE;
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
     }
-    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best_score)) {
+    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best.score)) {
         free(pts);
-        free(best_p);
+        free(best.p);
         return reject(out, SP_DRAGON_UNRECOGNISED, t0);
     }
     part* q = NULL;
-    sp_result r = new_part(d, cands[best], best_p, &best_rep, &best_view, pts, n, confidence, &q, err);
-    free(best_p);
+    sp_result r = new_part(d, best.t, best.p, &best.rep, &best.view, best.mirrored, pts, n, confidence, &q, err);
+    free(best.p);
     free(pts);
     if (r != SP_OK) return r;
     if (o.replace_last && d->part_n > 0) {
@@ -269,6 +351,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     out->part = d->part_n - 1;
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
+    out->note = d->parts[out->part]->note;
     out->ms_total = dragon_now_ms() - t0;
     return SP_OK;
 }

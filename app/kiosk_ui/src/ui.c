@@ -731,7 +731,10 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
             ui->flash_breaks[ui->flash_break_count++] = r->outline_breaks[i];
     ui->flash_until = ui->now + ui->desc.flash_ms;
     ui->fade_until = -1;
-    ui->hint_until = -1;
+    if (r->hint)
+        set_hint(ui, r->hint); // the part is there, but something needs saying
+    else
+        ui->hint_until = -1;
 }
 
 void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label)

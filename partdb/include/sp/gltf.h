@@ -77,6 +77,7 @@ typedef struct sp_gltf_scene_desc {
     const char* animation_name; ///< the ONE animation holding every part's channels; NULL: "animation"
     const char* extras_json;    ///< the scene's extras as a JSON object text, or NULL
     bool abstractions;          ///< also write each part's abstraction curves (off: viewers draw them as lines)
+    const sp_camera* camera;    ///< written as the scene's camera (a node "view" at the inverse of its view); NULL: none
 } sp_gltf_scene_desc;
 
 /// Writes several parts into one glTF (".glb" binary, else .gltf with

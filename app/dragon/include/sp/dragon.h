@@ -15,7 +15,7 @@
 ///         const sp_dragon_part* p = sp_dragon_part_get(d, i);  // p->character->rig.triangles, ->colors
 ///         draw(sp_dragon_part_xyz(d, i), ...);                // world space, vertex_count by 3
 ///     }
-///     sp_dragon_export_glb(d, "dragon.glb", &err);
+///     sp_dragon_export(d, "dragon.glb", &err);
 ///     sp_dragon_destroy(d);
 ///
 /// The shared world (one for the whole dragon, so that parts drawn in
@@ -38,18 +38,34 @@
 /// projections agree: the 3D part lands exactly where its fitted outline
 /// was drawn, with its rest-pose centre at depth z = 0. A perspective
 /// part camera is replaced by its weak-perspective (orthographic) equivalent
-/// at the depth of the rest-pose centre.
+/// at the depth of the rest-pose centre. A part that reaches sideways from
+/// its attachment end (a head, a tail) is also fitted facing the other way
+/// (the stroke mirrored left-right; placed, the part is turned half round
+/// the vertical axis, still a similarity): the facing its socket hints at
+/// (a head drawn at the tail end of a body faces away from it) is kept
+/// unless the other fits clearly better (mean error under 0.8 times).
 ///
-/// Attachment: a part whose category is not a torso attaches to the nearest
-/// socket (in canvas pixels, at the fitted poses) of any torso part (one
-/// whose `sp_part` has sockets, or category "torso"); the socket's joint
-/// then carries it, so the dragon moves as one. Its depth goes to the
-/// socket's; in the picture plane it moves onto the socket only when its
-/// attachment point is within `snap_fraction` of the canvas diagonal (a
-/// part drawn touching the body joins it, one drawn far away stays where
-/// it was drawn and still follows the body). Attachments are recomputed
-/// after every change, so a torso drawn last still collects the parts
-/// drawn before it, and undoing it frees them.
+/// Attachment: a part that is not a body (a body: category "torso", or
+/// sockets in its `sp_part`) attaches to the body whose surface, seen on the
+/// canvas at the fits, comes nearest its attachment end (`sp_part.attach`:
+/// a joint and a point; default: the root joint's origin), when that is
+/// within `snap_fraction` of the canvas diagonal; farther from every body it
+/// stays free where it was drawn. The attachment end moves onto that
+/// surface point (not at all when drawn over the body, where the nearest
+/// point is under it): on the body's near side (its visible surface), or on
+/// its far side for a second part of a kind drawn at the same place (their
+/// strokes' boxes overlap with IoU >= 0.3; a third goes near again), so
+/// two parts drawn at the same place do not z-fight; the body's socket for
+/// the category (if any) says which side the first one takes (the far side
+/// when the socket lies behind the body's middle). The body's joints that
+/// skin that surface point (the corners' skin weights blended by its
+/// barycentric coordinates) carry the part: at every time its attachment
+/// end is the skinned surface point and it turns and scales with the
+/// blended skin matrix (its nearest similarity), so it rides the body's
+/// animation with no gap. A body whose triangles have no area cannot hold
+/// a part: one drawn there stays free (sp_dragon_result.note says so).
+/// Attachments are recomputed when the bodies change, so a body drawn last
+/// still collects the parts drawn before it, and undoing it frees them.
 ///
 /// Animation: each part's first glTF animation clip, applied as offsets on
 /// its fitted parameters: p(t) = clamp(p_fit + clip(t') - rest) for
@@ -98,7 +114,7 @@ typedef struct sp_dragon_desc {
     int canvas_w, canvas_h; ///< drawing canvas, pixels; 0: 1280 x 800
     sp_solve_desc solve; ///< solver options; zero: the solver's defaults except time_cap_ms 250, representatives 100, samples 48
     double min_confidence; ///< a top guess scoring below this is rejected too; 0: 0.0 (only the classifier's own rejection)
-    double snap_fraction;  ///< attachment snap distance, fraction of the canvas diagonal; 0: 0.15; < 0: never snap in 2D
+    double snap_fraction;  ///< how near a body a part attaches, fraction of the canvas diagonal; 0: 0.06; < 0: never attach
     int max_variants;      ///< parts of one category fitted per stroke, best kept; 0: 4
     double fps;            ///< key rate of the exported animation, per second; 0: 30
     int max_parts;         ///< a stroke beyond this many parts is rejected (a kiosk runs all day); 0: 48
@@ -119,6 +135,16 @@ typedef enum sp_dragon_reject {
 /// "accepted", "too_short", "unrecognised", "no_part", "no_model", "fit_failed", "nothing_to_refit", "full".
 const char* sp_dragon_reject_name(sp_dragon_reject r);
 
+/// What else a visitor should be told about a stroke.
+typedef enum sp_dragon_note {
+    SP_DRAGON_NOTE_NONE = 0,
+    SP_DRAGON_NOTE_NO_SURFACE, ///< accepted, drawn at a body whose triangles have no area: the part stays free where drawn
+    SP_DRAGON_NOTE_NOT_FINITE, ///< a fit gave numbers that are not finite and was dropped (fit_failed when none was left)
+} sp_dragon_note;
+
+/// "none", "no_surface", "not_finite".
+const char* sp_dragon_note_name(sp_dragon_note n);
+
 /// A ranked category.
 typedef struct sp_dragon_guess {
     char category[SP_NAME_MAX];
@@ -135,12 +161,16 @@ typedef struct sp_dragon_part {
     int abstraction;               ///< index of the abstraction fitted
     const double* params;          ///< fitted parameters (rig.param_count)
     sp_solve_report report;        ///< the fit
-    sp_camera view;                ///< the part's own zoomed sketch view on the canvas (fitting happened in it)
+    sp_camera view;                ///< the part's own zoomed sketch view on the canvas (the fit's, turned when mirrored)
+    bool mirrored;                 ///< fitted facing the other way (the stroke mirrored left-right)
     sp_mat4 placement;             ///< part model space -> world at the fit (the similarity above), before attachment
-    bool is_torso;                 ///< offers sockets
-    int attached_to;               ///< index of the torso part it hangs on, -1: free
-    char socket[SP_NAME_MAX];      ///< the socket's name when attached
-    int socket_joint;              ///< the torso's joint carrying it, when attached
+    bool is_torso;                 ///< a body (carries other parts)
+    sp_vec2 attach_end;            ///< its attachment end (sp_part.attach) on the canvas as fitted, pixels
+    int attached_to;               ///< index of the body it hangs on, -1: free
+    sp_vec2 anchor;                ///< where it attaches: the body's surface point on the canvas, pixels (NaN when free)
+    bool far_side;                 ///< attached on the body's far side
+    char socket[SP_NAME_MAX];      ///< the body's socket that hinted its side and facing, "" when none
+    int carrier_joint;             ///< the body's joint weighing most in carrying it, when attached
     int stroke_points;             ///< the stroke as fitted (after cleaning): stroke_points by 2 in stroke_xy
     const sp_vec2* stroke_xy;
 } sp_dragon_part;
@@ -149,7 +179,8 @@ typedef struct sp_dragon_part {
 typedef struct sp_dragon_result {
     bool rejected; ///< nothing changed (see reason)
     sp_dragon_reject reason;
-    int guess_count; ///< ranked categories (0..SP_DRAGON_GUESSES), also when rejected by the classifier
+    sp_dragon_note note; ///< what else to tell (also when accepted)
+    int guess_count;     ///< ranked categories (0..SP_DRAGON_GUESSES), also when rejected by the classifier
     sp_dragon_guess guesses[SP_DRAGON_GUESSES];
     int part;                             ///< index of the new (or replaced) part, -1 when rejected
     double ms_classify, ms_fit, ms_total; ///< wall-clock, milliseconds
@@ -198,7 +229,7 @@ double sp_dragon_period(const sp_dragon* d);
 /// Evaluates every part at time t (seconds, wrapped into the loop): its
 /// animated parameters, its attachment, its skinned vertices and abstraction
 /// in world space, readable with the calls below until the next pose_at,
-/// change or export (then NULL). SP_ERR_NO_MEMORY is the only failure.
+/// change, report or export (then NULL). SP_ERR_NO_MEMORY is the only failure.
 sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err);
 /// Part i's vertices at the last pose_at, world, rig.vertex_count by 3.
 const double* sp_dragon_part_xyz(const sp_dragon* d, int i);
@@ -219,9 +250,12 @@ const sp_mat4* sp_dragon_part_transform(const sp_dragon* d, int i);
 bool sp_dragon_bounds(const sp_dragon* d, sp_vec3* lo, sp_vec3* hi);
 
 /// Writes one glTF (.glb, or .gltf with embedded buffers by extension) with
-/// every part (each its own skin) in the world above, attachments as node
-/// parents, and ONE looped animation of length sp_dragon_period holding the
-/// offsets (none when no part animates). Fails with SP_ERR_INVALID when there
+/// every part (each its own skin under its placement node) in the world
+/// above moved so that the dragon's box at t = 0 is centred at the origin,
+/// a camera node "view" that frames it (orthographic, looking along -Z like
+/// the canvas), and ONE looped animation of length sp_dragon_period holding
+/// the joints' offsets and the attached parts' placements as their bodies
+/// move (none when no part animates). Fails with SP_ERR_INVALID when there
 /// are no parts.
 sp_result sp_dragon_export(const sp_dragon* d, const char* path, sp_error* err);
 
@@ -239,9 +273,12 @@ sp_result sp_dragon_preload(sp_dragon* d, sp_error* err);
 /// The categories the current model knows (for hints); NULL when there is no model.
 const sp_clf* sp_dragon_model(const sp_dragon* d);
 
-/// The solve report of the whole dragon as JSON (DESIGN.md: the last part's
-/// solve report keys, plus "parts": [{"category", "confidence", "name",
-/// "attached_to", "socket", "report": {...}}]). Caller deletes (cJSON_Delete).
+/// The solve report of the whole dragon as JSON (DESIGN.md: the parts'
+/// solve reports combined, plus "parts": [{"category", "confidence", "name",
+/// "attached_to" (-1: free), "socket", "anchor_px" (null when free),
+/// "far_side", "mirrored", "outline_bbox_px" (the attached outline at t = 0),
+/// "stroke_bbox_px", "note", "report": {...}}]). Poses the dragon at t = 0.
+/// Caller deletes (cJSON_Delete).
 struct cJSON* sp_dragon_report_json(const sp_dragon* d);
 
 #ifdef __cplusplus

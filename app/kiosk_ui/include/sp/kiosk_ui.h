@@ -116,7 +116,7 @@ typedef struct sp_kiosk_job {
 /// The answer to a FIT or REFIT job.
 typedef struct sp_kiosk_fit_result {
     bool ok;                ///< false: rejected (hint shown, stroke fades, nothing else changes)
-    const char* hint;       ///< shown when rejected (NULL: a default)
+    const char* hint;       ///< shown when rejected (NULL: a default); when accepted, a note beside the part (NULL: none)
     const char* category;   ///< the fitted part's category
     const char* guesses[2]; ///< next two guesses (NULL or "" when none)
     int part_count;         ///< parts after the job
