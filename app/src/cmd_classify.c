@@ -1,17 +1,20 @@
-// cmd_classify.c: sketchpose classify --model M --strokes S.json
+// cmd_classify.c: sketchpose classify --model M|--db DB --strokes S.json
 #include <math.h>
 
 #include "clf_cli.h"
 #include "sp/classifier.h"
+#include "sp/partdb.h"
 #include "sp/sketch_io.h"
 
 int cmd_classify(int argc, char** argv)
 {
     const char* model = NULL;
+    const char* db_path = NULL;
     const char* strokes = NULL;
     int top = 5;
     sp_opt opts[] = {
-        {"--model", SP_OPT_STRING, &model, "M", "trained model (sketchpose train)", true},
+        {"--model", SP_OPT_STRING, &model, "M", "trained model (sketchpose train)", false},
+        {"--db", SP_OPT_STRING, &db_path, "DB", "use the part database's current model instead (sketchpose db train)", false},
         {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the drawing: stroke JSON, SVG, PNG or ndjson (first drawing)", true},
         {"--top", SP_OPT_INT, &top, "N", "ranked categories to print (default 5, at most 10)", false},
     };
@@ -22,9 +25,22 @@ int cmd_classify(int argc, char** argv)
         fprintf(stderr, "sketchpose classify: --top must be 1..%d\n", SP_CLF_MAX_RANKED);
         return SP_EXIT_USAGE;
     }
+    if (!model == !db_path) {
+        fprintf(stderr, "sketchpose classify: give --model M or --db DB (one of them)\n");
+        return SP_EXIT_USAGE;
+    }
     sp_error err = {0};
     sp_clf* clf = NULL;
-    if (sp_clf_load(model, &clf, &err) != SP_OK) {
+    sp_result lr;
+    if (db_path) {
+        sp_db* db = NULL;
+        lr = sp_db_open(db_path, SP_DB_READONLY, &db, &err);
+        if (lr == SP_OK) lr = sp_db_load_model(db, &clf, NULL, &err);
+        sp_db_close(db);
+    } else {
+        lr = sp_clf_load(model, &clf, &err);
+    }
+    if (lr != SP_OK) {
         fprintf(stderr, "sketchpose classify: %s\n", err.text);
         return SP_EXIT_INPUT;
     }

@@ -1,4 +1,4 @@
-// cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log
+// cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
 #include <dirent.h>
 #include <stdio.h>
@@ -11,6 +11,7 @@
 #include "sp/headless.h"
 #include "sp/part_preview.h"
 #include "sp/partdb.h"
+#include "sp/sketch_sheet.h"
 
 #ifndef SP_SOURCE_DIR
 #define SP_SOURCE_DIR "."
@@ -650,6 +651,161 @@ static int db_log(int argc, char** argv)
     return SP_EXIT_OK;
 }
 
+// ---- review: visitors' strokes collected by the kiosk -----------------------------------
+
+static void print_kiosk_sketch(const sp_db_kiosk_sketch* k)
+{
+    printf("{\"id\": %lld, \"category\": ", (long long)k->id);
+    clf_cli_json_str(stdout, k->category);
+    printf(", \"status\": \"%s\", \"created_at\": ", sp_db_status_name(k->status));
+    clf_cli_json_str(stdout, k->created_at);
+    printf(", \"points\": [");
+    const sp_stroke* st = k->sketch.stroke_count > 0 ? &k->sketch.strokes[0] : NULL;
+    for (int i = 0; st && i < st->count; ++i)
+        printf("%s[%.6g, %.6g]", i ? ", " : "", st->points[i].x, st->points[i].y);
+    printf("]");
+    if (st && st->t) {
+        printf(", \"t\": [");
+        for (int i = 0; i < st->count; ++i)
+            printf("%s%.6g", i ? ", " : "", st->t[i]);
+        printf("]");
+    }
+    printf("}");
+}
+
+// Reads the ids of --approve/--reject/--relabel: positive integers, else one line and false.
+static bool parse_ids(const char* cmd, const sp_str_list* l, int first, int count, int64_t* ids)
+{
+    for (int i = 0; i < count; ++i) {
+        const char* v = l->items[first + i];
+        char* end = NULL;
+        long long x = strtoll(v, &end, 10);
+        if (end == v || *end || x <= 0) {
+            fprintf(stderr, "%s: '%s' is not a kiosk sketch id (a positive number); nothing was changed\n", cmd, v);
+            return false;
+        }
+        ids[i] = x;
+    }
+    return true;
+}
+
+static int db_review(int argc, char** argv)
+{
+    const char* cmd = "sketchpose db review";
+    db_common c = {0};
+    const char *status = "pending", *sheet = NULL;
+    int limit = 100, after = 0;
+    sp_str_list approve = {0}, reject = {0}, relabel = {0};
+    sp_opt opts[] = {
+        DB_COMMON_OPTS(c),
+        {"--status", SP_OPT_STRING, &status, "S", "which to list: pending (default), approved, rejected or all", false},
+        {"--limit", SP_OPT_INT, &limit, "N", "list at most N, oldest first (default 100; 0: all)", false},
+        {"--after", SP_OPT_INT, &after, "ID", "list only ids above ID (the next page: the last id shown)", false},
+        {"--sheet", SP_OPT_STRING, &sheet, "out.png", "also draw the listed sketches as a labelled contact sheet", false},
+        {"--approve", SP_OPT_LIST, &approve, "ID...", "approve these kiosk sketches (`db train` uses approved ones)", false},
+        {"--reject", SP_OPT_LIST, &reject, "ID...", "reject these kiosk sketches (kept, never trained on)", false},
+        {"--relabel", SP_OPT_LIST, &relabel, "ID CATEGORY", "give a kiosk sketch another part category", false}};
+    const char* pos[1];
+    int npos;
+    int rc =
+        parse(argc, argv, cmd,
+              "the visitors' strokes the kiosk collected: list them as JSON (pending ones by default, oldest first), draw them, "
+              "approve, reject or relabel them; an unknown id changes nothing",
+              opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    if (rc >= 0) return rc;
+    int actions = (approve.count > 0) + (reject.count > 0) + (relabel.count > 0);
+    if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2) || limit < 0 || after < 0) {
+        fprintf(
+            stderr,
+            "%s: give one of --approve ID..., --reject ID..., --relabel ID CATEGORY (not with --sheet); --limit and --after are "
+            "not negative\n",
+            cmd);
+        return SP_EXIT_USAGE;
+    }
+    unsigned mask = 0;
+    for (int i = 0; i < SP_DB_STATUS_COUNT; ++i)
+        if (!strcmp(status, sp_db_status_name((sp_db_status)i))) mask = 1u << i;
+    if (!strcmp(status, "all")) mask = (1u << SP_DB_STATUS_COUNT) - 1;
+    if (!mask) {
+        fprintf(stderr, "%s: --status must be pending, approved, rejected or all, got '%s'\n", cmd, status);
+        return SP_EXIT_USAGE;
+    }
+    sp_error err = {0};
+    if (actions) {
+        const sp_str_list* l = approve.count ? &approve : reject.count ? &reject : &relabel;
+        int n = relabel.count ? 1 : l->count;
+        int64_t ids[256];
+        if (!parse_ids(cmd, l, 0, n, ids)) return SP_EXIT_INPUT;
+        sp_db* db = open_db(cmd, &c, 0);
+        if (!db) return SP_EXIT_INPUT;
+        sp_result r = relabel.count
+                          ? sp_db_kiosk_relabel(db, ids[0], relabel.items[1], c.by, &err)
+                          : sp_db_kiosk_set_status(db, ids, n, approve.count ? SP_DB_APPROVED : SP_DB_REJECTED, c.by, &err);
+        sp_db_close(db);
+        if (r != SP_OK) return fail(cmd, &err);
+        if (relabel.count) {
+            printf("{\"relabelled\": %lld, \"category\": ", (long long)ids[0]);
+            clf_cli_json_str(stdout, relabel.items[1]);
+            printf("}\n");
+        } else {
+            printf("{\"%s\": [", approve.count ? "approved" : "rejected");
+            for (int i = 0; i < n; ++i)
+                printf("%s%lld", i ? ", " : "", (long long)ids[i]);
+            printf("]}\n");
+        }
+        return SP_EXIT_OK;
+    }
+    sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
+    if (!db) return SP_EXIT_INPUT;
+    sp_db_kiosk_sketch* ks = NULL;
+    int n = 0, counts[SP_DB_STATUS_COUNT];
+    if (sp_db_kiosk_counts(db, counts, &err) != SP_OK ||
+        sp_db_kiosk_list(db, &(sp_db_kiosk_query){.statuses = mask, .limit = limit, .after = after}, &ks, &n, &err) != SP_OK) {
+        sp_db_close(db);
+        return fail(cmd, &err);
+    }
+    sp_db_close(db);
+    int code = SP_EXIT_OK;
+    if (sheet) {
+        sp_sheet_item* items = calloc((size_t)(n > 0 ? n : 1), sizeof *items);
+        char(*labels)[96] = calloc((size_t)(n > 0 ? n : 1), sizeof *labels);
+        char(*notes)[96] = calloc((size_t)(n > 0 ? n : 1), sizeof *notes);
+        for (int i = 0; items && labels && notes && i < n; ++i) {
+            snprintf(labels[i], sizeof labels[i], "%lld %s", (long long)ks[i].id, ks[i].category);
+            // "pending 12-02 04:44": month, day and time of the UTC created_at, to fit the cell.
+            const char* at = strlen(ks[i].created_at) >= 16 ? ks[i].created_at : "0000-00-00T00:00";
+            snprintf(notes[i], sizeof notes[i], "%s %.5s %.5s", sp_db_status_name(ks[i].status), at + 5, at + 11);
+            items[i] = (sp_sheet_item){.sketch = &ks[i].sketch, .label = labels[i], .note = notes[i]};
+        }
+        char title[160];
+        snprintf(title, sizeof title, "%s kiosk sketches, oldest first (%d shown)", status, n);
+        if (!items || !labels || !notes)
+            code = fail(cmd, &(sp_error){.text = "out of memory"});
+        else if (n == 0)
+            fprintf(stderr, "%s: no kiosk sketches listed (--status %s): no sheet written\n", cmd, status);
+        else if (sp_sheet_write_png(items, n, &(sp_sheet_desc){.title = title}, sheet, &err) != SP_OK)
+            code = fail(cmd, &err);
+        free(items);
+        free(labels);
+        free(notes);
+    }
+    if (code == SP_EXIT_OK) {
+        printf("{\"sketches\": [");
+        for (int i = 0; i < n; ++i) {
+            printf("%s", i ? ", " : "");
+            print_kiosk_sketch(&ks[i]);
+        }
+        printf("], \"counts\": {\"pending\": %d, \"approved\": %d, \"rejected\": %d}, \"next_after\": ", counts[SP_DB_PENDING],
+               counts[SP_DB_APPROVED], counts[SP_DB_REJECTED]);
+        if (limit > 0 && n == limit)
+            printf("%lld}\n", (long long)ks[n - 1].id);
+        else
+            printf("null}\n");
+    }
+    sp_db_kiosk_free(ks, n);
+    return code;
+}
+
 typedef struct db_sub {
     const char* name;
     int (*run)(int, char**);
@@ -667,6 +823,7 @@ static const db_sub k_subs[] = {
     {"train", db_train, "retrain the classifier from the stored sketches"},
     {"export", db_export, "write the parts and sketches to a folder"},
     {"log", db_log, "the curator log (JSON)"},
+    {"review", db_review, "the visitors' strokes the kiosk collected: list, draw, approve, reject, relabel"},
 };
 
 static void db_usage(FILE* f)

@@ -64,9 +64,10 @@ static void json_str(const char* s)
 
 // --parts DIR: every .glb/.gltf part of DIR (category from extras.sp_part),
 // `per_part` hand-drawn sketches each, into OUT/<category>/<part>-<style>-<family>-<i>.json.
-static int synth_parts(const char* dir, const char* abs_name, int per_part, uint64_t family, sp_handdraw_style style, double amplitude,
+static int synth_parts(const char* dir, const char* abs_name, int per_part, uint64_t family, const sp_handdraw_desc* base,
                        const char* out_dir)
 {
+    sp_handdraw_style style = base->style;
     sp_error err = {0};
     DIR* d = opendir(dir);
     if (!d) {
@@ -97,7 +98,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     }
     qsort(names, (size_t)n, sizeof *names, cmp_str);
     if (!make_dir(out_dir, &err)) goto fail;
-    sp_handdraw_desc desc = {.style = style, .amplitude = amplitude};
+    sp_handdraw_desc desc = *base;
     int total = 0, written = 0;
     printf("{\"out_dir\": ");
     json_str(out_dir);
@@ -127,7 +128,8 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
             goto fail_open;
         }
         uint64_t pf = sp_handdraw_part_family(family, stem);
-        for (int i = 0; i < per_part; ++i) {
+        int count = sp_handdraw_shape_available(&ch.rig, desc.shape) ? per_part : 0; // no single line through a head
+        for (int i = 0; i < count; ++i) {
             sp_sketch sk = {0};
             if (sp_handdraw_part(&ch.rig, a, &ch.camera, &desc, sp_handdraw_seed(pf, i), &sk, NULL, &err) != SP_OK) {
                 sp_character_free(&ch);
@@ -142,14 +144,14 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
                 goto fail_open;
             }
         }
-        total += per_part;
+        total += count;
         printf("%s{\"name\": ", written++ ? ", " : "");
         json_str(stem);
         printf(", \"category\": ");
         json_str(category);
         printf(", \"abstraction\": ");
         json_str(ch.rig.abstractions[a].name);
-        printf(", \"sketches\": %d}", per_part);
+        printf(", \"sketches\": %d}", count);
         sp_character_free(&ch);
     }
     printf("], \"sketches\": %d}\n", total);
@@ -174,22 +176,37 @@ int cmd_synth(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *out = NULL, *truth = NULL, *size = NULL, *pose = NULL;
     const char *parts = NULL, *out_dir = NULL, *style_name = NULL;
+    const char* shape_name = NULL;
     int seed = 0, per_part = 60;
-    double amplitude = 0.7853981633974483, noise = 0;
+    double amplitude = 0.7853981633974483, noise = 0, spikes = 0;
+    bool details = false;
     const sp_opt opts[] = {
         {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
         {"--seed", SP_OPT_INT, &seed, "N", "random seed (required unless --pose)", false},
         {"--pose", SP_OPT_STRING, &pose, "p.json", "draw this pose instead of a random one", false},
-        {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A", "largest change per rotation from rest, radians (default 0.785; with --parts 0.4)", false},
+        {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A",
+         "largest change per rotation from rest, radians (default 0.785; with --parts 0.4)", false},
         {"--out", SP_OPT_STRING, &out, "S.json", "stroke file to write (required unless --parts)", false},
         {"--truth", SP_OPT_STRING, &truth, "p.json", "also write the pose's parameters", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "canvas size (default: the rig's sketch view)", false},
         {"--noise", SP_OPT_DOUBLE, &noise, "PX", "Gaussian jitter of the stroke points, pixels (default 0)", false},
-        {"--style", SP_OPT_STRING, &style_name, "S", "hand-drawing model: normal, harsh or clean (default: none; with --parts: normal)", false},
-        {"--parts", SP_OPT_STRING, &parts, "DIR", "every .glb/.gltf part in DIR (category from extras.sp_part): a labelled folder", false},
+        {"--style", SP_OPT_STRING, &style_name, "S",
+         "hand-drawing model: normal, harsh or clean (default: none; with --parts: normal)", false},
+        {"--parts", SP_OPT_STRING, &parts, "DIR",
+         "every .glb/.gltf part in DIR (category from extras.sp_part): a labelled folder", false},
         {"--per-part", SP_OPT_INT, &per_part, "N", "with --parts: hand-drawn sketches per part (default 60)", false},
-        {"--out-dir", SP_OPT_STRING, &out_dir, "D", "with --parts: folder to write D/<category>/<part>-<style>-s<seed>-<i>.json", false},
+        {"--out-dir", SP_OPT_STRING, &out_dir, "D", "with --parts: folder to write D/<category>/<part>-<style>-s<seed>-<i>.json",
+         false},
+        {"--shape", SP_OPT_STRING, &shape_name, "S",
+         "with --parts: outline (default), top, underside, line (one line through the joints; parts whose skeleton is one or two "
+         "chains), "
+         "or piece (the silhouette of the part's far end: a head without its neck, one leg)",
+         false},
+        {"--details", SP_OPT_FLAG, &details, "",
+         "with --parts: the mesh's silhouette with its decorations instead of the abstraction", false},
+        {"--spikes", SP_OPT_DOUBLE, &spikes, "P",
+         "with --parts: chance 0..1 of a row of spikes added along the curve (default 0)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose synth",
                           "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "
@@ -211,8 +228,20 @@ int cmd_synth(int argc, char** argv)
             fprintf(stderr, "sketchpose synth: --per-part must be 1..100000, --seed and --amplitude not negative; --noise does not apply to --parts\n");
             return SP_EXIT_USAGE;
         }
-        return synth_parts(parts, abs_name, per_part, (uint64_t)(seeded ? seed : 1), style == SP_HANDDRAW_STYLE_COUNT ? SP_HANDDRAW_NORMAL : style,
-                           has_opt(argc, argv, "--amplitude") ? amplitude : 0.0, out_dir);
+        sp_handdraw_desc hd = {.style = style == SP_HANDDRAW_STYLE_COUNT ? SP_HANDDRAW_NORMAL : style,
+                               .amplitude = has_opt(argc, argv, "--amplitude") ? amplitude : 0.0,
+                               .details = details,
+                               .spikes = spikes};
+        static const char* const shapes[SP_HANDDRAW_SHAPE_COUNT] = {"outline", "top", "underside", "line", "piece"};
+        int k = 0;
+        while (shape_name && k < SP_HANDDRAW_SHAPE_COUNT && strcmp(shapes[k], shape_name) != 0)
+            ++k;
+        if (k == SP_HANDDRAW_SHAPE_COUNT || !(spikes >= 0 && spikes <= 1)) {
+            fprintf(stderr, "sketchpose synth: --shape must be outline, top, underside, line or piece, and --spikes 0..1\n");
+            return SP_EXIT_USAGE;
+        }
+        hd.shape = (sp_handdraw_shape)k;
+        return synth_parts(parts, abs_name, per_part, (uint64_t)(seeded ? seed : 1), &hd, out_dir);
     }
     if (!rig_path || !out || out_dir) {
         fprintf(stderr, "sketchpose synth: missing --rig R.gltf and --out S.json (or use --parts DIR --out-dir D; see --help)\n");

@@ -36,9 +36,9 @@ static const char* const k_migrations[SP_DB_SCHEMA_VERSION] = {
     " category TEXT NOT NULL,"
     " source TEXT NOT NULL CHECK (source IN ('synthetic', 'curated', 'kiosk')),"
     " part_id INTEGER REFERENCES parts(id) ON DELETE CASCADE," // synthetic sketches belong to their part
-    " strokes TEXT,"                                          // sketchpose-strokes JSON
-    " raster_w INTEGER, raster_h INTEGER, raster BLOB,"       // grey pixels of a PNG sketch
-    " png BLOB,"                                              // the PNG as given, for export
+    " strokes TEXT,"                                           // sketchpose-strokes JSON
+    " raster_w INTEGER, raster_h INTEGER, raster BLOB,"        // grey pixels of a PNG sketch
+    " png BLOB,"                                               // the PNG as given, for export
     " added_by TEXT NOT NULL,"
     " added_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),"
     " CHECK ((strokes IS NULL) <> (raster IS NULL)));"
@@ -66,10 +66,23 @@ static const char* const k_migrations[SP_DB_SCHEMA_VERSION] = {
     "INSERT INTO meta VALUES ('generation', 1);"
     "CREATE TRIGGER gen_parts_ins AFTER INSERT ON parts BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
     "CREATE TRIGGER gen_parts_del AFTER DELETE ON parts BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
-    "CREATE TRIGGER gen_sketches_ins AFTER INSERT ON sketches BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
-    "CREATE TRIGGER gen_sketches_del AFTER DELETE ON sketches BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
+    "CREATE TRIGGER gen_sketches_ins AFTER INSERT ON sketches BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; "
+    "END;"
+    "CREATE TRIGGER gen_sketches_del AFTER DELETE ON sketches BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; "
+    "END;"
     "CREATE TRIGGER gen_models_ins AFTER INSERT ON models BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;"
     "CREATE TRIGGER gen_models_del AFTER DELETE ON models BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;",
+    // 2 -> 3: visitors' strokes collected by the kiosk wait for review
+    // (status pending, approved or rejected; kiosk sketches added before
+    // were a curator's choice: approved). A pending kiosk sketch bumps no
+    // generation: it changes no model or part a reader uses, and the kiosk
+    // writing one must not make itself reload.
+    "ALTER TABLE sketches ADD COLUMN status TEXT CHECK (status IS NULL OR status IN ('pending', 'approved', 'rejected'));"
+    "UPDATE sketches SET status = 'approved' WHERE source = 'kiosk';"
+    "CREATE INDEX sketches_review ON sketches(source, status, id);"
+    "DROP TRIGGER gen_sketches_ins;"
+    "CREATE TRIGGER gen_sketches_ins AFTER INSERT ON sketches WHEN NEW.source <> 'kiosk' OR NEW.status = 'approved'"
+    " BEGIN UPDATE meta SET value = value + 1 WHERE key = 'generation'; END;",
 };
 
 // ---- helpers ---------------------------------------------------------------

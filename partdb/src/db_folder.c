@@ -52,10 +52,11 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
     db_str_printf(&m, "], \"sketches\": [");
-    if ((r = db_prepare(db,
-                        "SELECT s.id, s.category, s.source, p.name, s.strokes, s.png, s.raster_w, s.added_by FROM sketches s"
-                        " LEFT JOIN parts p ON p.id = s.part_id ORDER BY s.category, s.id",
-                        &st, err)) != SP_OK)
+    if ((r = db_prepare(
+             db,
+             "SELECT s.id, s.category, s.source, p.name, s.strokes, s.png, s.raster_w, s.added_by, s.status FROM sketches s"
+             " LEFT JOIN parts p ON p.id = s.part_id ORDER BY s.category, s.id",
+             &st, err)) != SP_OK)
         goto out;
     n = 0;
     char last_cat[SP_NAME_MAX] = "";
@@ -87,6 +88,10 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
         else db_str_printf(&m, "null");
         db_str_printf(&m, ", \"added_by\": ");
         db_str_json(&m, (const char*)sqlite3_column_text(st, 7));
+        if (sqlite3_column_type(st, 8) != SQLITE_NULL) {
+            db_str_printf(&m, ", \"status\": ");
+            db_str_json(&m, (const char*)sqlite3_column_text(st, 8));
+        }
         db_str_printf(&m, "}");
     }
     sqlite3_finalize(st);
@@ -213,6 +218,20 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
             if ((r = db_insert_sketch(db, jstr(it, "category"), s, s == SP_DB_SOURCE_SYNTHETIC ? part_id(db, pname) : 0, &smp[i],
                                       &png[i], jstr(it, "added_by") ? jstr(it, "added_by") : by, err)) != SP_OK)
                 break;
+            // A kiosk sketch keeps its review status (an export without one: approved, as stored before reviews).
+            const char* status = jstr(it, "status");
+            if (s == SP_DB_SOURCE_KIOSK && status && strcmp(status, "approved") != 0) {
+                sqlite3_stmt* up;
+                if ((r = db_prepare(db, "UPDATE sketches SET status = ? WHERE id = ?", &up, err)) != SP_OK) break;
+                sqlite3_bind_text(up, 1, status, -1, SQLITE_STATIC);
+                sqlite3_bind_int64(up, 2, sqlite3_last_insert_rowid(db->h));
+                int rc = sqlite3_step(up);
+                sqlite3_finalize(up);
+                if (rc != SQLITE_DONE) {
+                    r = db_fail(db, rc, "importing a kiosk sketch's review status", err);
+                    break;
+                }
+            }
             ++i;
         }
         char details[128];
@@ -299,6 +318,17 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
         if (!is_kiosk_part(file)) continue;
         sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = "assets"};
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
+    }
+    // People's own strokes of the parts (assets/sketches/<category>.ndjson,
+    // picked from Quick, Draw!; assets/sketches/README.md), when the folder has them.
+    char dir[1024];
+    struct stat st;
+    snprintf(dir, sizeof dir, "%s/sketches", c->assets);
+    if (r == SP_OK && stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) {
+        sp_dataset human;
+        if ((r = sp_dataset_load(dir, &human, err)) == SP_OK && human.count > 0)
+            r = sp_db_add_sketches(db, &human, NULL, SP_DB_SOURCE_CURATED, "assets", NULL, err);
+        sp_dataset_free(&human);
     }
     if (r == SP_OK) {
         sp_db_train_desc td = c->d.train;

@@ -126,8 +126,8 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     int folds = d.folds == 0 ? 3 : d.folds < 0 ? 0 : d.folds;
     double t0 = now_s();
     sp_dataset ds;
-    int unused = 0;
-    sp_result r = sp_db_load_dataset(db, &ds, &unused, err);
+    int unused = 0, kiosk = 0;
+    sp_result r = db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, &ds, &unused, &kiosk, err);
     if (r != SP_OK) return r;
     sp_clf* clf = NULL;
     void* bytes = NULL;
@@ -191,8 +191,8 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     db_str cb = {0};
     cats_json(&cb, ds.categories, ds.category_count);
     cats_s = cb.s;
-    db_str_printf(&rep, "{\"categories\": %s, \"drawings\": %d, \"unused_drawings\": %d, \"folds\": %d", cats_s ? cats_s : "[]", ds.count,
-                  unused, folds);
+    db_str_printf(&rep, "{\"categories\": %s, \"drawings\": %d, \"kiosk_sketches\": %d, \"unused_drawings\": %d, \"folds\": %d",
+                  cats_s ? cats_s : "[]", ds.count, kiosk, unused, folds);
     if (folds > 0) {
         db_str_printf(&rep, ", \"top1\": %.4f, \"per_class\": {", cv_n ? (double)cv_ok / cv_n : 0.0);
         for (int c = 0; c < ds.category_count; ++c) {

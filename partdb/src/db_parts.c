@@ -10,10 +10,9 @@
 #include "sp/solver.h"
 #include "sp/synth.h"
 
-// Rotation amplitude of the self-test poses and of synthetic training
-// sketches (radians): visibly posed, yet within reach of a rest-pose start.
+// Rotation amplitude of the self-test poses (radians): visibly posed, yet
+// within reach of a rest-pose start.
 #define SELFTEST_AMPLITUDE 0.5
-#define SYNTH_AMPLITUDE 0.4
 
 static void add_reason(char* buf, size_t cap, const char* fmt, ...)
 #if defined(__GNUC__)
@@ -60,20 +59,6 @@ static int pick_abstraction(const sp_character* ch, const sp_db_part_desc* d)
     const char* want = d && d->abstraction ? d->abstraction : part_extra(ch, "abstraction", buf, sizeof buf);
     if (want) return sp_rig_find_abstraction(&ch->rig, want);
     return ch->rig.abstraction_count > 0 ? 0 : -1;
-}
-
-sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out, sp_error* err)
-{
-    memset(out, 0, sizeof *out);
-    if (sp_dataset_add_category(out, "part") < 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-    // Random shape and pose within bounds, drawn as by a careful visitor
-    // (sp/handdraw.h); one in four exactly, which anchors small training sets
-    // on the part's shape (a stick-figure category added by a curator is
-    // recognised from 60 sketches about as well as from clean ones).
-    sp_handdraw_desc hd = {.style = SP_HANDDRAW_NORMAL, .amplitude = amplitude > 0 ? amplitude : SYNTH_AMPLITUDE, .clean_share = 0.25};
-    sp_result r = sp_handdraw_dataset(&ch->rig, abstraction, &ch->camera, &hd, seed, n, 0, 0, out, err);
-    if (r != SP_OK) sp_dataset_free(out);
-    return r;
 }
 
 // The solver fits the part's own synthetic sketches from the rest pose.

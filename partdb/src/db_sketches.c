@@ -65,10 +65,12 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
                            const sp_db_png* png, const char* by, sp_error* err)
 {
     sqlite3_stmt* st;
-    sp_result r = db_prepare(db,
-                             "INSERT INTO sketches(category, source, part_id, strokes, raster_w, raster_h, raster, png, added_by)"
-                             " VALUES (?,?,?,?,?,?,?,?,?)",
-                             &st, err);
+    // A kiosk sketch a curator adds is reviewed by that act: approved.
+    sp_result r =
+        db_prepare(db,
+                   "INSERT INTO sketches(category, source, part_id, strokes, raster_w, raster_h, raster, png, added_by, status)"
+                   " VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9, CASE WHEN ?2 = 'kiosk' THEN 'approved' END)",
+                   &st, err);
     if (r != SP_OK) return r;
     char* json = NULL;
     sqlite3_bind_text(st, 1, category, -1, SQLITE_TRANSIENT);
@@ -143,7 +145,10 @@ sp_result sp_db_sketch_counts(sp_db* db, char*** categories, int** counts, int* 
     *counts = NULL;
     *count = 0;
     sqlite3_stmt* st;
-    sp_result r = db_prepare(db, "SELECT category, count(*) FROM sketches GROUP BY category ORDER BY category", &st, err);
+    sp_result r = db_prepare(db,
+                             "SELECT category, count(*) FROM sketches WHERE source <> 'kiosk' OR status = 'approved'"
+                             " GROUP BY category ORDER BY category",
+                             &st, err);
     if (r != SP_OK) return r;
     int rc, n = 0, cap = 0;
     char** names = NULL;
@@ -186,8 +191,14 @@ static int find_cat(char** cats, int n, const char* c)
 
 sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err)
 {
+    return db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, out, unused, NULL, err);
+}
+
+sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* unused, int* kiosk, sp_error* err)
+{
     memset(out, 0, sizeof *out);
     if (unused) *unused = 0;
+    if (kiosk) *kiosk = 0;
     // One read transaction: categories and sketches are one consistent snapshot.
     sp_result r = db_exec(db, "BEGIN", err);
     if (r != SP_OK) return r;
@@ -200,12 +211,21 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
     out->categories = cats;
     out->category_count = ncat;
     sqlite3_stmt* st;
-    if ((r = db_prepare(db, "SELECT id, category, strokes, raster_w, raster_h, raster FROM sketches ORDER BY category, id", &st, err)) !=
-        SP_OK) {
+    // Every synthetic and curated sketch, and of the approved kiosk sketches
+    // the newest `kiosk_cap` per category (a year of visitors would otherwise
+    // swamp the parts' own sketches and the training time).
+    if ((r = db_prepare(
+             db,
+             "SELECT id, category, strokes, raster_w, raster_h, raster, source = 'kiosk' FROM sketches"
+             " WHERE source <> 'kiosk' OR id IN (SELECT id FROM (SELECT id, row_number() OVER"
+             " (PARTITION BY category ORDER BY id DESC) AS k FROM sketches WHERE source = 'kiosk' AND status = 'approved')"
+             " WHERE k <= ?1) ORDER BY category, id",
+             &st, err)) != SP_OK) {
         db_rollback(db);
         sp_dataset_free(out);
         return r;
     }
+    sqlite3_bind_int(st, 1, kiosk_cap);
     int rc, cap = 0;
     int* per_cat = calloc((size_t)(ncat > 0 ? ncat : 1), sizeof(int));
     if (!per_cat) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
@@ -245,8 +265,10 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
                 s->raster.h = h;
             }
         }
-        if (r == SP_OK) ++out->count;
-        else {
+        if (r == SP_OK) {
+            ++out->count;
+            if (kiosk) *kiosk += sqlite3_column_int(st, 6);
+        } else {
             sp_sketch_free(&s->sketch);
             sp_raster_free(&s->raster);
         }

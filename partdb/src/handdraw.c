@@ -524,10 +524,12 @@ sp_result sp_handdraw_part(const sp_rig* rig, int abstraction, const sp_camera* 
     if (!p) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     sp_synth_params(rig, seed, d.amplitude > 0 ? d.amplitude : SP_HANDDRAW_AMPLITUDE, p);
     sp_sketch clean = {0};
-    sp_result r = sp_synth_sketch(rig, abstraction, cam, p, &clean);
+    bool plain = d.shape == SP_HANDDRAW_SHAPE_OUTLINE && !d.details && !(d.spikes > 0);
+    sp_result r = plain ? sp_synth_sketch(rig, abstraction, cam, p, &clean)
+                        : sp_handdraw_clean_shape(rig, abstraction, cam, p, d.shape, d.details, d.spikes, seed, &clean);
     free(p);
     if (r != SP_OK)
-        return sp_fail(err, r, "hand-drawing model: cannot project abstraction '%s' (%s)", rig->abstractions[abstraction].name,
+        return sp_fail(err, r, "hand-drawing model: cannot draw abstraction '%s' (%s)", rig->abstractions[abstraction].name,
                        sp_result_name(r));
     // The perturbation's stream is independent of the pose's.
     r = sp_handdraw_apply(&clean, &hp, seed * 0xC2B2AE3D27D4EB4Full + 0x165667B19E3779F9ull, out, info, err);

@@ -399,6 +399,72 @@ static void test_db_synthetic_sketches(void)
     sp_dataset_free(&b);
 }
 
+// What a sketch shows (sp_handdraw_shape): the silhouette holds the
+// abstraction, the top lies above the underside and both span the part, a
+// line through the joints exactly for chain-shaped skeletons, a piece is
+// smaller than the whole, added spikes add ink. Clean (unperturbed) drawings
+// at the rest pose, so the geometry can be checked directly.
+static void test_part_shapes(void)
+{
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+        dragon_part* p = &parts()[i];
+        const sp_rig* rig = &p->ch.rig;
+        double* q = malloc(sizeof(double) * (size_t)rig->param_count);
+        sp_rig_defaults(rig, q);
+        sp_sketch ab = clean_sketch(i), sil, top, under, spiky;
+        ENSURE(sp_handdraw_clean_shape(rig, p->abstraction, &p->ch.camera, q, SP_HANDDRAW_SHAPE_OUTLINE, true, 0, 1, &sil) ==
+               SP_OK);
+        ENSURE(sil.stroke_count == 1 &&
+               sp_v2_len(sp_v2_sub(sil.strokes[0].points[0], sil.strokes[0].points[sil.strokes[0].count - 1])) < 1e-9);
+        sp_vec2 alo, ahi, slo, shi;
+        ENSURE(sp_sketch_bounds(&ab, &alo, &ahi) && sp_sketch_bounds(&sil, &slo, &shi));
+        double tol = 0.02 * diag(&sil);
+        ENSURE(alo.x >= slo.x - tol && alo.y >= slo.y - tol && ahi.x <= shi.x + tol && ahi.y <= shi.y + tol);
+        ENSURE(sp_handdraw_clean_shape(rig, p->abstraction, &p->ch.camera, q, SP_HANDDRAW_SHAPE_TOP, true, 0, 1, &top) == SP_OK);
+        ENSURE(sp_handdraw_clean_shape(rig, p->abstraction, &p->ch.camera, q, SP_HANDDRAW_SHAPE_UNDERSIDE, true, 0, 1, &under) ==
+               SP_OK);
+        double ty = 0, uy = 0;
+        for (int k = 0; k < top.strokes[0].count; ++k)
+            ty += top.strokes[0].points[k].y / top.strokes[0].count;
+        for (int k = 0; k < under.strokes[0].count; ++k)
+            uy += under.strokes[0].points[k].y / under.strokes[0].count;
+        sp_vec2 tlo, thi;
+        ENSURE(sp_sketch_bounds(&top, &tlo, &thi));
+        ENSURE(ty < uy && fabs(tlo.x - slo.x) < 1e-9 && fabs(thi.x - shi.x) < 1e-9);
+        // A single line: exactly when the skeleton's leaves are one or two (a tail, a pair of legs).
+        int leaves = 0;
+        for (int j = 0; j < rig->joint_count; ++j) {
+            bool leaf = true;
+            for (int c = 0; c < rig->joint_count; ++c)
+                leaf &= rig->joints[c].parent != j;
+            leaves += leaf;
+        }
+        bool line = sp_handdraw_shape_available(rig, SP_HANDDRAW_SHAPE_LINE);
+        ENSURE(line == (leaves == 1 || leaves == 2));
+        sp_sketch ln = {0};
+        ENSURE((sp_handdraw_clean_shape(rig, p->abstraction, &p->ch.camera, q, SP_HANDDRAW_SHAPE_LINE, false, 0, 1, &ln) ==
+                SP_OK) == line);
+        if (line) ENSURE(ln.stroke_count == 1 && ln.strokes[0].count >= 3 && diag(&ln) > 0.3 * diag(&sil));
+        if (sp_handdraw_shape_available(rig, SP_HANDDRAW_SHAPE_PIECE)) {
+            sp_sketch pc;
+            ENSURE(sp_handdraw_clean_shape(rig, p->abstraction, &p->ch.camera, q, SP_HANDDRAW_SHAPE_PIECE, true, 0, 7, &pc) ==
+                   SP_OK);
+            sp_vec2 plo, phi;
+            ENSURE(sp_sketch_bounds(&pc, &plo, &phi));
+            ENSURE((phi.x - plo.x) * (phi.y - plo.y) < 0.95 * (shi.x - slo.x) * (shi.y - slo.y));
+            sp_sketch_free(&pc);
+        }
+        ENSURE(sp_handdraw_clean_shape(rig, p->abstraction, &p->ch.camera, q, SP_HANDDRAW_SHAPE_OUTLINE, true, 1.0, 3, &spiky) ==
+               SP_OK);
+        ENSURE(poly_length(&spiky.strokes[0]) > 1.03 * poly_length(&sil.strokes[0]));
+        printf("  %-10s silhouette %d points, line %s, spikes +%.0f%% ink\n", p->name, sil.strokes[0].count, line ? "yes" : "no",
+               100 * (poly_length(&spiky.strokes[0]) / poly_length(&sil.strokes[0]) - 1));
+        sp_sketch_free(&ab), sp_sketch_free(&sil), sp_sketch_free(&top), sp_sketch_free(&under), sp_sketch_free(&spiky),
+            sp_sketch_free(&ln);
+        free(q);
+    }
+}
+
 // ---- the command line ------------------------------------------------------------
 
 static const char* sketchpose_bin(void)
@@ -668,6 +734,7 @@ int main(int argc, char** argv)
                                    {"handdraw_partial_split_direction", test_handdraw_partial_split_direction},
                                    {"handdraw_sampling_corners_wobble", test_handdraw_sampling_corners_wobble},
                                    {"db_synthetic_sketches", test_db_synthetic_sketches},
+                                   {"part_shapes", test_part_shapes},
                                    {"cli_synth_parts", test_cli_synth_parts},
                                    {"calibrate_reject", test_calibrate_reject},
                                    {"cli_train_calibrate", test_cli_train_calibrate},

@@ -9,6 +9,7 @@
 // `test_partdb --write-parts DIR` writes them for trying the CLI by hand.
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <signal.h>
 #include <sqlite3.h>
 #include <stdlib.h>
@@ -533,6 +534,36 @@ static void test_two_writers(void)
     sp_dataset_free(&ds);
 }
 
+// Runs write(db) in a child whose files may not grow past their size now (a
+// full disk); true when it failed there with SP_ERR_IO and a message.
+static bool on_full_disk(const char* path, sp_result (*write)(sp_db*, sp_error*))
+{
+    struct stat fs;
+    ENSURE(stat(path, &fs) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        sp_db* d = NULL;
+        sp_error e = {0};
+        if (sp_db_open(path, 0, &d, &e) != SP_OK) _exit(3);
+        struct rlimit rl = {(rlim_t)fs.st_size, (rlim_t)fs.st_size};
+        setrlimit(RLIMIT_FSIZE, &rl);
+        sp_result r = write(d, &e);
+        fprintf(stderr, "  disk full: %s\n", e.text);
+        sp_db_close(d);
+        _exit(r == SP_ERR_IO && e.text[0] ? 0 : 6);
+    }
+    int st;
+    ENSURE(waitpid(pid, &st, 0) == pid);
+    return WIFEXITED(st) && WEXITSTATUS(st) == 0;
+}
+
+static sp_result add_big_part(sp_db* db, sp_error* err)
+{
+    return sp_db_add_part_file(db, part_file(2), &(sp_db_part_desc){.synth_sketches = 200, .selftest_seeds = -1}, NULL, err);
+}
+
 static void test_read_only_and_full(void)
 {
     char p[1024];
@@ -574,24 +605,7 @@ static void test_read_only_and_full(void)
     ENSURE(rmdir(dir) == 0);
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
-    // Full disk: a child whose files may not grow past their size now.
-    struct stat fs;
-    ENSURE(stat(p, &fs) == 0);
-    pid = fork();
-    ENSURE(pid >= 0);
-    if (pid == 0) {
-        signal(SIGXFSZ, SIG_IGN);
-        sp_db* d = NULL;
-        sp_error e = {0};
-        if (sp_db_open(p, 0, &d, &e) != SP_OK) _exit(3);
-        struct rlimit rl = {(rlim_t)fs.st_size, (rlim_t)fs.st_size};
-        setrlimit(RLIMIT_FSIZE, &rl);
-        sp_result r = sp_db_add_part_file(d, part_file(2), &(sp_db_part_desc){.synth_sketches = 200, .selftest_seeds = -1}, NULL, &e);
-        fprintf(stderr, "  disk full: %s\n", e.text);
-        sp_db_close(d);
-        _exit(r == SP_ERR_IO ? 0 : 6);
-    }
-    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    ENSURE(on_full_disk(p, add_big_part));
     db = open_ok(p, 0);
     check_ok(db);
     sp_db_close(db);
@@ -654,11 +668,12 @@ static void test_schema_versions(void)
     ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED);
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
-    // Older (version 1: no generation counter): read-only refuses, writable migrates and keeps the data.
+    // Older (version 1: no generation counter, no review status): read-only refuses, writable migrates and keeps the data.
     ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
     ENSURE(sqlite3_exec(h,
                         "DROP TRIGGER gen_parts_ins; DROP TRIGGER gen_parts_del; DROP TRIGGER gen_sketches_ins; DROP TRIGGER gen_sketches_del;"
-                        "DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta; PRAGMA user_version = 1",
+                        "DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta;"
+                        "DROP INDEX sketches_review; ALTER TABLE sketches DROP COLUMN status; PRAGMA user_version = 1",
                         NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(h);
     ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED && strstr(err.text, "older"));
@@ -839,6 +854,262 @@ static void test_default_db(void)
     ENSURE(sp_db_create_default(p, dir, &dd, &err) == SP_ERR_INVALID);
 }
 
+// ---- visitors' strokes: collection and review ----------------------------------------
+
+// A visitor's stroke: a bent line on a 1280 x 800 canvas, with times; `k` moves it.
+static sp_stroke visitor_stroke(int k, sp_vec2* pts, double* t)
+{
+    for (int i = 0; i < 40; ++i) {
+        pts[i] = (sp_vec2){300 + 10 * i + k, 400 + 60 * sin(i * 0.2) + k};
+        t[i] = 16.7 * i;
+    }
+    return (sp_stroke){.count = 40, .points = pts, .t = t};
+}
+
+static int64_t collect_ok(sp_db* db, const char* category, int k)
+{
+    sp_vec2 pts[40];
+    double t[40];
+    sp_stroke st = visitor_stroke(k, pts, t);
+    int64_t id = 0;
+    sp_error err = {0};
+    sp_result r = sp_db_collect_kiosk_sketch(db, category, &st, 1280, 800, &id, &err);
+    if (r != SP_OK) fprintf(stderr, "  collect: %s\n", err.text);
+    ENSURE(r == SP_OK && id > 0);
+    return id;
+}
+
+// Collects until the database refuses (the WAL's slack fills first).
+static sp_result collect_many(sp_db* db, sp_error* err)
+{
+    sp_result r = SP_OK;
+    for (int i = 0; i < 2000 && r == SP_OK; ++i) {
+        sp_vec2 q[40];
+        double tq[40];
+        sp_stroke s = visitor_stroke(i, q, tq);
+        r = sp_db_collect_kiosk_sketch(db, "tail", &s, 1280, 800, NULL, err);
+    }
+    return r == SP_OK || strstr(err->text, "dropped") ? r : SP_ERR_INTERNAL;
+}
+
+static void test_kiosk_collect(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("kiosk.db"));
+    sp_db* reader = open_ok(p, SP_DB_READONLY);
+    sp_db* kiosk = open_ok(p, 0);
+    uint64_t g0 = sp_db_generation(reader);
+    int64_t a = collect_ok(kiosk, "tail", 0), b = collect_ok(kiosk, "tail", 5), c = collect_ok(kiosk, "wings", 9);
+    // Pending sketches change no model or part: a kiosk that collects does not make itself (or others) reload.
+    ENSURE(sp_db_generation(reader) == g0);
+    sp_error err = {0};
+    int counts[SP_DB_STATUS_COUNT];
+    ENSURE(sp_db_kiosk_counts(reader, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 3 && counts[SP_DB_APPROVED] == 0);
+    // Points and times only, oldest first.
+    sp_db_kiosk_sketch* ks;
+    int n;
+    ENSURE(sp_db_kiosk_list(reader, NULL, &ks, &n, &err) == SP_OK && n == 3);
+    ENSURE(ks[0].id == a && ks[1].id == b && ks[2].id == c && !strcmp(ks[2].category, "wings") && ks[0].status == SP_DB_PENDING);
+    ENSURE(ks[0].sketch.stroke_count == 1 && ks[0].sketch.strokes[0].count == 40 && ks[0].sketch.strokes[0].t);
+    ENSURE_NEAR(ks[1].sketch.strokes[0].points[3].x, 300 + 30 + 5, 1e-9);
+    ENSURE(strlen(ks[0].created_at) >= 20);
+    sp_db_kiosk_free(ks, n);
+    // Paging.
+    ENSURE(sp_db_kiosk_list(reader, &(sp_db_kiosk_query){.limit = 2}, &ks, &n, &err) == SP_OK && n == 2);
+    sp_db_kiosk_free(ks, n);
+    ENSURE(sp_db_kiosk_list(reader, &(sp_db_kiosk_query){.after = b}, &ks, &n, &err) == SP_OK && n == 1 && ks[0].id == c);
+    sp_db_kiosk_free(ks, n);
+    // Bad strokes and labels are refused with one line, nothing stored.
+    sp_vec2 pts[40];
+    double t[40];
+    sp_stroke st = visitor_stroke(0, pts, t);
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "a b", &st, 1280, 800, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "dropped"));
+    pts[7].y = NAN;
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_INVALID);
+    st = visitor_stroke(0, pts, t);
+    st.count = 1;
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_INVALID);
+    // A busy database drops the sketch within the collect timeout; a read-only one drops it at once.
+    sqlite3* other;
+    ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
+    ENSURE(sqlite3_exec(other, "BEGIN IMMEDIATE; INSERT INTO log(by, action) VALUES ('other', 'hold')", NULL, NULL, NULL) ==
+           SQLITE_OK);
+    st = visitor_stroke(0, pts, t);
+    double t0 = now_ms();
+    sp_result r = sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err);
+    double waited = now_ms() - t0;
+    fprintf(stderr, "  busy: %.0f ms: %s\n", waited, err.text);
+    ENSURE(r == SP_ERR_BUSY && strstr(err.text, "dropped") && waited < 500);
+    sqlite3_exec(other, "ROLLBACK", NULL, NULL, NULL);
+    sqlite3_close(other);
+    ENSURE(sp_db_collect_kiosk_sketch(reader, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_IO && strstr(err.text, "read-only"));
+    // A full disk drops it too.
+    sp_db_close(kiosk);
+    ENSURE(on_full_disk(p, collect_many));
+    kiosk = open_ok(p, 0);
+    check_ok(kiosk);
+    // Review: relabel, approve, reject; an unknown id or category changes nothing.
+    ENSURE(sp_db_kiosk_relabel(kiosk, b, "wings", "curator", &err) == SP_OK);
+    ENSURE(sp_db_kiosk_relabel(kiosk, b, "horns", "curator", &err) == SP_ERR_INVALID && strstr(err.text, "not a part category"));
+    ENSURE(sp_db_kiosk_relabel(kiosk, 999999, "tail", "curator", &err) == SP_ERR_INVALID &&
+           strstr(err.text, "no kiosk sketch 999999"));
+    int64_t bad[3] = {a, 999999, b};
+    ENSURE(sp_db_kiosk_set_status(kiosk, bad, 3, SP_DB_APPROVED, "curator", &err) == SP_ERR_INVALID);
+    int64_t some_synthetic = scalar(p, "SELECT min(id) FROM sketches WHERE source = 'synthetic'");
+    ENSURE(sp_db_kiosk_set_status(kiosk, &some_synthetic, 1, SP_DB_REJECTED, "curator", &err) == SP_ERR_INVALID);
+    ENSURE(sp_db_kiosk_counts(kiosk, counts, &err) == SP_OK && counts[SP_DB_PENDING] >= 3 && counts[SP_DB_APPROVED] == 0);
+    int64_t ok2[2] = {a, b};
+    ENSURE(sp_db_kiosk_set_status(kiosk, ok2, 2, SP_DB_APPROVED, "curator", &err) == SP_OK);
+    ENSURE(sp_db_kiosk_set_status(kiosk, &c, 1, SP_DB_REJECTED, "curator", &err) == SP_OK);
+    // Training uses the approved ones only, the newest per category up to the cap.
+    int unused, kiosk_n;
+    sp_dataset ds;
+    ENSURE(db_load_training_set(kiosk, SP_DB_KIOSK_TRAIN_MAX, &ds, &unused, &kiosk_n, &err) == SP_OK && kiosk_n == 2);
+    int synthetic = ds.count - 2;
+    sp_dataset_free(&ds);
+    ENSURE(db_load_training_set(kiosk, 0, &ds, &unused, &kiosk_n, &err) == SP_OK && kiosk_n == 0 && ds.count == synthetic);
+    sp_dataset_free(&ds);
+    char* report = NULL;
+    train_ok(kiosk, -1, &report);
+    ENSURE(strstr(report, "\"kiosk_sketches\": 2"));
+    free(report);
+    // Export keeps the review, and a rebuild from it too.
+    char dir[1024], q[1024];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("kiosk-export"));
+    snprintf(q, sizeof q, "%s", sp_test_tmp_path("kiosk-rebuilt.db"));
+    remove_db(q);
+    ENSURE(sp_db_export(kiosk, dir, &err) == SP_OK);
+    ENSURE(sp_db_create_from_export(q, dir, NULL, "test", &err) == SP_OK);
+    ENSURE(scalar(q, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'approved'") == 2);
+    ENSURE(scalar(q, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'rejected'") == 1);
+    ENSURE(scalar(q, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'") ==
+           scalar(p, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'"));
+    sp_db_close(kiosk);
+    sp_db_close(reader);
+}
+
+// A version 2 database (before reviews): its kiosk sketches were a curator's
+// additions and stay in training (approved); new pending ones bump no generation.
+static void test_kiosk_migration(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("v2.db"));
+    remove_db(p);
+    sqlite3* h;
+    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
+    sqlite3_close(h);
+    sp_db raw = {.path = p, .busy_ms = 1000};
+    ENSURE(sqlite3_open(p, &raw.h) == SQLITE_OK);
+    sp_error err = {0};
+    ENSURE(db_migrate(&raw, 2, &err) == SP_OK);
+    ENSURE(sqlite3_exec(
+               raw.h,
+               "INSERT INTO sketches(category, source, strokes, added_by) VALUES ('tail', 'kiosk',"
+               " '{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], [30, 40]]}]}', 'old')",
+               NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(raw.h);
+    sp_db* db = open_ok(p, 0);
+    ENSURE(sp_db_schema_version(db) == SP_DB_SCHEMA_VERSION);
+    int counts[SP_DB_STATUS_COUNT];
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_APPROVED] == 1 && counts[SP_DB_PENDING] == 0);
+    uint64_t g = sp_db_generation(db);
+    collect_ok(db, "tail", 0);
+    ENSURE(sp_db_generation(db) == g);
+    sp_db_close(db);
+}
+
+// Runs a command, returns its exit status; its stdout (first `cap` bytes) in out.
+static int run(const char* cmd, char* out, size_t cap)
+{
+    FILE* pp = popen(cmd, "r");
+    ENSURE(pp);
+    size_t n = fread(out, 1, cap - 1, pp);
+    out[n] = 0;
+    int st = pclose(pp);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+// The review through the command line, end to end: a stroke the visitor
+// corrected is collected with the corrected label, listed, approved, trained on.
+static void test_kiosk_review_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("review.db"));
+    sp_db* kiosk = open_ok(p, 0);
+    int64_t first = collect_ok(kiosk, "tail", 0); // the classifier's guess, left as it was
+    int64_t id = collect_ok(kiosk, "wings", 3);   // the visitor tapped the "Wings?" chip
+    sp_db_close(kiosk);
+    char cmd[4096], out[65536];
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s'", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 0);
+    char want[128];
+    snprintf(want, sizeof want, "{\"id\": %lld, \"category\": \"wings\", \"status\": \"pending\", \"created_at\": \"",
+             (long long)id);
+    ENSURE(strstr(out, "{\"sketches\": [{\"id\": ") && strstr(out, want) && strstr(out, "\"points\": [[303, 403]"));
+    ENSURE(strstr(out, "\"counts\": {\"pending\": 2, \"approved\": 0, \"rejected\": 0}"));
+    ENSURE(strstr(out, "{\"id\": ") < strstr(out, want)); // oldest first: the other one is listed before
+    // The contact sheet.
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --sheet '%s' >/dev/null", bin, p, sp_test_tmp_path("review.png"));
+    ENSURE(run(cmd, out, sizeof out) == 0);
+    struct stat fs;
+    ENSURE(stat(sp_test_tmp_path("review.png"), &fs) == 0 && fs.st_size > 1000);
+    // An unknown id: one line, exit 1, nothing changed.
+    char before[65], after[65];
+    file_sha(p, before);
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld 424242 2>&1 >/dev/null", bin, p, (long long)id);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "no kiosk sketch 424242") && !strchr(strchr(out, '\n') + 1, '\n'));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject nine 2>&1 >/dev/null", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "'nine' is not a kiosk sketch id"));
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+    // A database in use: one clear line, exit 1, nothing lost.
+    sqlite3* other;
+    ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
+    ENSURE(sqlite3_exec(other, "BEGIN IMMEDIATE; INSERT INTO log(by, action) VALUES ('other', 'hold')", NULL, NULL, NULL) ==
+           SQLITE_OK);
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --busy-timeout 0.2 --approve %lld 2>&1 >/dev/null", bin, p,
+             (long long)id);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "database is busy") && !strchr(strchr(out, '\n') + 1, '\n'));
+    sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
+    sqlite3_close(other);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'") == 2);
+    // Approve, reject the other, train: the new model's training set has it.
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld", bin, p, (long long)id);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "\"approved\": ["));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %lld >/dev/null", bin, p, (long long)first);
+    ENSURE(run(cmd, out, sizeof out) == 0);
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --status approved", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "\"status\": \"approved\"") && strstr(out, "\"category\": \"wings\""));
+    snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --words 64 --folds -1", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 0);
+    fprintf(stderr, "  train: %.160s\n", out);
+    ENSURE(strstr(out, "\"kiosk_sketches\": 1,"));
+    sp_db* db = open_ok(p, SP_DB_READONLY);
+    sp_dataset ds;
+    int unused, nk;
+    sp_error err = {0};
+    ENSURE(db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, &ds, &unused, &nk, &err) == SP_OK && nk == 1);
+    bool found = false;
+    for (int i = 0; i < ds.count; ++i) {
+        const sp_sketch* s = &ds.samples[i].sketch;
+        found |= !strcmp(ds.categories[ds.samples[i].label], "wings") && s->stroke_count == 1 && s->strokes[0].count == 40 &&
+                 s->strokes[0].points[0].x == 303 && s->strokes[0].points[0].y == 403;
+    }
+    ENSURE(found);
+    sp_dataset_free(&ds);
+    sp_db_close(db);
+    // The database's current model classifies (classify --db); a bad stroke file is one line and exit 1.
+    snprintf(cmd, sizeof cmd, "'%s' classify --db '%s' --strokes '%s/tests/data/visitors/tune/tail/tail-wavy-line.json'", bin, p,
+             SP_SOURCE_DIR);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "{\"ranked\": [{\"category\": "));
+    const char* badf = sp_test_tmp_path("bad-stroke.json");
+    ENSURE(db_write_file(badf, "{\"format\": \"sketchpose-strokes\", \"strokes\": [", 40, &err) == SP_OK);
+    snprintf(cmd, sizeof cmd, "'%s' classify --db '%s' --strokes '%s' 2>&1 >/dev/null", bin, p, badf);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "bad-stroke.json") && !strchr(strchr(out, '\n') + 1, '\n'));
+}
+
 int main(int argc, char** argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write-parts")) {
@@ -862,5 +1133,8 @@ int main(int argc, char** argv)
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
                                    {"default_db", test_default_db},
+                                   {"kiosk_collect", test_kiosk_collect},
+                                   {"kiosk_migration", test_kiosk_migration},
+                                   {"kiosk_review_cli", test_kiosk_review_cli},
                                    {0}});
 }

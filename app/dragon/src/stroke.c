@@ -95,17 +95,54 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
     return SP_OK;
 }
 
+// The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
+// that looks anything like a part becomes the best guess; refused are only
+// scribbles (checked before the fit, `fit` < 0) and strokes far from every
+// part, where "far" weighs `near`, the classifier's nearest-drawing distance
+// in units of the model's calibrated reject distance, together with how
+// badly the best guess's part takes the stroke (`fit`: the fit's mean error
+// over the stroke's diagonal). Taps and tiny strokes never get here.
+// Constants tuned on the tune half of tests/data/visitors (BENCHMARKS.md,
+// "Visitors' drawings").
+static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit)
+{
+    if (fit < 0) {
+        // A scribble: far more ink than its size, or crossing itself over and over.
+        enum { M = 64 };
+        sp_vec2 r[M], lo = pts[0], hi = pts[0];
+        for (int i = 1; i < n; ++i)
+            lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
+        if (sp_curve_length(pts, n, false) > 6.0 * sp_v2_len(sp_v2_sub(hi, lo))) return true;
+        if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return false;
+#define CROSS(a, b) ((a).x * (b).y - (a).y * (b).x)
+        int crossings = 0;
+        for (int i = 0; i + 1 < M; ++i)
+            for (int j = i + 2; j + 1 < M; ++j) {
+                sp_vec2 p = r[i], q = r[i + 1], u = r[j], v = r[j + 1];
+                double d1 = CROSS(sp_v2_sub(q, p), sp_v2_sub(u, p)), d2 = CROSS(sp_v2_sub(q, p), sp_v2_sub(v, p));
+                double d3 = CROSS(sp_v2_sub(v, u), sp_v2_sub(p, u)), d4 = CROSS(sp_v2_sub(v, u), sp_v2_sub(q, u));
+                crossings += d1 * d2 < 0 && d3 * d4 < 0;
+            }
+#undef CROSS
+        return crossings > 12;
+    }
+    return near + 6.0 * fit > 1.29;
+}
+
 // The stroke path's decision: the classifier's answer becomes a category
 // (accepted) or a refusal. Classifies also when the category is forced, so
 // the chips still show the classifier's guesses (out->guesses); a forced
-// category is taken as is; otherwise the top guess, unless the classifier
-// rejects the drawing or scores it under min_confidence. Sets
+// category is taken as is; otherwise the top guess, unless the kiosk's
+// refusal policy calls the stroke a scribble or the top guess scores under
+// min_confidence (the policy's other half waits for the fit: *near, the
+// classifier's nearest distance in units of its reject distance). Sets
 // out->ms_classify. Returns SP_DRAGON_ACCEPTED with category and *confidence
 // filled, or why the stroke is refused.
 static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, const char* forced, sp_dragon_result* out,
-                                            char category[SP_NAME_MAX], float* confidence)
+                                            char category[SP_NAME_MAX], float* confidence, double* near)
 {
     *confidence = 1.0f;
+    *near = 0.0;
     if (forced) dragon_copy_name(category, SP_NAME_MAX, forced);
     if (!d->clf) return forced ? SP_DRAGON_ACCEPTED : SP_DRAGON_NO_MODEL;
     sp_clf_answer a;
@@ -116,7 +153,10 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     if (r != SP_OK && !forced) return SP_DRAGON_UNRECOGNISED;
     out->ms_classify = dragon_now_ms() - tc;
     if (forced) return SP_DRAGON_ACCEPTED;
-    if (a.rejected || a.count == 0 || a.ranked[0].score < d->desc.min_confidence) return SP_DRAGON_UNRECOGNISED;
+    if (isfinite(a.reject_distance) && a.reject_distance > 0) *near = a.distance / a.reject_distance;
+    if (a.count == 0 || a.ranked[0].score < d->desc.min_confidence ||
+        kiosk_refuses(sk->strokes[0].points, sk->strokes[0].count, *near, -1.0))
+        return SP_DRAGON_UNRECOGNISED;
     dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a.ranked[0].category));
     *confidence = a.ranked[0].score;
     return SP_DRAGON_ACCEPTED;
@@ -152,7 +192,8 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
                     .strokes = &(sp_stroke){.count = n, .points = pts}};
     char category[SP_NAME_MAX] = "";
     float confidence = 1.0f;
-    sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence);
+    double near = 0.0;
+    sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence, &near);
     if (why != SP_DRAGON_ACCEPTED) {
         free(pts);
         return reject(out, why, t0);
@@ -198,6 +239,11 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     if (best < 0) {
         free(pts);
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
+    }
+    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best_score)) {
+        free(pts);
+        free(best_p);
+        return reject(out, SP_DRAGON_UNRECOGNISED, t0);
     }
     part* q = NULL;
     sp_result r = new_part(d, cands[best], best_p, &best_rep, &best_view, pts, n, confidence, &q, err);

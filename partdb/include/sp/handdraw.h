@@ -101,6 +101,18 @@ typedef struct sp_handdraw_info {
 sp_result sp_handdraw_apply(const sp_sketch* clean, const sp_handdraw_params* params, uint64_t seed, sp_sketch* out,
                             sp_handdraw_info* info, sp_error* err);
 
+/// What of a part a sketch shows (before the hand-drawing model perturbs it).
+typedef enum sp_handdraw_shape {
+    SP_HANDDRAW_SHAPE_OUTLINE = 0, ///< the abstraction's curves (or, with `details`, the mesh's silhouette)
+    SP_HANDDRAW_SHAPE_TOP,         ///< only the upper side of the closed outline, leftmost to rightmost point (one open stroke)
+    SP_HANDDRAW_SHAPE_UNDERSIDE,   ///< only its lower side
+    SP_HANDDRAW_SHAPE_LINE,        ///< one line through the joints: skeletons of one or two chains (tails, leg pairs)
+    /// the silhouette of the part's far end only: the mesh around a joint's subtree holding 25-75% of the
+    /// vertices, drawn from the seed (a head without its neck, one leg of a pair, the end of a tail)
+    SP_HANDDRAW_SHAPE_PIECE,
+    SP_HANDDRAW_SHAPE_COUNT
+} sp_handdraw_shape;
+
 /// How to draw a part. Zero means the default.
 typedef struct sp_handdraw_desc {
     const sp_handdraw_params* params; ///< NULL: sp_handdraw_preset(style)
@@ -110,6 +122,15 @@ typedef struct sp_handdraw_desc {
     /// clean style instead, in [0, 1]: they anchor a small training set on the
     /// part's exact shape while the others teach the variation.
     double clean_share;
+    sp_handdraw_shape shape; ///< what is drawn (default: the abstraction)
+    /// Outline, top and underside: the silhouette of the whole posed mesh, with
+    /// its decorations (horns, spikes, teeth, claws), traced from a raster,
+    /// instead of the abstraction (which leaves decorations out). Top and
+    /// underside use the silhouette anyway when the abstraction is not one closed curve.
+    bool details;
+    /// Chance in [0, 1] that a row of 3-8 spikes or teeth is added along 12-35%
+    /// of the curve (a detail the visitor adds that the part lacks).
+    double spikes;
 } sp_handdraw_desc;
 
 /// Default pose amplitude of synthetic part sketches (radians): visibly posed,
@@ -129,6 +150,17 @@ uint64_t sp_handdraw_part_family(uint64_t family, const char* part_name);
 /// perturbation model. info may be NULL.
 sp_result sp_handdraw_part(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_handdraw_desc* desc, uint64_t seed,
                            sp_sketch* out, sp_handdraw_info* info, sp_error* err);
+
+/// False when the rig cannot be drawn as `shape` (LINE needs a skeleton whose
+/// joints form one chain or two chains from a common joint, PIECE a joint
+/// whose subtree holds 25-75% of the vertices).
+bool sp_handdraw_shape_available(const sp_rig* rig, sp_handdraw_shape shape);
+/// The clean drawing of `shape` at parameters p, seen by cam, before any
+/// perturbation (closed curves repeat their first point at the end);
+/// `spikes` and `seed` as in sp_handdraw_desc. SP_ERR_INVALID when the shape
+/// is not available or the mesh has no area in the view.
+sp_result sp_handdraw_clean_shape(const sp_rig* rig, int abstraction, const sp_camera* cam, const double* p,
+                                  sp_handdraw_shape shape, bool details, double spikes, uint64_t seed, sp_sketch* out);
 
 /// Appends `n` hand-drawn sketches (seeds sp_handdraw_seed(family, 0..n-1)) to
 /// `ds` with label `label` (< ds->category_count); sample indices continue

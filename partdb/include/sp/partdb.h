@@ -46,12 +46,14 @@ extern "C" {
 #endif
 
 /// Schema version this build reads and writes (PRAGMA user_version).
-#define SP_DB_SCHEMA_VERSION 2
+#define SP_DB_SCHEMA_VERSION 3
 /// Default busy timeout: how long a writer waits for another writer.
 #define SP_DB_BUSY_MS_DEFAULT 5000
 /// Synthetic sketches stored with a part by default (per part: random shape and
-/// pose, drawn by the hand-drawing model of sp/handdraw.h, normal style).
-/// Why not 300 (the dragon bench's recipe): see docs/DESIGN.md (cost 4.5x, no bar gained in full).
+/// pose, the shapes of the default recipe, drawn by the hand-drawing model of
+/// sp/handdraw.h; docs/DESIGN.md "Part database training data"). Why not 300:
+/// see docs/DESIGN.md (cost 4.5x, no bar gained in full; 120 and 200 gained
+/// nothing on the visitors' drawings either).
 #define SP_DB_SYNTH_DEFAULT 60
 
 typedef struct sp_db sp_db;
@@ -110,7 +112,7 @@ typedef struct sp_db_part_desc {
     const char* added_by;    ///< NULL: $USER, else "unknown"
     int synth_sketches;      ///< synthetic sketches stored with it; 0: SP_DB_SYNTH_DEFAULT; -1: none
     uint64_t seed;           ///< seed family of the synthetic sketches (0: one of the part's own, from its name; sp/handdraw.h)
-    double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: 0.4; see sp/synth.h)
+    double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: the recipe's, 0.4 and the whole bounds by turns; see sp/synth.h)
     int selftest_seeds;      ///< solver self-test seeds; 0: 3; -1: skip the self-test
     double selftest_tolerance; ///< largest mean error over the seeds, fraction of the 2D diagonal; 0: 0.02
 } sp_db_part_desc;
@@ -167,11 +169,74 @@ typedef struct sp_db_png {
 } sp_db_png;
 sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png* png, sp_db_source source, const char* by, int* added,
                              sp_error* err);
-/// Number of sketches per category: parallel arrays (free with sp_db_free_strings / free()).
+/// Number of training sketches per category (kiosk sketches only when approved): parallel arrays (free with sp_db_free_strings /
+/// free()).
 sp_result sp_db_sketch_counts(sp_db* db, char*** categories, int** counts, int* count, sp_error* err);
-/// The stored sketches of the current part categories as a dataset (categories
-/// = sp_db_categories); `unused` (may be NULL) counts sketches of other categories.
+/// The training set: the stored sketches of the current part categories as a
+/// dataset (categories = sp_db_categories), kiosk sketches only when approved
+/// (the newest SP_DB_KIOSK_TRAIN_MAX per category); `unused` (may be NULL)
+/// counts sketches of other categories.
 sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err);
+
+// ---- visitors' strokes (kiosk sketches) -------------------------------------------
+
+/// How long sp_db_collect_kiosk_sketch waits for another writer, ms: short
+/// enough for a kiosk's UI thread (a frame is 16 ms), long enough to slip
+/// between a curator's short writes.
+#define SP_DB_COLLECT_BUSY_MS 15
+/// Approved kiosk sketches per category in a training set (the newest):
+/// `db train` within 2 minutes on 2 cores with a year of visitors stored
+/// (BENCHMARKS.md, "Kiosk sketches").
+#define SP_DB_KIOSK_TRAIN_MAX 200
+
+/// Review status of a kiosk sketch.
+typedef enum sp_db_status { SP_DB_PENDING, SP_DB_APPROVED, SP_DB_REJECTED, SP_DB_STATUS_COUNT } sp_db_status;
+/// "pending", "approved", "rejected".
+const char* sp_db_status_name(sp_db_status s);
+
+/// Stores one stroke a visitor left on the kiosk as a `kiosk` sketch, pending
+/// review, under `category` (the label the visitor left it with): the points
+/// (pixels) and, when given, their times (ms); nothing else about the visit.
+/// Made for the kiosk's UI thread: it waits at most SP_DB_COLLECT_BUSY_MS for
+/// another writer and commits without waiting for the disk (a power cut may
+/// lose the last strokes, never the database). A busy, read-only or full
+/// database keeps nothing and returns SP_ERR_BUSY or SP_ERR_IO with one line
+/// for the kiosk's log; so do a category that is not a plain name and a
+/// stroke with fewer than 2 points, more than 65536 or non-finite ones
+/// (SP_ERR_INVALID). *id (may be NULL) gets the new sketch's id.
+sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_stroke* stroke, double canvas_w, double canvas_h,
+                                     int64_t* id, sp_error* err);
+
+/// One kiosk sketch as stored (sp_db_kiosk_list).
+typedef struct sp_db_kiosk_sketch {
+    int64_t id;
+    char category[SP_NAME_MAX];
+    sp_db_status status;
+    char created_at[32]; ///< UTC, ISO 8601
+    sp_sketch sketch;    ///< its stroke(s)
+} sp_db_kiosk_sketch;
+
+/// Which kiosk sketches to list. Zero means the default.
+typedef struct sp_db_kiosk_query {
+    unsigned statuses; ///< bit (1 << sp_db_status) per status wanted; 0: pending only
+    int limit;         ///< at most this many, oldest first; 0: all
+    int64_t after;     ///< only ids above this (paging; 0: from the first)
+} sp_db_kiosk_query;
+
+/// Counts of kiosk sketches by status (counts[SP_DB_STATUS_COUNT]).
+sp_result sp_db_kiosk_counts(sp_db* db, int counts[SP_DB_STATUS_COUNT], sp_error* err);
+/// The kiosk sketches the query selects, oldest first (*out malloc'd; free
+/// with sp_db_kiosk_free). Uses the index on (source, status, id): a page
+/// costs the same with a hundred or a million stored.
+sp_result sp_db_kiosk_list(sp_db* db, const sp_db_kiosk_query* q, sp_db_kiosk_sketch** out, int* count, sp_error* err);
+void sp_db_kiosk_free(sp_db_kiosk_sketch* s, int count);
+/// Sets the review status of kiosk sketches, all in one transaction: an id
+/// that is not a kiosk sketch changes nothing and fails with SP_ERR_INVALID
+/// naming it. Logged for the curator log.
+sp_result sp_db_kiosk_set_status(sp_db* db, const int64_t* ids, int n, sp_db_status status, const char* by, sp_error* err);
+/// Gives a kiosk sketch another category (one of the current part
+/// categories; anything else fails with SP_ERR_INVALID and changes nothing).
+sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const char* by, sp_error* err);
 
 /// Training. Zero means the default.
 typedef struct sp_db_train_desc {
@@ -186,12 +251,13 @@ typedef struct sp_db_train_desc {
     double calibrate_quantile; ///< share of the calibration sketches accepted; 0: 0.96
 } sp_db_train_desc;
 /// Rebuilds the classifier from the stored sketches of the current part
-/// categories, cross-validates it for the report, calibrates its reject
+/// categories (synthetic, curated, and approved kiosk sketches: the newest
+/// SP_DB_KIOSK_TRAIN_MAX per category), cross-validates it for the report, calibrates its reject
 /// threshold on fresh hand-drawn sketches of the parts, and stores the model with
 /// its options and report in one transaction. `report_json` (may be NULL) gets
-/// the report: {"categories", "drawings", "folds", "top1", "per_class": {"<cat>": {"recall", "n"}}, "seconds_train",
-/// "seconds_cv", "reject_distance", "calibration": {"sketches", "quantile"} (absent without calibration)}
-/// (malloc'd, free()). Fails when a part category has no sketches.
+/// the report: {"categories", "drawings", "kiosk_sketches" (approved kiosk sketches among the drawings), "folds", "top1",
+/// "per_class": {"<cat>": {"recall", "n"}}, "seconds_train", "seconds_cv", "reject_distance", "calibration": {"sketches",
+/// "quantile"} (absent without calibration)} (malloc'd, free()). Fails when a part category has no sketches.
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err);
 /// The newest model; *id (may be NULL) its row id. SP_ERR_INVALID when none is stored.
 sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err);

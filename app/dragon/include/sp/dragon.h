@@ -108,7 +108,7 @@ typedef struct sp_dragon_desc {
 typedef enum sp_dragon_reject {
     SP_DRAGON_ACCEPTED = 0,
     SP_DRAGON_TOO_SHORT,        ///< fewer than 2 points, or smaller than 1% of the canvas (a tap)
-    SP_DRAGON_UNRECOGNISED,     ///< the classifier rejected it (or the top score < min_confidence)
+    SP_DRAGON_UNRECOGNISED,     ///< refused by the kiosk's policy (a scribble, or far from every part: docs/DESIGN.md), or the top score < min_confidence
     SP_DRAGON_NO_PART,          ///< the category has no part in the database (or none loads)
     SP_DRAGON_NO_MODEL,         ///< the database has no trained model and no category was forced
     SP_DRAGON_FIT_FAILED,       ///< every part of the category refused the stroke

@@ -1,0 +1,226 @@
+// db_kiosk.c: visitors' strokes collected by the kiosk, and their review
+// (sp/partdb.h, "visitors' strokes").
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "db_internal.h"
+#include "sp/curve.h"
+
+static const char* const k_status[SP_DB_STATUS_COUNT] = {"pending", "approved", "rejected"};
+
+const char* sp_db_status_name(sp_db_status s)
+{
+    return s >= 0 && s < SP_DB_STATUS_COUNT ? k_status[s] : "?";
+}
+
+static sp_db_status status_of(const char* s)
+{
+    for (int i = 0; s && i < SP_DB_STATUS_COUNT; ++i)
+        if (!strcmp(s, k_status[i])) return (sp_db_status)i;
+    return SP_DB_PENDING;
+}
+
+sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_stroke* stroke, double canvas_w, double canvas_h,
+                                     int64_t* id, sp_error* err)
+{
+    if (id) *id = 0;
+    if (!db_name_ok(category))
+        return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: category '%s' is not a plain name; sketch dropped", db->path,
+                       category ? category : "");
+    if (!stroke || stroke->count < 2 || stroke->count > 65536)
+        return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: %d points (2..65536); sketch dropped", db->path,
+                       stroke ? stroke->count : 0);
+    bool finite = sp_curve_is_valid(stroke->points, stroke->count) && isfinite(canvas_w) && isfinite(canvas_h);
+    for (int i = 0; finite && stroke->t && i < stroke->count; ++i)
+        finite = isfinite(stroke->t[i]);
+    if (!finite)
+        return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: a coordinate is not a finite number; sketch dropped", db->path);
+    sp_sketch sk = {.canvas_w = canvas_w, .canvas_h = canvas_h, .stroke_count = 1, .strokes = (sp_stroke*)stroke};
+    char* json = db_sketch_json(&sk);
+    if (!json) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: kiosk sketch: out of memory; sketch dropped", db->path);
+    // The UI thread must not wait: a short busy timeout, and a commit that
+    // does not wait for the disk (WAL with synchronous NORMAL stays consistent
+    // after a crash; a power cut may lose the last commits).
+    int busy = db->busy_ms;
+    sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
+    sqlite3_exec(db->h, "PRAGMA synchronous = NORMAL", NULL, NULL, NULL);
+    sqlite3_stmt* st = NULL;
+    sp_result r = db_begin(db, err);
+    if (r == SP_OK &&
+        (r = db_prepare(
+             db, "INSERT INTO sketches(category, source, strokes, added_by, status) VALUES (?, 'kiosk', ?, 'kiosk', 'pending')",
+             &st, err)) == SP_OK) {
+        sqlite3_bind_text(st, 1, category, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 2, json, -1, SQLITE_STATIC);
+        int rc = sqlite3_step(st);
+        if (rc != SQLITE_DONE)
+            r = db_fail(db, rc, "storing a kiosk sketch", err);
+        else if (id)
+            *id = sqlite3_last_insert_rowid(db->h);
+        sqlite3_finalize(st);
+        if (r == SP_OK)
+            r = db_commit(db, err);
+        else
+            db_rollback(db);
+    }
+    if (!db->readonly) sqlite3_exec(db->h, "PRAGMA synchronous = FULL", NULL, NULL, NULL);
+    sp_db_set_busy_timeout(db, busy);
+    free(json);
+    if (r != SP_OK) {
+        if (id) *id = 0;
+        char why[sizeof err->text];
+        snprintf(why, sizeof why, "%s", err->text);
+        sp_fail(err, r, "%s; sketch dropped", why);
+    }
+    return r;
+}
+
+sp_result sp_db_kiosk_counts(sp_db* db, int counts[SP_DB_STATUS_COUNT], sp_error* err)
+{
+    for (int i = 0; i < SP_DB_STATUS_COUNT; ++i)
+        counts[i] = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT status, count(*) FROM sketches WHERE source = 'kiosk' GROUP BY status", &st, err);
+    if (r != SP_OK) return r;
+    int rc;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW)
+        counts[status_of((const char*)sqlite3_column_text(st, 0))] += sqlite3_column_int(st, 1);
+    sqlite3_finalize(st);
+    return rc == SQLITE_DONE ? SP_OK : db_fail(db, rc, "counting kiosk sketches", err);
+}
+
+void sp_db_kiosk_free(sp_db_kiosk_sketch* s, int count)
+{
+    for (int i = 0; s && i < count; ++i)
+        sp_sketch_free(&s[i].sketch);
+    free(s);
+}
+
+sp_result sp_db_kiosk_list(sp_db* db, const sp_db_kiosk_query* q, sp_db_kiosk_sketch** out, int* count, sp_error* err)
+{
+    *out = NULL;
+    *count = 0;
+    sp_db_kiosk_query d = q ? *q : (sp_db_kiosk_query){0};
+    unsigned mask = d.statuses ? d.statuses : 1u << SP_DB_PENDING;
+    // The statuses are our own constants: written into the query, one index range each.
+    db_str sql = {0};
+    db_str_printf(&sql, "SELECT id, category, status, added_at, strokes FROM sketches WHERE source = 'kiosk' AND status IN (");
+    for (int i = 0, n = 0; i < SP_DB_STATUS_COUNT; ++i)
+        if (mask & (1u << i)) db_str_printf(&sql, "%s'%s'", n++ ? ", " : "", k_status[i]);
+    db_str_printf(&sql, ") AND id > ?1 ORDER BY id LIMIT ?2");
+    if (sql.oom) {
+        free(sql.s);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, sql.s, &st, err);
+    free(sql.s);
+    if (r != SP_OK) return r;
+    sqlite3_bind_int64(st, 1, d.after);
+    sqlite3_bind_int64(st, 2, d.limit > 0 ? d.limit : -1);
+    sp_db_kiosk_sketch* v = NULL;
+    int n = 0, cap = 0, rc;
+    while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 64;
+            sp_db_kiosk_sketch* g = realloc(v, sizeof *g * (size_t)cap);
+            if (!g) {
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+                break;
+            }
+            v = g;
+        }
+        sp_db_kiosk_sketch* k = &v[n];
+        memset(k, 0, sizeof *k);
+        k->id = sqlite3_column_int64(st, 0);
+        snprintf(k->category, sizeof k->category, "%s", (const char*)sqlite3_column_text(st, 1));
+        k->status = status_of((const char*)sqlite3_column_text(st, 2));
+        snprintf(k->created_at, sizeof k->created_at, "%s", (const char*)sqlite3_column_text(st, 3));
+        char what[96];
+        snprintf(what, sizeof what, "%s: kiosk sketch %lld", db->path, (long long)k->id);
+        const char* text = (const char*)sqlite3_column_text(st, 4);
+        if (!text)
+            r = sp_fail(err, SP_ERR_PARSE, "%s: no strokes", what);
+        else
+            r = sp_sketch_parse_json(text, (size_t)sqlite3_column_bytes(st, 4), what, &k->sketch, err);
+        if (r == SP_OK) ++n;
+    }
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading kiosk sketches", err);
+    sqlite3_finalize(st);
+    if (r != SP_OK) {
+        sp_db_kiosk_free(v, n);
+        return r;
+    }
+    *out = v;
+    *count = n;
+    return SP_OK;
+}
+
+// One UPDATE of one kiosk sketch inside the caller's transaction; SP_ERR_INVALID when id is not one.
+static sp_result update_one(sp_db* db, const char* sql, const char* value, int64_t id, sp_error* err)
+{
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, sql, &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, value, -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 2, id);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) return db_fail(db, rc, "reviewing kiosk sketches", err);
+    if (sqlite3_changes(db->h) == 0)
+        return sp_fail(err, SP_ERR_INVALID, "%s: no kiosk sketch %lld; nothing was changed", db->path, (long long)id);
+    return SP_OK;
+}
+
+sp_result sp_db_kiosk_set_status(sp_db* db, const int64_t* ids, int n, sp_db_status status, const char* by, sp_error* err)
+{
+    if (status < 0 || status >= SP_DB_STATUS_COUNT) return sp_fail(err, SP_ERR_INVALID, "unknown review status");
+    if (n <= 0) return sp_fail(err, SP_ERR_INVALID, "%s: no kiosk sketch ids given", db->path);
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    db_str b = {0};
+    db_str_printf(&b, "{\"status\": \"%s\", \"ids\": [", k_status[status]);
+    for (int i = 0; r == SP_OK && i < n; ++i) {
+        r = update_one(db, "UPDATE sketches SET status = ?1 WHERE id = ?2 AND source = 'kiosk'", k_status[status], ids[i], err);
+        db_str_printf(&b, "%s%lld", i ? ", " : "", (long long)ids[i]);
+    }
+    db_str_printf(&b, "]}");
+    if (r == SP_OK)
+        r = b.oom ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : db_log_row(db, by, "review", "kiosk sketches", b.s, err);
+    free(b.s);
+    if (r != SP_OK) {
+        db_rollback(db);
+        return r;
+    }
+    return db_commit(db, err);
+}
+
+sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const char* by, sp_error* err)
+{
+    char** cats;
+    int ncat;
+    sp_result r = sp_db_categories(db, &cats, &ncat, err);
+    if (r != SP_OK) return r;
+    bool known = false;
+    for (int i = 0; category && i < ncat; ++i)
+        known |= !strcmp(cats[i], category);
+    sp_db_free_strings(cats, ncat);
+    if (!known)
+        return sp_fail(err, SP_ERR_INVALID, "%s: '%s' is not a part category (see `sketchpose db list`); nothing was changed",
+                       db->path, category ? category : "");
+    if ((r = db_begin(db, err)) != SP_OK) return r;
+    r = update_one(db, "UPDATE sketches SET category = ?1 WHERE id = ?2 AND source = 'kiosk'", category, id, err);
+    if (r == SP_OK) {
+        char details[160], subject[48];
+        snprintf(details, sizeof details, "{\"category\": \"%s\"}", category);
+        snprintf(subject, sizeof subject, "kiosk sketch %lld", (long long)id);
+        r = db_log_row(db, by, "relabel", subject, details, err);
+    }
+    if (r != SP_OK) {
+        db_rollback(db);
+        return r;
+    }
+    return db_commit(db, err);
+}

@@ -1,0 +1,320 @@
+// bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
+//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--json]
+// Every drawing of one half of tests/data/visitors (drawings made neither by
+// nor for the project's hand-drawing model: tests/data/visitors/README.md) goes
+// through the kiosk pipeline (sp_dragon_add_points) one stroke at a time, on a
+// database built by the default recipe (the kiosk's first start): --db PATH is
+// used when it exists and created there by that recipe when it does not;
+// without --db a fresh one is built in a temporary folder. The canvas is
+// 1280 x 800, as the drawings'. Printed per part: the strokes that became the
+// right part, that were refused, that became a wrong part, and the right
+// part's share among the three guesses (given also for refused strokes); for
+// the non-parts the share refused; ms per stroke (classification, and pen-up
+// to fitted part). --list prints every drawing's answer; --sheet draws the
+// half with the answers (red frame: a refused or wrong part, an accepted
+// non-part). --fit-all also fits every category's part to every drawing and
+// prints each fit's error (mean error over the stroke's diagonal) beside the
+// classifier's scores and nearest distance: the data behind the refusal
+// policy and the re-ranking that was tried (BENCHMARKS.md). Tune on --half
+// tune (the default); report --half report.
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bench.h"
+#include "sp/dragon.h"
+#include "sp/partdb.h"
+#include "sp/sketch_io.h"
+#include "sp/sketch_sheet.h"
+
+#define NOT_A_PART "not_a_part"
+
+typedef struct outcome {
+    bool refused;
+    char answer[SP_NAME_MAX]; // the part it became ("" when refused)
+    bool top1, top3;          // the right category first / among the guesses (refusal aside)
+    double ms_classify, ms_total;
+    const char* reason;
+} outcome;
+
+static int json_file(const struct dirent* e)
+{
+    size_t n = strlen(e->d_name);
+    return n > 5 && !strcmp(e->d_name + n - 5, ".json");
+}
+
+static int by_name(const struct dirent** a, const struct dirent** b)
+{
+    return strcmp((*a)->d_name, (*b)->d_name);
+}
+
+// The file name (without .json) of sample i: sp_dataset_load reads each
+// category's files in name order, so its index is its place in that order.
+static void sample_name(const char* dir, const sp_dataset* ds, int i, char* out, size_t cap)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, ds->categories[ds->samples[i].label]);
+    struct dirent** list = NULL;
+    int n = scandir(path, &list, json_file, by_name);
+    snprintf(out, cap, "#%d", ds->samples[i].index);
+    for (int k = 0; k < n; ++k) {
+        if (k == ds->samples[i].index) snprintf(out, cap, "%.*s", (int)strlen(list[k]->d_name) - 5, list[k]->d_name);
+        free(list[k]);
+    }
+    free(list);
+}
+
+static int find(char** names, int n, const char* s)
+{
+    for (int i = 0; i < n; ++i)
+        if (!strcmp(names[i], s)) return i;
+    return -1;
+}
+
+int main(int argc, char** argv)
+{
+    const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_SOURCE_DIR "/tests/data/visitors",
+               *sheet = NULL;
+    bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--half") && i + 1 < argc)
+            half = argv[++i];
+        else if (!strcmp(argv[i], "--db") && i + 1 < argc)
+            db_path = argv[++i];
+        else if (!strcmp(argv[i], "--assets") && i + 1 < argc)
+            assets = argv[++i];
+        else if (!strcmp(argv[i], "--data") && i + 1 < argc)
+            data = argv[++i];
+        else if (!strcmp(argv[i], "--sheet") && i + 1 < argc)
+            sheet = argv[++i];
+        else if (!strcmp(argv[i], "--list"))
+            list = true;
+        else if (!strcmp(argv[i], "--fit-all"))
+            fit_all = true;
+        else if (strcmp(argv[i], "--json") != 0) {
+            fprintf(stderr, "usage: visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
+                            "[--list] [--json]\n");
+            return 2;
+        }
+    }
+    if (strcmp(half, "tune") != 0 && strcmp(half, "report") != 0) {
+        fprintf(stderr, "visitors: --half is tune or report\n");
+        return 2;
+    }
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/%s", data, half);
+    sp_dataset ds = {0};
+    sp_error err = {0};
+    if (sp_dataset_load(dir, &ds, &err) != SP_OK) {
+        fprintf(stderr, "visitors: %s\n", err.text);
+        return 1;
+    }
+    char tmp[] = "/tmp/sp-visitors-XXXXXX", tmp_db[64] = "";
+    if (!db_path) {
+        if (!mkdtemp(tmp)) {
+            fprintf(stderr, "visitors: cannot create a temporary folder\n");
+            return 1;
+        }
+        snprintf(tmp_db, sizeof tmp_db, "%s/default.db", tmp);
+        db_path = tmp_db;
+    }
+    double t_build = 0;
+    if (access(db_path, F_OK) != 0) {
+        double t0 = sp_bench_now_ms();
+        if (sp_db_create_default(db_path, assets, NULL, &err) != SP_OK) {
+            fprintf(stderr, "visitors: %s\n", err.text);
+            return 1;
+        }
+        t_build = sp_bench_now_ms() - t0;
+        fprintf(stderr, "visitors: built %s by the default recipe in %.1f s\n", db_path, t_build / 1000);
+    }
+    sp_dragon* d =
+        sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .assets_dir = assets, .canvas_w = 1280, .canvas_h = 800}, &err);
+    if (!d || sp_dragon_preload(d, &err) != SP_OK) {
+        fprintf(stderr, "visitors: %s\n", err.text);
+        return 1;
+    }
+    outcome* out = calloc((size_t)ds.count + 1, sizeof *out);
+    double* ms_c = malloc(sizeof(double) * ((size_t)ds.count + 1));
+    double* ms_t = malloc(sizeof(double) * ((size_t)ds.count + 1));
+    int n_ms = 0;
+    for (int i = 0; i < ds.count; ++i) {
+        const sp_sketch* s = &ds.samples[i].sketch;
+        const char* label = ds.categories[ds.samples[i].label];
+        sp_dragon_result res;
+        if (s->stroke_count != 1) {
+            fprintf(stderr, "visitors: drawing %d of %s has %d strokes (one expected)\n", i, label, s->stroke_count);
+            return 1;
+        }
+        if (sp_dragon_add_stroke(d, &s->strokes[0], NULL, &res, &err) != SP_OK) {
+            fprintf(stderr, "visitors: %s drawing %d: %s\n", label, i, err.text);
+            return 1;
+        }
+        outcome* o = &out[i];
+        o->refused = res.rejected;
+        o->reason = sp_dragon_reject_name(res.reason);
+        if (!res.rejected) snprintf(o->answer, sizeof o->answer, "%s", sp_dragon_part_get(d, res.part)->category);
+        for (int k = 0; k < res.guess_count; ++k)
+            o->top3 |= !strcmp(res.guesses[k].category, label);
+        o->top1 = res.guess_count > 0 && !strcmp(res.guesses[0].category, label);
+        o->ms_classify = res.ms_classify;
+        o->ms_total = res.ms_total;
+        // Every stroke that reached the classifier counts for the timing (taps stop before it).
+        if (res.ms_classify > 0) {
+            ms_c[n_ms] = res.ms_classify;
+            ms_t[n_ms++] = res.ms_total;
+        }
+        sp_dragon_clear(d);
+        if (fit_all) { // diagnostic: every category forced, the fit's error relative to the stroke's size
+            const sp_clf* clf = sp_dragon_model(d);
+            char name[256];
+            sample_name(dir, &ds, i, name, sizeof name);
+            printf("%-11s %-34s", label, name);
+            double best = 1e9;
+            int bc = -1;
+            for (int c = 0; clf && c < sp_clf_category_count(clf); ++c) {
+                sp_dragon_result fr;
+                sp_dragon_add_stroke(d, &s->strokes[0], &(sp_dragon_stroke_opts){.category = sp_clf_category(clf, c)}, &fr, &err);
+                double e = fr.part >= 0 ? sp_dragon_part_get(d, fr.part)->report.mean_error_px /
+                                              sp_dragon_part_get(d, fr.part)->report.bbox_diagonal_px
+                                        : 9;
+                printf(" %s=%.3f", sp_clf_category(clf, c), e);
+                if (e < best) best = e, bc = c;
+                sp_dragon_clear(d);
+            }
+            printf("  best=%s guess=%s", bc >= 0 ? sp_clf_category(clf, bc) : "-",
+                   res.guess_count ? res.guesses[0].category : "-");
+            sp_sketch one = {.canvas_w = 1280, .canvas_h = 800, .stroke_count = 1, .strokes = &s->strokes[0]};
+            sp_clf_answer a;
+            if (clf && sp_clf_classify(clf, &one, NULL, &a, &err) == SP_OK) {
+                printf(" dist=%.4f rej=%.4f clf:", a.distance, a.reject_distance);
+                for (int k = 0; k < a.count; ++k)
+                    printf(" %s=%.3f", sp_clf_category(clf, a.ranked[k].category), a.ranked[k].score);
+            }
+            printf("\n");
+        }
+    }
+    // Per part.
+    char** cats = ds.categories;
+    int nc = ds.category_count;
+    int *n = calloc((size_t)nc, sizeof(int)), *right = calloc((size_t)nc, sizeof(int)),
+        *refused = calloc((size_t)nc, sizeof(int)), *wrong = calloc((size_t)nc, sizeof(int)),
+        *top3 = calloc((size_t)nc, sizeof(int)), *top1 = calloc((size_t)nc, sizeof(int));
+    for (int i = 0; i < ds.count; ++i) {
+        int c = ds.samples[i].label;
+        n[c]++;
+        refused[c] += out[i].refused;
+        right[c] += !out[i].refused && !strcmp(out[i].answer, cats[c]);
+        wrong[c] += !out[i].refused && strcmp(out[i].answer, cats[c]) != 0;
+        top3[c] += out[i].top3;
+        top1[c] += out[i].top1;
+    }
+    int none = find(cats, nc, NOT_A_PART);
+    int pn = 0, pr = 0, pref = 0, pw = 0, p3 = 0, p1 = 0;
+    for (int c = 0; c < nc; ++c)
+        if (c != none) pn += n[c], pr += right[c], pref += refused[c], pw += wrong[c], p3 += top3[c], p1 += top1[c];
+    double mc = 0, mc90 = 0, mt = 0, mt90 = 0;
+    if (n_ms > 0) {
+        sp_bench_stats(ms_c, n_ms, &mc, &mc90);
+        sp_bench_stats(ms_t, n_ms, &mt, &mt90);
+    }
+    if (list)
+        for (int i = 0; i < ds.count; ++i) {
+            const char* label = cats[ds.samples[i].label];
+            bool ok = strcmp(label, NOT_A_PART) ? !out[i].refused && !strcmp(out[i].answer, label) : out[i].refused;
+            char name[256];
+            sample_name(dir, &ds, i, name, sizeof name);
+            fprintf(json ? stderr : stdout, "%-4s %-11s %-34s -> %-12s (%s)%s\n", ok ? "ok" : "MISS", label, name,
+                    out[i].refused ? "refused" : out[i].answer, out[i].reason, out[i].top3 ? "" : " not in top 3");
+        }
+    if (json) {
+        printf("[\n");
+        for (int c = 0; c < nc; ++c) {
+            if (c == none) continue;
+            printf("  {\"case\": \"%s %s\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": "
+                   "%d},\n",
+                   half, cats[c], n[c], right[c], refused[c], wrong[c], top1[c], top3[c]);
+        }
+        printf(
+            "  {\"case\": \"%s parts\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": %d},\n",
+            half, pn, pr, pref, pw, p1, p3);
+        if (none >= 0) printf("  {\"case\": \"%s not a part\", \"n\": %d, \"refused\": %d},\n", half, n[none], refused[none]);
+        printf("  {\"case\": \"%s classify\", \"ms_median\": %.3f, \"ms_p90\": %.3f, \"runs\": %d, \"target_ms\": 10},\n", half,
+               mc, mc90, n_ms);
+        printf("  {\"case\": \"%s pen-up to part\", \"ms_median\": %.3f, \"ms_p90\": %.3f, \"runs\": %d, \"target_ms\": 50}",
+               half, mt, mt90, n_ms);
+        if (t_build > 0)
+            printf(",\n  {\"case\": \"first build of the default database\", \"ms_median\": %.0f, \"runs\": 1, \"target_ms\": "
+                   "120000}",
+                   t_build);
+        printf("\n]\n");
+    } else {
+        printf("Visitors' drawings, %s half (%s), database %s\n", half, dir, db_path);
+        printf("%-12s %4s %14s %14s %14s %14s %14s\n", "part", "n", "right part", "refused", "wrong part", "top 3",
+               "first guess");
+#define PCT(a, b) ((b) > 0 ? 100.0 * (a) / (b) : 0.0)
+        for (int c = 0; c < nc; ++c) {
+            if (c == none) continue;
+            printf("%-12s %4d %6d (%4.0f%%) %6d (%4.0f%%) %6d (%4.0f%%) %6d (%4.0f%%) %6d (%4.0f%%)\n", cats[c], n[c], right[c],
+                   PCT(right[c], n[c]), refused[c], PCT(refused[c], n[c]), wrong[c], PCT(wrong[c], n[c]), top3[c],
+                   PCT(top3[c], n[c]), top1[c], PCT(top1[c], n[c]));
+        }
+        printf("%-12s %4d %6d (%4.1f%%) %6d (%4.1f%%) %6d (%4.1f%%) %6d (%4.1f%%) %6d (%4.1f%%)\n", "all parts", pn, pr,
+               PCT(pr, pn), pref, PCT(pref, pn), pw, PCT(pw, pn), p3, PCT(p3, pn), p1, PCT(p1, pn));
+        printf("%-12s %4s %14s %14s %14s %14s %14s\n", "targets", "", ">= 85%", "<= 5%", "", ">= 97%", "(refusal aside)");
+        if (none >= 0)
+            printf("%-12s %4d refused %d (%.1f%%)   target: >= 50%%\n", "not a part", n[none], refused[none],
+                   PCT(refused[none], n[none]));
+        printf("ms per stroke (%d strokes that reached the classifier): classification %.2f median, %.2f p90 (target 10); pen-up "
+               "to part %.2f "
+               "median, %.2f p90 (target 50)\n",
+               n_ms, mc, mc90, mt, mt90);
+#undef PCT
+    }
+    if (sheet) {
+        sp_sheet_item* items = calloc((size_t)ds.count, sizeof *items);
+        char(*notes)[96] = calloc((size_t)ds.count, sizeof *notes);
+        char(*labels)[96] = calloc((size_t)ds.count, sizeof *labels);
+        for (int i = 0; i < ds.count; ++i) {
+            const char* label = cats[ds.samples[i].label];
+            bool part = strcmp(label, NOT_A_PART) != 0;
+            sample_name(dir, &ds, i, labels[i], sizeof labels[i]);
+            snprintf(notes[i], sizeof notes[i], "-> %s", out[i].refused ? "refused" : out[i].answer);
+            items[i] = (sp_sheet_item){.sketch = &ds.samples[i].sketch,
+                                       .label = labels[i],
+                                       .note = notes[i],
+                                       .highlight = part ? out[i].refused || strcmp(out[i].answer, label) != 0 : !out[i].refused};
+        }
+        char title[256];
+        snprintf(title, sizeof title, "%s half: red = refused, wrong, or not a part", half);
+        if (sp_sheet_write_png(items, ds.count, &(sp_sheet_desc){.cols = 10, .cell = 170, .title = title}, sheet, &err) != SP_OK)
+            fprintf(stderr, "visitors: %s\n", err.text);
+        free(items);
+        free(notes);
+        free(labels);
+    }
+    free(n);
+    free(right);
+    free(refused);
+    free(wrong);
+    free(top3);
+    free(top1);
+    free(out);
+    free(ms_c);
+    free(ms_t);
+    sp_dragon_destroy(d);
+    sp_dataset_free(&ds);
+    if (tmp_db[0]) {
+        char cmd[256];
+        snprintf(cmd, sizeof cmd, "%s-wal", tmp_db);
+        unlink(cmd);
+        snprintf(cmd, sizeof cmd, "%s-shm", tmp_db);
+        unlink(cmd);
+        unlink(tmp_db);
+        rmdir(tmp);
+    }
+    return 0;
+}
