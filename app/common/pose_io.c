@@ -95,8 +95,10 @@ cJSON* sp_pose_to_json(const sp_param* params, int count, const double* p)
 {
     cJSON* root = cJSON_CreateObject();
     cJSON* values = sp_pose_params_json(params, count, p);
-    if (root && values) cJSON_AddItemToObject(root, "parameters", values);
-    else cJSON_Delete(values);
+    if (root && values)
+        cJSON_AddItemToObject(root, "parameters", values);
+    else
+        cJSON_Delete(values);
     return root;
 }
 

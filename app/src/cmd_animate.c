@@ -61,7 +61,8 @@ int cmd_animate(int argc, char** argv)
     sp_character* ch = sp_rig_handle_character(rig);
     if (!ch) {
         // A glTF animation keys joints; a black box's deformers have none.
-        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: animate needs a glTF character; a black-box rig plugin is posed by `pose`", rig_path);
+        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: animate needs a glTF character; a black-box rig plugin is posed by `pose`",
+                rig_path);
         goto fail;
     }
     run.rig = rig;
@@ -87,7 +88,8 @@ int cmd_animate(int argc, char** argv)
     }
     sp_animation anim;
     sp_result ar = sp_animation_from_keys(&ch->rig, kp, times, n, "sketchpose", &anim, &err);
-    sp_animation* grown = ar == SP_OK ? realloc(ch->rig.animations, sizeof(sp_animation) * (size_t)(ch->rig.animation_count + 1)) : NULL;
+    sp_animation* grown =
+        ar == SP_OK ? realloc(ch->rig.animations, sizeof(sp_animation) * (size_t)(ch->rig.animation_count + 1)) : NULL;
     if (!grown) {
         for (int c = 0; c < anim.channel_count; ++c) free(anim.channels[c].times), free(anim.channels[c].values);
         free(anim.channels);

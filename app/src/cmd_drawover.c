@@ -82,7 +82,8 @@ int cmd_drawover(int argc, char** argv)
     if (!ch) {
         // Its curves are embedded in the mesh surface, and a black box
         // evaluates only the abstractions it declares.
-        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: draw-over needs a glTF character; a black-box rig plugin is posed by `pose`", rig_path);
+        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: draw-over needs a glTF character; a black-box rig plugin is posed by `pose`",
+                rig_path);
         goto fail;
     }
     run.rig = rig;

@@ -62,7 +62,8 @@ static cJSON* inspect_json(sp_rig_handle* h)
         cJSON_AddNumberToObject(o, "duration_s", ch->rig.animations[a].duration_s);
         cJSON_AddItemToArray(anims, o);
     }
-    cJSON_AddBoolToObject(root, "camera_from_file", ch ? ch->has_camera : true); // a plugin declares its view (or asks for the default one)
+    // A plugin declares its sketch view (or asks for the default one).
+    cJSON_AddBoolToObject(root, "camera_from_file", ch ? ch->has_camera : true);
     if (ch) cJSON_AddBoolToObject(root, "derived_dofs", ch->derived_dofs);
     cJSON* part = ch && ch->part_json ? cJSON_Parse(ch->part_json) : NULL;
     if (part)

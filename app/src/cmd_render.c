@@ -97,7 +97,8 @@ int cmd_render(int argc, char** argv)
                 size_t n = strlen(names);
                 snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", abstractions[i].name);
             }
-            fprintf(stderr, "sketchpose render: %s has no abstraction '%s' (it has: %s)\n", rig_path, abs_name, nabs ? names : "none");
+            fprintf(stderr, "sketchpose render: %s has no abstraction '%s' (it has: %s)\n", rig_path, abs_name,
+                    nabs ? names : "none");
             sp_rig_handle_free(handle);
             return SP_EXIT_INPUT;
         }

@@ -144,7 +144,8 @@ int sp_blackbox_total_points(const sp_blackbox* bb);
 /// Index of abstraction a's first point in evaluate()'s abstraction_xyz.
 int sp_blackbox_first_point(const sp_blackbox* bb, int a);
 /// The abstraction as the solver's types see it (curves and correspondence;
-/// no skinning data, the rig computes its points).
+/// no skinning data, the rig computes its points). All of them are one array:
+/// abstraction a is sp_blackbox_abstraction_at(bb, 0) + a.
 const sp_abstraction* sp_blackbox_abstraction_at(const sp_blackbox* bb, int a);
 /// The parameters in the skinned rig's type (param_count; valid until
 /// sp_blackbox_free): name, bounds, default and group as the rig declares
