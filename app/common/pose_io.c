@@ -7,21 +7,29 @@
 #include <stdlib.h>
 #include <string.h>
 
-sp_result sp_pose_parse(const char* text, const char* what, const sp_rig* rig, double* p, int* clamped, sp_error* err)
+static int find_param(const sp_param* params, int count, const char* name)
+{
+    for (int k = 0; k < count; ++k)
+        if (!strcmp(params[k].name, name)) return k;
+    return -1;
+}
+
+sp_result sp_pose_parse(const char* text, const char* what, const sp_param* params, int count, double* p, int* clamped,
+                        sp_error* err)
 {
     if (clamped) *clamped = 0;
     cJSON* root = cJSON_Parse(text);
     if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: not valid JSON", what);
     sp_result r = SP_OK;
-    const cJSON* params = cJSON_GetObjectItemCaseSensitive(root, "parameters");
-    if (!cJSON_IsObject(params)) {
+    const cJSON* values = cJSON_GetObjectItemCaseSensitive(root, "parameters");
+    if (!cJSON_IsObject(values)) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: expected {\"parameters\": {\"<joint>.<channel>\": value, ...}}", what);
         goto done;
     }
     const cJSON* it;
-    cJSON_ArrayForEach(it, params)
+    cJSON_ArrayForEach(it, values)
     {
-        int k = sp_rig_find_param(rig, it->string);
+        int k = find_param(params, count, it->string);
         if (k < 0) {
             r = sp_fail(err, SP_ERR_INVALID, "%s: unknown parameter '%s' (see `sketchpose inspect`)", what, it->string);
             goto done;
@@ -31,9 +39,9 @@ sp_result sp_pose_parse(const char* text, const char* what, const sp_rig* rig, d
             goto done;
         }
         double v = it->valuedouble;
-        const sp_param* q = &rig->params[k];
-        if (v < q->min || v > q->max) {
-            double c = v < q->min ? q->min : q->max;
+        const sp_param* q = &params[k];
+        double c = sp_param_clamp(v, q->min, q->max, q->def);
+        if (c != v) {
             fprintf(stderr, "warning: %s: parameter '%s' = %g is outside [%g, %g], clamped to %g\n", what, it->string, v, q->min,
                     q->max, c);
             v = c;
@@ -46,7 +54,7 @@ done:
     return r;
 }
 
-sp_result sp_pose_read(const char* path, const sp_rig* rig, double* p, int* clamped, sp_error* err)
+sp_result sp_pose_read(const char* path, const sp_param* params, int count, double* p, int* clamped, sp_error* err)
 {
     FILE* f = fopen(path, "rb");
     if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
@@ -70,23 +78,33 @@ sp_result sp_pose_read(const char* path, const sp_rig* rig, double* p, int* clam
         return sp_fail(err, SP_ERR_IO, "%s: read error", path);
     }
     text[n] = 0;
-    sp_result r = sp_pose_parse(text, path, rig, p, clamped, err);
+    sp_result r = sp_pose_parse(text, path, params, count, p, clamped, err);
     free(text);
     return r;
 }
 
-cJSON* sp_pose_to_json(const sp_rig* rig, const double* p)
+cJSON* sp_pose_params_json(const sp_param* params, int count, const double* p)
+{
+    cJSON* o = cJSON_CreateObject();
+    for (int k = 0; o && k < count; ++k)
+        cJSON_AddNumberToObject(o, params[k].name, p[k]);
+    return o;
+}
+
+cJSON* sp_pose_to_json(const sp_param* params, int count, const double* p)
 {
     cJSON* root = cJSON_CreateObject();
-    cJSON* params = cJSON_AddObjectToObject(root, "parameters");
-    for (int k = 0; params && k < rig->param_count; ++k)
-        cJSON_AddNumberToObject(params, rig->params[k].name, p[k]);
+    cJSON* values = sp_pose_params_json(params, count, p);
+    if (root && values)
+        cJSON_AddItemToObject(root, "parameters", values);
+    else
+        cJSON_Delete(values);
     return root;
 }
 
-sp_result sp_pose_write(const char* path, const sp_rig* rig, const double* p, sp_error* err)
+sp_result sp_pose_write(const char* path, const sp_param* params, int count, const double* p, sp_error* err)
 {
-    cJSON* root = sp_pose_to_json(rig, p);
+    cJSON* root = sp_pose_to_json(params, count, p);
     char* text = root ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
     if (!text) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);

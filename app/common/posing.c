@@ -6,31 +6,22 @@
 
 #include "sp/sketch_io.h"
 
-int sp_pick_abstraction(const sp_character* ch, const char* rig_path, const char* name, sp_error* err)
+int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_path, const char* name, sp_error* err)
 {
-    const sp_rig* rig = &ch->rig;
-    if (rig->abstraction_count == 0) {
+    if (count == 0) {
         sp_fail(err, SP_ERR_INVALID, "%s: the rig has no sketch abstraction", rig_path);
         return -1;
     }
     if (!name) return 0;
-    int a = sp_rig_find_abstraction(rig, name);
-    if (a < 0) {
-        char list[256] = "";
-        for (int i = 0; i < rig->abstraction_count; ++i) {
-            size_t n = strlen(list);
-            snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", rig->abstractions[i].name);
-        }
-        sp_fail(err, SP_ERR_INVALID, "%s: no abstraction '%s' (it has: %s)", rig_path, name, list);
+    for (int a = 0; a < count; ++a)
+        if (!strcmp(abs[a].name, name)) return a;
+    char list[256] = "";
+    for (int i = 0; i < count; ++i) {
+        size_t n = strlen(list);
+        snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", abs[i].name);
     }
-    return a;
-}
-
-sp_camera sp_canvas_camera(const sp_character* ch, const sp_sketch* sk)
-{
-    if (sk && sk->canvas_w >= 1 && sk->canvas_h >= 1)
-        return sp_camera_resize(&ch->camera, (int)lround(sk->canvas_w), (int)lround(sk->canvas_h));
-    return ch->camera;
+    sp_fail(err, SP_ERR_INVALID, "%s: no abstraction '%s' (it has: %s)", rig_path, name, list);
+    return -1;
 }
 
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)

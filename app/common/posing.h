@@ -1,18 +1,16 @@
 /// posing.h: what the posing commands (pose, synth, drawover, animate,
-/// dragon) share: choosing an abstraction, the view camera on a stroke
-/// canvas, reading strokes with the file named in errors.
+/// dragon) share: choosing an abstraction, reading strokes with the file
+/// named in errors.
 #ifndef SP_POSING_H
 #define SP_POSING_H
 
 #include "sp/gltf.h"
 #include "sp/sketch.h"
 
-/// Index of the abstraction called `name` (NULL: the first one). -1 and a
-/// message naming the rig and the abstractions it has if there is none.
-int sp_pick_abstraction(const sp_character* ch, const char* rig_path, const char* name, sp_error* err);
-/// The character's sketch view on the sketch's canvas (or the camera's own
-/// canvas when the sketch gives none).
-sp_camera sp_canvas_camera(const sp_character* ch, const sp_sketch* sk);
+/// Index of the abstraction called `name` (NULL: the first one) among
+/// abs[0..count). -1 and a message naming the rig and the abstractions it
+/// has if there is none.
+int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_path, const char* name, sp_error* err);
 /// Reads a stroke file and checks that it has at least one stroke of two
 /// or more points; err names the file.
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);

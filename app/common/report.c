@@ -20,6 +20,11 @@ static cJSON* terms_json(const sp_energy_terms* e)
 
 cJSON* sp_report_to_json(const sp_solve_report* rep, const sp_rig* rig, const sp_abstraction* ab, const double* p)
 {
+    return sp_report_json(rep, ab, rig ? rig->params : NULL, rig ? rig->param_count : 0, rig ? p : NULL);
+}
+
+cJSON* sp_report_json(const sp_solve_report* rep, const sp_abstraction* ab, const sp_param* params, int count, const double* p)
+{
     cJSON* o = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "ms", rep->ms);
     cJSON_AddNumberToObject(o, "iterations", rep->iterations);
@@ -45,11 +50,9 @@ cJSON* sp_report_to_json(const sp_solve_report* rep, const sp_rig* rig, const sp
     }
     cJSON_AddNumberToObject(o, "unused_strokes", rep->unused_strokes);
     cJSON_AddStringToObject(o, "note", rep->note);
-    if (rig && p) {
-        cJSON* pose = sp_pose_to_json(rig, p);
-        cJSON* params = cJSON_DetachItemFromObject(pose, "parameters");
-        cJSON_AddItemToObject(o, "parameters", params ? params : cJSON_CreateObject());
-        cJSON_Delete(pose);
+    if (p) {
+        cJSON* values = sp_pose_params_json(params, count, p);
+        cJSON_AddItemToObject(o, "parameters", values ? values : cJSON_CreateObject());
     }
     return o;
 }

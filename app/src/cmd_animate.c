@@ -6,10 +6,9 @@
 #include <string.h>
 
 #include "cli.h"
+#include "commands.h"
 #include "posing.h"
-#include "report.h"
-#include "sp/gltf.h"
-#include "sp/solver.h"
+#include "solve_cmd.h"
 
 // "0,0.5,1.2" -> times; false if malformed or not increasing.
 static bool parse_times(const char* s, double* t, int n)
@@ -52,61 +51,55 @@ int cmd_animate(int argc, char** argv)
         free(times);
         return SP_EXIT_USAGE;
     }
-    sp_character ch = {0};
+    sp_rig_handle* rig = NULL;
     sp_error err = {0};
-    sp_solver* solver = NULL;
-    double* kp = NULL;
+    sp_solve_cmd run = {.cmd = "sketchpose animate"};
+    double *kp = NULL, *p0 = NULL;
     cJSON* all = cJSON_CreateArray();
     int exit_code = SP_EXIT_INPUT;
-    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) goto fail;
-    int a = sp_pick_abstraction(&ch, rig_path, abs_name, &err);
-    if (a < 0) goto fail;
-    const int P = ch.rig.param_count;
+    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    sp_character* ch = sp_rig_handle_character(rig);
+    if (!ch) {
+        // A glTF animation keys joints; a black box's deformers have none.
+        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: animate needs a glTF character; a black-box rig plugin is posed by `pose`",
+                rig_path);
+        goto fail;
+    }
+    run.rig = rig;
+    run.abstraction = sp_rig_handle_pick_abstraction(rig, abs_name, &err);
+    if (run.abstraction < 0) goto fail;
+    const int P = sp_rig_handle_param_count(rig);
+    if (sp_rig_handle_read_pose(rig, NULL, &p0, NULL, &err) != SP_OK) goto fail;
     kp = malloc(sizeof(double) * (size_t)(P + 1) * (size_t)n);
     if (!kp) goto oom;
-    sp_camera cam = ch.camera;
     for (int k = 0; k < n; ++k) {
         sp_sketch sk = {0};
         if (sp_read_strokes(keys.items[k], &sk, &err) != SP_OK) goto fail;
-        sp_camera kc = sp_canvas_camera(&ch, &sk);
-        // One solver for all keys when they share a canvas (the coarsening is reused).
-        if (!solver || kc.width != cam.width || kc.height != cam.height) {
-            sp_solver_destroy(solver);
-            cam = kc;
-            solver = sp_solver_create(&ch.rig, a, &cam, &(sp_solve_desc){0});
-            if (!solver) {
-                sp_sketch_free(&sk);
-                goto oom;
-            }
-        }
-        const double* start = k == 0 ? ch.pose : kp + (size_t)(k - 1) * P;
+        sp_camera cam = sp_rig_handle_camera(rig, sk.canvas_w, sk.canvas_h);
+        const double* start = k == 0 ? p0 : kp + (size_t)(k - 1) * P;
         sp_solve_report rep;
-        sp_result r = sp_solver_solve(solver, &sk, start, kp + (size_t)k * P, &rep, &err);
+        cJSON* j = NULL;
+        bool solved = sp_solve_cmd_solve(&run, &cam, &sk, keys.items[k], start, kp + (size_t)k * P, &rep, &j);
         sp_sketch_free(&sk);
-        if (r != SP_OK) {
-            fprintf(stderr, "sketchpose animate: %s: %s\n", keys.items[k], err.text);
-            goto done;
-        }
-        cJSON* j = sp_report_to_json(&rep, &ch.rig, &ch.rig.abstractions[a], kp + (size_t)k * P);
+        if (!solved) goto done;
         cJSON_AddStringToObject(j, "strokes", keys.items[k]);
         cJSON_AddNumberToObject(j, "time_s", times[k]);
         cJSON_AddItemToArray(all, j);
     }
     sp_animation anim;
-    sp_result ar = sp_animation_from_keys(&ch.rig, kp, times, n, "sketchpose", &anim, &err);
-    sp_animation* grown = ar == SP_OK ? realloc(ch.rig.animations, sizeof(sp_animation) * (size_t)(ch.rig.animation_count + 1)) : NULL;
+    sp_result ar = sp_animation_from_keys(&ch->rig, kp, times, n, "sketchpose", &anim, &err);
+    sp_animation* grown =
+        ar == SP_OK ? realloc(ch->rig.animations, sizeof(sp_animation) * (size_t)(ch->rig.animation_count + 1)) : NULL;
     if (!grown) {
         for (int c = 0; c < anim.channel_count; ++c) free(anim.channels[c].times), free(anim.channels[c].values);
         free(anim.channels);
         if (ar == SP_OK) goto oom;
         goto fail;
     }
-    ch.rig.animations = grown;
-    ch.rig.animations[ch.rig.animation_count++] = anim;
-    if (report && sp_json_write_file(report, all, &err) != SP_OK) goto fail;
-    sp_json_print(all);
-    if (sp_gltf_save(&ch, kp, out, &err) != SP_OK) goto fail;
-    exit_code = SP_EXIT_OK;
+    ch->rig.animations = grown;
+    ch->rig.animations[ch->rig.animation_count++] = anim;
+    // The keys' reports, then the character with the animation, at the first key's pose.
+    if (sp_solve_cmd_write(&run, all, kp, &(sp_solve_outputs){.report = report, .out = out})) exit_code = SP_EXIT_OK;
     goto done;
 oom:
     sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
@@ -114,8 +107,8 @@ fail:
     fprintf(stderr, "sketchpose animate: %s\n", err.text);
 done:
     cJSON_Delete(all);
-    sp_solver_destroy(solver);
-    free(kp), free(times);
-    sp_character_free(&ch);
+    sp_solve_cmd_end(&run);
+    free(kp), free(p0), free(times);
+    sp_rig_handle_free(rig);
     return exit_code;
 }

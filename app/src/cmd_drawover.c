@@ -6,12 +6,10 @@
 #include <string.h>
 
 #include "cli.h"
+#include "commands.h"
 #include "posing.h"
-#include "report.h"
+#include "solve_cmd.h"
 #include "sp/embed.h"
-#include "sp/gltf.h"
-#include "sp/snapshot.h"
-#include "sp/solver.h"
 
 // One abstraction with a curve per stroke of `on`, embedded in the mesh.
 static sp_result embed_strokes(const sp_rig* rig, const double* xyz, const sp_camera* cam, const sp_sketch* on, sp_abstraction* out,
@@ -70,64 +68,57 @@ int cmd_drawover(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, "sketchpose drawover", "Draw-over posing: redraw curves drawn over the character.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    sp_character ch = {0};
+    sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_sketch on = {0}, to = {0};
-    sp_solver* solver = NULL;
+    sp_solve_cmd run = {.cmd = "sketchpose drawover", .desc = desc};
     sp_abstraction emb = {0};
+    cJSON* rep_json = NULL;
     double *p = NULL, *xyz = NULL;
     sp_rig_eval* ev = NULL;
-    int exit_code = SP_EXIT_INPUT, a = -1;
-    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) goto fail;
+    int exit_code = SP_EXIT_INPUT;
+    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    sp_character* ch = sp_rig_handle_character(rig);
+    if (!ch) {
+        // Its curves are embedded in the mesh surface, and a black box
+        // evaluates only the abstractions it declares.
+        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: draw-over needs a glTF character; a black-box rig plugin is posed by `pose`",
+                rig_path);
+        goto fail;
+    }
+    run.rig = rig;
     if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
-    sp_camera cam = sp_canvas_camera(&ch, &on);
-    p = malloc(sizeof(double) * (size_t)(ch.rig.param_count + 1));
-    xyz = malloc(sizeof(double) * 3 * (size_t)(ch.rig.vertex_count + 1));
-    ev = sp_rig_eval_create(&ch.rig);
-    if (!p || !xyz || !ev) goto oom;
-    memcpy(p, ch.pose, sizeof(double) * (size_t)ch.rig.param_count);
+    sp_camera cam = sp_rig_handle_camera(rig, on.canvas_w, on.canvas_h);
+    if (sp_rig_handle_read_pose(rig, NULL, &p, NULL, &err) != SP_OK) goto fail;
+    xyz = malloc(sizeof(double) * 3 * (size_t)(ch->rig.vertex_count + 1));
+    ev = sp_rig_eval_create(&ch->rig);
+    if (!xyz || !ev) goto oom;
     sp_rig_eval_update(ev, p, false);
-    sp_rig_eval_points(ev, sp_rig_mesh_points(&ch.rig), xyz);
-    if (embed_strokes(&ch.rig, xyz, &cam, &on, &emb, &err) != SP_OK) {
+    sp_rig_eval_points(ev, sp_rig_mesh_points(&ch->rig), xyz);
+    if (embed_strokes(&ch->rig, xyz, &cam, &on, &emb, &err) != SP_OK) {
         fprintf(stderr, "sketchpose drawover: %s: %s\n", on_path, err.text);
         goto done;
     }
-    // The embedded curves join the rig only for the solve (the saver writes skinned abstractions).
-    a = sp_rig_add_abstraction(&ch.rig, &emb);
-    if (a < 0) goto oom;
-    solver = sp_solver_create(&ch.rig, a, &cam, &desc);
-    if (!solver) goto oom;
+    // The embedded curves join the rig for the solve and the picture; --out
+    // writes the file's own abstractions (sp_rig_posed.saved_abstractions).
+    run.abstraction = sp_rig_add_abstraction(&ch->rig, &emb);
+    if (run.abstraction < 0) goto oom;
     sp_solve_report rep;
-    if (sp_solver_solve(solver, &to, p, p, &rep, &err) != SP_OK) {
-        fprintf(stderr, "sketchpose drawover: %s: %s\n", to_path, err.text);
-        goto done;
-    }
-    cJSON* j = sp_report_to_json(&rep, &ch.rig, &ch.rig.abstractions[a], p);
-    sp_result wr = report ? sp_json_write_file(report, j, &err) : SP_OK;
-    sp_json_print(j);
-    cJSON_Delete(j);
-    if (wr != SP_OK) goto fail;
-    if (render) {
-        sp_snapshot_desc d = {.character = &ch, .params = p, .camera = &cam, .abstraction = a, .strokes = &to, .ghost = &on};
-        if (sp_snapshot_png(&d, render, &err) != SP_OK) goto fail;
-    }
-    sp_solver_destroy(solver);
-    solver = NULL;
-    sp_abstraction_free(&ch.rig.abstractions[--ch.rig.abstraction_count]);
-    if (out && sp_gltf_save(&ch, p, out, &err) != SP_OK) goto fail;
-    if (rep.note[0]) fprintf(stderr, "sketchpose drawover: %s\n", rep.note);
-    exit_code = SP_EXIT_OK;
+    if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
+    sp_solve_outputs o = {.report = report, .out = out, .render = render, .strokes = &to, .ghost = &on, .note = rep.note};
+    if (sp_solve_cmd_write(&run, rep_json, p, &o)) exit_code = SP_EXIT_OK;
     goto done;
 oom:
     sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
 fail:
     fprintf(stderr, "sketchpose drawover: %s\n", err.text);
 done:
-    sp_solver_destroy(solver);
+    cJSON_Delete(rep_json);
+    sp_solve_cmd_end(&run);
     sp_rig_eval_destroy(ev);
     sp_abstraction_free(&emb);
     free(p), free(xyz);
     sp_sketch_free(&on), sp_sketch_free(&to);
-    sp_character_free(&ch);
+    sp_rig_handle_free(rig);
     return exit_code;
 }

@@ -1,6 +1,7 @@
 // cmd_export.c: `sketchpose export --rig R [--pose p.json] --out X.glb`:
 // writes the rig posed by a pose file (default: the pose stored in R) as
-// .glb, or .gltf with embedded buffers when --out ends otherwise.
+// .glb, or .gltf with embedded buffers when --out ends otherwise. A
+// black-box plugin is written as its posed mesh, static (as `pose --out`).
 #include <cjson/cJSON.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,8 +9,7 @@
 
 #include "cli.h"
 #include "commands.h"
-#include "pose_io.h"
-#include "sp/gltf.h"
+#include "rig_handle.h"
 
 int cmd_export(int argc, char** argv)
 {
@@ -17,7 +17,8 @@ int cmd_export(int argc, char** argv)
     const char* pose_path = NULL;
     const char* out_path = NULL;
     sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
+         true},
         {"--pose", SP_OPT_STRING, &pose_path, "p.json", "pose file {\"parameters\": {...}}; default: the pose stored in R",
          false},
         {"--out", SP_OPT_STRING, &out_path, "X.glb", "output: .glb, or .gltf with embedded buffers", true},
@@ -26,31 +27,31 @@ int cmd_export(int argc, char** argv)
                           "Write a rig posed by a pose file as glTF (parameters baked into the joints).", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    sp_character ch = {0};
+    sp_rig_handle* rig = NULL;
     sp_error err = {0};
-    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) {
-        fprintf(stderr, "sketchpose export: %s\n", err.text);
-        return SP_EXIT_INPUT;
-    }
-    int clamped = 0;
-    if (pose_path && sp_pose_read(pose_path, &ch.rig, ch.pose, &clamped, &err) != SP_OK) {
-        fprintf(stderr, "sketchpose export: %s\n", err.text);
-        sp_character_free(&ch);
-        return SP_EXIT_INPUT;
-    }
-    if (sp_gltf_save(&ch, ch.pose, out_path, &err) != SP_OK) {
-        fprintf(stderr, "sketchpose export: %s\n", err.text);
-        sp_character_free(&ch);
-        return SP_EXIT_INPUT;
-    }
+    sp_rig_posed posed = {0};
+    double* p = NULL;
+    int clamped = 0, exit_code = SP_EXIT_INPUT;
+    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    if (sp_rig_handle_read_pose(rig, pose_path, &p, &clamped, &err) != SP_OK) goto fail;
+    sp_camera view = sp_rig_handle_camera(rig, 0, 0);
+    if (sp_rig_handle_posed(rig, -1, p, &view, &posed, &err) != SP_OK || sp_rig_posed_save(&posed, out_path, &err) != SP_OK)
+        goto fail;
     cJSON* root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "out", out_path);
-    cJSON_AddNumberToObject(root, "parameters", ch.rig.param_count);
+    cJSON_AddNumberToObject(root, "parameters", sp_rig_handle_param_count(rig));
     cJSON_AddNumberToObject(root, "clamped", clamped);
     char* text = cJSON_PrintUnformatted(root);
     if (text) puts(text);
     free(text);
     cJSON_Delete(root);
-    sp_character_free(&ch);
-    return SP_EXIT_OK;
+    exit_code = SP_EXIT_OK;
+    goto done;
+fail:
+    fprintf(stderr, "sketchpose export: %s\n", err.text);
+done:
+    sp_rig_posed_free(&posed);
+    free(p);
+    sp_rig_handle_free(rig);
+    return exit_code;
 }

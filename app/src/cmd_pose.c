@@ -1,16 +1,13 @@
-// sketchpose pose: redraw posing. Fits the rig to strokes drawn in its
-// sketch view and writes the posed .glb, a PNG and the solve report.
+// sketchpose pose: redraw posing. Fits the rig (a glTF character or a
+// black-box plugin) to strokes drawn in its sketch view and writes the
+// posed .glb, a PNG and the solve report.
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "cli.h"
-#include "plugin_rig.h"
-#include "pose_io.h"
+#include "commands.h"
 #include "posing.h"
-#include "report.h"
-#include "sp/gltf.h"
-#include "sp/snapshot.h"
-#include "sp/solver.h"
+#include "solve_cmd.h"
 
 int cmd_pose(int argc, char** argv)
 {
@@ -34,50 +31,32 @@ int cmd_pose(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, "sketchpose pose", "Redraw posing: fits the rig's abstraction to the strokes.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (sp_is_plugin_path(rig_path)) return sp_plugin_pose(rig_path, abs_name, strokes, start, out, render, report, &desc);
-    sp_character ch = {0};
     sp_error err = {0};
+    sp_rig_handle* rig = NULL;
     sp_sketch sk = {0};
-    sp_solver* solver = NULL;
+    sp_solve_cmd run = {.cmd = "sketchpose pose", .desc = desc};
+    cJSON* rep_json = NULL;
     double* p = NULL;
     int exit_code = SP_EXIT_INPUT;
-    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) goto fail;
-    int a = sp_pick_abstraction(&ch, rig_path, abs_name, &err);
-    if (a < 0) goto fail;
+    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    run.rig = rig;
+    run.abstraction = sp_rig_handle_pick_abstraction(rig, abs_name, &err);
+    if (run.abstraction < 0) goto fail;
     if (sp_read_strokes(strokes, &sk, &err) != SP_OK) goto fail;
-    sp_camera cam = sp_canvas_camera(&ch, &sk);
-    p = malloc(sizeof(double) * (size_t)(ch.rig.param_count + 1));
-    if (!p) goto oom;
-    for (int i = 0; i < ch.rig.param_count; ++i) p[i] = ch.pose[i];
-    if (start && sp_pose_read(start, &ch.rig, p, NULL, &err) != SP_OK) goto fail;
-    solver = sp_solver_create(&ch.rig, a, &cam, &desc);
-    if (!solver) goto oom;
+    sp_camera cam = sp_rig_handle_camera(rig, sk.canvas_w, sk.canvas_h);
+    if (sp_rig_handle_read_pose(rig, start, &p, NULL, &err) != SP_OK) goto fail;
     sp_solve_report rep;
-    if (sp_solver_solve(solver, &sk, p, p, &rep, &err) != SP_OK) {
-        fprintf(stderr, "sketchpose pose: %s: %s\n", strokes, err.text);
-        goto done;
-    }
-    cJSON* j = sp_report_to_json(&rep, &ch.rig, &ch.rig.abstractions[a], p);
-    sp_result wr = report ? sp_json_write_file(report, j, &err) : SP_OK;
-    sp_json_print(j);
-    cJSON_Delete(j);
-    if (wr != SP_OK) goto fail;
-    if (out && sp_gltf_save(&ch, p, out, &err) != SP_OK) goto fail;
-    if (render) {
-        sp_snapshot_desc d = {.character = &ch, .params = p, .camera = &cam, .abstraction = a, .strokes = &sk};
-        if (sp_snapshot_png(&d, render, &err) != SP_OK) goto fail;
-    }
-    if (rep.note[0]) fprintf(stderr, "sketchpose pose: %s\n", rep.note);
-    exit_code = SP_EXIT_OK;
+    if (!sp_solve_cmd_solve(&run, &cam, &sk, strokes, p, p, &rep, &rep_json)) goto done;
+    sp_solve_outputs o = {.report = report, .out = out, .render = render, .strokes = &sk, .note = rep.note};
+    if (sp_solve_cmd_write(&run, rep_json, p, &o)) exit_code = SP_EXIT_OK;
     goto done;
-oom:
-    sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
 fail:
     fprintf(stderr, "sketchpose pose: %s\n", err.text);
 done:
-    sp_solver_destroy(solver);
+    cJSON_Delete(rep_json);
+    sp_solve_cmd_end(&run);
     free(p);
     sp_sketch_free(&sk);
-    sp_character_free(&ch);
+    sp_rig_handle_free(rig);
     return exit_code;
 }

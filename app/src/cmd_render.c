@@ -6,9 +6,7 @@
 
 #include "cli.h"
 #include "commands.h"
-#include "plugin_rig.h"
-#include "pose_io.h"
-#include "sp/gltf.h"
+#include "rig_handle.h"
 #include "sp/headless.h"
 #include "sp/image.h"
 #include "sp/render.h"
@@ -83,61 +81,71 @@ int cmd_render(int argc, char** argv)
     }
 
     sp_error err = {0};
-    sp_character ch = {0};
-    // A plugin comes baked at the pose (a static character with no parameters).
-    bool plugin = sp_is_plugin_path(rig_path);
-    if (plugin ? sp_plugin_load_posed(rig_path, pose_path, &ch, &err) != SP_OK : sp_gltf_load(rig_path, &ch, &err) != SP_OK) {
+    sp_rig_handle* handle = NULL;
+    if (sp_rig_handle_load(rig_path, &handle, &err) != SP_OK) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         return SP_EXIT_INPUT;
     }
-    const sp_rig* rig = &ch.rig;
-    const sp_abstraction* ab = NULL;
+    int nabs = sp_rig_handle_abstraction_count(handle), ai = -1;
+    const sp_abstraction* abstractions = sp_rig_handle_abstractions(handle);
     if (abs_name && strcmp(abs_name, "none") != 0) {
-        int ai = sp_rig_find_abstraction(rig, abs_name);
+        for (int i = 0; i < nabs; ++i)
+            if (!strcmp(abstractions[i].name, abs_name)) ai = i;
         if (ai < 0) {
             char names[256] = "";
-            for (int i = 0; i < rig->abstraction_count; ++i) {
+            for (int i = 0; i < nabs; ++i) {
                 size_t n = strlen(names);
-                snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", rig->abstractions[i].name);
+                snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", abstractions[i].name);
             }
             fprintf(stderr, "sketchpose render: %s has no abstraction '%s' (it has: %s)\n", rig_path, abs_name,
-                    rig->abstraction_count ? names : "none");
-            sp_character_free(&ch);
+                    nabs ? names : "none");
+            sp_rig_handle_free(handle);
             return SP_EXIT_INPUT;
         }
-        ab = &rig->abstractions[ai];
-    } else if (!abs_name && rig->abstraction_count > 0) {
-        ab = &rig->abstractions[0];
+    } else if (!abs_name && nabs > 0) {
+        ai = 0;
     }
 
     int exit_code = SP_EXIT_INPUT;
-    double* p = malloc(sizeof(double) * (size_t)(rig->param_count ? rig->param_count : 1));
-    double* xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count ? rig->vertex_count : 1));
-    double* zxyz = ab ? malloc(sizeof(double) * 3 * (size_t)(ab->point_count ? ab->point_count : 1)) : NULL;
-    sp_vec2* ends = ab ? malloc(sizeof(sp_vec2) * 2 * (size_t)(ab->curve_count ? ab->curve_count : 1)) : NULL;
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    double* p = NULL;
+    sp_rig_posed posed = {0};
+    const sp_rig* rig = NULL;
+    const sp_abstraction* ab = NULL;
+    double *xyz = NULL, *zxyz = NULL;
+    sp_vec2* ends = NULL;
+    sp_rig_eval* ev = NULL;
     sp_headless* gl = NULL;
     sp_renderer* r = NULL;
     sp_render_target* target = NULL;
     sp_render_mesh* mesh = NULL;
     sp_image img = {0};
-    if (!p || !xyz || (ab && (!zxyz || !ends)) || !ev) {
-        fprintf(stderr, "sketchpose render: out of memory\n");
-        goto done;
-    }
-    // Parameters the pose file does not list keep the stored pose.
-    memcpy(p, ch.pose, sizeof(double) * (size_t)rig->param_count);
-    if (pose_path && !plugin && sp_pose_read(pose_path, rig, p, NULL, &err) != SP_OK) {
+    // Parameters the pose file does not list keep the start pose. The view is
+    // the rig's own (a plugin is baked in it, with every abstraction).
+    sp_camera view = sp_rig_handle_camera(handle, 0, 0);
+    if (sp_rig_handle_read_pose(handle, pose_path, &p, NULL, &err) != SP_OK ||
+        sp_rig_handle_posed(handle, -1, p, &view, &posed, &err) != SP_OK) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         goto done;
     }
-    sp_rig_eval_update(ev, p, false);
+    const sp_character* ch = posed.character;
+    const double* params = posed.params ? posed.params : ch->pose;
+    rig = &ch->rig;
+    ab = ai >= 0 ? &rig->abstractions[ai] : NULL;
+    xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count ? rig->vertex_count : 1));
+    zxyz = ab ? malloc(sizeof(double) * 3 * (size_t)(ab->point_count ? ab->point_count : 1)) : NULL;
+    ends = ab ? malloc(sizeof(sp_vec2) * 2 * (size_t)(ab->curve_count ? ab->curve_count : 1)) : NULL;
+    ev = sp_rig_eval_create(rig);
+    if (!xyz || (ab && (!zxyz || !ends)) || !ev) {
+        fprintf(stderr, "sketchpose render: out of memory\n");
+        goto done;
+    }
+    sp_rig_eval_update(ev, params, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
     if (ab) sp_rig_eval_abstraction(ev, ab, xyz, zxyz);
 
     sp_vec3 lo, hi;
     sp_bounds(xyz, rig->vertex_count, &lo, &hi);
-    sp_camera cam = fit_camera(&ch.camera, w, h);
+    sp_camera cam = fit_camera(&ch->camera, w, h);
     if (yaw != 0 || pitch != 0)
         orbit_camera(&cam, sp_v3_scale(sp_v3_add(lo, hi), 0.5), yaw * (3.14159265358979323846 / 180.0),
                      pitch * (3.14159265358979323846 / 180.0));
@@ -153,7 +161,7 @@ int cmd_render(int argc, char** argv)
     mesh = target ? sp_render_mesh_create(r,
                                           &(sp_mesh_desc){.vertex_count = rig->vertex_count,
                                                           .positions = xyz,
-                                                          .colors = ch.colors,
+                                                          .colors = ch->colors,
                                                           .triangle_count = rig->triangle_count,
                                                           .triangles = rig->triangles},
                                           &err)
@@ -202,6 +210,7 @@ done:
     free(zxyz);
     free(xyz);
     free(p);
-    sp_character_free(&ch);
+    sp_rig_posed_free(&posed);
+    sp_rig_handle_free(handle);
     return exit_code;
 }

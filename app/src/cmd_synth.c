@@ -10,9 +10,9 @@
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "plugin_rig.h"
 #include "pose_io.h"
 #include "posing.h"
+#include "rig_handle.h"
 #include "sp/gltf.h"
 #include "sp/handdraw.h"
 #include "sp/sketch_io.h"
@@ -120,7 +120,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         const char* an = abs_name;
         if (!an && part_field(&ch, "abstraction", want, sizeof want)) an = want;
         if (!an && sp_rig_find_abstraction(&ch.rig, "outline") >= 0) an = "outline";
-        int a = sp_pick_abstraction(&ch, path, an, &err);
+        int a = sp_pick_abstraction(ch.rig.abstractions, ch.rig.abstraction_count, path, an, &err);
         char cdir[4096];
         snprintf(cdir, sizeof cdir, "%s/%s", out_dir, category);
         if (a < 0 || !make_dir(cdir, &err)) {
@@ -260,34 +260,22 @@ int cmd_synth(int argc, char** argv)
         fprintf(stderr, "sketchpose synth: --amplitude and --noise must not be negative\n");
         return SP_EXIT_USAGE;
     }
-    if (sp_is_plugin_path(rig_path)) {
-        if (style != SP_HANDDRAW_STYLE_COUNT) {
-            fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
-            return SP_EXIT_USAGE;
-        }
-        return sp_plugin_synth(rig_path, abs_name, seed, pose, amplitude, out, truth, w, h, noise);
+    if (style != SP_HANDDRAW_STYLE_COUNT && sp_rig_path_is_plugin(rig_path)) {
+        fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
+        return SP_EXIT_USAGE;
     }
-    sp_character ch = {0};
+    sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_sketch sk = {0};
     double* p = NULL;
     int exit_code = SP_EXIT_INPUT;
-    if (sp_gltf_load(rig_path, &ch, &err) != SP_OK) goto fail;
-    int a = sp_pick_abstraction(&ch, rig_path, abs_name, &err);
+    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    int a = sp_rig_handle_pick_abstraction(rig, abs_name, &err);
     if (a < 0) goto fail;
-    sp_camera cam = w ? sp_camera_resize(&ch.camera, w, h) : ch.camera;
-    p = malloc(sizeof(double) * (size_t)(ch.rig.param_count + 1));
-    if (!p) goto fail;
-    if (pose) {
-        memcpy(p, ch.pose, sizeof(double) * (size_t)ch.rig.param_count);
-        if (sp_pose_read(pose, &ch.rig, p, NULL, &err) != SP_OK) goto fail;
-    } else {
-        sp_synth_params(&ch.rig, (uint64_t)(unsigned)seed, amplitude, p);
-    }
-    if (sp_synth_sketch(&ch.rig, a, &cam, p, &sk) != SP_OK) {
-        sp_fail(&err, SP_ERR_INTERNAL, "%s: cannot project abstraction '%s'", rig_path, ch.rig.abstractions[a].name);
-        goto fail;
-    }
+    sp_camera cam = sp_rig_handle_camera(rig, w, h);
+    if (sp_rig_handle_read_pose(rig, pose, &p, NULL, &err) != SP_OK) goto fail;
+    if (!pose) sp_rig_handle_synth_params(rig, (uint64_t)(unsigned)seed, amplitude, p);
+    if (sp_rig_handle_synth_sketch(rig, a, &cam, p, &sk, &err) != SP_OK) goto fail;
     if (style != SP_HANDDRAW_STYLE_COUNT) {
         sp_handdraw_params hp = sp_handdraw_preset(style);
         sp_sketch drawn;
@@ -297,7 +285,7 @@ int cmd_synth(int argc, char** argv)
     }
     if (noise > 0) sp_synth_jitter(&sk, noise, (uint64_t)(unsigned)seed);
     if (sp_sketch_write_json(out, &sk, &err) != SP_OK) goto fail;
-    if (truth && sp_pose_write(truth, &ch.rig, p, &err) != SP_OK) goto fail;
+    if (truth && sp_pose_write(truth, sp_rig_handle_params(rig), sp_rig_handle_param_count(rig), p, &err) != SP_OK) goto fail;
     exit_code = SP_EXIT_OK;
     goto done;
 fail:
@@ -305,6 +293,6 @@ fail:
 done:
     free(p);
     sp_sketch_free(&sk);
-    sp_character_free(&ch);
+    sp_rig_handle_free(rig);
     return exit_code;
 }

@@ -129,7 +129,7 @@ static void blackbox_destroy(sp_blackbox* bb, bool release)
     if (release && bb->rig->release) bb->rig->release(bb->rig->user);
     for (int a = 0; a < bb->abstraction_count; ++a)
         free(bb->abs[a].curves);
-    free(bb->abs), free(bb->first), free(bb->def);
+    free(bb->abs), free(bb->first), free(bb->params);
     free(bb);
 }
 
@@ -163,10 +163,15 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
     bb->abstraction_count = r->abstraction_count;
     bb->abs = calloc((size_t)r->abstraction_count, sizeof(sp_abstraction));
     bb->first = calloc((size_t)r->abstraction_count + 1, sizeof(int));
-    bb->def = malloc(sizeof(double) * (size_t)bb->P);
-    if (!bb->abs || !bb->first || !bb->def) goto oom;
-    for (int i = 0; i < bb->P; ++i)
-        bb->def[i] = r->params[i].def;
+    bb->params = calloc((size_t)bb->P, sizeof(sp_param));
+    if (!bb->abs || !bb->first || !bb->params) goto oom;
+    for (int i = 0; i < bb->P; ++i) {
+        const sp_blackbox_param* q = &r->params[i];
+        sp_param* d = &bb->params[i];
+        *d = (sp_param){
+            .joint = -1, .channel = SP_CH_COUNT, .min = q->min, .max = q->max, .def = q->def, .group = (sp_group)q->group};
+        snprintf(d->name, sizeof d->name, "%s", q->name); // validated: at most 127 bytes
+    }
     for (int a = 0; a < r->abstraction_count; ++a) {
         const sp_blackbox_abstraction* src = &r->abstractions[a];
         sp_abstraction* dst = &bb->abs[a];
@@ -194,11 +199,13 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
     {
         double* x = malloc(sizeof(double) * 3 * (size_t)bb->n);
         double* z = malloc(sizeof(double) * 3 * (size_t)(bb->total + 1));
-        if (!x || !z) {
-            free(x), free(z);
+        double* def = malloc(sizeof(double) * (size_t)bb->P);
+        if (!x || !z || !def) {
+            free(x), free(z), free(def);
             goto oom;
         }
-        res = sp_blackbox_evaluate(bb, bb->def, x, z, err);
+        sp_blackbox_defaults(bb, def);
+        res = sp_blackbox_evaluate(bb, def, x, z, err);
         double tol = 1e-6 * (bb->diag > 0 ? bb->diag : 1.0), worst = 0;
         int wi = 0;
         for (int i = 0; res == SP_OK && i < bb->n; ++i) {
@@ -206,7 +213,7 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
                                            (sp_vec3){r->rest[3 * i], r->rest[3 * i + 1], r->rest[3 * i + 2]}));
             if (d > worst) worst = d, wi = i;
         }
-        free(x), free(z);
+        free(x), free(z), free(def);
         if (res == SP_OK && worst > tol)
             res = sp_fail(err, SP_ERR_INVALID,
                           "%s: evaluate() at the defaults does not reproduce the rest mesh (vertex %d is %.3g away)", what, wi,
@@ -262,24 +269,15 @@ const sp_abstraction* sp_blackbox_abstraction_at(const sp_blackbox* bb, int a)
     return &bb->abs[a];
 }
 
-void sp_blackbox_defaults(const sp_blackbox* bb, double* p)
+const sp_param* sp_blackbox_params(const sp_blackbox* bb)
 {
-    memcpy(p, bb->def, sizeof(double) * (size_t)bb->P);
+    return bb->params;
 }
 
-int sp_blackbox_clamp(const sp_blackbox* bb, double* p)
+void sp_blackbox_defaults(const sp_blackbox* bb, double* p)
 {
-    int changed = 0;
-    for (int i = 0; i < bb->P; ++i) {
-        const sp_blackbox_param* q = &bb->rig->params[i];
-        double v = p[i];
-        if (!isfinite(v)) v = q->def;
-        if (v < q->min) v = q->min;
-        if (v > q->max) v = q->max;
-        if (v != p[i]) ++changed;
-        p[i] = v;
-    }
-    return changed;
+    for (int i = 0; i < bb->P; ++i)
+        p[i] = bb->params[i].def;
 }
 
 sp_camera sp_blackbox_camera(const sp_blackbox* bb, int width, int height)
@@ -329,7 +327,7 @@ sp_result sp_blackbox_evaluate(const sp_blackbox* bb, const double* p, double* v
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", bb->what);
     }
     memcpy(q, p, sizeof(double) * (size_t)bb->P);
-    sp_blackbox_clamp(bb, q);
+    sp_params_clamp(bb->params, bb->P, q);
     int rc = 0;
     size_t bad = 0;
     sp_result r = sp__blackbox_eval_raw(bb, q, x, abstraction_xyz, &rc, &bad);

@@ -16,7 +16,7 @@ struct sp_blackbox {
     sp_abstraction* abs; // the abstractions as the solver's types (curves only)
     int* first;          // abstraction_count + 1: first point of each in evaluate()'s output
     int total;           // abstraction points in all
-    double* def;         // P defaults
+    sp_param* params;    // P: the parameters as the rig's type (names, bounds, defaults, groups)
     double diag;         // rest mesh bounding-box diagonal
 };
 

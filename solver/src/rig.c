@@ -308,19 +308,20 @@ void sp_rig_defaults(const sp_rig* rig, double* p)
     for (int i = 0; i < rig->param_count; ++i) p[i] = rig->params[i].def;
 }
 
-int sp_rig_clamp(const sp_rig* rig, double* p)
+int sp_params_clamp(const sp_param* params, int count, double* p)
 {
     int changed = 0;
-    for (int i = 0; i < rig->param_count; ++i) {
-        const sp_param* q = &rig->params[i];
-        double v = p[i];
-        if (!isfinite(v)) v = q->def;
-        if (v < q->min) v = q->min;
-        if (v > q->max) v = q->max;
+    for (int i = 0; i < count; ++i) {
+        double v = sp_param_clamp(p[i], params[i].min, params[i].max, params[i].def);
         if (v != p[i]) ++changed;
         p[i] = v;
     }
     return changed;
+}
+
+int sp_rig_clamp(const sp_rig* rig, double* p)
+{
+    return sp_params_clamp(rig->params, rig->param_count, p);
 }
 
 // The quaternion of one rotation channel about the joint's own rest axis.
@@ -372,9 +373,7 @@ void sp_rig_params_from_trs(const sp_rig* rig, int joint, sp_vec3 t, sp_quat r, 
     for (int i = 0; i < jt->param_count; ++i) {
         int k = jt->first_param + i;
         const sp_param* pp = &rig->params[k];
-        double v = ch[pp->channel];
-        if (!isfinite(v)) v = pp->def;
-        p[k] = v < pp->min ? pp->min : (v > pp->max ? pp->max : v);
+        p[k] = sp_param_clamp(ch[pp->channel], pp->min, pp->max, pp->def);
     }
 }
 

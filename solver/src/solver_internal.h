@@ -141,7 +141,7 @@ typedef struct sp_pairing {
     const sp_ordered_info* loop_shift; // ordered, one closed curve: hold this shift and direction (NULL: the best each time)
 } sp_pairing;
 
-// The model's calls (model.h), and bounds as sp_rig_clamp has them.
+// The model's calls (model.h), and the bounds (sp_param_clamp).
 static inline void sp__model_update(sp_solver* s, const double* p, bool derivatives)
 {
     s->model->ops->update(s->model, p, derivatives);
@@ -154,11 +154,7 @@ static inline void sp__model_clamp(const sp_solver* s, double* p)
 {
     for (int i = 0; i < s->P; ++i) {
         const sp_model_param* q = &s->model->params[i];
-        double v = p[i];
-        if (!isfinite(v)) v = q->def;
-        if (v < q->min) v = q->min;
-        if (v > q->max) v = q->max;
-        p[i] = v;
+        p[i] = sp_param_clamp(p[i], q->min, q->max, q->def);
     }
 }
 // The pose a solve starts from: p_start (NULL: the defaults) inside the bounds.

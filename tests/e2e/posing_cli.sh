@@ -1,8 +1,9 @@
 #!/bin/sh
 # posing_cli.sh SKETCHPOSE SRC_DIR WORK_DIR [SHARED_DATA]: the posing
 # commands (synth, pose, animate, drawover) from the command line: exit
-# codes, machine-readable reports, bad strokes, and the Khronos validator on
-# an animate export when node and tests/tools/node_modules are there.
+# codes, machine-readable reports, bad strokes, draw-over's outputs, and the
+# Khronos validator on an animate export when node and
+# tests/tools/node_modules are there.
 set -u
 SP="$1"
 SRC="$2"
@@ -72,6 +73,25 @@ grep -q '"unused_strokes":	[1-9]' "$WORK/many_r.json" || fail "more strokes than
 # A million points: resampled, bounded by the time cap, no hang.
 awk 'BEGIN { printf "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [640, 480], \"strokes\": [{\"points\": ["; for (i = 0; i < 1000000; ++i) printf "%s[%.3f, %.3f]", (i ? ", " : ""), 200 + 150 * i / 1000000, 100 + 200 * i / 1000000 + 3 * sin(i); print "]}]}" }' >"$WORK/huge.json"
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/huge.json" --max-ms 5000
+
+# drawover: the cartoon man's stick figure drawn over him at his stored pose,
+# redrawn in another pose. The report names the drawn curves; the posed .glb
+# keeps the file's own abstractions, not the curves drawn over it.
+C="$SRC/assets/cartoon_man.glb"
+printf '{"parameters": {}}\n' >"$WORK/rest.json"
+expect 0 "$SP" synth --rig "$C" --pose "$WORK/rest.json" --out "$WORK/on.json"
+expect 0 "$SP" synth --rig "$C" --seed 3 --amplitude 0.3 --out "$WORK/to.json"
+expect 0 "$SP" drawover --rig "$C" --on "$WORK/on.json" --to "$WORK/to.json" --out "$WORK/d.glb" --render "$WORK/d.png" --report "$WORK/d_r.json"
+for key in '"stopped"' '"mean_error_px"' '"curve":	"stroke0"' '"parameters"'; do
+    grep -q "$key" "$WORK/d_r.json" || fail "drawover report lacks $key"
+done
+grep -q '"stopped":' "$WORK/out" || fail "drawover prints no report on stdout"
+[ -s "$WORK/d.png" ] || fail "drawover wrote no picture"
+expect 0 "$SP" inspect --rig "$WORK/d.glb"
+grep -q '"name":	"outline"' "$WORK/out" || fail "drawover --out lost the outline"
+grep -q '"name":	"drawover"' "$WORK/out" && fail "drawover --out kept the drawn curves"
+expect 1 "$SP" drawover --rig "$C" --on "$WORK/missing_on.json" --to "$WORK/to.json"
+one_line_naming missing_on.json
 
 # animate: a .glb with the animation; valid for Khronos's validator.
 "$SP" synth --rig "$RIG" --seed 5 --amplitude 0.3 --out "$WORK/k2.json" >/dev/null 2>&1

@@ -1,5 +1,5 @@
 if(TARGET sp_app_common)
   sp_unit_test(posing LIBS sp_app_common)
-  target_compile_definitions(test_posing PRIVATE SP_SKETCHPOSE="$<TARGET_FILE:sketchpose>")
-  add_dependencies(test_posing sketchpose)
+  target_compile_definitions(test_posing PRIVATE SP_SKETCHPOSE="$<TARGET_FILE:sketchpose>" SP_FACE_PLUGIN="$<TARGET_FILE:sp_face>")
+  add_dependencies(test_posing sketchpose sp_face)
 endif()

@@ -2,7 +2,8 @@
 // Jacobians against the analytic ones of a skinned rig wrapped as a black
 // box, bit-identical results for any thread count, the plugin loader's
 // errors, recovery of seeded targets on the `face` plugin with bounds
-// honoured, and `sketchpose synth/pose --rig face.so`.
+// honoured, and the commands on a plugin (`sketchpose synth/pose/inspect/
+// render/export --rig face.so`; drawover and animate refuse one).
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
@@ -251,6 +252,18 @@ static void test_face_asset(void)
         dev = fmax(dev, fabs((x2[i] - x0[i]) - 2 * (x1[i] - x0[i])));
     ENSURE(dev > 1e-3);
     free(x0), free(x1), free(x2);
+    // Its parameters in the skinned rig's type, clamped by the one clamp
+    // (sp_params_clamp): out of bounds to a bound, NaN and Inf to the default.
+    const sp_param* q = sp_blackbox_params(bb);
+    for (int i = 0; i < r->param_count; ++i) {
+        ENSURE(!strcmp(q[i].name, r->params[i].name) && q[i].min == r->params[i].min && q[i].max == r->params[i].max);
+        ENSURE(q[i].def == r->params[i].def && (int)q[i].group == r->params[i].group && q[i].joint == -1);
+    }
+    sp_blackbox_defaults(bb, p);
+    p[0] = q[0].max + 1, p[1] = q[1].min - 1, p[2] = NAN, p[3] = INFINITY;
+    ENSURE(sp_params_clamp(q, r->param_count, p) == 4);
+    ENSURE(p[0] == q[0].max && p[1] == q[1].min && p[2] == q[2].def && p[3] == q[3].def);
+    ENSURE(sp_params_clamp(q, r->param_count, p) == 0);
     sp_blackbox_free(bb2);
     sp_blackbox_free(bb);
 }
@@ -536,6 +549,80 @@ static char* slurp(const char* path)
     return buf;
 }
 
+// Runs cmd with stdout and stderr to files; returns the exit status. *out
+// and *err are the files' text (static buffers of slurp's: copy to keep).
+static int run_cli(const char* cmd, char** out, char** err)
+{
+    char full[8192], o[1024], e[1024];
+    snprintf(o, sizeof o, "%s", sp_test_tmp_path("cli_out.txt"));
+    snprintf(e, sizeof e, "%s", sp_test_tmp_path("cli_err.txt"));
+    snprintf(full, sizeof full, "%s > %s 2> %s", cmd, o, e);
+    int rc = system(full);
+    static char ob[1 << 16];
+    char* t = slurp(o);
+    snprintf(ob, sizeof ob, "%s", t ? t : "");
+    *out = ob;
+    *err = slurp(e);
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+// One line on stderr that names `a` (and `b` when not NULL).
+static bool one_line_naming(const char* e, const char* a, const char* b)
+{
+    return e && strchr(e, '\n') == e + strlen(e) - 1 && strstr(e, a) && (!b || strstr(e, b));
+}
+
+// A plugin's pose files (pose --start, synth --pose, render --pose, export
+// --pose) are read like a glTF rig's, by the plugin's parameter names: an
+// unknown name or a non-number is one line naming the file and the name,
+// exit 1; a value out of bounds is clamped with a warning.
+static void cli_plugin_pose_files(const char* bin, const char* strokes, const char* truth)
+{
+    char cmd[8192], bad[1024], far[1024];
+    char *out, *err;
+    snprintf(bad, sizeof bad, "%s", sp_test_tmp_path("face_bad_pose.json"));
+    snprintf(far, sizeof far, "%s", sp_test_tmp_path("face_far_pose.json"));
+    FILE* f = fopen(bad, "wb");
+    ENSURE(f && fputs("{\"parameters\": {\"jaw_opn\": 0.5}}", f) >= 0 && fclose(f) == 0);
+    f = fopen(far, "wb");
+    ENSURE(f && fputs("{\"parameters\": {\"jaw_open\": 7}}", f) >= 0 && fclose(f) == 0);
+    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s --start %s", bin, SP_FACE_PLUGIN, strokes, bad);
+    ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, bad, "'jaw_opn'"));
+    snprintf(cmd, sizeof cmd, "%s synth --rig %s --pose %s --out %s", bin, SP_FACE_PLUGIN, bad, sp_test_tmp_path("x.json"));
+    ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, bad, "'jaw_opn'"));
+    snprintf(cmd, sizeof cmd, "%s export --rig %s --pose %s --out %s", bin, SP_FACE_PLUGIN, far, sp_test_tmp_path("x.glb"));
+    ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(err, "clamped to 1") && strstr(out, "\"clamped\":1"));
+    // The truth pose file synth wrote starts a solve where it ends.
+    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s --start %s", bin, SP_FACE_PLUGIN, strokes, truth);
+    ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(out, "\"iterations\":\t"));
+}
+
+// export writes a plugin's posed mesh as a static glTF (as pose --out);
+// drawover and animate refuse a plugin in one line saying why; synth
+// --style is bad usage for a plugin; inspect lists no joints for one.
+static void cli_plugin_other_commands(const char* bin, const char* strokes, const char* truth)
+{
+    char cmd[8192], glb[1024];
+    char *out, *err;
+    snprintf(glb, sizeof glb, "%s", sp_test_tmp_path("face_export.glb"));
+    remove(glb);
+    snprintf(cmd, sizeof cmd, "%s export --rig %s --pose %s --out %s", bin, SP_FACE_PLUGIN, truth, glb);
+    ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(out, "\"parameters\":44") && strstr(out, "\"clamped\":0"));
+    snprintf(cmd, sizeof cmd, "%s inspect --rig %s", bin, glb);
+    ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(out, "\"vertices\":\t6537,") && strstr(out, "\"parameters\":\t[],"));
+    ENSURE(strstr(out, "\"name\":\t\"root\"") && strstr(out, "\"name\":\t\"face\"") && !strstr(out, "black_box"));
+    snprintf(cmd, sizeof cmd, "%s drawover --rig %s --on %s --to %s", bin, SP_FACE_PLUGIN, strokes, strokes);
+    ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, SP_FACE_PLUGIN, "needs a glTF character"));
+    snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s --out %s", bin, SP_FACE_PLUGIN, strokes, glb);
+    ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, SP_FACE_PLUGIN, "needs a glTF character"));
+    snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed 1 --style normal --out %s", bin, SP_FACE_PLUGIN,
+             sp_test_tmp_path("x.json"));
+    ENSURE(run_cli(cmd, &out, &err) == 2 && one_line_naming(err, "--style", NULL));
+    snprintf(cmd, sizeof cmd, "%s inspect --rig %s", bin, SP_FACE_PLUGIN);
+    ENSURE(run_cli(cmd, &out, &err) == 0 && !strncmp(out, "{\n\t\"black_box\":\ttrue,", 19) && strstr(out, "\"joints\":\t[]"));
+    ENSURE(!strstr(out, "derived_dofs"));
+}
+
 static void test_cli(void)
 {
     const char* bin = sketchpose();
@@ -606,6 +693,8 @@ static void test_cli(void)
     ENSURE(WIFEXITED(rc) && WEXITSTATUS(rc) == 1);
     e = slurp(log);
     ENSURE(e && strstr(e, "ABI version 99"));
+    cli_plugin_pose_files(bin, s, t);
+    cli_plugin_other_commands(bin, s, t);
 }
 
 int main(int argc, char** argv)

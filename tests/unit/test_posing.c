@@ -1,6 +1,7 @@
 // Posing uses beyond a single solve: key-pose animations (animate) and
 // draw-over curves embedded in the mesh (drawover), in process and through
-// the command line on CesiumMan when ../shared/data is there.
+// the command line on CesiumMan when ../shared/data is there; the commands'
+// rig handle on both kinds of rig.
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdlib.h>
@@ -8,6 +9,8 @@
 
 #include "fixtures.h"
 #include "posing.h"
+#include "rig_handle.h"
+#include "sp/blackbox.h"
 #include "sp/embed.h"
 #include "sp/gltf.h"
 #include "sp/solver.h"
@@ -289,13 +292,132 @@ static void test_synth_jitter(void)
     free(pts);
 }
 
+static void write_text(const char* path, const char* text)
+{
+    FILE* f = fopen(path, "wb");
+    ENSURE(f && fputs(text, f) >= 0 && fclose(f) == 0);
+}
+
+// The rig handle (rig_handle.h) on a glTF character and on the face plugin:
+// the plugin's parameter table is its own (names, bounds, groups, units),
+// start poses and pose files, abstraction picking, the view on a canvas, the
+// plugin baked static at p, and saved files keep only the file's own
+// abstractions (not those a command adds, as drawover does).
+static void test_rig_handle(void)
+{
+    ENSURE(sp_rig_path_is_plugin("dir/libface.so") && sp_rig_path_is_plugin("libface.so.1"));
+    ENSURE(!sp_rig_path_is_plugin("face.glb") && !sp_rig_path_is_plugin("lib.so/face.gltf") && !sp_rig_path_is_plugin(NULL));
+    sp_error err = {0};
+    sp_rig_handle *g = NULL, *f = NULL;
+    ENSURE(sp_rig_handle_load(sp_test_src_path("tests/e2e/data/two_bone_extras.gltf"), &g, &err) == SP_OK);
+    ENSURE(sp_rig_handle_load(SP_FACE_PLUGIN, &f, &err) == SP_OK);
+    sp_blackbox* bb = NULL;
+    ENSURE(sp_blackbox_load_plugin(SP_FACE_PLUGIN, &bb, &err) == SP_OK);
+    const sp_blackbox_rig* d = sp_blackbox_desc(bb);
+    sp_character* ch = sp_rig_handle_character(g);
+    ENSURE(ch && !sp_rig_handle_is_black_box(g) && !sp_rig_handle_character(f) && sp_rig_handle_is_black_box(f));
+
+    // Parameters.
+    ENSURE(sp_rig_handle_params(g) == ch->rig.params && sp_rig_handle_param_count(g) == ch->rig.param_count);
+    ENSURE(sp_rig_handle_unit(g, 0) == NULL);
+    ENSURE(sp_rig_handle_param_count(f) == d->param_count && d->param_count == 44);
+    static const char* const units[] = {"angle", "length", "factor", "weight"};
+    for (int k = 0; k < d->param_count; ++k) {
+        const sp_param* q = &sp_rig_handle_params(f)[k];
+        ENSURE(!strcmp(q->name, d->params[k].name) && q->min == d->params[k].min && q->max == d->params[k].max);
+        ENSURE(q->def == d->params[k].def && (int)q->group == d->params[k].group);
+        ENSURE(!strcmp(sp_rig_handle_unit(f, k), units[d->params[k].unit]));
+    }
+    ENSURE(sp_rig_handle_vertex_count(f) == d->vertex_count && sp_rig_handle_triangle_count(f) == d->triangle_count);
+    ENSURE(sp_rig_handle_vertex_count(g) == ch->rig.vertex_count);
+
+    // Start poses and pose files.
+    double *pg = NULL, *pf = NULL;
+    ENSURE(sp_rig_handle_read_pose(g, NULL, &pg, NULL, &err) == SP_OK);
+    ENSURE(!memcmp(pg, ch->pose, sizeof(double) * (size_t)ch->rig.param_count));
+    const char* pose = sp_test_tmp_path("handle_pose.json");
+    write_text(pose, "{\"parameters\": {\"jaw_open\": 5, \"smile_l\": 0.25}}");
+    int clamped = -1, jaw = -1, smile = -1;
+    ENSURE(sp_rig_handle_read_pose(f, pose, &pf, &clamped, &err) == SP_OK && clamped == 1);
+    for (int k = 0; k < d->param_count; ++k) {
+        if (!strcmp(d->params[k].name, "jaw_open"))
+            jaw = k;
+        else if (!strcmp(d->params[k].name, "smile_l"))
+            smile = k;
+        else
+            ENSURE(pf[k] == d->params[k].def);
+    }
+    ENSURE(jaw >= 0 && pf[jaw] == d->params[jaw].max && smile >= 0 && pf[smile] == 0.25);
+    free(pf);
+    write_text(pose, "{\"parameters\": {\"nope\": 1}}");
+    ENSURE(sp_rig_handle_read_pose(f, pose, &pf, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "'nope'") &&
+           strstr(err.text, pose));
+    free(pf);
+
+    // Abstractions and the view.
+    ENSURE(sp_rig_handle_abstraction_count(f) == 1 && !strcmp(sp_rig_handle_abstractions(f)[0].name, "face"));
+    ENSURE(sp_rig_handle_pick_abstraction(f, NULL, &err) == 0 && sp_rig_handle_pick_abstraction(f, "face", &err) == 0);
+    ENSURE(sp_rig_handle_pick_abstraction(f, "nope", &err) == -1 && strstr(err.text, "'nope'") &&
+           strstr(err.text, "it has: face"));
+    sp_camera v0 = sp_rig_handle_camera(f, 0, 0), v1 = sp_rig_handle_camera(f, 319.6, 240.2),
+              want = sp_blackbox_camera(bb, 640, 480);
+    ENSURE(v0.width == 640 && v0.height == 480 && v0.scale == want.scale && v0.cx == want.cx);
+    want = sp_camera_resize(&want, 320, 240);
+    ENSURE(v1.width == 320 && v1.height == 240 && v1.scale == want.scale && v1.cx == want.cx && v1.cy == want.cy);
+    ENSURE(sp_rig_handle_camera(g, 0.4, 0.4).width == ch->camera.width);
+
+    // A plugin at p baked static: one joint, no parameters, its posed mesh and
+    // abstraction, the given view; saved and loaded back as glTF.
+    ENSURE(sp_rig_handle_read_pose(f, NULL, &pf, NULL, &err) == SP_OK);
+    sp_rig_handle_synth_params(f, 3, 1.0, pf);
+    double* x = malloc(sizeof(double) * 3 * (size_t)d->vertex_count);
+    double* z = malloc(sizeof(double) * 3 * (size_t)sp_blackbox_total_points(bb));
+    ENSURE(sp_blackbox_evaluate(bb, pf, x, z, &err) == SP_OK);
+    sp_rig_posed v;
+    ENSURE(sp_rig_handle_posed(f, 0, pf, &v1, &v, &err) == SP_OK);
+    const sp_rig* br = &v.character->rig;
+    ENSURE(v.character == &v.baked && !v.params && v.abstraction == 0 && v.saved_abstractions == 1);
+    ENSURE(br->joint_count == 1 && br->param_count == 0 && br->vertex_count == d->vertex_count && br->abstraction_count == 1);
+    ENSURE(!memcmp(br->rest, x, sizeof(double) * 3 * (size_t)d->vertex_count));
+    ENSURE(!memcmp(br->abstractions[0].rest, z, sizeof(double) * 3 * (size_t)br->abstractions[0].point_count));
+    ENSURE(v.character->camera.width == 320 && v.character->camera.scale == v1.scale);
+    const char* glb = sp_test_tmp_path("handle_face.glb");
+    ENSURE(sp_rig_posed_save(&v, glb, &err) == SP_OK);
+    sp_rig_posed_free(&v);
+    sp_character back = {0};
+    ENSURE(sp_gltf_load(glb, &back, &err) == SP_OK);
+    ENSURE(back.rig.vertex_count == d->vertex_count && back.rig.abstraction_count == 1 &&
+           !strcmp(back.rig.abstractions[0].name, "face"));
+    sp_character_free(&back);
+
+    // A glTF character as it is; a curve a command adds is shown, not saved.
+    int own = ch->rig.abstraction_count;
+    sp_abstraction extra = ch->rig.abstractions[0];
+    snprintf(extra.name, sizeof extra.name, "added");
+    int a = sp_rig_add_abstraction(&ch->rig, &extra);
+    ENSURE(a == own && sp_rig_handle_abstraction_count(g) == own + 1);
+    ENSURE(sp_rig_handle_posed(g, a, pg, &ch->camera, &v, &err) == SP_OK);
+    ENSURE(v.character == ch && v.params == pg && v.abstraction == a && v.saved_abstractions == own);
+    const char* gl = sp_test_tmp_path("handle_two_bone.glb");
+    ENSURE(sp_rig_posed_save(&v, gl, &err) == SP_OK);
+    sp_rig_posed_free(&v);
+    ENSURE(sp_gltf_load(gl, &back, &err) == SP_OK && back.rig.abstraction_count == own);
+    sp_character_free(&back);
+
+    free(x), free(z), free(pf), free(pg);
+    sp_blackbox_free(bb);
+    sp_rig_handle_free(f);
+    sp_rig_handle_free(g);
+}
+
 int main(int argc, char** argv)
 {
-    return sp_test_run(argc, argv, (sp_test[]){
-        {"animation_from_keys", test_animation_from_keys},
-        {"drawover_fixture", test_drawover_fixture},
-        {"animate_cli_cesiumman", test_animate_cli_cesiumman},
-        {"drawover_cesiumman", test_drawover_cesiumman},
-        {"synth_jitter", test_synth_jitter},
-        {0}});
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"animation_from_keys", test_animation_from_keys},
+                                   {"drawover_fixture", test_drawover_fixture},
+                                   {"animate_cli_cesiumman", test_animate_cli_cesiumman},
+                                   {"drawover_cesiumman", test_drawover_cesiumman},
+                                   {"synth_jitter", test_synth_jitter},
+                                   {"rig_handle", test_rig_handle},
+                                   {0}});
 }

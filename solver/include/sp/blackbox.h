@@ -144,12 +144,16 @@ int sp_blackbox_total_points(const sp_blackbox* bb);
 /// Index of abstraction a's first point in evaluate()'s abstraction_xyz.
 int sp_blackbox_first_point(const sp_blackbox* bb, int a);
 /// The abstraction as the solver's types see it (curves and correspondence;
-/// no skinning data, the rig computes its points).
+/// no skinning data, the rig computes its points). All of them are one array:
+/// abstraction a is sp_blackbox_abstraction_at(bb, 0) + a.
 const sp_abstraction* sp_blackbox_abstraction_at(const sp_blackbox* bb, int a);
+/// The parameters in the skinned rig's type (param_count; valid until
+/// sp_blackbox_free): name, bounds, default and group as the rig declares
+/// them, `joint` -1 and `channel` SP_CH_COUNT (a black box has neither).
+/// sp_params_clamp clamps into their bounds; units are in sp_blackbox_desc.
+const sp_param* sp_blackbox_params(const sp_blackbox* bb);
 /// Writes the defaults (param_count values).
 void sp_blackbox_defaults(const sp_blackbox* bb, double* p);
-/// Clamps p into the bounds (NaN becomes the default); returns how many changed.
-int sp_blackbox_clamp(const sp_blackbox* bb, double* p);
 /// The sketch view on a width x height canvas: orthographic along
 /// view_forward (or sp_camera_default_view), framing the rest mesh.
 sp_camera sp_blackbox_camera(const sp_blackbox* bb, int width, int height);

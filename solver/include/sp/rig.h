@@ -166,7 +166,20 @@ int sp_rig_find_param(const sp_rig* rig, const char* name);
 int sp_rig_find_abstraction(const sp_rig* rig, const char* name);
 /// Writes every parameter's default into p (param_count).
 void sp_rig_defaults(const sp_rig* rig, double* p);
-/// Clamps p into the bounds; returns how many entries changed. NaN becomes the default.
+/// The one clamp of a parameter value, for every rig kind and the solve: a
+/// value that is not finite becomes `def`, then it is put inside [min, max].
+static inline double sp_param_clamp(double v, double min, double max, double def)
+{
+    if (!isfinite(v)) v = def;
+    if (v < min) v = min;
+    if (v > max) v = max;
+    return v;
+}
+/// Clamps p (count values) into the bounds of `params` (sp_param_clamp);
+/// returns how many entries changed. A black-box rig's parameters are
+/// sp_param too (sp_blackbox_params).
+int sp_params_clamp(const sp_param* params, int count, double* p);
+/// sp_params_clamp over the rig's parameters.
 int sp_rig_clamp(const sp_rig* rig, double* p);
 
 static inline sp_skinned_points sp_rig_mesh_points(const sp_rig* rig)

@@ -1,0 +1,69 @@
+// solve_cmd.c: the solve-report-write path of the posing commands (see solve_cmd.h).
+#include "solve_cmd.h"
+
+#include <stdio.h>
+
+#include "report.h"
+#include "sp/snapshot.h"
+
+bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
+                        double* p, sp_solve_report* rep, cJSON** report)
+{
+    *report = NULL;
+    if (!s->solver || cam->width != s->cam.width || cam->height != s->cam.height) {
+        sp_solver_destroy(s->solver);
+        s->cam = *cam;
+        s->solver = sp_rig_handle_solver(s->rig, s->abstraction, &s->cam, &s->desc);
+        if (!s->solver) {
+            fprintf(stderr, "%s: out of memory\n", s->cmd);
+            return false;
+        }
+    }
+    sp_error err = {0};
+    if (sp_solver_solve(s->solver, sk, start, p, rep, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s: %s\n", s->cmd, strokes, err.text);
+        return false;
+    }
+    *report = sp_report_json(rep, &sp_rig_handle_abstractions(s->rig)[s->abstraction], sp_rig_handle_params(s->rig),
+                             sp_rig_handle_param_count(s->rig), p);
+    return true;
+}
+
+// --out and --render of the rig at p.
+static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_solve_outputs* o, sp_error* err)
+{
+    sp_rig_posed v;
+    sp_result r = sp_rig_handle_posed(s->rig, s->abstraction, p, &s->cam, &v, err);
+    if (r == SP_OK && o->out) r = sp_rig_posed_save(&v, o->out, err);
+    if (r == SP_OK && o->render) {
+        sp_snapshot_desc d = {.character = v.character,
+                              .params = v.params,
+                              .camera = &s->cam,
+                              .abstraction = v.abstraction,
+                              .strokes = o->strokes,
+                              .ghost = o->ghost};
+        r = sp_snapshot_png(&d, o->render, err);
+    }
+    sp_rig_posed_free(&v);
+    return r;
+}
+
+bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double* p, const sp_solve_outputs* o)
+{
+    sp_error err = {0};
+    sp_result r = o->report ? sp_json_write_file(o->report, report, &err) : SP_OK;
+    sp_json_print(report);
+    if (r == SP_OK && (o->out || o->render)) r = write_posed(s, p, o, &err);
+    if (r != SP_OK) {
+        fprintf(stderr, "%s: %s\n", s->cmd, err.text);
+        return false;
+    }
+    if (o->note && o->note[0]) fprintf(stderr, "%s: %s\n", s->cmd, o->note);
+    return true;
+}
+
+void sp_solve_cmd_end(sp_solve_cmd* s)
+{
+    sp_solver_destroy(s->solver);
+    s->solver = NULL;
+}
