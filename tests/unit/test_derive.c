@@ -244,6 +244,15 @@ static int run(const char* cmd, char** out)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+static void print_file(const char* path)
+{
+    FILE* f = fopen(path, "r");
+    if (!f) return;
+    char line[512];
+    while (fgets(line, sizeof line, f)) fprintf(stderr, "  %s: %s", path, line);
+    fclose(f);
+}
+
 // ---- the lizard: what is derived --------------------------------------------------
 
 static void test_what_is_derived(void)
@@ -437,7 +446,9 @@ static void test_cli(void)
              "'%s' derive --rig '%s' --out '%s' --preview '%s' --category tail --view +z --attach-joint root 2>'%s'", bin, src,
              out, png, errf);
     char* text = NULL;
-    ENSURE(run(cmd, &text) == 0);
+    int status = run(cmd, &text);
+    if (status != 0) print_file(errf); // the command's own one-line reason, in the test log
+    ENSURE(status == 0);
     cJSON* j = cJSON_Parse(text);
     free(text);
     ENSURE(cJSON_IsObject(j));
