@@ -445,8 +445,10 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
         sn = p->stroke_points;
     }
     // A part drawn before any body waits where it was drawn; the visitor is told to draw one.
+    bool waiting = !p->is_torso && !has_body(k->dragon);
+    k->stats.waiting += waiting;
     sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true,
-                                                       .waiting = !p->is_torso && !has_body(k->dragon),
+                                                       .waiting = waiting,
                                                        .category = p->category,
                                                        .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
                                                        .part_count = sp_dragon_part_count(k->dragon),

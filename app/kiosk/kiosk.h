@@ -46,6 +46,7 @@ typedef struct sp_kiosk_desc {
 typedef struct sp_kiosk_stats {
     int strokes, parts_added, rejected, refits, undos, clears, saves, save_failures, pipeline_errors, reloads;
     int chosen;            ///< refused strokes made a part by a tap on a guess or the parts row
+    int waiting;           ///< parts drawn while no body was on the canvas (told to draw one)
     int kept, kept_chosen; ///< parts on the canvas at a Start over or timeout; of them, labelled by the visitor
     double last_fit_ms;    ///< wall time of the last classify+fit (the pipeline's)
     int fit_count;

@@ -201,10 +201,10 @@ static void draw_chips(sp_kiosk* k)
 {
     const sp_kiosk_ui* ui = k->ui;
     for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_GUESS3; ++t) {
+        if (!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t)) continue;
         const sp_kiosk_rect* r = &ui->target[t];
         char text[SP_KIOSK_LABEL_MAX + 8];
         sp_kiosk_ui_target_text(ui, (sp_kiosk_target)t, text, sizeof text);
-        if (!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t)) continue;
         bool pressed = (int)ui->pressed == t && ui->capture == SP_KCAP_TARGET;
         bool enabled = sp_kiosk_ui_target_enabled(ui, (sp_kiosk_target)t);
         float rad = 0.5f * r->h, px = 0.42f * r->h;

@@ -250,11 +250,12 @@ static void print_stats(const app* a, double start_ms)
     printf(
         "{\"parts\": %d, \"strokes\": %d, \"parts_added\": %d, \"rejected\": %d, \"refits\": %d, \"undos\": %d, \"clears\": %d, "
         "\"saves\": %d, \"save_failures\": %d, \"pipeline_errors\": %d, \"reloads\": %d, \"taps\": %d, \"dropped_strokes\": %d, "
-        "\"dropped_jobs\": %d, \"resets\": %d, \"offered\": %d, \"chosen\": %d, \"kept\": %d, \"kept_chosen\": %d, "
+        "\"dropped_jobs\": %d, \"resets\": %d, \"offered\": %d, \"chosen\": %d, \"waiting\": %d, \"kept\": %d, \"kept_chosen\": "
+        "%d, "
         "\"bodies\": %d, \"loose_parts\": %d, \"mode\": \"%s\", \"code\": \"%s\", \"last_save\": \"%s\",\n",
         st->parts, st->strokes, st->parts_added, st->rejected, st->refits, st->undos, st->clears, st->saves, st->save_failures,
         st->pipeline_errors, st->reloads, ui->taps, ui->dropped_strokes, ui->dropped_jobs, ui->resets, ui->offered, st->chosen,
-        st->kept, st->kept_chosen, bodies, loose,
+        st->waiting, st->kept, st->kept_chosen, bodies, loose,
         ui->mode == SP_KM_ATTRACT ? "attract"
         : ui->mode == SP_KM_TURN  ? "turn"
                                   : "draw",
