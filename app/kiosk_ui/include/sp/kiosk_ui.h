@@ -132,10 +132,10 @@ typedef struct sp_kiosk_job {
 
 /// Why a stroke was refused (each has its sentence in kiosk_text.h).
 typedef enum sp_kiosk_refusal {
-    SP_KREF_UNRECOGNISED = 0, ///< not a part the kiosk knows (a refit: the part did not fit)
+    SP_KREF_UNRECOGNISED = 0, ///< not a part the kiosk knows, or no model to tell (a refit: the part did not fit)
     SP_KREF_TOO_SMALL,        ///< too small for a part
     SP_KREF_TRICKY,           ///< no part of the category could take its shape
-    SP_KREF_NOT_READY,        ///< no model or no part: staff needed
+    SP_KREF_NOT_READY,        ///< the database has no part of the category: staff needed
     SP_KREF_FULL,             ///< the dragon has all the parts it can take
 } sp_kiosk_refusal;
 
