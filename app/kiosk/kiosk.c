@@ -11,6 +11,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "sp/kiosk_text.h"
+
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
@@ -45,34 +47,31 @@ sp_camera kiosk_fb_camera(const sp_kiosk* k)
     return sp_camera_resize(&k->canvas_cam, k->fb_w, k->fb_h);
 }
 
-void kiosk_pretty(const char* category, char* out, size_t cap)
-{
-    snprintf(out, cap, "%s", category ? category : "");
-    for (char* c = out; *c; ++c)
-        if (*c == '_' || *c == '-') *c = ' ';
-    if (out[0] >= 'a' && out[0] <= 'z') out[0] = (char)(out[0] - 'a' + 'A');
-}
-
 int kiosk_fitted_outline(const sp_dragon_part* p, float** out, int* cap, int* breaks, int max_breaks, int* nbreaks)
 {
+    // The abstraction at the fitted parameters, seen in the part's own view:
+    // exactly what the solver matched to the stroke (before any attachment).
+    return kiosk_outline(&p->character->rig, p->abstraction, p->params, &p->view, out, cap, breaks, max_breaks, nbreaks);
+}
+
+int kiosk_outline(const sp_rig* rig, int abstraction, const double* params, const sp_camera* view, float** out, int* cap,
+                  int* breaks, int max_breaks, int* nbreaks)
+{
     *nbreaks = 0;
-    const sp_rig* rig = &p->character->rig;
-    if (p->abstraction < 0 || p->abstraction >= rig->abstraction_count) return 0;
-    const sp_abstraction* ab = &rig->abstractions[p->abstraction];
+    if (abstraction < 0 || abstraction >= rig->abstraction_count) return 0;
+    const sp_abstraction* ab = &rig->abstractions[abstraction];
     int need = ab->point_count + ab->curve_count;
     if (need > *cap) {
         float* o = realloc(*out, sizeof(float) * 2 * (size_t)need);
         if (!o) return 0;
         *out = o, *cap = need;
     }
-    // The abstraction at the fitted parameters, seen in the part's own view:
-    // exactly what the solver matched to the stroke (before any attachment).
     sp_rig_eval* ev = sp_rig_eval_create(rig);
     double* z = malloc(sizeof(double) * 3 * (size_t)(ab->point_count + 1));
     double* mesh = ab->rest ? NULL : malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
     int n = 0;
     if (ev && z && (ab->rest || mesh)) {
-        sp_rig_eval_update(ev, p->params, false);
+        sp_rig_eval_update(ev, params, false);
         if (mesh) sp_rig_eval_points(ev, sp_rig_mesh_points(rig), mesh);
         sp_rig_eval_abstraction(ev, ab, mesh, z);
         for (int c = 0; c < ab->curve_count; ++c) {
@@ -82,7 +81,7 @@ int kiosk_fitted_outline(const sp_dragon_part* p, float** out, int* cap, int* br
             for (int j = 0; j <= cv->point_count; ++j) {
                 if (j == cv->point_count && !cv->closed) break;
                 int q = cv->first_point + (j % cv->point_count);
-                sp_vec2 px = sp_camera_project(&p->view, (sp_vec3){z[3 * q], z[3 * q + 1], z[3 * q + 2]});
+                sp_vec2 px = sp_camera_project(view, (sp_vec3){z[3 * q], z[3 * q + 1], z[3 * q + 2]});
                 (*out)[2 * n] = (float)px.x, (*out)[2 * n + 1] = (float)px.y;
                 ++n;
             }
@@ -245,6 +244,8 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
         sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory");
         goto fail;
     }
+    // The pipeline's own attachment (docs/DESIGN.md, "Which strokes join a
+    // dragon"): a part drawn far from every body stays where it was drawn.
     k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
                                                    .assets_dir = k->desc.assets_dir,
                                                    .canvas_w = k->canvas_w,
@@ -273,6 +274,7 @@ void sp_kiosk_destroy(sp_kiosk* k)
 {
     if (!k) return;
     kiosk_attract_free(k);
+    kiosk_row_free(k);
     mesh_cache_free(&k->meshes);
     sp_draw2d_destroy(k->d2);
     sp_renderer_destroy(k->r);
@@ -361,61 +363,98 @@ static void last_label(sp_kiosk* k, sp_kiosk_part_label* l)
 
 // ------------------------------------------------------------------ jobs
 
-static const char* reject_hint(sp_dragon_reject r)
+static sp_kiosk_refusal refusal_of(sp_dragon_reject r)
 {
     switch (r) {
     case SP_DRAGON_TOO_SHORT:
-        return "A bit bigger please: draw one long line";
+        return SP_KREF_TOO_SMALL;
     case SP_DRAGON_NO_PART:
-    case SP_DRAGON_NO_MODEL:
-        return "This kiosk is not ready yet. Please ask a guide";
-    case SP_DRAGON_FIT_FAILED:
-        return "That one was tricky. Try drawing it again";
     case SP_DRAGON_NOTHING_TO_REFIT:
-        return "Draw a part first";
+        return SP_KREF_NOT_READY;
+    case SP_DRAGON_FIT_FAILED:
+        return SP_KREF_TRICKY;
     case SP_DRAGON_FULL:
-        return "What a dragon! Save it, or tap Undo or Start over";
+        return SP_KREF_FULL;
     default:
-        return "Hmm, what is that? Try a head, wings, a tail, legs or a body";
+        return SP_KREF_UNRECOGNISED;
     }
 }
 
 // What to tell about an accepted part (NULL: nothing).
 static const char* note_hint(sp_dragon_note n)
 {
-    return n == SP_DRAGON_NOTE_NO_SURFACE ? "That body cannot hold parts: this one stays where you drew it" : NULL;
+    return n == SP_DRAGON_NOTE_NO_SURFACE ? sp_kiosk_text(SP_KTEXT_NO_SURFACE) : NULL;
 }
 
-static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const sp_error* err, bool refit)
+// The chips' guesses for a stroke: the classifier's ranked categories but
+// `skip` (the part it became, or the one that did not fit), then, as a sure
+// classifier votes for few categories, the model's others in the parts row's
+// order, so that the visitor always has `want` to choose from.
+static int stroke_guesses(const sp_kiosk* k, const sp_dragon_result* res, const char* skip, char out[][SP_NAME_MAX], int want)
+{
+    int n = 0;
+    for (int i = 0; i < res->guess_count && n < want; ++i)
+        if (!skip || strcmp(res->guesses[i].category, skip) != 0) snprintf(out[n++], SP_NAME_MAX, "%s", res->guesses[i].category);
+    const sp_clf* clf = sp_dragon_model(k->dragon);
+    while (clf && n < want) {
+        const char* next = NULL;
+        for (int c = 0; c < sp_clf_category_count(clf); ++c) {
+            const char* name = sp_clf_category(clf, c);
+            bool used = skip && !strcmp(name, skip);
+            for (int q = 0; q < n; ++q)
+                used = used || !strcmp(name, out[q]);
+            if (!used && (!next || sp_kiosk_part_order(name) < sp_kiosk_part_order(next))) next = name;
+        }
+        if (!next) break;
+        snprintf(out[n++], SP_NAME_MAX, "%s", next);
+    }
+    return n;
+}
+
+// A refused stroke: why, and what it could still become. Its chips are the
+// classifier's best guesses (the visitor picks one, or a part from the row);
+// a category that was tried and did not fit is not offered again. Strokes too
+// small for a part, a full dragon and a failing pipeline offer nothing.
+static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const char* tried)
+{
+    ++k->stats.rejected;
+    sp_kiosk_fit_result r = {.ok = false, .refusal = rc == SP_OK ? refusal_of(res->reason) : SP_KREF_UNRECOGNISED};
+    r.offer = rc == SP_OK &&
+              (res->reason == SP_DRAGON_UNRECOGNISED || res->reason == SP_DRAGON_NO_MODEL || res->reason == SP_DRAGON_FIT_FAILED);
+    if (res->reason == SP_DRAGON_FIT_FAILED && !tried && res->guess_count > 0) tried = res->guesses[0].category;
+    char offers[3][SP_NAME_MAX];
+    int n = r.offer ? stroke_guesses(k, res, tried, offers, 3) : 0;
+    for (int i = 0; i < n; ++i)
+        r.offers[i] = offers[i];
+    sp_kiosk_ui_fit_done(k->ui, &r);
+}
+
+static bool has_body(const sp_dragon* d)
+{
+    for (int i = 0; i < sp_dragon_part_count(d); ++i)
+        if (sp_dragon_part_get(d, i)->is_torso) return true;
+    return false;
+}
+
+// forced: the category the visitor chose for a refused stroke (NULL: classified).
+static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const sp_error* err, bool refit,
+                       const char* forced)
 {
     if (rc != SP_OK || res->rejected || res->part < 0 || res->part >= sp_dragon_part_count(k->dragon)) {
         if (rc != SP_OK) {
             ++k->stats.pipeline_errors;
             fprintf(stderr, "dragon-kiosk: %s\n", err->text);
         }
-        ++k->stats.rejected;
-        sp_kiosk_ui_fit_done(
-            k->ui, &(sp_kiosk_fit_result){.ok = false,
-                                          .hint = rc != SP_OK ? reject_hint(SP_DRAGON_UNRECOGNISED) : reject_hint(res->reason)});
+        answer_refusal(k, rc, res, forced);
         return;
     }
     ++k->rev;
     const sp_dragon_part* p = sp_dragon_part_get(k->dragon, res->part);
     // The chips: the fitted category, then the classifier's next guesses.
     part_guesses* g = guesses_of(k, p->id, true);
-    int ng = 0;
-    for (int i = 0; g && i < res->guess_count && ng < 2; ++i)
-        if (strcmp(res->guesses[i].category, p->category) != 0)
-            snprintf(g->guess[ng++], SP_NAME_MAX, "%s", res->guesses[i].category);
-    // A sure classifier votes for one category only; the visitor still gets
-    // two other parts to choose from (the model's other categories, in order).
-    const sp_clf* clf = sp_dragon_model(k->dragon);
-    for (int c = 0; g && clf && c < sp_clf_category_count(clf) && ng < 2; ++c) {
-        const char* name = sp_clf_category(clf, c);
-        bool used = !strcmp(name, p->category);
-        for (int q = 0; q < ng; ++q)
-            used = used || !strcmp(name, g->guess[q]);
-        if (!used) snprintf(g->guess[ng++], SP_NAME_MAX, "%s", name);
+    if (g) {
+        g->chosen = refit || forced;
+        stroke_guesses(k, res, p->category, g->guess, 2);
     }
     // The outline as fitted, in yellow over the stroke.
     int nb = 0;
@@ -439,8 +478,12 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
         }
         sn = p->stroke_points;
     }
+    // A part drawn before any body waits where it was drawn; the visitor is told to draw one.
+    bool waiting = !p->is_torso && !has_body(k->dragon);
+    k->stats.waiting += waiting;
     sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true,
                                                        .hint = note_hint(res->note),
+                                                       .waiting = waiting,
                                                        .category = p->category,
                                                        .guesses = {g ? g->guess[0] : NULL, g ? g->guess[1] : NULL},
                                                        .part_count = sp_dragon_part_count(k->dragon),
@@ -454,12 +497,14 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
         ++k->stats.refits;
     else
         ++k->stats.parts_added;
+    if (forced) ++k->stats.chosen;
 }
 
 static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
 {
     const sp_kiosk_line* s = j->stroke;
-    ++k->stats.strokes;
+    const char* forced = j->category[0] ? j->category : NULL;
+    if (!forced) ++k->stats.strokes; // a chosen part is the same stroke again
     if (s->count > k->scratch_cap) {
         sp_vec2* p = realloc(k->scratch, sizeof *p * (size_t)s->count);
         if (!p) {
@@ -474,12 +519,12 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     memset(&res, 0, sizeof res);
     sp_error err = {0};
     double t0 = now_ms();
-    sp_result rc =
-        sp_dragon_add_points(k->dragon, k->scratch, s->count, &(sp_dragon_stroke_opts){.replace_last = j->replace}, &res, &err);
+    sp_result rc = sp_dragon_add_points(k->dragon, k->scratch, s->count,
+                                        &(sp_dragon_stroke_opts){.category = forced, .replace_last = j->replace}, &res, &err);
     double ms = now_ms() - t0;
     k->stats.last_fit_ms = ms;
     k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
-    answer_fit(k, rc, &res, &err, false);
+    answer_fit(k, rc, &res, &err, false, forced);
 }
 
 static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
@@ -488,7 +533,7 @@ static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
     memset(&res, 0, sizeof res);
     sp_error err = {0};
     sp_result rc = sp_dragon_refit_last(k->dragon, j->category, &res, &err);
-    answer_fit(k, rc, &res, &err, true);
+    answer_fit(k, rc, &res, &err, true, NULL);
 }
 
 // A four-character code that reads aloud unambiguously (no 0/O, 1/I, 2/Z, 5/S, 8/B).
@@ -563,6 +608,20 @@ static void run_save(sp_kiosk* k)
     }
 }
 
+// The parts leave the canvas with the labels the visitor left them with
+// (Start over, the idle timeout). This is where a part's label is final:
+// Undo and Redraw took back the parts they removed (those never get here),
+// and a chip changes a part only while its stroke is the last one. Issue
+// 16's collection of visitors' strokes stores each part here.
+static void parts_kept(sp_kiosk* k)
+{
+    for (int i = 0; i < sp_dragon_part_count(k->dragon); ++i) {
+        const part_guesses* g = guesses_of(k, sp_dragon_part_get(k->dragon, i)->id, false);
+        ++k->stats.kept;
+        if (g && g->chosen) ++k->stats.kept_chosen;
+    }
+}
+
 static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
 {
     switch (j->kind) {
@@ -580,6 +639,7 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         break;
     }
     case SP_KJOB_CLEAR:
+        parts_kept(k);
         sp_dragon_clear(k->dragon);
         ++k->rev, ++k->stats.clears;
         k->guess_count = 0;
@@ -611,7 +671,12 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         sp_error err = {0};
         if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK)
             fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
-        if (reloaded) ++k->stats.reloads;
+        if (reloaded) ++k->stats.reloads, k->icons_loaded = false; // a curator may have changed the categories
+    }
+    // The parts row, once the first frame is on screen (starting fast matters more).
+    if (!k->heavy_done && !k->icons_loaded && k->updates >= 2) {
+        kiosk_row_load(k);
+        k->heavy_done = true;
     }
     if (k->ui->mode == SP_KM_ATTRACT) kiosk_attract_update(k);
     // Pose the dragon at the animation clock (only when something moves).
@@ -651,6 +716,42 @@ sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err)
     if (r == SP_OK) r = sp_image_write_png(&img, path, err);
     sp_image_free(&img);
     return r;
+}
+
+int sp_kiosk_loose_parts(sp_kiosk* k, int* bodies)
+{
+    int n = sp_dragon_part_count(k->dragon), loose = 0;
+    *bodies = 0;
+    sp_error err = {0};
+    k->posed = false;
+    sp_vec2* box = malloc(sizeof *box * 2 * (size_t)(n + 1));
+    if (!box || n == 0 || sp_dragon_pose_at(k->dragon, k->ui->anim_ms / 1000.0, &err) != SP_OK) {
+        free(box);
+        return 0;
+    }
+    // Boxes in the drawing view (x, y of the world).
+    for (int i = 0; i < n; ++i) {
+        const double* xyz = sp_dragon_part_xyz(k->dragon, i);
+        box[2 * i] = (sp_vec2){INFINITY, INFINITY}, box[2 * i + 1] = (sp_vec2){-INFINITY, -INFINITY};
+        for (int v = 0; xyz && v < sp_dragon_part_get(k->dragon, i)->character->rig.vertex_count; ++v) {
+            box[2 * i].x = fmin(box[2 * i].x, xyz[3 * v]), box[2 * i].y = fmin(box[2 * i].y, xyz[3 * v + 1]);
+            box[2 * i + 1].x = fmax(box[2 * i + 1].x, xyz[3 * v]), box[2 * i + 1].y = fmax(box[2 * i + 1].y, xyz[3 * v + 1]);
+        }
+        *bodies += sp_dragon_part_get(k->dragon, i)->is_torso;
+    }
+    for (int i = 0; i < n; ++i) {
+        if (sp_dragon_part_get(k->dragon, i)->is_torso) continue;
+        bool joined = false;
+        for (int j = 0; j < n && !joined; ++j) {
+            if (!sp_dragon_part_get(k->dragon, j)->is_torso) continue;
+            double m = 0.02 * sp_v2_len(sp_v2_sub(box[2 * j + 1], box[2 * j]));
+            joined = box[2 * i].x <= box[2 * j + 1].x + m && box[2 * j].x - m <= box[2 * i + 1].x &&
+                     box[2 * i].y <= box[2 * j + 1].y + m && box[2 * j].y - m <= box[2 * i + 1].y;
+        }
+        loose += !joined;
+    }
+    free(box);
+    return loose;
 }
 
 sp_result sp_kiosk_export(sp_kiosk* k, const char* path, sp_error* err)

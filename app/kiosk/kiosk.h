@@ -46,7 +46,10 @@ typedef struct sp_kiosk_desc {
 /// Measurements for logs and benchmarks.
 typedef struct sp_kiosk_stats {
     int strokes, parts_added, rejected, refits, undos, clears, saves, save_failures, pipeline_errors, reloads;
-    double last_fit_ms; ///< wall time of the last classify+fit (the pipeline's)
+    int chosen;            ///< refused strokes made a part by a tap on a guess or the parts row
+    int waiting;           ///< parts drawn while no body was on the canvas (told to draw one)
+    int kept, kept_chosen; ///< parts on the canvas at a Start over or timeout; of them, labelled by the visitor
+    double last_fit_ms;    ///< wall time of the last classify+fit (the pipeline's)
     int fit_count;
     double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
     double pose_ms;      ///< last pose_at + mesh update
@@ -78,5 +81,9 @@ const sp_kiosk_stats* sp_kiosk_stats_of(const sp_kiosk* k);
 const sp_dragon* sp_kiosk_dragon(const sp_kiosk* k);
 /// The path of the last save (without extension), "" before any.
 const char* sp_kiosk_last_save(const sp_kiosk* k);
+/// Parts that are not bodies and do not touch one (their boxes in the
+/// drawing view, at the current animation time, 2% apart or more), and in
+/// *bodies the bodies: what a visitor sees floating free.
+int sp_kiosk_loose_parts(sp_kiosk* k, int* bodies);
 
 #endif

@@ -29,21 +29,13 @@ static const double k_draw_ms = 1100, k_flash_ms = 600, k_alive_ms = 6000;
 
 static void demo_stroke(sp_kiosk* k, sp_db* db, int li)
 {
-    char** names = NULL;
-    int count = 0;
     sp_error err = {0};
-    if (sp_db_category_parts(db, k_layout[li].category, &names, &count, &err) != SP_OK || count == 0) {
-        sp_db_free_strings(names, count);
-        return;
-    }
     sp_character ch = {0};
-    sp_db_part_info info;
     double* p = NULL;
     sp_sketch sk = {0};
-    if (sp_db_load_part(db, names[0], &ch, &err) != SP_OK || sp_db_part(db, names[0], &info, &err) != SP_OK) goto done;
-    int a = sp_rig_find_abstraction(&ch.rig, info.abstraction);
-    if (a < 0) a = 0;
-    if (ch.rig.abstraction_count == 0 || !(p = malloc(sizeof(double) * ((size_t)ch.rig.param_count + 1)))) goto done;
+    int a = 0;
+    if (kiosk_load_category_part(db, k_layout[li].category, &ch, &a, &err) != SP_OK) goto done;
+    if (!(p = malloc(sizeof(double) * ((size_t)ch.rig.param_count + 1)))) goto done;
     sp_synth_params(&ch.rig, 11 + (uint64_t)li, 0.2, p);
     if (sp_synth_sketch(&ch.rig, a, &ch.camera, p, &sk) != SP_OK) goto done;
     int n = sp_sketch_point_count(&sk);
@@ -67,7 +59,6 @@ done:
     sp_sketch_free(&sk);
     free(p);
     sp_character_free(&ch);
-    sp_db_free_strings(names, count);
 }
 
 static void prepare(sp_kiosk* k)

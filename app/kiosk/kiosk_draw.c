@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sp/kiosk_text.h"
+
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
@@ -198,16 +200,15 @@ static void draw_button(sp_kiosk* k, sp_kiosk_target t)
 static void draw_chips(sp_kiosk* k)
 {
     const sp_kiosk_ui* ui = k->ui;
-    for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_GUESS2; ++t) {
+    for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_GUESS3; ++t) {
+        if (!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t)) continue;
         const sp_kiosk_rect* r = &ui->target[t];
-        if (!ui->chip[t - SP_KT_CHIP_LABEL][0] || r->w <= 0 || ui->part_count == 0 || ui->mode != SP_KM_DRAW) continue;
+        char text[SP_KIOSK_LABEL_MAX + 8];
+        sp_kiosk_ui_target_text(ui, (sp_kiosk_target)t, text, sizeof text);
         bool pressed = (int)ui->pressed == t && ui->capture == SP_KCAP_TARGET;
         bool enabled = sp_kiosk_ui_target_enabled(ui, (sp_kiosk_target)t);
-        char text[SP_KIOSK_LABEL_MAX + 8], pretty[SP_KIOSK_LABEL_MAX];
-        kiosk_pretty(ui->chip[t - SP_KT_CHIP_LABEL], pretty, sizeof pretty);
         float rad = 0.5f * r->h, px = 0.42f * r->h;
         if (t == SP_KT_CHIP_LABEL) {
-            snprintf(text, sizeof text, "%s", pretty);
             sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0, pressed ? k_yellow : k_white);
             sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.05f * r->h), k_ink);
             // A tick: this is what the kiosk thinks it is.
@@ -218,7 +219,6 @@ static void draw_chips(sp_kiosk* k)
             sp_draw2d_text_fit(k->d2, text, 0.5f * (left + r->x + r->w - 0.3f * r->h), r->y + 0.5f * r->h, px,
                                r->x + r->w - left - 0.3f * r->h, SP_ALIGN_CENTER, k_ink);
         } else {
-            snprintf(text, sizeof text, "%s?", pretty);
             sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0, pressed ? k_yellow : enabled ? k_navy : k_grey);
             sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.05f * r->h), pressed ? k_ink : k_white);
             sp_draw2d_text_fit(k->d2, text, r->x + 0.5f * r->w, r->y + 0.5f * r->h, px, r->w - 0.6f * r->h, SP_ALIGN_CENTER,
@@ -229,11 +229,28 @@ static void draw_chips(sp_kiosk* k)
 
 static void draw_message(sp_kiosk* k, const sp_kiosk_rect* box, const char* text, float px, const float bg[4], const float fg[4])
 {
+    if (box->h <= 0) return;
     float w = sp_font_width(k->font, text, px) + 2.0f * px;
     if (w > box->w) w = box->w;
     float x = box->x + 0.5f * (box->w - w);
     sp_draw2d_rect(k->d2, x, box->y, w, box->h, 0.3f * box->h, 0, bg);
     sp_draw2d_text_fit(k->d2, text, x + 0.5f * w, box->y + 0.5f * box->h, px, w - 1.2f * px, SP_ALIGN_CENTER, fg);
+}
+
+// The save code, big, and what it is for under it.
+static void draw_banner(sp_kiosk* k)
+{
+    const sp_kiosk_ui* ui = k->ui;
+    float big = 0.75f * ui->big_text_px, small = ui->text_px;
+    float w = fmaxf(sp_font_width(k->font, ui->banner[0], big), sp_font_width(k->font, ui->banner[1], small)) + 2.0f * big;
+    w = fminf(w, 0.92f * ui->canvas.w);
+    float h = 1.7f * big + 1.6f * small + 0.4f * big;
+    float x = ui->canvas.x + 0.5f * (ui->canvas.w - w), y = ui->canvas.y + ui->canvas.h - h - (float)(3 * ui->px_per_mm);
+    sp_draw2d_rect(k->d2, x, y, w, h, 0.25f * h, 0, k_green);
+    sp_draw2d_text_fit(k->d2, ui->banner[0], x + 0.5f * w, y + 0.2f * big + 0.85f * big, big, w - 1.2f * big, SP_ALIGN_CENTER,
+                       k_white);
+    sp_draw2d_text_fit(k->d2, ui->banner[1], x + 0.5f * w, y + h - 0.2f * big - 0.8f * small, small, w - 1.2f * big,
+                       SP_ALIGN_CENTER, k_white);
 }
 
 static void draw_countdown(sp_kiosk* k, double left_s)
@@ -250,7 +267,7 @@ static void draw_countdown(sp_kiosk* k, double left_s)
     sp_draw2d_text(k->d2, num, cx, cy, 0.8f * R, SP_ALIGN_CENTER, k_white);
     sp_kiosk_rect box = {ui->canvas.x + 0.05f * ui->canvas.w, cy + R + 0.6f * ui->text_px, 0.9f * ui->canvas.w,
                          2.2f * ui->text_px};
-    draw_message(k, &box, "Still drawing? Touch the screen", ui->text_px, k_panel, k_white);
+    draw_message(k, &box, sp_kiosk_text(SP_KTEXT_COUNTDOWN), ui->text_px, k_panel, k_white);
 }
 
 static void draw_attract_ui(sp_kiosk* k)
@@ -258,17 +275,18 @@ static void draw_attract_ui(sp_kiosk* k)
     const sp_kiosk_ui* ui = k->ui;
     float W = (float)k->fb_w, H = (float)k->fb_h;
     float big = fminf(ui->big_text_px * 1.25f, 0.09f * H);
-    sp_draw2d_text_fit(k->d2, "Draw a dragon!", 0.5f * W, 0.09f * H, big, 0.92f * W, SP_ALIGN_CENTER, k_ink);
-    sp_draw2d_text_fit(k->d2, "One line for each part: a body, a head, wings, a tail, legs", 0.5f * W, 0.09f * H + 0.9f * big,
-                       ui->text_px, 0.92f * W, SP_ALIGN_CENTER, (const float[4]){0.15f, 0.18f, 0.25f, 1});
+    sp_draw2d_text_fit(k->d2, sp_kiosk_text(SP_KTEXT_TITLE), 0.5f * W, 0.09f * H, big, 0.92f * W, SP_ALIGN_CENTER, k_ink);
+    sp_draw2d_text_fit(k->d2, sp_kiosk_text(SP_KTEXT_ATTRACT), 0.5f * W, 0.09f * H + 0.9f * big, ui->text_px, 0.92f * W,
+                       SP_ALIGN_CENTER, (const float[4]){0.15f, 0.18f, 0.25f, 1});
     // "Touch to start" breathes gently so that it reads as alive, not as a hover.
     double a = 0.8 + 0.2 * sin(ui->now / 1000.0 * 2.4);
+    const char* start = sp_kiosk_text(SP_KTEXT_TOUCH_TO_START);
     float bh = (float)(ui->px_per_mm * (ui->desc.min_target_mm + 3)),
-          bw = fminf(0.9f * W, sp_font_width(k->font, "Touch to start", ui->text_px * 1.3f) + 3 * bh);
+          bw = fminf(0.9f * W, sp_font_width(k->font, start, ui->text_px * 1.3f) + 3 * bh);
     float bx = 0.5f * (W - bw), by = H - bh - (float)(ui->px_per_mm * 8);
     sp_draw2d_rect(k->d2, bx, by, bw, bh, 0.5f * bh, 0, (const float[4]){k_navy[0], k_navy[1], k_navy[2], (float)a});
     icon(k->d2, SP_KT_REDRAW, false, bx + 0.6f * bh, by + 0.5f * bh, 0.55f * bh, k_yellow);
-    sp_draw2d_text_fit(k->d2, "Touch to start", bx + 0.5f * bw + 0.3f * bh, by + 0.5f * bh, ui->text_px * 1.3f, bw - 1.6f * bh,
+    sp_draw2d_text_fit(k->d2, start, bx + 0.5f * bw + 0.3f * bh, by + 0.5f * bh, ui->text_px * 1.3f, bw - 1.6f * bh,
                        SP_ALIGN_CENTER, k_white);
 }
 
@@ -285,15 +303,10 @@ static void draw_ui(sp_kiosk* k, int w, int h)
         for (int t = SP_KT_UNDO; t <= SP_KT_SAVE; ++t)
             draw_button(k, (sp_kiosk_target)t);
         draw_chips(k);
-        if (sp_kiosk_ui_hint_visible(ui)) draw_message(k, &ui->hint_box, ui->hint, ui->text_px, k_panel, k_white);
-        if (sp_kiosk_ui_banner_visible(ui)) {
-            char text[64];
-            snprintf(text, sizeof text, "Saved! Your code: %s", ui->code);
-            float bh = 2.0f * ui->big_text_px * 0.75f;
-            sp_kiosk_rect box = {ui->canvas.x + 0.04f * ui->canvas.w,
-                                 ui->canvas.y + ui->canvas.h - bh - (float)(3 * ui->px_per_mm), 0.92f * ui->canvas.w, bh};
-            draw_message(k, &box, text, 0.75f * ui->big_text_px, k_green, k_white);
-        }
+        kiosk_row_draw(k, k_navy, k_yellow, k_ink);
+        const char* message = sp_kiosk_ui_message(ui);
+        if (message) draw_message(k, &ui->hint_box, message, ui->text_px, k_panel, k_white);
+        if (sp_kiosk_ui_banner_visible(ui)) draw_banner(k);
         double left = sp_kiosk_ui_countdown_s(ui);
         if (left > 0) draw_countdown(k, left);
     }
@@ -329,6 +342,7 @@ void kiosk_draw_frame(sp_kiosk* k, int w, int h)
             if (fade > 0)
                 draw_line(k, &ui->fade_stroke, lw,
                           (const float[4]){SP_COLOR_STROKE[0], SP_COLOR_STROKE[1], SP_COLOR_STROKE[2], (float)fade});
+            if (sp_kiosk_ui_offering(ui)) draw_line(k, &ui->held_stroke, lw, SP_COLOR_STROKE);
             for (int i = 0; i < ui->pending_count; ++i)
                 draw_line(k, &ui->pending[(ui->pending_head + i) % SP_KIOSK_PENDING_MAX], lw, SP_COLOR_STROKE);
             if (sp_kiosk_ui_flashing(ui)) {
@@ -367,9 +381,9 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
     sp_renderer_end(k->r);
     sp_draw2d_begin(k->d2, W, H);
     sp_draw2d_rect(k->d2, 12, 12, W - 24.0f, H - 24.0f, 18, 5, k_ink);
-    sp_draw2d_text(k->d2, "My dragon", 48, H - 70.0f, 52, SP_ALIGN_LEFT, k_ink);
-    char text[32];
-    snprintf(text, sizeof text, "code %s", code);
+    sp_draw2d_text(k->d2, sp_kiosk_text(SP_KTEXT_POSTCARD_TITLE), 48, H - 70.0f, 52, SP_ALIGN_LEFT, k_ink);
+    char text[64];
+    snprintf(text, sizeof text, "%s %s", sp_kiosk_text(SP_KTEXT_POSTCARD_CODE), code);
     sp_draw2d_text(k->d2, text, W - 48.0f, H - 70.0f, 40, SP_ALIGN_RIGHT, (const float[4]){0.3f, 0.25f, 0.15f, 1});
     sp_draw2d_end(k->d2);
     sp_result r = sp_render_target_read(t, img, err);

@@ -1,5 +1,6 @@
 // kiosk_internal.h: the sp_kiosk struct, shared by kiosk.c (jobs, saving),
-// kiosk_draw.c (the frame) and kiosk_attract.c (the attract screen's demo).
+// kiosk_draw.c (the frame), kiosk_attract.c (the attract screen's demo) and
+// kiosk_row.c (the parts offered with a refused stroke).
 #ifndef SP_KIOSK_INTERNAL_H
 #define SP_KIOSK_INTERNAL_H
 
@@ -30,6 +31,7 @@ typedef struct mesh_cache {
 typedef struct part_guesses {
     uint64_t id;
     char guess[2][SP_NAME_MAX];
+    bool chosen; ///< the visitor chose its category (a guess chip, or a part for a refused stroke)
 } part_guesses;
 
 /// One stroke of the attract screen's demo dragon.
@@ -44,6 +46,13 @@ typedef struct demo_part {
 } demo_part;
 
 enum { DEMO_MAX = 8 };
+
+/// One button of the refusal's parts row: a category's outline at rest.
+typedef struct part_icon {
+    char category[SP_NAME_MAX];
+    float* xy; ///< n by 2 in the unit square (y down), centred, aspect kept
+    int n, breaks[8], break_n;
+} part_icon;
 
 struct sp_kiosk {
     sp_kiosk_desc desc;
@@ -74,6 +83,10 @@ struct sp_kiosk {
     bool software; // a software rasteriser (llvmpipe): cheaper background, coarser meshes
     double demo_posed_t;
     int demo_posed_parts;
+    // The refusal's parts row (kiosk_row.c), in the UI's row order.
+    part_icon icons[SP_KIOSK_ROW_MAX];
+    int icon_count;
+    bool icons_loaded;
     // Bookkeeping.
     sp_kiosk_stats stats;
     uint64_t code_state;
@@ -96,10 +109,13 @@ sp_camera kiosk_fb_camera(const sp_kiosk* k);
 /// A part's abstraction as fitted (its parameters, its own view), in canvas
 /// pixels: out (grown as needed) gets n points, breaks[] the curve starts. Returns n.
 int kiosk_fitted_outline(const sp_dragon_part* p, float** out, int* cap, int* breaks, int max_breaks, int* nbreaks);
-/// "front_legs" -> "Front legs".
-void kiosk_pretty(const char* category, char* out, size_t cap);
 /// Triangles the cached meshes draw.
 int mesh_cache_triangles(const mesh_cache* c);
+/// The same for any rig's abstraction at parameters params, projected by view.
+int kiosk_outline(const sp_rig* rig, int abstraction, const double* params, const sp_camera* view, float** out, int* cap,
+                  int* breaks, int max_breaks, int* nbreaks);
+/// Loads the first part of a category from db (*abstraction: the one its sketches are drawn of). SP_ERR_INVALID: none.
+sp_result kiosk_load_category_part(sp_db* db, const char* category, sp_character* ch, int* abstraction, sp_error* err);
 /// Brings the cached meshes in step with d's parts at its last pose_at.
 void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions);
 void mesh_cache_free(mesh_cache* c);
@@ -110,6 +126,13 @@ sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id);
 void kiosk_draw_frame(sp_kiosk* k, int w, int h);
 /// Renders the postcard (the dragon framed, a title and the code) into img.
 sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error* err);
+
+// kiosk_row.c
+/// Loads every category's outline from the database and gives the UI its row of parts.
+void kiosk_row_load(sp_kiosk* k);
+/// Draws the row's visible buttons (inside a draw2d batch).
+void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4]);
+void kiosk_row_free(sp_kiosk* k);
 
 // kiosk_attract.c
 /// Builds the demo strokes (once) and fits at most one demo part (when no heavy job ran).

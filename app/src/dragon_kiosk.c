@@ -21,6 +21,7 @@
 #include "kiosk.h"
 #include "sp/dragon.h"
 #include "sp/kiosk_session.h"
+#include "sp/kiosk_text.h"
 
 static const char* const k_cmd = "dragon-kiosk";
 
@@ -245,13 +246,17 @@ static void print_stats(const app* a, double start_ms)
 {
     const sp_kiosk_stats* st = sp_kiosk_stats_of(a->k);
     const sp_kiosk_ui* ui = sp_kiosk_ui_of(a->k);
+    int bodies = 0, loose = sp_kiosk_loose_parts(a->k, &bodies);
     int nf = a->frames < 8192 ? a->frames : 8192, nfit = st->fit_count < 4096 ? st->fit_count : 4096;
     printf(
         "{\"parts\": %d, \"strokes\": %d, \"parts_added\": %d, \"rejected\": %d, \"refits\": %d, \"undos\": %d, \"clears\": %d, "
         "\"saves\": %d, \"save_failures\": %d, \"pipeline_errors\": %d, \"reloads\": %d, \"taps\": %d, \"dropped_strokes\": %d, "
-        "\"dropped_jobs\": %d, \"resets\": %d, \"mode\": \"%s\", \"code\": \"%s\", \"last_save\": \"%s\",\n",
+        "\"dropped_jobs\": %d, \"resets\": %d, \"offered\": %d, \"chosen\": %d, \"waiting\": %d, \"kept\": %d, \"kept_chosen\": "
+        "%d, "
+        "\"bodies\": %d, \"loose_parts\": %d, \"mode\": \"%s\", \"code\": \"%s\", \"last_save\": \"%s\",\n",
         st->parts, st->strokes, st->parts_added, st->rejected, st->refits, st->undos, st->clears, st->saves, st->save_failures,
-        st->pipeline_errors, st->reloads, ui->taps, ui->dropped_strokes, ui->dropped_jobs, ui->resets,
+        st->pipeline_errors, st->reloads, ui->taps, ui->dropped_strokes, ui->dropped_jobs, ui->resets, ui->offered, st->chosen,
+        st->waiting, st->kept, st->kept_chosen, bodies, loose,
         ui->mode == SP_KM_ATTRACT ? "attract"
         : ui->mode == SP_KM_TURN  ? "turn"
                                   : "draw",
@@ -276,6 +281,9 @@ static void print_stats(const app* a, double start_ms)
     const sp_dragon* d = sp_kiosk_dragon(a->k);
     for (int i = 0; i < sp_dragon_part_count(d); ++i)
         printf("%s\"%s\"", i ? ", " : "", sp_dragon_part_get(d, i)->category);
+    printf("],\n \"attached_to\": [");
+    for (int i = 0; i < sp_dragon_part_count(d); ++i)
+        printf("%s%d", i ? ", " : "", sp_dragon_part_get(d, i)->attached_to);
     printf("]}\n");
 }
 
@@ -293,7 +301,7 @@ static void loading_screen(GLFWwindow* win, const char* font_path)
     glClear(GL_COLOR_BUFFER_BIT);
     if (d) {
         sp_draw2d_begin(d, w, h);
-        sp_draw2d_text_fit(d, "Getting the dragon parts ready...", 0.5f * w, 0.5f * h, 0.06f * h, 0.9f * w, SP_ALIGN_CENTER,
+        sp_draw2d_text_fit(d, sp_kiosk_text(SP_KTEXT_LOADING), 0.5f * w, 0.5f * h, 0.06f * h, 0.9f * w, SP_ALIGN_CENTER,
                            (const float[4]){0.06f, 0.07f, 0.1f, 1});
         sp_draw2d_end(d);
     }

@@ -148,6 +148,15 @@ static void script_close(script* s)
     ENSURE(fclose(s->f) == 0);
 }
 
+// Closes the script with its end time (script_open writes "end_ms": 0).
+static void script_end(script* s, const char* path, double end_ms)
+{
+    script_close(s);
+    char cmd[2300];
+    snprintf(cmd, sizeof cmd, "sed -i 's/\"end_ms\": 0,/\"end_ms\": %.0f,/' '%s'", end_ms, path);
+    ENSURE(system(cmd) == 0);
+}
+
 static bool have_xvfb(void)
 {
     return system("command -v xvfb-run >/dev/null 2>&1") == 0;
@@ -406,8 +415,8 @@ static void test_dragon_session(void)
     const char* exports = sp_test_tmp_path("kiosk_exports");
     const char* rec = sp_test_tmp_path("kiosk_dragon_rec.json");
     char args[4096];
-    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export '%s' --export-dir '%s' --record '%s'", sc, shot, glb, exports,
-             rec);
+    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export '%s' --export-dir '%s' --record '%s'", sc, shot, glb,
+             exports, rec);
     cJSON* st = NULL;
     ENSURE(run_kiosk(args, &st) == 0);
     ENSURE(st);
@@ -533,12 +542,7 @@ static void test_storms(void)
     script_press(&s, t + 200, "start_over");
     double up = script_stroke(&s, t + 600, g_strokes[0].xy, g_strokes[0].n, 4);
     if (g_strokes[0].rank > 0) script_press(&s, up + 250, g_strokes[0].rank == 1 ? "guess1" : "guess2");
-    double end = up + 2000;
-    script_close(&s);
-    // Patch end_ms in.
-    char cmd[2300];
-    snprintf(cmd, sizeof cmd, "sed -i 's/\"end_ms\": 0,/\"end_ms\": %.0f,/' '%s'", end, sc);
-    ENSURE(system(cmd) == 0);
+    script_end(&s, sc, up + 2000);
     const char* shot = sp_test_tmp_path("kiosk_storm.png");
     char args[4096];
     snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export-dir '%s'", sc, shot,
@@ -577,7 +581,8 @@ static void test_record_replay(void)
     }
     const char* b_png = sp_test_tmp_path("kiosk_rec_b.png");
     char args[4096];
-    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export-dir '%s'", g_rec.session, b_png, sp_test_tmp_path("kiosk_rec_ex2"));
+    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export-dir '%s'", g_rec.session, b_png,
+             sp_test_tmp_path("kiosk_rec_ex2"));
     cJSON* sb = NULL;
     ENSURE(run_kiosk(args, &sb) == 0 && sb);
     char* cb = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(sb, "categories"));
@@ -619,10 +624,7 @@ static void test_db_replaced(void)
             t = script_stroke(&s, t, g_strokes[i].xy, g_strokes[i].n, 2) + 600;
             if (i == DRAGON_PART_COUNT - 1) script_press(&s, t, "undo");
         }
-    double end = t + 1000;
-    script_close(&s);
-    snprintf(cmd, sizeof cmd, "sed -i 's/\"end_ms\": 0,/\"end_ms\": %.0f,/' '%s'", end, sc);
-    ENSURE(system(cmd) == 0);
+    script_end(&s, sc, t + 1000);
     // A second process replaces the file (a copy renamed over it: a new inode,
     // as a curator's tool would) every 0.3 s for as long as the kiosk runs.
     char stop[1200];
@@ -681,7 +683,7 @@ static void test_full_dragon(void)
     double end = 500;
     for (int i = 0; i < 3; ++i)
         end += 4 * (g_strokes[i].n - 1) + 1500;
-    script s = script_open(sc, end); // ends 1.5 s after the last stroke: its hint is still up
+    script s = script_open(sc, end);       // ends 1.5 s after the last stroke: its hint is still up
     script_event(&s, 0, "down", 640, 400); // leaves the attract screen
     script_event(&s, 60, "up", 640, 400);
     double t = 500;
@@ -701,6 +703,224 @@ static void test_full_dragon(void)
     cJSON_Delete(st);
 }
 
+// ------------------------------------------------------------ a visit (issue 16)
+
+// A drawing the test database's model refuses (a scribble, a star, a
+// spiral...), centred on (cx, cy); false when it refuses none of them.
+static bool refused_doodle(double cx, double cy, sp_vec2* xy, int* n)
+{
+    sp_db* db = NULL;
+    sp_clf* clf = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(e2e_db(), SP_DB_READONLY, &db, &err) == SP_OK);
+    ENSURE(sp_db_load_model(db, &clf, NULL, &err) == SP_OK);
+    sp_db_close(db);
+    bool found = false;
+    for (int c = 0; c < 60 && !found; ++c) {
+        sp_test_rng rng = {(uint64_t)c + 1};
+        int m = 0;
+        if (c % 3 == 0) { // a scribble
+            sp_vec2 p = {0, 0};
+            for (; m < 150; ++m) {
+                xy[m] = (sp_vec2){cx + p.x, cy + p.y};
+                p.x = fmax(-110, fmin(110, p.x + sp_test_range(&rng, -35, 35)));
+                p.y = fmax(-90, fmin(90, p.y + sp_test_range(&rng, -35, 35)));
+            }
+        } else if (c % 3 == 1) { // a star of 5-9 points
+            int k = 5 + c / 3 % 5;
+            for (; m <= 2 * k * 8; ++m) {
+                double a = M_PI * m / 8.0 / k, r = (m / 8 % 2 ? 45.0 : 110.0) + sp_test_range(&rng, -4, 4);
+                xy[m] = (sp_vec2){cx + r * sin(a), cy - r * cos(a)};
+            }
+        } else { // a spiral
+            double turns = 2 + c / 3 % 4;
+            for (; m < 160; ++m) {
+                double u = m / 159.0, a = 2 * M_PI * turns * u, r = 10 + 100 * u;
+                xy[m] = (sp_vec2){cx + r * cos(a) + sp_test_range(&rng, -2, 2), cy + r * sin(a)};
+            }
+        }
+        sp_sketch one = {.canvas_w = 1280, .canvas_h = 800};
+        sp_clf_answer ans;
+        if (sp_sketch_add_stroke(&one, xy, NULL, m) == SP_OK && sp_clf_classify(clf, &one, NULL, &ans, &err) == SP_OK &&
+            (ans.rejected || ans.count == 0))
+            found = true, *n = m;
+        sp_sketch_free(&one);
+    }
+    sp_clf_free(clf);
+    return found;
+}
+
+// The stroke moved by (dx, dy); returns the pen-up time. Taps the chip a
+// visitor would when the model does not rank the part first.
+static double part_stroke_at(script* s, double t, const stroke* st, double dx, double dy)
+{
+    sp_vec2 xy[4096];
+    int n = st->n < 4096 ? st->n : 4096;
+    for (int i = 0; i < n; ++i)
+        xy[i] = (sp_vec2){st->xy[i].x + dx, st->xy[i].y + dy};
+    double up = script_stroke(s, t, xy, n, fmin(4.0, 120.0 / n));
+    if (st->rank > 0) script_press(s, up + 150, st->rank == 1 ? "guess1" : "guess2");
+    return up;
+}
+
+static const char* stat_category(const cJSON* st, int i)
+{
+    const cJSON* c = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(st, "categories"), i);
+    return cJSON_IsString(c) ? c->valuestring : "";
+}
+
+// Issue 16, items 4 and 7, as a new visitor with a mouse: a body; a refused
+// drawing at the body stays with its guesses and the parts row, and one tap
+// makes it a part (the body stays a body), attached; a tail drawn far away
+// stays free where it was drawn (issue 15); with --idle 15 the countdown
+// shows after 10 s and a stroke drawn during it becomes a part; Save says
+// what the code is for.
+static void test_visit(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    sp_vec2 doodle[512];
+    int dn = 0;
+    // Both refused drawings overlap the body (its stroke's box is about 475..805 x 320..540).
+    const double shift = -320;
+    ENSURE(refused_doodle(800, 380, doodle, &dn));
+    const char* sc = sp_test_tmp_path("kiosk_visit.json");
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = part_stroke_at(&s, 500, &g_strokes[0], 0, 0) + 1200;
+    // Refused: mark it, then its first guess.
+    double up = script_stroke(&s, t, doodle, dn, 4);
+    script_mark(&s, up + 400, "refused");
+    script_press(&s, up + 1500, "guess1");
+    t = up + 2500;
+    // Refused again (at the body's other end): the parts row's second part, the head.
+    for (int i = 0; i < dn; ++i)
+        doodle[i].x += shift;
+    up = script_stroke(&s, t, doodle, dn, 4);
+    script_mark(&s, up + 400, "row");
+    script_press(&s, up + 1500, "part2");
+    t = up + 2500;
+    // A tail drawn far from the body, in the top left corner.
+    t = part_stroke_at(&s, t, &g_strokes[3], -170, -290) + 1500;
+    // 11 s without a touch: the countdown (5 s of --idle 15) shows; a stroke then is a part.
+    script_mark(&s, t + 11000, "countdown");
+    up = part_stroke_at(&s, t + 11500, &g_strokes[5], 0, 0);
+    script_press(&s, up + 1500, "save");
+    script_mark(&s, up + 2500, "saved");
+    script_end(&s, sc, up + 3000);
+    const char* shot = sp_test_tmp_path("kiosk_visit.png");
+    char args[4096];
+    snprintf(args, sizeof args, "--idle 15 --script '%s' --screenshot '%s' --export-dir '%s'", sc, shot,
+             sp_test_tmp_path("kiosk_visit_exports"));
+    cJSON* st = NULL;
+    ENSURE(run_kiosk(args, &st) == 0 && st);
+    char* txt = cJSON_PrintUnformatted(st);
+    fprintf(stderr, "  stats: %s\n", txt);
+    free(txt);
+    // Five parts: the body untouched by the chips, the two refused drawings
+    // made parts by one tap each (attached to the body), the far tail free,
+    // the countdown's stroke.
+    ENSURE(num(st, "parts") == 5 && num(st, "refits") == 0 && num(st, "offered") == 2 && num(st, "chosen") == 2);
+    ENSURE(!strcmp(stat_category(st, 0), "torso") && !strcmp(stat_category(st, 2), "head"));
+    ENSURE(!strcmp(stat_category(st, 3), "tail") && !strcmp(stat_category(st, 4), g_strokes[5].category));
+    ENSURE(num(st, "resets") == 0 && num(st, "saves") == 1 && num(st, "loose_parts") == 1 && num(st, "bodies") == 1);
+    const cJSON* att = cJSON_GetObjectItemCaseSensitive(st, "attached_to");
+    ENSURE(cJSON_GetArraySize(att) == 5 && cJSON_GetArrayItem(att, 1)->valuedouble == 0 &&
+           cJSON_GetArrayItem(att, 2)->valuedouble == 0 && cJSON_GetArrayItem(att, 3)->valuedouble == -1);
+    // The refused drawing stays on screen, in blue, while its chips are offered.
+    char path[2048];
+    snprintf(path, sizeof path, "%.*s-refused.png", (int)(strlen(shot) - 4), shot);
+    sp_image img = {0};
+    load_png(path, &img);
+    stroke d = {doodle, dn, 0, ""};
+    for (int i = 0; i < dn; ++i)
+        doodle[i].x -= shift;
+    int yellow, blue;
+    double med;
+    overlay_match(&img, &d, &yellow, &blue, &med);
+    fprintf(stderr, "  refused drawing: %d blue px on it\n", blue);
+    ENSURE(blue > 300);
+    sp_image_free(&img);
+    cJSON_Delete(st);
+}
+
+// Issue 16, item 7, and issue 15's rule: 20 strokes in 6 s, two of them
+// bodies, four tails, parts drawn near a body and far from both, a head
+// before any body. A part drawn near a body attaches to the nearest one; a
+// part drawn far from both stays free where it was drawn; the head waits and
+// joins the body drawn next to it.
+static void test_twenty_strokes(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    // Which part (index into the six), where, and what it must become: dragon
+    // one on the left (its parts join body one, the stroke at index 1),
+    // dragon two on the right (body two, index 7), parts between the two
+    // bodies (either), and parts far from both (free).
+    enum { BODY, ONE, TWO, EITHER, FREE };
+    static const struct {
+        int part;
+        double dx, dy;
+        int want;
+    } plan[20] = {
+        {1, -300, 0, ONE},    {0, -300, 0, BODY},   {3, -130, -300, FREE}, {2, -300, 0, ONE},   {4, -300, 0, ONE},
+        {5, -300, 0, ONE},    {3, 330, -295, FREE}, {0, 180, 0, BODY},     {1, 120, 0, TWO},    {3, 650, 270, FREE},
+        {2, 180, 0, TWO},     {4, 180, 0, TWO},     {5, 180, 0, TWO},      {3, -120, 0, ONE},   {1, -800, -135, FREE},
+        {2, -450, 460, FREE}, {4, 300, -400, FREE}, {5, 0, 0, EITHER},     {1, 150, 430, FREE}, {2, 0, 0, EITHER},
+    };
+    const char* sc = sp_test_tmp_path("kiosk_twenty.json");
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    bool inside = true;
+    int free_n = 0;
+    for (int i = 0; i < 20; ++i) {
+        // Every stroke starts and stays on the canvas, clear of the chips (or it would not be a stroke).
+        const stroke* p = &g_strokes[plan[i].part];
+        double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+        for (int k = 0; k < p->n; ++k) {
+            double x = p->xy[k].x + plan[i].dx, y = p->xy[k].y + plan[i].dy;
+            lo[0] = fmin(lo[0], x), lo[1] = fmin(lo[1], y), hi[0] = fmax(hi[0], x), hi[1] = fmax(hi[1], y);
+        }
+        if (!(lo[0] > 10 && hi[0] < 1150 && lo[1] > 85 && hi[1] < 795)) {
+            fprintf(stderr, "  stroke %d leaves the canvas: %.0f..%.0f x %.0f..%.0f\n", i, lo[0], hi[0], lo[1], hi[1]);
+            inside = false;
+        }
+        part_stroke_at(&s, 300 + 300 * i, p, plan[i].dx, plan[i].dy);
+        free_n += plan[i].want == FREE;
+    }
+    ENSURE(inside);
+    script_mark(&s, 7500, "twenty");
+    script_end(&s, sc, 8000);
+    char args[4096];
+    snprintf(args, sizeof args, "--script '%s' --screenshot '%s' --export-dir '%s'", sc, sp_test_tmp_path("kiosk_twenty.png"),
+             sp_test_tmp_path("kiosk_twenty_exports"));
+    cJSON* st = NULL;
+    ENSURE(run_kiosk(args, &st) == 0 && st);
+    const cJSON* att = cJSON_GetObjectItemCaseSensitive(st, "attached_to");
+    char* txt = cJSON_PrintUnformatted(att);
+    fprintf(stderr, "  parts %g, bodies %g, loose %g, dropped %g, attached_to %s\n", num(st, "parts"), num(st, "bodies"),
+            num(st, "loose_parts"), num(st, "dropped_strokes"), txt ? txt : "?");
+    free(txt);
+    // The replay runs on the script's clock, so no stroke is dropped and part i is stroke i.
+    ENSURE(num(st, "parts") == 20 && cJSON_GetArraySize(att) == 20 && num(st, "bodies") == 2 && num(st, "pipeline_errors") == 0);
+    for (int i = 0; i < 20; ++i) {
+        int to = (int)cJSON_GetArrayItem(att, i)->valuedouble;
+        bool ok = plan[i].want == BODY     ? to == -1 && !strcmp(stat_category(st, i), "torso")
+                  : plan[i].want == ONE    ? to == 1
+                  : plan[i].want == TWO    ? to == 7
+                  : plan[i].want == EITHER ? to == 1 || to == 7
+                                           : to == -1;
+        if (!ok) fprintf(stderr, "  stroke %d (%s): attached to %d\n", i, stat_category(st, i), to);
+        ENSURE(ok);
+    }
+    // What a visitor sees floating is what was drawn far away.
+    ENSURE(num(st, "loose_parts") == free_n);
+    ENSURE(num(st, "waiting") == 1); // the head, told to wait for a body (it joined the one drawn next to it)
+    cJSON_Delete(st);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -710,5 +930,7 @@ int main(int argc, char** argv)
                                    {"record_replay", test_record_replay},
                                    {"db_replaced", test_db_replaced},
                                    {"full_dragon", test_full_dragon},
+                                   {"visit", test_visit},
+                                   {"twenty_strokes", test_twenty_strokes},
                                    {0}});
 }

@@ -8,6 +8,7 @@
 #include "fixtures.h"
 #include "sp/kiosk_lod.h"
 #include "sp/kiosk_session.h"
+#include "sp/kiosk_text.h"
 #include "sp/kiosk_ui.h"
 #include "test.h"
 
@@ -18,7 +19,8 @@ static const char* const k_cats[6] = {"head", "wings", "tail", "torso", "front_l
 typedef struct fake {
     int parts;
     int cat[256]; // category index per part
-    int fits, refits, undos, clears, saves, rejects;
+    int fits, refits, undos, clears, saves, rejects, forced;
+    bool waiting;        // accepted parts are told to wait for a body
     int heavy_per_frame; // heavy jobs answered per drain (0: all)
     char log[8192];      // one letter per job, for replay comparisons
     int log_n;
@@ -27,6 +29,14 @@ typedef struct fake {
 static void fake_log(fake* f, char c)
 {
     if (f->log_n < (int)sizeof f->log - 1) f->log[f->log_n++] = c, f->log[f->log_n] = 0;
+}
+
+static int cat_index(const char* name)
+{
+    int c = 0;
+    while (c < 6 && strcmp(k_cats[c], name) != 0)
+        ++c;
+    return c < 6 ? c : -1;
 }
 
 // Category from the stroke's length (deterministic); strokes that stay
@@ -60,14 +70,16 @@ static void fake_drain(sp_kiosk_ui* ui, fake* f)
         heavy += j.heavy;
         switch (j.kind) {
         case SP_KJOB_FIT: {
-            fake_log(f, j.replace ? 'R' : 'F');
-            int c = fake_classify(j.stroke);
+            // A refused stroke is offered with three guesses; a chosen one is fitted as told.
+            fake_log(f, j.replace ? 'R' : j.category[0] ? 'P' : 'F');
+            int c = j.category[0] ? cat_index(j.category) : fake_classify(j.stroke);
             if (c < 0) {
                 ++f->rejects;
-                sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = false});
+                sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"head", "wings", "tail"}});
                 break;
             }
             ++f->fits;
+            f->forced += j.category[0] != 0;
             if (!j.replace || f->parts == 0) f->parts = f->parts < 256 ? f->parts + 1 : f->parts;
             f->cat[f->parts - 1] = c;
             float outline[2 * 64];
@@ -77,6 +89,7 @@ static void fake_drain(sp_kiosk_ui* ui, fake* f)
                 outline[2 * i] = j.stroke->xy[2 * k] + 2, outline[2 * i + 1] = j.stroke->xy[2 * k + 1] - 1;
             }
             sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true,
+                                                            .waiting = f->waiting,
                                                             .category = k_cats[c],
                                                             .guesses = {k_cats[(c + 1) % 6], k_cats[(c + 2) % 6]},
                                                             .part_count = f->parts,
@@ -87,10 +100,8 @@ static void fake_drain(sp_kiosk_ui* ui, fake* f)
         case SP_KJOB_REFIT: {
             fake_log(f, 'G');
             ++f->refits;
-            int c = 0;
-            while (c < 6 && strcmp(k_cats[c], j.category) != 0)
-                ++c;
-            if (c == 6 || f->parts == 0) {
+            int c = cat_index(j.category);
+            if (c < 0 || f->parts == 0) {
                 sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = false});
                 break;
             }
@@ -162,18 +173,50 @@ static void tap(sp_kiosk_ui* ui, double t, sp_kiosk_target tg)
     send(ui, SP_KEV_UP, t + 60, r->x + 0.5f * r->w, r->y + 0.5f * r->h);
 }
 
-static sp_kiosk_ui* started(fake* f)
+static const char* const k_row[6] = {"torso", "head", "wings", "tail", "front_legs", "hind_legs"};
+
+static sp_kiosk_ui* started_with(fake* f, const sp_kiosk_ui_desc* desc)
 {
-    sp_kiosk_ui* ui = sp_kiosk_ui_create(NULL);
+    sp_kiosk_ui* ui = sp_kiosk_ui_create(desc);
     ENSURE(ui);
     sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+    sp_kiosk_ui_set_parts(ui, k_row, 6);
     memset(f, 0, sizeof *f);
     send(ui, SP_KEV_DOWN, 0, 640, 400);
     send(ui, SP_KEV_UP, 50, 640, 400);
     return ui;
 }
 
+static sp_kiosk_ui* started(fake* f)
+{
+    return started_with(f, NULL);
+}
+
+// Started, with one part (the fake's head); *t: the stroke's pen-up.
+static sp_kiosk_ui* with_part(fake* f, const sp_kiosk_ui_desc* desc, double* t)
+{
+    sp_kiosk_ui* ui = started_with(f, desc);
+    *t = stroke(ui, 1000, 200, 300, 30, 10);
+    frame(ui, f, *t + 10);
+    ENSURE(ui->part_count == 1 && !strcmp(ui->chip[0], "head"));
+    return ui;
+}
+
+// A stroke the fake refuses (it stays within 40 px of a vertical line); returns the end time.
+static double refused_stroke(sp_kiosk_ui* ui, double t, float x, float y)
+{
+    send(ui, SP_KEV_DOWN, t, x, y);
+    for (int i = 1; i < 16; ++i)
+        send(ui, SP_KEV_MOVE, t + 8 * i, x + (i & 1 ? 12.0f : 0.0f), y + 15.0f * (float)i);
+    send(ui, SP_KEV_UP, t + 128, x, y + 15.0f * 16);
+    return t + 128;
+}
+
 // ------------------------------------------------------------ tests
+
+static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t seed, fake* f, sp_kiosk_ui** out,
+                        sp_kiosk_session* rec);
+static void check_targets(const sp_kiosk_ui* ui);
 
 static void test_flow(void)
 {
@@ -247,8 +290,8 @@ static void test_flow(void)
     // A rejected stroke: hint, fading stroke, nothing else changes.
     double t = stroke(ui, 4000, 100, 500, 20, 10);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = false, .hint = "Try a head"});
-    ENSURE(ui->part_count == 1 && strcmp(ui->chip[0], "head") == 0 && strcmp(ui->hint, "Try a head") == 0);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = false, .refusal = SP_KREF_TOO_SMALL});
+    ENSURE(ui->part_count == 1 && ui->chip[0][0] == 0 && strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_TOO_SMALL)) == 0);
     ENSURE(sp_kiosk_ui_fade(ui) > 0.99 && ui->fade_stroke.count > 2 && !sp_kiosk_ui_flashing(ui));
     frame(ui, &f, t + 600);
     ENSURE(sp_kiosk_ui_fade(ui) > 0.3 && sp_kiosk_ui_fade(ui) < 0.7);
@@ -308,6 +351,302 @@ static void test_flow(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// Issue 16, item 4: a refused stroke stays on screen with ITS three best
+// guesses as chips; a tap makes it that part; the chips never refer to any
+// stroke but the last (the old kiosk re-fitted the previous part: the body
+// became a head).
+static void test_refused_stroke(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    double t = stroke(ui, 1000, 200, 300, 18, 5); // the fake's torso (its length)
+    frame(ui, &f, t + 10);
+    ENSURE(f.parts == 1 && f.cat[0] == 3 && !strcmp(ui->chip[0], "torso") && ui->chip[3][0] == 0);
+    // Refused: the stroke stays, the chips are its guesses, the label goes.
+    t = refused_stroke(ui, 3000, 800, 200);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.category[0]);
+    int n = j.stroke->count;
+    float x0 = j.stroke->xy[0], y1 = j.stroke->xy[2 * n - 1];
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"head", "wings", "tail"}});
+    ENSURE(sp_kiosk_ui_offering(ui) && ui->held_stroke.count == n && ui->held_stroke.xy[0] == x0);
+    ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL) && ui->chips_offer);
+    char text[64];
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_GUESS1, text, sizeof text), "Head?"));
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_GUESS2, text, sizeof text), "Wings?"));
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_GUESS3, text, sizeof text), "Tail?"));
+    ENSURE(sp_kiosk_ui_target_enabled(ui, SP_KT_CHIP_GUESS3) &&
+           !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_UNRECOGNISED)));
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_fade(ui) == 0);
+    // ...for a moment (8 s), at full strength.
+    frame(ui, &f, t + 7700);
+    ENSURE(sp_kiosk_ui_offering(ui) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS2));
+    // One tap: the stroke becomes wings; the body stays a body (no re-fit of it).
+    tap(ui, t + 7750, SP_KT_CHIP_GUESS2);
+    ENSURE(!sp_kiosk_ui_offering(ui));
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !strcmp(j.category, "wings") && !j.replace);
+    ENSURE(j.stroke->count == n && j.stroke->xy[0] == x0 && j.stroke->xy[2 * n - 1] == y1);
+    sp_kiosk_ui_fit_done(ui,
+                         &(sp_kiosk_fit_result){.ok = true, .category = "wings", .guesses = {"head", "tail"}, .part_count = 2});
+    ENSURE(ui->part_count == 2 && !strcmp(ui->chip[0], "wings") && !ui->chips_offer && sp_kiosk_ui_flashing(ui));
+    ENSURE(ui->flash_stroke.count == n && ui->flash_stroke.xy[0] == x0);
+    ENSURE(ui->chosen == 1 && ui->offered == 1);
+    // The same through the fake pipeline: the body is untouched, no REFIT ever ran.
+    f.parts = 2, f.cat[1] = 2;
+    t = refused_stroke(ui, 12000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && f.rejects == 1);
+    tap(ui, t + 500, SP_KT_CHIP_GUESS1);
+    frame(ui, &f, t + 600);
+    ENSURE(f.parts == 3 && f.cat[0] == 3 && f.cat[1] == 2 && f.cat[2] == 0 && f.refits == 0 && f.forced == 1);
+    ENSURE(!strcmp(ui->chip[0], "head") && ui->part_count == 3);
+    // The moment passes: the stroke fades, its chips go, and no chip of an
+    // older stroke comes back in their place.
+    t = refused_stroke(ui, 20000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui));
+    sp_kiosk_rect g1 = ui->target[SP_KT_CHIP_GUESS1];
+    frame(ui, &f, t + 10 + 8000);
+    ENSURE(!sp_kiosk_ui_offering(ui) && sp_kiosk_ui_fade(ui) > 0.9 && ui->fade_stroke.count > 2);
+    for (int c = SP_KT_CHIP_LABEL; c <= SP_KT_PART_LAST; ++c)
+        ENSURE(!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)c));
+    send(ui, SP_KEV_DOWN, t + 8100, g1.x + 0.5f * g1.w, g1.y + 0.5f * g1.h);
+    send(ui, SP_KEV_UP, t + 8150, g1.x + 0.5f * g1.w, g1.y + 0.5f * g1.h);
+    frame(ui, &f, t + 8200);
+    ENSURE(f.refits == 0 && f.forced == 1 && f.parts == 3 && ui->job_count == 0);
+    // A new stroke ends an offer at once (it is the last stroke now).
+    t = refused_stroke(ui, 40000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui));
+    t = stroke(ui, t + 1000, 300, 500, 18, 5);
+    ENSURE(!sp_kiosk_ui_offering(ui) && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    frame(ui, &f, t + 10);
+    ENSURE(f.parts == 4 && !strcmp(ui->chip[0], "torso"));
+    // While a later stroke waits, the chips of the one before are gone: a tap
+    // where its guess was cannot re-fit the wrong part.
+    stroke(ui, t + 1000, 300, 500, 18, 5);
+    ENSURE(ui->pending_count == 1 && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    tap(ui, t + 1300, SP_KT_CHIP_GUESS1);
+    frame(ui, &f, t + 1400);
+    ENSURE(f.refits == 0 && f.parts == 5);
+    // Undo during an offer takes back the refused stroke, not a part.
+    t = refused_stroke(ui, 50000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui));
+    tap(ui, t + 300, SP_KT_UNDO);
+    frame(ui, &f, t + 400);
+    ENSURE(!sp_kiosk_ui_offering(ui) && f.undos == 0 && f.parts == 5 && sp_kiosk_ui_fade(ui) == 0);
+    // Redraw, refused, a guess: the chosen part replaces the last one.
+    tap(ui, t + 1000, SP_KT_REDRAW);
+    t = refused_stroke(ui, t + 1200, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && ui->redraw_armed);
+    tap(ui, t + 300, SP_KT_CHIP_GUESS3);
+    frame(ui, &f, t + 400);
+    ENSURE(f.parts == 5 && f.cat[4] == 2 && !ui->redraw_armed && f.log[f.log_n - 1] == 'R');
+    sp_kiosk_ui_destroy(ui);
+}
+
+// Issue 16, item 7: with a refused stroke comes a row of the six parts (each
+// a 15 mm target at least, its outline drawn by the kiosk over its name); a
+// tap makes the stroke that part. Driven by a scripted session.
+static void test_parts_row(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    ENSURE(ui->row_count == 6);
+    for (int i = 0; i < SP_KIOSK_ROW_MAX; ++i)
+        ENSURE(!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)(SP_KT_PART1 + i)));
+    char text[64];
+    for (int i = 0; i < 6; ++i) {
+        double t = refused_stroke(ui, 1000 + 3000 * i, 600, 100);
+        frame(ui, &f, t + 10);
+        for (int k = 0; k < SP_KIOSK_ROW_MAX; ++k)
+            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)(SP_KT_PART1 + k)) == (k < 6));
+        ENSURE(!strcmp(sp_kiosk_ui_target_category(ui, (sp_kiosk_target)(SP_KT_PART1 + i)), k_row[i]));
+        tap(ui, t + 500, (sp_kiosk_target)(SP_KT_PART1 + i));
+        frame(ui, &f, t + 600);
+        ENSURE(f.parts == i + 1 && !strcmp(k_cats[f.cat[i]], k_row[i]) && !sp_kiosk_ui_offering(ui));
+    }
+    // The row does not hide the refused stroke: drawn where the row would go,
+    // the row goes to the bottom of the canvas (the hint above it)...
+    double t = refused_stroke(ui, 20000, 150, 90);
+    frame(ui, &f, t + 10);
+    const sp_kiosk_rect *p1 = &ui->target[SP_KT_PART1], *g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    ENSURE(g1->y < 0.2f * ui->canvas.h && p1->y > 0.6f * ui->canvas.h && ui->hint_box.y + ui->hint_box.h < p1->y);
+    check_targets(ui);
+    for (int i = 0; i < ui->held_stroke.count; ++i)
+        ENSURE(ui->held_stroke.xy[2 * i + 1] < ui->hint_box.y);
+    // ...and drawn low, it stays under the chips.
+    t = refused_stroke(ui, t + 1000, 150, 500);
+    frame(ui, &f, t + 10);
+    ENSURE(p1->y < 0.3f * ui->canvas.h && p1->y > g1->y + g1->h && ui->hint_box.y > p1->y);
+    check_targets(ui);
+    tap(ui, t + 100, SP_KT_UNDO);
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_PART1, text, sizeof text), "Body"));
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, (sp_kiosk_target)(SP_KT_PART1 + 5), text, sizeof text), "Back legs"));
+    // Without a refused stroke the row never shows; the press is ignored.
+    sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 30000, 0, 0, SP_KT_PART1});
+    frame(ui, &f, 30100);
+    ENSURE(f.parts == 6 && f.forced == 6);
+    sp_kiosk_ui_destroy(ui);
+    // The same from a session file: "part2" is the row's second part, "guess1" the refused stroke's first guess.
+    const char* doc =
+        "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"end_ms\": 9000, \"events\": ["
+        "{\"t\": 0, \"type\": \"down\", \"x\": 640, \"y\": 400}, {\"t\": 50, \"type\": \"up\", \"x\": 640, \"y\": 400},"
+        "{\"t\": 500, \"type\": \"stroke\", \"points\": [[200, 300], [205, 320], [210, 340], [330, 360], [420, 380]]},"
+        "{\"t\": 1500, \"type\": \"stroke\", \"points\": [[800, 100], [812, 160], [800, 220], [812, 280], [800, 340]]},"
+        "{\"t\": 2500, \"type\": \"press\", \"target\": \"part2\"},"
+        "{\"t\": 4000, \"type\": \"stroke\", \"points\": [[900, 100], [912, 160], [900, 220], [912, 280], [900, 340]]},"
+        "{\"t\": 5000, \"type\": \"press\", \"target\": \"guess1\"}]}";
+    sp_kiosk_session s = {0};
+    sp_error err = {0};
+    ENSURE(sp_kiosk_session_parse(doc, strlen(doc), "row.json", &s, &err) == SP_OK);
+    ENSURE(s.events[s.count - 1].button == SP_KT_CHIP_GUESS1 && sp_kiosk_target_parse("part2") == SP_KT_PART1 + 1);
+    sp_kiosk_ui* b;
+    run_session(&s, 1000.0 / 60.0, 0, &f, &b, NULL);
+    ENSURE(f.parts == 3 && f.rejects == 2 && f.forced == 2 && f.refits == 0);
+    ENSURE(!strcmp(k_cats[f.cat[1]], "head") && !strcmp(k_cats[f.cat[2]], "head")); // the fake's first guess is "head"
+    ENSURE(b->chosen == 2 && b->part_count == 3);
+    sp_kiosk_ui_destroy(b);
+    sp_kiosk_session_free(&s);
+}
+
+// Issue 16, item 7: Start over returns to the first-draw prompt with the
+// animation stopped (the old kiosk showed a blank canvas and "Pause").
+static void test_start_over(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    ENSURE(ui->mode == SP_KM_DRAW && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PROMPT)));
+    double t = stroke(ui, 1000, 200, 300, 30, 10);
+    ENSURE(sp_kiosk_ui_message(ui) == NULL); // a stroke waits
+    frame(ui, &f, t + 10);
+    frame(ui, &f, t + 1000);
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_message(ui) == NULL);
+    tap(ui, t + 1100, SP_KT_PLAY);
+    tap(ui, t + 1300, SP_KT_SAVE);
+    frame(ui, &f, t + 1400);
+    frame(ui, &f, t + 3000);
+    ENSURE(ui->playing && ui->anim_ms > 1000 && sp_kiosk_ui_banner_visible(ui));
+    tap(ui, t + 3100, SP_KT_START_OVER);
+    tap(ui, t + 3400, SP_KT_START_OVER);
+    // At once: no part drawn, nothing playing, no old code, the prompt.
+    ENSURE(!ui->playing && ui->anim_ms == 0 && !sp_kiosk_ui_banner_visible(ui) && ui->chip[0][0] == 0);
+    frame(ui, &f, t + 3500);
+    ENSURE(f.clears == 1 && ui->part_count == 0 && ui->mode == SP_KM_DRAW);
+    ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PROMPT)));
+    frame(ui, &f, t + 60000); // the prompt stays as long as the canvas is empty
+    ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PROMPT)) && ui->anim_ms == 0);
+    // Undo of the last part does the same.
+    t = stroke(ui, t + 61000, 200, 300, 30, 10);
+    frame(ui, &f, t + 10);
+    tap(ui, t + 100, SP_KT_PLAY);
+    frame(ui, &f, t + 1000);
+    ENSURE(ui->playing);
+    tap(ui, t + 1100, SP_KT_UNDO);
+    frame(ui, &f, t + 1200);
+    ENSURE(ui->part_count == 0 && !ui->playing && ui->anim_ms == 0);
+    ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PROMPT)));
+    sp_kiosk_ui_destroy(ui);
+}
+
+static bool contains_word(const char* text, const char* word)
+{
+    char low[SP_KIOSK_TEXT_MAX];
+    size_t n = 0;
+    for (; text[n] && n < sizeof low - 1; ++n)
+        low[n] = (char)(text[n] >= 'A' && text[n] <= 'Z' ? text[n] - 'A' + 'a' : text[n]);
+    low[n] = 0;
+    return strstr(low, word) != NULL;
+}
+
+// Issue 16, item 7: one name for each part everywhere: the chips, the parts
+// row and every sentence ("Body" and "Back legs": a child's words; "torso"
+// and "hind" never show, though the files keep those ids).
+static void test_part_names(void)
+{
+    char name[SP_KIOSK_NAME_MAX];
+    const char* const want[6] = {"Body", "Head", "Wings", "Tail", "Front legs", "Back legs"};
+    for (int i = 0; i < 6; ++i) {
+        ENSURE(!strcmp(sp_kiosk_part_name(k_row[i], name, sizeof name), want[i]));
+        ENSURE(sp_kiosk_part_order(k_row[i]) == i);
+        for (int k = 0; k < i; ++k)
+            ENSURE(strcmp(want[k], want[i]) != 0);
+    }
+    ENSURE(!strcmp(sp_kiosk_part_name("spiky_tail", name, sizeof name), "Spiky tail"));
+    ENSURE(sp_kiosk_part_order("spiky_tail") == SP_KIOSK_PART_ORDER_UNKNOWN);
+    ENSURE(!strcmp(sp_kiosk_part_name(NULL, name, sizeof name), ""));
+    // Sentences that list parts use those names; none uses another.
+    for (int id = 0; id < SP_KTEXT_COUNT; ++id) {
+        const char* s = sp_kiosk_text((sp_kiosk_text_id)id);
+        ENSURE(s[0] && strlen(s) < SP_KIOSK_TEXT_MAX);
+        if (contains_word(s, "torso") || contains_word(s, "hind") || contains_word(s, "_"))
+            fprintf(stderr, "  text %d: \"%s\"\n", id, s);
+        ENSURE(!contains_word(s, "torso") && !contains_word(s, "hind") && !contains_word(s, "_"));
+    }
+    const sp_kiosk_text_id lists[] = {SP_KTEXT_PROMPT, SP_KTEXT_ATTRACT, SP_KTEXT_UNRECOGNISED_NO_OFFER};
+    for (size_t i = 0; i < sizeof lists / sizeof lists[0]; ++i)
+        for (int k = 0; k < 4; ++k) // body, head, wings, tail; legs below
+            ENSURE(contains_word(sp_kiosk_text(lists[i]), k == 0 ? "a body" : k == 1 ? "a head" : k == 2 ? "wings" : "a tail"));
+    ENSURE(contains_word(sp_kiosk_text(SP_KTEXT_PROMPT), "legs") && contains_word(sp_kiosk_text(SP_KTEXT_WAITING), "body"));
+    // The chips say the same: the label, guesses, the row.
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    stroke(ui, 1000, 200, 300, 18, 5);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j));
+    sp_kiosk_ui_fit_done(
+        ui, &(sp_kiosk_fit_result){.ok = true, .category = "torso", .guesses = {"hind_legs", "head"}, .part_count = 1});
+    char text[64];
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_LABEL, text, sizeof text), "Body"));
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_GUESS1, text, sizeof text), "Back legs?"));
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_GUESS2, text, sizeof text), "Head?"));
+    sp_kiosk_ui_destroy(ui);
+}
+
+// Issue 16, item 7: the save banner says what the code is for (Save names
+// the .glb and the postcard by it, where staff find them).
+static void test_save_code(void)
+{
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t);
+    tap(ui, t + 100, SP_KT_SAVE);
+    frame(ui, &f, t + 200);
+    ENSURE(sp_kiosk_ui_banner_visible(ui) && !strcmp(ui->code, "K7QX"));
+    ENSURE(strstr(ui->banner[0], "K7QX") && !strcmp(ui->banner[1], sp_kiosk_text(SP_KTEXT_CODE_USE)));
+    ENSURE(contains_word(ui->banner[1], "code") && contains_word(ui->banner[1], "guide") &&
+           contains_word(ui->banner[1], "find") && contains_word(ui->banner[1], "postcard"));
+    sp_kiosk_ui_destroy(ui);
+}
+
+// Issue 16, item 7: a part drawn while no body is on the canvas waits where it
+// was drawn (it joins the body drawn next); the visitor is told so.
+static void test_waiting_part(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    f.waiting = true;
+    double t = stroke(ui, 1000, 200, 300, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(f.parts == 1 && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_WAITING)));
+    f.waiting = false;
+    t = stroke(ui, t + 5000, 200, 300, 18, 5);
+    frame(ui, &f, t + 10);
+    ENSURE(f.parts == 2 && sp_kiosk_ui_message(ui) == NULL);
+    // Not for a stroke that is no longer the last.
+    f.waiting = true;
+    f.heavy_per_frame = 1;
+    t = stroke(ui, t + 5000, 200, 300, 30, 10);
+    t = stroke(ui, t + 100, 200, 300, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(f.parts == 3 && sp_kiosk_ui_message(ui) == NULL);
+    frame(ui, &f, t + 30);
+    ENSURE(f.parts == 4 && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_WAITING)));
+    sp_kiosk_ui_destroy(ui);
+}
+
 static void check_rect_mm(const sp_kiosk_ui* ui, const sp_kiosk_rect* r, const char* what, double min_mm)
 {
     double min_px = min_mm * ui->px_per_mm - 1e-3;
@@ -316,6 +655,43 @@ static void check_rect_mm(const sp_kiosk_ui* ui, const sp_kiosk_rect* r, const c
                 ui->px_per_mm, r->w, r->h, r->w / ui->px_per_mm, r->h / ui->px_per_mm);
     ENSURE(r->w >= min_px && r->h >= min_px);
     ENSURE(r->x >= -1e-3 && r->y >= -1e-3 && r->x + r->w <= ui->width + 1e-3 && r->y + r->h <= ui->height + 1e-3);
+}
+
+// Every visible target: at least 15 mm, hit in its middle and 1 mm inside
+// its edges, 2 mm from every other, toolbar buttons off the canvas.
+static void check_targets(const sp_kiosk_ui* ui)
+{
+    for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t) {
+        if (!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t)) continue;
+        const sp_kiosk_rect* r = &ui->target[t];
+        check_rect_mm(ui, r, sp_kiosk_target_name((sp_kiosk_target)t), 15.0);
+        float in = (float)ui->px_per_mm;
+        float pts[5][2] = {{r->x + 0.5f * r->w, r->y + 0.5f * r->h},
+                           {r->x + in, r->y + in},
+                           {r->x + r->w - in, r->y + in},
+                           {r->x + in, r->y + r->h - in},
+                           {r->x + r->w - in, r->y + r->h - in}};
+        for (int k = 0; k < 5; ++k)
+            ENSURE(sp_kiosk_ui_hit(ui, pts[k][0], pts[k][1]) == (sp_kiosk_target)t);
+        for (int u = SP_KT_UNDO; u < t; ++u) {
+            if (!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)u)) continue;
+            const sp_kiosk_rect* q = &ui->target[u];
+            double gap = fmax(fmax(q->x - (r->x + r->w), r->x - (q->x + q->w)), fmax(q->y - (r->y + r->h), r->y - (q->y + q->h)));
+            if (gap < 2.0 * ui->px_per_mm - 1e-3)
+                fprintf(stderr, "  %s and %s at %dx%d: %.1f px apart\n", sp_kiosk_target_name((sp_kiosk_target)u),
+                        sp_kiosk_target_name((sp_kiosk_target)t), ui->width, ui->height, gap);
+            ENSURE(gap >= 2.0 * ui->px_per_mm - 1e-3);
+        }
+        if (t <= SP_KT_SAVE) {
+            const sp_kiosk_rect* c = &ui->canvas;
+            bool apart = r->y >= c->y + c->h || r->x >= c->x + c->w;
+            ENSURE(apart);
+        } else { // chips lie above the hint, the parts row above or below it
+            const sp_kiosk_rect* h = &ui->hint_box;
+            ENSURE(r->y + r->h <= h->y + 1e-3 || (t >= SP_KT_PART1 && r->y >= h->y + h->h - 1e-3));
+            ENSURE(r->y >= ui->canvas.y && r->y + r->h <= ui->canvas.y + ui->canvas.h + 1e-3);
+        }
+    }
 }
 
 static void test_layout(void)
@@ -333,43 +709,33 @@ static void test_layout(void)
     fake f;
     for (size_t s = 0; s < sizeof screens / sizeof screens[0]; ++s) {
         sp_kiosk_ui* ui = started(&f);
+        sp_kiosk_ui_set_parts(ui, k_row, 6);
         sp_kiosk_ui_resize(ui, screens[s].w, screens[s].h, screens[s].ppm);
-        // Give it a part so every chip shows, with a long category name.
+        // A part: its label and two guesses show, with long names.
         stroke(ui, 1000, 0.2f * (float)screens[s].w, 0.3f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
         sp_kiosk_job j;
         ENSURE(sp_kiosk_ui_next_job(ui, &j));
         sp_kiosk_ui_fit_done(
             ui, &(sp_kiosk_fit_result){.ok = true, .category = "front_legs", .guesses = {"hind_legs", "wings"}, .part_count = 1});
-        for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t) {
-            const sp_kiosk_rect* r = &ui->target[t];
-            check_rect_mm(ui, r, sp_kiosk_target_name((sp_kiosk_target)t), 15.0);
-            // The centre and every point 1 mm inside the edge hit this target.
-            float in = (float)ui->px_per_mm;
-            float pts[5][2] = {{r->x + 0.5f * r->w, r->y + 0.5f * r->h},
-                               {r->x + in, r->y + in},
-                               {r->x + r->w - in, r->y + in},
-                               {r->x + in, r->y + r->h - in},
-                               {r->x + r->w - in, r->y + r->h - in}};
-            for (int k = 0; k < 5; ++k)
-                ENSURE(sp_kiosk_ui_hit(ui, pts[k][0], pts[k][1]) == (sp_kiosk_target)t);
-            // No two targets overlap (at least 2 mm apart), and toolbar buttons stay off the canvas.
-            for (int u = SP_KT_UNDO; u < t; ++u) {
-                const sp_kiosk_rect* q = &ui->target[u];
-                double gap =
-                    fmax(fmax(q->x - (r->x + r->w), r->x - (q->x + q->w)), fmax(q->y - (r->y + r->h), r->y - (q->y + q->h)));
-                ENSURE(gap >= 2.0 * ui->px_per_mm - 1e-3);
-            }
-            if (t <= SP_KT_SAVE) {
-                const sp_kiosk_rect* c = &ui->canvas;
-                bool apart = r->y >= c->y + c->h || r->x >= c->x + c->w;
-                ENSURE(apart);
-            }
-        }
+        for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
+            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) == (t <= SP_KT_CHIP_GUESS2));
+        check_targets(ui);
         // The canvas keeps most of the screen.
         ENSURE(ui->canvas.w * ui->canvas.h >= 0.45 * screens[s].w * screens[s].h);
         // Far from every target: nothing.
         ENSURE(sp_kiosk_ui_hit(ui, ui->canvas.x + 0.5f * ui->canvas.w, ui->canvas.y + 0.6f * ui->canvas.h) == SP_KT_NONE);
         ENSURE(sp_kiosk_ui_hit(ui, NAN, 3) == SP_KT_NONE);
+        // A refused stroke: three guesses and the six parts, no label.
+        stroke(ui, 3000, 0.2f * (float)screens[s].w, 0.5f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
+        ENSURE(sp_kiosk_ui_next_job(ui, &j));
+        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"hind_legs", "front_legs", "torso"}});
+        for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
+            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
+                   (t <= SP_KT_SAVE || (t >= SP_KT_CHIP_GUESS1 && t < SP_KT_PART1 + 6)));
+        check_targets(ui);
+        // The hint fits under them (none on a canvas too small: only the portrait phone-sized one).
+        ENSURE(ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
+        ENSURE(ui->hint_box.h > 0 || ui->canvas.w * ui->canvas.h < 120 * 120 * ui->px_per_mm * ui->px_per_mm);
         sp_kiosk_ui_destroy(ui);
     }
     // Degenerate sizes and densities never crash and fall back to 96 dpi.
@@ -384,21 +750,20 @@ static void test_layout(void)
 static void test_idle_timeout(void)
 {
     fake f;
-    sp_kiosk_ui* ui = started(&f);
-    double t = stroke(ui, 1000, 200, 300, 30, 10);
-    frame(ui, &f, t + 10);
-    ENSURE(ui->part_count == 1);
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t);
     // 80 s of nothing: the countdown shows 10 s...
     frame(ui, &f, t + 79900);
     ENSURE(sp_kiosk_ui_countdown_s(ui) == 0);
     frame(ui, &f, t + 80500);
     ENSURE_NEAR(sp_kiosk_ui_countdown_s(ui), 9.5, 1e-9);
-    // ...a touch anywhere cancels it and does nothing else.
+    // ...a line drawn then both stops it and becomes a part.
     send(ui, SP_KEV_DOWN, t + 81000, 400, 400);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0);
     send(ui, SP_KEV_MOVE, t + 81050, 600, 420);
     send(ui, SP_KEV_UP, t + 81100, 600, 420);
     frame(ui, &f, t + 81200);
-    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0 && f.fits == 1 && ui->mode == SP_KM_DRAW && ui->pending_count == 0);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0 && f.fits == 2 && ui->mode == SP_KM_DRAW && ui->pending_count == 0);
     // Held still with a finger down still times out (a stuck touch cannot keep the kiosk busy).
     double t2 = t + 81100;
     send(ui, SP_KEV_DOWN, t2 + 100, 400, 400);
@@ -410,6 +775,57 @@ static void test_idle_timeout(void)
     ENSURE(ui->mode == SP_KM_ATTRACT);
     // Attract never times out.
     frame(ui, &f, t2 + 1e7);
+    ENSURE(ui->mode == SP_KM_ATTRACT && f.clears == 1);
+    sp_kiosk_ui_destroy(ui);
+}
+
+// The countdown is at most a third of the idle time (--idle 15: 5 s after
+// 10 s); a touch during it resets the timer and acts: a chip tap, a button, a stroke.
+static void test_countdown(void)
+{
+    sp_kiosk_ui* d = sp_kiosk_ui_create(NULL);
+    ENSURE_NEAR(d->desc.countdown_ms, 10000, 1e-9);
+    sp_kiosk_ui_destroy(d);
+    d = sp_kiosk_ui_create(&(sp_kiosk_ui_desc){.idle_ms = 30000, .countdown_ms = 20000});
+    ENSURE_NEAR(d->desc.countdown_ms, 10000, 1e-9);
+    sp_kiosk_ui_destroy(d);
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, &(sp_kiosk_ui_desc){.idle_ms = 15000}, &t);
+    ENSURE_NEAR(ui->desc.countdown_ms, 5000, 1e-9);
+    ENSURE(sp_kiosk_ui_target_enabled(ui, SP_KT_CHIP_GUESS1));
+    frame(ui, &f, t + 9900);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0);
+    frame(ui, &f, t + 10500);
+    ENSURE_NEAR(sp_kiosk_ui_countdown_s(ui), 4.5, 1e-9);
+    // A guess chip tapped during the countdown re-fits (and the timer starts again).
+    tap(ui, t + 11000, SP_KT_CHIP_GUESS1);
+    frame(ui, &f, t + 11100);
+    ENSURE(f.refits == 1 && sp_kiosk_ui_countdown_s(ui) == 0);
+    frame(ui, &f, t + 11060 + 9990);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0);
+    // Play tapped during the countdown plays.
+    frame(ui, &f, t + 11060 + 12000);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) > 0 && !ui->playing);
+    tap(ui, t + 23100, SP_KT_PLAY);
+    ENSURE(ui->playing && sp_kiosk_ui_countdown_s(ui) == 0);
+    // A tap on the canvas during the countdown only stops it: no lesson in drawing.
+    frame(ui, &f, t + 23160 + 11000);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) > 0);
+    ui->hint_until = -1;
+    send(ui, SP_KEV_DOWN, t + 34200, 700, 500);
+    send(ui, SP_KEV_UP, t + 34250, 700, 500);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0 && ui->taps == 1 && !sp_kiosk_ui_hint_visible(ui));
+    // A whole stroke drawn during the countdown becomes a part.
+    frame(ui, &f, t + 34250 + 10500);
+    ENSURE(sp_kiosk_ui_countdown_s(ui) > 0);
+    stroke(ui, t + 45000, 300, 400, 30, 10);
+    frame(ui, &f, t + 45400);
+    ENSURE(f.fits == 2 && ui->part_count == 2 && sp_kiosk_ui_countdown_s(ui) == 0);
+    // Nothing more: the attract screen 15 s after the last touch.
+    frame(ui, &f, t + 45240 + 14990);
+    ENSURE(ui->mode == SP_KM_DRAW);
+    frame(ui, &f, t + 45240 + 15000);
     ENSURE(ui->mode == SP_KM_ATTRACT && f.clears == 1);
     sp_kiosk_ui_destroy(ui);
 }
@@ -541,6 +957,7 @@ static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t see
     memset(f, 0, sizeof *f);
     sp_kiosk_ui* ui = sp_kiosk_ui_create(NULL);
     sp_kiosk_ui_resize(ui, 1280, 800, 96 / 25.4);
+    sp_kiosk_ui_set_parts(ui, k_row, 6);
     sp_test_rng rng = {seed};
     double t = 0;
     for (int i = 0; i < s->count; ++i) {
@@ -769,6 +1186,13 @@ int main(int argc, char** argv)
                        (sp_test[]){{"flow", test_flow},
                                    {"layout", test_layout},
                                    {"idle_timeout", test_idle_timeout},
+                                   {"countdown", test_countdown},
+                                   {"refused_stroke", test_refused_stroke},
+                                   {"parts_row", test_parts_row},
+                                   {"start_over", test_start_over},
+                                   {"part_names", test_part_names},
+                                   {"save_code", test_save_code},
+                                   {"waiting_part", test_waiting_part},
                                    {"tap_storm", test_tap_storm},
                                    {"stroke_flood", test_stroke_flood},
                                    {"long_stroke", test_long_stroke},

@@ -8,9 +8,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sp/kiosk_text.h"
+
 static const char* const k_target_names[SP_KT_COUNT] = {
-    NULL, "undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2",
+    NULL,     "undo",  "redraw", "start_over", "play",  "turn",  "save",  "label", "guess1", "guess2",
+    "guess3", "part1", "part2",  "part3",      "part4", "part5", "part6", "part7", "part8",
 };
+_Static_assert(SP_KIOSK_ROW_MAX == 8, "k_target_names lists part1..part8");
 
 static const char* const k_event_names[SP_KEV_TYPE_COUNT] = {NULL, "down", "move", "up", "cancel", "press", "frame"};
 
@@ -88,8 +92,12 @@ static sp_kiosk_ui_desc with_defaults(const sp_kiosk_ui_desc* d)
     if (o.button_mm < o.min_target_mm) o.button_mm = o.min_target_mm;
     if (o.idle_ms == 0 || isnan(o.idle_ms)) o.idle_ms = 90000;
     if (!(o.countdown_ms > 0)) o.countdown_ms = 10000;
+    // The countdown is a warning, not most of the wait: a short --idle
+    // would otherwise show it nearly all the time.
+    if (o.idle_ms > 0 && o.countdown_ms > o.idle_ms / 3) o.countdown_ms = o.idle_ms / 3;
     if (!(o.flash_ms > 0)) o.flash_ms = 800;
     if (!(o.fade_ms > 0)) o.fade_ms = 1200;
+    if (!(o.offer_ms > 0)) o.offer_ms = 8000;
     if (!(o.hint_ms > 0)) o.hint_ms = 4000;
     if (!(o.banner_ms > 0)) o.banner_ms = 15000;
     if (!(o.confirm_ms > 0)) o.confirm_ms = 3000;
@@ -102,10 +110,10 @@ sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc)
     sp_kiosk_ui* ui = calloc(1, sizeof *ui);
     if (!ui) return NULL;
     ui->desc = with_defaults(desc);
-    bool ok = line_alloc(&ui->stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->job_stroke, SP_KIOSK_STROKE_MAX, true) &&
-              line_alloc(&ui->flash_stroke, SP_KIOSK_STROKE_MAX, true) &&
-              line_alloc(&ui->fade_stroke, SP_KIOSK_STROKE_MAX, true) &&
-              line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
+    bool ok =
+        line_alloc(&ui->stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->job_stroke, SP_KIOSK_STROKE_MAX, true) &&
+        line_alloc(&ui->flash_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->fade_stroke, SP_KIOSK_STROKE_MAX, true) &&
+        line_alloc(&ui->held_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
         ok = ok && line_alloc(&ui->pending[i], SP_KIOSK_STROKE_MAX, true);
     if (!ok) {
@@ -114,7 +122,7 @@ sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc)
     }
     ui->mode = SP_KM_ATTRACT;
     ui->playing = ui->desc.start_playing;
-    ui->flash_until = ui->fade_until = ui->hint_until = ui->banner_until = ui->clear_armed_until = -1;
+    ui->flash_until = ui->fade_until = ui->held_until = ui->hint_until = ui->banner_until = ui->clear_armed_until = -1;
     sp_kiosk_ui_resize(ui, 1280, 800, 0);
     return ui;
 }
@@ -126,6 +134,7 @@ void sp_kiosk_ui_destroy(sp_kiosk_ui* ui)
     line_free(&ui->job_stroke);
     line_free(&ui->flash_stroke);
     line_free(&ui->fade_stroke);
+    line_free(&ui->held_stroke);
     line_free(&ui->flash_outline);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
         line_free(&ui->pending[i]);
@@ -139,40 +148,98 @@ static double mm(const sp_kiosk_ui* ui, double v)
     return v * ui->px_per_mm;
 }
 
-// Chips sit in a row at the canvas's top-left and wrap when the row is full.
-// Their width follows the text: a DejaVu Sans character averages ~0.6 of
-// the text height, and the renderer shrinks text that would not fit anyway.
+static bool offering(const sp_kiosk_ui* ui)
+{
+    return ui->held_stroke.count > 0;
+}
+
+// Points of the held stroke with y in [y0, y1).
+static int held_points_within(const sp_kiosk_ui* ui, float y0, float y1)
+{
+    int n = 0;
+    for (int i = 0; i < ui->held_stroke.count; ++i)
+        n += ui->held_stroke.xy[2 * i + 1] >= y0 && ui->held_stroke.xy[2 * i + 1] < y1;
+    return n;
+}
+
+// The refused stroke stays in sight: when the parts row and the hint under
+// it (from top to end) would cover more of it than at the canvas's bottom,
+// they go there, the hint above the row. The chips stay at the top.
+static void keep_stroke_in_sight(sp_kiosk_ui* ui, float top, float end, float margin, float gap)
+{
+    float bottom = ui->canvas.y + ui->canvas.h - margin, start = bottom - (end - top);
+    if (start <= top || held_points_within(ui, top, end) <= held_points_within(ui, start, bottom)) return;
+    float row_end = end - ui->hint_box.h - gap, dy = bottom - row_end;
+    for (int i = 0; i < ui->row_count; ++i)
+        ui->target[SP_KT_PART1 + i].y += dy;
+    ui->hint_box.y = start;
+}
+
+// Chips sit in a row at the canvas's top-left and wrap when the row is full;
+// while a refused stroke is offered, the row of parts goes under them, and
+// the hint under both. Chip widths follow the text: a DejaVu Sans character
+// averages ~0.6 of the text height, and the renderer shrinks text that would
+// not fit anyway.
 static void layout_chips(sp_kiosk_ui* ui)
 {
     float h = (float)mm(ui, ui->desc.min_target_mm + 1.0);
     float pad = (float)mm(ui, 4.0), gap = (float)mm(ui, 3.0), margin = (float)mm(ui, 3.0);
+    float min = (float)mm(ui, ui->desc.min_target_mm);
     float chip_text = 0.42f * h;
-    float x = ui->canvas.x + margin, y = ui->canvas.y + margin;
-    float right = ui->canvas.x + ui->canvas.w - margin;
-    for (int i = 0; i < 3; ++i) {
-        sp_kiosk_rect* r = &ui->target[SP_KT_CHIP_LABEL + i];
-        size_t n = strlen(ui->chip[i]);
+    float left = ui->canvas.x + margin, right = ui->canvas.x + ui->canvas.w - margin;
+    float x = left, y = ui->canvas.y + margin;
+    for (int i = 0; i < 4; ++i) {
+        sp_kiosk_target t = (sp_kiosk_target)(SP_KT_CHIP_LABEL + i);
+        sp_kiosk_rect* r = &ui->target[t];
+        char text[SP_KIOSK_LABEL_MAX + 2];
+        size_t n = strlen(sp_kiosk_ui_target_text(ui, t, text, sizeof text));
         if (n == 0) {
             *r = (sp_kiosk_rect){0};
             continue;
         }
-        // The label chip says "<icon> Wings"; guesses say "Wings?".
+        // The label chip says "<tick> Wings"; guesses say "Wings?".
         float w = (float)(n + 1) * 0.62f * chip_text + 2 * pad + (i == 0 ? 0.9f * chip_text : 0.0f);
-        float minw = (float)mm(ui, ui->desc.min_target_mm) * 1.6f;
-        if (w < minw) w = minw;
-        if (w > right - (ui->canvas.x + margin)) w = right - (ui->canvas.x + margin);
-        if (w < (float)mm(ui, ui->desc.min_target_mm)) w = (float)mm(ui, ui->desc.min_target_mm);
-        if (x + w > right && x > ui->canvas.x + margin) {
-            x = ui->canvas.x + margin;
+        if (w < min * 1.6f) w = min * 1.6f;
+        if (w > right - left) w = right - left;
+        if (w < min) w = min;
+        if (x + w > right && x > left) {
+            x = left;
             y += h + gap;
         }
         *r = (sp_kiosk_rect){x, y, w, h};
         x += w + gap;
     }
-    float below = y + h + gap;
-    float hw = ui->canvas.w - 2 * margin;
+    float below = y + h + gap, chips_end = below;
+    // The parts row: an outline over its name, 26 x 22 mm, smaller (down to
+    // the smallest target) where the rows and the hint would not fit on the canvas.
+    bool row = offering(ui) && ui->row_count > 0;
+    float bottom = ui->canvas.y + ui->canvas.h - 2.2f * ui->text_px;
+    for (float scale = 1.0f; row; scale -= 0.1f) {
+        float bw = fmaxf((float)mm(ui, 26.0) * scale, min), bh = fmaxf((float)mm(ui, 22.0) * scale, min);
+        if (bw > right - left) bw = fmaxf(right - left, min);
+        x = left, y = below;
+        for (int i = 0; i < ui->row_count; ++i) {
+            if (x + bw > right && x > left) {
+                x = left;
+                y += bh + gap;
+            }
+            ui->target[SP_KT_PART1 + i] = (sp_kiosk_rect){x, y, bw, bh};
+            x += bw + gap;
+        }
+        if (y + bh + gap <= bottom || (bw <= min && bh <= min)) {
+            below = y + bh + gap;
+            break;
+        }
+    }
+    for (int i = row ? ui->row_count : 0; i < SP_KIOSK_ROW_MAX; ++i)
+        ui->target[SP_KT_PART1 + i] = (sp_kiosk_rect){0};
+    float hw = ui->canvas.w - 2 * margin, hh = 2.2f * ui->text_px;
     if (hw > (float)mm(ui, 220)) hw = (float)mm(ui, 220);
-    ui->hint_box = (sp_kiosk_rect){ui->canvas.x + 0.5f * (ui->canvas.w - hw), below, hw, 2.2f * ui->text_px};
+    // A canvas too small for the hint under the parts row (a phone held
+    // upright) shows none: the chips and the row say enough.
+    if (below + hh > ui->canvas.y + ui->canvas.h && row) hh = 0;
+    ui->hint_box = (sp_kiosk_rect){ui->canvas.x + 0.5f * (ui->canvas.w - hw), below, hw, hh};
+    if (row) keep_stroke_in_sight(ui, chips_end, below + hh, margin, gap);
 }
 
 void sp_kiosk_ui_resize(sp_kiosk_ui* ui, int width, int height, double px_per_mm)
@@ -240,8 +307,15 @@ static bool visible(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     if (t <= SP_KT_NONE || t >= SP_KT_COUNT || ui->target[t].w <= 0) return false;
     if (ui->mode == SP_KM_ATTRACT) return false;
-    if (t >= SP_KT_CHIP_LABEL) return ui->mode == SP_KM_DRAW && ui->part_count > 0 && ui->chip[t - SP_KT_CHIP_LABEL][0];
+    if (t >= SP_KT_PART1) return ui->mode == SP_KM_DRAW && offering(ui) && (int)t - SP_KT_PART1 < ui->row_count;
+    if (t >= SP_KT_CHIP_LABEL)
+        return ui->mode == SP_KM_DRAW && (ui->part_count > 0 || ui->chips_offer) && ui->chip[t - SP_KT_CHIP_LABEL][0];
     return true;
+}
+
+bool sp_kiosk_ui_target_visible(const sp_kiosk_ui* ui, sp_kiosk_target t)
+{
+    return visible(ui, t);
 }
 
 bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t)
@@ -252,13 +326,16 @@ bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t)
         return ui->part_count > 0 || ui->mode == SP_KM_TURN;
     case SP_KT_CHIP_GUESS1:
     case SP_KT_CHIP_GUESS2:
-        return !ui->refit_queued;
+    case SP_KT_CHIP_GUESS3:
+        return ui->chips_offer || !ui->refit_queued;
     case SP_KT_CHIP_LABEL:
         return true;
     case SP_KT_SAVE:
         return ui->part_count > 0 && !ui->save_queued;
+    case SP_KT_UNDO: // also takes back a refused stroke that is still offered
+        return ui->part_count > 0 || offering(ui);
     default:
-        return ui->part_count > 0;
+        return t >= SP_KT_PART1 || ui->part_count > 0;
     }
 }
 
@@ -300,6 +377,36 @@ double sp_kiosk_ui_fade(const sp_kiosk_ui* ui)
 bool sp_kiosk_ui_hint_visible(const sp_kiosk_ui* ui)
 {
     return ui->hint[0] && ui->now < ui->hint_until;
+}
+
+bool sp_kiosk_ui_offering(const sp_kiosk_ui* ui)
+{
+    return offering(ui);
+}
+
+const char* sp_kiosk_ui_target_category(const sp_kiosk_ui* ui, sp_kiosk_target t)
+{
+    if (t >= SP_KT_CHIP_LABEL && t <= SP_KT_CHIP_GUESS3) return ui->chip[t - SP_KT_CHIP_LABEL];
+    if (t >= SP_KT_PART1 && t <= SP_KT_PART_LAST && (int)t - SP_KT_PART1 < ui->row_count) return ui->row[t - SP_KT_PART1];
+    return "";
+}
+
+const char* sp_kiosk_ui_target_text(const sp_kiosk_ui* ui, sp_kiosk_target t, char* out, size_t cap)
+{
+    char name[SP_KIOSK_NAME_MAX];
+    sp_kiosk_part_name(sp_kiosk_ui_target_category(ui, t), name, sizeof name);
+    bool guess = t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && name[0];
+    snprintf(out, cap, guess ? "%s?" : "%s", name);
+    return out;
+}
+
+const char* sp_kiosk_ui_message(const sp_kiosk_ui* ui)
+{
+    if (sp_kiosk_ui_hint_visible(ui)) return ui->hint;
+    // An empty canvas always says what to do: at the start, after Start over, after the last Undo.
+    bool idle_canvas = ui->mode == SP_KM_DRAW && ui->part_count == 0 && ui->capture != SP_KCAP_STROKE && ui->pending_count == 0 &&
+                       !ui->fit_in_flight && !offering(ui) && !sp_kiosk_ui_flashing(ui);
+    return idle_canvas ? sp_kiosk_text(SP_KTEXT_PROMPT) : NULL;
 }
 
 bool sp_kiosk_ui_banner_visible(const sp_kiosk_ui* ui)
@@ -349,28 +456,92 @@ static void set_hint(sp_kiosk_ui* ui, const char* text)
     ui->hint_until = ui->now + ui->desc.hint_ms;
 }
 
+// Copies a category into a fixed label (GCC cannot tell that the two, both
+// often inside *ui, never overlap, so no snprintf).
+static void copy_label(char dst[SP_KIOSK_LABEL_MAX], const char* src)
+{
+    size_t n = src ? strnlen(src, SP_KIOSK_LABEL_MAX - 1) : 0;
+    memmove(dst, src ? src : "", n);
+    dst[n] = 0;
+}
+
+// The chips: a label and guesses, or (label NULL) none. A guess equal to the
+// label or to an earlier guess is dropped (it would re-fit to the same
+// thing); the rest close up.
+static void set_chip_list(sp_kiosk_ui* ui, const char* label, const char* const* guesses, int n, bool offer)
+{
+    char tmp[4][SP_KIOSK_LABEL_MAX]; // the inputs may point into ui->chip (refresh after undo)
+    memset(tmp, 0, sizeof tmp);
+    copy_label(tmp[0], label);
+    int k = 1;
+    for (int i = 0; i < n && k < 4 && (label || offer); ++i) {
+        if (!guesses[i] || !guesses[i][0]) continue;
+        bool dup = false;
+        for (int j = 0; j < k; ++j)
+            dup = dup || !strncmp(guesses[i], tmp[j], SP_KIOSK_LABEL_MAX - 1);
+        if (!dup) copy_label(tmp[k++], guesses[i]);
+    }
+    memcpy(ui->chip, tmp, sizeof tmp);
+    ui->chips_offer = offer;
+    layout_chips(ui);
+}
+
+static void set_chips(sp_kiosk_ui* ui, const char* label, const char* g1, const char* g2)
+{
+    set_chip_list(ui, label, (const char* const[2]){g1, g2}, label ? 2 : 0, false);
+}
+
+// The refused stroke is no longer offered: it fades out (fade) or goes at
+// once, and its chips and the parts row go with it.
+static void end_offer(sp_kiosk_ui* ui, bool fade)
+{
+    if (!offering(ui)) return;
+    if (fade) {
+        line_copy(&ui->fade_stroke, &ui->held_stroke);
+        ui->fade_until = ui->now + ui->desc.fade_ms;
+    }
+    ui->held_stroke.count = 0;
+    ui->held_until = -1;
+    if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_UNRECOGNISED))) ui->hint_until = -1;
+    if (ui->chips_offer)
+        set_chips(ui, NULL, NULL, NULL);
+    else
+        layout_chips(ui); // the parts row goes
+}
+
 static void clear_overlays(sp_kiosk_ui* ui)
 {
+    end_offer(ui, false);
     ui->flash_until = ui->fade_until = -1;
     ui->flash_stroke.count = ui->flash_outline.count = ui->fade_stroke.count = 0;
     ui->flash_break_count = 0;
 }
 
-static void set_chips(sp_kiosk_ui* ui, const char* label, const char* g1, const char* g2)
+// Queues a FIT job for a stroke (copied into the pending ring); NULL when the job queue is full.
+static sp_kiosk_job* queue_fit(sp_kiosk_ui* ui, const sp_kiosk_line* stroke)
 {
-    const char* s[3] = {label, g1, g2};
-    char tmp[3][SP_KIOSK_LABEL_MAX]; // the labels may point into ui->chip (refresh after undo)
-    for (int i = 0; i < 3; ++i)
-        snprintf(tmp[i], sizeof tmp[i], "%s", s[i] && label ? s[i] : "");
-    memcpy(ui->chip, tmp, sizeof tmp);
-    // A guess equal to the label (or to the other guess) would re-fit to the same thing.
-    if (ui->chip[1][0] && strcmp(ui->chip[1], ui->chip[0]) == 0) ui->chip[1][0] = 0;
-    if (ui->chip[2][0] && (strcmp(ui->chip[2], ui->chip[0]) == 0 || strcmp(ui->chip[2], ui->chip[1]) == 0)) ui->chip[2][0] = 0;
-    if (!ui->chip[1][0] && ui->chip[2][0]) {
-        memcpy(ui->chip[1], ui->chip[2], sizeof ui->chip[1]);
-        ui->chip[2][0] = 0;
+    if (ui->pending_count == SP_KIOSK_PENDING_MAX) drop_oldest_fit(ui);
+    sp_kiosk_job* j = push_job(ui, SP_KJOB_FIT);
+    if (!j) {
+        ++ui->dropped_strokes;
+        return NULL;
     }
-    layout_chips(ui);
+    int slot = (ui->pending_head + ui->pending_count++) % SP_KIOSK_PENDING_MAX;
+    line_copy(&ui->pending[slot], stroke);
+    j->replace = ui->redraw_armed;
+    ui->redraw_armed = false;
+    return j;
+}
+
+// A chip or the parts row chose what the held stroke is: fit it as that.
+static void take_offer(sp_kiosk_ui* ui, const char* category)
+{
+    if (!offering(ui) || !category[0]) return;
+    sp_kiosk_job* j = queue_fit(ui, &ui->held_stroke);
+    if (!j) return;
+    copy_label(j->category, category);
+    ++ui->chosen;
+    end_offer(ui, false);
 }
 
 static void finish_stroke(sp_kiosk_ui* ui)
@@ -383,26 +554,37 @@ static void finish_stroke(sp_kiosk_ui* ui)
     double diag = s->count > 0 ? hypot(hi[0] - lo[0], hi[1] - lo[1]) : 0;
     if (s->count < 2 || diag < mm(ui, ui->desc.tap_mm)) {
         ++ui->taps;
-        set_hint(ui, "Press, draw one line, then lift your finger");
+        // A touch that only stopped the countdown needs no lesson in drawing.
+        if (!ui->woke) set_hint(ui, sp_kiosk_text(SP_KTEXT_TAP));
         s->count = 0;
         return;
     }
     ++ui->strokes_finished;
-    if (ui->pending_count == SP_KIOSK_PENDING_MAX) drop_oldest_fit(ui);
-    sp_kiosk_job* j = push_job(ui, SP_KJOB_FIT);
-    if (!j) {
-        ++ui->dropped_strokes;
-        s->count = 0;
-        return;
-    }
-    int slot = (ui->pending_head + ui->pending_count++) % SP_KIOSK_PENDING_MAX;
-    line_copy(&ui->pending[slot], s);
-    j->replace = ui->redraw_armed;
-    ui->redraw_armed = false;
+    // This is the last stroke now: chips and offers of earlier ones go.
+    end_offer(ui, true);
+    set_chips(ui, NULL, NULL, NULL);
+    queue_fit(ui, s);
     s->count = 0;
 }
 
 // ------------------------------------------------------------------ events
+
+// What a new dragon starts from (Start over, the idle timeout): nothing on
+// the canvas but the first-draw prompt, the animation stopped at its start,
+// the drawing view.
+static void fresh_canvas(sp_kiosk_ui* ui)
+{
+    clear_overlays(ui);
+    set_chips(ui, NULL, NULL, NULL);
+    ui->hint[0] = 0;
+    ui->hint_until = -1;
+    ui->code[0] = 0;
+    ui->banner_until = ui->clear_armed_until = -1;
+    ui->redraw_armed = false;
+    ui->playing = ui->desc.start_playing;
+    ui->anim_ms = 0;
+    ui->yaw = ui->pitch = 0;
+}
 
 static void reset_to_attract(sp_kiosk_ui* ui)
 {
@@ -419,14 +601,7 @@ static void reset_to_attract(sp_kiosk_ui* ui)
     ui->capture = SP_KCAP_NONE;
     ui->pressed = SP_KT_NONE;
     ui->stroke.count = 0;
-    clear_overlays(ui);
-    ui->hint[0] = 0;
-    ui->code[0] = 0;
-    ui->banner_until = ui->clear_armed_until = -1;
-    ui->redraw_armed = false;
-    ui->playing = ui->desc.start_playing;
-    ui->anim_ms = 0;
-    ui->yaw = ui->pitch = 0;
+    fresh_canvas(ui);
     ++ui->resets;
 }
 
@@ -442,6 +617,7 @@ static void advance(sp_kiosk_ui* ui, double t)
         ui->yaw *= f, ui->pitch *= f;
         if (fabs(ui->yaw) < 1e-3 && fabs(ui->pitch) < 1e-3) ui->yaw = ui->pitch = 0;
     }
+    if (offering(ui) && t >= ui->held_until) end_offer(ui, true);
     if (ui->mode != SP_KM_ATTRACT && ui->desc.idle_ms > 0 && t - ui->last_input >= ui->desc.idle_ms) reset_to_attract(ui);
 }
 
@@ -481,12 +657,18 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     ++ui->activations[t];
     if (!sp_kiosk_ui_target_enabled(ui, t)) {
-        if (ui->part_count == 0 && t < SP_KT_CHIP_LABEL) set_hint(ui, "Draw a dragon part first");
+        if (ui->part_count == 0 && t < SP_KT_CHIP_LABEL) set_hint(ui, sp_kiosk_text(SP_KTEXT_NEED_PART));
+        return;
+    }
+    if (t >= SP_KT_PART1) {
+        take_offer(ui, ui->row[t - SP_KT_PART1]);
         return;
     }
     switch (t) {
     case SP_KT_UNDO:
-        if (push_job(ui, SP_KJOB_UNDO)) {
+        if (offering(ui)) { // the refused stroke was the last thing drawn: it is what goes
+            end_offer(ui, false);
+        } else if (push_job(ui, SP_KJOB_UNDO)) {
             clear_overlays(ui);
             ui->redraw_armed = false;
         }
@@ -494,23 +676,19 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     case SP_KT_REDRAW:
         ui->redraw_armed = !ui->redraw_armed;
         if (ui->redraw_armed)
-            set_hint(ui, "Draw the new part: it replaces the last one");
+            set_hint(ui, sp_kiosk_text(SP_KTEXT_REDRAW));
         else
             ui->hint_until = -1;
         break;
     case SP_KT_START_OVER:
         if (sp_kiosk_ui_clear_armed(ui)) {
             if (push_job(ui, SP_KJOB_CLEAR)) {
-                clear_overlays(ui);
-                ui->redraw_armed = false;
-                ui->clear_armed_until = -1;
-                ui->hint_until = -1;
-                ui->yaw = ui->pitch = 0;
+                fresh_canvas(ui);
                 ui->mode = SP_KM_DRAW;
             }
         } else {
             ui->clear_armed_until = ui->now + ui->desc.confirm_ms;
-            set_hint(ui, "Tap again to start over");
+            set_hint(ui, sp_kiosk_text(SP_KTEXT_CONFIRM_CLEAR));
         }
         break;
     case SP_KT_PLAY:
@@ -519,8 +697,9 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     case SP_KT_TURN:
         ui->mode = ui->mode == SP_KM_TURN ? SP_KM_DRAW : SP_KM_TURN;
         ui->mode_since = ui->now;
+        end_offer(ui, false); // its chips only show in the drawing view
         if (ui->mode == SP_KM_TURN)
-            set_hint(ui, "Drag to turn your dragon");
+            set_hint(ui, sp_kiosk_text(SP_KTEXT_TURN));
         else
             ui->hint_until = -1;
         break;
@@ -532,17 +711,19 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         }
         break;
     case SP_KT_CHIP_LABEL:
-        set_hint(ui, "Not right? Tap another guess");
+        set_hint(ui, sp_kiosk_text(SP_KTEXT_LABEL));
         break;
     case SP_KT_CHIP_GUESS1:
-    case SP_KT_CHIP_GUESS2: {
+    case SP_KT_CHIP_GUESS2:
+    case SP_KT_CHIP_GUESS3: {
+        const char* c = ui->chip[t - SP_KT_CHIP_LABEL];
+        if (ui->chips_offer) {
+            take_offer(ui, c);
+            break;
+        }
         sp_kiosk_job* j = push_job(ui, SP_KJOB_REFIT);
         if (j) {
-            // Both live in *ui (GCC cannot tell they never overlap): copy by hand.
-            const char* c = ui->chip[t - SP_KT_CHIP_LABEL];
-            size_t n = strnlen(c, sizeof j->category - 1);
-            memcpy(j->category, c, n);
-            j->category[n] = 0;
+            copy_label(j->category, c);
             ui->refit_queued = true;
         }
         break;
@@ -563,10 +744,9 @@ static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
         if (up && ui->pressed != SP_KT_NONE && sp_kiosk_ui_hit(ui, x, y) == ui->pressed) activate(ui, ui->pressed);
         break;
     case SP_KCAP_ATTRACT:
-        if (up) {
+        if (up) { // the empty canvas shows the first-draw prompt (sp_kiosk_ui_message)
             ui->mode = SP_KM_DRAW;
             ui->mode_since = ui->now;
-            set_hint(ui, "Draw a dragon part in one line: a head, wings, a tail...");
         }
         break;
     default:
@@ -579,13 +759,11 @@ static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
 static void on_down(sp_kiosk_ui* ui, float x, float y)
 {
     if (ui->capture != SP_KCAP_NONE) end_capture(ui, ui->last_x, ui->last_y, false);
-    bool countdown = sp_kiosk_ui_countdown_s(ui) > 0;
+    // A touch during the countdown stops it and does what it does anywhere
+    // else: the visitor who was about to draw or tap should not have to do it twice.
+    ui->woke = sp_kiosk_ui_countdown_s(ui) > 0;
     ui->last_input = ui->now;
     ui->last_x = x, ui->last_y = y;
-    if (countdown) { // the touch only says "still here"
-        ui->capture = SP_KCAP_SWALLOW;
-        return;
-    }
     if (ui->mode == SP_KM_ATTRACT) {
         ui->capture = SP_KCAP_ATTRACT;
         return;
@@ -697,24 +875,65 @@ bool sp_kiosk_ui_next_job(sp_kiosk_ui* ui, sp_kiosk_job* job)
     return false;
 }
 
+static const char* refusal_text(sp_kiosk_refusal why, bool refit)
+{
+    switch (why) {
+    case SP_KREF_TOO_SMALL:
+        return sp_kiosk_text(SP_KTEXT_TOO_SMALL);
+    case SP_KREF_TRICKY:
+        return sp_kiosk_text(SP_KTEXT_TRICKY);
+    case SP_KREF_NOT_READY:
+        return sp_kiosk_text(SP_KTEXT_NOT_READY);
+    case SP_KREF_FULL:
+        return sp_kiosk_text(SP_KTEXT_FULL);
+    default:
+        return sp_kiosk_text(refit ? SP_KTEXT_REFIT_FAILED : SP_KTEXT_UNRECOGNISED_NO_OFFER);
+    }
+}
+
+// The refused last stroke stays, with its guesses as chips and the parts row.
+static void hold(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
+{
+    line_copy(&ui->held_stroke, &ui->job_stroke);
+    ui->held_until = ui->now + ui->desc.offer_ms;
+    ui->fade_until = -1;
+    set_chip_list(ui, NULL, r->offers, 3, true);
+    set_hint(ui, sp_kiosk_text(SP_KTEXT_UNRECOGNISED));
+    ui->hint_until = ui->held_until;
+    ++ui->offered;
+}
+
 void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
 {
     bool refit = ui->inflight_kind == SP_KJOB_REFIT;
     ui->fit_in_flight = false;
     if (refit) ui->refit_queued = false;
+    // Chips and offers are for the last stroke only: not when one drawn since waits.
+    bool last = ui->pending_count == 0;
     if (!r->ok) {
-        if (!refit) {
-            line_copy(&ui->fade_stroke, &ui->job_stroke);
-            ui->fade_until = ui->now + ui->desc.fade_ms;
-            if (ui->inflight_replace) ui->redraw_armed = true; // still waiting for the replacement
+        if (refit) {
+            set_hint(ui, refusal_text(r->refusal, true));
+            return;
         }
-        set_hint(ui, r->hint ? r->hint
-                     : refit ? "That shape did not fit there"
-                             : "Hmm, what is that? Try one big line for a head, wings or a tail");
+        // Still waiting for the replacement: a chip for this stroke, or the next stroke, replaces.
+        if (ui->inflight_replace) ui->redraw_armed = true;
+        bool any_offer = ui->row_count > 0;
+        for (int i = 0; i < 3; ++i)
+            any_offer = any_offer || (r->offers[i] && r->offers[i][0]);
+        if (last && r->offer && any_offer) {
+            hold(ui, r);
+            return;
+        }
+        line_copy(&ui->fade_stroke, &ui->job_stroke);
+        ui->fade_until = ui->now + ui->desc.fade_ms;
+        if (last) set_hint(ui, refusal_text(r->refusal, false));
         return;
     }
     ui->part_count = r->part_count;
-    set_chips(ui, r->category, r->guesses[0], r->guesses[1]);
+    if (last)
+        set_chips(ui, r->category, r->guesses[0], r->guesses[1]);
+    else
+        set_chips(ui, NULL, NULL, NULL);
     ++ui->revision;
     if (r->stroke && r->stroke_count > 0) {
         line_set(&ui->flash_stroke, r->stroke, r->stroke_count, SP_KIOSK_STROKE_MAX);
@@ -731,22 +950,30 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
             ui->flash_breaks[ui->flash_break_count++] = r->outline_breaks[i];
     ui->flash_until = ui->now + ui->desc.flash_ms;
     ui->fade_until = -1;
-    if (r->hint)
-        set_hint(ui, r->hint); // the part is there, but something needs saying
-    else
-        ui->hint_until = -1;
+    ui->hint_until = -1;
+    // The part is there, but something needs saying (only for the last stroke).
+    if (last && r->hint)
+        set_hint(ui, r->hint);
+    else if (last && r->waiting)
+        set_hint(ui, sp_kiosk_text(SP_KTEXT_WAITING));
 }
 
 void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label)
 {
     ui->part_count = part_count < 0 ? 0 : part_count;
-    if (label && label->category && part_count > 0)
+    clear_overlays(ui);
+    // After Undo the chips are the part that is now last (its stroke is the
+    // last on the canvas), unless a stroke drawn since is waiting.
+    if (label && label->category && ui->part_count > 0 && ui->pending_count == 0)
         set_chips(ui, label->category, label->guesses[0], label->guesses[1]);
     else
         set_chips(ui, NULL, NULL, NULL);
     ++ui->revision;
-    clear_overlays(ui);
-    if (ui->part_count == 0) ui->redraw_armed = false;
+    if (ui->part_count == 0) { // an empty canvas starts again: the animation too
+        ui->redraw_armed = false;
+        ui->playing = ui->desc.start_playing;
+        ui->anim_ms = 0;
+    }
 }
 
 void sp_kiosk_ui_saved(sp_kiosk_ui* ui, bool ok, const char* code)
@@ -757,7 +984,17 @@ void sp_kiosk_ui_saved(sp_kiosk_ui* ui, bool ok, const char* code)
         snprintf(ui->code, sizeof ui->code, "%s", code);
         ui->saved_revision = ui->revision;
         ui->banner_until = ui->now + ui->desc.banner_ms;
+        snprintf(ui->banner[0], sizeof ui->banner[0], "%s %s", sp_kiosk_text(SP_KTEXT_SAVED), ui->code);
+        snprintf(ui->banner[1], sizeof ui->banner[1], "%s", sp_kiosk_text(SP_KTEXT_CODE_USE));
     } else {
-        set_hint(ui, "Sorry, saving did not work. Please ask a guide");
+        set_hint(ui, sp_kiosk_text(SP_KTEXT_SAVE_FAILED));
     }
+}
+
+void sp_kiosk_ui_set_parts(sp_kiosk_ui* ui, const char* const* categories, int count)
+{
+    ui->row_count = 0;
+    for (int i = 0; categories && i < count && ui->row_count < SP_KIOSK_ROW_MAX; ++i)
+        if (categories[i] && categories[i][0]) copy_label(ui->row[ui->row_count++], categories[i]);
+    layout_chips(ui);
 }

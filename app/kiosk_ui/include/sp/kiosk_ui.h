@@ -23,13 +23,25 @@
 /// Coordinates are framebuffer pixels, y down; sizes come from px_per_mm so
 /// that every touch target is at least desc.min_target_mm (15 mm) on any
 /// screen.
+///
+/// Chips refer to the last stroke only: the last part's label and two other
+/// guesses, or, when the last stroke was refused, that stroke's three best
+/// guesses and a row of every part (sp_kiosk_ui_set_parts), offered while
+/// the refused stroke stays on screen (desc.offer_ms); a tap on one makes
+/// the stroke that part (a FIT job with a category). A new stroke hides the
+/// chips until its own answer.
 #ifndef SP_KIOSK_UI_H
 #define SP_KIOSK_UI_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "sp/kiosk_event.h"
+
+enum {
+    SP_KIOSK_ROW_MAX = 8, ///< parts in the refusal's row (sp_kiosk_ui_set_parts)
+};
 
 /// Touch targets (the order of the toolbar).
 typedef enum sp_kiosk_target {
@@ -40,13 +52,17 @@ typedef enum sp_kiosk_target {
     SP_KT_PLAY,        ///< play / pause the animation
     SP_KT_TURN,        ///< orbit mode (drag turns the dragon) / back to the drawing view
     SP_KT_SAVE,        ///< export .glb + postcard, show the code
-    SP_KT_CHIP_LABEL,  ///< the last part's category (informative)
-    SP_KT_CHIP_GUESS1, ///< next guess: re-fit the last stroke as this category
+    SP_KT_CHIP_LABEL,  ///< the last part's category (informative; hidden while a refused stroke is offered)
+    SP_KT_CHIP_GUESS1, ///< next guess: re-fit the last part as this category; a refused stroke: its best guess
     SP_KT_CHIP_GUESS2, ///< the guess after that
+    SP_KT_CHIP_GUESS3, ///< a refused stroke's third guess
+    SP_KT_PART1,       ///< the refusal's row of parts, in sp_kiosk_ui_set_parts order: make the refused stroke this part
+    SP_KT_PART_LAST = SP_KT_PART1 + SP_KIOSK_ROW_MAX - 1,
     SP_KT_COUNT
 } sp_kiosk_target;
 
-/// "undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2"; NULL otherwise.
+/// "undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2", "guess3",
+/// "part1".."part8"; NULL otherwise.
 const char* sp_kiosk_target_name(sp_kiosk_target t);
 /// Parses a target name; SP_KT_NONE when unknown.
 sp_kiosk_target sp_kiosk_target_parse(const char* s);
@@ -72,9 +88,10 @@ typedef struct sp_kiosk_ui_desc {
     double min_target_mm; ///< smallest side of any touch target; 0: 15
     double button_mm;     ///< preferred toolbar button height; 0: 18 (never below min_target_mm)
     double idle_ms;       ///< no input for this long returns to the attract screen; 0: 90000; < 0: never
-    double countdown_ms;  ///< the last part of idle_ms, shown as a countdown; 0: 10000
+    double countdown_ms;  ///< the last part of idle_ms, shown as a countdown; 0: 10000; never more than a third of idle_ms
     double flash_ms;      ///< fitted outline shown over the stroke; 0: 800
     double fade_ms;       ///< a rejected stroke fades out; 0: 1200
+    double offer_ms;      ///< a refused stroke stays, with its guesses and the parts row, this long; 0: 8000
     double hint_ms;       ///< hints stay this long; 0: 4000
     double banner_ms;     ///< the save code stays this long; 0: 15000
     double confirm_ms;    ///< Start over needs a second tap within this; 0: 3000
@@ -96,7 +113,7 @@ typedef struct sp_kiosk_line {
 /// What the caller has to do next.
 typedef enum sp_kiosk_job_kind {
     SP_KJOB_NONE = 0,
-    SP_KJOB_FIT,   ///< classify + fit `stroke`; replace: it replaces the last part (Redraw)
+    SP_KJOB_FIT,   ///< classify + fit `stroke` (as `category` when not ""); replace: it replaces the last part (Redraw)
     SP_KJOB_REFIT, ///< re-fit the last part's stroke as `category`
     SP_KJOB_UNDO,  ///< remove the last part
     SP_KJOB_CLEAR, ///< remove every part (Start over, idle timeout)
@@ -109,18 +126,31 @@ typedef struct sp_kiosk_job {
     bool heavy;                        ///< FIT, REFIT, SAVE: do one per frame
     bool replace;                      ///< FIT: replace the last part
     const sp_kiosk_line* stroke;       ///< FIT: the stroke (pixels, with times)
-    char category[SP_KIOSK_LABEL_MAX]; ///< REFIT
+    char category[SP_KIOSK_LABEL_MAX]; ///< REFIT; FIT: "" to classify, else the part the visitor chose for a refused stroke
     double t_ms;                       ///< when it was asked for
 } sp_kiosk_job;
 
+/// Why a stroke was refused (each has its sentence in kiosk_text.h).
+typedef enum sp_kiosk_refusal {
+    SP_KREF_UNRECOGNISED = 0, ///< not a part the kiosk knows, or no model to tell (a refit: the part did not fit)
+    SP_KREF_TOO_SMALL,        ///< too small for a part
+    SP_KREF_TRICKY,           ///< no part of the category could take its shape
+    SP_KREF_NOT_READY,        ///< the database has no part of the category: staff needed
+    SP_KREF_FULL,             ///< the dragon has all the parts it can take
+} sp_kiosk_refusal;
+
 /// The answer to a FIT or REFIT job.
 typedef struct sp_kiosk_fit_result {
-    bool ok;                ///< false: rejected (hint shown, stroke fades, nothing else changes)
-    const char* hint;       ///< shown when rejected (NULL: a default); when accepted, a note beside the part (NULL: none)
-    const char* category;   ///< the fitted part's category
-    const char* guesses[2]; ///< next two guesses (NULL or "" when none)
-    int part_count;         ///< parts after the job
-    const float* outline;   ///< outline_count by 2: the fitted abstraction in pixels (flashed in yellow)
+    bool ok;                  ///< false: refused (a hint; the stroke is offered or fades; nothing else changes)
+    sp_kiosk_refusal refusal; ///< !ok: why
+    bool offer;               ///< !ok, FIT: the stroke can still become a part by a tap (it stays, with the parts row)
+    const char* offers[3];    ///< !ok: the refused stroke's best guesses, best first (NULL or "" when none)
+    bool waiting;             ///< ok: the part waits for a body to join (none on the canvas)
+    const char* hint;         ///< ok: a note shown beside the part (NULL: none; it replaces the waiting hint)
+    const char* category;     ///< the fitted part's category
+    const char* guesses[2];   ///< next two guesses (NULL or "" when none)
+    int part_count;           ///< parts after the job
+    const float* outline;     ///< outline_count by 2: the fitted abstraction in pixels (flashed in yellow)
     int outline_count;
     const int* outline_breaks; ///< indices where a new curve of the outline starts (may be NULL)
     int outline_break_count;
@@ -177,16 +207,23 @@ typedef struct sp_kiosk_ui {
     double flash_until;
     sp_kiosk_line fade_stroke; ///< a rejected stroke, fading until fade_until
     double fade_until;
+    sp_kiosk_line held_stroke; ///< the last stroke, refused, offered until held_until (then it fades)
+    double held_until;
     char hint[SP_KIOSK_TEXT_MAX];
     double hint_until;
-    char code[16]; ///< the last save code
+    bool woke;                         ///< the finger now down touched during the idle countdown
+    char code[16];                     ///< the last save code
+    char banner[2][SP_KIOSK_TEXT_MAX]; ///< the save banner: the code, then what it is for
     double banner_until;
     bool save_failed;
     // Parts as the caller reported them.
     int part_count;
-    char chip[3][SP_KIOSK_LABEL_MAX]; ///< label, guess 1, guess 2 ("" = hidden)
-    uint64_t revision;                ///< grows with every change of the dragon
-    uint64_t saved_revision;          ///< revision at the last successful save (0: never)
+    char chip[4][SP_KIOSK_LABEL_MAX];               ///< categories of the label and guesses 1-3 ("" = hidden)
+    bool chips_offer;                               ///< the guesses are the held stroke's (no label)
+    int row_count;                                  ///< parts in the refusal's row
+    char row[SP_KIOSK_ROW_MAX][SP_KIOSK_LABEL_MAX]; ///< their categories
+    uint64_t revision;                              ///< grows with every change of the dragon
+    uint64_t saved_revision;                        ///< revision at the last successful save (0: never)
     bool redraw_armed;
     double clear_armed_until;
     // Animation and view.
@@ -195,6 +232,7 @@ typedef struct sp_kiosk_ui {
     double yaw, pitch; ///< orbit, radians (0, 0: the drawing view)
     // Counters (tests, logs).
     int strokes_finished, taps, activations[SP_KT_COUNT], resets;
+    int offered, chosen; ///< refused strokes held with offers; of them, made a part by a tap
 } sp_kiosk_ui;
 
 /// A fresh UI on the attract screen (NULL when out of memory). desc may be NULL.
@@ -216,10 +254,15 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r);
 void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label);
 /// Reports a SAVE job: ok with the code to show, or a failure (a friendly message is shown).
 void sp_kiosk_ui_saved(sp_kiosk_ui* ui, bool ok, const char* code);
+/// The categories of the refusal's row of parts, in order (at most
+/// SP_KIOSK_ROW_MAX; more are ignored). Call when the database's parts change.
+void sp_kiosk_ui_set_parts(sp_kiosk_ui* ui, const char* const* categories, int count);
 
 /// The target whose touch area contains (x, y) (slightly larger than its
 /// drawn rectangle), SP_KT_NONE when none. Only visible targets count.
 sp_kiosk_target sp_kiosk_ui_hit(const sp_kiosk_ui* ui, float x, float y);
+/// Whether a target is shown now (chips and the parts row come and go).
+bool sp_kiosk_ui_target_visible(const sp_kiosk_ui* ui, sp_kiosk_target t);
 /// Whether a target is shown and does something now (e.g. Undo needs a part).
 bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t);
 /// Seconds left on the idle countdown, or 0 when it is not showing.
@@ -228,6 +271,15 @@ double sp_kiosk_ui_countdown_s(const sp_kiosk_ui* ui);
 bool sp_kiosk_ui_flashing(const sp_kiosk_ui* ui);
 /// Opacity 0..1 of the fading rejected stroke.
 double sp_kiosk_ui_fade(const sp_kiosk_ui* ui);
+/// Whether a refused stroke is held with its offers (guess chips, parts row).
+bool sp_kiosk_ui_offering(const sp_kiosk_ui* ui);
+/// The category a chip or row target stands for ("" when hidden).
+const char* sp_kiosk_ui_target_category(const sp_kiosk_ui* ui, sp_kiosk_target t);
+/// What a chip or row target says ("Body", "Wings?"; "" when hidden) into out.
+const char* sp_kiosk_ui_target_text(const sp_kiosk_ui* ui, sp_kiosk_target t, char* out, size_t cap);
+/// The line of text under the chips now: a hint while one shows, else the
+/// first-draw prompt on an empty canvas, else NULL.
+const char* sp_kiosk_ui_message(const sp_kiosk_ui* ui);
 /// Whether the hint / the save banner is showing.
 bool sp_kiosk_ui_hint_visible(const sp_kiosk_ui* ui);
 bool sp_kiosk_ui_banner_visible(const sp_kiosk_ui* ui);

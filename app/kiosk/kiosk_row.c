@@ -1,0 +1,134 @@
+// kiosk_row.c: the row of parts offered with a refused stroke: every category
+// of the database as a button showing its first part's outline at rest (as
+// the attract screen draws outlines) over its name. The outlines are loaded
+// once, after the first frame, and again when the database changes.
+#include "kiosk_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sp/kiosk_text.h"
+
+sp_result kiosk_load_category_part(sp_db* db, const char* category, sp_character* ch, int* abstraction, sp_error* err)
+{
+    char** names = NULL;
+    int count = 0;
+    sp_db_part_info info;
+    sp_result r = sp_db_category_parts(db, category, &names, &count, err);
+    if (r == SP_OK && count == 0) r = sp_fail(err, SP_ERR_INVALID, "%s: no part of category %s", sp_db_path(db), category);
+    if (r == SP_OK) r = sp_db_load_part(db, names[0], ch, err);
+    if (r == SP_OK) r = sp_db_part(db, names[0], &info, err);
+    if (r == SP_OK && ch->rig.abstraction_count == 0)
+        r = sp_fail(err, SP_ERR_INVALID, "%s: part %s has no abstraction", sp_db_path(db), names[0]);
+    if (r == SP_OK) {
+        int a = sp_rig_find_abstraction(&ch->rig, info.abstraction);
+        *abstraction = a < 0 ? 0 : a;
+    } else {
+        sp_character_free(ch);
+    }
+    sp_db_free_strings(names, count);
+    return r;
+}
+
+static int by_row_order(const void* a, const void* b)
+{
+    const char *x = *(const char*const*)a, *y = *(const char*const*)b;
+    int ox = sp_kiosk_part_order(x), oy = sp_kiosk_part_order(y);
+    return ox != oy ? (ox < oy ? -1 : 1) : strcmp(x, y);
+}
+
+// The outline in the unit square (y down), centred, its aspect kept.
+static void normalise(part_icon* ic)
+{
+    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int i = 0; i < ic->n; ++i)
+        for (int c = 0; c < 2; ++c)
+            lo[c] = fminf(lo[c], ic->xy[2 * i + c]), hi[c] = fmaxf(hi[c], ic->xy[2 * i + c]);
+    float s = fmaxf(hi[0] - lo[0], hi[1] - lo[1]);
+    if (!(s > 0)) {
+        ic->n = 0;
+        return;
+    }
+    for (int i = 0; i < ic->n; ++i)
+        for (int c = 0; c < 2; ++c)
+            ic->xy[2 * i + c] = 0.5f + (ic->xy[2 * i + c] - 0.5f * (lo[c] + hi[c])) / s;
+}
+
+void kiosk_row_free(sp_kiosk* k)
+{
+    for (int i = 0; i < k->icon_count; ++i)
+        free(k->icons[i].xy);
+    memset(k->icons, 0, sizeof k->icons);
+    k->icon_count = 0;
+}
+
+void kiosk_row_load(sp_kiosk* k)
+{
+    k->icons_loaded = true;
+    kiosk_row_free(k);
+    sp_db* db = NULL;
+    sp_error err = {0};
+    char** cats = NULL;
+    int n = 0;
+    if (sp_db_open(k->db_path, SP_DB_READONLY, &db, &err) != SP_OK || sp_db_categories(db, &cats, &n, &err) != SP_OK) {
+        fprintf(stderr, "dragon-kiosk: refused strokes get no parts row: %s\n", err.text);
+        sp_db_close(db);
+        return;
+    }
+    qsort(cats, (size_t)n, sizeof *cats, by_row_order);
+    const char* row[SP_KIOSK_ROW_MAX];
+    for (int c = 0; c < n && k->icon_count < SP_KIOSK_ROW_MAX; ++c) {
+        part_icon* ic = &k->icons[k->icon_count];
+        sp_character ch = {0};
+        int a = 0;
+        if (kiosk_load_category_part(db, cats[c], &ch, &a, &err) != SP_OK) {
+            fprintf(stderr, "dragon-kiosk: parts row: %s\n", err.text);
+            continue;
+        }
+        int cap = 0;
+        ic->n = kiosk_outline(&ch.rig, a, ch.pose, &ch.camera, &ic->xy, &cap, ic->breaks, 8, &ic->break_n);
+        sp_character_free(&ch);
+        normalise(ic);
+        snprintf(ic->category, sizeof ic->category, "%s", cats[c]);
+        row[k->icon_count++] = ic->category;
+    }
+    sp_db_free_strings(cats, n);
+    sp_db_close(db);
+    sp_kiosk_ui_set_parts(k->ui, row, k->icon_count);
+}
+
+void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4])
+{
+    const sp_kiosk_ui* ui = k->ui;
+    for (int i = 0; i < k->icon_count; ++i) {
+        sp_kiosk_target t = (sp_kiosk_target)(SP_KT_PART1 + i);
+        if (!sp_kiosk_ui_target_visible(ui, t)) continue;
+        const sp_kiosk_rect* r = &ui->target[t];
+        bool pressed = ui->pressed == t && ui->capture == SP_KCAP_TARGET;
+        float rad = 0.16f * fminf(r->w, r->h);
+        sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0, pressed ? yellow : navy);
+        sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.025f * r->h), (const float[4]){1, 1, 1, 0.9f});
+        // The outline in the upper part, its name under it.
+        const part_icon* ic = &k->icons[i];
+        float box = fminf(0.62f * r->h, 0.8f * r->w), x0 = r->x + 0.5f * (r->w - box), y0 = r->y + 0.07f * r->h;
+        float lw = fmaxf(2.0f, 0.035f * r->h), pts[2 * 256];
+        int start = 0;
+        for (int b = 0; b <= ic->break_n; ++b) {
+            int end = b < ic->break_n ? ic->breaks[b] : ic->n;
+            // At most 256 points a curve: thinned evenly (an icon needs no more).
+            int m = end - start < 256 ? end - start : 256;
+            for (int q = 0; q < m; ++q) {
+                int s = start + (m > 1 ? (int)((long)q * (end - start - 1) / (m - 1)) : 0);
+                pts[2 * q] = x0 + box * ic->xy[2 * s], pts[2 * q + 1] = y0 + box * ic->xy[2 * s + 1];
+            }
+            if (m > 1) sp_draw2d_polyline(k->d2, pts, m, false, lw, pressed ? ink : yellow);
+            start = end;
+        }
+        char name[SP_KIOSK_NAME_MAX];
+        sp_kiosk_ui_target_text(ui, t, name, sizeof name);
+        sp_draw2d_text_fit(k->d2, name, r->x + 0.5f * r->w, r->y + 0.84f * r->h, 0.17f * r->h, 0.92f * r->w, SP_ALIGN_CENTER,
+                           pressed ? ink : (const float[4]){1, 1, 1, 1});
+    }
+}
