@@ -1053,7 +1053,7 @@ typedef struct wbuf {
 
 static void put(wbuf* b, const void* v, size_t n)
 {
-    if (b->oom) return;
+    if (b->oom || n == 0) return; // n == 0: v may be NULL (a model without shape evidence)
     if (b->n + n > b->cap) {
         size_t cap = b->cap ? b->cap : 4096;
         while (cap < b->n + n)
