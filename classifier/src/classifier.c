@@ -17,6 +17,7 @@
 #include "feat.h"
 #include "cv_adapter.h"
 #include "kmeans.h"
+#include "shape.h"
 
 struct sp_clf {
     sp_clf_desc desc; // resolved, progress NULL
@@ -39,6 +40,10 @@ struct sp_clf {
     struct FLANNParameters hist_params;
     int16_t* coarse;   // train_count by coarse_stride: the whole-drawing level quantised (knn_shortlist)
     int coarse_stride; // words rounded up to 8
+    int shape_count;   // training stroke drawings with a shape descriptor (0: no shape evidence)
+    float* shapes;     // shape_count by SP_SHAPE_DIM, standardised by shape_mu / shape_sd
+    int* shape_labels; // shape_count
+    float shape_mu[SP_SHAPE_DIM], shape_sd[SP_SHAPE_DIM];
 };
 
 sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
@@ -61,6 +66,7 @@ sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
     if (!(r.reject_quantile > 0.0 && r.reject_quantile <= 1.0)) r.reject_quantile = 0.98;
     if (r.seed == 0) r.seed = 1;
     if (r.threads <= 0) r.threads = 2;
+    if (!(r.shape_weight > 0.0) || !isfinite(r.shape_weight)) r.shape_weight = -1.0;
     return r;
 }
 
@@ -91,6 +97,8 @@ void sp_clf_free(sp_clf* clf)
     free(clf->hists);
     free(clf->labels);
     free(clf->coarse);
+    free(clf->shapes);
+    free(clf->shape_labels);
     free(clf);
 }
 
@@ -244,7 +252,54 @@ static void finish_hist(const sp_clf* c, const float* raw, float* out)
 // ---------------------------------------------------------------------------
 // Voting
 
-static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, sp_clf_answer* a)
+// Floors of the fusion: a category without votes, or without shape neighbours,
+// is unlikely, not impossible (the two kinds of evidence disagree on drawings
+// of designs the training set lacks; tuned with the shape's weight on the
+// visitors' tune half, BENCHMARKS.md "Visitors' drawings").
+#define FUSE_VOTE_FLOOR 0.02
+#define SHAPE_FLOOR 0.01
+
+// The shape evidence's share per category (`p`, category_count, sums to 1):
+// the knn training drawings nearest in (standardised) shape, each weighted by
+// how much farther than the nearest one it is. False without shape evidence
+// (none in the model, switched off, or the drawing has no shape descriptor).
+static bool shape_shares(const sp_clf* c, const sp_sketch* sk, double* p)
+{
+    if (c->shape_count == 0 || !(c->desc.shape_weight > 0.0) || !sk || sk->stroke_count == 0) return false;
+    float x[SP_SHAPE_DIM];
+    sp_error e = {0};
+    if (sp_shape_describe(sk, x, &e) != SP_OK) return false;
+    for (int d = 0; d < SP_SHAPE_DIM; ++d)
+        x[d] = (x[d] - c->shape_mu[d]) / c->shape_sd[d];
+    int k = c->desc.knn < c->shape_count ? c->desc.knn : c->shape_count, have = 0, near[64];
+    double best[64];
+    for (int i = 0; i < c->shape_count; ++i) {
+        const float* y = c->shapes + (size_t)i * SP_SHAPE_DIM;
+        double s = 0.0;
+        for (int d = 0; d < SP_SHAPE_DIM; ++d)
+            s += (double)(y[d] - x[d]) * (y[d] - x[d]);
+        if (have == k && s >= best[k - 1]) continue;
+        int j = have < k ? have++ : k - 1;
+        for (; j > 0 && best[j - 1] > s; --j)
+            best[j] = best[j - 1], near[j] = near[j - 1];
+        best[j] = s, near[j] = i;
+    }
+    double total = 0.0;
+    for (int i = 0; i < c->category_count; ++i)
+        p[i] = SHAPE_FLOOR;
+    for (int j = 0; j < have; ++j)
+        p[c->shape_labels[near[j]]] += exp(-(best[j] - best[0]) / (2.0 * (best[0] + 1.0)));
+    for (int i = 0; i < c->category_count; ++i)
+        total += p[i];
+    for (int i = 0; i < c->category_count; ++i)
+        p[i] /= total;
+    return true;
+}
+
+// The votes of the nn nearest training histograms; with `shape` (the shape
+// evidence's shares, or NULL) every category's score is its vote share (plus
+// the floor) times its shape share raised to shape_weight, renormalised.
+static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, const double* shape, sp_clf_answer* a)
 {
     memset(a, 0, sizeof *a);
     float* score = calloc((size_t)c->category_count, sizeof(float));
@@ -259,6 +314,12 @@ static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, sp_cl
         float w = expf(-(fmaxf(d2[j], 0.0f) - fmaxf(d2[0], 0.0f)) * inv);
         score[c->labels[idx[j]]] += w;
         total += w;
+    }
+    if (shape && total > 0.0) {
+        double fused = 0.0;
+        for (int k = 0; k < c->category_count; ++k)
+            fused += score[k] = (float)((score[k] / total + FUSE_VOTE_FLOOR) * pow(shape[k], c->desc.shape_weight));
+        total = fused;
     }
     for (int r = 0; r < SP_CLF_MAX_RANKED; ++r) {
         int best = -1;
@@ -411,7 +472,7 @@ static sp_result knn_shortlist(const sp_clf* c, const float* q, int nn, int* idx
     return SP_OK;
 }
 
-static sp_result classify_hist(const sp_clf* c, float* hist, sp_clf_answer* out, sp_error* err)
+static sp_result classify_hist(const sp_clf* c, float* hist, const double* shape, sp_clf_answer* out, sp_error* err)
 {
     int nn = c->desc.knn < c->train_count ? c->desc.knn : c->train_count;
     int idx[64];
@@ -424,7 +485,7 @@ static sp_result classify_hist(const sp_clf* c, float* hist, sp_clf_answer* out,
         if (flann_find_nearest_neighbors_index_float(c->hist_index, hist, 1, idx, d2, nn, &p) < 0)
             return sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram search failed");
     }
-    vote(c, idx, d2, nn, out);
+    vote(c, idx, d2, nn, shape, out);
     return SP_OK;
 }
 
@@ -433,15 +494,18 @@ sp_result sp_clf_classify(const sp_clf* c, const sp_sketch* sketch, const sp_ras
     memset(out, 0, sizeof *out);
     sp_features* f = malloc(sizeof *f);
     float* raw = malloc(sizeof(float) * (size_t)c->hist_dim * 2);
-    sp_result rc = (!f || !raw) ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : SP_OK;
+    double* shape = malloc(sizeof(double) * (size_t)c->category_count);
+    sp_result rc = (!f || !raw || !shape) ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : SP_OK;
     if (rc == SP_OK) rc = sp_feat_extract(sketch, raster, f, err);
     if (rc == SP_OK) rc = raw_hist(c, f, raw, err);
     if (rc == SP_OK) {
         finish_hist(c, raw, raw + c->hist_dim);
-        rc = classify_hist(c, raw + c->hist_dim, out, err);
+        bool shaped = sketch && sketch->stroke_count > 0 && shape_shares(c, sketch, shape);
+        rc = classify_hist(c, raw + c->hist_dim, shaped ? shape : NULL, out, err);
     }
     free(f);
     free(raw);
+    free(shape);
     return rc;
 }
 
@@ -632,6 +696,47 @@ static int cmp_float(const void* a, const void* b)
     return (x > y) - (x < y);
 }
 
+// The shape descriptors of the training stroke drawings (originals: the
+// descriptor is mirror-invariant), standardised per value over them.
+static sp_result train_shapes(sp_clf* c, const sp_dataset* data, const unsigned char* use, sp_error* err)
+{
+    for (int d = 0; d < SP_SHAPE_DIM; ++d)
+        c->shape_sd[d] = 1.0f;
+    if (!(c->desc.shape_weight > 0.0)) return SP_OK;
+    c->shapes = malloc(sizeof(float) * SP_SHAPE_DIM * (size_t)(data->count ? data->count : 1));
+    c->shape_labels = malloc(sizeof(int) * (size_t)(data->count ? data->count : 1));
+    if (!c->shapes || !c->shape_labels) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while training");
+    int n = 0;
+    for (int i = 0; i < data->count; ++i) {
+        const sp_sample* s = &data->samples[i];
+        if ((use && !use[i]) || s->label < 0 || s->label >= data->category_count || s->sketch.stroke_count == 0) continue;
+        sp_error e = {0};
+        if (sp_shape_describe(&s->sketch, c->shapes + (size_t)n * SP_SHAPE_DIM, &e) != SP_OK) continue;
+        c->shape_labels[n++] = s->label;
+    }
+    if (n == 0) return SP_OK; // raster drawings only: the votes alone rank
+    double mu[SP_SHAPE_DIM] = {0}, var[SP_SHAPE_DIM] = {0};
+    for (int i = 0; i < n; ++i)
+        for (int d = 0; d < SP_SHAPE_DIM; ++d)
+            mu[d] += c->shapes[(size_t)i * SP_SHAPE_DIM + d] / n;
+    for (int i = 0; i < n; ++i)
+        for (int d = 0; d < SP_SHAPE_DIM; ++d) {
+            double v = c->shapes[(size_t)i * SP_SHAPE_DIM + d] - mu[d];
+            var[d] += v * v / n;
+        }
+    for (int d = 0; d < SP_SHAPE_DIM; ++d) {
+        c->shape_mu[d] = (float)mu[d];
+        c->shape_sd[d] = (float)fmax(sqrt(var[d]), 1e-3); // a value all drawings share weighs nothing, not infinitely much
+    }
+    for (int i = 0; i < n; ++i)
+        for (int d = 0; d < SP_SHAPE_DIM; ++d) {
+            float* v = &c->shapes[(size_t)i * SP_SHAPE_DIM + d];
+            *v = (*v - c->shape_mu[d]) / c->shape_sd[d];
+        }
+    c->shape_count = n;
+    return SP_OK;
+}
+
 sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const sp_clf_desc* desc, sp_clf** out, sp_error* err)
 {
     *out = NULL;
@@ -785,6 +890,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     }
     c->train_count = n;
     if ((rc = build_hist_index(c, err)) != SP_OK) goto fail;
+    if ((rc = train_shapes(c, data, use, err)) != SP_OK) goto fail;
 
     // Leave-one-out nearest distances (another drawing, not a variant of the same one)
     // give the voting bandwidth (median) and the reject threshold (quantile).
@@ -947,7 +1053,7 @@ typedef struct wbuf {
 
 static void put(wbuf* b, const void* v, size_t n)
 {
-    if (b->oom) return;
+    if (b->oom || n == 0) return; // n == 0: v may be NULL (a model without shape evidence)
     if (b->n + n > b->cap) {
         size_t cap = b->cap ? b->cap : 4096;
         while (cap < b->n + n)
@@ -1005,6 +1111,13 @@ sp_result sp_clf_save(const sp_clf* c, const char* path, sp_error* err)
     put(&b, c->labels, sizeof(int32_t) * (size_t)c->train_count);
     put_f32(&b, c->bandwidth);
     put_f32(&b, c->reject);
+    put_f64(&b, d->shape_weight);
+    put_i32(&b, c->shape_count);
+    put_i32(&b, SP_SHAPE_DIM);
+    put(&b, c->shape_mu, sizeof c->shape_mu);
+    put(&b, c->shape_sd, sizeof c->shape_sd);
+    put(&b, c->shapes, sizeof(float) * (size_t)c->shape_count * SP_SHAPE_DIM);
+    put(&b, c->shape_labels, sizeof(int32_t) * (size_t)c->shape_count);
     if (b.oom) {
         free(b.p);
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
@@ -1083,9 +1196,9 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
         fclose(f);
         return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model written on a machine of other byte order", path);
     }
-    if (version != SP_CLF_FILE_VERSION) {
+    if (version != SP_CLF_FILE_VERSION && version != 1) {
         fclose(f);
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model format version %u, this build reads version %d (retrain)", path,
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model format version %u, this build reads versions 1 to %d (retrain)", path,
                        version, SP_CLF_FILE_VERSION);
     }
     if (len > (uint64_t)1 << 32) {
@@ -1159,6 +1272,28 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
     get(&b, c->labels, sizeof(int32_t) * (size_t)c->train_count);
     c->bandwidth = get_f32(&b);
     c->reject = get_f32(&b);
+    c->desc.shape_weight = -1.0; // version 1: no shape evidence
+    if (version >= 2) {
+        get(&b, &c->desc.shape_weight, 8);
+        c->shape_count = get_i32(&b);
+        if (b.bad || get_i32(&b) != SP_SHAPE_DIM || c->shape_count < 0 || !isfinite(c->desc.shape_weight) ||
+            (size_t)c->shape_count * (SP_SHAPE_DIM + 1) * 4 + 2 * sizeof c->shape_mu > b.n - b.at)
+            goto corrupt;
+        get(&b, c->shape_mu, sizeof c->shape_mu);
+        get(&b, c->shape_sd, sizeof c->shape_sd);
+        c->shapes = malloc(sizeof(float) * SP_SHAPE_DIM * (size_t)(c->shape_count ? c->shape_count : 1));
+        c->shape_labels = malloc(sizeof(int) * (size_t)(c->shape_count ? c->shape_count : 1));
+        if (!c->shapes || !c->shape_labels) goto oom;
+        get(&b, c->shapes, sizeof(float) * SP_SHAPE_DIM * (size_t)c->shape_count);
+        get(&b, c->shape_labels, sizeof(int32_t) * (size_t)c->shape_count);
+        for (int i = 0; i < c->shape_count; ++i)
+            if (c->shape_labels[i] < 0 || c->shape_labels[i] >= c->category_count) goto corrupt;
+        for (int d = 0; d < SP_SHAPE_DIM; ++d)
+            if (!(c->shape_sd[d] > 0)) goto corrupt;
+        if (!all_finite(c->shapes, (size_t)c->shape_count * SP_SHAPE_DIM) || !all_finite(c->shape_mu, SP_SHAPE_DIM) ||
+            !all_finite(c->shape_sd, SP_SHAPE_DIM))
+            goto corrupt;
+    }
     if (b.bad || b.at != b.n || !(c->bandwidth > 0) || isnan(c->reject)) goto corrupt;
     for (int i = 0; i < c->train_count; ++i)
         if (c->labels[i] < 0 || c->labels[i] >= c->category_count) goto corrupt;

@@ -9,6 +9,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -235,4 +236,37 @@ extern "C" sp_result sp_cv_dot_rows(const float* a, int n, const float* b, int k
         return SP_OK;
     }
     SP_CV_FIREWALL(err, "dot products")
+}
+
+extern "C" sp_result sp_cv_convexity(const int* xy, int n, double* area, double* hull_area, sp_cv_defect* defects, int max,
+                                     int* count, sp_error* err)
+{
+    *count = 0;
+    *area = *hull_area = 0.0;
+    try {
+        if (n < 4) return sp_fail(err, SP_ERR_INVALID, "convexity: %d points (4 needed)", n);
+        std::vector<cv::Point> pts((size_t)n);
+        for (int i = 0; i < n; ++i)
+            pts[(size_t)i] = cv::Point(xy[2 * i], xy[2 * i + 1]);
+        *area = std::fabs(cv::contourArea(pts));
+        std::vector<int> idx;
+        cv::convexHull(pts, idx, false, false);
+        std::vector<cv::Point> hull;
+        for (int i : idx)
+            hull.push_back(pts[(size_t)i]);
+        *hull_area = hull.size() >= 3 ? cv::contourArea(hull) : 0.0;
+        // Why sorted: a drawn stroke may cross itself, and convexityDefects
+        // refuses hull indices that are not monotonous along the polygon; in
+        // polygon order every hull edge spans the run of points it covers.
+        std::sort(idx.begin(), idx.end());
+        if (idx.size() < 3) return SP_OK;
+        std::vector<cv::Vec4i> d;
+        cv::convexityDefects(pts, idx, d);
+        for (const cv::Vec4i& v : d) {
+            if (*count >= max) break;
+            defects[(*count)++] = sp_cv_defect{v[0], v[1], v[2], (float)v[3] / 256.0f};
+        }
+        return SP_OK;
+    }
+    SP_CV_FIREWALL(err, "convexity")
 }

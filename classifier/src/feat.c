@@ -7,15 +7,23 @@
 
 #include "cv_adapter.h"
 
-sp_result sp_feat_rasterise(const sp_sketch* s, unsigned char* canvas, sp_error* err)
+sp_result sp_feat_check_drawing(const sp_sketch* s, int* total, sp_vec2* lo, sp_vec2* hi, sp_error* err)
 {
-    int total = sp_sketch_point_count(s);
-    if (total == 0) return sp_fail(err, SP_ERR_INVALID, "empty drawing (no points)");
-    if (total > SP_SKETCH_MAX_POINTS)
+    *total = sp_sketch_point_count(s);
+    if (*total == 0) return sp_fail(err, SP_ERR_INVALID, "empty drawing (no points)");
+    if (*total > SP_SKETCH_MAX_POINTS)
         return sp_fail(err, SP_ERR_UNSUPPORTED, "drawing has more than %d points", SP_SKETCH_MAX_POINTS);
     if (!sp_sketch_is_valid(s)) return sp_fail(err, SP_ERR_INVALID, "drawing has non-finite coordinates");
+    sp_sketch_bounds(s, lo, hi);
+    return SP_OK;
+}
+
+sp_result sp_feat_rasterise(const sp_sketch* s, unsigned char* canvas, sp_error* err)
+{
+    int total;
     sp_vec2 lo, hi;
-    sp_sketch_bounds(s, &lo, &hi);
+    sp_result rc = sp_feat_check_drawing(s, &total, &lo, &hi, err);
+    if (rc != SP_OK) return rc;
     double ext = fmax(hi.x - lo.x, hi.y - lo.y);
     const double fit = SP_FEAT_FRAME - 2 * SP_FEAT_PAD;
     // A single dot (or all points equal) has no extent: draw it as a dot in the middle.
@@ -40,7 +48,7 @@ sp_result sp_feat_rasterise(const sp_sketch* s, unsigned char* canvas, sp_error*
         }
         counts[nl++] = st->count;
     }
-    sp_result rc = sp_cv_draw_polylines(xy, counts, nl, SP_FEAT_CANVAS, SP_FEAT_THICKNESS, canvas, err);
+    rc = sp_cv_draw_polylines(xy, counts, nl, SP_FEAT_CANVAS, SP_FEAT_THICKNESS, canvas, err);
     free(xy);
     free(counts);
     return rc;

@@ -31,6 +31,10 @@ typedef struct sp_features {
     float pos[SP_FEAT_MAX * 2];            ///< count by 2, sample point in [0,1]^2 of the frame
 } sp_features;
 
+/// What every stroke drawing must be before it is described: it has points, at
+/// most SP_SKETCH_MAX_POINTS (SP_ERR_UNSUPPORTED), all finite (SP_ERR_INVALID
+/// otherwise); *total gets its point count, *lo and *hi its bounding box.
+sp_result sp_feat_check_drawing(const sp_sketch* s, int* total, sp_vec2* lo, sp_vec2* hi, sp_error* err);
 /// Draws a sketch, normalised to the frame, into a SP_FEAT_CANVAS^2 image (ink bright).
 /// Fails with SP_ERR_INVALID on an empty or non-finite sketch.
 sp_result sp_feat_rasterise(const sp_sketch* s, unsigned char* canvas, sp_error* err);

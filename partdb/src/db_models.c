@@ -73,9 +73,9 @@ static char* desc_json(const sp_clf_desc* d)
     db_str_printf(&b,
                   "{\"words\": %d, \"vocab_samples\": %d, \"kmeans_iterations\": %d, \"soft_neighbours\": %d, \"knn\": %d,"
                   " \"pyramid\": %d, \"tfidf\": %d, \"hellinger\": %d, \"mirror\": %d, \"augment\": %d, \"reject_quantile\": %.6g,"
-                  " \"seed\": %u, \"threads\": %d}",
+                  " \"seed\": %u, \"threads\": %d, \"shape_weight\": %.6g}",
                   d->words, d->vocab_samples, d->kmeans_iterations, d->soft_neighbours, d->knn, d->pyramid, d->tfidf, d->hellinger,
-                  d->mirror, d->augment, d->reject_quantile, (unsigned)d->seed, d->threads);
+                  d->mirror, d->augment, d->reject_quantile, (unsigned)d->seed, d->threads, d->shape_weight);
     return b.oom ? (free(b.s), NULL) : b.s;
 }
 
@@ -123,6 +123,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
 {
     if (report_json) *report_json = NULL;
     sp_db_train_desc d = desc ? *desc : (sp_db_train_desc){0};
+    if (d.clf.shape_weight == 0.0) d.clf.shape_weight = SP_DB_SHAPE_WEIGHT;
     int folds = d.folds == 0 ? 3 : d.folds < 0 ? 0 : d.folds;
     double t0 = now_s();
     sp_dataset ds;

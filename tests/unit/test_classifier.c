@@ -11,6 +11,7 @@
 
 // Internals (tests may reach into src/, STYLE.md).
 #include "../../classifier/src/feat.h"
+#include "../../classifier/src/shape.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wall"
@@ -636,6 +637,140 @@ static void test_model_files(void)
     ENSURE(back == NULL);
 }
 
+// The model file's FNV-1a checksum (classifier.c), to write an older version's file.
+static uint64_t model_checksum(const unsigned char* p, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ p[i]) * 0x100000001b3ull;
+    return h;
+}
+
+static void test_shape_descriptor(void)
+{
+    sp_error err = {0};
+    float a[SP_SHAPE_DIM], b[SP_SHAPE_DIM];
+    for (int kind = 0; kind < 3; ++kind) {
+        sp_sketch s = {0}, m = {0};
+        g_rng = 99 + (uint64_t)kind;
+        make_shape(kind, &s);
+        ENSURE(sp_shape_describe(&s, a, &err) == SP_OK);
+        for (int i = 0; i < SP_SHAPE_DIM; ++i)
+            ENSURE(isfinite(a[i]) && strcmp(sp_shape_feature_name(i), "?"));
+        // Mirror-invariant: a part may face either way.
+        ENSURE(sp_sketch_clone(&s, &m) == SP_OK);
+        for (int k = 0; k < m.stroke_count; ++k)
+            for (int j = 0; j < m.strokes[k].count; ++j)
+                m.strokes[k].points[j].x = 1000.0 - m.strokes[k].points[j].x;
+        ENSURE(sp_shape_describe(&m, b, &err) == SP_OK);
+        for (int i = 0; i < SP_SHAPE_DIM; ++i)
+            ENSURE_NEAR(a[i], b[i], 0.02 + 0.02 * fabs(a[i]));
+        sp_sketch_free(&s);
+        sp_sketch_free(&m);
+    }
+    // A circle is closed and round, a line open and long: the descriptor tells them apart.
+    sp_sketch c = {0}, l = {0};
+    make_shape(0, &c);
+    make_shape(1, &l);
+    ENSURE(sp_shape_describe(&c, a, &err) == SP_OK && sp_shape_describe(&l, b, &err) == SP_OK);
+    ENSURE(a[0] < 0.2f && b[0] > 0.8f); // gap between the ends over the diagonal
+    ENSURE(a[2] < 0.5f && b[2] > 0.9f); // elongation
+    sp_sketch_free(&c);
+    sp_sketch_free(&l);
+    // A dot is described (all zero), bad drawings are refused with a message.
+    sp_vec2 dot[3] = {{5, 5}, {5, 5}, {5, 5}}, bad[2] = {{0, 0}, {NAN, 1}};
+    sp_sketch s = {0};
+    ENSURE(sp_sketch_add_stroke(&s, dot, NULL, 3) == SP_OK);
+    ENSURE(sp_shape_describe(&s, a, &err) == SP_OK);
+    for (int i = 0; i < SP_SHAPE_DIM; ++i)
+        ENSURE(a[i] == 0.0f);
+    sp_sketch_free(&s);
+    ENSURE(sp_sketch_add_stroke(&s, bad, NULL, 2) == SP_OK);
+    ENSURE(sp_shape_describe(&s, a, &err) == SP_ERR_INVALID && contains(err.text, "finite"));
+    sp_sketch_free(&s);
+    ENSURE(sp_shape_describe(&s, a, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
+}
+
+static void test_shape_evidence(void)
+{
+    sp_dataset train = shapes(20, 7), test = shapes(5, 555);
+    sp_error err = {0};
+    sp_clf* plain = shapes_model();
+    sp_clf* shaped = NULL;
+    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5, .shape_weight = 0.75};
+    ENSURE(sp_clf_train(&train, NULL, &d, &shaped, &err) == SP_OK);
+    ENSURE(sp_clf_get_desc(shaped).shape_weight == 0.75 && sp_clf_get_desc(plain).shape_weight < 0);
+    const char* path = sp_test_tmp_path("shaped.spclf");
+    ENSURE(sp_clf_save(shaped, path, &err) == SP_OK);
+    sp_clf* back = NULL;
+    ENSURE(sp_clf_load(path, &back, &err) == SP_OK && sp_clf_get_desc(back).shape_weight == 0.75);
+    int right = 0, differs = 0;
+    for (int i = 0; i < test.count; ++i) {
+        const sp_sketch* sk = &test.samples[i].sketch;
+        sp_clf_answer p, a, b;
+        ENSURE(sp_clf_classify(plain, sk, NULL, &p, &err) == SP_OK);
+        ENSURE(sp_clf_classify(shaped, sk, NULL, &a, &err) == SP_OK);
+        ENSURE(sp_clf_classify(back, sk, NULL, &b, &err) == SP_OK);
+        // Fused: every category ranked, scores summing to 1; the same votes
+        // (same training) give the same nearest distance.
+        ENSURE(a.count == 3 && a.distance == p.distance && a.rejected == p.rejected);
+        ENSURE_NEAR(a.ranked[0].score + a.ranked[1].score + a.ranked[2].score, 1.0, 1e-4);
+        ENSURE(a.count == b.count && a.distance == b.distance);
+        for (int j = 0; j < a.count; ++j)
+            ENSURE(a.ranked[j].category == b.ranked[j].category && a.ranked[j].score == b.ranked[j].score);
+        right += a.ranked[0].category == test.samples[i].label;
+        differs += a.ranked[0].score != p.ranked[0].score;
+    }
+    ENSURE(right >= test.count * 9 / 10 && differs > 0);
+    // A raster has no shape descriptor: the votes alone rank, as without shape evidence.
+    sp_raster r = {0};
+    const char* png = sp_test_tmp_path("shaped.png");
+    write_png_sketch(png, 120, 90);
+    ENSURE(sp_raster_read_png(png, &r, &err) == SP_OK);
+    remove(png);
+    sp_clf_answer p, a;
+    ENSURE(sp_clf_classify(plain, NULL, &r, &p, &err) == SP_OK && sp_clf_classify(shaped, NULL, &r, &a, &err) == SP_OK);
+    ENSURE(p.count == a.count);
+    for (int j = 0; j < a.count; ++j)
+        ENSURE(a.ranked[j].category == p.ranked[j].category && a.ranked[j].score == p.ranked[j].score);
+    sp_raster_free(&r);
+
+    // A version 1 file (no shape section) is still read, as a model without shape evidence.
+    const char* plain_path = sp_test_tmp_path("plain.spclf");
+    ENSURE(sp_clf_save(plain, plain_path, &err) == SP_OK);
+    long n = file_size(plain_path);
+    unsigned char* buf = malloc((size_t)n);
+    FILE* f = fopen(plain_path, "rb");
+    ENSURE(f && buf && fread(buf, 1, (size_t)n, f) == (size_t)n);
+    fclose(f);
+    const size_t tail = 8 + 4 + 4 + 2 * sizeof(float) * SP_SHAPE_DIM; // weight, count, dim, mean, spread
+    uint64_t len;
+    memcpy(&len, buf + 16, 8);
+    len -= tail;
+    uint32_t v1 = 1;
+    memcpy(buf + 8, &v1, 4);
+    memcpy(buf + 16, &len, 8);
+    uint64_t sum = model_checksum(buf + 24, (size_t)len);
+    memcpy(buf + 24 + len, &sum, 8);
+    f = fopen(plain_path, "wb");
+    ENSURE(f && fwrite(buf, 1, 24 + (size_t)len + 8, f) == 24 + (size_t)len + 8);
+    fclose(f);
+    free(buf);
+    sp_clf* old = NULL;
+    ENSURE(sp_clf_load(plain_path, &old, &err) == SP_OK && sp_clf_get_desc(old).shape_weight < 0);
+    sp_clf_answer o;
+    ENSURE(sp_clf_classify(old, &test.samples[1].sketch, NULL, &o, &err) == SP_OK &&
+           sp_clf_classify(plain, &test.samples[1].sketch, NULL, &p, &err) == SP_OK);
+    ENSURE(o.count == p.count && o.ranked[0].category == p.ranked[0].category && o.ranked[0].score == p.ranked[0].score);
+    sp_clf_free(old);
+    remove(plain_path);
+    remove(path);
+    sp_clf_free(back);
+    sp_clf_free(shaped);
+    sp_dataset_free(&train);
+    sp_dataset_free(&test);
+}
+
 static void test_classify_edge_drawings(void)
 {
     sp_clf* clf = shapes_model();
@@ -776,6 +911,8 @@ int main(int argc, char** argv)
                                    {"reject", test_reject},
                                    {"deterministic", test_deterministic},
                                    {"model_files", test_model_files},
+                                   {"shape_descriptor", test_shape_descriptor},
+                                   {"shape_evidence", test_shape_evidence},
                                    {"classify_edge_drawings", test_classify_edge_drawings},
                                    {"quickdraw_small", test_quickdraw_small},
                                    {"augment_hook", test_augment_hook},

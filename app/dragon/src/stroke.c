@@ -231,7 +231,7 @@ static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit)
 #undef CROSS
         return crossings > 12;
     }
-    return near + 6.0 * fit > 1.29;
+    return near + 6.0 * fit > 1.26;
 }
 
 // The stroke path's decision: the classifier's answer becomes a category

@@ -7,9 +7,14 @@
 /// and Hellinger-mapped). A k-nearest-neighbour search over the training
 /// histograms (full distances for a shortlist of candidates nearest on the
 /// whole-drawing level; FLANN's kd-tree beyond 20000 training histograms)
-/// votes, weighted by distance, for ranked categories; a drawing
-/// farther from every training drawing than a threshold learned on the training
-/// set is rejected.
+/// votes, weighted by distance, for categories. Optionally (`shape_weight`),
+/// global shape evidence the local features lack (open or closed, elongation
+/// and axis against the upright canvas, solidity, convexity defects and where
+/// they open, turning angles, centroid-distance Fourier magnitudes, where the
+/// ink lies) votes too, by its own k nearest training drawings; the two are
+/// fused as a product of their shares into the ranked categories. A drawing
+/// farther from every training drawing (histogram distance) than a threshold
+/// learned on the training set is rejected.
 ///
 ///     sp_dataset ds; sp_dataset_load("data/", &ds, &err);
 ///     sp_clf* clf; sp_clf_train(&ds, NULL, &(sp_clf_desc){0}, &clf, &err);
@@ -32,8 +37,9 @@
 extern "C" {
 #endif
 
-/// Model file format version written by sp_clf_save; others are refused by sp_clf_load.
-#define SP_CLF_FILE_VERSION 1
+/// Model file format version written by sp_clf_save; sp_clf_load also reads version 1
+/// (models without shape evidence), and refuses others.
+#define SP_CLF_FILE_VERSION 2
 /// Most ranked categories in an answer.
 #define SP_CLF_MAX_RANKED 10
 
@@ -64,6 +70,13 @@ typedef struct sp_clf_desc {
     /// and thread-safe (called from the training threads). Not stored in the model.
     sp_result (*augment_fn)(void* user, const sp_sketch* in, int sample, int k, sp_sketch* out);
     void* augment_user;
+    /// Weight of the global shape evidence (stroke drawings only; rasters are
+    /// ranked by the votes): each category's vote share (plus 0.02) times its
+    /// shape share raised to this power ranks. 0 (default) or < 0: none, the
+    /// votes alone rank. It helps single-stroke drawings of a few categories
+    /// (partdb.h's sp_db_train_desc turns it on) and costs accuracy on Quick,
+    /// Draw!'s 100 (BENCHMARKS.md, "Visitors' drawings").
+    double shape_weight;
 } sp_clf_desc;
 
 /// One ranked category: index into the model's categories, and its vote share in [0, 1].
@@ -74,7 +87,9 @@ typedef struct sp_clf_rank {
 
 /// A classification: categories by decreasing score (scores sum to <= 1).
 typedef struct sp_clf_answer {
-    int count; ///< ranked entries (categories that got votes, at most SP_CLF_MAX_RANKED)
+    /// ranked entries, at most SP_CLF_MAX_RANKED: the categories that got votes
+    /// or, with shape evidence, every category (each has a fused score)
+    int count;
     sp_clf_rank ranked[SP_CLF_MAX_RANKED];
     bool rejected;         ///< nothing in the training set is close: ask again
     float distance;        ///< histogram distance to the nearest training drawing

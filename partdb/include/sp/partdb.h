@@ -238,9 +238,17 @@ sp_result sp_db_kiosk_set_status(sp_db* db, const int64_t* ids, int n, sp_db_sta
 /// categories; anything else fails with SP_ERR_INVALID and changes nothing).
 sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const char* by, sp_error* err);
 
+/// The classifier's shape evidence weight (sp_clf_desc.shape_weight) a part
+/// database trains with unless told otherwise; tuned on the visitors' tune half
+/// (tests/data/visitors).
+#define SP_DB_SHAPE_WEIGHT 0.75
+
 /// Training. Zero means the default.
 typedef struct sp_db_train_desc {
-    sp_clf_desc clf;    ///< classifier options (progress reported through it)
+    /// Classifier options (progress reported through it). Here clf.shape_weight
+    /// 0 means SP_DB_SHAPE_WEIGHT: a part is drawn in one stroke, whose global
+    /// shape tells the parts apart where the bag of features does not (< 0: none).
+    sp_clf_desc clf;
     int folds;          ///< cross-validation folds for the report; 0: 3; -1: none
     const char* by;     ///< curator (NULL: $USER)
     /// Reject threshold calibration: this many hand-drawn sketches per part, in
