@@ -16,12 +16,12 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
 
 #include "dragon_internal.h" // fault injection: sp_dragon.fit_hook
+#include "sp/clock.h"
 #include "sp/curve.h"
 #include "sp/dragon.h"
 #include "sp/dragon_snapshot.h"
@@ -31,13 +31,6 @@
 #include "test.h"
 
 #define PI 3.14159265358979323846
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
 
 // ---- test parts --------------------------------------------------------------------
 
@@ -1738,9 +1731,9 @@ static void test_six_real_parts(void)
     ENSURE(right >= k - 1);
     // Pen-up to fitted part once the parts are loaded (what a visitor waits for).
     sp_dragon* d2 = new_dragon(path);
-    double tp = now_ms();
+    double tp = sp_now_ms();
     ENSURE(sp_dragon_preload(d2, &err) == SP_OK);
-    fprintf(stderr, "  preloading %d parts: %.0f ms\n", np, now_ms() - tp);
+    fprintf(stderr, "  preloading %d parts: %.0f ms\n", np, sp_now_ms() - tp);
     double ms[256];
     int nm = 0;
     for (int rep = 0; rep < 3; ++rep)
