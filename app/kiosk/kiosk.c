@@ -1,7 +1,6 @@
 // kiosk.c: the kiosk's core: the UI's jobs against the pipeline, saving,
 // the mesh cache, the canvas <-> framebuffer mapping.
 #include "kiosk_internal.h"
-#include "sp/clock.h"
 
 #include <errno.h>
 #include <math.h>
@@ -13,6 +12,8 @@
 
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
+
+#include "sp/clock.h"
 
 // ------------------------------------------------------------------ mapping
 
