@@ -15,11 +15,4 @@ int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_pa
 /// or more points; err names the file.
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 
-/// A glTF-style animation that passes through key poses: keys is nkeys by
-/// rig->param_count, times nkeys seconds (increasing). Every joint with
-/// parameters gets LINEAR channels for the paths its parameters touch
-/// (rotation, translation, scale), sampled from sp_rig_local_trs at each key.
-sp_result sp_animation_from_keys(const sp_rig* rig, const double* keys, const double* times, int nkeys, const char* name,
-                                 sp_animation* out, sp_error* err);
-
 #endif

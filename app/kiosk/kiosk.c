@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "sp/kiosk_text.h"
@@ -16,12 +15,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
+#include "sp/clock.h"
 
 // ------------------------------------------------------------------ mapping
 
@@ -518,10 +512,10 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     sp_dragon_result res;
     memset(&res, 0, sizeof res);
     sp_error err = {0};
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     sp_result rc = sp_dragon_add_points(k->dragon, k->scratch, s->count,
                                         &(sp_dragon_stroke_opts){.category = forced, .replace_last = j->replace}, &res, &err);
-    double ms = now_ms() - t0;
+    double ms = sp_now_ms() - t0;
     k->stats.last_fit_ms = ms;
     k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
     answer_fit(k, rc, &res, &err, false, forced);
@@ -682,7 +676,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     // Pose the dragon at the animation clock (only when something moves).
     double t = k->ui->anim_ms / 1000.0;
     if (!k->posed || k->posed_rev != k->rev || k->posed_t != t) {
-        double t0 = now_ms();
+        double t0 = sp_now_ms();
         sp_error err = {0};
         if (sp_dragon_pose_at(k->dragon, t, &err) == SP_OK) {
             mesh_cache_sync(&k->meshes, k->r, k->dragon, true);
@@ -690,7 +684,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         } else {
             fprintf(stderr, "dragon-kiosk: %s\n", err.text);
         }
-        k->stats.pose_ms = now_ms() - t0;
+        k->stats.pose_ms = sp_now_ms() - t0;
         k->stats.triangles = mesh_cache_triangles(&k->meshes);
     }
     k->stats.parts = sp_dragon_part_count(k->dragon);

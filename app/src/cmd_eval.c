@@ -1,23 +1,10 @@
 // cmd_eval.c: sketchpose eval --model M --data DIR [--folds K]
 #include <stdlib.h>
-#include <time.h>
 
 #include "clf_cli.h"
 #include "sp/classifier.h"
+#include "sp/clock.h"
 #include "sp/sketch_io.h"
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
 
 // Classifies samples with mask[i] set by `clf` (whose categories are looked up by name in ds).
 static void run(const sp_clf* clf, const sp_dataset* ds, const unsigned char* mask, int* confusion, int* top1, int* top3, int* n,
@@ -35,9 +22,9 @@ static void run(const sp_clf* clf, const sp_dataset* ds, const unsigned char* ma
         const sp_sample* s = &ds->samples[i];
         sp_clf_answer a;
         sp_error err = {0};
-        double t0 = now_ms();
+        double t0 = sp_now_ms();
         sp_result r = sp_clf_classify(clf, &s->sketch, &s->raster, &a, &err);
-        ms[(*nms)++] = now_ms() - t0;
+        ms[(*nms)++] = sp_now_ms() - t0;
         ++*n;
         if (r != SP_OK) {
             ++*failed;
@@ -134,7 +121,7 @@ int cmd_eval(int argc, char** argv)
             fold_top3[f] = top3 - top30;
         }
     }
-    qsort(ms, (size_t)nms, sizeof(double), cmp_double);
+    qsort(ms, (size_t)nms, sizeof(double), sp_cmp_double);
     printf("{\"top1\": %.4f, \"top3\": %.4f, \"n\": %d, \"ms_median\": %.3f, \"ms_p90\": %.3f, \"rejected\": %d, "
            "\"failed\": %d, \"folds\": %d,\n",
            n ? (double)top1 / n : 0.0, n ? (double)top3 / n : 0.0, n, nms ? ms[nms / 2] : 0.0,

@@ -19,6 +19,7 @@
 #include "cli.h"
 #include "draw2d.h"
 #include "kiosk.h"
+#include "sp/clock.h"
 #include "sp/dragon.h"
 #include "sp/kiosk_session.h"
 #include "sp/kiosk_text.h"
@@ -53,13 +54,6 @@ static void on_signal(int sig)
 {
     (void)sig;
     g_quit = 1;
-}
-
-static double wall_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
 static long rss_kb(void)
@@ -104,7 +98,7 @@ static void push_event(app* a, const sp_kiosk_event* ev)
         a->recording = false;
     }
     if (sp_kiosk_ui_of(a->k)->strokes_finished > before) {
-        a->up_wall[(a->up_head + a->up_count) % 8] = wall_ms();
+        a->up_wall[(a->up_head + a->up_count) % 8] = sp_now_ms();
         if (a->up_count < 8)
             ++a->up_count;
         else
@@ -185,9 +179,9 @@ static void cb_error(int code, const char* text)
 // One frame: update at t, draw, swap; the pen-up latency of strokes whose fit just landed.
 static void frame(app* a, double t, bool render)
 {
-    double w0 = wall_ms();
+    double w0 = sp_now_ms();
     sp_kiosk_update(a->k, t);
-    double wu = wall_ms(), wd = wu;
+    double wu = sp_now_ms(), wd = wu;
     const sp_kiosk_ui* ui = sp_kiosk_ui_of(a->k);
     const sp_kiosk_stats* st = sp_kiosk_stats_of(a->k);
     int fits = st->fit_count, dropped = ui->dropped_strokes;
@@ -195,10 +189,10 @@ static void frame(app* a, double t, bool render)
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         sp_kiosk_draw(a->k);
         if (a->scripted) glFinish(); // frame times mean finished frames, not queued ones
-        wd = wall_ms();
+        wd = sp_now_ms();
         glfwSwapBuffers(a->win);
     }
-    double w1 = wall_ms();
+    double w1 = sp_now_ms();
     for (; a->seen_dropped < dropped && a->up_count > 0; ++a->seen_dropped)
         a->up_head = (a->up_head + 1) % 8, --a->up_count;
     a->seen_dropped = dropped;
@@ -224,19 +218,13 @@ static void frame(app* a, double t, bool render)
     }
 }
 
-static int cmp_double(const void* x, const void* y)
-{
-    double a = *(const double*)x, b = *(const double*)y;
-    return a < b ? -1 : a > b;
-}
-
 static double quantile(const double* v, int n, double q)
 {
     if (n <= 0) return 0;
     double* s = malloc(sizeof *s * (size_t)n);
     if (!s) return 0;
     memcpy(s, v, sizeof *s * (size_t)n);
-    qsort(s, (size_t)n, sizeof *s, cmp_double);
+    qsort(s, (size_t)n, sizeof *s, sp_cmp_double);
     double r = s[(int)fmin(n - 1, floor(q * (n - 1) + 0.5))];
     free(s);
     return r;
@@ -336,7 +324,7 @@ static void mark_path(const char* shot, const char* name, char* out, size_t cap)
 
 int main(int argc, char** argv)
 {
-    double start = wall_ms();
+    double start = sp_now_ms();
     const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL,
                *size = NULL;
     const char* font = NULL;
@@ -488,7 +476,7 @@ int main(int argc, char** argv)
             // decides depends only on the clock, and marks and the end render
             // their own screenshots offscreen.
             frame(&a, target, n % 10 == 0 || at_end);
-            if (n++ == 0) first_frame_ms = wall_ms() - start;
+            if (n++ == 0) first_frame_ms = sp_now_ms() - start;
             glfwPollEvents();
             for (; mi < session.mark_count && session.marks[mi].t_ms <= target; ++mi) {
                 if (!shot) continue;
@@ -508,7 +496,7 @@ int main(int argc, char** argv)
         while (!glfwWindowShouldClose(win) && !g_quit) {
             glfwPollEvents();
             frame(&a, live_t(&a), true);
-            if (n++ == 0) first_frame_ms = wall_ms() - start;
+            if (n++ == 0) first_frame_ms = sp_now_ms() - start;
         }
     }
     if (shot && sp_kiosk_screenshot(a.k, shot, &err) != SP_OK) {

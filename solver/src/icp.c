@@ -8,16 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "solver_internal.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
+#include "sp/clock.h"
 
 const char* sp_stop_reason_name(sp_stop_reason r)
 {
@@ -221,7 +214,7 @@ static bool iterate_round(sp_solver* s, attempt_run* r, int its, const sp_weight
 {
     for (int i = 0; i < its; ++i) {
         if (r->rep->iterations >= s->d.max_iterations) break;
-        if (now_ms() - r->t0 > r->time_cap_ms) {
+        if (sp_now_ms() - r->t0 > r->time_cap_ms) {
             r->time_up = true;
             break;
         }
@@ -363,7 +356,7 @@ static sp_result run_plan(sp_solver* s, attempt_run* r, double* p_out)
 static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_start, const attempt* at, double time_cap_ms,
                              double* p_out, sp_solve_report* rep, plan* pl, sp_error* err)
 {
-    attempt_run r = {.sk = sk, .at = at, .pl = pl, .t0 = now_ms(), .time_cap_ms = time_cap_ms, .rep = rep, .err = err};
+    attempt_run r = {.sk = sk, .at = at, .pl = pl, .t0 = sp_now_ms(), .time_cap_ms = time_cap_ms, .rep = rep, .err = err};
     s->ypoly_valid = false; // the strokes may be new
     memset(rep, 0, sizeof *rep);
     if (!sp__sketch_ok(sk, err)) return SP_ERR_INVALID;
@@ -389,7 +382,7 @@ static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_
     else
         res = sp__build_pairs(s, sk, &(sp_pairing){pl->start_pairing, false, at->loop_shift}, rep, err);
     if (res == SP_OK) res = run_plan(s, &r, p_out);
-    rep->ms = now_ms() - r.t0;
+    rep->ms = sp_now_ms() - r.t0;
 done:
     free(r.it.p), free(r.it.trial), free(r.it.delta), free(r.moves);
     return res;

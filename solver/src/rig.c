@@ -1,5 +1,6 @@
-// rig.c: the rig as data: validation, parameters, the TRS parameterisation
-// and animation sampling. Evaluation (FK, skinning, Jacobians) is in eval.c.
+// rig.c: the rig as data: validation, parameters, the TRS parameterisation,
+// animation sampling and animations through key poses. Evaluation (FK,
+// skinning, Jacobians) is in eval.c.
 #include "sp/rig.h"
 
 #include <assert.h>
@@ -427,4 +428,58 @@ void sp_animation_sample(const sp_animation* anim, double t, sp_vec3* trans, sp_
         else if (ch->path == SP_ANIM_SCALE) scale[j] = (sp_vec3){v[0], v[1], v[2]};
         else rot[j] = sp_quat_norm((sp_quat){v[0], v[1], v[2], v[3]});
     }
+}
+
+sp_result sp_animation_from_keys(const sp_rig* rig, const double* keys, const double* times, int nkeys, const char* name,
+                                 sp_animation* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    snprintf(out->name, sizeof out->name, "%s", name);
+    if (nkeys < 1) return sp_fail(err, SP_ERR_INVALID, "an animation needs at least one key");
+    for (int k = 1; k < nkeys; ++k)
+        if (!(times[k] > times[k - 1]))
+            return sp_fail(err, SP_ERR_INVALID, "key times must increase (key %d: %g after %g)", k, times[k], times[k - 1]);
+    // Up to three channels per joint with parameters.
+    out->channels = calloc((size_t)rig->joint_count * 3, sizeof(sp_anim_channel));
+    if (!out->channels) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    const int P = rig->param_count;
+    for (int j = 0; j < rig->joint_count; ++j) {
+        const sp_joint* jt = &rig->joints[j];
+        bool path[3] = {false, false, false};
+        for (int i = 0; i < jt->param_count; ++i) {
+            sp_channel c = rig->params[jt->first_param + i].channel;
+            path[sp_channel_is_rotation(c) ? SP_ANIM_ROTATION : (sp_channel_is_scale(c) ? SP_ANIM_SCALE : SP_ANIM_TRANSLATION)] =
+                true;
+        }
+        for (int ph = 0; ph < 3; ++ph) {
+            if (!path[ph]) continue;
+            int comps = ph == SP_ANIM_ROTATION ? 4 : 3;
+            sp_anim_channel* ch = &out->channels[out->channel_count];
+            ch->joint = j;
+            ch->path = (sp_anim_path)ph;
+            ch->interp = SP_INTERP_LINEAR;
+            ch->key_count = nkeys;
+            ch->times = malloc(sizeof(float) * (size_t)nkeys);
+            ch->values = malloc(sizeof(float) * (size_t)(nkeys * comps));
+            ++out->channel_count;
+            if (!ch->times || !ch->values) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+            for (int k = 0; k < nkeys; ++k) {
+                sp_vec3 t, s;
+                sp_quat r;
+                sp_rig_local_trs(rig, j, keys + (size_t)k * P, &t, &r, &s);
+                ch->times[k] = (float)times[k];
+                float* v = ch->values + k * comps;
+                if (ph == SP_ANIM_ROTATION) {
+                    // Keep neighbouring keys on the same hemisphere so slerp takes the short way.
+                    if (k > 0 && v[-4] * r.x + v[-3] * r.y + v[-2] * r.z + v[-1] * r.w < 0) r = (sp_quat){-r.x, -r.y, -r.z, -r.w};
+                    v[0] = (float)r.x, v[1] = (float)r.y, v[2] = (float)r.z, v[3] = (float)r.w;
+                } else {
+                    sp_vec3 x = ph == SP_ANIM_SCALE ? s : t;
+                    v[0] = (float)x.x, v[1] = (float)x.y, v[2] = (float)x.z;
+                }
+            }
+        }
+    }
+    out->duration_s = times[nkeys - 1];
+    return SP_OK;
 }

@@ -4,25 +4,12 @@
 // descriptors -> histogram -> FLANN k-NN), training on 2000 drawings.
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../../classifier/src/feat.h"
 #include "sp/classifier.h"
+#include "sp/clock.h"
 #include "sp/sketch_io.h"
 #include "test.h"
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
 
 typedef struct row {
     const char* name;
@@ -33,7 +20,7 @@ typedef struct row {
 
 static row summarise(const char* name, double* ms, int n, double target)
 {
-    qsort(ms, (size_t)n, sizeof(double), cmp_double);
+    qsort(ms, (size_t)n, sizeof(double), sp_cmp_double);
     row r = {name, ms[n / 2], ms[(int)(0.9 * (n - 1))], target, n, ""};
     return r;
 }
@@ -71,13 +58,13 @@ int main(int argc, char** argv)
     unsigned char* use = malloc((size_t)ds.count);
     for (int i = 0; i < ds.count; ++i)
         use[i] = ds.samples[i].index % 5 != 0;
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     sp_clf* clf = NULL;
     if (sp_clf_train(&ds, use, &(sp_clf_desc){0}, &clf, &err) != SP_OK) {
         fprintf(stderr, "bench_classifier: %s\n", err.text);
         return 1;
     }
-    double train_ms = now_ms() - t0;
+    double train_ms = sp_now_ms() - t0;
     rows[nr++] = (row){"train 2000 quickdraw (x2 mirrored)", train_ms, train_ms, 0, 1, ""};
 
     double* ms = malloc(sizeof(double) * (size_t)(runs > ds.count ? runs : ds.count));
@@ -85,9 +72,9 @@ int main(int argc, char** argv)
     int n = 0;
     for (int k = 0; k < runs; ++k) {
         const sp_sample* s = &ds.samples[(k * 5) % ds.count];
-        double a = now_ms();
+        double a = sp_now_ms();
         sp_feat_extract(&s->sketch, NULL, f, &err);
-        ms[n++] = now_ms() - a;
+        ms[n++] = sp_now_ms() - a;
     }
     rows[nr++] = summarise("rasterise + descriptors", ms, n, 0);
 
@@ -96,9 +83,9 @@ int main(int argc, char** argv)
     for (int k = 0; k < runs; ++k) {
         const sp_sample* s = &ds.samples[(k * 5) % ds.count];
         sp_clf_answer a;
-        double t = now_ms();
+        double t = sp_now_ms();
         sp_clf_classify(clf, &s->sketch, NULL, &a, &err);
-        ms[n++] = now_ms() - t;
+        ms[n++] = sp_now_ms() - t;
         if (s->index % 5 == 0) {
             ++tested;
             right += a.count > 0 && a.ranked[0].category == s->label;

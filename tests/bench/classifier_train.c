@@ -10,19 +10,12 @@
 // reject calibration) from the progress callback.
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "sp/classifier.h"
+#include "sp/clock.h"
 #include "sp/handdraw.h"
 #include "sp/sketch_io.h"
 #include "test.h"
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
 
 // Stage boundaries seen through the progress callback.
 typedef struct stages {
@@ -32,7 +25,7 @@ typedef struct stages {
 static void on_progress(void* user, const char* stage, int done, int total)
 {
     stages* s = user;
-    double t = now_ms() - s->t0;
+    double t = sp_now_ms() - s->t0;
     if (!strcmp(stage, "descriptors") && done == total)
         s->descriptors = t;
     else if (!strcmp(stage, "vocabulary") && done == total)
@@ -110,13 +103,13 @@ int main(int argc, char** argv)
     for (int r = 0; r < nr; ++r) {
         rows[r].desc.progress = on_progress;
         rows[r].desc.progress_user = &rows[r].st;
-        rows[r].st.t0 = now_ms();
+        rows[r].st.t0 = sp_now_ms();
         sp_clf* clf = NULL;
         if (sp_clf_train(&ds, NULL, &rows[r].desc, &clf, &err) != SP_OK) {
             fprintf(stderr, "bench_classifier_train: %s\n", err.text);
             return 1;
         }
-        rows[r].ms = now_ms() - rows[r].st.t0;
+        rows[r].ms = sp_now_ms() - rows[r].st.t0;
         sp_clf_free(clf);
     }
     if (json) {

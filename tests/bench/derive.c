@@ -14,6 +14,7 @@
 
 #include "bench.h"
 #include "foreign_gltf.h"
+#include "sp/clock.h"
 #include "sp/derive.h"
 #include "sp/gltf.h"
 #include "test.h"
@@ -28,13 +29,13 @@ static bool derive_once(const char* in, const char* out, stage_ms* t, int* verti
 {
     sp_character src = {0}, part = {0};
     sp_error err = {0};
-    double t0 = sp_bench_now_ms();
+    double t0 = sp_now_ms();
     bool ok = sp_gltf_load(in, &src, &err) == SP_OK;
-    double t1 = sp_bench_now_ms();
+    double t1 = sp_now_ms();
     ok = ok && sp_part_derive(&src, NULL, &part, NULL, &err) == SP_OK;
-    double t2 = sp_bench_now_ms();
+    double t2 = sp_now_ms();
     ok = ok && sp_gltf_save(&part, NULL, out, &err) == SP_OK;
-    double t3 = sp_bench_now_ms();
+    double t3 = sp_now_ms();
     if (!ok) fprintf(stderr, "bench derive: %s\n", err.text);
     *t = (stage_ms){t1 - t0, t2 - t1, t3 - t2, t3 - t0};
     *vertices = src.rig.vertex_count;

@@ -14,26 +14,13 @@
 // else the code-built stand-ins (tests/support/dragon_parts.h).
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "dragon_parts.h"
 #include "sp/classifier.h"
+#include "sp/clock.h"
 #include "sp/handdraw.h"
 #include "sp/partdb.h"
 #include "test.h"
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
 
 typedef struct variant {
     const char* name;
@@ -54,9 +41,9 @@ static answer* classify_all(const sp_clf* clf, const sp_dataset* ds, double* ms_
     for (int i = 0; i < ds->count; ++i) {
         sp_clf_answer r;
         sp_error err = {0};
-        double t = now_ms();
+        double t = sp_now_ms();
         sp_result rc = sp_clf_classify(clf, &ds->samples[i].sketch, NULL, &r, &err);
-        ms[i] = now_ms() - t;
+        ms[i] = sp_now_ms() - t;
         a[i].label = -1;
         for (int c = 0; ds->samples[i].label >= 0 && c < sp_clf_category_count(clf); ++c)
             if (!strcmp(sp_clf_category(clf, c), ds->categories[ds->samples[i].label])) a[i].label = c;
@@ -65,7 +52,7 @@ static answer* classify_all(const sp_clf* clf, const sp_dataset* ds, double* ms_
         for (int j = 0; rc == SP_OK && j < r.count && j < 3; ++j)
             a[i].top3 |= r.ranked[j].category == a[i].label;
     }
-    qsort(ms, (size_t)ds->count, sizeof(double), cmp_double);
+    qsort(ms, (size_t)ds->count, sizeof(double), sp_cmp_double);
     if (ms_median) *ms_median = ds->count ? ms[ds->count / 2] : 0;
     if (ms_p90) *ms_p90 = ds->count ? ms[(int)(0.9 * (ds->count - 1))] : 0;
     free(ms);
@@ -158,7 +145,7 @@ int main(int argc, char** argv)
     bool assets = dragon_parts_load(sp_test_src_path("assets"), parts);
     sp_error err = {0};
     sp_dataset train, test, cal, scrib = {0};
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     if (dragon_set(parts, ntrain, 1, &(sp_handdraw_desc){.style = SP_HANDDRAW_NORMAL, .clean_share = 0.25}, &train, &err) !=
             SP_OK ||
         dragon_set(parts, ntest, 2, &(sp_handdraw_desc){.style = SP_HANDDRAW_HARSH}, &test, &err) != SP_OK ||
@@ -166,7 +153,7 @@ int main(int argc, char** argv)
         fprintf(stderr, "bench_dragon_classes: %s\n", err.text);
         return 1;
     }
-    double gen_ms = now_ms() - t0;
+    double gen_ms = sp_now_ms() - t0;
     if (nscrib > 0 && dragon_scribbles(sp_test_data_dir(), nscrib, &scrib, &err) != SP_OK)
         fprintf(stderr, "bench_dragon_classes: no scribbles (%s)\n", err.text);
     fprintf(
@@ -205,12 +192,12 @@ int main(int argc, char** argv)
                "reject", "train ms", "ms med", "ms p90");
     for (int v = 0; v < nv; ++v) {
         sp_clf* clf = NULL;
-        double a0 = now_ms();
+        double a0 = sp_now_ms();
         if (sp_clf_train(&train, NULL, &vs[v].desc, &clf, &err) != SP_OK) {
             fprintf(stderr, "bench_dragon_classes: %s: %s\n", vs[v].name, err.text);
             return 1;
         }
-        double train_ms = now_ms() - a0;
+        double train_ms = sp_now_ms() - a0;
         double med, p90;
         answer* at = classify_all(clf, &test, &med, &p90);
         answer* as = classify_all(clf, &scrib, NULL, NULL);

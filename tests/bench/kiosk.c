@@ -24,6 +24,7 @@
 #include "fixtures.h"
 #include "kiosk.h"
 #include "kiosk_parts.h"
+#include "sp/clock.h"
 #include "sp/headless.h"
 #include "sp/render.h"
 
@@ -58,13 +59,13 @@ static double frame(sp_kiosk* k, double t)
         sp_render_target_bind(g_target);
     else
         glBindFramebuffer(GL_FRAMEBUFFER, g_fbo);
-    double t0 = sp_bench_now_ms(), c0 = cpu_ms();
+    double t0 = sp_now_ms(), c0 = cpu_ms();
     sp_kiosk_update(k, t);
     if (g_ncpu < 4096) g_upd_cpu[g_ncpu] = cpu_ms() - c0;
     sp_kiosk_draw(k);
     glFinish();
     if (g_ncpu < 4096) g_cpu[g_ncpu++] = cpu_ms() - c0;
-    return sp_bench_now_ms() - t0;
+    return sp_now_ms() - t0;
 }
 
 // The CPU time of the frames since the last call, as an extra JSON member.
@@ -103,7 +104,7 @@ static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row*
     long warm = 0, peak = 0;
     static double samples[4096];
     int ns = 0;
-    double t0 = sp_bench_now_ms();
+    double t0 = sp_now_ms();
     sp_vec2* xy = NULL;
     int cap = 0;
     for (int i = 0; i < n; ++i) {
@@ -145,7 +146,7 @@ static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row*
     free(xy);
     long end = rss_kb();
     if (!peak) peak = warm;
-    double ms = (sp_bench_now_ms() - t0) / n;
+    double ms = (sp_now_ms() - t0) / n;
     *row = (sp_bench_row){"soak: ms per stroke", ms, ms, n, -1, -1, ""};
     // The last ten samples' median: the level memory settles at (a single
     // sample can catch the allocator holding a freed postcard or export).
@@ -256,7 +257,7 @@ int main(int argc, char** argv)
     }
 
     // Start to first frame (the database exists, as in a museum after install).
-    double t0 = sp_bench_now_ms();
+    double t0 = sp_now_ms();
     sp_kiosk* k = sp_kiosk_create(
         &(sp_kiosk_desc){.db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod}, &err);
     if (!k) {
@@ -265,7 +266,7 @@ int main(int argc, char** argv)
     }
     sp_kiosk_resize(k, W, H, 96 / 25.4);
     frame(k, 0);
-    double start = sp_bench_now_ms() - t0;
+    double start = sp_now_ms() - t0;
     rows[nr++] = (sp_bench_row){"start to first frame", start, start, 1, -1, 2000, ""};
     snprintf(rows[nr - 1].extra, sizeof rows[nr - 1].extra, "\"database\": \"%s\"", real ? "assets" : "stand-ins");
 
@@ -304,10 +305,10 @@ int main(int argc, char** argv)
             for (int p = 1; p < s->n; ++p)
                 ev(k, SP_KEV_MOVE, t + 0.01 * p, s->xy[p].x, s->xy[p].y);
             t += 0.01 * s->n;
-            double up = sp_bench_now_ms();
+            double up = sp_now_ms();
             ev(k, SP_KEV_UP, t, s->xy[s->n - 1].x, s->xy[s->n - 1].y);
             frame(k, t += step);
-            lat[n++] = sp_bench_now_ms() - up;
+            lat[n++] = sp_now_ms() - up;
             for (int f = 0; f < 60; ++f) // the flash ends, the part shows
                 frame(k, t += step);
         }
@@ -348,10 +349,10 @@ int main(int argc, char** argv)
         for (int p = 1; p < s->n; ++p)
             ev(k, SP_KEV_MOVE, t + 0.01 * p, s->xy[p].x + dx, s->xy[p].y + dy);
         t += 0.01 * s->n;
-        double up = sp_bench_now_ms();
+        double up = sp_now_ms();
         ev(k, SP_KEV_UP, t, s->xy[s->n - 1].x + dx, s->xy[s->n - 1].y + dy);
         frame(k, t += step);
-        lat20[more++] = sp_bench_now_ms() - up;
+        lat20[more++] = sp_now_ms() - up;
         for (int f = 0; f < 60; ++f)
             frame(k, t += step);
     }

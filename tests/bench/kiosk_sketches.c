@@ -20,6 +20,7 @@
 
 #include "bench.h"
 #include "db_internal.h"
+#include "sp/clock.h"
 #include "sp/gltf.h"
 #include "sp/handdraw.h"
 #include "sp/partdb.h"
@@ -107,7 +108,7 @@ int main(int argc, char** argv)
     }
     // A year of them: in bulk (as the kiosk's call stores them: pending, points
     // and times), then the last 1,000 through the kiosk's call, timed.
-    double t0 = sp_bench_now_ms();
+    double t0 = sp_now_ms();
     int timed = count < 1000 ? count : 1000;
     char* text[DISTINCT];
     for (int i = 0; i < nd; ++i)
@@ -131,13 +132,13 @@ int main(int argc, char** argv)
     if (db_commit(db, &err) != SP_OK) fail(&err);
     for (int i = 0; i < nd; ++i)
         free(text[i]);
-    double fill_s = (sp_bench_now_ms() - t0) / 1000;
+    double fill_s = (sp_now_ms() - t0) / 1000;
     double* ms_collect = malloc(sizeof(double) * (size_t)timed);
     for (int i = count - timed; i < count; ++i) {
         const sp_stroke* s = &strokes[i % nd];
-        double t = sp_bench_now_ms();
+        double t = sp_now_ms();
         if (sp_db_collect_kiosk_sketch(db, cats[labels[i % nd]], s, 1280, 800, NULL, &err) != SP_OK) fail(&err);
-        ms_collect[i - (count - timed)] = sp_bench_now_ms() - t;
+        ms_collect[i - (count - timed)] = sp_now_ms() - t;
     }
     // Approve a share (the worst case for training: all of them), in batches of 256 ids.
     int64_t first = 0;
@@ -158,19 +159,19 @@ int main(int argc, char** argv)
     double ms_page[20], ms_approve[20];
     unsigned mask = napprove < count ? 1u << SP_DB_PENDING : 1u << SP_DB_APPROVED;
     for (int r = 0; r < 20; ++r) {
-        double t = sp_bench_now_ms();
+        double t = sp_now_ms();
         int counts[SP_DB_STATUS_COUNT];
         if (sp_db_kiosk_counts(db, counts, &err) != SP_OK) fail(&err);
         if (sp_db_kiosk_list(db, &(sp_db_kiosk_query){.statuses = mask, .limit = 100}, &page, &n, &err) != SP_OK || n != 100)
             fail(&err);
-        ms_page[r] = sp_bench_now_ms() - t;
+        ms_page[r] = sp_now_ms() - t;
         int64_t ids[100];
         for (int k = 0; k < 100; ++k)
             ids[k] = page[k].id;
         sp_db_kiosk_free(page, n);
-        t = sp_bench_now_ms();
+        t = sp_now_ms();
         if (sp_db_kiosk_set_status(db, ids, 100, SP_DB_APPROVED, "bench", &err) != SP_OK) fail(&err);
-        ms_approve[r] = sp_bench_now_ms() - t;
+        ms_approve[r] = sp_now_ms() - t;
     }
     // The command a curator types: `db review` (first page of 100 as JSON), five runs.
     double ms_cli[5];
@@ -178,17 +179,17 @@ int main(int argc, char** argv)
     char cmd[1024];
     snprintf(cmd, sizeof cmd, "'%s/app/sketchpose' db review --db '%s' --status all >/dev/null", SP_BINARY_DIR, path);
     for (int r = 0; r < 5 && access(SP_BINARY_DIR "/app/sketchpose", X_OK) == 0; ++r) {
-        double t = sp_bench_now_ms();
+        double t = sp_now_ms();
         if (system(cmd) != 0) break;
-        ms_cli[ncli++] = sp_bench_now_ms() - t;
+        ms_cli[ncli++] = sp_now_ms() - t;
     }
     // Training with the default options (cross-validation and calibration included).
     char* report = NULL;
     struct rusage ru0, ru1;
     getrusage(RUSAGE_SELF, &ru0);
-    t0 = sp_bench_now_ms();
+    t0 = sp_now_ms();
     if (sp_db_train(db, &(sp_db_train_desc){.by = "bench"}, &report, &err) != SP_OK) fail(&err);
-    double train_ms = sp_bench_now_ms() - t0;
+    double train_ms = sp_now_ms() - t0;
     getrusage(RUSAGE_SELF, &ru1);
     double cpu_s =
         (double)(ru1.ru_utime.tv_sec - ru0.ru_utime.tv_sec) + 1e-6 * (double)(ru1.ru_utime.tv_usec - ru0.ru_utime.tv_usec) +

@@ -3,24 +3,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
-double sp_bench_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return x < y ? -1 : x > y;
-}
+#include "sp/math.h"
 
 void sp_bench_stats(double* ms, int n, double* median, double* p90)
 {
-    qsort(ms, (size_t)n, sizeof(double), cmp_double);
+    qsort(ms, (size_t)n, sizeof(double), sp_cmp_double);
     *median = n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
     int k = (int)(0.9 * (n - 1) + 0.5);
     *p90 = ms[k];

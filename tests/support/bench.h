@@ -18,8 +18,6 @@ typedef struct sp_bench_row {
     char extra[256];  ///< extra JSON members, e.g. "\"vertices\": 50000" (may be empty)
 } sp_bench_row;
 
-/// Monotonic clock in milliseconds.
-double sp_bench_now_ms(void);
 /// Median and 90th percentile of n samples (sorts them).
 void sp_bench_stats(double* ms, int n, double* median, double* p90);
 /// Prints the rows as a table, or as JSON when json is set.

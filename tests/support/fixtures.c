@@ -5,6 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <cjson/cJSON.h>
+
+#include "test.h"
+
 double sp_test_uniform(sp_test_rng* r)
 {
     uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
@@ -134,4 +138,22 @@ void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplit
         if (sp_channel_is_rotation(q->channel)) lo = fmax(lo, q->def - amplitude), hi = fmin(hi, q->def + amplitude);
         p[i] = sp_test_range(rng, lo, hi);
     }
+}
+
+cJSON* sp_fixture_glb_json(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    ENSURE(f);
+    unsigned char h[20];
+    ENSURE(fread(h, 1, 20, f) == 20);
+    ENSURE(!memcmp(h, "glTF", 4));
+    uint32_t len = (uint32_t)h[12] | (uint32_t)h[13] << 8 | (uint32_t)h[14] << 16 | (uint32_t)h[15] << 24;
+    char* text = malloc(len + 1);
+    ENSURE(fread(text, 1, len, f) == len);
+    text[len] = 0;
+    fclose(f);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    ENSURE(j);
+    return j;
 }

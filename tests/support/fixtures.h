@@ -3,6 +3,11 @@
 /// sp_fixture_tree_rig builds a tube mesh around any skeleton: rings of
 /// vertices along every bone, skinned smoothly between the bone's two joints,
 /// plus a "stick" abstraction (points along each bone, rigid to its parent).
+///
+/// The fixture library (sp_test_fixtures, tests/CMakeLists.txt) holds every
+/// fixture the tests and benchmarks share: these rigs, the dragon parts
+/// (dragon_parts.h), the pipeline test's parts (test_parts.h), the foreign
+/// lizard (foreign_gltf.h) and sp_fixture_glb_json.
 #ifndef SP_FIXTURES_H
 #define SP_FIXTURES_H
 
@@ -31,5 +36,9 @@ typedef struct sp_fixture_desc {
 void sp_fixture_tree_rig(const sp_fixture_desc* desc, sp_rig* out);
 /// Random in-bounds parameters (rotations within +-amplitude of the default).
 void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p);
+
+/// A GLB file's JSON chunk, parsed (fails the running test when the file is
+/// no GLB or its JSON does not parse). Free with cJSON_Delete.
+struct cJSON* sp_fixture_glb_json(const char* path);
 
 #endif

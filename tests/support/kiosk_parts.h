@@ -1,5 +1,5 @@
 /// kiosk_parts.h: a part database and dragon strokes for the kiosk's end-to-end
-/// test and benchmark (header-only; needs sp::partdb).
+/// test and benchmark (header-only; needs sp_test_fixtures).
 ///
 /// kp_build_db() fills a new database with the six dragon parts: assets/<part>.glb
 /// when all six are there and pass the database's checks (a quickly trained
@@ -11,11 +11,7 @@
 #ifndef SP_TEST_KIOSK_PARTS_H
 #define SP_TEST_KIOSK_PARTS_H
 
-// The shared parts header defines helpers other programs use (static).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
 #include "dragon_parts.h"
-#pragma GCC diagnostic pop
 
 #include "sp/partdb.h"
 #include "sp/synth.h"

@@ -7,7 +7,7 @@
 # so that they run in parallel (the sanitizer build runs the first 10 seeds
 # of each part's recovery and does not assert the rate).
 add_executable(test_assets unit/test_assets.c)
-target_link_libraries(test_assets PRIVATE sp_test_support sp::partdb PkgConfig::CJSON)
+target_link_libraries(test_assets PRIVATE sp_test_fixtures sp::partdb PkgConfig::CJSON)
 target_compile_definitions(test_assets PRIVATE SP_ASSETGEN="$<TARGET_FILE:sp-assetgen>")
 add_dependencies(test_assets sp-assetgen)
 foreach(check regenerate_identical contents characters random_poses validator gltf_client)
@@ -16,7 +16,7 @@ foreach(check regenerate_identical contents characters random_poses validator gl
 endforeach()
 
 add_executable(test_assets_recovery unit/test_assets_recovery.c)
-target_link_libraries(test_assets_recovery PRIVATE sp_test_support sp::partdb)
+target_link_libraries(test_assets_recovery PRIVATE sp_test_fixtures sp::partdb)
 if(SP_SANITIZE)
   target_compile_definitions(test_assets_recovery PRIVATE SP_ASSETS_RECOVERY_CASES=10)
 endif()

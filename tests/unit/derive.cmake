@@ -6,7 +6,7 @@
 # pipeline after `db train`. One CTest entry per check so that they run in parallel.
 if(TARGET sketchpose)
   add_executable(test_derive unit/test_derive.c)
-  target_link_libraries(test_derive PRIVATE sp_test_support sp_render sp::partdb PkgConfig::CJSON)
+  target_link_libraries(test_derive PRIVATE sp_test_fixtures sp_render sp::partdb PkgConfig::CJSON)
   add_dependencies(test_derive sketchpose)
   set(timeout 300)
   if(SP_SANITIZE)

@@ -359,12 +359,6 @@ static void test_threads_bit_identical(void)
     sp_blackbox_free(bb);
 }
 
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
-
 // Seeded targets anywhere within the bounds (amplitude pi: every parameter
 // uniform in its range), their abstraction projected as strokes, solved
 // from the rest pose.
@@ -400,8 +394,8 @@ static void test_face_recovery(void)
         ok += rel[i] <= 0.01;
         sp_sketch_free(&sk);
     }
-    qsort(rel, CASES, sizeof(double), cmp_double);
-    qsort(ms, CASES, sizeof(double), cmp_double);
+    qsort(rel, CASES, sizeof(double), sp_cmp_double);
+    qsort(ms, CASES, sizeof(double), sp_cmp_double);
     printf("  face recovery: %d/%d within 1%% of the diagonal; error median %.3f%%, p95 %.3f%%, worst %.3f%%; solve median %.0f "
            "ms\n",
            ok, CASES, 100 * rel[CASES / 2], 100 * rel[(int)(0.95 * (CASES - 1) + 0.5)], 100 * rel[CASES - 1], ms[CASES / 2]);

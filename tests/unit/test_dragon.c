@@ -5,10 +5,11 @@
 // change nothing; undo / clear / refit; live update from a second connection
 // and a database replaced on disk.
 //
-// The parts are built here (chains in the XY plane with a tube mesh, a closed
-// outline abstraction, a looping clip, sp_part sockets / attach hints), so the
-// test does not depend on assets/; `six_real_parts` runs the same checks on
-// the shipped parts once assets/ holds them (skipped before).
+// The parts are built in code (tests/support/test_parts.h: chains in the XY
+// plane with a tube mesh, a closed outline abstraction, a looping clip,
+// sp_part sockets / attach hints), so the test does not depend on assets/;
+// `six_real_parts` runs the same checks on the shipped parts once assets/
+// holds them (skipped before).
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -16,12 +17,13 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
 
 #include "dragon_internal.h" // fault injection: sp_dragon.fit_hook
+#include "fixtures.h"
+#include "sp/clock.h"
 #include "sp/curve.h"
 #include "sp/dragon.h"
 #include "sp/dragon_snapshot.h"
@@ -29,244 +31,11 @@
 #include "sp/sketch_io.h"
 #include "sp/synth.h"
 #include "test.h"
+#include "test_parts.h"
 
 #define PI 3.14159265358979323846
 
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
-
-// ---- test parts --------------------------------------------------------------------
-
-typedef struct spec {
-    const char* name;
-    const char* category;
-    int joints;          // chain joints (the last is the tip)
-    double bone_len;     // world units
-    double angle0, bend; // chain direction in the XY plane and rest bend per joint, radians
-    double r0, r1;       // tube radius at the root and at the tip
-    double clip_s;       // clip duration, seconds (0: no clip)
-    double sway;         // clip amplitude, radians
-    float color[3];
-    const char* extras; // sp_part JSON
-} spec;
-
-// Distinct silhouettes, so a small classifier trained on their synthetic sketches tells them apart.
-static const spec k_specs[] = {
-    {"torso_t",
-     "torso",
-     4,
-     1.0,
-     0.0,
-     0.0,
-     0.55,
-     0.45,
-     2.0,
-     0.06,
-     {0.35f, 0.55f, 0.3f},
-     "{\"category\": \"torso\", \"sockets\": ["
-     "{\"name\": \"neck\", \"joint\": \"j3\", \"accepts\": [\"head\"]},"
-     "{\"name\": \"tail\", \"joint\": \"j0\", \"accepts\": [\"tail\"]},"
-     "{\"name\": \"back\", \"joint\": \"j1\", \"position\": [1.0, 0.5, 0.0], \"accepts\": [\"wings\"]},"
-     "{\"name\": \"hips\", \"joint\": \"j1\", \"position\": [0.8, -0.5, 0.0], \"accepts\": [\"legs\"]}]}"},
-    {"tail_t",
-     "tail",
-     6,
-     0.6,
-     PI,
-     -0.25,
-     0.22,
-     0.03,
-     1.0,
-     0.3,
-     {0.3f, 0.5f, 0.3f},
-     "{\"category\": \"tail\", \"attach\": {\"joint\": \"j0\"}}"},
-    {"head_t",
-     "head",
-     3,
-     0.35,
-     0.5,
-     -0.5,
-     0.3,
-     0.32,
-     0.8,
-     0.25,
-     {0.4f, 0.6f, 0.35f},
-     "{\"category\": \"head\", \"attach\": \"j0\"}"},
-    {"wings_t", "wings", 4, 0.7, 1.2, -0.7, 0.06, 0.35, 0.5, 0.4, {0.7f, 0.3f, 0.25f}, "{\"category\": \"wings\"}"},
-    {"legs_t",
-     "legs",
-     4,
-     0.5,
-     -PI / 2,
-     0.25,
-     0.12,
-     0.12,
-     0.0,
-     0.0,
-     {0.3f, 0.45f, 0.25f},
-     "{\"category\": \"legs\", \"attach\": {\"joint\": \"j0\"}}"},
-};
-enum { NSPEC = sizeof k_specs / sizeof k_specs[0] };
-// Added later by the live-update test (a category the first model does not know).
-static const spec k_horns = {
-    "horns_t", "horns", 5, 0.3, PI / 2, 0.9, 0.12, 0.01, 0.0, 0.0, {0.8f, 0.8f, 0.7f}, "{\"category\": \"horns\"}"};
-
-// The chain's rig: rotation about z per joint, root placement (tx, ty, uniform s),
-// per-joint uniform scales as shape parameters; a tube mesh; a closed outline.
-// flat: the mesh collapsed onto the chain (every triangle of zero area); the outline keeps its width.
-static void build_rig(const spec* s, bool flat, sp_rig* rig)
-{
-    memset(rig, 0, sizeof *rig);
-    int nj = s->joints, bones = nj - 1, rings = 6, rv = 10;
-    rig->joint_count = nj;
-    rig->joints = calloc((size_t)nj, sizeof(sp_joint));
-    sp_mat4* world = malloc(sizeof(sp_mat4) * (size_t)nj);
-    for (int j = 0; j < nj; ++j) {
-        sp_joint* jt = &rig->joints[j];
-        snprintf(jt->name, sizeof jt->name, "j%d", j);
-        jt->parent = j - 1;
-        jt->rest_t = j == 0 ? sp_v3(0, 0, 0) : sp_v3(s->bone_len, 0, 0);
-        jt->rest_r = sp_quat_axis_angle(sp_v3(0, 0, 1), j == 0 ? s->angle0 : s->bend);
-        jt->rest_s = sp_v3(1, 1, 1);
-        sp_mat4 local = sp_mat4_trs(jt->rest_t, jt->rest_r, jt->rest_s);
-        world[j] = j == 0 ? local : sp_mat4_mul(&world[j - 1], &local);
-        sp_mat4_inverse(&world[j], &jt->inverse_bind);
-    }
-    for (int j = 0; j < nj; ++j) {
-        if (j == 0) {
-            sp_rig_add_param(rig, j, SP_CH_RZ, -0.8, 0.8, SP_GROUP_POSE);
-            sp_rig_add_param(rig, j, SP_CH_TX, -3, 3, SP_GROUP_POSE);
-            sp_rig_add_param(rig, j, SP_CH_TY, -3, 3, SP_GROUP_POSE);
-            sp_rig_add_param(rig, j, SP_CH_S, 0.5, 2.0, SP_GROUP_SHAPE);
-        } else if (j < nj - 1) {
-            sp_rig_add_param(rig, j, SP_CH_RZ, -0.9, 0.9, SP_GROUP_POSE);
-            sp_rig_add_param(rig, j, SP_CH_S, 0.7, 1.4, SP_GROUP_SHAPE);
-        }
-    }
-    int nv = bones * rings * rv;
-    rig->vertex_count = nv;
-    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
-    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
-    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
-    rig->triangle_count = bones * (rings - 1) * rv * 2;
-    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
-    // Outline: one side root -> tip, the other tip -> root (a closed loop).
-    int side = bones * (rings - 1) + 1, np = 2 * side;
-    sp_abstraction ab = {0};
-    snprintf(ab.name, sizeof ab.name, "outline");
-    ab.correspondence = SP_CORR_CLOSEST;
-    ab.curve_count = 1;
-    ab.curves = calloc(1, sizeof(sp_curve));
-    snprintf(ab.curves[0].name, sizeof ab.curves[0].name, "outline");
-    ab.curves[0].point_count = np;
-    ab.curves[0].closed = true;
-    ab.point_count = np;
-    ab.rest = malloc(sizeof(double) * 3 * (size_t)np);
-    ab.joints = calloc((size_t)np * 4, sizeof(uint16_t));
-    ab.weights = calloc((size_t)np * 4, sizeof(float));
-    int v = 0, t = 0;
-    for (int b = 0; b < bones; ++b) {
-        sp_vec3 a = sp_mat4_translation(&world[b]), c = sp_mat4_translation(&world[b + 1]);
-        sp_vec3 dir = sp_v3_sub(c, a);
-        sp_vec3 n1 = sp_v3_norm(sp_v3(-dir.y, dir.x, 0)), n2 = sp_v3(0, 0, 1);
-        int base = v;
-        for (int r = 0; r < rings; ++r) {
-            double u = (double)r / (rings - 1), ug = (b + u) / bones;
-            double radius = s->r0 + (s->r1 - s->r0) * ug;
-            sp_vec3 centre = sp_v3_add(a, sp_v3_scale(dir, u));
-            float w0 = (float)(1.0 - 0.5 * u), w1 = (float)(0.5 * u);
-            for (int k = 0; k < rv; ++k) {
-                double ang = 2.0 * PI * k / rv;
-                double rm = flat ? 0.0 : radius;
-                sp_vec3 p = sp_v3_add(centre, sp_v3_add(sp_v3_scale(n1, rm * cos(ang)), sp_v3_scale(n2, rm * sin(ang))));
-                rig->rest[3 * v] = p.x, rig->rest[3 * v + 1] = p.y, rig->rest[3 * v + 2] = p.z;
-                rig->joints4[4 * v] = (uint16_t)b, rig->joints4[4 * v + 1] = (uint16_t)(b + 1);
-                rig->weights4[4 * v] = w0, rig->weights4[4 * v + 1] = w1;
-                ++v;
-            }
-            // Outline points at this ring (the first ring of later bones repeats the previous tip ring).
-            if (r == 0 && b > 0) continue;
-            int i = b * (rings - 1) + r, k2 = np - 1 - i;
-            sp_vec3 l = sp_v3_add(centre, sp_v3_scale(n1, radius)), rr = sp_v3_sub(centre, sp_v3_scale(n1, radius));
-            ab.rest[3 * i] = l.x, ab.rest[3 * i + 1] = l.y, ab.rest[3 * i + 2] = 0;
-            ab.rest[3 * k2] = rr.x, ab.rest[3 * k2 + 1] = rr.y, ab.rest[3 * k2 + 2] = 0;
-            ab.joints[4 * i] = ab.joints[4 * k2] = (uint16_t)b;
-            ab.joints[4 * i + 1] = ab.joints[4 * k2 + 1] = (uint16_t)(b + 1);
-            ab.weights[4 * i] = ab.weights[4 * k2] = w0;
-            ab.weights[4 * i + 1] = ab.weights[4 * k2 + 1] = w1;
-        }
-        for (int r = 0; r + 1 < rings; ++r)
-            for (int k = 0; k < rv; ++k) {
-                uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
-                uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
-                uint32_t* tr = rig->triangles + 3 * t;
-                tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
-                t += 2;
-            }
-    }
-    rig->abstraction_count = 1;
-    rig->abstractions = malloc(sizeof(sp_abstraction));
-    rig->abstractions[0] = ab;
-    if (s->clip_s > 0) {
-        // A sway of every joint but the root and the tip: rest, +sway, rest, -sway, rest.
-        rig->animation_count = 1;
-        rig->animations = calloc(1, sizeof(sp_animation));
-        sp_animation* an = &rig->animations[0];
-        snprintf(an->name, sizeof an->name, "sway");
-        an->duration_s = s->clip_s;
-        an->channels = calloc((size_t)nj, sizeof(sp_anim_channel));
-        for (int j = 1; j < nj - 1; ++j) {
-            sp_anim_channel* ch = &an->channels[an->channel_count++];
-            ch->joint = j;
-            ch->path = SP_ANIM_ROTATION;
-            ch->interp = SP_INTERP_LINEAR;
-            ch->key_count = 5;
-            ch->times = malloc(sizeof(float) * 5);
-            ch->values = malloc(sizeof(float) * 20);
-            // Not at rest at the first key (as the shipped clips, whose phase
-            // lags along a chain): the animation test tells offsets from rest
-            // apart from offsets from the first frame.
-            const double off[5] = {0.5, 1, -0.5, -1, 0.5};
-            for (int k = 0; k < 5; ++k) {
-                ch->times[k] = (float)(s->clip_s * k / 4);
-                sp_quat q = sp_quat_mul(rig->joints[j].rest_r, sp_quat_axis_angle(sp_v3(0, 0, 1), s->sway * off[k]));
-                ch->values[4 * k] = (float)q.x, ch->values[4 * k + 1] = (float)q.y, ch->values[4 * k + 2] = (float)q.z,
-                               ch->values[4 * k + 3] = (float)q.w;
-            }
-        }
-    }
-    free(world);
-    sp_error err = {0};
-    sp_result r = sp_rig_finalize(rig, s->name, NULL, &err);
-    if (r != SP_OK) fprintf(stderr, "  %s: %s\n", s->name, err.text);
-    ENSURE(r == SP_OK);
-}
-
-static void write_part(const spec* s, bool flat, const char* path)
-{
-    sp_rig rig;
-    build_rig(s, flat, &rig);
-    sp_character ch = {0};
-    sp_error err = {0};
-    ENSURE(sp_character_from_rig(&rig, &ch, &err) == SP_OK);
-    for (int i = 0; i < ch.rig.vertex_count; ++i)
-        for (int c = 0; c < 3; ++c)
-            ch.colors[4 * i + c] = s->color[c];
-    ch.part_json = strdup(s->extras);
-    // Seen from the front (-Z), where the outline lies: the default view could pick -X for a fat, short tube.
-    sp_vec3 lo, hi;
-    sp_bounds(ch.rig.rest, ch.rig.vertex_count, &lo, &hi);
-    ch.camera = sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, lo, hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), 640, 480);
-    ch.has_camera = true;
-    sp_result r = sp_gltf_save(&ch, NULL, path, &err);
-    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
-    ENSURE(r == SP_OK);
-    sp_character_free(&ch);
-}
+// ---- test parts: tests/support/test_parts.h (the fixture library) -----------------
 
 static void remove_db(const char* path)
 {
@@ -278,13 +47,13 @@ static void remove_db(const char* path)
     unlink(side);
 }
 
-// Writes the part (flat: see build_rig) and adds it to the database with `sketches` synthetic sketches (-1: none).
-static void add_spec_sketches(sp_db* db, const spec* s, bool flat, uint64_t seed, int sketches)
+// Writes the part (flat: see test_part_rig) and adds it to the database with `sketches` synthetic sketches (-1: none).
+static void add_spec_sketches(sp_db* db, const test_part_spec* s, bool flat, uint64_t seed, int sketches)
 {
     char file[64];
     snprintf(file, sizeof file, "%s.glb", s->name);
     const char* path = sp_test_tmp_path(file);
-    write_part(s, flat, path);
+    test_part_write(s, flat, path);
     sp_error err = {0};
     sp_result r =
         sp_db_add_part_file(db, path, &(sp_db_part_desc){.name = s->name, .synth_sketches = sketches, .seed = seed}, NULL, &err);
@@ -292,7 +61,7 @@ static void add_spec_sketches(sp_db* db, const spec* s, bool flat, uint64_t seed
     ENSURE(r == SP_OK);
 }
 
-static void add_spec(sp_db* db, const spec* s, uint64_t seed)
+static void add_spec(sp_db* db, const test_part_spec* s, uint64_t seed)
 {
     add_spec_sketches(db, s, false, seed, 40);
 }
@@ -321,8 +90,8 @@ static const char* test_db(void)
     sp_db* db = NULL;
     sp_error err = {0};
     ENSURE(sp_db_open(path, SP_DB_CREATE, &db, &err) == SP_OK);
-    for (int i = 0; i < NSPEC; ++i)
-        add_spec(db, &k_specs[i], (uint64_t)i + 1);
+    for (int i = 0; i < TEST_PART_COUNT; ++i)
+        add_spec(db, &k_test_parts[i], (uint64_t)i + 1);
     train(db);
     sp_db_close(db);
     return path;
@@ -442,7 +211,7 @@ static sp_dragon* new_dragon(const char* db_path)
 static int draw_layout(sp_dragon* d, sp_db* db, uint64_t seed, bool verbose)
 {
     int right = 0;
-    for (int i = 0; i < NSPEC; ++i) {
+    for (int i = 0; i < TEST_PART_COUNT; ++i) {
         sp_vec2* xy;
         int n = part_stroke(db, k_layout[i].name, seed + (uint64_t)i, 0.3, k_layout[i].cx, k_layout[i].cy, k_layout[i].size, &xy);
         sp_dragon_result res;
@@ -458,15 +227,15 @@ static int draw_layout(sp_dragon* d, sp_db* db, uint64_t seed, bool verbose)
             ENSURE(res.reason == SP_DRAGON_UNRECOGNISED);
             ENSURE(part_stroke(db, k_layout[i].name, seed + (uint64_t)i, 0.3, k_layout[i].cx, k_layout[i].cy, k_layout[i].size,
                                &xy) > 0);
-            ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = k_specs[i].category}, &res, &err) ==
+            ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = k_test_parts[i].category}, &res, &err) ==
                    SP_OK);
             free(xy);
             ENSURE(!res.rejected);
         } else {
-            right += !strcmp(sp_dragon_part_get(d, res.part)->category, k_specs[i].category);
-            if (strcmp(sp_dragon_part_get(d, res.part)->category, k_specs[i].category)) {
+            right += !strcmp(sp_dragon_part_get(d, res.part)->category, k_test_parts[i].category);
+            if (strcmp(sp_dragon_part_get(d, res.part)->category, k_test_parts[i].category)) {
                 // A wrong guess: the chip tap re-fits it as what was meant.
-                ENSURE(sp_dragon_refit_last(d, k_specs[i].category, &res, &err) == SP_OK && !res.rejected);
+                ENSURE(sp_dragon_refit_last(d, k_test_parts[i].category, &res, &err) == SP_OK && !res.rejected);
             }
         }
         ENSURE(res.part == i && sp_dragon_part_count(d) == i + 1);
@@ -775,10 +544,10 @@ static void test_build_and_attach(void)
     ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
     sp_dragon* d = new_dragon(path);
     int right = draw_layout(d, db, 100, true);
-    fprintf(stderr, "  classified %d of %d right\n", right, NSPEC);
-    ENSURE(right >= NSPEC - 1);
+    fprintf(stderr, "  classified %d of %d right\n", right, TEST_PART_COUNT);
+    ENSURE(right >= TEST_PART_COUNT - 1);
     ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
-    for (int i = 0; i < NSPEC; ++i) {
+    for (int i = 0; i < TEST_PART_COUNT; ++i) {
         const sp_dragon_part* p = sp_dragon_part_get(d, i);
         double rel = p->report.mean_error_px / p->report.bbox_diagonal_px;
         double px = stroke_to_outline_px(d, i);
@@ -809,9 +578,9 @@ static void test_build_and_attach(void)
     // Every part but the torso hangs on the torso (drawn near it), with the
     // socket meant for its kind as the hint, its attachment end on the
     // torso's surface as the torso moves.
-    const char* want[NSPEC] = {"", "tail", "neck", "back", "hips"};
+    const char* want[TEST_PART_COUNT] = {"", "tail", "neck", "back", "hips"};
     ENSURE(sp_dragon_part_get(d, 0)->is_torso && sp_dragon_part_get(d, 0)->attached_to == -1);
-    for (int i = 1; i < NSPEC; ++i) {
+    for (int i = 1; i < TEST_PART_COUNT; ++i) {
         ENSURE(sp_dragon_part_get(d, i)->attached_to == 0);
         ENSURE(!strcmp(sp_dragon_part_get(d, i)->socket, want[i]));
     }
@@ -871,8 +640,8 @@ static void test_animation(void)
         free(rest), free(want);
     }
     // Two times differ (every animated part moves), and the loop closes at T.
-    ENSURE(n == NSPEC);
-    double* x0[NSPEC];
+    ENSURE(n == TEST_PART_COUNT);
+    double* x0[TEST_PART_COUNT];
     for (int i = 0; i < n; ++i) {
         int nv = sp_dragon_part_get(d, i)->character->rig.vertex_count;
         x0[i] = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -908,25 +677,6 @@ static void test_animation(void)
     }
     sp_dragon_destroy(d);
     sp_db_close(db);
-}
-
-// Reads a GLB's JSON chunk.
-static cJSON* glb_json(const char* path)
-{
-    FILE* f = fopen(path, "rb");
-    ENSURE(f);
-    unsigned char h[20];
-    ENSURE(fread(h, 1, 20, f) == 20);
-    ENSURE(!memcmp(h, "glTF", 4));
-    uint32_t len = (uint32_t)h[12] | (uint32_t)h[13] << 8 | (uint32_t)h[14] << 16 | (uint32_t)h[15] << 24;
-    char* text = malloc(len + 1);
-    ENSURE(fread(text, 1, len, f) == len);
-    text[len] = 0;
-    fclose(f);
-    cJSON* j = cJSON_Parse(text);
-    free(text);
-    ENSURE(j);
-    return j;
 }
 
 // The Khronos validator on a file: 1 pass, 0 fail, -1 when it is not installed.
@@ -1184,7 +934,7 @@ static void check_export(sp_dragon* d, const char* file, int parts)
     sp_result r = sp_dragon_export(d, file, &err);
     if (r != SP_OK) fprintf(stderr, "  export: %s\n", err.text);
     ENSURE(r == SP_OK);
-    cJSON* j = glb_json(file);
+    cJSON* j = sp_fixture_glb_json(file);
     const cJSON* skins = cJSON_GetObjectItem(j, "skins");
     const cJSON* anims = cJSON_GetObjectItem(j, "animations");
     ENSURE(cJSON_GetArraySize(skins) == parts);
@@ -1244,7 +994,7 @@ static void test_export(void)
     sp_dragon* d = new_dragon(path);
     ENSURE(sp_dragon_export(d, sp_test_tmp_path("dragon_empty.glb"), &err) == SP_ERR_INVALID);
     draw_layout(d, db, 300, false);
-    check_export(d, sp_test_tmp_path("dragon_test.glb"), NSPEC);
+    check_export(d, sp_test_tmp_path("dragon_test.glb"), TEST_PART_COUNT);
     // The test clips are LINEAR and their keys are among the exported ones: exact between keys too.
     check_playback(d, sp_test_tmp_path("dragon_test.glb"), 1e-4);
     // .gltf with embedded buffers, by extension.
@@ -1456,7 +1206,7 @@ static void test_live_update(void)
     ENSURE(sp_db_open(path, 0, &writer, &err) == SP_OK);
     // Horns: not in the database yet.
     sp_rig rig;
-    build_rig(&k_horns, false, &rig);
+    test_part_rig(&k_test_part_horns, false, &rig);
     sp_character ch = {0};
     ENSURE(sp_character_from_rig(&rig, &ch, &err) == SP_OK);
     sp_sketch sk = {0};
@@ -1480,7 +1230,7 @@ static void test_live_update(void)
     ENSURE(sp_dragon_add_points(d, tail, 40, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK && !res.rejected);
     const sp_character* tail_rig = sp_dragon_part_get(d, res.part)->character;
     // A curator adds the part and retrains, from another connection.
-    add_spec(writer, &k_horns, 9);
+    add_spec(writer, &k_test_part_horns, 9);
     train(writer);
     bool reloaded = false;
     ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded);
@@ -1506,7 +1256,7 @@ static void test_live_update(void)
     // sp_db_create_from_export does): reopened, horns are back.
     copy_file(test_db(), other);
     ENSURE(sp_db_open(other, 0, &writer, &err) == SP_OK);
-    add_spec(writer, &k_horns, 10);
+    add_spec(writer, &k_test_part_horns, 10);
     train(writer);
     sp_db_close(writer);
     ENSURE(rename(other, path) == 0);
@@ -1533,7 +1283,7 @@ static void test_command(void)
     sp_error err = {0};
     ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
     sp_sketch sk = {.canvas_w = 1280, .canvas_h = 800};
-    for (int i = 0; i < NSPEC; ++i) {
+    for (int i = 0; i < TEST_PART_COUNT; ++i) {
         sp_vec2* xy;
         int n = part_stroke(db, k_layout[i].name, 400 + (uint64_t)i, 0.3, k_layout[i].cx, k_layout[i].cy, k_layout[i].size, &xy);
         ENSURE(sp_sketch_add_stroke(&sk, xy, NULL, n) == SP_OK);
@@ -1568,7 +1318,7 @@ static void test_command(void)
     for (size_t k = 0; k < sizeof keys / sizeof keys[0]; ++k)
         ENSURE(cJSON_GetObjectItem(j, keys[k]) != NULL);
     const cJSON* parts = cJSON_GetObjectItem(j, "parts");
-    ENSURE(cJSON_GetArraySize(parts) == NSPEC);
+    ENSURE(cJSON_GetArraySize(parts) == TEST_PART_COUNT);
     const cJSON* pj;
     cJSON_ArrayForEach(pj, parts)
     {
@@ -1582,7 +1332,7 @@ static void test_command(void)
         json_box(cJSON_GetObjectItem(pj, "stroke_bbox_px"), sb);
         const cJSON* at = cJSON_GetObjectItem(pj, "attached_to");
         const cJSON* anchor = cJSON_GetObjectItem(pj, "anchor_px");
-        ENSURE(cJSON_IsNumber(at) && at->valueint >= -1 && at->valueint < NSPEC);
+        ENSURE(cJSON_IsNumber(at) && at->valueint >= -1 && at->valueint < TEST_PART_COUNT);
         ENSURE(at->valueint >= 0 ? cJSON_GetArraySize(anchor) == 2 : cJSON_IsNull(anchor));
     }
     const cJSON* sj;
@@ -1738,9 +1488,9 @@ static void test_six_real_parts(void)
     ENSURE(right >= k - 1);
     // Pen-up to fitted part once the parts are loaded (what a visitor waits for).
     sp_dragon* d2 = new_dragon(path);
-    double tp = now_ms();
+    double tp = sp_now_ms();
     ENSURE(sp_dragon_preload(d2, &err) == SP_OK);
-    fprintf(stderr, "  preloading %d parts: %.0f ms\n", np, now_ms() - tp);
+    fprintf(stderr, "  preloading %d parts: %.0f ms\n", np, sp_now_ms() - tp);
     double ms[256];
     int nm = 0;
     for (int rep = 0; rep < 3; ++rep)
@@ -1919,10 +1669,10 @@ static void test_robustness(void)
     sp_db* db = NULL;
     sp_error err = {0};
     ENSURE(sp_db_open(path, SP_DB_CREATE, &db, &err) == SP_OK);
-    spec flat = k_specs[0];
+    test_part_spec flat = k_test_parts[0];
     flat.name = "flat_t";
     add_spec_sketches(db, &flat, true, 1, -1);
-    add_spec_sketches(db, &k_specs[4], false, 2, -1);
+    add_spec_sketches(db, &k_test_parts[4], false, 2, -1);
     sp_dragon* d = new_dragon(path);
     sp_vec2* xy;
     int n = part_stroke(db, "flat_t", 5, 0.3, 640, 420, 440, &xy);

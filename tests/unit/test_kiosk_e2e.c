@@ -215,24 +215,6 @@ static int validate(const char* file)
     return rc == 0;
 }
 
-static cJSON* glb_json(const char* path)
-{
-    FILE* f = fopen(path, "rb");
-    ENSURE(f);
-    unsigned char h[20];
-    ENSURE(fread(h, 1, 20, f) == 20);
-    ENSURE(!memcmp(h, "glTF", 4));
-    uint32_t len = (uint32_t)h[12] | (uint32_t)h[13] << 8 | (uint32_t)h[14] << 16 | (uint32_t)h[15] << 24;
-    char* text = malloc(len + 1);
-    ENSURE(fread(text, 1, len, f) == len);
-    text[len] = 0;
-    fclose(f);
-    cJSON* j = cJSON_Parse(text);
-    free(text);
-    ENSURE(j);
-    return j;
-}
-
 // ------------------------------------------------------------ picture checks
 
 static bool is_yellow(const uint8_t* p)
@@ -470,7 +452,7 @@ static void test_dragon_session(void)
     fprintf(stderr, "  turned vs playing: %.1f%% of the pixels differ\n", 100 * dturn);
     ENSURE(dturn > 0.02);
     // The export: six skinned parts, one animation, 0 validator errors.
-    cJSON* g = glb_json(glb);
+    cJSON* g = sp_fixture_glb_json(glb);
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "skins")) == DRAGON_PART_COUNT);
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "animations")) == 1);
     cJSON_Delete(g);

@@ -17,12 +17,12 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "db_internal.h"
 #include "fixtures.h"
 #include "mini_gltf.h"
+#include "sp/clock.h"
 #include "sp/partdb.h"
 #include "sp/synth.h"
 #include "test.h"
@@ -43,13 +43,6 @@ static const fixture_part k_parts[] = {
     {"horns_a", "horns", 8, true, 5},
     {"tail_b", "tail", 5, false, 7},
 };
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
 
 static void write_part(const fixture_part* fp, const char* path)
 {
@@ -405,7 +398,7 @@ static void crash_loop(crash_op op, int runs, uint64_t seed)
     // One uninterrupted run measures how long the operation takes (hook included).
     g_hook_ms = 15;
     int parts0 = scalar(p, "SELECT count(*) FROM parts"), sk0 = scalar(p, "SELECT count(*) FROM sketches");
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     pid_t pid = fork();
     ENSURE(pid >= 0);
     if (pid == 0) {
@@ -414,7 +407,7 @@ static void crash_loop(crash_op op, int runs, uint64_t seed)
     }
     int status;
     ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
-    double span = now_ms() - t0;
+    double span = sp_now_ms() - t0;
     sp_error err = {0};
     if (op == OP_ADD_PART) {
         sp_db* db = open_ok(p, 0);
@@ -502,9 +495,9 @@ static void test_two_writers(void)
     sp_db_set_busy_timeout(db, 300);
     sp_dataset ds = one_sketch("tail");
     sp_error err = {0};
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     sp_result r = sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err);
-    double waited = now_ms() - t0;
+    double waited = sp_now_ms() - t0;
     fprintf(stderr, "  busy after %.0f ms: %s\n", waited, err.text);
     ENSURE(r == SP_ERR_BUSY);
     ENSURE(strstr(err.text, "database is busy (held by another writer for more than 0.3 s)"));
@@ -802,10 +795,10 @@ static void test_generation(void)
     uint64_t g0 = sp_db_generation(reader);
     ENSURE(g0 > 0 && sp_db_generation(reader) == g0);
     // A cheap poll: a thousand calls with nothing changed.
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     for (int i = 0; i < 1000; ++i)
         ENSURE(sp_db_generation(reader) == g0);
-    double per = (now_ms() - t0) / 1000;
+    double per = (sp_now_ms() - t0) / 1000;
     fprintf(stderr, "  sp_db_generation: %.2f us per unchanged poll\n", per * 1000);
     int64_t id0 = 0, id1 = 0;
     sp_clf* clf;
@@ -841,11 +834,11 @@ static void test_default_db(void)
     sp_db* db = NULL;
     sp_error err = {0};
     sp_db_default_desc dd = {.synth_per_part = 20, .train = quick_train(-1)};
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     sp_result r = sp_db_create_default(p, dir, &dd, &err);
     if (r != SP_OK) fprintf(stderr, "  default: %s\n", err.text);
     ENSURE(r == SP_OK);
-    fprintf(stderr, "  default database of 3 parts x 20 sketches in %.0f ms\n", now_ms() - t0);
+    fprintf(stderr, "  default database of 3 parts x 20 sketches in %.0f ms\n", sp_now_ms() - t0);
     ENSURE(sp_db_open_or_create_default(p, dir, SP_DB_READONLY, &db, &err) == SP_OK);
     check_ok(db);
     char** cats;
@@ -937,9 +930,9 @@ static void test_kiosk_collect(void)
     ENSURE(sqlite3_exec(other, "BEGIN IMMEDIATE; INSERT INTO log(by, action) VALUES ('other', 'hold')", NULL, NULL, NULL) ==
            SQLITE_OK);
     st = visitor_stroke(0, pts, t);
-    double t0 = now_ms();
+    double t0 = sp_now_ms();
     sp_result r = sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err);
-    double waited = now_ms() - t0;
+    double waited = sp_now_ms() - t0;
     fprintf(stderr, "  busy: %.0f ms: %s\n", waited, err.text);
     ENSURE(r == SP_ERR_BUSY && strstr(err.text, "dropped") && waited < 500);
     sqlite3_exec(other, "ROLLBACK", NULL, NULL, NULL);

@@ -14,16 +14,8 @@
 
 #include <stdio.h>
 #include <sys/types.h>
-#include <time.h>
 
 #include "sp/dragon.h"
-
-static inline double dragon_now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
-}
 
 static inline void dragon_copy_name(char* dst, size_t cap, const char* src)
 {

@@ -16,12 +16,6 @@ static void animation_free(sp_animation* a)
     memset(a, 0, sizeof *a);
 }
 
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return x < y ? -1 : x > y;
-}
-
 // The export's key times over one period [0, T] (*out malloc'd; returns the
 // count, 0 when out of memory): a grid at desc.fps, plus every key of every
 // part's clip as retimed into the loop, so that LINEAR keys do not cut the
@@ -55,7 +49,7 @@ static int key_times(const sp_dragon* d, double** out)
                     if (u > 0 && u < 1) k[n++] = (r + u) * per;
                 }
     }
-    qsort(k, n, sizeof *k, cmp_double);
+    qsort(k, n, sizeof *k, sp_cmp_double);
     // Keys closer than a millisecond are one key (float times must increase).
     size_t m = 0;
     for (size_t i = 0; i < n; ++i)

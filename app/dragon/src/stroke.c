@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "dragon_internal.h"
+#include "sp/clock.h"
 #include "sp/curve.h"
 
 // Cleans a stroke: clamps onto the canvas, drops repeated points, resamples
@@ -196,7 +197,7 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
     out->rejected = true;
     out->reason = why;
     out->part = -1;
-    out->ms_total = dragon_now_ms() - t0;
+    out->ms_total = sp_now_ms() - t0;
     return SP_OK;
 }
 
@@ -252,11 +253,11 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     if (!d->clf) return forced ? SP_DRAGON_ACCEPTED : SP_DRAGON_NO_MODEL;
     sp_clf_answer a;
     sp_error cerr = {0};
-    double tc = dragon_now_ms();
+    double tc = sp_now_ms();
     sp_result r = sp_clf_classify(d->clf, sk, NULL, &a, &cerr);
     if (r == SP_OK) fill_guesses(d->clf, &a, out);
     if (r != SP_OK && !forced) return SP_DRAGON_UNRECOGNISED;
-    out->ms_classify = dragon_now_ms() - tc;
+    out->ms_classify = sp_now_ms() - tc;
     if (forced) return SP_DRAGON_ACCEPTED;
     if (isfinite(a.reject_distance) && a.reject_distance > 0) *near = a.distance / a.reject_distance;
     if (a.count == 0 || a.ranked[0].score < d->desc.min_confidence ||
@@ -270,7 +271,7 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
 sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
                                sp_dragon_result* out, sp_error* err)
 {
-    double t0 = dragon_now_ms();
+    double t0 = sp_now_ms();
     memset(out, 0, sizeof *out);
     out->part = -1;
     sp_dragon_stroke_opts o = opts ? *opts : (sp_dragon_stroke_opts){0};
@@ -304,7 +305,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         return reject(out, why, t0);
     }
     // Fit every variant of the category (and facing); keep the one that matches best.
-    double tf = dragon_now_ms();
+    double tf = sp_now_ms();
     tpl* cands[16];
     int cap = d->desc.max_variants < 16 ? d->desc.max_variants : 16;
     sp_error lerr = {0};
@@ -316,7 +317,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     fit_choice best;
     int not_finite = 0;
     bool fitted = fit_variants(d, cands, nc, &sk, lo, hi, &best, &not_finite);
-    out->ms_fit = dragon_now_ms() - tf;
+    out->ms_fit = sp_now_ms() - tf;
     if (!fitted) {
         free(pts);
         if (not_finite > 0) out->note = SP_DRAGON_NOTE_NOT_FINITE;
@@ -352,7 +353,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
     out->note = d->parts[out->part]->note;
-    out->ms_total = dragon_now_ms() - t0;
+    out->ms_total = sp_now_ms() - t0;
     return SP_OK;
 }
 
@@ -366,7 +367,7 @@ sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_res
 {
     if (d->part_n == 0 || !category) {
         memset(out, 0, sizeof *out);
-        return reject(out, SP_DRAGON_NOTHING_TO_REFIT, dragon_now_ms());
+        return reject(out, SP_DRAGON_NOTHING_TO_REFIT, sp_now_ms());
     }
     part* last = d->parts[d->part_n - 1];
     // A copy: the part (and its stroke) is freed when replaced.

@@ -129,6 +129,19 @@ sp_clf_desc sp_clf_get_desc(const sp_clf* clf);
 /// The training-time options with defaults resolved (what a zero field means).
 sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* desc);
 
+/// Reads a PNG into grey pixels (alpha composited over white). Refuses files whose
+/// header says more than SP_RASTER_MAX_SIDE a side before decoding anything, and
+/// files that are not PNGs whatever their name.
+sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err);
+/// Reads any single drawing by extension (.json, .svg, .png; .ndjson gives its first drawing).
+/// For a PNG, `raster` receives the pixels and `sketch` stays empty; `raster` may be NULL
+/// when the caller only accepts strokes.
+sp_result sp_drawing_read(const char* path, sp_sketch* sketch, sp_raster* raster, sp_error* err);
+/// Loads a labelled folder: `dir/<category>/*.{json,svg,png}` and `dir/<category>.ndjson`.
+/// Files are read in name order so that sample indices (and folds) are reproducible.
+/// Fails on the first unreadable file, naming it.
+sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -233,6 +233,13 @@ static inline sp_sim3 sp_sim3_from_mat4(const sp_mat4* m)
     return (sp_sim3){sp_mat4_translation(m), sp_quat_from_columns(x, y, z), s};
 }
 
+/// qsort comparator of doubles, ascending (NaNs compare equal to anything).
+static inline int sp_cmp_double(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
 #ifdef __cplusplus
 }
 #endif

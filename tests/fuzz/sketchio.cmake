@@ -1,4 +1,4 @@
-# fuzz_ndjson, fuzz_svg: libFuzzer over the classifier's sketch readers (SP_FUZZ=ON, clang only).
+# fuzz_ndjson, fuzz_svg: libFuzzer over sketchio's stroke readers (SP_FUZZ=ON, clang only).
 # fuzz_ndjson also feeds the stroke JSON reader. Run longer by hand, e.g.
 #   build-fuzz/tests/fuzz_svg -max_total_time=60 /tmp/svg-corpus tests/fuzz/corpus/svg
 if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang" OR NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
@@ -6,10 +6,10 @@ if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang" OR NOT CMAKE_CXX_COMPILER_ID MATCHES 
   return()
 endif()
 # Coverage feedback from the readers themselves, not only the entry points.
-target_compile_options(sp_classifier PRIVATE -fsanitize=fuzzer-no-link,address -fno-omit-frame-pointer)
+target_compile_options(sp_sketchio PRIVATE -fsanitize=fuzzer-no-link,address -fno-omit-frame-pointer)
 foreach(t ndjson svg)
   add_executable(fuzz_${t} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_${t}.c)
-  target_link_libraries(fuzz_${t} PRIVATE sp::classifier)
+  target_link_libraries(fuzz_${t} PRIVATE sp::sketchio)
   target_compile_options(fuzz_${t} PRIVATE -fsanitize=fuzzer,address -fno-omit-frame-pointer)
   target_link_options(fuzz_${t} PRIVATE -fsanitize=fuzzer,address)
   # Short smoke run over the seeds; new inputs go to the build tree, never into the checked-in seeds.

@@ -1,11 +1,14 @@
-/// sp/sketch_io.h: reading (and writing) the sketch files people feed us.
+/// sp/sketch_io.h: reading and writing the stroke files people feed us, beside
+/// the stroke type (sp/sketch.h). No OpenCV: a command that only reads
+/// strokes (`pose`, `drawover`, `animate`) needs only this and cJSON.
 ///
 /// Formats (DESIGN.md "Files people feed it"):
 ///   - the JSON stroke file `{"format": "sketchpose-strokes", "version": 1, ...}` (read and write);
 ///   - Quick, Draw! `.ndjson`, many drawings per file;
 ///   - SVG line/path drawings (TU Berlin: <path d> with M/L/H/V/C/S/Q/T/Z, group transforms), curves flattened;
-///   - PNG raster sketches (dark lines on a light background), kept as pixels;
-///   - a labelled folder `DIR/<category>/*.{json,svg,png}` and/or `DIR/<category>.ndjson`.
+///   - labelled sets of drawings (sp_dataset) as data. PNG raster sketches, any drawing by its
+///     extension and labelled folders are read by the classifier (sp/classifier.h:
+///     sp_raster_read_png, sp_drawing_read, sp_dataset_load), which decodes PNGs with OpenCV.
 ///
 ///     sp_sketch s = {0}; sp_error err = {0};
 ///     if (sp_sketch_read_json("S.json", &s, &err) != SP_OK) fprintf(stderr, "%s\n", err.text);
@@ -13,12 +16,12 @@
 ///     sp_sketch_free(&s);
 ///
 /// Every reader validates what it reads (finite coordinates, at most
-/// SP_SKETCH_MAX_POINTS points, PNGs at most SP_RASTER_MAX_SIDE a side) and
-/// fails with one line in `err` naming the file and the problem. Nothing is
-/// partially returned on failure.
+/// SP_SKETCH_MAX_POINTS points) and fails with one line in `err` naming the
+/// file and the problem. Nothing is partially returned on failure.
 #ifndef SP_SKETCH_IO_H
 #define SP_SKETCH_IO_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "sp/result.h"
@@ -69,10 +72,6 @@ sp_result sp_sketch_read_svg(const char* path, sp_sketch* out, sp_error* err);
 /// Parses SVG text of `len` bytes (need not be NUL-terminated).
 sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err);
 
-/// Reads a PNG into grey pixels (alpha composited over white). Refuses files whose
-/// header says more than SP_RASTER_MAX_SIDE a side before decoding anything, and
-/// files that are not PNGs whatever their name.
-sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err);
 /// Frees the pixels and zeroes the raster.
 void sp_raster_free(sp_raster* r);
 
@@ -81,19 +80,21 @@ void sp_raster_free(sp_raster* r);
 sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, const char* name, int label, sp_error* err);
 /// Reads one .ndjson file into `ds` with label `label`.
 sp_result sp_dataset_read_ndjson(sp_dataset* ds, const char* path, int label, sp_error* err);
-/// Loads a labelled folder: `dir/<category>/*.{json,svg,png}` and `dir/<category>.ndjson`.
-/// Files are read in name order so that sample indices (and folds) are reproducible.
-/// Fails on the first unreadable file, naming it.
-sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err);
 /// Adds a category name (copied) and returns its index, or -1 when out of memory.
 int sp_dataset_add_category(sp_dataset* ds, const char* name);
 /// Frees everything and zeroes the set.
 void sp_dataset_free(sp_dataset* ds);
 
-/// Reads any single drawing by extension (.json, .svg, .png; .ndjson gives its first drawing).
-/// For a PNG, `raster` receives the pixels and `sketch` stays empty; `raster` may be NULL
-/// when the caller only accepts strokes.
-sp_result sp_drawing_read(const char* path, sp_sketch* sketch, sp_raster* raster, sp_error* err);
+/// Appends a drawing to `ds`, which takes over its strokes and pixels, and
+/// sets its `index` (its position within its category). SP_ERR_NO_MEMORY
+/// leaves `smp` with the caller.
+sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
+
+/// Reads a whole drawing file into *out (malloc'd, NUL-terminated, *len
+/// bytes without the NUL): regular files of at most SP_SKETCH_MAX_FILE_BYTES.
+sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
+/// True when `path`'s extension (after its last '.', in its last component) is `ext`, ignoring case.
+bool sp_path_ext_is(const char* path, const char* ext);
 
 #ifdef __cplusplus
 }

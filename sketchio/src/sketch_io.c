@@ -1,24 +1,21 @@
-// sketch_io.c: readers for stroke JSON, Quick, Draw! ndjson, SVG, PNG and
-// labelled folders, and the stroke JSON writer.
+// sketch_io.c: readers for stroke JSON, Quick, Draw! ndjson and SVG, the
+// stroke JSON writer, and labelled sets of drawings as data. PNGs and
+// folders (which may hold PNGs) are the classifier's (drawing_io.c).
 #include "sp/sketch_io.h"
 
 #include <cjson/cJSON.h>
 #include <ctype.h>
-#include <dirent.h>
 #include <errno.h>
 #include <math.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
-#include "cv_adapter.h"
-
 // ---------------------------------------------------------------------------
 // Files
 
-static sp_result read_file(const char* path, char** out, size_t* len, sp_error* err)
+sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err)
 {
     *out = NULL;
     *len = 0;
@@ -60,7 +57,7 @@ static const char* ext_of(const char* path)
     return dot + 1;
 }
 
-static bool ext_is(const char* path, const char* ext)
+bool sp_path_ext_is(const char* path, const char* ext)
 {
     return strcasecmp(ext_of(path), ext) == 0;
 }
@@ -209,7 +206,7 @@ sp_result sp_sketch_read_json(const char* path, sp_sketch* out, sp_error* err)
     memset(out, 0, sizeof *out);
     char* text;
     size_t len;
-    sp_result rc = read_file(path, &text, &len, err);
+    sp_result rc = sp_sketch_file_read(path, &text, &len, err);
     if (rc != SP_OK) return rc;
     rc = sp_sketch_parse_json(text, len, path, out, err);
     free(text);
@@ -262,7 +259,7 @@ int sp_dataset_add_category(sp_dataset* ds, const char* name)
     return ds->category_count++;
 }
 
-static sp_result dataset_push(sp_dataset* ds, sp_sample* smp)
+sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp)
 {
     // Grow geometrically; the capacity is implied by count (powers of two).
     int n = ds->count;
@@ -395,7 +392,7 @@ sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, 
         cJSON_Delete(root);
         if (rc != SP_OK) return rc;
         smp.sketch.canvas_w = smp.sketch.canvas_h = 256.0; // Quick, Draw! simplified drawings are 0..255
-        if (dataset_push(ds, &smp) != SP_OK) {
+        if (sp_dataset_add_sample(ds, &smp) != SP_OK) {
             sp_sketch_free(&smp.sketch);
             return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
         }
@@ -407,7 +404,7 @@ sp_result sp_dataset_read_ndjson(sp_dataset* ds, const char* path, int label, sp
 {
     char* text;
     size_t len;
-    sp_result rc = read_file(path, &text, &len, err);
+    sp_result rc = sp_sketch_file_read(path, &text, &len, err);
     if (rc != SP_OK) return rc;
     rc = sp_dataset_parse_ndjson(ds, text, len, path, label, err);
     free(text);
@@ -846,184 +843,9 @@ sp_result sp_sketch_read_svg(const char* path, sp_sketch* out, sp_error* err)
     memset(out, 0, sizeof *out);
     char* text;
     size_t len;
-    sp_result rc = read_file(path, &text, &len, err);
+    sp_result rc = sp_sketch_file_read(path, &text, &len, err);
     if (rc != SP_OK) return rc;
     rc = sp_sketch_parse_svg(text, len, path, out, err);
     free(text);
     return rc;
-}
-
-// ---------------------------------------------------------------------------
-// PNG
-
-sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
-{
-    memset(out, 0, sizeof *out);
-    // Why read the header ourselves: a decoder would allocate the whole image
-    // before we could refuse a 20000x20000 file.
-    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
-    unsigned char hdr[24];
-    size_t got = fread(hdr, 1, sizeof hdr, f);
-    fclose(f);
-    if (got < 8 || memcmp(hdr, sig, 8) != 0) return sp_fail(err, SP_ERR_PARSE, "%s: not a PNG file", path);
-    if (got < 24 || memcmp(hdr + 12, "IHDR", 4) != 0) return sp_fail(err, SP_ERR_PARSE, "%s: PNG header truncated", path);
-    uint32_t w = (uint32_t)hdr[16] << 24 | (uint32_t)hdr[17] << 16 | (uint32_t)hdr[18] << 8 | hdr[19];
-    uint32_t h = (uint32_t)hdr[20] << 24 | (uint32_t)hdr[21] << 16 | (uint32_t)hdr[22] << 8 | hdr[23];
-    if (w == 0 || h == 0) return sp_fail(err, SP_ERR_PARSE, "%s: PNG has zero size", path);
-    if (w > SP_RASTER_MAX_SIDE || h > SP_RASTER_MAX_SIDE)
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: PNG is %ux%u, larger than %dx%d", path, w, h, SP_RASTER_MAX_SIDE,
-                       SP_RASTER_MAX_SIDE);
-    char* bytes;
-    size_t len;
-    sp_result rc = read_file(path, &bytes, &len, err);
-    if (rc != SP_OK) return rc;
-    rc = sp_cv_decode_grey((const unsigned char*)bytes, len, path, &out->pixels, &out->w, &out->h, err);
-    free(bytes);
-    if (rc == SP_OK && (out->w != (int)w || out->h != (int)h)) {
-        sp_raster_free(out);
-        return sp_fail(err, SP_ERR_PARSE, "%s: decoded size differs from the PNG header", path);
-    }
-    return rc;
-}
-
-// ---------------------------------------------------------------------------
-// Any drawing, folders
-
-sp_result sp_drawing_read(const char* path, sp_sketch* sketch, sp_raster* raster, sp_error* err)
-{
-    memset(sketch, 0, sizeof *sketch);
-    if (raster) memset(raster, 0, sizeof *raster);
-    if (ext_is(path, "json")) return sp_sketch_read_json(path, sketch, err);
-    if (ext_is(path, "svg")) return sp_sketch_read_svg(path, sketch, err);
-    if (ext_is(path, "png")) {
-        if (!raster) return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: a PNG has no strokes; give a .json or .svg", path);
-        return sp_raster_read_png(path, raster, err);
-    }
-    if (ext_is(path, "ndjson")) {
-        sp_dataset ds = {0};
-        sp_result rc = sp_dataset_read_ndjson(&ds, path, -1, err);
-        if (rc == SP_OK && ds.count == 0) rc = sp_fail(err, SP_ERR_INVALID, "%s: no drawings", path);
-        if (rc == SP_OK) {
-            *sketch = ds.samples[0].sketch;
-            ds.samples[0].sketch = (sp_sketch){0};
-        }
-        sp_dataset_free(&ds);
-        return rc;
-    }
-    return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: unknown drawing type (want .json, .svg, .png or .ndjson)", path);
-}
-
-static int cmp_str(const void* a, const void* b)
-{
-    return strcmp(*(char* const*)a, *(char* const*)b);
-}
-
-// Sorted entry names of a directory (excluding dot files). *names malloc'd.
-static sp_result list_dir(const char* dir, char*** names, int* count, sp_error* err)
-{
-    *names = NULL;
-    *count = 0;
-    DIR* d = opendir(dir);
-    if (!d) return sp_fail(err, SP_ERR_IO, "%s: cannot open folder (%s)", dir, strerror(errno));
-    struct dirent* e;
-    int n = 0, cap = 0;
-    char** v = NULL;
-    while ((e = readdir(d)) != NULL) {
-        if (e->d_name[0] == '.') continue;
-        if (n == cap) {
-            cap = cap ? cap * 2 : 32;
-            char** g = realloc(v, sizeof(char*) * (size_t)cap);
-            if (!g) goto oom;
-            v = g;
-        }
-        if (!(v[n] = strdup(e->d_name))) goto oom;
-        ++n;
-    }
-    closedir(d);
-    if (n) qsort(v, (size_t)n, sizeof(char*), cmp_str);
-    *names = v;
-    *count = n;
-    return SP_OK;
-oom:
-    closedir(d);
-    for (int i = 0; i < n; ++i)
-        free(v[i]);
-    free(v);
-    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory listing", dir);
-}
-
-static void free_names(char** v, int n)
-{
-    for (int i = 0; i < n; ++i)
-        free(v[i]);
-    free(v);
-}
-
-static bool is_dir(const char* path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
-{
-    memset(out, 0, sizeof *out);
-    char** names;
-    int n;
-    sp_result rc = list_dir(dir, &names, &n, err);
-    if (rc != SP_OK) return rc;
-    sp_dataset ds = {0};
-    char path[4096];
-    // Categories first (sorted), so labels do not depend on which kind of file came first.
-    for (int i = 0; i < n && rc == SP_OK; ++i) {
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        char cat[1024];
-        if (is_dir(path))
-            snprintf(cat, sizeof cat, "%s", names[i]);
-        else if (ext_is(names[i], "ndjson")) {
-            snprintf(cat, sizeof cat, "%s", names[i]);
-            cat[strlen(cat) - 7] = '\0';
-        } else
-            continue;
-        if (sp_dataset_add_category(&ds, cat) < 0) rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", dir);
-    }
-    if (rc == SP_OK && ds.category_count > 1) qsort(ds.categories, (size_t)ds.category_count, sizeof(char*), cmp_str);
-    for (int i = 0; i < n && rc == SP_OK; ++i) {
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        if (is_dir(path)) {
-            int label = sp_dataset_add_category(&ds, names[i]);
-            char** files;
-            int nf;
-            if ((rc = list_dir(path, &files, &nf, err)) != SP_OK) break;
-            for (int j = 0; j < nf && rc == SP_OK; ++j) {
-                if (!ext_is(files[j], "json") && !ext_is(files[j], "svg") && !ext_is(files[j], "png")) continue;
-                char fp[4096 + 256];
-                snprintf(fp, sizeof fp, "%s/%s", path, files[j]);
-                sp_sample smp = {.label = label};
-                rc = sp_drawing_read(fp, &smp.sketch, &smp.raster, err);
-                if (rc == SP_OK && dataset_push(&ds, &smp) != SP_OK) {
-                    sp_sketch_free(&smp.sketch);
-                    sp_raster_free(&smp.raster);
-                    rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", fp);
-                }
-            }
-            free_names(files, nf);
-        } else if (ext_is(names[i], "ndjson")) {
-            char cat[1024];
-            snprintf(cat, sizeof cat, "%s", names[i]);
-            cat[strlen(cat) - 7] = '\0';
-            rc = sp_dataset_read_ndjson(&ds, path, sp_dataset_add_category(&ds, cat), err);
-        }
-    }
-    free_names(names, n);
-    if (rc == SP_OK && ds.count == 0)
-        rc = sp_fail(err, SP_ERR_INVALID, "%s: no drawings (want <category>/*.json|svg|png or <category>.ndjson)", dir);
-    if (rc != SP_OK) {
-        sp_dataset_free(&ds);
-        return rc;
-    }
-    *out = ds;
-    return SP_OK;
 }
