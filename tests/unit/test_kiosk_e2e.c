@@ -163,13 +163,14 @@ static bool have_xvfb(void)
 }
 
 // Runs the kiosk under Xvfb; returns its exit code; stats JSON in *stats (may be NULL).
-static int run_kiosk(const char* args, cJSON** stats)
+// Runs the kiosk on db; its stderr is kept in kiosk_stderr.txt.
+static int run_kiosk_on(const char* db, const char* args, cJSON** stats)
 {
     const char* out = sp_test_tmp_path("kiosk_stats.json");
     const char* errf = sp_test_tmp_path("kiosk_stderr.txt");
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --stats %s > '%s' 2> '%s'", SP_DRAGON_KIOSK,
-             e2e_db(), args, out, errf);
+             db, args, out, errf);
     double t0 = wall_s();
     int rc = system(cmd);
     rc = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
@@ -190,6 +191,11 @@ static int run_kiosk(const char* args, cJSON** stats)
         }
     }
     return rc;
+}
+
+static int run_kiosk(const char* args, cJSON** stats)
+{
+    return run_kiosk_on(e2e_db(), args, stats);
 }
 
 static double num(const cJSON* j, const char* key)
@@ -921,6 +927,139 @@ static void test_twenty_strokes(void)
     cJSON_Delete(st);
 }
 
+// ------------------------------------------------------------ collection (issue 16, item 5)
+
+// A sketchpose command's JSON on stdout (NULL when it fails or prints none).
+static cJSON* sketchpose_json(const char* args)
+{
+    const char* out = sp_test_tmp_path("sketchpose_out.json");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s/app/sketchpose' %s > '%s'", SP_BINARY_DIR, args, out);
+    int rc = system(cmd);
+    FILE* f = fopen(out, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 20];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    cJSON* j = WIFEXITED(rc) && WEXITSTATUS(rc) == 0 ? cJSON_Parse(buf) : NULL;
+    if (!j) fprintf(stderr, "  `sketchpose %s` failed: %.300s\n", args, buf);
+    return j;
+}
+
+// The pending kiosk sketches of db (review's "sketches"), or NULL.
+static cJSON* review(const char* db)
+{
+    char args[1200];
+    snprintf(args, sizeof args, "db review --db '%s'", db);
+    return sketchpose_json(args);
+}
+
+static int pending_count(const char* db)
+{
+    cJSON* r = review(db);
+    int n = r ? cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(r, "sketches")) : -1;
+    cJSON_Delete(r);
+    return n;
+}
+
+// Issue 16, item 5, end to end: a visitor draws a body, a tail that they
+// relabel with a chip, and wings they take back with Undo, and leaves. The
+// review lists the body and the tail's stroke with the chip's label (its
+// points and times as drawn), not the wings; approved and trained, the new
+// model's training set has it.
+static void test_collect(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    char db[1100], cmd[4096];
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_collect.db"));
+    kp_remove_db(db);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
+    ENSURE(system(cmd) == 0);
+    ENSURE(pending_count(db) == 0);
+    const stroke* tail = &g_strokes[3];
+    const char* sc = sp_test_tmp_path("kiosk_collect.json");
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = part_stroke_at(&s, 500, &g_strokes[0], 0, 0) + 1500;
+    double up = script_stroke(&s, t, tail->xy, tail->n, 4);
+    script_press(&s, up + 1500, "guess1"); // the visitor's label
+    up = script_stroke(&s, up + 2500, g_strokes[2].xy, g_strokes[2].n, 4);
+    script_press(&s, up + 1500, "undo");
+    script_end(&s, sc, up + 2500); // the kiosk closes with the body and the tail on the canvas
+    char args[2048];
+    snprintf(args, sizeof args, "--script '%s'", sc);
+    cJSON* st = NULL;
+    ENSURE(run_kiosk_on(db, args, &st) == 0 && st);
+    fprintf(stderr, "  parts %g (%s, %s), refits %g, collected %g, stored %g, dropped %g\n", num(st, "parts"),
+            stat_category(st, 0), stat_category(st, 1), num(st, "refits"), num(st, "collected"), num(st, "collect_stored"),
+            num(st, "collect_dropped"));
+    ENSURE(num(st, "parts") == 2 && num(st, "refits") == 1 + (g_strokes[0].rank > 0) && num(st, "undos") == 1);
+    ENSURE(num(st, "collected") == 2 && num(st, "collect_stored") == 2 && num(st, "collect_dropped") == 0);
+    char label[64];
+    snprintf(label, sizeof label, "%s", stat_category(st, 1));
+    ENSURE(strcmp(label, "tail") != 0); // the chip's category, whichever the model ranked next
+    cJSON_Delete(st);
+    // The review: oldest first, the body then the relabelled tail; no wings.
+    cJSON* r = review(db);
+    ENSURE(r);
+    const cJSON* list = cJSON_GetObjectItemCaseSensitive(r, "sketches");
+    ENSURE(cJSON_GetArraySize(list) == 2);
+    const cJSON* body = cJSON_GetArrayItem(list, 0);
+    const cJSON* sk = cJSON_GetArrayItem(list, 1);
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(body, "category")->valuestring, "torso"));
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(sk, "category")->valuestring, label));
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(sk, "status")->valuestring, "pending"));
+    // Its points are the stroke as drawn (canvas = framebuffer here), its times the pen's.
+    const cJSON* pts = cJSON_GetObjectItemCaseSensitive(sk, "points");
+    const cJSON* ts = cJSON_GetObjectItemCaseSensitive(sk, "t");
+    int n = cJSON_GetArraySize(pts);
+    fprintf(stderr, "  review: #%g %s, %d points (drawn %d), last at %g ms\n",
+            cJSON_GetObjectItemCaseSensitive(sk, "id")->valuedouble, label, n, tail->n,
+            n > 0 ? cJSON_GetArrayItem(ts, n - 1)->valuedouble : -1);
+    ENSURE(n >= tail->n / 2 && n <= tail->n && cJSON_GetArraySize(ts) == n);
+    double x0 = cJSON_GetArrayItem(cJSON_GetArrayItem(pts, 0), 0)->valuedouble;
+    double y0 = cJSON_GetArrayItem(cJSON_GetArrayItem(pts, 0), 1)->valuedouble;
+    ENSURE(fabs(x0 - tail->xy[0].x) < 1.5 && fabs(y0 - tail->xy[0].y) < 1.5);
+    ENSURE(cJSON_GetArrayItem(ts, 0)->valuedouble == 0 && cJSON_GetArrayItem(ts, n - 1)->valuedouble > 100);
+    // Approve it, train: the new model's training set includes it.
+    char ids[1200];
+    snprintf(ids, sizeof ids, "db review --db '%s' --approve %.0f", db, cJSON_GetObjectItemCaseSensitive(sk, "id")->valuedouble);
+    cJSON_Delete(r);
+    cJSON* ap = sketchpose_json(ids);
+    ENSURE(ap && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(ap, "approved")) == 1);
+    cJSON_Delete(ap);
+    snprintf(args, sizeof args, "db train --db '%s' --folds -1 --words 96 --threads 2", db);
+    double t0 = wall_s();
+    cJSON* tr = sketchpose_json(args);
+    ENSURE(tr);
+    fprintf(stderr, "  db train: %.1f s, kiosk_sketches %g\n", wall_s() - t0, num(tr, "kiosk_sketches"));
+    ENSURE(num(tr, "kiosk_sketches") >= 1);
+    cJSON_Delete(tr);
+    ENSURE(pending_count(db) == 1); // the body, still waiting for review
+    // Start over collects the visit's parts; --no-collect keeps nothing.
+    sc = sp_test_tmp_path("kiosk_collect2.json");
+    s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    up = part_stroke_at(&s, 500, &g_strokes[0], 0, 0);
+    script_press(&s, up + 1500, "start_over");
+    script_press(&s, up + 1700, "start_over");
+    script_end(&s, sc, up + 2500);
+    for (int off = 1; off >= 0; --off) {
+        snprintf(args, sizeof args, "--script '%s'%s", sc, off ? " --no-collect" : "");
+        ENSURE(run_kiosk_on(db, args, &st) == 0 && st);
+        fprintf(stderr, "  %s: start over %g, collected %g, stored %g\n", off ? "--no-collect" : "collecting", num(st, "clears"),
+                num(st, "collected"), num(st, "collect_stored"));
+        ENSURE(num(st, "clears") == 1 && num(st, "parts") == 0);
+        ENSURE(num(st, "collected") == (off ? 0 : 1) && num(st, "collect_stored") == (off ? 0 : 1));
+        cJSON_Delete(st);
+        ENSURE(pending_count(db) == (off ? 1 : 2));
+    }
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -932,5 +1071,6 @@ int main(int argc, char** argv)
                                    {"full_dragon", test_full_dragon},
                                    {"visit", test_visit},
                                    {"twenty_strokes", test_twenty_strokes},
+                                   {"collect", test_collect},
                                    {0}});
 }
