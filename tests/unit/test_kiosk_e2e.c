@@ -1060,6 +1060,79 @@ static void test_collect(void)
     }
 }
 
+// Lines of a file that contain `what`.
+static int lines_with(const char* path, const char* what)
+{
+    FILE* f = fopen(path, "r");
+    if (!f) return -1;
+    char line[4096];
+    int n = 0;
+    while (fgets(line, sizeof line, f))
+        n += strstr(line, what) != NULL;
+    fclose(f);
+    return n;
+}
+
+// A database the kiosk may not write (mode 0444; as root, the kiosk runs in
+// an unprivileged child, since root ignores permissions): the visit goes on
+// as ever, and each stroke left is dropped with one line on stderr.
+static void test_collect_read_only(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const char* reach = sp_test_reachable_dir("sp_kiosk");
+    ENSURE(reach);
+    char dir[1024], db[1100], sc[1100], out[1100], errf[1100], cmd[8192];
+    snprintf(dir, sizeof dir, "%s", reach);
+    ENSURE(chmod(dir, 0777) == 0); // the reader may create the database's -shm beside it
+    snprintf(db, sizeof db, "%s/ro.db", dir);
+    snprintf(sc, sizeof sc, "%s/session.json", dir);
+    snprintf(out, sizeof out, "%s/stats.json", dir);
+    snprintf(errf, sizeof errf, "%s/stderr.txt", dir);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s' && chmod 0444 '%s'", e2e_db(), db, db);
+    ENSURE(system(cmd) == 0);
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = part_stroke_at(&s, 500, &g_strokes[0], 0, 0) + 1500;
+    t = part_stroke_at(&s, t, &g_strokes[3], 0, 0);
+    script_end(&s, sc, t + 2000);
+    ENSURE(chmod(sc, 0644) == 0);
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --script '%s' --stats > '%s' 2> '%s'", dir,
+             SP_DRAGON_KIOSK, db, sc, out, errf);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
+        int rc = system(cmd);
+        _exit(WIFEXITED(rc) ? WEXITSTATUS(rc) : 6);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status));
+    snprintf(cmd, sizeof cmd, "sed -e 's/^/  kiosk: /' '%s' >&2", errf);
+    if (system(cmd) != 0) fprintf(stderr, "  (no stderr)\n");
+    ENSURE(WEXITSTATUS(status) == 0);
+    FILE* f = fopen(out, "rb");
+    ENSURE(f);
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    cJSON* st = cJSON_Parse(buf);
+    ENSURE(st);
+    fprintf(stderr, "  parts %g, collected %g, stored %g, dropped %g\n", num(st, "parts"), num(st, "collected"),
+            num(st, "collect_stored"), num(st, "collect_dropped"));
+    ENSURE(num(st, "parts") == 2 && num(st, "pipeline_errors") == 0);
+    ENSURE(num(st, "collected") == 2 && num(st, "collect_stored") == 0 && num(st, "collect_dropped") == 2);
+    cJSON_Delete(st);
+    // One line says why at start, one line a sketch.
+    ENSURE(lines_with(errf, "cannot be collected") == 1 && lines_with(errf, "sketch dropped") == 2);
+    ENSURE(pending_count(db) == 0);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ENSURE(system(cmd) == 0);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -1072,5 +1145,6 @@ int main(int argc, char** argv)
                                    {"visit", test_visit},
                                    {"twenty_strokes", test_twenty_strokes},
                                    {"collect", test_collect},
+                                   {"collect_read_only", test_collect_read_only},
                                    {0}});
 }
