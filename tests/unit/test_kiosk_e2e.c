@@ -24,7 +24,10 @@
 #include <cjson/cJSON.h>
 
 #include "fixtures.h"
+#include "kiosk.h"
 #include "kiosk_parts.h"
+#include "sp/dragon.h"
+#include "sp/headless.h"
 #include "sp/image.h"
 #include "test.h"
 
@@ -1133,6 +1136,94 @@ static void test_collect_read_only(void)
     ENSURE(system(cmd) == 0);
 }
 
+// Runs an in-process kiosk's updates at 60 a second from *t to until.
+static void updates_until(sp_kiosk* k, double* t, double until)
+{
+    for (; *t < until; *t += 1000.0 / 60.0)
+        sp_kiosk_update(k, *t);
+}
+
+// A running kiosk picks up the model `db train` stores, trained on a stroke
+// it collected itself: the kiosk in-process on a headless context (it polls
+// the database's generation every 2 s of its clock), the curator's review
+// and training on another handle meanwhile.
+static void test_collect_reload(void)
+{
+    six_strokes();
+    char db[1100], cmd[4096];
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_reload.db"));
+    kp_remove_db(db);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
+    ENSURE(system(cmd) == 0);
+    sp_error err = {0};
+    sp_headless* gl = sp_headless_create(&err);
+    if (!gl) SKIP("no headless OpenGL");
+    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
+                                                   .canvas_w = 1280,
+                                                   .canvas_h = 800,
+                                                   .export_dir = sp_test_tmp_path("kiosk_reload_ex"),
+                                                   .no_attract_demo = true,
+                                                   .fit_time_cap_ms = 60000},
+                                  &err);
+    if (!k) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(k);
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    double t = 0;
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, 640, 400, 0}); // leaves the attract screen
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, t + 60, 640, 400, 0});
+    updates_until(k, &t, 500);
+    // The visitor draws a tail, then starts over: the stroke is collected.
+    const stroke* tail = &g_strokes[3];
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, (float)tail->xy[0].x, (float)tail->xy[0].y, 0});
+    for (int i = 1; i < tail->n; ++i)
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, t + 4 * i, (float)tail->xy[i].x, (float)tail->xy[i].y, 0});
+    sp_kiosk_input(
+        k, &(sp_kiosk_event){SP_KEV_UP, t + 4 * tail->n, (float)tail->xy[tail->n - 1].x, (float)tail->xy[tail->n - 1].y, 0});
+    updates_until(k, &t, t + 4 * tail->n + 1500);
+    ENSURE(st->parts == 1);
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_START_OVER});
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t + 200, 0, 0, SP_KT_START_OVER});
+    updates_until(k, &t, t + 3000);
+    ENSURE(st->parts == 0 && st->collected == 1 && st->reloads == 0);
+    int stored = 0, dropped = 0;
+    for (int i = 0; i < 200 && stored == 0; ++i) { // the writer's thread
+        usleep(10000);
+        sp_kiosk_collect_counts(k, &stored, &dropped);
+    }
+    ENSURE(stored == 1);
+    // Which model: its reject distance (this training's leave-one-out
+    // threshold differs from the calibrated one the database came with).
+    double before = sp_clf_reject_distance(sp_dragon_model(sp_kiosk_dragon(k)));
+    // The curator approves it and trains, while the kiosk runs.
+    sp_db* w = NULL;
+    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK);
+    sp_db_kiosk_sketch* ks = NULL;
+    int n = 0;
+    ENSURE(sp_db_kiosk_list(w, NULL, &ks, &n, &err) == SP_OK && n == 1);
+    ENSURE(!strcmp(ks[0].category, "tail"));
+    ENSURE(sp_db_kiosk_set_status(w, &ks[0].id, 1, SP_DB_APPROVED, "test", &err) == SP_OK);
+    sp_db_kiosk_free(ks, n);
+    sp_db_train_desc td = kp_quick_train();
+    td.calibrate = -1;
+    char* report = NULL;
+    ENSURE(sp_db_train(w, &td, &report, &err) == SP_OK);
+    cJSON* rep = cJSON_Parse(report);
+    free(report);
+    ENSURE(rep && num(rep, "kiosk_sketches") == 1);
+    cJSON_Delete(rep);
+    sp_clf* fresh = NULL;
+    ENSURE(sp_db_load_model(w, &fresh, NULL, &err) == SP_OK);
+    sp_db_close(w);
+    updates_until(k, &t, t + 2500);
+    double after = sp_clf_reject_distance(sp_dragon_model(sp_kiosk_dragon(k))), want = sp_clf_reject_distance(fresh);
+    fprintf(stderr, "  reloads %d; the kiosk's model: reject distance %.4f before, %.4f after (the new model's: %.4f)\n",
+            st->reloads, before, after, want);
+    ENSURE(st->reloads == 1 && after == want && before != want);
+    sp_clf_free(fresh);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -1146,5 +1237,6 @@ int main(int argc, char** argv)
                                    {"twenty_strokes", test_twenty_strokes},
                                    {"collect", test_collect},
                                    {"collect_read_only", test_collect_read_only},
+                                   {"collect_reload", test_collect_reload},
                                    {0}});
 }
