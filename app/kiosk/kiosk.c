@@ -16,7 +16,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
-static void forget_strokes(sp_kiosk* k, int from);
+static void forget_strokes(sp_kiosk* k);
 
 static double now_ms(void)
 {
@@ -282,7 +282,7 @@ void sp_kiosk_destroy(sp_kiosk* k)
 {
     if (!k) return;
     sp_kiosk_close_collection(k);
-    forget_strokes(k, 0);
+    forget_strokes(k);
     kiosk_attract_free(k);
     kiosk_row_free(k);
     mesh_cache_free(&k->meshes);
@@ -370,12 +370,12 @@ static part_guesses* guesses_of(sp_kiosk* k, uint64_t id, bool create)
     return g;
 }
 
-// Forgets the kept strokes from entry `from` on (0: every part's).
-static void forget_strokes(sp_kiosk* k, int from)
+// Forgets every part's chips and kept stroke.
+static void forget_strokes(sp_kiosk* k)
 {
-    for (int i = from; i < k->guess_count; ++i)
+    for (int i = 0; i < k->guess_count; ++i)
         free(k->guesses[i].xy), free(k->guesses[i].t);
-    k->guess_count = from;
+    k->guess_count = 0;
 }
 
 // Keeps an accepted part's stroke for collection (canvas pixels; ms since
@@ -729,7 +729,7 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         parts_left(k);
         sp_dragon_clear(k->dragon);
         ++k->rev, ++k->stats.clears;
-        forget_strokes(k, 0);
+        forget_strokes(k);
         sp_kiosk_ui_parts_changed(k->ui, 0, NULL);
         break;
     case SP_KJOB_SAVE:

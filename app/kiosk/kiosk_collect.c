@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "kiosk_internal.h"
 #include "sp/partdb.h"
@@ -22,6 +23,9 @@ typedef struct queued {
 
 struct kiosk_collector {
     sp_db* db; // the writer's own handle; NULL: it could not be opened, every sketch is dropped
+    char path[1024];
+    dev_t dev; // the file the handle has open
+    ino_t ino;
     double canvas_w, canvas_h;
     bool threaded;
     pthread_t thread;
@@ -50,6 +54,23 @@ static void count_result(kiosk_collector* c, bool stored)
     pthread_mutex_unlock(&c->lock);
 }
 
+// The database file at c->path is still the one the handle has open; a file
+// replaced by a rename (a curator's new database) is opened anew, so that
+// no stroke goes into the old, unlinked one.
+static void follow_file(kiosk_collector* c)
+{
+    struct stat st;
+    if (stat(c->path, &st) != 0 || (st.st_dev == c->dev && st.st_ino == c->ino)) return;
+    sp_db* db = NULL;
+    sp_error err = {0};
+    if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
+        fprintf(stderr, "dragon-kiosk: the database was replaced and cannot be written: %s\n", err.text);
+        return; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
+    }
+    sp_db_close(c->db);
+    c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
+}
+
 // The writer: one sketch a transaction, each waiting at most
 // SP_DB_COLLECT_BUSY_MS for another writer (partdb.h); whatever fails is
 // dropped with one line (the error says "sketch dropped").
@@ -65,6 +86,7 @@ static void* collector_main(void* arg)
         memset(&c->q[c->head], 0, sizeof s);
         c->head = (c->head + 1) % QUEUE_MAX, --c->count;
         pthread_mutex_unlock(&c->lock);
+        follow_file(c);
         sp_error err = {0};
         sp_stroke st = {.count = s.n, .points = s.xy, .t = s.t};
         sp_result r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
@@ -85,6 +107,7 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
         return NULL;
     }
     c->canvas_w = canvas_w, c->canvas_h = canvas_h;
+    snprintf(c->path, sizeof c->path, "%s", db_path);
     pthread_mutex_init(&c->lock, NULL);
     pthread_cond_init(&c->wake, NULL);
     // A writable handle of its own (the pipeline reads through a read-only
@@ -92,6 +115,8 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     // first frame. A database that cannot be written keeps the kiosk running:
     // each sketch is then dropped with one line.
     sp_error err = {0};
+    struct stat st;
+    if (stat(db_path, &st) == 0) c->dev = st.st_dev, c->ino = st.st_ino;
     if (sp_db_open(db_path, 0, &c->db, &err) != SP_OK) {
         fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected: %s\n", err.text);
         c->db = NULL;
