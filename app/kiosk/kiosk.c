@@ -17,6 +17,8 @@
 
 #include "sp/clock.h"
 
+static void forget_strokes(sp_kiosk* k);
+
 // ------------------------------------------------------------------ mapping
 
 static double fit_factor(const sp_kiosk* k)
@@ -238,6 +240,11 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
         sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory");
         goto fail;
     }
+    // The collector's writable handle first: opening it migrates an older
+    // schema, which the pipeline's read-only handle could not read. A
+    // database that does not exist yet is built by the pipeline.
+    if (!k->desc.no_collect && access(k->db_path, F_OK) == 0)
+        k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
     // The pipeline's own attachment (docs/DESIGN.md, "Which strokes join a
     // dragon"): a part drawn far from every body stays where it was drawn.
     k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
@@ -248,6 +255,7 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
                                                    .max_parts = k->desc.max_parts},
                                  err);
     if (!k->dragon) goto fail;
+    if (!k->desc.no_collect && !k->collector) k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
     k->canvas_cam = sp_dragon_camera(k->dragon);
     if (!(k->r = sp_renderer_create(&(sp_renderer_desc){0}, err))) goto fail;
     // Software rasterisers pay per triangle: coarser display meshes there.
@@ -267,6 +275,8 @@ fail:
 void sp_kiosk_destroy(sp_kiosk* k)
 {
     if (!k) return;
+    sp_kiosk_close_collection(k);
+    forget_strokes(k);
     kiosk_attract_free(k);
     kiosk_row_free(k);
     mesh_cache_free(&k->meshes);
@@ -305,6 +315,14 @@ const sp_kiosk_stats* sp_kiosk_stats_of(const sp_kiosk* k)
     return &k->stats;
 }
 
+void sp_kiosk_collect_counts(const sp_kiosk* k, int* stored, int* dropped)
+{
+    if (k->collector)
+        kiosk_collector_counts(k->collector, stored, dropped);
+    else
+        *stored = k->collect_stored, *dropped = k->collect_dropped;
+}
+
 const sp_dragon* sp_kiosk_dragon(const sp_kiosk* k)
 {
     return k->dragon;
@@ -328,7 +346,10 @@ static part_guesses* guesses_of(sp_kiosk* k, uint64_t id, bool create)
         bool alive = false;
         for (int j = 0; j < sp_dragon_part_count(k->dragon) && !alive; ++j)
             alive = sp_dragon_part_get(k->dragon, j)->id == k->guesses[i].id;
-        if (alive) k->guesses[w++] = k->guesses[i];
+        if (alive)
+            k->guesses[w++] = k->guesses[i];
+        else
+            free(k->guesses[i].xy), free(k->guesses[i].t); // undone or redrawn: never collected
     }
     k->guess_count = w;
     if (k->guess_count == k->guess_cap) {
@@ -341,6 +362,35 @@ static part_guesses* guesses_of(sp_kiosk* k, uint64_t id, bool create)
     memset(g, 0, sizeof *g);
     g->id = id;
     return g;
+}
+
+// Forgets every part's chips and kept stroke.
+static void forget_strokes(sp_kiosk* k)
+{
+    for (int i = 0; i < k->guess_count; ++i)
+        free(k->guesses[i].xy), free(k->guesses[i].t);
+    k->guess_count = 0;
+}
+
+// Keeps an accepted part's stroke for collection (canvas pixels; ms since
+// its first point): only when collecting, and only the points and times.
+static void keep_stroke(sp_kiosk* k, int part, const sp_vec2* xy, const double* t, int n)
+{
+    if (!k->collector || part < 0 || part >= sp_dragon_part_count(k->dragon) || n < 2) return;
+    part_guesses* g = guesses_of(k, sp_dragon_part_get(k->dragon, part)->id, false);
+    if (!g) return;
+    free(g->xy), free(g->t);
+    g->xy = malloc(sizeof *g->xy * (size_t)n);
+    g->t = t ? malloc(sizeof *g->t * (size_t)n) : NULL;
+    if (!g->xy || (t && !g->t)) {
+        free(g->xy), free(g->t);
+        g->xy = NULL, g->t = NULL, g->n = 0;
+        return;
+    }
+    memcpy(g->xy, xy, sizeof *g->xy * (size_t)n);
+    for (int i = 0; t && i < n; ++i)
+        g->t[i] = t[i] - t[0];
+    g->n = n;
 }
 
 // The label chip and the next two guesses of the last part, for the UI.
@@ -519,15 +569,29 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     k->stats.last_fit_ms = ms;
     k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
     answer_fit(k, rc, &res, &err, false, forced);
+    if (rc == SP_OK && !res.rejected) keep_stroke(k, res.part, k->scratch, s->t, s->count);
 }
 
 static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
 {
+    // The re-fitted part is a new part of the same stroke: the kept stroke
+    // moves to it (or back, when the re-fit fails and the part stays).
+    int n = sp_dragon_part_count(k->dragon);
+    uint64_t old_id = n > 0 ? sp_dragon_part_get(k->dragon, n - 1)->id : 0;
+    part_guesses* old = n > 0 ? guesses_of(k, old_id, false) : NULL;
+    part_guesses kept = {0};
+    if (old) kept.xy = old->xy, kept.t = old->t, kept.n = old->n, old->xy = NULL, old->t = NULL, old->n = 0;
     sp_dragon_result res;
     memset(&res, 0, sizeof res);
     sp_error err = {0};
     sp_result rc = sp_dragon_refit_last(k->dragon, j->category, &res, &err);
     answer_fit(k, rc, &res, &err, true, NULL);
+    bool moved = rc == SP_OK && !res.rejected && res.part >= 0 && res.part < sp_dragon_part_count(k->dragon);
+    part_guesses* to = guesses_of(k, moved ? sp_dragon_part_get(k->dragon, res.part)->id : old_id, false);
+    if (to && !to->xy)
+        to->xy = kept.xy, to->t = kept.t, to->n = kept.n;
+    else
+        free(kept.xy), free(kept.t);
 }
 
 // A four-character code that reads aloud unambiguously (no 0/O, 1/I, 2/Z, 5/S, 8/B).
@@ -602,18 +666,41 @@ static void run_save(sp_kiosk* k)
     }
 }
 
-// The parts leave the canvas with the labels the visitor left them with
-// (Start over, the idle timeout). This is where a part's label is final:
-// Undo and Redraw took back the parts they removed (those never get here),
-// and a chip changes a part only while its stroke is the last one. Issue
-// 16's collection of visitors' strokes stores each part here.
-static void parts_kept(sp_kiosk* k)
+// The parts on the canvas leave it (Start over, the idle timeout, the kiosk
+// closing) with the labels the visitor left them with. This is where a
+// part's label is final: Undo and Redraw took back the parts they removed
+// (those never get here), and a chip changes a part only while its stroke
+// is the last one. Each stroke goes to the collector (docs/DESIGN.md,
+// "Collecting visitors' strokes").
+static void collect_parts(sp_kiosk* k)
+{
+    for (int i = 0; k->collector && i < sp_dragon_part_count(k->dragon); ++i) {
+        const sp_dragon_part* p = sp_dragon_part_get(k->dragon, i);
+        const part_guesses* g = guesses_of(k, p->id, false);
+        if (g && g->n >= 2) {
+            kiosk_collector_push(k->collector, p->category, g->xy, g->t, g->n);
+            ++k->stats.collected;
+        }
+    }
+}
+
+// Start over or the idle timeout: the visit's parts are kept (counted) and collected.
+static void parts_left(sp_kiosk* k)
 {
     for (int i = 0; i < sp_dragon_part_count(k->dragon); ++i) {
         const part_guesses* g = guesses_of(k, sp_dragon_part_get(k->dragon, i)->id, false);
         ++k->stats.kept;
         if (g && g->chosen) ++k->stats.kept_chosen;
     }
+    collect_parts(k);
+}
+
+void sp_kiosk_close_collection(sp_kiosk* k)
+{
+    if (!k->collector) return;
+    if (k->dragon) collect_parts(k);
+    kiosk_collector_close(k->collector, &k->collect_stored, &k->collect_dropped);
+    k->collector = NULL;
 }
 
 static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
@@ -633,10 +720,10 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         break;
     }
     case SP_KJOB_CLEAR:
-        parts_kept(k);
+        parts_left(k);
         sp_dragon_clear(k->dragon);
         ++k->rev, ++k->stats.clears;
-        k->guess_count = 0;
+        forget_strokes(k);
         sp_kiosk_ui_parts_changed(k->ui, 0, NULL);
         break;
     case SP_KJOB_SAVE:

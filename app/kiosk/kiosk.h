@@ -41,6 +41,8 @@ typedef struct sp_kiosk_desc {
     int lod_triangles; ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full
                        ///< meshes
     int max_parts;     ///< parts a dragon may have (sp_dragon_desc.max_parts); 0: the pipeline's (48)
+    bool no_collect;   ///< keep no visitors' strokes (default: each part left on the canvas is stored as a pending kiosk
+                       ///< sketch; docs/DESIGN.md "Collecting visitors' strokes")
 } sp_kiosk_desc;
 
 /// Measurements for logs and benchmarks.
@@ -49,6 +51,7 @@ typedef struct sp_kiosk_stats {
     int chosen;            ///< refused strokes made a part by a tap on a guess or the parts row
     int waiting;           ///< parts drawn while no body was on the canvas (told to draw one)
     int kept, kept_chosen; ///< parts on the canvas at a Start over or timeout; of them, labelled by the visitor
+    int collected;         ///< strokes handed to the collector (sp_kiosk_collect_counts: stored, dropped)
     double last_fit_ms;    ///< wall time of the last classify+fit (the pipeline's)
     int fit_count;
     double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
@@ -77,6 +80,13 @@ sp_result sp_kiosk_export(sp_kiosk* k, const char* path, sp_error* err);
 const sp_kiosk_ui* sp_kiosk_ui_of(const sp_kiosk* k);
 /// Counters and timings.
 const sp_kiosk_stats* sp_kiosk_stats_of(const sp_kiosk* k);
+/// Ends collection, as when the kiosk closes (sp_kiosk_destroy does it):
+/// the parts still on the canvas are collected and everything queued is
+/// written (each sketch waits at most SP_DB_COLLECT_BUSY_MS for the database).
+void sp_kiosk_close_collection(sp_kiosk* k);
+/// Visitors' strokes the collector has stored in the database and dropped
+/// so far (both 0 with no_collect).
+void sp_kiosk_collect_counts(const sp_kiosk* k, int* stored, int* dropped);
 /// The pipeline (read only: parts, categories).
 const sp_dragon* sp_kiosk_dragon(const sp_kiosk* k);
 /// The path of the last save (without extension), "" before any.

@@ -32,7 +32,16 @@ typedef struct part_guesses {
     uint64_t id;
     char guess[2][SP_NAME_MAX];
     bool chosen; ///< the visitor chose its category (a guess chip, or a part for a refused stroke)
+    // The stroke as the visitor drew it, for collection: canvas pixels and
+    // ms since its first point (NULL when not kept).
+    sp_vec2* xy;
+    double* t;
+    int n;
 } part_guesses;
+
+/// The writer of visitors' strokes (kiosk_collect.c): a thread with its own
+/// database handle, so that the frame loop never waits for the database.
+typedef struct kiosk_collector kiosk_collector;
 
 /// One stroke of the attract screen's demo dragon.
 typedef struct demo_part {
@@ -69,8 +78,10 @@ struct sp_kiosk {
     mesh_cache meshes;
     part_guesses* guesses;
     int guess_count, guess_cap;
-    uint64_t rev;       // grows with every change of the dragon
-    uint64_t posed_rev; // rev and time of the last pose_at
+    kiosk_collector* collector;          // NULL: collection off (--no-collect) or closed
+    int collect_stored, collect_dropped; // the collector's counts when it closed
+    uint64_t rev;                        // grows with every change of the dragon
+    uint64_t posed_rev;                  // rev and time of the last pose_at
     double posed_t;
     bool posed;
     // The attract screen's demo dragon.
@@ -116,6 +127,20 @@ int kiosk_outline(const sp_rig* rig, int abstraction, const double* params, cons
                   int* breaks, int max_breaks, int* nbreaks);
 /// Loads the first part of a category from db (*abstraction: the one its sketches are drawn of). SP_ERR_INVALID: none.
 sp_result kiosk_load_category_part(sp_db* db, const char* category, sp_character* ch, int* abstraction, sp_error* err);
+// kiosk_collect.c
+/// Opens db_path for writing (migrating an older schema) and starts the
+/// writer. A database that cannot be written gives one line on stderr and a
+/// collector that drops every sketch with one line each. NULL: out of memory.
+kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, double canvas_h);
+/// Queues one stroke (copied; t may be NULL) as a pending kiosk sketch of
+/// category. Never waits for the database; what cannot be stored is dropped
+/// with one line on stderr.
+void kiosk_collector_push(kiosk_collector* c, const char* category, const sp_vec2* xy, const double* t, int n);
+/// Sketches stored and dropped so far.
+void kiosk_collector_counts(kiosk_collector* c, int* stored, int* dropped);
+/// Writes what is still queued, stops the writer, closes the handle (NULL is
+/// fine); *stored and *dropped get the final counts.
+void kiosk_collector_close(kiosk_collector* c, int* stored, int* dropped);
 /// Brings the cached meshes in step with d's parts at its last pose_at.
 void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions);
 void mesh_cache_free(mesh_cache* c);

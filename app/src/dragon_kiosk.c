@@ -249,6 +249,9 @@ static void print_stats(const app* a, double start_ms)
         : ui->mode == SP_KM_TURN  ? "turn"
                                   : "draw",
         ui->code, sp_kiosk_last_save(a->k));
+    int stored = 0, dropped = 0;
+    sp_kiosk_collect_counts(a->k, &stored, &dropped);
+    printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d,\n", st->collected, stored, dropped);
     // What a visitor reads on screen now (JSON-escaped).
     cJSON* hint = cJSON_CreateString(sp_kiosk_ui_hint_visible(ui) ? ui->hint : "");
     char* hint_text = hint ? cJSON_PrintUnformatted(hint) : NULL;
@@ -328,7 +331,7 @@ int main(int argc, char** argv)
     const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL,
                *size = NULL;
     const char* font = NULL;
-    bool fullscreen = false, stats = false;
+    bool fullscreen = false, stats = false, no_collect = false;
     double idle_s = 0;
     int lod = 0, msaa = -1, max_parts = 0;
     sp_opt opts[] = {
@@ -350,6 +353,8 @@ int main(int argc, char** argv)
          false},
         {"--max-parts", SP_OPT_INT, &max_parts, "N", "parts a dragon may have before new strokes are refused (default 48)",
          false},
+        {"--no-collect", SP_OPT_FLAG, &no_collect, "",
+         "keep no visitors' strokes (default: each part left on the canvas is stored in the database for review)", false},
         {"--stats", SP_OPT_FLAG, &stats, "", "print counters and timings as JSON at the end", false},
     };
     int rc = sp_cli_parse(argc, argv, k_cmd, "The dragon kiosk: draw a part in one line, see it come alive.", opts,
@@ -427,6 +432,7 @@ int main(int argc, char** argv)
                         .code_seed = script ? 1 : (uint64_t)time(NULL),
                         .lod_triangles = lod,
                         .max_parts = max_parts,
+                        .no_collect = no_collect,
                         // A replay must not depend on the machine's speed: the solver's
                         // wall-clock cap (a visitor's safety net) is lifted; its
                         // iteration caps still bound every fit.
@@ -514,6 +520,7 @@ int main(int argc, char** argv)
             exit_code = SP_EXIT_INPUT;
         }
     }
+    sp_kiosk_close_collection(a.k); // the last visitor's parts, before the counts are printed
     if (stats) print_stats(&a, first_frame_ms);
     sp_kiosk_destroy(a.k);
     glfwDestroyWindow(win);

@@ -2,6 +2,7 @@
 // llvmpipe in CI): the same code as the window (sp_kiosk), drawing into a
 // 1280 x 800 offscreen framebuffer and waiting for each frame (glFinish).
 //   build/tests/bench/kiosk [--json] [--runs N] [--db DB] [--lod N (triangles per part, -1: all)] [--png last.png]
+//                           [--no-collect (keep no visitors' strokes: the A/B of collection)]
 //   build/tests/bench/kiosk --soak N [--json]   N strokes in one session (undo, start over and
 //   save now and then); resident memory right after each Start over (every 40
 //   strokes): the first one after 200 strokes (warm-up) against the largest later one.
@@ -167,6 +168,7 @@ int main(int argc, char** argv)
     const char* db = NULL;
     const char* png = NULL;
     int lod = 0, soak = 0;
+    bool no_collect = false;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--runs") && i + 1 < argc)
             runs = atoi(argv[++i]);
@@ -178,6 +180,8 @@ int main(int argc, char** argv)
             soak = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--db") && i + 1 < argc)
             db = argv[++i];
+        else if (!strcmp(argv[i], "--no-collect"))
+            no_collect = true;
     }
     if (runs < 3) runs = 3;
     sp_error err = {0};
@@ -229,13 +233,17 @@ int main(int argc, char** argv)
         sp_render_target_bind(target);
         g_target = target;
     }
-    sp_bench_row rows[10];
+    sp_bench_row rows[12];
     int nr = 0;
     if (soak > 0) {
-        sp_kiosk* k = sp_kiosk_create(
-            &(sp_kiosk_desc){
-                .db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod, .no_attract_demo = true},
-            &err);
+        sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
+                                                       .canvas_w = W,
+                                                       .canvas_h = H,
+                                                       .export_dir = dir,
+                                                       .lod_triangles = lod,
+                                                       .no_attract_demo = true,
+                                                       .no_collect = no_collect},
+                                      &err);
         if (!k) {
             fprintf(stderr, "bench kiosk: %s\n", err.text);
             return 1;
@@ -259,7 +267,9 @@ int main(int argc, char** argv)
     // Start to first frame (the database exists, as in a museum after install).
     double t0 = sp_now_ms();
     sp_kiosk* k = sp_kiosk_create(
-        &(sp_kiosk_desc){.db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod}, &err);
+        &(sp_kiosk_desc){
+            .db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod, .no_collect = no_collect},
+        &err);
     if (!k) {
         fprintf(stderr, "bench kiosk: %s\n", err.text);
         return 1;
@@ -298,6 +308,8 @@ int main(int argc, char** argv)
     // update + draw. Rounds of six strokes, cleared in between.
     int rounds = runs / 6 < 2 ? 2 : runs / 6, n = 0;
     double* lat = malloc(sizeof(double) * (size_t)(rounds * DRAGON_PART_COUNT));
+    double* clear_ms = malloc(sizeof(double) * (size_t)rounds);
+    int nc = 0;
     for (int round = 0; round < rounds; ++round) {
         for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
             const kp_stroke* s = &strokes[i];
@@ -313,15 +325,22 @@ int main(int argc, char** argv)
                 frame(k, t += step);
         }
         if (round + 1 < rounds) {
+            // The frame that clears six parts (and hands their strokes to the collector).
             press(k, t += step, SP_KT_START_OVER);
             press(k, t += step, SP_KT_START_OVER);
-            frame(k, t += step);
+            clear_ms[nc++] = frame(k, t += step);
         }
     }
     r = (sp_bench_row){"pen-up to fitted part on screen", 0, 0, n, 100, 50, ""};
     sp_bench_stats(lat, n, &r.ms_median, &r.ms_p90);
-    snprintf(r.extra, sizeof r.extra, "\"parts\": %d", sp_kiosk_stats_of(k)->parts);
+    snprintf(r.extra, sizeof r.extra, "\"parts\": %d, \"collect\": %s", sp_kiosk_stats_of(k)->parts,
+             no_collect ? "false" : "true");
     rows[nr++] = r;
+    r = (sp_bench_row){"frame: Start over with six parts", 0, 0, nc, -1, 33, ""};
+    sp_bench_stats(clear_ms, nc, &r.ms_median, &r.ms_p90);
+    snprintf(r.extra, sizeof r.extra, "\"collected\": %d", sp_kiosk_stats_of(k)->collected);
+    rows[nr++] = r;
+    free(clear_ms);
 
     // Six animated parts.
     press(k, t += step, SP_KT_PLAY);

@@ -1,5 +1,8 @@
 #include "test.h"
 
+#include <stdlib.h>
+#include <string.h>
+#include <stdbool.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -34,6 +37,35 @@ const char* sp_test_tmp_path(const char* name)
     mkdir(SP_BINARY_DIR "/tmp", 0755);
     snprintf(b, 1024, "%s/tmp/%d_%s", SP_BINARY_DIR, (int)getpid(), name);
     return b;
+}
+
+// True when every folder from / down to dir lets other users pass (o+x).
+static bool others_may_enter(const char* dir)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (;;) {
+        struct stat st;
+        if (stat(buf[0] ? buf : "/", &st) != 0 || !(st.st_mode & S_IXOTH)) return false;
+        char* slash = strrchr(buf, '/');
+        if (!slash) return true;
+        *slash = 0;
+        if (!buf[0]) return stat("/", &st) == 0 && (st.st_mode & S_IXOTH);
+    }
+}
+
+const char* sp_test_reachable_dir(const char* prefix)
+{
+    static char dir[1024]; // until the next call
+    const char* tmpdir = getenv("TMPDIR");
+    const char* candidates[] = {SP_BINARY_DIR "/tmp", tmpdir && tmpdir[0] ? tmpdir : P_tmpdir, P_tmpdir};
+    for (size_t i = 0; i < sizeof candidates / sizeof candidates[0]; ++i) {
+        mkdir(candidates[i], 0755);
+        if (!others_may_enter(candidates[i])) continue;
+        if (snprintf(dir, sizeof dir, "%s/%s_XXXXXX", candidates[i], prefix) >= 1000) continue;
+        if (mkdtemp(dir) && chmod(dir, 0755) == 0) return dir;
+    }
+    return NULL;
 }
 
 // 0 ok, 1 failed, 2 skipped. The setjmp lives here, apart from the loop's

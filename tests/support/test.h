@@ -57,6 +57,12 @@ const char* sp_test_data_dir(void);
 /// Path inside the project source tree / the build tree (static buffer, rotates over 8).
 const char* sp_test_src_path(const char* rel);
 const char* sp_test_tmp_path(const char* name);
+/// A fresh folder <prefix>_XXXXXX (mode 0755) that any user can reach, for
+/// cases run as another user (root ignores permissions, so a test drops
+/// them in a child): the build folder may lie under one only its owner may
+/// enter (a clone in a fresh `mktemp -d`). NULL when there is none; the
+/// path stays until the next call.
+const char* sp_test_reachable_dir(const char* prefix);
 /// Runs the NULL-terminated table; argv[1] filters by substring.
 int sp_test_run(int argc, char** argv, const sp_test* tests);
 

@@ -24,7 +24,10 @@
 #include <cjson/cJSON.h>
 
 #include "fixtures.h"
+#include "kiosk.h"
 #include "kiosk_parts.h"
+#include "sp/dragon.h"
+#include "sp/headless.h"
 #include "sp/image.h"
 #include "test.h"
 
@@ -163,13 +166,14 @@ static bool have_xvfb(void)
 }
 
 // Runs the kiosk under Xvfb; returns its exit code; stats JSON in *stats (may be NULL).
-static int run_kiosk(const char* args, cJSON** stats)
+// Runs the kiosk on db; its stderr is kept in kiosk_stderr.txt.
+static int run_kiosk_on(const char* db, const char* args, cJSON** stats)
 {
     const char* out = sp_test_tmp_path("kiosk_stats.json");
     const char* errf = sp_test_tmp_path("kiosk_stderr.txt");
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --stats %s > '%s' 2> '%s'", SP_DRAGON_KIOSK,
-             e2e_db(), args, out, errf);
+             db, args, out, errf);
     double t0 = wall_s();
     int rc = system(cmd);
     rc = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
@@ -190,6 +194,11 @@ static int run_kiosk(const char* args, cJSON** stats)
         }
     }
     return rc;
+}
+
+static int run_kiosk(const char* args, cJSON** stats)
+{
+    return run_kiosk_on(e2e_db(), args, stats);
 }
 
 static double num(const cJSON* j, const char* key)
@@ -903,6 +912,300 @@ static void test_twenty_strokes(void)
     cJSON_Delete(st);
 }
 
+// ------------------------------------------------------------ collection (issue 16, item 5)
+
+// A sketchpose command's JSON on stdout (NULL when it fails or prints none).
+static cJSON* sketchpose_json(const char* args)
+{
+    const char* out = sp_test_tmp_path("sketchpose_out.json");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s/app/sketchpose' %s > '%s'", SP_BINARY_DIR, args, out);
+    int rc = system(cmd);
+    FILE* f = fopen(out, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 20];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    cJSON* j = WIFEXITED(rc) && WEXITSTATUS(rc) == 0 ? cJSON_Parse(buf) : NULL;
+    if (!j) fprintf(stderr, "  `sketchpose %s` failed: %.300s\n", args, buf);
+    return j;
+}
+
+// The pending kiosk sketches of db (review's "sketches"), or NULL.
+static cJSON* review(const char* db)
+{
+    char args[1200];
+    snprintf(args, sizeof args, "db review --db '%s'", db);
+    return sketchpose_json(args);
+}
+
+static int pending_count(const char* db)
+{
+    cJSON* r = review(db);
+    int n = r ? cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(r, "sketches")) : -1;
+    cJSON_Delete(r);
+    return n;
+}
+
+// Issue 16, item 5, end to end: a visitor draws a body, a tail that they
+// relabel with a chip, and wings they take back with Undo, and leaves. The
+// review lists the body and the tail's stroke with the chip's label (its
+// points and times as drawn), not the wings; approved and trained, the new
+// model's training set has it.
+static void test_collect(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    char db[1100], cmd[4096];
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_collect.db"));
+    kp_remove_db(db);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
+    ENSURE(system(cmd) == 0);
+    ENSURE(pending_count(db) == 0);
+    const stroke* tail = &g_strokes[3];
+    const char* sc = sp_test_tmp_path("kiosk_collect.json");
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = part_stroke_at(&s, 500, &g_strokes[0], 0, 0) + 1500;
+    double up = script_stroke(&s, t, tail->xy, tail->n, 4);
+    script_press(&s, up + 1500, "guess1"); // the visitor's label
+    up = script_stroke(&s, up + 2500, g_strokes[2].xy, g_strokes[2].n, 4);
+    script_press(&s, up + 1500, "undo");
+    script_end(&s, sc, up + 2500); // the kiosk closes with the body and the tail on the canvas
+    char args[2048];
+    snprintf(args, sizeof args, "--script '%s'", sc);
+    cJSON* st = NULL;
+    ENSURE(run_kiosk_on(db, args, &st) == 0 && st);
+    fprintf(stderr, "  parts %g (%s, %s), refits %g, collected %g, stored %g, dropped %g\n", num(st, "parts"),
+            stat_category(st, 0), stat_category(st, 1), num(st, "refits"), num(st, "collected"), num(st, "collect_stored"),
+            num(st, "collect_dropped"));
+    ENSURE(num(st, "parts") == 2 && num(st, "refits") == 1 + (g_strokes[0].rank > 0) && num(st, "undos") == 1);
+    ENSURE(num(st, "collected") == 2 && num(st, "collect_stored") == 2 && num(st, "collect_dropped") == 0);
+    char label[64];
+    snprintf(label, sizeof label, "%s", stat_category(st, 1));
+    ENSURE(strcmp(label, "tail") != 0); // the chip's category, whichever the model ranked next
+    cJSON_Delete(st);
+    // The review: oldest first, the body then the relabelled tail; no wings.
+    cJSON* r = review(db);
+    ENSURE(r);
+    const cJSON* list = cJSON_GetObjectItemCaseSensitive(r, "sketches");
+    ENSURE(cJSON_GetArraySize(list) == 2);
+    const cJSON* body = cJSON_GetArrayItem(list, 0);
+    const cJSON* sk = cJSON_GetArrayItem(list, 1);
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(body, "category")->valuestring, "torso"));
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(sk, "category")->valuestring, label));
+    ENSURE(!strcmp(cJSON_GetObjectItemCaseSensitive(sk, "status")->valuestring, "pending"));
+    // Its points are the stroke as drawn (canvas = framebuffer here), its times the pen's.
+    const cJSON* pts = cJSON_GetObjectItemCaseSensitive(sk, "points");
+    const cJSON* ts = cJSON_GetObjectItemCaseSensitive(sk, "t");
+    int n = cJSON_GetArraySize(pts);
+    fprintf(stderr, "  review: #%g %s, %d points (drawn %d), last at %g ms\n",
+            cJSON_GetObjectItemCaseSensitive(sk, "id")->valuedouble, label, n, tail->n,
+            n > 0 ? cJSON_GetArrayItem(ts, n - 1)->valuedouble : -1);
+    ENSURE(n >= tail->n / 2 && n <= tail->n && cJSON_GetArraySize(ts) == n);
+    double x0 = cJSON_GetArrayItem(cJSON_GetArrayItem(pts, 0), 0)->valuedouble;
+    double y0 = cJSON_GetArrayItem(cJSON_GetArrayItem(pts, 0), 1)->valuedouble;
+    ENSURE(fabs(x0 - tail->xy[0].x) < 1.5 && fabs(y0 - tail->xy[0].y) < 1.5);
+    ENSURE(cJSON_GetArrayItem(ts, 0)->valuedouble == 0 && cJSON_GetArrayItem(ts, n - 1)->valuedouble > 100);
+    // Approve it, train: the new model's training set includes it.
+    char ids[1200];
+    snprintf(ids, sizeof ids, "db review --db '%s' --approve %.0f", db, cJSON_GetObjectItemCaseSensitive(sk, "id")->valuedouble);
+    cJSON_Delete(r);
+    cJSON* ap = sketchpose_json(ids);
+    ENSURE(ap && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(ap, "approved")) == 1);
+    cJSON_Delete(ap);
+    snprintf(args, sizeof args, "db train --db '%s' --folds -1 --words 96 --threads 2", db);
+    double t0 = wall_s();
+    cJSON* tr = sketchpose_json(args);
+    ENSURE(tr);
+    fprintf(stderr, "  db train: %.1f s, kiosk_sketches %g\n", wall_s() - t0, num(tr, "kiosk_sketches"));
+    ENSURE(num(tr, "kiosk_sketches") >= 1);
+    cJSON_Delete(tr);
+    ENSURE(pending_count(db) == 1); // the body, still waiting for review
+    // Start over collects the visit's parts; --no-collect keeps nothing.
+    sc = sp_test_tmp_path("kiosk_collect2.json");
+    s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    up = part_stroke_at(&s, 500, &g_strokes[0], 0, 0);
+    script_press(&s, up + 1500, "start_over");
+    script_press(&s, up + 1700, "start_over");
+    script_end(&s, sc, up + 2500);
+    for (int off = 1; off >= 0; --off) {
+        snprintf(args, sizeof args, "--script '%s'%s", sc, off ? " --no-collect" : "");
+        ENSURE(run_kiosk_on(db, args, &st) == 0 && st);
+        fprintf(stderr, "  %s: start over %g, collected %g, stored %g\n", off ? "--no-collect" : "collecting", num(st, "clears"),
+                num(st, "collected"), num(st, "collect_stored"));
+        ENSURE(num(st, "clears") == 1 && num(st, "parts") == 0);
+        ENSURE(num(st, "collected") == (off ? 0 : 1) && num(st, "collect_stored") == (off ? 0 : 1));
+        cJSON_Delete(st);
+        ENSURE(pending_count(db) == (off ? 1 : 2));
+    }
+}
+
+// Lines of a file that contain `what`.
+static int lines_with(const char* path, const char* what)
+{
+    FILE* f = fopen(path, "r");
+    if (!f) return -1;
+    char line[4096];
+    int n = 0;
+    while (fgets(line, sizeof line, f))
+        n += strstr(line, what) != NULL;
+    fclose(f);
+    return n;
+}
+
+// A database the kiosk may not write (mode 0444; as root, the kiosk runs in
+// an unprivileged child, since root ignores permissions): the visit goes on
+// as ever, and each stroke left is dropped with one line on stderr.
+static void test_collect_read_only(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const char* reach = sp_test_reachable_dir("sp_kiosk");
+    ENSURE(reach);
+    char dir[1024], db[1100], sc[1100], out[1100], errf[1100], cmd[8192];
+    snprintf(dir, sizeof dir, "%s", reach);
+    ENSURE(chmod(dir, 0777) == 0); // the reader may create the database's -shm beside it
+    snprintf(db, sizeof db, "%s/ro.db", dir);
+    snprintf(sc, sizeof sc, "%s/session.json", dir);
+    snprintf(out, sizeof out, "%s/stats.json", dir);
+    snprintf(errf, sizeof errf, "%s/stderr.txt", dir);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s' && chmod 0444 '%s'", e2e_db(), db, db);
+    ENSURE(system(cmd) == 0);
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    double t = part_stroke_at(&s, 500, &g_strokes[0], 0, 0) + 1500;
+    t = part_stroke_at(&s, t, &g_strokes[3], 0, 0);
+    script_end(&s, sc, t + 2000);
+    ENSURE(chmod(sc, 0644) == 0);
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --script '%s' --stats > '%s' 2> '%s'", dir,
+             SP_DRAGON_KIOSK, db, sc, out, errf);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
+        int rc = system(cmd);
+        _exit(WIFEXITED(rc) ? WEXITSTATUS(rc) : 6);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status));
+    snprintf(cmd, sizeof cmd, "sed -e 's/^/  kiosk: /' '%s' >&2", errf);
+    if (system(cmd) != 0) fprintf(stderr, "  (no stderr)\n");
+    ENSURE(WEXITSTATUS(status) == 0);
+    FILE* f = fopen(out, "rb");
+    ENSURE(f);
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    cJSON* st = cJSON_Parse(buf);
+    ENSURE(st);
+    fprintf(stderr, "  parts %g, collected %g, stored %g, dropped %g\n", num(st, "parts"), num(st, "collected"),
+            num(st, "collect_stored"), num(st, "collect_dropped"));
+    ENSURE(num(st, "parts") == 2 && num(st, "pipeline_errors") == 0);
+    ENSURE(num(st, "collected") == 2 && num(st, "collect_stored") == 0 && num(st, "collect_dropped") == 2);
+    cJSON_Delete(st);
+    // One line says why at start, one line a sketch.
+    ENSURE(lines_with(errf, "cannot be collected") == 1 && lines_with(errf, "sketch dropped") == 2);
+    ENSURE(pending_count(db) == 0);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ENSURE(system(cmd) == 0);
+}
+
+// Runs an in-process kiosk's updates at 60 a second from *t to until.
+static void updates_until(sp_kiosk* k, double* t, double until)
+{
+    for (; *t < until; *t += 1000.0 / 60.0)
+        sp_kiosk_update(k, *t);
+}
+
+// A running kiosk picks up the model `db train` stores, trained on a stroke
+// it collected itself: the kiosk in-process on a headless context (it polls
+// the database's generation every 2 s of its clock), the curator's review
+// and training on another handle meanwhile.
+static void test_collect_reload(void)
+{
+    six_strokes();
+    char db[1100], cmd[4096];
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_reload.db"));
+    kp_remove_db(db);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
+    ENSURE(system(cmd) == 0);
+    sp_error err = {0};
+    sp_headless* gl = sp_headless_create(&err);
+    if (!gl) SKIP("no headless OpenGL");
+    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
+                                                   .canvas_w = 1280,
+                                                   .canvas_h = 800,
+                                                   .export_dir = sp_test_tmp_path("kiosk_reload_ex"),
+                                                   .no_attract_demo = true,
+                                                   .fit_time_cap_ms = 60000},
+                                  &err);
+    if (!k) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(k);
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    double t = 0;
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, 640, 400, 0}); // leaves the attract screen
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, t + 60, 640, 400, 0});
+    updates_until(k, &t, 500);
+    // The visitor draws a tail, then starts over: the stroke is collected.
+    const stroke* tail = &g_strokes[3];
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, (float)tail->xy[0].x, (float)tail->xy[0].y, 0});
+    for (int i = 1; i < tail->n; ++i)
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, t + 4 * i, (float)tail->xy[i].x, (float)tail->xy[i].y, 0});
+    sp_kiosk_input(
+        k, &(sp_kiosk_event){SP_KEV_UP, t + 4 * tail->n, (float)tail->xy[tail->n - 1].x, (float)tail->xy[tail->n - 1].y, 0});
+    updates_until(k, &t, t + 4 * tail->n + 1500);
+    ENSURE(st->parts == 1);
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_START_OVER});
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t + 200, 0, 0, SP_KT_START_OVER});
+    updates_until(k, &t, t + 3000);
+    ENSURE(st->parts == 0 && st->collected == 1 && st->reloads == 0);
+    int stored = 0, dropped = 0;
+    for (int i = 0; i < 200 && stored == 0; ++i) { // the writer's thread
+        usleep(10000);
+        sp_kiosk_collect_counts(k, &stored, &dropped);
+    }
+    ENSURE(stored == 1);
+    // Which model: its reject distance (this training's leave-one-out
+    // threshold differs from the calibrated one the database came with).
+    double before = sp_clf_reject_distance(sp_dragon_model(sp_kiosk_dragon(k)));
+    // The curator approves it and trains, while the kiosk runs.
+    sp_db* w = NULL;
+    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK);
+    sp_db_kiosk_sketch* ks = NULL;
+    int n = 0;
+    ENSURE(sp_db_kiosk_list(w, NULL, &ks, &n, &err) == SP_OK && n == 1);
+    ENSURE(!strcmp(ks[0].category, "tail"));
+    ENSURE(sp_db_kiosk_set_status(w, &ks[0].id, 1, SP_DB_APPROVED, "test", &err) == SP_OK);
+    sp_db_kiosk_free(ks, n);
+    sp_db_train_desc td = kp_quick_train();
+    td.calibrate = -1;
+    char* report = NULL;
+    ENSURE(sp_db_train(w, &td, &report, &err) == SP_OK);
+    cJSON* rep = cJSON_Parse(report);
+    free(report);
+    ENSURE(rep && num(rep, "kiosk_sketches") == 1);
+    cJSON_Delete(rep);
+    sp_clf* fresh = NULL;
+    ENSURE(sp_db_load_model(w, &fresh, NULL, &err) == SP_OK);
+    sp_db_close(w);
+    updates_until(k, &t, t + 2500);
+    double after = sp_clf_reject_distance(sp_dragon_model(sp_kiosk_dragon(k))), want = sp_clf_reject_distance(fresh);
+    fprintf(stderr, "  reloads %d; the kiosk's model: reject distance %.4f before, %.4f after (the new model's: %.4f)\n",
+            st->reloads, before, after, want);
+    ENSURE(st->reloads == 1 && after == want && before != want);
+    sp_clf_free(fresh);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -914,5 +1217,8 @@ int main(int argc, char** argv)
                                    {"full_dragon", test_full_dragon},
                                    {"visit", test_visit},
                                    {"twenty_strokes", test_twenty_strokes},
+                                   {"collect", test_collect},
+                                   {"collect_read_only", test_collect_read_only},
+                                   {"collect_reload", test_collect_reload},
                                    {0}});
 }

@@ -167,38 +167,6 @@ static const char* base_db(const char* name)
     return path;
 }
 
-// True when every folder from / down to dir lets other users pass (o+x).
-static bool others_may_enter(const char* dir)
-{
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", dir);
-    for (;;) {
-        struct stat st;
-        if (stat(buf[0] ? buf : "/", &st) != 0 || !(st.st_mode & S_IXOTH)) return false;
-        char* slash = strrchr(buf, '/');
-        if (!slash) return true;
-        *slash = 0;
-        if (!buf[0]) return stat("/", &st) == 0 && (st.st_mode & S_IXOTH);
-    }
-}
-
-// A fresh folder (mode 0755) that any user can reach, for the cases run as
-// another user: the build folder may lie under one that only its owner may
-// enter (a clone in a fresh `mktemp -d`). NULL when there is none.
-static const char* reachable_dir(void)
-{
-    static char dir[1000];
-    const char* tmpdir = getenv("TMPDIR");
-    const char* candidates[] = {SP_BINARY_DIR "/tmp", tmpdir && tmpdir[0] ? tmpdir : P_tmpdir, P_tmpdir};
-    for (size_t i = 0; i < sizeof candidates / sizeof candidates[0]; ++i) {
-        mkdir(candidates[i], 0755);
-        if (!others_may_enter(candidates[i])) continue;
-        if (snprintf(dir, sizeof dir, "%s/sp_partdb_XXXXXX", candidates[i]) >= 1000) continue;
-        if (mkdtemp(dir) && chmod(dir, 0755) == 0) return dir;
-    }
-    return NULL;
-}
-
 static void copy_file(const char* from, const char* to)
 {
     FILE* a = fopen(from, "rb");
@@ -575,7 +543,7 @@ static void test_read_only_and_full(void)
     sp_db_close(db);
     // A file the user may not write (a non-root child, as root ignores
     // permissions), in a folder that child can reach wherever the clone lives.
-    const char* dir = reachable_dir();
+    const char* dir = sp_test_reachable_dir("sp_partdb");
     ENSURE(dir);
     char ro[1024];
     snprintf(ro, sizeof ro, "%s/ro.db", dir);
@@ -612,7 +580,7 @@ static void test_read_only_and_full(void)
 // not "no such database" (root ignores permissions: its child drops them).
 static void test_unreachable(void)
 {
-    const char* dir = reachable_dir();
+    const char* dir = sp_test_reachable_dir("sp_partdb");
     ENSURE(dir);
     char p[1024];
     snprintf(p, sizeof p, "%s/x.db", dir);

@@ -1,0 +1,191 @@
+// kiosk_collect.c: the visitors' strokes the kiosk keeps for review (issue
+// 16, item 5), written by a thread of their own so that the frame loop never
+// waits for the database (docs/DESIGN.md, "Collecting visitors' strokes").
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "kiosk_internal.h"
+#include "sp/partdb.h"
+
+// Sketches waiting for the writer: more than a whole dragon's (48 parts),
+// so only a database that keeps refusing drops what it cannot take.
+enum { QUEUE_MAX = 256 };
+
+typedef struct queued {
+    char category[SP_NAME_MAX];
+    sp_vec2* xy;
+    double* t;
+    int n;
+} queued;
+
+struct kiosk_collector {
+    sp_db* db; // the writer's own handle; NULL: it could not be opened, every sketch is dropped
+    char path[1024];
+    dev_t dev; // the file the handle has open
+    ino_t ino;
+    double canvas_w, canvas_h;
+    bool threaded;
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    queued q[QUEUE_MAX]; // a ring: head, count
+    int head, count;
+    bool stop;
+    int stored, dropped;
+};
+
+static void queued_free(queued* s)
+{
+    free(s->xy);
+    free(s->t);
+    memset(s, 0, sizeof *s);
+}
+
+static void count_result(kiosk_collector* c, bool stored)
+{
+    pthread_mutex_lock(&c->lock);
+    if (stored)
+        ++c->stored;
+    else
+        ++c->dropped;
+    pthread_mutex_unlock(&c->lock);
+}
+
+// The database file at c->path is still the one the handle has open; a file
+// replaced by a rename (a curator's new database) is opened anew, so that
+// no stroke goes into the old, unlinked one.
+static void follow_file(kiosk_collector* c)
+{
+    struct stat st;
+    if (stat(c->path, &st) != 0 || (st.st_dev == c->dev && st.st_ino == c->ino)) return;
+    sp_db* db = NULL;
+    sp_error err = {0};
+    if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
+        fprintf(stderr, "dragon-kiosk: the database was replaced and cannot be written: %s\n", err.text);
+        return; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
+    }
+    sp_db_close(c->db);
+    c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
+}
+
+// The writer: one sketch a transaction, each waiting at most
+// SP_DB_COLLECT_BUSY_MS for another writer (partdb.h); whatever fails is
+// dropped with one line (the error says "sketch dropped").
+static void* collector_main(void* arg)
+{
+    kiosk_collector* c = arg;
+    pthread_mutex_lock(&c->lock);
+    for (;;) {
+        while (c->count == 0 && !c->stop)
+            pthread_cond_wait(&c->wake, &c->lock);
+        if (c->count == 0) break; // stopping, and everything is written
+        queued s = c->q[c->head];
+        memset(&c->q[c->head], 0, sizeof s);
+        c->head = (c->head + 1) % QUEUE_MAX, --c->count;
+        pthread_mutex_unlock(&c->lock);
+        follow_file(c);
+        sp_error err = {0};
+        sp_stroke st = {.count = s.n, .points = s.xy, .t = s.t};
+        sp_result r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
+        if (r != SP_OK) fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+        queued_free(&s);
+        count_result(c, r == SP_OK);
+        pthread_mutex_lock(&c->lock);
+    }
+    pthread_mutex_unlock(&c->lock);
+    return NULL;
+}
+
+kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, double canvas_h)
+{
+    kiosk_collector* c = calloc(1, sizeof *c);
+    if (!c) {
+        fprintf(stderr, "dragon-kiosk: out of memory: visitors' strokes are not collected\n");
+        return NULL;
+    }
+    c->canvas_w = canvas_w, c->canvas_h = canvas_h;
+    snprintf(c->path, sizeof c->path, "%s", db_path);
+    pthread_mutex_init(&c->lock, NULL);
+    pthread_cond_init(&c->wake, NULL);
+    // A writable handle of its own (the pipeline reads through a read-only
+    // one); opening migrates an older schema. It runs at start, before the
+    // first frame. A database that cannot be written keeps the kiosk running:
+    // each sketch is then dropped with one line.
+    sp_error err = {0};
+    struct stat st;
+    if (stat(db_path, &st) == 0) c->dev = st.st_dev, c->ino = st.st_ino;
+    if (sp_db_open(db_path, 0, &c->db, &err) != SP_OK) {
+        fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected: %s\n", err.text);
+        c->db = NULL;
+    }
+    c->threaded = c->db && pthread_create(&c->thread, NULL, collector_main, c) == 0;
+    if (c->db && !c->threaded) {
+        fprintf(stderr, "dragon-kiosk: %s: visitors' strokes cannot be collected: no thread to write them\n", db_path);
+        sp_db_close(c->db);
+        c->db = NULL;
+    }
+    return c;
+}
+
+void kiosk_collector_push(kiosk_collector* c, const char* category, const sp_vec2* xy, const double* t, int n)
+{
+    if (!c) return;
+    if (!c->threaded) {
+        fprintf(stderr, "dragon-kiosk: a %s stroke not collected (the database cannot be written); sketch dropped\n", category);
+        count_result(c, false);
+        return;
+    }
+    queued s = {.n = n, .xy = malloc(sizeof *s.xy * (size_t)n), .t = t ? malloc(sizeof *s.t * (size_t)n) : NULL};
+    snprintf(s.category, sizeof s.category, "%s", category);
+    pthread_mutex_lock(&c->lock);
+    const char* why = n <= 0                  ? "no points"
+                      : !s.xy || (t && !s.t)  ? "out of memory"
+                      : c->count >= QUEUE_MAX ? "too many waiting for the database"
+                                              : NULL;
+    bool ok = !why;
+    if (ok) {
+        memcpy(s.xy, xy, sizeof *s.xy * (size_t)n);
+        if (t) memcpy(s.t, t, sizeof *s.t * (size_t)n);
+        c->q[(c->head + c->count++) % QUEUE_MAX] = s;
+        pthread_cond_signal(&c->wake);
+    } else {
+        ++c->dropped;
+    }
+    pthread_mutex_unlock(&c->lock);
+    if (!ok) {
+        fprintf(stderr, "dragon-kiosk: a %s stroke not collected (%s); sketch dropped\n", category, why);
+        queued_free(&s);
+    }
+}
+
+void kiosk_collector_counts(kiosk_collector* c, int* stored, int* dropped)
+{
+    *stored = *dropped = 0;
+    if (!c) return;
+    pthread_mutex_lock(&c->lock);
+    *stored = c->stored, *dropped = c->dropped;
+    pthread_mutex_unlock(&c->lock);
+}
+
+void kiosk_collector_close(kiosk_collector* c, int* stored, int* dropped)
+{
+    *stored = *dropped = 0;
+    if (!c) return;
+    if (c->threaded) {
+        // The writer empties the queue first (each sketch waits at most
+        // SP_DB_COLLECT_BUSY_MS), so closing the kiosk keeps what was left.
+        pthread_mutex_lock(&c->lock);
+        c->stop = true;
+        pthread_cond_signal(&c->wake);
+        pthread_mutex_unlock(&c->lock);
+        pthread_join(c->thread, NULL);
+    }
+    kiosk_collector_counts(c, stored, dropped);
+    sp_db_close(c->db);
+    pthread_cond_destroy(&c->wake);
+    pthread_mutex_destroy(&c->lock);
+    free(c);
+}
