@@ -1,9 +1,9 @@
 // cmd_train.c: sketchpose train --data DIR --model M
 #include <math.h>
-#include <time.h>
 
 #include "clf_cli.h"
 #include "sp/classifier.h"
+#include "sp/clock.h"
 #include "sp/sketch_io.h"
 
 int cmd_train(int argc, char** argv)
@@ -28,8 +28,7 @@ int cmd_train(int argc, char** argv)
         fprintf(stderr, "sketchpose train: --calibrate-quantile must be in (0, 1]\n");
         return SP_EXIT_USAGE;
     }
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = sp_now_ms();
     sp_error err = {0};
     sp_dataset ds;
     if (sp_dataset_load(data, &ds, &err) != SP_OK) {
@@ -64,12 +63,11 @@ int cmd_train(int argc, char** argv)
         sp_dataset_free(&ds);
         return SP_EXIT_INPUT;
     }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
     printf("{\"model\": ");
     clf_cli_json_str(stdout, model);
     float rd = sp_clf_reject_distance(clf);
     printf(", \"categories\": %d, \"drawings\": %d, \"seconds\": %.3f, \"reject_distance\": %.4f}\n", ds.category_count, ds.count,
-           (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec), isfinite(rd) ? rd : -1.0);
+           (sp_now_ms() - t0) / 1e3, isfinite(rd) ? rd : -1.0);
     sp_clf_free(clf);
     sp_dataset_free(&ds);
     return SP_EXIT_OK;

@@ -4,10 +4,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "db_internal.h"
+#include "sp/clock.h"
 #include "sp/handdraw.h"
 
 // The classifier reads and writes model files; the database keeps the file's
@@ -53,9 +53,7 @@ static sp_result model_from_bytes(const void* bytes, size_t size, const char* wh
 
 static double now_s(void)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+    return sp_now_ms() / 1e3;
 }
 
 static bool classify_ok(const sp_clf* clf, const sp_sample* s)

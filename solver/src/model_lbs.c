@@ -55,11 +55,6 @@ typedef struct lbs_model {
     reg_lbs reg;
 } lbs_model;
 
-static int cmp_int(const void* a, const void* b)
-{
-    return *(const int*)a - *(const int*)b;
-}
-
 // Parameters that move a point skinned to `joints`/`weights`: those of
 // every influence joint and its ancestors, sorted, unique. Returns the count.
 static int point_columns(const sp_rig* rig, const uint16_t* joints, const float* weights, int ninf, int* out)
@@ -71,7 +66,7 @@ static int point_columns(const sp_rig* rig, const uint16_t* joints, const float*
             for (int q = 0; q < rig->joints[a].param_count; ++q)
                 out[n++] = rig->joints[a].first_param + q;
     }
-    qsort(out, (size_t)n, sizeof(int), cmp_int);
+    qsort(out, (size_t)n, sizeof(int), sp_cmp_int);
     int u = 0;
     for (int i = 0; i < n; ++i)
         if (u == 0 || out[u - 1] != out[i]) out[u++] = out[i];
@@ -173,7 +168,7 @@ static bool lbs_prepare(sp_model* m, const int* reps, int k)
         R->anc_first[j] = na;
         for (int a = j; a >= 0; a = rig->joints[a].parent)
             for (int q = 0; q < rig->joints[a].param_count; ++q) R->anc[na++] = rig->joints[a].first_param + q;
-        qsort(R->anc + R->anc_first[j], (size_t)(na - R->anc_first[j]), sizeof(int), cmp_int);
+        qsort(R->anc + R->anc_first[j], (size_t)(na - R->anc_first[j]), sizeof(int), sp_cmp_int);
     }
     R->anc_first[nj] = na;
     R->E = malloc(sizeof(double) * 12 * ((size_t)na + 1));

@@ -7,11 +7,6 @@
 
 #include "solver_internal.h"
 
-static int cmp_int(const void* a, const void* b)
-{
-    return *(const int*)a - *(const int*)b;
-}
-
 // k-means of the rest vertices (FLANN), centres snapped to the nearest vertex.
 static int coarsen(const double* rest_in, int n, int k, int* reps)
 {
@@ -50,7 +45,7 @@ static int coarsen(const double* rest_in, int n, int k, int* reps)
     int m = 0;
     if (idx && dist && flann_find_nearest_neighbors_index_double(idx, centers, got, reps, dist, 1, &ip) == 0) {
         // Two centres may snap to one vertex: keep each vertex once.
-        qsort(reps, (size_t)got, sizeof(int), cmp_int);
+        qsort(reps, (size_t)got, sizeof(int), sp_cmp_int);
         for (int i = 0; i < got; ++i)
             if (m == 0 || reps[m - 1] != reps[i]) reps[m++] = reps[i];
     } else {

@@ -240,6 +240,13 @@ static inline int sp_cmp_double(const void* a, const void* b)
     return (x > y) - (x < y);
 }
 
+/// The same for ints (no subtraction, so no overflow).
+static inline int sp_cmp_int(const void* a, const void* b)
+{
+    int x = *(const int*)a, y = *(const int*)b;
+    return (x > y) - (x < y);
+}
+
 #ifdef __cplusplus
 }
 #endif
