@@ -447,7 +447,10 @@ static void test_cli(void)
              out, png, errf);
     char* text = NULL;
     int status = run(cmd, &text);
-    if (status != 0) print_file(errf); // the command's own one-line reason, in the test log
+    if (status != 0) {
+        print_file(errf); // the command's own one-line reason, in the test log
+        free(text);
+    }
     ENSURE(status == 0);
     cJSON* j = cJSON_Parse(text);
     free(text);
@@ -729,9 +732,10 @@ static void test_validator(void)
                 (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "numErrors")),
                 (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "numWarnings")));
         if (rc != 0) fprintf(stderr, "%s\n", report ? report : "");
-        ENSURE(rc == 0 && j && cJSON_GetNumberValue(cJSON_GetObjectItem(j, "numErrors")) == 0);
+        bool clean = rc == 0 && j && cJSON_GetNumberValue(cJSON_GetObjectItem(j, "numErrors")) == 0;
         cJSON_Delete(j);
         free(report);
+        ENSURE(clean);
     }
 }
 
