@@ -94,6 +94,16 @@ static void* collector_main(void* arg)
         queued_free(&s);
         count_result(c, r == SP_OK);
         pthread_mutex_lock(&c->lock);
+        if (r == SP_OK && c->count == 0) {
+            // Once the queue is empty, the visit's sketches go from the WAL
+            // into the file itself: a curator's copy of the file has them,
+            // and a file renamed over it (follow_file) never meets this
+            // file's WAL. A reader in the way only postpones it.
+            pthread_mutex_unlock(&c->lock);
+            sp_db_set_busy_timeout(c->db, SP_DB_COLLECT_BUSY_MS); // closing the kiosk waits for this
+            sp_db_checkpoint(c->db, NULL);
+            pthread_mutex_lock(&c->lock);
+        }
     }
     pthread_mutex_unlock(&c->lock);
     return NULL;

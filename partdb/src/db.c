@@ -429,6 +429,15 @@ void sp_db_set_busy_timeout(sp_db* db, int ms)
     sqlite3_busy_timeout(db->h, db->busy_ms);
 }
 
+sp_result sp_db_checkpoint(sp_db* db, sp_error* err)
+{
+    int log = 0, done = 0;
+    int rc = sqlite3_wal_checkpoint_v2(db->h, NULL, SQLITE_CHECKPOINT_TRUNCATE, &log, &done);
+    if (rc == SQLITE_BUSY || (rc == SQLITE_OK && done < log))
+        return sp_fail(err, SP_ERR_BUSY, "%s: checkpoint: the database is in use; its WAL is kept", db->path);
+    return rc == SQLITE_OK ? SP_OK : db_fail(db, rc, "checkpointing", err);
+}
+
 const char* sp_db_path(const sp_db* db) { return db->path; }
 
 int sp_db_schema_version(sp_db* db)

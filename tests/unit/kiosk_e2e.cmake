@@ -3,7 +3,7 @@
 # replay; the database replaced while running; visitors' strokes collected,
 # reviewed (sketchpose db review) and trained on (db train). Skips itself without xvfb-run.
 if(TARGET dragon-kiosk)
-  sp_unit_test(kiosk_e2e LIBS sp_kiosk sp_render sp::partdb TIMEOUT 900)
+  sp_unit_test(kiosk_e2e LIBS sp_kiosk sp_render sp::partdb SQLite::SQLite3 TIMEOUT 900)
   target_compile_definitions(test_kiosk_e2e PRIVATE SP_DRAGON_KIOSK="$<TARGET_FILE:dragon-kiosk>")
   add_dependencies(test_kiosk_e2e dragon-kiosk sketchpose)
 endif()

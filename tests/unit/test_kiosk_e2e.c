@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
+#include <sqlite3.h>
 
 #include "fixtures.h"
 #include "kiosk.h"
@@ -74,6 +75,17 @@ static const char* e2e_db(void)
     ENSURE(ok);
     fprintf(stderr, "  database of the %s in %.1f s\n", g_real_assets ? "assets" : "stand-ins", wall_s() - t0);
     return path;
+}
+
+// A fresh copy of the test database at tmp/<name> (the collection tests
+// write into copies; the shared one stays as built).
+static void e2e_db_copy(const char* name, char* path, size_t size)
+{
+    snprintf(path, size, "%s", sp_test_tmp_path(name));
+    kp_remove_db(path);
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), path);
+    ENSURE(system(cmd) == 0);
 }
 
 typedef kp_stroke stroke;
@@ -196,9 +208,13 @@ static int run_kiosk_on(const char* db, const char* args, cJSON** stats)
     return rc;
 }
 
+// The shared test database stays as built: sessions on it keep no strokes
+// (the collection tests run on copies of it).
 static int run_kiosk(const char* args, cJSON** stats)
 {
-    return run_kiosk_on(e2e_db(), args, stats);
+    char with[8192];
+    snprintf(with, sizeof with, "%s --no-collect", args);
+    return run_kiosk_on(e2e_db(), with, stats);
 }
 
 static double num(const cJSON* j, const char* key)
@@ -957,11 +973,8 @@ static void test_collect(void)
 {
     NEED_XVFB();
     six_strokes();
-    char db[1100], cmd[4096];
-    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_collect.db"));
-    kp_remove_db(db);
-    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
-    ENSURE(system(cmd) == 0);
+    char db[1100];
+    e2e_db_copy("kiosk_collect.db", db, sizeof db);
     ENSURE(pending_count(db) == 0);
     const stroke* tail = &g_strokes[3];
     const char* sc = sp_test_tmp_path("kiosk_collect.json");
@@ -1125,6 +1138,58 @@ static void updates_until(sp_kiosk* k, double* t, double until)
         sp_kiosk_update(k, *t);
 }
 
+// A kiosk in-process on a headless context, past its attract screen; NULL
+// (and *gl NULL) without headless OpenGL.
+static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headless** gl, double* t)
+{
+    sp_error err = {0};
+    *gl = sp_headless_create(&err);
+    if (!*gl) return NULL;
+    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
+                                                   .canvas_w = 1280,
+                                                   .canvas_h = 800,
+                                                   .export_dir = sp_test_tmp_path(export_dir),
+                                                   .no_attract_demo = true,
+                                                   .fit_time_cap_ms = 60000},
+                                  &err);
+    if (!k) {
+        fprintf(stderr, "  %s\n", err.text);
+        return NULL;
+    }
+    *t = 0;
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, *t, 640, 400, 0}); // leaves the attract screen
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, *t + 60, 640, 400, 0});
+    updates_until(k, t, 500);
+    return k;
+}
+
+// The visitor draws one part and starts over: the stroke goes to the writer.
+static void draw_then_start_over(sp_kiosk* k, double* t, const stroke* s)
+{
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    const int parts = st->parts;
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, *t, (float)s->xy[0].x, (float)s->xy[0].y, 0});
+    for (int i = 1; i < s->n; ++i)
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, *t + 4 * i, (float)s->xy[i].x, (float)s->xy[i].y, 0});
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, *t + 4 * s->n, (float)s->xy[s->n - 1].x, (float)s->xy[s->n - 1].y, 0});
+    updates_until(k, t, *t + 4 * s->n + 1500);
+    ENSURE(st->parts == parts + 1);
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, *t, 0, 0, SP_KT_START_OVER});
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, *t + 200, 0, 0, SP_KT_START_OVER});
+    updates_until(k, t, *t + 3000);
+    ENSURE(st->parts == 0);
+}
+
+// Waits (up to 2 s) for the writer's thread to have settled `want` sketches.
+static void wait_collected(sp_kiosk* k, int want, int* stored, int* dropped)
+{
+    for (int i = 0; i < 200; ++i) {
+        sp_kiosk_collect_counts(k, stored, dropped);
+        if (*stored + *dropped >= want) return;
+        usleep(10000);
+    }
+}
+
 // A running kiosk picks up the model `db train` stores, trained on a stroke
 // it collected itself: the kiosk in-process on a headless context (it polls
 // the database's generation every 2 s of its clock), the curator's review
@@ -1132,46 +1197,20 @@ static void updates_until(sp_kiosk* k, double* t, double until)
 static void test_collect_reload(void)
 {
     six_strokes();
-    char db[1100], cmd[4096];
-    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_reload.db"));
-    kp_remove_db(db);
-    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
-    ENSURE(system(cmd) == 0);
+    char db[1100];
+    e2e_db_copy("kiosk_reload.db", db, sizeof db);
     sp_error err = {0};
-    sp_headless* gl = sp_headless_create(&err);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_reload_ex", &gl, &t);
     if (!gl) SKIP("no headless OpenGL");
-    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
-                                                   .canvas_w = 1280,
-                                                   .canvas_h = 800,
-                                                   .export_dir = sp_test_tmp_path("kiosk_reload_ex"),
-                                                   .no_attract_demo = true,
-                                                   .fit_time_cap_ms = 60000},
-                                  &err);
-    if (!k) fprintf(stderr, "  %s\n", err.text);
     ENSURE(k);
     const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
-    double t = 0;
-    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, 640, 400, 0}); // leaves the attract screen
-    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, t + 60, 640, 400, 0});
-    updates_until(k, &t, 500);
     // The visitor draws a tail, then starts over: the stroke is collected.
-    const stroke* tail = &g_strokes[3];
-    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, (float)tail->xy[0].x, (float)tail->xy[0].y, 0});
-    for (int i = 1; i < tail->n; ++i)
-        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, t + 4 * i, (float)tail->xy[i].x, (float)tail->xy[i].y, 0});
-    sp_kiosk_input(
-        k, &(sp_kiosk_event){SP_KEV_UP, t + 4 * tail->n, (float)tail->xy[tail->n - 1].x, (float)tail->xy[tail->n - 1].y, 0});
-    updates_until(k, &t, t + 4 * tail->n + 1500);
-    ENSURE(st->parts == 1);
-    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_START_OVER});
-    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t + 200, 0, 0, SP_KT_START_OVER});
-    updates_until(k, &t, t + 3000);
-    ENSURE(st->parts == 0 && st->collected == 1 && st->reloads == 0);
+    draw_then_start_over(k, &t, &g_strokes[3]);
+    ENSURE(st->collected == 1 && st->reloads == 0);
     int stored = 0, dropped = 0;
-    for (int i = 0; i < 200 && stored == 0; ++i) { // the writer's thread
-        usleep(10000);
-        sp_kiosk_collect_counts(k, &stored, &dropped);
-    }
+    wait_collected(k, 1, &stored, &dropped);
     ENSURE(stored == 1);
     // Which model: its reject distance (this training's leave-one-out
     // threshold differs from the calibrated one the database came with).
@@ -1206,6 +1245,72 @@ static void test_collect_reload(void)
     sp_headless_destroy(gl);
 }
 
+// A curator's tool holds the database's write lock while a visitor leaves:
+// the writer waits its short while, drops that sketch and the kiosk goes
+// on; once the lock is gone the next visitor's stroke is stored.
+static void test_collect_busy(void)
+{
+    six_strokes();
+    char db[1100];
+    e2e_db_copy("kiosk_busy.db", db, sizeof db);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_busy_ex", &gl, &t);
+    if (!gl) SKIP("no headless OpenGL");
+    ENSURE(k);
+    sqlite3* curator = NULL;
+    ENSURE(sqlite3_open(db, &curator) == SQLITE_OK);
+    ENSURE(sqlite3_exec(curator, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK);
+    draw_then_start_over(k, &t, &g_strokes[3]);
+    int stored = 0, dropped = 0;
+    wait_collected(k, 1, &stored, &dropped);
+    fprintf(stderr, "  write lock held: stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 0 && dropped == 1);
+    ENSURE(sqlite3_exec(curator, "COMMIT", NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(curator);
+    // The kiosk never stopped: the next visitor's part is made and kept.
+    draw_then_start_over(k, &t, &g_strokes[0]);
+    wait_collected(k, 2, &stored, &dropped);
+    fprintf(stderr, "  lock released: stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 1 && dropped == 1);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+    ENSURE(pending_count(db) == 1);
+}
+
+// A curator replaces the database file (a rename over it) while the kiosk
+// runs: strokes collected afterwards go into the new file, none into the
+// old, unlinked one.
+static void test_collect_replaced(void)
+{
+    six_strokes();
+    char db[1100], old_copy[1100], next[1100];
+    e2e_db_copy("kiosk_repl.db", db, sizeof db);
+    e2e_db_copy("kiosk_repl_next.db", next, sizeof next);
+    snprintf(old_copy, sizeof old_copy, "%s", sp_test_tmp_path("kiosk_repl_old.db"));
+    kp_remove_db(old_copy);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_repl_ex", &gl, &t);
+    if (!gl) SKIP("no headless OpenGL");
+    ENSURE(k);
+    draw_then_start_over(k, &t, &g_strokes[3]);
+    int stored = 0, dropped = 0;
+    wait_collected(k, 1, &stored, &dropped);
+    ENSURE(stored == 1);
+    // The old file stays reachable under a second name, so the test can
+    // show that nothing more went into it.
+    ENSURE(link(db, old_copy) == 0);
+    ENSURE(rename(next, db) == 0);
+    draw_then_start_over(k, &t, &g_strokes[0]);
+    wait_collected(k, 2, &stored, &dropped);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+    int in_new = pending_count(db), in_old = pending_count(old_copy);
+    fprintf(stderr, "  stored %d, dropped %d; pending in the new file %d, in the old %d\n", stored, dropped, in_new, in_old);
+    ENSURE(stored == 2 && dropped == 0 && in_new == 1 && in_old == 1);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -1220,5 +1325,7 @@ int main(int argc, char** argv)
                                    {"collect", test_collect},
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
+                                   {"collect_busy", test_collect_busy},
+                                   {"collect_replaced", test_collect_replaced},
                                    {0}});
 }

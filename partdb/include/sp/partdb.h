@@ -77,6 +77,13 @@ sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* er
 void sp_db_close(sp_db* db);
 /// Sets how long a write waits for another writer (milliseconds, >= 0).
 void sp_db_set_busy_timeout(sp_db* db, int ms);
+/// Moves what is committed from the WAL into the main file and empties the
+/// WAL, waiting at most the busy timeout for readers: afterwards a copy of
+/// the file, or the file renamed away, holds every commit, and a file
+/// renamed over it does not meet this one's WAL. SP_ERR_BUSY when a reader
+/// or writer kept it from finishing (nothing is lost: the commits stay in
+/// the WAL until the next checkpoint).
+sp_result sp_db_checkpoint(sp_db* db, sp_error* err);
 /// The file's path as opened.
 const char* sp_db_path(const sp_db* db);
 /// The schema version of the open database (== SP_DB_SCHEMA_VERSION once open).
