@@ -9,6 +9,7 @@
 #include "clf_cli.h"
 #include "cli.h"
 #include "sp/headless.h"
+#include "sp/math.h"
 #include "sp/part_preview.h"
 #include "sp/partdb.h"
 #include "sp/sketch_sheet.h"
@@ -322,8 +323,6 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
     return r;
 }
 
-static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
-
 // Sorted entries of a directory, no dot files (*names malloc'd).
 static int list_dir(const char* dir, char*** names)
 {
@@ -343,7 +342,7 @@ static int list_dir(const char* dir, char*** names)
         if ((out[n] = strdup(e->d_name))) ++n;
     }
     closedir(d);
-    if (n) qsort(out, (size_t)n, sizeof *out, cmp_str);
+    if (n) qsort(out, (size_t)n, sizeof *out, sp_cmp_cstr);
     *names = out;
     return n;
 }

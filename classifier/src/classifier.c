@@ -18,6 +18,7 @@
 #include "cv_adapter.h"
 #include "kmeans.h"
 #include "shape.h"
+#include "sp/math.h"
 
 struct sp_clf {
     sp_clf_desc desc; // resolved, progress NULL
@@ -690,12 +691,6 @@ static int loo_block(void* user, int b)
     return rc;
 }
 
-static int cmp_float(const void* a, const void* b)
-{
-    float x = *(const float*)a, y = *(const float*)b;
-    return (x > y) - (x < y);
-}
-
 // The shape descriptors of the training stroke drawings (originals: the
 // descriptor is mirror-invariant), standardised per value over them.
 static sp_result train_shapes(sp_clf* c, const sp_dataset* data, const unsigned char* use, sp_error* err)
@@ -837,7 +832,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
             goto oom;
         }
         sp_nearest_words(c->vocab, c->vnorm, c->words, sample, total, 1, idx, d2);
-        qsort(d2, (size_t)total, sizeof(float), cmp_float);
+        qsort(d2, (size_t)total, sizeof(float), sp_cmp_float);
         c->sigma = sqrtf(fmaxf(d2[total / 2], 0.0f));
         if (!(c->sigma > 1e-3f)) c->sigma = 1e-3f;
         free(idx);
@@ -934,7 +929,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
         for (int i = 0; i < n; ++i)
             if (loo[i] >= 0.0f) loo[m++] = loo[i];
         if (m > 0) {
-            qsort(loo, (size_t)m, sizeof(float), cmp_float);
+            qsort(loo, (size_t)m, sizeof(float), sp_cmp_float);
             c->bandwidth = fmaxf(loo[m / 2], 1e-4f);
             int qi = (int)ceil(c->desc.reject_quantile * m) - 1;
             if (qi < 0) qi = 0;
@@ -1019,7 +1014,7 @@ sp_result sp_clf_calibrate_reject(sp_clf* c, const sp_dataset* held_out, const u
         free(d);
         return sp_fail(err, SP_ERR_INVALID, "calibration: no usable held-out drawing");
     }
-    qsort(d, (size_t)m, sizeof(float), cmp_float);
+    qsort(d, (size_t)m, sizeof(float), sp_cmp_float);
     int qi = (int)ceil(quantile * m) - 1;
     if (qi < 0) qi = 0;
     if (qi >= m) qi = m - 1;

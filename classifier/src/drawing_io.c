@@ -11,6 +11,7 @@
 
 #include "cv_adapter.h"
 #include "sp/classifier.h"
+#include "sp/math.h"
 
 // ---------------------------------------------------------------------------
 // PNG
@@ -74,11 +75,6 @@ sp_result sp_drawing_read(const char* path, sp_sketch* sketch, sp_raster* raster
     return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: unknown drawing type (want .json, .svg, .png or .ndjson)", path);
 }
 
-static int cmp_str(const void* a, const void* b)
-{
-    return strcmp(*(char* const*)a, *(char* const*)b);
-}
-
 // Sorted entry names of a directory (excluding dot files). *names malloc'd.
 static sp_result list_dir(const char* dir, char*** names, int* count, sp_error* err)
 {
@@ -101,7 +97,7 @@ static sp_result list_dir(const char* dir, char*** names, int* count, sp_error* 
         ++n;
     }
     closedir(d);
-    if (n) qsort(v, (size_t)n, sizeof(char*), cmp_str);
+    if (n) qsort(v, (size_t)n, sizeof(char*), sp_cmp_cstr);
     *names = v;
     *count = n;
     return SP_OK;
@@ -148,7 +144,7 @@ sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
             continue;
         if (sp_dataset_add_category(&ds, cat) < 0) rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", dir);
     }
-    if (rc == SP_OK && ds.category_count > 1) qsort(ds.categories, (size_t)ds.category_count, sizeof(char*), cmp_str);
+    if (rc == SP_OK && ds.category_count > 1) qsort(ds.categories, (size_t)ds.category_count, sizeof(char*), sp_cmp_cstr);
     for (int i = 0; i < n && rc == SP_OK; ++i) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
         if (is_dir(path)) {

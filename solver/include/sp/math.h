@@ -9,6 +9,7 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -246,6 +247,16 @@ static inline int sp_cmp_int(const void* a, const void* b)
     int x = *(const int*)a, y = *(const int*)b;
     return (x > y) - (x < y);
 }
+
+/// The same for floats.
+static inline int sp_cmp_float(const void* a, const void* b)
+{
+    float x = *(const float*)a, y = *(const float*)b;
+    return (x > y) - (x < y);
+}
+
+/// qsort comparator of C strings (an array of char*), by strcmp.
+static inline int sp_cmp_cstr(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
 
 #ifdef __cplusplus
 }
