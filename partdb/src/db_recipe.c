@@ -25,14 +25,14 @@ typedef struct recipe_slot {
 } recipe_slot;
 
 // One cycle of the recipe; sketch i takes slot i mod 20, its pose amplitude
-// alternating between near and full every other cycle slot.
+// alternating between near and full every other cycle slot (pieces: near).
 static const recipe_slot k_cycle[20] = {
-    {SP_HANDDRAW_SHAPE_OUTLINE, false, 0, true},    {SP_HANDDRAW_SHAPE_OUTLINE, false, 0, false},
+    {SP_HANDDRAW_SHAPE_OUTLINE, false, 0, true},    {SP_HANDDRAW_SHAPE_PIECE, false, 0, false},
     {SP_HANDDRAW_SHAPE_OUTLINE, true, 0, false},    {SP_HANDDRAW_SHAPE_OUTLINE, true, 1, false},
     {SP_HANDDRAW_SHAPE_OUTLINE, false, 1, false},   {SP_HANDDRAW_SHAPE_PIECE, true, 0, false},
     {SP_HANDDRAW_SHAPE_OUTLINE, true, 0, false},    {SP_HANDDRAW_SHAPE_TOP, true, 0, false},
     {SP_HANDDRAW_SHAPE_UNDERSIDE, false, 0, false}, {SP_HANDDRAW_SHAPE_LINE, false, 0, false},
-    {SP_HANDDRAW_SHAPE_OUTLINE, true, 0, true},     {SP_HANDDRAW_SHAPE_OUTLINE, false, 0, false},
+    {SP_HANDDRAW_SHAPE_OUTLINE, true, 0, true},     {SP_HANDDRAW_SHAPE_PIECE, false, 0, false},
     {SP_HANDDRAW_SHAPE_PIECE, true, 0, false},      {SP_HANDDRAW_SHAPE_OUTLINE, true, 1, false},
     {SP_HANDDRAW_SHAPE_OUTLINE, false, 1, false},   {SP_HANDDRAW_SHAPE_OUTLINE, true, 0, false},
     {SP_HANDDRAW_SHAPE_PIECE, true, 1, false},      {SP_HANDDRAW_SHAPE_TOP, false, 0, false},
@@ -59,6 +59,8 @@ sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint
         if ((slot.shape == SP_HANDDRAW_SHAPE_LINE && !line) || (slot.shape == SP_HANDDRAW_SHAPE_PIECE && !piece))
             slot = (recipe_slot){SP_HANDDRAW_SHAPE_OUTLINE, true, slot.spikes, false};
         double amp = amplitude > 0 ? amplitude : (i / 20) % 2 == (i % 2) ? AMPLITUDE_NEAR : AMPLITUDE_FULL;
+        // A piece in a near pose: a head alone with its jaws gaping is a V, not a head.
+        if (slot.shape == SP_HANDDRAW_SHAPE_PIECE && amplitude <= 0) amp = AMPLITUDE_NEAR;
         sp_handdraw_desc hd = {.style = slot.clean ? SP_HANDDRAW_CLEAN : SP_HANDDRAW_NORMAL,
                                .amplitude = slot.clean ? AMPLITUDE_NEAR : amp,
                                .shape = slot.shape,

@@ -76,9 +76,10 @@ done:
 // ---- a piece: the far end of the part --------------------------------------
 
 // Flags the vertices whose strongest joint lies in the subtree of a joint
-// drawn at random among those whose subtree holds 25-75% of the vertices
-// (the head without its neck, one leg of a pair, the end of a tail, the hand
-// of a wing). False when no joint qualifies.
+// whose subtree holds 25-75% of the vertices: the smallest such subtree that
+// still holds half of them when there is one (the head without its neck, the
+// hand of a wing, the far half of a tail: what a visitor draws as the part),
+// else one drawn at random (one leg of a pair). False when no joint qualifies.
 static bool piece_vertices(const sp_rig* rig, uint64_t seed, unsigned char* keep)
 {
     int J = rig->joint_count, V = rig->vertex_count;
@@ -103,6 +104,8 @@ static bool piece_vertices(const sp_rig* rig, uint64_t seed, unsigned char* keep
     if (nc == 0) goto done;
     sp_rng rng = {seed ^ 0x2545F4914F6CDD1Dull};
     int pick = cand[(int)(sp_rng_uniform(&rng) * nc)];
+    for (int k = 0, best = V + 1; k < nc; ++k)
+        if (count[cand[k]] >= V / 2 && count[cand[k]] < best) best = count[cand[k]], pick = cand[k];
     for (int v = 0; v < V; ++v) {
         int j = strongest[v] < J ? strongest[v] : -1;
         while (j >= 0 && j != pick)

@@ -108,7 +108,8 @@ typedef enum sp_handdraw_shape {
     SP_HANDDRAW_SHAPE_UNDERSIDE,   ///< only its lower side
     SP_HANDDRAW_SHAPE_LINE,        ///< one line through the joints: skeletons of one or two chains (tails, leg pairs)
     /// the silhouette of the part's far end only: the mesh around a joint's subtree holding 25-75% of the
-    /// vertices, drawn from the seed (a head without its neck, one leg of a pair, the end of a tail)
+    /// vertices, the smallest holding at least half when there is one (a head without its neck, a wing's
+    /// hand, a tail's far half), else drawn from the seed (one leg of a pair)
     SP_HANDDRAW_SHAPE_PIECE,
     SP_HANDDRAW_SHAPE_COUNT
 } sp_handdraw_shape;
