@@ -737,7 +737,7 @@ static bool refused_doodle(double cx, double cy, sp_vec2* xy, int* n)
             found = true, *n = m;
         sp_sketch_free(&one);
     }
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     return found;
 }
 
@@ -1138,7 +1138,8 @@ static void test_collect_reload(void)
     snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), db);
     ENSURE(system(cmd) == 0);
     sp_error err = {0};
-    sp_headless* gl = sp_headless_create(&err);
+    sp_headless* gl;
+    sp_headless_create(&gl, &err);
     if (!gl) SKIP("no headless OpenGL");
     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
                                                    .canvas_w = 1280,
@@ -1201,7 +1202,7 @@ static void test_collect_reload(void)
     fprintf(stderr, "  reloads %d; the kiosk's model: reject distance %.4f before, %.4f after (the new model's: %.4f)\n",
             st->reloads, before, after, want);
     ENSURE(st->reloads == 1 && after == want && before != want);
-    sp_clf_free(fresh);
+    sp_clf_destroy(fresh);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
 }
