@@ -701,6 +701,38 @@ static void test_cli(void)
     cli_plugin_other_commands(bin, s, t);
 }
 
+// The creators say why they refuse (docs/DESIGN.md, "API conventions"):
+// *out NULL, SP_ERR_INVALID and a line naming the rig; err may be NULL.
+static void test_creation_says_why(void)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 3, .seed = 1}, &rig);
+    lbs_box box;
+    lbs_box_init(&box, &rig);
+    sp_blackbox* bb = NULL;
+    sp_error err = {0};
+    ENSURE(sp_blackbox_open(&box.desc, "lbs box", &bb, &err) == SP_OK);
+    sp_camera cam = sp_blackbox_camera(bb, 640, 480);
+    const int a = rig.abstraction_count, row = rig.vertex_count;
+    sp_solver* s = (sp_solver*)&err; // a creator writes NULL on failure
+    ENSURE(sp_solver_create_blackbox(bb, a, &cam, NULL, &s, &err) == SP_ERR_INVALID && !s);
+    fprintf(stderr, "  %s\n", err.text);
+    char want[128];
+    snprintf(want, sizeof want, "lbs box: abstraction %d does not exist", a);
+    ENSURE(strstr(err.text, want));
+    sp_blackbox_fd* fd = (sp_blackbox_fd*)&err;
+    ENSURE(sp_blackbox_fd_create(bb, 0, &row, 1, 1, &fd, &err) == SP_ERR_INVALID && !fd);
+    fprintf(stderr, "  %s\n", err.text);
+    snprintf(want, sizeof want, "lbs box: row 0 is vertex %d, out of range", row);
+    ENSURE(strstr(err.text, want));
+    ENSURE(sp_blackbox_fd_create(bb, -1, NULL, 0, 1, &fd, NULL) == SP_ERR_INVALID && !fd);
+    ENSURE(sp_solver_create_blackbox(bb, 0, &cam, NULL, &s, NULL) == SP_OK && s);
+    sp_solver_destroy(s);
+    sp_blackbox_destroy(bb);
+    free(box.rest);
+    sp_rig_free(&rig);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -714,5 +746,6 @@ int main(int argc, char** argv)
                                    {"face_bounds", test_face_bounds},
                                    {"face_recovery", test_face_recovery},
                                    {"cli", test_cli},
+                                   {"creation_says_why", test_creation_says_why},
                                    {0}});
 }

@@ -553,17 +553,39 @@ static void test_stop_reasons_of_closest_point_solves(void)
     sp_rig_free(&st.rig);
 }
 
+// sp_solver_create refuses an abstraction the rig does not have, and says
+// so (docs/DESIGN.md, "API conventions"); err may be NULL.
+static void test_creation_says_why(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 3, .seed = 1});
+    sp_error err = {0};
+    sp_solver* s = (sp_solver*)&err; // a creator writes NULL on failure
+    ENSURE(sp_solver_create(&st.rig, st.rig.abstraction_count, &st.cam, NULL, &s, &err) == SP_ERR_INVALID && !s);
+    fprintf(stderr, "  %s\n", err.text);
+    char want[128];
+    snprintf(want, sizeof want, "abstraction %d does not exist (the rig has %d)", st.rig.abstraction_count,
+             st.rig.abstraction_count);
+    ENSURE(!strcmp(err.text, want));
+    ENSURE(sp_solver_create(&st.rig, -1, &st.cam, NULL, &s, NULL) == SP_ERR_INVALID && !s);
+    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, NULL, &s, NULL) == SP_OK && s);
+    sp_solver_destroy(s);
+    sp_solver_destroy(NULL);
+    sp_rig_free(&st.rig);
+}
+
 int main(int argc, char** argv)
 {
-    return sp_test_run(argc, argv, (sp_test[]){
-        {"recovery_chain", test_recovery_chain},
-        {"bounds_exact", test_bounds_exact},
-        {"order_independence_and_determinism", test_order_independence_and_determinism},
-        {"bad_strokes", test_bad_strokes},
-        {"regulariser_paths_agree", test_regulariser_paths_agree},
-        {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
-        {"gauss_newton_consistent", test_gauss_newton_consistent},
-        {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
-        {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
-        {0}});
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"recovery_chain", test_recovery_chain},
+                                   {"bounds_exact", test_bounds_exact},
+                                   {"order_independence_and_determinism", test_order_independence_and_determinism},
+                                   {"bad_strokes", test_bad_strokes},
+                                   {"regulariser_paths_agree", test_regulariser_paths_agree},
+                                   {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
+                                   {"gauss_newton_consistent", test_gauss_newton_consistent},
+                                   {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
+                                   {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
+                                   {"creation_says_why", test_creation_says_why},
+                                   {0}});
 }

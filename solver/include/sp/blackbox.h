@@ -14,7 +14,7 @@
 ///     if (sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){0}, &s, &err) != SP_OK) ... err.text ...
 ///     sp_solver_solve(s, &sketch, NULL, p, &report, &err);
 ///     sp_solver_destroy(s);
-///     sp_blackbox_destroy(bb);                 // after every solver made from it
+///     sp_blackbox_destroy(bb);              // after every solver made from it
 ///
 /// How to write a rig (plugin side; docs/blackbox.md has a full example):
 /// fill an `sp_blackbox_rig` and return it from one exported function
