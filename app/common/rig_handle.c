@@ -56,6 +56,15 @@ sp_result sp_rig_handle_load(const char* path, sp_rig_handle** out, sp_error* er
     return SP_OK;
 }
 
+sp_result sp_rig_handle_load_character(const char* path, const char* command, sp_rig_handle** out, sp_error* err)
+{
+    *out = NULL;
+    if (sp_rig_path_is_plugin(path))
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: %s needs a glTF character; a black-box rig plugin is posed by `pose`", path,
+                       command);
+    return sp_rig_handle_load(path, out, err);
+}
+
 void sp_rig_handle_free(sp_rig_handle* h)
 {
     if (!h) return;

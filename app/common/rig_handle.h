@@ -42,6 +42,11 @@ bool sp_rig_path_is_plugin(const char* path);
 /// Loads a glTF character or a plugin, by sp_rig_path_is_plugin. On failure
 /// *out is NULL and err names the file and the problem (the loaders' messages).
 sp_result sp_rig_handle_load(const char* path, sp_rig_handle** out, sp_error* err);
+/// sp_rig_handle_load for commands that need a glTF character's joints and
+/// mesh (`command` names it in the message): a plugin path is refused in one
+/// line, before it is loaded, as "<path>: <command> needs a glTF character;
+/// a black-box rig plugin is posed by `pose`".
+sp_result sp_rig_handle_load_character(const char* path, const char* command, sp_rig_handle** out, sp_error* err);
 /// Frees the rig (and unloads a plugin). NULL is fine.
 void sp_rig_handle_free(sp_rig_handle* h);
 

@@ -57,14 +57,9 @@ int cmd_animate(int argc, char** argv)
     double *kp = NULL, *p0 = NULL;
     cJSON* all = cJSON_CreateArray();
     int exit_code = SP_EXIT_INPUT;
-    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    // A glTF animation keys joints; a black box's deformers have none.
+    if (sp_rig_handle_load_character(rig_path, "animate", &rig, &err) != SP_OK) goto fail;
     sp_character* ch = sp_rig_handle_character(rig);
-    if (!ch) {
-        // A glTF animation keys joints; a black box's deformers have none.
-        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: animate needs a glTF character; a black-box rig plugin is posed by `pose`",
-                rig_path);
-        goto fail;
-    }
     run.rig = rig;
     run.abstraction = sp_rig_handle_pick_abstraction(rig, abs_name, &err);
     if (run.abstraction < 0) goto fail;

@@ -77,15 +77,10 @@ int cmd_drawover(int argc, char** argv)
     double *p = NULL, *xyz = NULL;
     sp_rig_eval* ev = NULL;
     int exit_code = SP_EXIT_INPUT;
-    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
+    // Its curves are embedded in the mesh surface, and a black box evaluates
+    // only the abstractions it declares.
+    if (sp_rig_handle_load_character(rig_path, "draw-over", &rig, &err) != SP_OK) goto fail;
     sp_character* ch = sp_rig_handle_character(rig);
-    if (!ch) {
-        // Its curves are embedded in the mesh surface, and a black box
-        // evaluates only the abstractions it declares.
-        sp_fail(&err, SP_ERR_UNSUPPORTED, "%s: draw-over needs a glTF character; a black-box rig plugin is posed by `pose`",
-                rig_path);
-        goto fail;
-    }
     run.rig = rig;
     if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
     sp_camera cam = sp_rig_handle_camera(rig, on.canvas_w, on.canvas_h);

@@ -4,9 +4,9 @@ if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang" OR NOT CMAKE_CXX_COMPILER_ID MATCHES 
   return()
 endif()
 # Coverage feedback from the loader itself, not only the entry point.
-target_compile_options(sp_partdb PRIVATE -fsanitize=fuzzer-no-link,address -fno-omit-frame-pointer)
+target_compile_options(sp_gltf PRIVATE -fsanitize=fuzzer-no-link,address -fno-omit-frame-pointer)
 add_executable(fuzz_gltf ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_gltf.c)
-target_link_libraries(fuzz_gltf PRIVATE sp::partdb)
+target_link_libraries(fuzz_gltf PRIVATE sp::gltf)
 target_compile_options(fuzz_gltf PRIVATE -fsanitize=fuzzer,address -fno-omit-frame-pointer)
 target_link_options(fuzz_gltf PRIVATE -fsanitize=fuzzer,address)
 # A short smoke run over the seed corpus, so that CTest notices a crashing

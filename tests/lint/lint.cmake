@@ -20,6 +20,19 @@ add_test(NAME function_length_passes_120 COMMAND function_length 120 ${sp_lint_d
 add_test(NAME function_length_fails_121 COMMAND function_length 120 ${sp_lint_dir}/f121.c)
 set_tests_properties(function_length_fails_121 PROPERTIES PASS_REGULAR_EXPRESSION "f121.c:205: f is 121 lines, limit 120")
 
+# The posing commands link neither OpenCV nor SQLite (the solver's own FLANN
+# is fine): no classifier, no database. The check is checked too: the whole
+# sketchpose, which classifies and trains, does link them.
+if(TARGET sp_pose_cmds)
+  add_executable(pose_links lint/pose_links.c)
+  target_link_libraries(pose_links PRIVATE sp_pose_cmds)
+  set(sp_forbidden "libopencv|libsqlite3")
+  add_test(NAME pose_links_no_classifier
+           COMMAND sh -c "$<TARGET_FILE:pose_links> >/dev/null && ldd $<TARGET_FILE:pose_links> > pose_links.ldd && ! grep -E '${sp_forbidden}' pose_links.ldd")
+  add_test(NAME pose_links_check_sees_opencv
+           COMMAND sh -c "ldd $<TARGET_FILE:sketchpose> | grep -E '${sp_forbidden}'")
+endif()
+
 # No public header names a third-party library (tests/lint/public_headers.c
 # says what counts): the headers under <library>/include/sp are all a user
 # compiles against. Checked too: a header that includes GLFW, returns a cJSON

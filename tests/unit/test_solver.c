@@ -576,16 +576,16 @@ static void test_creation_says_why(void)
 
 int main(int argc, char** argv)
 {
-    return sp_test_run(argc, argv,
-                       (sp_test[]){{"recovery_chain", test_recovery_chain},
-                                   {"bounds_exact", test_bounds_exact},
-                                   {"order_independence_and_determinism", test_order_independence_and_determinism},
-                                   {"bad_strokes", test_bad_strokes},
-                                   {"regulariser_paths_agree", test_regulariser_paths_agree},
-                                   {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
-                                   {"gauss_newton_consistent", test_gauss_newton_consistent},
-                                   {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
-                                   {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
-                                   {"creation_says_why", test_creation_says_why},
-                                   {0}});
+    return sp_test_run(argc, argv, (sp_test[]){
+        {"recovery_chain", test_recovery_chain},
+        {"bounds_exact", test_bounds_exact},
+        {"order_independence_and_determinism", test_order_independence_and_determinism},
+        {"bad_strokes", test_bad_strokes},
+        {"regulariser_paths_agree", test_regulariser_paths_agree},
+        {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
+        {"gauss_newton_consistent", test_gauss_newton_consistent},
+        {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
+        {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
+        {"creation_says_why", test_creation_says_why},
+        {0}});
 }
