@@ -69,7 +69,7 @@ void sp_rig_handle_free(sp_rig_handle* h)
 {
     if (!h) return;
     sp_character_free(&h->ch);
-    sp_blackbox_free(h->bb);
+    sp_blackbox_destroy(h->bb);
     free(h->path);
     free(h);
 }
@@ -149,9 +149,11 @@ sp_camera sp_rig_handle_camera(const sp_rig_handle* h, double width, double heig
     return h->view;
 }
 
-sp_solver* sp_rig_handle_solver(const sp_rig_handle* h, int a, const sp_camera* cam, const sp_solve_desc* desc)
+sp_result sp_rig_handle_solver(const sp_rig_handle* h, int a, const sp_camera* cam, const sp_solve_desc* desc, sp_solver** out,
+                               sp_error* err)
 {
-    return h->bb ? sp_solver_create_blackbox(h->bb, a, cam, desc) : sp_solver_create(&h->ch.rig, a, cam, desc);
+    return h->bb ? sp_solver_create_blackbox(h->bb, a, cam, desc, out, err)
+                 : sp_solver_create(&h->ch.rig, a, cam, desc, out, err);
 }
 
 void sp_rig_handle_synth_params(const sp_rig_handle* h, uint64_t seed, double amplitude, double* p)

@@ -13,7 +13,8 @@
 ///     sp_camera cam = sp_rig_handle_camera(rig, sketch.canvas_w, sketch.canvas_h);
 ///     double* p = NULL;                               // sp_rig_handle_param_count(rig) values
 ///     if (sp_rig_handle_read_pose(rig, NULL, &p, NULL, &err) != SP_OK) ...   // or a --start file
-///     sp_solver* s = sp_rig_handle_solver(rig, a, &cam, &(sp_solve_desc){0});
+///     sp_solver* s;
+///     if (sp_rig_handle_solver(rig, a, &cam, &(sp_solve_desc){0}, &s, &err) != SP_OK) ... err.text ...
 ///     ... sp_solver_solve(s, &sketch, p, p, &report, &err) ...
 ///     sp_solver_destroy(s);
 ///     sp_rig_handle_free(rig);                        // after every solver made from it
@@ -89,8 +90,10 @@ int sp_rig_handle_pick_abstraction(const sp_rig_handle* h, const char* name, sp_
 sp_camera sp_rig_handle_camera(const sp_rig_handle* h, double width, double height);
 
 /// A solver for abstraction a seen by cam (sp_solver_create or
-/// sp_solver_create_blackbox); h and cam must outlive it. NULL when out of memory.
-sp_solver* sp_rig_handle_solver(const sp_rig_handle* h, int a, const sp_camera* cam, const sp_solve_desc* desc);
+/// sp_solver_create_blackbox, whose failures it returns); h and cam must
+/// outlive it.
+sp_result sp_rig_handle_solver(const sp_rig_handle* h, int a, const sp_camera* cam, const sp_solve_desc* desc, sp_solver** out,
+                               sp_error* err);
 
 /// A random pose within bounds (sp_synth_params' amplitude rule), deterministic for a seed.
 void sp_rig_handle_synth_params(const sp_rig_handle* h, uint64_t seed, double amplitude, double* p);

@@ -62,7 +62,8 @@ int kiosk_outline(const sp_rig* rig, int abstraction, const double* params, cons
         if (!o) return 0;
         *out = o, *cap = need;
     }
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     double* z = malloc(sizeof(double) * 3 * (size_t)(ab->point_count + 1));
     double* mesh = ab->rest ? NULL : malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
     int n = 0;
@@ -175,7 +176,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
                 it.triangles = it.lod.tri_count;
             }
         }
-        it.mesh = sp_render_mesh_create(r, &md, &err);
+        sp_render_mesh_create(r, &md, &it.mesh, &err);
         if (!it.mesh) {
             fprintf(stderr, "dragon-kiosk: part %s: %s\n", p->name, err.text);
             sp_lod_free(&it.lod);
@@ -236,10 +237,7 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
     for (int i = 0; i < DEMO_MAX; ++i)
         k->demo_parts[i].part = -1;
     if (!(k->font = sp_font_load(k->desc.font_path, err))) goto fail;
-    if (!(k->ui = sp_kiosk_ui_create(&k->desc.ui))) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory");
-        goto fail;
-    }
+    if (sp_kiosk_ui_create(&k->desc.ui, &k->ui, err) != SP_OK) goto fail;
     // The collector's writable handle first: opening it migrates an older
     // schema, which the pipeline's read-only handle could not read. A
     // database that does not exist yet is built by the pipeline.
@@ -247,17 +245,17 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
         k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
     // The pipeline's own attachment (docs/DESIGN.md, "Which strokes join a
     // dragon"): a part drawn far from every body stays where it was drawn.
-    k->dragon = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
-                                                   .assets_dir = k->desc.assets_dir,
-                                                   .canvas_w = k->canvas_w,
-                                                   .canvas_h = k->canvas_h,
-                                                   .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
-                                                   .max_parts = k->desc.max_parts},
-                                 err);
-    if (!k->dragon) goto fail;
+    if (sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
+                                           .assets_dir = k->desc.assets_dir,
+                                           .canvas_w = k->canvas_w,
+                                           .canvas_h = k->canvas_h,
+                                           .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
+                                           .max_parts = k->desc.max_parts},
+                         &k->dragon, err) != SP_OK)
+        goto fail;
     if (!k->desc.no_collect && !k->collector) k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
     k->canvas_cam = sp_dragon_camera(k->dragon);
-    if (!(k->r = sp_renderer_create(&(sp_renderer_desc){0}, err))) goto fail;
+    if (sp_renderer_create(&(sp_renderer_desc){0}, &k->r, err) != SP_OK) goto fail;
     // Software rasterisers pay per triangle: coarser display meshes there.
     const char* gl_name = (const char*)glGetString(GL_RENDERER);
     k->software = gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast") ||
@@ -786,7 +784,8 @@ sp_result sp_kiosk_screenshot(sp_kiosk* k, const char* path, sp_error* err)
 {
     GLint bound = 0; // restored after: the caller's framebuffer need not be the window's
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
-    sp_render_target* t = sp_render_target_create(k->fb_w, k->fb_h, 0, err);
+    sp_render_target* t;
+    sp_render_target_create(k->fb_w, k->fb_h, 0, &t, err);
     if (!t) return SP_ERR_INTERNAL;
     sp_render_target_bind(t);
     kiosk_draw_frame(k, k->fb_w, k->fb_h);

@@ -75,12 +75,12 @@ static void prepare(sp_kiosk* k)
         demo_stroke(k, db, li);
     sp_db_close(db);
     if (k->demo_count == 0) return;
-    k->demo = sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
-                                                 .canvas_w = k->canvas_w,
-                                                 .canvas_h = k->canvas_h,
-                                                 .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
-                               &err);
-    if (!k->demo) fprintf(stderr, "dragon-kiosk: attract screen without its demo: %s\n", err.text);
+    if (sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
+                                           .canvas_w = k->canvas_w,
+                                           .canvas_h = k->canvas_h,
+                                           .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
+                         &k->demo, &err) != SP_OK)
+        fprintf(stderr, "dragon-kiosk: attract screen without its demo: %s\n", err.text);
 }
 
 // Where the demo is: the part being drawn (or -1 once all are), the time

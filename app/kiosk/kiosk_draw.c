@@ -371,7 +371,8 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
     sp_render_fit_depth(&cam, lo, hi);
     GLint bound = 0; // restored after: the caller's framebuffer need not be the window's
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
-    sp_render_target* t = sp_render_target_create(W, H, 0, err);
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, err);
     if (!t) return SP_ERR_INTERNAL;
     sp_render_target_bind(t);
     sp_renderer_begin(k->r, &cam, W, H);

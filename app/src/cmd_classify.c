@@ -48,7 +48,7 @@ int cmd_classify(int argc, char** argv)
     sp_raster r;
     if (sp_drawing_read(strokes, &s, &r, &err) != SP_OK) {
         fprintf(stderr, "sketchpose classify: %s\n", err.text);
-        sp_clf_free(clf);
+        sp_clf_destroy(clf);
         return SP_EXIT_INPUT;
     }
     sp_clf_answer a;
@@ -57,7 +57,7 @@ int cmd_classify(int argc, char** argv)
     sp_raster_free(&r);
     if (res != SP_OK) {
         fprintf(stderr, "sketchpose classify: %s: %s\n", strokes, err.text);
-        sp_clf_free(clf);
+        sp_clf_destroy(clf);
         return SP_EXIT_INPUT;
     }
     printf("{\"ranked\": [");
@@ -68,6 +68,6 @@ int cmd_classify(int argc, char** argv)
     }
     printf("], \"rejected\": %s, \"distance\": %.4f, \"reject_distance\": %.4f}\n", a.rejected ? "true" : "false", a.distance,
            isfinite(a.reject_distance) ? a.reject_distance : -1.0);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     return SP_EXIT_OK;
 }

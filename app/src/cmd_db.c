@@ -218,7 +218,8 @@ static int db_add_part(int argc, char** argv)
     sp_error err = {0};
     if (preview) {
         // A renderer first: without one nothing is stored.
-        sp_headless* gl = sp_headless_create(&err);
+        sp_headless* gl;
+        sp_headless_create(&gl, &err);
         if (!gl) return fail(cmd, &err);
         sp_headless_destroy(gl);
     }

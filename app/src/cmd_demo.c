@@ -182,7 +182,8 @@ int cmd_demo(int argc, char** argv)
         fprintf(stderr, "sketchpose demo: %s\n", err.text);
         return SP_EXIT_INPUT;
     }
-    sp_dragon* d = sp_dragon_create(&(sp_dragon_desc){.db = db, .canvas_w = DEMO_W, .canvas_h = DEMO_H}, &err);
+    sp_dragon* d;
+    sp_dragon_create(&(sp_dragon_desc){.db = db, .canvas_w = DEMO_W, .canvas_h = DEMO_H}, &d, &err);
     if (!d) {
         fprintf(stderr, "sketchpose demo: %s\n", err.text);
         sp_db_close(db);
@@ -246,7 +247,10 @@ int cmd_demo(int argc, char** argv)
         fprintf(stderr, "sketchpose demo: no part was recognised; is the model in %s trained?\n", path);
         goto done;
     }
-    j = sp_dragon_report_json(d);
+    char* text = NULL;
+    if (sp_dragon_report_json(d, &text, &err) != SP_OK) goto fail;
+    j = cJSON_Parse(text);
+    free(text);
     if (!j) goto oom;
     if (sp_sketch_write_json(strokes, &drawn, &err) != SP_OK || sp_json_write_file(report, j, &err) != SP_OK ||
         sp_dragon_export(d, glb, &err) != SP_OK ||

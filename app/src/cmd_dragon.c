@@ -51,10 +51,11 @@ int cmd_dragon(int argc, char** argv)
     }
     int w = sk.canvas_w >= 1 && sk.canvas_w <= 16384 ? (int)sk.canvas_w : 0,
         h = sk.canvas_h >= 1 && sk.canvas_h <= 16384 ? (int)sk.canvas_h : 0;
-    sp_dragon* d = sp_dragon_create(
+    sp_dragon* d;
+    sp_dragon_create(
         &(sp_dragon_desc){
             .db_path = db_path, .assets_dir = assets, .canvas_w = w, .canvas_h = h, .solve = {.time_cap_ms = max_ms}},
-        &err);
+        &d, &err);
     if (!d) {
         fprintf(stderr, "sketchpose dragon: %s\n", err.text);
         sp_sketch_free(&sk);
@@ -90,7 +91,14 @@ int cmd_dragon(int argc, char** argv)
         if (res.rejected)
             fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (%s)\n", strokes, i, sp_dragon_reject_name(res.reason));
     }
-    j = sp_dragon_report_json(d);
+    char* text = NULL;
+    if (sp_dragon_report_json(d, &text, &err) != SP_OK) goto fail;
+    j = cJSON_Parse(text);
+    free(text);
+    if (!j) {
+        sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
+        goto fail;
+    }
     cJSON_AddItemToObject(j, "strokes", list);
     list = NULL;
     if (sp_dragon_part_count(d) == 0) {

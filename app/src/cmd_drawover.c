@@ -86,7 +86,7 @@ int cmd_drawover(int argc, char** argv)
     sp_camera cam = sp_rig_handle_camera(rig, on.canvas_w, on.canvas_h);
     if (sp_rig_handle_read_pose(rig, NULL, &p, NULL, &err) != SP_OK) goto fail;
     xyz = malloc(sizeof(double) * 3 * (size_t)(ch->rig.vertex_count + 1));
-    ev = sp_rig_eval_create(&ch->rig);
+    sp_rig_eval_create(&ch->rig, &ev, NULL);
     if (!xyz || !ev) goto oom;
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(&ch->rig), xyz);

@@ -107,7 +107,7 @@ int cmd_eval(int argc, char** argv)
             desc.progress_user = prefix;
             if (sp_clf_train(&ds, mask, &desc, &fc, &err) != SP_OK) {
                 fprintf(stderr, "sketchpose eval: fold %d: %s\n", f, err.text);
-                sp_clf_free(clf);
+                sp_clf_destroy(clf);
                 sp_dataset_free(&ds);
                 return SP_EXIT_INPUT;
             }
@@ -115,7 +115,7 @@ int cmd_eval(int argc, char** argv)
                 mask[i] = !mask[i];
             int n0 = n, top10 = top1, top30 = top3;
             run(fc, &ds, mask, confusion, &top1, &top3, &n, &rejected, &failed, ms, &nms);
-            sp_clf_free(fc);
+            sp_clf_destroy(fc);
             fold_n[f] = n - n0;
             fold_top1[f] = top1 - top10;
             fold_top3[f] = top3 - top30;
@@ -160,7 +160,7 @@ int cmd_eval(int argc, char** argv)
     free(confusion);
     free(ms);
     free(mask);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_dataset_free(&ds);
     return SP_EXIT_OK;
 }

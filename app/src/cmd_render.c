@@ -134,7 +134,7 @@ int cmd_render(int argc, char** argv)
     xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count ? rig->vertex_count : 1));
     zxyz = ab ? malloc(sizeof(double) * 3 * (size_t)(ab->point_count ? ab->point_count : 1)) : NULL;
     ends = ab ? malloc(sizeof(sp_vec2) * 2 * (size_t)(ab->curve_count ? ab->curve_count : 1)) : NULL;
-    ev = sp_rig_eval_create(rig);
+    sp_rig_eval_create(rig, &ev, NULL);
     if (!xyz || (ab && (!zxyz || !ends)) || !ev) {
         fprintf(stderr, "sketchpose render: out of memory\n");
         goto done;
@@ -151,21 +151,21 @@ int cmd_render(int argc, char** argv)
                      pitch * (3.14159265358979323846 / 180.0));
     sp_render_fit_depth(&cam, lo, hi);
 
-    gl = sp_headless_create(&err);
+    sp_headless_create(&gl, &err);
     if (!gl) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         goto done;
     }
-    r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
-    target = r ? sp_render_target_create(w, h, 0, &err) : NULL;
-    mesh = target ? sp_render_mesh_create(r,
-                                          &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                                          .positions = xyz,
-                                                          .colors = ch->colors,
-                                                          .triangle_count = rig->triangle_count,
-                                                          .triangles = rig->triangles},
-                                          &err)
-                  : NULL;
+    sp_renderer_create(&(sp_renderer_desc){0}, &r, &err);
+    if (r) sp_render_target_create(w, h, 0, &target, &err);
+    if (target)
+        sp_render_mesh_create(r,
+                              &(sp_mesh_desc){.vertex_count = rig->vertex_count,
+                                              .positions = xyz,
+                                              .colors = ch->colors,
+                                              .triangle_count = rig->triangle_count,
+                                              .triangles = rig->triangles},
+                              &mesh, &err);
     if (!mesh) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         goto done;

@@ -52,14 +52,14 @@ int cmd_train(int argc, char** argv)
         }
         if (r != SP_OK) {
             fprintf(stderr, "sketchpose train: --calibrate: %s\n", err.text);
-            sp_clf_free(clf);
+            sp_clf_destroy(clf);
             sp_dataset_free(&ds);
             return SP_EXIT_INPUT;
         }
     }
     if (sp_clf_save(clf, model, &err) != SP_OK) {
         fprintf(stderr, "sketchpose train: %s\n", err.text);
-        sp_clf_free(clf);
+        sp_clf_destroy(clf);
         sp_dataset_free(&ds);
         return SP_EXIT_INPUT;
     }
@@ -68,7 +68,7 @@ int cmd_train(int argc, char** argv)
     float rd = sp_clf_reject_distance(clf);
     printf(", \"categories\": %d, \"drawings\": %d, \"seconds\": %.3f, \"reject_distance\": %.4f}\n", ds.category_count, ds.count,
            (sp_now_ms() - t0) / 1e3, isfinite(rd) ? rd : -1.0);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_dataset_free(&ds);
     return SP_EXIT_OK;
 }

@@ -10,16 +10,15 @@ bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
                         double* p, sp_solve_report* rep, cJSON** report)
 {
     *report = NULL;
+    sp_error err = {0};
     if (!s->solver || cam->width != s->cam.width || cam->height != s->cam.height) {
         sp_solver_destroy(s->solver);
         s->cam = *cam;
-        s->solver = sp_rig_handle_solver(s->rig, s->abstraction, &s->cam, &s->desc);
-        if (!s->solver) {
-            fprintf(stderr, "%s: out of memory\n", s->cmd);
+        if (sp_rig_handle_solver(s->rig, s->abstraction, &s->cam, &s->desc, &s->solver, &err) != SP_OK) {
+            fprintf(stderr, "%s: %s\n", s->cmd, err.text);
             return false;
         }
     }
-    sp_error err = {0};
     if (sp_solver_solve(s->solver, sk, start, p, rep, &err) != SP_OK) {
         fprintf(stderr, "%s: %s: %s\n", s->cmd, strokes, err.text);
         return false;

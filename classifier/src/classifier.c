@@ -84,7 +84,7 @@ sp_clf_desc sp_clf_get_desc(const sp_clf* clf)
     return clf->desc;
 }
 
-void sp_clf_free(sp_clf* clf)
+void sp_clf_destroy(sp_clf* clf)
 {
     if (!clf) return;
     if (clf->vocab_index) flann_free_index_float(clf->vocab_index, &clf->vocab_params);
@@ -960,7 +960,7 @@ fail:
     free(sample);
     free(src);
     free(loo);
-    sp_clf_free(c);
+    sp_clf_destroy(c);
     return rc;
 }
 
@@ -1297,17 +1297,17 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
         goto corrupt;
     free(p);
     if ((rc = build_vocab_index(c, err)) != SP_OK || (rc = build_hist_index(c, err)) != SP_OK) {
-        sp_clf_free(c);
+        sp_clf_destroy(c);
         return rc;
     }
     *out = c;
     return SP_OK;
 corrupt:
     free(p);
-    sp_clf_free(c);
+    sp_clf_destroy(c);
     return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (inconsistent contents)", path);
 oom:
     free(p);
-    sp_clf_free(c);
+    sp_clf_destroy(c);
     return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
 }

@@ -38,7 +38,8 @@ void sp_character_warn(sp_character* ch, const char* fmt, ...)
 static sp_result default_camera(sp_character* ch)
 {
     const sp_rig* rig = &ch->rig;
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
     int n = rig->vertex_count > 0 ? rig->vertex_count : rig->joint_count;
     double* xyz = malloc(sizeof(double) * 3 * (size_t)n);

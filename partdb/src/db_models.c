@@ -168,7 +168,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
             cv_ok += ok;
             ++cv_n;
         }
-        sp_clf_free(m);
+        sp_clf_destroy(m);
     }
     t_cv = now_s() - t_cv;
     double t_train = now_s();
@@ -264,7 +264,7 @@ done:
     free(use);
     free(n_cls);
     free(ok_cls);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_dataset_free(&ds);
     return r;
 }
@@ -389,7 +389,7 @@ sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err)
             char** cats;
             int n;
             if ((r = sp_db_categories(db, &cats, &n, err)) != SP_OK) {
-                sp_clf_free(clf);
+                sp_clf_destroy(clf);
                 goto out;
             }
             bool same = n == sp_clf_category_count(clf);
@@ -410,7 +410,7 @@ sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err)
                 free(b.s);
             }
             sp_db_free_strings(cats, n);
-            sp_clf_free(clf);
+            sp_clf_destroy(clf);
         }
     } else if (count_rows(db, "parts") > 0) {
         problem(&pb, &np, "no trained model: run `sketchpose db train`");

@@ -67,7 +67,8 @@ static double self_test(const sp_character* ch, int abstraction, int seeds, char
     const sp_rig* rig = &ch->rig;
     double* p = malloc(sizeof(double) * (size_t)rig->param_count);
     double* q = malloc(sizeof(double) * (size_t)rig->param_count);
-    sp_solver* s = sp_solver_create(rig, abstraction, &ch->camera, &(sp_solve_desc){.time_cap_ms = 2000});
+    sp_solver* s;
+    sp_solver_create(rig, abstraction, &ch->camera, &(sp_solve_desc){.time_cap_ms = 2000}, &s, NULL);
     double sum = 0;
     int done = 0;
     if (!p || !q || !s) {

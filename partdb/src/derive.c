@@ -700,7 +700,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     if ((r = sp_rig_finalize(&R, what, NULL, err)) != SP_OK) goto done;
 
     // The side view of the rest pose, the root's reach, the abstractions.
-    ev = sp_rig_eval_create(&R);
+    sp_rig_eval_create(&R, &ev, NULL);
     p = malloc(sizeof(double) * (size_t)(R.param_count + 1));
     is_skin = malloc(sizeof(bool) * (size_t)R.joint_count);
     if (!ev || !p || !is_skin) {

@@ -29,7 +29,8 @@ static sp_result silhouette(const sp_rig* rig, const sp_camera* cam, const doubl
     double* w = malloc(sizeof(double) * 4 * (size_t)V);
     unsigned char *skip_v = keep ? malloc((size_t)V) : NULL, *skip_t = keep ? malloc((size_t)T) : NULL;
     sp_vec2* pts = malloc(sizeof(sp_vec2) * (SIL_POINTS + 1));
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_abstraction ab = {0};
     sp_result r = SP_ERR_NO_MEMORY;
     if (!xyz || !w || (keep && (!skip_v || !skip_t)) || !pts || !ev) goto done;
@@ -167,7 +168,8 @@ static sp_result centre_line(const sp_rig* rig, const sp_camera* cam, const doub
     if (!(nl == 1 || nl == 2) || rig->joint_count < 3) return SP_ERR_INVALID;
     int* a = malloc(sizeof(int) * (size_t)rig->joint_count * 2);
     sp_vec2* pts = malloc(sizeof(sp_vec2) * ((size_t)rig->joint_count * 2 + 4));
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_result r = SP_OK;
     if (!a || !pts || !ev) {
         r = SP_ERR_NO_MEMORY;

@@ -47,7 +47,8 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
     sp_mat4* inv = malloc(sizeof(sp_mat4) * (size_t)J);
     sp_vec3* pos = malloc(sizeof(sp_vec3) * (size_t)J);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     stick_buf b = {0};
     sp_result r = SP_OK;
     if (!nchild || !chain || !p || !inv || !pos || !ev) {

@@ -279,12 +279,14 @@ sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp)
 
 void sp_raster_free(sp_raster* r)
 {
+    if (!r) return;
     free(r->pixels);
     memset(r, 0, sizeof *r);
 }
 
 void sp_dataset_free(sp_dataset* ds)
 {
+    if (!ds) return;
     for (int i = 0; i < ds->count; ++i) {
         sp_sketch_free(&ds->samples[i].sketch);
         sp_raster_free(&ds->samples[i].raster);

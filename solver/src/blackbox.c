@@ -230,7 +230,7 @@ oom:
     return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
 }
 
-void sp_blackbox_free(sp_blackbox* bb)
+void sp_blackbox_destroy(sp_blackbox* bb)
 {
     if (!bb) return;
     void* dl = bb->dl;
@@ -522,13 +522,20 @@ static int online_cores(void)
     return n < 1 ? 1 : (n > 8 ? 8 : (int)n);
 }
 
-sp_blackbox_fd* sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, const int* rows, int nrows, int threads)
+sp_result sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, const int* rows, int nrows, int threads,
+                                sp_blackbox_fd** out, sp_error* err)
 {
-    if (abstraction < 0 || abstraction >= bb->abstraction_count || nrows < 0) return NULL;
+    *out = NULL;
+    if (abstraction < 0 || abstraction >= bb->abstraction_count)
+        return sp_fail(err, SP_ERR_INVALID, "%s: abstraction %d does not exist (the rig has %d)", bb->what, abstraction,
+                       bb->abstraction_count);
+    if (nrows < 0) return sp_fail(err, SP_ERR_INVALID, "%s: %d rows", bb->what, nrows);
     for (int i = 0; i < nrows; ++i)
-        if (rows[i] < 0 || rows[i] >= bb->n) return NULL;
+        if (rows[i] < 0 || rows[i] >= bb->n)
+            return sp_fail(err, SP_ERR_INVALID, "%s: row %d is vertex %d, out of range (%d vertices)", bb->what, i, rows[i],
+                           bb->n);
     sp_blackbox_fd* fd = calloc(1, sizeof *fd);
-    if (!fd) return NULL;
+    if (!fd) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory making a finite-difference engine", bb->what);
     fd->bb = bb;
     fd->a = abstraction;
     fd->first = bb->first[abstraction];
@@ -547,6 +554,7 @@ sp_blackbox_fd* sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, co
     pthread_mutex_init(&fd->mu, NULL);
     pthread_cond_init(&fd->wake, NULL);
     pthread_cond_init(&fd->done, NULL);
+    sp_result r = SP_ERR_NO_MEMORY;
     if (!fd->rows || !fd->lanes || !fd->Jt || !fd->status || !fd->rc || !fd->bad || !fd->tids) goto fail;
     if (nrows) memcpy(fd->rows, rows, sizeof(int) * (size_t)nrows);
     for (int t = 0; t < fd->threads; ++t) {
@@ -563,16 +571,19 @@ sp_blackbox_fd* sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, co
         worker_arg* wa = malloc(sizeof *wa);
         if (!wa) goto fail;
         *wa = (worker_arg){fd, t};
-        if (pthread_create(&fd->tids[t], NULL, worker, wa) != 0) {
+        int rc = pthread_create(&fd->tids[t], NULL, worker, wa);
+        if (rc != 0) {
             free(wa);
+            r = sp_fail(err, SP_ERR_INTERNAL, "%s: cannot start finite-difference thread %d (%s)", bb->what, t, strerror(rc));
             goto fail;
         }
         fd->started = t;
     }
-    return fd;
+    *out = fd;
+    return SP_OK;
 fail:
     sp_blackbox_fd_destroy(fd);
-    return NULL;
+    return r == SP_ERR_NO_MEMORY ? sp_fail(err, r, "%s: out of memory making a finite-difference engine", bb->what) : r;
 }
 
 void sp_blackbox_fd_destroy(sp_blackbox_fd* fd)
@@ -667,7 +678,7 @@ static bool bbm_prepare(sp_model* m, const int* reps, int k)
 {
     bb_model* B = (bb_model*)m;
     sp_blackbox_fd_destroy(B->fd);
-    B->fd = sp_blackbox_fd_create(B->bb, B->a, reps, k, B->threads);
+    sp_blackbox_fd_create(B->bb, B->a, reps, k, B->threads, &B->fd, NULL);
     size_t P = (size_t)m->P;
     free(B->pJ), free(B->Jr), free(B->Jz);
     B->J_valid = false;
@@ -759,11 +770,15 @@ static void bbm_destroy(sp_model* m)
 // No closed-form regularisers: the solver sums the representatives' rows.
 static const sp_model_ops bb_ops = {bbm_columns, bbm_prepare, bbm_update, bbm_abstraction, bbm_rows, bbm_jacobians, bbm_destroy, NULL, NULL, NULL};
 
-sp_solver* sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, const sp_camera* cam, const sp_solve_desc* desc)
+sp_result sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, const sp_camera* cam, const sp_solve_desc* desc,
+                                    sp_solver** out, sp_error* err)
 {
-    if (abstraction < 0 || abstraction >= bb->abstraction_count) return NULL;
+    *out = NULL;
+    if (abstraction < 0 || abstraction >= bb->abstraction_count)
+        return sp_fail(err, SP_ERR_INVALID, "%s: abstraction %d does not exist (the rig has %d)", bb->what, abstraction,
+                       bb->abstraction_count);
     bb_model* B = calloc(1, sizeof *B);
-    if (!B) return NULL;
+    if (!B) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory making a solver", bb->what);
     B->bb = bb;
     B->a = abstraction;
     B->threads = desc ? desc->threads : 0;
@@ -773,7 +788,7 @@ sp_solver* sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, con
     B->p = malloc(sizeof(double) * (size_t)bb->P);
     if (!B->params || !B->x || !B->z || !B->p) {
         bbm_destroy(&B->base);
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory making a solver", bb->what);
     }
     for (int i = 0; i < bb->P; ++i) {
         const sp_blackbox_param* q = &bb->rig->params[i];
@@ -787,5 +802,5 @@ sp_solver* sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, con
                          .ab = &bb->abs[abstraction],
                          .embedded = false,
                          .placement_count = 0};
-    return sp__solver_create_model(&B->base, cam, desc);
+    return sp__solver_create_model(&B->base, cam, desc, out, err);
 }

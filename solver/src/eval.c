@@ -23,29 +23,28 @@ struct sp_rig_eval {
     bool has_deriv;
 };
 
-sp_rig_eval* sp_rig_eval_create(const sp_rig* rig)
+sp_result sp_rig_eval_create(const sp_rig* rig, sp_rig_eval** out, sp_error* err)
 {
+    *out = NULL;
     sp_rig_eval* ev = calloc(1, sizeof *ev);
-    if (!ev) return NULL;
+    if (!ev) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making a rig evaluator");
     size_t nj = (size_t)rig->joint_count, np = (size_t)(rig->param_count > 0 ? rig->param_count : 1);
     ev->rig = rig;
     ev->local = malloc(sizeof(sp_mat4) * nj);
     ev->world = malloc(sizeof(sp_mat4) * nj);
     ev->skin = malloc(sizeof(sp_mat4) * nj);
     ev->deriv = malloc(sizeof(sp_mat4) * np);
-    if (!ev->local || !ev->world || !ev->skin || !ev->deriv) {
-        sp_rig_eval_destroy(ev);
-        return NULL;
-    }
     double* p = malloc(sizeof(double) * np);
-    if (!p) {
+    if (!ev->local || !ev->world || !ev->skin || !ev->deriv || !p) {
+        free(p);
         sp_rig_eval_destroy(ev);
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making a rig evaluator (%d joints)", rig->joint_count);
     }
     sp_rig_defaults(rig, p);
     sp_rig_eval_update(ev, p, false);
     free(p);
-    return ev;
+    *out = ev;
+    return SP_OK;
 }
 
 void sp_rig_eval_destroy(sp_rig_eval* ev)

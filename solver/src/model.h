@@ -79,7 +79,8 @@ struct sp_model {
 // outlive it). NULL when out of memory.
 sp_model* sp__model_lbs_create(const sp_rig* rig, int abstraction);
 
-// The solver on any model (takes it over, destroys it on failure).
-sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_solve_desc* desc);
+// The solver on any model (takes it over, destroys it on failure; a NULL
+// model is a failed allocation), as sp_solver_create.
+sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_solve_desc* desc, sp_solver** out, sp_error* err);
 
 #endif

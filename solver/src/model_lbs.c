@@ -543,7 +543,7 @@ sp_model* sp__model_lbs_create(const sp_rig* rig, int abstraction)
     const sp_abstraction* ab = &rig->abstractions[abstraction];
     int P = rig->param_count > 0 ? rig->param_count : 1;
     L->rig = rig;
-    L->ev = sp_rig_eval_create(rig);
+    sp_rig_eval_create(rig, &L->ev, NULL);
     L->params = malloc(sizeof(sp_model_param) * (size_t)P);
     L->scratch = calloc(3 * (size_t)P, sizeof(double));
     L->mesh = ab->rest ? NULL : malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));

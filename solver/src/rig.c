@@ -179,6 +179,7 @@ sp_result sp_rig_finalize(sp_rig* rig, const char* what, int* renormalised, sp_e
 
 void sp_abstraction_free(sp_abstraction* a)
 {
+    if (!a) return;
     free(a->curves);
     free(a->rest);
     free(a->joints);
@@ -190,6 +191,7 @@ void sp_abstraction_free(sp_abstraction* a)
 
 void sp_rig_free(sp_rig* rig)
 {
+    if (!rig) return;
     free(rig->joints);
     free(rig->params);
     free(rig->rest);

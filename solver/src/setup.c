@@ -66,10 +66,14 @@ static int coarsen(const double* rest_in, int n, int k, int* reps)
 // that any other CBLAS/LAPACKE implementation links too.
 extern void openblas_set_num_threads(int n) __attribute__((weak));
 
-sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_solve_desc* desc)
+sp_result sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_solve_desc* desc, sp_solver** out,
+                           sp_error* err)
 {
-    if (abstraction < 0 || abstraction >= rig->abstraction_count) return NULL;
-    return sp__solver_create_model(sp__model_lbs_create(rig, abstraction), cam, desc);
+    *out = NULL;
+    if (abstraction < 0 || abstraction >= rig->abstraction_count)
+        return sp_fail(err, SP_ERR_INVALID, "abstraction %d does not exist (the rig has %d)", abstraction,
+                       rig->abstraction_count);
+    return sp__solver_create_model(sp__model_lbs_create(rig, abstraction), cam, desc, out, err);
 }
 
 static int find_group(sp_solver* s, const int* cols, int n)
@@ -147,14 +151,14 @@ static bool make_groups(sp_solver* s)
     return true;
 }
 
-sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_solve_desc* desc)
+sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_solve_desc* desc, sp_solver** out, sp_error* err)
 {
     if (openblas_set_num_threads) openblas_set_num_threads(1);
-    if (!m) return NULL;
-    sp_solver* s = calloc(1, sizeof *s);
+    *out = NULL;
+    sp_solver* s = m ? calloc(1, sizeof *s) : NULL;
     if (!s) {
-        m->ops->destroy(m);
-        return NULL;
+        if (m) m->ops->destroy(m);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making a solver");
     }
     s->model = m;
     s->ab = m->ab;
@@ -238,11 +242,12 @@ sp_solver* sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_s
         goto fail;
     for (int i = 0; i < s->P; ++i)
         s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
-    return s;
+    *out = s;
+    return SP_OK;
 fail:
     free(tmp);
     sp_solver_destroy(s);
-    return NULL;
+    return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making a solver (%d parameters, %d abstraction points)", P, l);
 }
 
 void sp_solver_destroy(sp_solver* s)

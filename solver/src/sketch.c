@@ -5,6 +5,7 @@
 
 void sp_sketch_free(sp_sketch* s)
 {
+    if (!s) return;
     for (int i = 0; i < s->stroke_count; ++i) {
         free(s->strokes[i].points);
         free(s->strokes[i].t);

@@ -53,7 +53,8 @@ sp_result sp_abstraction_project(const sp_rig* rig, int abstraction, const sp_ca
 {
     if (abstraction < 0 || abstraction >= rig->abstraction_count) return SP_ERR_INVALID;
     const sp_abstraction* ab = &rig->abstractions[abstraction];
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     double* mesh = ab->rest ? NULL : malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
     double* z = malloc(sizeof(double) * 3 * (size_t)(ab->point_count + 1));
     sp_result r = SP_OK;

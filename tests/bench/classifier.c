@@ -114,7 +114,7 @@ int main(int argc, char** argv)
     free(ms);
     free(f);
     free(use);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_dataset_free(&ds);
     return 0;
 }

@@ -110,7 +110,7 @@ int main(int argc, char** argv)
             return 1;
         }
         rows[r].ms = sp_now_ms() - rows[r].st.t0;
-        sp_clf_free(clf);
+        sp_clf_destroy(clf);
     }
     if (json) {
         printf("[");

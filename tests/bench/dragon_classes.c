@@ -105,7 +105,7 @@ static int report_db_model(const char* db_path, const sp_dataset* test, const sp
     }
     free(at);
     free(as);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     return 0;
 }
 
@@ -262,7 +262,7 @@ int main(int argc, char** argv)
         free(at);
         free(as);
         free(cd);
-        sp_clf_free(clf);
+        sp_clf_destroy(clf);
     }
     if (json) printf("\n]\n");
 done:

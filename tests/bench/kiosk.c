@@ -203,7 +203,8 @@ int main(int argc, char** argv)
         fprintf(stderr, "bench kiosk: %s\n", err.text);
         return 1;
     }
-    sp_headless* gl = sp_headless_create(&err);
+    sp_headless* gl;
+    sp_headless_create(&gl, &err);
     if (!gl) {
         fprintf(stderr, "bench kiosk: %s\n", err.text);
         return 1;
@@ -226,7 +227,7 @@ int main(int argc, char** argv)
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
         g_fbo = fbo;
     } else {
-        if (!(target = sp_render_target_create(W, H, 4, &err))) {
+        if (sp_render_target_create(W, H, 4, &target, &err) != SP_OK) {
             fprintf(stderr, "bench kiosk: %s\n", err.text);
             return 1;
         }

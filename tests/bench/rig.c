@@ -59,7 +59,7 @@ static sp_bench_row time_it(const char* name, void (*fn)(ctx*), ctx* c, int runs
 static int bench_rig(const char* label, const sp_rig* rig, int runs, sp_bench_row* rows)
 {
     ctx c = {.rig = rig};
-    c.ev = sp_rig_eval_create(rig);
+    sp_rig_eval_create(rig, &c.ev, NULL);
     c.p = malloc(sizeof(double) * rig->param_count);
     c.x = malloc(sizeof(double) * 3 * rig->vertex_count);
     sp_test_rng rng = {1};

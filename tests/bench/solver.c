@@ -53,7 +53,8 @@ static void run_solves_ab(const sp_rig* rig, int ab, const sp_camera* cam, int f
     int P = rig->param_count;
     double* truth = malloc(sizeof(double) * P);
     double* out = malloc(sizeof(double) * P);
-    sp_solver* s = sp_solver_create(rig, ab, cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(rig, ab, cam, &(sp_solve_desc){0}, &s, NULL);
     o->ms = malloc(sizeof(double) * n);
     o->rel = malloc(sizeof(double) * n);
     o->its = malloc(sizeof(double) * n);
@@ -164,7 +165,8 @@ static bool face_row(int runs, sp_bench_row* row)
     }
     const sp_blackbox_rig* r = sp_blackbox_desc(bb);
     sp_camera cam = sp_blackbox_camera(bb, 640, 480);
-    sp_solver* s = sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){0}, &s, NULL);
     outcome o = {.its = malloc(sizeof(double) * runs), .ms = malloc(sizeof(double) * runs), .rel = malloc(sizeof(double) * runs), .n = runs};
     double* truth = malloc(sizeof(double) * r->param_count);
     double* out = malloc(sizeof(double) * r->param_count);
@@ -189,7 +191,7 @@ static bool face_row(int runs, sp_bench_row* row)
              r->param_count, 3 * r->vertex_count, 2 * sp_blackbox_abstraction_points(bb, 0), ok, it_med);
     free(truth), free(out), free(o.ms), free(o.rel), free(o.its), free(o.cpu_ms);
     sp_solver_destroy(s);
-    sp_blackbox_free(bb);
+    sp_blackbox_destroy(bb);
     return true;
 }
 

@@ -132,8 +132,8 @@ int main(int argc, char** argv)
         t_build = sp_now_ms() - t0;
         fprintf(stderr, "visitors: built %s by the default recipe in %.1f s\n", db_path, t_build / 1000);
     }
-    sp_dragon* d =
-        sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .assets_dir = assets, .canvas_w = 1280, .canvas_h = 800}, &err);
+    sp_dragon* d;
+    sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .assets_dir = assets, .canvas_w = 1280, .canvas_h = 800}, &d, &err);
     if (!d || sp_dragon_preload(d, &err) != SP_OK) {
         fprintf(stderr, "visitors: %s\n", err.text);
         return 1;

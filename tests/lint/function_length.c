@@ -20,6 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lint_scan.h"
+
 enum { NAME_MAX_LEN = 128 };
 
 typedef struct scan {
@@ -28,92 +30,18 @@ typedef struct scan {
     int over; // functions over the limit
 } scan;
 
-static char* read_all(const char* path, size_t* n)
-{
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    size_t cap = 1 << 16, len = 0;
-    char* buf = malloc(cap + 1);
-    size_t got;
-    while (buf && (got = fread(buf + len, 1, cap - len, f)) > 0) {
-        len += got;
-        if (len == cap) {
-            char* more = realloc(buf, 2 * cap + 1);
-            if (!more) free(buf);
-            buf = more, cap *= 2;
-        }
-    }
-    fclose(f);
-    if (buf) buf[len] = 0;
-    *n = len;
-    return buf;
-}
-
-// Skips a comment, literal or preprocessor line starting at s[i] (counting
-// newlines into *line); returns the index after it, or i when there is none.
-static size_t skip_inert(const char* s, size_t n, size_t i, int* line, bool at_line_start)
-{
-    if (s[i] == '/' && i + 1 < n && s[i + 1] == '/') {
-        while (i < n && s[i] != '\n')
-            ++i;
-        return i;
-    }
-    if (s[i] == '/' && i + 1 < n && s[i + 1] == '*') {
-        for (i += 2; i + 1 < n && !(s[i] == '*' && s[i + 1] == '/'); ++i)
-            *line += s[i] == '\n';
-        return i + 2 < n ? i + 2 : n;
-    }
-    if (s[i] == '"' || s[i] == '\'') {
-        const char q = s[i];
-        for (++i; i < n && s[i] != q; ++i) {
-            if (s[i] == '\\' && i + 1 < n) ++i;
-            *line += s[i] == '\n';
-        }
-        return i + 1;
-    }
-    if (s[i] == '#' && at_line_start) { // a directive, with its continuation lines
-        for (; i < n && s[i] != '\n'; ++i)
-            if (s[i] == '\\' && i + 1 < n && s[i + 1] == '\n') ++i, ++*line;
-        return i;
-    }
-    return i;
-}
-
 static void check_file(scan* sc)
 {
     size_t n;
-    char* s = read_all(sc->path, &n);
-    if (!s) {
-        fprintf(stderr, "function_length: cannot read %s\n", sc->path);
-        exit(2);
-    }
-    int line = 1, depth = 0, parens = 0, body_line = 0;
+    char* s = lint_read_all("function_length", sc->path, &n);
+    int depth = 0, parens = 0, body_line = 0;
     char last = 0; // the last significant character at file scope
     char ident[NAME_MAX_LEN] = "", name[NAME_MAX_LEN] = "", body_name[NAME_MAX_LEN] = "";
-    bool at_line_start = true;
-    for (size_t i = 0; i < n;) {
-        size_t j = skip_inert(s, n, i, &line, at_line_start);
-        if (j != i) {
-            i = j;
-            continue;
-        }
-        const char c = s[i];
-        if (c == '\n') {
-            ++line, at_line_start = true, ++i;
-            continue;
-        }
-        if (isspace((unsigned char)c)) {
-            ++i;
-            continue;
-        }
-        at_line_start = false;
+    for (lint_cursor cur = {.s = s, .n = n, .line = 1, .at_line_start = true}; lint_next(&cur);) {
+        cur.at_line_start = false;
+        const char c = s[cur.i];
         if (isalpha((unsigned char)c) || c == '_') {
-            size_t k = 0;
-            while (i < n && (isalnum((unsigned char)s[i]) || s[i] == '_')) {
-                if (k + 1 < sizeof ident) ident[k++] = s[i];
-                ++i;
-            }
-            ident[k] = 0;
+            lint_word(&cur, ident, sizeof ident);
             if (depth == 0) last = 'a';
             continue;
         }
@@ -122,7 +50,7 @@ static void check_file(scan* sc)
             if (c == ')') --parens;
             if (c == '{') {
                 if (last == ')')
-                    body_line = line, snprintf(body_name, sizeof body_name, "%s", name);
+                    body_line = cur.line, snprintf(body_name, sizeof body_name, "%s", name);
                 else
                     body_line = 0; // an initialiser or a type
             }
@@ -130,14 +58,14 @@ static void check_file(scan* sc)
         }
         if (c == '{') ++depth;
         if (c == '}' && --depth == 0 && body_line > 0) {
-            const int len = line - body_line + 1;
+            const int len = cur.line - body_line + 1;
             if (len > sc->max) {
                 printf("%s:%d: %s is %d lines, limit %d\n", sc->path, body_line, body_name, len, sc->max);
                 ++sc->over;
             }
             body_line = 0;
         }
-        ++i;
+        ++cur.i;
     }
     free(s);
 }

@@ -3,7 +3,7 @@
 # a function is measured). The check is checked too: a generated function
 # of 121 lines fails it and one of 120 lines, beside a longer initialiser,
 # passes.
-add_executable(function_length lint/function_length.c)
+add_executable(function_length lint/function_length.c lint/lint_scan.c)
 target_link_libraries(function_length PRIVATE sp_flags)
 file(GLOB SP_SOLVER_C CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/solver/src/*.c)
 add_test(NAME function_length_solver COMMAND function_length 120 ${SP_SOLVER_C})
@@ -32,3 +32,23 @@ if(TARGET sp_pose_cmds)
   add_test(NAME pose_links_check_sees_opencv
            COMMAND sh -c "ldd $<TARGET_FILE:sketchpose> | grep -E '${sp_forbidden}'")
 endif()
+
+# No public header names a third-party library (tests/lint/public_headers.c
+# says what counts): the headers under <library>/include/sp are all a user
+# compiles against. Checked too: a header that includes GLFW, returns a cJSON
+# tree and takes a cv::Mat fails on each; one that names them only in
+# comments and strings passes.
+add_executable(public_headers lint/public_headers.c lint/lint_scan.c)
+target_link_libraries(public_headers PRIVATE sp_flags)
+file(GLOB SP_PUBLIC_HEADERS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/*/include/sp/*.h ${PROJECT_SOURCE_DIR}/app/*/include/sp/*.h)
+add_test(NAME public_headers_no_third_party COMMAND public_headers ${SP_PUBLIC_HEADERS})
+file(WRITE ${sp_lint_dir}/foreign.h
+  "#include <stdbool.h>\n#include <GLFW/glfw3.h>\nstruct cJSON* sp_x_json(void);\nvoid sp_x_show(const cv::Mat* m);\n")
+file(WRITE ${sp_lint_dir}/clean.h
+  "#include <stdint.h>\n#include \"sp/result.h\"\n/// Built on cJSON and GLFW (glfwPollEvents); FLANN's kd-tree.\n"
+  "#define SP_X_NAME \"cJSON\"\nsp_result sp_x_json(char** json, sp_error* err); // free() it, no cJSON_Delete\n"
+  "int sp_glyph_count(void);\n")
+add_test(NAME public_headers_fails_foreign COMMAND public_headers ${sp_lint_dir}/foreign.h)
+set_tests_properties(public_headers_fails_foreign PROPERTIES PASS_REGULAR_EXPRESSION
+  "foreign.h:2: includes <GLFW/glfw3.h>.*foreign.h:3: names cJSON .*foreign.h:4: names a C\\+\\+ scope")
+add_test(NAME public_headers_passes_comments COMMAND public_headers ${sp_lint_dir}/clean.h)

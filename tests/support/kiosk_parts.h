@@ -220,7 +220,7 @@ static inline bool kp_six_strokes(const char* db_path, kp_stroke* out, sp_error*
         if (!found) sp_fail(err, SP_ERR_INVALID, "no seed of %s is ranked in the model's top 3", kp_layout[li].category);
         ok = found;
     }
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_db_close(db);
     return ok;
 }

@@ -34,7 +34,8 @@ static void check_model(const char* rel)
     sp_vec3* s = malloc(sizeof(sp_vec3) * J);
     sp_mat4* w = malloc(sizeof(sp_mat4) * J);
     double* p = malloc(sizeof(double) * P);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     const sp_animation* an = &rig->animations[0];
     int checked = 0;
     for (int k = 0; k <= 20; ++k) {

@@ -300,7 +300,8 @@ static void test_random_poses(void)
         double* p = malloc(sizeof(double) * (size_t)rig->param_count);
         double* x = malloc(sizeof(double) * 3 * (size_t)nv);
         double* A = malloc(sizeof(double) * 9 * (size_t)nv);
-        sp_rig_eval* ev = sp_rig_eval_create(rig);
+        sp_rig_eval* ev;
+        sp_rig_eval_create(rig, &ev, NULL);
         ENSURE(p && x && A && ev);
         // Rest normals once; degenerate faces (none expected) are skipped.
         double* n0s = malloc(sizeof(double) * 3 * (size_t)nt);
@@ -502,7 +503,8 @@ static void test_characters(void)
         ENSURE_NEAR(ch.camera.view.m[10], 1.0, 1e-6); // looking along -Z
         check_clip(rig);
         // Elbows and knees bent 60 and 90 degrees: no folded face, no collapse.
-        sp_rig_eval* ev = sp_rig_eval_create(rig);
+        sp_rig_eval* ev;
+        sp_rig_eval_create(rig, &ev, NULL);
         double* p = malloc(sizeof(double) * (size_t)rig->param_count);
         ENSURE(ev && p);
         for (int b = 0; b < 4 && cs->bends[b].param; ++b) {

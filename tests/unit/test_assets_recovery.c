@@ -69,7 +69,8 @@ static void recover_abstraction(const char* name, const char* abstraction, int c
     double* its = malloc(sizeof(double) * (size_t)cases);  // iterations (every attempt of a solve)
     // No wall-clock cap: the protocol measures what the solver reaches, and
     // a time cap would make the slow sanitizer build stop elsewhere.
-    sp_solver* s = sp_solver_create(rig, ab, &ch.camera, &(sp_solve_desc){.time_cap_ms = 1e9});
+    sp_solver* s;
+    sp_solver_create(rig, ab, &ch.camera, &(sp_solve_desc){.time_cap_ms = 1e9}, &s, NULL);
     ENSURE(truth && out && errs && its && s);
     int ok = 0;
     double worst = 0, ms = 0, err_sum = 0;

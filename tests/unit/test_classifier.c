@@ -573,8 +573,8 @@ static void test_deterministic(void)
     } while (ca != EOF && cb != EOF);
     fclose(fa);
     fclose(fb);
-    sp_clf_free(a);
-    sp_clf_free(b);
+    sp_clf_destroy(a);
+    sp_clf_destroy(b);
     sp_dataset_free(&train);
     ENSURE(same); // the same model whatever the thread count
 }
@@ -619,7 +619,7 @@ static void test_model_files(void)
             ENSURE(a.ranked[j].category == b.ranked[j].category && a.ranked[j].score == b.ranked[j].score);
     }
     sp_dataset_free(&test);
-    sp_clf_free(back);
+    sp_clf_destroy(back);
 
     long n = file_size(path);
     const char* bad = sp_test_tmp_path("bad.spclf");
@@ -762,11 +762,11 @@ static void test_shape_evidence(void)
     ENSURE(sp_clf_classify(old, &test.samples[1].sketch, NULL, &o, &err) == SP_OK &&
            sp_clf_classify(plain, &test.samples[1].sketch, NULL, &p, &err) == SP_OK);
     ENSURE(o.count == p.count && o.ranked[0].category == p.ranked[0].category && o.ranked[0].score == p.ranked[0].score);
-    sp_clf_free(old);
+    sp_clf_destroy(old);
     remove(plain_path);
     remove(path);
-    sp_clf_free(back);
-    sp_clf_free(shaped);
+    sp_clf_destroy(back);
+    sp_clf_destroy(shaped);
     sp_dataset_free(&train);
     sp_dataset_free(&test);
 }
@@ -817,7 +817,7 @@ static int quickdraw_fold0(int categories, const sp_clf_desc* d, int* top1, int*
             *top3 += a.ranked[k].category == all.samples[i].label;
         ++n;
     }
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     free(use);
     sp_dataset_free(&all);
     return n;
@@ -871,7 +871,7 @@ static void test_augment_hook(void)
         sp_clf_answer a;
         ENSURE(sp_clf_classify(clf, &train.samples[0].sketch, NULL, &a, &err) == SP_OK);
         ENSURE(a.count > 0 && a.ranked[0].category == train.samples[0].label && a.distance < 1e-3f);
-        sp_clf_free(clf);
+        sp_clf_destroy(clf);
     }
     sp_dataset_free(&train);
 }
@@ -890,7 +890,7 @@ static void test_quickdraw_fold(void)
 
 static void test_cleanup(void)
 {
-    sp_clf_free(g_model);
+    sp_clf_destroy(g_model);
     g_model = NULL;
 }
 

@@ -101,7 +101,8 @@ static sp_vec3 pivot(const sp_rig* rig, const char* name)
     int j = sp_rig_find_joint(rig, name);
     ENSURE(j >= 0);
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_rig_defaults(rig, p);
     sp_rig_eval_update(ev, p, false);
     sp_vec3 t = sp_mat4_translation(&sp_rig_eval_world(ev)[j]);
@@ -515,10 +516,12 @@ typedef struct silhouette {
 static silhouette measure(const sp_character* part)
 {
     sp_error err = {0};
-    sp_headless* gl = sp_headless_create(&err);
+    sp_headless* gl;
+    sp_headless_create(&gl, &err);
     if (!gl) fprintf(stderr, "  cannot create a headless OpenGL context: %s\n", err.text);
     ENSURE(gl);
-    sp_renderer* r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
+    sp_renderer* r;
+    sp_renderer_create(&(sp_renderer_desc){0}, &r, &err);
     ENSURE(r);
     const sp_rig* rig = &part->rig;
     sp_camera cam = part->camera;
@@ -528,13 +531,15 @@ static silhouette measure(const sp_character* part)
     sp_vec3 lo, hi;
     sp_bounds(xyz, rig->vertex_count, &lo, &hi);
     sp_render_fit_depth(&cam, lo, hi);
-    sp_render_target* t = sp_render_target_create(W, H, 0, &err);
-    sp_render_mesh* m = sp_render_mesh_create(r,
-                                              &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                                              .positions = xyz,
-                                                              .triangle_count = rig->triangle_count,
-                                                              .triangles = rig->triangles},
-                                              &err);
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, &err);
+    sp_render_mesh* m;
+    sp_render_mesh_create(r,
+                          &(sp_mesh_desc){.vertex_count = rig->vertex_count,
+                                          .positions = xyz,
+                                          .triangle_count = rig->triangle_count,
+                                          .triangles = rig->triangles},
+                          &m, &err);
     ENSURE(t && m);
     const float bg[4] = {1, 0, 1, 1};
     sp_render_target_bind(t);

@@ -137,7 +137,8 @@ static int part_stroke_ex(sp_db* db, const char* name, uint64_t seed, double amp
     double f = size / sp_v2_len(sp_v2_sub(hi, lo));
     sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
     if (by_root) {
-        sp_rig_eval* ev = sp_rig_eval_create(&ch.rig);
+        sp_rig_eval* ev;
+        sp_rig_eval_create(&ch.rig, &ev, NULL);
         sp_rig_eval_update(ev, p, false);
         int root = 0;
         while (ch.rig.joints[root].parent >= 0)
@@ -201,7 +202,8 @@ static const layout k_layout[] = {
 static sp_dragon* new_dragon(const char* db_path)
 {
     sp_error err = {0};
-    sp_dragon* d = sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .canvas_w = 1280, .canvas_h = 800}, &err);
+    sp_dragon* d;
+    sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .canvas_w = 1280, .canvas_h = 800}, &d, &err);
     if (!d) fprintf(stderr, "  create: %s\n", err.text);
     ENSURE(d);
     return d;
@@ -251,7 +253,8 @@ static sp_vec2* fitted_px(const sp_dragon* d, int i)
 {
     const sp_dragon_part* p = sp_dragon_part_get(d, i);
     const sp_rig* rig = &p->character->rig;
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     double* xyz = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
     sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
     ENSURE(ev && xyz && px);
@@ -286,7 +289,8 @@ static sp_vec3 attach_end(const sp_dragon* d, int i)
 {
     const sp_dragon_part* p = sp_dragon_part_get(d, i);
     const sp_rig* rig = &p->character->rig;
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_rig_eval_update(ev, sp_dragon_part_params(d, i), false);
     int root = 0;
     while (rig->joints[root].parent >= 0)
@@ -341,6 +345,18 @@ static double iou(const double a[4], const double b[4])
     if (ix <= 0 || iy <= 0) return 0;
     double in = ix * iy;
     return in / ((a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - in);
+}
+
+// The dragon's report (sp_dragon_report_json's text) as a tree.
+static cJSON* report_tree(const sp_dragon* d)
+{
+    char* text = NULL;
+    sp_error err = {0};
+    ENSURE(sp_dragon_report_json(d, &text, &err) == SP_OK);
+    cJSON* rep = cJSON_Parse(text);
+    free(text);
+    ENSURE(rep != NULL);
+    return rep;
 }
 
 // A report box [x0, y0, x1, y1].
@@ -437,7 +453,7 @@ static sp_dragon* many_body_first(sp_db* db, const char* path, drawn lay[MANY], 
 // was drawn as lay[i]; the body is part `body`. Prints the figures.
 static void check_many(sp_dragon* d, const drawn* lay, const int* part_of, int count, int body)
 {
-    cJSON* rep = sp_dragon_report_json(d);
+    cJSON* rep = report_tree(d);
     const cJSON* parts = cJSON_GetObjectItem(rep, "parts");
     ENSURE(cJSON_GetArraySize(parts) == sp_dragon_part_count(d));
     double boxes[MANY][4];
@@ -1104,7 +1120,7 @@ static void test_rejects_and_bad_strokes(void)
     ENSURE(!strcmp(before, after));
     // A full dragon takes no more parts (Redraw still works).
     sp_dragon* small = NULL;
-    small = sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .max_parts = 2}, &err);
+    sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .max_parts = 2}, &small, &err);
     ENSURE(small);
     n = part_stroke(db, "tail_t", 8, 0.3, 300, 400, 300, &xy);
     for (int k = 0; k < 3; ++k)
@@ -1633,7 +1649,7 @@ static void test_body_last_and_undo(void)
     // Undo the body: every part free, on its stroke again.
     ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == MANY);
     ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
-    cJSON* rep = sp_dragon_report_json(d);
+    cJSON* rep = report_tree(d);
     for (int i = 0; i < MANY; ++i) {
         const cJSON* pj = cJSON_GetArrayItem(cJSON_GetObjectItem(rep, "parts"), i);
         double ob[4], sb[4];
@@ -1689,7 +1705,7 @@ static void test_robustness(void)
             sp_dragon_note_name(res.note), sp_dragon_part_get(d, 1)->attached_to);
     ENSURE(!res.rejected && res.note == SP_DRAGON_NOTE_NO_SURFACE && sp_dragon_part_get(d, 1)->attached_to == -1);
     ENSURE(sp_dragon_pose_at(d, 0.4, &err) == SP_OK);
-    cJSON* rep = sp_dragon_report_json(d);
+    cJSON* rep = report_tree(d);
     ENSURE(!strcmp(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(rep, "parts"), 1), "note")->valuestring,
                    "no_surface"));
     cJSON_Delete(rep);
@@ -1739,7 +1755,7 @@ static void test_robustness(void)
     fprintf(stderr, "  stroke 49: %s (the slowest of the 47 before: %.0f ms)\n", sp_dragon_reject_name(res.reason), worst_ms);
     ENSURE(res.rejected && res.reason == SP_DRAGON_FULL && sp_dragon_part_count(d) == 48);
     ENSURE(sp_dragon_pose_at(d, 0.7, &err) == SP_OK);
-    rep = sp_dragon_report_json(d);
+    rep = report_tree(d);
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItem(rep, "parts")) == 48);
     cJSON_Delete(rep);
     ENSURE(sp_dragon_export(d, sp_test_tmp_path("dragon_48.glb"), &err) == SP_OK);

@@ -600,7 +600,7 @@ static void test_calibrate_reject(void)
     sp_clf* back = NULL;
     ENSURE(sp_clf_load(path, &back, &err) == SP_OK);
     ENSURE(sp_clf_reject_distance(back) == sp_clf_reject_distance(clf));
-    sp_clf_free(back);
+    sp_clf_destroy(back);
     unlink(path);
     // Bad arguments.
     ENSURE(sp_clf_calibrate_reject(clf, &held, NULL, 0.0, 1.0, NULL, NULL, &err) == SP_ERR_INVALID &&
@@ -610,7 +610,7 @@ static void test_calibrate_reject(void)
     unsigned char none[64] = {0};
     ENSURE(sp_clf_calibrate_reject(clf, &held, none, 0.9, 1.0, NULL, NULL, &err) == SP_ERR_INVALID &&
            strstr(err.text, "no usable"));
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_dataset_free(&train);
     sp_dataset_free(&held);
     for (int i = 0; i < DRAGON_PART_COUNT; ++i)
@@ -659,7 +659,7 @@ static void test_cli_train_calibrate(void)
         ENSURE(sp_clf_classify(clf, &held.samples[i].sketch, NULL, &a, &err) == SP_OK && !a.rejected);
     }
     sp_dataset_free(&held);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     snprintf(cmd, sizeof cmd,
              "'%s' train --data '%s' --model '%s' --words 32 --calibrate '%s' --calibrate-quantile 2 2>/dev/null", bin, tr, model,
              cal);
@@ -720,7 +720,7 @@ static void test_dragon_accuracy_and_rejection(void)
     // Calibration is what makes the dragon sketches pass: the training set's own threshold rejects more of them.
     ENSURE(before.rejected > s.rejected);
     if (have_scribbles) ENSURE(s.scribbles == 80 && s.scribbles_rejected >= 0.8 * s.scribbles);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_dataset_free(&train);
     sp_dataset_free(&test);
     sp_dataset_free(&cal);

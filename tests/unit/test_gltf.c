@@ -57,7 +57,8 @@ static const char* write_mini(const char* name, const mini_desc* d)
 // Skinned mesh vertices of ch at p (malloc'd, vertex_count by 3).
 static double* skin_mesh(const sp_rig* rig, const double* p)
 {
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     double* x = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(rig), x);
@@ -174,7 +175,8 @@ static void ensure_stick(const sp_character* ch)
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
     double* z = malloc(sizeof(double) * 3 * (size_t)ab->point_count);
     sp_rig_defaults(rig, p);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_abstraction(ev, ab, NULL, z);
     const sp_mat4* g = sp_rig_eval_world(ev);

@@ -202,7 +202,8 @@ static void asset_solves(const char* name, const char* abstraction, const int* s
     ENSURE(ab >= 0);
     double* truth = malloc(sizeof(double) * (size_t)rig->param_count);
     double* out = malloc(sizeof(double) * (size_t)rig->param_count);
-    sp_solver* s = sp_solver_create(rig, ab, &ch.camera, &k_uncapped);
+    sp_solver* s;
+    sp_solver_create(rig, ab, &ch.camera, &k_uncapped, &s, NULL);
     ENSURE(truth && out && s);
     for (int i = 0; i < n; ++i) {
         sp_synth_params(rig, (uint64_t)seeds[i], 0.7853981633974483, truth);
@@ -237,7 +238,8 @@ static void drawover_solves(const int* seeds, int n)
     double* xyz = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
     double* truth = malloc(sizeof(double) * (size_t)P);
     double* out = malloc(sizeof(double) * (size_t)P);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     ENSURE(xyz && truth && out && ev);
     sp_rig_eval_update(ev, ch.pose, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
@@ -248,7 +250,8 @@ static void drawover_solves(const int* seeds, int n)
                           &err) == SP_OK);
     int a = sp_rig_add_abstraction(rig, &emb);
     ENSURE(a >= 0);
-    sp_solver* s = sp_solver_create(rig, a, &ch.camera, &k_uncapped);
+    sp_solver* s;
+    sp_solver_create(rig, a, &ch.camera, &k_uncapped, &s, NULL);
     ENSURE(s);
     for (int i = 0; i < n; ++i) {
         sp_synth_params(rig, (uint64_t)seeds[i], 0.5, truth);
@@ -312,7 +315,8 @@ static void test_face(void)
     // Two finite-difference threads (results are the same bits for any count).
     sp_solve_desc d = k_uncapped;
     d.threads = 2;
-    sp_solver* s = sp_solver_create_blackbox(bb, 0, &cam, &d);
+    sp_solver* s;
+    sp_solver_create_blackbox(bb, 0, &cam, &d, &s, NULL);
     double* truth = malloc(sizeof(double) * (size_t)P);
     double* out = malloc(sizeof(double) * (size_t)P);
     ENSURE(s && truth && out);
@@ -329,7 +333,7 @@ static void test_face(void)
     }
     sp_solver_destroy(s);
     free(truth), free(out);
-    sp_blackbox_free(bb);
+    sp_blackbox_destroy(bb);
     group_done("face");
 }
 
@@ -394,7 +398,8 @@ static void test_dragon(void)
         ENSURE(r == SP_OK);
     }
     sp_dragon_desc dd = {.db = db, .canvas_w = 1280, .canvas_h = 800, .solve = k_uncapped};
-    sp_dragon* d = sp_dragon_create(&dd, &err);
+    sp_dragon* d;
+    sp_dragon_create(&dd, &d, &err);
     if (!d) fprintf(stderr, "  %s\n", err.text);
     ENSURE(d);
     for (int step = 0; step < NDRAW + 2; ++step) {

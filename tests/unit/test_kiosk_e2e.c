@@ -753,7 +753,7 @@ static bool refused_doodle(double cx, double cy, sp_vec2* xy, int* n)
             found = true, *n = m;
         sp_sketch_free(&one);
     }
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     return found;
 }
 
@@ -1143,8 +1143,7 @@ static void updates_until(sp_kiosk* k, double* t, double until)
 static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headless** gl, double* t)
 {
     sp_error err = {0};
-    *gl = sp_headless_create(&err);
-    if (!*gl) return NULL;
+    if (sp_headless_create(gl, &err) != SP_OK) return NULL;
     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
                                                    .canvas_w = 1280,
                                                    .canvas_h = 800,
@@ -1240,7 +1239,7 @@ static void test_collect_reload(void)
     fprintf(stderr, "  reloads %d; the kiosk's model: reject distance %.4f before, %.4f after (the new model's: %.4f)\n",
             st->reloads, before, after, want);
     ENSURE(st->reloads == 1 && after == want && before != want);
-    sp_clf_free(fresh);
+    sp_clf_destroy(fresh);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
 }

@@ -177,7 +177,8 @@ static const char* const k_row[6] = {"torso", "head", "wings", "tail", "front_le
 
 static sp_kiosk_ui* started_with(fake* f, const sp_kiosk_ui_desc* desc)
 {
-    sp_kiosk_ui* ui = sp_kiosk_ui_create(desc);
+    sp_kiosk_ui* ui;
+    sp_kiosk_ui_create(desc, &ui, NULL);
     ENSURE(ui);
     sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
     sp_kiosk_ui_set_parts(ui, k_row, 6);
@@ -221,7 +222,8 @@ static void check_targets(const sp_kiosk_ui* ui);
 static void test_flow(void)
 {
     fake f;
-    sp_kiosk_ui* ui = sp_kiosk_ui_create(NULL);
+    sp_kiosk_ui* ui;
+    sp_kiosk_ui_create(NULL, &ui, NULL);
     sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
     memset(&f, 0, sizeof f);
     ENSURE(ui->mode == SP_KM_ATTRACT);
@@ -739,7 +741,8 @@ static void test_layout(void)
         sp_kiosk_ui_destroy(ui);
     }
     // Degenerate sizes and densities never crash and fall back to 96 dpi.
-    sp_kiosk_ui* ui = sp_kiosk_ui_create(NULL);
+    sp_kiosk_ui* ui;
+    sp_kiosk_ui_create(NULL, &ui, NULL);
     sp_kiosk_ui_resize(ui, 0, -5, NAN);
     ENSURE(ui->width == 1 && ui->height == 1);
     ENSURE_NEAR(ui->px_per_mm, 96 / 25.4, 1e-9);
@@ -783,10 +786,11 @@ static void test_idle_timeout(void)
 // 10 s); a touch during it resets the timer and acts: a chip tap, a button, a stroke.
 static void test_countdown(void)
 {
-    sp_kiosk_ui* d = sp_kiosk_ui_create(NULL);
+    sp_kiosk_ui* d;
+    sp_kiosk_ui_create(NULL, &d, NULL);
     ENSURE_NEAR(d->desc.countdown_ms, 10000, 1e-9);
     sp_kiosk_ui_destroy(d);
-    d = sp_kiosk_ui_create(&(sp_kiosk_ui_desc){.idle_ms = 30000, .countdown_ms = 20000});
+    sp_kiosk_ui_create(&(sp_kiosk_ui_desc){.idle_ms = 30000, .countdown_ms = 20000}, &d, NULL);
     ENSURE_NEAR(d->desc.countdown_ms, 10000, 1e-9);
     sp_kiosk_ui_destroy(d);
     fake f;
@@ -955,7 +959,8 @@ static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t see
                         sp_kiosk_session* rec)
 {
     memset(f, 0, sizeof *f);
-    sp_kiosk_ui* ui = sp_kiosk_ui_create(NULL);
+    sp_kiosk_ui* ui;
+    sp_kiosk_ui_create(NULL, &ui, NULL);
     sp_kiosk_ui_resize(ui, 1280, 800, 96 / 25.4);
     sp_kiosk_ui_set_parts(ui, k_row, 6);
     sp_test_rng rng = {seed};

@@ -258,7 +258,7 @@ static void test_round_trip(void)
     ENSURE(sp_clf_category_count(clf) == 1 && !strcmp(sp_clf_category(clf, 0), "wings"));
     // A part database's model weighs the strokes' shape unless told otherwise.
     ENSURE(sp_clf_get_desc(clf).shape_weight == SP_DB_SHAPE_WEIGHT);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     add_ok(db, 0, 20);
     train_ok(db, -1, NULL);
     check_ok(db);
@@ -326,7 +326,7 @@ static void test_curator_category(void)
     fprintf(stderr, "  horns recognised %d/%d after train\n", right, n);
     ENSURE(right >= 21); // 70%; chance is 33%
     sp_character_free(&ch);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     sp_db_close(db);
 }
 
@@ -772,13 +772,13 @@ static void test_generation(void)
     sp_clf* clf;
     sp_error err = {0};
     ENSURE(sp_db_load_model(reader, &clf, &id0, &err) == SP_OK);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     train_ok(writer, -1, NULL);
     uint64_t g1 = sp_db_generation(reader);
     ENSURE(g1 > g0);
     ENSURE(sp_db_generation(writer) == g1);
     ENSURE(sp_db_load_model(reader, &clf, &id1, &err) == SP_OK && id1 > id0);
-    sp_clf_free(clf);
+    sp_clf_destroy(clf);
     ENSURE(sp_db_remove_part(writer, "wings_a", "t", &err) == SP_OK);
     ENSURE(sp_db_generation(reader) > g1);
     sp_db_close(writer);

@@ -32,7 +32,8 @@ static void check_animation_keys(const sp_rig* rig, const sp_animation* an, cons
     sp_quat* r = malloc(sizeof(sp_quat) * J);
     sp_vec3* s = malloc(sizeof(sp_vec3) * J);
     sp_mat4* w = malloc(sizeof(sp_mat4) * J);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     for (int k = 0; k < n; ++k) {
         // Prefilled with the rest pose: a joint with parameters but no channel fails.
         for (int j = 0; j < J; ++j) t[j] = rig->joints[j].rest_t, r[j] = rig->joints[j].rest_r, s[j] = rig->joints[j].rest_s;
@@ -96,7 +97,8 @@ static void test_drawover_fixture(void)
     sp_sketch to = {0};
     sp_sketch_add_stroke(&to, s_bent.strokes[3].points, NULL, s_bent.strokes[3].count);
     double* xyz = malloc(sizeof(double) * 3 * rig.vertex_count);
-    sp_rig_eval* ev = sp_rig_eval_create(&rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(&rig, &ev, NULL);
     sp_rig_eval_update(ev, p0, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(&rig), xyz);
     sp_abstraction emb;
@@ -104,7 +106,8 @@ static void test_drawover_fixture(void)
     ENSURE(sp_embed_curve(&rig, xyz, &cam, on->points, on->count, 32, "drawover", &emb, &err) == SP_OK);
     int a = sp_rig_add_abstraction(&rig, &emb);
     ENSURE(a == 1);
-    sp_solver* s = sp_solver_create(&rig, a, &cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(&rig, a, &cam, &(sp_solve_desc){0}, &s, NULL);
     sp_solve_report rep;
     ENSURE(sp_solver_solve(s, &to, p0, p, &rep, &err) == SP_OK);
     ENSURE(rep.mean_error_px <= 0.02 * rep.bbox_diagonal_px);
@@ -162,7 +165,8 @@ static void test_drawover_cesiumman(void)
     int n = s_rest.strokes[c].count, from = n / 3;
     double* xyz = malloc(sizeof(double) * 3 * rig->vertex_count);
     double* x1 = malloc(sizeof(double) * 3 * rig->vertex_count);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_rig_eval_update(ev, ch.pose, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
     sp_abstraction emb;
@@ -172,7 +176,8 @@ static void test_drawover_cesiumman(void)
     // target is reachable by bending the arm alone.
     sp_sketch to = {0};
     ENSURE(sp_synth_sketch(rig, a, &ch.camera, bent, &to) == SP_OK);
-    sp_solver* s = sp_solver_create(rig, a, &ch.camera, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(rig, a, &ch.camera, &(sp_solve_desc){0}, &s, NULL);
     sp_solve_report rep;
     ENSURE(sp_solver_solve(s, &to, ch.pose, p, &rep, &err) == SP_OK);
     sp_rig_eval_update(ev, p, false);
@@ -405,7 +410,7 @@ static void test_rig_handle(void)
     sp_character_free(&back);
 
     free(x), free(z), free(pf), free(pg);
-    sp_blackbox_free(bb);
+    sp_blackbox_destroy(bb);
     sp_rig_handle_free(f);
     sp_rig_handle_free(g);
 }

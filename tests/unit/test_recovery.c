@@ -16,7 +16,8 @@ static int recovered(const sp_rig* rig, const sp_camera* cam, int cases)
     int P = rig->param_count, ok = 0;
     double* truth = malloc(sizeof(double) * P);
     double* out = malloc(sizeof(double) * P);
-    sp_solver* s = sp_solver_create(rig, 0, cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(rig, 0, cam, &(sp_solve_desc){0}, &s, NULL);
     for (int i = 1; i <= cases; ++i) {
         sp_synth_params(rig, (uint64_t)i, 0.7853981633974483, truth);
         sp_sketch sk;

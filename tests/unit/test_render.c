@@ -31,10 +31,10 @@ static void need_gl(void)
 {
     if (!g_gl) {
         sp_error err = {0};
-        g_gl = sp_headless_create(&err);
+        sp_headless_create(&g_gl, &err);
         if (!g_gl) fprintf(stderr, "  cannot create a headless OpenGL context: %s\n", err.text);
         ENSURE(g_gl != NULL);
-        g_r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
+        sp_renderer_create(&(sp_renderer_desc){0}, &g_r, &err);
         if (!g_r) fprintf(stderr, "  %s\n", err.text);
         ENSURE(g_r != NULL);
     }
@@ -53,7 +53,8 @@ static void scene_make(scene* s, double bend)
     s->xyz = malloc(sizeof(double) * 3 * (size_t)s->rig.vertex_count);
     const sp_abstraction* a = &s->rig.abstractions[0];
     s->stick = malloc(sizeof(double) * 3 * (size_t)a->point_count);
-    sp_rig_eval* ev = sp_rig_eval_create(&s->rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(&s->rig, &ev, NULL);
     sp_rig_eval_update(ev, s->p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(&s->rig), s->xyz);
     sp_rig_eval_abstraction(ev, a, s->xyz, s->stick);
@@ -72,13 +73,14 @@ static void scene_free(scene* s)
 static sp_render_mesh* scene_mesh(const scene* s)
 {
     sp_error err = {0};
-    sp_render_mesh* m = sp_render_mesh_create(g_r,
-                                              &(sp_mesh_desc){.vertex_count = s->rig.vertex_count,
-                                                              .positions = s->xyz,
-                                                              .base_color = {0.8f, 0.3f, 0.25f, 1.0f},
-                                                              .triangle_count = s->rig.triangle_count,
-                                                              .triangles = s->rig.triangles},
-                                              &err);
+    sp_render_mesh* m;
+    sp_render_mesh_create(g_r,
+                          &(sp_mesh_desc){.vertex_count = s->rig.vertex_count,
+                                          .positions = s->xyz,
+                                          .base_color = {0.8f, 0.3f, 0.25f, 1.0f},
+                                          .triangle_count = s->rig.triangle_count,
+                                          .triangles = s->rig.triangles},
+                          &m, &err);
     if (!m) fprintf(stderr, "  %s\n", err.text);
     ENSURE(m != NULL);
     return m;
@@ -158,7 +160,8 @@ static void check_mesh_alignment(sp_camera_kind kind, const char* png)
     scene_make(&s, 0.9);
     sp_camera cam = sp_camera_frame(kind, s.lo, s.hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
     sp_error err = {0};
-    sp_render_target* t = sp_render_target_create(W, H, 0, &err);
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, &err);
     ENSURE(t != NULL);
     sp_render_mesh* m = scene_mesh(&s);
     sp_image img = {0};
@@ -224,7 +227,8 @@ static void test_viewport_scale(void)
     scene_make(&s, 0.6);
     sp_camera cam = sp_camera_frame(SP_CAMERA_PERSPECTIVE, s.lo, s.hi, sp_v3(0.3, -0.2, -1), sp_v3(0, 1, 0), W, H);
     sp_error err = {0};
-    sp_render_target* t = sp_render_target_create(2 * W, 2 * H, 0, &err);
+    sp_render_target* t;
+    sp_render_target_create(2 * W, 2 * H, 0, &t, &err);
     ENSURE(t != NULL);
     sp_render_mesh* m = scene_mesh(&s);
     sp_image img = {0};
@@ -248,16 +252,19 @@ static void test_depth_and_model(void)
     scene_make(&s, 0.7);
     sp_camera cam = sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, s.lo, s.hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
     sp_error err = {0};
-    sp_render_target* t = sp_render_target_create(W, H, 0, &err);
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, &err);
     ENSURE(t != NULL);
     sp_mesh_desc d = {.vertex_count = s.rig.vertex_count,
                       .positions = s.xyz,
                       .base_color = {0.9f, 0.05f, 0.05f, 1},
                       .triangle_count = s.rig.triangle_count,
                       .triangles = s.rig.triangles};
-    sp_render_mesh* red = sp_render_mesh_create(g_r, &d, &err);
+    sp_render_mesh* red;
+    sp_render_mesh_create(g_r, &d, &red, &err);
     d.base_color[0] = 0.05f, d.base_color[2] = 0.9f;
-    sp_render_mesh* blue = sp_render_mesh_create(g_r, &d, &err);
+    sp_render_mesh* blue;
+    sp_render_mesh_create(g_r, &d, &blue, &err);
     ENSURE(red && blue);
     const double dz = 0.5 * (s.hi.z - s.lo.z) + 0.2;
     sp_mat4 closer = sp_mat4_trs(sp_v3(0, 0, dz), sp_quat_identity(), sp_v3(1, 1, 1));
@@ -332,7 +339,8 @@ static void test_abstraction_overlay(void)
     scene_make(&s, 0.9);
     sp_camera cam = sp_camera_frame(SP_CAMERA_PERSPECTIVE, s.lo, s.hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
     sp_error err = {0};
-    sp_render_target* t = sp_render_target_create(W, H, 0, &err);
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, &err);
     ENSURE(t != NULL);
     sp_render_mesh* m = scene_mesh(&s);
     sp_image img = {0};
@@ -358,7 +366,8 @@ static void test_polyline(void)
     need_gl();
     sp_camera cam = {.kind = SP_CAMERA_ORTHOGRAPHIC, .view = sp_mat4_identity(), .scale = 1, .width = W, .height = H};
     sp_error err = {0};
-    sp_render_target* t = sp_render_target_create(W, H, 0, &err);
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, &err);
     ENSURE(t != NULL);
     const sp_vec2 pts[4] = {{40.5, 40.5}, {200.5, 60.5}, {120.5, 200.5}, {280.5, 210.5}};
     sp_render_target_bind(t);

@@ -13,7 +13,8 @@
 static void numeric_jacobian(const sp_rig* rig, sp_skinned_points pts, const double* p, double* J)
 {
     int P = rig->param_count, n = pts.count;
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     double* q = malloc(sizeof(double) * P);
     double* xp = malloc(sizeof(double) * 3 * n);
     double* xm = malloc(sizeof(double) * 3 * n);
@@ -39,7 +40,8 @@ static void check_jacobian(const sp_rig* rig, sp_skinned_points pts, const doubl
     int P = rig->param_count, n = pts.count;
     double* Ja = malloc(sizeof(double) * 3 * n * P);
     double* Jn = malloc(sizeof(double) * 3 * n * P);
-    sp_rig_eval* ev = sp_rig_eval_create(rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
     sp_rig_eval_update(ev, p, true);
     sp_rig_eval_jacobian(ev, pts, NULL, n, Ja);
     numeric_jacobian(rig, pts, p, Jn);
@@ -116,7 +118,8 @@ static void test_defaults_give_rest(void)
     double* p = malloc(sizeof(double) * rig.param_count);
     double* x = malloc(sizeof(double) * 3 * rig.vertex_count);
     sp_rig_defaults(&rig, p);
-    sp_rig_eval* ev = sp_rig_eval_create(&rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(&rig, &ev, NULL);
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(&rig), x);
     for (int i = 0; i < 3 * rig.vertex_count; ++i) ENSURE_NEAR(x[i], rig.rest[i], 1e-7); // weights are float
@@ -148,7 +151,8 @@ static void test_fk_naive(void)
     sp_test_rng rng = {5};
     double* p = malloc(sizeof(double) * rig.param_count);
     sp_fixture_random_params(&rig, &rng, 0.8, p);
-    sp_rig_eval* ev = sp_rig_eval_create(&rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(&rig, &ev, NULL);
     sp_rig_eval_update(ev, p, false);
     for (int j = 0; j < rig.joint_count; ++j) {
         sp_mat4 w;
@@ -356,7 +360,8 @@ static void check_regularisers(bool one_view)
     m->ops->reg_normal(m, wp, wd, H, g);
 
     // The reference: per representative, from rows and the dense Jacobian.
-    sp_rig_eval* ev = sp_rig_eval_create(&rig);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(&rig, &ev, NULL);
     double* x0 = malloc(sizeof(double) * 3 * k);
     double* x1 = malloc(sizeof(double) * 3 * k);
     double* J = malloc(sizeof(double) * 3 * k * P);

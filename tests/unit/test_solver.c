@@ -60,7 +60,8 @@ static void test_recovery_chain(void)
 {
     setup st;
     make_setup(&st, &(sp_fixture_desc){.joint_count = 5, .seed = 3});
-    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0}, &s, NULL);
     ENSURE(s);
     int P = st.rig.param_count, ok = 0, cases = 20;
     double* truth = malloc(sizeof(double) * P);
@@ -87,7 +88,8 @@ static void test_bounds_exact(void)
     // Narrow every scale to [0.9, 1.1], then draw the figure shrunk to 40%.
     for (int q = 0; q < st.rig.param_count; ++q)
         if (sp_channel_is_scale(st.rig.params[q].channel)) st.rig.params[q].min = 0.9, st.rig.params[q].max = 1.1;
-    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0}, &s, NULL);
     int P = st.rig.param_count;
     double* p = malloc(sizeof(double) * P);
     sp_rig_defaults(&st.rig, p);
@@ -122,7 +124,8 @@ static void test_order_independence_and_determinism(void)
 {
     setup st;
     make_setup(&st, &(sp_fixture_desc){.joint_count = 7, .branching = true, .seed = 8});
-    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0}, &s, NULL);
     int P = st.rig.param_count;
     double* truth = malloc(sizeof(double) * P);
     double* a = malloc(sizeof(double) * P);
@@ -159,7 +162,8 @@ static void test_bad_strokes(void)
 {
     setup st;
     make_setup(&st, &(sp_fixture_desc){.joint_count = 3, .seed = 1});
-    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+    sp_solver* s;
+    sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0}, &s, NULL);
     double* p = malloc(sizeof(double) * st.rig.param_count);
     sp_solve_report rep;
     sp_error err = {0};
@@ -194,7 +198,8 @@ static void test_regulariser_paths_agree(void)
 {
     setup st;
     make_setup(&st, &(sp_fixture_desc){.joint_count = 8, .branching = true, .root_scale = true, .seed = 12});
-    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.time_cap_ms = 1e9});
+    sp_solver* s;
+    sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.time_cap_ms = 1e9}, &s, NULL);
     ENSURE(s);
     const int P = st.rig.param_count;
     double* truth = malloc(sizeof(double) * P);
@@ -244,7 +249,8 @@ static void test_gauss_newton_consistent(void)
         const double boost = variant == 2 ? 1e10 : 1.0;
         setup st;
         make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .branching = true, .all_channels = true, .closest = closest, .seed = 5});
-        sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0});
+        sp_solver* s;
+        sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){0}, &s, NULL);
         ENSURE(s);
         const int P = st.rig.param_count;
         double* ref = malloc(sizeof(double) * P);
@@ -497,7 +503,8 @@ static void test_stalled_when_no_step_lowers_w(void)
     const sp_solve_desc d = {.lambda_pose = -1, .lambda_plane = -1, .lambda_dist = -1, .threads = 1, .time_cap_ms = 1e9};
     sp_blackbox* rigs[2] = {smooth, jumpy};
     for (int k = 0; k < 2; ++k) {
-        sp_solver* s = sp_solver_create_blackbox(rigs[k], 0, &cam, &d);
+        sp_solver* s;
+        sp_solver_create_blackbox(rigs[k], 0, &cam, &d, &s, NULL);
         ENSURE(s);
         double p = 0;
         sp_solve_report rep;
@@ -514,8 +521,8 @@ static void test_stalled_when_no_step_lowers_w(void)
         sp_solver_destroy(s);
     }
     sp_sketch_free(&sk);
-    sp_blackbox_free(smooth);
-    sp_blackbox_free(jumpy);
+    sp_blackbox_destroy(smooth);
+    sp_blackbox_destroy(jumpy);
 }
 
 // Stalled (b): closest-point rounds at the configured weights that end no
@@ -526,7 +533,8 @@ static void test_stop_reasons_of_closest_point_solves(void)
 {
     setup st;
     make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .root_scale = true, .stick_points = 10, .closest = true, .seed = 1});
-    sp_solver* s = sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.time_cap_ms = 1e9});
+    sp_solver* s;
+    sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.time_cap_ms = 1e9}, &s, NULL);
     ENSURE(s);
     int P = st.rig.param_count, n[4] = {0};
     double* truth = malloc(sizeof(double) * P);
@@ -545,6 +553,27 @@ static void test_stop_reasons_of_closest_point_solves(void)
     sp_rig_free(&st.rig);
 }
 
+// sp_solver_create refuses an abstraction the rig does not have, and says
+// so (docs/DESIGN.md, "API conventions"); err may be NULL.
+static void test_creation_says_why(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 3, .seed = 1});
+    sp_error err = {0};
+    sp_solver* s = (sp_solver*)&err; // a creator writes NULL on failure
+    ENSURE(sp_solver_create(&st.rig, st.rig.abstraction_count, &st.cam, NULL, &s, &err) == SP_ERR_INVALID && !s);
+    fprintf(stderr, "  %s\n", err.text);
+    char want[128];
+    snprintf(want, sizeof want, "abstraction %d does not exist (the rig has %d)", st.rig.abstraction_count,
+             st.rig.abstraction_count);
+    ENSURE(!strcmp(err.text, want));
+    ENSURE(sp_solver_create(&st.rig, -1, &st.cam, NULL, &s, NULL) == SP_ERR_INVALID && !s);
+    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, NULL, &s, NULL) == SP_OK && s);
+    sp_solver_destroy(s);
+    sp_solver_destroy(NULL);
+    sp_rig_free(&st.rig);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv, (sp_test[]){
@@ -557,5 +586,6 @@ int main(int argc, char** argv)
         {"gauss_newton_consistent", test_gauss_newton_consistent},
         {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
         {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
+        {"creation_says_why", test_creation_says_why},
         {0}});
 }

@@ -41,13 +41,11 @@ const char* sp_dragon_note_name(sp_dragon_note n)
     return "unknown";
 }
 
-sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err)
+sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error* err)
 {
+    *out = NULL;
     sp_dragon* d = calloc(1, sizeof *d);
-    if (!d) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-        return NULL;
-    }
+    if (!d) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making the dragon pipeline");
     d->desc = desc ? *desc : (sp_dragon_desc){0};
     sp_dragon_desc* o = &d->desc;
     if (o->canvas_w <= 0 || o->canvas_h <= 0) o->canvas_w = 1280, o->canvas_h = 800;
@@ -79,9 +77,10 @@ sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err)
         dragon_copy_name(d->db_path, sizeof d->db_path, o->db_path ? o->db_path : sp_db_default_path());
         const char* env = getenv("SP_ASSETS");
         dragon_copy_name(d->assets_dir, sizeof d->assets_dir, o->assets_dir ? o->assets_dir : env && *env ? env : "assets");
-        if (sp_db_open_or_create_default(d->db_path, d->assets_dir, SP_DB_READONLY, &d->db, err) != SP_OK) {
+        sp_result r = sp_db_open_or_create_default(d->db_path, d->assets_dir, SP_DB_READONLY, &d->db, err);
+        if (r != SP_OK) {
             free(d);
-            return NULL;
+            return r;
         }
         dragon_file_id(d->db_path, &d->dev, &d->ino);
         d->own_db = true;
@@ -90,7 +89,8 @@ sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err)
     d->gen = sp_db_generation(d->db);
     sp_error merr = {0};
     if (sp_db_load_model(d->db, &d->clf, NULL, &merr) != SP_OK) d->clf = NULL; // strokes then need a forced category
-    return d;
+    *out = d;
+    return SP_OK;
 }
 
 void sp_dragon_destroy(sp_dragon* d)
@@ -99,7 +99,7 @@ void sp_dragon_destroy(sp_dragon* d)
     sp_dragon_clear(d);
     free(d->parts);
     dragon_cache_clear(d);
-    sp_clf_free(d->clf);
+    sp_clf_destroy(d->clf);
     if (d->own_db) sp_db_close(d->db);
     free(d);
 }

@@ -132,7 +132,7 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
     t->abstraction = info.abstraction[0] ? sp_rig_find_abstraction(rig, info.abstraction) : -1;
     if (t->abstraction < 0) t->abstraction = rig->abstraction_count > 0 ? 0 : -1;
     size_t P = (size_t)rig->param_count + 1, J = (size_t)rig->joint_count + 1;
-    t->ev = sp_rig_eval_create(rig);
+    sp_rig_eval_create(rig, &t->ev, NULL);
     t->scratch_p = malloc(sizeof(double) * P);
     t->tr = malloc(sizeof(sp_vec3) * J);
     t->sc = malloc(sizeof(sp_vec3) * J);
@@ -212,7 +212,7 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
         sp_rig_defaults(rig, t->clip0);
     }
     t->solver_cam = t->base;
-    t->solver = sp_solver_create(rig, t->abstraction, &t->solver_cam, solve);
+    sp_solver_create(rig, t->abstraction, &t->solver_cam, solve, &t->solver, NULL);
     if (!t->solver) {
         sp_fail(err, SP_ERR_NO_MEMORY, "part %s: cannot prepare the solver (out of memory)", name);
         goto fail;
@@ -324,7 +324,7 @@ static void reload_model(sp_dragon* d)
     sp_result r = sp_db_load_model(d->db, &clf, NULL, &merr);
     if (r == SP_OK || r == SP_ERR_INVALID) {
         // SP_ERR_INVALID: no model stored (strokes then need a forced category).
-        sp_clf_free(d->clf);
+        sp_clf_destroy(d->clf);
         d->clf = r == SP_OK ? clf : NULL;
     }
 }

@@ -23,12 +23,8 @@ static void outline_box(const sp_dragon* d, const part* p, double b[4])
     }
 }
 
-struct cJSON* sp_dragon_report_json(const sp_dragon* dc)
+static cJSON* report_tree(sp_dragon* d)
 {
-    // Why the cast: the outlines' boxes at t = 0 are read from a pose, which
-    // reuses the parts' evaluation buffers (sp/dragon.h says a report ends
-    // the last pose).
-    sp_dragon* d = (sp_dragon*)dc;
     sp_error perr = {0};
     bool posed = sp_dragon_pose_at(d, 0, &perr) == SP_OK;
     cJSON* o = cJSON_CreateObject();
@@ -122,4 +118,16 @@ struct cJSON* sp_dragon_report_json(const sp_dragon* dc)
     cJSON_AddItemToObject(o, "parts", parts);
     d->posed = false;
     return o;
+}
+
+sp_result sp_dragon_report_json(const sp_dragon* dc, char** json, sp_error* err)
+{
+    // Why the cast: the outlines' boxes at t = 0 are read from a pose, which
+    // reuses the parts' evaluation buffers (sp/dragon.h says a report ends
+    // the last pose).
+    cJSON* o = report_tree((sp_dragon*)dc);
+    // cJSON allocates with malloc (the project sets no hooks): free() frees it.
+    *json = o ? cJSON_PrintUnformatted(o) : NULL;
+    cJSON_Delete(o);
+    return *json ? SP_OK : sp_fail(err, SP_ERR_NO_MEMORY, "dragon report: out of memory");
 }

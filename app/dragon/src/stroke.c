@@ -46,7 +46,7 @@ static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_
     q->xyz = malloc(sizeof(double) * 3 * ((size_t)rig->vertex_count + 1));
     q->outline = malloc(sizeof(double) * 3 * ((size_t)rig->abstractions[t->abstraction].point_count + 1));
     q->stroke = malloc(sizeof(sp_vec2) * (size_t)(n > 0 ? n : 1));
-    q->ev = sp_rig_eval_create(rig);
+    sp_rig_eval_create(rig, &q->ev, NULL);
     if (!q->p_fit || !q->p_t || !q->xyz || !q->outline || !q->stroke || !q->ev) {
         q->t = NULL;
         dragon_part_free(q);

@@ -105,10 +105,11 @@ static sp_kiosk_ui_desc with_defaults(const sp_kiosk_ui_desc* d)
     return o;
 }
 
-sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc)
+sp_result sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc, sp_kiosk_ui** out, sp_error* err)
 {
+    *out = NULL;
     sp_kiosk_ui* ui = calloc(1, sizeof *ui);
-    if (!ui) return NULL;
+    if (!ui) return sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory making the UI");
     ui->desc = with_defaults(desc);
     bool ok =
         line_alloc(&ui->stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->job_stroke, SP_KIOSK_STROKE_MAX, true) &&
@@ -118,13 +119,14 @@ sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc)
         ok = ok && line_alloc(&ui->pending[i], SP_KIOSK_STROKE_MAX, true);
     if (!ok) {
         sp_kiosk_ui_destroy(ui);
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "kiosk: out of memory making the UI");
     }
     ui->mode = SP_KM_ATTRACT;
     ui->playing = ui->desc.start_playing;
     ui->flash_until = ui->fade_until = ui->held_until = ui->hint_until = ui->banner_until = ui->clear_armed_until = -1;
     sp_kiosk_ui_resize(ui, 1280, 800, 0);
-    return ui;
+    *out = ui;
+    return SP_OK;
 }
 
 void sp_kiosk_ui_destroy(sp_kiosk_ui* ui)

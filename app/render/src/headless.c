@@ -54,35 +54,34 @@ static const char* egl_error_name(EGLint e)
     }
 }
 
-sp_headless* sp_headless_create(sp_error* err)
+sp_result sp_headless_create(sp_headless** out, sp_error* err)
 {
+    *out = NULL;
+    sp_result res = SP_ERR_UNSUPPORTED;
     // Client extensions are queried on EGL_NO_DISPLAY; NULL means EGL 1.4
     // without EXT_client_extensions, i.e. no platform displays at all.
     const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!has_extension(client, "EGL_MESA_platform_surfaceless")) {
-        sp_fail(err, SP_ERR_UNSUPPORTED,
-                "EGL: EGL_MESA_platform_surfaceless is not available (install libegl-mesa0 and libgl1-mesa-dri)");
-        return NULL;
+        return sp_fail(err, SP_ERR_UNSUPPORTED,
+                       "EGL: EGL_MESA_platform_surfaceless is not available (install libegl-mesa0 and libgl1-mesa-dri)");
     }
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_display = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
     if (!get_display) {
-        sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: eglGetPlatformDisplayEXT is missing");
-        return NULL;
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: eglGetPlatformDisplayEXT is missing");
     }
     EGLDisplay dpy = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
     EGLint major = 0, minor = 0;
     if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor)) { // no-op when already initialised
-        sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: cannot initialise the surfaceless display (%s)", egl_error_name(eglGetError()));
-        return NULL;
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: cannot initialise the surfaceless display (%s)",
+                       egl_error_name(eglGetError()));
     }
     sp_headless* h = calloc(1, sizeof *h);
     if (!h) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "EGL: out of memory");
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "EGL: out of memory");
     }
     h->display = dpy;
     if (!eglBindAPI(EGL_OPENGL_API)) {
-        sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: desktop OpenGL is not available (%s)", egl_error_name(eglGetError()));
+        res = sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: desktop OpenGL is not available (%s)", egl_error_name(eglGetError()));
         goto fail;
     }
     // Why no config when possible: we never create a surface, and the
@@ -92,7 +91,7 @@ sp_headless* sp_headless_create(sp_error* err)
         const EGLint attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_NONE};
         EGLint n = 0;
         if (!eglChooseConfig(dpy, attrs, &config, 1, &n) || n < 1) {
-            sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: no OpenGL config on the surfaceless display");
+            res = sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: no OpenGL config on the surfaceless display");
             goto fail;
         }
     }
@@ -101,20 +100,22 @@ sp_headless* sp_headless_create(sp_error* err)
         EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     h->context = eglCreateContext(dpy, config, EGL_NO_CONTEXT, ctx_attrs);
     if (h->context == EGL_NO_CONTEXT) {
-        sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: cannot create an OpenGL 3.3 core context (%s)", egl_error_name(eglGetError()));
+        res =
+            sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: cannot create an OpenGL 3.3 core context (%s)", egl_error_name(eglGetError()));
         goto fail;
     }
     if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->context)) {
-        sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: cannot make the context current without a surface (%s)",
-                egl_error_name(eglGetError()));
+        res = sp_fail(err, SP_ERR_UNSUPPORTED, "EGL: cannot make the context current without a surface (%s)",
+                      egl_error_name(eglGetError()));
         goto fail;
     }
     const char* name = (const char*)glGetString(GL_RENDERER);
     snprintf(h->renderer, sizeof h->renderer, "%s", name ? name : "unknown");
-    return h;
+    *out = h;
+    return SP_OK;
 fail:
     sp_headless_destroy(h);
-    return NULL;
+    return res;
 }
 
 void sp_headless_destroy(sp_headless* h)

@@ -277,13 +277,14 @@ void sp_render_fit_depth(sp_camera* cam, sp_vec3 lo, sp_vec3 hi)
 
 // --------------------------------------------------------------- renderer
 
-sp_renderer* sp_renderer_create(const sp_renderer_desc* desc, sp_error* err)
+sp_result sp_renderer_create(const sp_renderer_desc* desc, sp_renderer** out, sp_error* err)
 {
+    *out = NULL;
+    sp_result res = SP_ERR_INTERNAL;
     sp_renderer_desc d = desc ? *desc : (sp_renderer_desc){0};
     sp_renderer* r = calloc(1, sizeof *r);
     if (!r) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory");
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory");
     }
     r->exposure = d.exposure > 0 ? d.exposure : 1.0f;
     r->ambient = d.ambient > 0 ? d.ambient : 0.35f;
@@ -321,13 +322,14 @@ sp_renderer* sp_renderer_create(const sp_renderer_desc* desc, sp_error* err)
     glBindVertexArray(0);
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) {
-        sp_fail(err, SP_ERR_INTERNAL, "render: GL error 0x%x while creating the renderer", e);
+        res = sp_fail(err, SP_ERR_INTERNAL, "render: GL error 0x%x while creating the renderer", e);
         goto fail;
     }
-    return r;
+    *out = r;
+    return SP_OK;
 fail:
     sp_renderer_destroy(r);
-    return NULL;
+    return res;
 }
 
 void sp_renderer_destroy(sp_renderer* r)
@@ -690,24 +692,22 @@ static void upload_dynamic(sp_render_mesh* m)
     glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
-sp_render_mesh* sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* d, sp_error* err)
+sp_result sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* d, sp_render_mesh** out, sp_error* err)
 {
+    *out = NULL;
     assert(r && d);
     if (d->vertex_count < 0 || d->triangle_count < 0 || (d->vertex_count > 0 && !d->positions) ||
         (d->triangle_count > 0 && !d->triangles)) {
-        sp_fail(err, SP_ERR_INVALID, "render: mesh description is incomplete");
-        return NULL;
+        return sp_fail(err, SP_ERR_INVALID, "render: mesh description is incomplete");
     }
     for (int i = 0; i < 3 * d->vertex_count; ++i)
         if (!isfinite(d->positions[i])) {
-            sp_fail(err, SP_ERR_INVALID, "render: vertex %d has a non-finite position", i / 3);
-            return NULL;
+            return sp_fail(err, SP_ERR_INVALID, "render: vertex %d has a non-finite position", i / 3);
         }
     for (int i = 0; i < 3 * d->triangle_count; ++i)
         if (d->triangles[i] >= (uint32_t)d->vertex_count) {
-            sp_fail(err, SP_ERR_INVALID, "render: triangle %d refers to vertex %u of %d", i / 3, d->triangles[i],
-                    d->vertex_count);
-            return NULL;
+            return sp_fail(err, SP_ERR_INVALID, "render: triangle %d refers to vertex %u of %d", i / 3, d->triangles[i],
+                           d->vertex_count);
         }
     sp_render_mesh* m = calloc(1, sizeof *m);
     size_t nv = (size_t)d->vertex_count, nt = (size_t)d->triangle_count;
@@ -726,16 +726,14 @@ sp_render_mesh* sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* d, sp_
     if (!m || !m->tris || !m->weld || !m->pos || !m->nrm || !m->acc || !col) {
         free(col);
         sp_render_mesh_destroy(m);
-        sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory for a %d-vertex mesh", d->vertex_count);
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory for a %d-vertex mesh", d->vertex_count);
     }
     if (nt) memcpy(m->tris, d->triangles, sizeof(uint32_t) * 3 * nt);
     load_positions(m, d->positions);
     if (!build_weld(m)) {
         free(col);
         sp_render_mesh_destroy(m);
-        sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory");
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory");
     }
     if (d->normals)
         memcpy(m->nrm, d->normals, sizeof(float) * 3 * nv);
@@ -771,10 +769,10 @@ sp_render_mesh* sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* d, sp_
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) {
         sp_render_mesh_destroy(m);
-        sp_fail(err, SP_ERR_INTERNAL, "render: GL error 0x%x while uploading a mesh", e);
-        return NULL;
+        return sp_fail(err, SP_ERR_INTERNAL, "render: GL error 0x%x while uploading a mesh", e);
     }
-    return m;
+    *out = m;
+    return SP_OK;
 }
 
 void sp_render_mesh_update(sp_render_mesh* m, const double* positions, const float* normals)
@@ -856,25 +854,23 @@ void sp_renderer_draw_mesh(sp_renderer* r, const sp_render_mesh* m, const sp_mat
 
 // ------------------------------------------------------------ render target
 
-sp_render_target* sp_render_target_create(int width, int height, int samples, sp_error* err)
+sp_result sp_render_target_create(int width, int height, int samples, sp_render_target** out, sp_error* err)
 {
+    *out = NULL;
     if (width <= 0 || height <= 0) {
-        sp_fail(err, SP_ERR_INVALID, "render: bad target size %dx%d", width, height);
-        return NULL;
+        return sp_fail(err, SP_ERR_INVALID, "render: bad target size %dx%d", width, height);
     }
     GLint max_rb = 0, max_samples = 0;
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
     if (width > max_rb || height > max_rb) {
-        sp_fail(err, SP_ERR_UNSUPPORTED, "render: %dx%d exceeds the GL limit of %d pixels", width, height, max_rb);
-        return NULL;
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "render: %dx%d exceeds the GL limit of %d pixels", width, height, max_rb);
     }
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
     if (samples <= 0) samples = 4;
     if (samples > max_samples) samples = max_samples;
     sp_render_target* t = calloc(1, sizeof *t);
     if (!t) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory");
-        return NULL;
+        return sp_fail(err, SP_ERR_NO_MEMORY, "render: out of memory");
     }
     t->w = width, t->h = height, t->samples = samples;
     glGenFramebuffers(1, &t->fbo_ms);
@@ -899,12 +895,12 @@ sp_render_target* sp_render_target_create(int width, int height, int samples, sp
     glBindRenderbuffer(GL_RENDERBUFFER, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_ms);
     if (s1 != GL_FRAMEBUFFER_COMPLETE || s2 != GL_FRAMEBUFFER_COMPLETE) {
-        sp_fail(err, SP_ERR_UNSUPPORTED, "render: offscreen framebuffer %dx%d (%d samples) is incomplete (0x%x, 0x%x)", width,
-                height, samples, s1, s2);
         sp_render_target_destroy(t);
-        return NULL;
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "render: offscreen framebuffer %dx%d (%d samples) is incomplete (0x%x, 0x%x)",
+                       width, height, samples, s1, s2);
     }
-    return t;
+    *out = t;
+    return SP_OK;
 }
 
 void sp_render_target_destroy(sp_render_target* t)

@@ -15,10 +15,13 @@ sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc*
     int n = sp_dragon_part_count(d);
     sp_vec3 lo, hi;
     if (sp_dragon_bounds(d, &lo, &hi)) sp_render_fit_depth(&cam, lo, hi);
-    sp_headless* gl = sp_headless_create(err);
+    sp_headless* gl;
+    sp_headless_create(&gl, err);
     if (!gl) return SP_ERR_UNSUPPORTED;
-    sp_renderer* r = sp_renderer_create(&(sp_renderer_desc){0}, err);
-    sp_render_target* t = r ? sp_render_target_create(cam.width, cam.height, 0, err) : NULL;
+    sp_renderer* r;
+    sp_renderer_create(&(sp_renderer_desc){0}, &r, err);
+    sp_render_target* t = NULL;
+    if (r) sp_render_target_create(cam.width, cam.height, 0, &t, err);
     sp_render_mesh** meshes = calloc((size_t)(n > 0 ? n : 1), sizeof *meshes);
     if (!r || !t) {
         res = SP_ERR_INTERNAL;
@@ -32,13 +35,13 @@ sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc*
         const sp_dragon_part* p = sp_dragon_part_get(d, i);
         const sp_rig* rig = &p->character->rig;
         if (rig->vertex_count <= 0 || rig->triangle_count <= 0) continue;
-        meshes[i] = sp_render_mesh_create(r,
-                                          &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                                          .positions = sp_dragon_part_xyz(d, i),
-                                                          .colors = p->character->colors,
-                                                          .triangle_count = rig->triangle_count,
-                                                          .triangles = rig->triangles},
-                                          err);
+        sp_render_mesh_create(r,
+                              &(sp_mesh_desc){.vertex_count = rig->vertex_count,
+                                              .positions = sp_dragon_part_xyz(d, i),
+                                              .colors = p->character->colors,
+                                              .triangle_count = rig->triangle_count,
+                                              .triangles = rig->triangles},
+                              &meshes[i], err);
         if (!meshes[i]) {
             res = SP_ERR_INTERNAL;
             goto done;

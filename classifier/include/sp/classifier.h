@@ -20,7 +20,7 @@
 ///     sp_clf* clf; sp_clf_train(&ds, NULL, &(sp_clf_desc){0}, &clf, &err);
 ///     sp_clf_answer a; sp_clf_classify(clf, &sketch, NULL, &a, &err);
 ///     printf("%s %.2f\n", sp_clf_category(clf, a.ranked[0].category), a.ranked[0].score);
-///     sp_clf_save(clf, "m.spclf", &err); sp_clf_free(clf);
+///     sp_clf_save(clf, "m.spclf", &err); sp_clf_destroy(clf);
 ///
 /// A trained model is immutable: classification may run on several threads at once.
 #ifndef SP_CLASSIFIER_H
@@ -119,7 +119,7 @@ sp_result sp_clf_save(const sp_clf* clf, const char* path, sp_error* err);
 /// Loads a model; a corrupt, truncated or other-version file is refused with a clear message.
 sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err);
 /// Frees the model (NULL is fine).
-void sp_clf_free(sp_clf* clf);
+void sp_clf_destroy(sp_clf* clf);
 
 /// Number of categories and the name of one.
 int sp_clf_category_count(const sp_clf* clf);

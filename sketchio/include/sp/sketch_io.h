@@ -1,6 +1,6 @@
 /// sp/sketch_io.h: reading and writing the stroke files people feed us, beside
 /// the stroke type (sp/sketch.h). No OpenCV: a command that only reads
-/// strokes (`pose`, `drawover`, `animate`) needs only this and cJSON.
+/// strokes (`pose`, `drawover`, `animate`) needs only this and a JSON parser.
 ///
 /// Formats (DESIGN.md "Files people feed it"):
 ///   - the JSON stroke file `{"format": "sketchpose-strokes", "version": 1, ...}` (read and write);

@@ -10,10 +10,11 @@
 ///     sp_error err = {0};
 ///     if (sp_blackbox_load_plugin("libsp_face.so", &bb, &err) != SP_OK) ... err.text ...
 ///     sp_camera cam = sp_blackbox_camera(bb, 640, 480);
-///     sp_solver* s = sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){0});
+///     sp_solver* s;
+///     if (sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){0}, &s, &err) != SP_OK) ... err.text ...
 ///     sp_solver_solve(s, &sketch, NULL, p, &report, &err);
 ///     sp_solver_destroy(s);
-///     sp_blackbox_free(bb);                 // after every solver made from it
+///     sp_blackbox_destroy(bb);              // after every solver made from it
 ///
 /// How to write a rig (plugin side; docs/blackbox.md has a full example):
 /// fill an `sp_blackbox_rig` and return it from one exported function
@@ -121,7 +122,7 @@ typedef struct sp_blackbox sp_blackbox;
 /// Validates a description and wraps it: versions, counts, names, bounds,
 /// indices; evaluate() must succeed at the defaults, give finite values and
 /// reproduce `rest`. `what` names the rig in messages (a path). On success
-/// the host owns the description (sp_blackbox_free calls its release). On
+/// the host owns the description (sp_blackbox_destroy calls its release). On
 /// failure *out is NULL, and release is called if the version and struct
 /// size matched (only then is the layout known), so a bad rig is still freed.
 sp_result sp_blackbox_open(const sp_blackbox_rig* rig, const char* what, sp_blackbox** out, sp_error* err);
@@ -131,9 +132,9 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* rig, const char* what, sp_blac
 /// struct size, inconsistent counts, NaN or failing evaluation.
 sp_result sp_blackbox_load_plugin(const char* path, sp_blackbox** out, sp_error* err);
 /// Releases the rig and unloads its plugin. NULL is fine.
-void sp_blackbox_free(sp_blackbox* bb);
+void sp_blackbox_destroy(sp_blackbox* bb);
 
-/// The description (read-only; valid until sp_blackbox_free).
+/// The description (read-only; valid until sp_blackbox_destroy).
 const sp_blackbox_rig* sp_blackbox_desc(const sp_blackbox* bb);
 /// Index of an abstraction by name, -1 if none.
 int sp_blackbox_find_abstraction(const sp_blackbox* bb, const char* name);
@@ -148,7 +149,7 @@ int sp_blackbox_first_point(const sp_blackbox* bb, int a);
 /// abstraction a is sp_blackbox_abstraction_at(bb, 0) + a.
 const sp_abstraction* sp_blackbox_abstraction_at(const sp_blackbox* bb, int a);
 /// The parameters in the skinned rig's type (param_count; valid until
-/// sp_blackbox_free): name, bounds, default and group as the rig declares
+/// sp_blackbox_destroy): name, bounds, default and group as the rig declares
 /// them, `joint` -1 and `channel` SP_CH_COUNT (a black box has neither).
 /// sp_params_clamp clamps into their bounds; units are in sp_blackbox_desc.
 const sp_param* sp_blackbox_params(const sp_blackbox* bb);
@@ -178,8 +179,12 @@ double sp_blackbox_fd_step(const sp_blackbox* bb, int k);
 typedef struct sp_blackbox_fd sp_blackbox_fd;
 /// threads: how many threads evaluate (the caller's included); 0: the
 /// online cores, at most 8. rows (nrows vertex indices) are copied.
-/// NULL if out of memory or an index is out of range.
-sp_blackbox_fd* sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, const int* rows, int nrows, int threads);
+/// Fails (naming the rig) with SP_ERR_INVALID for an index out of range,
+/// SP_ERR_NO_MEMORY when out of memory, SP_ERR_INTERNAL when a thread
+/// cannot start; then *out is NULL.
+sp_result sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, const int* rows, int nrows, int threads,
+                                sp_blackbox_fd** out, sp_error* err);
+/// NULL is fine.
 void sp_blackbox_fd_destroy(sp_blackbox_fd* fd);
 /// Threads the engine uses.
 int sp_blackbox_fd_threads(const sp_blackbox_fd* fd);
@@ -194,10 +199,12 @@ sp_result sp_blackbox_fd_jacobian(sp_blackbox_fd* fd, const double* p, double* J
 /// bounds and report as sp_solver_create, with finite-difference Jacobians
 /// on `desc->threads` threads (0: the online cores). bb and cam must
 /// outlive the solver. There is no root-placement stage (the rig's
-/// parameters have no skeleton). NULL if out of memory or a is invalid.
+/// parameters have no skeleton). Fails as sp_solver_create (also when a
+/// finite-difference thread cannot start); then *out is NULL.
 /// A failing or NaN evaluation during a solve makes sp_solver_solve return
 /// SP_ERR_INVALID with a message naming the rig.
-sp_solver* sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, const sp_camera* cam, const sp_solve_desc* desc);
+sp_result sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, const sp_camera* cam, const sp_solve_desc* desc,
+                                    sp_solver** out, sp_error* err);
 
 /// A random parameter vector within bounds, the amplitude rule of
 /// sp/synth.h: angles move at most `amplitude` radians from their default,

@@ -6,7 +6,8 @@
 /// at a parameter vector p (forward kinematics, linear blend skinning, paper
 /// eq. 13) and gives the analytic Jacobians dx/dp for only the rows asked for.
 ///
-///     sp_rig_eval* ev = sp_rig_eval_create(&rig);
+///     sp_rig_eval* ev;
+///     if (sp_rig_eval_create(&rig, &ev, &err) != SP_OK) ... err.text ...
 ///     sp_rig_eval_update(ev, p, true);                 // FK + derivative operators
 ///     sp_rig_eval_points(ev, sp_rig_mesh_points(&rig), xyz);   // n by 3
 ///     sp_rig_eval_jacobian(ev, pts, rows, nrows, J);   // (3*nrows) by P, row-major
@@ -207,7 +208,9 @@ sp_result sp_animation_from_keys(const sp_rig* rig, const double* keys, const do
 
 /// Evaluator: FK state and derivative operators for one rig.
 typedef struct sp_rig_eval sp_rig_eval;
-sp_rig_eval* sp_rig_eval_create(const sp_rig* rig);
+/// An evaluator at the rig's defaults (the rig must outlive it). Fails only
+/// when out of memory; then *out is NULL.
+sp_result sp_rig_eval_create(const sp_rig* rig, sp_rig_eval** out, sp_error* err);
 void sp_rig_eval_destroy(sp_rig_eval* ev);
 /// Forward kinematics at p (param_count values). With `derivatives`, also
 /// the per-parameter operators D_k = dG_a/dp_k * G_a^-1 used by the Jacobians.

@@ -2,9 +2,10 @@
 ///
 /// How to use:
 ///
-///     sp_solver* s = sp_solver_create(&rig, abstraction_index, &camera, &(sp_solve_desc){0});
+///     sp_solver* s;
 ///     sp_solve_report rep;
 ///     sp_error err = {0};
+///     if (sp_solver_create(&rig, abstraction_index, &camera, &(sp_solve_desc){0}, &s, &err) != SP_OK) ... err.text ...
 ///     if (sp_solver_solve(s, &sketch, p_start, p_out, &rep, &err) != SP_OK) ... err.text ...
 ///     sp_solver_destroy(s);
 ///
@@ -119,8 +120,11 @@ typedef struct sp_solver sp_solver;
 /// Prepares a solver for one rig, abstraction and view: the coarsening
 /// (k-means of the rest vertices with FLANN, cluster centres snapped to the
 /// nearest vertex) and buffers. The rig and camera must outlive the solver.
-/// Returns NULL if out of memory or the abstraction index is invalid.
-sp_solver* sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_solve_desc* desc);
+/// Fails with SP_ERR_INVALID for an abstraction index out of range, with
+/// SP_ERR_NO_MEMORY when out of memory; then *out is NULL.
+sp_result sp_solver_create(const sp_rig* rig, int abstraction, const sp_camera* cam, const sp_solve_desc* desc, sp_solver** out,
+                           sp_error* err);
+/// NULL is fine.
 void sp_solver_destroy(sp_solver* s);
 /// Representative vertex indices chosen by the coarsening (*count of them).
 const int* sp_solver_representatives(const sp_solver* s, int* count);

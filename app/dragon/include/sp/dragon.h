@@ -4,8 +4,9 @@
 /// How to use (the kiosk window, `sketchpose dragon`, tests):
 ///
 ///     sp_error err = {0};
-///     sp_dragon* d = sp_dragon_create(&(sp_dragon_desc){.db_path = "sketchpose.db", .canvas_w = 1280, .canvas_h = 800}, &err);
-///     if (!d) { fprintf(stderr, "%s\n", err.text); ... }
+///     sp_dragon* d;
+///     if (sp_dragon_create(&(sp_dragon_desc){.db_path = "sketchpose.db", .canvas_w = 1280, .canvas_h = 800}, &d, &err) != SP_OK)
+///         ... fprintf(stderr, "%s\n", err.text) ...
 ///     sp_dragon_result res;
 ///     if (sp_dragon_add_stroke(d, &stroke, NULL, &res, &err) != SP_OK) ... bad numbers: err.text ...
 ///     else if (res.rejected) ... a friendly hint (res.reason); nothing changed ...
@@ -193,9 +194,9 @@ typedef struct sp_dragon_stroke_opts {
 } sp_dragon_stroke_opts;
 
 /// Opens the database (creating the default one when missing), loads the
-/// newest model. NULL and one line in err on failure. A database without a
-/// model still opens (strokes then need a forced category).
-sp_dragon* sp_dragon_create(const sp_dragon_desc* desc, sp_error* err);
+/// newest model. On failure *out is NULL and err has one line. A database
+/// without a model still opens (strokes then need a forced category).
+sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error* err);
 /// Frees everything (NULL is fine). Does not close a caller's database.
 void sp_dragon_destroy(sp_dragon* d);
 
@@ -278,8 +279,8 @@ const sp_clf* sp_dragon_model(const sp_dragon* d);
 /// "attached_to" (-1: free), "socket", "anchor_px" (null when free),
 /// "far_side", "mirrored", "outline_bbox_px" (the attached outline at t = 0),
 /// "stroke_bbox_px", "note", "report": {...}}]). Poses the dragon at t = 0.
-/// Caller deletes (cJSON_Delete).
-struct cJSON* sp_dragon_report_json(const sp_dragon* d);
+/// *json: UTF-8 text, malloc'd, free() it; NULL on failure (out of memory).
+sp_result sp_dragon_report_json(const sp_dragon* d, char** json, sp_error* err);
 
 #ifdef __cplusplus
 }

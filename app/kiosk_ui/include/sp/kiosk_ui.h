@@ -2,7 +2,8 @@
 ///
 /// How to use (the window's main loop; a test does the same with a fake pipeline):
 ///
-///     sp_kiosk_ui* ui = sp_kiosk_ui_create(&(sp_kiosk_ui_desc){0});
+///     sp_kiosk_ui* ui;
+///     if (sp_kiosk_ui_create(&(sp_kiosk_ui_desc){0}, &ui, &err) != SP_OK) ... err.text ...
 ///     sp_kiosk_ui_resize(ui, fb_w, fb_h, px_per_mm);   // and on every resize
 ///     ... per GLFW callback: sp_kiosk_ui_event(ui, &ev);
 ///     ... per frame: sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_FRAME, now_ms});
@@ -38,6 +39,7 @@
 #include <stdint.h>
 
 #include "sp/kiosk_event.h"
+#include "sp/result.h"
 
 enum {
     SP_KIOSK_ROW_MAX = 8, ///< parts in the refusal's row (sp_kiosk_ui_set_parts)
@@ -235,8 +237,10 @@ typedef struct sp_kiosk_ui {
     int offered, chosen; ///< refused strokes held with offers; of them, made a part by a tap
 } sp_kiosk_ui;
 
-/// A fresh UI on the attract screen (NULL when out of memory). desc may be NULL.
-sp_kiosk_ui* sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc);
+/// A fresh UI on the attract screen. desc may be NULL. Fails only when out
+/// of memory; then *out is NULL.
+sp_result sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc, sp_kiosk_ui** out, sp_error* err);
+/// NULL is fine.
 void sp_kiosk_ui_destroy(sp_kiosk_ui* ui);
 
 /// Lays the screen out for a width x height framebuffer with px_per_mm pixels

@@ -3,8 +3,11 @@
 /// How to use (the `sketchpose render` command, tests, the scripted kiosk):
 ///
 ///     sp_error err = {0};
-///     sp_headless* gl = sp_headless_create(&err);   // EGL, surfaceless Mesa platform
-///     if (!gl) { fprintf(stderr, "%s\n", err.text); return 1; }
+///     sp_headless* gl;
+///     if (sp_headless_create(&gl, &err) != SP_OK) {   // EGL, surfaceless Mesa platform
+///         fprintf(stderr, "%s\n", err.text);
+///         return 1;
+///     }
 ///     ... the context is current on this thread: create an sp_render_target
 ///         (render.h), an sp_renderer, draw, sp_render_target_read ...
 ///     sp_headless_destroy(gl);
@@ -25,10 +28,11 @@ extern "C" {
 typedef struct sp_headless sp_headless;
 
 /// Creates an OpenGL 3.3+ core profile context on the EGL surfaceless
-/// platform and makes it current on the calling thread. Returns NULL and a
-/// one-line message in err (e.g. "EGL: EGL_MESA_platform_surfaceless is not
-/// available (install libegl-mesa0 and libgl1-mesa-dri)") on failure.
-sp_headless* sp_headless_create(sp_error* err);
+/// platform and makes it current on the calling thread. On failure *out is
+/// NULL and err has a one-line message (e.g. "EGL:
+/// EGL_MESA_platform_surfaceless is not available (install libegl-mesa0 and
+/// libgl1-mesa-dri)").
+sp_result sp_headless_create(sp_headless** out, sp_error* err);
 /// Releases the context (NULL is fine).
 void sp_headless_destroy(sp_headless* h);
 /// "Mesa llvmpipe (LLVM 15...)": the GL_RENDERER string, for logs.

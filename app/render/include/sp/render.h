@@ -3,11 +3,12 @@
 /// How to use (a GL 3.3 core context must be current: a GLFW window, or
 /// sp_headless_create from headless.h):
 ///
-///     sp_renderer* r = sp_renderer_create(&(sp_renderer_desc){0}, &err);
-///     sp_render_target* t = sp_render_target_create(640, 480, 0, &err); // offscreen, 4x MSAA
-///     sp_render_mesh* m = sp_render_mesh_create(r, &(sp_mesh_desc){
+///     sp_renderer* r; sp_render_target* t; sp_render_mesh* m;
+///     if (sp_renderer_create(&(sp_renderer_desc){0}, &r, &err) != SP_OK) ... err.text ...
+///     sp_render_target_create(640, 480, 0, &t, &err);  // offscreen, 4x MSAA
+///     sp_render_mesh_create(r, &(sp_mesh_desc){
 ///         .vertex_count = n, .positions = xyz, .colors = ch.colors,
-///         .triangle_count = rig.triangle_count, .triangles = rig.triangles}, &err);
+///         .triangle_count = rig.triangle_count, .triangles = rig.triangles}, &m, &err);
 ///     sp_render_target_bind(t);
 ///     sp_renderer_begin(r, &camera, 640, 480);
 ///     sp_renderer_clear(r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
@@ -67,9 +68,9 @@ typedef struct sp_renderer_desc {
     bool no_rim;    ///< turn the rim light off
 } sp_renderer_desc;
 
-/// Compiles the shaders. Needs a current GL 3.3 core context. NULL and a
-/// message in err on failure.
-sp_renderer* sp_renderer_create(const sp_renderer_desc* desc, sp_error* err);
+/// Compiles the shaders. Needs a current GL 3.3 core context. On failure
+/// *out is NULL and err says why.
+sp_result sp_renderer_create(const sp_renderer_desc* desc, sp_renderer** out, sp_error* err);
 /// Frees the GL objects (the context must still be current). NULL is fine.
 void sp_renderer_destroy(sp_renderer* r);
 
@@ -107,9 +108,9 @@ typedef struct sp_mesh_desc {
     const uint32_t* triangles; ///< triangle_count by 3, indices < vertex_count
 } sp_mesh_desc;
 
-/// Uploads a mesh (copies everything it needs). NULL and err on failure
-/// (bad index, NaN position, out of memory).
-sp_render_mesh* sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* desc, sp_error* err);
+/// Uploads a mesh (copies everything it needs). On failure (bad index, NaN
+/// position, out of memory) *out is NULL and err says why.
+sp_result sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* desc, sp_render_mesh** out, sp_error* err);
 /// New positions (vertex_count by 3, world) for the next draws, e.g. a new
 /// pose. normals NULL recomputes smooth normals from the triangles.
 void sp_render_mesh_update(sp_render_mesh* m, const double* positions, const float* normals);
@@ -146,8 +147,9 @@ void sp_renderer_draw_curve3d(sp_renderer* r, const double* xyz, int n, bool clo
 void sp_renderer_draw_abstraction(sp_renderer* r, const sp_abstraction* a, const double* xyz, float width, const float rgba[4]);
 
 /// An offscreen framebuffer: multisampled colour (RGBA8) and depth, resolved
-/// on read. samples 0 means 4; clamped to what the driver offers.
-sp_render_target* sp_render_target_create(int width, int height, int samples, sp_error* err);
+/// on read. samples 0 means 4; clamped to what the driver offers. On
+/// failure *out is NULL and err says why.
+sp_result sp_render_target_create(int width, int height, int samples, sp_render_target** out, sp_error* err);
 /// NULL is fine.
 void sp_render_target_destroy(sp_render_target* t);
 /// Binds it for drawing (then call sp_renderer_begin with its size).
