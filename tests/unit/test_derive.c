@@ -379,6 +379,12 @@ static void test_part_carried(void)
     ENSURE_NEAR(s->position.y, 0.25, 1e-12);
     ENSURE_NEAR(s->position.z, -0.125, 1e-12);
     sp_character_free(&part);
+    // A category no sp_part can hold is refused, not cut short.
+    char long_name[SP_NAME_MAX + 1];
+    memset(long_name, 'c', SP_NAME_MAX);
+    long_name[SP_NAME_MAX] = 0;
+    ENSURE(sp_part_derive(&src, &(sp_derive_desc){.category = long_name}, &part, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "a name of 1 to 63 characters") && part.rig.joint_count == 0);
     sp_character_free(&src);
 }
 
