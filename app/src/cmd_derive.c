@@ -15,12 +15,6 @@
 
 static const char* k_cmd = "sketchpose derive";
 
-static cJSON* vec3_json(const cJSON* part, const char* key)
-{
-    const cJSON* at = cJSON_GetObjectItemCaseSensitive(part, "attach");
-    return cJSON_Duplicate(cJSON_GetObjectItemCaseSensitive(at, key), true);
-}
-
 int cmd_derive(int argc, char** argv)
 {
     const char *rig_path = NULL, *out_path = NULL, *preview = NULL, *view = NULL;
@@ -80,12 +74,10 @@ int cmd_derive(int argc, char** argv)
         fprintf(stderr, "%s: warning: %s\n", k_cmd, part.warnings[i]);
 
     cJSON* root = cJSON_CreateObject();
-    cJSON* sp_part = part.part_json ? cJSON_Parse(part.part_json) : NULL;
     cJSON_AddStringToObject(root, "out", out_path);
     if (preview) cJSON_AddStringToObject(root, "preview", preview);
-    const cJSON* cat = cJSON_GetObjectItemCaseSensitive(sp_part, "category");
-    if (cJSON_IsString(cat))
-        cJSON_AddStringToObject(root, "category", cat->valuestring);
+    if (part.part.category[0])
+        cJSON_AddStringToObject(root, "category", part.part.category);
     else
         cJSON_AddNullToObject(root, "category");
     cJSON_AddStringToObject(root, "abstraction", part.rig.abstractions[ab].name);
@@ -99,7 +91,8 @@ int cmd_derive(int argc, char** argv)
     cJSON_AddNumberToObject(root, "parameters", part.rig.param_count);
     cJSON* att = cJSON_AddObjectToObject(root, "attach");
     cJSON_AddStringToObject(att, "joint", info.attach_joint);
-    cJSON_AddItemToObject(att, "position", vec3_json(sp_part, "position"));
+    const sp_vec3 at = part.part.attach.position; // the derived part always has its attachment point
+    cJSON_AddItemToObject(att, "position", cJSON_CreateDoubleArray((const double[3]){at.x, at.y, at.z}, 3));
     cJSON* abs = cJSON_AddArrayToObject(root, "abstractions");
     for (int a = 0; a < part.rig.abstraction_count; ++a) {
         const sp_abstraction* x = &part.rig.abstractions[a];
@@ -126,7 +119,6 @@ int cmd_derive(int argc, char** argv)
     if (text) puts(text);
     free(text);
     cJSON_Delete(root);
-    cJSON_Delete(sp_part);
     code = SP_EXIT_OK;
 done:
     sp_image_free(&sheet);

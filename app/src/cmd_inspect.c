@@ -65,7 +65,15 @@ static cJSON* inspect_json(sp_rig_handle* h)
     // A plugin declares its sketch view (or asks for the default one).
     cJSON_AddBoolToObject(root, "camera_from_file", ch ? ch->has_camera : true);
     if (ch) cJSON_AddBoolToObject(root, "derived_dofs", ch->derived_dofs);
-    cJSON* part = ch && ch->part_json ? cJSON_Parse(ch->part_json) : NULL;
+    // sp_part as it is written (sp_part_write_json), parsed only to nest it in the output.
+    char* part_text = NULL;
+    sp_error part_err = {0};
+    if (ch && ch->has_part && sp_part_write_json(&ch->part, &part_text, &part_err) != SP_OK) {
+        cJSON_Delete(root); // only out of memory: the loader's part always writes
+        return NULL;
+    }
+    cJSON* part = part_text ? cJSON_Parse(part_text) : NULL;
+    free(part_text);
     if (part)
         cJSON_AddItemToObject(root, "part", part);
     else

@@ -1,7 +1,6 @@
 // sketchpose synth: strokes of a random pose within bounds (tests, training);
 // with --style, passed through the hand-drawing model; with --parts DIR, a
 // labelled folder of hand-drawn sketches of every part in DIR.
-#include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -28,17 +27,6 @@ static bool has_opt(int argc, char** argv, const char* name)
 static int cmp_str(const void* a, const void* b)
 {
     return strcmp(*(char* const*)a, *(char* const*)b);
-}
-
-// The part's extras.sp_part string field `key` into buf, or false.
-static bool part_field(const sp_character* ch, const char* key, char* buf, size_t cap)
-{
-    cJSON* j = ch->part_json ? cJSON_Parse(ch->part_json) : NULL;
-    const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, key);
-    bool ok = cJSON_IsString(v) && v->valuestring && v->valuestring[0] && strlen(v->valuestring) < cap;
-    if (ok) snprintf(buf, cap, "%s", v->valuestring);
-    cJSON_Delete(j);
-    return ok;
 }
 
 static bool make_dir(const char* path, sp_error* err)
@@ -104,21 +92,22 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     json_str(out_dir);
     printf(", \"style\": \"%s\", \"seed\": %llu, \"parts\": [", sp_handdraw_style_name(style), (unsigned long long)family);
     for (int k = 0; k < n; ++k) {
-        char path[4096], stem[256], category[SP_NAME_MAX], want[SP_NAME_MAX];
+        char path[4096], stem[256], category[SP_NAME_MAX];
         snprintf(path, sizeof path, "%s/%s", dir, names[k]);
         snprintf(stem, sizeof stem, "%s", names[k]);
         *strrchr(stem, '.') = 0;
         sp_character ch = {0};
         if (sp_gltf_load(path, &ch, &err) != SP_OK) goto fail_open;
-        if (!part_field(&ch, "category", category, sizeof category)) {
+        if (!ch.part.category[0]) {
             // A character beside the parts (assets/ holds both): not a part, left out.
             fprintf(stderr, "sketchpose synth: %s: skipped (no extras.sp_part.category: not a part)\n", path);
             sp_character_free(&ch);
             continue;
         }
+        snprintf(category, sizeof category, "%s", ch.part.category);
         // The abstraction: --abstraction, else the part's own choice, else its outline, else the first.
         const char* an = abs_name;
-        if (!an && part_field(&ch, "abstraction", want, sizeof want)) an = want;
+        if (!an && ch.part.abstraction[0]) an = ch.part.abstraction;
         if (!an && sp_rig_find_abstraction(&ch.rig, "outline") >= 0) an = "outline";
         int a = sp_pick_abstraction(ch.rig.abstractions, ch.rig.abstraction_count, path, an, &err);
         char cdir[4096];

@@ -29,8 +29,10 @@ sp_gen_rgb sp_dragon_scales(double u, double a, sp_vec3 p, double belly, double 
 /// root_reach_view).
 void sp_dragon_root_params(sp_gen_rig* g, int root);
 
-/// `sp_part` extras of a part that attaches to a torso socket.
-char* sp_dragon_attach_json(const char* category, const char* socket, const char* joint, sp_vec3 position);
+/// A position for `sp_part`, rounded to 0.1 mm so that the file's text is short and stable.
+sp_vec3 sp_dragon_part_position(sp_vec3 v);
+/// `sp_part` of a part that attaches to a torso socket (owns nothing).
+sp_part sp_dragon_attach_part(const char* category, const char* socket, const char* joint, sp_vec3 position);
 
 /// A row of dorsal spikes along a path between arc lengths s0 and s1,
 /// standing on the tube's top (profile `up` at each spike's u) and skinned

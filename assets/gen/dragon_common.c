@@ -1,6 +1,6 @@
 // dragon_common.c: the dragon palette, scaly skin, root placement, spikes.
-#include <cjson/cJSON.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,24 +54,20 @@ void sp_dragon_root_params(sp_gen_rig* g, int root)
     sp_gen_param(g, root, SP_CH_S, 0.5, 2.0, SP_GROUP_SHAPE);
 }
 
-static cJSON* vec_json(sp_vec3 v)
+sp_vec3 sp_dragon_part_position(sp_vec3 v)
 {
-    // Rounded to 0.1 mm so the text is short and stable.
-    double a[3] = {round(v.x * 1e4) / 1e4, round(v.y * 1e4) / 1e4, round(v.z * 1e4) / 1e4};
-    return cJSON_CreateDoubleArray(a, 3);
+    return sp_v3(round(v.x * 1e4) / 1e4, round(v.y * 1e4) / 1e4, round(v.z * 1e4) / 1e4);
 }
 
-char* sp_dragon_attach_json(const char* category, const char* socket, const char* joint, sp_vec3 position)
+sp_part sp_dragon_attach_part(const char* category, const char* socket, const char* joint, sp_vec3 position)
 {
-    cJSON* root = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "category", category);
-    cJSON* at = cJSON_AddObjectToObject(root, "attach");
-    cJSON_AddStringToObject(at, "socket", socket);
-    cJSON_AddStringToObject(at, "joint", joint);
-    cJSON_AddItemToObject(at, "position", vec_json(position));
-    char* s = sp_gen_check_alloc(cJSON_PrintUnformatted(root));
-    cJSON_Delete(root);
-    return s;
+    sp_part p = {.has_attach = true};
+    snprintf(p.category, sizeof p.category, "%s", category);
+    snprintf(p.attach.socket, sizeof p.attach.socket, "%s", socket);
+    snprintf(p.attach.joint, sizeof p.attach.joint, "%s", joint);
+    p.attach.has_position = true;
+    p.attach.position = sp_dragon_part_position(position);
+    return p;
 }
 
 void sp_dragon_spikes(sp_gen_mesh* m, const sp_dragon_spikes_desc* d)

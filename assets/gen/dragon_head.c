@@ -332,9 +332,8 @@ sp_result sp_dragon_head(const char* path, sp_error* err)
         jaw_a[q] = -0.14 * pow(0.5 - 0.5 * cos(2.0 * k_pi * q / (KEYS - 1)), 3.0);
     sp_gen_clip_rz(&g, jaw, jaw_a);
 
-    char* json = sp_dragon_attach_json("head", "head", "neck_root", g.pivot[j[0]]);
-    sp_result r = sp_gen_save(&g, &m, &(sp_gen_save_desc){.part_json = json, .name = "head", .root_reach_view = true}, path, err);
-    free(json);
+    sp_part part = sp_dragon_attach_part("head", "head", "neck_root", g.pivot[j[0]]);
+    sp_result r = sp_gen_save(&g, &m, &(sp_gen_save_desc){.part = &part, .name = "head", .root_reach_view = true}, path, err);
     sp_gen_mesh_free(&m);
     sp_gen_path_free(&neck);
     sp_gen_path_free(&skull);

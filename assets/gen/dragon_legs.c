@@ -262,10 +262,9 @@ static sp_result build_pair(const leg_desc* d, const char* path, sp_error* err)
             sp_gen_clip_rz(&g, j[k], a[k]);
     }
 
-    char* json = sp_dragon_attach_json(d->category, d->category, d->root_name, g.pivot[root]);
+    sp_part part = sp_dragon_attach_part(d->category, d->category, d->root_name, g.pivot[root]);
     sp_result r =
-        sp_gen_save(&g, &m, &(sp_gen_save_desc){.part_json = json, .name = d->category, .root_reach_view = true}, path, err);
-    free(json);
+        sp_gen_save(&g, &m, &(sp_gen_save_desc){.part = &part, .name = d->category, .root_reach_view = true}, path, err);
     sp_gen_mesh_free(&m);
     sp_gen_rig_free(&g);
     return r;

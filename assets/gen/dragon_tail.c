@@ -134,9 +134,8 @@ sp_result sp_dragon_tail(const char* path, sp_error* err)
         sp_gen_clip_rz(&g, j[k], a);
     }
 
-    char* json = sp_dragon_attach_json("tail", "tail", "tail_root", g.pivot[j[0]]);
-    sp_result r = sp_gen_save(&g, &m, &(sp_gen_save_desc){.part_json = json, .name = "tail", .root_reach_view = true}, path, err);
-    free(json);
+    sp_part part = sp_dragon_attach_part("tail", "tail", "tail_root", g.pivot[j[0]]);
+    sp_result r = sp_gen_save(&g, &m, &(sp_gen_save_desc){.part = &part, .name = "tail", .root_reach_view = true}, path, err);
     sp_gen_mesh_free(&m);
     sp_gen_path_free(&tail);
     sp_gen_rig_free(&g);

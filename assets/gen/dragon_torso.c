@@ -5,8 +5,8 @@
 //   torso -> lumbar -> pelvis -> tail_base        (towards -X)
 //   torso -> chest -> shoulders -> neck_base      (towards +X)
 //   torso -> belly                                (the belly's bulge, breathing)
-#include <cjson/cJSON.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "dragon.h"
@@ -50,13 +50,11 @@ static sp_gen_rgb color(double u, double a, sp_vec3 p, void* user)
     return sp_dragon_scales(u, a, p, 1.0, 16.0);
 }
 
-static cJSON* socket_json(const char* name, const char* joint, sp_vec3 p)
+static sp_part_socket socket_at(const char* name, const char* joint, sp_vec3 p)
 {
-    cJSON* s = cJSON_CreateObject();
-    cJSON_AddStringToObject(s, "name", name);
-    cJSON_AddStringToObject(s, "joint", joint);
-    double a[3] = {round(p.x * 1e4) / 1e4, round(p.y * 1e4) / 1e4, round(p.z * 1e4) / 1e4};
-    cJSON_AddItemToObject(s, "position", cJSON_CreateDoubleArray(a, 3));
+    sp_part_socket s = {.has_position = true, .position = sp_dragon_part_position(p)};
+    snprintf(s.name, sizeof s.name, "%s", name);
+    snprintf(s.joint, sizeof s.joint, "%s", joint);
     return s;
 }
 
@@ -160,16 +158,11 @@ sp_result sp_dragon_torso(const char* path, sp_error* err)
     sp_vec3 wing_at = sp_gen_path_at(&body, 0.70 * L, &T);
     sp_vec3 front_at = sp_gen_path_at(&body, 0.74 * L, &T);
     sp_vec3 hind_at = sp_gen_path_at(&body, 0.2 * L, &T);
-    cJSON* part = cJSON_CreateObject();
-    cJSON_AddStringToObject(part, "category", "torso");
-    cJSON* sockets = cJSON_AddArrayToObject(part, "sockets");
-    cJSON_AddItemToArray(sockets, socket_json("head", "neck_base", neck_end));
-    cJSON_AddItemToArray(sockets, socket_json("tail", "tail_base", tail_end));
-    cJSON_AddItemToArray(sockets, socket_json("wings", "shoulders", sp_v3(wing_at.x, wing_at.y + 0.30, 0)));
-    cJSON_AddItemToArray(sockets, socket_json("front_legs", "shoulders", sp_v3(front_at.x, front_at.y - 0.22, 0)));
-    cJSON_AddItemToArray(sockets, socket_json("hind_legs", "pelvis", sp_v3(hind_at.x, hind_at.y - 0.25, 0)));
-    char* json = sp_gen_check_alloc(cJSON_PrintUnformatted(part));
-    cJSON_Delete(part);
+    sp_part_socket sockets[] = {socket_at("head", "neck_base", neck_end), socket_at("tail", "tail_base", tail_end),
+                                socket_at("wings", "shoulders", sp_v3(wing_at.x, wing_at.y + 0.30, 0)),
+                                socket_at("front_legs", "shoulders", sp_v3(front_at.x, front_at.y - 0.22, 0)),
+                                socket_at("hind_legs", "pelvis", sp_v3(hind_at.x, hind_at.y - 0.25, 0))};
+    sp_part part = {.category = "torso", .socket_count = 5, .sockets = sockets};
 
     // Breathing: the belly swells and the chest lifts, a slow 3 s loop.
     enum { KEYS = 25 };
@@ -187,9 +180,7 @@ sp_result sp_dragon_torso(const char* path, sp_error* err)
     sp_gen_clip_scale(&g, chest, chest_s);
     sp_gen_clip_rz(&g, lumbar, sway);
 
-    sp_result r =
-        sp_gen_save(&g, &m, &(sp_gen_save_desc){.part_json = json, .name = "torso", .root_reach_view = true}, path, err);
-    free(json);
+    sp_result r = sp_gen_save(&g, &m, &(sp_gen_save_desc){.part = &part, .name = "torso", .root_reach_view = true}, path, err);
     sp_gen_mesh_free(&m);
     sp_gen_path_free(&body);
     sp_gen_rig_free(&g);

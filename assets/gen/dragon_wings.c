@@ -340,10 +340,8 @@ sp_result sp_dragon_wings(const char* path, sp_error* err)
         sp_gen_clip_rz(&g, fa[k], a);
     }
 
-    char* json = sp_dragon_attach_json("wings", "wings", "wing_root", g.pivot[root]);
-    sp_result r =
-        sp_gen_save(&g, &m, &(sp_gen_save_desc){.part_json = json, .name = "wings", .root_reach_view = true}, path, err);
-    free(json);
+    sp_part part = sp_dragon_attach_part("wings", "wings", "wing_root", g.pivot[root]);
+    sp_result r = sp_gen_save(&g, &m, &(sp_gen_save_desc){.part = &part, .name = "wings", .root_reach_view = true}, path, err);
     sp_gen_mesh_free(&m);
     sp_gen_rig_free(&g);
     return r;

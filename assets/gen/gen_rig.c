@@ -224,7 +224,13 @@ sp_result sp_gen_save(sp_gen_rig* g, const sp_gen_mesh* mesh, const sp_gen_save_
     }
     ch.camera = cam;
     ch.has_camera = true;
-    if (d->part_json) ch.part_json = sp_gen_check_alloc(strdup(d->part_json));
+    if (d->part) {
+        ch.has_part = true;
+        if ((res = sp_part_copy(d->part, &ch.part, err)) != SP_OK) {
+            sp_character_free(&ch);
+            return res;
+        }
+    }
     res = sp_gltf_save(&ch, NULL, path, err);
     sp_character_free(&ch);
     return res;

@@ -10,7 +10,7 @@
 ///     ... build an sp_gen_mesh skinned to these joints ...
 ///     sp_gen_clip_begin(&g, "sway", 2.0, 25);
 ///     sp_gen_clip_rz(&g, t1, angles);                 // 25 angles, radians, offsets from rest
-///     sp_gen_save(&g, &mesh, &(sp_gen_save_desc){.category = "tail", .part_json = json}, "assets/tail.glb", &err);
+///     sp_gen_save(&g, &mesh, &(sp_gen_save_desc){.part = &part}, "assets/tail.glb", &err);
 ///
 /// Joints are placed by their pivot in the part's rest space and an
 /// in-plane rest angle (rotation about +Z: the bone's direction in the side
@@ -55,7 +55,7 @@ void sp_gen_clip_scale(sp_gen_rig* g, int joint, const sp_vec3* factors);
 void sp_gen_clip_translate(sp_gen_rig* g, int joint, const sp_vec3* offsets);
 
 typedef struct sp_gen_save_desc {
-    const char* part_json; ///< the scene's extras.sp_part as JSON text
+    const sp_part* part;   ///< the scene's extras.sp_part, or NULL (copied)
     int outline_points;    ///< 0: 150
     double frame_margin;   ///< the camera frames the rest pose grown by this factor (0: 1.35)
     const char* name;      ///< for messages

@@ -16,7 +16,7 @@ void sp_character_free(sp_character* ch)
     sp_rig_free(&ch->rig);
     free(ch->pose);
     free(ch->colors);
-    free(ch->part_json);
+    sp_part_free(&ch->part);
     free(ch->warnings);
     memset(ch, 0, sizeof *ch);
 }
@@ -335,7 +335,7 @@ void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, doub
     if (clamped > 0) sp_character_warn(ch, "sp_pose: %d parameters clamped to their bounds", clamped);
 }
 
-// Scene extras: sp_part (kept as compact JSON) and sp_pose (applied to ch->pose).
+// Scene extras: sp_part (parsed into ch->part) and sp_pose (applied to ch->pose).
 static sp_result scene_extras(sp_character* ch, const char* json, const char* what, sp_error* err)
 {
     if (!json || !*json) return SP_OK;
@@ -344,8 +344,8 @@ static sp_result scene_extras(sp_character* ch, const char* json, const char* wh
     sp_result r = SP_OK;
     const cJSON* part = cJSON_GetObjectItemCaseSensitive(root, "sp_part");
     if (part) {
-        ch->part_json = cJSON_PrintUnformatted(part);
-        if (!ch->part_json) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+        r = sp_part_from_cjson(part, what, &ch->part, err);
+        ch->has_part = r == SP_OK;
     }
     const cJSON* pose = cJSON_GetObjectItemCaseSensitive(root, "sp_pose");
     if (r == SP_OK && pose) {

@@ -294,9 +294,7 @@ static bool is_kiosk_part(const char* file)
     sp_character ch = {0};
     sp_error err = {0};
     if (sp_gltf_load(file, &ch, &err) != SP_OK) return true;
-    cJSON* j = ch.part_json ? cJSON_Parse(ch.part_json) : NULL;
-    bool part = cJSON_IsString(cJSON_GetObjectItem(j, "category"));
-    cJSON_Delete(j);
+    bool part = ch.part.category[0] != 0;
     sp_character_free(&ch);
     return part;
 }

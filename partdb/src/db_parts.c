@@ -1,5 +1,4 @@
 // db_parts.c: validating, storing, listing and loading rigged parts.
-#include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,25 +37,15 @@ static void copy_name(char* dst, size_t cap, const char* src)
     snprintf(dst, cap, "%s", src ? src : "");
 }
 
-// The part's `sp_part` extras field `key` as a string (static buffer), or NULL.
-static const char* part_extra(const sp_character* ch, const char* key, char* buf, size_t cap)
+// A name of the part's sp_part, or NULL when the file gives none.
+static const char* part_name(const char* name)
 {
-    if (!ch->part_json) return NULL;
-    cJSON* j = cJSON_Parse(ch->part_json);
-    const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, key);
-    const char* out = NULL;
-    if (cJSON_IsString(v) && v->valuestring) {
-        copy_name(buf, cap, v->valuestring);
-        out = buf;
-    }
-    cJSON_Delete(j);
-    return out;
+    return name[0] ? name : NULL;
 }
 
 static int pick_abstraction(const sp_character* ch, const sp_db_part_desc* d)
 {
-    char buf[SP_NAME_MAX];
-    const char* want = d && d->abstraction ? d->abstraction : part_extra(ch, "abstraction", buf, sizeof buf);
+    const char* want = d && d->abstraction ? d->abstraction : part_name(ch->part.abstraction);
     if (want) return sp_rig_find_abstraction(&ch->rig, want);
     return ch->rig.abstraction_count > 0 ? 0 : -1;
 }
@@ -113,8 +102,7 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
     char reasons[sizeof err->text] = "";
     if (rig->joint_count == 0 || !rig->weights4 || !rig->joints4) add_reason(reasons, sizeof reasons, "no skin");
     if (rig->vertex_count == 0 || rig->triangle_count == 0) add_reason(reasons, sizeof reasons, "no triangle mesh");
-    char cat[SP_NAME_MAX];
-    const char* category = d && d->category ? d->category : part_extra(&ch, "category", cat, sizeof cat);
+    const char* category = d && d->category ? d->category : part_name(ch.part.category);
     if (!category) add_reason(reasons, sizeof reasons, "no category (give --category or the scene's extras.sp_part.category)");
     else if (!db_name_ok(category)) add_reason(reasons, sizeof reasons, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", category);
     int a = pick_abstraction(&ch, d);

@@ -4,7 +4,6 @@
 // point and the clip re-keyed on the new frames.
 #include "sp/derive.h"
 
-#include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -549,45 +548,23 @@ static sp_result add_outline(sp_rig* R, const double* xyz, const sp_mat4* skin, 
     return r;
 }
 
-static cJSON* vec_json(sp_vec3 v)
-{
-    double a[3] = {v.x, v.y, v.z};
-    return cJSON_CreateDoubleArray(a, 3);
-}
-
 // sp_part: the source's (sockets turned into the part's space), with the
 // category, the abstraction and the attachment point.
-static char* part_json(const work* w, const sp_rig* R, const char* category, const char* abstraction, int attach)
+static sp_result derived_part(const work* w, const sp_rig* R, const char* category, const char* abstraction, int attach,
+                              sp_part* out, sp_error* err)
 {
-    cJSON* part = w->src->part_json ? cJSON_Parse(w->src->part_json) : NULL;
-    if (!cJSON_IsObject(part)) {
-        cJSON_Delete(part);
-        part = cJSON_CreateObject();
-    }
-    if (!part) return NULL;
-    cJSON* sockets = cJSON_GetObjectItemCaseSensitive(part, "sockets");
-    cJSON* s;
-    cJSON_ArrayForEach(s, sockets)
-    {
-        cJSON* pos = cJSON_GetObjectItemCaseSensitive(s, "position");
-        if (cJSON_GetArraySize(pos) != 3) continue;
-        double v[3];
-        for (int i = 0; i < 3; ++i)
-            v[i] = cJSON_GetNumberValue(cJSON_GetArrayItem(pos, i));
-        cJSON_ReplaceItemInObjectCaseSensitive(s, "position", vec_json(sp_mat4_point(&w->W, sp_v3(v[0], v[1], v[2]))));
-    }
-    cJSON_DeleteItemFromObjectCaseSensitive(part, "category");
-    cJSON_DeleteItemFromObjectCaseSensitive(part, "abstraction");
-    cJSON_DeleteItemFromObjectCaseSensitive(part, "attach");
-    if (category) cJSON_AddStringToObject(part, "category", category);
-    cJSON_AddStringToObject(part, "abstraction", abstraction);
-    cJSON* at = cJSON_AddObjectToObject(part, "attach");
-    if (at && category) cJSON_AddStringToObject(at, "socket", category);
-    if (at) cJSON_AddStringToObject(at, "joint", R->joints[attach].name);
-    if (at) cJSON_AddItemToObject(at, "position", vec_json(w->j[attach].pivot));
-    char* text = cJSON_PrintUnformatted(part);
-    cJSON_Delete(part);
-    return text;
+    memset(out, 0, sizeof *out);
+    if (w->src->has_part && sp_part_copy(&w->src->part, out, err) != SP_OK) return SP_ERR_NO_MEMORY;
+    for (int i = 0; i < out->socket_count; ++i)
+        if (out->sockets[i].has_position) out->sockets[i].position = sp_mat4_point(&w->W, out->sockets[i].position);
+    snprintf(out->category, sizeof out->category, "%s", category ? category : "");
+    snprintf(out->abstraction, sizeof out->abstraction, "%s", abstraction);
+    free(out->attach.extra);
+    out->has_attach = true;
+    out->attach = (sp_part_attach){.has_position = true, .position = w->j[attach].pivot};
+    snprintf(out->attach.socket, sizeof out->attach.socket, "%s", category ? category : "");
+    snprintf(out->attach.joint, sizeof out->attach.joint, "%s", R->joints[attach].name);
+    return SP_OK;
 }
 
 sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp_character* out, sp_derive_info* info_out,
@@ -611,17 +588,9 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     if (strcmp(abstraction, "outline") != 0 && strcmp(abstraction, "stick") != 0)
         return sp_fail(err, SP_ERR_INVALID, "abstraction '%s': a derived part's sketches show its outline or its stick figure",
                        abstraction);
-    char cat_buf[SP_NAME_MAX];
-    const char* category = d.category;
-    if (!category && src->part_json) {
-        cJSON* p = cJSON_Parse(src->part_json);
-        const cJSON* c = cJSON_GetObjectItemCaseSensitive(p, "category");
-        if (cJSON_IsString(c)) {
-            snprintf(cat_buf, sizeof cat_buf, "%s", c->valuestring);
-            category = cat_buf;
-        }
-        cJSON_Delete(p);
-    }
+    const char* category = d.category ? d.category : src->part.category[0] ? src->part.category : NULL;
+    if (category && (!*category || strlen(category) >= SP_NAME_MAX))
+        return sp_fail(err, SP_ERR_INVALID, "category '%s': a name of 1 to %d characters", category, SP_NAME_MAX - 1);
 
     work w = {0};
     w.src = src;
@@ -645,7 +614,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     sp_rig_eval* ev = NULL;
     double* p = NULL;
     bool* is_skin = NULL;
-    char* json = NULL;
+    sp_part part = {0};
     sp_result r = SP_OK;
     if (!w.G || !w.Ginv || !w.S || !w.influences || !w.to_derived || !w.xyz || !tr || !rot || !sc) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
@@ -736,10 +705,8 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         r = sp_fail(err, SP_ERR_INVALID, "abstraction 'stick': the skeleton has no bones to draw a stick figure of");
         goto done;
     }
-    json = part_json(&w, &R, category, abstraction, attach);
-    if (!json) {
+    if ((r = derived_part(&w, &R, category, abstraction, attach, &part, err)) != SP_OK) {
         sp_character_free(&notes);
-        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         goto done;
     }
     info->derived = SP_DERIVED_OUTLINE | (stick ? SP_DERIVED_STICK : 0) | SP_DERIVED_PARAMETERS | SP_DERIVED_ATTACH |
@@ -753,8 +720,9 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     if (src->colors) memcpy(out->colors, src->colors, sizeof(float) * 4 * nv);
     out->camera = cam;
     out->has_camera = true;
-    out->part_json = json;
-    json = NULL;
+    out->has_part = true;
+    out->part = part;
+    memset(&part, 0, sizeof part);
     for (int i = 0; i < src->warning_count; ++i)
         sp_character_warn(out, "%s", src->warnings[i]);
     for (int i = 0; i < notes.warning_count; ++i)
@@ -766,7 +734,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
                           sr->animation_count - 1);
     if (!w.clip) sp_character_warn(out, "no animation with keys: the part has no clip (it holds its fitted pose in the kiosk)");
 done:
-    free(json);
+    sp_part_free(&part);
     free(is_skin);
     free(p);
     sp_rig_eval_destroy(ev);

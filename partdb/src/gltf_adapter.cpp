@@ -1018,7 +1018,7 @@ Value num_array(const double* v, int n)
     return Value(std::move(a));
 }
 
-// cJSON tree -> tinygltf value (for sp_part, which we keep as JSON text).
+// cJSON tree -> tinygltf value (sp_part, a scene's extras).
 Value from_cjson(const cJSON* j)
 {
     if (cJSON_IsBool(j)) return Value(cJSON_IsTrue(j) ? true : false);
@@ -1463,10 +1463,13 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
     pose["parameters"] = Value(std::move(params));
     Value::Object sx;
     sx["sp_pose"] = Value(std::move(pose));
-    if (ch->part_json) {
-        cJSON* part = cJSON_Parse(ch->part_json);
-        if (part) sx["sp_part"] = from_cjson(part);
-        cJSON_Delete(part);
+    if (ch->has_part) {
+        cJSON* part = nullptr;
+        sp_error e = {};
+        sp_result r = sp_part_to_cjson(&ch->part, &part, &e);
+        if (r != SP_OK) fail(r, "%s", e.text);
+        std::unique_ptr<cJSON, void (*)(cJSON*)> owner(part, cJSON_Delete); // freed also when from_cjson throws
+        sx["sp_part"] = from_cjson(part);
     }
     scene.extras = Value(std::move(sx));
     scene.name = "sketchpose";

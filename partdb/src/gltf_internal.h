@@ -66,6 +66,12 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err);
 /// default camera.
 sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err);
 
+/// sp/part.h's reader and writer on cJSON trees: the loader's scene extras
+/// and the savers' tinygltf values.
+struct cJSON;
+sp_result sp_part_from_cjson(const struct cJSON* j, const char* what, sp_part* out, sp_error* err);
+sp_result sp_part_to_cjson(const sp_part* part, struct cJSON** out, sp_error* err);
+
 /// Splits an affine matrix into translation, rotation and scale (a negative
 /// determinant goes into the x scale; shear is lost), as glTF nodes hold it.
 void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s);

@@ -140,25 +140,12 @@ void dragon_standin(int i, dragon_part* out)
     DRAGON_CHECK(sp_rig_finalize(&rig, "stand-in", NULL, &err) == SP_OK);
     memset(out, 0, sizeof *out);
     DRAGON_CHECK(sp_character_from_rig(&rig, &out->ch, &err) == SP_OK);
-    char json[128];
-    snprintf(json, sizeof json, "{\"category\": \"%s\", \"abstraction\": \"outline\"}", k_dragon_part_names[i]);
-    out->ch.part_json = strdup(json);
+    out->ch.has_part = true;
+    snprintf(out->ch.part.category, sizeof out->ch.part.category, "%s", k_dragon_part_names[i]);
+    snprintf(out->ch.part.abstraction, sizeof out->ch.part.abstraction, "outline");
     snprintf(out->name, sizeof out->name, "%s", k_dragon_part_names[i]);
     snprintf(out->category, sizeof out->category, "%s", k_dragon_part_names[i]);
     out->abstraction = 0;
-}
-
-// The part's extras.sp_part.category (a tiny scan: the key's string value).
-bool dragon_part_category(const char* part_json, char* out, size_t cap)
-{
-    const char* k = part_json ? strstr(part_json, "\"category\"") : NULL;
-    if (!k) return false;
-    k = strchr(k + 10, '"');
-    const char* e = k ? strchr(k + 1, '"') : NULL;
-    if (!k || !e || (size_t)(e - k - 1) >= cap) return false;
-    memcpy(out, k + 1, (size_t)(e - k - 1));
-    out[e - k - 1] = 0;
-    return true;
 }
 
 // Fills parts[6] from assets/ when all six load, else with the stand-ins.
@@ -178,8 +165,7 @@ bool dragon_parts_load(const char* assets_dir, dragon_part parts[DRAGON_PART_COU
             break;
         }
         snprintf(p->name, sizeof p->name, "%s", k_dragon_part_names[i]);
-        if (!dragon_part_category(p->ch.part_json, p->category, sizeof p->category))
-            snprintf(p->category, sizeof p->category, "%.63s", p->name);
+        snprintf(p->category, sizeof p->category, "%.63s", p->ch.part.category[0] ? p->ch.part.category : p->name);
         p->abstraction = sp_rig_find_abstraction(&p->ch.rig, "outline");
         if (p->abstraction < 0) p->abstraction = 0;
         ++loaded;

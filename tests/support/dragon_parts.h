@@ -49,9 +49,6 @@ extern const char* const k_dragon_part_names[DRAGON_PART_COUNT];
 /// Stand-in part i (0..5) as a character with an `outline` abstraction (asserts on failure).
 void dragon_standin(int i, dragon_part* out);
 
-/// The part's extras.sp_part.category (a tiny scan: the key's string value).
-bool dragon_part_category(const char* part_json, char* out, size_t cap);
-
 /// Fills parts[6] from assets/ when all six load, else with the stand-ins.
 /// Returns true when the assets were used. Free with dragon_parts_free.
 bool dragon_parts_load(const char* assets_dir, dragon_part parts[DRAGON_PART_COUNT]);

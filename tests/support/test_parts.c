@@ -207,7 +207,8 @@ void test_part_write(const test_part_spec* s, bool flat, const char* path)
     for (int i = 0; i < ch.rig.vertex_count; ++i)
         for (int c = 0; c < 3; ++c)
             ch.colors[4 * i + c] = s->color[c];
-    ch.part_json = strdup(s->extras);
+    ENSURE(sp_part_parse_json(s->extras, s->name, &ch.part, &err) == SP_OK);
+    ch.has_part = true;
     // Seen from the front (-Z), where the outline lies: the default view could pick -X for a fat, short tube.
     sp_vec3 lo, hi;
     sp_bounds(ch.rig.rest, ch.rig.vertex_count, &lo, &hi);

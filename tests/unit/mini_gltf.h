@@ -27,6 +27,7 @@ typedef struct mini_desc {
     float w1;          ///< weight of vertex 1 (0: 1); e.g. 0.5 needs renormalising
     bool strip;        ///< TRIANGLE_STRIP instead of indexed TRIANGLES
     bool byte_joints;  ///< JOINTS_0 as UNSIGNED_BYTE (in a separate view)
+    const char* part;  ///< with extras: the scene's sp_part JSON (NULL: a tail attached by the short form)
 } mini_desc;
 
 static void mini_base64(const unsigned char* d, size_t n, char* out)
@@ -86,6 +87,9 @@ static char* mini_gltf(const mini_desc* d)
     const char* dofs_tip = ", \"extras\": {\"sp_dofs\": [{\"channel\": \"rx\", \"min\": -1.5, \"max\": 1.5}, "
                            "{\"channel\": \"rz\", \"min\": -1.5, \"max\": 1.5}]}";
     bool ex = d->extras || d->bad_dofs;
+    char scene_extras[2048];
+    snprintf(scene_extras, sizeof scene_extras, ", \"extras\": {\"sp_part\": %s}",
+             d->part ? d->part : "{\"category\": \"tail\", \"attach\": \"back\"}");
     char* out = malloc(8192);
     snprintf(out, 8192,
              "{\"asset\": {\"version\": \"2.0\", \"generator\": \"sketchpose tests (hand-made)\"},\n"
@@ -128,8 +132,7 @@ static char* mini_gltf(const mini_desc* d)
              " ],\n"
              " \"buffers\": [{\"byteLength\": 300, \"uri\": \"%s\"}]\n"
              "}\n",
-             d->armature ? "3" : "0", ex ? ", 4, 5" : "",
-             ex ? ", \"extras\": {\"sp_part\": {\"category\": \"tail\", \"attach\": \"back\"}}" : "", ex ? dofs_root : "",
+             d->armature ? "3" : "0", ex ? ", 4, 5" : "", ex ? scene_extras : "", ex ? dofs_root : "",
              d->cycle ? ", \"children\": [0]" : "", ex ? dofs_tip : "", d->armature ? ", \"children\": [0]" : "",
              d->pos_accessor ? d->pos_accessor : 0, d->byte_joints ? 5 : 1, d->strip ? "" : ", \"indices\": 3", d->strip ? 5 : 4,
              d->empty_skin ? "" : "0, 1", d->pos_count ? d->pos_count : 4, uri);

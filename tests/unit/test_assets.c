@@ -160,44 +160,36 @@ static void test_regenerate_identical(void)
 
 // ---- contents ---------------------------------------------------------------
 
-static void check_part_json(const char* name, const sp_character* ch)
+static void check_part(const char* name, const sp_character* ch)
 {
-    ENSURE(ch->part_json != NULL);
-    cJSON* root = cJSON_Parse(ch->part_json);
-    ENSURE(root != NULL);
-    const cJSON* cat = cJSON_GetObjectItemCaseSensitive(root, "category");
-    bool ok = cJSON_IsString(cat) && strcmp(cat->valuestring, name) == 0;
+    ENSURE(ch->has_part);
+    const sp_part* part = &ch->part;
+    bool ok = strcmp(part->category, name) == 0;
     if (strcmp(name, "torso") == 0) {
-        const cJSON* sockets = cJSON_GetObjectItemCaseSensitive(root, "sockets");
-        ok = ok && cJSON_IsArray(sockets) && cJSON_GetArraySize(sockets) == 5;
+        ok = ok && part->socket_count == 5;
         for (int k = 0; ok && k < 5; ++k) {
             bool found = false;
-            const cJSON* s;
-            cJSON_ArrayForEach(s, sockets)
-            {
-                const cJSON* n = cJSON_GetObjectItemCaseSensitive(s, "name");
-                const cJSON* j = cJSON_GetObjectItemCaseSensitive(s, "joint");
-                const cJSON* p = cJSON_GetObjectItemCaseSensitive(s, "position");
-                if (cJSON_IsString(n) && strcmp(n->valuestring, k_sockets[k]) == 0) {
-                    found = cJSON_IsString(j) && sp_rig_find_joint(&ch->rig, j->valuestring) >= 0 && cJSON_IsArray(p) &&
-                            cJSON_GetArraySize(p) == 3;
-                }
+            for (int i = 0; i < part->socket_count; ++i) {
+                const sp_part_socket* s = &part->sockets[i];
+                if (strcmp(s->name, k_sockets[k]) == 0)
+                    found = s->joint[0] && sp_rig_find_joint(&ch->rig, s->joint) >= 0 && s->has_position;
             }
             ok = found;
         }
     } else {
-        const cJSON* at = cJSON_GetObjectItemCaseSensitive(root, "attach");
-        const cJSON* s = cJSON_GetObjectItemCaseSensitive(at, "socket");
-        const cJSON* j = cJSON_GetObjectItemCaseSensitive(at, "joint");
-        const cJSON* p = cJSON_GetObjectItemCaseSensitive(at, "position");
+        const sp_part_attach* at = &part->attach;
         bool known = false;
-        for (int k = 0; cJSON_IsString(s) && k < 5; ++k)
-            known |= strcmp(s->valuestring, k_sockets[k]) == 0;
-        ok = ok && known && cJSON_IsString(j) && sp_rig_find_joint(&ch->rig, j->valuestring) == 0 && cJSON_IsArray(p) &&
-             cJSON_GetArraySize(p) == 3;
+        for (int k = 0; part->has_attach && k < 5; ++k)
+            known |= strcmp(at->socket, k_sockets[k]) == 0;
+        ok = ok && known && at->joint[0] && sp_rig_find_joint(&ch->rig, at->joint) == 0 && at->has_position;
     }
-    if (!ok) fprintf(stderr, "  %s: bad sp_part %s\n", name, ch->part_json);
-    cJSON_Delete(root);
+    if (!ok) {
+        char* text = NULL;
+        sp_error err = {0};
+        sp_part_write_json(part, &text, &err);
+        fprintf(stderr, "  %s: bad sp_part %s\n", name, text ? text : err.text);
+        free(text);
+    }
     ENSURE(ok);
 }
 
@@ -260,7 +252,7 @@ static void test_contents(void)
         ENSURE(ch.has_camera && ch.camera.kind == SP_CAMERA_ORTHOGRAPHIC);
         // The side view looks along -Z.
         ENSURE_NEAR(ch.camera.view.m[10], 1.0, 1e-6);
-        check_part_json(k_parts[i], &ch);
+        check_part(k_parts[i], &ch);
         check_clip(rig);
         sp_character_free(&ch);
     }
@@ -488,7 +480,7 @@ static void test_characters(void)
                 rig->vertex_count, 3 * rig->vertex_count, rig->param_count, pose, shape, rig->joint_count);
         ENSURE(ch.warning_count == 0);
         ENSURE(!ch.derived_abstraction && !ch.derived_dofs);
-        ENSURE(ch.part_json == NULL); // a character, not a kiosk part
+        ENSURE(!ch.has_part); // a character, not a kiosk part
         ENSURE(rig->vertex_count >= cs->vertices[0] && rig->vertex_count <= cs->vertices[1]);
         ENSURE(rig->param_count >= cs->params[0] && rig->param_count <= cs->params[1]);
         ENSURE(rig->joint_count >= cs->joints[0] && rig->joint_count <= cs->joints[1]);

@@ -192,11 +192,10 @@ static void check_conventions(const sp_character* part)
            rig->abstractions[o].point_count == 150 && rig->abstractions[o].correspondence == SP_CORR_CLOSEST);
 }
 
-static cJSON* part_extras(const sp_character* part)
+static const sp_part* part_extras(const sp_character* part)
 {
-    cJSON* j = part->part_json ? cJSON_Parse(part->part_json) : NULL;
-    ENSURE(cJSON_IsObject(j));
-    return j;
+    ENSURE(part->has_part);
+    return &part->part;
 }
 
 // The models of ../shared/data/gltf, or SKIP.
@@ -298,15 +297,14 @@ static void test_what_is_derived(void)
     ENSURE_NEAR(tail_swing, 0.25, 0.02); // the sway's in-plane amplitude comes back as rz offsets
     free(p), free(tr), free(sc), free(rot);
     // The attachment point: the root's pivot, as the kiosk reads sp_part.
-    cJSON* ex = part_extras(&part);
-    ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(ex, "category")), "lizard"));
-    ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(ex, "abstraction")), "outline"));
-    cJSON* at = cJSON_GetObjectItem(ex, "attach");
-    ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(at, "joint")), "root"));
-    ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(at, "socket")), "lizard"));
-    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItem(at, "position")) == 3);
-    ENSURE_NEAR(cJSON_GetArrayItem(cJSON_GetObjectItem(at, "position"), 0)->valuedouble, 0.0, 1e-9);
-    cJSON_Delete(ex);
+    const sp_part* ex = part_extras(&part);
+    ENSURE(!strcmp(ex->category, "lizard"));
+    ENSURE(!strcmp(ex->abstraction, "outline"));
+    const sp_part_attach* at = &ex->attach;
+    ENSURE(ex->has_attach && !strcmp(at->joint, "root"));
+    ENSURE(!strcmp(at->socket, "lizard"));
+    ENSURE(at->has_position);
+    ENSURE_NEAR(at->position.x, 0.0, 1e-9);
     // Written and read back: the same part (what `db add-part` stores).
     const char* out = sp_test_tmp_path("lizard_sp.glb");
     sp_error err = {0};
@@ -327,14 +325,13 @@ static void test_options(void)
     load_ok(lizard("lizard_opt.glb", (sp_foreign_desc){0}), &src);
     sp_derive_info info;
     derive_ok(&src, &(sp_derive_desc){.abstraction = "stick", .attach_joint = "tail_3"}, &part, &info);
-    cJSON* ex = part_extras(&part);
-    ENSURE(!cJSON_GetObjectItem(ex, "category") &&
-           !strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(ex, "abstraction")), "stick"));
-    cJSON* at = cJSON_GetObjectItem(ex, "attach");
-    ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(at, "joint")), "tail_3") && !cJSON_GetObjectItem(at, "socket"));
-    ENSURE_NEAR(cJSON_GetArrayItem(cJSON_GetObjectItem(at, "position"), 0)->valuedouble, -1.5, 1e-6);
-    ENSURE_NEAR(cJSON_GetArrayItem(cJSON_GetObjectItem(at, "position"), 1)->valuedouble, 0.22, 1e-6);
-    cJSON_Delete(ex);
+    const sp_part* ex = part_extras(&part);
+    ENSURE(!ex->category[0] && !strcmp(ex->abstraction, "stick"));
+    const sp_part_attach* at = &ex->attach;
+    ENSURE(ex->has_attach && !strcmp(at->joint, "tail_3") && !at->socket[0]);
+    ENSURE(at->has_position);
+    ENSURE_NEAR(at->position.x, -1.5, 1e-6);
+    ENSURE_NEAR(at->position.y, 0.22, 1e-6);
     sp_character_free(&part);
     sp_error err = {0};
     ENSURE(sp_part_derive(&src, &(sp_derive_desc){.attach_joint = "tail_9"}, &part, NULL, &err) == SP_ERR_INVALID);
@@ -352,6 +349,43 @@ static void test_options(void)
     check_conventions(&part);
     ENSURE(deform_gap(&src, &part, 1, 1, 3) < 1e-5);
     sp_character_free(&part);
+    sp_character_free(&src);
+}
+
+// The source's sp_part comes along: its sockets turned into the part's
+// space with it, its unknown keys kept; category, abstraction and attach are
+// the derived ones.
+static void test_part_carried(void)
+{
+    sp_character src = {0}, part = {0};
+    load_ok(lizard("lizard_part.glb", (sp_foreign_desc){.facing_left = true}), &src);
+    sp_error err = {0};
+    ENSURE(sp_part_parse_json("{\"category\": \"beast\", \"attach\": {\"joint\": \"neck\", \"note\": 1}, \"rank\": [2, \"b\"], "
+                              "\"sockets\": [{\"name\": \"saddle\", \"joint\": \"root\", \"position\": [0.5, 0.25, 0.125], "
+                              "\"accepts\": [\"rider\"], \"depth\": 3}]}",
+                              "lizard_part.glb", &src.part, &err) == SP_OK);
+    src.has_part = true;
+    derive_ok(&src, &(sp_derive_desc){.view = SP_DERIVE_VIEW_POS_Z}, &part, NULL);
+    const sp_part* ex = part_extras(&part);
+    ENSURE(!strcmp(ex->category, "beast") && !strcmp(ex->abstraction, "outline"));
+    ENSURE(!strcmp(ex->attach.joint, "root") && !strcmp(ex->attach.socket, "beast") && !ex->attach.extra);
+    ENSURE(ex->extra && !strcmp(ex->extra, "{\"rank\":[2,\"b\"]}"));
+    ENSURE(ex->socket_count == 1);
+    const sp_part_socket* s = &ex->sockets[0];
+    ENSURE(!strcmp(s->name, "saddle") && !strcmp(s->joint, "root") && s->accept_count == 1 && !strcmp(s->accepts[0], "rider"));
+    ENSURE(s->extra && !strcmp(s->extra, "{\"depth\":3}"));
+    // Seen from +Z the part is turned half round the vertical: x and z change sign.
+    ENSURE(s->has_position);
+    ENSURE_NEAR(s->position.x, -0.5, 1e-12);
+    ENSURE_NEAR(s->position.y, 0.25, 1e-12);
+    ENSURE_NEAR(s->position.z, -0.125, 1e-12);
+    sp_character_free(&part);
+    // A category no sp_part can hold is refused, not cut short.
+    char long_name[SP_NAME_MAX + 1];
+    memset(long_name, 'c', SP_NAME_MAX);
+    long_name[SP_NAME_MAX] = 0;
+    ENSURE(sp_part_derive(&src, &(sp_derive_desc){.category = long_name}, &part, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "a name of 1 to 63 characters") && part.rig.joint_count == 0);
     sp_character_free(&src);
 }
 
@@ -869,6 +903,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"what_is_derived", test_what_is_derived},
                                    {"options", test_options},
+                                   {"part_carried", test_part_carried},
                                    {"zup_and_facing", test_zup_and_facing},
                                    {"refusals", test_refusals},
                                    {"cli", test_cli},

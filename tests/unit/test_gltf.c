@@ -45,6 +45,26 @@ static bool has_warning(const sp_character* ch, const char* text)
     return false;
 }
 
+// The writer's text of a part (sp_part_write_json), malloc'd.
+static char* part_text(const sp_part* part)
+{
+    char* text = NULL;
+    sp_error err = {0};
+    sp_result r = sp_part_write_json(part, &text, &err);
+    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_OK && text);
+    return text;
+}
+
+// The same part: every field, unknown keys included, as the writer writes it.
+static void ensure_same_part(const sp_part* a, const sp_part* b)
+{
+    char *ta = part_text(a), *tb = part_text(b);
+    if (strcmp(ta, tb) != 0) fprintf(stderr, "  sp_part differs:\n  %s\n  %s\n", ta, tb);
+    ENSURE(!strcmp(ta, tb));
+    free(ta), free(tb);
+}
+
 static const char* write_mini(const char* name, const mini_desc* d)
 {
     const char* path = sp_test_tmp_path(name);
@@ -148,8 +168,8 @@ static void round_trip(sp_character* ch, const char* name, uint64_t seed)
     ENSURE_NEAR(back.camera.scale, ch->camera.scale, 1e-6 * ch->camera.scale);
     for (int k = 0; k < 16; ++k)
         ENSURE_NEAR(back.camera.view.m[k], ch->camera.view.m[k], 1e-6 * (1 + fabs(ch->camera.view.m[k])));
-    ENSURE((back.part_json == NULL) == (ch->part_json == NULL));
-    if (ch->part_json) ENSURE(!strcmp(back.part_json, ch->part_json));
+    ENSURE(back.has_part == ch->has_part);
+    if (ch->has_part) ensure_same_part(&back.part, &ch->part);
     // The skinned mesh at p is the same through both rigs.
     double* xa = skin_mesh(&ch->rig, p);
     double* xb = skin_mesh(&back.rig, back.pose);
@@ -325,7 +345,7 @@ static void test_mini_extras(void)
     const sp_abstraction* ab = &ch.rig.abstractions[0];
     ENSURE(!strcmp(ab->name, "outline") && ab->correspondence == SP_CORR_CLOSEST);
     ENSURE(ab->curve_count == 1 && ab->curves[0].closed && ab->point_count == 4 && !strcmp(ab->curves[0].name, "body"));
-    ENSURE(ch.part_json && strstr(ch.part_json, "\"category\":\"tail\"") && strstr(ch.part_json, "\"attach\":\"back\""));
+    ENSURE(ch.has_part && !strcmp(ch.part.category, "tail") && ch.part.has_attach && !strcmp(ch.part.attach.joint, "back"));
     ENSURE(ch.has_camera && ch.camera.kind == SP_CAMERA_PERSPECTIVE);
     ENSURE_NEAR(ch.camera.scale, 240.0 / tan(0.4), 1e-9);
     ENSURE_NEAR(ch.camera.view.m[13], -1.0, 1e-12);
@@ -343,7 +363,8 @@ static void test_fixture_round_trip(void)
     sp_character ch;
     sp_error err = {0};
     ENSURE(sp_character_from_rig(&rig, &ch, &err) == SP_OK);
-    ch.part_json = strdup("{\"category\":\"wings\",\"n\":2}");
+    ENSURE(sp_part_parse_json("{\"category\":\"wings\",\"n\":2}", "fixture", &ch.part, &err) == SP_OK);
+    ch.has_part = true;
     round_trip(&ch, "fixture_rt.glb", 21);
     round_trip(&ch, "fixture_rt.gltf", 22);
     // In memory too.
@@ -376,6 +397,110 @@ static void ensure_fails(const char* path, const char* name, const char* expect)
 static void bad_mini(const char* name, mini_desc d, const char* expect)
 {
     ensure_fails(write_mini(name, &d), name, expect);
+}
+
+// ---- sp_part -----------------------------------------------------------------
+
+// Every key the struct knows, in every form, and keys it does not know at
+// every level: parsed into the fields, written back whole, and unchanged
+// through save and load (.glb and .gltf). No JSON null: tinygltf's values
+// have none to write, so the glTF writer drops a null (sp/part.h).
+static const char k_full_part[] =
+    "{\"category\": \"torso\", \"abstraction\": \"outline\", \"zz_note\": \"caf\\u00e9 \\\"x\\\"\", "
+    "\"sockets\": [{\"name\": \"neck\", \"joint\": \"tip\", \"position\": [0.1, -2.5, 1e-7], \"accepts\": [\"head\", "
+    "\"horns\"], \"tilt\": 0.25}, {\"name\": \"tail\", \"accepts\": \"tail\"}, {\"name\": \"back\"}], "
+    "\"attach\": {\"socket\": \"body\", \"joint\": \"root\", \"position\": [0, 1, 0], \"weight\": [1, 2.5, \"w\"]}, "
+    "\"a_meta\": {\"n\": 3, \"big\": 1e300, \"on\": true, \"list\": [{\"k\": false}]}}";
+// The same as the writer writes it: keys sorted, short forms in full.
+static const char k_full_part_written[] =
+    "{\"a_meta\":{\"big\":1e+300,\"list\":[{\"k\":false}],\"n\":3,\"on\":true},\"abstraction\":\"outline\","
+    "\"attach\":{\"joint\":\"root\",\"position\":[0,1,0],\"socket\":\"body\",\"weight\":[1,2.5,\"w\"]},"
+    "\"category\":\"torso\",\"sockets\":[{\"accepts\":[\"head\",\"horns\"],\"joint\":\"tip\",\"name\":\"neck\","
+    "\"position\":[0.1,-2.5,1e-07],\"tilt\":0.25},{\"accepts\":[\"tail\"],\"name\":\"tail\"},{\"name\":\"back\"}],"
+    "\"zz_note\":\"caf\u00e9 \\\"x\\\"\"}";
+
+static void test_part_round_trip(void)
+{
+    sp_character ch = load_ok(write_mini("part_full.gltf", &(mini_desc){.extras = true, .part = k_full_part}));
+    const sp_part* p = &ch.part;
+    ENSURE(ch.has_part && !strcmp(p->category, "torso") && !strcmp(p->abstraction, "outline"));
+    ENSURE(p->socket_count == 3);
+    const sp_part_socket* s = &p->sockets[0];
+    ENSURE(!strcmp(s->name, "neck") && !strcmp(s->joint, "tip") && s->has_position);
+    ENSURE(s->position.x == 0.1 && s->position.y == -2.5 && s->position.z == 1e-7);
+    ENSURE(s->accept_count == 2 && !strcmp(s->accepts[0], "head") && !strcmp(s->accepts[1], "horns"));
+    ENSURE(s->extra && !strcmp(s->extra, "{\"tilt\":0.25}"));
+    ENSURE(p->sockets[1].accept_count == 1 && !strcmp(p->sockets[1].accepts[0], "tail") && !p->sockets[1].joint[0]);
+    ENSURE(!p->sockets[2].has_position && p->sockets[2].accept_count == 0 && !p->sockets[2].extra);
+    ENSURE(p->has_attach && !strcmp(p->attach.socket, "body") && !strcmp(p->attach.joint, "root") && p->attach.has_position);
+    ENSURE(p->attach.position.y == 1.0 && p->attach.extra && strstr(p->attach.extra, "\"weight\""));
+    ENSURE(p->extra && strstr(p->extra, "\"zz_note\"") && strstr(p->extra, "\"a_meta\"") && !strstr(p->extra, "category"));
+    char* text = part_text(p);
+    if (strcmp(text, k_full_part_written) != 0) fprintf(stderr, "  written: %s\n", text);
+    ENSURE(!strcmp(text, k_full_part_written));
+    free(text);
+    // Through files: the same part, so the same text.
+    const char* names[] = {"part_full_rt.glb", "part_full_rt.gltf"};
+    for (int i = 0; i < 2; ++i) {
+        sp_error err = {0};
+        ENSURE(sp_gltf_save(&ch, NULL, sp_test_tmp_path(names[i]), &err) == SP_OK);
+        sp_character back = load_ok(sp_test_tmp_path(names[i]));
+        ENSURE(back.has_part);
+        ensure_same_part(&back.part, &ch.part);
+        sp_character_free(&back);
+    }
+    // A copy is the same part and owns its own memory.
+    sp_part copy;
+    sp_error err = {0};
+    ENSURE(sp_part_copy(&ch.part, &copy, &err) == SP_OK && copy.sockets != ch.part.sockets && copy.extra != ch.part.extra);
+    // A save refuses a part no file can hold, in one line naming the file.
+    ch.part.sockets[0].position.z = INFINITY;
+    ENSURE(sp_gltf_save(&ch, NULL, sp_test_tmp_path("part_inf.glb"), &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "part_inf.glb") && strstr(err.text, "socket 'neck'") && !strchr(err.text, '\n'));
+    sp_character_free(&ch);
+    text = part_text(&copy);
+    ENSURE(!strcmp(text, k_full_part_written));
+    free(text);
+    // The writer refuses what no file can hold.
+    copy.sockets[0].position.y = NAN;
+    char* bad = NULL;
+    ENSURE(sp_part_write_json(&copy, &bad, &err) == SP_ERR_INVALID && !bad && strstr(err.text, "neck") &&
+           strstr(err.text, "not finite"));
+    copy.sockets[0].position.y = 0;
+    copy.sockets[1].name[0] = 0;
+    ENSURE(sp_part_write_json(&copy, &bad, &err) == SP_ERR_INVALID && strstr(err.text, "sockets[1] has no name"));
+    sp_part_free(&copy);
+    ENSURE(copy.sockets == NULL && copy.socket_count == 0);
+    ENSURE(sp_part_parse_json("{\"category\": ", "cut.json", &copy, &err) == SP_ERR_PARSE && strstr(err.text, "cut.json"));
+}
+
+// Malformed sp_part: the load fails with one line naming the file and the key.
+static void test_part_bad(void)
+{
+    static const struct {
+        const char* file;
+        const char* part;
+        const char* expect;
+    } k_bad[] = {
+        {"part_array.gltf", "[1, 2]", "sp_part must be a JSON object"},
+        {"part_category.gltf", "{\"category\": 5}", "sp_part: category must be a name of 1 to 63 characters"},
+        {"part_empty_name.gltf", "{\"category\": \"\"}", "category must be a name"},
+        {"part_long_name.gltf", "{\"abstraction\": \"a123456789a123456789a123456789a123456789a123456789a123456789abcd\"}",
+         "abstraction must be a name"},
+        {"part_sockets.gltf", "{\"sockets\": {\"name\": \"a\"}}", "sockets must be a list"},
+        {"part_socket_kind.gltf", "{\"sockets\": [\"neck\"]}", "sockets[0] must be an object"},
+        {"part_socket_name.gltf", "{\"sockets\": [{\"name\": \"a\"}, {\"joint\": \"root\"}]}", "sockets[1] has no name"},
+        {"part_socket_joint.gltf", "{\"sockets\": [{\"name\": \"a\", \"joint\": 1}]}", "sockets[0].joint must be a name"},
+        {"part_socket_pos.gltf", "{\"sockets\": [{\"name\": \"a\", \"position\": [0, 1]}]}",
+         "sockets[0].position must be 3 finite numbers"},
+        {"part_socket_pos2.gltf", "{\"sockets\": [{\"name\": \"a\", \"position\": [0, \"1\", 2]}]}", "position must be 3"},
+        {"part_accepts.gltf", "{\"sockets\": [{\"name\": \"a\", \"accepts\": [\"head\", 2]}]}", "sockets[0].accepts must be"},
+        {"part_attach.gltf", "{\"attach\": 3}", "attach must be an object or a joint name"},
+        {"part_attach_pos.gltf", "{\"attach\": {\"position\": null}}", "attach.position must be 3 finite numbers"},
+        {"part_attach_socket.gltf", "{\"attach\": {\"socket\": [\"a\"]}}", "attach.socket must be a name"},
+    };
+    for (size_t i = 0; i < sizeof k_bad / sizeof k_bad[0]; ++i)
+        bad_mini(k_bad[i].file, (mini_desc){.extras = true, .part = k_bad[i].part}, k_bad[i].expect);
 }
 
 static void test_bad_input(void)
@@ -474,6 +599,8 @@ int main(int argc, char** argv)
                                    {"mini_plain", test_mini_plain},
                                    {"mini_extras", test_mini_extras},
                                    {"fixture_round_trip", test_fixture_round_trip},
+                                   {"part_round_trip", test_part_round_trip},
+                                   {"part_bad", test_part_bad},
                                    {"bad_input", test_bad_input},
                                    {"mutations", test_mutations},
                                    {0}});

@@ -53,9 +53,8 @@ static void write_part(const fixture_part* fp, const char* path)
     sp_character ch = {0};
     sp_error err = {0};
     ENSURE(sp_character_from_rig(&rig, &ch, &err) == SP_OK);
-    char json[128];
-    snprintf(json, sizeof json, "{\"category\": \"%s\"}", fp->category);
-    ch.part_json = strdup(json);
+    ch.has_part = true;
+    snprintf(ch.part.category, sizeof ch.part.category, "%s", fp->category);
     sp_result r = sp_gltf_save(&ch, NULL, path, &err);
     if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
     ENSURE(r == SP_OK);

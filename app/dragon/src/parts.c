@@ -1,7 +1,6 @@
 // parts.c: parts as stored (templates: the rig, its sketch view on the
 // canvas, its sp_part hints, its clip, its prepared solver), cached by name,
 // and the database behind them (polled for changes, reopened when replaced).
-#include <cjson/cJSON.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
@@ -27,19 +26,6 @@ void dragon_tpl_release(tpl* t)
     free(t);
 }
 
-static bool read_vec3(const cJSON* a, sp_vec3* out)
-{
-    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != 3) return false;
-    double v[3];
-    for (int i = 0; i < 3; ++i) {
-        const cJSON* e = cJSON_GetArrayItem(a, i);
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) return false;
-        v[i] = e->valuedouble;
-    }
-    *out = (sp_vec3){v[0], v[1], v[2]};
-    return true;
-}
-
 // A point given in model space at the rest pose, as an offset in `joint`'s frame.
 static sp_vec3 to_joint_local(tpl* t, int joint, sp_vec3 model)
 {
@@ -62,54 +48,33 @@ static void read_part_extras(tpl* t)
         }
     t->attach_local = (sp_vec3){0, 0, 0};
     t->is_torso = !strcmp(t->category, "torso");
-    cJSON* part = t->ch.part_json ? cJSON_Parse(t->ch.part_json) : NULL;
-    if (!part) return;
-    const cJSON* sockets = cJSON_GetObjectItemCaseSensitive(part, "sockets");
-    int n = cJSON_IsArray(sockets) ? cJSON_GetArraySize(sockets) : 0;
-    if (n > 0) t->sockets = calloc((size_t)n, sizeof(dsocket));
-    const cJSON* s;
-    if (t->sockets) cJSON_ArrayForEach(s, sockets)
-        {
-            dsocket* d = &t->sockets[t->socket_count];
-            const cJSON* name = cJSON_GetObjectItemCaseSensitive(s, "name");
-            const cJSON* joint = cJSON_GetObjectItemCaseSensitive(s, "joint");
-            const cJSON* pos = cJSON_GetObjectItemCaseSensitive(s, "position");
-            const cJSON* acc = cJSON_GetObjectItemCaseSensitive(s, "accepts");
-            d->joint = cJSON_IsString(joint) ? sp_rig_find_joint(rig, joint->valuestring) : t->attach_joint;
-            if (d->joint < 0) continue; // a socket on a joint the part does not have: ignore it
-            snprintf(d->name, sizeof d->name, "%s", cJSON_IsString(name) ? name->valuestring : "socket");
-            sp_vec3 p;
-            d->local = read_vec3(pos, &p) ? to_joint_local(t, d->joint, p) : (sp_vec3){0, 0, 0};
-            if (cJSON_IsArray(acc)) {
-                const cJSON* c;
-                size_t len = 0;
-                d->accepts[len++] = ',';
-                cJSON_ArrayForEach(c, acc) if (cJSON_IsString(c) && len + strlen(c->valuestring) + 2 < sizeof d->accepts)
-                {
-                    len += (size_t)snprintf(d->accepts + len, sizeof d->accepts - len, "%s,", c->valuestring);
-                }
-                if (len == 1) d->accepts[0] = 0;
-            } else if (cJSON_IsString(acc)) {
-                snprintf(d->accepts, sizeof d->accepts, ",%s,", acc->valuestring);
-            }
-            ++t->socket_count;
+    if (!t->ch.has_part) return;
+    const sp_part* part = &t->ch.part;
+    if (part->socket_count > 0) t->sockets = calloc((size_t)part->socket_count, sizeof(dsocket));
+    for (int i = 0; t->sockets && i < part->socket_count; ++i) {
+        const sp_part_socket* s = &part->sockets[i];
+        dsocket* d = &t->sockets[t->socket_count];
+        d->joint = s->joint[0] ? sp_rig_find_joint(rig, s->joint) : t->attach_joint;
+        if (d->joint < 0) continue; // a socket on a joint the part does not have: ignore it
+        dragon_copy_name(d->name, sizeof d->name, s->name);
+        d->local = s->has_position ? to_joint_local(t, d->joint, s->position) : (sp_vec3){0, 0, 0};
+        size_t len = 0;
+        for (int k = 0; k < s->accept_count; ++k) {
+            if (len == 0) d->accepts[len++] = ',';
+            if (len + strlen(s->accepts[k]) + 2 < sizeof d->accepts)
+                len += (size_t)snprintf(d->accepts + len, sizeof d->accepts - len, "%s,", s->accepts[k]);
         }
-    if (t->socket_count > 0) t->is_torso = true;
-    const cJSON* at = cJSON_GetObjectItemCaseSensitive(part, "attach");
-    if (cJSON_IsString(at)) {
-        int j = sp_rig_find_joint(rig, at->valuestring);
-        if (j >= 0) t->attach_joint = j;
-    } else if (cJSON_IsObject(at)) {
-        const cJSON* joint = cJSON_GetObjectItemCaseSensitive(at, "joint");
-        const cJSON* pos = cJSON_GetObjectItemCaseSensitive(at, "position");
-        const cJSON* sock = cJSON_GetObjectItemCaseSensitive(at, "socket");
-        int j = cJSON_IsString(joint) ? sp_rig_find_joint(rig, joint->valuestring) : -1;
-        if (j >= 0) t->attach_joint = j;
-        sp_vec3 p;
-        if (read_vec3(pos, &p)) t->attach_local = to_joint_local(t, t->attach_joint, p);
-        if (cJSON_IsString(sock)) dragon_copy_name(t->prefer, sizeof t->prefer, sock->valuestring);
+        if (len == 1) d->accepts[0] = 0;
+        ++t->socket_count;
     }
-    cJSON_Delete(part);
+    if (t->socket_count > 0) t->is_torso = true;
+    if (part->has_attach) {
+        const sp_part_attach* at = &part->attach;
+        int j = at->joint[0] ? sp_rig_find_joint(rig, at->joint) : -1;
+        if (j >= 0) t->attach_joint = j;
+        if (at->has_position) t->attach_local = to_joint_local(t, t->attach_joint, at->position);
+        if (at->socket[0]) dragon_copy_name(t->prefer, sizeof t->prefer, at->socket);
+    }
 }
 
 static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve, sp_error* err)

@@ -57,7 +57,7 @@ bool sp_derive_view_parse(const char* s, sp_derive_view* out);
 
 /// How to derive. Zero means the default.
 typedef struct sp_derive_desc {
-    const char* category;     ///< sp_part.category; NULL: the file's sp_part.category, else none
+    const char* category;     ///< sp_part.category (1 to SP_NAME_MAX - 1 characters); NULL: the file's, else none
     const char* abstraction;  ///< "outline" (NULL) or "stick": what the part's sketches show (sp_part.abstraction)
     const char* attach_joint; ///< the joint the part attaches by (NULL: the root)
     sp_derive_view view;

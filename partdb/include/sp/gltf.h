@@ -24,6 +24,7 @@
 
 #include <stdbool.h>
 
+#include "sp/part.h"
 #include "sp/result.h"
 #include "sp/rig.h"
 
@@ -39,7 +40,8 @@ typedef struct sp_character {
     float* colors;            ///< rig.vertex_count by 4, linear RGBA base colour per vertex
     bool has_camera;          ///< a camera came from the file's scene
     sp_camera camera;         ///< the sketch view: the file's camera, else a front orthographic view of the rest pose
-    char* part_json;          ///< the scene's `extras.sp_part` as compact JSON, or NULL
+    bool has_part;            ///< the scene has `extras.sp_part` (a kiosk part)
+    sp_part part;             ///< it, parsed (sp/part.h)
     bool derived_abstraction; ///< the stick figure was derived from the skeleton
     bool derived_dofs;        ///< default rotation DOFs were added
     int mesh_skins;           ///< distinct skins of the scene's skinned meshes (the rig is the first one's)
