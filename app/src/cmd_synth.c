@@ -14,6 +14,7 @@
 #include "rig_handle.h"
 #include "sp/gltf.h"
 #include "sp/handdraw.h"
+#include "sp/math.h"
 #include "sp/sketch_io.h"
 #include "sp/synth.h"
 
@@ -22,11 +23,6 @@ static bool has_opt(int argc, char** argv, const char* name)
     for (int i = 1; i < argc; ++i)
         if (!strcmp(argv[i], name)) return true;
     return false;
-}
-
-static int cmp_str(const void* a, const void* b)
-{
-    return strcmp(*(char* const*)a, *(char* const*)b);
 }
 
 static bool make_dir(const char* path, sp_error* err)
@@ -84,7 +80,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         free(names);
         return SP_EXIT_INPUT;
     }
-    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    qsort(names, (size_t)n, sizeof *names, sp_cmp_cstr);
     if (!make_dir(out_dir, &err)) goto fail;
     sp_handdraw_desc desc = *base;
     int total = 0, written = 0;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "db_internal.h"
+#include "sp/math.h"
 
 static sp_result make_dir(const char* path, sp_error* err)
 {
@@ -253,8 +254,6 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
 
 // ---- the default database ---------------------------------------------------------
 
-static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
-
 static bool is_part_file(const char* n)
 {
     size_t l = strlen(n);
@@ -358,7 +357,7 @@ sp_result sp_db_create_default(const char* path, const char* assets_dir, const s
         free(c.names);
         return sp_fail(err, SP_ERR_INVALID, "%s: no parts (*.glb, *.gltf) to build the default database from", assets_dir);
     }
-    qsort(c.names, (size_t)c.n, sizeof *c.names, cmp_str);
+    qsort(c.names, (size_t)c.n, sizeof *c.names, sp_cmp_cstr);
     sp_result r = build_then_link(path, fill_default, &c, err);
     sp_db_free_strings(c.names, c.n);
     return r;

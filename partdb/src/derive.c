@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "gltf_internal.h"
+#include "sp/math.h"
 #include "sp/outline.h"
 
 // Parameter bounds (DESIGN.md, "Generated dragon parts"; radians, factors).
@@ -228,12 +229,6 @@ static sp_result build_joints(work* w, sp_derive_info* info, sp_error* err)
     return SP_OK;
 }
 
-static int cmp_float(const void* a, const void* b)
-{
-    float x = *(const float*)a, y = *(const float*)b;
-    return x < y ? -1 : x > y;
-}
-
 // The first animation with keys, re-keyed on the derived frames: at each key
 // time the source skeleton's motion M_j(t) = G_j(t) G_j^-1 (in the part's
 // space) carries each derived frame, F_j(t) = M_j(t) F_j, and the local TRS
@@ -274,7 +269,7 @@ static sp_result convert_clip(work* w, sp_error* err)
             t[m++] = an->channels[c].times[k];
     for (size_t k = 0; k < steady; ++k)
         t[m++] = fminf(t1, t0 + (float)k / CLIP_RATE);
-    qsort(t, m, sizeof(float), cmp_float);
+    qsort(t, m, sizeof(float), sp_cmp_float);
     size_t u = 0;
     for (size_t k = 0; k < m; ++k)
         if (u == 0 || t[k] - t[u - 1] > 1e-6f) t[u++] = t[k];
