@@ -68,6 +68,7 @@ static void follow_file(kiosk_collector* c)
         return; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
     }
     sp_db_close(c->db);
+    sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
     c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
 }
 
@@ -100,7 +101,6 @@ static void* collector_main(void* arg)
             // and a file renamed over it (follow_file) never meets this
             // file's WAL. A reader in the way only postpones it.
             pthread_mutex_unlock(&c->lock);
-            sp_db_set_busy_timeout(c->db, SP_DB_COLLECT_BUSY_MS); // closing the kiosk waits for this
             sp_db_checkpoint(c->db, NULL);
             pthread_mutex_lock(&c->lock);
         }
@@ -131,6 +131,9 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
         fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected: %s\n", err.text);
         c->db = NULL;
     }
+    // Every wait of the writer's (a store, a checkpoint) is short: closing the
+    // kiosk waits for the writer.
+    if (c->db) sp_db_set_busy_timeout(c->db, SP_DB_COLLECT_BUSY_MS);
     c->threaded = c->db && pthread_create(&c->thread, NULL, collector_main, c) == 0;
     if (c->db && !c->threaded) {
         fprintf(stderr, "dragon-kiosk: %s: visitors' strokes cannot be collected: no thread to write them\n", db_path);

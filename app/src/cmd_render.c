@@ -158,14 +158,8 @@ int cmd_render(int argc, char** argv)
     }
     sp_renderer_create(&(sp_renderer_desc){0}, &r, &err);
     if (r) sp_render_target_create(w, h, 0, &target, &err);
-    if (target)
-        sp_render_mesh_create(r,
-                              &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                              .positions = xyz,
-                                              .colors = ch->colors,
-                                              .triangle_count = rig->triangle_count,
-                                              .triangles = rig->triangles},
-                              &mesh, &err);
+    const sp_mesh_desc md = sp_mesh_desc_of_rig(rig, xyz, ch->colors);
+    if (target) sp_render_mesh_create(r, &md, &mesh, &err);
     if (!mesh) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);
         goto done;

@@ -568,12 +568,8 @@ static silhouette measure(const sp_character* part)
     sp_render_target* t;
     sp_render_target_create(W, H, 0, &t, &err);
     sp_render_mesh* m;
-    sp_render_mesh_create(r,
-                          &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                          .positions = xyz,
-                                          .triangle_count = rig->triangle_count,
-                                          .triangles = rig->triangles},
-                          &m, &err);
+    const sp_mesh_desc md = sp_mesh_desc_of_rig(rig, xyz, NULL);
+    sp_render_mesh_create(r, &md, &m, &err);
     ENSURE(t && m);
     const float bg[4] = {1, 0, 1, 1};
     sp_render_target_bind(t);

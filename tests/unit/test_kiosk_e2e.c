@@ -177,6 +177,23 @@ static bool have_xvfb(void)
     return system("command -v xvfb-run >/dev/null 2>&1") == 0;
 }
 
+// The kiosk's --stats file as JSON, or NULL (said on stderr).
+static cJSON* read_stats(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "  no stats file %s\n", path);
+        return NULL;
+    }
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    cJSON* j = cJSON_Parse(buf);
+    if (!j) fprintf(stderr, "  stats are not JSON: %s\n", buf);
+    return j;
+}
+
 // Runs the kiosk under Xvfb; returns its exit code; stats JSON in *stats (may be NULL).
 // Runs the kiosk on db; its stderr is kept in kiosk_stderr.txt.
 static int run_kiosk_on(const char* db, const char* args, cJSON** stats)
@@ -193,18 +210,7 @@ static int run_kiosk_on(const char* db, const char* args, cJSON** stats)
     char show[2200];
     snprintf(show, sizeof show, "sed -e 's/^/  kiosk: /' '%s' >&2", errf);
     if (system(show) != 0) fprintf(stderr, "  (no stderr)\n");
-    if (stats) {
-        *stats = NULL;
-        FILE* f = fopen(out, "rb");
-        if (f) {
-            static char buf[1 << 16];
-            size_t n = fread(buf, 1, sizeof buf - 1, f);
-            buf[n] = 0;
-            fclose(f);
-            *stats = cJSON_Parse(buf);
-            if (!*stats) fprintf(stderr, "  stats are not JSON: %s\n", buf);
-        }
-    }
+    if (stats) *stats = read_stats(out);
     return rc;
 }
 
@@ -665,13 +671,7 @@ static void test_db_replaced(void)
     waitpid(pid, &status, 0);
     ENSURE(WIFEXITED(status) && WEXITSTATUS(status) == 0); // it replaced the file at least once
     ENSURE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0);
-    FILE* f = fopen(out, "rb");
-    ENSURE(f);
-    static char buf[1 << 16];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    cJSON* st = cJSON_Parse(buf);
+    cJSON* st = read_stats(out);
     ENSURE(st);
     fprintf(stderr, "  parts %g, strokes %g, added %g, reloads %g, errors %g\n", num(st, "parts"), num(st, "strokes"),
             num(st, "parts_added"), num(st, "reloads"), num(st, "pipeline_errors"));
@@ -1111,13 +1111,7 @@ static void test_collect_read_only(void)
     snprintf(cmd, sizeof cmd, "sed -e 's/^/  kiosk: /' '%s' >&2", errf);
     if (system(cmd) != 0) fprintf(stderr, "  (no stderr)\n");
     ENSURE(WEXITSTATUS(status) == 0);
-    FILE* f = fopen(out, "rb");
-    ENSURE(f);
-    static char buf[1 << 16];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    cJSON* st = cJSON_Parse(buf);
+    cJSON* st = read_stats(out);
     ENSURE(st);
     fprintf(stderr, "  parts %g, collected %g, stored %g, dropped %g\n", num(st, "parts"), num(st, "collected"),
             num(st, "collect_stored"), num(st, "collect_dropped"));

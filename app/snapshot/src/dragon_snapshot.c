@@ -16,17 +16,13 @@ sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc*
     sp_vec3 lo, hi;
     if (sp_dragon_bounds(d, &lo, &hi)) sp_render_fit_depth(&cam, lo, hi);
     sp_headless* gl;
-    sp_headless_create(&gl, err);
-    if (!gl) return SP_ERR_UNSUPPORTED;
+    if ((res = sp_headless_create(&gl, err)) != SP_OK) return res;
     sp_renderer* r;
-    sp_renderer_create(&(sp_renderer_desc){0}, &r, err);
     sp_render_target* t = NULL;
-    if (r) sp_render_target_create(cam.width, cam.height, 0, &t, err);
+    res = sp_renderer_create(&(sp_renderer_desc){0}, &r, err);
+    if (res == SP_OK) res = sp_render_target_create(cam.width, cam.height, 0, &t, err);
     sp_render_mesh** meshes = calloc((size_t)(n > 0 ? n : 1), sizeof *meshes);
-    if (!r || !t) {
-        res = SP_ERR_INTERNAL;
-        goto done;
-    }
+    if (res != SP_OK) goto done;
     if (!meshes) {
         res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while rendering");
         goto done;
@@ -35,17 +31,8 @@ sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc*
         const sp_dragon_part* p = sp_dragon_part_get(d, i);
         const sp_rig* rig = &p->character->rig;
         if (rig->vertex_count <= 0 || rig->triangle_count <= 0) continue;
-        sp_render_mesh_create(r,
-                              &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                              .positions = sp_dragon_part_xyz(d, i),
-                                              .colors = p->character->colors,
-                                              .triangle_count = rig->triangle_count,
-                                              .triangles = rig->triangles},
-                              &meshes[i], err);
-        if (!meshes[i]) {
-            res = SP_ERR_INTERNAL;
-            goto done;
-        }
+        const sp_mesh_desc md = sp_mesh_desc_of_rig(rig, sp_dragon_part_xyz(d, i), p->character->colors);
+        if ((res = sp_render_mesh_create(r, &md, &meshes[i], err)) != SP_OK) goto done;
     }
     sp_render_target_bind(t);
     sp_renderer_begin(r, &cam, cam.width, cam.height);

@@ -20,20 +20,16 @@ sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error*
     sp_camera fitted = *d->camera;
     const sp_camera* cam = &fitted;
     sp_headless* gl;
-    sp_headless_create(&gl, err);
-    if (!gl) return SP_ERR_UNSUPPORTED;
-    sp_result res = SP_OK;
+    sp_result res = sp_headless_create(&gl, err);
+    if (res != SP_OK) return res;
     sp_renderer* r;
-    sp_renderer_create(&(sp_renderer_desc){0}, &r, err);
     sp_render_target* t = NULL;
-    if (r) sp_render_target_create(cam->width, cam->height, 0, &t, err);
+    res = sp_renderer_create(&(sp_renderer_desc){0}, &r, err);
+    if (res == SP_OK) res = sp_render_target_create(cam->width, cam->height, 0, &t, err);
     sp_rig_eval* ev;
     sp_rig_eval_create(rig, &ev, NULL);
     double* xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
-    if (!r || !t) {
-        res = SP_ERR_INTERNAL;
-        goto done;
-    }
+    if (res != SP_OK) goto done;
     if (!ev || !xyz) {
         res = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while rendering");
         goto done;
@@ -48,17 +44,8 @@ sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error*
         sp_render_fit_depth(&fitted, lo, hi);
     }
     if (rig->vertex_count > 0 && rig->triangle_count > 0) {
-        sp_render_mesh_create(r,
-                              &(sp_mesh_desc){.vertex_count = rig->vertex_count,
-                                              .positions = xyz,
-                                              .colors = ch->colors,
-                                              .triangle_count = rig->triangle_count,
-                                              .triangles = rig->triangles},
-                              &m, err);
-        if (!m) {
-            res = SP_ERR_INTERNAL;
-            goto done;
-        }
+        const sp_mesh_desc md = sp_mesh_desc_of_rig(rig, xyz, ch->colors);
+        if ((res = sp_render_mesh_create(r, &md, &m, err)) != SP_OK) goto done;
     }
     sp_render_target_bind(t);
     sp_renderer_begin(r, cam, cam->width, cam->height);

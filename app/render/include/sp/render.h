@@ -108,6 +108,17 @@ typedef struct sp_mesh_desc {
     const uint32_t* triangles; ///< triangle_count by 3, indices < vertex_count
 } sp_mesh_desc;
 
+/// A skinned rig's mesh posed at `positions` (its vertices by 3, world, as
+/// sp_rig_eval_points gives them), with per-vertex `colors` or NULL.
+static inline sp_mesh_desc sp_mesh_desc_of_rig(const sp_rig* rig, const double* positions, const float* colors)
+{
+    return (sp_mesh_desc){.vertex_count = rig->vertex_count,
+                          .positions = positions,
+                          .colors = colors,
+                          .triangle_count = rig->triangle_count,
+                          .triangles = rig->triangles};
+}
+
 /// Uploads a mesh (copies everything it needs). On failure (bad index, NaN
 /// position, out of memory) *out is NULL and err says why.
 sp_result sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* desc, sp_render_mesh** out, sp_error* err);
