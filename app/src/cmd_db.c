@@ -132,13 +132,14 @@ static int db_init(int argc, char** argv)
     db_common c = {0};
     const char* from = NULL;
     const char* assets = NULL;
-    int synth = 0, folds = 0;
+    int synth = 0, concepts = 0, folds = 0;
     bool no_train = false;
     clf_cli_opts o = {0};
     sp_opt opts[] = {DB_COMMON_OPTS(c),
                      {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
                      {"--assets", SP_OPT_STRING, &assets, "DIR", "parts to build the default database from (default: the source tree's assets/)", false},
                      {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
+                     {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category (default 60, -1 none)", false},
                      {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
                      {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
                      CLF_CLI_OPTS(o)};
@@ -157,7 +158,7 @@ static int db_init(int argc, char** argv)
     else {
         char def[1024];
         snprintf(def, sizeof def, "%s/assets", SP_SOURCE_DIR);
-        r = sp_db_create_default(db_path(&c), assets ? assets : def, &(sp_db_default_desc){.synth_per_part = synth, .train = td}, &err);
+        r = sp_db_create_default(db_path(&c), assets ? assets : def, &(sp_db_default_desc){.synth_per_part = synth, .concepts_per_category = concepts, .train = td}, &err);
     }
     if (r != SP_OK) return fail(cmd, &err);
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);

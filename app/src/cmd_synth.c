@@ -1,6 +1,7 @@
 // sketchpose synth: strokes of a random pose within bounds (tests, training);
 // with --style, passed through the hand-drawing model; with --parts DIR, a
-// labelled folder of hand-drawn sketches of every part in DIR.
+// labelled folder of hand-drawn sketches of every part in DIR; with
+// --concepts, the default recipe's concept sketches (sp/concept.h).
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -12,9 +13,11 @@
 #include "pose_io.h"
 #include "posing.h"
 #include "rig_handle.h"
+#include "sp/concept.h"
 #include "sp/gltf.h"
 #include "sp/handdraw.h"
 #include "sp/math.h"
+#include "sp/sketch_sheet.h"
 #include "sp/sketch_io.h"
 #include "sp/synth.h"
 
@@ -157,14 +160,62 @@ done:
     return code;
 }
 
+// --concepts: `per_part` concept sketches of each of the six parts (seeds
+// sp_handdraw_seed(family, i), as the default recipe draws them), into
+// OUT/<category>/concept-s<family>-<i>.json and/or one contact sheet.
+static int synth_concepts(int per_part, uint64_t family, bool clean, const char* out_dir, const char* sheet)
+{
+    sp_error err = {0};
+    int n = per_part * SP_CONCEPT_COUNT, code = SP_EXIT_INPUT, made = 0;
+    sp_sketch* sk = calloc((size_t)n, sizeof *sk);
+    sp_sheet_item* items = calloc((size_t)n, sizeof *items);
+    char(*labels)[48] = calloc((size_t)n, sizeof *labels);
+    if (!sk || !items || !labels) {
+        sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
+        goto fail;
+    }
+    if (out_dir && !make_dir(out_dir, &err)) goto fail;
+    for (int c = 0; c < SP_CONCEPT_COUNT; ++c) {
+        char cdir[4096];
+        snprintf(cdir, sizeof cdir, "%s/%s", out_dir ? out_dir : ".", sp_concept_name((sp_concept)c));
+        if (out_dir && !make_dir(cdir, &err)) goto fail;
+        for (int i = 0; i < per_part; ++i, ++made) {
+            uint64_t sd = sp_handdraw_seed(family, i);
+            sp_result r = clean ? sp_concept_clean((sp_concept)c, sd, &sk[made], &err) : sp_concept_sketch((sp_concept)c, sd, &sk[made], &err);
+            if (r != SP_OK) goto fail;
+            snprintf(labels[made], sizeof labels[made], "%s %d", sp_concept_name((sp_concept)c), i);
+            items[made] = (sp_sheet_item){.sketch = &sk[made], .label = labels[made]};
+            char file[4400];
+            snprintf(file, sizeof file, "%s/concept-s%llu-%04d.json", cdir, (unsigned long long)family, i);
+            if (out_dir && sp_sketch_write_json(file, &sk[made], &err) != SP_OK) goto fail;
+        }
+    }
+    char title[96];
+    snprintf(title, sizeof title, "concept sketches, seed family %llu", (unsigned long long)family);
+    if (sheet && sp_sheet_write_png(items, n, &(sp_sheet_desc){.cols = per_part < 12 ? per_part : 12, .title = title}, sheet, &err) != SP_OK)
+        goto fail;
+    printf("{\"concepts\": %d, \"per_part\": %d, \"seed\": %llu}\n", made, per_part, (unsigned long long)family);
+    code = SP_EXIT_OK;
+    goto done;
+fail:
+    fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
+done:
+    for (int i = 0; sk && i < n; ++i)
+        sp_sketch_free(&sk[i]);
+    free(sk);
+    free(items);
+    free(labels);
+    return code;
+}
+
 int cmd_synth(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *out = NULL, *truth = NULL, *size = NULL, *pose = NULL;
     const char *parts = NULL, *out_dir = NULL, *style_name = NULL;
-    const char* shape_name = NULL;
+    const char *shape_name = NULL, *sheet = NULL;
     int seed = 0, per_part = 60;
     double amplitude = 0.7853981633974483, noise = 0, spikes = 0;
-    bool details = false;
+    bool details = false, concepts = false;
     const sp_opt opts[] = {
         {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
@@ -192,6 +243,11 @@ int cmd_synth(int argc, char** argv)
          "with --parts: the mesh's silhouette with its decorations instead of the abstraction", false},
         {"--spikes", SP_OPT_DOUBLE, &spikes, "P",
          "with --parts: chance 0..1 of a row of spikes added along the curve (default 0)", false},
+        {"--concepts", SP_OPT_FLAG, &concepts, "",
+         "the default recipe's concept sketches of the six dragon parts (designs of its own, not the parts' shapes), "
+         "--per-part each (--style normal, the default, or clean), into --out-dir D/<category>/ and/or --sheet",
+         false},
+        {"--sheet", SP_OPT_STRING, &sheet, "S.png", "with --concepts: a labelled contact sheet of them", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose synth",
                           "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "
@@ -203,6 +259,19 @@ int cmd_synth(int argc, char** argv)
     if (style_name && (style = sp_handdraw_style_parse(style_name)) == SP_HANDDRAW_STYLE_COUNT) {
         fprintf(stderr, "sketchpose synth: --style must be normal, harsh or clean, got '%s'\n", style_name);
         return SP_EXIT_USAGE;
+    }
+    if (concepts) {
+        if (parts || rig_path || out || pose || truth || size || (!out_dir && !sheet)) {
+            fprintf(stderr, "sketchpose synth: --concepts needs --out-dir D or --sheet S.png and takes none of --parts, --rig, --out, "
+                            "--pose, --truth, --size\n");
+            return SP_EXIT_USAGE;
+        }
+        if (per_part < 1 || per_part > 10000 || seed < 0 || (style != SP_HANDDRAW_STYLE_COUNT && style != SP_HANDDRAW_NORMAL &&
+                                                             style != SP_HANDDRAW_CLEAN)) {
+            fprintf(stderr, "sketchpose synth: --per-part must be 1..10000 with --concepts, --seed not negative, --style normal or clean\n");
+            return SP_EXIT_USAGE;
+        }
+        return synth_concepts(per_part, (uint64_t)(seeded ? seed : 1), style == SP_HANDDRAW_CLEAN, out_dir, sheet);
     }
     if (parts) {
         if (!out_dir || rig_path || out || pose || truth || size) {

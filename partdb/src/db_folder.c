@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include "db_internal.h"
+#include "sp/concept.h"
+#include "sp/handdraw.h"
 #include "sp/math.h"
 
 static sp_result make_dir(const char* path, sp_error* err)
@@ -298,6 +300,36 @@ static bool is_kiosk_part(const char* file)
     return part;
 }
 
+// Concept sketches (sp/concept.h) for every category of the stored parts that
+// has a concept, seeds sp_handdraw_seed(category's family, i): the designs
+// visitors draw that the parts' own shapes do not cover.
+static sp_result add_concepts(sp_db* db, int per_category, sp_error* err)
+{
+    char** cats = NULL;
+    int ncat = 0;
+    sp_result r = sp_db_categories(db, &cats, &ncat, err);
+    for (int k = 0; r == SP_OK && k < ncat; ++k) {
+        sp_concept c = sp_concept_parse(cats[k]);
+        if (c == SP_CONCEPT_COUNT) continue;
+        sp_dataset ds = {0};
+        if (sp_dataset_add_category(&ds, cats[k]) < 0 || !(ds.samples = calloc((size_t)per_category, sizeof *ds.samples))) {
+            sp_dataset_free(&ds);
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+            break;
+        }
+        uint64_t family = sp_handdraw_part_family(1, cats[k]);
+        for (int i = 0; r == SP_OK && i < per_category; ++i) {
+            r = sp_concept_sketch(c, sp_handdraw_seed(family, i), &ds.samples[i].sketch, err);
+            ds.samples[i].label = 0, ds.samples[i].index = i;
+            ds.count = i + (r == SP_OK);
+        }
+        if (r == SP_OK) r = sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_SYNTHETIC, "concepts", NULL, err);
+        sp_dataset_free(&ds);
+    }
+    sp_db_free_strings(cats, ncat);
+    return r;
+}
+
 typedef struct default_ctx {
     const char* assets;
     char** names;
@@ -316,6 +348,8 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
         sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = "assets"};
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
     }
+    int nconcepts = c->d.concepts_per_category == 0 ? SP_DB_CONCEPTS_DEFAULT : c->d.concepts_per_category < 0 ? 0 : c->d.concepts_per_category;
+    if (r == SP_OK && nconcepts > 0) r = add_concepts(db, nconcepts, err);
     // People's own strokes of the parts (assets/sketches/<category>.ndjson,
     // picked from Quick, Draw!; assets/sketches/README.md), when the folder has them.
     char dir[1024];

@@ -16,6 +16,7 @@
 #include "db_internal.h"
 #include "dragon_parts.h"
 #include "sp/classifier.h"
+#include "sp/concept.h"
 #include "sp/curve.h"
 #include "sp/handdraw.h"
 #include "sp/synth.h"
@@ -132,6 +133,67 @@ static void test_handdraw_deterministic(void)
     ENSURE(sp_handdraw_seed(1, 0) != sp_handdraw_seed(2, 0) && sp_handdraw_seed(1, 0) != sp_handdraw_seed(1, 1));
     ENSURE(sp_handdraw_part_family(1, "wings") != sp_handdraw_part_family(1, "tail"));
     ENSURE(sp_handdraw_part_family(1, "wings") == sp_handdraw_part_family(1, "wings"));
+}
+
+// Concept sketches (sp/concept.h): the six parts as visitors imagine them.
+static bool sketches_equal(const sp_sketch* a, const sp_sketch* b)
+{
+    if (a->stroke_count != b->stroke_count) return false;
+    for (int s = 0; s < a->stroke_count; ++s) {
+        if (a->strokes[s].count != b->strokes[s].count) return false;
+        if (memcmp(a->strokes[s].points, b->strokes[s].points, sizeof(sp_vec2) * (size_t)a->strokes[s].count)) return false;
+    }
+    return true;
+}
+
+static void test_concepts(void)
+{
+    for (int c = 0; c < SP_CONCEPT_COUNT; ++c)
+        ENSURE(sp_concept_parse(sp_concept_name((sp_concept)c)) == (sp_concept)c);
+    ENSURE(sp_concept_parse("horns") == SP_CONCEPT_COUNT && sp_concept_parse(NULL) == SP_CONCEPT_COUNT);
+    sp_error err = {0};
+    sp_sketch sk;
+    ENSURE(sp_concept_clean(SP_CONCEPT_COUNT, 1, &sk, &err) == SP_ERR_INVALID && sk.stroke_count == 0);
+    enum { N = 300 };
+    for (int c = 0; c < SP_CONCEPT_COUNT; ++c) {
+        double aspect_sum = 0, aspect_sq = 0;
+        int closed = 0;
+        for (int i = 0; i < N; ++i) {
+            uint64_t seed = sp_handdraw_seed(9, i);
+            // The clean design: one stroke, about 340 px across, centred on the kiosk's canvas.
+            ENSURE(sp_concept_clean((sp_concept)c, seed, &sk, &err) == SP_OK);
+            ENSURE(sk.stroke_count == 1 && sk.strokes[0].count >= 4 && sp_sketch_is_valid(&sk));
+            ENSURE(sk.canvas_w == SP_CONCEPT_CANVAS_W && sk.canvas_h == SP_CONCEPT_CANVAS_H);
+            sp_vec2 lo, hi;
+            ENSURE(sp_sketch_bounds(&sk, &lo, &hi));
+            ENSURE_NEAR(hypot(hi.x - lo.x, hi.y - lo.y), 340, 1e-6);
+            ENSURE_NEAR((lo.x + hi.x) / 2, SP_CONCEPT_CANVAS_W / 2, 1e-6);
+            const sp_stroke* st = &sk.strokes[0];
+            closed += st->points[0].x == st->points[st->count - 1].x && st->points[0].y == st->points[st->count - 1].y;
+            double a = log((hi.x - lo.x + 1) / (hi.y - lo.y + 1));
+            aspect_sum += a, aspect_sq += a * a;
+            sp_sketch_free(&sk);
+            // Drawn by hand: valid, with times, the same for the same seed, another for the next.
+            sp_sketch x, y, z;
+            ENSURE(sp_concept_sketch((sp_concept)c, seed, &x, &err) == SP_OK);
+            ENSURE(sp_sketch_is_valid(&x) && x.stroke_count >= 1 && x.strokes[0].t);
+            if (i < 20) {
+                ENSURE(sp_concept_sketch((sp_concept)c, seed, &y, &err) == SP_OK);
+                ENSURE(sp_concept_sketch((sp_concept)c, seed + 1, &z, &err) == SP_OK);
+                ENSURE(sketches_equal(&x, &y) && !sketches_equal(&x, &z));
+                sp_sketch_free(&y);
+                sp_sketch_free(&z);
+            }
+            sp_sketch_free(&x);
+        }
+        // Designs vary (proportions, pose, facing) and mix closed outlines with open lines where people draw both.
+        double mean = aspect_sum / N, sd = sqrt(fmax(0, aspect_sq / N - mean * mean));
+        fprintf(stderr, "  %-10s closed %3d of %d, log aspect %.2f +- %.2f\n", sp_concept_name((sp_concept)c), closed, N, mean, sd);
+        ENSURE(sd > 0.1);
+        if (c == SP_CONCEPT_TAIL || c == SP_CONCEPT_FRONT_LEGS || c == SP_CONCEPT_HIND_LEGS) ENSURE(closed > N / 10 && closed < N * 9 / 10);
+        if (c == SP_CONCEPT_HEAD || c == SP_CONCEPT_TORSO) ENSURE(closed > N / 2);
+        if (c == SP_CONCEPT_TAIL) ENSURE(mean > 0.5); // long and thin
+    }
 }
 
 static void test_handdraw_bad_input(void)
@@ -506,6 +568,43 @@ static bool write_standins(const char* dir)
     return true;
 }
 
+static void test_cli_synth_concepts(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char out[1024], cmd[8192];
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("concepts_out"));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && '%s' synth --concepts --per-part 3 --seed 4 --out-dir '%s' --sheet '%s/sheet.png' > /dev/null",
+             out, bin, out, out);
+    ENSURE(system(cmd) == 0);
+    sp_dataset ds;
+    sp_error err = {0};
+    ENSURE(sp_dataset_load(out, &ds, &err) == SP_OK);
+    ENSURE(ds.count == 3 * SP_CONCEPT_COUNT && ds.category_count == SP_CONCEPT_COUNT);
+    // The files are the library's sketches of that seed family, as the default recipe draws them.
+    sp_sketch want;
+    ENSURE(sp_concept_sketch(SP_CONCEPT_WINGS, sp_handdraw_seed(4, 2), &want, &err) == SP_OK);
+    const sp_sample* got = NULL;
+    for (int i = 0; i < ds.count; ++i)
+        if (!strcmp(ds.categories[ds.samples[i].label], "wings") && ds.samples[i].index == 2) got = &ds.samples[i];
+    ENSURE(got && got->sketch.stroke_count == want.stroke_count && got->sketch.strokes[0].count == want.strokes[0].count);
+    for (int i = 0; i < want.strokes[0].count; ++i)
+        ENSURE_NEAR(got->sketch.strokes[0].points[i].x, want.strokes[0].points[i].x, 1e-3);
+    sp_sketch_free(&want);
+    sp_dataset_free(&ds);
+    char png[1100];
+    snprintf(png, sizeof png, "%s/sheet.png", out);
+    struct stat st;
+    ENSURE(stat(png, &st) == 0 && st.st_size > 1000);
+    // Bad usage: exit 2.
+    snprintf(cmd, sizeof cmd, "'%s' synth --concepts --per-part 3 2>/dev/null", bin);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' synth --concepts --per-part 3 --style harsh --sheet '%s/x.png' 2>/dev/null", bin, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' synth --concepts --per-part 0 --sheet '%s/x.png' 2>/dev/null", bin, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+}
+
 static void test_cli_synth_parts(void)
 {
     const char* bin = sketchpose_bin();
@@ -748,7 +847,9 @@ int main(int argc, char** argv)
                                    {"handdraw_sampling_corners_wobble", test_handdraw_sampling_corners_wobble},
                                    {"db_synthetic_sketches", test_db_synthetic_sketches},
                                    {"part_shapes", test_part_shapes},
+                                   {"concepts", test_concepts},
                                    {"cli_synth_parts", test_cli_synth_parts},
+                                   {"cli_synth_concepts", test_cli_synth_concepts},
                                    {"calibrate_reject", test_calibrate_reject},
                                    {"cli_train_calibrate", test_cli_train_calibrate},
                                    {"dragon_accuracy_and_rejection", test_dragon_accuracy_and_rejection},

@@ -800,7 +800,7 @@ static void test_default_db(void)
     remove_db(p);
     sp_db* db = NULL;
     sp_error err = {0};
-    sp_db_default_desc dd = {.synth_per_part = 20, .train = quick_train(-1)};
+    sp_db_default_desc dd = {.synth_per_part = 20, .concepts_per_category = 5, .train = quick_train(-1)};
     double t0 = sp_now_ms();
     sp_result r = sp_db_create_default(p, dir, &dd, &err);
     if (r != SP_OK) fprintf(stderr, "  default: %s\n", err.text);
@@ -812,6 +812,13 @@ static void test_default_db(void)
     int n;
     ENSURE(sp_db_categories(db, &cats, &n, &err) == SP_OK && n == 3);
     sp_db_free_strings(cats, n);
+    // Concept sketches join the categories that have a concept (tail, wings), not a curator's own (horns).
+    int* counts;
+    ENSURE(sp_db_sketch_counts(db, &cats, &counts, &n, &err) == SP_OK && n == 3);
+    for (int i = 0; i < n; ++i)
+        ENSURE(counts[i] == (strcmp(cats[i], "horns") ? 25 : 20));
+    sp_db_free_strings(cats, n);
+    free(counts);
     sp_db_close(db);
     ENSURE(sp_db_create_default(p, dir, &dd, &err) == SP_ERR_INVALID);
 }

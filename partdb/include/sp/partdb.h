@@ -55,6 +55,9 @@ extern "C" {
 /// see docs/DESIGN.md (cost 4.5x, no bar gained in full; 120 and 200 gained
 /// nothing on the visitors' drawings either).
 #define SP_DB_SYNTH_DEFAULT 60
+/// Concept sketches per part category of the default database (sp/concept.h:
+/// the parts as visitors imagine them, designs of their own).
+#define SP_DB_CONCEPTS_DEFAULT 60
 
 typedef struct sp_db sp_db;
 
@@ -300,9 +303,12 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
 
 /// The default database: every `*.glb`/`*.gltf` part of assets_dir (category
 /// from its sp_part extras; files without one, such as the paper's characters, are skipped), `synth_per_part` synthetic sketches each (0:
-/// SP_DB_SYNTH_DEFAULT) and a trained model. Creates `path`; refuses an existing file.
+/// SP_DB_SYNTH_DEFAULT), `concepts_per_category` concept sketches for each category
+/// that has a concept (0: SP_DB_CONCEPTS_DEFAULT; -1: none), the people's strokes
+/// of assets_dir/sketches, and a trained model. Creates `path`; refuses an existing file.
 typedef struct sp_db_default_desc {
     int synth_per_part;
+    int concepts_per_category;
     sp_db_train_desc train;
 } sp_db_default_desc;
 sp_result sp_db_create_default(const char* path, const char* assets_dir, const sp_db_default_desc* desc, sp_error* err);

@@ -1,0 +1,57 @@
+/// sp/concept.h: drawings of the dragon parts as visitors imagine them, not
+/// as the shipped parts look (the default recipe's "concept" sketches, issue 16
+/// item 2; docs/DESIGN.md "Part database training data").
+///
+/// The parts' own silhouettes, however posed and cropped, are one design each;
+/// a child's head is a round skull with a snout, horns or a frill, a wing is an
+/// arm with 2-5 scallops, a tail a wavy line ending in a spade or a curl. Each
+/// concept is a small shape grammar with its designs drawn from the seed
+/// (proportions, features, pose, facing), traced as one stroke the way a
+/// person draws a part in the kiosk, then passed through the hand-drawing
+/// model (sp/handdraw.h, normal style). Same seed, same bits on every machine.
+///
+///     sp_concept c = sp_concept_parse("head");
+///     if (c != SP_CONCEPT_COUNT) sp_concept_sketch(c, seed, &sketch, &err);
+#ifndef SP_CONCEPT_H
+#define SP_CONCEPT_H
+
+#include <stdint.h>
+
+#include "sp/result.h"
+#include "sp/sketch.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// The parts a concept exists for (the kiosk's six categories).
+typedef enum sp_concept {
+    SP_CONCEPT_HEAD = 0,
+    SP_CONCEPT_WINGS,
+    SP_CONCEPT_TAIL,
+    SP_CONCEPT_FRONT_LEGS,
+    SP_CONCEPT_HIND_LEGS,
+    SP_CONCEPT_TORSO,
+    SP_CONCEPT_COUNT
+} sp_concept;
+
+/// The category name of a concept ("head", "wings", "tail", "front_legs", "hind_legs", "torso").
+const char* sp_concept_name(sp_concept c);
+/// The concept of a part category; SP_CONCEPT_COUNT when there is none (a curator's own category).
+sp_concept sp_concept_parse(const char* category);
+
+/// Canvas of concept sketches, pixels (the kiosk's).
+#define SP_CONCEPT_CANVAS_W 1280.0
+#define SP_CONCEPT_CANVAS_H 800.0
+
+/// The clean drawing of the design of `seed`: one stroke, a closed one
+/// repeating its first point at the end, about 300 px across, centred on
+/// the canvas. SP_ERR_INVALID for an unknown concept.
+sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
+/// The same design through the hand-drawing model (normal style), with timestamps.
+sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
