@@ -150,6 +150,10 @@ static int db_init(int argc, char** argv)
                    "export folder",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
+    if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000) {
+        fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000\n", cmd);
+        return SP_EXIT_USAGE;
+    }
     sp_error err = {0};
     sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};
     if (clf_cli_tty()) td.clf.progress = clf_cli_progress;

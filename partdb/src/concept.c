@@ -446,7 +446,7 @@ static void torso(path* P, sp_rng* r)
     if (!back_only) put_v(P, P->p[0]);
 }
 
-static sp_result draw_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err)
+sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
     if ((unsigned)c >= SP_CONCEPT_COUNT) return sp_fail(err, SP_ERR_INVALID, "concept %d: no such part", (int)c);
@@ -461,7 +461,7 @@ static sp_result draw_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_erro
     case SP_CONCEPT_TORSO: torso(&P, &r); break;
     default: break;
     }
-    // Facing, a tilt, and a size about 300 px across, centred on the canvas.
+    // Facing, a tilt up to 17 degrees, a bounding-box diagonal of 340 px, centred on the canvas.
     double mirror = chance(&r, 0.5) ? -1 : 1, turn = U(&r, -0.3, 0.3), cs = cos(turn), sn = sin(turn);
     sp_vec2 lo = {INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY};
     for (int i = 0; i < P.n; ++i) {
@@ -479,12 +479,10 @@ static sp_result draw_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_erro
     return SP_OK;
 }
 
-sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err) { return draw_clean(c, seed, out, err); }
-
 sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err)
 {
     sp_sketch clean;
-    sp_result res = draw_clean(c, seed, &clean, err);
+    sp_result res = sp_concept_clean(c, seed, &clean, err);
     if (res != SP_OK) return res;
     sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
     res = sp_handdraw_apply(&clean, &hp, seed * 0xC2B2AE3D27D4EB4Full + 0x27D4EB2F165667C5ull, out, NULL, err);

@@ -603,6 +603,11 @@ static void test_cli_synth_concepts(void)
     ENSURE(WEXITSTATUS(system(cmd)) == 2);
     snprintf(cmd, sizeof cmd, "'%s' synth --concepts --per-part 0 --sheet '%s/x.png' 2>/dev/null", bin, out);
     ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    // The default database's count of them: a bad one is bad usage, before anything is built.
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/never.db' --concepts 20000 2>/dev/null", bin, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "%s/never.db", out);
+    ENSURE(access(cmd, F_OK) != 0);
 }
 
 static void test_cli_synth_parts(void)

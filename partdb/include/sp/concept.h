@@ -45,8 +45,8 @@ sp_concept sp_concept_parse(const char* category);
 #define SP_CONCEPT_CANVAS_H 800.0
 
 /// The clean drawing of the design of `seed`: one stroke, a closed one
-/// repeating its first point at the end, about 300 px across, centred on
-/// the canvas. SP_ERR_INVALID for an unknown concept.
+/// repeating its first point at the end, its bounding box 340 px across the
+/// diagonal, centred on the canvas. SP_ERR_INVALID for an unknown concept.
 sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
 /// The same design through the hand-drawing model (normal style), with timestamps.
 sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
