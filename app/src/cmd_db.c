@@ -1,6 +1,5 @@
 // cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -330,29 +329,6 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
 }
 
 // Sorted entries of a directory, no dot files (*names malloc'd).
-static int list_dir(const char* dir, char*** names)
-{
-    DIR* d = opendir(dir);
-    if (!d) return -1;
-    int n = 0, cap = 0;
-    char** out = NULL;
-    struct dirent* e;
-    while ((e = readdir(d))) {
-        if (e->d_name[0] == '.') continue;
-        if (n == cap) {
-            cap = cap ? 2 * cap : 16;
-            char** g = realloc(out, sizeof *out * (size_t)cap);
-            if (!g) break;
-            out = g;
-        }
-        if ((out[n] = strdup(e->d_name))) ++n;
-    }
-    closedir(d);
-    if (n) qsort(out, (size_t)n, sizeof *out, sp_cmp_cstr);
-    *names = out;
-    return n;
-}
-
 static bool is_dir(const char* p)
 {
     struct stat st;
@@ -364,9 +340,9 @@ static bool is_dir(const char* p)
 static sp_result add_folder(sketch_set* s, const char* dir, const char* only, sp_error* err)
 {
     char** names;
-    int n = list_dir(dir, &names);
-    if (n < 0) return sp_fail(err, SP_ERR_IO, "%s: cannot read the folder", dir);
-    sp_result r = SP_OK;
+    int n;
+    sp_result r = sp_dir_list(dir, &names, &n, err);
+    if (r != SP_OK) return r;
     int before = s->ds.count;
     char path[2048];
     for (int i = 0; r == SP_OK && i < n; ++i) {
@@ -374,24 +350,21 @@ static sp_result add_folder(sketch_set* s, const char* dir, const char* only, sp
         if (is_dir(path)) {
             if (only && strcmp(only, names[i]) != 0) continue;
             char** files;
-            int m = list_dir(path, &files);
+            int m;
+            r = sp_dir_list(path, &files, &m, err);
             for (int j = 0; r == SP_OK && j < m; ++j) {
                 char fp[4096];
                 snprintf(fp, sizeof fp, "%s/%s", path, files[j]);
                 if (has_ext(fp, ".json") || has_ext(fp, ".svg") || has_ext(fp, ".png")) r = add_file(s, fp, names[i], err);
             }
-            for (int j = 0; j < m; ++j)
-                free(files[j]);
-            free(m > 0 ? files : NULL);
+            sp_dir_list_free(files, m);
         } else if (has_ext(names[i], ".ndjson")) {
             char cat[256];
             snprintf(cat, sizeof cat, "%.*s", (int)(strlen(names[i]) - 7), names[i]);
             if (!only || !strcmp(only, cat)) r = add_file(s, path, cat, err);
         }
     }
-    for (int i = 0; i < n; ++i)
-        free(names[i]);
-    free(n > 0 ? names : NULL);
+    sp_dir_list_free(names, n);
     if (r == SP_OK && s->ds.count == before) r = sp_fail(err, SP_ERR_INVALID, "%s: no drawings found%s%s", dir, only ? " for category " : "", only ? only : "");
     return r;
 }

@@ -2,7 +2,6 @@
 // with --style, passed through the hand-drawing model; with --parts DIR, a
 // labelled folder of hand-drawn sketches of every part in DIR; with
 // --concepts, the default recipe's concept sketches (sp/concept.h).
-#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -56,34 +55,25 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
 {
     sp_handdraw_style style = base->style;
     sp_error err = {0};
-    DIR* d = opendir(dir);
-    if (!d) {
-        fprintf(stderr, "sketchpose synth: %s: cannot open the parts folder (%s)\n", dir, strerror(errno));
+    char** names = NULL;
+    int n = 0;
+    if (sp_dir_list(dir, &names, &n, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose synth: %s\n", err.text);
         return SP_EXIT_INPUT;
     }
-    char** names = NULL;
-    int n = 0, cap = 0;
-    for (struct dirent* e; (e = readdir(d));) {
-        size_t l = strlen(e->d_name);
-        bool glb = l > 4 && !strcmp(e->d_name + l - 4, ".glb"), gltf = l > 5 && !strcmp(e->d_name + l - 5, ".gltf");
-        if (!glb && !gltf) continue;
-        if (n == cap) {
-            cap = cap ? 2 * cap : 16;
-            char** g = realloc(names, sizeof *g * (size_t)cap);
-            if (!g) break;
-            names = g;
-        }
-        if (!(names[n] = strdup(e->d_name))) break;
-        ++n;
+    // Only the .glb and .gltf files, in the listing's sorted order.
+    int kept = 0;
+    for (int k = 0; k < n; ++k) {
+        if (sp_path_ext_is(names[k], "glb") || sp_path_ext_is(names[k], "gltf")) names[kept++] = names[k];
+        else free(names[k]);
     }
-    closedir(d);
+    n = kept;
     int code = SP_EXIT_INPUT;
     if (n == 0) {
         fprintf(stderr, "sketchpose synth: %s: no .glb or .gltf parts in the folder\n", dir);
         free(names);
         return SP_EXIT_INPUT;
     }
-    qsort(names, (size_t)n, sizeof *names, sp_cmp_cstr);
     if (!make_dir(out_dir, &err)) goto fail;
     sp_handdraw_desc desc = *base;
     int total = 0, written = 0;

@@ -1,7 +1,6 @@
 // drawing_io.c: the drawings that need a decoder (PNG, through OpenCV), any
 // drawing by its extension, and labelled folders (which may hold PNGs). The
 // stroke files themselves are read by sketchio (sp/sketch_io.h).
-#include <dirent.h>
 #include <errno.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -75,47 +74,6 @@ sp_result sp_drawing_read(const char* path, sp_sketch* sketch, sp_raster* raster
     return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: unknown drawing type (want .json, .svg, .png or .ndjson)", path);
 }
 
-// Sorted entry names of a directory (excluding dot files). *names malloc'd.
-static sp_result list_dir(const char* dir, char*** names, int* count, sp_error* err)
-{
-    *names = NULL;
-    *count = 0;
-    DIR* d = opendir(dir);
-    if (!d) return sp_fail(err, SP_ERR_IO, "%s: cannot open folder (%s)", dir, strerror(errno));
-    struct dirent* e;
-    int n = 0, cap = 0;
-    char** v = NULL;
-    while ((e = readdir(d)) != NULL) {
-        if (e->d_name[0] == '.') continue;
-        if (n == cap) {
-            cap = cap ? cap * 2 : 32;
-            char** g = realloc(v, sizeof(char*) * (size_t)cap);
-            if (!g) goto oom;
-            v = g;
-        }
-        if (!(v[n] = strdup(e->d_name))) goto oom;
-        ++n;
-    }
-    closedir(d);
-    if (n) qsort(v, (size_t)n, sizeof(char*), sp_cmp_cstr);
-    *names = v;
-    *count = n;
-    return SP_OK;
-oom:
-    closedir(d);
-    for (int i = 0; i < n; ++i)
-        free(v[i]);
-    free(v);
-    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory listing", dir);
-}
-
-static void free_names(char** v, int n)
-{
-    for (int i = 0; i < n; ++i)
-        free(v[i]);
-    free(v);
-}
-
 static bool is_dir(const char* path)
 {
     struct stat st;
@@ -127,7 +85,7 @@ sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
     memset(out, 0, sizeof *out);
     char** names;
     int n;
-    sp_result rc = list_dir(dir, &names, &n, err);
+    sp_result rc = sp_dir_list(dir, &names, &n, err);
     if (rc != SP_OK) return rc;
     sp_dataset ds = {0};
     char path[4096];
@@ -151,7 +109,7 @@ sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
             int label = sp_dataset_add_category(&ds, names[i]);
             char** files;
             int nf;
-            if ((rc = list_dir(path, &files, &nf, err)) != SP_OK) break;
+            if ((rc = sp_dir_list(path, &files, &nf, err)) != SP_OK) break;
             for (int j = 0; j < nf && rc == SP_OK; ++j) {
                 if (!sp_path_ext_is(files[j], "json") && !sp_path_ext_is(files[j], "svg") && !sp_path_ext_is(files[j], "png"))
                     continue;
@@ -165,7 +123,7 @@ sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
                     rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", fp);
                 }
             }
-            free_names(files, nf);
+            sp_dir_list_free(files, nf);
         } else if (sp_path_ext_is(names[i], "ndjson")) {
             char cat[1024];
             snprintf(cat, sizeof cat, "%s", names[i]);
@@ -173,7 +131,7 @@ sp_result sp_dataset_load(const char* dir, sp_dataset* out, sp_error* err)
             rc = sp_dataset_read_ndjson(&ds, path, sp_dataset_add_category(&ds, cat), err);
         }
     }
-    free_names(names, n);
+    sp_dir_list_free(names, n);
     if (rc == SP_OK && ds.count == 0)
         rc = sp_fail(err, SP_ERR_INVALID, "%s: no drawings (want <category>/*.json|svg|png or <category>.ndjson)", dir);
     if (rc != SP_OK) {

@@ -1,7 +1,6 @@
 // db_folder.c: export to and import from a folder, and the default database
 // built from assets/.
 #include <cjson/cJSON.h>
-#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -372,27 +371,18 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
 sp_result sp_db_create_default(const char* path, const char* assets_dir, const sp_db_default_desc* desc, sp_error* err)
 {
     default_ctx c = {.assets = assets_dir, .d = desc ? *desc : (sp_db_default_desc){0}};
-    DIR* dp = opendir(assets_dir);
-    if (!dp) return sp_fail(err, SP_ERR_IO, "%s: %s", assets_dir, strerror(errno));
-    int cap = 0;
-    struct dirent* e;
-    while ((e = readdir(dp))) {
-        if (!is_part_file(e->d_name)) continue;
-        if (c.n == cap) {
-            cap = cap ? 2 * cap : 16;
-            char** g = realloc(c.names, sizeof *c.names * (size_t)cap);
-            if (!g) break;
-            c.names = g;
-        }
-        if ((c.names[c.n] = strdup(e->d_name))) ++c.n;
+    int n = 0;
+    sp_result r = sp_dir_list(assets_dir, &c.names, &n, err);
+    if (r != SP_OK) return r;
+    for (int i = 0; i < n; ++i) { // the parts only, in the listing's sorted order
+        if (is_part_file(c.names[i])) c.names[c.n++] = c.names[i];
+        else free(c.names[i]);
     }
-    closedir(dp);
     if (c.n == 0) {
         free(c.names);
         return sp_fail(err, SP_ERR_INVALID, "%s: no parts (*.glb, *.gltf) to build the default database from", assets_dir);
     }
-    qsort(c.names, (size_t)c.n, sizeof *c.names, sp_cmp_cstr);
-    sp_result r = build_then_link(path, fill_default, &c, err);
+    r = build_then_link(path, fill_default, &c, err);
     sp_db_free_strings(c.names, c.n);
     return r;
 }

@@ -5,6 +5,7 @@
 
 #include <cjson/cJSON.h>
 #include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -60,6 +61,43 @@ static const char* ext_of(const char* path)
 bool sp_path_ext_is(const char* path, const char* ext)
 {
     return strcasecmp(ext_of(path), ext) == 0;
+}
+
+sp_result sp_dir_list(const char* dir, char*** names, int* count, sp_error* err)
+{
+    *names = NULL;
+    *count = 0;
+    DIR* d = opendir(dir);
+    if (!d) return sp_fail(err, SP_ERR_IO, "%s: cannot open the folder (%s)", dir, strerror(errno));
+    int n = 0, cap = 0;
+    char** v = NULL;
+    for (struct dirent* e; (e = readdir(d));) {
+        if (e->d_name[0] == '.') continue;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 32;
+            char** g = realloc(v, sizeof *v * (size_t)cap);
+            if (!g) goto oom;
+            v = g;
+        }
+        if (!(v[n] = strdup(e->d_name))) goto oom;
+        ++n;
+    }
+    closedir(d);
+    if (n) qsort(v, (size_t)n, sizeof *v, sp_cmp_cstr);
+    *names = v;
+    *count = n;
+    return SP_OK;
+oom:
+    closedir(d);
+    sp_dir_list_free(v, n);
+    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory listing the folder", dir);
+}
+
+void sp_dir_list_free(char** names, int count)
+{
+    for (int i = 0; i < count; ++i)
+        free(names[i]);
+    free(names);
 }
 
 // Line number of byte `at` in text (1-based), for parse messages.

@@ -398,6 +398,16 @@ static void test_folder(void)
     }
     ENSURE(apples == 2 && pngs == 1);
     sp_dataset_free(&ds);
+    // The listing under it: sorted, without dot files; a missing folder is named.
+    snprintf(p, sizeof p, "%s/.hidden", sub);
+    write_text(p, "x");
+    char** names;
+    int n;
+    ENSURE(sp_dir_list(sub, &names, &n, &err) == SP_OK && n == 4);
+    ENSURE(!strcmp(names[0], "a.svg") && !strcmp(names[1], "b.json") && !strcmp(names[2], "c.png") && !strcmp(names[3], "notes.txt"));
+    sp_dir_list_free(names, n);
+    snprintf(p, sizeof p, "%s/none", dir);
+    ENSURE(sp_dir_list(p, &names, &n, &err) == SP_ERR_IO && strstr(err.text, p) && names == NULL && n == 0);
     // One bad file fails the whole load, naming it.
     snprintf(p, sizeof p, "%s/d.json", sub);
     write_text(p, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[0, 0], [5]]}]}");

@@ -95,6 +95,12 @@ sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
 /// True when `path`'s extension (after its last '.', in its last component) is `ext`, ignoring case.
 bool sp_path_ext_is(const char* path, const char* ext);
+/// The names in folder `dir`, sorted bytewise so that every machine reads a
+/// folder in the same order, leaving out those starting with '.': *names a
+/// malloc'd array of *count malloc'd strings (free with sp_dir_list_free).
+/// SP_ERR_IO (naming the folder and why) when it cannot be read.
+sp_result sp_dir_list(const char* dir, char*** names, int* count, sp_error* err);
+void sp_dir_list_free(char** names, int count);
 
 #ifdef __cplusplus
 }
