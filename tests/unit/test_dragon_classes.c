@@ -581,9 +581,9 @@ static void test_cli_synth_concepts(void)
     sp_error err = {0};
     ENSURE(sp_dataset_load(out, &ds, &err) == SP_OK);
     ENSURE(ds.count == 3 * SP_CONCEPT_COUNT && ds.category_count == SP_CONCEPT_COUNT);
-    // The files are the library's sketches of that seed family, as the default recipe draws them.
+    // The files are the library's sketches of that seed family, seeded as the default recipe seeds them.
     sp_sketch want;
-    ENSURE(sp_concept_sketch(SP_CONCEPT_WINGS, sp_handdraw_seed(4, 2), &want, &err) == SP_OK);
+    ENSURE(sp_concept_sketch(SP_CONCEPT_WINGS, sp_handdraw_seed(sp_handdraw_part_family(4, "wings"), 2), &want, &err) == SP_OK);
     const sp_sample* got = NULL;
     for (int i = 0; i < ds.count; ++i)
         if (!strcmp(ds.categories[ds.samples[i].label], "wings") && ds.samples[i].index == 2) got = &ds.samples[i];
