@@ -161,10 +161,10 @@ static void head(path* P, sp_rng* r)
         sp_vec2 n1 = {j1.x - lean * nl, j1.y + nl}, n2 = {n1.x - nw, n1.y - U(r, 0.0, 0.3)};
         put_v(P, n1);
         if (neck_open) { // drawn from the neck's far end round to its other end, open
-            path Q = {.n = 0};
-            put_v(&Q, n2);
-            for (int i = 0; i < P->n; ++i) put_v(&Q, P->p[i]);
-            *P = Q;
+            int n = P->n < PATH_CAP ? P->n : PATH_CAP - 1;
+            memmove(P->p + 1, P->p, sizeof *P->p * (size_t)n);
+            P->p[0] = n2;
+            P->n = n + 1;
             return;
         }
         put_v(P, n2);

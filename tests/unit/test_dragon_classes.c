@@ -136,16 +136,6 @@ static void test_handdraw_deterministic(void)
 }
 
 // Concept sketches (sp/concept.h): the six parts as visitors imagine them.
-static bool sketches_equal(const sp_sketch* a, const sp_sketch* b)
-{
-    if (a->stroke_count != b->stroke_count) return false;
-    for (int s = 0; s < a->stroke_count; ++s) {
-        if (a->strokes[s].count != b->strokes[s].count) return false;
-        if (memcmp(a->strokes[s].points, b->strokes[s].points, sizeof(sp_vec2) * (size_t)a->strokes[s].count)) return false;
-    }
-    return true;
-}
-
 static void test_concepts(void)
 {
     for (int c = 0; c < SP_CONCEPT_COUNT; ++c)
@@ -180,7 +170,7 @@ static void test_concepts(void)
             if (i < 20) {
                 ENSURE(sp_concept_sketch((sp_concept)c, seed, &y, &err) == SP_OK);
                 ENSURE(sp_concept_sketch((sp_concept)c, seed + 1, &z, &err) == SP_OK);
-                ENSURE(sketches_equal(&x, &y) && !sketches_equal(&x, &z));
+                ENSURE(same_sketch(&x, &y) && !same_sketch(&x, &z));
                 sp_sketch_free(&y);
                 sp_sketch_free(&z);
             }
