@@ -130,7 +130,7 @@ static int db_init(int argc, char** argv)
     const char* cmd = "sketchpose db init";
     db_common c = {0};
     const char* from = NULL;
-    const char* assets = NULL;
+    const char *assets = NULL, *quickdraw = NULL;
     int synth = 0, concepts = 0, folds = 0;
     bool no_train = false;
     clf_cli_opts o = {0};
@@ -139,6 +139,10 @@ static int db_init(int argc, char** argv)
                      {"--assets", SP_OPT_STRING, &assets, "DIR", "parts to build the default database from (default: the source tree's assets/)", false},
                      {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
                      {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category (default 60, -1 none)", false},
+                     {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
+                      "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder picks.json "
+                      "names, ../shared/data/quickdraw beside the clone)",
+                      false},
                      {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
                      {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
                      CLF_CLI_OPTS(o)};
@@ -157,11 +161,24 @@ static int db_init(int argc, char** argv)
     sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};
     if (clf_cli_tty()) td.clf.progress = clf_cli_progress;
     sp_result r;
+    int npeople = -1;
     if (from) r = sp_db_create_from_export(db_path(&c), from, no_train ? NULL : &td, c.by, &err);
     else {
         char def[1024];
         snprintf(def, sizeof def, "%s/assets", SP_SOURCE_DIR);
-        r = sp_db_create_default(db_path(&c), assets ? assets : def, &(sp_db_default_desc){.synth_per_part = synth, .concepts_per_category = concepts, .train = td}, &err);
+        if (!assets) assets = def;
+        // Read first to say how many people's strokes join, or that they cannot.
+        sp_dataset people;
+        bool missing = false;
+        if ((r = sp_db_people_strokes(assets, quickdraw, &people, &missing, &err)) != SP_OK) return fail(cmd, &err);
+        npeople = people.count;
+        sp_dataset_free(&people);
+        if (missing)
+            fprintf(stderr, "%s: %s/sketches/picks.json: the Quick, Draw! data is not where it says; building without the people's strokes "
+                            "(--quickdraw DIR names it)\n", cmd, assets);
+        r = sp_db_create_default(db_path(&c), assets,
+                                 &(sp_db_default_desc){.synth_per_part = synth, .concepts_per_category = concepts, .quickdraw_dir = quickdraw, .train = td},
+                                 &err);
     }
     if (r != SP_OK) return fail(cmd, &err);
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
@@ -175,7 +192,9 @@ static int db_init(int argc, char** argv)
     }
     printf("{\"db\": ");
     clf_cli_json_str(stdout, db_path(&c));
-    printf(", \"parts\": %d, \"models\": %s}\n", n, models);
+    printf(", \"parts\": %d", n);
+    if (npeople >= 0) printf(", \"people_strokes\": %d", npeople);
+    printf(", \"models\": %s}\n", models);
     free(parts);
     free(models);
     sp_db_close(db);

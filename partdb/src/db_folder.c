@@ -349,14 +349,9 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
     }
     int nconcepts = c->d.concepts_per_category == 0 ? SP_DB_CONCEPTS_DEFAULT : c->d.concepts_per_category < 0 ? 0 : c->d.concepts_per_category;
     if (r == SP_OK && nconcepts > 0) r = add_concepts(db, nconcepts, err);
-    // People's own strokes of the parts (assets/sketches/<category>.ndjson,
-    // picked from Quick, Draw!; assets/sketches/README.md), when the folder has them.
-    char dir[1024];
-    struct stat st;
-    snprintf(dir, sizeof dir, "%s/sketches", c->assets);
-    if (r == SP_OK && stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) {
+    if (r == SP_OK) {
         sp_dataset human;
-        if ((r = sp_dataset_load(dir, &human, err)) == SP_OK && human.count > 0)
+        if ((r = sp_db_people_strokes(c->assets, c->d.quickdraw_dir, &human, NULL, err)) == SP_OK && human.count > 0)
             r = sp_db_add_sketches(db, &human, NULL, SP_DB_SOURCE_CURATED, "assets", NULL, err);
         sp_dataset_free(&human);
     }

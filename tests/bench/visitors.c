@@ -1,7 +1,9 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
 //   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--json]
-// Every drawing of one half of tests/data/visitors (drawings made neither by
-// nor for the project's hand-drawing model: tests/data/visitors/README.md) goes
+// Every drawing of one half of the visitors' set (drawings made neither by nor
+// for the project's hand-drawing model: tests/data/visitors/README.md; --data
+// defaults to the whole set the build makes from designs.json and the Quick,
+// Draw! data, <build>/tests/data/visitors) goes
 // through the kiosk pipeline (sp_dragon_add_points) one stroke at a time, on a
 // database built by the default recipe (the kiosk's first start): --db PATH is
 // used when it exists and created there by that recipe when it does not;
@@ -77,7 +79,7 @@ static int find(char** names, int n, const char* s)
 
 int main(int argc, char** argv)
 {
-    const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_SOURCE_DIR "/tests/data/visitors",
+    const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_BINARY_DIR "/tests/data/visitors",
                *sheet = NULL;
     bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false;
     for (int i = 1; i < argc; ++i) {

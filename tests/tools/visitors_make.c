@@ -1,8 +1,13 @@
-// visitors_make.c: builds the visitors' evaluation set (tests/data/visitors/)
-// from its sources, so that the set can be rebuilt and audited:
+// visitors_make.c: builds the visitors' evaluation set from its sources, so
+// that the set can be rebuilt and audited:
 //
-//   sp-visitors-make --designs tests/data/visitors/designs.json --quickdraw ../shared/data/quickdraw --out tests/data/visitors
+//   sp-visitors-make --designs tests/data/visitors/designs.json [--quickdraw ../shared/data/quickdraw] --out DIR
 //                    [--train-out assets/sketches]
+//
+// The repository keeps the hand-placed drawings (tests/data/visitors, made
+// without --quickdraw); the build makes the whole set, the people's strokes
+// read from the Quick, Draw! data, in <build>/tests/data/visitors
+// (tests/bench/visitors.cmake): the data's terms ask that it not be copied.
 //
 // designs.json lists every drawing, in two kinds:
 //   {"name", "label", "closed": true|false, "points": [[x, y], ...]}   hand-placed control points
@@ -28,8 +33,9 @@
 // database's default training set instead: {"label", "qd", "drawing", "stroke"}.
 // None may come from a drawing the evaluation uses (the tool refuses that:
 // evaluation and training drawings have different makers). With
-// --train-out DIR they are written to DIR/<label>.ndjson in Quick, Draw!'s
-// own format (word, countrycode, key_id kept; the drawing is the one stroke).
+// --train-out DIR they are written to DIR/picks.json as references ({"category",
+// "file", "line" from 1, "stroke", "key_id"}), which the default recipe reads
+// from the data (sp_db_people_strokes).
 //
 // Output: <out>/<half>/<label>/<name>.json (sketchpose-strokes, one stroke,
 // canvas 1280 x 800), half = tune or report: within each label, the
@@ -266,13 +272,18 @@ static cJSON* qd_line(const char* dir, const char* cat, int index)
     return j;
 }
 
-// The training picks: checked against the evaluation's drawings, written as ndjson.
+// The training picks: checked against the evaluation's drawings and written as
+// out_dir/picks.json, which names each stroke (file, line from 1, stroke from 0,
+// key_id) for the default recipe to read from the data (sp_db_people_strokes):
+// the data's terms ask that it not be copied into the repository.
 static int write_training(const cJSON* root, const char* qd_dir, const char* out_dir)
 {
     const cJSON* train = cJSON_GetObjectItem(root, "training");
     const cJSON* eval = cJSON_GetObjectItem(root, "drawings");
     const cJSON *t, *e;
-    int n = 0;
+    cJSON* out = cJSON_CreateObject();
+    cJSON_AddStringToObject(out, "quickdraw", "../../../shared/data/quickdraw");
+    cJSON* picks = cJSON_AddArrayToObject(out, "picks");
     cJSON_ArrayForEach(t, train)
     {
         const char* qd = cJSON_GetStringValue(cJSON_GetObjectItem(t, "qd"));
@@ -281,6 +292,7 @@ static int write_training(const cJSON* root, const char* qd_dir, const char* out
             si = (int)cJSON_GetNumberValue(cJSON_GetObjectItem(t, "stroke"));
         if (!qd || !label) {
             fprintf(stderr, "training pick without qd or label\n");
+            cJSON_Delete(out);
             return 1;
         }
         cJSON_ArrayForEach(e, eval)
@@ -289,53 +301,53 @@ static int write_training(const cJSON* root, const char* qd_dir, const char* out
             if (eq && !strcmp(eq, qd) && (int)cJSON_GetNumberValue(cJSON_GetObjectItem(e, "drawing")) == di) {
                 fprintf(stderr, "training pick %s drawing %d is also an evaluation drawing (%s)\n", qd, di,
                         cJSON_GetStringValue(cJSON_GetObjectItem(e, "name")));
+                cJSON_Delete(out);
                 return 1;
             }
         }
         cJSON* j = qd_line(qd_dir, qd, di);
-        cJSON* strokes = cJSON_GetObjectItem(j, "drawing");
-        cJSON* stroke = cJSON_GetArrayItem(strokes, si);
-        if (!stroke) {
-            fprintf(stderr, "%s/%s.ndjson: no drawing %d stroke %d\n", qd_dir, qd, di, si);
+        const char* key = cJSON_GetStringValue(cJSON_GetObjectItem(j, "key_id"));
+        if (!key || !cJSON_GetArrayItem(cJSON_GetObjectItem(j, "drawing"), si)) {
+            fprintf(stderr, "%s/%s.ndjson: no drawing %d stroke %d with a key_id\n", qd_dir, qd, di, si);
             cJSON_Delete(j);
+            cJSON_Delete(out);
             return 1;
         }
-        if (out_dir) {
-            char path[1024];
-            snprintf(path, sizeof path, "%s/%s.ndjson", out_dir, label);
-            // A label's first pick starts its file afresh.
-            bool first = true;
-            const cJSON* u;
-            cJSON_ArrayForEach(u, train)
-            {
-                if (u == t) break;
-                if (!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(u, "label")), label)) first = false;
-            }
-            FILE* f = fopen(path, first ? "w" : "a");
-            if (!f) {
-                fprintf(stderr, "%s: cannot write\n", path);
-                cJSON_Delete(j);
-                return 1;
-            }
-            cJSON* o = cJSON_CreateObject();
-            cJSON_AddStringToObject(o, "word", cJSON_GetStringValue(cJSON_GetObjectItem(j, "word")));
-            cJSON_AddStringToObject(o, "countrycode", cJSON_GetStringValue(cJSON_GetObjectItem(j, "countrycode")));
-            cJSON_AddStringToObject(o, "key_id", cJSON_GetStringValue(cJSON_GetObjectItem(j, "key_id")));
-            char picked[128];
-            snprintf(picked, sizeof picked, "%s.ndjson line %d stroke %d", qd, di + 1, si);
-            cJSON_AddStringToObject(o, "picked", picked);
-            cJSON* dr = cJSON_AddArrayToObject(o, "drawing");
-            cJSON_AddItemToArray(dr, cJSON_Duplicate(stroke, true));
-            char* line = cJSON_PrintUnformatted(o);
-            fprintf(f, "%s\n", line);
-            free(line);
-            cJSON_Delete(o);
-            fclose(f);
-        }
+        char file[128];
+        snprintf(file, sizeof file, "%s.ndjson", qd);
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "category", label);
+        cJSON_AddStringToObject(o, "file", file);
+        cJSON_AddNumberToObject(o, "line", di + 1);
+        cJSON_AddNumberToObject(o, "stroke", si);
+        cJSON_AddStringToObject(o, "key_id", key);
+        cJSON_AddItemToArray(picks, o);
         cJSON_Delete(j);
-        ++n;
     }
-    return 0;
+    int rc = 0;
+    if (out_dir) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/picks.json", out_dir);
+        FILE* f = fopen(path, "w");
+        // One pick a line: the file is read and reviewed by people.
+        if (f) {
+            fprintf(f, "{\"quickdraw\": \"%s\", \"picks\": [\n", cJSON_GetStringValue(cJSON_GetObjectItem(out, "quickdraw")));
+            const cJSON* o;
+            cJSON_ArrayForEach(o, picks)
+            {
+                char* line = cJSON_PrintUnformatted(o);
+                fprintf(f, "  %s%s\n", line, o->next ? "," : "");
+                free(line);
+            }
+            fprintf(f, "]}\n");
+        }
+        if (!f || fclose(f) != 0) {
+            fprintf(stderr, "%s: cannot write\n", path);
+            rc = 1;
+        }
+    }
+    cJSON_Delete(out);
+    return rc;
 }
 
 typedef struct counter {
@@ -356,8 +368,8 @@ int main(int argc, char** argv)
         else if (!strcmp(argv[i], "--out"))
             out_dir = argv[i + 1];
     }
-    if (!designs || !qd_dir || !out_dir) {
-        fprintf(stderr, "usage: sp-visitors-make --designs designs.json --quickdraw DIR --out DIR [--train-out DIR]\n");
+    if (!designs || !out_dir || (train_out && !qd_dir)) {
+        fprintf(stderr, "usage: sp-visitors-make --designs designs.json [--quickdraw DIR] --out DIR [--train-out DIR (needs --quickdraw)]\n");
         return 2;
     }
     char* text = read_text(designs);
@@ -368,9 +380,9 @@ int main(int argc, char** argv)
         fprintf(stderr, "%s: not a designs file (no \"drawings\" array)\n", designs);
         return 1;
     }
-    if (write_training(root, qd_dir, train_out) != 0) return 1;
+    if (qd_dir && write_training(root, qd_dir, train_out) != 0) return 1;
     counter cnt[32] = {0};
-    int ncnt = 0, written = 0;
+    int ncnt = 0, written = 0, skipped = 0;
     static sp_vec2 pts[MAXP];
     static double ts[MAXP];
     const cJSON* d;
@@ -386,6 +398,12 @@ int main(int argc, char** argv)
         placement pl = read_placement(d, &rng);
         const char* qd = cJSON_GetStringValue(cJSON_GetObjectItem(d, "qd"));
         int n = 0;
+        // Without the data, its drawings are left out; the split stays the same
+        // (hand-placed and Quick, Draw! drawings alternate halves separately).
+        if (qd && !qd_dir) {
+            ++skipped;
+            continue;
+        }
         bool times = true;
         if (qd) {
             char path[1024];
@@ -497,9 +515,10 @@ int main(int argc, char** argv)
             }
             free(list);
         }
-        char file[1100], title[128];
+        char file[1100], title[192];
         snprintf(file, sizeof file, "%s/%s.png", out_dir, half);
-        snprintf(title, sizeof title, "tests/data/visitors, %s half: %d drawings", half, n);
+        snprintf(title, sizeof title, "visitors' drawings, %s half: %d drawings%s", half, n,
+                 skipped ? ", hand-placed only" : "");
         sp_error err = {0};
         if (n > 0 && sp_sheet_write_png(items, n, &(sp_sheet_desc){.cell = 130, .cols = 12, .title = title}, file, &err) != SP_OK) {
             fprintf(stderr, "%s\n", err.text);
@@ -508,7 +527,7 @@ int main(int argc, char** argv)
         for (int k = 0; k < n; ++k)
             sp_sketch_free(&sketches[k]);
     }
-    printf("{\"written\": %d, \"labels\": {", written);
+    printf("{\"written\": %d, \"quickdraw_left_out\": %d, \"labels\": {", written, skipped);
     for (int c = 0; c < ncnt; ++c)
         printf("%s\"%s\": {\"hand\": %d, \"quickdraw\": %d}", c ? ", " : "", cnt[c].label, cnt[c].hand, cnt[c].qd);
     printf("}}\n");

@@ -1775,7 +1775,7 @@ static void test_visitors_policy(void)
     const char* path = real_db();
     if (!path) SKIP("assets/ has no parts yet");
     char dir[1024];
-    snprintf(dir, sizeof dir, "%s/tests/data/visitors/tune", SP_SOURCE_DIR);
+    snprintf(dir, sizeof dir, "%s/tests/data/visitors/tune", SP_BINARY_DIR); // built from designs.json (tests/bench/visitors.cmake)
     sp_dataset ds;
     sp_error err = {0};
     ENSURE(sp_dataset_load(dir, &ds, &err) == SP_OK);

@@ -784,18 +784,129 @@ static void test_generation(void)
     sp_db_close(reader);
 }
 
+static void put_text(const char* path, const char* text)
+{
+    FILE* f = fopen(path, "wb");
+    ENSURE(f && fputs(text, f) >= 0 && fclose(f) == 0);
+}
+
+// A project-made stand-in for the Quick, Draw! data beside an assets folder:
+// <root>/qd/fix.ndjson (two drawings) and <root>/assets/sketches/picks.json
+// naming three of their strokes (`picks`: the JSON array's items).
+static void people_fixture(const char* root, const char* picks)
+{
+    char cmd[2200], f[1100];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s/qd' '%s/assets/sketches' && mkdir -p '%s/qd' '%s/assets/sketches'", root, root, root, root);
+    ENSURE(system(cmd) == 0);
+    snprintf(f, sizeof f, "%s/qd/fix.ndjson", root);
+    put_text(f, "{\"word\":\"x\",\"key_id\":\"111\",\"drawing\":[[[0,10,20],[0,5,0]],[[30,40],[30,41]]]}\n"
+                "{\"word\":\"y\",\"key_id\":\"222\",\"drawing\":[[[5,6,7,8],[1,2,3,4]]]}\n");
+    snprintf(f, sizeof f, "%s/assets/sketches/picks.json", root);
+    char text[2048];
+    snprintf(text, sizeof text, "{\"quickdraw\": \"../../qd\", \"picks\": [%s]}", picks);
+    put_text(f, text);
+}
+
+#define PEOPLE_PICKS                                                                                                             \
+    "{\"category\":\"tail\",\"file\":\"fix.ndjson\",\"line\":2,\"stroke\":0,\"key_id\":\"222\"},"                             \
+    "{\"category\":\"horns\",\"file\":\"fix.ndjson\",\"line\":1,\"stroke\":1,\"key_id\":\"111\"},"                            \
+    "{\"category\":\"tail\",\"file\":\"fix.ndjson\",\"line\":1,\"stroke\":0,\"key_id\":\"111\"}"
+
+// The people's strokes of the default recipe are named in picks.json and read
+// from the data, never copied: order, checks, and a data folder that is absent.
+static void test_people_strokes(void)
+{
+    char root[1024], assets[1100];
+    snprintf(root, sizeof root, "%s", sp_test_tmp_path("people"));
+    snprintf(assets, sizeof assets, "%s/assets", root);
+    people_fixture(root, PEOPLE_PICKS);
+    sp_dataset ds;
+    sp_error err = {0};
+    bool missing = true;
+    ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && !missing);
+    // Categories sorted; within one, the file's order; each a one-stroke sketch on Quick, Draw!'s canvas.
+    ENSURE(ds.count == 3 && ds.category_count == 2 && !strcmp(ds.categories[0], "horns") && !strcmp(ds.categories[1], "tail"));
+    ENSURE(ds.samples[0].label == 0 && ds.samples[1].label == 1 && ds.samples[2].label == 1);
+    for (int i = 0; i < 3; ++i)
+        ENSURE(ds.samples[i].sketch.stroke_count == 1 && ds.samples[i].sketch.canvas_w == 256);
+    ENSURE(ds.samples[0].sketch.strokes[0].count == 2 && ds.samples[0].sketch.strokes[0].points[1].y == 41);
+    ENSURE(ds.samples[1].sketch.strokes[0].count == 4 && ds.samples[1].sketch.strokes[0].points[3].x == 8);
+    ENSURE(ds.samples[2].sketch.strokes[0].count == 3 && ds.samples[2].sketch.strokes[0].points[1].y == 5);
+    sp_dataset_free(&ds);
+    // The data's folder given explicitly.
+    char qd[1100];
+    snprintf(qd, sizeof qd, "%s/qd", root);
+    ENSURE(sp_db_people_strokes(assets, qd, &ds, NULL, &err) == SP_OK && ds.count == 3);
+    sp_dataset_free(&ds);
+    // Not there: built without (empty, *missing), unless the caller named the folder.
+    char cmd[2400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", qd);
+    ENSURE(system(cmd) == 0);
+    ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && missing && ds.count == 0);
+    ENSURE(sp_db_people_strokes(assets, qd, &ds, &missing, &err) == SP_ERR_IO && strstr(err.text, qd));
+    // Picks the data does not have: one line naming the file and line.
+    struct {
+        const char* pick;
+        sp_result want;
+        const char* says;
+    } bad[] = {
+        {"{\"category\":\"tail\",\"file\":\"fix.ndjson\",\"line\":1,\"stroke\":0,\"key_id\":\"999\"}", SP_ERR_INVALID, "fix.ndjson:1: key_id 111"},
+        {"{\"category\":\"tail\",\"file\":\"fix.ndjson\",\"line\":9,\"stroke\":0,\"key_id\":\"111\"}", SP_ERR_INVALID, "no line 9"},
+        {"{\"category\":\"tail\",\"file\":\"fix.ndjson\",\"line\":2,\"stroke\":1,\"key_id\":\"222\"}", SP_ERR_INVALID, "fix.ndjson:2: no stroke 1"},
+        {"{\"category\":\"tail\",\"file\":\"none.ndjson\",\"line\":1,\"stroke\":0,\"key_id\":\"1\"}", SP_ERR_IO, "none.ndjson"},
+        {"{\"category\":\"tail\",\"file\":\"../fix.ndjson\",\"line\":1,\"stroke\":0,\"key_id\":\"111\"}", SP_ERR_PARSE, "picks.json"},
+        {"{\"file\":\"fix.ndjson\",\"line\":1,\"stroke\":0,\"key_id\":\"111\"}", SP_ERR_PARSE, "picks.json"},
+        {"{\"category\":\"tail\",\"file\":\"fix.ndjson\",\"line\":0,\"stroke\":0,\"key_id\":\"111\"}", SP_ERR_PARSE, "picks.json"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        people_fixture(root, bad[i].pick);
+        sp_result r = sp_db_people_strokes(assets, NULL, &ds, NULL, &err);
+        if (r != bad[i].want || !strstr(err.text, bad[i].says)) fprintf(stderr, "  pick %zu: %d %s\n", i, r, err.text);
+        ENSURE(r == bad[i].want && strstr(err.text, bad[i].says) && ds.count == 0);
+    }
+    char f[1200];
+    snprintf(f, sizeof f, "%s/sketches/picks.json", assets);
+    put_text(f, "{\"picks\": 3}");
+    ENSURE(sp_db_people_strokes(assets, NULL, &ds, NULL, &err) == SP_ERR_PARSE && strstr(err.text, "picks.json: not a picks file"));
+    // No picks.json: nothing to add.
+    remove(f);
+    ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && ds.count == 0 && !missing);
+
+    // The project's own picks, read from ../shared/data.
+    char qdreal[1100];
+    snprintf(qdreal, sizeof qdreal, "%s/quickdraw", SP_SHARED_DATA);
+    struct stat st;
+    if (stat(qdreal, &st) != 0) SKIP("../shared/data/quickdraw is absent (the fixture above covers the code)");
+    ENSURE(sp_db_people_strokes(sp_test_src_path("assets"), NULL, &ds, &missing, &err) == SP_OK && !missing);
+    fprintf(stderr, "  assets/sketches/picks.json: %d people's strokes in %d categories\n", ds.count, ds.category_count);
+    ENSURE(ds.count >= 60 && ds.category_count == 6);
+    for (int i = 0; i < ds.count; ++i)
+        ENSURE(ds.samples[i].sketch.stroke_count == 1 && ds.samples[i].sketch.strokes[0].count >= 2);
+    sp_dataset_free(&ds);
+}
+
+// An assets folder of three fixture parts (tail, wings, horns) and the
+// people's strokes that its picks.json names (two tails and a horn), in the
+// temporary folder `name`; returns that folder.
+static const char* default_assets(const char* name, char* assets, size_t cap)
+{
+    static char root[1024];
+    snprintf(root, sizeof root, "%s", sp_test_tmp_path(name));
+    snprintf(assets, cap, "%s/assets", root);
+    people_fixture(root, PEOPLE_PICKS);
+    for (int i = 0; i < 3; ++i) {
+        char f[1200];
+        snprintf(f, sizeof f, "%s/%s.glb", assets, k_parts[i].name);
+        write_part(&k_parts[i], f);
+    }
+    return root;
+}
+
 static void test_default_db(void)
 {
     // The default database from an assets folder of fixture parts.
-    char dir[1024], p[1024], cmd[2200];
-    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("assets"));
-    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
-    ENSURE(system(cmd) == 0);
-    for (int i = 0; i < 3; ++i) {
-        char f[1100];
-        snprintf(f, sizeof f, "%s/%s.glb", dir, k_parts[i].name);
-        write_part(&k_parts[i], f);
-    }
+    char dir[1100], p[1024];
+    default_assets("default", dir, sizeof dir);
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("default.db"));
     remove_db(p);
     sp_db* db = NULL;
@@ -812,11 +923,12 @@ static void test_default_db(void)
     int n;
     ENSURE(sp_db_categories(db, &cats, &n, &err) == SP_OK && n == 3);
     sp_db_free_strings(cats, n);
-    // Concept sketches join the categories that have a concept (tail, wings), not a curator's own (horns).
+    // Concept sketches join the categories that have a concept (tail, wings), not a curator's own (horns);
+    // the people's strokes join theirs.
     int* counts;
     ENSURE(sp_db_sketch_counts(db, &cats, &counts, &n, &err) == SP_OK && n == 3);
     for (int i = 0; i < n; ++i)
-        ENSURE(counts[i] == (strcmp(cats[i], "horns") ? 25 : 20));
+        ENSURE(counts[i] == (!strcmp(cats[i], "horns") ? 21 : !strcmp(cats[i], "tail") ? 27 : 25));
     sp_db_free_strings(cats, n);
     free(counts);
     sp_db_close(db);
@@ -998,6 +1110,34 @@ static int run(const char* cmd, char* out, size_t cap)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+// db init through the command line: it says how many people's strokes joined,
+// and a --quickdraw folder that is not there is one line, exit 1, no database.
+static void test_default_db_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char root[1024], assets[1100], p[1024], cmd[8192], out[65536];
+    snprintf(root, sizeof root, "%s", default_assets("defcli", assets, sizeof assets));
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("defcli.db"));
+    remove_db(p);
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 --quickdraw '%s/nowhere' 2>&1",
+             bin, p, assets, root);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") && strchr(out, '\n') == out + strlen(out) - 1);
+    struct stat st;
+    ENSURE(stat(p, &st) != 0);
+    // Two tails and a horn join.
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>/dev/null", bin, p, assets);
+    int rc = run(cmd, out, sizeof out);
+    if (rc != 0) fprintf(stderr, "  db init: %d %s\n", rc, out);
+    ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3"));
+    // The data moved away: built without them, with a warning that names picks.json.
+    remove_db(p);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s/qd' && '%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>&1 >/dev/null",
+             root, bin, p, assets);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "sketches/picks.json: the Quick, Draw! data is not where it says"));
+    ENSURE(stat(p, &st) == 0);
+}
+
 // The review through the command line, end to end: a stroke the visitor
 // corrected is collected with the corrected label, listed, approved, trained on.
 static void test_kiosk_review_cli(void)
@@ -1101,7 +1241,9 @@ int main(int argc, char** argv)
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
+                                   {"people_strokes", test_people_strokes},
                                    {"default_db", test_default_db},
+                                   {"default_db_cli", test_default_db_cli},
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},

@@ -305,13 +305,28 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
 /// from its sp_part extras; files without one, such as the paper's characters, are skipped), `synth_per_part` synthetic sketches each (0:
 /// SP_DB_SYNTH_DEFAULT), `concepts_per_category` concept sketches for each category
 /// that has a concept (0: SP_DB_CONCEPTS_DEFAULT; -1: none), the people's strokes
-/// of assets_dir/sketches, and a trained model. Creates `path`; refuses an existing file.
+/// that assets_dir/sketches/picks.json names (sp_db_people_strokes; built
+/// without them when the Quick, Draw! folder is not there and `quickdraw_dir`
+/// is NULL), and a trained model. Creates `path`; refuses an existing file.
 typedef struct sp_db_default_desc {
     int synth_per_part;
     int concepts_per_category;
+    const char* quickdraw_dir; ///< NULL: the folder picks.json names
     sp_db_train_desc train;
 } sp_db_default_desc;
 sp_result sp_db_create_default(const char* path, const char* assets_dir, const sp_db_default_desc* desc, sp_error* err);
+/// The people's own strokes of the parts that the default recipe trains on.
+/// assets_dir/sketches/picks.json names each in the Quick, Draw! data ("file",
+/// "line" from 1, "stroke" from 0, "key_id") and says where that data is
+/// ("quickdraw", relative to itself); `quickdraw_dir` (NULL: that folder)
+/// overrides it. The repository keeps the names only: the strokes are read
+/// from the data, whose terms ask that it not be copied. *out gets the labels
+/// as categories, sorted, and the strokes in the file's order. No picks.json:
+/// an empty set. The data's folder not there: an empty set and *missing true
+/// (may be NULL), or SP_ERR_IO naming it when `quickdraw_dir` was given. A pick
+/// the data does not have (no such line or stroke, another key_id) is an
+/// error naming the file and line.
+sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err);
 /// Creates `path` from an export folder (sp_db_import), then trains when
 /// `train` is not NULL. Built beside `path` and moved into place when complete.
 sp_result sp_db_create_from_export(const char* path, const char* dir, const sp_db_train_desc* train, const char* by, sp_error* err);

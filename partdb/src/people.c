@@ -1,0 +1,149 @@
+// people.c: the people's own strokes of the dragon parts that the default
+// recipe trains on (sp_db_people_strokes in sp/partdb.h). The repository
+// keeps only which strokes they are (assets/sketches/picks.json); the strokes
+// themselves are read from the Quick, Draw! data, which is not ours to copy.
+#include <cjson/cJSON.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "sp/partdb.h"
+#include "sp/sketch_io.h"
+
+// Line `line` (from 1) of `text`, as a pointer and length; false when the text is shorter.
+static bool nth_line(const char* text, size_t len, int line, const char** at, size_t* n)
+{
+    size_t b = 0;
+    for (int i = 1; b < len; ++i) {
+        size_t e = b;
+        while (e < len && text[e] != '\n')
+            ++e;
+        if (i == line) {
+            *at = text + b, *n = e - b;
+            return true;
+        }
+        b = e + 1;
+    }
+    return false;
+}
+
+// Stroke `stroke` of line `line` of `path`, checked against `key_id`, as a one-stroke sketch.
+static sp_result read_pick(const char* path, int line, int stroke, const char* key_id, sp_sketch* out, sp_error* err)
+{
+    char* text;
+    size_t len;
+    sp_result r = sp_sketch_file_read(path, &text, &len, err);
+    if (r != SP_OK) return r;
+    const char* at;
+    size_t n;
+    if (!nth_line(text, len, line, &at, &n)) {
+        free(text);
+        return sp_fail(err, SP_ERR_INVALID, "%s: no line %d (assets/sketches/picks.json names it)", path, line);
+    }
+    cJSON* j = cJSON_ParseWithLength(at, n);
+    const char* key = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(j, "key_id"));
+    if (!key || strcmp(key, key_id) != 0) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s:%d: key_id %s, picks.json expects %s (another copy of the data?)", path, line,
+                    key ? key : "missing", key_id);
+    }
+    cJSON_Delete(j);
+    sp_dataset one = {0};
+    if (r == SP_OK) r = sp_dataset_parse_ndjson(&one, at, n, path, -1, err);
+    free(text);
+    if (r == SP_OK && (one.count != 1 || stroke >= one.samples[0].sketch.stroke_count))
+        r = sp_fail(err, SP_ERR_INVALID, "%s:%d: no stroke %d", path, line, stroke);
+    if (r == SP_OK) {
+        const sp_sketch* s = &one.samples[0].sketch;
+        const sp_stroke* st = &s->strokes[stroke];
+        *out = (sp_sketch){.canvas_w = s->canvas_w, .canvas_h = s->canvas_h};
+        if (sp_sketch_add_stroke(out, st->points, st->t, st->count) != SP_OK)
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    sp_dataset_free(&one);
+    return r;
+}
+
+static int cmp_str(const void* a, const void* b) { return strcmp(*(const char* const*)a, *(const char* const*)b); }
+
+sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    if (missing) *missing = false;
+    char path[2048];
+    snprintf(path, sizeof path, "%s/sketches/picks.json", assets_dir);
+    struct stat st;
+    if (stat(path, &st) != 0) return SP_OK; // an assets folder without people's strokes
+    char* text;
+    size_t len;
+    sp_result r = sp_sketch_file_read(path, &text, &len, err);
+    if (r != SP_OK) return r;
+    cJSON* root = cJSON_ParseWithLength(text, len);
+    free(text);
+    const cJSON* picks = cJSON_GetObjectItemCaseSensitive(root, "picks");
+    const char* from = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(root, "quickdraw"));
+    if (!cJSON_IsArray(picks) || !from) {
+        cJSON_Delete(root);
+        return sp_fail(err, SP_ERR_PARSE, "%s: not a picks file (want {\"quickdraw\": DIR, \"picks\": [...]})", path);
+    }
+    char dir[2048];
+    if (quickdraw_dir) snprintf(dir, sizeof dir, "%s", quickdraw_dir);
+    else if (from[0] == '/') snprintf(dir, sizeof dir, "%s", from);
+    else snprintf(dir, sizeof dir, "%s/sketches/%s", assets_dir, from);
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        cJSON_Delete(root);
+        if (missing) *missing = true;
+        return quickdraw_dir ? sp_fail(err, SP_ERR_IO, "%s: no such folder (the Quick, Draw! data)", dir) : SP_OK;
+    }
+    // Categories sorted, as a labelled folder would give them; strokes in the file's order.
+    int n = cJSON_GetArraySize(picks);
+    const char** cats = calloc((size_t)(n ? n : 1), sizeof *cats);
+    int ncat = 0;
+    if (!cats) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    const cJSON* p;
+    if (r == SP_OK) cJSON_ArrayForEach(p, picks)
+    {
+        const char* c = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category"));
+        if (!c || !*c) {
+            r = sp_fail(err, SP_ERR_PARSE, "%s: a pick without \"category\"", path);
+            break;
+        }
+        int k = 0;
+        while (k < ncat && strcmp(cats[k], c) != 0)
+            ++k;
+        if (k == ncat) cats[ncat++] = c;
+    }
+    if (r == SP_OK) qsort(cats, (size_t)ncat, sizeof *cats, cmp_str);
+    sp_dataset ds = {0};
+    for (int k = 0; r == SP_OK && k < ncat; ++k)
+        if (sp_dataset_add_category(&ds, cats[k]) < 0) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    for (int k = 0; r == SP_OK && k < ncat; ++k) {
+        cJSON_ArrayForEach(p, picks)
+        {
+            if (strcmp(cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category")), cats[k]) != 0) continue;
+            const char* file = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "file"));
+            const char* key = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "key_id"));
+            const cJSON* line = cJSON_GetObjectItemCaseSensitive(p, "line");
+            const cJSON* stroke = cJSON_GetObjectItemCaseSensitive(p, "stroke");
+            if (!file || !key || !cJSON_IsNumber(line) || !cJSON_IsNumber(stroke) || line->valueint < 1 || stroke->valueint < 0 ||
+                strchr(file, '/')) {
+                r = sp_fail(err, SP_ERR_PARSE, "%s: a pick needs \"file\" (a name in the data's folder), \"line\" >= 1, \"stroke\" >= 0, \"key_id\"",
+                            path);
+                break;
+            }
+            char fp[4200];
+            snprintf(fp, sizeof fp, "%s/%s", dir, file);
+            sp_sample smp = {.label = k};
+            if ((r = read_pick(fp, line->valueint, stroke->valueint, key, &smp.sketch, err)) != SP_OK) break;
+            if (sp_dataset_add_sample(&ds, &smp) != SP_OK) {
+                sp_sketch_free(&smp.sketch);
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+            }
+        }
+    }
+    free(cats);
+    cJSON_Delete(root);
+    if (r != SP_OK) sp_dataset_free(&ds);
+    else *out = ds;
+    return r;
+}
