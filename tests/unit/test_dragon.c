@@ -1799,7 +1799,12 @@ static void test_visitors_policy(void)
     }
     fprintf(stderr, "  %d parts: %d right, %d refused, %d in the top 3; %d of %d non-parts refused\n", parts, right, refused,
             top3, non_refused, non);
-    ENSURE(parts >= 60 && non >= 20);
+    // Without ../shared/data the set (and the model's training) lacks the Quick, Draw! strokes: the hand-placed drawings remain.
+    char qd[1100];
+    snprintf(qd, sizeof qd, "%s/quickdraw", SP_SHARED_DATA);
+    bool people = access(qd, F_OK) == 0;
+    if (!people) fprintf(stderr, "  %s is absent: the hand-placed drawings only, a model without people's strokes\n", qd);
+    ENSURE(people ? parts >= 60 && non >= 20 : parts >= 40 && non >= 14);
     ENSURE(refused <= parts / 6);
     ENSURE(right >= parts / 2);
     ENSURE(top3 >= 9 * parts / 10);
