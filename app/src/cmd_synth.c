@@ -2,11 +2,9 @@
 // with --style, passed through the hand-drawing model; with --parts DIR, a
 // labelled folder of hand-drawn sketches of every part in DIR; with
 // --concepts, the default recipe's concept sketches (sp/concept.h).
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "cli.h"
 #include "pose_io.h"
@@ -27,15 +25,6 @@ static bool has_opt(int argc, char** argv, const char* name)
     return false;
 }
 
-static bool make_dir(const char* path, sp_error* err)
-{
-    if (mkdir(path, 0777) == 0 || errno == EEXIST) {
-        struct stat st;
-        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return true;
-    }
-    sp_fail(err, SP_ERR_IO, "%s: cannot create the folder (%s)", path, strerror(errno == EEXIST ? ENOTDIR : errno));
-    return false;
-}
 
 static void json_str(const char* s)
 {
@@ -74,7 +63,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         free(names);
         return SP_EXIT_INPUT;
     }
-    if (!make_dir(out_dir, &err)) goto fail;
+    if (sp_dir_make(out_dir, &err) != SP_OK) goto fail;
     sp_handdraw_desc desc = *base;
     int total = 0, written = 0;
     printf("{\"out_dir\": ");
@@ -101,7 +90,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         int a = sp_pick_abstraction(ch.rig.abstractions, ch.rig.abstraction_count, path, an, &err);
         char cdir[4096];
         snprintf(cdir, sizeof cdir, "%s/%s", out_dir, category);
-        if (a < 0 || !make_dir(cdir, &err)) {
+        if (a < 0 || sp_dir_make(cdir, &err) != SP_OK) {
             sp_character_free(&ch);
             goto fail_open;
         }
@@ -165,11 +154,11 @@ static int synth_concepts(int per_part, uint64_t family, bool clean, const char*
         sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
         goto fail;
     }
-    if (out_dir && !make_dir(out_dir, &err)) goto fail;
+    if (out_dir && sp_dir_make(out_dir, &err) != SP_OK) goto fail;
     for (int c = 0; c < SP_CONCEPT_COUNT; ++c) {
         char cdir[4096];
         snprintf(cdir, sizeof cdir, "%s/%s", out_dir ? out_dir : ".", sp_concept_name((sp_concept)c));
-        if (out_dir && !make_dir(cdir, &err)) goto fail;
+        if (out_dir && sp_dir_make(cdir, &err) != SP_OK) goto fail;
         for (int i = 0; i < per_part; ++i, ++made) {
             uint64_t sd = sp_handdraw_seed(sp_handdraw_part_family(family, sp_concept_name((sp_concept)c)), i);
             sp_result r = clean ? sp_concept_clean((sp_concept)c, sd, &sk[made], &err) : sp_concept_sketch((sp_concept)c, sd, &sk[made], &err);

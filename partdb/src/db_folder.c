@@ -13,21 +13,15 @@
 #include "sp/handdraw.h"
 #include "sp/math.h"
 
-static sp_result make_dir(const char* path, sp_error* err)
-{
-    if (mkdir(path, 0777) == 0 || errno == EEXIST) return SP_OK;
-    return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
-}
-
 sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
 {
     char path[1024];
-    sp_result r = make_dir(dir, err);
+    sp_result r = sp_dir_make(dir, err);
     if (r != SP_OK) return r;
     snprintf(path, sizeof path, "%s/parts", dir);
-    if ((r = make_dir(path, err)) != SP_OK) return r;
+    if ((r = sp_dir_make(path, err)) != SP_OK) return r;
     snprintf(path, sizeof path, "%s/sketches", dir);
-    if ((r = make_dir(path, err)) != SP_OK) return r;
+    if ((r = sp_dir_make(path, err)) != SP_OK) return r;
     if ((r = db_exec(db, "BEGIN", err)) != SP_OK) return r; // one snapshot
     db_str m = {0};
     db_str_printf(&m, "{\"format\": \"sketchpose-db-export\", \"version\": 1, \"schema\": %d, \"parts\": [", SP_DB_SCHEMA_VERSION);
@@ -69,7 +63,7 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
         if (strcmp(cat, last_cat) != 0) {
             snprintf(last_cat, sizeof last_cat, "%s", cat);
             snprintf(path, sizeof path, "%s/sketches/%s", dir, cat);
-            if ((r = make_dir(path, err)) != SP_OK) break;
+            if ((r = sp_dir_make(path, err)) != SP_OK) break;
         }
         const char* ext;
         if (sqlite3_column_type(st, 4) != SQLITE_NULL) {
@@ -310,12 +304,8 @@ static sp_result add_concepts(sp_db* db, int per_category, sp_error* err)
     for (int k = 0; r == SP_OK && k < ncat; ++k) {
         sp_concept c = sp_concept_parse(cats[k]);
         if (c == SP_CONCEPT_COUNT) continue;
-        sp_dataset ds = {0};
-        if (sp_dataset_add_category(&ds, cats[k]) < 0 || !(ds.samples = calloc((size_t)per_category, sizeof *ds.samples))) {
-            sp_dataset_free(&ds);
-            r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-            break;
-        }
+        sp_dataset ds;
+        if ((r = db_dataset_one(&ds, cats[k], per_category, err)) != SP_OK) break;
         uint64_t family = sp_handdraw_part_family(1, cats[k]);
         for (int i = 0; r == SP_OK && i < per_category; ++i) {
             r = sp_concept_sketch(c, sp_handdraw_seed(family, i), &ds.samples[i].sketch, err);

@@ -39,20 +39,24 @@ static const recipe_slot k_cycle[20] = {
     {SP_HANDDRAW_SHAPE_UNDERSIDE, true, 0, false},  {SP_HANDDRAW_SHAPE_LINE, false, 0, false},
 };
 
-sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out,
-                            sp_error* err)
+sp_result db_dataset_one(sp_dataset* out, const char* category, int n, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    if (sp_dataset_add_category(out, "part") < 0) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-    sp_sample* s = n > 0 ? calloc((size_t)n, sizeof *s) : NULL;
-    if (n > 0 && !s) {
+    if (sp_dataset_add_category(out, category) < 0 || (n > 0 && !(out->samples = calloc((size_t)n, sizeof *out->samples)))) {
         sp_dataset_free(out);
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     }
-    out->samples = s;
+    return SP_OK;
+}
+
+sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out,
+                            sp_error* err)
+{
+    sp_result r = db_dataset_one(out, "part", n, err);
+    if (r != SP_OK) return r;
+    sp_sample* s = out->samples;
     bool line = sp_handdraw_shape_available(&ch->rig, SP_HANDDRAW_SHAPE_LINE),
          piece = sp_handdraw_shape_available(&ch->rig, SP_HANDDRAW_SHAPE_PIECE);
-    sp_result r = SP_OK;
     for (int i = 0; r == SP_OK && i < n; ++i) {
         recipe_slot slot = k_cycle[i % 20];
         // No single line through a head or a torso: their silhouette instead.

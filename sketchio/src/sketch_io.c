@@ -93,6 +93,16 @@ oom:
     return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory listing the folder", dir);
 }
 
+sp_result sp_dir_make(const char* path, sp_error* err)
+{
+    if (mkdir(path, 0777) == 0 || errno == EEXIST) {
+        struct stat st;
+        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return SP_OK;
+        errno = ENOTDIR;
+    }
+    return sp_fail(err, SP_ERR_IO, "%s: cannot create the folder (%s)", path, strerror(errno));
+}
+
 void sp_dir_list_free(char** names, int count)
 {
     for (int i = 0; i < count; ++i)

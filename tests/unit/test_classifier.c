@@ -4,6 +4,7 @@
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "sp/classifier.h"
 #include "sp/sketch_io.h"
@@ -408,6 +409,15 @@ static void test_folder(void)
     sp_dir_list_free(names, n);
     snprintf(p, sizeof p, "%s/none", dir);
     ENSURE(sp_dir_list(p, &names, &n, &err) == SP_ERR_IO && strstr(err.text, p) && names == NULL && n == 0);
+    // Making a folder: new or already there is fine; a file in the way or a missing parent is named.
+    snprintf(p, sizeof p, "%s/made", dir);
+    rmdir(p);
+    ENSURE(sp_dir_make(p, &err) == SP_OK && sp_dir_make(p, &err) == SP_OK && sp_dir_list(p, &names, &n, &err) == SP_OK && n == 0);
+    sp_dir_list_free(names, n);
+    snprintf(p, sizeof p, "%s/notes.txt", sub);
+    ENSURE(sp_dir_make(p, &err) == SP_ERR_IO && strstr(err.text, p) && strstr(err.text, "cannot create the folder"));
+    snprintf(p, sizeof p, "%s/none/deeper", dir);
+    ENSURE(sp_dir_make(p, &err) == SP_ERR_IO && strstr(err.text, p));
     // One bad file fails the whole load, naming it.
     snprintf(p, sizeof p, "%s/d.json", sub);
     write_text(p, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[0, 0], [5]]}]}");

@@ -558,6 +558,23 @@ static bool write_standins(const char* dir)
     return true;
 }
 
+// A written labelled folder's drawing `index` of `category` holds `want`'s
+// points (to 1e-3 px: the files and a .glb's float32 round them).
+static void ensure_written(const sp_dataset* ds, const char* category, int index, const sp_sketch* want)
+{
+    const sp_sample* got = NULL;
+    for (int i = 0; i < ds->count; ++i)
+        if (!strcmp(ds->categories[ds->samples[i].label], category) && ds->samples[i].index == index) got = &ds->samples[i];
+    ENSURE(got && got->sketch.stroke_count == want->stroke_count);
+    for (int s = 0; s < want->stroke_count; ++s) {
+        ENSURE(got->sketch.strokes[s].count == want->strokes[s].count);
+        for (int i = 0; i < want->strokes[s].count; ++i) {
+            ENSURE_NEAR(got->sketch.strokes[s].points[i].x, want->strokes[s].points[i].x, 1e-3);
+            ENSURE_NEAR(got->sketch.strokes[s].points[i].y, want->strokes[s].points[i].y, 1e-3);
+        }
+    }
+}
+
 static void test_cli_synth_concepts(void)
 {
     const char* bin = sketchpose_bin();
@@ -574,12 +591,7 @@ static void test_cli_synth_concepts(void)
     // The files are the library's sketches of that seed family, seeded as the default recipe seeds them.
     sp_sketch want;
     ENSURE(sp_concept_sketch(SP_CONCEPT_WINGS, sp_handdraw_seed(sp_handdraw_part_family(4, "wings"), 2), &want, &err) == SP_OK);
-    const sp_sample* got = NULL;
-    for (int i = 0; i < ds.count; ++i)
-        if (!strcmp(ds.categories[ds.samples[i].label], "wings") && ds.samples[i].index == 2) got = &ds.samples[i];
-    ENSURE(got && got->sketch.stroke_count == want.stroke_count && got->sketch.strokes[0].count == want.strokes[0].count);
-    for (int i = 0; i < want.strokes[0].count; ++i)
-        ENSURE_NEAR(got->sketch.strokes[0].points[i].x, want.strokes[0].points[i].x, 1e-3);
+    ensure_written(&ds, "wings", 2, &want);
     sp_sketch_free(&want);
     sp_dataset_free(&ds);
     char png[1100];
@@ -623,15 +635,7 @@ static void test_cli_synth_parts(void)
     sp_sketch want;
     ENSURE(sp_handdraw_part(&p.ch.rig, 0, &p.ch.camera, &(sp_handdraw_desc){.style = SP_HANDDRAW_HARSH},
                             sp_handdraw_seed(sp_handdraw_part_family(5, "tail"), 1), &want, NULL, &err) == SP_OK);
-    const sp_sample* got = NULL;
-    for (int i = 0; i < ds.count; ++i)
-        if (ds.samples[i].label == 3 && ds.samples[i].index == 1) got = &ds.samples[i];
-    ENSURE(got && got->sketch.stroke_count == want.stroke_count);
-    for (int s = 0; s < want.stroke_count; ++s) {
-        ENSURE(got->sketch.strokes[s].count == want.strokes[s].count);
-        for (int i = 0; i < want.strokes[s].count; ++i)
-            ENSURE_NEAR(got->sketch.strokes[s].points[i].x, want.strokes[s].points[i].x, 1e-3); // the .glb stores float32
-    }
+    ensure_written(&ds, "tail", 1, &want);
     sp_sketch_free(&want);
     sp_character_free(&p.ch);
     sp_dataset_free(&ds);

@@ -101,6 +101,9 @@ bool sp_path_ext_is(const char* path, const char* ext);
 /// SP_ERR_IO (naming the folder and why) when it cannot be read.
 sp_result sp_dir_list(const char* dir, char*** names, int* count, sp_error* err);
 void sp_dir_list_free(char** names, int count);
+/// Creates folder `path` (its parent must exist); one that exists already is
+/// fine. SP_ERR_IO naming it and why otherwise (also when a file has its name).
+sp_result sp_dir_make(const char* path, sp_error* err);
 
 #ifdef __cplusplus
 }
