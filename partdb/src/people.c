@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "sp/math.h"
 #include "sp/partdb.h"
 #include "sp/sketch_io.h"
 
@@ -64,8 +65,6 @@ static sp_result read_pick(const char* path, int line, int stroke, const char* k
     return r;
 }
 
-static int cmp_str(const void* a, const void* b) { return strcmp(*(const char* const*)a, *(const char* const*)b); }
-
 sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err)
 {
     memset(out, 0, sizeof *out);
@@ -101,8 +100,9 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
     int ncat = 0;
     if (!cats) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     const cJSON* p;
-    if (r == SP_OK) cJSON_ArrayForEach(p, picks)
+    cJSON_ArrayForEach(p, picks)
     {
+        if (r != SP_OK) break;
         const char* c = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category"));
         if (!c || !*c) {
             r = sp_fail(err, SP_ERR_PARSE, "%s: a pick without \"category\"", path);
@@ -113,7 +113,7 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
             ++k;
         if (k == ncat) cats[ncat++] = c;
     }
-    if (r == SP_OK) qsort(cats, (size_t)ncat, sizeof *cats, cmp_str);
+    if (r == SP_OK) qsort(cats, (size_t)ncat, sizeof *cats, sp_cmp_cstr);
     sp_dataset ds = {0};
     for (int k = 0; r == SP_OK && k < ncat; ++k)
         if (sp_dataset_add_category(&ds, cats[k]) < 0) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);

@@ -22,3 +22,10 @@ add_custom_command(OUTPUT ${SP_VISITORS_DIR}/built
   DEPENDS sp-visitors-make ${PROJECT_SOURCE_DIR}/tests/data/visitors/designs.json
   COMMENT "Building the visitors' drawings in ${SP_VISITORS_DIR}")
 add_custom_target(sp_visitors_data ALL DEPENDS ${SP_VISITORS_DIR}/built)
+set(SP_VISITORS_CHECK_QD)
+if(EXISTS ${SP_SHARED_DATA}/quickdraw)
+  set(SP_VISITORS_CHECK_QD -DQD=${SP_SHARED_DATA}/quickdraw)
+endif()
+add_test(NAME visitors_set COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:sp-visitors-make> -DSRC=${PROJECT_SOURCE_DIR}
+                                   -DOUT=${PROJECT_BINARY_DIR}/visitors-check ${SP_VISITORS_CHECK_QD}
+                                   -P ${CMAKE_CURRENT_SOURCE_DIR}/tools/visitors_check.cmake)
