@@ -25,7 +25,6 @@ static bool has_opt(int argc, char** argv, const char* name)
     return false;
 }
 
-
 static void json_str(const char* s)
 {
     putchar('"');
