@@ -167,12 +167,10 @@ static int db_init(int argc, char** argv)
         char def[1024];
         snprintf(def, sizeof def, "%s/assets", SP_SOURCE_DIR);
         if (!assets) assets = def;
-        // Read first to say how many people's strokes join, or that they cannot.
-        sp_dataset people;
+        // How many people's strokes join, or that they cannot.
         bool missing = false;
-        if ((r = sp_db_people_strokes(assets, quickdraw, &people, &missing, &err)) != SP_OK) return fail(cmd, &err);
-        npeople = people.count;
-        sp_dataset_free(&people);
+        if ((r = sp_db_people_source(assets, quickdraw, &npeople, &missing, &err)) != SP_OK) return fail(cmd, &err);
+        if (missing) npeople = 0;
         if (missing)
             fprintf(stderr, "%s: %s/sketches/picks.json: the Quick, Draw! data is not where it says; building without the people's strokes "
                             "(--quickdraw DIR names it)\n", cmd, assets);

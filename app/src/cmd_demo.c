@@ -178,12 +178,11 @@ int cmd_demo(int argc, char** argv)
     bool created = stat(path, &st) != 0;
     if (created) {
         printf("creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
-        sp_dataset people;
+        int picks;
         bool missing = false;
-        if (sp_db_people_strokes(assets, NULL, &people, &missing, &err) == SP_OK && missing)
+        if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
             printf("note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's strokes "
                    "(fewer visitors' drawings recognised)\n", assets);
-        sp_dataset_free(&people);
     }
     fflush(stdout);
     if (sp_db_open_or_create_default(path, assets, SP_DB_READONLY, &db, &err) != SP_OK) {

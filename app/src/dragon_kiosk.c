@@ -438,16 +438,13 @@ int main(int argc, char** argv)
                         // iteration caps still bound every fit.
                         .fit_time_cap_ms = script ? 60000 : 0};
     if (access(db ? db : sp_db_default_path(), F_OK) != 0) {
-        // As the pipeline resolves the parts' folder (sp_dragon_desc.assets_dir).
-        const char* env = getenv("SP_ASSETS");
-        const char* from = assets ? assets : env && *env ? env : "assets";
-        sp_dataset people;
+        const char* from = assets ? assets : sp_dragon_default_assets();
+        int picks;
         bool missing = false;
         sp_error perr = {0};
-        if (sp_db_people_strokes(from, NULL, &people, &missing, &perr) == SP_OK && missing)
+        if (sp_db_people_source(from, NULL, &picks, &missing, &perr) == SP_OK && missing)
             fprintf(stderr, "%s: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building the database without the "
                             "people's strokes (fewer visitors' drawings recognised)\n", k_cmd, from);
-        sp_dataset_free(&people);
         loading_screen(win, font);
     }
     a.k = sp_kiosk_create(&kd, &err);

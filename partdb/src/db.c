@@ -149,6 +149,18 @@ bool db_name_ok(const char* s)
     return true;
 }
 
+sp_result db_read_json(const char* path, cJSON** root, sp_error* err)
+{
+    void* text;
+    size_t size;
+    *root = NULL;
+    sp_result r = db_read_file(path, &text, &size, err);
+    if (r != SP_OK) return r;
+    *root = cJSON_ParseWithLength(text, size);
+    free(text);
+    return SP_OK;
+}
+
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err)
 {
     *data = NULL;

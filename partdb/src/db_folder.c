@@ -153,12 +153,9 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
 {
     char path[1024];
     snprintf(path, sizeof path, "%s/manifest.json", dir);
-    void* text;
-    size_t size;
-    sp_result r = db_read_file(path, &text, &size, err);
+    cJSON* man;
+    sp_result r = db_read_json(path, &man, err);
     if (r != SP_OK) return r;
-    cJSON* man = cJSON_ParseWithLength(text, size);
-    free(text);
     const cJSON* parts = cJSON_GetObjectItemCaseSensitive(man, "parts");
     const cJSON* sketches = cJSON_GetObjectItemCaseSensitive(man, "sketches");
     if (!man || !cJSON_IsArray(parts) || !cJSON_IsArray(sketches) || !jstr(man, "format") ||

@@ -2,6 +2,7 @@
 #ifndef SP_DB_INTERNAL_H
 #define SP_DB_INTERNAL_H
 
+#include <cjson/cJSON.h>
 #include <sqlite3.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -57,6 +58,9 @@ sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err);
 char* db_sketch_json(const sp_sketch* s);
 /// Reads a whole file (malloc'd, NUL-terminated beyond size).
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err);
+/// Reads and parses a JSON file: *root NULL when its bytes are not JSON (the
+/// caller names what it wanted); errors are the reading's.
+sp_result db_read_json(const char* path, cJSON** root, sp_error* err);
 /// Writes a whole file.
 sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err);
 /// The training set: sp_db_load_dataset with at most `kiosk_cap` approved

@@ -2,14 +2,13 @@
 // recipe trains on (sp_db_people_strokes in sp/partdb.h). The repository
 // keeps only which strokes they are (assets/sketches/picks.json); the strokes
 // themselves are read from the Quick, Draw! data, which is not ours to copy.
-#include <cjson/cJSON.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
+#include "db_internal.h"
 #include "sp/math.h"
-#include "sp/partdb.h"
 #include "sp/sketch_io.h"
 
 // Line `line` (from 1) of `text`, as a pointer and length; false when the text is shorter.
@@ -29,19 +28,28 @@ static bool nth_line(const char* text, size_t len, int line, const char** at, si
     return false;
 }
 
-// Stroke `stroke` of line `line` of `path`, checked against `key_id`, as a one-stroke sketch.
-static sp_result read_pick(const char* path, int line, int stroke, const char* key_id, sp_sketch* out, sp_error* err)
-{
+// The data file last read: a category's picks of one file mostly follow each other.
+typedef struct data_file {
+    char path[4200];
     char* text;
     size_t len;
-    sp_result r = sp_sketch_file_read(path, &text, &len, err);
-    if (r != SP_OK) return r;
+} data_file;
+
+// Stroke `stroke` of line `line` of `path`, checked against `key_id`, as a one-stroke sketch.
+static sp_result read_pick(data_file* f, const char* path, int line, int stroke, const char* key_id, sp_sketch* out, sp_error* err)
+{
+    if (!f->text || strcmp(f->path, path) != 0) {
+        free(f->text);
+        f->text = NULL;
+        sp_result r = sp_sketch_file_read(path, &f->text, &f->len, err);
+        if (r != SP_OK) return r;
+        snprintf(f->path, sizeof f->path, "%s", path);
+    }
     const char* at;
     size_t n;
-    if (!nth_line(text, len, line, &at, &n)) {
-        free(text);
+    if (!nth_line(f->text, f->len, line, &at, &n))
         return sp_fail(err, SP_ERR_INVALID, "%s: no line %d (assets/sketches/picks.json names it)", path, line);
-    }
+    sp_result r = SP_OK;
     cJSON* j = cJSON_ParseWithLength(at, n);
     const char* key = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(j, "key_id"));
     if (!key || strcmp(key, key_id) != 0) {
@@ -51,7 +59,6 @@ static sp_result read_pick(const char* path, int line, int stroke, const char* k
     cJSON_Delete(j);
     sp_dataset one = {0};
     if (r == SP_OK) r = sp_dataset_parse_ndjson(&one, at, n, path, -1, err);
-    free(text);
     if (r == SP_OK && (one.count != 1 || stroke >= one.samples[0].sketch.stroke_count))
         r = sp_fail(err, SP_ERR_INVALID, "%s:%d: no stroke %d", path, line, stroke);
     if (r == SP_OK) {
@@ -65,47 +72,73 @@ static sp_result read_pick(const char* path, int line, int stroke, const char* k
     return r;
 }
 
-sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err)
+// assets_dir/sketches/picks.json parsed (*root NULL: there is none) and the
+// data's folder it names, or `quickdraw_dir`, in dir; *missing when that
+// folder is not there (an error when the caller named it).
+static sp_result load_picks(const char* assets_dir, const char* quickdraw_dir, cJSON** root, char dir[2048], bool* missing,
+                            sp_error* err)
 {
-    memset(out, 0, sizeof *out);
-    if (missing) *missing = false;
+    *root = NULL;
+    *missing = false;
     char path[2048];
     snprintf(path, sizeof path, "%s/sketches/picks.json", assets_dir);
     struct stat st;
     if (stat(path, &st) != 0) return SP_OK; // an assets folder without people's strokes
-    char* text;
-    size_t len;
-    sp_result r = sp_sketch_file_read(path, &text, &len, err);
+    sp_result r = db_read_json(path, root, err);
     if (r != SP_OK) return r;
-    cJSON* root = cJSON_ParseWithLength(text, len);
-    free(text);
-    const cJSON* picks = cJSON_GetObjectItemCaseSensitive(root, "picks");
-    const char* from = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(root, "quickdraw"));
-    if (!cJSON_IsArray(picks) || !from) {
-        cJSON_Delete(root);
+    const char* from = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(*root, "quickdraw"));
+    if (!cJSON_IsArray(cJSON_GetObjectItemCaseSensitive(*root, "picks")) || !from) {
+        cJSON_Delete(*root);
+        *root = NULL;
         return sp_fail(err, SP_ERR_PARSE, "%s: not a picks file (want {\"quickdraw\": DIR, \"picks\": [...]})", path);
     }
-    char dir[2048];
-    if (quickdraw_dir) snprintf(dir, sizeof dir, "%s", quickdraw_dir);
-    else if (from[0] == '/') snprintf(dir, sizeof dir, "%s", from);
-    else snprintf(dir, sizeof dir, "%s/sketches/%s", assets_dir, from);
-    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
-        cJSON_Delete(root);
-        if (missing) *missing = true;
-        return quickdraw_dir ? sp_fail(err, SP_ERR_IO, "%s: no such folder (the Quick, Draw! data)", dir) : SP_OK;
+    if (quickdraw_dir) snprintf(dir, 2048, "%s", quickdraw_dir);
+    else if (from[0] == '/') snprintf(dir, 2048, "%s", from);
+    else snprintf(dir, 2048, "%s/sketches/%s", assets_dir, from);
+    *missing = stat(dir, &st) != 0 || !S_ISDIR(st.st_mode);
+    if (*missing && quickdraw_dir) {
+        cJSON_Delete(*root);
+        *root = NULL;
+        return sp_fail(err, SP_ERR_IO, "%s: no such folder (the Quick, Draw! data)", dir);
     }
+    return SP_OK;
+}
+
+sp_result sp_db_people_source(const char* assets_dir, const char* quickdraw_dir, int* picks, bool* missing, sp_error* err)
+{
+    cJSON* root;
+    char dir[2048];
+    sp_result r = load_picks(assets_dir, quickdraw_dir, &root, dir, missing, err);
+    *picks = root ? cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(root, "picks")) : 0;
+    cJSON_Delete(root);
+    return r;
+}
+
+sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    cJSON* root;
+    char dir[2048];
+    bool gone;
+    sp_result r = load_picks(assets_dir, quickdraw_dir, &root, dir, &gone, err);
+    if (missing) *missing = gone;
+    if (r != SP_OK || !root || gone) {
+        cJSON_Delete(root);
+        return r;
+    }
+    const cJSON* picks = cJSON_GetObjectItemCaseSensitive(root, "picks");
     // Categories sorted, as a labelled folder would give them; strokes in the file's order.
     int n = cJSON_GetArraySize(picks);
     const char** cats = calloc((size_t)(n ? n : 1), sizeof *cats);
     int ncat = 0;
-    if (!cats) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    if (!cats) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", assets_dir);
     const cJSON* p;
     cJSON_ArrayForEach(p, picks)
     {
         if (r != SP_OK) break;
         const char* c = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category"));
         if (!c || !*c) {
-            r = sp_fail(err, SP_ERR_PARSE, "%s: a pick without \"category\"", path);
+            r = sp_fail(err, SP_ERR_PARSE, "%s/sketches/picks.json: a pick without \"category\"", assets_dir);
             break;
         }
         int k = 0;
@@ -116,7 +149,8 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
     if (r == SP_OK) qsort(cats, (size_t)ncat, sizeof *cats, sp_cmp_cstr);
     sp_dataset ds = {0};
     for (int k = 0; r == SP_OK && k < ncat; ++k)
-        if (sp_dataset_add_category(&ds, cats[k]) < 0) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+        if (sp_dataset_add_category(&ds, cats[k]) < 0) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", assets_dir);
+    data_file f = {.text = NULL};
     for (int k = 0; r == SP_OK && k < ncat; ++k) {
         cJSON_ArrayForEach(p, picks)
         {
@@ -127,20 +161,23 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
             const cJSON* stroke = cJSON_GetObjectItemCaseSensitive(p, "stroke");
             if (!file || !key || !cJSON_IsNumber(line) || !cJSON_IsNumber(stroke) || line->valueint < 1 || stroke->valueint < 0 ||
                 strchr(file, '/')) {
-                r = sp_fail(err, SP_ERR_PARSE, "%s: a pick needs \"file\" (a name in the data's folder), \"line\" >= 1, \"stroke\" >= 0, \"key_id\"",
-                            path);
+                r = sp_fail(err, SP_ERR_PARSE,
+                            "%s/sketches/picks.json: a pick needs \"file\" (a name in the data's folder), \"line\" >= 1, \"stroke\" >= 0, "
+                            "\"key_id\"",
+                            assets_dir);
                 break;
             }
             char fp[4200];
             snprintf(fp, sizeof fp, "%s/%s", dir, file);
             sp_sample smp = {.label = k};
-            if ((r = read_pick(fp, line->valueint, stroke->valueint, key, &smp.sketch, err)) != SP_OK) break;
+            if ((r = read_pick(&f, fp, line->valueint, stroke->valueint, key, &smp.sketch, err)) != SP_OK) break;
             if (sp_dataset_add_sample(&ds, &smp) != SP_OK) {
                 sp_sketch_free(&smp.sketch);
-                r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", fp);
             }
         }
     }
+    free(f.text);
     free(cats);
     cJSON_Delete(root);
     if (r != SP_OK) sp_dataset_free(&ds);

@@ -824,6 +824,8 @@ static void test_people_strokes(void)
     sp_error err = {0};
     bool missing = true;
     ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && !missing);
+    int picks = 0;
+    ENSURE(sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && picks == 3 && !missing);
     // Categories sorted; within one, the file's order; each a one-stroke sketch on Quick, Draw!'s canvas.
     ENSURE(ds.count == 3 && ds.category_count == 2 && !strcmp(ds.categories[0], "horns") && !strcmp(ds.categories[1], "tail"));
     ENSURE(ds.samples[0].label == 0 && ds.samples[1].label == 1 && ds.samples[2].label == 1);
@@ -844,6 +846,8 @@ static void test_people_strokes(void)
     ENSURE(system(cmd) == 0);
     ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && missing && ds.count == 0);
     ENSURE(sp_db_people_strokes(assets, qd, &ds, &missing, &err) == SP_ERR_IO && strstr(err.text, qd));
+    ENSURE(sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && picks == 3 && missing);
+    ENSURE(sp_db_people_source(assets, qd, &picks, &missing, &err) == SP_ERR_IO && strstr(err.text, qd));
     // Picks the data does not have: one line naming the file and line.
     struct {
         const char* pick;
@@ -871,6 +875,7 @@ static void test_people_strokes(void)
     // No picks.json: nothing to add.
     remove(f);
     ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && ds.count == 0 && !missing);
+    ENSURE(sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && picks == 0 && !missing);
 
     // The project's own picks, read from ../shared/data.
     char qdreal[1100];

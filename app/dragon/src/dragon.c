@@ -41,6 +41,12 @@ const char* sp_dragon_note_name(sp_dragon_note n)
     return "unknown";
 }
 
+const char* sp_dragon_default_assets(void)
+{
+    const char* env = getenv("SP_ASSETS");
+    return env && *env ? env : "assets";
+}
+
 sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error* err)
 {
     *out = NULL;
@@ -75,8 +81,7 @@ sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error
         dragon_copy_name(d->db_path, sizeof d->db_path, sp_db_path(o->db));
     } else {
         dragon_copy_name(d->db_path, sizeof d->db_path, o->db_path ? o->db_path : sp_db_default_path());
-        const char* env = getenv("SP_ASSETS");
-        dragon_copy_name(d->assets_dir, sizeof d->assets_dir, o->assets_dir ? o->assets_dir : env && *env ? env : "assets");
+        dragon_copy_name(d->assets_dir, sizeof d->assets_dir, o->assets_dir ? o->assets_dir : sp_dragon_default_assets());
         sp_result r = sp_db_open_or_create_default(d->db_path, d->assets_dir, SP_DB_READONLY, &d->db, err);
         if (r != SP_OK) {
             free(d);

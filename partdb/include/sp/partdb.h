@@ -327,6 +327,11 @@ sp_result sp_db_create_default(const char* path, const char* assets_dir, const s
 /// the data does not have (no such line or stroke, another key_id) is an
 /// error naming the file and line.
 sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err);
+/// What sp_db_people_strokes would read, from picks.json alone (the data is not
+/// read): *picks, the strokes it names, and *missing, whether the data's
+/// folder is not there (SP_ERR_IO when `quickdraw_dir` names one that is not).
+/// A database the default recipe builds holds all *picks of them, or none.
+sp_result sp_db_people_source(const char* assets_dir, const char* quickdraw_dir, int* picks, bool* missing, sp_error* err);
 /// Creates `path` from an export folder (sp_db_import), then trains when
 /// `train` is not NULL. Built beside `path` and moved into place when complete.
 sp_result sp_db_create_from_export(const char* path, const char* dir, const sp_db_train_desc* train, const char* by, sp_error* err);

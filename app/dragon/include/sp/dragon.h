@@ -111,7 +111,7 @@ typedef struct sp_dragon sp_dragon;
 typedef struct sp_dragon_desc {
     sp_db* db;              ///< an open database to use (not owned, must outlive the dragon); NULL: open db_path
     const char* db_path;    ///< NULL: sp_db_default_path(); created from assets_dir when missing
-    const char* assets_dir; ///< parts for a missing default database; NULL: $SP_ASSETS, else "assets"
+    const char* assets_dir; ///< parts for a missing default database; NULL: sp_dragon_default_assets()
     int canvas_w, canvas_h; ///< drawing canvas, pixels; 0: 1280 x 800
     sp_solve_desc solve; ///< solver options; zero: the solver's defaults except time_cap_ms 250, representatives 100, samples 48
     double min_confidence; ///< a top guess scoring below this is rejected too; 0: 0.0 (only the classifier's own rejection)
@@ -197,6 +197,8 @@ typedef struct sp_dragon_stroke_opts {
 /// newest model. On failure *out is NULL and err has one line. A database
 /// without a model still opens (strokes then need a forced category).
 sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error* err);
+/// The parts' folder for a missing default database when the desc names none: $SP_ASSETS, else "assets".
+const char* sp_dragon_default_assets(void);
 /// Frees everything (NULL is fine). Does not close a caller's database.
 void sp_dragon_destroy(sp_dragon* d);
 
