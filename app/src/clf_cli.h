@@ -16,7 +16,7 @@
 typedef struct clf_cli_opts {
     int words, knn, augment, soft, threads, seed, pyramid;
     bool no_pyramid, no_tfidf, no_hellinger, no_mirror, handdraw;
-    double reject_quantile, shape_weight;
+    double reject_quantile, shape_weight, picture_weight;
 } clf_cli_opts;
 
 #define CLF_CLI_OPTS(o)                                                                                         \
@@ -32,6 +32,7 @@ typedef struct clf_cli_opts {
         {"--no-mirror", SP_OPT_FLAG, &(o).no_mirror, "", "do not add mirrored training drawings", false},    \
         {"--reject-quantile", SP_OPT_DOUBLE, &(o).reject_quantile, "Q", "reject threshold quantile (0.98)", false}, \
         {"--shape-weight", SP_OPT_DOUBLE, &(o).shape_weight, "W", "global shape evidence weight (0: none; part databases 0.75; < 0: none)", false}, \
+        {"--picture-weight", SP_OPT_DOUBLE, &(o).picture_weight, "W", "whole-drawing picture evidence weight (0: the default, 0.3; < 0: none)", false}, \
         {"--seed", SP_OPT_INT, &(o).seed, "S", "random seed (default 1)", false},                              \
         {"--threads", SP_OPT_INT, &(o).threads, "T", "worker threads (default 2)", false}
 
@@ -57,6 +58,7 @@ static inline sp_clf_desc clf_cli_desc(const clf_cli_opts* o)
     d.mirror = o->no_mirror ? -1 : 0;
     d.reject_quantile = o->reject_quantile;
     d.shape_weight = o->shape_weight;
+    d.picture_weight = o->picture_weight;
     d.seed = (uint32_t)o->seed;
     d.threads = o->threads;
     if (o->handdraw) d.augment_fn = clf_cli_handdraw;

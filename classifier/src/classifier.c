@@ -17,6 +17,7 @@
 #include "feat.h"
 #include "cv_adapter.h"
 #include "kmeans.h"
+#include "picture.h"
 #include "shape.h"
 #include "sp/math.h"
 
@@ -45,6 +46,10 @@ struct sp_clf {
     float* shapes;     // shape_count by SP_SHAPE_DIM, standardised by shape_mu / shape_sd
     int* shape_labels; // shape_count
     float shape_mu[SP_SHAPE_DIM], shape_sd[SP_SHAPE_DIM];
+    int pic_count;       // training pictures, mirrored ones included (0: no picture evidence)
+    float* pics;         // pic_count by SP_PICTURE_DIM
+    int* pic_labels;     // pic_count
+    float pic_bandwidth; // voting kernel width (picture distance)
 };
 
 sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
@@ -68,6 +73,8 @@ sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
     if (r.seed == 0) r.seed = 1;
     if (r.threads <= 0) r.threads = 2;
     if (!(r.shape_weight > 0.0) || !isfinite(r.shape_weight)) r.shape_weight = -1.0;
+    if (r.picture_weight == 0.0) r.picture_weight = SP_CLF_PICTURE_WEIGHT;
+    if (!(r.picture_weight > 0.0) || !isfinite(r.picture_weight)) r.picture_weight = -1.0;
     return r;
 }
 
@@ -100,6 +107,8 @@ void sp_clf_destroy(sp_clf* clf)
     free(clf->coarse);
     free(clf->shapes);
     free(clf->shape_labels);
+    free(clf->pics);
+    free(clf->pic_labels);
     free(clf);
 }
 
@@ -259,6 +268,25 @@ static void finish_hist(const sp_clf* c, const float* raw, float* out)
 // visitors' tune half, BENCHMARKS.md "Visitors' drawings").
 #define FUSE_VOTE_FLOOR 0.02
 #define SHAPE_FLOOR 0.01
+#define PICTURE_FLOOR 0.02
+
+static float dist2(const float* a, const float* b, int n, float stop);
+
+// The k rows of `rows` (count by dim) nearest to x: near[] and their squared
+// distances best[], nearest first; returns how many (min(k, count)).
+static int nearest_rows(const float* rows, int count, int dim, const float* x, int k, int* near, double* best)
+{
+    int have = 0;
+    for (int i = 0; i < count; ++i) {
+        double s = dist2(rows + (size_t)i * dim, x, dim, have == k ? (float)best[k - 1] : INFINITY);
+        if (have == k && s >= best[k - 1]) continue;
+        int j = have < k ? have++ : k - 1;
+        for (; j > 0 && best[j - 1] > s; --j)
+            best[j] = best[j - 1], near[j] = near[j - 1];
+        best[j] = s, near[j] = i;
+    }
+    return have;
+}
 
 // The shape evidence's share per category (`p`, category_count, sums to 1):
 // the knn training drawings nearest in (standardised) shape, each weighted by
@@ -272,19 +300,9 @@ static bool shape_shares(const sp_clf* c, const sp_sketch* sk, double* p)
     if (sp_shape_describe(sk, x, &e) != SP_OK) return false;
     for (int d = 0; d < SP_SHAPE_DIM; ++d)
         x[d] = (x[d] - c->shape_mu[d]) / c->shape_sd[d];
-    int k = c->desc.knn < c->shape_count ? c->desc.knn : c->shape_count, have = 0, near[64];
+    int k = c->desc.knn < c->shape_count ? c->desc.knn : c->shape_count, near[64];
     double best[64];
-    for (int i = 0; i < c->shape_count; ++i) {
-        const float* y = c->shapes + (size_t)i * SP_SHAPE_DIM;
-        double s = 0.0;
-        for (int d = 0; d < SP_SHAPE_DIM; ++d)
-            s += (double)(y[d] - x[d]) * (y[d] - x[d]);
-        if (have == k && s >= best[k - 1]) continue;
-        int j = have < k ? have++ : k - 1;
-        for (; j > 0 && best[j - 1] > s; --j)
-            best[j] = best[j - 1], near[j] = near[j - 1];
-        best[j] = s, near[j] = i;
-    }
+    int have = nearest_rows(c->shapes, c->shape_count, SP_SHAPE_DIM, x, k, near, best);
     double total = 0.0;
     for (int i = 0; i < c->category_count; ++i)
         p[i] = SHAPE_FLOOR;
@@ -297,10 +315,39 @@ static bool shape_shares(const sp_clf* c, const sp_sketch* sk, double* p)
     return true;
 }
 
-// The votes of the nn nearest training histograms; with `shape` (the shape
-// evidence's shares, or NULL) every category's score is its vote share (plus
-// the floor) times its shape share raised to shape_weight, renormalised.
-static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, const double* shape, sp_clf_answer* a)
+// The picture evidence's share per category (`p`, category_count, sums to 1):
+// the knn training pictures nearest, weighted by a kernel of the training
+// set's typical nearest distance, as the histogram votes are. False without
+// picture evidence.
+static bool picture_shares(const sp_clf* c, const sp_sketch* sk, double* p)
+{
+    if (c->pic_count == 0 || !(c->desc.picture_weight > 0.0) || !sk || sk->stroke_count == 0) return false;
+    float x[SP_PICTURE_DIM];
+    sp_error e = {0};
+    if (sp_picture_describe(sk, false, x, &e) != SP_OK) return false;
+    int k = c->desc.knn < c->pic_count ? c->desc.knn : c->pic_count, near[64];
+    double best[64];
+    int have = nearest_rows(c->pics, c->pic_count, SP_PICTURE_DIM, x, k, near, best);
+    const double inv = 1.0 / (2.0 * (double)c->pic_bandwidth * c->pic_bandwidth);
+    double total = 0.0;
+    for (int i = 0; i < c->category_count; ++i)
+        p[i] = 0.0;
+    for (int j = 0; j < have; ++j) {
+        double w = exp(-(best[j] - best[0]) * inv);
+        p[c->pic_labels[near[j]]] += w;
+        total += w;
+    }
+    for (int i = 0; i < c->category_count; ++i)
+        p[i] = total > 0.0 ? p[i] / total : 1.0 / c->category_count;
+    return true;
+}
+
+// The votes of the nn nearest training histograms; with `shape` or `pic`
+// (the shape and picture evidence's shares, or NULL) every category's score
+// is its vote share (plus the floor) times its shape share raised to
+// shape_weight times its picture share (plus its floor) raised to
+// picture_weight, renormalised.
+static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, const double* shape, const double* pic, sp_clf_answer* a)
 {
     memset(a, 0, sizeof *a);
     float* score = calloc((size_t)c->category_count, sizeof(float));
@@ -316,10 +363,14 @@ static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, const
         score[c->labels[idx[j]]] += w;
         total += w;
     }
-    if (shape && total > 0.0) {
+    if ((shape || pic) && total > 0.0) {
         double fused = 0.0;
-        for (int k = 0; k < c->category_count; ++k)
-            fused += score[k] = (float)((score[k] / total + FUSE_VOTE_FLOOR) * pow(shape[k], c->desc.shape_weight));
+        for (int k = 0; k < c->category_count; ++k) {
+            double f = score[k] / total + FUSE_VOTE_FLOOR;
+            if (shape) f *= pow(shape[k], c->desc.shape_weight);
+            if (pic) f *= pow(pic[k] + PICTURE_FLOOR, c->desc.picture_weight);
+            fused += score[k] = (float)f;
+        }
         total = fused;
     }
     for (int r = 0; r < SP_CLF_MAX_RANKED; ++r) {
@@ -473,7 +524,8 @@ static sp_result knn_shortlist(const sp_clf* c, const float* q, int nn, int* idx
     return SP_OK;
 }
 
-static sp_result classify_hist(const sp_clf* c, float* hist, const double* shape, sp_clf_answer* out, sp_error* err)
+static sp_result classify_hist(const sp_clf* c, float* hist, const double* shape, const double* pic, sp_clf_answer* out,
+                               sp_error* err)
 {
     int nn = c->desc.knn < c->train_count ? c->desc.knn : c->train_count;
     int idx[64];
@@ -486,7 +538,7 @@ static sp_result classify_hist(const sp_clf* c, float* hist, const double* shape
         if (flann_find_nearest_neighbors_index_float(c->hist_index, hist, 1, idx, d2, nn, &p) < 0)
             return sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram search failed");
     }
-    vote(c, idx, d2, nn, shape, out);
+    vote(c, idx, d2, nn, shape, pic, out);
     return SP_OK;
 }
 
@@ -495,14 +547,16 @@ sp_result sp_clf_classify(const sp_clf* c, const sp_sketch* sketch, const sp_ras
     memset(out, 0, sizeof *out);
     sp_features* f = malloc(sizeof *f);
     float* raw = malloc(sizeof(float) * (size_t)c->hist_dim * 2);
-    double* shape = malloc(sizeof(double) * (size_t)c->category_count);
+    double* shape = malloc(sizeof(double) * (size_t)c->category_count * 2);
     sp_result rc = (!f || !raw || !shape) ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : SP_OK;
     if (rc == SP_OK) rc = sp_feat_extract(sketch, raster, f, err);
     if (rc == SP_OK) rc = raw_hist(c, f, raw, err);
     if (rc == SP_OK) {
         finish_hist(c, raw, raw + c->hist_dim);
-        bool shaped = sketch && sketch->stroke_count > 0 && shape_shares(c, sketch, shape);
-        rc = classify_hist(c, raw + c->hist_dim, shaped ? shape : NULL, out, err);
+        double* pic = shape + c->category_count;
+        bool strokes = sketch && sketch->stroke_count > 0;
+        bool shaped = strokes && shape_shares(c, sketch, shape), pictured = strokes && picture_shares(c, sketch, pic);
+        rc = classify_hist(c, raw + c->hist_dim, shaped ? shape : NULL, pictured ? pic : NULL, out, err);
     }
     free(f);
     free(raw);
@@ -732,6 +786,84 @@ static sp_result train_shapes(sp_clf* c, const sp_dataset* data, const unsigned 
     return SP_OK;
 }
 
+// Leave-one-out queries for the picture evidence's bandwidth at most: the
+// median nearest distance of a few hundred drawings is as good as of all.
+#define PICTURE_LOO_MAX 512
+
+typedef struct picture_loo_ctx {
+    const sp_clf* c;
+    const int* src;     // per picture: its drawing
+    int count;          // pictures
+    const int* queries; // pictures asked about
+    double* near;       // per query: distance to the nearest picture of another drawing (-1: none)
+} picture_loo_ctx;
+
+static int picture_loo_one(void* user, int q)
+{
+    const picture_loo_ctx* k = user;
+    const int i = k->queries[q];
+    const float* x = k->c->pics + (size_t)i * SP_PICTURE_DIM;
+    double best = INFINITY;
+    for (int j = 0; j < k->count; ++j) {
+        if (k->src[j] == k->src[i]) continue;
+        double s2 = dist2(k->c->pics + (size_t)j * SP_PICTURE_DIM, x, SP_PICTURE_DIM, (float)best);
+        if (s2 < best) best = s2;
+    }
+    k->near[q] = isfinite(best) ? sqrt(best) : -1.0;
+    return 0;
+}
+
+// The pictures of the training stroke drawings (and, with `mirror`, of them
+// mirrored), and the voting bandwidth: the median distance from a drawing to
+// the nearest picture of another drawing.
+static sp_result train_pictures(sp_clf* c, const sp_dataset* data, const unsigned char* use, sp_error* err)
+{
+    if (!(c->desc.picture_weight > 0.0)) return SP_OK;
+    const int per = c->desc.mirror > 0 ? 2 : 1;
+    size_t cap = (size_t)(data->count ? data->count : 1) * per;
+    c->pics = malloc(sizeof(float) * SP_PICTURE_DIM * cap);
+    c->pic_labels = malloc(sizeof(int) * cap);
+    int* src = malloc(sizeof(int) * cap);
+    int* queries = malloc(sizeof(int) * cap);
+    double* near = malloc(sizeof(double) * cap);
+    if (!c->pics || !c->pic_labels || !src || !queries || !near) {
+        free(src), free(queries), free(near);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while training");
+    }
+    int n = 0;
+    for (int i = 0; i < data->count; ++i) {
+        const sp_sample* s = &data->samples[i];
+        if ((use && !use[i]) || s->label < 0 || s->label >= data->category_count || s->sketch.stroke_count == 0) continue;
+        for (int m = 0; m < per; ++m) {
+            sp_error e = {0};
+            if (sp_picture_describe(&s->sketch, m == 1, c->pics + (size_t)n * SP_PICTURE_DIM, &e) != SP_OK) break;
+            c->pic_labels[n] = s->label;
+            src[n++] = i;
+        }
+    }
+    // Every stride-th original drawing asks for its nearest picture of another drawing.
+    int originals = 0, nq = 0, q = 0;
+    for (int i = 0; i < n; ++i)
+        originals += i == 0 || src[i] != src[i - 1];
+    int stride = (originals + PICTURE_LOO_MAX - 1) / PICTURE_LOO_MAX;
+    for (int i = 0; i < n; ++i)
+        if ((i == 0 || src[i] != src[i - 1]) && q++ % (stride > 0 ? stride : 1) == 0) queries[nq++] = i;
+    picture_loo_ctx k = {c, src, n, queries, near};
+    sp_parallel_for(nq, c->desc.threads, picture_loo_one, &k);
+    int m = 0;
+    for (int i = 0; i < nq; ++i)
+        if (near[i] >= 0.0) near[m++] = near[i];
+    if (m > 0) {
+        qsort(near, (size_t)m, sizeof(double), sp_cmp_double);
+        c->pic_bandwidth = (float)fmax(near[m / 2], 1e-4);
+    } else {
+        c->pic_bandwidth = 1.0f;
+    }
+    free(src), free(queries), free(near);
+    c->pic_count = n;
+    return SP_OK;
+}
+
 sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const sp_clf_desc* desc, sp_clf** out, sp_error* err)
 {
     *out = NULL;
@@ -886,6 +1018,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     c->train_count = n;
     if ((rc = build_hist_index(c, err)) != SP_OK) goto fail;
     if ((rc = train_shapes(c, data, use, err)) != SP_OK) goto fail;
+    if ((rc = train_pictures(c, data, use, err)) != SP_OK) goto fail;
 
     // Leave-one-out nearest distances (another drawing, not a variant of the same one)
     // give the voting bandwidth (median) and the reject threshold (quantile).
@@ -1113,6 +1246,12 @@ sp_result sp_clf_save(const sp_clf* c, const char* path, sp_error* err)
     put(&b, c->shape_sd, sizeof c->shape_sd);
     put(&b, c->shapes, sizeof(float) * (size_t)c->shape_count * SP_SHAPE_DIM);
     put(&b, c->shape_labels, sizeof(int32_t) * (size_t)c->shape_count);
+    put_f64(&b, d->picture_weight);
+    put_i32(&b, c->pic_count);
+    put_i32(&b, SP_PICTURE_DIM);
+    put_f32(&b, c->pic_bandwidth);
+    put(&b, c->pics, sizeof(float) * (size_t)c->pic_count * SP_PICTURE_DIM);
+    put(&b, c->pic_labels, sizeof(int32_t) * (size_t)c->pic_count);
     if (b.oom) {
         free(b.p);
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
@@ -1191,7 +1330,7 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
         fclose(f);
         return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model written on a machine of other byte order", path);
     }
-    if (version != SP_CLF_FILE_VERSION && version != 1) {
+    if (version < 1 || version > SP_CLF_FILE_VERSION) {
         fclose(f);
         return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model format version %u, this build reads versions 1 to %d (retrain)", path,
                        version, SP_CLF_FILE_VERSION);
@@ -1287,6 +1426,25 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
             if (!(c->shape_sd[d] > 0)) goto corrupt;
         if (!all_finite(c->shapes, (size_t)c->shape_count * SP_SHAPE_DIM) || !all_finite(c->shape_mu, SP_SHAPE_DIM) ||
             !all_finite(c->shape_sd, SP_SHAPE_DIM))
+            goto corrupt;
+    }
+    c->desc.picture_weight = -1.0; // versions 1 and 2: no picture evidence
+    if (version >= 3) {
+        get(&b, &c->desc.picture_weight, 8);
+        c->pic_count = get_i32(&b);
+        if (b.bad || get_i32(&b) != SP_PICTURE_DIM || c->pic_count < 0 || !isfinite(c->desc.picture_weight) ||
+            (size_t)c->pic_count * (SP_PICTURE_DIM + 1) * 4 + 4 > b.n - b.at)
+            goto corrupt;
+        c->pic_bandwidth = get_f32(&b);
+        c->pics = malloc(sizeof(float) * SP_PICTURE_DIM * (size_t)(c->pic_count ? c->pic_count : 1));
+        c->pic_labels = malloc(sizeof(int) * (size_t)(c->pic_count ? c->pic_count : 1));
+        if (!c->pics || !c->pic_labels) goto oom;
+        get(&b, c->pics, sizeof(float) * SP_PICTURE_DIM * (size_t)c->pic_count);
+        get(&b, c->pic_labels, sizeof(int32_t) * (size_t)c->pic_count);
+        for (int i = 0; i < c->pic_count; ++i)
+            if (c->pic_labels[i] < 0 || c->pic_labels[i] >= c->category_count) goto corrupt;
+        if (!all_finite(c->pics, (size_t)c->pic_count * SP_PICTURE_DIM) ||
+            (c->pic_count > 0 && !(c->pic_bandwidth > 0 && isfinite(c->pic_bandwidth))))
             goto corrupt;
     }
     if (b.bad || b.at != b.n || !(c->bandwidth > 0) || isnan(c->reject)) goto corrupt;

@@ -224,6 +224,22 @@ extern "C" sp_result sp_cv_orientation_maps(const unsigned char* img, int size, 
     SP_CV_FIREWALL(err, "orientation")
 }
 
+extern "C" sp_result sp_cv_blur_halve(const float* planes, int count, int size, double sigma, float* out, sp_error* err)
+{
+    try {
+        single_threaded();
+        const int half = size / 2, k = 2 * (int)std::lround(4.0 * sigma) + 1;
+        for (int i = 0; i < count; ++i) {
+            cv::Mat src(size, size, CV_32FC1, const_cast<float*>(planes) + (size_t)i * size * size), blurred;
+            cv::Mat dst(half, half, CV_32FC1, out + (size_t)i * half * half);
+            cv::GaussianBlur(src, blurred, cv::Size(k, k), sigma, sigma, cv::BORDER_REFLECT);
+            cv::resize(blurred, dst, dst.size(), 0, 0, cv::INTER_AREA);
+        }
+        return SP_OK;
+    }
+    SP_CV_FIREWALL(err, "picture")
+}
+
 extern "C" sp_result sp_cv_dot_rows(const float* a, int n, const float* b, int k, int dim, float* out, sp_error* err)
 {
     try {

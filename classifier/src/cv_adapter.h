@@ -37,6 +37,12 @@ sp_result sp_cv_fit_raster(const unsigned char* grey, int w, int h, int size, in
 /// maps: 4 planes of (size/down)^2 floats, plane-major.
 sp_result sp_cv_orientation_maps(const unsigned char* img, int size, int down, double sigma, float* maps, sp_error* err);
 
+/// Blurs each of `count` planes (size x size floats, plane-major) with a
+/// Gaussian of `sigma` pixels (reflected at the borders, 4 sigma wide each
+/// side) and halves it by averaging 2 x 2 blocks: out is count planes of
+/// (size/2)^2. size must be even.
+sp_result sp_cv_blur_halve(const float* planes, int count, int size, double sigma, float* out, sp_error* err);
+
 /// Dot products of every row of `a` (n by dim) with every row of `b` (k by dim):
 /// out is n by k, row-major (OpenCV's gemm: several times faster than a
 /// hand-vectorised scan on this machine, 1.3 vs 9 ms for 784 x 500 x 64).

@@ -71,9 +71,9 @@ static char* desc_json(const sp_clf_desc* d)
     db_str_printf(&b,
                   "{\"words\": %d, \"vocab_samples\": %d, \"kmeans_iterations\": %d, \"soft_neighbours\": %d, \"knn\": %d,"
                   " \"pyramid\": %d, \"tfidf\": %d, \"hellinger\": %d, \"mirror\": %d, \"augment\": %d, \"reject_quantile\": %.6g,"
-                  " \"seed\": %u, \"threads\": %d, \"shape_weight\": %.6g}",
+                  " \"seed\": %u, \"threads\": %d, \"shape_weight\": %.6g, \"picture_weight\": %.6g}",
                   d->words, d->vocab_samples, d->kmeans_iterations, d->soft_neighbours, d->knn, d->pyramid, d->tfidf, d->hellinger,
-                  d->mirror, d->augment, d->reject_quantile, (unsigned)d->seed, d->threads, d->shape_weight);
+                  d->mirror, d->augment, d->reject_quantile, (unsigned)d->seed, d->threads, d->shape_weight, d->picture_weight);
     return b.oom ? (free(b.s), NULL) : b.s;
 }
 

@@ -12,6 +12,7 @@
 
 // Internals (tests may reach into src/, STYLE.md).
 #include "../../classifier/src/feat.h"
+#include "../../classifier/src/picture.h"
 #include "../../classifier/src/shape.h"
 
 #pragma GCC diagnostic push
@@ -525,7 +526,7 @@ static sp_clf* shapes_model(void)
     if (g_model) return g_model;
     sp_dataset train = shapes(20, 7);
     sp_error err = {0};
-    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5};
+    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5, .picture_weight = -1};
     sp_result rc = sp_clf_train(&train, NULL, &d, &g_model, &err);
     if (rc != SP_OK) fprintf(stderr, "  %s\n", err.text);
     sp_dataset_free(&train);
@@ -711,74 +712,240 @@ static void test_shape_descriptor(void)
     ENSURE(sp_shape_describe(&s, a, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
 }
 
+// Classifies `test` with `before` (a model without one kind of evidence),
+// `fused` (the same training with it) and `loaded` (fused saved and read
+// back): the same votes give the same nearest distance, the fused scores of
+// every category sum to 1, and the loaded model answers exactly as the fused
+// one. *right: fused first guesses right; *differs: first scores changed.
+static void compare_fused(const sp_clf* before, const sp_clf* fused, const sp_clf* loaded, const sp_dataset* test, int* right,
+                          int* differs)
+{
+    sp_error err = {0};
+    *right = *differs = 0;
+    for (int i = 0; i < test->count; ++i) {
+        const sp_sketch* sk = &test->samples[i].sketch;
+        sp_clf_answer p, a, b;
+        ENSURE(sp_clf_classify(before, sk, NULL, &p, &err) == SP_OK);
+        ENSURE(sp_clf_classify(fused, sk, NULL, &a, &err) == SP_OK);
+        ENSURE(sp_clf_classify(loaded, sk, NULL, &b, &err) == SP_OK);
+        ENSURE(a.count == sp_clf_category_count(fused) && a.distance == p.distance && a.rejected == p.rejected);
+        double sum = 0.0;
+        for (int j = 0; j < a.count; ++j)
+            sum += a.ranked[j].score;
+        ENSURE_NEAR(sum, 1.0, 1e-4);
+        ENSURE(a.count == b.count && a.distance == b.distance);
+        for (int j = 0; j < a.count; ++j)
+            ENSURE(a.ranked[j].category == b.ranked[j].category && a.ranked[j].score == b.ranked[j].score);
+        *right += a.ranked[0].category == test->samples[i].label;
+        *differs += a.ranked[0].score != p.ranked[0].score;
+    }
+}
+
+// A raster has neither shape nor picture: `with` ranks it exactly as `without`.
+static void expect_raster_unchanged(const sp_clf* without, const sp_clf* with)
+{
+    sp_error err = {0};
+    sp_raster r = {0};
+    const char* png = sp_test_tmp_path("evidence.png");
+    write_png_sketch(png, 120, 90);
+    ENSURE(sp_raster_read_png(png, &r, &err) == SP_OK);
+    remove(png);
+    sp_clf_answer p, a;
+    ENSURE(sp_clf_classify(without, NULL, &r, &p, &err) == SP_OK && sp_clf_classify(with, NULL, &r, &a, &err) == SP_OK);
+    ENSURE(p.count == a.count);
+    for (int j = 0; j < a.count; ++j)
+        ENSURE(a.ranked[j].category == p.ranked[j].category && a.ranked[j].score == p.ranked[j].score);
+    sp_raster_free(&r);
+}
+
+// Sum of one plane of a picture (5 planes of 12 x 12).
+static double plane_sum(const float* pic, int plane)
+{
+    double s = 0.0;
+    for (int i = 0; i < SP_PICTURE_DIM / 5; ++i)
+        s += pic[plane * (SP_PICTURE_DIM / 5) + i];
+    return s;
+}
+
+static void test_picture_descriptor(void)
+{
+    sp_error err = {0};
+    float* a = malloc(sizeof(float) * SP_PICTURE_DIM * 3);
+    ENSURE(a != NULL);
+    float *b = a + SP_PICTURE_DIM, *c = b + SP_PICTURE_DIM;
+    for (int kind = 0; kind < 3; ++kind) {
+        sp_sketch s = {0}, m = {0};
+        g_rng = 77 + (uint64_t)kind;
+        make_shape(kind, &s);
+        ENSURE(sp_picture_describe(&s, false, a, &err) == SP_OK);
+        double sum = 0.0;
+        for (int i = 0; i < SP_PICTURE_DIM; ++i) {
+            ENSURE(isfinite(a[i]) && a[i] >= 0.0f && a[i] <= 1.0f);
+            sum += a[i];
+        }
+        ENSURE(sum > 1.0);
+        // Mirrored on request: the same as the drawing mirrored (anywhere: the picture sits on the centroid), moved,
+        // and scaled by 3.
+        ENSURE(sp_sketch_clone(&s, &m) == SP_OK);
+        for (int k = 0; k < m.strokes[0].count; ++k)
+            m.strokes[0].points[k] = (sp_vec2){3 * (1000.0 - m.strokes[0].points[k].x), 3 * m.strokes[0].points[k].y - 50};
+        ENSURE(sp_picture_describe(&s, true, b, &err) == SP_OK && sp_picture_describe(&m, false, c, &err) == SP_OK);
+        double diff = 0.0, mirror_diff = 0.0;
+        for (int i = 0; i < SP_PICTURE_DIM; ++i)
+            diff += fabs(b[i] - c[i]), mirror_diff += fabs(a[i] - b[i]);
+        ENSURE(diff < 0.02 * sum);
+        if (kind == 2) ENSURE(mirror_diff > 0.1 * sum); // a zigzag is not its own mirror image
+        sp_sketch_free(&s);
+        sp_sketch_free(&m);
+    }
+    // A horizontal line runs at 0 degrees only: its first plane has ink, the 45, 90 and 135 degree planes none; the
+    // ends are marked.
+    sp_sketch s = {0};
+    sp_vec2 line[2] = {{10, 50}, {200, 50}};
+    ENSURE(sp_sketch_add_stroke(&s, line, NULL, 2) == SP_OK);
+    ENSURE(sp_picture_describe(&s, false, a, &err) == SP_OK);
+    ENSURE(plane_sum(a, 0) > 1.0 && plane_sum(a, 1) == 0.0 && plane_sum(a, 2) == 0.0 && plane_sum(a, 3) == 0.0);
+    ENSURE(plane_sum(a, 4) > 0.5);
+    sp_sketch_free(&s);
+    // A vertical line: the 90 degree plane.
+    sp_vec2 upright[2] = {{50, 10}, {50, 200}};
+    ENSURE(sp_sketch_add_stroke(&s, upright, NULL, 2) == SP_OK);
+    ENSURE(sp_picture_describe(&s, false, a, &err) == SP_OK);
+    ENSURE(plane_sum(a, 2) > 1.0 && plane_sum(a, 0) == 0.0);
+    sp_sketch_free(&s);
+    // A dot is one, its ends in the middle; a scribble whose ink is thousands of diagonals long is described from
+    // a bounded number of samples; bad drawings are refused with a message.
+    sp_vec2 dot[3] = {{5, 5}, {5, 5}, {5, 5}}, bad[2] = {{0, 0}, {NAN, 1}};
+    ENSURE(sp_sketch_add_stroke(&s, dot, NULL, 3) == SP_OK);
+    ENSURE(sp_picture_describe(&s, false, a, &err) == SP_OK);
+    ENSURE(plane_sum(a, 0) == 0.0 && plane_sum(a, 4) > 0.0);
+    sp_sketch_free(&s);
+    int n = 200000;
+    sp_vec2* zig = malloc(sizeof(sp_vec2) * (size_t)n);
+    ENSURE(zig != NULL);
+    for (int i = 0; i < n; ++i)
+        zig[i] = (sp_vec2){i % 2 ? 300 : 0, (i % 1000) * 0.3};
+    ENSURE(sp_sketch_add_stroke(&s, zig, NULL, n) == SP_OK);
+    ENSURE(sp_picture_describe(&s, false, a, &err) == SP_OK);
+    for (int i = 0; i < SP_PICTURE_DIM; ++i)
+        ENSURE(isfinite(a[i]));
+    sp_sketch_free(&s);
+    free(zig);
+    ENSURE(sp_sketch_add_stroke(&s, bad, NULL, 2) == SP_OK);
+    ENSURE(sp_picture_describe(&s, false, a, &err) == SP_ERR_INVALID && contains(err.text, "finite"));
+    sp_sketch_free(&s);
+    ENSURE(sp_picture_describe(&s, false, a, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
+    free(a);
+}
+
+// Writes `from` (a model file) as an older version: the last `cut` bytes of its
+// body (the sections that version lacks) dropped, the header and checksum redone.
+static void write_old_version(const char* from, const char* to, uint32_t version, size_t cut)
+{
+    long n = file_size(from);
+    unsigned char* buf = malloc((size_t)n);
+    FILE* f = fopen(from, "rb");
+    ENSURE(f && buf && fread(buf, 1, (size_t)n, f) == (size_t)n);
+    fclose(f);
+    uint64_t len;
+    memcpy(&len, buf + 16, 8);
+    len -= cut;
+    memcpy(buf + 8, &version, 4);
+    memcpy(buf + 16, &len, 8);
+    uint64_t sum = model_checksum(buf + 24, (size_t)len);
+    memcpy(buf + 24 + len, &sum, 8);
+    f = fopen(to, "wb");
+    ENSURE(f && fwrite(buf, 1, 24 + (size_t)len + 8, f) == 24 + (size_t)len + 8);
+    fclose(f);
+    free(buf);
+}
+
+// Bytes of an empty picture section (weight, count, dimension, bandwidth) and of an empty shape section (weight,
+// count, dimension, mean, spread).
+#define EMPTY_PICTURE_SECTION (8 + 4 + 4 + 4)
+#define EMPTY_SHAPE_SECTION (8 + 4 + 4 + 2 * sizeof(float) * SP_SHAPE_DIM)
+
+static void test_picture_evidence(void)
+{
+    sp_dataset train = shapes(20, 7), test = shapes(8, 555);
+    sp_error err = {0};
+    sp_clf *shaped = NULL, *pictured = NULL, *back = NULL, *old = NULL;
+    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5, .shape_weight = 0.75, .picture_weight = -1};
+    ENSURE(sp_clf_train(&train, NULL, &d, &shaped, &err) == SP_OK);
+    d.picture_weight = 0; // the default
+    ENSURE(sp_clf_train(&train, NULL, &d, &pictured, &err) == SP_OK);
+    ENSURE(sp_clf_get_desc(pictured).picture_weight == SP_CLF_PICTURE_WEIGHT && sp_clf_get_desc(shaped).picture_weight < 0);
+    const char* path = sp_test_tmp_path("pictured.spclf");
+    ENSURE(sp_clf_save(pictured, path, &err) == SP_OK);
+    ENSURE(sp_clf_load(path, &back, &err) == SP_OK && sp_clf_get_desc(back).picture_weight == SP_CLF_PICTURE_WEIGHT);
+    // The same votes and shape evidence (the same training), fused with the picture's.
+    int right, differs;
+    compare_fused(shaped, pictured, back, &test, &right, &differs);
+    ENSURE(right >= test.count * 9 / 10 && differs == test.count);
+    expect_raster_unchanged(shaped, pictured);
+    // A damaged picture section is refused.
+    long n = file_size(path);
+    const char* bad = sp_test_tmp_path("pictured_bad.spclf");
+    write_old_version(path, bad, 3, 4); // the last picture label cut off
+    ENSURE(sp_clf_load(bad, &old, &err) == SP_ERR_PARSE && contains(err.text, "corrupt") && old == NULL);
+    ENSURE(n > 0);
+
+    // A version 2 file (no picture section) is still read, as a model without picture evidence.
+    const char* v2 = sp_test_tmp_path("shaped_v2.spclf");
+    const char* cur = sp_test_tmp_path("shaped_v3.spclf");
+    ENSURE(sp_clf_save(shaped, cur, &err) == SP_OK);
+    write_old_version(cur, v2, 2, EMPTY_PICTURE_SECTION);
+    ENSURE(sp_clf_load(v2, &old, &err) == SP_OK && sp_clf_get_desc(old).picture_weight < 0 &&
+           sp_clf_get_desc(old).shape_weight == 0.75);
+    for (int i = 0; i < test.count; ++i) {
+        sp_clf_answer o, s;
+        ENSURE(sp_clf_classify(old, &test.samples[i].sketch, NULL, &o, &err) == SP_OK &&
+               sp_clf_classify(shaped, &test.samples[i].sketch, NULL, &s, &err) == SP_OK);
+        ENSURE(o.count == s.count && o.ranked[0].category == s.ranked[0].category && o.ranked[0].score == s.ranked[0].score);
+    }
+    sp_clf_destroy(old);
+    remove(v2);
+    remove(cur);
+    remove(bad);
+    remove(path);
+    sp_clf_destroy(back);
+    sp_clf_destroy(pictured);
+    sp_clf_destroy(shaped);
+    sp_dataset_free(&train);
+    sp_dataset_free(&test);
+}
+
 static void test_shape_evidence(void)
 {
     sp_dataset train = shapes(20, 7), test = shapes(5, 555);
     sp_error err = {0};
     sp_clf* plain = shapes_model();
     sp_clf* shaped = NULL;
-    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5, .shape_weight = 0.75};
+    sp_clf_desc d = {.words = 48, .vocab_samples = 8000, .knn = 5, .shape_weight = 0.75, .picture_weight = -1};
     ENSURE(sp_clf_train(&train, NULL, &d, &shaped, &err) == SP_OK);
     ENSURE(sp_clf_get_desc(shaped).shape_weight == 0.75 && sp_clf_get_desc(plain).shape_weight < 0);
     const char* path = sp_test_tmp_path("shaped.spclf");
     ENSURE(sp_clf_save(shaped, path, &err) == SP_OK);
     sp_clf* back = NULL;
     ENSURE(sp_clf_load(path, &back, &err) == SP_OK && sp_clf_get_desc(back).shape_weight == 0.75);
-    int right = 0, differs = 0;
-    for (int i = 0; i < test.count; ++i) {
-        const sp_sketch* sk = &test.samples[i].sketch;
-        sp_clf_answer p, a, b;
-        ENSURE(sp_clf_classify(plain, sk, NULL, &p, &err) == SP_OK);
-        ENSURE(sp_clf_classify(shaped, sk, NULL, &a, &err) == SP_OK);
-        ENSURE(sp_clf_classify(back, sk, NULL, &b, &err) == SP_OK);
-        // Fused: every category ranked, scores summing to 1; the same votes
-        // (same training) give the same nearest distance.
-        ENSURE(a.count == 3 && a.distance == p.distance && a.rejected == p.rejected);
-        ENSURE_NEAR(a.ranked[0].score + a.ranked[1].score + a.ranked[2].score, 1.0, 1e-4);
-        ENSURE(a.count == b.count && a.distance == b.distance);
-        for (int j = 0; j < a.count; ++j)
-            ENSURE(a.ranked[j].category == b.ranked[j].category && a.ranked[j].score == b.ranked[j].score);
-        right += a.ranked[0].category == test.samples[i].label;
-        differs += a.ranked[0].score != p.ranked[0].score;
-    }
+    // Fused: every category ranked, scores summing to 1; the same votes
+    // (same training) give the same nearest distance.
+    int right, differs;
+    compare_fused(plain, shaped, back, &test, &right, &differs);
     ENSURE(right >= test.count * 9 / 10 && differs > 0);
     // A raster has no shape descriptor: the votes alone rank, as without shape evidence.
-    sp_raster r = {0};
-    const char* png = sp_test_tmp_path("shaped.png");
-    write_png_sketch(png, 120, 90);
-    ENSURE(sp_raster_read_png(png, &r, &err) == SP_OK);
-    remove(png);
-    sp_clf_answer p, a;
-    ENSURE(sp_clf_classify(plain, NULL, &r, &p, &err) == SP_OK && sp_clf_classify(shaped, NULL, &r, &a, &err) == SP_OK);
-    ENSURE(p.count == a.count);
-    for (int j = 0; j < a.count; ++j)
-        ENSURE(a.ranked[j].category == p.ranked[j].category && a.ranked[j].score == p.ranked[j].score);
-    sp_raster_free(&r);
+    expect_raster_unchanged(plain, shaped);
 
-    // A version 1 file (no shape section) is still read, as a model without shape evidence.
+    // A version 1 file (no shape section, no picture section) is still read, as a model without shape evidence.
     const char* plain_path = sp_test_tmp_path("plain.spclf");
+    const char* v1_path = sp_test_tmp_path("plain_v1.spclf");
     ENSURE(sp_clf_save(plain, plain_path, &err) == SP_OK);
-    long n = file_size(plain_path);
-    unsigned char* buf = malloc((size_t)n);
-    FILE* f = fopen(plain_path, "rb");
-    ENSURE(f && buf && fread(buf, 1, (size_t)n, f) == (size_t)n);
-    fclose(f);
-    const size_t tail = 8 + 4 + 4 + 2 * sizeof(float) * SP_SHAPE_DIM; // weight, count, dim, mean, spread
-    uint64_t len;
-    memcpy(&len, buf + 16, 8);
-    len -= tail;
-    uint32_t v1 = 1;
-    memcpy(buf + 8, &v1, 4);
-    memcpy(buf + 16, &len, 8);
-    uint64_t sum = model_checksum(buf + 24, (size_t)len);
-    memcpy(buf + 24 + len, &sum, 8);
-    f = fopen(plain_path, "wb");
-    ENSURE(f && fwrite(buf, 1, 24 + (size_t)len + 8, f) == 24 + (size_t)len + 8);
-    fclose(f);
-    free(buf);
+    write_old_version(plain_path, v1_path, 1, EMPTY_SHAPE_SECTION + EMPTY_PICTURE_SECTION);
+    remove(plain_path);
+    plain_path = v1_path;
     sp_clf* old = NULL;
     ENSURE(sp_clf_load(plain_path, &old, &err) == SP_OK && sp_clf_get_desc(old).shape_weight < 0);
-    sp_clf_answer o;
+    sp_clf_answer o, p;
     ENSURE(sp_clf_classify(old, &test.samples[1].sketch, NULL, &o, &err) == SP_OK &&
            sp_clf_classify(plain, &test.samples[1].sketch, NULL, &p, &err) == SP_OK);
     ENSURE(o.count == p.count && o.ranked[0].category == p.ranked[0].category && o.ranked[0].score == p.ranked[0].score);
@@ -933,6 +1100,8 @@ int main(int argc, char** argv)
                                    {"model_files", test_model_files},
                                    {"shape_descriptor", test_shape_descriptor},
                                    {"shape_evidence", test_shape_evidence},
+                                   {"picture_descriptor", test_picture_descriptor},
+                                   {"picture_evidence", test_picture_evidence},
                                    {"classify_edge_drawings", test_classify_edge_drawings},
                                    {"quickdraw_small", test_quickdraw_small},
                                    {"augment_hook", test_augment_hook},

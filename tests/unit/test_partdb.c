@@ -255,8 +255,9 @@ static void test_round_trip(void)
     sp_clf* clf;
     ENSURE(sp_db_load_model(db, &clf, NULL, &err) == SP_OK);
     ENSURE(sp_clf_category_count(clf) == 1 && !strcmp(sp_clf_category(clf, 0), "wings"));
-    // A part database's model weighs the strokes' shape unless told otherwise.
+    // A part database's model weighs the strokes' shape and picture unless told otherwise.
     ENSURE(sp_clf_get_desc(clf).shape_weight == SP_DB_SHAPE_WEIGHT);
+    ENSURE(sp_clf_get_desc(clf).picture_weight == SP_CLF_PICTURE_WEIGHT);
     sp_clf_destroy(clf);
     add_ok(db, 0, 20);
     train_ok(db, -1, NULL);

@@ -11,10 +11,12 @@
 /// global shape evidence the local features lack (open or closed, elongation
 /// and axis against the upright canvas, solidity, convexity defects and where
 /// they open, turning angles, centroid-distance Fourier magnitudes, where the
-/// ink lies) votes too, by its own k nearest training drawings; the two are
-/// fused as a product of their shares into the ranked categories. A drawing
-/// farther from every training drawing (histogram distance) than a threshold
-/// learned on the training set is rejected.
+/// ink lies) votes too, by its own k nearest training drawings, and so
+/// (`picture_weight`, on by default) does a small picture of the whole
+/// drawing's line directions; they are fused as a product of their shares
+/// into the ranked categories. A drawing farther from every training drawing
+/// (histogram distance) than a threshold learned on the training set is
+/// rejected.
 ///
 ///     sp_dataset ds; sp_dataset_load("data/", &ds, &err);
 ///     sp_clf* clf; sp_clf_train(&ds, NULL, &(sp_clf_desc){0}, &clf, &err);
@@ -37,9 +39,12 @@
 extern "C" {
 #endif
 
-/// Model file format version written by sp_clf_save; sp_clf_load also reads version 1
-/// (models without shape evidence), and refuses others.
-#define SP_CLF_FILE_VERSION 2
+/// Model file format version written by sp_clf_save; sp_clf_load also reads versions 1
+/// (models without shape evidence) and 2 (without picture evidence), and refuses others.
+#define SP_CLF_FILE_VERSION 3
+/// The picture evidence's weight by default (sp_clf_desc.picture_weight);
+/// chosen on the visitors' tune half (tests/data/visitors).
+#define SP_CLF_PICTURE_WEIGHT 0.3
 /// Most ranked categories in an answer.
 #define SP_CLF_MAX_RANKED 10
 
@@ -77,6 +82,15 @@ typedef struct sp_clf_desc {
     /// (partdb.h's sp_db_train_desc turns it on) and costs accuracy on Quick,
     /// Draw!'s 100 (BENCHMARKS.md, "Visitors' drawings").
     double shape_weight;
+    /// Weight of the picture evidence (stroke drawings only; rasters are
+    /// ranked without it): the whole drawing as a small picture of where its
+    /// line runs which way (after Ouyang and Davis 2009), voted on by the k
+    /// nearest training pictures (mirrored ones too); each category's fused
+    /// score is multiplied by its picture share (plus 0.02) raised to this
+    /// power. 0: SP_CLF_PICTURE_WEIGHT; < 0: none. The bag of features sees
+    /// local strokes, the shape descriptor global measures; the picture keeps
+    /// the layout (BENCHMARKS.md: Quick, Draw!'s 100 and the visitors' drawings).
+    double picture_weight;
 } sp_clf_desc;
 
 /// One ranked category: index into the model's categories, and its vote share in [0, 1].
