@@ -181,7 +181,7 @@ typedef struct sp_dragon_result {
     bool rejected; ///< nothing changed (see reason)
     sp_dragon_reject reason;
     sp_dragon_note note; ///< what else to tell (also when accepted)
-    int guess_count;     ///< ranked categories (0..SP_DRAGON_GUESSES), also when rejected by the classifier
+    int guess_count;     ///< ranked categories (0..SP_DRAGON_GUESSES), also when rejected by the classifier; the accepted part's first (the fit re-ranks them)
     sp_dragon_guess guesses[SP_DRAGON_GUESSES];
     int part;                             ///< index of the new (or replaced) part, -1 when rejected
     double ms_classify, ms_fit, ms_total; ///< wall-clock, milliseconds
