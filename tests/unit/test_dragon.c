@@ -1838,9 +1838,11 @@ static void test_visitors_policy(void)
         if (!res.rejected) reranked += check_rerank(d, stroke, &res);
         sp_dragon_clear(d);
     }
-    fprintf(stderr, "  %d parts: %d right, %d refused, %d in the top 3; %d of %d non-parts refused; %d accepted as another than the classifier's first guess\n",
+    fprintf(stderr,
+            "  %d parts: %d right, %d refused, %d in the top 3; %d of %d non-parts refused; %d accepted as another than the "
+            "classifier's first guess\n",
             parts, right, refused, top3, non_refused, non, reranked);
-    ENSURE(reranked > 0); // the fit's evidence decides some strokes (about one in ten)
+    ENSURE(reranked > 0); // the fit's evidence decides some strokes
     // Without ../shared/data the set (and the model's training) lacks the Quick, Draw! strokes: the hand-placed drawings remain.
     char qd[1100];
     snprintf(qd, sizeof qd, "%s/quickdraw", SP_SHARED_DATA);
