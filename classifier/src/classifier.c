@@ -1306,6 +1306,22 @@ static bool all_finite(const float* v, size_t n)
     return true;
 }
 
+// One section of training rows (count by dim floats) and their labels, as
+// the histograms, shape values and pictures are stored: allocated, read and
+// checked (finite values, labels among the categories). SP_ERR_PARSE when
+// the section is inconsistent (the buffer's size already checked by the caller).
+static sp_result get_rows(rbuf* b, int count, int dim, int categories, float** rows, int** labels)
+{
+    *rows = malloc(sizeof(float) * (size_t)dim * (size_t)(count ? count : 1));
+    *labels = malloc(sizeof(int) * (size_t)(count ? count : 1));
+    if (!*rows || !*labels) return SP_ERR_NO_MEMORY;
+    get(b, *rows, sizeof(float) * (size_t)dim * (size_t)count);
+    get(b, *labels, sizeof(int32_t) * (size_t)count);
+    for (int i = 0; i < count; ++i)
+        if ((*labels)[i] < 0 || (*labels)[i] >= categories) return SP_ERR_PARSE;
+    return b->bad || !all_finite(*rows, (size_t)dim * (size_t)count) ? SP_ERR_PARSE : SP_OK;
+}
+
 sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
 {
     *out = NULL;
@@ -1399,11 +1415,7 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
     }
     c->train_count = get_i32(&b);
     if (b.bad || c->train_count < 1 || (size_t)c->train_count * ((size_t)c->hist_dim + 1) * 4 > b.n - b.at) goto corrupt;
-    c->hists = malloc(sizeof(float) * (size_t)c->train_count * c->hist_dim);
-    c->labels = malloc(sizeof(int) * (size_t)c->train_count);
-    if (!c->hists || !c->labels) goto oom;
-    get(&b, c->hists, sizeof(float) * (size_t)c->train_count * c->hist_dim);
-    get(&b, c->labels, sizeof(int32_t) * (size_t)c->train_count);
+    if ((rc = get_rows(&b, c->train_count, c->hist_dim, c->category_count, &c->hists, &c->labels)) != SP_OK) goto bad_rows;
     c->bandwidth = get_f32(&b);
     c->reject = get_f32(&b);
     c->desc.shape_weight = -1.0; // version 1: no shape evidence
@@ -1415,18 +1427,11 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
             goto corrupt;
         get(&b, c->shape_mu, sizeof c->shape_mu);
         get(&b, c->shape_sd, sizeof c->shape_sd);
-        c->shapes = malloc(sizeof(float) * SP_SHAPE_DIM * (size_t)(c->shape_count ? c->shape_count : 1));
-        c->shape_labels = malloc(sizeof(int) * (size_t)(c->shape_count ? c->shape_count : 1));
-        if (!c->shapes || !c->shape_labels) goto oom;
-        get(&b, c->shapes, sizeof(float) * SP_SHAPE_DIM * (size_t)c->shape_count);
-        get(&b, c->shape_labels, sizeof(int32_t) * (size_t)c->shape_count);
-        for (int i = 0; i < c->shape_count; ++i)
-            if (c->shape_labels[i] < 0 || c->shape_labels[i] >= c->category_count) goto corrupt;
+        if ((rc = get_rows(&b, c->shape_count, SP_SHAPE_DIM, c->category_count, &c->shapes, &c->shape_labels)) != SP_OK)
+            goto bad_rows;
         for (int d = 0; d < SP_SHAPE_DIM; ++d)
             if (!(c->shape_sd[d] > 0)) goto corrupt;
-        if (!all_finite(c->shapes, (size_t)c->shape_count * SP_SHAPE_DIM) || !all_finite(c->shape_mu, SP_SHAPE_DIM) ||
-            !all_finite(c->shape_sd, SP_SHAPE_DIM))
-            goto corrupt;
+        if (!all_finite(c->shape_mu, SP_SHAPE_DIM) || !all_finite(c->shape_sd, SP_SHAPE_DIM)) goto corrupt;
     }
     c->desc.picture_weight = -1.0; // versions 1 and 2: no picture evidence
     if (version >= 3) {
@@ -1436,23 +1441,12 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
             (size_t)c->pic_count * (SP_PICTURE_DIM + 1) * 4 + 4 > b.n - b.at)
             goto corrupt;
         c->pic_bandwidth = get_f32(&b);
-        c->pics = malloc(sizeof(float) * SP_PICTURE_DIM * (size_t)(c->pic_count ? c->pic_count : 1));
-        c->pic_labels = malloc(sizeof(int) * (size_t)(c->pic_count ? c->pic_count : 1));
-        if (!c->pics || !c->pic_labels) goto oom;
-        get(&b, c->pics, sizeof(float) * SP_PICTURE_DIM * (size_t)c->pic_count);
-        get(&b, c->pic_labels, sizeof(int32_t) * (size_t)c->pic_count);
-        for (int i = 0; i < c->pic_count; ++i)
-            if (c->pic_labels[i] < 0 || c->pic_labels[i] >= c->category_count) goto corrupt;
-        if (!all_finite(c->pics, (size_t)c->pic_count * SP_PICTURE_DIM) ||
-            (c->pic_count > 0 && !(c->pic_bandwidth > 0 && isfinite(c->pic_bandwidth))))
-            goto corrupt;
+        if ((rc = get_rows(&b, c->pic_count, SP_PICTURE_DIM, c->category_count, &c->pics, &c->pic_labels)) != SP_OK)
+            goto bad_rows;
+        if (c->pic_count > 0 && !(c->pic_bandwidth > 0 && isfinite(c->pic_bandwidth))) goto corrupt;
     }
     if (b.bad || b.at != b.n || !(c->bandwidth > 0) || isnan(c->reject)) goto corrupt;
-    for (int i = 0; i < c->train_count; ++i)
-        if (c->labels[i] < 0 || c->labels[i] >= c->category_count) goto corrupt;
-    if (!all_finite(c->vocab, (size_t)c->words * SP_FEAT_DIM) || !all_finite(c->hists, (size_t)c->train_count * c->hist_dim) ||
-        (c->idf && !all_finite(c->idf, (size_t)c->words)))
-        goto corrupt;
+    if (!all_finite(c->vocab, (size_t)c->words * SP_FEAT_DIM) || (c->idf && !all_finite(c->idf, (size_t)c->words))) goto corrupt;
     free(p);
     if ((rc = build_vocab_index(c, err)) != SP_OK || (rc = build_hist_index(c, err)) != SP_OK) {
         sp_clf_destroy(c);
@@ -1460,6 +1454,8 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
     }
     *out = c;
     return SP_OK;
+bad_rows:
+    if (rc == SP_ERR_NO_MEMORY) goto oom;
 corrupt:
     free(p);
     sp_clf_destroy(c);
