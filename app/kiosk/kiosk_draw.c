@@ -200,7 +200,7 @@ static void draw_button(sp_kiosk* k, sp_kiosk_target t)
 static void draw_chips(sp_kiosk* k)
 {
     const sp_kiosk_ui* ui = k->ui;
-    for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_GUESS3; ++t) {
+    for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t) {
         if (!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t)) continue;
         const sp_kiosk_rect* r = &ui->target[t];
         char text[SP_KIOSK_LABEL_MAX + 8];

@@ -283,11 +283,10 @@ static void test_flow(void)
     // it): the part is there and the note shows.
     tap(ui, 2700, SP_KT_CHIP_GUESS1);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT);
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true,
-                                                    .hint = "It stays where you drew it",
-                                                    .category = "head",
-                                                    .guesses = {"wings", "tail"},
-                                                    .part_count = 1});
+    sp_kiosk_ui_fit_done(
+        ui,
+        &(sp_kiosk_fit_result){
+            .ok = true, .hint = "It stays where you drew it", .category = "head", .guesses = {"wings", "tail"}, .part_count = 1});
     ENSURE(ui->part_count == 1 && sp_kiosk_ui_hint_visible(ui) && strcmp(ui->hint, "It stays where you drew it") == 0);
     // A rejected stroke: hint, fading stroke, nothing else changes.
     double t = stroke(ui, 4000, 100, 500, 20, 10);
@@ -514,6 +513,93 @@ static void test_parts_row(void)
     sp_kiosk_session_free(&s);
 }
 
+// A part the classifier got wrong, whose part is not among the two other
+// guesses, is still one choice away: "Other?" opens the row of
+// parts for the last part, in place of the two guesses; a tap re-fits it as
+// that part. The row closes with the answer, a second tap, a new stroke or
+// Undo, and never opens for a refused stroke's chips (its row is there).
+static void test_something_else(void)
+{
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t); // the fake's head; its guesses wings, tail
+    char text[64];
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE) && sp_kiosk_ui_target_enabled(ui, SP_KT_CHIP_MORE));
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_MORE, text, sizeof text), "Other?"));
+    ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && !strcmp(sp_kiosk_target_name(SP_KT_CHIP_MORE), "more"));
+    // Open: the six parts instead of the guesses, the hint says what to do;
+    // a tap makes the part back legs.
+    tap(ui, t + 500, SP_KT_CHIP_MORE);
+    for (int k = 0; k < SP_KIOSK_ROW_MAX; ++k)
+        ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)(SP_KT_PART1 + k)) == (k < 6));
+    ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL));
+    ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PICK_PART)) && !sp_kiosk_ui_offering(ui));
+    check_targets(ui);
+    tap(ui, t + 900, (sp_kiosk_target)(SP_KT_PART1 + 5));
+    ENSURE(!sp_kiosk_ui_target_enabled(ui, SP_KT_CHIP_MORE)); // one re-fit at a time
+    frame(ui, &f, t + 1000);
+    ENSURE(f.refits == 1 && f.parts == 1 && !strcmp(k_cats[f.cat[0]], "hind_legs") && f.fits == 1);
+    ENSURE(!strcmp(ui->chip[0], "hind_legs") && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    // A second tap closes it, and so do a new stroke and Undo.
+    tap(ui, t + 2000, SP_KT_CHIP_MORE);
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    tap(ui, t + 2200, SP_KT_CHIP_MORE);
+    ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && !sp_kiosk_ui_hint_visible(ui));
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    tap(ui, t + 2400, SP_KT_CHIP_MORE);
+    t = stroke(ui, t + 3000, 300, 500, 18, 5);
+    ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
+    frame(ui, &f, t + 10);
+    ENSURE(f.parts == 2 && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    tap(ui, t + 500, SP_KT_CHIP_MORE);
+    tap(ui, t + 900, SP_KT_UNDO);
+    frame(ui, &f, t + 1000);
+    ENSURE(f.parts == 1 && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
+    // A part drawn where the row would open: the row opens at the canvas's
+    // bottom instead, the hint above it, and covers none of the stroke.
+    t = stroke(ui, t + 2000, 100, 110, 40, 15);
+    frame(ui, &f, t + 10);
+    tap(ui, t + 500, SP_KT_CHIP_MORE);
+    const sp_kiosk_rect* p1 = &ui->target[SP_KT_PART1];
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && p1->y > 0.6f * ui->canvas.h && ui->hint_box.y < p1->y);
+    for (int i = 0; i < ui->flash_stroke.count; ++i)
+        ENSURE(ui->flash_stroke.xy[2 * i + 1] < ui->hint_box.y);
+    check_targets(ui);
+    tap(ui, t + 900, SP_KT_CHIP_MORE);
+    // A refused stroke's chips have no "Other?": its row is there already.
+    t = refused_stroke(ui, t + 2000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE) &&
+           sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    sp_kiosk_ui_destroy(ui);
+    // Without a row of parts (no database yet) there is nothing to open.
+    sp_kiosk_ui_create(NULL, &ui, NULL);
+    sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+    memset(&f, 0, sizeof f);
+    send(ui, SP_KEV_DOWN, 0, 640, 400);
+    send(ui, SP_KEV_UP, 50, 640, 400);
+    t = stroke(ui, 1000, 200, 300, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 1 && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
+    sp_kiosk_ui_destroy(ui);
+    // From a session file: a stroke, "more", "part4" (the row's tail).
+    const char* doc =
+        "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"end_ms\": 5000, \"events\": ["
+        "{\"t\": 0, \"type\": \"down\", \"x\": 640, \"y\": 400}, {\"t\": 50, \"type\": \"up\", \"x\": 640, \"y\": 400},"
+        "{\"t\": 500, \"type\": \"stroke\", \"points\": [[200, 300], [205, 320], [210, 340], [330, 360], [420, 380]]},"
+        "{\"t\": 1500, \"type\": \"press\", \"target\": \"more\"},"
+        "{\"t\": 2500, \"type\": \"press\", \"target\": \"part4\"}]}";
+    sp_kiosk_session s = {0};
+    sp_error err = {0};
+    ENSURE(sp_kiosk_session_parse(doc, strlen(doc), "more.json", &s, &err) == SP_OK);
+    sp_kiosk_ui* b;
+    run_session(&s, 1000.0 / 60.0, 0, &f, &b, NULL);
+    ENSURE(f.parts == 1 && f.refits == 1 && !strcmp(k_cats[f.cat[0]], "tail") && !strcmp(b->chip[0], "tail"));
+    sp_kiosk_ui_destroy(b);
+    sp_kiosk_session_free(&s);
+}
+
 // Issue 16, item 7: Start over returns to the first-draw prompt with the
 // animation stopped (the old kiosk showed a blank canvas and "Pause").
 static void test_start_over(void)
@@ -720,20 +806,30 @@ static void test_layout(void)
         sp_kiosk_ui_fit_done(
             ui, &(sp_kiosk_fit_result){.ok = true, .category = "front_legs", .guesses = {"hind_legs", "wings"}, .part_count = 1});
         for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
-            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) == (t <= SP_KT_CHIP_GUESS2));
+            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) == (t <= SP_KT_CHIP_GUESS2 || t == SP_KT_CHIP_MORE));
         check_targets(ui);
         // The canvas keeps most of the screen.
         ENSURE(ui->canvas.w * ui->canvas.h >= 0.45 * screens[s].w * screens[s].h);
         // Far from every target: nothing.
         ENSURE(sp_kiosk_ui_hit(ui, ui->canvas.x + 0.5f * ui->canvas.w, ui->canvas.y + 0.6f * ui->canvas.h) == SP_KT_NONE);
         ENSURE(sp_kiosk_ui_hit(ui, NAN, 3) == SP_KT_NONE);
+        // "Other?" opens the row of parts in place of the two guesses, all of them targets.
+        sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 1500, 0, 0, SP_KT_CHIP_MORE});
+        for (int t = SP_KT_CHIP_LABEL; t < SP_KT_COUNT; ++t)
+            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
+                   (t == SP_KT_CHIP_LABEL || t == SP_KT_CHIP_MORE || (t >= SP_KT_PART1 && t < SP_KT_PART1 + 6)));
+        check_targets(ui);
+        ENSURE(ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
+        sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 1600, 0, 0, SP_KT_CHIP_MORE}); // closed again
+        ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS2));
         // A refused stroke: three guesses and the six parts, no label.
         stroke(ui, 3000, 0.2f * (float)screens[s].w, 0.5f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
         ENSURE(sp_kiosk_ui_next_job(ui, &j));
         sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"hind_legs", "front_legs", "torso"}});
         for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
             ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
-                   (t <= SP_KT_SAVE || (t >= SP_KT_CHIP_GUESS1 && t < SP_KT_PART1 + 6)));
+                   (t <= SP_KT_SAVE || (t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3) ||
+                    (t >= SP_KT_PART1 && t < SP_KT_PART1 + 6)));
         check_targets(ui);
         // The hint fits under them (none on a canvas too small: only the portrait phone-sized one).
         ENSURE(ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
@@ -1194,6 +1290,7 @@ int main(int argc, char** argv)
                                    {"countdown", test_countdown},
                                    {"refused_stroke", test_refused_stroke},
                                    {"parts_row", test_parts_row},
+                                   {"something_else", test_something_else},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},

@@ -11,8 +11,8 @@
 #include "sp/kiosk_text.h"
 
 static const char* const k_target_names[SP_KT_COUNT] = {
-    NULL,     "undo",  "redraw", "start_over", "play",  "turn",  "save",  "label", "guess1", "guess2",
-    "guess3", "part1", "part2",  "part3",      "part4", "part5", "part6", "part7", "part8",
+    NULL,     "undo", "redraw", "start_over", "play",  "turn",  "save",  "label", "guess1", "guess2",
+    "guess3", "more", "part1",  "part2",      "part3", "part4", "part5", "part6", "part7",  "part8",
 };
 _Static_assert(SP_KIOSK_ROW_MAX == 8, "k_target_names lists part1..part8");
 
@@ -155,22 +155,44 @@ static bool offering(const sp_kiosk_ui* ui)
     return ui->held_stroke.count > 0;
 }
 
-// Points of the held stroke with y in [y0, y1).
-static int held_points_within(const sp_kiosk_ui* ui, float y0, float y1)
+// "Other?" goes with a part's own chips (not a refused stroke's),
+// when there is a row of parts to open.
+static bool more_shown(const sp_kiosk_ui* ui)
+{
+    return !ui->chips_offer && ui->chip[0][0] && ui->row_count > 0;
+}
+
+// The row of parts: a refused stroke's offer, or opened for the last part.
+static bool row_shown(const sp_kiosk_ui* ui)
+{
+    return ui->row_count > 0 && (offering(ui) || (ui->row_open && more_shown(ui)));
+}
+
+// The row opened for the last part holds every guess: it takes the guess
+// chips' place (on a small screen both would not fit above the toolbar).
+static bool guess_hidden(const sp_kiosk_ui* ui, sp_kiosk_target t)
+{
+    return t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && !ui->chips_offer && ui->row_open && more_shown(ui);
+}
+
+// Points of a stroke with y in [y0, y1).
+static int points_within(const sp_kiosk_line* l, float y0, float y1)
 {
     int n = 0;
-    for (int i = 0; i < ui->held_stroke.count; ++i)
-        n += ui->held_stroke.xy[2 * i + 1] >= y0 && ui->held_stroke.xy[2 * i + 1] < y1;
+    for (int i = 0; i < l->count; ++i)
+        n += l->xy[2 * i + 1] >= y0 && l->xy[2 * i + 1] < y1;
     return n;
 }
 
-// The refused stroke stays in sight: when the parts row and the hint under
-// it (from top to end) would cover more of it than at the canvas's bottom,
+// The stroke the row is about stays in sight (the refused one, or the last
+// part's, kept from its flash): when the parts row and the hint under it
+// (from top to end) would cover more of it than at the canvas's bottom,
 // they go there, the hint above the row. The chips stay at the top.
 static void keep_stroke_in_sight(sp_kiosk_ui* ui, float top, float end, float margin, float gap)
 {
+    const sp_kiosk_line* l = offering(ui) ? &ui->held_stroke : &ui->flash_stroke;
     float bottom = ui->canvas.y + ui->canvas.h - margin, start = bottom - (end - top);
-    if (start <= top || held_points_within(ui, top, end) <= held_points_within(ui, start, bottom)) return;
+    if (start <= top || points_within(l, top, end) <= points_within(l, start, bottom)) return;
     float row_end = end - ui->hint_box.h - gap, dy = bottom - row_end;
     for (int i = 0; i < ui->row_count; ++i)
         ui->target[SP_KT_PART1 + i].y += dy;
@@ -190,12 +212,12 @@ static void layout_chips(sp_kiosk_ui* ui)
     float chip_text = 0.42f * h;
     float left = ui->canvas.x + margin, right = ui->canvas.x + ui->canvas.w - margin;
     float x = left, y = ui->canvas.y + margin;
-    for (int i = 0; i < 4; ++i) {
+    for (int i = 0; i < 5; ++i) {
         sp_kiosk_target t = (sp_kiosk_target)(SP_KT_CHIP_LABEL + i);
         sp_kiosk_rect* r = &ui->target[t];
-        char text[SP_KIOSK_LABEL_MAX + 2];
+        char text[SP_KIOSK_TEXT_MAX];
         size_t n = strlen(sp_kiosk_ui_target_text(ui, t, text, sizeof text));
-        if (n == 0) {
+        if (n == 0 || (t == SP_KT_CHIP_MORE && !more_shown(ui)) || guess_hidden(ui, t)) {
             *r = (sp_kiosk_rect){0};
             continue;
         }
@@ -214,7 +236,7 @@ static void layout_chips(sp_kiosk_ui* ui)
     float below = y + h + gap, chips_end = below;
     // The parts row: an outline over its name, 26 x 22 mm, smaller (down to
     // the smallest target) where the rows and the hint would not fit on the canvas.
-    bool row = offering(ui) && ui->row_count > 0;
+    bool row = row_shown(ui);
     float bottom = ui->canvas.y + ui->canvas.h - 2.2f * ui->text_px;
     for (float scale = 1.0f; row; scale -= 0.1f) {
         float bw = fmaxf((float)mm(ui, 26.0) * scale, min), bh = fmaxf((float)mm(ui, 22.0) * scale, min);
@@ -309,9 +331,11 @@ static bool visible(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     if (t <= SP_KT_NONE || t >= SP_KT_COUNT || ui->target[t].w <= 0) return false;
     if (ui->mode == SP_KM_ATTRACT) return false;
-    if (t >= SP_KT_PART1) return ui->mode == SP_KM_DRAW && offering(ui) && (int)t - SP_KT_PART1 < ui->row_count;
+    if (t >= SP_KT_PART1) return ui->mode == SP_KM_DRAW && row_shown(ui) && (int)t - SP_KT_PART1 < ui->row_count;
+    if (t == SP_KT_CHIP_MORE) return ui->mode == SP_KM_DRAW && ui->part_count > 0 && more_shown(ui);
     if (t >= SP_KT_CHIP_LABEL)
-        return ui->mode == SP_KM_DRAW && (ui->part_count > 0 || ui->chips_offer) && ui->chip[t - SP_KT_CHIP_LABEL][0];
+        return ui->mode == SP_KM_DRAW && (ui->part_count > 0 || ui->chips_offer) && ui->chip[t - SP_KT_CHIP_LABEL][0] &&
+               !guess_hidden(ui, t);
     return true;
 }
 
@@ -329,6 +353,7 @@ bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t)
     case SP_KT_CHIP_GUESS1:
     case SP_KT_CHIP_GUESS2:
     case SP_KT_CHIP_GUESS3:
+    case SP_KT_CHIP_MORE:
         return ui->chips_offer || !ui->refit_queued;
     case SP_KT_CHIP_LABEL:
         return true;
@@ -337,7 +362,8 @@ bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t)
     case SP_KT_UNDO: // also takes back a refused stroke that is still offered
         return ui->part_count > 0 || offering(ui);
     default:
-        return t >= SP_KT_PART1 || ui->part_count > 0;
+        if (t >= SP_KT_PART1) return offering(ui) || !ui->refit_queued;
+        return ui->part_count > 0;
     }
 }
 
@@ -395,6 +421,10 @@ const char* sp_kiosk_ui_target_category(const sp_kiosk_ui* ui, sp_kiosk_target t
 
 const char* sp_kiosk_ui_target_text(const sp_kiosk_ui* ui, sp_kiosk_target t, char* out, size_t cap)
 {
+    if (t == SP_KT_CHIP_MORE) {
+        snprintf(out, cap, "%s", sp_kiosk_text(SP_KTEXT_MORE));
+        return out;
+    }
     char name[SP_KIOSK_NAME_MAX];
     sp_kiosk_part_name(sp_kiosk_ui_target_category(ui, t), name, sizeof name);
     bool guess = t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && name[0];
@@ -485,6 +515,7 @@ static void set_chip_list(sp_kiosk_ui* ui, const char* label, const char* const*
     }
     memcpy(ui->chip, tmp, sizeof tmp);
     ui->chips_offer = offer;
+    ui->row_open = false; // new chips: the row opens again only when asked
     layout_chips(ui);
 }
 
@@ -655,6 +686,16 @@ static bool inside(const sp_kiosk_rect* r, float x, float y)
     return x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
 }
 
+// A guess chip or the row chose another part for the last one: re-fit it as that.
+static void refit_last(sp_kiosk_ui* ui, const char* category)
+{
+    sp_kiosk_job* j = push_job(ui, SP_KJOB_REFIT);
+    if (j) {
+        copy_label(j->category, category);
+        ui->refit_queued = true;
+    }
+}
+
 static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     ++ui->activations[t];
@@ -663,7 +704,14 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         return;
     }
     if (t >= SP_KT_PART1) {
-        take_offer(ui, ui->row[t - SP_KT_PART1]);
+        if (offering(ui)) {
+            take_offer(ui, ui->row[t - SP_KT_PART1]);
+            return;
+        }
+        refit_last(ui, ui->row[t - SP_KT_PART1]);
+        ui->row_open = false;
+        layout_chips(ui);
+        ui->hint_until = -1;
         return;
     }
     switch (t) {
@@ -723,13 +771,17 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             take_offer(ui, c);
             break;
         }
-        sp_kiosk_job* j = push_job(ui, SP_KJOB_REFIT);
-        if (j) {
-            copy_label(j->category, c);
-            ui->refit_queued = true;
-        }
+        refit_last(ui, c);
         break;
     }
+    case SP_KT_CHIP_MORE:
+        ui->row_open = !ui->row_open;
+        layout_chips(ui);
+        if (ui->row_open)
+            set_hint(ui, sp_kiosk_text(SP_KTEXT_PICK_PART));
+        else
+            ui->hint_until = -1;
+        break;
     default:
         break;
     }

@@ -41,6 +41,8 @@ typedef enum sp_kiosk_text_id {
     SP_KTEXT_CONFIRM_CLEAR,         ///< Start over, first tap
     SP_KTEXT_TURN,                  ///< Turn mode
     SP_KTEXT_LABEL,                 ///< the label chip tapped
+    SP_KTEXT_MORE,                  ///< the chip that opens the parts row for the last part
+    SP_KTEXT_PICK_PART,             ///< the parts row opened for the last part
     SP_KTEXT_UNRECOGNISED,          ///< a refused stroke (its guesses and the parts row are offered)
     SP_KTEXT_UNRECOGNISED_NO_OFFER, ///< a refused stroke when nothing can be offered
     SP_KTEXT_TOO_SMALL,             ///< a refused stroke too small for a part

@@ -25,12 +25,13 @@
 /// that every touch target is at least desc.min_target_mm (15 mm) on any
 /// screen.
 ///
-/// Chips refer to the last stroke only: the last part's label and two other
-/// guesses, or, when the last stroke was refused, that stroke's three best
-/// guesses and a row of every part (sp_kiosk_ui_set_parts), offered while
-/// the refused stroke stays on screen (desc.offer_ms); a tap on one makes
-/// the stroke that part (a FIT job with a category). A new stroke hides the
-/// chips until its own answer.
+/// Chips refer to the last stroke only: the last part's label, two other
+/// guesses and "Other?", which opens a row of every part
+/// (sp_kiosk_ui_set_parts; a tap on one re-fits the last part as it, a
+/// REFIT job), or, when the last stroke was refused, that stroke's three
+/// best guesses and the row, offered while the refused stroke stays on
+/// screen (desc.offer_ms); a tap on one makes the stroke that part (a FIT
+/// job with a category). A new stroke hides the chips until its own answer.
 #ifndef SP_KIOSK_UI_H
 #define SP_KIOSK_UI_H
 
@@ -58,13 +59,14 @@ typedef enum sp_kiosk_target {
     SP_KT_CHIP_GUESS1, ///< next guess: re-fit the last part as this category; a refused stroke: its best guess
     SP_KT_CHIP_GUESS2, ///< the guess after that
     SP_KT_CHIP_GUESS3, ///< a refused stroke's third guess
-    SP_KT_PART1,       ///< the refusal's row of parts, in sp_kiosk_ui_set_parts order: make the refused stroke this part
+    SP_KT_CHIP_MORE,   ///< "Other?" beside the last part's chips: opens the parts row for it (toggles)
+    SP_KT_PART1,       ///< the row of parts, in sp_kiosk_ui_set_parts order: make the refused stroke, or the last part, this part
     SP_KT_PART_LAST = SP_KT_PART1 + SP_KIOSK_ROW_MAX - 1,
     SP_KT_COUNT
 } sp_kiosk_target;
 
 /// "undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2", "guess3",
-/// "part1".."part8"; NULL otherwise.
+/// "more", "part1".."part8"; NULL otherwise.
 const char* sp_kiosk_target_name(sp_kiosk_target t);
 /// Parses a target name; SP_KT_NONE when unknown.
 sp_kiosk_target sp_kiosk_target_parse(const char* s);
@@ -203,7 +205,7 @@ typedef struct sp_kiosk_ui {
     bool inflight_replace;
     bool refit_queued, save_queued;
     // Results on screen.
-    sp_kiosk_line flash_stroke, flash_outline; ///< shown until flash_until
+    sp_kiosk_line flash_stroke, flash_outline; ///< shown until flash_until (the stroke kept after: the last part's)
     int flash_breaks[64];
     int flash_break_count;
     double flash_until;
@@ -222,7 +224,8 @@ typedef struct sp_kiosk_ui {
     int part_count;
     char chip[4][SP_KIOSK_LABEL_MAX];               ///< categories of the label and guesses 1-3 ("" = hidden)
     bool chips_offer;                               ///< the guesses are the held stroke's (no label)
-    int row_count;                                  ///< parts in the refusal's row
+    int row_count;                                  ///< parts in the row (a refusal's, or opened by "Other?")
+    bool row_open;                                  ///< the row is open for the last part ("Other?")
     char row[SP_KIOSK_ROW_MAX][SP_KIOSK_LABEL_MAX]; ///< their categories
     uint64_t revision;                              ///< grows with every change of the dragon
     uint64_t saved_revision;                        ///< revision at the last successful save (0: never)
