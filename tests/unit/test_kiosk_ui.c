@@ -517,7 +517,7 @@ static void test_parts_row(void)
 // guesses, is still one choice away: "Other?" opens the row of
 // parts for the last part, in place of the two guesses; a tap re-fits it as
 // that part. The row closes with the answer, a second tap, a new stroke or
-// Undo, and never opens for a refused stroke's chips (its row is there).
+// Undo or Turn, and never opens for a refused stroke's chips (its row is there).
 static void test_something_else(void)
 {
     fake f;
@@ -541,13 +541,17 @@ static void test_something_else(void)
     ENSURE(f.refits == 1 && f.parts == 1 && !strcmp(k_cats[f.cat[0]], "hind_legs") && f.fits == 1);
     ENSURE(!strcmp(ui->chip[0], "hind_legs") && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
     ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
-    // A second tap closes it, and so do a new stroke and Undo.
+    // A second tap closes it, and so do Turn, a new stroke and Undo.
     tap(ui, t + 2000, SP_KT_CHIP_MORE);
     ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
     tap(ui, t + 2200, SP_KT_CHIP_MORE);
     ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && !sp_kiosk_ui_hint_visible(ui));
     ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
-    tap(ui, t + 2400, SP_KT_CHIP_MORE);
+    tap(ui, t + 2300, SP_KT_CHIP_MORE);
+    tap(ui, t + 2350, SP_KT_TURN);
+    tap(ui, t + 2400, SP_KT_TURN);
+    ENSURE(ui->mode == SP_KM_DRAW && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    tap(ui, t + 2450, SP_KT_CHIP_MORE);
     t = stroke(ui, t + 3000, 300, 500, 18, 5);
     ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
     frame(ui, &f, t + 10);

@@ -748,6 +748,10 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         ui->mode = ui->mode == SP_KM_TURN ? SP_KM_DRAW : SP_KM_TURN;
         ui->mode_since = ui->now;
         end_offer(ui, false); // its chips only show in the drawing view
+        if (ui->row_open) {   // and so does the row opened for the last part
+            ui->row_open = false;
+            layout_chips(ui);
+        }
         if (ui->mode == SP_KM_TURN)
             set_hint(ui, sp_kiosk_text(SP_KTEXT_TURN));
         else
