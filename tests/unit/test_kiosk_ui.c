@@ -514,11 +514,11 @@ static void test_parts_row(void)
 }
 
 // A part the classifier got wrong, whose part is not among the two other
-// guesses, is still one choice away: "Other?" opens the row of
-// parts for the last part, in place of the two guesses; a tap re-fits it as
-// that part. The row closes with the answer, a second tap, a new stroke or
-// Undo or Turn, and never opens for a refused stroke's chips (its row is there).
-static void test_something_else(void)
+// guesses, is still one choice away: "Other?" opens the row of parts for the
+// last part, in place of the two guesses; a tap re-fits it as that part. The
+// row closes with the answer, a second tap, Turn, a new stroke or Undo, and
+// never opens for a refused stroke's chips (its row is there).
+static void test_other_chip(void)
 {
     fake f;
     double t;
@@ -1294,7 +1294,7 @@ int main(int argc, char** argv)
                                    {"countdown", test_countdown},
                                    {"refused_stroke", test_refused_stroke},
                                    {"parts_row", test_parts_row},
-                                   {"something_else", test_something_else},
+                                   {"other_chip", test_other_chip},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},
