@@ -172,7 +172,7 @@ static bool row_shown(const sp_kiosk_ui* ui)
 // chips' place (on a small screen both would not fit above the toolbar).
 static bool guess_hidden(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
-    return t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && !ui->chips_offer && ui->row_open && more_shown(ui);
+    return t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && ui->row_open && more_shown(ui);
 }
 
 // Points of a stroke with y in [y0, y1).
@@ -686,6 +686,14 @@ static bool inside(const sp_kiosk_rect* r, float x, float y)
     return x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
 }
 
+// The row opened for the last part closes, and its hint with it.
+static void close_row(sp_kiosk_ui* ui)
+{
+    ui->row_open = false;
+    if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_PICK_PART))) ui->hint_until = -1;
+    layout_chips(ui);
+}
+
 // A guess chip or the row chose another part for the last one: re-fit it as that.
 static void refit_last(sp_kiosk_ui* ui, const char* category)
 {
@@ -709,9 +717,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             return;
         }
         refit_last(ui, ui->row[t - SP_KT_PART1]);
-        ui->row_open = false;
-        layout_chips(ui);
-        ui->hint_until = -1;
+        close_row(ui);
         return;
     }
     switch (t) {
@@ -747,11 +753,8 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     case SP_KT_TURN:
         ui->mode = ui->mode == SP_KM_TURN ? SP_KM_DRAW : SP_KM_TURN;
         ui->mode_since = ui->now;
-        end_offer(ui, false); // its chips only show in the drawing view
-        if (ui->row_open) {   // and so does the row opened for the last part
-            ui->row_open = false;
-            layout_chips(ui);
-        }
+        end_offer(ui, false);            // its chips only show in the drawing view
+        if (ui->row_open) close_row(ui); // and so does the row opened for the last part
         if (ui->mode == SP_KM_TURN)
             set_hint(ui, sp_kiosk_text(SP_KTEXT_TURN));
         else
@@ -779,12 +782,13 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         break;
     }
     case SP_KT_CHIP_MORE:
-        ui->row_open = !ui->row_open;
-        layout_chips(ui);
-        if (ui->row_open)
+        if (ui->row_open) {
+            close_row(ui);
+        } else {
+            ui->row_open = true;
+            layout_chips(ui);
             set_hint(ui, sp_kiosk_text(SP_KTEXT_PICK_PART));
-        else
-            ui->hint_until = -1;
+        }
         break;
     default:
         break;
