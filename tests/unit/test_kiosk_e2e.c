@@ -809,7 +809,7 @@ static void test_visit(void)
     script_press(&s, up + 1500, "part2");
     t = up + 2500;
     // A tail drawn far from the body, in the top left corner; the visitor
-    // meant a head, not among its guesses: "Other?", then the row's head.
+    // meant a head: "Other?", then the row's head.
     t = part_stroke_at(&s, t, &g_strokes[3], -170, -290) + 500;
     script_press(&s, t, "more");
     script_mark(&s, t + 300, "other");
