@@ -303,7 +303,7 @@ static void draw_ui(sp_kiosk* k, int w, int h)
         for (int t = SP_KT_UNDO; t <= SP_KT_SAVE; ++t)
             draw_button(k, (sp_kiosk_target)t);
         draw_chips(k);
-        kiosk_row_draw(k, k_navy, k_yellow, k_ink);
+        kiosk_row_draw(k, k_navy, k_yellow, k_ink, k_green);
         const char* message = sp_kiosk_ui_message(ui);
         if (message) draw_message(k, &ui->hint_box, message, ui->text_px, k_panel, k_white);
         if (sp_kiosk_ui_banner_visible(ui)) draw_banner(k);

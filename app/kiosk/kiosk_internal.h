@@ -155,8 +155,9 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
 // kiosk_row.c
 /// Loads every category's outline from the database and gives the UI its row of parts.
 void kiosk_row_load(sp_kiosk* k);
-/// Draws the row's visible buttons (inside a draw2d batch).
-void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4]);
+/// Draws the row's visible buttons (inside a draw2d batch); the last part's
+/// own category green while the row is open for it.
+void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4], const float green[4]);
 void kiosk_row_free(sp_kiosk* k);
 
 // kiosk_attract.c

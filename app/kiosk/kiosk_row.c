@@ -99,7 +99,7 @@ void kiosk_row_load(sp_kiosk* k)
     sp_kiosk_ui_set_parts(k->ui, row, k->icon_count);
 }
 
-void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4])
+void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4], const float green[4])
 {
     const sp_kiosk_ui* ui = k->ui;
     for (int i = 0; i < k->icon_count; ++i) {
@@ -108,7 +108,11 @@ void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], con
         const sp_kiosk_rect* r = &ui->target[t];
         bool pressed = ui->pressed == t && ui->capture == SP_KCAP_TARGET;
         float rad = 0.16f * fminf(r->w, r->h);
-        sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0, pressed ? yellow : navy);
+        // The part's own category, when the row is open for it, is drawn as chosen.
+        sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, 0,
+                       pressed                             ? yellow
+                       : sp_kiosk_ui_target_current(ui, t) ? green
+                                                           : navy);
         sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.025f * r->h), (const float[4]){1, 1, 1, 0.9f});
         // The outline in the upper part, its name under it.
         const part_icon* ic = &k->icons[i];

@@ -535,6 +535,15 @@ static void test_other_chip(void)
     ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL));
     ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PICK_PART)) && !sp_kiosk_ui_offering(ui));
     check_targets(ui);
+    // The part's own category (head, the row's second) is drawn as chosen; a
+    // tap on it only closes the row.
+    for (int k = 0; k < SP_KIOSK_ROW_MAX; ++k)
+        ENSURE(sp_kiosk_ui_target_current(ui, (sp_kiosk_target)(SP_KT_PART1 + k)) == (k == 1));
+    ENSURE(!sp_kiosk_ui_target_current(ui, SP_KT_CHIP_LABEL));
+    tap(ui, t + 700, (sp_kiosk_target)(SP_KT_PART1 + 1));
+    frame(ui, &f, t + 750);
+    ENSURE(f.refits == 0 && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && !sp_kiosk_ui_hint_visible(ui));
+    tap(ui, t + 800, SP_KT_CHIP_MORE);
     tap(ui, t + 900, (sp_kiosk_target)(SP_KT_PART1 + 5));
     ENSURE(!sp_kiosk_ui_target_enabled(ui, SP_KT_CHIP_MORE)); // one re-fit at a time
     frame(ui, &f, t + 1000);
@@ -587,19 +596,19 @@ static void test_other_chip(void)
     frame(ui, &f, t + 10);
     ENSURE(ui->part_count == 1 && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
     sp_kiosk_ui_destroy(ui);
-    // From a session file: a stroke, "more", "part4" (the row's tail).
+    // From a session file: a stroke (the fake's tail), "more", "part2" (the row's head).
     const char* doc =
         "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"end_ms\": 5000, \"events\": ["
         "{\"t\": 0, \"type\": \"down\", \"x\": 640, \"y\": 400}, {\"t\": 50, \"type\": \"up\", \"x\": 640, \"y\": 400},"
         "{\"t\": 500, \"type\": \"stroke\", \"points\": [[200, 300], [205, 320], [210, 340], [330, 360], [420, 380]]},"
         "{\"t\": 1500, \"type\": \"press\", \"target\": \"more\"},"
-        "{\"t\": 2500, \"type\": \"press\", \"target\": \"part4\"}]}";
+        "{\"t\": 2500, \"type\": \"press\", \"target\": \"part2\"}]}";
     sp_kiosk_session s = {0};
     sp_error err = {0};
     ENSURE(sp_kiosk_session_parse(doc, strlen(doc), "more.json", &s, &err) == SP_OK);
     sp_kiosk_ui* b;
     run_session(&s, 1000.0 / 60.0, 0, &f, &b, NULL);
-    ENSURE(f.parts == 1 && f.refits == 1 && !strcmp(k_cats[f.cat[0]], "tail") && !strcmp(b->chip[0], "tail"));
+    ENSURE(f.parts == 1 && f.refits == 1 && !strcmp(k_cats[f.cat[0]], "head") && !strcmp(b->chip[0], "head"));
     sp_kiosk_ui_destroy(b);
     sp_kiosk_session_free(&s);
 }

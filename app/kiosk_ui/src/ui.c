@@ -412,6 +412,12 @@ bool sp_kiosk_ui_offering(const sp_kiosk_ui* ui)
     return offering(ui);
 }
 
+bool sp_kiosk_ui_target_current(const sp_kiosk_ui* ui, sp_kiosk_target t)
+{
+    return t >= SP_KT_PART1 && t <= SP_KT_PART_LAST && (int)t - SP_KT_PART1 < ui->row_count && !offering(ui) && row_shown(ui) &&
+           !strcmp(ui->row[t - SP_KT_PART1], ui->chip[0]);
+}
+
 const char* sp_kiosk_ui_target_category(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     if (t >= SP_KT_CHIP_LABEL && t <= SP_KT_CHIP_GUESS3) return ui->chip[t - SP_KT_CHIP_LABEL];
@@ -716,7 +722,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             take_offer(ui, ui->row[t - SP_KT_PART1]);
             return;
         }
-        refit_last(ui, ui->row[t - SP_KT_PART1]);
+        if (!sp_kiosk_ui_target_current(ui, t)) refit_last(ui, ui->row[t - SP_KT_PART1]); // the same part again: nothing to do
         close_row(ui);
         return;
     }

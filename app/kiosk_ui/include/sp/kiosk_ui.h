@@ -280,6 +280,10 @@ bool sp_kiosk_ui_flashing(const sp_kiosk_ui* ui);
 double sp_kiosk_ui_fade(const sp_kiosk_ui* ui);
 /// Whether a refused stroke is held with its offers (guess chips, parts row).
 bool sp_kiosk_ui_offering(const sp_kiosk_ui* ui);
+/// Whether t is the row's tile of the last part's own category while the
+/// row is open for that part ("Other?"): drawn as chosen; a tap on it only
+/// closes the row.
+bool sp_kiosk_ui_target_current(const sp_kiosk_ui* ui, sp_kiosk_target t);
 /// The category a chip or row target stands for ("" when hidden).
 const char* sp_kiosk_ui_target_category(const sp_kiosk_ui* ui, sp_kiosk_target t);
 /// What a chip or row target says ("Body", "Wings?"; "" when hidden) into out.
