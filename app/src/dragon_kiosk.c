@@ -252,6 +252,7 @@ static void print_stats(const app* a, double start_ms)
     int stored = 0, dropped = 0;
     sp_kiosk_collect_counts(a->k, &stored, &dropped);
     printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d,\n", st->collected, stored, dropped);
+    printf(" \"others\": %d, \"others_chosen\": %d,\n", ui->others, ui->others_chosen);
     // What a visitor reads on screen now (JSON-escaped).
     cJSON* hint = cJSON_CreateString(sp_kiosk_ui_hint_visible(ui) ? ui->hint : "");
     char* hint_text = hint ? cJSON_PrintUnformatted(hint) : NULL;

@@ -834,6 +834,7 @@ static void test_visit(void)
     // made parts by one tap each (attached to the body), the far tail made a
     // head by the row and free, the countdown's stroke.
     ENSURE(num(st, "parts") == 5 && num(st, "refits") == 1 && num(st, "offered") == 2 && num(st, "chosen") == 2);
+    ENSURE(num(st, "others") == 1 && num(st, "others_chosen") == 1);
     ENSURE(!strcmp(stat_category(st, 0), "torso") && !strcmp(stat_category(st, 2), "head"));
     ENSURE(!strcmp(stat_category(st, 3), "head") && !strcmp(stat_category(st, 4), g_strokes[5].category));
     ENSURE(num(st, "resets") == 0 && num(st, "saves") == 1 && num(st, "loose_parts") == 1 && num(st, "bodies") == 1);

@@ -548,6 +548,7 @@ static void test_other_chip(void)
     ENSURE(!sp_kiosk_ui_target_enabled(ui, SP_KT_CHIP_MORE)); // one re-fit at a time
     frame(ui, &f, t + 1000);
     ENSURE(f.refits == 1 && f.parts == 1 && !strcmp(k_cats[f.cat[0]], "hind_legs") && f.fits == 1);
+    ENSURE(ui->others == 2 && ui->others_chosen == 1); // the first opening ended on the part's own tile
     ENSURE(!strcmp(ui->chip[0], "hind_legs") && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
     ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
     // A second tap closes it, and so do Turn, a new stroke and Undo.

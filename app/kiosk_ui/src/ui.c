@@ -722,7 +722,10 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             take_offer(ui, ui->row[t - SP_KT_PART1]);
             return;
         }
-        if (!sp_kiosk_ui_target_current(ui, t)) refit_last(ui, ui->row[t - SP_KT_PART1]); // the same part again: nothing to do
+        if (!sp_kiosk_ui_target_current(ui, t)) { // the same part again: nothing to do
+            refit_last(ui, ui->row[t - SP_KT_PART1]);
+            ++ui->others_chosen;
+        }
         close_row(ui);
         return;
     }
@@ -792,6 +795,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             close_row(ui);
         } else {
             ui->row_open = true;
+            ++ui->others;
             layout_chips(ui);
             set_hint(ui, sp_kiosk_text(SP_KTEXT_PICK_PART));
         }

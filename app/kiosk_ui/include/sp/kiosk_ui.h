@@ -237,7 +237,8 @@ typedef struct sp_kiosk_ui {
     double yaw, pitch; ///< orbit, radians (0, 0: the drawing view)
     // Counters (tests, logs).
     int strokes_finished, taps, activations[SP_KT_COUNT], resets;
-    int offered, chosen; ///< refused strokes held with offers; of them, made a part by a tap
+    int offered, chosen;       ///< refused strokes held with offers; of them, made a part by a tap
+    int others, others_chosen; ///< rows opened by "Other?"; of them, closed by re-fitting the part as another
 } sp_kiosk_ui;
 
 /// A fresh UI on the attract screen. desc may be NULL. Fails only when out
