@@ -219,6 +219,24 @@ static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t see
                         sp_kiosk_session* rec);
 static void check_targets(const sp_kiosk_ui* ui);
 
+// A session file of 1280 x 800 that starts with a tap (the attract screen)
+// and then has `events` (JSON objects, comma-separated), parsed into *s and
+// replayed at 60 updates a second through the fake pipeline.
+static sp_kiosk_ui* replay_events(const char* events, double end_ms, const char* name, fake* f, sp_kiosk_session* s)
+{
+    char doc[4096];
+    snprintf(
+        doc, sizeof doc,
+        "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"end_ms\": %g, \"events\": ["
+        "{\"t\": 0, \"type\": \"down\", \"x\": 640, \"y\": 400}, {\"t\": 50, \"type\": \"up\", \"x\": 640, \"y\": 400}, %s]}",
+        end_ms, events);
+    sp_error err = {0};
+    ENSURE(sp_kiosk_session_parse(doc, strlen(doc), name, s, &err) == SP_OK);
+    sp_kiosk_ui* b;
+    run_session(s, 1000.0 / 60.0, 0, f, &b, NULL);
+    return b;
+}
+
 static void test_flow(void)
 {
     fake f;
@@ -492,20 +510,15 @@ static void test_parts_row(void)
     ENSURE(f.parts == 6 && f.forced == 6);
     sp_kiosk_ui_destroy(ui);
     // The same from a session file: "part2" is the row's second part, "guess1" the refused stroke's first guess.
-    const char* doc =
-        "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"end_ms\": 9000, \"events\": ["
-        "{\"t\": 0, \"type\": \"down\", \"x\": 640, \"y\": 400}, {\"t\": 50, \"type\": \"up\", \"x\": 640, \"y\": 400},"
+    sp_kiosk_session s = {0};
+    sp_kiosk_ui* b = replay_events(
         "{\"t\": 500, \"type\": \"stroke\", \"points\": [[200, 300], [205, 320], [210, 340], [330, 360], [420, 380]]},"
         "{\"t\": 1500, \"type\": \"stroke\", \"points\": [[800, 100], [812, 160], [800, 220], [812, 280], [800, 340]]},"
         "{\"t\": 2500, \"type\": \"press\", \"target\": \"part2\"},"
         "{\"t\": 4000, \"type\": \"stroke\", \"points\": [[900, 100], [912, 160], [900, 220], [912, 280], [900, 340]]},"
-        "{\"t\": 5000, \"type\": \"press\", \"target\": \"guess1\"}]}";
-    sp_kiosk_session s = {0};
-    sp_error err = {0};
-    ENSURE(sp_kiosk_session_parse(doc, strlen(doc), "row.json", &s, &err) == SP_OK);
+        "{\"t\": 5000, \"type\": \"press\", \"target\": \"guess1\"}",
+        9000, "row.json", &f, &s);
     ENSURE(s.events[s.count - 1].button == SP_KT_CHIP_GUESS1 && sp_kiosk_target_parse("part2") == SP_KT_PART1 + 1);
-    sp_kiosk_ui* b;
-    run_session(&s, 1000.0 / 60.0, 0, &f, &b, NULL);
     ENSURE(f.parts == 3 && f.rejects == 2 && f.forced == 2 && f.refits == 0);
     ENSURE(!strcmp(k_cats[f.cat[1]], "head") && !strcmp(k_cats[f.cat[2]], "head")); // the fake's first guess is "head"
     ENSURE(b->chosen == 2 && b->part_count == 3);
@@ -598,17 +611,12 @@ static void test_other_chip(void)
     ENSURE(ui->part_count == 1 && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
     sp_kiosk_ui_destroy(ui);
     // From a session file: a stroke (the fake's tail), "more", "part2" (the row's head).
-    const char* doc =
-        "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"end_ms\": 5000, \"events\": ["
-        "{\"t\": 0, \"type\": \"down\", \"x\": 640, \"y\": 400}, {\"t\": 50, \"type\": \"up\", \"x\": 640, \"y\": 400},"
+    sp_kiosk_session s = {0};
+    sp_kiosk_ui* b = replay_events(
         "{\"t\": 500, \"type\": \"stroke\", \"points\": [[200, 300], [205, 320], [210, 340], [330, 360], [420, 380]]},"
         "{\"t\": 1500, \"type\": \"press\", \"target\": \"more\"},"
-        "{\"t\": 2500, \"type\": \"press\", \"target\": \"part2\"}]}";
-    sp_kiosk_session s = {0};
-    sp_error err = {0};
-    ENSURE(sp_kiosk_session_parse(doc, strlen(doc), "more.json", &s, &err) == SP_OK);
-    sp_kiosk_ui* b;
-    run_session(&s, 1000.0 / 60.0, 0, &f, &b, NULL);
+        "{\"t\": 2500, \"type\": \"press\", \"target\": \"part2\"}",
+        5000, "more.json", &f, &s);
     ENSURE(f.parts == 1 && f.refits == 1 && !strcmp(k_cats[f.cat[0]], "head") && !strcmp(b->chip[0], "head"));
     sp_kiosk_ui_destroy(b);
     sp_kiosk_session_free(&s);
