@@ -162,17 +162,23 @@ static bool more_shown(const sp_kiosk_ui* ui)
     return !ui->chips_offer && ui->chip[0][0] && ui->row_count > 0;
 }
 
+// The row opened by "Other?" for the last part (and still about it).
+static bool row_for_part(const sp_kiosk_ui* ui)
+{
+    return ui->row_open && more_shown(ui);
+}
+
 // The row of parts: a refused stroke's offer, or opened for the last part.
 static bool row_shown(const sp_kiosk_ui* ui)
 {
-    return ui->row_count > 0 && (offering(ui) || (ui->row_open && more_shown(ui)));
+    return ui->row_count > 0 && (offering(ui) || row_for_part(ui));
 }
 
 // The row opened for the last part holds every guess: it takes the guess
 // chips' place (on a small screen both would not fit above the toolbar).
 static bool guess_hidden(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
-    return t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && ui->row_open && more_shown(ui);
+    return t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && row_for_part(ui);
 }
 
 // Points of a stroke with y in [y0, y1).
@@ -414,7 +420,7 @@ bool sp_kiosk_ui_offering(const sp_kiosk_ui* ui)
 
 bool sp_kiosk_ui_target_current(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
-    return t >= SP_KT_PART1 && t <= SP_KT_PART_LAST && (int)t - SP_KT_PART1 < ui->row_count && !offering(ui) && row_shown(ui) &&
+    return t >= SP_KT_PART1 && t <= SP_KT_PART_LAST && (int)t - SP_KT_PART1 < ui->row_count && row_for_part(ui) &&
            !strcmp(ui->row[t - SP_KT_PART1], ui->chip[0]);
 }
 
