@@ -263,6 +263,8 @@ static sp_result build_pair(const leg_desc* d, const char* path, sp_error* err)
     }
 
     sp_part part = sp_dragon_attach_part(d->category, d->category, d->root_name, g.pivot[root]);
+    // Front and hind legs: the kiosk tells them apart by where on a body they are drawn.
+    snprintf(part.family, sizeof part.family, "legs");
     sp_result r =
         sp_gen_save(&g, &m, &(sp_gen_save_desc){.part = &part, .name = d->category, .root_reach_view = true}, path, err);
     sp_gen_mesh_free(&m);

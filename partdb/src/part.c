@@ -146,10 +146,11 @@ static sp_result read_attach(const cJSON* at, const char* what, sp_part_attach* 
 
 static sp_result read_part(const cJSON* j, const char* what, sp_part* out, sp_error* err)
 {
-    static const char* const known[] = {"category", "abstraction", "sockets", "attach", NULL};
+    static const char* const known[] = {"category", "abstraction", "family", "sockets", "attach", NULL};
     if (!cJSON_IsObject(j)) return sp_fail(err, SP_ERR_INVALID, "%s: sp_part must be a JSON object", what);
     if (!opt_name(j, "category", out->category)) return bad_name(what, "category", err);
     if (!opt_name(j, "abstraction", out->abstraction)) return bad_name(what, "abstraction", err);
+    if (!opt_name(j, "family", out->family)) return bad_name(what, "family", err);
     const cJSON* sockets = cJSON_GetObjectItemCaseSensitive(j, "sockets");
     if (sockets && !cJSON_IsArray(sockets)) return sp_fail(err, SP_ERR_INVALID, "%s: sp_part: sockets must be a list", what);
     int n = cJSON_GetArraySize(sockets);
@@ -275,7 +276,8 @@ sp_result sp_part_to_cjson(const sp_part* p, cJSON** out, sp_error* err)
     if (p->has_attach && p->attach.has_position && !finite3(p->attach.position))
         return sp_fail(err, SP_ERR_INVALID, "sp_part: attach: the position is not finite");
     cJSON* o = cJSON_CreateObject();
-    bool ok = o && add_name(o, "category", p->category) && add_name(o, "abstraction", p->abstraction);
+    bool ok = o && add_name(o, "category", p->category) && add_name(o, "abstraction", p->abstraction) &&
+              add_name(o, "family", p->family);
     if (ok && p->socket_count > 0) {
         cJSON* arr = cJSON_AddArrayToObject(o, "sockets");
         for (int i = 0; ok && i < p->socket_count; ++i)

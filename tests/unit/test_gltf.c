@@ -406,7 +406,7 @@ static void bad_mini(const char* name, mini_desc d, const char* expect)
 // through save and load (.glb and .gltf). No JSON null: tinygltf's values
 // have none to write, so the glTF writer drops a null (sp/part.h).
 static const char k_full_part[] =
-    "{\"category\": \"torso\", \"abstraction\": \"outline\", \"zz_note\": \"caf\\u00e9 \\\"x\\\"\", "
+    "{\"category\": \"torso\", \"abstraction\": \"outline\", \"family\": \"trunk\", \"zz_note\": \"caf\\u00e9 \\\"x\\\"\", "
     "\"sockets\": [{\"name\": \"neck\", \"joint\": \"tip\", \"position\": [0.1, -2.5, 1e-7], \"accepts\": [\"head\", "
     "\"horns\"], \"tilt\": 0.25}, {\"name\": \"tail\", \"accepts\": \"tail\"}, {\"name\": \"back\"}], "
     "\"attach\": {\"socket\": \"body\", \"joint\": \"root\", \"position\": [0, 1, 0], \"weight\": [1, 2.5, \"w\"]}, "
@@ -415,7 +415,7 @@ static const char k_full_part[] =
 static const char k_full_part_written[] =
     "{\"a_meta\":{\"big\":1e+300,\"list\":[{\"k\":false}],\"n\":3,\"on\":true},\"abstraction\":\"outline\","
     "\"attach\":{\"joint\":\"root\",\"position\":[0,1,0],\"socket\":\"body\",\"weight\":[1,2.5,\"w\"]},"
-    "\"category\":\"torso\",\"sockets\":[{\"accepts\":[\"head\",\"horns\"],\"joint\":\"tip\",\"name\":\"neck\","
+    "\"category\":\"torso\",\"family\":\"trunk\",\"sockets\":[{\"accepts\":[\"head\",\"horns\"],\"joint\":\"tip\",\"name\":\"neck\","
     "\"position\":[0.1,-2.5,1e-07],\"tilt\":0.25},{\"accepts\":[\"tail\"],\"name\":\"tail\"},{\"name\":\"back\"}],"
     "\"zz_note\":\"caf\u00e9 \\\"x\\\"\"}";
 
@@ -423,7 +423,7 @@ static void test_part_round_trip(void)
 {
     sp_character ch = load_ok(write_mini("part_full.gltf", &(mini_desc){.extras = true, .part = k_full_part}));
     const sp_part* p = &ch.part;
-    ENSURE(ch.has_part && !strcmp(p->category, "torso") && !strcmp(p->abstraction, "outline"));
+    ENSURE(ch.has_part && !strcmp(p->category, "torso") && !strcmp(p->abstraction, "outline") && !strcmp(p->family, "trunk"));
     ENSURE(p->socket_count == 3);
     const sp_part_socket* s = &p->sockets[0];
     ENSURE(!strcmp(s->name, "neck") && !strcmp(s->joint, "tip") && s->has_position);
@@ -495,6 +495,7 @@ static void test_part_bad(void)
          "sockets[0].position must be 3 finite numbers"},
         {"part_socket_pos2.gltf", "{\"sockets\": [{\"name\": \"a\", \"position\": [0, \"1\", 2]}]}", "position must be 3"},
         {"part_accepts.gltf", "{\"sockets\": [{\"name\": \"a\", \"accepts\": [\"head\", 2]}]}", "sockets[0].accepts must be"},
+        {"part_family.gltf", "{\"family\": [\"legs\"]}", "sp_part: family must be a name"},
         {"part_attach.gltf", "{\"attach\": 3}", "attach must be an object or a joint name"},
         {"part_attach_pos.gltf", "{\"attach\": {\"position\": null}}", "attach.position must be 3 finite numbers"},
         {"part_attach_socket.gltf", "{\"attach\": {\"socket\": [\"a\"]}}", "attach.socket must be a name"},

@@ -60,6 +60,7 @@ typedef struct sp_part_attach {
 typedef struct sp_part {
     char category[SP_NAME_MAX];    ///< "" = none
     char abstraction[SP_NAME_MAX]; ///< what its sketches show, "" = none said
+    char family[SP_NAME_MAX];      ///< parts told apart by where on a body they are drawn (front and hind legs), "" = none
     int socket_count;              ///< a part with sockets is a body
     sp_part_socket* sockets;       ///< socket_count (owned)
     bool has_attach;               ///< it says where it attaches
@@ -69,7 +70,8 @@ typedef struct sp_part {
 
 /// Parses an sp_part JSON object (text); `what` (the file) names it in
 /// messages. SP_ERR_PARSE for text that is not JSON, SP_ERR_INVALID (one
-/// line) for a known key of the wrong kind: a name that is not a string of 1
+/// line) for a known key of the wrong kind: a name (`category`,
+/// `abstraction`, `family`, a socket's or a joint's) that is not a string of 1
 /// to SP_NAME_MAX - 1 characters, `sockets` not a list of objects, a socket
 /// without a name, a position that is not 3 finite numbers, `accepts` not a
 /// name or a list of names, `attach` not an object or a joint name. On
