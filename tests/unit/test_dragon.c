@@ -1869,6 +1869,86 @@ static void test_visitors_policy(void)
     sp_dataset_free(&ds);
 }
 
+// Draws the shipped part of `category` (a synthetic stroke of its own) in
+// the box centred at (cx, cy), optionally mirrored, classified or forced;
+// returns the result (ENSURE'd accepted).
+static sp_dragon_result draw_part(sp_dragon* d, sp_db* db, const char* category, double cx, double cy, double size, bool mirror,
+                                  bool forced)
+{
+    char** names = NULL;
+    int n = 0;
+    sp_error err = {0};
+    ENSURE(sp_db_category_parts(db, category, &names, &n, &err) == SP_OK && n > 0);
+    sp_vec2* xy;
+    int k = part_stroke_ex(db, names[0], 500, 0.3, (sp_vec2){cx, cy}, size, false, mirror, &xy);
+    sp_db_free_strings(names, n);
+    sp_dragon_result res;
+    ENSURE(sp_dragon_add_points(d, xy, k, forced ? &(sp_dragon_stroke_opts){.category = category} : NULL, &res, &err) == SP_OK);
+    free(xy);
+    ENSURE(!res.rejected);
+    return res;
+}
+
+static bool guessed(const sp_dragon_result* res, const char* category)
+{
+    for (int g = 0; g < res->guess_count; ++g)
+        if (!strcmp(res->guesses[g].category, category)) return true;
+    return false;
+}
+
+// Front and hind legs are one family (sp_part.family "legs"): legs drawn at
+// a body whose facing its head tells become the legs of that end, whichever
+// the drawing looks like; the chips still offer what it looks like; a chip's
+// choice, a free part and a body without a head or tail keep the
+// classifier's answer.
+static void test_family_by_place(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_db* db = NULL;
+    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
+    sp_dragon* d = new_dragon(path);
+    // A dragon facing right as modelled, then mirrored (its head drawn on the left).
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        double front = mirrored ? 520 : 760, rear = mirrored ? 760 : 520, head = mirrored ? 380 : 900;
+        sp_dragon_clear(d);
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        // No head yet: the facing is unknown and the classifier's answer stays.
+        sp_dragon_result res = draw_part(d, db, "front_legs", rear, 570, 190, mirrored, false);
+        ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, "front_legs"));
+        ENSURE(sp_dragon_part_get(d, res.part)->attached_to == 0);
+        ENSURE(sp_dragon_undo(d));
+        draw_part(d, db, "head", head, 300, 200, mirrored, true);
+        ENSURE(sp_dragon_part_get(d, 1)->attached_to == 0);
+        static const char* const kinds[2] = {"front_legs", "hind_legs"};
+        for (int drawn = 0; drawn < 2; ++drawn)
+            for (int at_rear = 0; at_rear < 2; ++at_rear) {
+                res = draw_part(d, db, kinds[drawn], at_rear ? rear : front, 570, 190, mirrored, false);
+                const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+                fprintf(stderr, "  facing %s, %s drawn at the %s: %s, fit %.1f%% (chips %s, %s)\n", mirrored ? "left" : "right",
+                        kinds[drawn], at_rear ? "rear" : "front", p->category,
+                        100 * p->report.mean_error_px / p->report.bbox_diagonal_px, res.guesses[0].category,
+                        res.guess_count > 1 ? res.guesses[1].category : "-");
+                ENSURE(p->attached_to == 0);
+                ENSURE(!strcmp(p->category, kinds[at_rear]));
+                ENSURE(!strcmp(res.guesses[0].category, p->category));
+                ENSURE(guessed(&res, kinds[drawn])); // a part made the other kind keeps what it looks like in the chips
+                ENSURE(p->report.mean_error_px / p->report.bbox_diagonal_px < 0.05); // the kind it became takes the stroke
+                // The chip's choice stands wherever the legs are.
+                ENSURE(sp_dragon_refit_last(d, kinds[!at_rear], &res, &err) == SP_OK && !res.rejected);
+                ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, kinds[!at_rear]));
+                ENSURE(sp_dragon_undo(d));
+            }
+        // Far from the body the legs stay what they look like.
+        res = draw_part(d, db, "front_legs", rear, 770, 60, mirrored, false);
+        ENSURE(sp_dragon_part_get(d, res.part)->attached_to < 0);
+        ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, "front_legs"));
+    }
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -1884,5 +1964,6 @@ int main(int argc, char** argv)
                                    {"body_last_and_undo", test_body_last_and_undo},
                                    {"robustness", test_robustness},
                                    {"visitors_policy", test_visitors_policy},
+                                   {"family_by_place", test_family_by_place},
                                    {0}});
 }

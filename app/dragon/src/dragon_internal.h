@@ -47,6 +47,7 @@ typedef struct tpl {
     int attach_joint;
     sp_vec3 attach_local;
     char prefer[SP_NAME_MAX]; // preferred socket name
+    char family[SP_NAME_MAX]; // sp_part.family: told apart from its kin by where it is drawn on a body
     const sp_animation* clip;
     double clip_start, clip_len; // seconds
     double* clip0;               // the rest parameters: the clip's offsets are keyed relative to them
@@ -142,6 +143,13 @@ sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4*
 /// its socket, or its own reach, puts a part of its kind); 0: no hint (no
 /// body, or drawn over its middle).
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi);
+/// The category that attached part i takes from where it was drawn, when it
+/// has a family (sp_part.family): the family's member whose socket on the
+/// body lies nearest the part's anchor along the body, the dragon's facing
+/// read from the sideways parts (heads, tails) on that body. False (out
+/// untouched) for a free part, a body with fewer than two of the family's
+/// sockets, or a facing the body's parts do not tell or disagree on.
+bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
 

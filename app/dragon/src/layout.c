@@ -338,6 +338,67 @@ static void attach(sp_dragon* d, int i, int k, const surface_hit* h, sp_vec3 a)
     dragon_copy_name(p->pub.socket, sizeof p->pub.socket, so ? so->name : "");
 }
 
+// The body's horizontal extent on the canvas at its fit (body_prepare'd).
+static void body_span(const part* q, double* mid, double* half)
+{
+    int n = q->t->ch.rig.vertex_count;
+    double a = n > 0 ? q->body_px[0].x : 0, b = a;
+    for (int v = 1; v < n; ++v)
+        a = fmin(a, q->body_px[v].x), b = fmax(b, q->body_px[v].x);
+    *mid = 0.5 * (a + b), *half = 0.5 * (b - a);
+}
+
+// Canvas x of body q's socket, less the body's middle.
+static double socket_u(const sp_dragon* d, const part* q, const dsocket* so, double mid)
+{
+    return sp_camera_project(&d->world, fitted_point(q, &q->pub.placement, so->joint, so->local)).x - mid;
+}
+
+bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
+{
+    const part* p = d->parts[i];
+    int k = p->pub.attached_to;
+    if (!p->t->family[0] || k < 0) return false;
+    part* q = d->parts[k];
+    double mid, half;
+    body_span(q, &mid, &half);
+    // Facing: a head or tail drawn at the end of the body other than its
+    // socket's says the dragon is drawn mirrored; near the middle it says nothing.
+    int mirrored = -1;
+    for (int j = 0; j < d->part_n; ++j) {
+        const part* o = d->parts[j];
+        if (j == i || o->pub.attached_to != k || !o->t->lengthwise) continue;
+        const dsocket* so = NULL;
+        for (int s = 0; !so && s < q->t->socket_count; ++s)
+            if (socket_accepts(&q->t->sockets[s], o->pub.category, o->t->prefer)) so = &q->t->sockets[s];
+        if (!so) continue;
+        double su = socket_u(d, q, so, mid), du = o->pub.anchor.x - mid;
+        if (!(fabs(su) > 0.25 * half && fabs(du) > 0.25 * half)) continue;
+        int m = (su > 0) != (du > 0);
+        if (mirrored >= 0 && m != mirrored) return false;
+        mirrored = m;
+    }
+    if (mirrored < 0) return false;
+    double u = (mirrored ? -1 : 1) * (p->pub.anchor.x - mid);
+    const char* best = NULL;
+    double bd = INFINITY;
+    int members = 0;
+    for (int s = 0; s < q->t->socket_count; ++s) {
+        const dsocket* so = &q->t->sockets[s];
+        tpl* kin[1];
+        sp_error lerr = {0};
+        if (dragon_category_templates(d, so->name, kin, 1, &lerr) < 1) continue;
+        bool same = !strcmp(kin[0]->family, p->t->family);
+        if (!same) continue;
+        ++members;
+        double dd = fabs(socket_u(d, q, so, mid) - u);
+        if (dd < bd) bd = dd, best = so->name;
+    }
+    if (members < 2 || !best) return false;
+    dragon_copy_name(out, SP_NAME_MAX, best);
+    return true;
+}
+
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
 {
     sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);

@@ -50,6 +50,7 @@ static void read_part_extras(tpl* t)
     t->is_torso = !strcmp(t->category, "torso");
     if (!t->ch.has_part) return;
     const sp_part* part = &t->ch.part;
+    dragon_copy_name(t->family, sizeof t->family, part->family);
     if (part->socket_count > 0) t->sockets = calloc((size_t)part->socket_count, sizeof(dsocket));
     for (int i = 0; t->sockets && i < part->socket_count; ++i) {
         const sp_part_socket* s = &part->sockets[i];

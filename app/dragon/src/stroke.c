@@ -324,6 +324,50 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     return SP_DRAGON_ACCEPTED;
 }
 
+// A classified part of a family (front or hind legs) drawn at a body
+// becomes the family's member for the place it was drawn
+// (dragon_family_member): what it looks like decided the family, where it
+// is decides which one. The last part is re-fitted as that member, which
+// goes first in out->guesses, so the chips offer the other back. The
+// classifier keeps its answer when the member has no part that fits.
+static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_error* err)
+{
+    int i = d->part_n - 1;
+    part* old = d->parts[i];
+    char member[SP_NAME_MAX];
+    if (!dragon_family_member(d, i, member) || !strcmp(member, old->pub.category)) return SP_OK;
+    // The part's own copy of its cleaned stroke: the caller's is gone.
+    sp_sketch sk = {.canvas_w = d->desc.canvas_w,
+                    .canvas_h = d->desc.canvas_h,
+                    .stroke_count = 1,
+                    .strokes = &(sp_stroke){.count = old->stroke_n, .points = old->stroke}};
+    sp_vec2 lo = {old->stroke_box[0], old->stroke_box[1]}, hi = {old->stroke_box[2], old->stroke_box[3]};
+    fit_choice f;
+    int not_finite = 0;
+    bool any_part = false;
+    if (!fit_category(d, member, &sk, lo, hi, &f, &not_finite, &any_part)) return SP_OK;
+    int g = 0;
+    while (g < out->guess_count && strcmp(out->guesses[g].category, member))
+        ++g;
+    sp_dragon_guess chosen = {.confidence = 0.0f};
+    if (g < out->guess_count) {
+        chosen = out->guesses[g];
+    } else {
+        dragon_copy_name(chosen.category, sizeof chosen.category, member);
+        g = out->guess_count < SP_DRAGON_GUESSES ? out->guess_count++ : SP_DRAGON_GUESSES - 1;
+    }
+    part* q = NULL;
+    sp_result r = new_part(d, f.t, f.p, &f.rep, &f.view, f.mirrored, old->stroke, old->stroke_n, chosen.confidence, &q, err);
+    free(f.p);
+    if (r != SP_OK) return r;
+    memmove(&out->guesses[1], &out->guesses[0], sizeof chosen * (size_t)g);
+    out->guesses[0] = chosen;
+    dragon_part_free(old);
+    d->parts[i] = q;
+    dragon_relayout(d);
+    return SP_OK;
+}
+
 sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
                                sp_dragon_result* out, sp_error* err)
 {
@@ -405,6 +449,10 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         d->parts[d->part_n++] = q;
     }
     dragon_relayout(d);
+    if (!o.category && d->clf) {
+        r = take_family_member(d, out, err);
+        if (r != SP_OK) return r;
+    }
     out->part = d->part_n - 1;
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
