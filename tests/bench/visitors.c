@@ -1,5 +1,6 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
-//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--json]
+//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--on-body]
+//            [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
 // defaults to the whole set the build makes from designs.json and the Quick,
@@ -17,8 +18,13 @@
 // non-part). --fit-all also fits every category's part to every drawing and
 // prints each fit's error (mean error over the stroke's diagonal) beside the
 // classifier's scores and nearest distance: the data behind the refusal
-// policy and the re-ranking that was tried (BENCHMARKS.md). Tune on --half
-// tune (the default); report --half report.
+// policy and the re-ranking that was tried (BENCHMARKS.md). --on-body also
+// draws every leg drawing at a dragon, as a visitor adds legs to a body:
+// the half's bodies and heads in turn (forced, so that only the legs are
+// measured), the dragon facing right, then left (the legs mirrored with
+// it), the legs under the body's front or rear; printed per kind: the
+// legs that became their own kind at their own end, and at the other end.
+// Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -34,6 +40,92 @@
 #include "sp/sketch_sheet.h"
 
 #define NOT_A_PART "not_a_part"
+
+// The stroke moved and scaled so that its box has diagonal `diag` and its
+// top centre at `at` (its centre when !top), mirrored left-right on request.
+static sp_stroke placed(const sp_stroke* in, double diag, sp_vec2 at, bool top, bool mirror)
+{
+    sp_stroke o = {.count = in->count, .points = malloc(sizeof(sp_vec2) * (size_t)(in->count + 1))};
+    sp_vec2 lo = in->points[0], hi = in->points[0];
+    for (int i = 1; i < in->count; ++i)
+        lo.x = fmin(lo.x, in->points[i].x), lo.y = fmin(lo.y, in->points[i].y), hi.x = fmax(hi.x, in->points[i].x),
+        hi.y = fmax(hi.y, in->points[i].y);
+    double f = diag / fmax(hypot(hi.x - lo.x, hi.y - lo.y), 1e-9), cx = 0.5 * (lo.x + hi.x);
+    double ref_y = top ? lo.y : 0.5 * (lo.y + hi.y);
+    for (int i = 0; o.points && i < in->count; ++i)
+        o.points[i] = (sp_vec2){at.x + (mirror ? -1 : 1) * f * (in->points[i].x - cx), at.y + f * (in->points[i].y - ref_y)};
+    return o;
+}
+
+// --on-body: legs drawn at a dragon (a body and a head drawn first). Prints
+// and returns nothing; a failed stroke is reported and skipped.
+static void legs_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half)
+{
+    static const char* const kinds[2] = {"front_legs", "hind_legs"};
+    int body_i[64], head_i[64], nb = 0, nh = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        const char* label = ds->categories[ds->samples[i].label];
+        if (!strcmp(label, "torso") && nb < 64) body_i[nb++] = i;
+        if (!strcmp(label, "head") && nh < 64) head_i[nh++] = i;
+    }
+    if (nb == 0 || nh == 0) return;
+    int n[2] = {0}, own[2] = {0}, other[2] = {0}, alone[2] = {0};
+    sp_error err = {0};
+    int m = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        const char* label = ds->categories[ds->samples[i].label];
+        int kind = !strcmp(label, kinds[0]) ? 0 : !strcmp(label, kinds[1]) ? 1 : -1;
+        if (kind < 0) continue;
+        const sp_stroke* legs = &ds->samples[i].sketch.strokes[0];
+        sp_dragon_result res;
+        sp_dragon_clear(d);
+        if (sp_dragon_add_stroke(d, legs, NULL, &res, &err) == SP_OK && !res.rejected)
+            alone[kind] += !strcmp(sp_dragon_part_get(d, res.part)->category, label);
+        for (int facing = 0; facing < 2; ++facing, ++m)
+            for (int end = 0; end < 2; ++end) { // 0: the legs' own end, 1: the other
+                sp_dragon_clear(d);
+                // Body: box diagonal 500 at the canvas's centre; the head above its front end, the legs under it.
+                const sp_stroke* b = &ds->samples[body_i[m % nb]].sketch.strokes[0];
+                const sp_stroke* h = &ds->samples[head_i[m % nh]].sketch.strokes[0];
+                sp_stroke bs = placed(b, 500, (sp_vec2){640, 400}, false, false);
+                sp_vec2 lo = {640, 400}, hi = lo;
+                for (int k = 0; bs.points && k < bs.count; ++k)
+                    lo.x = fmin(lo.x, bs.points[k].x), lo.y = fmin(lo.y, bs.points[k].y), hi.x = fmax(hi.x, bs.points[k].x),
+                    hi.y = fmax(hi.y, bs.points[k].y);
+                double dir = facing ? -1 : 1, w = hi.x - lo.x; // dir: the side the head is on
+                sp_stroke hs = placed(h, 200, (sp_vec2){640 + dir * (0.5 * w - 20), lo.y - 20}, false, facing != 0);
+                bool front = (kind == 0) == (end == 0);
+                sp_stroke ls = placed(legs, 260, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
+                                      true, facing != 0);
+                bool ok = bs.points && hs.points && ls.points &&
+                          sp_dragon_add_stroke(d, &bs, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK &&
+                          !res.rejected &&
+                          sp_dragon_add_stroke(d, &hs, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
+                          !res.rejected && sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK;
+                if (ok && !res.rejected) {
+                    bool right = !strcmp(sp_dragon_part_get(d, res.part)->category, label);
+                    if (end == 0)
+                        own[kind] += right;
+                    else
+                        other[kind] += right;
+                }
+                if (end == 0) n[kind]++;
+                free(bs.points), free(hs.points), free(ls.points);
+            }
+    }
+    sp_dragon_clear(d);
+    if (json) {
+        for (int k = 0; k < 2; ++k)
+            printf("  {\"case\": \"%s %s on a body\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d},\n", half,
+                   kinds[k], n[k], alone[k], own[k], other[k]);
+        return;
+    }
+    printf("Legs drawn at a dragon (a body and a head first; facing right, then left): became their own kind\n");
+    printf("%-12s %6s %22s %22s %22s\n", "legs", "drawn", "alone (no body)", "at their own end", "at the other end");
+    for (int k = 0; k < 2; ++k)
+        printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k], other[k],
+               n[k]);
+}
 
 typedef struct outcome {
     bool refused;
@@ -81,7 +173,7 @@ int main(int argc, char** argv)
 {
     const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_BINARY_DIR "/tests/data/visitors",
                *sheet = NULL;
-    bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false;
+    bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false, on_body = false;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--half") && i + 1 < argc)
             half = argv[++i];
@@ -97,9 +189,11 @@ int main(int argc, char** argv)
             list = true;
         else if (!strcmp(argv[i], "--fit-all"))
             fit_all = true;
+        else if (!strcmp(argv[i], "--on-body"))
+            on_body = true;
         else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "usage: visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                            "[--list] [--json]\n");
+                            "[--list] [--fit-all] [--on-body] [--json]\n");
             return 2;
         }
     }
@@ -235,6 +329,7 @@ int main(int argc, char** argv)
         }
     if (json) {
         printf("[\n");
+        if (on_body) legs_on_body(d, &ds, true, half);
         for (int c = 0; c < nc; ++c) {
             if (c == none) continue;
             printf("  {\"case\": \"%s %s\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": "
@@ -276,6 +371,7 @@ int main(int argc, char** argv)
                "median, %.2f p90 (target 50)\n",
                n_ms, mc, mc90, mt, mt90);
 #undef PCT
+        if (on_body) legs_on_body(d, &ds, false, half);
     }
     if (sheet) {
         sp_sheet_item* items = calloc((size_t)ds.count, sizeof *items);
