@@ -145,7 +145,8 @@ sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4*
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi);
 /// The category that attached part i takes from where it was drawn, when it
 /// has a family (sp_part.family): the family's member whose socket on the
-/// body lies nearest the part's anchor along the body, the dragon's facing
+/// body lies nearest the part's anchor along the body (the family's sockets
+/// centred on the body's middle), the dragon's facing
 /// read from the sideways parts (heads, tails) on that body. False (out
 /// untouched) for a free part, a body with fewer than two of the family's
 /// sockets, or a facing the body's parts do not tell or disagree on.
