@@ -57,8 +57,9 @@ static sp_stroke placed(const sp_stroke* in, double diag, sp_vec2 at, bool top, 
     return o;
 }
 
-// --on-body: legs drawn at a dragon (a body and a head drawn first). Prints
-// and returns nothing; a failed stroke is reported and skipped.
+// --on-body: legs drawn at a dragon (a body and a head drawn first), printed
+// as a table (or JSON rows). A scene whose body, head or legs stroke fails
+// or is refused counts as legs not of their kind.
 static void legs_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half)
 {
     static const char* const kinds[2] = {"front_legs", "hind_legs"};
