@@ -1898,9 +1898,10 @@ static bool guessed(const sp_dragon_result* res, const char* category)
 
 // Front and hind legs are one family (sp_part.family "legs"): legs drawn at
 // a body whose facing its head tells become the legs of that end, whichever
-// the drawing looks like; the chips still offer what it looks like; a chip's
-// choice, a free part and a body without a head or tail keep the
-// classifier's answer.
+// the drawing looks like (a tail tells the facing too); the chips still
+// offer what it looks like; a chip's choice, a free part, a body without a
+// head or tail, and a head and a tail that disagree keep the classifier's
+// answer.
 static void test_family_by_place(void)
 {
     const char* path = real_db();
@@ -1944,6 +1945,23 @@ static void test_family_by_place(void)
         res = draw_part(d, db, "front_legs", rear, 770, 60, mirrored, false);
         ENSURE(sp_dragon_part_get(d, res.part)->attached_to < 0);
         ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, "front_legs"));
+        ENSURE(sp_dragon_undo(d));
+        // A tail at the head's end contradicts the head: no facing, no change.
+        // (Tails drawn high: a tail's root lies low in its box.)
+        draw_part(d, db, "tail", mirrored ? 330 : 950, 370, 320, !mirrored, true);
+        ENSURE(sp_dragon_part_get(d, 2)->attached_to == 0);
+        for (int at_rear = 0; at_rear < 2; ++at_rear) { // neither the head's facing nor the tail's wins
+            res = draw_part(d, db, "front_legs", at_rear ? rear : front, 570, 190, mirrored, false);
+            ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, "front_legs"));
+            ENSURE(sp_dragon_undo(d));
+        }
+        // A tail alone tells the facing as a head does.
+        sp_dragon_clear(d);
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        draw_part(d, db, "tail", mirrored ? 950 : 330, 370, 320, mirrored, true);
+        ENSURE(sp_dragon_part_get(d, 1)->attached_to == 0);
+        res = draw_part(d, db, "front_legs", rear, 570, 190, mirrored, false);
+        ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, "hind_legs"));
     }
     sp_dragon_destroy(d);
     sp_db_close(db);
