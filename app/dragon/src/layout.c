@@ -338,14 +338,24 @@ static void attach(sp_dragon* d, int i, int k, const surface_hit* h, sp_vec3 a)
     dragon_copy_name(p->pub.socket, sizeof p->pub.socket, so ? so->name : "");
 }
 
-// The body's horizontal extent on the canvas at its fit (body_prepare'd).
-static void body_span(const part* q, double* mid, double* half)
+// The body's box on the canvas at its fit (body_prepare'd); false without vertices.
+static bool body_box(const part* q, sp_vec2* lo, sp_vec2* hi)
 {
     int n = q->t->ch.rig.vertex_count;
-    double a = n > 0 ? q->body_px[0].x : 0, b = a;
+    if (n <= 0) return false;
+    *lo = *hi = q->body_px[0];
     for (int v = 1; v < n; ++v)
-        a = fmin(a, q->body_px[v].x), b = fmax(b, q->body_px[v].x);
-    *mid = 0.5 * (a + b), *half = 0.5 * (b - a);
+        lo->x = fmin(lo->x, q->body_px[v].x), lo->y = fmin(lo->y, q->body_px[v].y), hi->x = fmax(hi->x, q->body_px[v].x),
+        hi->y = fmax(hi->y, q->body_px[v].y);
+    return true;
+}
+
+// Body q's first socket for a part of this category (or preferring it), or NULL.
+static const dsocket* kind_socket(const part* q, const char* category, const char* prefer)
+{
+    for (int s = 0; s < q->t->socket_count; ++s)
+        if (socket_accepts(&q->t->sockets[s], category, prefer)) return &q->t->sockets[s];
+    return NULL;
 }
 
 // Canvas x of body q's socket, less the body's middle.
@@ -360,17 +370,16 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
     int k = p->pub.attached_to;
     if (!p->t->family[0] || k < 0) return false;
     part* q = d->parts[k];
-    double mid, half;
-    body_span(q, &mid, &half);
+    sp_vec2 blo, bhi;
+    if (!body_box(q, &blo, &bhi)) return false;
+    double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x);
     // Facing: a head or tail drawn at the end of the body other than its
     // socket's says the dragon is drawn mirrored; near the middle it says nothing.
     int mirrored = -1;
     for (int j = 0; j < d->part_n; ++j) {
         const part* o = d->parts[j];
         if (j == i || o->pub.attached_to != k || !o->t->lengthwise) continue;
-        const dsocket* so = NULL;
-        for (int s = 0; !so && s < q->t->socket_count; ++s)
-            if (socket_accepts(&q->t->sockets[s], o->pub.category, o->t->prefer)) so = &q->t->sockets[s];
+        const dsocket* so = kind_socket(q, o->pub.category, o->t->prefer);
         if (!so) continue;
         double su = socket_u(d, q, so, mid), du = o->pub.anchor.x - mid;
         if (!(fabs(su) > 0.25 * half && fabs(du) > 0.25 * half)) continue;
@@ -416,13 +425,8 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
     sp_vec2 blo = {0, 0}, bhi = {0, 0};
     for (int k = 0; k < d->part_n; ++k) {
         part* q = d->parts[k];
-        if (!q->t->is_torso || !body_prepare(d, q)) continue;
-        int n = q->t->ch.rig.vertex_count;
-        if (n <= 0) continue;
-        sp_vec2 a = q->body_px[0], b = q->body_px[0];
-        for (int v = 1; v < n; ++v)
-            a.x = fmin(a.x, q->body_px[v].x), a.y = fmin(a.y, q->body_px[v].y), b.x = fmax(b.x, q->body_px[v].x),
-            b.y = fmax(b.y, q->body_px[v].y);
+        sp_vec2 a, b;
+        if (!q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) continue;
         double dist = box_distance(c, a, b);
         if (dist < bd) bd = dist, body = q, blo = a, bhi = b;
     }
@@ -433,13 +437,10 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
     // The side a part of its kind takes facing as modelled: its socket's,
     // else the way it reaches.
     int natural = t->outward;
-    for (int s = 0; s < body->t->socket_count; ++s) {
-        const dsocket* so = &body->t->sockets[s];
-        if (!socket_accepts(so, t->category, t->prefer)) continue;
-        sp_vec3 w = fitted_point(body, &body->pub.placement, so->joint, so->local);
-        double su = sp_camera_project(&d->world, w).x - mid;
+    const dsocket* so = kind_socket(body, t->category, t->prefer);
+    if (so) {
+        double su = socket_u(d, body, so, mid);
         if (fabs(su) > 0.25 * half) natural = su > 0 ? 1 : -1;
-        break;
     }
     return (side > 0 ? 1 : -1) == natural ? 1 : -1;
 }

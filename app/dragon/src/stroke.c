@@ -205,6 +205,14 @@ static bool fit_category(sp_dragon* d, const char* category, const sp_sketch* sk
 // first), and skipping them saves two of three extra fits.
 #define RERANK_MIN_SHARE 0.2
 
+// Puts `chosen` first in out->guesses, guesses 0..g-1 moving up one (over
+// slot g: chosen's own place, or the last slot for a guess not among them).
+static void guess_to_front(sp_dragon_result* out, int g, sp_dragon_guess chosen)
+{
+    memmove(&out->guesses[1], &out->guesses[0], sizeof chosen * (size_t)g);
+    out->guesses[0] = chosen;
+}
+
 // How well a part can take the drawn shape is evidence the classifier lacks:
 // fits the stroke with each of the classifier's best guesses (out->guesses,
 // at most SP_DRAGON_GUESSES, those scoring at least RERANK_MIN_SHARE of the
@@ -231,8 +239,7 @@ static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2
     }
     if (kept < 0) return false;
     sp_dragon_guess chosen = out->guesses[kept];
-    memmove(&out->guesses[1], &out->guesses[0], sizeof chosen * (size_t)kept);
-    out->guesses[0] = chosen;
+    guess_to_front(out, kept, chosen);
     dragon_copy_name(category, SP_NAME_MAX, chosen.category);
     *confidence = chosen.confidence;
     return true;
@@ -360,8 +367,7 @@ static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_erro
     sp_result r = new_part(d, f.t, f.p, &f.rep, &f.view, f.mirrored, old->stroke, old->stroke_n, chosen.confidence, &q, err);
     free(f.p);
     if (r != SP_OK) return r;
-    memmove(&out->guesses[1], &out->guesses[0], sizeof chosen * (size_t)g);
-    out->guesses[0] = chosen;
+    guess_to_front(out, g, chosen);
     dragon_part_free(old);
     d->parts[i] = q;
     dragon_relayout(d);
