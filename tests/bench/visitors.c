@@ -41,15 +41,19 @@
 
 #define NOT_A_PART "not_a_part"
 
+static void stroke_box(const sp_stroke* s, sp_vec2* lo, sp_vec2* hi)
+{
+    sp_sketch one = {.stroke_count = 1, .strokes = (sp_stroke*)s};
+    if (!sp_sketch_bounds(&one, lo, hi)) *lo = *hi = (sp_vec2){0, 0};
+}
+
 // The stroke moved and scaled so that its box has diagonal `diag` and its
 // top centre at `at` (its centre when !top), mirrored left-right on request.
 static sp_stroke placed(const sp_stroke* in, double diag, sp_vec2 at, bool top, bool mirror)
 {
     sp_stroke o = {.count = in->count, .points = malloc(sizeof(sp_vec2) * (size_t)(in->count + 1))};
-    sp_vec2 lo = in->points[0], hi = in->points[0];
-    for (int i = 1; i < in->count; ++i)
-        lo.x = fmin(lo.x, in->points[i].x), lo.y = fmin(lo.y, in->points[i].y), hi.x = fmax(hi.x, in->points[i].x),
-        hi.y = fmax(hi.y, in->points[i].y);
+    sp_vec2 lo, hi;
+    stroke_box(in, &lo, &hi);
     double f = diag / fmax(hypot(hi.x - lo.x, hi.y - lo.y), 1e-9), cx = 0.5 * (lo.x + hi.x);
     double ref_y = top ? lo.y : 0.5 * (lo.y + hi.y);
     for (int i = 0; o.points && i < in->count; ++i)
@@ -90,9 +94,7 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const ch
                 const sp_stroke* h = &ds->samples[head_i[m % nh]].sketch.strokes[0];
                 sp_stroke bs = placed(b, 500, (sp_vec2){640, 400}, false, false);
                 sp_vec2 lo = {640, 400}, hi = lo;
-                for (int k = 0; bs.points && k < bs.count; ++k)
-                    lo.x = fmin(lo.x, bs.points[k].x), lo.y = fmin(lo.y, bs.points[k].y), hi.x = fmax(hi.x, bs.points[k].x),
-                    hi.y = fmax(hi.y, bs.points[k].y);
+                if (bs.points) stroke_box(&bs, &lo, &hi);
                 double dir = facing ? -1 : 1, w = hi.x - lo.x; // dir: the side the head is on
                 sp_stroke hs = placed(h, 200, (sp_vec2){640 + dir * (0.5 * w - 20), lo.y - 20}, false, facing != 0);
                 bool front = (kind == 0) == (end == 0);
