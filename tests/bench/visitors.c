@@ -41,6 +41,14 @@
 
 #define NOT_A_PART "not_a_part"
 
+typedef struct outcome {
+    bool refused;
+    char answer[SP_NAME_MAX]; // the part it became ("" when refused)
+    bool top1, top3;          // the right category first / among the guesses (refusal aside)
+    double ms_classify, ms_total;
+    const char* reason;
+} outcome;
+
 static void stroke_box(const sp_stroke* s, sp_vec2* lo, sp_vec2* hi)
 {
     sp_sketch one = {.stroke_count = 1, .strokes = (sp_stroke*)s};
@@ -64,7 +72,8 @@ static sp_stroke placed(const sp_stroke* in, double diag, sp_vec2 at, bool top, 
 // --on-body: legs drawn at a dragon (a body and a head drawn first), printed
 // as a table (or JSON rows). A scene whose body, head or legs stroke fails
 // or is refused counts as legs not of their kind.
-static void legs_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half)
+// `alone`: the drawings' single-stroke outcomes (no body, no rule).
+static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alone_out, bool json, const char* half)
 {
     static const char* const kinds[2] = {"front_legs", "hind_legs"};
     int body_i[64], head_i[64], nb = 0, nh = 0;
@@ -83,9 +92,7 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const ch
         if (kind < 0) continue;
         const sp_stroke* legs = &ds->samples[i].sketch.strokes[0];
         sp_dragon_result res;
-        sp_dragon_clear(d);
-        if (sp_dragon_add_stroke(d, legs, NULL, &res, &err) == SP_OK && !res.rejected)
-            alone[kind] += !strcmp(sp_dragon_part_get(d, res.part)->category, label);
+        alone[kind] += !alone_out[i].refused && !strcmp(alone_out[i].answer, label);
         for (int facing = 0; facing < 2; ++facing, ++m)
             for (int end = 0; end < 2; ++end) { // 0: the legs' own end, 1: the other
                 sp_dragon_clear(d);
@@ -129,14 +136,6 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const ch
         printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k], other[k],
                n[k]);
 }
-
-typedef struct outcome {
-    bool refused;
-    char answer[SP_NAME_MAX]; // the part it became ("" when refused)
-    bool top1, top3;          // the right category first / among the guesses (refusal aside)
-    double ms_classify, ms_total;
-    const char* reason;
-} outcome;
 
 static int json_file(const struct dirent* e)
 {
@@ -332,7 +331,7 @@ int main(int argc, char** argv)
         }
     if (json) {
         printf("[\n");
-        if (on_body) legs_on_body(d, &ds, true, half);
+        if (on_body) legs_on_body(d, &ds, out, true, half);
         for (int c = 0; c < nc; ++c) {
             if (c == none) continue;
             printf("  {\"case\": \"%s %s\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": "
@@ -374,7 +373,7 @@ int main(int argc, char** argv)
                "median, %.2f p90 (target 50)\n",
                n_ms, mc, mc90, mt, mt90);
 #undef PCT
-        if (on_body) legs_on_body(d, &ds, false, half);
+        if (on_body) legs_on_body(d, &ds, out, false, half);
     }
     if (sheet) {
         sp_sheet_item* items = calloc((size_t)ds.count, sizeof *items);
