@@ -24,6 +24,9 @@
 // measured), the dragon facing right, then left (the legs mirrored with
 // it), the legs under the body's front or rear; printed per kind: the
 // legs that became their own kind at their own end, and at the other end.
+// It then draws every head, tail and wing drawing touching a dragon's body
+// (parts_on_body): printed per kind, those that became their own kind, a
+// body, another part, or were refused.
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>
@@ -69,6 +72,47 @@ static sp_stroke placed(const sp_stroke* in, double diag, sp_vec2 at, bool top, 
     return o;
 }
 
+// The half's body and head drawings (sample indices): the --on-body scenes' dragons.
+typedef struct scene_set {
+    int body[64], head[64], nb, nh;
+} scene_set;
+
+static bool scene_drawings(const sp_dataset* ds, scene_set* s)
+{
+    s->nb = s->nh = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        const char* label = ds->categories[ds->samples[i].label];
+        if (!strcmp(label, "torso") && s->nb < 64) s->body[s->nb++] = i;
+        if (!strcmp(label, "head") && s->nh < 64) s->head[s->nh++] = i;
+    }
+    return s->nb > 0 && s->nh > 0;
+}
+
+// Scene m's dragon on a cleared canvas: its body (forced a body, box
+// diagonal 500 at the canvas's centre; its box to *lo, *hi) and, with_head,
+// its head (forced a head, diagonal 200, centred 20 px inside the body's
+// front top corner, at *head_at); facing left mirrors the head. False when
+// a stroke fails or is refused.
+static bool draw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head, sp_vec2* lo,
+                        sp_vec2* hi, sp_vec2* head_at)
+{
+    sp_dragon_clear(d);
+    sp_dragon_result res;
+    sp_error err = {0};
+    sp_stroke bs = placed(&ds->samples[s->body[m % s->nb]].sketch.strokes[0], 500, (sp_vec2){640, 400}, false, false);
+    *lo = *hi = (sp_vec2){640, 400};
+    if (bs.points) stroke_box(&bs, lo, hi);
+    *head_at = (sp_vec2){640 + (left ? -1 : 1) * (0.5 * (hi->x - lo->x) - 20), lo->y - 20};
+    sp_stroke hs =
+        with_head ? placed(&ds->samples[s->head[m % s->nh]].sketch.strokes[0], 200, *head_at, false, left) : (sp_stroke){0};
+    bool ok = bs.points && (!with_head || hs.points) &&
+              sp_dragon_add_stroke(d, &bs, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK && !res.rejected &&
+              (!with_head || (sp_dragon_add_stroke(d, &hs, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
+                              !res.rejected));
+    free(bs.points), free(hs.points);
+    return ok;
+}
+
 // --on-body: legs drawn at a dragon (a body and a head drawn first), printed
 // as a table (or JSON rows). A scene whose body, head or legs stroke fails
 // or is refused counts as legs not of their kind.
@@ -76,13 +120,8 @@ static sp_stroke placed(const sp_stroke* in, double diag, sp_vec2 at, bool top, 
 static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alone_out, bool json, const char* half)
 {
     static const char* const kinds[2] = {"front_legs", "hind_legs"};
-    int body_i[64], head_i[64], nb = 0, nh = 0;
-    for (int i = 0; i < ds->count; ++i) {
-        const char* label = ds->categories[ds->samples[i].label];
-        if (!strcmp(label, "torso") && nb < 64) body_i[nb++] = i;
-        if (!strcmp(label, "head") && nh < 64) head_i[nh++] = i;
-    }
-    if (nb == 0 || nh == 0) return;
+    scene_set scenes;
+    if (!scene_drawings(ds, &scenes)) return;
     int n[2] = {0}, own[2] = {0}, other[2] = {0}, alone[2] = {0};
     sp_error err = {0};
     int m = 0;
@@ -95,23 +134,14 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
         alone[kind] += !alone_out[i].refused && !strcmp(alone_out[i].answer, label);
         for (int facing = 0; facing < 2; ++facing, ++m)
             for (int end = 0; end < 2; ++end) { // 0: the legs' own end, 1: the other
-                sp_dragon_clear(d);
-                // Body: box diagonal 500 at the canvas's centre; the head above its front end, the legs under it.
-                const sp_stroke* b = &ds->samples[body_i[m % nb]].sketch.strokes[0];
-                const sp_stroke* h = &ds->samples[head_i[m % nh]].sketch.strokes[0];
-                sp_stroke bs = placed(b, 500, (sp_vec2){640, 400}, false, false);
-                sp_vec2 lo = {640, 400}, hi = lo;
-                if (bs.points) stroke_box(&bs, &lo, &hi);
+                // The legs' top at 60% of the body's height, a quarter of its width from the middle.
+                sp_vec2 lo, hi, head_at;
+                bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, true, &lo, &hi, &head_at);
                 double dir = facing ? -1 : 1, w = hi.x - lo.x; // dir: the side the head is on
-                sp_stroke hs = placed(h, 200, (sp_vec2){640 + dir * (0.5 * w - 20), lo.y - 20}, false, facing != 0);
                 bool front = (kind == 0) == (end == 0);
                 sp_stroke ls = placed(legs, 260, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
                                       true, facing != 0);
-                bool ok = bs.points && hs.points && ls.points &&
-                          sp_dragon_add_stroke(d, &bs, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK &&
-                          !res.rejected &&
-                          sp_dragon_add_stroke(d, &hs, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
-                          !res.rejected && sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK;
+                ok = ok && ls.points && sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK;
                 if (ok && !res.rejected) {
                     bool right = !strcmp(sp_dragon_part_get(d, res.part)->category, label);
                     if (end == 0)
@@ -120,7 +150,7 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
                         other[kind] += right;
                 }
                 if (end == 0) n[kind]++;
-                free(bs.points), free(hs.points), free(ls.points);
+                free(ls.points);
             }
     }
     sp_dragon_clear(d);
@@ -135,6 +165,81 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
     for (int k = 0; k < 2; ++k)
         printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k], other[k],
                n[k]);
+}
+
+// The stroke moved by (dx, dy), in place.
+static void shifted(sp_stroke* s, double dx, double dy)
+{
+    for (int i = 0; s->points && i < s->count; ++i)
+        s->points[i].x += dx, s->points[i].y += dy;
+}
+
+// --on-body: heads, tails and wings drawn touching a dragon's body, as a
+// visitor adds them: the half's bodies in turn (forced a body, box diagonal
+// 500 at the canvas's centre); for tails and wings also one of its heads
+// (forced a head, over the body's front end, as for the legs); the dragon
+// facing right, then left (everything mirrored). The part (classified):
+// a head centred 20 px inside the body's front top corner; a tail reaching
+// out of the rear, its box 30 px into the body's, centred on the body's
+// height; wings standing on the body's back, their box 30 px into it.
+// Counted per kind: became its own kind, a body (a second dragon), another
+// part, refused.
+static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half)
+{
+    static const char* const kinds[3] = {"head", "tail", "wings"};
+    scene_set scenes;
+    if (!scene_drawings(ds, &scenes)) return;
+    int n[3] = {0}, own[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0};
+    sp_error err = {0};
+    int m = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        const char* label = ds->categories[ds->samples[i].label];
+        int kind = -1;
+        for (int k = 0; k < 3; ++k)
+            if (!strcmp(label, kinds[k])) kind = k;
+        if (kind < 0) continue;
+        const sp_stroke* part_s = &ds->samples[i].sketch.strokes[0];
+        for (int facing = 0; facing < 2; ++facing, ++m) {
+            sp_dragon_result res;
+            sp_vec2 lo, hi, head_at, plo, phi;
+            bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, kind != 0, &lo, &hi, &head_at);
+            double dir = facing ? -1 : 1;
+            sp_stroke ps = placed(part_s, kind == 0 ? 200 : 260, kind == 0 ? head_at : (sp_vec2){640, 400}, false, facing != 0);
+            if (ps.points && kind > 0) {
+                stroke_box(&ps, &plo, &phi);
+                if (kind == 1) // the tail's near edge 30 px inside the body's rear edge
+                    shifted(&ps, dir > 0 ? (lo.x + 30) - phi.x : (hi.x - 30) - plo.x,
+                            0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
+                else // the wings' bottom 30 px into the body's top, over its middle
+                    shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y + 30) - phi.y);
+            }
+            ok = ok && ps.points && sp_dragon_add_stroke(d, &ps, NULL, &res, &err) == SP_OK;
+            n[kind]++;
+            if (!ok || res.rejected) {
+                refused[kind]++;
+            } else {
+                const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+                if (!strcmp(p->category, label))
+                    own[kind]++;
+                else if (p->is_torso)
+                    body[kind]++;
+                else
+                    other[kind]++;
+            }
+            free(ps.points);
+        }
+    }
+    sp_dragon_clear(d);
+    if (json) {
+        for (int k = 0; k < 3; ++k)
+            printf("  {\"case\": \"%s %s on a body\", \"n\": %d, \"own\": %d, \"body\": %d, \"other\": %d, \"refused\": %d},\n",
+                   half, kinds[k], n[k], own[k], body[k], other[k], refused[k]);
+        return;
+    }
+    printf("Heads, tails and wings drawn touching a dragon's body (facing right, then left)\n");
+    printf("%-12s %6s %12s %12s %12s %12s\n", "part", "drawn", "own kind", "a body", "other part", "refused");
+    for (int k = 0; k < 3; ++k)
+        printf("%-12s %6d %12d %12d %12d %12d\n", kinds[k], n[k], own[k], body[k], other[k], refused[k]);
 }
 
 static int json_file(const struct dirent* e)
@@ -331,7 +436,7 @@ int main(int argc, char** argv)
         }
     if (json) {
         printf("[\n");
-        if (on_body) legs_on_body(d, &ds, out, true, half);
+        if (on_body) legs_on_body(d, &ds, out, true, half), parts_on_body(d, &ds, true, half);
         for (int c = 0; c < nc; ++c) {
             if (c == none) continue;
             printf("  {\"case\": \"%s %s\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": "
@@ -373,7 +478,7 @@ int main(int argc, char** argv)
                "median, %.2f p90 (target 50)\n",
                n_ms, mc, mc90, mt, mt90);
 #undef PCT
-        if (on_body) legs_on_body(d, &ds, out, false, half);
+        if (on_body) legs_on_body(d, &ds, out, false, half), parts_on_body(d, &ds, false, half);
     }
     if (sheet) {
         sp_sheet_item* items = calloc((size_t)ds.count, sizeof *items);
