@@ -1896,6 +1896,15 @@ static bool guessed(const sp_dragon_result* res, const char* category)
     return false;
 }
 
+// A pipeline on the database at `path`, and the database opened read-only
+// beside it (for the parts' names and strokes).
+static sp_dragon* dragon_and_db(const char* path, sp_db** db)
+{
+    sp_error err = {0};
+    ENSURE(sp_db_open(path, SP_DB_READONLY, db, &err) == SP_OK);
+    return new_dragon(path);
+}
+
 // Front and hind legs are one family (sp_part.family "legs"): legs drawn at
 // a body whose facing its head tells become the legs of that end, whichever
 // the drawing looks like (a tail tells the facing too); the chips still
@@ -1908,8 +1917,7 @@ static void test_family_by_place(void)
     if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_db* db = NULL;
-    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
-    sp_dragon* d = new_dragon(path);
+    sp_dragon* d = dragon_and_db(path, &db);
     // A dragon facing right as modelled, then mirrored (its head drawn on the left).
     for (int mirrored = 0; mirrored < 2; ++mirrored) {
         double front = mirrored ? 520 : 760, rear = mirrored ? 760 : 520, head = mirrored ? 380 : 900;
@@ -1967,6 +1975,80 @@ static void test_family_by_place(void)
     sp_db_close(db);
 }
 
+// A stroke drawn on a body (overlapping it, clearly smaller) is a part of
+// that dragon, never a second body: the classifier's "body" stays among the
+// chips and a chip's choice stands; a body drawn apart, or about as large,
+// is a second dragon; a Redraw of the body is a body.
+static void test_drawn_on_body(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    // A visitor's closed head (the visitors' set, tune half), which alone the classifier takes for a body.
+    char file[1200];
+    snprintf(file, sizeof file, "%s/tests/data/visitors/tune/head/head-blunt-round-ear.json", SP_BINARY_DIR);
+    sp_sketch head;
+    ENSURE(sp_sketch_read_json(file, &head, &err) == SP_OK && head.stroke_count == 1);
+    sp_vec2 lo, hi;
+    ENSURE(sp_sketch_bounds(&head, &lo, &hi));
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        sp_dragon_clear(d);
+        sp_dragon_result res, body = draw_part(d, db, "torso", 640, 420, 420, false, true);
+        ENSURE(sp_dragon_part_get(d, body.part)->is_torso);
+        // The head drawn apart from the body, then over the body's front top corner (diagonal 180).
+        for (int on = 0; on < 2; ++on) {
+            const sp_stroke* s = &head.strokes[0];
+            sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)s->count);
+            double f = 180 / hypot(hi.x - lo.x, hi.y - lo.y), cx = on ? (mirrored ? 470 : 810) : (mirrored ? 1130 : 150),
+                   cy = on ? 300 : 120;
+            for (int i = 0; i < s->count; ++i)
+                xy[i] = (sp_vec2){cx + (mirrored ? -f : f) * (s->points[i].x - 0.5 * (lo.x + hi.x)),
+                                  cy + f * (s->points[i].y - 0.5 * (lo.y + hi.y))};
+            ENSURE(sp_dragon_add_points(d, xy, s->count, NULL, &res, &err) == SP_OK && !res.rejected);
+            free(xy);
+            const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+            fprintf(stderr, "  head drawn %s, facing %s: %s (chips %s, %s, %s)\n", on ? "on the body" : "apart",
+                    mirrored ? "left" : "right", p->category, res.guesses[0].category, res.guesses[1].category,
+                    res.guesses[2].category);
+            if (!on) { // the premise: alone it looks like a body, and apart it is a second dragon
+                ENSURE(p->is_torso);
+                ENSURE(sp_dragon_undo(d));
+                continue;
+            }
+            ENSURE(!strcmp(p->category, "head"));
+            ENSURE(p->attached_to == body.part);
+            ENSURE(!strcmp(res.guesses[0].category, "head"));
+            ENSURE(guessed(&res, "torso")); // what it looked like is one tap away
+            // The chip's choice stands: a body on a body is a second body.
+            ENSURE(sp_dragon_refit_last(d, "torso", &res, &err) == SP_OK && !res.rejected);
+            ENSURE(sp_dragon_part_get(d, res.part)->is_torso);
+            ENSURE(sp_dragon_undo(d));
+        }
+        // The body's own stroke, small on the body: not a body; about as large: a second dragon.
+        res = draw_part(d, db, "torso", mirrored ? 500 : 780, 330, 150, false, false);
+        ENSURE(!sp_dragon_part_get(d, res.part)->is_torso && guessed(&res, "torso"));
+        ENSURE(sp_dragon_undo(d));
+        res = draw_part(d, db, "torso", 700, 460, 400, false, false);
+        ENSURE(sp_dragon_part_get(d, res.part)->is_torso);
+        ENSURE(sp_dragon_undo(d));
+        // Redraw of the body with a smaller one: the body it replaces does not count.
+        char** names = NULL;
+        int n = 0;
+        ENSURE(sp_db_category_parts(db, "torso", &names, &n, &err) == SP_OK && n > 0);
+        sp_vec2* xy;
+        int k = part_stroke_ex(db, names[0], 500, 0.3, (sp_vec2){640, 420}, 250, false, false, &xy);
+        sp_db_free_strings(names, n);
+        ENSURE(sp_dragon_add_points(d, xy, k, &(sp_dragon_stroke_opts){.replace_last = true}, &res, &err) == SP_OK);
+        free(xy);
+        ENSURE(!res.rejected && sp_dragon_part_count(d) == 1 && sp_dragon_part_get(d, res.part)->is_torso);
+    }
+    sp_sketch_free(&head);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -1983,5 +2065,6 @@ int main(int argc, char** argv)
                                    {"robustness", test_robustness},
                                    {"visitors_policy", test_visitors_policy},
                                    {"family_by_place", test_family_by_place},
+                                   {"drawn_on_body", test_drawn_on_body},
                                    {0}});
 }

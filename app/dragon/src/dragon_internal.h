@@ -151,6 +151,12 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi);
 /// untouched) for a free part, a body with fewer than two of the family's
 /// sockets, or a facing the body's parts do not tell or disagree on.
 bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
+/// Whether a stroke with box [lo, hi] is drawn on a body: its box overlaps
+/// a body's on the canvas and is clearly smaller than it. Such a
+/// stroke is a part of that dragon, never a second body (docs/DESIGN.md,
+/// "Which strokes join a dragon"). Part `skip` (the one a Redraw
+/// replaces, or -1) does not count.
+bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
 

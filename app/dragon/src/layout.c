@@ -417,6 +417,24 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
     return true;
 }
 
+// "Clearly smaller" for dragon_drawn_on_body: the stroke's box diagonal
+// against the body's. A second body drawn over the first is about as large
+// (a bigger dragon); a head, tail or wing drawn on a body is smaller.
+#define ON_BODY_SIZE 0.75
+
+bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
+{
+    double diag = hypot(hi.x - lo.x, hi.y - lo.y);
+    for (int k = 0; k < d->part_n; ++k) {
+        part* q = d->parts[k];
+        sp_vec2 a, b;
+        if (k == skip || !q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) continue;
+        bool overlaps = lo.x <= b.x && a.x <= hi.x && lo.y <= b.y && a.y <= hi.y;
+        if (overlaps && diag <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y)) return true;
+    }
+    return false;
+}
+
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
 {
     sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);

@@ -213,21 +213,33 @@ static void guess_to_front(sp_dragon_result* out, int g, sp_dragon_guess chosen)
     out->guesses[0] = chosen;
 }
 
+// Whether the category's parts are bodies (its first part is).
+static bool category_is_body(sp_dragon* d, const char* category)
+{
+    tpl* t[1];
+    sp_error lerr = {0};
+    return dragon_category_templates(d, category, t, 1, &lerr) == 1 && t[0]->is_torso;
+}
+
 // How well a part can take the drawn shape is evidence the classifier lacks:
 // fits the stroke with each of the classifier's best guesses (out->guesses,
 // at most SP_DRAGON_GUESSES, those scoring at least RERANK_MIN_SHARE of the
 // first) and keeps the category whose score over its fit's error is highest
-// (BENCHMARKS.md, "Visitors' drawings", sixth pass). The kept category moves
-// to the front of out->guesses; category and *confidence become its name
-// and score.
-static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, sp_dragon_result* out,
+// (BENCHMARKS.md, "Visitors' drawings", sixth pass). no_body: the stroke is
+// drawn on a body (dragon_drawn_on_body), so the guesses that are bodies are
+// passed over and the shares count from the first other guess. The kept
+// category moves to the front of out->guesses; category and *confidence
+// become its name and score.
+static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, bool no_body, sp_dragon_result* out,
                           char category[SP_NAME_MAX], float* confidence, fit_choice* best, int* not_finite, bool* any_part)
 {
-    int kept = -1;
+    int kept = -1, first = -1;
     double kept_rank = 0.0;
     for (int g = 0; g < out->guess_count; ++g) {
         fit_choice f;
-        if (g > 0 && out->guesses[g].confidence < RERANK_MIN_SHARE * out->guesses[0].confidence) continue;
+        if (no_body && category_is_body(d, out->guesses[g].category)) continue;
+        if (first < 0) first = g;
+        if (g > first && out->guesses[g].confidence < RERANK_MIN_SHARE * out->guesses[first].confidence) continue;
         if (!fit_category(d, out->guesses[g].category, sk, lo, hi, &f, not_finite, any_part)) continue;
         double rank = out->guesses[g].confidence / fmax(f.score, RERANK_FIT_FLOOR);
         if (kept >= 0 && rank <= kept_rank) {
@@ -417,8 +429,16 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     fit_choice best;
     int not_finite = 0;
     bool any_part = false;
-    bool fitted = !o.category && d->clf ? rerank_by_fit(d, &sk, lo, hi, out, category, &confidence, &best, &not_finite, &any_part)
-                                        : fit_category(d, category, &sk, lo, hi, &best, &not_finite, &any_part);
+    bool fitted;
+    if (!o.category && d->clf) {
+        // A stroke drawn on a body is a part of that dragon: a body guess is
+        // taken only when no other guess has a part that fits.
+        bool on_body = dragon_drawn_on_body(d, lo, hi, o.replace_last ? d->part_n - 1 : -1);
+        fitted = rerank_by_fit(d, &sk, lo, hi, on_body, out, category, &confidence, &best, &not_finite, &any_part) ||
+                 (on_body && rerank_by_fit(d, &sk, lo, hi, false, out, category, &confidence, &best, &not_finite, &any_part));
+    } else {
+        fitted = fit_category(d, category, &sk, lo, hi, &best, &not_finite, &any_part);
+    }
     out->ms_fit = sp_now_ms() - tf;
     if (!any_part) {
         free(pts);
