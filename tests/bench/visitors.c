@@ -189,7 +189,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     static const char* const kinds[3] = {"head", "tail", "wings"};
     scene_set scenes;
     if (!scene_drawings(ds, &scenes)) return;
-    int n[3] = {0}, own[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0};
+    int n[3] = {0}, own[3] = {0}, attached[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0};
     sp_error err = {0};
     int m = 0;
     for (int i = 0; i < ds->count; ++i) {
@@ -220,7 +220,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             } else {
                 const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
                 if (!strcmp(p->category, label))
-                    own[kind]++;
+                    own[kind]++, attached[kind] += p->attached_to == 0;
                 else if (p->is_torso)
                     body[kind]++;
                 else
@@ -232,14 +232,15 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     sp_dragon_clear(d);
     if (json) {
         for (int k = 0; k < 3; ++k)
-            printf("  {\"case\": \"%s %s on a body\", \"n\": %d, \"own\": %d, \"body\": %d, \"other\": %d, \"refused\": %d},\n",
-                   half, kinds[k], n[k], own[k], body[k], other[k], refused[k]);
+            printf("  {\"case\": \"%s %s on a body\", \"n\": %d, \"own\": %d, \"own_attached\": %d, \"body\": %d, \"other\": "
+                   "%d, \"refused\": %d},\n",
+                   half, kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k]);
         return;
     }
     printf("Heads, tails and wings drawn touching a dragon's body (facing right, then left)\n");
-    printf("%-12s %6s %12s %12s %12s %12s\n", "part", "drawn", "own kind", "a body", "other part", "refused");
+    printf("%-12s %6s %12s %12s %12s %12s %12s\n", "part", "drawn", "own kind", "attached", "a body", "other part", "refused");
     for (int k = 0; k < 3; ++k)
-        printf("%-12s %6d %12d %12d %12d %12d\n", kinds[k], n[k], own[k], body[k], other[k], refused[k]);
+        printf("%-12s %6d %12d %12d %12d %12d %12d\n", kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k]);
 }
 
 static int json_file(const struct dirent* e)

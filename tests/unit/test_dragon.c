@@ -1975,6 +1975,29 @@ static void test_family_by_place(void)
     sp_db_close(db);
 }
 
+// A drawing of the visitors' set (built from designs.json; `rel` under its
+// tune half, one stroke) moved and scaled so that its box has diagonal
+// `diag` and centre `at`, mirrored left-right on request. malloc'd; *n points.
+static sp_vec2* visitor_stroke(const char* rel, double diag, sp_vec2 at, bool mirror, int* n)
+{
+    char file[1200];
+    snprintf(file, sizeof file, "%s/tests/data/visitors/tune/%s", SP_BINARY_DIR, rel);
+    sp_sketch sk;
+    sp_error err = {0};
+    sp_vec2 lo, hi;
+    ENSURE(sp_sketch_read_json(file, &sk, &err) == SP_OK && sk.stroke_count == 1 && sp_sketch_bounds(&sk, &lo, &hi));
+    const sp_stroke* s = &sk.strokes[0];
+    sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)s->count);
+    ENSURE(xy);
+    double f = diag / hypot(hi.x - lo.x, hi.y - lo.y);
+    for (int i = 0; i < s->count; ++i)
+        xy[i] = (sp_vec2){at.x + (mirror ? -f : f) * (s->points[i].x - 0.5 * (lo.x + hi.x)),
+                          at.y + f * (s->points[i].y - 0.5 * (lo.y + hi.y))};
+    *n = s->count;
+    sp_sketch_free(&sk);
+    return xy;
+}
+
 // A stroke drawn on a body (overlapping it, clearly smaller) is a part of
 // that dragon, never a second body: the classifier's "body" stays among the
 // chips and a chip's choice stands; a body drawn apart, or about as large,
@@ -1987,26 +2010,16 @@ static void test_drawn_on_body(void)
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
     // A visitor's closed head (the visitors' set, tune half), which alone the classifier takes for a body.
-    char file[1200];
-    snprintf(file, sizeof file, "%s/tests/data/visitors/tune/head/head-blunt-round-ear.json", SP_BINARY_DIR);
-    sp_sketch head;
-    ENSURE(sp_sketch_read_json(file, &head, &err) == SP_OK && head.stroke_count == 1);
-    sp_vec2 lo, hi;
-    ENSURE(sp_sketch_bounds(&head, &lo, &hi));
     for (int mirrored = 0; mirrored < 2; ++mirrored) {
         sp_dragon_clear(d);
         sp_dragon_result res, body = draw_part(d, db, "torso", 640, 420, 420, false, true);
         ENSURE(sp_dragon_part_get(d, body.part)->is_torso);
         // The head drawn apart from the body, then over the body's front top corner (diagonal 180).
         for (int on = 0; on < 2; ++on) {
-            const sp_stroke* s = &head.strokes[0];
-            sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)s->count);
-            double f = 180 / hypot(hi.x - lo.x, hi.y - lo.y), cx = on ? (mirrored ? 470 : 810) : (mirrored ? 1130 : 150),
-                   cy = on ? 300 : 120;
-            for (int i = 0; i < s->count; ++i)
-                xy[i] = (sp_vec2){cx + (mirrored ? -f : f) * (s->points[i].x - 0.5 * (lo.x + hi.x)),
-                                  cy + f * (s->points[i].y - 0.5 * (lo.y + hi.y))};
-            ENSURE(sp_dragon_add_points(d, xy, s->count, NULL, &res, &err) == SP_OK && !res.rejected);
+            int n;
+            sp_vec2 at = {on ? (mirrored ? 470 : 810) : (mirrored ? 1130 : 150), on ? 300 : 120};
+            sp_vec2* xy = visitor_stroke("head/head-blunt-round-ear.json", 180, at, mirrored, &n);
+            ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
             free(xy);
             const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
             fprintf(stderr, "  head drawn %s, facing %s: %s (chips %s, %s, %s)\n", on ? "on the body" : "apart",
@@ -2044,7 +2057,61 @@ static void test_drawn_on_body(void)
         free(xy);
         ENSURE(!res.rejected && sp_dragon_part_count(d) == 1 && sp_dragon_part_get(d, res.part)->is_torso);
     }
-    sp_sketch_free(&head);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
+// A head or tail drawn out of a body's end has its root at the body, also
+// when the other facing fits the stroke better (visitors' tails ending in a
+// spade, a flame or a curl fit best reversed): it attaches there, facing
+// away from the body, whichever end of the body it comes out of.
+static void test_root_at_the_body(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    static const char* const tails[] = {"tail/tail-outline-spade.json", "tail/tail-outline-flame.json",
+                                        "tail/tail-line-curl.json", "tail/tail-wavy-line.json"};
+    int reversed_alone = 0;
+    for (int k = 0; k < 4; ++k)
+        for (int right = 0; right < 2; ++right) { // the tail out of the body's left end (as modelled), then its right
+            sp_dragon_clear(d);
+            sp_dragon_result res, body = draw_part(d, db, "torso", 640, 420, 420, false, true);
+            sp_vec2* px = fitted_px(d, body.part);
+            int nv = sp_dragon_part_get(d, body.part)->character->rig.vertex_count;
+            sp_vec2 blo = px[0], bhi = px[0];
+            for (int v = 1; v < nv; ++v)
+                blo.x = fmin(blo.x, px[v].x), blo.y = fmin(blo.y, px[v].y), bhi.x = fmax(bhi.x, px[v].x),
+                bhi.y = fmax(bhi.y, px[v].y);
+            free(px);
+            // Its box 30 px into the body's, centred on the body's height (the visitors bench's --on-body scene).
+            int n;
+            sp_vec2* xy = visitor_stroke(tails[k], 260, (sp_vec2){0, 0}, right, &n);
+            sp_vec2 lo = xy[0], hi = xy[0];
+            for (int i = 1; i < n; ++i)
+                lo.x = fmin(lo.x, xy[i].x), hi.x = fmax(hi.x, xy[i].x);
+            double dx = right ? (bhi.x - 30) - lo.x : (blo.x + 30) - hi.x, dy = 0.5 * (blo.y + bhi.y);
+            for (int i = 0; i < n; ++i)
+                xy[i].x += dx, xy[i].y += dy;
+            ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK &&
+                   !res.rejected);
+            const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+            fprintf(stderr, "  %s out of the body's %s end: attached to %d, mirrored %d, fit %.2f%%\n", tails[k],
+                    right ? "right" : "left", p->attached_to, p->mirrored,
+                    100 * p->report.mean_error_px / p->report.bbox_diagonal_px);
+            ENSURE(p->attached_to == body.part);
+            ENSURE(p->mirrored == (right != 0)); // facing away from the body
+            // The premise: drawn alone, its shape fits the other facing better.
+            sp_dragon_clear(d);
+            ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK &&
+                   !res.rejected);
+            reversed_alone += sp_dragon_part_get(d, res.part)->mirrored != (right != 0);
+            free(xy);
+        }
+    fprintf(stderr, "  drawn alone, %d of 8 fit reversed\n", reversed_alone);
+    ENSURE(reversed_alone >= 4);
     sp_dragon_destroy(d);
     sp_db_close(db);
 }
@@ -2066,5 +2133,6 @@ int main(int argc, char** argv)
                                    {"visitors_policy", test_visitors_policy},
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
+                                   {"root_at_the_body", test_root_at_the_body},
                                    {0}});
 }

@@ -89,7 +89,7 @@ static sp_result new_part(sp_dragon* d, tpl* t, const double* p, const sp_solve_
 typedef struct fit_choice {
     tpl* t;
     bool mirrored;
-    double score; // mean error over the stroke's diagonal
+    double score; // mean error over the stroke's diagonal (of the better facing when kept by place: fit_variants)
     double* p;    // malloc'd, rig.param_count
     sp_solve_report rep;
     sp_camera view; // the view it was fitted in (turned when mirrored)
@@ -153,19 +153,29 @@ static bool fit_one(sp_dragon* d, tpl* t, const sp_sketch* sk, sp_vec2 lo, sp_ve
 // Fits every candidate part. A part that reaches sideways (a head, a tail)
 // is fitted in the facing the bodies' sockets hint at and, when there is no
 // hint or that fit is poor, in the other too: the hinted one is kept unless
-// the other fits clearly better. The best candidate goes to *best.
+// the other fits clearly better, and always when the stroke comes out of
+// the end of the body that hints. The best candidate goes to *best.
 static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, fit_choice* best,
                          int* not_finite)
 {
     bool any = false;
     for (int c = 0; c < nc; ++c) {
         tpl* t = cands[c];
-        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi) : 1;
+        bool touching = false;
+        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi, &touching) : 1;
         fit_choice a, b;
         bool got = fit_one(d, t, sk, lo, hi, hint < 0, &a, not_finite);
         bool other = t->lengthwise && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
         if (other && fit_one(d, t, sk, lo, hi, !(hint < 0), &b, not_finite)) {
-            if (!got || b.score < 0.8 * a.score) {
+            if (got && touching) {
+                // Drawn out of a body's end, the part's root is at the body
+                // whichever facing fits better (a visitor's tail ending in a
+                // spade or a flame fits reversed): the hinted facing is the
+                // part, and the better facing's error is the category's
+                // evidence for the ranking and the refusal.
+                a.score = fmin(a.score, b.score);
+                free(b.p);
+            } else if (!got || b.score < 0.8 * a.score) {
                 if (got) free(a.p);
                 a = b, got = true;
             } else {
