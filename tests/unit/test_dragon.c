@@ -1291,6 +1291,22 @@ static void test_live_update(void)
     sp_dragon_destroy(d);
 }
 
+// A JSON file parsed (ENSURE'd readable, at most 4 MB, and valid).
+static cJSON* json_file(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    ENSURE(f);
+    char* text = calloc(1, 1 << 22);
+    ENSURE(text);
+    size_t got = fread(text, 1, (1 << 22) - 1, f);
+    fclose(f);
+    ENSURE(got > 0);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    ENSURE(j);
+    return j;
+}
+
 // `sketchpose dragon`: a stroke file in, a .glb, a PNG and the report out.
 static void test_command(void)
 {
@@ -1319,15 +1335,7 @@ static void test_command(void)
     ENSURE(system(cmd) == 0);
     struct stat st;
     ENSURE(stat(png, &st) == 0 && st.st_size > 1000);
-    FILE* f = fopen(rep, "rb");
-    ENSURE(f);
-    char* text = calloc(1, 1 << 22);
-    size_t got = fread(text, 1, (1 << 22) - 1, f);
-    fclose(f);
-    ENSURE(got > 0);
-    cJSON* j = cJSON_Parse(text);
-    free(text);
-    ENSURE(j);
+    cJSON* j = json_file(rep);
     const char* keys[] = {"ms",           "iterations",    "icp_rounds",   "stopped",          "energy_before",
                           "energy_after", "mean_error_px", "max_error_px", "bbox_diagonal_px", "curves",
                           "parameters",   "parts"};
@@ -1400,14 +1408,7 @@ static void check_demo(const char* db_path)
     // Its strokes are on the body: every part but the torso attached, lying on its stroke.
     char rep[1200];
     snprintf(rep, sizeof rep, "%s/report.json", dir);
-    f = fopen(rep, "rb");
-    ENSURE(f);
-    char* json = calloc(1, 1 << 22);
-    ENSURE(fread(json, 1, (1 << 22) - 1, f) > 0);
-    fclose(f);
-    cJSON* j = cJSON_Parse(json);
-    free(json);
-    ENSURE(j);
+    cJSON* j = json_file(rep);
     const cJSON* pj;
     double worst = 1;
     cJSON_ArrayForEach(pj, cJSON_GetObjectItem(j, "parts"))
@@ -2063,14 +2064,7 @@ static void test_drawn_on_body(void)
     sp_dragon_clear(d);
     char file[1200];
     snprintf(file, sizeof file, "%s/docs/img/kiosk_on_body.json", SP_SOURCE_DIR);
-    FILE* f = fopen(file, "rb");
-    ENSURE(f);
-    char* text = calloc(1, 1 << 20);
-    ENSURE(text && fread(text, 1, (1 << 20) - 1, f) > 0);
-    fclose(f);
-    cJSON* session = cJSON_Parse(text);
-    free(text);
-    ENSURE(session);
+    cJSON* session = json_file(file);
     const cJSON* e;
     int strokes = 0;
     cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(session, "events"))
