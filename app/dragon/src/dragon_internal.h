@@ -141,10 +141,10 @@ sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4*
 /// Which way template t should face for a stroke in the box [lo, hi]: +1 as
 /// modelled, -1 mirrored (drawn on the other side of the nearest body than
 /// its socket, or its own reach, puts a part of its kind); 0: no hint (no
-/// body, or drawn over its middle). *touching: the stroke comes out of
+/// body, or drawn over its middle). *out_of_end: the stroke comes out of
 /// that body's end, where the body's socket for its kind is: its box
 /// overlaps the body's on the canvas and reaches past that end.
-int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* touching);
+int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* out_of_end);
 /// The category that attached part i takes from where it was drawn, when it
 /// has a family (sp_part.family): the family's member whose socket on the
 /// body lies nearest the part's anchor along the body (the family's sockets

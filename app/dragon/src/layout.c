@@ -441,9 +441,9 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
 // head socket at 0.7-0.95 on 9 of 11, its tail socket at 0.8-0.96).
 #define END_SOCKET 0.6
 
-int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* touching)
+int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* out_of_end)
 {
-    *touching = false;
+    *out_of_end = false;
     sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
     const part* body = NULL;
     double bd = INFINITY;
@@ -469,7 +469,7 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool*
         if (fabs(su) > 0.25 * half) natural = su > 0 ? 1 : -1;
         at_end = fabs(su) > END_SOCKET * half;
     }
-    *touching =
+    *out_of_end =
         at_end && lo.x <= bhi.x && blo.x <= hi.x && lo.y <= bhi.y && blo.y <= hi.y && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
     return (side > 0 ? 1 : -1) == natural ? 1 : -1;
 }

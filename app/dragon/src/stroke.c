@@ -161,13 +161,13 @@ static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk,
     bool any = false;
     for (int c = 0; c < nc; ++c) {
         tpl* t = cands[c];
-        bool touching = false;
-        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi, &touching) : 1;
+        bool out_of_end = false;
+        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi, &out_of_end) : 1;
         fit_choice a, b;
         bool got = fit_one(d, t, sk, lo, hi, hint < 0, &a, not_finite);
         bool other = t->lengthwise && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
         if (other && fit_one(d, t, sk, lo, hi, !(hint < 0), &b, not_finite)) {
-            if (got && touching) {
+            if (got && out_of_end) {
                 // Drawn out of a body's end, the part's root is at the body
                 // whichever facing fits better (a visitor's tail ending in a
                 // spade or a flame fits reversed): the hinted facing is the
