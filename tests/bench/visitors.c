@@ -25,8 +25,8 @@
 // it), the legs under the body's front or rear; printed per kind: the
 // legs that became their own kind at their own end, and at the other end.
 // It then draws every head, tail and wing drawing touching a dragon's body
-// (parts_on_body): printed per kind, those that became their own kind, a
-// body, another part, or were refused.
+// (parts_on_body): printed per kind, those that became their own kind (and
+// attached to the body), a body, another part, or were refused.
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>
@@ -182,8 +182,8 @@ static void shifted(sp_stroke* s, double dx, double dy)
 // a head centred 20 px inside the body's front top corner; a tail reaching
 // out of the rear, its box 30 px into the body's, centred on the body's
 // height; wings standing on the body's back, their box 30 px into it.
-// Counted per kind: became its own kind, a body (a second dragon), another
-// part, refused.
+// Counted per kind: became its own kind (and of those, attached to the
+// body), a body (a second dragon), another part, refused.
 static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half)
 {
     static const char* const kinds[3] = {"head", "tail", "wings"};
