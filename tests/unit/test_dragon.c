@@ -2060,7 +2060,7 @@ static void test_drawn_on_body(void)
     }
     // The README's session (docs/img/kiosk_on_body.json): a body, then a round
     // head, a club-ended tail and drooping wings drawn on it, all classified
-    // (alone, the classifier takes each of the three for a body).
+    // (alone, the default database's model takes each of the three for a body).
     sp_dragon_clear(d);
     char file[1200];
     snprintf(file, sizeof file, "%s/docs/img/kiosk_on_body.json", SP_SOURCE_DIR);
