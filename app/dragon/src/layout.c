@@ -350,6 +350,12 @@ static bool body_box(const part* q, sp_vec2* lo, sp_vec2* hi)
     return true;
 }
 
+// Whether the boxes [lo, hi] and [a, b] overlap (touching counts).
+static bool boxes_overlap(sp_vec2 lo, sp_vec2 hi, sp_vec2 a, sp_vec2 b)
+{
+    return lo.x <= b.x && a.x <= hi.x && lo.y <= b.y && a.y <= hi.y;
+}
+
 // Body q's first socket for a part of this category (or preferring it), or NULL.
 static const dsocket* kind_socket(const part* q, const char* category, const char* prefer)
 {
@@ -429,8 +435,7 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
         part* q = d->parts[k];
         sp_vec2 a, b;
         if (k == skip || !q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) continue;
-        bool overlaps = lo.x <= b.x && a.x <= hi.x && lo.y <= b.y && a.y <= hi.y;
-        if (overlaps && diag <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y)) return true;
+        if (boxes_overlap(lo, hi, a, b) && diag <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y)) return true;
     }
     return false;
 }
@@ -469,8 +474,7 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool*
         if (fabs(su) > 0.25 * half) natural = su > 0 ? 1 : -1;
         at_end = fabs(su) > END_SOCKET * half;
     }
-    *out_of_end =
-        at_end && lo.x <= bhi.x && blo.x <= hi.x && lo.y <= bhi.y && blo.y <= hi.y && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
+    *out_of_end = at_end && boxes_overlap(lo, hi, blo, bhi) && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
     return (side > 0 ? 1 : -1) == natural ? 1 : -1;
 }
 

@@ -237,27 +237,33 @@ static bool category_is_body(sp_dragon* d, const char* category)
 // first) and keeps the category whose score over its fit's error is highest
 // (BENCHMARKS.md, "Visitors' drawings", sixth pass). no_body: the stroke is
 // drawn on a body (dragon_drawn_on_body), so the guesses that are bodies are
-// passed over and the shares count from the first other guess. The kept
+// passed over (and the shares count from the first other guess) unless no
+// other guess has a part that fits. The kept
 // category moves to the front of out->guesses; category and *confidence
 // become its name and score.
 static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, bool no_body, sp_dragon_result* out,
                           char category[SP_NAME_MAX], float* confidence, fit_choice* best, int* not_finite, bool* any_part)
 {
-    int kept = -1, first = -1;
+    int kept = -1;
     double kept_rank = 0.0;
-    for (int g = 0; g < out->guess_count; ++g) {
-        fit_choice f;
-        if (no_body && category_is_body(d, out->guesses[g].category)) continue;
-        if (first < 0) first = g;
-        if (g > first && out->guesses[g].confidence < RERANK_MIN_SHARE * out->guesses[first].confidence) continue;
-        if (!fit_category(d, out->guesses[g].category, sk, lo, hi, &f, not_finite, any_part)) continue;
-        double rank = out->guesses[g].confidence / fmax(f.score, RERANK_FIT_FLOOR);
-        if (kept >= 0 && rank <= kept_rank) {
-            free(f.p);
-            continue;
+    // Pass 1, only when drawn on a body and no other guess fitted: the body
+    // guesses, their shares counted from the first guess as without the rule.
+    for (int pass = 0; pass < (no_body ? 2 : 1) && kept < 0; ++pass) {
+        int first = pass == 1 ? 0 : -1;
+        for (int g = 0; g < out->guess_count; ++g) {
+            fit_choice f;
+            if (no_body && category_is_body(d, out->guesses[g].category) != (pass == 1)) continue;
+            if (first < 0) first = g;
+            if (g > first && out->guesses[g].confidence < RERANK_MIN_SHARE * out->guesses[first].confidence) continue;
+            if (!fit_category(d, out->guesses[g].category, sk, lo, hi, &f, not_finite, any_part)) continue;
+            double rank = out->guesses[g].confidence / fmax(f.score, RERANK_FIT_FLOOR);
+            if (kept >= 0 && rank <= kept_rank) {
+                free(f.p);
+                continue;
+            }
+            if (kept >= 0) free(best->p);
+            *best = f, kept = g, kept_rank = rank;
         }
-        if (kept >= 0) free(best->p);
-        *best = f, kept = g, kept_rank = rank;
     }
     if (kept < 0) return false;
     sp_dragon_guess chosen = out->guesses[kept];
@@ -444,8 +450,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         // A stroke drawn on a body is a part of that dragon: a body guess is
         // taken only when no other guess has a part that fits.
         bool on_body = dragon_drawn_on_body(d, lo, hi, o.replace_last ? d->part_n - 1 : -1);
-        fitted = rerank_by_fit(d, &sk, lo, hi, on_body, out, category, &confidence, &best, &not_finite, &any_part) ||
-                 (on_body && rerank_by_fit(d, &sk, lo, hi, false, out, category, &confidence, &best, &not_finite, &any_part));
+        fitted = rerank_by_fit(d, &sk, lo, hi, on_body, out, category, &confidence, &best, &not_finite, &any_part);
     } else {
         fitted = fit_category(d, category, &sk, lo, hi, &best, &not_finite, &any_part);
     }
