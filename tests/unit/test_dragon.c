@@ -1873,16 +1873,25 @@ static void test_visitors_policy(void)
 // Draws the shipped part of `category` (a synthetic stroke of its own) in
 // the box centred at (cx, cy), optionally mirrored, classified or forced;
 // returns the result (ENSURE'd accepted).
-static sp_dragon_result draw_part(sp_dragon* d, sp_db* db, const char* category, double cx, double cy, double size, bool mirror,
-                                  bool forced)
+// The synthetic stroke of the shipped part of `category` in the box centred
+// at (cx, cy), optionally mirrored: *xy malloc'd, returns the point count.
+static int category_stroke(sp_db* db, const char* category, double cx, double cy, double size, bool mirror, sp_vec2** xy)
 {
     char** names = NULL;
     int n = 0;
     sp_error err = {0};
     ENSURE(sp_db_category_parts(db, category, &names, &n, &err) == SP_OK && n > 0);
-    sp_vec2* xy;
-    int k = part_stroke_ex(db, names[0], 500, 0.3, (sp_vec2){cx, cy}, size, false, mirror, &xy);
+    int k = part_stroke_ex(db, names[0], 500, 0.3, (sp_vec2){cx, cy}, size, false, mirror, xy);
     sp_db_free_strings(names, n);
+    return k;
+}
+
+static sp_dragon_result draw_part(sp_dragon* d, sp_db* db, const char* category, double cx, double cy, double size, bool mirror,
+                                  bool forced)
+{
+    sp_error err = {0};
+    sp_vec2* xy;
+    int k = category_stroke(db, category, cx, cy, size, mirror, &xy);
     sp_dragon_result res;
     ENSURE(sp_dragon_add_points(d, xy, k, forced ? &(sp_dragon_stroke_opts){.category = category} : NULL, &res, &err) == SP_OK);
     free(xy);
@@ -1976,6 +1985,13 @@ static void test_family_by_place(void)
     sp_db_close(db);
 }
 
+// The box of n points (sp_sketch_bounds of them as one stroke).
+static void points_box(const sp_vec2* xy, int n, sp_vec2* lo, sp_vec2* hi)
+{
+    sp_sketch one = {.stroke_count = 1, .strokes = &(sp_stroke){.count = n, .points = (sp_vec2*)xy}};
+    ENSURE(sp_sketch_bounds(&one, lo, hi));
+}
+
 // A drawing of the visitors' set (built from designs.json; `rel` under its
 // tune half, one stroke) moved and scaled so that its box has diagonal
 // `diag` and centre `at`, mirrored left-right on request. malloc'd; *n points.
@@ -2048,12 +2064,8 @@ static void test_drawn_on_body(void)
         ENSURE(sp_dragon_part_get(d, res.part)->is_torso);
         ENSURE(sp_dragon_undo(d));
         // Redraw of the body with a smaller one: the body it replaces does not count.
-        char** names = NULL;
-        int n = 0;
-        ENSURE(sp_db_category_parts(db, "torso", &names, &n, &err) == SP_OK && n > 0);
         sp_vec2* xy;
-        int k = part_stroke_ex(db, names[0], 500, 0.3, (sp_vec2){640, 420}, 250, false, false, &xy);
-        sp_db_free_strings(names, n);
+        int k = category_stroke(db, "torso", 640, 420, 250, false, &xy);
         ENSURE(sp_dragon_add_points(d, xy, k, &(sp_dragon_stroke_opts){.replace_last = true}, &res, &err) == SP_OK);
         free(xy);
         ENSURE(!res.rejected && sp_dragon_part_count(d) == 1 && sp_dragon_part_get(d, res.part)->is_torso);
@@ -2116,19 +2128,13 @@ static void test_root_at_the_body(void)
         for (int right = 0; right < 2; ++right) { // the tail out of the body's left end (as modelled), then its right
             sp_dragon_clear(d);
             sp_dragon_result res, body = draw_part(d, db, "torso", 640, 420, 420, false, true);
-            sp_vec2* px = fitted_px(d, body.part);
-            int nv = sp_dragon_part_get(d, body.part)->character->rig.vertex_count;
-            sp_vec2 blo = px[0], bhi = px[0];
-            for (int v = 1; v < nv; ++v)
-                blo.x = fmin(blo.x, px[v].x), blo.y = fmin(blo.y, px[v].y), bhi.x = fmax(bhi.x, px[v].x),
-                bhi.y = fmax(bhi.y, px[v].y);
+            sp_vec2* px = fitted_px(d, body.part), blo, bhi, lo, hi;
+            points_box(px, sp_dragon_part_get(d, body.part)->character->rig.vertex_count, &blo, &bhi);
             free(px);
             // Its box 30 px into the body's, centred on the body's height (the visitors bench's --on-body scene).
             int n;
             sp_vec2* xy = visitor_stroke(tails[k], 260, (sp_vec2){0, 0}, right, &n);
-            sp_vec2 lo = xy[0], hi = xy[0];
-            for (int i = 1; i < n; ++i)
-                lo.x = fmin(lo.x, xy[i].x), hi.x = fmax(hi.x, xy[i].x);
+            points_box(xy, n, &lo, &hi);
             double dx = right ? (bhi.x - 30) - lo.x : (blo.x + 30) - hi.x, dy = 0.5 * (blo.y + bhi.y);
             for (int i = 0; i < n; ++i)
                 xy[i].x += dx, xy[i].y += dy;
