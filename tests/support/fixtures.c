@@ -157,3 +157,41 @@ cJSON* sp_fixture_glb_json(const char* path)
     ENSURE(j);
     return j;
 }
+
+cJSON* sp_fixture_json_file(const char* path)
+{
+    FILE* f = fopen(path, "rb");
+    ENSURE(f);
+    char* text = calloc(1, 1 << 22);
+    ENSURE(text);
+    size_t got = fread(text, 1, (1 << 22) - 1, f);
+    fclose(f);
+    ENSURE(got > 0);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    ENSURE(j);
+    return j;
+}
+
+int sp_fixture_session_strokes(const char* path, sp_vec2** xy, int* n, int cap)
+{
+    cJSON* session = sp_fixture_json_file(path);
+    const cJSON* e;
+    int strokes = 0;
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(session, "events"))
+    {
+        const cJSON* type = cJSON_GetObjectItemCaseSensitive(e, "type");
+        if (!cJSON_IsString(type) || strcmp(type->valuestring, "stroke") != 0 || strokes == cap) continue;
+        const cJSON* pts = cJSON_GetObjectItemCaseSensitive(e, "points");
+        int m = cJSON_GetArraySize(pts);
+        sp_vec2* p = malloc(sizeof(sp_vec2) * (size_t)(m > 0 ? m : 1));
+        ENSURE(p && m > 1);
+        for (int i = 0; i < m; ++i) {
+            const cJSON* pt = cJSON_GetArrayItem(pts, i);
+            p[i] = (sp_vec2){cJSON_GetArrayItem(pt, 0)->valuedouble, cJSON_GetArrayItem(pt, 1)->valuedouble};
+        }
+        xy[strokes] = p, n[strokes++] = m;
+    }
+    cJSON_Delete(session);
+    return strokes;
+}

@@ -41,4 +41,14 @@ void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplit
 /// no GLB or its JSON does not parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_glb_json(const char* path);
 
+/// A JSON file (up to 4 MiB), parsed (fails the running test when it does
+/// not read or parse). Free with cJSON_Delete.
+struct cJSON* sp_fixture_json_file(const char* path);
+
+/// The strokes of a kiosk session file (sketchpose-kiosk-session, e.g. the
+/// README's docs/img/kiosk_on_body.json), in order, at most cap: each
+/// malloc'd, n[k] points. Fails the running test when the file does not
+/// parse. Returns how many.
+int sp_fixture_session_strokes(const char* path, sp_vec2** xy, int* n, int cap);
+
 #endif

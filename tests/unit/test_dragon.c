@@ -1292,21 +1292,6 @@ static void test_live_update(void)
 }
 
 // A JSON file parsed (ENSURE'd readable, at most 4 MB, and valid).
-static cJSON* json_file(const char* path)
-{
-    FILE* f = fopen(path, "rb");
-    ENSURE(f);
-    char* text = calloc(1, 1 << 22);
-    ENSURE(text);
-    size_t got = fread(text, 1, (1 << 22) - 1, f);
-    fclose(f);
-    ENSURE(got > 0);
-    cJSON* j = cJSON_Parse(text);
-    free(text);
-    ENSURE(j);
-    return j;
-}
-
 // `sketchpose dragon`: a stroke file in, a .glb, a PNG and the report out.
 static void test_command(void)
 {
@@ -1335,7 +1320,7 @@ static void test_command(void)
     ENSURE(system(cmd) == 0);
     struct stat st;
     ENSURE(stat(png, &st) == 0 && st.st_size > 1000);
-    cJSON* j = json_file(rep);
+    cJSON* j = sp_fixture_json_file(rep);
     const char* keys[] = {"ms",           "iterations",    "icp_rounds",   "stopped",          "energy_before",
                           "energy_after", "mean_error_px", "max_error_px", "bbox_diagonal_px", "curves",
                           "parameters",   "parts"};
@@ -1408,7 +1393,7 @@ static void check_demo(const char* db_path)
     // Its strokes are on the body: every part but the torso attached, lying on its stroke.
     char rep[1200];
     snprintf(rep, sizeof rep, "%s/report.json", dir);
-    cJSON* j = json_file(rep);
+    cJSON* j = sp_fixture_json_file(rep);
     const cJSON* pj;
     double worst = 1;
     cJSON_ArrayForEach(pj, cJSON_GetObjectItem(j, "parts"))
@@ -2015,6 +2000,15 @@ static sp_vec2* visitor_stroke(const char* rel, double diag, sp_vec2 at, bool mi
     return xy;
 }
 
+// The strokes of the README's kiosk session (docs/img/kiosk_on_body.json: a
+// body, then a round head, a club-ended tail and drooping wings drawn on it).
+static int readme_session(sp_vec2** xy, int* n, int cap)
+{
+    char file[1200];
+    snprintf(file, sizeof file, "%s/docs/img/kiosk_on_body.json", SP_SOURCE_DIR);
+    return sp_fixture_session_strokes(file, xy, n, cap);
+}
+
 // A stroke drawn on a body (overlapping it, clearly smaller) is a part of
 // that dragon, never a second body: the classifier's "body" stays among the
 // chips and a chip's choice stands; a body drawn apart, or about as large,
@@ -2074,29 +2068,13 @@ static void test_drawn_on_body(void)
     // head, a club-ended tail and drooping wings drawn on it, all classified
     // (alone, the default database's model takes each of the three for a body).
     sp_dragon_clear(d);
-    char file[1200];
-    snprintf(file, sizeof file, "%s/docs/img/kiosk_on_body.json", SP_SOURCE_DIR);
-    cJSON* session = json_file(file);
-    const cJSON* e;
-    int strokes = 0;
-    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(session, "events"))
-    {
-        const cJSON* type = cJSON_GetObjectItemCaseSensitive(e, "type");
-        if (!cJSON_IsString(type) || strcmp(type->valuestring, "stroke") != 0) continue;
-        const cJSON* pts = cJSON_GetObjectItemCaseSensitive(e, "points");
-        int n = cJSON_GetArraySize(pts);
-        sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)n);
-        ENSURE(xy && n > 1);
-        for (int i = 0; i < n; ++i) {
-            const cJSON* pt = cJSON_GetArrayItem(pts, i);
-            xy[i] = (sp_vec2){cJSON_GetArrayItem(pt, 0)->valuedouble, cJSON_GetArrayItem(pt, 1)->valuedouble};
-        }
+    sp_vec2* xy[8];
+    int n[8], strokes = readme_session(xy, n, 8);
+    for (int k = 0; k < strokes; ++k) {
         sp_dragon_result res;
-        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
-        free(xy);
-        ++strokes;
+        ENSURE(sp_dragon_add_points(d, xy[k], n[k], NULL, &res, &err) == SP_OK && !res.rejected);
+        free(xy[k]);
     }
-    cJSON_Delete(session);
     // One dragon: the body, and three parts attached to it (which parts is
     // the model's call: the README's picture is the default database's, this
     // test's model is trained quickly).
@@ -2110,6 +2088,30 @@ static void test_drawn_on_body(void)
     sp_db_close(db);
 }
 
+// The visitors' tails these tests draw out of a body's end.
+static const char* const k_end_tails[4] = {"tail/tail-outline-spade.json", "tail/tail-outline-flame.json",
+                                           "tail/tail-line-curl.json", "tail/tail-wavy-line.json"};
+
+// On a cleared canvas, the test body (forced, at the canvas's middle; its
+// result to *body) and a visitor's tail stroke (diagonal 260, mirrored when
+// right) placed out of the body's left end, or its right: its box 30 px
+// into the body's, centred on the body's height (the visitors bench's
+// --on-body scene). The stroke is malloc'd, *n points; not drawn.
+static sp_vec2* tail_out_of_body(sp_dragon* d, sp_db* db, const char* tail, bool right, sp_dragon_result* body, int* n)
+{
+    sp_dragon_clear(d);
+    *body = draw_part(d, db, "torso", 640, 420, 420, false, true);
+    sp_vec2 *px = fitted_px(d, body->part), blo, bhi, lo, hi;
+    points_box(px, sp_dragon_part_get(d, body->part)->character->rig.vertex_count, &blo, &bhi);
+    free(px);
+    sp_vec2* xy = visitor_stroke(tail, 260, (sp_vec2){0, 0}, right, n);
+    points_box(xy, *n, &lo, &hi);
+    double dx = right ? (bhi.x - 30) - lo.x : (blo.x + 30) - hi.x, dy = 0.5 * (blo.y + bhi.y);
+    for (int i = 0; i < *n; ++i)
+        xy[i].x += dx, xy[i].y += dy;
+    return xy;
+}
+
 // A head or tail drawn out of a body's end has its root at the body, also
 // when the other facing fits the stroke better (visitors' tails ending in a
 // spade, a flame or a curl fit best reversed): it attaches there, facing
@@ -2121,27 +2123,16 @@ static void test_root_at_the_body(void)
     sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
-    static const char* const tails[] = {"tail/tail-outline-spade.json", "tail/tail-outline-flame.json",
-                                        "tail/tail-line-curl.json", "tail/tail-wavy-line.json"};
     int reversed_alone = 0;
     for (int k = 0; k < 4; ++k)
         for (int right = 0; right < 2; ++right) { // the tail out of the body's left end (as modelled), then its right
-            sp_dragon_clear(d);
-            sp_dragon_result res, body = draw_part(d, db, "torso", 640, 420, 420, false, true);
-            sp_vec2* px = fitted_px(d, body.part), blo, bhi, lo, hi;
-            points_box(px, sp_dragon_part_get(d, body.part)->character->rig.vertex_count, &blo, &bhi);
-            free(px);
-            // Its box 30 px into the body's, centred on the body's height (the visitors bench's --on-body scene).
+            sp_dragon_result res, body;
             int n;
-            sp_vec2* xy = visitor_stroke(tails[k], 260, (sp_vec2){0, 0}, right, &n);
-            points_box(xy, n, &lo, &hi);
-            double dx = right ? (bhi.x - 30) - lo.x : (blo.x + 30) - hi.x, dy = 0.5 * (blo.y + bhi.y);
-            for (int i = 0; i < n; ++i)
-                xy[i].x += dx, xy[i].y += dy;
+            sp_vec2* xy = tail_out_of_body(d, db, k_end_tails[k], right, &body, &n);
             ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK &&
                    !res.rejected);
             const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
-            fprintf(stderr, "  %s out of the body's %s end: attached to %d, mirrored %d, fit %.2f%%\n", tails[k],
+            fprintf(stderr, "  %s out of the body's %s end: attached to %d, mirrored %d, fit %.2f%%\n", k_end_tails[k],
                     right ? "right" : "left", p->attached_to, p->mirrored,
                     100 * p->report.mean_error_px / p->report.bbox_diagonal_px);
             ENSURE(p->attached_to == body.part);
@@ -2155,6 +2146,143 @@ static void test_root_at_the_body(void)
         }
     fprintf(stderr, "  drawn alone, %d of 8 fit reversed\n", reversed_alone);
     ENSURE(reversed_alone >= 4);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
+// The same tails drawn before the body: when the body comes, a tail coming
+// out of its end that hangs free turns to face away from it and attaches,
+// keeping its id; Undo of the body, or a chip that makes the body another
+// part, gives the tail its former fit back.
+static void test_parts_before_body(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    int turned = 0;
+    for (int k = 0; k < 4; ++k)
+        for (int right = 0; right < 2; ++right) {
+            sp_dragon_result res, body;
+            int n;
+            sp_vec2* xy = tail_out_of_body(d, db, k_end_tails[k], right, &body, &n);
+            sp_dragon_clear(d); // the tail first, the body after it
+            ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK &&
+                   !res.rejected && res.part == 0);
+            free(xy);
+            const sp_dragon_part* t = sp_dragon_part_get(d, 0);
+            uint64_t id = t->id;
+            bool was_mirrored = t->mirrored;
+            int np = t->character->rig.param_count;
+            double before[256];
+            ENSURE(np <= 256);
+            memcpy(before, t->params, sizeof(double) * (size_t)np);
+            body = draw_part(d, db, "torso", 640, 420, 420, false, true);
+            t = sp_dragon_part_get(d, 0);
+            fprintf(stderr, "  %s, then the body, out of its %s end: mirrored %d -> %d, attached to %d\n", k_end_tails[k],
+                    right ? "right" : "left", was_mirrored, t->mirrored, t->attached_to);
+            ENSURE(body.part == 1 && t->id == id && !strcmp(t->category, "tail"));
+            ENSURE(t->attached_to == 1 && t->mirrored == (right != 0)); // facing away from the body
+            turned += was_mirrored != t->mirrored;
+            // Undo of the body: the tail's own fit again, free.
+            ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == 1);
+            t = sp_dragon_part_get(d, 0);
+            ENSURE(t->id == id && t->mirrored == was_mirrored && t->attached_to == -1);
+            ENSURE(!memcmp(t->params, before, sizeof(double) * (size_t)np));
+            // The body again, then a chip makes it a head: the tail's own fit again.
+            body = draw_part(d, db, "torso", 640, 420, 420, false, true);
+            ENSURE(sp_dragon_part_get(d, 0)->mirrored == (right != 0));
+            ENSURE(sp_dragon_refit_last(d, "head", &res, &err) == SP_OK && !res.rejected && res.part == 1);
+            t = sp_dragon_part_get(d, 0);
+            ENSURE(t->mirrored == was_mirrored && !memcmp(t->params, before, sizeof(double) * (size_t)np));
+            ENSURE(sp_dragon_pose_at(d, 0.25, &err) == SP_OK);
+        }
+    // The premise: drawn alone, most of these tails face the other way.
+    fprintf(stderr, "  turned by the body drawn after them: %d of 8\n", turned);
+    ENSURE(turned >= 4);
+    // A visitor's closed head, which alone is a body (test_drawn_on_body),
+    // drawn first over where the body's front top corner will be: when the
+    // body comes it is the head it is when drawn after the body.
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        sp_dragon_result res, after;
+        int n;
+        sp_vec2* xy = visitor_stroke("head/head-blunt-round-ear.json", 180, (sp_vec2){mirrored ? 470 : 810, 300}, mirrored, &n);
+        sp_dragon_clear(d);
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &after, &err) == SP_OK && !after.rejected);
+        const sp_dragon_part* want = sp_dragon_part_get(d, 1);
+        ENSURE(!strcmp(want->category, "head") && want->attached_to == 0);
+        int np = want->character->rig.param_count;
+        double want_p[256];
+        ENSURE(np <= 256);
+        memcpy(want_p, want->params, sizeof(double) * (size_t)np);
+        bool want_mirrored = want->mirrored;
+        sp_dragon_clear(d);
+        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
+        ENSURE(sp_dragon_part_get(d, 0)->is_torso); // the premise
+        uint64_t id = sp_dragon_part_get(d, 0)->id;
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        const sp_dragon_part* h = sp_dragon_part_get(d, 0);
+        fprintf(stderr, "  round head, then the body (facing %s): %s, attached to %d\n", mirrored ? "left" : "right", h->category,
+                h->attached_to);
+        ENSURE(h->id == id && !strcmp(h->category, "head") && h->attached_to == 1 && h->mirrored == want_mirrored);
+        ENSURE(!memcmp(h->params, want_p, sizeof(double) * (size_t)np));
+        // Undo of the body: a body again.
+        ENSURE(sp_dragon_undo(d) && sp_dragon_part_get(d, 0)->is_torso && sp_dragon_part_get(d, 0)->id == id);
+        // A body chosen with a chip stays one: a second dragon.
+        ENSURE(sp_dragon_refit_last(d, "torso", &res, &err) == SP_OK && !res.rejected);
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        ENSURE(sp_dragon_part_get(d, 0)->is_torso);
+        free(xy);
+    }
+    // Legs drawn before the body (after the head): the legs of their end,
+    // as when drawn after it; legs chosen with a chip stay what they are.
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        double rear = mirrored ? 760 : 520, head = mirrored ? 380 : 900;
+        sp_dragon_clear(d);
+        draw_part(d, db, "head", head, 300, 200, mirrored, true);
+        sp_dragon_result res = draw_part(d, db, "front_legs", rear, 570, 190, mirrored, false);
+        ENSURE(res.part == 1 && !strcmp(sp_dragon_part_get(d, 1)->category, "front_legs")); // no body: what they look like
+        uint64_t id = sp_dragon_part_get(d, 1)->id;
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        const sp_dragon_part* legs = sp_dragon_part_get(d, 1);
+        fprintf(stderr, "  front legs drawn at the rear, then the body (facing %s): %s, attached to %d\n",
+                mirrored ? "left" : "right", legs->category, legs->attached_to);
+        ENSURE(!strcmp(legs->category, "hind_legs") && legs->attached_to == 2 && legs->id == id);
+        ENSURE(sp_dragon_part_get(d, 0)->attached_to == 2); // the head, which tells the facing
+        ENSURE(sp_dragon_undo(d) && !strcmp(sp_dragon_part_get(d, 1)->category, "front_legs"));
+        ENSURE(sp_dragon_undo(d)); // the legs, drawn again and chosen with a chip
+        res = draw_part(d, db, "front_legs", rear, 570, 190, mirrored, false);
+        ENSURE(sp_dragon_refit_last(d, "front_legs", &res, &err) == SP_OK && !res.rejected);
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        ENSURE(!strcmp(sp_dragon_part_get(d, 1)->category, "front_legs"));
+    }
+    // The README's session with the tail drawn first: the same dragon.
+    sp_vec2* xy[8];
+    int n[8], strokes = readme_session(xy, n, 8);
+    ENSURE(strokes == 4);
+    static const int orders[2][4] = {{0, 1, 2, 3}, {2, 0, 1, 3}};
+    sp_dragon* same[2] = {d, new_dragon(path)};
+    for (int o = 0; o < 2; ++o) {
+        sp_dragon_clear(same[o]);
+        for (int k = 0; k < 4; ++k) {
+            sp_dragon_result res;
+            ENSURE(sp_dragon_add_points(same[o], xy[orders[o][k]], n[orders[o][k]], NULL, &res, &err) == SP_OK && !res.rejected);
+        }
+    }
+    for (int k = 0; k < 4; ++k) { // stroke k of the session is part k, then part orders[1]^-1(k)
+        int j = k == 2 ? 0 : k < 2 ? k + 1 : 3;
+        const sp_dragon_part *a = sp_dragon_part_get(same[0], k), *b = sp_dragon_part_get(same[1], j);
+        int aa = a->attached_to, ba = b->attached_to < 0 ? -1 : orders[1][b->attached_to];
+        fprintf(stderr, "  README session, stroke %d: %s (attached to stroke %d); tail first: %s (%d)\n", k + 1, a->category,
+                aa + 1, b->category, ba + 1);
+        ENSURE(!strcmp(a->category, b->category) && aa == ba && a->mirrored == b->mirrored);
+        ENSURE(!memcmp(a->params, b->params, sizeof(double) * (size_t)a->character->rig.param_count));
+    }
+    for (int k = 0; k < 4; ++k)
+        free(xy[k]);
+    sp_dragon_destroy(same[1]);
     sp_dragon_destroy(d);
     sp_db_close(db);
 }
@@ -2177,5 +2305,6 @@ int main(int argc, char** argv)
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},
+                                   {"parts_before_body", test_parts_before_body},
                                    {0}});
 }

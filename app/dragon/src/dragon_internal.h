@@ -96,6 +96,12 @@ typedef struct part {
     double* body_xyz;
     sp_vec2* body_px;
     bool body_has_surface;
+    // Its fit before a body drawn later changed it (decided it again or
+    // turned it: stroke.c, parts_meet_body), and that body's id: Undo of
+    // the body, or its Redraw, gives the fit back.
+    struct part* before;
+    uint64_t before_by;
+    bool chosen; // its category was the caller's (a chip's), not the classifier's
     // Posed at the last pose_at.
     double *p_t, *xyz, *outline;
     sp_mat4 world_t;
@@ -159,6 +165,8 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
 /// "Which strokes join a dragon"). Part `skip` (the one a Redraw
 /// replaces, or -1) does not count.
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
+/// The same test against part k only (false when k is not a body).
+bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
 

@@ -428,15 +428,18 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
 // (a bigger dragon); a head, tail or wing drawn on a body is smaller.
 #define ON_BODY_SIZE 0.75
 
+bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k)
+{
+    part* q = d->parts[k];
+    sp_vec2 a, b;
+    if (!q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) return false;
+    return boxes_overlap(lo, hi, a, b) && hypot(hi.x - lo.x, hi.y - lo.y) <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y);
+}
+
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
 {
-    double diag = hypot(hi.x - lo.x, hi.y - lo.y);
-    for (int k = 0; k < d->part_n; ++k) {
-        part* q = d->parts[k];
-        sp_vec2 a, b;
-        if (k == skip || !q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) continue;
-        if (boxes_overlap(lo, hi, a, b) && diag <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y)) return true;
-    }
+    for (int k = 0; k < d->part_n; ++k)
+        if (k != skip && dragon_on_body(d, lo, hi, k)) return true;
     return false;
 }
 

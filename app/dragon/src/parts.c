@@ -196,6 +196,7 @@ fail:
 void dragon_part_free(part* p)
 {
     if (!p) return;
+    dragon_part_free(p->before);
     dragon_tpl_release(p->t);
     free(p->p_fit);
     free(p->stroke);

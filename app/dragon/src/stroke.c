@@ -359,28 +359,42 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     return SP_DRAGON_ACCEPTED;
 }
 
-// A classified part of a family (front or hind legs) drawn at a body
-// becomes the family's member for the place it was drawn
-// (dragon_family_member): what it looks like decided the family, where it
-// is decides which one. The last part is re-fitted as that member, which
-// goes first in out->guesses, so the chips offer the other back. The
-// classifier keeps its answer when the member has no part that fits.
+// Part p's own copy of its cleaned stroke as a sketch (s holds the stroke).
+static sp_sketch part_sketch(const sp_dragon* d, const part* p, sp_stroke* s)
+{
+    *s = (sp_stroke){.count = p->stroke_n, .points = p->stroke};
+    return (sp_sketch){.canvas_w = d->desc.canvas_w, .canvas_h = d->desc.canvas_h, .stroke_count = 1, .strokes = s};
+}
+
+// Part i of a family (front or hind legs), attached to a body, fitted as the
+// family's member for the place it was drawn (dragon_family_member): what it
+// looks like decided the family, where it is decides which one. False when
+// it is that member already, the place does not tell, or the member has no
+// part that fits.
+static bool fit_family_member(sp_dragon* d, int i, char member[SP_NAME_MAX], fit_choice* f)
+{
+    part* old = d->parts[i];
+    if (!dragon_family_member(d, i, member) || !strcmp(member, old->pub.category)) return false;
+    sp_stroke st;
+    sp_sketch sk = part_sketch(d, old, &st);
+    sp_vec2 lo = {old->stroke_box[0], old->stroke_box[1]}, hi = {old->stroke_box[2], old->stroke_box[3]};
+    int not_finite = 0;
+    bool any_part = false;
+    return fit_category(d, member, &sk, lo, hi, f, &not_finite, &any_part);
+}
+
+// A classified part of a family drawn at a body becomes the family's member
+// for the place it was drawn (fit_family_member). The last part is
+// re-fitted as that member, which goes first in out->guesses, so the chips
+// offer the other back. The classifier keeps its answer when the member has
+// no part that fits.
 static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_error* err)
 {
     int i = d->part_n - 1;
     part* old = d->parts[i];
     char member[SP_NAME_MAX];
-    if (!dragon_family_member(d, i, member) || !strcmp(member, old->pub.category)) return SP_OK;
-    // The part's own copy of its cleaned stroke: the caller's is gone.
-    sp_sketch sk = {.canvas_w = d->desc.canvas_w,
-                    .canvas_h = d->desc.canvas_h,
-                    .stroke_count = 1,
-                    .strokes = &(sp_stroke){.count = old->stroke_n, .points = old->stroke}};
-    sp_vec2 lo = {old->stroke_box[0], old->stroke_box[1]}, hi = {old->stroke_box[2], old->stroke_box[3]};
     fit_choice f;
-    int not_finite = 0;
-    bool any_part = false;
-    if (!fit_category(d, member, &sk, lo, hi, &f, &not_finite, &any_part)) return SP_OK;
+    if (!fit_family_member(d, i, member, &f)) return SP_OK;
     int g = 0;
     while (g < out->guess_count && strcmp(out->guesses[g].category, member))
         ++g;
@@ -400,6 +414,127 @@ static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_erro
     d->parts[i] = q;
     dragon_relayout(d);
     return SP_OK;
+}
+
+// The canvas box of part i's stroke.
+static void stroke_box_of(const part* p, sp_vec2* lo, sp_vec2* hi)
+{
+    *lo = (sp_vec2){p->stroke_box[0], p->stroke_box[1]}, *hi = (sp_vec2){p->stroke_box[2], p->stroke_box[3]};
+}
+
+// Part i becomes fit f (which it frees), keeping its id (the kiosk keys its
+// chips and its kept stroke by id) and its stroke; the part it was is kept
+// for the body with id `by` to give back (give_back_fits). False when out of
+// memory: the part stays as it was.
+static bool replace_before_body(sp_dragon* d, int i, fit_choice* f, float confidence, uint64_t by)
+{
+    part *old = d->parts[i], *q = NULL;
+    sp_error lerr = {0};
+    sp_result r = new_part(d, f->t, f->p, &f->rep, &f->view, f->mirrored, old->stroke, old->stroke_n, confidence, &q, &lerr);
+    free(f->p);
+    if (r != SP_OK) return false;
+    q->pub.id = old->pub.id;
+    q->chosen = old->chosen;
+    q->before = old, q->before_by = by;
+    d->parts[i] = q;
+    return true;
+}
+
+// Part i, taken by the classifier for a body when it was drawn alone, lies
+// on the body just drawn (dragon_on_body): decided again as if drawn after
+// that body (the on-body rule of rerank_by_fit), so the tail a visitor
+// started with becomes a tail of this dragon instead of a second one. A
+// body a chip chose stays. The new part takes the old one's place and id;
+// false (nothing changed) when no other guess has a part that fits.
+static bool decide_again_on_body(sp_dragon* d, int i, int body)
+{
+    part* old = d->parts[i];
+    sp_vec2 lo, hi;
+    stroke_box_of(old, &lo, &hi);
+    if (!old->t->is_torso || old->chosen || !d->clf || !dragon_on_body(d, lo, hi, body)) return false;
+    sp_stroke st;
+    sp_sketch sk = part_sketch(d, old, &st);
+    sp_dragon_result res = {.part = -1};
+    char category[SP_NAME_MAX] = "";
+    float confidence = 1.0f;
+    double near = 0.0;
+    if (classify_and_decide(d, &sk, NULL, &res, category, &confidence, &near) != SP_DRAGON_ACCEPTED) return false;
+    // Off the canvas while it is fitted: as a body it would hint its own facing.
+    memmove(&d->parts[i], &d->parts[i + 1], sizeof(part*) * (size_t)(d->part_n - i - 1));
+    --d->part_n;
+    fit_choice f;
+    int not_finite = 0;
+    bool any_part = false, fitted = rerank_by_fit(d, &sk, lo, hi, true, &res, category, &confidence, &f, &not_finite, &any_part);
+    memmove(&d->parts[i + 1], &d->parts[i], sizeof(part*) * (size_t)(d->part_n - i));
+    d->parts[i] = old;
+    ++d->part_n;
+    if (!fitted) return false;
+    if (f.t->is_torso) {
+        free(f.p);
+        return false;
+    }
+    return replace_before_body(d, i, &f, confidence, d->parts[body]->pub.id);
+}
+
+// Parts drawn before a body, when the body comes (the last part), as if
+// drawn after it:
+// - a part the classifier took for a body that lies on it is decided again
+//   (decide_again_on_body);
+// - a head or a tail on it, coming out of its end (dragon_facing_hint),
+//   that hangs free turns to the facing the body hints at (fit_variants),
+//   so that its root rides the body;
+// - legs attached to it become the legs of their end (take_family_member).
+// Each keeps its id and its stroke; its former fit is kept for Undo or a
+// Redraw of the body (give_back_fits).
+static void parts_meet_body(sp_dragon* d)
+{
+    int body = d->part_n - 1;
+    uint64_t by = d->parts[body]->pub.id;
+    bool changed = false;
+    for (int i = 0; i < body; ++i)
+        changed |= decide_again_on_body(d, i, body);
+    if (changed) dragon_relayout(d);
+    changed = false;
+    for (int i = 0; i < body; ++i) {
+        part* old = d->parts[i];
+        if ((old->before && old->before_by == by) || old->t->is_torso || !old->t->lengthwise || old->pub.attached_to >= 0)
+            continue;
+        sp_vec2 lo, hi;
+        stroke_box_of(old, &lo, &hi);
+        bool out_of_end = false;
+        if (!dragon_on_body(d, lo, hi, body)) continue; // another dragon's part
+        int hint = dragon_facing_hint(d, old->t, lo, hi, &out_of_end);
+        if (!out_of_end || (hint < 0) == old->pub.mirrored) continue;
+        sp_stroke st;
+        sp_sketch sk = part_sketch(d, old, &st);
+        fit_choice f;
+        int not_finite = 0;
+        if (!fit_one(d, old->t, &sk, lo, hi, hint < 0, &f, &not_finite)) continue;
+        changed |= replace_before_body(d, i, &f, old->pub.confidence, by);
+    }
+    if (changed) dragon_relayout(d);
+    // Legs take their kind from where they are on the body, as when drawn
+    // after it (take_family_member); a chip's choice stands.
+    changed = false;
+    for (int i = 0; i < body; ++i) {
+        char member[SP_NAME_MAX];
+        fit_choice f;
+        if (!d->parts[i]->chosen && d->parts[i]->pub.attached_to == body && fit_family_member(d, i, member, &f))
+            changed |= replace_before_body(d, i, &f, d->parts[i]->pub.confidence, by);
+    }
+    if (changed) dragon_relayout(d);
+}
+
+// Gives back the fits that the body with this id changed (parts_meet_body).
+static void give_back_fits(sp_dragon* d, uint64_t body_id)
+{
+    for (int i = 0; i < d->part_n; ++i)
+        while (d->parts[i]->before && d->parts[i]->before_by == body_id) { // decided again, then turned or made the other legs
+            part* q = d->parts[i];
+            d->parts[i] = q->before;
+            q->before = NULL;
+            dragon_part_free(q);
+        }
 }
 
 sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
@@ -474,7 +609,9 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     free(best.p);
     free(pts);
     if (r != SP_OK) return r;
+    q->chosen = o.category != NULL;
     if (o.replace_last && d->part_n > 0) {
+        give_back_fits(d, d->parts[d->part_n - 1]->pub.id);
         dragon_part_free(d->parts[d->part_n - 1]);
         d->parts[d->part_n - 1] = q;
     } else {
@@ -490,6 +627,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         d->parts[d->part_n++] = q;
     }
     dragon_relayout(d);
+    if (q->t->is_torso) parts_meet_body(d);
     if (!o.category && d->clf) {
         r = take_family_member(d, out, err);
         if (r != SP_OK) return r;
@@ -528,7 +666,9 @@ sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_res
 bool sp_dragon_undo(sp_dragon* d)
 {
     if (d->part_n == 0) return false;
-    dragon_part_free(d->parts[--d->part_n]);
+    part* last = d->parts[--d->part_n];
+    give_back_fits(d, last->pub.id);
+    dragon_part_free(last);
     dragon_relayout(d);
     return true;
 }
