@@ -130,7 +130,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         if (!xyz || rig->vertex_count <= 0 || rig->triangle_count <= 0) continue;
         int at = -1;
         for (int j = 0; j < c->count; ++j)
-            if (c->items[j].id == p->id) at = j;
+            if (c->items[j].id == p->id && c->items[j].character == p->character) at = j;
         if (at >= 0) {
             struct cached_mesh* it = &c->items[at];
             it->seen = true;
@@ -151,7 +151,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
             c->items = it, c->cap = cap;
         }
         sp_error err = {0};
-        struct cached_mesh it = {p->id, NULL, true, false, {0}, rig->triangle_count};
+        struct cached_mesh it = {p->id, p->character, NULL, true, false, {0}, rig->triangle_count};
         sp_mesh_desc md = {.vertex_count = rig->vertex_count,
                            .positions = xyz,
                            .colors = p->character->colors,
@@ -184,7 +184,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         }
         c->items[c->count++] = it;
     }
-    // Parts that are gone (undo, clear, redraw) free their meshes.
+    // Parts that are gone (undo, clear, redraw) or changed free their meshes.
     int w = 0;
     for (int i = 0; i < c->count; ++i) {
         if (c->items[i].seen) {

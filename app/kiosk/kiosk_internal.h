@@ -15,6 +15,7 @@
 typedef struct mesh_cache {
     struct cached_mesh {
         uint64_t id;
+        const void* character; ///< the part's character: a part keeps its id when a body drawn later changes it
         sp_render_mesh* mesh;
         bool seen;
         bool coarse;
