@@ -92,11 +92,12 @@ static bool scene_drawings(const sp_dataset* ds, scene_set* s)
 // diagonal 500 at the canvas's centre; its box to *lo, *hi) and, with_head,
 // its head (forced a head, diagonal 200, centred 20 px inside the body's
 // front top corner, at *head_at); facing left mirrors the head. False when
-// a stroke fails or is refused.
-static bool draw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head, sp_vec2* lo,
-                        sp_vec2* hi, sp_vec2* head_at)
+// a stroke fails or is refused. keep: on the canvas as it is, the head
+// drawn before the body (the body last, after the parts).
+static bool add_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head, bool keep,
+                       sp_vec2* lo, sp_vec2* hi, sp_vec2* head_at)
 {
-    sp_dragon_clear(d);
+    if (!keep) sp_dragon_clear(d);
     sp_dragon_result res;
     sp_error err = {0};
     sp_stroke bs = placed(&ds->samples[s->body[m % s->nb]].sketch.strokes[0], 500, (sp_vec2){640, 400}, false, false);
@@ -105,19 +106,39 @@ static bool draw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, 
     *head_at = (sp_vec2){640 + (left ? -1 : 1) * (0.5 * (hi->x - lo->x) - 20), lo->y - 20};
     sp_stroke hs =
         with_head ? placed(&ds->samples[s->head[m % s->nh]].sketch.strokes[0], 200, *head_at, false, left) : (sp_stroke){0};
-    bool ok = bs.points && (!with_head || hs.points) &&
-              sp_dragon_add_stroke(d, &bs, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK && !res.rejected &&
-              (!with_head || (sp_dragon_add_stroke(d, &hs, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
-                              !res.rejected));
+    bool ok = bs.points && (!with_head || hs.points);
+    for (int k = 0; k < 2 && ok; ++k) {
+        bool body = (k == 0) != keep;
+        if (body)
+            ok =
+                sp_dragon_add_stroke(d, &bs, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK && !res.rejected;
+        else if (with_head)
+            ok = sp_dragon_add_stroke(d, &hs, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK && !res.rejected;
+    }
     free(bs.points), free(hs.points);
     return ok;
+}
+
+static bool draw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head, sp_vec2* lo,
+                        sp_vec2* hi, sp_vec2* head_at)
+{
+    return add_dragon(d, ds, s, m, left, with_head, false, lo, hi, head_at);
+}
+
+// The same dragon added to the canvas as it is (after a part drawn first),
+// the body last.
+static bool redraw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head)
+{
+    sp_vec2 lo, hi, head_at;
+    return add_dragon(d, ds, s, m, left, with_head, true, &lo, &hi, &head_at);
 }
 
 // --on-body: legs drawn at a dragon (a body and a head drawn first), printed
 // as a table (or JSON rows). A scene whose body, head or legs stroke fails
 // or is refused counts as legs not of their kind.
 // `alone`: the drawings' single-stroke outcomes (no body, no rule).
-static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alone_out, bool json, const char* half)
+static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alone_out, bool json, const char* half,
+                         bool parts_first)
 {
     static const char* const kinds[2] = {"front_legs", "hind_legs"};
     scene_set scenes;
@@ -141,7 +162,13 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
                 bool front = (kind == 0) == (end == 0);
                 sp_stroke ls = placed(legs, 260, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
                                       true, facing != 0);
-                ok = ok && ls.points && sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK;
+                if (parts_first && ok && ls.points) { // the same strokes, the legs' first
+                    sp_dragon_clear(d);
+                    ok = sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK &&
+                         redraw_dragon(d, ds, &scenes, m, facing != 0, true);
+                } else {
+                    ok = ok && ls.points && sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK;
+                }
                 if (ok && !res.rejected) {
                     bool right = !strcmp(sp_dragon_part_get(d, res.part)->category, label);
                     if (end == 0)
@@ -156,11 +183,12 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
     sp_dragon_clear(d);
     if (json) {
         for (int k = 0; k < 2; ++k)
-            printf("  {\"case\": \"%s %s on a body\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d},\n", half,
-                   kinds[k], n[k], alone[k], own[k], other[k]);
+            printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d},\n", half,
+                   kinds[k], parts_first ? ", drawn first" : "", n[k], alone[k], own[k], other[k]);
         return;
     }
-    printf("Legs drawn at a dragon (a body and a head first; facing right, then left): became their own kind\n");
+    printf("Legs drawn at a dragon (%s; facing right, then left): became their own kind\n",
+           parts_first ? "the legs first, then a head and the body" : "a body and a head first");
     printf("%-12s %6s %22s %22s %22s\n", "legs", "drawn", "alone (no body)", "at their own end", "at the other end");
     for (int k = 0; k < 2; ++k)
         printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k], other[k],
@@ -183,8 +211,10 @@ static void shifted(sp_stroke* s, double dx, double dy)
 // out of the rear, its box 30 px into the body's, centred on the body's
 // height; wings standing on the body's back, their box 30 px into it.
 // Counted per kind: became its own kind (and of those, attached to the
-// body), a body (a second dragon), another part, refused.
-static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half)
+// body), a body (a second dragon), another part, refused. parts_first: the
+// part is drawn first, on a clear canvas, then the head and the body, as
+// a visitor who starts with the tail.
+static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half, bool parts_first)
 {
     static const char* const kinds[3] = {"head", "tail", "wings"};
     scene_set scenes;
@@ -213,14 +243,20 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
                 else // the wings' bottom 30 px into the body's top, over its middle
                     shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y + 30) - phi.y);
             }
-            ok = ok && ps.points && sp_dragon_add_stroke(d, &ps, NULL, &res, &err) == SP_OK;
+            if (parts_first && ok && ps.points) { // the same strokes, the part's first
+                sp_dragon_clear(d);
+                ok = sp_dragon_add_stroke(d, &ps, NULL, &res, &err) == SP_OK &&
+                     redraw_dragon(d, ds, &scenes, m, facing != 0, kind != 0);
+            } else {
+                ok = ok && ps.points && sp_dragon_add_stroke(d, &ps, NULL, &res, &err) == SP_OK;
+            }
             n[kind]++;
             if (!ok || res.rejected) {
                 refused[kind]++;
             } else {
                 const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
                 if (!strcmp(p->category, label))
-                    own[kind]++, attached[kind] += p->attached_to == 0;
+                    own[kind]++, attached[kind] += p->attached_to >= 0 && sp_dragon_part_get(d, p->attached_to)->is_torso;
                 else if (p->is_torso)
                     body[kind]++;
                 else
@@ -232,12 +268,13 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     sp_dragon_clear(d);
     if (json) {
         for (int k = 0; k < 3; ++k)
-            printf("  {\"case\": \"%s %s on a body\", \"n\": %d, \"own\": %d, \"own_attached\": %d, \"body\": %d, \"other\": "
+            printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"own\": %d, \"own_attached\": %d, \"body\": %d, \"other\": "
                    "%d, \"refused\": %d},\n",
-                   half, kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k]);
+                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], own[k], attached[k], body[k], other[k], refused[k]);
         return;
     }
-    printf("Heads, tails and wings drawn touching a dragon's body (facing right, then left)\n");
+    printf("Heads, tails and wings drawn touching a dragon's body%s (facing right, then left)\n",
+           parts_first ? ", each drawn first, then the head and the body" : "");
     printf("%-12s %6s %12s %12s %12s %12s %12s\n", "part", "drawn", "own kind", "attached", "a body", "other part", "refused");
     for (int k = 0; k < 3; ++k)
         printf("%-12s %6d %12d %12d %12d %12d %12d\n", kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k]);
@@ -437,7 +474,12 @@ int main(int argc, char** argv)
         }
     if (json) {
         printf("[\n");
-        if (on_body) legs_on_body(d, &ds, out, true, half), parts_on_body(d, &ds, true, half);
+        if (on_body) {
+            for (int first = 0; first < 2; ++first) {
+                legs_on_body(d, &ds, out, true, half, first);
+                parts_on_body(d, &ds, true, half, first);
+            }
+        }
         for (int c = 0; c < nc; ++c) {
             if (c == none) continue;
             printf("  {\"case\": \"%s %s\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": "
@@ -479,7 +521,12 @@ int main(int argc, char** argv)
                "median, %.2f p90 (target 50)\n",
                n_ms, mc, mc90, mt, mt90);
 #undef PCT
-        if (on_body) legs_on_body(d, &ds, out, false, half), parts_on_body(d, &ds, false, half);
+        if (on_body) {
+            for (int first = 0; first < 2; ++first) {
+                legs_on_body(d, &ds, out, false, half, first);
+                parts_on_body(d, &ds, false, half, first);
+            }
+        }
     }
     if (sheet) {
         sp_sheet_item* items = calloc((size_t)ds.count, sizeof *items);
