@@ -98,7 +98,7 @@ typedef struct part {
     bool body_has_surface;
     // Its fit before a body drawn later changed it (decided it again or
     // turned it: stroke.c, parts_meet_body), and that body's id: Undo of
-    // the body, or its Redraw, gives the fit back.
+    // the body, or a Redraw or chip that replaces it, gives the fit back.
     struct part* before;
     uint64_t before_by;
     bool chosen; // its category was the caller's (a chip's), not the classifier's

@@ -416,7 +416,7 @@ static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_erro
     return SP_OK;
 }
 
-// The canvas box of part i's stroke.
+// The box of part p's stroke on the canvas.
 static void stroke_box_of(const part* p, sp_vec2* lo, sp_vec2* hi)
 {
     *lo = (sp_vec2){p->stroke_box[0], p->stroke_box[1]}, *hi = (sp_vec2){p->stroke_box[2], p->stroke_box[3]};
