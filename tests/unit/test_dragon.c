@@ -2258,6 +2258,24 @@ static void test_parts_before_body(void)
         draw_part(d, db, "torso", 640, 420, 420, false, true);
         ENSURE(!strcmp(sp_dragon_part_get(d, 1)->category, "front_legs"));
     }
+    // Legs drawn on the body before its head: when the head comes and tells
+    // the facing, they are the legs of their end; Undo of the head gives
+    // them back.
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        double rear = mirrored ? 760 : 520, head = mirrored ? 380 : 900;
+        sp_dragon_clear(d);
+        draw_part(d, db, "torso", 640, 420, 420, false, true);
+        draw_part(d, db, "front_legs", rear, 570, 190, mirrored, false);
+        uint64_t id = sp_dragon_part_get(d, 1)->id;
+        ENSURE(!strcmp(sp_dragon_part_get(d, 1)->category, "front_legs")); // no facing yet
+        draw_part(d, db, "head", head, 300, 200, mirrored, true);
+        ENSURE(sp_dragon_part_get(d, 2)->attached_to == 0);
+        const sp_dragon_part* legs = sp_dragon_part_get(d, 1);
+        fprintf(stderr, "  front legs drawn at the rear, then the head (facing %s): %s\n", mirrored ? "left" : "right",
+                legs->category);
+        ENSURE(!strcmp(legs->category, "hind_legs") && legs->attached_to == 0 && legs->id == id);
+        ENSURE(sp_dragon_undo(d) && !strcmp(sp_dragon_part_get(d, 1)->category, "front_legs"));
+    }
     // The README's session with the tail drawn first: the same dragon.
     sp_vec2* xy[8];
     int n[8], strokes = readme_session(xy, n, 8);

@@ -96,9 +96,11 @@ typedef struct part {
     double* body_xyz;
     sp_vec2* body_px;
     bool body_has_surface;
-    // Its fit before a body drawn later changed it (decided it again or
-    // turned it: stroke.c, parts_meet_body), and that body's id: Undo of
-    // the body, or a Redraw or chip that replaces it, gives the fit back.
+    // Its fit before a part drawn later changed it (a body that decided it
+    // again or turned it, a body, head or tail that made legs the other
+    // legs: stroke.c, parts_meet_body, legs_by_place), and that part's id:
+    // Undo of that part, or a Redraw or chip that replaces it, gives the fit
+    // back.
     struct part* before;
     uint64_t before_by;
     bool chosen; // its category was the caller's (a chip's), not the classifier's

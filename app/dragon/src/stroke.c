@@ -476,6 +476,23 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
     return replace_before_body(d, i, &f, confidence, d->parts[body]->pub.id);
 }
 
+// Legs attached to body `body` take their kind from where they are on it,
+// as when drawn after the part with id `by` (take_family_member): a body
+// just drawn, or a head or tail that just told its facing. A chip's choice
+// stands.
+static void legs_by_place(sp_dragon* d, int body, uint64_t by)
+{
+    bool changed = false;
+    for (int i = 0; i < d->part_n; ++i) {
+        char member[SP_NAME_MAX];
+        fit_choice f;
+        if (d->parts[i]->pub.id != by && !d->parts[i]->chosen && d->parts[i]->pub.attached_to == body &&
+            fit_family_member(d, i, member, &f))
+            changed |= replace_before_body(d, i, &f, d->parts[i]->pub.confidence, by);
+    }
+    if (changed) dragon_relayout(d);
+}
+
 // Parts drawn before a body, when the body comes (the last part), as if
 // drawn after it:
 // - a part the classifier took for a body that lies on it is decided again
@@ -483,7 +500,7 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
 // - a head or a tail on it, coming out of its end (dragon_facing_hint),
 //   that hangs free turns to the facing the body hints at (fit_variants),
 //   so that its root rides the body;
-// - legs attached to it become the legs of their end (take_family_member).
+// - legs attached to it become the legs of their end (legs_by_place).
 // Each keeps its id and its stroke; its former fit is kept for Undo or a
 // Redraw of the body (give_back_fits).
 static void parts_meet_body(sp_dragon* d)
@@ -513,23 +530,14 @@ static void parts_meet_body(sp_dragon* d)
         changed |= replace_before_body(d, i, &f, old->pub.confidence, by);
     }
     if (changed) dragon_relayout(d);
-    // Legs take their kind from where they are on the body, as when drawn
-    // after it (take_family_member); a chip's choice stands.
-    changed = false;
-    for (int i = 0; i < body; ++i) {
-        char member[SP_NAME_MAX];
-        fit_choice f;
-        if (!d->parts[i]->chosen && d->parts[i]->pub.attached_to == body && fit_family_member(d, i, member, &f))
-            changed |= replace_before_body(d, i, &f, d->parts[i]->pub.confidence, by);
-    }
-    if (changed) dragon_relayout(d);
+    legs_by_place(d, body, by);
 }
 
-// Gives back the fits that the body with this id changed (parts_meet_body).
-static void give_back_fits(sp_dragon* d, uint64_t body_id)
+// Gives back the fits that the part with this id changed when it came (parts_meet_body, legs_by_place).
+static void give_back_fits(sp_dragon* d, uint64_t by)
 {
     for (int i = 0; i < d->part_n; ++i)
-        while (d->parts[i]->before && d->parts[i]->before_by == body_id) { // decided again, then turned or made the other legs
+        while (d->parts[i]->before && d->parts[i]->before_by == by) { // decided again, then turned or made the other legs
             part* q = d->parts[i];
             d->parts[i] = q->before;
             q->before = NULL;
@@ -632,6 +640,10 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         r = take_family_member(d, out, err);
         if (r != SP_OK) return r;
     }
+    // A head or tail tells the facing of the body it hangs on: the legs
+    // already there take their kind from where they are.
+    const part* last = d->parts[d->part_n - 1];
+    if (last->t->lengthwise && last->pub.attached_to >= 0) legs_by_place(d, last->pub.attached_to, last->pub.id);
     out->part = d->part_n - 1;
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
