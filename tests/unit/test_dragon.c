@@ -2150,10 +2150,11 @@ static void test_root_at_the_body(void)
     sp_db_close(db);
 }
 
-// The same tails drawn before the body: when the body comes, a tail coming
-// out of its end that hangs free turns to face away from it and attaches,
-// keeping its id; Undo of the body, or a chip that makes the body another
-// part, gives the tail its former fit back.
+// Parts drawn before the body end as if drawn after it, keeping their ids:
+// the same tails turn to face away from the body and attach; a round head
+// that alone is a body becomes the head; legs become the legs of their end
+// (also when the head comes after them). Undo of the body (or the head), or
+// a chip that makes the body another part, gives the former fits back.
 static void test_parts_before_body(void)
 {
     const char* path = real_db();
