@@ -7,7 +7,8 @@
 /// The fixture library (sp_test_fixtures, tests/CMakeLists.txt) holds every
 /// fixture the tests and benchmarks share: these rigs, the dragon parts
 /// (dragon_parts.h), the pipeline test's parts (test_parts.h), the foreign
-/// lizard (foreign_gltf.h) and sp_fixture_glb_json.
+/// lizard (foreign_gltf.h), sp_fixture_glb_json and the JSON and kiosk
+/// session readers.
 #ifndef SP_FIXTURES_H
 #define SP_FIXTURES_H
 
