@@ -125,12 +125,19 @@ static bool draw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, 
     return add_dragon(d, ds, s, m, left, with_head, false, lo, hi, head_at);
 }
 
-// The same dragon added to the canvas as it is (after a part drawn first),
-// the body last.
-static bool redraw_dragon(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head)
+// The part's stroke (classified; its result to *res) added to scene m's
+// dragon, already drawn; first: instead drawn on a cleared canvas before the
+// same dragon, the body last. False when a stroke fails or is refused (the
+// part's refusal is in *res).
+static bool add_part(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int m, bool left, bool with_head, bool first,
+                     const sp_stroke* part, sp_dragon_result* res)
 {
+    sp_error err = {0};
+    if (!first) return sp_dragon_add_stroke(d, part, NULL, res, &err) == SP_OK;
     sp_vec2 lo, hi, head_at;
-    return add_dragon(d, ds, s, m, left, with_head, true, &lo, &hi, &head_at);
+    sp_dragon_clear(d);
+    return sp_dragon_add_stroke(d, part, NULL, res, &err) == SP_OK &&
+           add_dragon(d, ds, s, m, left, with_head, true, &lo, &hi, &head_at);
 }
 
 // --on-body: legs drawn at a dragon (a body and a head drawn first), printed
@@ -144,7 +151,6 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
     scene_set scenes;
     if (!scene_drawings(ds, &scenes)) return;
     int n[2] = {0}, own[2] = {0}, other[2] = {0}, alone[2] = {0};
-    sp_error err = {0};
     int m = 0;
     for (int i = 0; i < ds->count; ++i) {
         const char* label = ds->categories[ds->samples[i].label];
@@ -162,13 +168,7 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
                 bool front = (kind == 0) == (end == 0);
                 sp_stroke ls = placed(legs, 260, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
                                       true, facing != 0);
-                if (parts_first && ok && ls.points) { // the same strokes, the legs' first
-                    sp_dragon_clear(d);
-                    ok = sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK &&
-                         redraw_dragon(d, ds, &scenes, m, facing != 0, true);
-                } else {
-                    ok = ok && ls.points && sp_dragon_add_stroke(d, &ls, NULL, &res, &err) == SP_OK;
-                }
+                ok = ok && ls.points && add_part(d, ds, &scenes, m, facing != 0, true, parts_first, &ls, &res);
                 if (ok && !res.rejected) {
                     bool right = !strcmp(sp_dragon_part_get(d, res.part)->category, label);
                     if (end == 0)
@@ -220,7 +220,6 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     scene_set scenes;
     if (!scene_drawings(ds, &scenes)) return;
     int n[3] = {0}, own[3] = {0}, attached[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0};
-    sp_error err = {0};
     int m = 0;
     for (int i = 0; i < ds->count; ++i) {
         const char* label = ds->categories[ds->samples[i].label];
@@ -243,13 +242,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
                 else // the wings' bottom 30 px into the body's top, over its middle
                     shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y + 30) - phi.y);
             }
-            if (parts_first && ok && ps.points) { // the same strokes, the part's first
-                sp_dragon_clear(d);
-                ok = sp_dragon_add_stroke(d, &ps, NULL, &res, &err) == SP_OK &&
-                     redraw_dragon(d, ds, &scenes, m, facing != 0, kind != 0);
-            } else {
-                ok = ok && ps.points && sp_dragon_add_stroke(d, &ps, NULL, &res, &err) == SP_OK;
-            }
+            ok = ok && ps.points && add_part(d, ds, &scenes, m, facing != 0, kind != 0, parts_first, &ps, &res);
             n[kind]++;
             if (!ok || res.rejected) {
                 refused[kind]++;

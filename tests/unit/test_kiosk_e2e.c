@@ -1329,10 +1329,9 @@ static void test_body_after_parts(void)
     const stroke* body = &g_strokes[0];
     ENSURE(!strcmp(body->category, "torso"));
     // The body's stroke at a third of its size, over its upper front.
-    sp_vec2 lo = body->xy[0], hi = body->xy[0];
-    for (int i = 1; i < body->n; ++i)
-        lo.x = fmin(lo.x, body->xy[i].x), lo.y = fmin(lo.y, body->xy[i].y), hi.x = fmax(hi.x, body->xy[i].x),
-        hi.y = fmax(hi.y, body->xy[i].y);
+    sp_vec2 lo, hi;
+    ENSURE(sp_sketch_bounds(&(sp_sketch){.stroke_count = 1, .strokes = &(sp_stroke){.count = body->n, .points = body->xy}}, &lo,
+                            &hi));
     sp_vec2 c = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y)}, at = {c.x + 0.25 * (hi.x - lo.x), c.y - 0.2 * (hi.y - lo.y)};
     sp_vec2* small = malloc(sizeof(sp_vec2) * (size_t)body->n);
     ENSURE(small);

@@ -359,6 +359,12 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     return SP_DRAGON_ACCEPTED;
 }
 
+// The box of part p's stroke on the canvas.
+static void stroke_box_of(const part* p, sp_vec2* lo, sp_vec2* hi)
+{
+    *lo = (sp_vec2){p->stroke_box[0], p->stroke_box[1]}, *hi = (sp_vec2){p->stroke_box[2], p->stroke_box[3]};
+}
+
 // Part p's own copy of its cleaned stroke as a sketch (s holds the stroke).
 static sp_sketch part_sketch(const sp_dragon* d, const part* p, sp_stroke* s)
 {
@@ -377,7 +383,8 @@ static bool fit_family_member(sp_dragon* d, int i, char member[SP_NAME_MAX], fit
     if (!dragon_family_member(d, i, member) || !strcmp(member, old->pub.category)) return false;
     sp_stroke st;
     sp_sketch sk = part_sketch(d, old, &st);
-    sp_vec2 lo = {old->stroke_box[0], old->stroke_box[1]}, hi = {old->stroke_box[2], old->stroke_box[3]};
+    sp_vec2 lo, hi;
+    stroke_box_of(old, &lo, &hi);
     int not_finite = 0;
     bool any_part = false;
     return fit_category(d, member, &sk, lo, hi, f, &not_finite, &any_part);
@@ -414,12 +421,6 @@ static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_erro
     d->parts[i] = q;
     dragon_relayout(d);
     return SP_OK;
-}
-
-// The box of part p's stroke on the canvas.
-static void stroke_box_of(const part* p, sp_vec2* lo, sp_vec2* hi)
-{
-    *lo = (sp_vec2){p->stroke_box[0], p->stroke_box[1]}, *hi = (sp_vec2){p->stroke_box[2], p->stroke_box[3]};
 }
 
 // Part i becomes fit f (which it frees), keeping its id (the kiosk keys its
