@@ -2150,6 +2150,70 @@ static void test_root_at_the_body(void)
     sp_db_close(db);
 }
 
+// Densified polygon: k points per side (the last point included). malloc'd.
+static sp_vec2* polygon_stroke(const sp_vec2* corners, int m, int k, int* n)
+{
+    sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)((m - 1) * k + 1));
+    ENSURE(xy);
+    *n = 0;
+    for (int c = 0; c + 1 < m; ++c)
+        for (int i = 0; i < k; ++i)
+            xy[(*n)++] = sp_v2_add(corners[c], sp_v2_scale(sp_v2_sub(corners[c + 1], corners[c]), (double)i / k));
+    xy[(*n)++] = corners[m - 1];
+    return xy;
+}
+
+// The refusal's mirror evidence (docs/DESIGN.md, "Refusal policy"): a
+// visitor's tree and sun (tune half), each its own mirror image about an
+// upright line and taken for a part drawn in profile, are refused, and the
+// tree turned a quarter is not; a neat pair of legs and a humped body, as
+// symmetric, stay parts.
+static void test_mirror_refusal(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_dragon* d = new_dragon(path);
+    sp_error err = {0};
+    const char* doodles[] = {"not_a_part/tree.json", "not_a_part/sun.json"};
+    for (int k = 0; k < 2; ++k) {
+        int n;
+        sp_vec2* xy = visitor_stroke(doodles[k], 320, (sp_vec2){640, 400}, false, &n);
+        sp_dragon_result res;
+        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK);
+        fprintf(stderr, "  %s: %s, first guess %s\n", doodles[k], res.rejected ? "refused" : "accepted",
+                res.guess_count ? res.guesses[0].category : "-");
+        ENSURE(res.rejected && res.reason == SP_DRAGON_UNRECOGNISED);
+        ENSURE(res.guess_count > 0 && strcmp(res.guesses[0].category, "torso") != 0 && !strstr(res.guesses[0].category, "legs"));
+        if (k == 0) {
+            // The tree turned a quarter about its centre is no longer
+            // symmetric about an upright line, and the rest of the evidence
+            // takes it for a part: the mirror is what refuses it.
+            for (int i = 0; i < n; ++i)
+                xy[i] = (sp_vec2){640 - (xy[i].y - 400), 400 + (xy[i].x - 640)};
+            ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
+        }
+        free(xy);
+        sp_dragon_clear(d);
+    }
+    // As symmetric, and parts: a pair of legs as one outline, a body with two humps.
+    int n;
+    sp_vec2 legs[] = {{540, 300}, {540, 520}, {580, 520}, {580, 380}, {700, 380}, {700, 520}, {740, 520}, {740, 300}, {540, 300}};
+    sp_vec2* xy = polygon_stroke(legs, 9, 10, &n);
+    sp_dragon_result res;
+    ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
+    ENSURE(strstr(sp_dragon_part_get(d, res.part)->category, "legs"));
+    free(xy);
+    sp_vec2 body[81];
+    for (int i = 0; i <= 80; ++i) {
+        double t = 2 * M_PI * i / 80, x = cos(t), y = 0.5 * sin(t);
+        if (y < 0) y -= 0.3 * (exp(-pow((x - 0.4) / 0.25, 2)) + exp(-pow((x + 0.4) / 0.25, 2)));
+        body[i] = (sp_vec2){640 + 200 * x, 400 + 200 * y};
+    }
+    ENSURE(sp_dragon_add_points(d, body, 81, NULL, &res, &err) == SP_OK && !res.rejected);
+    ENSURE(!strcmp(sp_dragon_part_get(d, res.part)->category, "torso"));
+    sp_dragon_destroy(d);
+}
+
 // Parts drawn before the body end as if drawn after it, keeping their ids:
 // the same tails turn to face away from the body and attach; a round head
 // that alone is a body becomes the head; legs become the legs of their end
@@ -2321,6 +2385,7 @@ int main(int argc, char** argv)
                                    {"body_last_and_undo", test_body_last_and_undo},
                                    {"robustness", test_robustness},
                                    {"visitors_policy", test_visitors_policy},
+                                   {"mirror_refusal", test_mirror_refusal},
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},

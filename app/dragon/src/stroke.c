@@ -292,16 +292,58 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
     return SP_OK;
 }
 
+// A stroke nearer than this to its mirror image (mirror_gap) counts as
+// symmetric, and each unit nearer adds MIRROR_WEIGHT to its distance from
+// every part. On the tune half of tests/data/visitors no part taken for a
+// head, tail or wing came under 0.08, and every weight from 4 to 50 gave
+// the same answers (BENCHMARKS.md, "Visitors' drawings", eleventh pass).
+#define MIRROR_GAP_SYMMETRIC 0.08
+#define MIRROR_WEIGHT 7.0
+
+// How far a stroke is from being its own mirror image about the upright line
+// through its centroid: the mean distance from each of its points to the
+// mirrored stroke and back, over its RMS radius (0: symmetric). 1 (far from
+// symmetric) when it cannot be measured.
+static double mirror_gap(const sp_vec2* pts, int n)
+{
+    enum { M = 96 };
+    sp_vec2 r[M];
+    if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return 1.0;
+    sp_vec2 c = {0, 0};
+    for (int i = 0; i < M; ++i)
+        c = sp_v2_add(c, r[i]);
+    c = sp_v2_scale(c, 1.0 / M);
+    double rms = 0;
+    for (int i = 0; i < M; ++i)
+        rms += sp_v2_dot(sp_v2_sub(r[i], c), sp_v2_sub(r[i], c));
+    rms = sqrt(rms / M);
+    if (!(rms > 0)) return 1.0;
+    // The mirror image's points are the stroke's with x reflected, so the
+    // distance from the stroke to its image and from the image to the stroke
+    // are the same sum: one direction suffices.
+    double sum = 0;
+    for (int i = 0; i < M; ++i) {
+        sp_vec2 m = {2 * c.x - r[i].x, r[i].y};
+        double best = INFINITY;
+        for (int j = 0; j < M; ++j)
+            best = fmin(best, sp_v2_dot(sp_v2_sub(m, r[j]), sp_v2_sub(m, r[j])));
+        sum += sqrt(best);
+    }
+    return sum / M / rms;
+}
+
 // The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
 // that looks anything like a part becomes the best guess; refused are only
 // scribbles (checked before the fit, `fit` < 0) and strokes far from every
 // part, where "far" weighs `near`, the classifier's nearest-drawing distance
 // in units of the model's calibrated reject distance, together with how
 // badly the best guess's part takes the stroke (`fit`: the fit's mean error
-// over the stroke's diagonal). Taps and tiny strokes never get here.
+// over the stroke's diagonal) and, when that part is drawn in profile
+// (`profile`), how nearly the stroke is its own mirror image. Taps and tiny
+// strokes never get here.
 // Constants tuned on the tune half of tests/data/visitors (BENCHMARKS.md,
 // "Visitors' drawings").
-static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit)
+static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bool profile)
 {
     if (fit < 0) {
         // A scribble: far more ink than its size, or crossing itself over and over.
@@ -323,7 +365,12 @@ static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit)
 #undef CROSS
         return crossings > 12;
     }
-    return near + 6.0 * fit > 1.26;
+    // A part drawn in profile (a head, a tail, a wing) is seldom its own
+    // mirror image about an upright line; much else a visitor draws is (a
+    // tree, a sun). Bodies and leg pairs are left out: a visitor's
+    // oval or humped body and a neat pair of legs are symmetric too.
+    double sym = profile ? fmax(0.0, MIRROR_GAP_SYMMETRIC - mirror_gap(pts, n)) : 0.0;
+    return near + 6.0 * fit + MIRROR_WEIGHT * sym > 1.26;
 }
 
 // The stroke path's decision: the classifier's answer becomes a category
@@ -352,7 +399,7 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     if (forced) return SP_DRAGON_ACCEPTED;
     if (isfinite(a.reject_distance) && a.reject_distance > 0) *near = a.distance / a.reject_distance;
     if (a.count == 0 || a.ranked[0].score < d->desc.min_confidence ||
-        kiosk_refuses(sk->strokes[0].points, sk->strokes[0].count, *near, -1.0))
+        kiosk_refuses(sk->strokes[0].points, sk->strokes[0].count, *near, -1.0, false))
         return SP_DRAGON_UNRECOGNISED;
     dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a.ranked[0].category));
     *confidence = a.ranked[0].score;
@@ -608,7 +655,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         if (not_finite > 0) out->note = SP_DRAGON_NOTE_NOT_FINITE;
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
     }
-    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best.score)) {
+    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best.score, !best.t->is_torso && !best.t->family[0])) {
         free(pts);
         free(best.p);
         return reject(out, SP_DRAGON_UNRECOGNISED, t0);
