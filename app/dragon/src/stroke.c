@@ -273,6 +273,21 @@ static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2
     return true;
 }
 
+// The family of a category's parts ("" for none or no part).
+static const char* category_family(sp_dragon* d, const char* category)
+{
+    tpl* t[1];
+    sp_error lerr = {0};
+    return dragon_category_templates(d, category, t, 1, &lerr) == 1 ? t[0]->family : "";
+}
+
+static bool among_guesses(const sp_dragon_result* out, const char* category)
+{
+    for (int g = 0; g < out->guess_count; ++g)
+        if (!strcmp(out->guesses[g].category, category)) return true;
+    return false;
+}
+
 static void fill_guesses(const sp_clf* clf, const sp_clf_answer* a, sp_dragon_result* out)
 {
     out->guess_count = 0;
@@ -280,6 +295,27 @@ static void fill_guesses(const sp_clf* clf, const sp_clf_answer* a, sp_dragon_re
         sp_dragon_guess* g = &out->guesses[out->guess_count++];
         dragon_copy_name(g->category, sizeof g->category, sp_clf_category(clf, a->ranked[i].category));
         g->confidence = a->ranked[i].score;
+    }
+}
+
+// Front and hind legs are one family, told apart by where they are drawn
+// (layout.c), and each other's commonest confusion: when the first of the
+// final guesses (the part, or a refused stroke's best guess) has kin the
+// guesses lack, the best-ranked of them in the classifier's answer `a`
+// takes the last slot, so a stroke taken for legs offers both kinds.
+static void offer_kin(sp_dragon* d, const sp_clf_answer* a, sp_dragon_result* out)
+{
+    if (!d->clf || out->guess_count < 2) return;
+    char family[SP_NAME_MAX];
+    dragon_copy_name(family, sizeof family, category_family(d, out->guesses[0].category));
+    if (!family[0]) return;
+    for (int i = 0; i < a->count; ++i) {
+        const char* kin = sp_clf_category(d->clf, a->ranked[i].category);
+        if (among_guesses(out, kin) || strcmp(category_family(d, kin), family) != 0) continue;
+        sp_dragon_guess* last = &out->guesses[out->guess_count - 1];
+        dragon_copy_name(last->category, sizeof last->category, kin);
+        last->confidence = a->ranked[i].score;
+        return;
     }
 }
 
@@ -383,26 +419,27 @@ static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bo
 // out->ms_classify. Returns SP_DRAGON_ACCEPTED with category and *confidence
 // filled, or why the stroke is refused.
 static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, const char* forced, sp_dragon_result* out,
-                                            char category[SP_NAME_MAX], float* confidence, double* near)
+                                            char category[SP_NAME_MAX], float* confidence, double* near, sp_clf_answer* a)
 {
     *confidence = 1.0f;
     *near = 0.0;
+    a->count = 0;
     if (forced) dragon_copy_name(category, SP_NAME_MAX, forced);
     if (!d->clf) return forced ? SP_DRAGON_ACCEPTED : SP_DRAGON_NO_MODEL;
-    sp_clf_answer a;
     sp_error cerr = {0};
     double tc = sp_now_ms();
-    sp_result r = sp_clf_classify(d->clf, sk, NULL, &a, &cerr);
-    if (r == SP_OK) fill_guesses(d->clf, &a, out);
+    sp_result r = sp_clf_classify(d->clf, sk, NULL, a, &cerr);
+    if (r == SP_OK) fill_guesses(d->clf, a, out);
+    if (r != SP_OK) a->count = 0;
     if (r != SP_OK && !forced) return SP_DRAGON_UNRECOGNISED;
     out->ms_classify = sp_now_ms() - tc;
     if (forced) return SP_DRAGON_ACCEPTED;
-    if (isfinite(a.reject_distance) && a.reject_distance > 0) *near = a.distance / a.reject_distance;
-    if (a.count == 0 || a.ranked[0].score < d->desc.min_confidence ||
+    if (isfinite(a->reject_distance) && a->reject_distance > 0) *near = a->distance / a->reject_distance;
+    if (a->count == 0 || a->ranked[0].score < d->desc.min_confidence ||
         kiosk_refuses(sk->strokes[0].points, sk->strokes[0].count, *near, -1.0, false))
         return SP_DRAGON_UNRECOGNISED;
-    dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a.ranked[0].category));
-    *confidence = a.ranked[0].score;
+    dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a->ranked[0].category));
+    *confidence = a->ranked[0].score;
     return SP_DRAGON_ACCEPTED;
 }
 
@@ -506,7 +543,8 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
     char category[SP_NAME_MAX] = "";
     float confidence = 1.0f;
     double near = 0.0;
-    if (classify_and_decide(d, &sk, NULL, &res, category, &confidence, &near) != SP_DRAGON_ACCEPTED) return false;
+    sp_clf_answer a;
+    if (classify_and_decide(d, &sk, NULL, &res, category, &confidence, &near, &a) != SP_DRAGON_ACCEPTED) return false;
     // Off the canvas while it is fitted: as a body it would hint its own facing.
     memmove(&d->parts[i], &d->parts[i + 1], sizeof(part*) * (size_t)(d->part_n - i - 1));
     --d->part_n;
@@ -624,9 +662,11 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     char category[SP_NAME_MAX] = "";
     float confidence = 1.0f;
     double near = 0.0;
-    sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence, &near);
+    sp_clf_answer a;
+    sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence, &near, &a);
     if (why != SP_DRAGON_ACCEPTED) {
         free(pts);
+        offer_kin(d, &a, out);
         return reject(out, why, t0);
     }
     // Fit every variant of the category (and facing); keep the one that
@@ -646,6 +686,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         fitted = fit_category(d, category, &sk, lo, hi, &best, &not_finite, &any_part);
     }
     out->ms_fit = sp_now_ms() - tf;
+    offer_kin(d, &a, out);
     if (!any_part) {
         free(pts);
         return reject(out, SP_DRAGON_NO_PART, t0);
