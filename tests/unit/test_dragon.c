@@ -1790,11 +1790,12 @@ static bool check_rerank(sp_dragon* d, const sp_stroke* stroke, const sp_dragon_
 // The kiosk's refusal policy on visitors' drawings (the tune half of
 // tests/data/visitors, never trained on): a stroke that looks anything like a
 // part becomes a part, clear non-parts are refused. Floors under what this
-// quickly trained model reaches (71% right, 9% refused, 97% in the top 3, 40%
-// of the non-parts refused; before the picture evidence and the fit's
-// re-ranking 65%, 11%, 97%, 40%; before the recipe's concept sketches 53%,
-// 3%, 74%, 44%); the classifier's own reject threshold refused half of the
-// parts. Every accepted stroke's part is checked against the fit's ranking.
+// quickly trained model reaches (71% right, 9% refused, 97% in the top 3, 52%
+// of the non-parts refused, 40% before the mirror evidence; before the
+// picture evidence and the fit's re-ranking 65%, 11%, 97%, 40%; before the
+// recipe's concept sketches 53%, 3%, 74%, 44%); the classifier's own reject
+// threshold refused half of the parts. Every accepted stroke's part is
+// checked against the fit's ranking.
 static void test_visitors_policy(void)
 {
     const char* path = real_db();
