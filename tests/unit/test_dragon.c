@@ -2166,19 +2166,6 @@ static void test_root_at_the_body(void)
     sp_db_close(db);
 }
 
-// Densified polygon: k points per side (the last point included). malloc'd.
-static sp_vec2* polygon_stroke(const sp_vec2* corners, int m, int k, int* n)
-{
-    sp_vec2* xy = malloc(sizeof(sp_vec2) * (size_t)((m - 1) * k + 1));
-    ENSURE(xy);
-    *n = 0;
-    for (int c = 0; c + 1 < m; ++c)
-        for (int i = 0; i < k; ++i)
-            xy[(*n)++] = sp_v2_add(corners[c], sp_v2_scale(sp_v2_sub(corners[c + 1], corners[c]), (double)i / k));
-    xy[(*n)++] = corners[m - 1];
-    return xy;
-}
-
 // The refusal's mirror evidence (docs/DESIGN.md, "Refusal policy"): a
 // visitor's tree and sun (tune half), each its own mirror image about an
 // upright line and taken for a part drawn in profile, are refused, and the
@@ -2212,13 +2199,12 @@ static void test_mirror_refusal(void)
         sp_dragon_clear(d);
     }
     // As symmetric, and parts: a pair of legs as one outline, a body with two humps.
-    int n;
     sp_vec2 legs[] = {{540, 300}, {540, 520}, {580, 520}, {580, 380}, {700, 380}, {700, 520}, {740, 520}, {740, 300}, {540, 300}};
-    sp_vec2* xy = polygon_stroke(legs, 9, 10, &n);
+    sp_vec2 xy[81];
+    ENSURE(sp_curve_resample(legs, 9, false, 81, xy) == SP_OK);
     sp_dragon_result res;
-    ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
+    ENSURE(sp_dragon_add_points(d, xy, 81, NULL, &res, &err) == SP_OK && !res.rejected);
     ENSURE(strstr(sp_dragon_part_get(d, res.part)->category, "legs"));
-    free(xy);
     sp_vec2 body[81];
     for (int i = 0; i <= 80; ++i) {
         double t = 2 * M_PI * i / 80, x = cos(t), y = 0.5 * sin(t);

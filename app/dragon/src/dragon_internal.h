@@ -63,6 +63,9 @@ typedef struct tpl {
 void dragon_tpl_release(tpl* t);
 /// The loaded templates of `category` (loaded and cached on first use), at most cap.
 int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int cap, sp_error* err);
+/// The first of them (what every part of a category shares: a body or not,
+/// its family), or NULL when the category has no part that loads.
+tpl* dragon_category_first(sp_dragon* d, const char* category);
 /// Releases every cached template.
 void dragon_cache_clear(sp_dragon* d);
 /// The file's device and inode (a database replaced on disk is a new inode); false when it does not exist.

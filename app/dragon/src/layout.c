@@ -403,9 +403,8 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
     int idx[MEMBERS_MAX], members = 0;
     for (int s = 0; s < q->t->socket_count && members < MEMBERS_MAX; ++s) {
         const dsocket* so = &q->t->sockets[s];
-        tpl* kin[1];
-        sp_error lerr = {0};
-        if (dragon_category_templates(d, so->name, kin, 1, &lerr) < 1 || strcmp(kin[0]->family, p->t->family) != 0) continue;
+        const tpl* kin = dragon_category_first(d, so->name);
+        if (!kin || strcmp(kin->family, p->t->family) != 0) continue;
         su[members] = socket_u(d, q, so, mid);
         mean += su[members];
         idx[members++] = s;

@@ -361,6 +361,13 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
     return got;
 }
 
+tpl* dragon_category_first(sp_dragon* d, const char* category)
+{
+    tpl* t[1];
+    sp_error lerr = {0};
+    return dragon_category_templates(d, category, t, 1, &lerr) == 1 ? t[0] : NULL;
+}
+
 sp_result sp_dragon_preload(sp_dragon* d, sp_error* err)
 {
     if (!d->db) return SP_OK;

@@ -226,9 +226,8 @@ static void guess_to_front(sp_dragon_result* out, int g, sp_dragon_guess chosen)
 // Whether the category's parts are bodies (its first part is).
 static bool category_is_body(sp_dragon* d, const char* category)
 {
-    tpl* t[1];
-    sp_error lerr = {0};
-    return dragon_category_templates(d, category, t, 1, &lerr) == 1 && t[0]->is_torso;
+    const tpl* t = dragon_category_first(d, category);
+    return t && t->is_torso;
 }
 
 // How well a part can take the drawn shape is evidence the classifier lacks:
@@ -276,9 +275,8 @@ static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2
 // The family of a category's parts ("" for none or no part).
 static const char* category_family(sp_dragon* d, const char* category)
 {
-    tpl* t[1];
-    sp_error lerr = {0};
-    return dragon_category_templates(d, category, t, 1, &lerr) == 1 ? t[0]->family : "";
+    const tpl* t = dragon_category_first(d, category);
+    return t ? t->family : "";
 }
 
 static bool among_guesses(const sp_dragon_result* out, const char* category)
