@@ -2216,6 +2216,63 @@ static void test_mirror_refusal(void)
     sp_dragon_destroy(d);
 }
 
+// A drawing with the symmetry of a regular polygon or a star is refused
+// whatever it is taken for (a triangle, a square, a house, a star), and only
+// that symmetry refuses it: the same triangle stretched sideways, a round
+// body with a wobble that repeats five times round and an oval body whose
+// quarter turn lands near itself are parts.
+static void test_polygon_refusal(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_dragon* d = new_dragon(path);
+    sp_error err = {0};
+    sp_dragon_result res;
+    const char* doodles[] = {"not_a_part/triangle.json", "not_a_part/house.json"};
+    for (int k = 0; k < 2; ++k) {
+        int n;
+        sp_vec2* xy = visitor_stroke(doodles[k], 320, (sp_vec2){640, 400}, false, &n);
+        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK);
+        fprintf(stderr, "  %s: %s\n", doodles[k], res.rejected ? "refused" : "accepted");
+        ENSURE(res.rejected && res.reason == SP_DRAGON_UNRECOGNISED && res.guess_count > 0);
+        if (k == 0) {
+            for (int i = 0; i < n; ++i)
+                xy[i].x = 640 + 1.6 * (xy[i].x - 640);
+            ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
+        }
+        free(xy);
+        sp_dragon_clear(d);
+    }
+    // Drawn by hand here: a square and a five-pointed star, each corner
+    // written twice so the resampling keeps it.
+    sp_vec2 square[] = {{500, 260}, {780, 260}, {780, 540}, {500, 540}, {500, 260}};
+    sp_vec2 star[11];
+    for (int i = 0; i <= 10; ++i) {
+        double a = M_PI / 2 + M_PI * i / 5, r = i % 2 ? 0.4 * 150 : 150;
+        star[i] = (sp_vec2){640 + r * cos(a), 400 - r * sin(a)};
+    }
+    const sp_vec2* polygons[] = {square, star};
+    const int corners[] = {5, 11};
+    for (int k = 0; k < 2; ++k) {
+        sp_vec2 xy[101];
+        ENSURE(sp_curve_resample(polygons[k], corners[k], false, 101, xy) == SP_OK);
+        ENSURE(sp_dragon_add_points(d, xy, 101, NULL, &res, &err) == SP_OK);
+        ENSURE(res.rejected && res.reason == SP_DRAGON_UNRECOGNISED);
+        sp_dragon_clear(d);
+    }
+    for (int k = 0; k < 2; ++k) {
+        sp_vec2 body[81];
+        for (int i = 0; i <= 80; ++i) {
+            double t = 2 * M_PI * i / 80, r = k == 0 ? 1 + 0.04 * sin(5 * t) : 1;
+            body[i] = (sp_vec2){640 + 200 * r * cos(t), 400 + 200 * r * (k == 0 ? 1 : 0.82) * sin(t)};
+        }
+        ENSURE(sp_dragon_add_points(d, body, 81, NULL, &res, &err) == SP_OK && !res.rejected);
+        fprintf(stderr, "  %s body: %s\n", k == 0 ? "round" : "oval", sp_dragon_part_get(d, res.part)->category);
+        sp_dragon_clear(d);
+    }
+    sp_dragon_destroy(d);
+}
+
 // Parts drawn before the body end as if drawn after it, keeping their ids:
 // the same tails turn to face away from the body and attach; a round head
 // that alone is a body becomes the head; legs become the legs of their end
@@ -2388,6 +2445,7 @@ int main(int argc, char** argv)
                                    {"robustness", test_robustness},
                                    {"visitors_policy", test_visitors_policy},
                                    {"mirror_refusal", test_mirror_refusal},
+                                   {"polygon_refusal", test_polygon_refusal},
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},

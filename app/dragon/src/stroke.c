@@ -334,41 +334,103 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
 #define MIRROR_GAP_SYMMETRIC 0.08
 #define MIRROR_WEIGHT 7.0
 
+// A stroke turned by a k-th of a turn (k = 3..8) that lands within this of
+// itself, nearer than TURN_GAP_RATIO times where an arbitrary turn lands it,
+// has the symmetry of a regular polygon or a star (turns_onto_itself).
+// TURN_GAP_ROUND keeps circles out: an arbitrary turn lands a round stroke
+// on itself too, and a round body is a part. No training drawing of a part
+// (714 single strokes) and no tune drawing of a part meets all three; every
+// value within +-0.01 of the gap and from 0.75 to 0.9 of the ratio refuses
+// the same tune drawings (BENCHMARKS.md, "Visitors' drawings", twelfth pass).
+#define TURN_GAP_SYMMETRIC 0.10
+#define TURN_GAP_RATIO 0.85
+#define TURN_GAP_ROUND 0.09
+
+enum { SHAPE_POINTS = 96 };
+
+// The stroke resampled to SHAPE_POINTS points about their centroid, over
+// their RMS radius, so that gaps between it and its images are in units of
+// its size. False when that cannot be measured (a stroke of one point).
+static bool shape_points(const sp_vec2* pts, int n, sp_vec2 r[SHAPE_POINTS])
+{
+    if (sp_curve_resample(pts, n, false, SHAPE_POINTS, r) != SP_OK) return false;
+    sp_vec2 c = {0, 0};
+    for (int i = 0; i < SHAPE_POINTS; ++i)
+        c = sp_v2_add(c, r[i]);
+    c = sp_v2_scale(c, 1.0 / SHAPE_POINTS);
+    double rms = 0;
+    for (int i = 0; i < SHAPE_POINTS; ++i) {
+        r[i] = sp_v2_sub(r[i], c);
+        rms += sp_v2_dot(r[i], r[i]);
+    }
+    rms = sqrt(rms / SHAPE_POINTS);
+    if (!(rms > 0)) return false;
+    for (int i = 0; i < SHAPE_POINTS; ++i)
+        r[i] = sp_v2_scale(r[i], 1.0 / rms);
+    return true;
+}
+
+// The mean distance from the points r, each mapped by the 2x2 matrix m (row
+// major), to the nearest of the unmapped points.
+static double mapped_gap(const sp_vec2 r[SHAPE_POINTS], const double m[4])
+{
+    double sum = 0;
+    for (int i = 0; i < SHAPE_POINTS; ++i) {
+        sp_vec2 t = {m[0] * r[i].x + m[1] * r[i].y, m[2] * r[i].x + m[3] * r[i].y};
+        double best = INFINITY;
+        for (int j = 0; j < SHAPE_POINTS; ++j)
+            best = fmin(best, sp_v2_dot(sp_v2_sub(t, r[j]), sp_v2_sub(t, r[j])));
+        sum += sqrt(best);
+    }
+    return sum / SHAPE_POINTS;
+}
+
 // How far a stroke is from being its own mirror image about the upright line
 // through its centroid: the mean distance from each of its points to the
 // mirrored stroke and back, over its RMS radius (0: symmetric). 1 (far from
 // symmetric) when it cannot be measured.
 static double mirror_gap(const sp_vec2* pts, int n)
 {
-    enum { M = 96 };
-    sp_vec2 r[M];
-    if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return 1.0;
-    sp_vec2 c = {0, 0};
-    for (int i = 0; i < M; ++i)
-        c = sp_v2_add(c, r[i]);
-    c = sp_v2_scale(c, 1.0 / M);
-    double rms = 0;
-    for (int i = 0; i < M; ++i)
-        rms += sp_v2_dot(sp_v2_sub(r[i], c), sp_v2_sub(r[i], c));
-    rms = sqrt(rms / M);
-    if (!(rms > 0)) return 1.0;
-    // The mirror image's points are the stroke's with x reflected, so the
-    // distance from the stroke to its image and from the image to the stroke
-    // are the same sum: one direction suffices.
-    double sum = 0;
-    for (int i = 0; i < M; ++i) {
-        sp_vec2 m = {2 * c.x - r[i].x, r[i].y};
-        double best = INFINITY;
-        for (int j = 0; j < M; ++j)
-            best = fmin(best, sp_v2_dot(sp_v2_sub(m, r[j]), sp_v2_sub(m, r[j])));
-        sum += sqrt(best);
-    }
-    return sum / M / rms;
+    sp_vec2 r[SHAPE_POINTS];
+    if (!shape_points(pts, n, r)) return 1.0;
+    // A mirror is its own inverse, so the distance from the stroke to its
+    // image and from the image to the stroke are the same sum.
+    return mapped_gap(r, (const double[4]){-1, 0, 0, 1});
+}
+
+// The same gap for the stroke turned by `angle`: the mean of the way there
+// (turned by angle) and back (turned by -angle).
+static double turn_gap(const sp_vec2 r[SHAPE_POINTS], double angle)
+{
+    double c = cos(angle), s = sin(angle);
+    return 0.5 * (mapped_gap(r, (const double[4]){c, -s, s, c}) + mapped_gap(r, (const double[4]){c, s, -s, c}));
+}
+
+// Whether the stroke has the symmetry of a regular polygon or a star (a
+// triangle, a square, a house, a sun): no dragon part a visitor draws does.
+static bool turns_onto_itself(const sp_vec2* pts, int n)
+{
+    sp_vec2 r[SHAPE_POINTS];
+    if (!shape_points(pts, n, r)) return false;
+    double symmetric = INFINITY;
+    for (int k = 3; k <= 8; ++k)
+        symmetric = fmin(symmetric, turn_gap(r, 2 * M_PI / k));
+    if (symmetric >= TURN_GAP_SYMMETRIC) return false;
+    // An arbitrary turn: the median over turns of 5, 15, ... 175 degrees
+    // (a turn by -a lands as far as one by a).
+    enum { TURNS = 18 };
+    double arbitrary[TURNS];
+    for (int i = 0; i < TURNS; ++i)
+        arbitrary[i] = turn_gap(r, (5.0 + 10.0 * i) * M_PI / 180.0);
+    qsort(arbitrary, TURNS, sizeof arbitrary[0], sp_cmp_double);
+    double typical = 0.5 * (arbitrary[TURNS / 2 - 1] + arbitrary[TURNS / 2]);
+    return typical >= TURN_GAP_ROUND && symmetric < TURN_GAP_RATIO * typical;
 }
 
 // The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
 // that looks anything like a part becomes the best guess; refused are only
-// scribbles (checked before the fit, `fit` < 0) and strokes far from every
+// scribbles and regular polygons or stars (checked before the fit, `fit` <
+// 0) and strokes far from every
 // part, where "far" weighs `near`, the classifier's nearest-drawing distance
 // in units of the model's calibrated reject distance, together with how
 // badly the best guess's part takes the stroke (`fit`: the fit's mean error
@@ -380,7 +442,8 @@ static double mirror_gap(const sp_vec2* pts, int n)
 static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bool profile)
 {
     if (fit < 0) {
-        // A scribble: far more ink than its size, or crossing itself over and over.
+        // A scribble: far more ink than its size, or crossing itself over
+        // and over; or a shape with a polygon's or a star's symmetry.
         enum { M = 64 };
         sp_vec2 r[M], lo = pts[0], hi = pts[0];
         for (int i = 1; i < n; ++i)
@@ -397,7 +460,7 @@ static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bo
                 crossings += d1 * d2 < 0 && d3 * d4 < 0;
             }
 #undef CROSS
-        return crossings > 12;
+        return crossings > 12 || turns_onto_itself(pts, n);
     }
     // A part drawn in profile (a head, a tail, a wing) is seldom its own
     // mirror image about an upright line; much else a visitor draws is (a
