@@ -430,13 +430,12 @@ static bool turns_onto_itself(const sp_vec2* pts, int n)
 // The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
 // that looks anything like a part becomes the best guess; refused are only
 // scribbles and regular polygons or stars (checked before the fit, `fit` <
-// 0) and strokes far from every
-// part, where "far" weighs `near`, the classifier's nearest-drawing distance
-// in units of the model's calibrated reject distance, together with how
-// badly the best guess's part takes the stroke (`fit`: the fit's mean error
-// over the stroke's diagonal) and, when that part is drawn in profile
-// (`profile`), how nearly the stroke is its own mirror image. Taps and tiny
-// strokes never get here.
+// 0) and strokes far from every part, where "far" weighs `near`, the
+// classifier's nearest-drawing distance in units of the model's calibrated
+// reject distance, together with how badly the best guess's part takes the
+// stroke (`fit`: the fit's mean error over the stroke's diagonal) and, when
+// that part is drawn in profile (`profile`), how nearly the stroke is its
+// own mirror image. Taps and tiny strokes never get here.
 // Constants tuned on the tune half of tests/data/visitors (BENCHMARKS.md,
 // "Visitors' drawings").
 static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bool profile)
