@@ -2219,8 +2219,8 @@ static void test_mirror_refusal(void)
 // A drawing with the symmetry of a regular polygon or a star is refused
 // whatever it is taken for (a triangle, a square, a house, a star), and only
 // that symmetry refuses it: the same triangle stretched sideways, a round
-// body with a wobble that repeats five times round and an oval body whose
-// quarter turn lands near itself are parts.
+// body with a wobble that repeats five times round and an oval body (each
+// lands near itself at any turn) are parts.
 static void test_polygon_refusal(void)
 {
     const char* path = real_db();
@@ -2243,8 +2243,8 @@ static void test_polygon_refusal(void)
         free(xy);
         sp_dragon_clear(d);
     }
-    // Drawn by hand here: a square and a five-pointed star, each corner
-    // written twice so the resampling keeps it.
+    // Drawn here: a square and a five-pointed star, their outlines
+    // resampled to 101 points.
     sp_vec2 square[] = {{500, 260}, {780, 260}, {780, 540}, {500, 540}, {500, 260}};
     sp_vec2 star[11];
     for (int i = 0; i <= 10; ++i) {
