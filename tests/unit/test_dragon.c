@@ -2166,6 +2166,20 @@ static void test_root_at_the_body(void)
     sp_db_close(db);
 }
 
+// A visitor's doodle (tune half) drawn at the canvas's centre: refused as
+// unrecognised, with guesses for the chips. Returns its points, which the
+// caller frees, for the caller's further checks.
+static sp_vec2* refused_doodle(sp_dragon* d, const char* rel, sp_dragon_result* res, int* n)
+{
+    sp_error err = {0};
+    sp_vec2* xy = visitor_stroke(rel, 320, (sp_vec2){640, 400}, false, n);
+    ENSURE(sp_dragon_add_points(d, xy, *n, NULL, res, &err) == SP_OK);
+    fprintf(stderr, "  %s: %s, first guess %s\n", rel, res->rejected ? "refused" : "accepted",
+            res->guess_count ? res->guesses[0].category : "-");
+    ENSURE(res->rejected && res->reason == SP_DRAGON_UNRECOGNISED && res->guess_count > 0);
+    return xy;
+}
+
 // The refusal's mirror evidence (docs/DESIGN.md, "Refusal policy"): a
 // visitor's tree and sun (tune half), each its own mirror image about an
 // upright line and taken for a part drawn in profile, are refused, and the
@@ -2180,13 +2194,9 @@ static void test_mirror_refusal(void)
     const char* doodles[] = {"not_a_part/tree.json", "not_a_part/sun.json"};
     for (int k = 0; k < 2; ++k) {
         int n;
-        sp_vec2* xy = visitor_stroke(doodles[k], 320, (sp_vec2){640, 400}, false, &n);
         sp_dragon_result res;
-        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK);
-        fprintf(stderr, "  %s: %s, first guess %s\n", doodles[k], res.rejected ? "refused" : "accepted",
-                res.guess_count ? res.guesses[0].category : "-");
-        ENSURE(res.rejected && res.reason == SP_DRAGON_UNRECOGNISED);
-        ENSURE(res.guess_count > 0 && strcmp(res.guesses[0].category, "torso") != 0 && !strstr(res.guesses[0].category, "legs"));
+        sp_vec2* xy = refused_doodle(d, doodles[k], &res, &n);
+        ENSURE(strcmp(res.guesses[0].category, "torso") != 0 && !strstr(res.guesses[0].category, "legs"));
         if (k == 0) {
             // The tree turned a quarter about its centre is no longer
             // symmetric about an upright line, and the rest of the evidence
@@ -2231,10 +2241,7 @@ static void test_polygon_refusal(void)
     const char* doodles[] = {"not_a_part/triangle.json", "not_a_part/house.json"};
     for (int k = 0; k < 2; ++k) {
         int n;
-        sp_vec2* xy = visitor_stroke(doodles[k], 320, (sp_vec2){640, 400}, false, &n);
-        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK);
-        fprintf(stderr, "  %s: %s\n", doodles[k], res.rejected ? "refused" : "accepted");
-        ENSURE(res.rejected && res.reason == SP_DRAGON_UNRECOGNISED && res.guess_count > 0);
+        sp_vec2* xy = refused_doodle(d, doodles[k], &res, &n);
         if (k == 0) {
             for (int i = 0; i < n; ++i)
                 xy[i].x = 640 + 1.6 * (xy[i].x - 640);

@@ -489,8 +489,10 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     sp_error cerr = {0};
     double tc = sp_now_ms();
     sp_result r = sp_clf_classify(d->clf, sk, NULL, a, &cerr);
-    if (r == SP_OK) fill_guesses(d->clf, a, out);
-    if (r != SP_OK) a->count = 0;
+    if (r == SP_OK)
+        fill_guesses(d->clf, a, out);
+    else
+        a->count = 0; // a failed classification leaves no answer to offer kin from
     if (r != SP_OK && !forced) return SP_DRAGON_UNRECOGNISED;
     out->ms_classify = sp_now_ms() - tc;
     if (forced) return SP_DRAGON_ACCEPTED;
