@@ -246,12 +246,10 @@ static void test_flow(void)
     memset(&f, 0, sizeof f);
     ENSURE(ui->mode == SP_KM_ATTRACT);
     ENSURE(sp_kiosk_ui_hit(ui, ui->target[SP_KT_UNDO].x + 5, ui->target[SP_KT_UNDO].y + 5) == SP_KT_NONE); // no toolbar yet
-    // A touch starts; the touch itself draws nothing.
+    // A tap starts, with no lesson in drawing and nothing to fit.
     send(ui, SP_KEV_DOWN, 100, 640, 300);
-    send(ui, SP_KEV_MOVE, 120, 700, 300);
-    ENSURE(ui->stroke.count == 0);
-    send(ui, SP_KEV_UP, 150, 700, 300);
-    ENSURE(ui->mode == SP_KM_DRAW);
+    send(ui, SP_KEV_UP, 150, 641, 300);
+    ENSURE(ui->mode == SP_KM_DRAW && ui->taps == 1 && !sp_kiosk_ui_hint_visible(ui));
     frame(ui, &f, 160);
     ENSURE(f.log_n == 0);
     // Buttons that need a part do nothing yet.
@@ -900,6 +898,42 @@ static void test_idle_timeout(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// The attract screen asks for one line per part, so a child often draws at
+// once: that stroke leaves the screen and is the visit's first part, drawn
+// live. A touch where the toolbar is about to appear only starts.
+static void test_attract_stroke(void)
+{
+    fake f;
+    memset(&f, 0, sizeof f);
+    sp_kiosk_ui* ui;
+    sp_kiosk_ui_create(NULL, &ui, NULL);
+    sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+    ENSURE(ui->mode == SP_KM_ATTRACT);
+    send(ui, SP_KEV_DOWN, 100, 300, 300);
+    ENSURE(ui->mode == SP_KM_DRAW);
+    for (int i = 1; i < 30; ++i)
+        send(ui, SP_KEV_MOVE, 100 + 10 * i, 300.0f + 12.0f * (float)i, 300.0f + 40.0f * sinf(0.3f * (float)i));
+    ENSURE(ui->stroke.count >= 29);
+    send(ui, SP_KEV_UP, 400, 660, 310);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->count >= 30);
+    ENSURE_NEAR(j.stroke->xy[0], 300, 1e-6);
+    ENSURE(!sp_kiosk_ui_hint_visible(ui));
+    sp_kiosk_ui_destroy(ui);
+
+    // A drag from where Undo will be: started, nothing pressed, nothing drawn.
+    sp_kiosk_ui_create(NULL, &ui, NULL);
+    sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+    const sp_kiosk_rect r = ui->target[SP_KT_UNDO];
+    send(ui, SP_KEV_DOWN, 100, r.x + 0.5f * r.w, r.y + 0.5f * r.h);
+    send(ui, SP_KEV_MOVE, 150, r.x - 200, r.y + 0.5f * r.h);
+    send(ui, SP_KEV_UP, 200, r.x - 200, r.y + 0.5f * r.h);
+    frame(ui, &f, 210);
+    ENSURE(ui->mode == SP_KM_DRAW && f.log_n == 0 && ui->stroke.count == 0 && !sp_kiosk_ui_next_job(ui, &j));
+    ENSURE(!sp_kiosk_ui_hint_visible(ui));
+    sp_kiosk_ui_destroy(ui);
+}
+
 // The countdown is at most a third of the idle time (--idle 15: 5 s after
 // 10 s); a touch during it resets the timer and acts: a chip tap, a button, a stroke.
 static void test_countdown(void)
@@ -935,9 +969,10 @@ static void test_countdown(void)
     frame(ui, &f, t + 23160 + 11000);
     ENSURE(sp_kiosk_ui_countdown_s(ui) > 0);
     ui->hint_until = -1;
+    int taps = ui->taps;
     send(ui, SP_KEV_DOWN, t + 34200, 700, 500);
     send(ui, SP_KEV_UP, t + 34250, 700, 500);
-    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0 && ui->taps == 1 && !sp_kiosk_ui_hint_visible(ui));
+    ENSURE(sp_kiosk_ui_countdown_s(ui) == 0 && ui->taps == taps + 1 && !sp_kiosk_ui_hint_visible(ui));
     // A whole stroke drawn during the countdown becomes a part.
     frame(ui, &f, t + 34250 + 10500);
     ENSURE(sp_kiosk_ui_countdown_s(ui) > 0);
@@ -1056,12 +1091,13 @@ static void test_long_stroke(void)
     ENSURE_NEAR(j.stroke->xy[2 * j.stroke->count - 2], 1279, 1e-6);
     ENSURE_NEAR(j.stroke->xy[2 * j.stroke->count - 1], 0, 1e-6);
     // One point, and a tiny wiggle, are taps: a hint, no job.
+    int taps = ui->taps;
     send(ui, SP_KEV_DOWN, 3000, 500, 500);
     send(ui, SP_KEV_UP, 3010, 500, 500);
     send(ui, SP_KEV_DOWN, 3100, 500, 500);
     send(ui, SP_KEV_MOVE, 3110, 505, 502);
     send(ui, SP_KEV_UP, 3120, 505, 502);
-    ENSURE(!sp_kiosk_ui_next_job(ui, &j) && ui->taps == 2 && sp_kiosk_ui_hint_visible(ui));
+    ENSURE(!sp_kiosk_ui_next_job(ui, &j) && ui->taps == taps + 2 && sp_kiosk_ui_hint_visible(ui));
     // A focus loss in mid-stroke keeps the stroke.
     send(ui, SP_KEV_DOWN, 4000, 100, 100);
     send(ui, SP_KEV_MOVE, 4010, 300, 150);
@@ -1310,6 +1346,7 @@ int main(int argc, char** argv)
                                    {"layout", test_layout},
                                    {"idle_timeout", test_idle_timeout},
                                    {"countdown", test_countdown},
+                                   {"attract_stroke", test_attract_stroke},
                                    {"refused_stroke", test_refused_stroke},
                                    {"parts_row", test_parts_row},
                                    {"other_chip", test_other_chip},

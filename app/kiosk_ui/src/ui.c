@@ -821,12 +821,6 @@ static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
     case SP_KCAP_TARGET:
         if (up && ui->pressed != SP_KT_NONE && sp_kiosk_ui_hit(ui, x, y) == ui->pressed) activate(ui, ui->pressed);
         break;
-    case SP_KCAP_ATTRACT:
-        if (up) { // the empty canvas shows the first-draw prompt (sp_kiosk_ui_message)
-            ui->mode = SP_KM_DRAW;
-            ui->mode_since = ui->now;
-        }
-        break;
     default:
         break;
     }
@@ -843,8 +837,17 @@ static void on_down(sp_kiosk_ui* ui, float x, float y)
     ui->last_input = ui->now;
     ui->last_x = x, ui->last_y = y;
     if (ui->mode == SP_KM_ATTRACT) {
-        ui->capture = SP_KCAP_ATTRACT;
-        return;
+        // The attract screen invites drawing, so a child often starts with a
+        // stroke: it leaves the screen and is already the visit's first stroke.
+        // A tap only starts (no lesson in drawing); the empty canvas then shows
+        // the first-draw prompt (sp_kiosk_ui_message).
+        ui->mode = SP_KM_DRAW;
+        ui->mode_since = ui->now;
+        ui->woke = true;
+        if (sp_kiosk_ui_hit(ui, x, y) != SP_KT_NONE || !inside(&ui->canvas, x, y)) {
+            ui->capture = SP_KCAP_SWALLOW; // the toolbar was not on screen to be aimed at
+            return;
+        }
     }
     sp_kiosk_target t = sp_kiosk_ui_hit(ui, x, y);
     if (t != SP_KT_NONE) {

@@ -73,7 +73,7 @@ sp_kiosk_target sp_kiosk_target_parse(const char* s);
 
 /// Which screen.
 typedef enum sp_kiosk_mode {
-    SP_KM_ATTRACT, ///< "draw a dragon": an animation shows how; a tap starts
+    SP_KM_ATTRACT, ///< "draw a dragon": an animation shows how; a touch starts, a stroke is the first part
     SP_KM_DRAW,    ///< strokes become parts
     SP_KM_TURN,    ///< drags orbit the view
 } sp_kiosk_mode;
@@ -186,7 +186,7 @@ typedef struct sp_kiosk_ui {
     double mode_since; ///< when the current mode began
     sp_kiosk_mode mode;
     // The finger.
-    enum { SP_KCAP_NONE, SP_KCAP_STROKE, SP_KCAP_TARGET, SP_KCAP_ORBIT, SP_KCAP_ATTRACT, SP_KCAP_SWALLOW } capture;
+    enum { SP_KCAP_NONE, SP_KCAP_STROKE, SP_KCAP_TARGET, SP_KCAP_ORBIT, SP_KCAP_SWALLOW } capture;
     sp_kiosk_target pressed; ///< the target under the finger (drawn pressed)
     float last_x, last_y;
     sp_kiosk_line stroke;  ///< the stroke being drawn (blue)
@@ -215,7 +215,7 @@ typedef struct sp_kiosk_ui {
     double held_until;
     char hint[SP_KIOSK_TEXT_MAX];
     double hint_until;
-    bool woke;                         ///< the finger now down touched during the idle countdown
+    bool woke;                         ///< the finger now down touched during the idle countdown or on the attract screen
     char code[16];                     ///< the last save code
     char banner[2][SP_KIOSK_TEXT_MAX]; ///< the save banner: the code, then what it is for
     double banner_until;
