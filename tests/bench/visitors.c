@@ -1,5 +1,6 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
-//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--on-body]
+//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--on-body
+//   [--gap PX]]
 //            [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
@@ -26,7 +27,8 @@
 // legs that became their own kind at their own end, and at the other end.
 // It then draws every head, tail and wing drawing touching a dragon's body
 // (parts_on_body): printed per kind, those that became their own kind (and
-// attached to the body), a body, another part, or were refused.
+// attached to the body), a body, another part, or were refused; with
+// --gap PX drawn that far apart instead (their box PX beyond the body's).
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>
@@ -214,7 +216,7 @@ static void shifted(sp_stroke* s, double dx, double dy)
 // body), a body (a second dragon), another part, refused. parts_first: the
 // part is drawn first, on a clear canvas, then the head and the body, as
 // a visitor who starts with the tail.
-static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half, bool parts_first)
+static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const char* half, bool parts_first, double gap)
 {
     static const char* const kinds[3] = {"head", "tail", "wings"};
     scene_set scenes;
@@ -234,7 +236,15 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, kind != 0, &lo, &hi, &head_at);
             double dir = facing ? -1 : 1;
             sp_stroke ps = placed(part_s, kind == 0 ? 200 : 260, kind == 0 ? head_at : (sp_vec2){640, 400}, false, facing != 0);
-            if (ps.points && kind > 0) {
+            if (ps.points && gap > 0) { // apart: the part's box `gap` px outside the body's, beyond its end or above it
+                stroke_box(&ps, &plo, &phi);
+                if (kind == 2)
+                    shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y - gap) - phi.y);
+                else if ((kind == 0) == (dir > 0))
+                    shifted(&ps, (hi.x + gap) - plo.x, kind == 0 ? 0 : 0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
+                else
+                    shifted(&ps, (lo.x - gap) - phi.x, kind == 0 ? 0 : 0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
+            } else if (ps.points && kind > 0) {
                 stroke_box(&ps, &plo, &phi);
                 if (kind == 1) // the tail's near edge 30 px inside the body's rear edge
                     shifted(&ps, dir > 0 ? (lo.x + 30) - phi.x : (hi.x - 30) - plo.x,
@@ -261,13 +271,18 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     sp_dragon_clear(d);
     if (json) {
         for (int k = 0; k < 3; ++k)
-            printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"own\": %d, \"own_attached\": %d, \"body\": %d, \"other\": "
-                   "%d, \"refused\": %d},\n",
-                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], own[k], attached[k], body[k], other[k], refused[k]);
+            printf("  {\"case\": \"%s %s on a body%s\", \"gap_px\": %g, \"n\": %d, \"own\": %d, \"own_attached\": %d, "
+                   "\"body\": %d, \"other\": %d, \"refused\": %d},\n",
+                   half, kinds[k], parts_first ? ", drawn first" : "", gap, n[k], own[k], attached[k], body[k], other[k],
+                   refused[k]);
         return;
     }
-    printf("Heads, tails and wings drawn touching a dragon's body%s (facing right, then left)\n",
-           parts_first ? ", each drawn first, then the head and the body" : "");
+    if (gap > 0)
+        printf("Heads, tails and wings drawn %g px apart from a dragon's body%s (facing right, then left)\n", gap,
+               parts_first ? ", each drawn first, then the head and the body" : "");
+    else
+        printf("Heads, tails and wings drawn touching a dragon's body%s (facing right, then left)\n",
+               parts_first ? ", each drawn first, then the head and the body" : "");
     printf("%-12s %6s %12s %12s %12s %12s %12s\n", "part", "drawn", "own kind", "attached", "a body", "other part", "refused");
     for (int k = 0; k < 3; ++k)
         printf("%-12s %6d %12d %12d %12d %12d %12d\n", kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k]);
@@ -312,6 +327,7 @@ int main(int argc, char** argv)
     const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_BINARY_DIR "/tests/data/visitors",
                *sheet = NULL;
     bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false, on_body = false;
+    double gap = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--half") && i + 1 < argc)
             half = argv[++i];
@@ -329,9 +345,11 @@ int main(int argc, char** argv)
             fit_all = true;
         else if (!strcmp(argv[i], "--on-body"))
             on_body = true;
+        else if (!strcmp(argv[i], "--gap") && i + 1 < argc)
+            gap = atof(argv[++i]);
         else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "usage: visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                            "[--list] [--fit-all] [--on-body] [--json]\n");
+                            "[--list] [--fit-all] [--on-body [--gap PX]] [--json]\n");
             return 2;
         }
     }
@@ -470,7 +488,7 @@ int main(int argc, char** argv)
         if (on_body) {
             for (int first = 0; first < 2; ++first) {
                 legs_on_body(d, &ds, out, true, half, first);
-                parts_on_body(d, &ds, true, half, first);
+                parts_on_body(d, &ds, true, half, first, gap);
             }
         }
         for (int c = 0; c < nc; ++c) {
@@ -517,7 +535,7 @@ int main(int argc, char** argv)
         if (on_body) {
             for (int first = 0; first < 2; ++first) {
                 legs_on_body(d, &ds, out, false, half, first);
-                parts_on_body(d, &ds, false, half, first);
+                parts_on_body(d, &ds, false, half, first, gap);
             }
         }
     }

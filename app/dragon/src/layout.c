@@ -356,6 +356,20 @@ static bool boxes_overlap(sp_vec2 lo, sp_vec2 hi, sp_vec2 a, sp_vec2 b)
     return lo.x <= b.x && a.x <= hi.x && lo.y <= b.y && a.y <= hi.y;
 }
 
+// The snap distance on the canvas: a part's attachment end within it of a body attaches.
+static double snap_px(const sp_dragon* d)
+{
+    return d->desc.snap_fraction > 0 ? d->desc.snap_fraction * hypot(d->desc.canvas_w, d->desc.canvas_h) : 0;
+}
+
+// Whether the stroke's box [lo, hi] lies on or near a body's box [a, b]:
+// within the snap distance, so that a part drawn there would attach.
+static bool near_body_box(const sp_dragon* d, sp_vec2 lo, sp_vec2 hi, sp_vec2 a, sp_vec2 b)
+{
+    double g = snap_px(d);
+    return boxes_overlap(lo, hi, (sp_vec2){a.x - g, a.y - g}, (sp_vec2){b.x + g, b.y + g});
+}
+
 // Body q's first socket for a part of this category (or preferring it), or NULL.
 static const dsocket* kind_socket(const part* q, const char* category, const char* prefer)
 {
@@ -432,7 +446,9 @@ bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k)
     part* q = d->parts[k];
     sp_vec2 a, b;
     if (!q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) return false;
-    return boxes_overlap(lo, hi, a, b) && hypot(hi.x - lo.x, hi.y - lo.y) <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y);
+    // Near counts as on: a part drawn within the snap distance of a body
+    // attaches to it, so a small shape drawn there is meant for that dragon.
+    return near_body_box(d, lo, hi, a, b) && hypot(hi.x - lo.x, hi.y - lo.y) <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y);
 }
 
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
@@ -476,7 +492,7 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool*
         if (fabs(su) > 0.25 * half) natural = su > 0 ? 1 : -1;
         at_end = fabs(su) > END_SOCKET * half;
     }
-    *out_of_end = at_end && boxes_overlap(lo, hi, blo, bhi) && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
+    *out_of_end = at_end && near_body_box(d, lo, hi, blo, bhi) && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
     return (side > 0 ? 1 : -1) == natural ? 1 : -1;
 }
 
@@ -506,7 +522,7 @@ static void layout_part(sp_dragon* d, int i)
     sp_vec2 a2 = sp_camera_project(&d->world, a);
     p->pub.attach_end = a2;
     if (p->t->is_torso) return;
-    double snap = d->desc.snap_fraction > 0 ? d->desc.snap_fraction * hypot(d->desc.canvas_w, d->desc.canvas_h) : 0;
+    double snap = snap_px(d);
     int bk = -1;
     surface_hit best = {.dist = INFINITY};
     for (int k = 0; k < d->part_n; ++k) {
