@@ -1,7 +1,6 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
-//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all] [--on-body
-//   [--gap PX]]
-//            [--json]
+//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all]
+//            [--on-body [--gap PX]] [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
 // defaults to the whole set the build makes from designs.json and the Quick,

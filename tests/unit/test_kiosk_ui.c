@@ -921,17 +921,21 @@ static void test_attract_stroke(void)
     ENSURE(!sp_kiosk_ui_hint_visible(ui));
     sp_kiosk_ui_destroy(ui);
 
-    // A drag from where Undo will be: started, nothing pressed, nothing drawn.
-    sp_kiosk_ui_create(NULL, &ui, NULL);
-    sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
-    const sp_kiosk_rect r = ui->target[SP_KT_UNDO];
-    send(ui, SP_KEV_DOWN, 100, r.x + 0.5f * r.w, r.y + 0.5f * r.h);
-    send(ui, SP_KEV_MOVE, 150, r.x - 200, r.y + 0.5f * r.h);
-    send(ui, SP_KEV_UP, 200, r.x - 200, r.y + 0.5f * r.h);
-    frame(ui, &f, 210);
-    ENSURE(ui->mode == SP_KM_DRAW && f.log_n == 0 && ui->stroke.count == 0 && !sp_kiosk_ui_next_job(ui, &j));
-    ENSURE(!sp_kiosk_ui_hint_visible(ui));
-    sp_kiosk_ui_destroy(ui);
+    // A tap, and a drag, from where Undo will be: started, nothing pressed
+    // (Undo with no part would say "Draw a dragon part first"), nothing drawn.
+    for (int drag = 0; drag < 2; ++drag) {
+        sp_kiosk_ui_create(NULL, &ui, NULL);
+        sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+        const sp_kiosk_rect r = ui->target[SP_KT_UNDO];
+        float x = r.x + 0.5f * r.w, y = r.y + 0.5f * r.h;
+        send(ui, SP_KEV_DOWN, 100, x, y);
+        if (drag) send(ui, SP_KEV_MOVE, 150, x - 200, y);
+        send(ui, SP_KEV_UP, 200, drag ? x - 200 : x, y);
+        frame(ui, &f, 210);
+        ENSURE(ui->mode == SP_KM_DRAW && f.log_n == 0 && ui->stroke.count == 0 && !sp_kiosk_ui_next_job(ui, &j));
+        ENSURE(!sp_kiosk_ui_hint_visible(ui));
+        sp_kiosk_ui_destroy(ui);
+    }
 }
 
 // The countdown is at most a third of the idle time (--idle 15: 5 s after
