@@ -235,21 +235,17 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, kind != 0, &lo, &hi, &head_at);
             double dir = facing ? -1 : 1;
             sp_stroke ps = placed(part_s, kind == 0 ? 200 : 260, kind == 0 ? head_at : (sp_vec2){640, 400}, false, facing != 0);
-            if (ps.points && gap > 0) { // apart: the part's box `gap` px outside the body's, beyond its end or above it
+            if (ps.points && (kind > 0 || gap > 0)) {
                 stroke_box(&ps, &plo, &phi);
-                if (kind == 2)
-                    shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y - gap) - phi.y);
-                else if ((kind == 0) == (dir > 0))
-                    shifted(&ps, (hi.x + gap) - plo.x, kind == 0 ? 0 : 0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
-                else
-                    shifted(&ps, (lo.x - gap) - phi.x, kind == 0 ? 0 : 0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
-            } else if (ps.points && kind > 0) {
-                stroke_box(&ps, &plo, &phi);
-                if (kind == 1) // the tail's near edge 30 px inside the body's rear edge
-                    shifted(&ps, dir > 0 ? (lo.x + 30) - phi.x : (hi.x - 30) - plo.x,
-                            0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
-                else // the wings' bottom 30 px into the body's top, over its middle
-                    shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y + 30) - phi.y);
+                // Into the body's box by 30 px (touching), or `gap` px apart.
+                double in = gap > 0 ? -gap : 30;
+                if (kind == 2) { // the wings over the body's middle, on (or above) its back
+                    shifted(&ps, 640 - 0.5 * (plo.x + phi.x), (lo.y + in) - phi.y);
+                } else { // the tail out of the rear end, centred on the body's height; apart, the head beyond the front
+                    bool at_right = (kind == 0) == (dir > 0);
+                    shifted(&ps, at_right ? (hi.x - in) - plo.x : (lo.x + in) - phi.x,
+                            kind == 0 ? 0 : 0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
+                }
             }
             ok = ok && ps.points && add_part(d, ds, &scenes, m, facing != 0, kind != 0, parts_first, &ps, &res);
             n[kind]++;

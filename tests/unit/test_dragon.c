@@ -2016,6 +2016,28 @@ static sp_vec2* visitor_stroke(const char* rel, double diag, sp_vec2 at, bool mi
     return xy;
 }
 
+// The box of part i's mesh at its fit on the canvas (fitted_px).
+static void fitted_box(const sp_dragon* d, int i, sp_vec2* lo, sp_vec2* hi)
+{
+    sp_vec2* px = fitted_px(d, i);
+    points_box(px, sp_dragon_part_get(d, i)->character->rig.vertex_count, lo, hi);
+    free(px);
+}
+
+// A visitor's drawing (visitor_stroke: diagonal `diag`, its centre at height
+// y, mirrored on request) at the right or left end of the box [blo, bhi]:
+// its own box `inset` px into it (negative: that far beyond). malloc'd; *n points.
+static sp_vec2* at_box_end(const char* rel, double diag, double y, bool mirror, sp_vec2 blo, sp_vec2 bhi, bool right,
+                           double inset, int* n)
+{
+    sp_vec2 lo, hi, *xy = visitor_stroke(rel, diag, (sp_vec2){0, y}, mirror, n);
+    points_box(xy, *n, &lo, &hi);
+    double dx = right ? (bhi.x - inset) - lo.x : (blo.x + inset) - hi.x;
+    for (int k = 0; k < *n; ++k)
+        xy[k].x += dx;
+    return xy;
+}
+
 // The strokes of the README's kiosk session (docs/img/kiosk_on_body.json: a
 // body, then a round head, a club-ended tail and drooping wings drawn on it).
 static int readme_session(sp_vec2** xy, int* n, int cap)
@@ -2069,15 +2091,10 @@ static void test_drawn_on_body(void)
         // Drawn near the body's front end, 30 px beyond the fitted body's box
         // (the snap distance is 6% of the canvas diagonal, 91 px): near counts as on.
         {
-            sp_vec2 *bxy = fitted_px(d, body.part), blo, bhi, hlo, hhi;
+            sp_vec2 blo, bhi;
             int n;
-            points_box(bxy, sp_dragon_part_get(d, body.part)->character->rig.vertex_count, &blo, &bhi);
-            free(bxy);
-            sp_vec2* xy = visitor_stroke("head/head-blunt-round-ear.json", 180, (sp_vec2){0, blo.y + 40}, mirrored, &n);
-            points_box(xy, n, &hlo, &hhi);
-            double dx = mirrored ? (blo.x - 30) - hhi.x : (bhi.x + 30) - hlo.x;
-            for (int i = 0; i < n; ++i)
-                xy[i].x += dx;
+            fitted_box(d, body.part, &blo, &bhi);
+            sp_vec2* xy = at_box_end("head/head-blunt-round-ear.json", 180, blo.y + 40, mirrored, blo, bhi, !mirrored, -30, &n);
             ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && !res.rejected);
             free(xy);
             const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
@@ -2139,15 +2156,9 @@ static sp_vec2* tail_out_of_body(sp_dragon* d, sp_db* db, const char* tail, bool
 {
     sp_dragon_clear(d);
     *body = draw_part(d, db, "torso", 640, 420, 420, false, true);
-    sp_vec2 *px = fitted_px(d, body->part), blo, bhi, lo, hi;
-    points_box(px, sp_dragon_part_get(d, body->part)->character->rig.vertex_count, &blo, &bhi);
-    free(px);
-    sp_vec2* xy = visitor_stroke(tail, 260, (sp_vec2){0, 0}, right, n);
-    points_box(xy, *n, &lo, &hi);
-    double dx = right ? (bhi.x - inset) - lo.x : (blo.x + inset) - hi.x, dy = 0.5 * (blo.y + bhi.y);
-    for (int i = 0; i < *n; ++i)
-        xy[i].x += dx, xy[i].y += dy;
-    return xy;
+    sp_vec2 blo, bhi;
+    fitted_box(d, body->part, &blo, &bhi);
+    return at_box_end(tail, 260, 0.5 * (blo.y + bhi.y), right, blo, bhi, right, inset, n);
 }
 
 // A head or tail drawn out of a body's end has its root at the body, also

@@ -429,38 +429,42 @@ static bool turns_onto_itself(const sp_vec2* pts, int n)
 
 // The kiosk's refusal policy (docs/DESIGN.md, "Refusal policy"): a stroke
 // that looks anything like a part becomes the best guess; refused are only
-// scribbles and regular polygons or stars (checked before the fit, `fit` <
-// 0) and strokes far from every part, where "far" weighs `near`, the
-// classifier's nearest-drawing distance in units of the model's calibrated
-// reject distance, together with how badly the best guess's part takes the
-// stroke (`fit`: the fit's mean error over the stroke's diagonal) and, when
-// that part is drawn in profile (`profile`), how nearly the stroke is its
-// own mirror image. Taps and tiny strokes never get here.
-// Constants tuned on the tune half of tests/data/visitors (BENCHMARKS.md,
-// "Visitors' drawings").
+// what is clearly not a part, in two halves. Before the fit
+// (refused_before_fit): scribbles, and regular polygons or stars. After it
+// (kiosk_refuses): strokes far from every part. Taps and tiny strokes never
+// get here. Constants tuned on the tune half of tests/data/visitors
+// (BENCHMARKS.md, "Visitors' drawings").
+
+// A scribble (far more ink than its size, or crossing itself over and over)
+// or a shape with a polygon's or a star's symmetry.
+static bool refused_before_fit(const sp_vec2* pts, int n)
+{
+    enum { M = 64 };
+    sp_vec2 r[M], lo = pts[0], hi = pts[0];
+    for (int i = 1; i < n; ++i)
+        lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
+    if (sp_curve_length(pts, n, false) > 6.0 * sp_v2_len(sp_v2_sub(hi, lo))) return true;
+    if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return false;
+#define CROSS(a, b) ((a).x * (b).y - (a).y * (b).x)
+    int crossings = 0;
+    for (int i = 0; i + 1 < M; ++i)
+        for (int j = i + 2; j + 1 < M; ++j) {
+            sp_vec2 p = r[i], q = r[i + 1], u = r[j], v = r[j + 1];
+            double d1 = CROSS(sp_v2_sub(q, p), sp_v2_sub(u, p)), d2 = CROSS(sp_v2_sub(q, p), sp_v2_sub(v, p));
+            double d3 = CROSS(sp_v2_sub(v, u), sp_v2_sub(p, u)), d4 = CROSS(sp_v2_sub(v, u), sp_v2_sub(q, u));
+            crossings += d1 * d2 < 0 && d3 * d4 < 0;
+        }
+#undef CROSS
+    return crossings > 12 || turns_onto_itself(pts, n);
+}
+
+// Far from every part: `near`, the classifier's nearest-drawing distance in
+// units of the model's calibrated reject distance, weighed together with
+// how badly the best guess's part takes the stroke (`fit`: the fit's mean
+// error over the stroke's diagonal) and, when that part is drawn in profile
+// (`profile`), how nearly the stroke is its own mirror image.
 static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bool profile)
 {
-    if (fit < 0) {
-        // A scribble: far more ink than its size, or crossing itself over
-        // and over; or a shape with a polygon's or a star's symmetry.
-        enum { M = 64 };
-        sp_vec2 r[M], lo = pts[0], hi = pts[0];
-        for (int i = 1; i < n; ++i)
-            lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
-        if (sp_curve_length(pts, n, false) > 6.0 * sp_v2_len(sp_v2_sub(hi, lo))) return true;
-        if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return false;
-#define CROSS(a, b) ((a).x * (b).y - (a).y * (b).x)
-        int crossings = 0;
-        for (int i = 0; i + 1 < M; ++i)
-            for (int j = i + 2; j + 1 < M; ++j) {
-                sp_vec2 p = r[i], q = r[i + 1], u = r[j], v = r[j + 1];
-                double d1 = CROSS(sp_v2_sub(q, p), sp_v2_sub(u, p)), d2 = CROSS(sp_v2_sub(q, p), sp_v2_sub(v, p));
-                double d3 = CROSS(sp_v2_sub(v, u), sp_v2_sub(p, u)), d4 = CROSS(sp_v2_sub(v, u), sp_v2_sub(q, u));
-                crossings += d1 * d2 < 0 && d3 * d4 < 0;
-            }
-#undef CROSS
-        return crossings > 12 || turns_onto_itself(pts, n);
-    }
     // A part drawn in profile (a head, a tail, a wing) is seldom its own
     // mirror image about an upright line; much else a visitor draws is (a
     // tree, a sun). Bodies and leg pairs are left out: a visitor's
@@ -472,8 +476,8 @@ static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bo
 // The stroke path's decision: the classifier's answer becomes a category
 // (accepted) or a refusal. Classifies also when the category is forced, so
 // the chips still show the classifier's guesses (out->guesses); a forced
-// category is taken as is; otherwise the top guess, unless the kiosk's
-// refusal policy calls the stroke a scribble or the top guess scores under
+// category is taken as is; otherwise the top guess, unless the stroke is
+// refused before the fit (refused_before_fit) or the top guess scores under
 // min_confidence (the policy's other half waits for the fit: *near, the
 // classifier's nearest distance in units of its reject distance). Sets
 // out->ms_classify. Returns SP_DRAGON_ACCEPTED with category and *confidence
@@ -498,7 +502,7 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     if (forced) return SP_DRAGON_ACCEPTED;
     if (isfinite(a->reject_distance) && a->reject_distance > 0) *near = a->distance / a->reject_distance;
     if (a->count == 0 || a->ranked[0].score < d->desc.min_confidence ||
-        kiosk_refuses(sk->strokes[0].points, sk->strokes[0].count, *near, -1.0, false))
+        refused_before_fit(sk->strokes[0].points, sk->strokes[0].count))
         return SP_DRAGON_UNRECOGNISED;
     dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a->ranked[0].category));
     *confidence = a->ranked[0].score;

@@ -836,20 +836,21 @@ static void on_down(sp_kiosk_ui* ui, float x, float y)
     ui->woke = sp_kiosk_ui_countdown_s(ui) > 0;
     ui->last_input = ui->now;
     ui->last_x = x, ui->last_y = y;
-    if (ui->mode == SP_KM_ATTRACT) {
-        // The attract screen invites drawing, so a child often starts with a
-        // stroke: it leaves the screen and is already the visit's first stroke.
-        // A tap only starts (no lesson in drawing); the empty canvas then shows
-        // the first-draw prompt (sp_kiosk_ui_message).
+    // The attract screen invites drawing, so a child often starts with a
+    // stroke: it leaves the screen and is already the visit's first stroke.
+    // A tap only starts (no lesson in drawing); the empty canvas then shows
+    // the first-draw prompt (sp_kiosk_ui_message).
+    bool starting = ui->mode == SP_KM_ATTRACT;
+    if (starting) {
         ui->mode = SP_KM_DRAW;
         ui->mode_since = ui->now;
         ui->woke = true;
-        if (sp_kiosk_ui_hit(ui, x, y) != SP_KT_NONE || !inside(&ui->canvas, x, y)) {
-            ui->capture = SP_KCAP_SWALLOW; // the toolbar was not on screen to be aimed at
-            return;
-        }
     }
     sp_kiosk_target t = sp_kiosk_ui_hit(ui, x, y);
+    if (starting && (t != SP_KT_NONE || !inside(&ui->canvas, x, y))) {
+        ui->capture = SP_KCAP_SWALLOW; // the toolbar was not on screen to be aimed at
+        return;
+    }
     if (t != SP_KT_NONE) {
         ui->capture = SP_KCAP_TARGET;
         ui->pressed = t;
