@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "sp/curve.h"
+#include "sp/gltf.h"
 #include "sp/handdraw.h"
 #include "sp/outline.h"
 #include "sp/synth.h"
@@ -122,22 +123,6 @@ done:
 
 // ---- a single line through the joints -------------------------------------
 
-// Leaves of the skeleton (joints without children); returns their count (up to cap).
-static int leaves(const sp_rig* rig, int* out, int cap)
-{
-    int n = 0;
-    for (int j = 0; j < rig->joint_count; ++j) {
-        bool leaf = true;
-        for (int c = j + 1; c < rig->joint_count && leaf; ++c)
-            leaf = rig->joints[c].parent != j;
-        if (leaf) {
-            if (n < cap) out[n] = j;
-            ++n;
-        }
-    }
-    return n;
-}
-
 bool sp_handdraw_shape_available(const sp_rig* rig, sp_handdraw_shape shape)
 {
     if (shape == SP_HANDDRAW_SHAPE_PIECE) {
@@ -147,60 +132,28 @@ bool sp_handdraw_shape_available(const sp_rig* rig, sp_handdraw_shape shape)
         return ok;
     }
     if (shape != SP_HANDDRAW_SHAPE_LINE) return shape >= 0 && shape < SP_HANDDRAW_SHAPE_COUNT;
-    int lv[2];
-    int n = leaves(rig, lv, 2);
-    return rig->joint_count >= 3 && (n == 1 || n == 2);
-}
-
-// Chain from joint j up to the root (j first); returns its length.
-static int chain_up(const sp_rig* rig, int j, int* out)
-{
-    int n = 0;
-    for (; j >= 0 && n < rig->joint_count; j = rig->joints[j].parent)
-        out[n++] = j;
-    return n;
+    int order[2];
+    return sp_rig_line_joints(rig, order, 2) > 0;
 }
 
 static sp_result centre_line(const sp_rig* rig, const sp_camera* cam, const double* p, sp_sketch* out)
 {
-    int lv[2];
-    int nl = leaves(rig, lv, 2);
-    if (!(nl == 1 || nl == 2) || rig->joint_count < 3) return SP_ERR_INVALID;
-    int* a = malloc(sizeof(int) * (size_t)rig->joint_count * 2);
-    sp_vec2* pts = malloc(sizeof(sp_vec2) * ((size_t)rig->joint_count * 2 + 4));
+    int* order = malloc(sizeof(int) * ((size_t)rig->joint_count + 1));
+    sp_vec2* pts = malloc(sizeof(sp_vec2) * ((size_t)rig->joint_count + 4));
     sp_rig_eval* ev;
     sp_rig_eval_create(rig, &ev, NULL);
     sp_result r = SP_OK;
-    if (!a || !pts || !ev) {
+    if (!order || !pts || !ev) {
         r = SP_ERR_NO_MEMORY;
+        goto done;
+    }
+    int no = sp_rig_line_joints(rig, order, rig->joint_count);
+    if (no == 0) {
+        r = SP_ERR_INVALID;
         goto done;
     }
     sp_rig_eval_update(ev, p, false);
     const sp_mat4* G = sp_rig_eval_world(ev);
-    int* b = a + rig->joint_count;
-    int na = chain_up(rig, lv[0], a), nb = nl == 2 ? chain_up(rig, lv[1], b) : 0;
-    // Leaf A up to the lowest common ancestor, then down to leaf B (one leaf: up to the root).
-    int lca = na - 1;
-    if (nl == 2)
-        for (int i = 0; i < na; ++i) {
-            bool shared = false;
-            for (int k = 0; k < nb && !shared; ++k)
-                shared = b[k] == a[i];
-            if (shared) {
-                lca = i;
-                break;
-            }
-        }
-    int order[512], no = 0;
-    for (int i = 0; i <= lca && no < 500; ++i)
-        order[no++] = a[i];
-    if (nl == 2) {
-        int k = 0;
-        while (k < nb && b[k] != a[lca])
-            ++k;
-        for (int i = k - 1; i >= 0 && no < 500; --i)
-            order[no++] = b[i];
-    }
     // Joint pivots (the world transforms' translations), each end pushed on
     // by its last bone's length: a leaf joint is where the tip starts.
     int n = 0;
@@ -220,7 +173,7 @@ static sp_result centre_line(const sp_rig* rig, const sp_camera* cam, const doub
     sp_curve_smooth(pts, n, false, 1, pts);
     r = n >= 2 ? sp_sketch_add_stroke(out, pts, NULL, n) : SP_ERR_INVALID;
 done:
-    free(a);
+    free(order);
     free(pts);
     sp_rig_eval_destroy(ev);
     return r;

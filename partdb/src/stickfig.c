@@ -39,6 +39,20 @@ static bool stick_push(stick_buf* b, const sp_mat4* inv_skin, int joint, sp_vec3
     return true;
 }
 
+// Appends b as one open, ordered curve of `abstraction`; `what` names it in the error.
+static sp_result stick_append(sp_rig* rig, const stick_buf* b, const char* abstraction, const char* curve, const char* what,
+                              sp_error* err)
+{
+    if (sp_gltf_append_curve(rig, abstraction, SP_CORR_ORDERED, curve, false, b->n, b->rest, b->joints, b->weights) != SP_OK)
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    return SP_OK;
+}
+
+static void stick_free(stick_buf* b)
+{
+    free(b->rest), free(b->joints), free(b->weights);
+}
+
 sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
 {
     int J = rig->joint_count;
@@ -111,15 +125,164 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
             }
             char name[SP_NAME_MAX];
             snprintf(name, sizeof name, "%.31s-%.31s", rig->joints[chain[0]].name, rig->joints[chain[len - 1]].name);
-            if (sp_gltf_append_curve(rig, "stick", SP_CORR_ORDERED, name, false, b.n, b.rest, b.joints, b.weights) != SP_OK) {
-                r = sp_fail(err, SP_ERR_NO_MEMORY, "stick figure: out of memory");
-                goto done;
-            }
+            if ((r = stick_append(rig, &b, "stick", name, "stick figure", err)) != SP_OK) goto done;
         }
     }
 done:
     sp_rig_eval_destroy(ev);
     free(nchild), free(chain), free(p), free(inv), free(pos);
-    free(b.rest), free(b.joints), free(b.weights);
+    stick_free(&b);
+    return r;
+}
+
+// ---- the line through a chain-shaped skeleton -----------------------------
+
+// Leaves of the skeleton (joints without children); returns their count (up to cap).
+static int leaves(const sp_rig* rig, int* out, int cap)
+{
+    int n = 0;
+    for (int j = 0; j < rig->joint_count; ++j) {
+        bool leaf = true;
+        for (int c = j + 1; c < rig->joint_count && leaf; ++c)
+            leaf = rig->joints[c].parent != j;
+        if (leaf) {
+            if (n < cap) out[n] = j;
+            ++n;
+        }
+    }
+    return n;
+}
+
+// Chain from joint j up to the root (j first); returns its length.
+static int chain_up(const sp_rig* rig, int j, int* out)
+{
+    int n = 0;
+    for (; j >= 0 && n < rig->joint_count; j = rig->joints[j].parent)
+        out[n++] = j;
+    return n;
+}
+
+int sp_rig_line_joints(const sp_rig* rig, int* order, int cap)
+{
+    int lv[2];
+    int nl = leaves(rig, lv, 2);
+    if (!(nl == 1 || nl == 2) || rig->joint_count < 3) return 0;
+    int* a = malloc(sizeof(int) * (size_t)rig->joint_count * 2);
+    if (!a) return 0;
+    int* b = a + rig->joint_count;
+    int na = chain_up(rig, lv[0], a), nb = nl == 2 ? chain_up(rig, lv[1], b) : 0;
+    // Leaf A up to the lowest common ancestor, then down to leaf B (one leaf: up to the root).
+    int lca = na - 1;
+    if (nl == 2)
+        for (int i = 0; i < na; ++i) {
+            bool shared = false;
+            for (int k = 0; k < nb && !shared; ++k)
+                shared = b[k] == a[i];
+            if (shared) {
+                lca = i;
+                break;
+            }
+        }
+    int no = 0;
+    for (int i = 0; i <= lca && no < cap; ++i)
+        order[no++] = a[i];
+    if (nl == 2) {
+        int k = 0;
+        while (k < nb && b[k] != a[lca])
+            ++k;
+        for (int i = k - 1; i >= 0 && no < cap; --i)
+            order[no++] = b[i];
+    }
+    free(a);
+    return no;
+}
+
+// Points along the whole line, spread by length (the outline has 150).
+enum { LINE_POINTS = 96 };
+
+// The end of the line beyond joint `joint` at `pivot`, coming from `from`:
+// as far along that way as the vertices `joint` moves most reach (xyz: the
+// mesh at the default parameters; NULL, or none reaching on: 0.8 of the
+// last bone, as the training's line shape).
+static sp_vec3 pushed_end(const sp_rig* rig, const double* xyz, int joint, sp_vec3 pivot, sp_vec3 from)
+{
+    sp_vec3 d = sp_v3_sub(pivot, from);
+    double len = sp_v3_len(d), reach = 0.8 * len;
+    if (!(len > 0)) return pivot;
+    d = sp_v3_scale(d, 1.0 / len);
+    double far = 0;
+    for (int v = 0; xyz && v < rig->vertex_count; ++v) {
+        int strongest = 0;
+        for (int k = 1; k < 4; ++k)
+            if (rig->weights4[4 * v + k] > rig->weights4[4 * v + strongest]) strongest = k;
+        if (rig->joints4[4 * v + strongest] != joint) continue;
+        sp_vec3 x = {xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]};
+        far = fmax(far, sp_v3_dot(sp_v3_sub(x, pivot), d));
+    }
+    return sp_v3_add(pivot, sp_v3_scale(d, far > 0 ? far : reach));
+}
+
+sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err)
+{
+    *added = false;
+    int J = rig->joint_count;
+    if (sp_rig_find_abstraction(rig, "line") >= 0) return SP_OK;
+    int* order = malloc(sizeof(int) * (size_t)(J + 1));
+    double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
+    sp_vec3* at = malloc(sizeof(sp_vec3) * (size_t)(J + 3)); // the path's points: the two pushed ends added
+    int* bone = malloc(sizeof(int) * (size_t)(J + 3));       // the joint moving the segment from at[i] to at[i + 1]
+    double* xyz = NULL;
+    sp_rig_eval* ev = NULL;
+    sp_rig_eval_create(rig, &ev, NULL);
+    stick_buf b = {0};
+    sp_result r = SP_OK;
+    if (!order || !p || !at || !bone || !ev) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "line: out of memory");
+        goto done;
+    }
+    int n = sp_rig_line_joints(rig, order, J);
+    if (n < 2) goto done;
+    sp_rig_defaults(rig, p);
+    sp_rig_eval_update(ev, p, false);
+    const sp_mat4* world = sp_rig_eval_world(ev);
+    const sp_mat4* skin = sp_rig_eval_skin(ev);
+    // Joint pivots, each end pushed on to the end of the mesh there (a
+    // visitor's line ends where the drawn part does: a tail's spade, the
+    // toes' claws).
+    for (int i = 0; i < n; ++i)
+        at[i + 1] = sp_mat4_translation(&world[order[i]]);
+    if (rig->vertex_count > 0 && (xyz = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count)))
+        sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
+    at[0] = pushed_end(rig, xyz, order[0], at[1], at[2]);
+    at[n + 1] = pushed_end(rig, xyz, order[n - 1], at[n], at[n - 1]);
+    // A segment is the bone of the parent of its two joints; a pushed end is its joint's.
+    bone[0] = order[0], bone[n] = order[n - 1];
+    for (int i = 1; i < n; ++i) {
+        int u = order[i - 1], v = order[i];
+        bone[i] = rig->joints[u].parent == v ? v : u;
+    }
+    double total = 0;
+    for (int i = 0; i <= n; ++i)
+        total += sp_v3_len(sp_v3_sub(at[i + 1], at[i]));
+    if (!(total > 0) || !isfinite(total)) goto done;
+    for (int i = 0; i <= n; ++i) {
+        sp_vec3 d = sp_v3_sub(at[i + 1], at[i]);
+        int k = (int)ceil(LINE_POINTS * sp_v3_len(d) / total);
+        sp_mat4 inv;
+        if (!sp_mat4_inverse(&skin[bone[i]], &inv)) {
+            r = sp_fail(err, SP_ERR_INVALID, "line: joint %s has a singular skin matrix", rig->joints[bone[i]].name);
+            goto done;
+        }
+        for (int s = 0; s < k || (i == n && s == k); ++s)
+            if (!stick_push(&b, &inv, bone[i], sp_v3_add(at[i], sp_v3_scale(d, k > 0 ? (double)s / k : 0.0)))) {
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "line: out of memory");
+                goto done;
+            }
+    }
+    if (b.n >= 2 && (r = stick_append(rig, &b, "line", "line", "line", err)) == SP_OK) *added = true;
+done:
+    sp_rig_eval_destroy(ev);
+    free(order), free(p), free(at), free(bone), free(xyz);
+    stick_free(&b);
     return r;
 }

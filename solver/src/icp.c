@@ -114,22 +114,6 @@ typedef struct attempt {
     const sp_ordered_info* loop_shift; // hold this shift and direction through the ordered rounds (NULL: the best each round)
 } attempt;
 
-// A stroke whose ends meet within a fifth of its bounding-box diagonal: a
-// person drawing a closed outline (gaps at closure are common, see the
-// hand-drawing model of the classifier's training data).
-static bool stroke_is_loop(const sp_stroke* st)
-{
-    if (st->count < 8) return false;
-    double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
-    for (int i = 0; i < st->count; ++i) {
-        lx = fmin(lx, st->points[i].x), hx = fmax(hx, st->points[i].x);
-        ly = fmin(ly, st->points[i].y), hy = fmax(hy, st->points[i].y);
-    }
-    double diag = hypot(hx - lx, hy - ly);
-    sp_vec2 gap = sp_v2_sub(st->points[st->count - 1], st->points[0]);
-    return diag > 0 && sp_v2_len(gap) <= 0.2 * diag;
-}
-
 // The stages of attempt `at`. The placement stage is skipped when the
 // strokes' box already overlaps the abstraction's at the start pose by an
 // IoU over 0.5 (a character redrawn where it stands: closest points would
@@ -146,7 +130,7 @@ static void plan_attempt(const sp_solver* s, const sp_sketch* sk, const attempt*
     const sp_model* m = s->model;
     const bool placing = !s->d.no_root_alignment && m->placement_count > 0 && start_iou <= 0.5;
     const bool loop = s->ab->correspondence == SP_CORR_CLOSEST && s->ab->curve_count == 1 && s->ab->curves[0].closed &&
-                      sk->stroke_count == 1 && stroke_is_loop(&sk->strokes[0]) && at->allow_loop;
+                      sk->stroke_count == 1 && sp_stroke_is_loop(&sk->strokes[0]) && at->allow_loop;
     *pl = (plan){.loop = loop, .placed_free = placing && loop && at->place_free, .graduate_vertex = m->embedded};
     pl->boost_from = pl->placed_free ? m->placement_count : 0;
     const bool place_stage = placing && !pl->placed_free;

@@ -83,3 +83,18 @@ bool sp_sketch_is_valid(const sp_sketch* s)
         }
     return true;
 }
+
+// Why a fifth: gaps at closure are common in hand drawing (see the
+// hand-drawing model of the classifier's training data).
+bool sp_stroke_is_loop(const sp_stroke* st)
+{
+    if (st->count < 8) return false;
+    double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
+    for (int i = 0; i < st->count; ++i) {
+        lx = fmin(lx, st->points[i].x), hx = fmax(hx, st->points[i].x);
+        ly = fmin(ly, st->points[i].y), hy = fmax(hy, st->points[i].y);
+    }
+    double diag = hypot(hx - lx, hy - ly);
+    sp_vec2 gap = sp_v2_sub(st->points[st->count - 1], st->points[0]);
+    return diag > 0 && sp_v2_len(gap) <= 0.2 * diag;
+}

@@ -258,6 +258,72 @@ static void test_contents(void)
     }
 }
 
+// ---- the line drawn parts are fitted with ------------------------------------
+
+// Distance from q to the polyline through z (n points, 3 each).
+static double to_polyline(const double* z, int n, sp_vec3 q)
+{
+    double best = INFINITY;
+    for (int i = 0; i + 1 < n; ++i) {
+        sp_vec3 a = {z[3 * i], z[3 * i + 1], z[3 * i + 2]}, b = {z[3 * i + 3], z[3 * i + 4], z[3 * i + 5]};
+        sp_vec3 ab = sp_v3_sub(b, a);
+        double l2 = sp_v3_dot(ab, ab), t = l2 > 0 ? fmin(fmax(sp_v3_dot(sp_v3_sub(q, a), ab) / l2, 0.0), 1.0) : 0.0;
+        best = fmin(best, sp_v3_len(sp_v3_sub(q, sp_v3_add(a, sp_v3_scale(ab, t)))));
+    }
+    return best;
+}
+
+// sp_rig_add_line: the tail and the leg pairs get one open, ordered curve
+// through their joints that rides their bones (at rest and in random poses
+// every joint's pivot lies on it), its ends beyond the end joints, as far
+// as the mesh reaches there; the other parts get none, and a second call
+// adds nothing.
+static void test_line(void)
+{
+    for (int i = 0; i < PART_COUNT; ++i) {
+        sp_character ch = {0};
+        load_part(k_parts[i], &ch);
+        sp_rig* rig = &ch.rig;
+        int before = rig->abstraction_count;
+        bool added = false, chain = !strcmp(k_parts[i], "tail") || strstr(k_parts[i], "legs");
+        sp_error err = {0};
+        ENSURE(sp_rig_add_line(rig, &added, &err) == SP_OK && added == chain);
+        ENSURE(rig->abstraction_count == before + chain);
+        if (chain) {
+            const sp_abstraction* ab = &rig->abstractions[sp_rig_find_abstraction(rig, "line")];
+            ENSURE(ab->correspondence == SP_CORR_ORDERED && ab->curve_count == 1 && !ab->curves[0].closed);
+            ENSURE(ab->point_count >= 96 && ab->point_count <= 120);
+            int order[64], n = sp_rig_line_joints(rig, order, 64);
+            ENSURE(n == rig->joint_count); // a tail is one chain; the legs meet at their root
+            double* p = malloc(sizeof(double) * (size_t)rig->param_count);
+            double* z = malloc(sizeof(double) * 3 * (size_t)ab->point_count);
+            sp_rig_eval* ev;
+            ENSURE(p && z && sp_rig_eval_create(rig, &ev, &err) == SP_OK);
+            for (int pose = 0; pose < 4; ++pose) {
+                if (pose == 0)
+                    sp_rig_defaults(rig, p);
+                else
+                    sp_synth_params(rig, (uint64_t)pose, 0.6, p);
+                sp_rig_eval_update(ev, p, false);
+                sp_rig_eval_abstraction(ev, ab, NULL, z);
+                const sp_mat4* G = sp_rig_eval_world(ev);
+                sp_vec3 first = {z[0], z[1], z[2]},
+                        last = {z[3 * ab->point_count - 3], z[3 * ab->point_count - 2], z[3 * ab->point_count - 1]};
+                double size = sp_v3_len(sp_v3_sub(last, first));
+                for (int k = 0; k < n; ++k)
+                    ENSURE(to_polyline(z, ab->point_count, sp_mat4_translation(&G[order[k]])) < 1e-9 * fmax(size, 1.0));
+                // The ends lie beyond the end joints.
+                ENSURE(sp_v3_len(sp_v3_sub(first, sp_mat4_translation(&G[order[0]]))) > 0.02 * size);
+                ENSURE(sp_v3_len(sp_v3_sub(last, sp_mat4_translation(&G[order[n - 1]]))) > 0.02 * size);
+            }
+            sp_rig_eval_destroy(ev);
+            free(p), free(z);
+        }
+        ENSURE(sp_rig_add_line(rig, &added, &err) == SP_OK && !added && rig->abstraction_count == before + chain);
+        sp_character_free(&ch);
+    }
+}
+
 // ---- folds and mirrors under random poses -----------------------------------
 
 static double det3(const double* a) // column-major 3x3
@@ -647,6 +713,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"regenerate_identical", test_regenerate_identical},
                                    {"contents", test_contents},
+                                   {"line", test_line},
                                    {"characters", test_characters},
                                    {"random_poses", test_random_poses},
                                    {"validator", test_validator},

@@ -89,6 +89,20 @@ typedef struct sp_gltf_scene_desc {
 /// is not a similarity, or non-finite values.
 sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const char* path, sp_error* err);
 
+/// The joints of a skeleton of one chain (a tail: its tip up to the root) or
+/// two chains from one joint (a pair of legs: one leaf up to the joint they
+/// share, then down to the other leaf), in that order, at most cap of them;
+/// 0 for any other skeleton or one of fewer than 3 joints.
+int sp_rig_line_joints(const sp_rig* rig, int* order, int cap);
+/// Appends the `line` abstraction to such a rig: one open curve (ordered
+/// pairs) through those joints' pivots at the default parameters, each end
+/// pushed on by 0.8 of its last bone (as the training's line shape), about
+/// 96 points, each rigid with the bone it lies on. What a visitor draws as
+/// one line (a wavy tail, legs as a peaked line) is fitted with it.
+/// *added is false, and nothing changes, for another skeleton or a rig that
+/// already has a `line`; also on SP_ERR_NO_MEMORY or SP_ERR_INVALID (a
+/// singular skin matrix), when the rig is not to be fitted with a line.
+sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err);
 /// Makes a character of a finalized rig, which it takes over (*rig is zeroed):
 /// default pose, light grey vertices, the default front orthographic camera.
 /// For generators and tests that build rigs in code and want to save them.

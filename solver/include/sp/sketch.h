@@ -39,6 +39,10 @@ int sp_sketch_point_count(const sp_sketch* s);
 bool sp_sketch_bounds(const sp_sketch* s, sp_vec2* lo, sp_vec2* hi);
 /// True when every coordinate (and time) is finite.
 bool sp_sketch_is_valid(const sp_sketch* s);
+/// Whether a stroke is drawn as a loop: at least 8 points, its ends within a
+/// fifth of its bounding box's diagonal (people leave gaps when they close
+/// an outline). The solver matches a loop to a closed outline in order first.
+bool sp_stroke_is_loop(const sp_stroke* st);
 
 #ifdef __cplusplus
 }
