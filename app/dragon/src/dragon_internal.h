@@ -57,6 +57,11 @@ typedef struct tpl {
     sp_solver* solver;
     sp_camera solver_cam; // the solver reads the camera through this pointer at every solve
     sp_rig_eval* ev;
+    // The same part fitted with its `line` abstraction (sp_rig_add_line: a
+    // tail, a pair of legs), for strokes drawn as one open line; NULL for
+    // other parts and for the line template itself.
+    struct tpl* line;
+    bool* active; // the line template's solver moves these (param_count; NULL: all)
 } tpl;
 
 /// Drops one reference (the last frees it). NULL is fine.

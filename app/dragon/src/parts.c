@@ -14,7 +14,9 @@
 void dragon_tpl_release(tpl* t)
 {
     if (!t || --t->refs > 0) return;
+    dragon_tpl_release(t->line);
     sp_solver_destroy(t->solver);
+    free(t->active);
     sp_rig_eval_destroy(t->ev);
     free(t->sockets);
     free(t->clip0);
@@ -78,7 +80,11 @@ static void read_part_extras(tpl* t)
     }
 }
 
-static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve, sp_error* err)
+// Loads part `name` as a template fitted with its `outline` (the part's
+// abstraction), or with a `line` added to it (line: NULL, and nothing in
+// err, when its skeleton has no line).
+static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve, bool line,
+                     sp_error* err)
 {
     tpl* t = calloc(1, sizeof *t);
     if (!t) {
@@ -95,8 +101,17 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
     dragon_copy_name(t->category, sizeof t->category, info.category);
     dragon_copy_name(t->sha256, sizeof t->sha256, info.sha256);
     const sp_rig* rig = &t->ch.rig;
-    t->abstraction = info.abstraction[0] ? sp_rig_find_abstraction(rig, info.abstraction) : -1;
-    if (t->abstraction < 0) t->abstraction = rig->abstraction_count > 0 ? 0 : -1;
+    if (line) {
+        bool added = false;
+        if (sp_rig_add_line(&t->ch.rig, &added, err) != SP_OK || !added) {
+            dragon_tpl_release(t);
+            return NULL;
+        }
+        t->abstraction = sp_rig_find_abstraction(rig, "line");
+    } else {
+        t->abstraction = info.abstraction[0] ? sp_rig_find_abstraction(rig, info.abstraction) : -1;
+        if (t->abstraction < 0) t->abstraction = rig->abstraction_count > 0 ? 0 : -1;
+    }
     size_t P = (size_t)rig->param_count + 1, J = (size_t)rig->joint_count + 1;
     sp_rig_eval_create(rig, &t->ev, NULL);
     t->scratch_p = malloc(sizeof(double) * P);
@@ -178,13 +193,38 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
         sp_rig_defaults(rig, t->clip0);
     }
     t->solver_cam = t->base;
-    sp_solver_create(rig, t->abstraction, &t->solver_cam, solve, &t->solver, NULL);
+    sp_solve_desc sd = *solve;
+    if (line) {
+        // A line says nothing of a part's thickness: its proportions stay
+        // as modelled (the bone scales held at rest) and only the pose and
+        // the root's size move, so a tail drawn as a line is not fattened.
+        t->active = malloc(sizeof(bool) * P);
+        if (!t->active) {
+            sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+            goto fail;
+        }
+        for (int k = 0; k < rig->param_count; ++k)
+            t->active[k] = rig->params[k].group == SP_GROUP_POSE ||
+                           (rig->joints[rig->params[k].joint].parent < 0 && rig->params[k].channel == SP_CH_S);
+        sd.active = t->active;
+    }
+    sp_solver_create(rig, t->abstraction, &t->solver_cam, &sd, &t->solver, NULL);
     if (!t->solver) {
         sp_fail(err, SP_ERR_NO_MEMORY, "part %s: cannot prepare the solver (out of memory)", name);
         goto fail;
     }
     free(xyz);
     free(xy);
+    int ends[2];
+    if (!line && !t->is_torso && sp_rig_line_joints(rig, ends, 2) > 0) {
+        sp_error lerr = {0}; // a part whose line cannot be made is still fitted with its outline
+        t->line = tpl_load(db, name, canvas_w, canvas_h, solve, true, &lerr);
+        if (t->line) {
+            // Which way the part reaches is the part's, whichever curve is fitted.
+            t->line->lengthwise = t->lengthwise;
+            t->line->outward = t->outward;
+        }
+    }
     return t;
 fail:
     free(xyz);
@@ -345,7 +385,7 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
         for (int k = 0; k < d->cache_n && !t; ++k)
             if (!strcmp(d->cache[k]->name, names[i])) t = d->cache[k];
         if (!t) {
-            t = tpl_load(d->db, names[i], d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, err);
+            t = tpl_load(d->db, names[i], d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, false, err);
             if (!t) continue; // a part that does not load is skipped; err keeps why
             tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
             if (!c) {

@@ -9,6 +9,7 @@
 #include "dragon_internal.h"
 #include "sp/clock.h"
 #include "sp/curve.h"
+#include "sp/synth.h"
 
 // Cleans a stroke: clamps onto the canvas, drops repeated points, resamples
 // very long strokes. *out malloc'd. Returns the point count (0 on no memory).
@@ -191,6 +192,67 @@ static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk,
         }
     }
     return any;
+}
+
+// How far apart fit f's curves and the stroke are, both ways: the mean of
+// the stroke's points' mean distance to the curves and the curves' points'
+// mean distance to the stroke, over the stroke's box diagonal. The solver's
+// error goes one way only, so an outline along one side of a line drawing
+// scores as well as a line on it. INFINITY when it cannot be measured.
+static double two_way_gap(const fit_choice* f, const sp_stroke* st)
+{
+    const sp_rig* rig = &f->t->ch.rig;
+    const sp_abstraction* ab = &rig->abstractions[f->t->abstraction];
+    int m = ab->point_count, n = st->count;
+    double* xy = malloc(sizeof(double) * 2 * (size_t)m);
+    sp_vec2* c = malloc(sizeof(sp_vec2) * (size_t)m);
+    int* next = malloc(sizeof(int) * (size_t)(m > n ? m : n));
+    double* dist = malloc(sizeof(double) * (size_t)(m > n ? m : n));
+    double gap = INFINITY;
+    if (!xy || !c || !next || !dist || sp_abstraction_project(rig, f->t->abstraction, &f->view, f->p, xy) != SP_OK) goto done;
+    for (int i = 0; i < m; ++i)
+        c[i] = (sp_vec2){xy[2 * i], xy[2 * i + 1]}, next[i] = i + 1;
+    for (int k = 0; k < ab->curve_count; ++k) {
+        const sp_curve* cv = &ab->curves[k];
+        next[cv->first_point + cv->point_count - 1] = cv->closed ? cv->first_point : -1;
+    }
+    double to_curve = 0, to_stroke = 0;
+    if (sp_polyline_distances(c, next, m, st->points, n, dist) != SP_OK) goto done;
+    for (int i = 0; i < n; ++i)
+        to_curve += dist[i];
+    for (int i = 0; i < n; ++i)
+        next[i] = i + 1 < n ? i + 1 : -1;
+    if (sp_polyline_distances(st->points, next, n, c, m, dist) != SP_OK) goto done;
+    for (int i = 0; i < m; ++i)
+        to_stroke += dist[i];
+    sp_vec2 lo, hi;
+    sp_sketch one = {.stroke_count = 1, .strokes = (sp_stroke*)st};
+    if (sp_sketch_bounds(&one, &lo, &hi)) gap = 0.5 * (to_curve / n + to_stroke / m) / fmax(sp_v2_len(sp_v2_sub(hi, lo)), 1.0);
+done:
+    free(xy), free(c), free(next), free(dist);
+    return gap;
+}
+
+// A stroke drawn as one open line (not a loop: sp_stroke_is_loop) may be a
+// tail or a pair of legs drawn as a line, which the part's outline can only
+// take folded or shrunk: the kept fit f is fitted again with the part's
+// line (tpl.line) in the same facing, and the line's fit replaces it when
+// it lies nearer the stroke both ways (two_way_gap). The outline's score
+// stays f's evidence (the ranking and the refusal are measured on outlines).
+static void prefer_line(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, fit_choice* f)
+{
+    fit_choice l;
+    int not_finite = 0;
+    if (!f->t->line || sp_stroke_is_loop(&sk->strokes[0]) || !fit_one(d, f->t->line, sk, lo, hi, f->mirrored, &l, &not_finite))
+        return;
+    double gf = two_way_gap(f, &sk->strokes[0]), gl = two_way_gap(&l, &sk->strokes[0]);
+    if (gl < gf) {
+        l.score = f->score;
+        free(f->p);
+        *f = l;
+    } else {
+        free(l.p);
+    }
 }
 
 // Fits every part of `category` (each variant and facing) to the stroke: the
@@ -537,7 +599,9 @@ static bool fit_family_member(sp_dragon* d, int i, char member[SP_NAME_MAX], fit
     stroke_box_of(old, &lo, &hi);
     int not_finite = 0;
     bool any_part = false;
-    return fit_category(d, member, &sk, lo, hi, f, &not_finite, &any_part);
+    if (!fit_category(d, member, &sk, lo, hi, f, &not_finite, &any_part)) return false;
+    prefer_line(d, &sk, lo, hi, f);
+    return true;
 }
 
 // A classified part of a family drawn at a body becomes the family's member
@@ -625,6 +689,7 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
         free(f.p);
         return false;
     }
+    prefer_line(d, &sk, lo, hi, &f);
     return replace_before_body(d, i, &f, confidence, d->parts[body]->pub.id);
 }
 
@@ -679,6 +744,7 @@ static void parts_meet_body(sp_dragon* d)
         fit_choice f;
         int not_finite = 0;
         if (!fit_one(d, old->t, &sk, lo, hi, hint < 0, &f, &not_finite)) continue;
+        prefer_line(d, &sk, lo, hi, &f);
         changed |= replace_before_body(d, i, &f, old->pub.confidence, by);
     }
     if (changed) dragon_relayout(d);
@@ -767,6 +833,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         free(best.p);
         return reject(out, SP_DRAGON_UNRECOGNISED, t0);
     }
+    prefer_line(d, &sk, lo, hi, &best);
     part* q = NULL;
     sp_result r = new_part(d, best.t, best.p, &best.rep, &best.view, best.mirrored, pts, n, confidence, &q, err);
     free(best.p);
