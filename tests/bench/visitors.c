@@ -23,10 +23,12 @@
 // the half's bodies and heads in turn (forced, so that only the legs are
 // measured), the dragon facing right, then left (the legs mirrored with
 // it), the legs under the body's front or rear; printed per kind: the
-// legs that became their own kind at their own end, and at the other end.
+// legs that became their own kind at their own end, and at the other end,
+// and of those taken for legs, how many face the way their dragon does.
 // It then draws every head, tail and wing drawing touching a dragon's body
 // (parts_on_body): printed per kind, those that became their own kind (and
-// attached to the body), a body, another part, or were refused; with
+// attached to the body; facing the way the dragon does), a body, another
+// part, or were refused; with
 // --gap PX drawn that far apart instead (their box PX beyond the body's).
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
@@ -151,7 +153,7 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
     static const char* const kinds[2] = {"front_legs", "hind_legs"};
     scene_set scenes;
     if (!scene_drawings(ds, &scenes)) return;
-    int n[2] = {0}, own[2] = {0}, other[2] = {0}, alone[2] = {0};
+    int n[2] = {0}, own[2] = {0}, other[2] = {0}, alone[2] = {0}, as_legs[2] = {0}, faced[2] = {0};
     int m = 0;
     for (int i = 0; i < ds->count; ++i) {
         const char* label = ds->categories[ds->samples[i].label];
@@ -171,7 +173,9 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
                                       true, facing != 0);
                 ok = ok && ls.points && add_part(d, ds, &scenes, m, facing != 0, true, parts_first, &ls, &res);
                 if (ok && !res.rejected) {
-                    bool right = !strcmp(sp_dragon_part_get(d, res.part)->category, label);
+                    const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+                    bool right = !strcmp(p->category, label);
+                    if (strstr(p->category, "legs")) as_legs[kind]++, faced[kind] += p->mirrored == (facing != 0);
                     if (end == 0)
                         own[kind] += right;
                     else
@@ -184,16 +188,18 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
     sp_dragon_clear(d);
     if (json) {
         for (int k = 0; k < 2; ++k)
-            printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d},\n", half,
-                   kinds[k], parts_first ? ", drawn first" : "", n[k], alone[k], own[k], other[k]);
+            printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d, "
+                   "\"as_legs\": %d, \"facing_the_dragon\": %d},\n",
+                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], alone[k], own[k], other[k], as_legs[k], faced[k]);
         return;
     }
     printf("Legs drawn at a dragon (%s; facing right, then left): became their own kind\n",
            parts_first ? "the legs first, then a head and the body" : "a body and a head first");
-    printf("%-12s %6s %22s %22s %22s\n", "legs", "drawn", "alone (no body)", "at their own end", "at the other end");
+    printf("%-12s %6s %22s %22s %22s %22s\n", "legs", "drawn", "alone (no body)", "at their own end", "at the other end",
+           "facing their dragon");
     for (int k = 0; k < 2; ++k)
-        printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k], other[k],
-               n[k]);
+        printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k],
+               other[k], n[k], faced[k], as_legs[k]);
 }
 
 // The stroke moved by (dx, dy), in place.
@@ -220,7 +226,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     static const char* const kinds[3] = {"head", "tail", "wings"};
     scene_set scenes;
     if (!scene_drawings(ds, &scenes)) return;
-    int n[3] = {0}, own[3] = {0}, attached[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0};
+    int n[3] = {0}, own[3] = {0}, attached[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0}, faced[3] = {0};
     int m = 0;
     for (int i = 0; i < ds->count; ++i) {
         const char* label = ds->categories[ds->samples[i].label];
@@ -254,7 +260,8 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             } else {
                 const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
                 if (!strcmp(p->category, label))
-                    own[kind]++, attached[kind] += p->attached_to >= 0 && sp_dragon_part_get(d, p->attached_to)->is_torso;
+                    own[kind]++, attached[kind] += p->attached_to >= 0 && sp_dragon_part_get(d, p->attached_to)->is_torso,
+                        faced[kind] += p->mirrored == (facing != 0);
                 else if (p->is_torso)
                     body[kind]++;
                 else
@@ -267,9 +274,9 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     if (json) {
         for (int k = 0; k < 3; ++k)
             printf("  {\"case\": \"%s %s on a body%s\", \"gap_px\": %g, \"n\": %d, \"own\": %d, \"own_attached\": %d, "
-                   "\"body\": %d, \"other\": %d, \"refused\": %d},\n",
+                   "\"body\": %d, \"other\": %d, \"refused\": %d, \"own_facing_the_dragon\": %d},\n",
                    half, kinds[k], parts_first ? ", drawn first" : "", gap, n[k], own[k], attached[k], body[k], other[k],
-                   refused[k]);
+                   refused[k], faced[k]);
         return;
     }
     if (gap > 0)
@@ -278,9 +285,11 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     else
         printf("Heads, tails and wings drawn touching a dragon's body%s (facing right, then left)\n",
                parts_first ? ", each drawn first, then the head and the body" : "");
-    printf("%-12s %6s %12s %12s %12s %12s %12s\n", "part", "drawn", "own kind", "attached", "a body", "other part", "refused");
+    printf("%-12s %6s %12s %12s %12s %12s %12s %14s\n", "part", "drawn", "own kind", "attached", "a body", "other part",
+           "refused", "facing dragon");
     for (int k = 0; k < 3; ++k)
-        printf("%-12s %6d %12d %12d %12d %12d %12d\n", kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k]);
+        printf("%-12s %6d %12d %12d %12d %12d %12d %14d\n", kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k],
+               faced[k]);
 }
 
 static int json_file(const struct dirent* e)

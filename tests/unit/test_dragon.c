@@ -2272,6 +2272,104 @@ static void test_line_drawn(void)
     sp_dragon_destroy(d);
 }
 
+// Legs and wings face the way their dragon does (docs/DESIGN.md, "The kiosk
+// pipeline"): a dragon of visitors' drawings (tune half) drawn facing left
+// (mirrored, its head at the left end of the body) gets its legs and wings
+// fitted mirrored too; drawn before the head, they turn when it comes, and
+// Undo of the head gives their former fits back. Facing right, nothing is
+// mirrored.
+static void test_facing_follows_dragon(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_dragon* d = new_dragon(path);
+    sp_error err = {0};
+    const char* rel[] = {"torso/torso-humped.json", "head/head-open-jaw-teeth.json", "front_legs/front-legs-boots.json",
+                         "hind_legs/hind-legs-boots.json", "wings/wing-2-scallops-drooping.json"};
+    const char* category[] = {"torso", "head", "front_legs", "hind_legs", "wings"};
+    const double cx[] = {640, 900, 740, 520, 620}, cy[] = {400, 280, 590, 590, 240}, diag[] = {420, 200, 190, 190, 240};
+    for (int left = 0; left < 2; ++left)
+        for (int head_last = 0; head_last < 2; ++head_last) {
+            sp_dragon_clear(d);
+            const int order[2][5] = {{0, 1, 2, 3, 4}, {0, 2, 3, 4, 1}};
+            for (int j = 0; j < 5; ++j) {
+                int k = order[head_last][j], n;
+                sp_vec2* xy = visitor_stroke(rel[k], diag[k], (sp_vec2){left ? 1280 - cx[k] : cx[k], cy[k]}, left, &n);
+                sp_dragon_result res;
+                ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = category[k]}, &res, &err) == SP_OK &&
+                       !res.rejected);
+                free(xy);
+            }
+            for (int i = 1; i < 5; ++i) {
+                const sp_dragon_part* p = sp_dragon_part_get(d, i);
+                fprintf(stderr, "  facing %s, head %s: %s attached to %d, mirrored %d\n", left ? "left" : "right",
+                        head_last ? "last" : "second", p->category, p->attached_to, p->mirrored);
+                ENSURE(p->attached_to == 0 && p->mirrored == (left != 0));
+            }
+            if (head_last) {
+                ENSURE(sp_dragon_undo(d));
+                for (int i = 1; i < 4; ++i)
+                    ENSURE(!sp_dragon_part_get(d, i)->mirrored);
+            }
+        }
+    sp_dragon_destroy(d);
+}
+
+// A head drawn before the body faces as it would drawn after it: each of
+// the visitors' heads (tune half) at the body's front top corner, the
+// dragon facing right and left, drawn after the body, then before it.
+static void test_head_first_faces_as_after(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    char dir[1200];
+    snprintf(dir, sizeof dir, "%s/tests/data/visitors/tune/head", SP_BINARY_DIR);
+    struct dirent** names = NULL;
+    int nn = scandir(dir, &names, NULL, alphasort), compared = 0;
+    for (int f = 0; f < nn; ++f) {
+        const char* name = names[f]->d_name;
+        size_t len = strlen(name);
+        if (len > 5 && !strcmp(name + len - 5, ".json"))
+            for (int left = 0; left < 2; ++left) {
+                char rel[300];
+                snprintf(rel, sizeof rel, "head/%s", name);
+                bool facing[2];
+                for (int first = 0; first < 2; ++first) {
+                    sp_dragon_clear(d);
+                    sp_dragon_result body = draw_part(d, db, "torso", 640, 420, 420, left, true), res;
+                    sp_vec2 blo, bhi;
+                    fitted_box(d, body.part, &blo, &bhi);
+                    int n;
+                    sp_vec2* xy = visitor_stroke(rel, 200, (sp_vec2){left ? blo.x + 20 : bhi.x - 20, blo.y + 20}, left, &n);
+                    sp_dragon_stroke_opts head = {.category = "head"};
+                    if (first) {
+                        sp_dragon_clear(d);
+                        ENSURE(sp_dragon_add_points(d, xy, n, &head, &res, &err) == SP_OK && !res.rejected);
+                        draw_part(d, db, "torso", 640, 420, 420, left, true);
+                    } else {
+                        ENSURE(sp_dragon_add_points(d, xy, n, &head, &res, &err) == SP_OK && !res.rejected);
+                    }
+                    free(xy);
+                    const sp_dragon_part* h = sp_dragon_part_get(d, first ? 0 : 1);
+                    ENSURE(!strcmp(h->category, "head"));
+                    facing[first] = h->mirrored;
+                }
+                fprintf(stderr, "  %s, dragon facing %s: mirrored %d drawn after the body, %d before\n", name,
+                        left ? "left" : "right", facing[0], facing[1]);
+                ENSURE(facing[0] == facing[1]);
+                ++compared;
+            }
+        free(names[f]);
+    }
+    free(names);
+    ENSURE(compared >= 14);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // A visitor's doodle (tune half) drawn at the canvas's centre: refused as
 // unrecognised, with guesses for the chips. Returns its points, which the
 // caller frees, for the caller's further checks.
@@ -2561,6 +2659,8 @@ int main(int argc, char** argv)
                                    {"robustness", test_robustness},
                                    {"visitors_policy", test_visitors_policy},
                                    {"line_drawn", test_line_drawn},
+                                   {"facing_follows_dragon", test_facing_follows_dragon},
+                                   {"head_first_faces_as_after", test_head_first_faces_as_after},
                                    {"mirror_refusal", test_mirror_refusal},
                                    {"polygon_refusal", test_polygon_refusal},
                                    {"family_by_place", test_family_by_place},

@@ -106,9 +106,9 @@ typedef struct part {
     bool body_has_surface;
     // Its fit before a part drawn later changed it (a body that decided it
     // again or turned it, a body, head or tail that made legs the other
-    // legs: stroke.c, parts_meet_body, legs_by_place), and that part's id:
-    // Undo of that part, or a Redraw or chip that replaces it, gives the fit
-    // back.
+    // legs or turned legs or wings: stroke.c, parts_meet_body,
+    // parts_by_place), and that part's id: Undo of that part, or a Redraw
+    // or chip that replaces it, gives the fit back.
     struct part* before;
     uint64_t before_by;
     bool chosen; // its category was the caller's (a chip's), not the classifier's
@@ -161,6 +161,12 @@ sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4*
 /// that body's end, where the body's socket for its kind is: its box
 /// overlaps the body's on the canvas and reaches past that end.
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* out_of_end);
+/// Which way a part that does not reach sideways (legs, wings) should face
+/// for a stroke in the box [lo, hi]: the way the dragon it is drawn at faces
+/// (the nearest body whose box is within the snap distance of the stroke's,
+/// its facing told by the heads and tails attached at its ends: +1 as
+/// modelled, -1 mirrored); 0 when no body or nothing tells.
+int dragon_facing_at(sp_dragon* d, sp_vec2 lo, sp_vec2 hi);
 /// The category that attached part i takes from where it was drawn, when it
 /// has a family (sp_part.family): the family's member whose socket on the
 /// body lies nearest the part's anchor along the body (the family's sockets

@@ -384,6 +384,31 @@ static double socket_u(const sp_dragon* d, const part* q, const dsocket* so, dou
     return sp_camera_project(&d->world, fitted_point(q, &q->pub.placement, so->joint, so->local)).x - mid;
 }
 
+// Which way the dragon of body k faces: 1 mirrored, 0 as modelled, -1 not
+// told. A head or tail attached at the end of the body other than its
+// socket's says the dragon is drawn mirrored; one near the middle says
+// nothing, and two that disagree tell nothing.
+static int body_facing(sp_dragon* d, int k)
+{
+    part* q = d->parts[k];
+    sp_vec2 blo, bhi;
+    if (!body_prepare(d, q) || !body_box(q, &blo, &bhi)) return -1;
+    double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x);
+    int mirrored = -1;
+    for (int j = 0; j < d->part_n; ++j) {
+        const part* o = d->parts[j];
+        if (o->pub.attached_to != k || !o->t->lengthwise) continue;
+        const dsocket* so = kind_socket(q, o->pub.category, o->t->prefer);
+        if (!so) continue;
+        double su = socket_u(d, q, so, mid), du = o->pub.anchor.x - mid;
+        if (!(fabs(su) > 0.25 * half && fabs(du) > 0.25 * half)) continue;
+        int m = (su > 0) != (du > 0);
+        if (mirrored >= 0 && m != mirrored) return -1;
+        mirrored = m;
+    }
+    return mirrored;
+}
+
 bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
 {
     const part* p = d->parts[i];
@@ -392,21 +417,8 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX])
     part* q = d->parts[k];
     sp_vec2 blo, bhi;
     if (!body_box(q, &blo, &bhi)) return false;
-    double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x);
-    // Facing: a head or tail drawn at the end of the body other than its
-    // socket's says the dragon is drawn mirrored; near the middle it says nothing.
-    int mirrored = -1;
-    for (int j = 0; j < d->part_n; ++j) {
-        const part* o = d->parts[j];
-        if (j == i || o->pub.attached_to != k || !o->t->lengthwise) continue;
-        const dsocket* so = kind_socket(q, o->pub.category, o->t->prefer);
-        if (!so) continue;
-        double su = socket_u(d, q, so, mid), du = o->pub.anchor.x - mid;
-        if (!(fabs(su) > 0.25 * half && fabs(du) > 0.25 * half)) continue;
-        int m = (su > 0) != (du > 0);
-        if (mirrored >= 0 && m != mirrored) return false;
-        mirrored = m;
-    }
+    double mid = 0.5 * (blo.x + bhi.x);
+    int mirrored = body_facing(d, k);
     if (mirrored < 0) return false;
     double u = (mirrored ? -1 : 1) * (p->pub.anchor.x - mid);
     // The family's sockets along the body, centred on its middle: the
@@ -494,6 +506,22 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool*
     }
     *out_of_end = at_end && near_body_box(d, lo, hi, blo, bhi) && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
     return (side > 0 ? 1 : -1) == natural ? 1 : -1;
+}
+
+int dragon_facing_at(sp_dragon* d, sp_vec2 lo, sp_vec2 hi)
+{
+    sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
+    int body = -1;
+    double bd = INFINITY;
+    for (int k = 0; k < d->part_n; ++k) {
+        part* q = d->parts[k];
+        sp_vec2 a, b;
+        if (!q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b) || !near_body_box(d, lo, hi, a, b)) continue;
+        double dist = box_distance(c, a, b);
+        if (dist < bd) bd = dist, body = k;
+    }
+    int m = body >= 0 ? body_facing(d, body) : -1;
+    return m < 0 ? 0 : m ? -1 : 1;
 }
 
 // A key for the set of bodies a layout was made against (their ids in order).

@@ -163,7 +163,9 @@ static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk,
     for (int c = 0; c < nc; ++c) {
         tpl* t = cands[c];
         bool out_of_end = false;
-        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi, &out_of_end) : 1;
+        // A part that reaches sideways faces away from the body it comes
+        // out of; legs and wings face the way their dragon does.
+        int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi, &out_of_end) : t->is_torso ? 1 : dragon_facing_at(d, lo, hi);
         fit_choice a, b;
         bool got = fit_one(d, t, sk, lo, hi, hint < 0, &a, not_finite);
         bool other = t->lengthwise && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
@@ -693,19 +695,44 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
     return replace_before_body(d, i, &f, confidence, d->parts[body]->pub.id);
 }
 
-// Legs attached to body `body` take their kind from where they are on it,
-// as when drawn after the part with id `by` (take_family_member): a body
-// just drawn, or a head or tail that just told its facing. A chip's choice
-// stands.
-static void legs_by_place(sp_dragon* d, int body, uint64_t by)
+// Part i (legs, wings) fitted again facing the way its dragon faces
+// (dragon_facing_at), when it faces the other way. False when it faces that
+// way already, the dragon does not tell, or the fit fails.
+static bool turn_to_dragon(sp_dragon* d, int i, fit_choice* f)
+{
+    part* old = d->parts[i];
+    sp_vec2 lo, hi;
+    stroke_box_of(old, &lo, &hi);
+    int hint = dragon_facing_at(d, lo, hi);
+    if (hint == 0 || (hint < 0) == old->pub.mirrored) return false;
+    sp_stroke st;
+    sp_sketch sk = part_sketch(d, old, &st);
+    int not_finite = 0;
+    if (!fit_one(d, old->t, &sk, lo, hi, hint < 0, f, &not_finite)) return false;
+    prefer_line(d, &sk, lo, hi, f);
+    return true;
+}
+
+// Legs and wings attached to body `body` follow its dragon, as when drawn
+// after the part with id `by` (a body just drawn, or a head or tail that
+// just told its facing): legs take their kind from where they are on it
+// (take_family_member; a chip's choice stands), and legs and wings face
+// the way the dragon does (turn_to_dragon).
+static void parts_by_place(sp_dragon* d, int body, uint64_t by)
 {
     bool changed = false;
     for (int i = 0; i < d->part_n; ++i) {
+        part* p = d->parts[i];
+        sp_vec2 lo, hi;
+        stroke_box_of(p, &lo, &hi);
+        // Free but drawn on the body: a part fitted facing the wrong way
+        // may hold its attachment end away from the body.
+        bool at_body = p->pub.attached_to == body || (p->pub.attached_to < 0 && dragon_on_body(d, lo, hi, body));
+        if (p->pub.id == by || !at_body || p->t->is_torso || p->t->lengthwise) continue;
         char member[SP_NAME_MAX];
         fit_choice f;
-        if (d->parts[i]->pub.id != by && !d->parts[i]->chosen && d->parts[i]->pub.attached_to == body &&
-            fit_family_member(d, i, member, &f))
-            changed |= replace_before_body(d, i, &f, d->parts[i]->pub.confidence, by);
+        if ((!p->chosen && fit_family_member(d, i, member, &f)) || turn_to_dragon(d, i, &f))
+            changed |= replace_before_body(d, i, &f, p->pub.confidence, by);
     }
     if (changed) dragon_relayout(d);
 }
@@ -714,10 +741,11 @@ static void legs_by_place(sp_dragon* d, int body, uint64_t by)
 // drawn after it:
 // - a part the classifier took for a body that lies on it is decided again
 //   (decide_again_on_body);
-// - a head or a tail on it, coming out of its end (dragon_facing_hint),
-//   that hangs free turns to the facing the body hints at (fit_variants),
-//   so that its root rides the body;
-// - legs attached to it become the legs of their end (legs_by_place).
+// - a head or a tail on it takes the facing it would have been fitted in
+//   after the body (fit_variants: the facing the body hints at, kept when
+//   it comes out of the body's end), so that its root rides the body;
+// - legs attached to it become the legs of their end, and legs and wings
+//   face the way its dragon does (parts_by_place).
 // Each keeps its id and its stroke; its former fit is kept for Undo or a
 // Redraw of the body (give_back_fits).
 static void parts_meet_body(sp_dragon* d)
@@ -731,27 +759,29 @@ static void parts_meet_body(sp_dragon* d)
     changed = false;
     for (int i = 0; i < body; ++i) {
         part* old = d->parts[i];
-        if ((old->before && old->before_by == by) || old->t->is_torso || !old->t->lengthwise || old->pub.attached_to >= 0)
-            continue;
+        if ((old->before && old->before_by == by) || old->t->is_torso || !old->t->lengthwise) continue;
         sp_vec2 lo, hi;
         stroke_box_of(old, &lo, &hi);
-        bool out_of_end = false;
-        if (!dragon_on_body(d, lo, hi, body)) continue; // another dragon's part
-        int hint = dragon_facing_hint(d, old->t, lo, hi, &out_of_end);
-        if (!out_of_end || (hint < 0) == old->pub.mirrored) continue;
+        bool others = old->pub.attached_to >= 0 && old->pub.attached_to != body;
+        if (others || !dragon_on_body(d, lo, hi, body)) continue; // another dragon's part
         sp_stroke st;
         sp_sketch sk = part_sketch(d, old, &st);
         fit_choice f;
         int not_finite = 0;
-        if (!fit_one(d, old->t, &sk, lo, hi, hint < 0, &f, &not_finite)) continue;
+        tpl* t = old->t;
+        if (!fit_variants(d, &t, 1, &sk, lo, hi, &f, &not_finite)) continue;
+        if (f.mirrored == old->pub.mirrored) {
+            free(f.p);
+            continue;
+        }
         prefer_line(d, &sk, lo, hi, &f);
         changed |= replace_before_body(d, i, &f, old->pub.confidence, by);
     }
     if (changed) dragon_relayout(d);
-    legs_by_place(d, body, by);
+    parts_by_place(d, body, by);
 }
 
-// Gives back the fits that the part with this id changed when it came (parts_meet_body, legs_by_place).
+// Gives back the fits that the part with this id changed when it came (parts_meet_body, parts_by_place).
 static void give_back_fits(sp_dragon* d, uint64_t by)
 {
     for (int i = 0; i < d->part_n; ++i)
@@ -863,9 +893,10 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         if (r != SP_OK) return r;
     }
     // A head or tail tells the facing of the body it hangs on: the legs
-    // already there take their kind from where they are.
+    // already there take their kind from where they are, and legs and
+    // wings turn to face the way it does.
     const part* last = d->parts[d->part_n - 1];
-    if (last->t->lengthwise && last->pub.attached_to >= 0) legs_by_place(d, last->pub.attached_to, last->pub.id);
+    if (last->t->lengthwise && last->pub.attached_to >= 0) parts_by_place(d, last->pub.attached_to, last->pub.id);
     out->part = d->part_n - 1;
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
