@@ -21,6 +21,31 @@ void sp_character_free(sp_character* ch)
     memset(ch, 0, sizeof *ch);
 }
 
+sp_result sp_character_clone(const sp_character* src, sp_character* dst, sp_error* err)
+{
+    memset(dst, 0, sizeof *dst);
+    if (sp_rig_clone(&src->rig, &dst->rig) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "character: out of memory");
+    size_t np = (size_t)src->rig.param_count, nc = 4 * (size_t)src->rig.vertex_count;
+    dst->pose = src->pose ? malloc(sizeof(double) * (np + 1)) : NULL;
+    dst->colors = src->colors ? malloc(sizeof(float) * (nc + 1)) : NULL;
+    dst->warnings = src->warning_count > 0 ? malloc(sizeof *src->warnings * (size_t)src->warning_count) : NULL;
+    bool ok = (!src->pose || dst->pose) && (!src->colors || dst->colors) && (src->warning_count == 0 || dst->warnings) &&
+              (!src->has_part || sp_part_copy(&src->part, &dst->part, NULL) == SP_OK);
+    if (!ok) {
+        sp_character_free(dst);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "character: out of memory");
+    }
+    if (src->pose) memcpy(dst->pose, src->pose, sizeof(double) * np);
+    if (src->colors) memcpy(dst->colors, src->colors, sizeof(float) * nc);
+    if (src->warning_count > 0) memcpy(dst->warnings, src->warnings, sizeof *src->warnings * (size_t)src->warning_count);
+    dst->warning_count = src->warning_count;
+    dst->has_camera = src->has_camera, dst->camera = src->camera;
+    dst->has_part = src->has_part;
+    dst->derived_abstraction = src->derived_abstraction, dst->derived_dofs = src->derived_dofs;
+    dst->mesh_skins = src->mesh_skins;
+    return SP_OK;
+}
+
 void sp_character_warn(sp_character* ch, const char* fmt, ...)
 {
     char(*grown)[SP_WARNING_MAX] = realloc(ch->warnings, sizeof *ch->warnings * (size_t)(ch->warning_count + 1));

@@ -277,7 +277,7 @@ static double to_polyline(const double* z, int n, sp_vec3 q)
 // through their joints that rides their bones (at rest and in random poses
 // every joint's pivot lies on it), its ends beyond the end joints, as far
 // as the mesh reaches there; the other parts get none, and a second call
-// adds nothing.
+// adds nothing. A copy of the part (sp_character_clone) is the same part.
 static void test_line(void)
 {
     for (int i = 0; i < PART_COUNT; ++i) {
@@ -320,6 +320,16 @@ static void test_line(void)
             free(p), free(z);
         }
         ENSURE(sp_rig_add_line(rig, &added, &err) == SP_OK && !added && rig->abstraction_count == before + chain);
+        // The kiosk adds the line to a copy of the part as loaded (sp_character_clone).
+        sp_character copy;
+        ENSURE(sp_character_clone(&ch, &copy, &err) == SP_OK);
+        ENSURE(copy.rig.abstraction_count == rig->abstraction_count && copy.rig.vertex_count == rig->vertex_count &&
+               copy.rig.animation_count == rig->animation_count && copy.has_part == ch.has_part &&
+               !strcmp(copy.part.category, ch.part.category) && copy.pose != ch.pose &&
+               !memcmp(copy.pose, ch.pose, sizeof(double) * (size_t)rig->param_count) &&
+               !memcmp(copy.colors, ch.colors, sizeof(float) * 4 * (size_t)rig->vertex_count) &&
+               !memcmp(copy.rig.rest, rig->rest, sizeof(double) * 3 * (size_t)rig->vertex_count));
+        sp_character_free(&copy);
         sp_character_free(&ch);
     }
 }

@@ -2206,6 +2206,23 @@ static void test_root_at_the_body(void)
     sp_db_close(db);
 }
 
+// Adds a stroke as `category` (as a chip would: this test's quick database
+// must not decide what it is); returns the new part's index.
+static int add_as(sp_dragon* d, const sp_vec2* xy, int n, const char* category)
+{
+    sp_error err = {0};
+    sp_dragon_result res;
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = category}, &res, &err) == SP_OK && !res.rejected);
+    return res.part;
+}
+
+// The name of the abstraction part i was fitted with ("outline", "line").
+static const char* fitted_curve(const sp_dragon* d, int i)
+{
+    const sp_dragon_part* p = sp_dragon_part_get(d, i);
+    return p->character->rig.abstractions[p->abstraction].name;
+}
+
 // How far the fitted curve of part i reaches along the stroke xy: the
 // share of the stroke's points within `near` px of the curve.
 static double fitted_reach(const sp_dragon* d, int i, const sp_vec2* xy, int n, double near)
@@ -2233,7 +2250,6 @@ static void test_line_drawn(void)
     const char* path = real_db();
     if (!path) SKIP("assets/ has no parts yet");
     sp_dragon* d = new_dragon(path);
-    sp_error err = {0};
     const char* lines[] = {"tail/tail-wavy-line.json", "tail/tail-wavy-line-rising.json"};
     int as_line = 0, total = 0;
     double reach_sum = 0;
@@ -2241,13 +2257,10 @@ static void test_line_drawn(void)
         for (int mirror = 0; mirror < 2; ++mirror)
             for (int size = 0; size < 2; ++size) {
                 int n;
-                sp_dragon_result res;
                 sp_vec2* xy = visitor_stroke(lines[k], size ? 420 : 300, (sp_vec2){640, 400}, mirror, &n);
-                ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK &&
-                       !res.rejected);
-                const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
-                const char* curve = p->character->rig.abstractions[p->abstraction].name;
-                double reach = fitted_reach(d, res.part, xy, n, 0.06 * (size ? 420 : 300));
+                int i = add_as(d, xy, n, "tail");
+                const char* curve = fitted_curve(d, i);
+                double reach = fitted_reach(d, i, xy, n, 0.06 * (size ? 420 : 300));
                 fprintf(stderr, "  %s%s, %.0f px: fitted with its %s, %.0f%% of the stroke within 6%% of its size\n", lines[k],
                         mirror ? " mirrored" : "", size ? 420.0 : 300.0, curve, 100 * reach);
                 as_line += !strcmp(curve, "line");
@@ -2262,12 +2275,8 @@ static void test_line_drawn(void)
     const char* closed[][2] = {{"tail/tail-outline-spade.json", "tail"}, {"tail/tail-wavy-line.json", "head"}};
     for (int k = 0; k < 2; ++k) {
         int n;
-        sp_dragon_result res;
         sp_vec2* xy = visitor_stroke(closed[k][0], 320, (sp_vec2){640, 400}, false, &n);
-        ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = closed[k][1]}, &res, &err) == SP_OK &&
-               !res.rejected);
-        const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
-        ENSURE(!strcmp(p->character->rig.abstractions[p->abstraction].name, "outline"));
+        ENSURE(!strcmp(fitted_curve(d, add_as(d, xy, n, closed[k][1])), "outline"));
         sp_dragon_clear(d);
         free(xy);
     }
@@ -2285,7 +2294,6 @@ static void test_facing_follows_dragon(void)
     const char* path = real_db();
     if (!path) SKIP("assets/ has no parts yet");
     sp_dragon* d = new_dragon(path);
-    sp_error err = {0};
     const char* rel[] = {"torso/torso-humped.json", "head/head-open-jaw-teeth.json", "front_legs/front-legs-boots.json",
                          "hind_legs/hind-legs-boots.json", "wings/wing-2-scallops-drooping.json"};
     const char* category[] = {"torso", "head", "front_legs", "hind_legs", "wings"};
@@ -2297,9 +2305,7 @@ static void test_facing_follows_dragon(void)
             for (int j = 0; j < 5; ++j) {
                 int k = order[head_last][j], n;
                 sp_vec2* xy = visitor_stroke(rel[k], diag[k], (sp_vec2){left ? 1280 - cx[k] : cx[k], cy[k]}, left, &n);
-                sp_dragon_result res;
-                ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = category[k]}, &res, &err) == SP_OK &&
-                       !res.rejected);
+                add_as(d, xy, n, category[k]);
                 free(xy);
             }
             for (int i = 1; i < 5; ++i) {
@@ -2326,18 +2332,16 @@ static void test_facing_follows_dragon(void)
     const char* want[] = {"torso", "front_legs", "hind_legs", "wings", "head", "tail"};
     ENSURE(count == 6);
     for (int k = 0; k < count; ++k) {
-        sp_dragon_result res;
-        ENSURE(sp_dragon_add_points(d, xy[k], n[k], &(sp_dragon_stroke_opts){.category = want[k]}, &res, &err) == SP_OK &&
-               !res.rejected);
+        add_as(d, xy[k], n[k], want[k]);
         free(xy[k]);
     }
     for (int i = 0; i < 6; ++i) {
         const sp_dragon_part* p = sp_dragon_part_get(d, i);
         fprintf(stderr, "  README picture: %s, attached to %d, mirrored %d, fitted with its %s\n", p->category, p->attached_to,
-                p->mirrored, p->character->rig.abstractions[p->abstraction].name);
+                p->mirrored, fitted_curve(d, i));
         ENSURE(!strcmp(p->category, want[i]) && (i == 0 || (p->attached_to == 0 && p->mirrored)));
     }
-    ENSURE(!strcmp(sp_dragon_part_get(d, 5)->character->rig.abstractions[sp_dragon_part_get(d, 5)->abstraction].name, "line"));
+    ENSURE(!strcmp(fitted_curve(d, 5), "line"));
     sp_dragon_destroy(d);
 }
 
@@ -2348,7 +2352,6 @@ static void test_head_first_faces_as_after(void)
 {
     const char* path = real_db();
     if (!path) SKIP("assets/ has no parts yet");
-    sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
     char dir[1200];
@@ -2365,19 +2368,14 @@ static void test_head_first_faces_as_after(void)
                 bool facing[2];
                 for (int first = 0; first < 2; ++first) {
                     sp_dragon_clear(d);
-                    sp_dragon_result body = draw_part(d, db, "torso", 640, 420, 420, left, true), res;
+                    sp_dragon_result body = draw_part(d, db, "torso", 640, 420, 420, left, true);
                     sp_vec2 blo, bhi;
                     fitted_box(d, body.part, &blo, &bhi);
                     int n;
                     sp_vec2* xy = visitor_stroke(rel, 200, (sp_vec2){left ? blo.x + 20 : bhi.x - 20, blo.y + 20}, left, &n);
-                    sp_dragon_stroke_opts head = {.category = "head"};
-                    if (first) {
-                        sp_dragon_clear(d);
-                        ENSURE(sp_dragon_add_points(d, xy, n, &head, &res, &err) == SP_OK && !res.rejected);
-                        draw_part(d, db, "torso", 640, 420, 420, left, true);
-                    } else {
-                        ENSURE(sp_dragon_add_points(d, xy, n, &head, &res, &err) == SP_OK && !res.rejected);
-                    }
+                    if (first) sp_dragon_clear(d);
+                    add_as(d, xy, n, "head");
+                    if (first) draw_part(d, db, "torso", 640, 420, 420, left, true);
                     free(xy);
                     const sp_dragon_part* h = sp_dragon_part_get(d, first ? 0 : 1);
                     ENSURE(!strcmp(h->category, "head"));

@@ -80,10 +80,11 @@ static void read_part_extras(tpl* t)
     }
 }
 
-// Loads part `name` as a template fitted with its `outline` (the part's
-// abstraction), or with a `line` added to it (line: NULL, and nothing in
-// err, when its skeleton has no line).
-static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve, bool line,
+// Loads part `name` from the database as a template fitted with its
+// abstraction (`outline`); or, with line_of, makes line_of's part fitted
+// with a `line` added to it, from a copy of its character (NULL, and
+// nothing in err, when its skeleton has no line).
+static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve,
                      sp_error* err)
 {
     tpl* t = calloc(1, sizeof *t);
@@ -93,15 +94,16 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
     }
     t->refs = 1;
     sp_db_part_info info;
-    if (sp_db_part(db, name, &info, err) != SP_OK || sp_db_load_part(db, name, &t->ch, err) != SP_OK) {
+    if (line_of ? sp_character_clone(&line_of->ch, &t->ch, err) != SP_OK
+                : sp_db_part(db, name, &info, err) != SP_OK || sp_db_load_part(db, name, &t->ch, err) != SP_OK) {
         free(t);
         return NULL;
     }
     dragon_copy_name(t->name, sizeof t->name, name);
-    dragon_copy_name(t->category, sizeof t->category, info.category);
-    dragon_copy_name(t->sha256, sizeof t->sha256, info.sha256);
+    dragon_copy_name(t->category, sizeof t->category, line_of ? line_of->category : info.category);
+    dragon_copy_name(t->sha256, sizeof t->sha256, line_of ? line_of->sha256 : info.sha256);
     const sp_rig* rig = &t->ch.rig;
-    if (line) {
+    if (line_of) {
         bool added = false;
         if (sp_rig_add_line(&t->ch.rig, &added, err) != SP_OK || !added) {
             dragon_tpl_release(t);
@@ -194,7 +196,7 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
     }
     t->solver_cam = t->base;
     sp_solve_desc sd = *solve;
-    if (line) {
+    if (line_of) {
         // A line says nothing of a part's thickness: its proportions stay
         // as modelled (the bone scales held at rest) and only the pose and
         // the root's size move, so a tail drawn as a line is not fattened.
@@ -216,9 +218,9 @@ static tpl* tpl_load(sp_db* db, const char* name, int canvas_w, int canvas_h, co
     free(xyz);
     free(xy);
     int ends[2];
-    if (!line && !t->is_torso && sp_rig_line_joints(rig, ends, 2) > 0) {
+    if (!line_of && !t->is_torso && sp_rig_line_joints(rig, ends, 2) > 0) {
         sp_error lerr = {0}; // a part whose line cannot be made is still fitted with its outline
-        t->line = tpl_load(db, name, canvas_w, canvas_h, solve, true, &lerr);
+        t->line = tpl_load(db, t, name, canvas_w, canvas_h, solve, &lerr);
         if (t->line) {
             // Which way the part reaches is the part's, whichever curve is fitted.
             t->line->lengthwise = t->lengthwise;
@@ -385,7 +387,7 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
         for (int k = 0; k < d->cache_n && !t; ++k)
             if (!strcmp(d->cache[k]->name, names[i])) t = d->cache[k];
         if (!t) {
-            t = tpl_load(d->db, names[i], d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, false, err);
+            t = tpl_load(d->db, NULL, names[i], d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, err);
             if (!t) continue; // a part that does not load is skipped; err keeps why
             tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
             if (!c) {

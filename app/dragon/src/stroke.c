@@ -198,10 +198,10 @@ static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk,
 
 // How far apart fit f's curves and the stroke are, both ways: the mean of
 // the stroke's points' mean distance to the curves and the curves' points'
-// mean distance to the stroke, over the stroke's box diagonal. The solver's
-// error goes one way only, so an outline along one side of a line drawing
-// scores as well as a line on it. INFINITY when it cannot be measured.
-static double two_way_gap(const fit_choice* f, const sp_stroke* st)
+// mean distance to the stroke, over `diag` (the stroke's box diagonal). The
+// solver's error goes one way only, so an outline along one side of a line
+// drawing scores as well as a line on it. INFINITY when it cannot be measured.
+static double two_way_gap(const fit_choice* f, const sp_stroke* st, double diag)
 {
     const sp_rig* rig = &f->t->ch.rig;
     const sp_abstraction* ab = &rig->abstractions[f->t->abstraction];
@@ -227,9 +227,7 @@ static double two_way_gap(const fit_choice* f, const sp_stroke* st)
     if (sp_polyline_distances(st->points, next, n, c, m, dist) != SP_OK) goto done;
     for (int i = 0; i < m; ++i)
         to_stroke += dist[i];
-    sp_vec2 lo, hi;
-    sp_sketch one = {.stroke_count = 1, .strokes = (sp_stroke*)st};
-    if (sp_sketch_bounds(&one, &lo, &hi)) gap = 0.5 * (to_curve / n + to_stroke / m) / fmax(sp_v2_len(sp_v2_sub(hi, lo)), 1.0);
+    gap = 0.5 * (to_curve / n + to_stroke / m) / fmax(diag, 1.0);
 done:
     free(xy), free(c), free(next), free(dist);
     return gap;
@@ -247,7 +245,8 @@ static void prefer_line(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 h
     int not_finite = 0;
     if (!f->t->line || sp_stroke_is_loop(&sk->strokes[0]) || !fit_one(d, f->t->line, sk, lo, hi, f->mirrored, &l, &not_finite))
         return;
-    double gf = two_way_gap(f, &sk->strokes[0]), gl = two_way_gap(&l, &sk->strokes[0]);
+    double diag = sp_v2_len(sp_v2_sub(hi, lo)), gf = two_way_gap(f, &sk->strokes[0], diag),
+           gl = two_way_gap(&l, &sk->strokes[0], diag);
     if (gl < gf) {
         l.score = f->score;
         free(f->p);

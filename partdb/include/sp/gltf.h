@@ -107,6 +107,8 @@ sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err);
 /// default pose, light grey vertices, the default front orthographic camera.
 /// For generators and tests that build rigs in code and want to save them.
 sp_result sp_character_from_rig(sp_rig* rig, sp_character* out, sp_error* err);
+/// Deep copy (SP_ERR_NO_MEMORY leaves *dst zeroed).
+sp_result sp_character_clone(const sp_character* src, sp_character* dst, sp_error* err);
 /// Frees everything the character owns and zeroes it.
 void sp_character_free(sp_character* ch);
 /// Appends a warning line (printf style).
