@@ -417,6 +417,8 @@ static sp_kiosk_refusal refusal_of(sp_dragon_reject r)
         return SP_KREF_TRICKY;
     case SP_DRAGON_FULL:
         return SP_KREF_FULL;
+    case SP_DRAGON_DETAIL:
+        return SP_KREF_DETAIL;
     default:
         return SP_KREF_UNRECOGNISED;
     }
@@ -461,8 +463,8 @@ static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* re
 {
     ++k->stats.rejected;
     sp_kiosk_fit_result r = {.ok = false, .refusal = rc == SP_OK ? refusal_of(res->reason) : SP_KREF_UNRECOGNISED};
-    r.offer = rc == SP_OK &&
-              (res->reason == SP_DRAGON_UNRECOGNISED || res->reason == SP_DRAGON_NO_MODEL || res->reason == SP_DRAGON_FIT_FAILED);
+    r.offer = rc == SP_OK && (res->reason == SP_DRAGON_UNRECOGNISED || res->reason == SP_DRAGON_NO_MODEL ||
+                              res->reason == SP_DRAGON_FIT_FAILED || res->reason == SP_DRAGON_DETAIL);
     if (res->reason == SP_DRAGON_FIT_FAILED && !tried && res->guess_count > 0) tried = res->guesses[0].category;
     char offers[3][SP_NAME_MAX];
     int n = r.offer ? stroke_guesses(k, res, tried, offers, 3) : 0;

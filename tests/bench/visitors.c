@@ -1,6 +1,6 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
 //   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all]
-//            [--on-body [--gap PX]] [--json]
+//            [--on-body [--gap PX] [--part-scale F]] [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
 // defaults to the whole set the build makes from designs.json and the Quick,
@@ -30,6 +30,8 @@
 // attached to the body; facing the way the dragon does), a body, another
 // part, or were refused; with
 // --gap PX drawn that far apart instead (their box PX beyond the body's).
+// --part-scale F draws the legs, heads, tails and wings F times their size
+// (a visitor's small parts on a large body; the body stays 500 px).
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>
@@ -147,6 +149,9 @@ static bool add_part(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int
 // as a table (or JSON rows). A scene whose body, head or legs stroke fails
 // or is refused counts as legs not of their kind.
 // `alone`: the drawings' single-stroke outcomes (no body, no rule).
+// --part-scale: the on-body parts' size against the bench's own.
+static double part_scale = 1;
+
 static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alone_out, bool json, const char* half,
                          bool parts_first)
 {
@@ -169,8 +174,9 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
                 bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, true, &lo, &hi, &head_at);
                 double dir = facing ? -1 : 1, w = hi.x - lo.x; // dir: the side the head is on
                 bool front = (kind == 0) == (end == 0);
-                sp_stroke ls = placed(legs, 260, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
-                                      true, facing != 0);
+                sp_stroke ls =
+                    placed(legs, 260 * part_scale, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
+                           true, facing != 0);
                 ok = ok && ls.points && add_part(d, ds, &scenes, m, facing != 0, true, parts_first, &ls, &res);
                 if (ok && !res.rejected) {
                     const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
@@ -240,7 +246,8 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             sp_vec2 lo, hi, head_at, plo, phi;
             bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, kind != 0, &lo, &hi, &head_at);
             double dir = facing ? -1 : 1;
-            sp_stroke ps = placed(part_s, kind == 0 ? 200 : 260, kind == 0 ? head_at : (sp_vec2){640, 400}, false, facing != 0);
+            sp_stroke ps = placed(part_s, (kind == 0 ? 200 : 260) * part_scale, kind == 0 ? head_at : (sp_vec2){640, 400}, false,
+                                  facing != 0);
             if (ps.points && (kind > 0 || gap > 0)) {
                 stroke_box(&ps, &plo, &phi);
                 // Into the body's box by 30 px (touching), or `gap` px apart.
@@ -351,9 +358,11 @@ int main(int argc, char** argv)
             on_body = true;
         else if (!strcmp(argv[i], "--gap") && i + 1 < argc)
             gap = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--part-scale") && i + 1 < argc && atof(argv[i + 1]) > 0)
+            part_scale = atof(argv[++i]);
         else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "usage: visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                            "[--list] [--fit-all] [--on-body [--gap PX]] [--json]\n");
+                            "[--list] [--fit-all] [--on-body [--gap PX] [--part-scale F]] [--json]\n");
             return 2;
         }
     }
@@ -536,6 +545,7 @@ int main(int argc, char** argv)
                "median, %.2f p90 (target 50)\n",
                n_ms, mc, mc90, mt, mt90);
 #undef PCT
+        if (on_body && part_scale != 1) printf("Parts drawn at a dragon at %g times the size below\n", part_scale);
         if (on_body) {
             for (int first = 0; first < 2; ++first) {
                 legs_on_body(d, &ds, out, false, half, first);

@@ -2667,6 +2667,159 @@ static void test_parts_before_body(void)
     sp_db_close(db);
 }
 
+// Whether every point of a circle of radius r about c (and c) lies in part
+// i's projected mesh as posed at t = 0 (attached, as the visitor sees it).
+static bool disc_on_part(const sp_dragon* d, int i, sp_vec2 c, double r)
+{
+    const sp_rig* rig = &sp_dragon_part_get(d, i)->character->rig;
+    const double* xyz = sp_dragon_part_xyz(d, i);
+    sp_camera cam = sp_dragon_camera(d);
+    for (int k = 0; k <= 12; ++k) {
+        sp_vec2 x = k == 12 ? c : (sp_vec2){c.x + r * cos(k * M_PI / 6), c.y + r * sin(k * M_PI / 6)};
+        bool in = false;
+        for (int f = 0; f < rig->triangle_count && !in; ++f) {
+            sp_vec2 v[3];
+            for (int e = 0; e < 3; ++e) {
+                const double* w = xyz + 3 * rig->triangles[3 * f + e];
+                v[e] = sp_camera_project(&cam, (sp_vec3){w[0], w[1], w[2]});
+            }
+            double d1 = (v[1].x - v[0].x) * (x.y - v[0].y) - (v[1].y - v[0].y) * (x.x - v[0].x);
+            double d2 = (v[2].x - v[1].x) * (x.y - v[1].y) - (v[2].y - v[1].y) * (x.x - v[1].x);
+            double d3 = (v[0].x - v[2].x) * (x.y - v[2].y) - (v[0].y - v[2].y) * (x.x - v[2].x);
+            in = (d1 >= 0 && d2 >= 0 && d3 >= 0) || (d1 <= 0 && d2 <= 0 && d3 <= 0);
+        }
+        if (!in) return false;
+    }
+    return true;
+}
+
+// A point of part i where a disc of radius 2r lies on it and on no part
+// in `not_on` (-1: none), searched on a grid over its box (false: none).
+static bool spot_on_part(sp_dragon* d, int i, double r, int not_on, sp_vec2* out)
+{
+    sp_error err = {0};
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
+    sp_vec2 lo, hi;
+    const sp_rig* rig = &sp_dragon_part_get(d, i)->character->rig;
+    const double* xyz = sp_dragon_part_xyz(d, i);
+    sp_camera cam = sp_dragon_camera(d);
+    lo = hi = sp_camera_project(&cam, (sp_vec3){xyz[0], xyz[1], xyz[2]});
+    for (int v = 1; v < rig->vertex_count; ++v) {
+        sp_vec2 x = sp_camera_project(&cam, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
+        lo.x = fmin(lo.x, x.x), lo.y = fmin(lo.y, x.y), hi.x = fmax(hi.x, x.x), hi.y = fmax(hi.y, x.y);
+    }
+    // From the box's middle outwards, so the spot is well inside.
+    for (int ring = 0; ring <= 8; ++ring)
+        for (int gx = -ring; gx <= ring; ++gx)
+            for (int gy = -ring; gy <= ring; ++gy) {
+                if (abs(gx) != ring && abs(gy) != ring) continue;
+                sp_vec2 c = {0.5 * (lo.x + hi.x) + gx * (hi.x - lo.x) / 18, 0.5 * (lo.y + hi.y) + gy * (hi.y - lo.y) / 18};
+                if (disc_on_part(d, i, c, 2 * r) && (not_on < 0 || !disc_on_part(d, not_on, c, 3 * r + 10))) {
+                    *out = c;
+                    return true;
+                }
+            }
+    return false;
+}
+
+// A small wobbly loop (an eye, a spot) of radius r about c; 40 points.
+static void small_loop(sp_vec2 c, double r, sp_vec2 xy[40])
+{
+    for (int k = 0; k < 40; ++k) {
+        double a = 2 * M_PI * k / 37.0; // a little overshoot, as drawn
+        xy[k] = (sp_vec2){c.x + r * (1 + 0.08 * sin(3 * a)) * cos(a), c.y + 0.9 * r * sin(a)};
+    }
+}
+
+// A small stroke drawn on a part is a detail of it (an eye on the head,
+// spots on the body): refused as such, with its guesses for the chips,
+// nothing added. Before, each became a tiny part: a head on the body, a
+// body or a head floating at the head. The same loop drawn apart from
+// every part, as large as a part, or chosen with a chip is a part; so is a
+// visitor's pair of legs drawn small on the body.
+static void test_details_on_parts(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_dragon_result res;
+    sp_dragon* d = new_dragon(path);
+    int n;
+    sp_vec2* xy = visitor_stroke("torso/torso-pear.json", 500, (sp_vec2){600, 450}, false, &n);
+    int body = add_as(d, xy, n, "torso");
+    free(xy);
+    sp_vec2 blo, bhi; // the head centred 20 px inside the body's front top corner, as visitors draw it
+    fitted_box(d, body, &blo, &bhi);
+    sp_vec2 head_at = {bhi.x - 20, blo.y + 20};
+    xy = visitor_stroke("head/head-frill.json", 220, head_at, false, &n);
+    int head = add_as(d, xy, n, "head");
+    free(xy);
+    ENSURE(sp_dragon_part_get(d, head)->attached_to == body);
+    sp_vec2 spot, eye, loop[40];
+    ENSURE(spot_on_part(d, body, 16, -1, &spot) && spot_on_part(d, head, 8, body, &eye));
+    fprintf(stderr, "  body at (600, 450), head at (%.0f, %.0f)\n", head_at.x, head_at.y);
+    // Three spots on the body, an eye on the head: details.
+    for (int k = 0; k < 4; ++k) {
+        sp_vec2 c = k == 3 ? eye : (sp_vec2){spot.x + (k - 1) * 40, spot.y + (k == 1 ? 0 : 20)};
+        if (k < 3 && !disc_on_part(d, body, c, 18)) c = spot; // stays on the body whatever its shape
+        small_loop(c, k == 3 ? 8 : 16, loop);
+        ENSURE(sp_dragon_add_points(d, loop, 40, NULL, &res, &err) == SP_OK);
+        fprintf(stderr, "  %s at (%.0f, %.0f): %s, guesses %d (%s)\n", k == 3 ? "eye" : "spot", c.x, c.y,
+                sp_dragon_reject_name(res.reason), res.guess_count, res.guess_count ? res.guesses[0].category : "");
+        ENSURE(res.rejected && res.reason == SP_DRAGON_DETAIL && res.part == -1 && res.guess_count > 0);
+        ENSURE(sp_dragon_part_count(d) == 2);
+    }
+    // A chip makes the eye a part: a chosen category is never a detail.
+    ENSURE(sp_dragon_add_points(d, loop, 40, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK && !res.rejected);
+    ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == 2);
+    // A Redraw of the head: the head it replaces holds no details.
+    ENSURE(sp_dragon_add_points(d, loop, 40, &(sp_dragon_stroke_opts){.replace_last = true}, &res, &err) == SP_OK);
+    fprintf(stderr, "  the eye as a Redraw of the head: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason != SP_DRAGON_DETAIL);
+    if (!res.rejected) {
+        ENSURE(sp_dragon_undo(d)); // the redrawn "head" is gone; put the head back
+        xy = visitor_stroke("head/head-frill.json", 220, head_at, false, &n);
+        head = add_as(d, xy, n, "head");
+        free(xy);
+    }
+    // The spot drawn apart from every part, or as large as a part: not a detail.
+    small_loop((sp_vec2){150, 700}, 16, loop);
+    ENSURE(sp_dragon_add_points(d, loop, 40, NULL, &res, &err) == SP_OK && res.reason != SP_DRAGON_DETAIL);
+    if (!res.rejected) ENSURE(sp_dragon_undo(d));
+    small_loop(spot, 70, loop);
+    ENSURE(sp_dragon_add_points(d, loop, 40, NULL, &res, &err) == SP_OK && res.reason != SP_DRAGON_DETAIL);
+    if (!res.rejected) ENSURE(sp_dragon_undo(d));
+    // A visitor's legs drawn small, their top inside the body: a part.
+    xy = visitor_stroke("front_legs/front-legs-boots.json", 110, (sp_vec2){spot.x, spot.y + 30}, false, &n);
+    ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK);
+    free(xy);
+    fprintf(stderr, "  small legs on the body: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason != SP_DRAGON_DETAIL);
+    // A dense scribble on the body (shading) is a detail too, not "what is that?".
+    sp_vec2 shade[200];
+    for (int k = 0; k < 200; ++k)
+        shade[k] = (sp_vec2){spot.x - 15 + 30 * fabs(fmod(k * 0.37, 2.0) - 1), spot.y - 12 + 0.12 * k};
+    ENSURE(sp_dragon_add_points(d, shade, 200, NULL, &res, &err) == SP_OK && res.reason == SP_DRAGON_DETAIL);
+    // The README's picture (docs/img/kiosk_detail.json): the body and the
+    // head as the kiosk makes them on the default database (this test's
+    // quick database classifies otherwise), then three spots and an eye.
+    sp_dragon_clear(d);
+    char file[1200];
+    snprintf(file, sizeof file, "%s/docs/img/kiosk_detail.json", SP_SOURCE_DIR);
+    sp_vec2* s6[8];
+    int n6[8], count = sp_fixture_session_strokes(file, s6, n6, 8);
+    ENSURE(count == 6);
+    for (int k = 0; k < count; ++k) {
+        if (k < 2)
+            add_as(d, s6[k], n6[k], k == 0 ? "torso" : "head");
+        else
+            ENSURE(sp_dragon_add_points(d, s6[k], n6[k], NULL, &res, &err) == SP_OK && res.reason == SP_DRAGON_DETAIL);
+        free(s6[k]);
+    }
+    ENSURE(sp_dragon_part_count(d) == 2);
+    sp_dragon_destroy(d);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -2691,5 +2844,6 @@ int main(int argc, char** argv)
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},
                                    {"parts_before_body", test_parts_before_body},
+                                   {"details_on_parts", test_details_on_parts},
                                    {0}});
 }

@@ -713,6 +713,36 @@ static void test_part_names(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// A small line drawn on a part (an eye, a spot) is refused as a detail: the
+// hint says the dragon has its own, and the stroke is offered as any
+// refused stroke is (its guesses, the parts row), so a visitor who meant a
+// small part makes it one with a tap; when the moment passes the hint goes.
+static void test_detail_refused(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    double t = stroke(ui, 1000, 200, 300, 18, 5);
+    frame(ui, &f, t + 10);
+    t = refused_stroke(ui, 3000, 800, 200);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    sp_kiosk_ui_fit_done(ui,
+                         &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .offer = true, .offers = {"head", "wings", "tail"}});
+    ENSURE(sp_kiosk_ui_offering(ui) && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_DETAIL)));
+    char text[64];
+    ENSURE(!strcmp(sp_kiosk_ui_target_text(ui, SP_KT_CHIP_GUESS1, text, sizeof text), "Head?"));
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    frame(ui, &f, t + 10 + 8000);
+    const char* m = sp_kiosk_ui_message(ui); // NULL: no message
+    ENSURE(!sp_kiosk_ui_offering(ui) && (!m || strcmp(m, sp_kiosk_text(SP_KTEXT_DETAIL)) != 0));
+    // Without an offer (nothing to guess), the refusal still says why.
+    t = refused_stroke(ui, 20000, 800, 200);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL});
+    ENSURE(!sp_kiosk_ui_offering(ui) && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_DETAIL)));
+    sp_kiosk_ui_destroy(ui);
+}
+
 // Issue 16, item 7: the save banner says what the code is for (Save names
 // the .glb and the postcard by it, where staff find them).
 static void test_save_code(void)
@@ -1352,6 +1382,7 @@ int main(int argc, char** argv)
                                    {"countdown", test_countdown},
                                    {"attract_stroke", test_attract_stroke},
                                    {"refused_stroke", test_refused_stroke},
+                                   {"detail_refused", test_detail_refused},
                                    {"parts_row", test_parts_row},
                                    {"other_chip", test_other_chip},
                                    {"start_over", test_start_over},

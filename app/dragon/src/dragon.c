@@ -24,6 +24,8 @@ const char* sp_dragon_reject_name(sp_dragon_reject r)
         return "nothing_to_refit";
     case SP_DRAGON_FULL:
         return "full";
+    case SP_DRAGON_DETAIL:
+        return "detail";
     }
     return "unknown";
 }

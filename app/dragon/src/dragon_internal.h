@@ -183,6 +183,13 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
 /// The same test against part k only (false when k is not a body).
 bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
+/// The part that a stroke (pts: n canvas points, box [lo, hi]) is a detail
+/// of, or -1: the part drawn last whose projected mesh at its fit (as
+/// shown, after attachment) holds nearly all the stroke's points and whose
+/// box's diagonal is over eight times the stroke's (an eye on a head, spots on a
+/// body: docs/DESIGN.md, "Details are not parts"). Part `skip` (the one a
+/// Redraw replaces, or -1) does not count.
+int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
 

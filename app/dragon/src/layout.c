@@ -470,6 +470,79 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
     return false;
 }
 
+// A stroke at most this fraction of a part's size (box diagonals on the
+// canvas) lying on that part is a detail of it: an eye on a head, spots on
+// a body. Larger, it is a part drawn over another: the visitors' tune
+// half drawn on a body at a third of the on-body bench's size (legs and
+// wings 91 px against a body of 500) keeps every part; at 0.3 of it some
+// legs drawn inside the body's outline become details.
+#define DETAIL_SIZE 0.12
+// The share of the stroke's points that must lie on the part.
+#define DETAIL_ON 0.9
+// How near the part's mesh a point counts as on it: the smaller of these
+// fractions of the part's box diagonal and the stroke's (a child's eye on a
+// thin snout runs over its edge; a small part drawn at a body's edge
+// reaches beyond it).
+#define DETAIL_NEAR 0.04
+#define DETAIL_NEAR_OWN 0.3
+// The stroke's points tested (evenly by index), enough to tell on from off.
+#define DETAIL_SAMPLES 32
+
+// Whether canvas point x lies on a part's projected mesh (px: its vertices
+// on the canvas) or within `near` pixels of it.
+static bool on_mesh(const sp_rig* rig, const sp_vec2* px, sp_vec2 x, double near)
+{
+    for (int f = 0; f < rig->triangle_count; ++f) {
+        const uint32_t* tr = rig->triangles + 3 * f;
+        sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
+        sp_vec2 lo = {fmin(a.x, fmin(b.x, c.x)), fmin(a.y, fmin(b.y, c.y))};
+        sp_vec2 hi = {fmax(a.x, fmax(b.x, c.x)), fmax(a.y, fmax(b.y, c.y))};
+        if (!(box_distance(x, lo, hi) <= near)) continue; // also skips non-finite corners
+        double bary[3];
+        if (sp_v2_len(sp_v2_sub(x, closest_on_triangle(x, a, b, c, bary))) <= near) return true;
+    }
+    return false;
+}
+
+int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip)
+{
+    double diag = hypot(hi.x - lo.x, hi.y - lo.y);
+    for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
+        part* q = d->parts[k];
+        // Its stroke's box first (cheap): a part is shown about where it was
+        // drawn, moved at most by the snap distance when it attaches.
+        double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]);
+        if (k == skip || n < 2 || !(diag <= 2 * DETAIL_SIZE * qd)) continue;
+        const sp_rig* rig = &q->t->ch.rig;
+        int nv = rig->vertex_count;
+        if (nv <= 0 || rig->triangle_count <= 0) continue;
+        double* xyz = malloc(sizeof(double) * 3 * (size_t)nv);
+        sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)nv);
+        if (!xyz || !px) {
+            free(xyz), free(px);
+            return -1; // out of memory: not a detail, the stroke goes on as a part
+        }
+        sp_rig_eval_update(q->t->ev, q->p_fit, false);
+        sp_rig_eval_points(q->t->ev, sp_rig_mesh_points(rig), xyz);
+        sp_mat4_points(&q->world_fit, xyz, nv);
+        sp_vec2 a = {INFINITY, INFINITY}, b = {-INFINITY, -INFINITY};
+        for (int v = 0; v < nv; ++v) {
+            px[v] = sp_camera_project(&d->world, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
+            a.x = fmin(a.x, px[v].x), a.y = fmin(a.y, px[v].y), b.x = fmax(b.x, px[v].x), b.y = fmax(b.y, px[v].y);
+        }
+        int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0, s = 0;
+        double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
+        bool detail = diag <= DETAIL_SIZE * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
+        for (; detail && s < m; ++s) { // stops once too many points are off
+            off += !on_mesh(rig, px, pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)], near);
+            detail = off <= (1 - DETAIL_ON) * m;
+        }
+        free(xyz), free(px);
+        if (detail) return k;
+    }
+    return -1;
+}
+
 // A socket farther than this from the body's middle (in half-lengths of the
 // body on the canvas) is at an end: a head's or a tail's, not the wings' or
 // the legs' (the shipped torso fitted to the visitors' tune bodies puts its

@@ -32,6 +32,7 @@ static const char* const k_text[SP_KTEXT_COUNT] = {
     [SP_KTEXT_UNRECOGNISED] = "Hmm, what is that? Tap the part you drew",
     [SP_KTEXT_UNRECOGNISED_NO_OFFER] = "Hmm, what is that? Try a body, a head, wings, a tail or legs",
     [SP_KTEXT_TOO_SMALL] = "A bit bigger please: draw one long line",
+    [SP_KTEXT_DETAIL] = "Your dragon has its own eyes and scales! Was it a part? Tap it",
     [SP_KTEXT_TRICKY] = "That one was tricky. Try drawing it again",
     [SP_KTEXT_NOT_READY] = "This kiosk is not ready yet. Please ask a guide",
     [SP_KTEXT_FULL] = "What a dragon! Save it, or tap Undo or Start over",

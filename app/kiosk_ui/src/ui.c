@@ -547,7 +547,8 @@ static void end_offer(sp_kiosk_ui* ui, bool fade)
     }
     ui->held_stroke.count = 0;
     ui->held_until = -1;
-    if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_UNRECOGNISED))) ui->hint_until = -1;
+    if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_UNRECOGNISED)) || !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DETAIL)))
+        ui->hint_until = -1;
     if (ui->chips_offer)
         set_chips(ui, NULL, NULL, NULL);
     else
@@ -968,6 +969,8 @@ static const char* refusal_text(sp_kiosk_refusal why, bool refit)
         return sp_kiosk_text(SP_KTEXT_NOT_READY);
     case SP_KREF_FULL:
         return sp_kiosk_text(SP_KTEXT_FULL);
+    case SP_KREF_DETAIL:
+        return sp_kiosk_text(SP_KTEXT_DETAIL);
     default:
         return sp_kiosk_text(refit ? SP_KTEXT_REFIT_FAILED : SP_KTEXT_UNRECOGNISED_NO_OFFER);
     }
@@ -980,7 +983,7 @@ static void hold(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
     ui->held_until = ui->now + ui->desc.offer_ms;
     ui->fade_until = -1;
     set_chip_list(ui, NULL, r->offers, 3, true);
-    set_hint(ui, sp_kiosk_text(SP_KTEXT_UNRECOGNISED));
+    set_hint(ui, sp_kiosk_text(r->refusal == SP_KREF_DETAIL ? SP_KTEXT_DETAIL : SP_KTEXT_UNRECOGNISED));
     ui->hint_until = ui->held_until;
     ++ui->offered;
 }

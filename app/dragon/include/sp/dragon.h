@@ -131,9 +131,10 @@ typedef enum sp_dragon_reject {
     SP_DRAGON_FIT_FAILED,       ///< every part of the category refused the stroke
     SP_DRAGON_NOTHING_TO_REFIT, ///< sp_dragon_refit_last with no stroke kept
     SP_DRAGON_FULL,             ///< max_parts parts already (Redraw, refit, undo and clear still work)
+    SP_DRAGON_DETAIL,           ///< a small stroke drawn on a part (an eye, a spot): a detail, not a part (guesses filled)
 } sp_dragon_reject;
 
-/// "accepted", "too_short", "unrecognised", "no_part", "no_model", "fit_failed", "nothing_to_refit", "full".
+/// "accepted", "too_short", "unrecognised", "no_part", "no_model", "fit_failed", "nothing_to_refit", "full", "detail".
 const char* sp_dragon_reject_name(sp_dragon_reject r);
 
 /// What else a visitor should be told about a stroke.

@@ -141,6 +141,7 @@ typedef enum sp_kiosk_refusal {
     SP_KREF_TRICKY,           ///< no part of the category could take its shape
     SP_KREF_NOT_READY,        ///< the database has no part of the category: staff needed
     SP_KREF_FULL,             ///< the dragon has all the parts it can take
+    SP_KREF_DETAIL,           ///< a small line drawn on a part (an eye, a spot): a detail, not a part
 } sp_kiosk_refusal;
 
 /// The answer to a FIT or REFIT job.
