@@ -488,19 +488,44 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
 // The stroke's points tested (evenly by index), enough to tell on from off.
 #define DETAIL_SAMPLES 32
 
-// Whether canvas point x lies on a part's projected mesh (px: its vertices
-// on the canvas) or within `near` pixels of it.
-static bool on_mesh(const sp_rig* rig, const sp_vec2* px, sp_vec2 x, double near)
+// A part's projected mesh (px: its vertices on the canvas) rasterised over
+// the window of w x h pixels whose corner is o: a cell is covered when its
+// centre lies in a triangle. One pass over the triangles serves all of a
+// stroke's points.
+static void cover(const sp_rig* rig, const sp_vec2* px, sp_vec2 o, int w, int h, unsigned char* cells)
 {
     for (int f = 0; f < rig->triangle_count; ++f) {
         const uint32_t* tr = rig->triangles + 3 * f;
         sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
-        sp_vec2 lo = {fmin(a.x, fmin(b.x, c.x)), fmin(a.y, fmin(b.y, c.y))};
-        sp_vec2 hi = {fmax(a.x, fmax(b.x, c.x)), fmax(a.y, fmax(b.y, c.y))};
-        if (!(box_distance(x, lo, hi) <= near)) continue; // also skips non-finite corners
-        double bary[3];
-        if (sp_v2_len(sp_v2_sub(x, closest_on_triangle(x, a, b, c, bary))) <= near) return true;
+        if (!isfinite(a.x + a.y + b.x + b.y + c.x + c.y)) continue;
+        double area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+        if (area2 == 0) continue;
+        // The cells whose centres its box holds, clamped to the window before
+        // the cast (a far-flung fit's corners overflow an int).
+        double fx0 = ceil(fmin(a.x, fmin(b.x, c.x)) - o.x - 0.5), fx1 = floor(fmax(a.x, fmax(b.x, c.x)) - o.x - 0.5);
+        double fy0 = ceil(fmin(a.y, fmin(b.y, c.y)) - o.y - 0.5), fy1 = floor(fmax(a.y, fmax(b.y, c.y)) - o.y - 0.5);
+        if (fx1 < 0 || fy1 < 0 || fx0 > w - 1 || fy0 > h - 1) continue;
+        int x0 = (int)fmax(0, fx0), x1 = (int)fmin(w - 1, fx1), y0 = (int)fmax(0, fy0), y1 = (int)fmin(h - 1, fy1);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                sp_vec2 p = {o.x + x + 0.5, o.y + y + 0.5};
+                double e0 = (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+                double e1 = (c.x - b.x) * (p.y - b.y) - (c.y - b.y) * (p.x - b.x);
+                double e2 = (a.x - c.x) * (p.y - c.y) - (a.y - c.y) * (p.x - c.x);
+                if (area2 > 0 ? (e0 >= 0 && e1 >= 0 && e2 >= 0) : (e0 <= 0 && e1 <= 0 && e2 <= 0)) cells[(size_t)y * w + x] = 1;
+            }
     }
+}
+
+// Whether a covered cell's centre lies within r pixels of canvas point p.
+static bool covered_near(const unsigned char* cells, int w, int h, sp_vec2 o, sp_vec2 p, double r)
+{
+    double cx = p.x - o.x - 0.5, cy = p.y - o.y - 0.5;
+    int x0 = (int)fmax(0, ceil(cx - r)), x1 = (int)fmin(w - 1, floor(cx + r));
+    int y0 = (int)fmax(0, ceil(cy - r)), y1 = (int)fmin(h - 1, floor(cy + r));
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+            if (cells[(size_t)y * w + x] && (x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r) return true;
     return false;
 }
 
@@ -510,9 +535,11 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
         part* q = d->parts[k];
         // Its stroke's box first (cheap): a part is shown about where it was
-        // drawn, moved at most by the snap distance when it attaches.
-        double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]);
-        if (k == skip || n < 2 || !(diag <= 2 * DETAIL_SIZE * qd)) continue;
+        // drawn (its fit reaching a little beyond the stroke, its horns and
+        // spikes too), moved at most by the snap distance when it attaches.
+        double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]), g = snap_px(d) + 0.25 * qd;
+        sp_vec2 qlo = {q->stroke_box[0] - g, q->stroke_box[1] - g}, qhi = {q->stroke_box[2] + g, q->stroke_box[3] + g};
+        if (k == skip || n < 2 || !(diag <= 2 * DETAIL_SIZE * qd) || !boxes_overlap(lo, hi, qlo, qhi)) continue;
         const sp_rig* rig = &q->t->ch.rig;
         int nv = rig->vertex_count;
         if (nv <= 0 || rig->triangle_count <= 0) continue;
@@ -530,13 +557,24 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
             px[v] = sp_camera_project(&d->world, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
             a.x = fmin(a.x, px[v].x), a.y = fmin(a.y, px[v].y), b.x = fmax(b.x, px[v].x), b.y = fmax(b.y, px[v].y);
         }
-        int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0, s = 0;
+        int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0;
         double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
         bool detail = diag <= DETAIL_SIZE * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
-        for (; detail && s < m; ++s) { // stops once too many points are off
-            off += !on_mesh(rig, px, pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)], near);
+        // The window: the stroke's box grown by `near` (and a cell); none for
+        // a mesh that is not finite or a window beyond reason.
+        sp_vec2 o = {floor(lo.x - near - 1), floor(lo.y - near - 1)};
+        double wd = ceil(hi.x + near + 1 - o.x) + 1, hd = ceil(hi.y + near + 1 - o.y) + 1;
+        detail = detail && isfinite(near) && wd * hd <= 4e6;
+        int w = detail ? (int)wd : 0, h = detail ? (int)hd : 0;
+        unsigned char* cells = detail ? calloc((size_t)w * (size_t)h, 1) : NULL;
+        detail = detail && cells;
+        if (detail) cover(rig, px, o, w, h, cells);
+        for (int s = 0; detail && s < m; ++s) { // stops once too many points are off
+            // Half a cell's diagonal more: a point in a covered cell is on the mesh.
+            off += !covered_near(cells, w, h, o, pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)], near + 0.71);
             detail = off <= (1 - DETAIL_ON) * m;
         }
+        free(cells);
         free(xyz), free(px);
         if (detail) return k;
     }
