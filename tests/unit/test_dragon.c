@@ -2693,8 +2693,9 @@ static bool disc_on_part(const sp_dragon* d, int i, sp_vec2 c, double r)
     return true;
 }
 
-// A point of part i where a disc of radius 2r lies on it and on no part
-// in `not_on` (-1: none), searched on a grid over its box (false: none).
+// A point of part i where a disc of radius 2r lies on it and one of radius
+// 3r + 10 not on part `not_on` (-1: none), searched on a grid over its box
+// from the middle out (false: none found).
 static bool spot_on_part(sp_dragon* d, int i, double r, int not_on, sp_vec2* out)
 {
     sp_error err = {0};
@@ -2708,7 +2709,6 @@ static bool spot_on_part(sp_dragon* d, int i, double r, int not_on, sp_vec2* out
         sp_vec2 x = sp_camera_project(&cam, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
         lo.x = fmin(lo.x, x.x), lo.y = fmin(lo.y, x.y), hi.x = fmax(hi.x, x.x), hi.y = fmax(hi.y, x.y);
     }
-    // From the box's middle outwards, so the spot is well inside.
     for (int ring = 0; ring <= 8; ++ring)
         for (int gx = -ring; gx <= ring; ++gx)
             for (int gy = -ring; gy <= ring; ++gy) {

@@ -472,10 +472,10 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
 
 // A stroke at most this fraction of a part's size (box diagonals on the
 // canvas) lying on that part is a detail of it: an eye on a head, spots on
-// a body. Larger, it is a part drawn over another: the visitors' tune
-// half drawn on a body at a third of the on-body bench's size (legs and
-// wings 91 px against a body of 500) keeps every part; at 0.3 of it some
-// legs drawn inside the body's outline become details.
+// a body. Larger, it is a part drawn over another: the visitors' parts
+// drawn on a body at 0.3 of the on-body bench's size (legs, tails and wings
+// 78 px against a body of 500) stay parts; smaller, some lie on the body's
+// stubs and spikes and become details (BENCHMARKS.md, "Sixteenth pass").
 #define DETAIL_SIZE 0.12
 // The share of the stroke's points that must lie on the part.
 #define DETAIL_ON 0.9
