@@ -67,28 +67,23 @@ void sp_skin8_pack(const sp_skin8* s, uint16_t joints[4], float weights[4])
     }
 }
 
-static unsigned char* at(grid* g, int x, int y)
-{
-    return &g->c[(size_t)y * (size_t)g->w + (size_t)x];
-}
 static int get(const grid* g, int x, int y)
 {
     if (x < 0 || y < 0 || x >= g->w || y >= g->h) return 0;
     return g->c[(size_t)y * (size_t)g->w + (size_t)x];
 }
 
-// Cells whose centre lies in the triangle (either winding).
-static void fill_triangle(grid* g, const double* a, const double* b, const double* c)
+void sp_raster_triangle(unsigned char* cells, int w, int h, const double a[2], const double b[2], const double c[2])
 {
-    double x0 = fmin(a[0], fmin(b[0], c[0])), x1 = fmax(a[0], fmax(b[0], c[0]));
-    double y0 = fmin(a[1], fmin(b[1], c[1])), y1 = fmax(a[1], fmax(b[1], c[1]));
-    int cx0 = (int)floor(x0 - 0.5), cx1 = (int)ceil(x1 - 0.5), cy0 = (int)floor(y0 - 0.5), cy1 = (int)ceil(y1 - 0.5);
-    if (cx0 < 0) cx0 = 0;
-    if (cy0 < 0) cy0 = 0;
-    if (cx1 >= g->w) cx1 = g->w - 1;
-    if (cy1 >= g->h) cy1 = g->h - 1;
+    if (!isfinite(a[0] + a[1] + b[0] + b[1] + c[0] + c[1])) return;
     double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
     if (area == 0.0) return;
+    // The cells whose centres the box holds, clamped to the grid before the
+    // cast (a far-flung corner would overflow an int).
+    double x0 = ceil(fmin(a[0], fmin(b[0], c[0])) - 0.5), x1 = floor(fmax(a[0], fmax(b[0], c[0])) - 0.5);
+    double y0 = ceil(fmin(a[1], fmin(b[1], c[1])) - 0.5), y1 = floor(fmax(a[1], fmax(b[1], c[1])) - 0.5);
+    if (x1 < 0 || y1 < 0 || x0 > w - 1 || y0 > h - 1) return;
+    int cx0 = (int)fmax(x0, 0), cx1 = (int)fmin(x1, w - 1), cy0 = (int)fmax(y0, 0), cy1 = (int)fmin(y1, h - 1);
     double sgn = area > 0 ? 1.0 : -1.0;
     for (int y = cy0; y <= cy1; ++y)
         for (int x = cx0; x <= cx1; ++x) {
@@ -96,7 +91,7 @@ static void fill_triangle(grid* g, const double* a, const double* b, const doubl
             double e0 = sgn * ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]));
             double e1 = sgn * ((c[0] - b[0]) * (py - b[1]) - (c[1] - b[1]) * (px - b[0]));
             double e2 = sgn * ((a[0] - c[0]) * (py - c[1]) - (a[1] - c[1]) * (px - c[0]));
-            if (e0 >= 0 && e1 >= 0 && e2 >= 0) *at(g, x, y) = 1;
+            if (e0 >= 0 && e1 >= 0 && e2 >= 0) cells[(size_t)y * (size_t)w + (size_t)x] = 1;
         }
 }
 
@@ -394,7 +389,7 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
             res = sp_fail(err, SP_ERR_INVALID, "outline: triangle %d refers to a vertex past %d", t, nv);
             goto done;
         }
-        fill_triangle(&g, cell + 2 * q[0], cell + 2 * q[1], cell + 2 * q[2]);
+        sp_raster_triangle(g.c, g.w, g.h, cell + 2 * q[0], cell + 2 * q[1], cell + 2 * q[2]);
     }
     // Closing (dilate, erode) removes hairline gaps between touching pieces.
     if (!morph(&g, true) || !morph(&g, true) || !morph(&g, false) || !morph(&g, false)) goto oom;

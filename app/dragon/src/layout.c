@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "dragon_internal.h"
+#include "sp/outline.h"
 
 // Pixels within which two candidate surface points count as equally near
 // the attachment end (the near and the far side of a silhouette edge).
@@ -83,6 +84,18 @@ sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* v
 
 // ---- bodies as seen on the canvas ------------------------------------------------------
 
+// Part q's mesh at its fit moved by m into the world (xyz: vertex_count by
+// 3) and seen on the canvas (px).
+static void mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px)
+{
+    const sp_rig* rig = &q->t->ch.rig;
+    sp_rig_eval_update(q->t->ev, q->p_fit, false);
+    sp_rig_eval_points(q->t->ev, sp_rig_mesh_points(rig), xyz);
+    sp_mat4_points(m, xyz, rig->vertex_count);
+    for (int v = 0; v < rig->vertex_count; ++v)
+        px[v] = sp_camera_project(&d->world, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
+}
+
 // A body's vertices at its fit, in the world and on the canvas, and the
 // area of its surface (kept: a body's fit never changes).
 static bool body_prepare(const sp_dragon* d, part* q)
@@ -97,13 +110,7 @@ static bool body_prepare(const sp_dragon* d, part* q)
         q->body_xyz = NULL, q->body_px = NULL;
         return false;
     }
-    sp_rig_eval_update(q->t->ev, q->p_fit, false);
-    sp_rig_eval_points(q->t->ev, sp_rig_mesh_points(rig), q->body_xyz);
-    sp_mat4_points(&q->pub.placement, q->body_xyz, (int)n);
-    for (size_t v = 0; v < n; ++v) {
-        const double* x = q->body_xyz + 3 * v;
-        q->body_px[v] = sp_camera_project(&d->world, (sp_vec3){x[0], x[1], x[2]});
-    }
+    mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px);
     // Its surface: the triangles' area in the world. None (every triangle of
     // zero area, or nothing finite) means there is nothing to hold a part.
     double area = 0;
@@ -338,16 +345,20 @@ static void attach(sp_dragon* d, int i, int k, const surface_hit* h, sp_vec3 a)
     dragon_copy_name(p->pub.socket, sizeof p->pub.socket, so ? so->name : "");
 }
 
+// The box of n canvas points; false when there are none.
+static bool px_box(const sp_vec2* px, int n, sp_vec2* lo, sp_vec2* hi)
+{
+    if (n <= 0) return false;
+    *lo = *hi = px[0];
+    for (int v = 1; v < n; ++v)
+        lo->x = fmin(lo->x, px[v].x), lo->y = fmin(lo->y, px[v].y), hi->x = fmax(hi->x, px[v].x), hi->y = fmax(hi->y, px[v].y);
+    return true;
+}
+
 // The body's box on the canvas at its fit (body_prepare'd); false without vertices.
 static bool body_box(const part* q, sp_vec2* lo, sp_vec2* hi)
 {
-    int n = q->t->ch.rig.vertex_count;
-    if (n <= 0) return false;
-    *lo = *hi = q->body_px[0];
-    for (int v = 1; v < n; ++v)
-        lo->x = fmin(lo->x, q->body_px[v].x), lo->y = fmin(lo->y, q->body_px[v].y), hi->x = fmax(hi->x, q->body_px[v].x),
-        hi->y = fmax(hi->y, q->body_px[v].y);
-    return true;
+    return px_box(q->body_px, q->t->ch.rig.vertex_count, lo, hi);
 }
 
 // Whether the boxes [lo, hi] and [a, b] overlap (touching counts).
@@ -489,31 +500,17 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
 #define DETAIL_SAMPLES 32
 
 // A part's projected mesh (px: its vertices on the canvas) rasterised over
-// the window of w x h pixels whose corner is o: a cell is covered when its
-// centre lies in a triangle. One pass over the triangles serves all of a
-// stroke's points.
+// the window of w x h pixels whose corner is o (sp_raster_triangle: a cell
+// is covered when its centre lies in a triangle). One pass over the
+// triangles serves all of a stroke's points.
 static void cover(const sp_rig* rig, const sp_vec2* px, sp_vec2 o, int w, int h, unsigned char* cells)
 {
     for (int f = 0; f < rig->triangle_count; ++f) {
         const uint32_t* tr = rig->triangles + 3 * f;
-        sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
-        if (!isfinite(a.x + a.y + b.x + b.y + c.x + c.y)) continue;
-        double area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-        if (area2 == 0) continue;
-        // The cells whose centres its box holds, clamped to the window before
-        // the cast (a far-flung fit's corners overflow an int).
-        double fx0 = ceil(fmin(a.x, fmin(b.x, c.x)) - o.x - 0.5), fx1 = floor(fmax(a.x, fmax(b.x, c.x)) - o.x - 0.5);
-        double fy0 = ceil(fmin(a.y, fmin(b.y, c.y)) - o.y - 0.5), fy1 = floor(fmax(a.y, fmax(b.y, c.y)) - o.y - 0.5);
-        if (fx1 < 0 || fy1 < 0 || fx0 > w - 1 || fy0 > h - 1) continue;
-        int x0 = (int)fmax(0, fx0), x1 = (int)fmin(w - 1, fx1), y0 = (int)fmax(0, fy0), y1 = (int)fmin(h - 1, fy1);
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) {
-                sp_vec2 p = {o.x + x + 0.5, o.y + y + 0.5};
-                double e0 = (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
-                double e1 = (c.x - b.x) * (p.y - b.y) - (c.y - b.y) * (p.x - b.x);
-                double e2 = (a.x - c.x) * (p.y - c.y) - (a.y - c.y) * (p.x - c.x);
-                if (area2 > 0 ? (e0 >= 0 && e1 >= 0 && e2 >= 0) : (e0 <= 0 && e1 <= 0 && e2 <= 0)) cells[(size_t)y * w + x] = 1;
-            }
+        double c[3][2];
+        for (int k = 0; k < 3; ++k)
+            c[k][0] = px[tr[k]].x - o.x, c[k][1] = px[tr[k]].y - o.y;
+        sp_raster_triangle(cells, w, h, c[0], c[1], c[2]);
     }
 }
 
@@ -549,14 +546,9 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
             free(xyz), free(px);
             return -1; // out of memory: not a detail, the stroke goes on as a part
         }
-        sp_rig_eval_update(q->t->ev, q->p_fit, false);
-        sp_rig_eval_points(q->t->ev, sp_rig_mesh_points(rig), xyz);
-        sp_mat4_points(&q->world_fit, xyz, nv);
-        sp_vec2 a = {INFINITY, INFINITY}, b = {-INFINITY, -INFINITY};
-        for (int v = 0; v < nv; ++v) {
-            px[v] = sp_camera_project(&d->world, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
-            a.x = fmin(a.x, px[v].x), a.y = fmin(a.y, px[v].y), b.x = fmax(b.x, px[v].x), b.y = fmax(b.y, px[v].y);
-        }
+        mesh_on_canvas(d, q, &q->world_fit, xyz, px); // as shown: after attachment
+        sp_vec2 a, b;
+        px_box(px, nv, &a, &b);
         int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0;
         double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
         bool detail = diag <= DETAIL_SIZE * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);

@@ -828,7 +828,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // A small stroke drawn on a part is a detail of it (an eye, spots,
     // shading): the kiosk's parts have theirs, and a tiny part there is not
     // what was meant. Its guesses stay, so a chip still makes it a part.
-    if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category && d->clf &&
+    if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
         dragon_detail_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1) >= 0)
         why = SP_DRAGON_DETAIL;
     if (why != SP_DRAGON_ACCEPTED) {

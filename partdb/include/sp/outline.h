@@ -99,6 +99,13 @@ typedef struct sp_outline_info {
 /// keep_largest) the silhouette falls apart; SP_ERR_NO_MEMORY.
 sp_result sp_outline_trace(const sp_outline_desc* desc, sp_abstraction* out, sp_outline_info* info, sp_error* err);
 
+/// The tracer's rasteriser, for others that need a mesh's cover: marks
+/// (sets to 1) the cells of a w x h grid (row-major, a byte a cell) whose
+/// centre (x + 0.5, y + 0.5) lies in triangle a b c, given in cells (either
+/// winding, edges included). A triangle of no area, or with a corner that is
+/// not finite, marks none; parts beyond the grid are clipped.
+void sp_raster_triangle(unsigned char* cells, int w, int h, const double a[2], const double b[2], const double c[2]);
+
 #ifdef __cplusplus
 }
 #endif
