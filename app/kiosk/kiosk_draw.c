@@ -78,13 +78,19 @@ static sp_camera scene_camera(sp_kiosk* k, bool orbit, bool* any, sp_vec3* lo, s
     return cam;
 }
 
-static void draw_dragon(sp_kiosk* k, bool hide_last)
+// The parts and the details drawn on them (ink `ink` pixels wide).
+static void draw_dragon(sp_kiosk* k, bool hide_last, float ink)
 {
     int n = sp_dragon_part_count(k->dragon);
     for (int i = 0; i < n; ++i) {
         if (hide_last && i == n - 1) continue;
         sp_render_mesh* m = mesh_cache_get(&k->meshes, sp_dragon_part_get(k->dragon, i)->id);
         if (m) sp_renderer_draw_mesh(k->r, m, NULL);
+    }
+    for (int i = 0; i < sp_dragon_detail_count(k->dragon); ++i) {
+        sp_dragon_detail e;
+        if (sp_dragon_detail_get(k->dragon, i, &e) && e.xyz && !(hide_last && e.part == n - 1))
+            sp_renderer_draw_curve3d_facing(k->r, e.xyz, e.normal, e.point_count, ink, SP_COLOR_INK);
     }
 }
 
@@ -334,7 +340,7 @@ void kiosk_draw_frame(sp_kiosk* k, int w, int h)
         kiosk_attract_draw_scene(k);
     } else {
         if (any) sp_renderer_draw_ground_shadow(k->r, lo, hi, 0);
-        draw_dragon(k, sp_kiosk_ui_flashing(ui));
+        draw_dragon(k, sp_kiosk_ui_flashing(ui), 0.8f * ui->line_px);
         // Strokes and outlines belong to the drawing view only.
         if (ui->yaw == 0 && ui->pitch == 0) {
             float lw = ui->line_px;
@@ -378,7 +384,8 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
     sp_renderer_begin(k->r, &cam, W, H);
     sp_renderer_clear(k->r, (const float[4]){0.98f, 0.95f, 0.86f, 1}, (const float[4]){0.85f, 0.78f, 0.62f, 1});
     sp_renderer_draw_ground_shadow(k->r, lo, hi, 0);
-    draw_dragon(k, false);
+    // The ink as thick on the dragon as on the canvas it was drawn on.
+    draw_dragon(k, false, (float)(0.8 * k->ui->line_px * cam.scale / kiosk_fb_camera(k).scale));
     sp_renderer_end(k->r);
     sp_draw2d_begin(k->d2, W, H);
     sp_draw2d_rect(k->d2, 12, 12, W - 24.0f, H - 24.0f, 18, 5, k_ink);

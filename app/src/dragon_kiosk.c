@@ -276,6 +276,12 @@ static void print_stats(const app* a, double start_ms)
     printf("],\n \"attached_to\": [");
     for (int i = 0; i < sp_dragon_part_count(d); ++i)
         printf("%s%d", i ? ", " : "", sp_dragon_part_get(d, i)->attached_to);
+    printf("],\n \"details_on\": [");
+    for (int i = 0; i < sp_dragon_detail_count(d); ++i) {
+        sp_dragon_detail e;
+        sp_dragon_detail_get(d, i, &e);
+        printf("%s%d", i ? ", " : "", e.part);
+    }
     printf("]}\n");
 }
 

@@ -1391,6 +1391,56 @@ static void test_body_after_parts(void)
     free(small);
 }
 
+// Details drawn on the dragon stay on it as ink (issue 16 item 7): the
+// README's detail session (docs/img/kiosk_detail.json: a body, a head,
+// three spots on the body, an eye on the head), its body and head made so
+// by the parts row whatever this database's model says; then, while the eye
+// is offered, nothing, a chip, or Undo.
+static void test_detail_ink(void)
+{
+    NEED_XVFB();
+    char file[1200];
+    snprintf(file, sizeof file, "%s", sp_test_src_path("docs/img/kiosk_detail.json"));
+    sp_vec2* xy[8];
+    int n[8], count = sp_fixture_session_strokes(file, xy, n, 8);
+    ENSURE(count == 6);
+    static const char* const then[3] = {NULL, "guess1", "undo"};
+    static const int want_parts[3] = {2, 3, 2}, want_details[3] = {4, 3, 3};
+    for (int v = 0; v < 3; ++v) {
+        char sc[1100];
+        snprintf(sc, sizeof sc, "%s", sp_test_tmp_path("kiosk_detail_ink.json"));
+        script s = script_open(sc, 0);
+        double t = 500;
+        for (int k = 0; k < count; ++k) {
+            t = script_stroke(&s, t, xy[k], n[k], 8) + 1500;
+            if (k < 2) { // "Other?", then the row's body or head (a tap on the part's own tile only closes the row)
+                script_press(&s, t, "more");
+                script_press(&s, t + 300, k == 0 ? "part1" : "part2");
+                t += 1600;
+            }
+        }
+        if (then[v]) script_press(&s, t, then[v]);
+        script_end(&s, sc, t + 1500);
+        char args[2400];
+        snprintf(args, sizeof args, "--script '%s' --lod -1", sc);
+        cJSON* st = NULL;
+        ENSURE(run_kiosk(args, &st) == 0 && st);
+        const cJSON* cat = cJSON_GetObjectItemCaseSensitive(st, "categories");
+        const cJSON* on = cJSON_GetObjectItemCaseSensitive(st, "details_on");
+        fprintf(stderr, "  then %s: %d parts (%s, %s), %d details\n", then[v] ? then[v] : "nothing", cJSON_GetArraySize(cat),
+                cJSON_GetStringValue(cJSON_GetArrayItem(cat, 0)), cJSON_GetStringValue(cJSON_GetArrayItem(cat, 1)),
+                cJSON_GetArraySize(on));
+        ENSURE(cJSON_GetArraySize(cat) == want_parts[v] && cJSON_GetArraySize(on) == want_details[v]);
+        ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetArrayItem(cat, 0)), "torso") &&
+               !strcmp(cJSON_GetStringValue(cJSON_GetArrayItem(cat, 1)), "head"));
+        for (int i = 0; i < want_details[v]; ++i) // the spots on the body; the eye, kept, on the head
+            ENSURE(cJSON_GetArrayItem(on, i)->valueint == (i < 3 ? 0 : 1));
+        cJSON_Delete(st);
+    }
+    for (int k = 0; k < count; ++k)
+        free(xy[k]);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -1408,5 +1458,6 @@ int main(int argc, char** argv)
                                    {"collect_busy", test_collect_busy},
                                    {"collect_replaced", test_collect_replaced},
                                    {"body_after_parts", test_body_after_parts},
+                                   {"detail_ink", test_detail_ink},
                                    {0}});
 }

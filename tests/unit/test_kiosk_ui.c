@@ -740,6 +740,21 @@ static void test_detail_refused(void)
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL});
     ENSURE(!sp_kiosk_ui_offering(ui) && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_DETAIL)));
+    // Kept on the dragon as ink: Undo while it is offered takes it back from
+    // the dragon too (an UNDO job); a stroke only held needs none.
+    t = refused_stroke(ui, 30000, 800, 200);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    sp_kiosk_ui_fit_done(
+        ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .offer = true, .kept = true, .offers = {"head", "wings", "tail"}});
+    ENSURE(sp_kiosk_ui_offering(ui));
+    tap(ui, t + 200, SP_KT_UNDO);
+    ENSURE(!sp_kiosk_ui_offering(ui) && sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_UNDO);
+    t = refused_stroke(ui, 40000, 800, 200);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    sp_kiosk_ui_fit_done(ui,
+                         &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .offer = true, .offers = {"head", "wings", "tail"}});
+    tap(ui, t + 200, SP_KT_UNDO);
+    ENSURE(!sp_kiosk_ui_offering(ui) && !sp_kiosk_ui_next_job(ui, &j));
     sp_kiosk_ui_destroy(ui);
 }
 

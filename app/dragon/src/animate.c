@@ -88,6 +88,7 @@ sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err)
         sp_mat4_points(&p->world_t, p->xyz, p->t->ch.rig.vertex_count);
         sp_mat4_points(&p->world_t, p->outline, p->t->ch.rig.abstractions[p->t->abstraction].point_count);
     }
+    dragon_details_pose(d);
     d->posed = true;
     return SP_OK;
 }

@@ -6,6 +6,7 @@
 //              the parts list (add, redraw, refit, undo, clear);
 //   layout.c   where a part goes: its view on the canvas, its placement in
 //              the world, attachment to a body;
+//   detail.c   details kept as ink bound to their part's mesh;
 //   animate.c  the clips as offsets, posing the dragon at a time;
 //   report.c   the report JSON;  export.c  the glTF export;
 //   dragon.c   create, destroy and the small accessors.
@@ -118,6 +119,19 @@ typedef struct part {
     sp_rig_eval* ev;
 } part;
 
+// A detail (detail.c): a stroke kept as ink on a part, each point bound to
+// one of the part's triangles by barycentric coordinates.
+typedef struct detail {
+    uint64_t id, host; // its own id and its part's
+    const tpl* t;      // the part's template and facing when bound: shown only while the part has them
+    bool mirrored;
+    int n;
+    uint32_t* tri;        // n by 3 (one block with the arrays below)
+    double *bary, *flip;  // n by 3; n: +1 or -1, the triangle's winding towards the side drawn on
+    double *xyz, *normal; // posed at the last pose_at, n by 3
+    bool shown;           // posed and its part as bound
+} detail;
+
 struct sp_dragon {
     sp_dragon_desc desc;
     sp_db* db;
@@ -132,6 +146,8 @@ struct sp_dragon {
     part** parts;
     int part_n, part_cap;
     uint64_t next_id;
+    detail** details; // SP_DRAGON_MAX_DETAILS slots, allocated with the first
+    int detail_n;
     sp_camera world;
     double period;
     bool posed;
@@ -192,5 +208,31 @@ bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
 int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
+/// Part q's mesh evaluated at its fit, moved into the world by m, and
+/// projected on the canvas (xyz: vertex_count by 3, px: vertex_count).
+void dragon_mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px);
+
+// ---- detail.c ----------------------------------------------------------------------
+
+/// How near a part's mesh (on the canvas) a detail's point counts as on it:
+/// the smaller of these fractions of the part's box diagonal and the
+/// stroke's (a child's eye on a thin snout runs over its edge; a small part
+/// drawn at a body's edge reaches beyond it), pixels.
+static inline double dragon_detail_near(double mesh_diag, double stroke_diag)
+{
+    return mesh_diag * 0.04 < stroke_diag * 0.3 ? mesh_diag * 0.04 : stroke_diag * 0.3;
+}
+
+/// Keeps the stroke (pts: n canvas points, box [lo, hi]) as a detail of
+/// part k: its index, or -1 when the dragon holds SP_DRAGON_MAX_DETAILS, no
+/// two points lie on or near the part's mesh, or memory runs out.
+int dragon_detail_keep(sp_dragon* d, int k, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi);
+/// Poses every detail on its part's vertices at the last pose_at (after them).
+void dragon_details_pose(sp_dragon* d);
+/// Drops the details whose part is gone (replaced by a Redraw or a chip).
+void dragon_details_prune(sp_dragon* d);
+/// Drops the last detail (n > 0) or every detail.
+void dragon_detail_pop(sp_dragon* d);
+void dragon_details_clear(sp_dragon* d);
 
 #endif

@@ -385,6 +385,7 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
     out->rejected = true;
     out->reason = why;
     out->part = -1;
+    if (why != SP_DRAGON_DETAIL) out->detail = -1;
     out->ms_total = sp_now_ms() - t0;
     return SP_OK;
 }
@@ -797,8 +798,11 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
 {
     double t0 = sp_now_ms();
     memset(out, 0, sizeof *out);
-    out->part = -1;
+    out->part = out->detail = -1;
     sp_dragon_stroke_opts o = opts ? *opts : (sp_dragon_stroke_opts){0};
+    // A chip for a detail: the part takes the detail's place when the detail is the last change.
+    bool drop_detail = o.replace_detail && d->detail_n > 0 &&
+                       d->details[d->detail_n - 1]->id > (d->part_n > 0 ? d->parts[d->part_n - 1]->pub.id : 0);
     if (count < 0 || (count > 0 && !xy)) return sp_fail(err, SP_ERR_INVALID, "stroke: %d points", count);
     if (count > 0 && !sp_curve_is_valid(xy, count))
         return sp_fail(err, SP_ERR_INVALID, "stroke: a coordinate is not a finite number");
@@ -826,12 +830,14 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     sp_clf_answer a;
     sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence, &near, &a);
     // A small stroke drawn on a part is a detail of it (an eye, spots,
-    // shading): the kiosk's parts have theirs, and a tiny part there is not
-    // what was meant. Its guesses stay, so a chip still makes it a part.
+    // shading): a tiny part there is not what was meant. It is kept as ink
+    // on the part; its guesses stay, so a chip still makes it a part.
+    int host = -1;
     if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
-        dragon_detail_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1) >= 0)
+        (host = dragon_detail_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1)) >= 0)
         why = SP_DRAGON_DETAIL;
     if (why != SP_DRAGON_ACCEPTED) {
+        if (why == SP_DRAGON_DETAIL) out->detail = dragon_detail_keep(d, host, pts, n, lo, hi);
         free(pts);
         offer_kin(d, &a, out);
         return reject(out, why, t0);
@@ -879,6 +885,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         give_back_fits(d, d->parts[d->part_n - 1]->pub.id);
         dragon_part_free(d->parts[d->part_n - 1]);
         d->parts[d->part_n - 1] = q;
+        dragon_details_prune(d); // the replaced part's ink goes with it
     } else {
         if (d->part_n == d->part_cap) {
             int cap2 = d->part_cap ? 2 * d->part_cap : 8;
@@ -902,6 +909,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // wings turn to face the way it does.
     const part* last = d->parts[d->part_n - 1];
     if (last->t->lengthwise && last->pub.attached_to >= 0) parts_by_place(d, last->pub.attached_to, last->pub.id);
+    if (drop_detail) dragon_detail_pop(d);
     out->part = d->part_n - 1;
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
@@ -935,6 +943,11 @@ sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_res
 
 bool sp_dragon_undo(sp_dragon* d)
 {
+    // A detail always comes after its part, so popping by id never leaves ink without its part.
+    if (d->detail_n > 0 && d->details[d->detail_n - 1]->id > (d->part_n > 0 ? d->parts[d->part_n - 1]->pub.id : 0)) {
+        dragon_detail_pop(d);
+        return true;
+    }
     if (d->part_n == 0) return false;
     part* last = d->parts[--d->part_n];
     give_back_fits(d, last->pub.id);
@@ -945,6 +958,7 @@ bool sp_dragon_undo(sp_dragon* d)
 
 void sp_dragon_clear(sp_dragon* d)
 {
+    dragon_details_clear(d);
     while (d->part_n > 0)
         dragon_part_free(d->parts[--d->part_n]);
     dragon_relayout(d);

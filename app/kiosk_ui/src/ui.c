@@ -547,6 +547,7 @@ static void end_offer(sp_kiosk_ui* ui, bool fade)
     }
     ui->held_stroke.count = 0;
     ui->held_until = -1;
+    ui->held_kept = false;
     if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_UNRECOGNISED)) || !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DETAIL)))
         ui->hint_until = -1;
     if (ui->chips_offer)
@@ -738,7 +739,8 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     }
     switch (t) {
     case SP_KT_UNDO:
-        if (offering(ui)) { // the refused stroke was the last thing drawn: it is what goes
+        // The refused stroke was the last thing drawn: it is what goes (kept as ink, the dragon gives it back too).
+        if (offering(ui) && !ui->held_kept) {
             end_offer(ui, false);
         } else if (push_job(ui, SP_KJOB_UNDO)) {
             clear_overlays(ui);
@@ -981,6 +983,7 @@ static void hold(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
 {
     line_copy(&ui->held_stroke, &ui->job_stroke);
     ui->held_until = ui->now + ui->desc.offer_ms;
+    ui->held_kept = r->kept;
     ui->fade_until = -1;
     set_chip_list(ui, NULL, r->offers, 3, true);
     set_hint(ui, sp_kiosk_text(r->refusal == SP_KREF_DETAIL ? SP_KTEXT_DETAIL : SP_KTEXT_UNRECOGNISED));

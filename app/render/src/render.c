@@ -564,6 +564,23 @@ void sp_renderer_draw_curve3d(sp_renderer* r, const double* xyz, int n, bool clo
     if (px != stack) free(px);
 }
 
+void sp_renderer_draw_curve3d_facing(sp_renderer* r, const double* xyz, const double* normal, int n, float width,
+                                     const float rgba[4])
+{
+    assert(r && r->in_frame && ((xyz && normal) || n == 0));
+    for (int i = 0; i < n;) {
+        int j = i;
+        while (j < n) {
+            sp_vec3 p = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
+            if (!(sp_v3_dot(sp_camera_view_dir(&r->cam, p), (sp_vec3){normal[3 * j], normal[3 * j + 1], normal[3 * j + 2]}) < 0))
+                break;
+            ++j;
+        }
+        if (j > i) sp_renderer_draw_curve3d(r, xyz + 3 * (size_t)i, j - i, false, width, rgba);
+        i = j + 1;
+    }
+}
+
 void sp_renderer_draw_abstraction(sp_renderer* r, const sp_abstraction* a, const double* xyz, float width, const float rgba[4])
 {
     assert(r && a && (xyz || a->point_count == 0));

@@ -41,6 +41,11 @@ sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc*
     for (int i = 0; i < n; ++i)
         if (meshes[i]) sp_renderer_draw_mesh(r, meshes[i], NULL);
     float line = (float)fmax(2.0, cam.height / 160.0);
+    for (int i = 0; i < sp_dragon_detail_count(d); ++i) {
+        sp_dragon_detail e;
+        if (sp_dragon_detail_get(d, i, &e) && e.xyz)
+            sp_renderer_draw_curve3d_facing(r, e.xyz, e.normal, e.point_count, line, SP_COLOR_INK);
+    }
     for (int i = 0; o.strokes && i < n; ++i) {
         const sp_dragon_part* p = sp_dragon_part_get(d, i);
         sp_renderer_draw_polyline(r, p->stroke_xy, p->stroke_points, false, line * 1.2f, SP_COLOR_STROKE);

@@ -131,7 +131,7 @@ typedef enum sp_dragon_reject {
     SP_DRAGON_FIT_FAILED,       ///< every part of the category refused the stroke
     SP_DRAGON_NOTHING_TO_REFIT, ///< sp_dragon_refit_last with no stroke kept
     SP_DRAGON_FULL,             ///< max_parts parts already (Redraw, refit, undo and clear still work)
-    SP_DRAGON_DETAIL,           ///< a small stroke drawn on a part (an eye, a spot): a detail, not a part (guesses filled)
+    SP_DRAGON_DETAIL,           ///< a small stroke drawn on a part (an eye): a detail, kept as ink on it (guesses filled)
 } sp_dragon_reject;
 
 /// "accepted", "too_short", "unrecognised", "no_part", "no_model", "fit_failed", "nothing_to_refit", "full", "detail".
@@ -179,12 +179,13 @@ typedef struct sp_dragon_part {
 
 /// What one stroke did.
 typedef struct sp_dragon_result {
-    bool rejected; ///< nothing changed (see reason)
+    bool rejected; ///< no part was added or changed (see reason); only a detail may have been kept (detail)
     sp_dragon_reject reason;
     sp_dragon_note note; ///< what else to tell (also when accepted)
     int guess_count;     ///< ranked categories (0..SP_DRAGON_GUESSES), also when rejected by the classifier; the accepted part's first (the fit re-ranks them)
     sp_dragon_guess guesses[SP_DRAGON_GUESSES];
     int part;                             ///< index of the new (or replaced) part, -1 when rejected
+    int detail;                           ///< SP_DRAGON_DETAIL: the detail kept as ink, -1 when none (full, nothing bound)
     double ms_classify, ms_fit, ms_total; ///< wall-clock, milliseconds
 } sp_dragon_result;
 
@@ -192,6 +193,7 @@ typedef struct sp_dragon_result {
 typedef struct sp_dragon_stroke_opts {
     const char* category; ///< use this category instead of classifying (the guesses are still filled)
     bool replace_last;    ///< the stroke replaces the last part (Redraw); a rejected stroke keeps it
+    bool replace_detail;  ///< a chip for a detail: an accepted part takes the place of the last change if it is a detail
 } sp_dragon_stroke_opts;
 
 /// Opens the database (creating the default one when missing), loads the
@@ -216,10 +218,33 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
 /// A chip tap: re-fits the last part's stroke as `category` (replacing that
 /// part). Rejected (nothing changed) when there is no part or no part of that category.
 sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_result* out, sp_error* err);
-/// Removes the last part; false when there was none.
+/// Removes the last change: the last detail when it came after the last
+/// part, else the last part; false when there was neither.
 bool sp_dragon_undo(sp_dragon* d);
-/// Removes every part.
+/// Removes every part and detail.
 void sp_dragon_clear(sp_dragon* d);
+
+/// Details: a stroke refused as SP_DRAGON_DETAIL (an eye, spots, scales) is
+/// kept as ink on its part, at most SP_DRAGON_MAX_DETAILS of them. Each point
+/// is bound to the part's mesh where the visitor drew it (the front-most
+/// triangle under it at the fit as shown, barycentric; a point just off the
+/// mesh to the nearest triangle near it), so the ink rides the part's
+/// animation. A detail lives as long as its part: a Redraw or chip that
+/// replaces the part drops it; while a later part has the part fitted as
+/// another template or facing (legs made the other legs, a part turned) it
+/// is not shown. Details are not in the glTF export.
+enum { SP_DRAGON_MAX_DETAILS = 256, SP_DRAGON_DETAIL_POINTS = 128 };
+typedef struct sp_dragon_detail {
+    uint64_t id;          ///< unique for the dragon's lifetime, from the same counter as parts' (later = larger)
+    int part;             ///< index of the part it is drawn on
+    int point_count;      ///< points bound (2..SP_DRAGON_DETAIL_POINTS)
+    const double* xyz;    ///< at the last pose_at: world, point_count by 3; NULL when not posed or not shown
+    const double* normal; ///< at the last pose_at: the surface's unit normal under each point, on the side it was drawn on
+} sp_dragon_detail;
+/// Number of details, oldest first.
+int sp_dragon_detail_count(const sp_dragon* d);
+/// Detail i (0 <= i < count); false for a bad i.
+bool sp_dragon_detail_get(const sp_dragon* d, int i, sp_dragon_detail* out);
 
 /// Number of parts, in drawing order.
 int sp_dragon_part_count(const sp_dragon* d);

@@ -46,7 +46,7 @@ typedef enum sp_kiosk_text_id {
     SP_KTEXT_UNRECOGNISED,          ///< a refused stroke (its guesses and the parts row are offered)
     SP_KTEXT_UNRECOGNISED_NO_OFFER, ///< a refused stroke when nothing can be offered
     SP_KTEXT_TOO_SMALL,             ///< a refused stroke too small for a part
-    SP_KTEXT_DETAIL,                ///< a small line drawn on a part: a detail (its guesses and the parts row are offered)
+    SP_KTEXT_DETAIL,                ///< a small line drawn on a part: kept as a detail, its guesses and the parts row offered
     SP_KTEXT_TRICKY,                ///< no part could take the stroke's shape
     SP_KTEXT_NOT_READY,             ///< no model or no parts: staff needed
     SP_KTEXT_FULL,                  ///< the dragon has as many parts as it can take

@@ -149,6 +149,7 @@ typedef struct sp_kiosk_fit_result {
     bool ok;                  ///< false: refused (a hint; the stroke is offered or fades; nothing else changes)
     sp_kiosk_refusal refusal; ///< !ok: why
     bool offer;               ///< !ok, FIT: the stroke can still become a part by a tap (it stays, with the parts row)
+    bool kept;                ///< !ok, FIT: the stroke stays on the dragon as a detail (Undo takes it back as a change)
     const char* offers[3];    ///< !ok: the refused stroke's best guesses, best first (NULL or "" when none)
     bool waiting;             ///< ok: the part waits for a body to join (none on the canvas)
     const char* hint;         ///< ok: a note shown beside the part (NULL: none; it replaces the waiting hint)
@@ -214,6 +215,7 @@ typedef struct sp_kiosk_ui {
     double fade_until;
     sp_kiosk_line held_stroke; ///< the last stroke, refused, offered until held_until (then it fades)
     double held_until;
+    bool held_kept; ///< the held stroke is also kept as a detail: Undo takes it back from the dragon too
     char hint[SP_KIOSK_TEXT_MAX];
     double hint_until;
     bool woke;                         ///< the finger now down touched during the idle countdown or on the attract screen

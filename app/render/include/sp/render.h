@@ -54,6 +54,7 @@ extern "C" {
 #define SP_COLOR_STROKE ((const float[4]){0.15f, 0.35f, 0.95f, 1.0f})   ///< the user's strokes
 #define SP_COLOR_ABSTRACTION ((const float[4]){1.0f, 0.8f, 0.1f, 1.0f}) ///< fitted abstraction curves
 #define SP_COLOR_OUTLINE ((const float[4]){0.08f, 0.08f, 0.1f, 0.85f})  ///< dark halo under light lines
+#define SP_COLOR_INK ((const float[4]){0.1f, 0.07f, 0.07f, 1.0f})       ///< details drawn on the dragon (eyes, spots)
 #define SP_COLOR_BACKGROUND_TOP ((const float[4]){0.93f, 0.94f, 0.96f, 1.0f})
 #define SP_COLOR_BACKGROUND_BOTTOM ((const float[4]){0.68f, 0.72f, 0.79f, 1.0f})
 
@@ -153,6 +154,11 @@ void sp_renderer_draw_polyline(sp_renderer* r, const sp_vec2* px, int n, bool cl
 void sp_renderer_draw_dots(sp_renderer* r, const sp_vec2* px, int n, float radius, const float rgba[4]);
 /// A 3D polyline (n by 3, world) projected with the frame's camera.
 void sp_renderer_draw_curve3d(sp_renderer* r, const double* xyz, int n, bool closed, float width, const float rgba[4]);
+/// The same, drawn only where it faces the camera: the runs of consecutive
+/// points whose normal (n by 3, world) points towards the camera (ink on a
+/// surface, hidden where the surface turns away).
+void sp_renderer_draw_curve3d_facing(sp_renderer* r, const double* xyz, const double* normal, int n, float width,
+                                     const float rgba[4]);
 /// Every curve of an abstraction; xyz are its points in world space
 /// (a->point_count by 3, from sp_rig_eval_abstraction).
 void sp_renderer_draw_abstraction(sp_renderer* r, const sp_abstraction* a, const double* xyz, float width, const float rgba[4]);

@@ -1,0 +1,238 @@
+// detail.c: details (an eye, spots, scales drawn on a part) kept as ink on
+// the part: each point bound to the part's mesh where it was drawn, so it
+// rides the part's animation and attachment (docs/DESIGN.md, "Details are
+// not parts").
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dragon_internal.h"
+#include "sp/curve.h"
+
+static void detail_free(detail* e)
+{
+    if (!e) return;
+    free(e->tri);
+    free(e);
+}
+
+// Barycentric coordinates of p in the canvas triangle abc (false when it has no area).
+static bool bary_of(sp_vec2 p, sp_vec2 a, sp_vec2 b, sp_vec2 c, double w[3])
+{
+    double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    if (!(fabs(det) > 1e-12)) return false;
+    w[1] = ((p.x - a.x) * (c.y - a.y) - (c.x - a.x) * (p.y - a.y)) / det;
+    w[2] = ((b.x - a.x) * (p.y - a.y) - (p.x - a.x) * (b.y - a.y)) / det;
+    w[0] = 1 - w[1] - w[2];
+    return isfinite(w[1]) && isfinite(w[2]);
+}
+
+// The point of the segment ab nearest p.
+static sp_vec2 segment_nearest(sp_vec2 p, sp_vec2 a, sp_vec2 b)
+{
+    sp_vec2 ab = sp_v2_sub(b, a);
+    double l2 = sp_v2_dot(ab, ab);
+    double s = l2 > 0 ? fmin(1, fmax(0, sp_v2_dot(sp_v2_sub(p, a), ab) / l2)) : 0;
+    return sp_v2_add(a, sp_v2_scale(ab, s));
+}
+
+// The point of the triangle abc's edges nearest p (p outside it).
+static sp_vec2 edge_nearest(sp_vec2 p, sp_vec2 a, sp_vec2 b, sp_vec2 c)
+{
+    sp_vec2 q[3] = {segment_nearest(p, a, b), segment_nearest(p, b, c), segment_nearest(p, c, a)};
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+        if (sp_v2_len(sp_v2_sub(p, q[i])) < sp_v2_len(sp_v2_sub(p, q[k]))) k = i;
+    return q[k];
+}
+
+static sp_vec3 vertex(const double* xyz, uint32_t v)
+{
+    return (sp_vec3){xyz[3 * (size_t)v], xyz[3 * (size_t)v + 1], xyz[3 * (size_t)v + 2]};
+}
+
+// The triangle's normal in the world, turned to the side `flip` says.
+static sp_vec3 face_normal(const double* xyz, const uint32_t* tr, double flip)
+{
+    sp_vec3 a = vertex(xyz, tr[0]);
+    sp_vec3 n = sp_v3_cross(sp_v3_sub(vertex(xyz, tr[1]), a), sp_v3_sub(vertex(xyz, tr[2]), a));
+    double l = sp_v3_len(n);
+    return l > 0 && isfinite(l) ? sp_v3_scale(n, flip / l) : (sp_vec3){0, 0, flip};
+}
+
+// Binds the points to a mesh as shown (xyz: world, px: its vertices on the
+// canvas): each to the front-most triangle under it (nearest the viewer,
+// +z), or, off the mesh, to the nearest point of a triangle within `near`
+// pixels (not beyond it: a triangle seen edge-on on the canvas would fling
+// an extrapolated point far in depth). Returns how many were bound (kept
+// in order).
+static int bind_points(const sp_rig* rig, const double* xyz, const sp_vec2* px, const sp_vec2* pts, int m, double near, detail* e)
+{
+    double* best = malloc(sizeof(double) * 2 * (size_t)m); // per point: depth when on, distance when off
+    int* face = malloc(sizeof(int) * (size_t)m);
+    bool* on = calloc((size_t)m, sizeof(bool));
+    if (!best || !face || !on) {
+        free(best), free(face), free(on);
+        return 0;
+    }
+    sp_vec2 lo = pts[0], hi = pts[0];
+    for (int i = 0; i < m; ++i) {
+        best[2 * i] = -INFINITY, best[2 * i + 1] = near, face[i] = -1;
+        lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
+    }
+    for (int f = 0; f < rig->triangle_count; ++f) {
+        const uint32_t* tr = rig->triangles + 3 * (size_t)f;
+        sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
+        // Only triangles near the stroke's box (most of the mesh is not).
+        if (!(fmax(a.x, fmax(b.x, c.x)) >= lo.x - near && fmin(a.x, fmin(b.x, c.x)) <= hi.x + near &&
+              fmax(a.y, fmax(b.y, c.y)) >= lo.y - near && fmin(a.y, fmin(b.y, c.y)) <= hi.y + near))
+            continue;
+        for (int i = 0; i < m; ++i) {
+            double w[3];
+            if (!bary_of(pts[i], a, b, c, w)) continue;
+            if (w[0] >= 0 && w[1] >= 0 && w[2] >= 0) {
+                double z = w[0] * xyz[3 * tr[0] + 2] + w[1] * xyz[3 * tr[1] + 2] + w[2] * xyz[3 * tr[2] + 2];
+                if (!on[i] || z > best[2 * i]) on[i] = true, best[2 * i] = z, face[i] = f;
+            } else if (!on[i]) {
+                double dist = sp_v2_len(sp_v2_sub(pts[i], edge_nearest(pts[i], a, b, c)));
+                if (dist <= best[2 * i + 1]) best[2 * i + 1] = dist, face[i] = f;
+            }
+        }
+    }
+    int k = 0;
+    for (int i = 0; i < m; ++i) {
+        if (face[i] < 0) continue; // off the mesh and not near it: left out of the ink
+        const uint32_t* tr = rig->triangles + 3 * (size_t)face[i];
+        sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]], p = on[i] ? pts[i] : edge_nearest(pts[i], a, b, c);
+        double w[3];
+        if (!bary_of(p, a, b, c, w)) continue;
+        for (int j = 0; j < 3; ++j) // on its edge: rounding must not reach outside
+            w[j] = fmin(1, fmax(0, w[j]));
+        memcpy(e->tri + 3 * k, tr, sizeof(uint32_t) * 3);
+        memcpy(e->bary + 3 * k, w, sizeof w);
+        e->flip[k] = face_normal(xyz, tr, 1).z >= 0 ? 1 : -1; // the side facing the canvas's viewer
+        ++k;
+    }
+    free(best), free(face), free(on);
+    return k;
+}
+
+int dragon_detail_keep(sp_dragon* d, int k, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi)
+{
+    if (k < 0 || k >= d->part_n || n < 2 || d->detail_n >= SP_DRAGON_MAX_DETAILS) return -1;
+    const part* q = d->parts[k];
+    const sp_rig* rig = &q->t->ch.rig;
+    if (rig->vertex_count <= 0 || rig->triangle_count <= 0) return -1;
+    if (!d->details && !(d->details = calloc(SP_DRAGON_MAX_DETAILS, sizeof(detail*)))) return -1;
+    // A long stroke is resampled along its length: the ink's shape, not every pen sample.
+    int m = n <= SP_DRAGON_DETAIL_POINTS ? n : SP_DRAGON_DETAIL_POINTS;
+    detail* e = calloc(1, sizeof *e);
+    sp_vec2* rs = m < n ? malloc(sizeof(sp_vec2) * (size_t)m) : NULL;
+    size_t mm = (size_t)m;
+    // One block: tri (3m uint32), then bary (3m), flip (m), xyz (3m), normal (3m) doubles.
+    uint32_t* block = malloc(sizeof(uint32_t) * 4 * mm + sizeof(double) * 10 * mm);
+    if (!e || (m < n && !rs) || !block || (rs && sp_curve_resample(pts, n, false, m, rs) != SP_OK)) {
+        free(e), free(rs), free(block);
+        return -1;
+    }
+    e->tri = block;
+    e->bary = (double*)(void*)(block + 4 * mm); // 4m uint32s keep the doubles aligned
+    e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
+    // Where the part is shown at its fit; its size on the canvas sets how
+    // far off it a point may be bound (as the detail test).
+    double* xyz = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
+    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
+    if (xyz && px) {
+        dragon_mesh_on_canvas(d, q, &q->world_fit, xyz, px);
+        sp_vec2 a = px[0], b = px[0];
+        for (int v = 1; v < rig->vertex_count; ++v)
+            a.x = fmin(a.x, px[v].x), a.y = fmin(a.y, px[v].y), b.x = fmax(b.x, px[v].x), b.y = fmax(b.y, px[v].y);
+        double near = dragon_detail_near(hypot(b.x - a.x, b.y - a.y), hypot(hi.x - lo.x, hi.y - lo.y)) + 0.71;
+        e->n = isfinite(near) ? bind_points(rig, xyz, px, rs ? rs : pts, m, near, e) : 0;
+    }
+    free(xyz), free(px);
+    free(rs);
+    if (e->n < 2) {
+        detail_free(e);
+        return -1;
+    }
+    e->id = d->next_id++;
+    e->host = q->pub.id;
+    e->t = q->t;
+    e->mirrored = q->pub.mirrored;
+    d->details[d->detail_n] = e;
+    return d->detail_n++;
+}
+
+static const part* host_of(const sp_dragon* d, const detail* e, int* index)
+{
+    for (int k = 0; k < d->part_n; ++k)
+        if (d->parts[k]->pub.id == e->host) {
+            *index = k;
+            return d->parts[k];
+        }
+    *index = -1;
+    return NULL;
+}
+
+void dragon_details_pose(sp_dragon* d)
+{
+    for (int i = 0; i < d->detail_n; ++i) {
+        detail* e = d->details[i];
+        int k;
+        const part* q = host_of(d, e, &k);
+        e->shown = q && q->t == e->t && q->pub.mirrored == e->mirrored;
+        for (int j = 0; e->shown && j < e->n; ++j) {
+            const uint32_t* tr = e->tri + 3 * j;
+            sp_vec3 s = {0, 0, 0};
+            for (int c = 0; c < 3; ++c)
+                s = sp_v3_add(s, sp_v3_scale(vertex(q->xyz, tr[c]), e->bary[3 * j + c]));
+            sp_vec3 nrm = face_normal(q->xyz, tr, e->flip[j]);
+            memcpy(e->xyz + 3 * j, &(double[3]){s.x, s.y, s.z}, sizeof(double) * 3);
+            memcpy(e->normal + 3 * j, &(double[3]){nrm.x, nrm.y, nrm.z}, sizeof(double) * 3);
+        }
+    }
+}
+
+void dragon_details_prune(sp_dragon* d)
+{
+    int kept = 0;
+    for (int i = 0; i < d->detail_n; ++i) {
+        int k;
+        if (host_of(d, d->details[i], &k))
+            d->details[kept++] = d->details[i];
+        else
+            detail_free(d->details[i]);
+    }
+    d->detail_n = kept;
+}
+
+void dragon_detail_pop(sp_dragon* d)
+{
+    if (d->detail_n > 0) detail_free(d->details[--d->detail_n]);
+}
+
+void dragon_details_clear(sp_dragon* d)
+{
+    while (d->detail_n > 0)
+        dragon_detail_pop(d);
+    free(d->details);
+    d->details = NULL;
+}
+
+int sp_dragon_detail_count(const sp_dragon* d)
+{
+    return d->detail_n;
+}
+
+bool sp_dragon_detail_get(const sp_dragon* d, int i, sp_dragon_detail* out)
+{
+    if (i < 0 || i >= d->detail_n) return false;
+    const detail* e = d->details[i];
+    int k;
+    host_of(d, e, &k);
+    bool shown = d->posed && e->shown;
+    *out = (sp_dragon_detail){
+        .id = e->id, .part = k, .point_count = e->n, .xyz = shown ? e->xyz : NULL, .normal = shown ? e->normal : NULL};
+    return true;
+}
