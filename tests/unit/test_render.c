@@ -417,6 +417,76 @@ static void test_polyline(void)
     sp_render_target_destroy(t);
 }
 
+// Ink on a surface (sp_renderer_draw_curve3d_facing): drawn where its
+// surface faces the camera, covered by a mesh in front of it, not drawn at
+// all where its normal faces away.
+static void test_ink_on_surface(void)
+{
+    need_gl();
+    // A grey square at z = 0 facing +z and a green one at z = 0.5 over its right half.
+    const double back[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const double front[12] = {0.2, -1, 0.5, 1, -1, 0.5, 1, 1, 0.5, 0.2, 1, 0.5};
+    const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+    sp_error err = {0};
+    sp_render_mesh *mb = NULL, *mf = NULL;
+    sp_render_mesh_create(
+        g_r,
+        &(sp_mesh_desc){
+            .vertex_count = 4, .positions = back, .base_color = {0.6f, 0.6f, 0.6f, 1}, .triangle_count = 2, .triangles = tris},
+        &mb, &err);
+    sp_render_mesh_create(
+        g_r,
+        &(sp_mesh_desc){
+            .vertex_count = 4, .positions = front, .base_color = {0.1f, 0.7f, 0.1f, 1}, .triangle_count = 2, .triangles = tris},
+        &mf, &err);
+    ENSURE(mb && mf);
+    sp_camera cam =
+        sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, sp_v3(-1, -1, 0), sp_v3(1, 1, 0.5), sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
+    sp_render_fit_depth(&cam, sp_v3(-1, -1, -0.1), sp_v3(1, 1, 0.6));
+    // A line across the grey square at y = 0.3 (above) and y = -0.3 (its normal turned away).
+    double line[2][3 * 41], up[3 * 41], down[3 * 41];
+    for (int i = 0; i <= 40; ++i)
+        for (int k = 0; k < 2; ++k) {
+            double* q = line[k] + 3 * i;
+            q[0] = -0.9 + 1.8 * i / 40, q[1] = k ? -0.3 : 0.3, q[2] = 0;
+            up[3 * i] = down[3 * i] = 0, up[3 * i + 1] = down[3 * i + 1] = 0, up[3 * i + 2] = 1, down[3 * i + 2] = -1;
+        }
+    sp_render_target* t;
+    sp_render_target_create(W, H, 0, &t, &err);
+    ENSURE(t != NULL);
+    sp_render_target_bind(t);
+    sp_renderer_begin(g_r, &cam, W, H);
+    sp_renderer_clear(g_r, k_bg, NULL);
+    sp_renderer_draw_mesh(g_r, mb, NULL);
+    sp_renderer_draw_mesh(g_r, mf, NULL);
+    sp_renderer_draw_curve3d_facing(g_r, line[0], up, 41, 5.0f, SP_COLOR_INK);
+    sp_renderer_draw_curve3d_facing(g_r, line[1], down, 41, 5.0f, SP_COLOR_INK);
+    sp_renderer_end(g_r);
+    sp_image img = {0};
+    ENSURE(sp_render_target_read(t, &img, &err) == SP_OK);
+    save_for_people(&img, "render_ink.png");
+    int shown = 0, covered = 0, away = 0;
+    for (int i = 1; i < 40; ++i)
+        for (int k = 0; k < 2; ++k) {
+            const double* q = line[k] + 3 * i;
+            sp_vec2 u = sp_camera_project(&cam, sp_v3(q[0], q[1], q[2]));
+            const uint8_t* p = sp_image_at(&img, (int)floor(u.x), (int)floor(u.y));
+            bool ink = near_color(p, SP_COLOR_INK, 12);
+            if (k == 1)
+                away += ink;
+            else if (q[0] < 0.15)
+                shown += ink;
+            else if (q[0] > 0.25)
+                covered += ink;
+        }
+    printf("  ink shown %d of the uncovered points, %d covered, %d facing away\n", shown, covered, away);
+    ENSURE(shown >= 20 && covered == 0 && away == 0);
+    sp_image_free(&img);
+    sp_render_mesh_destroy(mb);
+    sp_render_mesh_destroy(mf);
+    sp_render_target_destroy(t);
+}
+
 static void test_png_roundtrip(void)
 {
     sp_image img = {0}, back = {0};
@@ -475,6 +545,7 @@ int main(int argc, char** argv)
                                      {"depth_and_model", test_depth_and_model},
                                      {"abstraction_overlay", test_abstraction_overlay},
                                      {"polyline", test_polyline},
+                                     {"ink_on_surface", test_ink_on_surface},
                                      {0}});
     sp_renderer_destroy(g_r);
     sp_headless_destroy(g_gl);

@@ -86,6 +86,7 @@ static const char* k_overlay_vs =
     "layout(location = 2) in vec4 a_par;\n"
     "layout(location = 3) in vec4 a_col;\n"
     "layout(location = 4) in vec4 a_nb;\n"
+    "layout(location = 5) in float a_z;\n"
     "uniform vec2 u_size;\n"
     "out vec2 v_px;\n"
     "flat out vec4 v_seg;\n"
@@ -94,7 +95,7 @@ static const char* k_overlay_vs =
     "flat out vec4 v_nb;\n"
     "void main() {\n"
     "    v_px = a_px; v_seg = a_seg; v_par = a_par; v_col = a_col; v_nb = a_nb;\n"
-    "    gl_Position = vec4(2.0 * a_px.x / u_size.x - 1.0, 1.0 - 2.0 * a_px.y / u_size.y, 0.0, 1.0);\n"
+    "    gl_Position = vec4(2.0 * a_px.x / u_size.x - 1.0, 1.0 - 2.0 * a_px.y / u_size.y, a_z, 1.0);\n"
     "}\n";
 
 static const char* k_overlay_fs =
@@ -134,6 +135,7 @@ static const char* k_overlay_fs =
 
 typedef struct overlay_vertex {
     float px[2], seg[4], par[4], col[4], nb[4];
+    float z; // NDC depth, used only by depth-tested overlays (ink on a surface)
 } overlay_vertex;
 
 struct sp_renderer {
@@ -319,6 +321,8 @@ sp_result sp_renderer_create(const sp_renderer_desc* desc, sp_renderer** out, sp
     glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, stride, (const void*)offsetof(overlay_vertex, col));
     glEnableVertexAttribArray(4);
     glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, stride, (const void*)offsetof(overlay_vertex, nb));
+    glEnableVertexAttribArray(5);
+    glVertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, stride, (const void*)offsetof(overlay_vertex, z));
     glBindVertexArray(0);
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) {
@@ -380,9 +384,9 @@ static bool ov_reserve(sp_renderer* r, size_t extra)
 }
 
 // Appends a quad (two triangles) with corners c (4 by 2, in order around it), all
-// carrying the same primitive description.
-static void ov_quad(sp_renderer* r, const float* c, const float seg[4], const float nb[4], const float par[4], const float col[4],
-                    const float* col_bottom)
+// carrying the same primitive description; z: the corners' depths (NULL: 0).
+static void ov_quad(sp_renderer* r, const float* c, const float* z, const float seg[4], const float nb[4], const float par[4],
+                    const float col[4], const float* col_bottom)
 {
     if (!ov_reserve(r, 6)) return;
     static const int order[6] = {0, 1, 2, 0, 2, 3};
@@ -390,6 +394,7 @@ static void ov_quad(sp_renderer* r, const float* c, const float seg[4], const fl
         overlay_vertex* v = &r->ov[r->ov_count++];
         int k = order[i];
         v->px[0] = c[2 * k], v->px[1] = c[2 * k + 1];
+        v->z = z ? z[k] : 0.0f;
         memcpy(v->seg, seg, sizeof v->seg);
         memcpy(v->nb, nb ? nb : seg, sizeof v->nb);
         memcpy(v->par, par, sizeof v->par);
@@ -403,7 +408,7 @@ static void ov_quad(sp_renderer* r, const float* c, const float seg[4], const fl
 // capsules overlap at the joins. That first capsule's coverage is already
 // the whole polyline's there: the shader measures the distance to the
 // neighbouring segments too.
-static void ov_flush_ex(sp_renderer* r, bool once)
+static void ov_flush_ex(sp_renderer* r, bool once, bool depth)
 {
     if (!r->ov_count) return;
     if (once) {
@@ -431,13 +436,19 @@ static void ov_flush_ex(sp_renderer* r, bool once)
         glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)r->overlay_vbo_bytes, NULL, GL_STREAM_DRAW);
         glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)bytes, r->ov);
     }
-    glDisable(GL_DEPTH_TEST);
+    if (depth) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LEQUAL);
+    } else {
+        glDisable(GL_DEPTH_TEST);
+    }
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     if (once) glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
     glDrawArrays(GL_TRIANGLES, 0, (GLsizei)r->ov_count);
     if (once) glDisable(GL_STENCIL_TEST);
+    if (depth) glDisable(GL_DEPTH_TEST);
     glBindVertexArray(0);
     glDepthMask(GL_TRUE);
     r->ov_count = 0;
@@ -445,7 +456,7 @@ static void ov_flush_ex(sp_renderer* r, bool once)
 
 static void ov_flush(sp_renderer* r)
 {
-    ov_flush_ex(r, false);
+    ov_flush_ex(r, false, false);
 }
 
 void sp_renderer_clear(sp_renderer* r, const float top[4], const float bottom[4])
@@ -462,7 +473,7 @@ void sp_renderer_clear(sp_renderer* r, const float top[4], const float bottom[4]
     float W = (float)r->cam.width, H = (float)r->cam.height;
     const float c[8] = {0, 0, W, 0, W, H, 0, H};
     const float seg[4] = {0}, par[4] = {0, 2, 0, 0};
-    ov_quad(r, c, seg, NULL, par, top, bottom);
+    ov_quad(r, c, NULL, seg, NULL, par, top, bottom);
     ov_flush(r);
 }
 
@@ -477,8 +488,9 @@ void sp_renderer_end(sp_renderer* r)
 // ------------------------------------------------------------------ overlays
 
 // Segment a-b of a polyline whose neighbouring points are p0 (before a) and
-// p3 (after b); p0 == a and p3 == b at the ends.
-static void capsule(sp_renderer* r, sp_vec2 p0, sp_vec2 a, sp_vec2 b, sp_vec2 p3, float radius, const float rgba[4])
+// p3 (after b); p0 == a and p3 == b at the ends. z: the depths of a and b (NULL: 0).
+static void capsule(sp_renderer* r, sp_vec2 p0, sp_vec2 a, sp_vec2 b, sp_vec2 p3, const float* z, float radius,
+                    const float rgba[4])
 {
     // The quad covers the capsule plus a feather of two viewport pixels.
     double pad = radius + 2.0 * (double)r->cam.width / (double)r->vw;
@@ -495,12 +507,14 @@ static void capsule(sp_renderer* r, sp_vec2 p0, sp_vec2 a, sp_vec2 b, sp_vec2 p3
     const float seg[4] = {(float)a.x, (float)a.y, (float)b.x, (float)b.y};
     const float nb[4] = {(float)p0.x, (float)p0.y, (float)p3.x, (float)p3.y};
     const float par[4] = {radius, 0, 0, 0};
-    ov_quad(r, c, seg, nb, par, rgba, NULL);
+    const float zq[4] = {z ? z[0] : 0, z ? z[1] : 0, z ? z[1] : 0, z ? z[0] : 0}; // corners 0, 3 at a; 1, 2 at b
+    ov_quad(r, c, zq, seg, nb, par, rgba, NULL);
 }
 
-void sp_renderer_draw_polyline(sp_renderer* r, const sp_vec2* px, int n, bool closed, float width, const float rgba[4])
+// A polyline; z (NULL: none) gives each point's depth, and then it is
+// depth-tested against the meshes drawn before it.
+static void polyline(sp_renderer* r, const sp_vec2* px, const float* z, int n, bool closed, float width, const float rgba[4])
 {
-    assert(r && r->in_frame && rgba && (px || n == 0));
     if (n <= 0 || !(width > 0)) return;
     float radius = 0.5f * width;
     // Keep only points at least a capsule's reach apart (the last point
@@ -509,46 +523,68 @@ void sp_renderer_draw_polyline(sp_renderer* r, const sp_vec2* px, int n, bool cl
     // shape changes by less than the line's own width.
     double reach = radius + 2.0 * (double)r->cam.width / (double)r->vw;
     sp_vec2 stack[256];
+    float zstack[256];
     sp_vec2* q = n <= 256 ? stack : malloc(sizeof(sp_vec2) * (size_t)n);
-    if (!q) return;
+    float* qz = n <= 256 ? zstack : malloc(sizeof(float) * (size_t)n);
+    if (!q || !qz) {
+        if (q != stack) free(q);
+        if (qz != zstack) free(qz);
+        return;
+    }
     int m = 0;
     for (int i = 0; i < n; ++i) {
-        if (!sp_v2_is_valid(px[i])) continue;
+        if (!sp_v2_is_valid(px[i]) || (z && !isfinite(z[i]))) continue;
         if (m > 0 && sp_v2_len(sp_v2_sub(px[i], q[m - 1])) < reach) {
-            if (i == n - 1 && m > 1) q[m - 1] = px[i]; // keep the true end
+            if (i == n - 1 && m > 1) q[m - 1] = px[i], qz[m - 1] = z ? z[i] : 0; // keep the true end
             continue;
         }
+        qz[m] = z ? z[i] : 0;
         q[m++] = px[i];
     }
     if (m == 1 && n > 1) {
         // Everything within one reach: a short dash from the first to the last valid point.
         for (int i = n - 1; i > 0; --i)
-            if (sp_v2_is_valid(px[i])) {
+            if (sp_v2_is_valid(px[i]) && !(z && !isfinite(z[i]))) {
+                qz[m] = z ? z[i] : 0;
                 q[m++] = px[i];
                 break;
             }
     }
-    if (m == 1) capsule(r, q[0], q[0], q[0], q[0], radius, rgba);
+    const float* zz = z ? qz : NULL;
+    if (m == 1 && !z) capsule(r, q[0], q[0], q[0], q[0], NULL, radius, rgba);
+    if (m == 1 && z) {
+        ov_flush(r);
+        capsule(r, q[0], q[0], q[0], q[0], (const float[2]){qz[0], qz[0]}, radius, rgba);
+        ov_flush_ex(r, false, true);
+    }
     if (m >= 2) {
         ov_flush(r); // this polyline gets its own stencil value
         bool loop = closed && m > 2;
         int segs = loop ? m : m - 1;
         for (int i = 0; i < segs; ++i) {
-            sp_vec2 a = q[i], b = q[(i + 1) % m];
+            int ia = i, ib = (i + 1) % m;
+            sp_vec2 a = q[ia], b = q[ib];
             sp_vec2 p0 = (i > 0 || loop) ? q[(i + m - 1) % m] : a;
             sp_vec2 p3 = (i + 2 < m || loop) ? q[(i + 2) % m] : b;
-            capsule(r, p0, a, b, p3, radius, rgba);
+            capsule(r, p0, a, b, p3, zz ? (const float[2]){zz[ia], zz[ib]} : NULL, radius, rgba);
         }
-        ov_flush_ex(r, true);
+        ov_flush_ex(r, true, z != NULL);
     }
     if (q != stack) free(q);
+    if (qz != zstack) free(qz);
+}
+
+void sp_renderer_draw_polyline(sp_renderer* r, const sp_vec2* px, int n, bool closed, float width, const float rgba[4])
+{
+    assert(r && r->in_frame && rgba && (px || n == 0));
+    polyline(r, px, NULL, n, closed, width, rgba);
 }
 
 void sp_renderer_draw_dots(sp_renderer* r, const sp_vec2* px, int n, float radius, const float rgba[4])
 {
     assert(r && r->in_frame && rgba && (px || n == 0));
     for (int i = 0; i < n; ++i)
-        if (sp_v2_is_valid(px[i])) capsule(r, px[i], px[i], px[i], px[i], radius, rgba);
+        if (sp_v2_is_valid(px[i])) capsule(r, px[i], px[i], px[i], px[i], NULL, radius, rgba);
 }
 
 void sp_renderer_draw_curve3d(sp_renderer* r, const double* xyz, int n, bool closed, float width, const float rgba[4])
@@ -568,17 +604,40 @@ void sp_renderer_draw_curve3d_facing(sp_renderer* r, const double* xyz, const do
                                      const float rgba[4])
 {
     assert(r && r->in_frame && ((xyz && normal) || n == 0));
+    if (n <= 0) return;
+    sp_vec2 stack[256];
+    float zstack[256];
+    sp_vec2* px = n <= 256 ? stack : malloc(sizeof(sp_vec2) * (size_t)n);
+    float* z = n <= 256 ? zstack : malloc(sizeof(float) * (size_t)n);
+    if (!px || !z) {
+        if (px != stack) free(px);
+        if (z != zstack) free(z);
+        return;
+    }
+    // Lifted towards the camera by more than the line's own width before the
+    // depth test: on a curved surface the ink must not sink into it, and a
+    // part in front of it still covers it.
+    double lift_px = fmax(4.0, 1.5 * (double)width);
+    const double* P = r->proj.m;
     for (int i = 0; i < n;) {
         int j = i;
-        while (j < n) {
+        for (; j < n; ++j) {
             sp_vec3 p = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
-            if (!(sp_v3_dot(sp_camera_view_dir(&r->cam, p), (sp_vec3){normal[3 * j], normal[3 * j + 1], normal[3 * j + 2]}) < 0))
-                break;
-            ++j;
+            sp_vec3 dir = sp_camera_view_dir(&r->cam, p);
+            if (!(sp_v3_dot(dir, (sp_vec3){normal[3 * j], normal[3 * j + 1], normal[3 * j + 2]}) < 0)) break;
+            sp_vec3 c = sp_mat4_point(&r->cam.view, p);
+            double per_px = r->cam.kind == SP_CAMERA_ORTHOGRAPHIC ? 1.0 / r->cam.scale : fabs(c.z) / r->cam.scale;
+            sp_vec3 q = sp_v3_sub(p, sp_v3_scale(dir, lift_px * per_px));
+            sp_vec3 cq = sp_mat4_point(&r->cam.view, q);
+            double w = P[11] * cq.z + P[15];
+            px[j - i] = sp_camera_project(&r->cam, p);
+            z[j - i] = (float)((P[10] * cq.z + P[14]) / w);
         }
-        if (j > i) sp_renderer_draw_curve3d(r, xyz + 3 * (size_t)i, j - i, false, width, rgba);
+        if (j > i) polyline(r, px, z, j - i, false, width, rgba);
         i = j + 1;
     }
+    if (px != stack) free(px);
+    if (z != zstack) free(z);
 }
 
 void sp_renderer_draw_abstraction(sp_renderer* r, const sp_abstraction* a, const double* xyz, float width, const float rgba[4])
@@ -621,7 +680,7 @@ void sp_renderer_draw_ground_shadow(sp_renderer* r, sp_vec3 lo, sp_vec3 hi, floa
     const float seg[4] = {(float)centre.x, (float)centre.y, (float)ex, (float)ey};
     const float par[4] = {0, 1, 0.15f, 0};
     const float col[4] = {0.1f, 0.1f, 0.14f, opacity};
-    ov_quad(r, q, seg, NULL, par, col, NULL);
+    ov_quad(r, q, NULL, seg, NULL, par, col, NULL);
     // Why flush now: the shadow belongs behind the meshes drawn after it.
     ov_flush(r);
 }
