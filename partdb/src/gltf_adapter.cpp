@@ -1307,6 +1307,44 @@ void write_mesh(Writer& w, tinygltf::Scene& scene, const sp_character* ch, int s
     m.nodes.push_back(nd);
 }
 
+// Ink drawn on a scene part: a LINE_STRIP node per line, skinned by the part's skin.
+void write_lines(Writer& w, tinygltf::Scene& scene, const sp_gltf_scene_part* part, int joint_count, int skin_index,
+                 const std::string& prefix)
+{
+    tinygltf::Model& m = w.m;
+    if (part->line_count > 0 && !part->lines) fail(SP_ERR_INVALID, "%s: %d ink lines missing", prefix.c_str(), part->line_count);
+    for (int l = 0; l < part->line_count; ++l) {
+        const sp_gltf_scene_line* ln = &part->lines[l];
+        if (ln->point_count < 2 || !ln->rest || !ln->joints || !ln->weights)
+            fail(SP_ERR_INVALID, "%s: ink line %d has no points", prefix.c_str(), l);
+        for (size_t k = 0; k < 4 * (size_t)ln->point_count; ++k)
+            if (ln->joints[k] >= joint_count)
+                fail(SP_ERR_INVALID, "%s: ink line %d names a joint it does not have", prefix.c_str(), l);
+        tinygltf::Primitive prim;
+        w.skinned_attributes(prim, ln->point_count, ln->rest, ln->joints, ln->weights);
+        prim.mode = TINYGLTF_MODE_LINE_STRIP;
+        tinygltf::Material mat;
+        mat.name = "sp_ink";
+        mat.pbrMetallicRoughness.metallicFactor = 0.0;
+        mat.pbrMetallicRoughness.roughnessFactor = 1.0;
+        for (int c = 0; c < 4; ++c)
+            mat.pbrMetallicRoughness.baseColorFactor[(size_t)c] =
+                std::isfinite(ln->color[c]) ? std::min(1.0, std::max(0.0, (double)ln->color[c])) : 0.0;
+        m.materials.push_back(mat);
+        prim.material = (int)m.materials.size() - 1;
+        tinygltf::Mesh mesh;
+        mesh.name = prefix + "ink" + std::to_string(l);
+        mesh.primitives.push_back(prim);
+        m.meshes.push_back(mesh);
+        tinygltf::Node nd;
+        nd.name = mesh.name;
+        nd.mesh = (int)m.meshes.size() - 1;
+        nd.skin = skin_index;
+        scene.nodes.push_back((int)m.nodes.size());
+        m.nodes.push_back(nd);
+    }
+}
+
 // Abstractions: a node per curve, skinned by the rig's skin.
 void write_abstractions(Writer& w, tinygltf::Scene& scene, const sp_rig* rig, int skin_index, const std::string& prefix)
 {
@@ -1527,6 +1565,7 @@ tinygltf::Model build_scene(const sp_gltf_scene_desc* d)
         int skin = write_skin(w, rig, base, name);
         m.skins[(size_t)skin].skeleton = place;
         write_mesh(w, scene, ch, skin, name + "/mesh", name + "/mesh");
+        write_lines(w, scene, part, rig->joint_count, skin, name + "/");
         if (d->abstractions) write_abstractions(w, scene, rig, skin, name + "/");
         if (part->animation) write_channels(w, part->animation, base, anim);
         int nk = part->placement_key_count;

@@ -194,6 +194,55 @@ void dragon_details_pose(sp_dragon* d)
     }
 }
 
+int dragon_detail_points(const sp_dragon* d, int i)
+{
+    return i >= 0 && i < d->detail_n ? d->details[i]->n : 0;
+}
+
+int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joints, float* weights)
+{
+    if (i < 0 || i >= d->detail_n) return -1;
+    const detail* e = d->details[i];
+    int k;
+    const part* q = host_of(d, e, &k);
+    if (!q || q->t != e->t || q->pub.mirrored != e->mirrored) return -1;
+    const sp_rig* rig = &q->t->ch.rig;
+    for (int j = 0; j < e->n; ++j) {
+        const uint32_t* tr = e->tri + 3 * j;
+        const double* b = e->bary + 3 * j;
+        uint16_t jj[12];
+        double ww[12];
+        int m = 0;
+        for (int c = 0; c < 3; ++c) {
+            for (int a = 0; a < 3; ++a)
+                rest[3 * j + a] = (c ? rest[3 * j + a] : 0) + b[c] * rig->rest[3 * (size_t)tr[c] + (size_t)a];
+            for (int f = 0; f < 4; ++f) {
+                uint16_t jn = rig->joints4[4 * (size_t)tr[c] + (size_t)f];
+                double w = b[c] * rig->weights4[4 * (size_t)tr[c] + (size_t)f];
+                if (!(w > 0)) continue;
+                int s = 0;
+                while (s < m && jj[s] != jn)
+                    ++s;
+                if (s == m) jj[m] = jn, ww[m++] = 0;
+                ww[s] += w;
+            }
+        }
+        // The four largest influences, renormalised (the export's skin takes four).
+        double sum = 0;
+        for (int f = 0; f < 4; ++f) {
+            int big = -1;
+            for (int s = 0; s < m; ++s)
+                if (ww[s] > 0 && (big < 0 || ww[s] > ww[big])) big = s;
+            joints[4 * j + f] = big >= 0 ? jj[big] : 0;
+            weights[4 * j + f] = big >= 0 ? (float)ww[big] : 0.0f;
+            if (big >= 0) sum += ww[big], ww[big] = 0;
+        }
+        for (int f = 0; f < 4; ++f)
+            weights[4 * j + f] = sum > 0 ? (float)(weights[4 * j + f] / sum) : (f == 0);
+    }
+    return k;
+}
+
 void dragon_details_prune(sp_dragon* d)
 {
     int kept = 0;

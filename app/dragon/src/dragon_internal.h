@@ -229,6 +229,14 @@ static inline double dragon_detail_near(double mesh_diag, double stroke_diag)
 int dragon_detail_keep(sp_dragon* d, int k, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi);
 /// Poses every detail on its part's vertices at the last pose_at (after them).
 void dragon_details_pose(sp_dragon* d);
+/// Detail i's points in its part's bind space with their skin (for the
+/// export; rest: n by 3, joints and weights: n by 4 for the detail's n
+/// points): each point's corners and their four influences blended by its
+/// barycentric coordinates, the four largest kept. Returns its part's index,
+/// -1 when the part does not show it (then nothing is written).
+int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joints, float* weights);
+/// Points of detail i.
+int dragon_detail_points(const sp_dragon* d, int i);
 /// Drops the details whose part is gone (replaced by a Redraw or a chip).
 void dragon_details_prune(sp_dragon* d);
 /// Drops the last detail (n > 0) or every detail.

@@ -96,7 +96,16 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
     float* place_trs = animated ? malloc(sizeof(float) * 8 * (size_t)n * (size_t)(K + 1)) : NULL;
     float* ftimes = animated ? malloc(sizeof(float) * (size_t)(K + 1)) : NULL;
     char(*names)[SP_NAME_MAX + 16] = calloc((size_t)n, sizeof *names);
-    if (!parts || !anims || !keys || !names || (animated && (!place_trs || !ftimes || !times))) {
+    // The details shown, as ink on their parts' skins: one block of points for all of them.
+    int nd = d->detail_n, total = 0;
+    for (int i = 0; i < nd; ++i)
+        total += dragon_detail_points(d, i);
+    sp_gltf_scene_line* lines = calloc((size_t)nd + 1, sizeof *lines);
+    double* ink_rest = malloc(sizeof(double) * 3 * ((size_t)total + 1));
+    uint16_t* ink_joints = malloc(sizeof(uint16_t) * 4 * ((size_t)total + 1));
+    float* ink_weights = malloc(sizeof(float) * 4 * ((size_t)total + 1));
+    if (!parts || !anims || !keys || !names || !lines || !ink_rest || !ink_joints || !ink_weights ||
+        (animated && (!place_trs || !ftimes || !times))) {
         res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
         goto done;
     }
@@ -120,6 +129,22 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
                 res = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
                 goto done;
             }
+        }
+    }
+    // Grouped by part (each part's lines one run of the array), in drawing order within it.
+    for (int i = 0, used = 0, at = 0; i < n; ++i) {
+        parts[i].lines = lines + used;
+        for (int k = 0; k < nd; ++k) {
+            int m = dragon_detail_points(d, k);
+            double* r = ink_rest + 3 * (size_t)at;
+            uint16_t* j = ink_joints + 4 * (size_t)at;
+            float* w = ink_weights + 4 * (size_t)at;
+            sp_dragon_detail e;
+            if (!sp_dragon_detail_get(d, k, &e) || e.part != i || dragon_detail_skinned(d, k, r, j, w) != i) continue;
+            lines[used++] =
+                (sp_gltf_scene_line){.point_count = m, .rest = r, .joints = j, .weights = w, .color = {0.01f, 0.006f, 0.006f, 1}};
+            at += m;
+            ++parts[i].line_count;
         }
     }
     if (animated) {
@@ -201,6 +226,7 @@ done:
         if (keys) free(keys[i]);
     }
     free(parts), free(anims), free(keys), free(place_trs), free(ftimes), free(times), free(names);
+    free(lines), free(ink_rest), free(ink_joints), free(ink_weights);
     d->posed = false;
     return res;
 }

@@ -60,6 +60,16 @@ sp_result sp_gltf_save(const sp_character* ch, const double* params, const char*
 /// Same as sp_gltf_save to a malloc'd GLB in memory (*data freed by the caller with free()).
 sp_result sp_gltf_save_memory(const sp_character* ch, const double* params, void** data, size_t* size, sp_error* err);
 /// One part of a scene written by sp_gltf_save_scene.
+/// A polyline drawn on a part (ink: a kiosk visitor's eye or spots),
+/// skinned by the part's skin like its mesh.
+typedef struct sp_gltf_scene_line {
+    int point_count;        ///< at least 2
+    const double* rest;     ///< point_count by 3, the part's bind space (like its mesh's rest vertices)
+    const uint16_t* joints; ///< point_count by 4, the part's rig joint indices
+    const float* weights;   ///< point_count by 4
+    float color[4];         ///< linear RGBA
+} sp_gltf_scene_line;
+
 typedef struct sp_gltf_scene_part {
     const sp_character* character; ///< its rig, mesh and colours (written as its own skin)
     const double* params;          ///< the pose baked into its joint nodes (rig.param_count); NULL: character->pose
@@ -70,6 +80,8 @@ typedef struct sp_gltf_scene_part {
     int placement_key_count;       ///< keys of an animated placement (0: static), LINEAR
     const float* placement_times;  ///< placement_key_count seconds, increasing
     const float* placement_trs;    ///< placement_key_count by 8: tx ty tz, qx qy qz qw, uniform scale
+    int line_count;                ///< ink drawn on the part: LINE_STRIP nodes "<name>/ink<k>" on its skin
+    const sp_gltf_scene_line* lines;
 } sp_gltf_scene_part;
 
 /// A scene of several rigged parts (e.g. the kiosk's dragon).

@@ -232,7 +232,7 @@ void sp_dragon_clear(sp_dragon* d);
 /// animation. A detail lives as long as its part: a Redraw or chip that
 /// replaces the part drops it; while a later part has the part fitted as
 /// another template or facing (legs made the other legs, a part turned) it
-/// is not shown. Details are not in the glTF export.
+/// is not shown. The export writes each detail shown as a line on its part's skin.
 enum { SP_DRAGON_MAX_DETAILS = 256, SP_DRAGON_DETAIL_POINTS = 128 };
 typedef struct sp_dragon_detail {
     uint64_t id;          ///< unique for the dragon's lifetime, from the same counter as parts' (later = larger)
@@ -282,7 +282,8 @@ bool sp_dragon_bounds(const sp_dragon* d, sp_vec3* lo, sp_vec3* hi);
 /// every part (each its own skin under its placement node) in the world
 /// above moved so that the dragon's box at t = 0 is centred at the origin,
 /// a camera node "view" that frames it (orthographic, looking along -Z like
-/// the canvas), and ONE looped animation of length sp_dragon_period holding
+/// the canvas), the details shown as lines on their parts' skins ("<part>/ink<k>"),
+/// and ONE looped animation of length sp_dragon_period holding
 /// the joints' offsets and the attached parts' placements as their bodies
 /// move (none when no part animates). Fails with SP_ERR_INVALID when there
 /// are no parts.
