@@ -1235,6 +1235,23 @@ int write_skin(Writer& w, const sp_rig* rig, int base, const std::string& name)
     return (int)w.m.skins.size() - 1;
 }
 
+// A mesh of one primitive on a new root node of the scene, skinned by skin_index (extras: the node's, or null).
+void add_skinned_node(tinygltf::Model& m, tinygltf::Scene& scene, tinygltf::Primitive& prim, const std::string& mesh_name,
+                      const std::string& name, int skin_index, Value extras)
+{
+    tinygltf::Mesh mesh;
+    mesh.name = mesh_name;
+    mesh.primitives.push_back(prim);
+    m.meshes.push_back(mesh);
+    tinygltf::Node nd;
+    nd.name = name;
+    nd.mesh = (int)m.meshes.size() - 1;
+    nd.skin = skin_index;
+    nd.extras = std::move(extras);
+    scene.nodes.push_back((int)m.nodes.size());
+    m.nodes.push_back(nd);
+}
+
 // The skinned triangle mesh of a character (with its material) on a new root node.
 void write_mesh(Writer& w, tinygltf::Scene& scene, const sp_character* ch, int skin_index, const std::string& mesh_name,
                 const std::string& node_name)
@@ -1295,16 +1312,7 @@ void write_mesh(Writer& w, tinygltf::Scene& scene, const sp_character* ch, int s
     } else {
         prim.mode = TINYGLTF_MODE_POINTS;
     }
-    tinygltf::Mesh mesh;
-    mesh.name = mesh_name;
-    mesh.primitives.push_back(prim);
-    m.meshes.push_back(mesh);
-    tinygltf::Node nd;
-    nd.name = node_name;
-    nd.mesh = (int)m.meshes.size() - 1;
-    nd.skin = skin_index;
-    scene.nodes.push_back((int)m.nodes.size());
-    m.nodes.push_back(nd);
+    add_skinned_node(m, scene, prim, mesh_name, node_name, skin_index, Value());
 }
 
 // Ink drawn on a scene part: a LINE_STRIP node per line, skinned by the part's skin.
@@ -1332,16 +1340,8 @@ void write_lines(Writer& w, tinygltf::Scene& scene, const sp_gltf_scene_part* pa
                 std::isfinite(ln->color[c]) ? std::min(1.0, std::max(0.0, (double)ln->color[c])) : 0.0;
         m.materials.push_back(mat);
         prim.material = (int)m.materials.size() - 1;
-        tinygltf::Mesh mesh;
-        mesh.name = prefix + "ink" + std::to_string(l);
-        mesh.primitives.push_back(prim);
-        m.meshes.push_back(mesh);
-        tinygltf::Node nd;
-        nd.name = mesh.name;
-        nd.mesh = (int)m.meshes.size() - 1;
-        nd.skin = skin_index;
-        scene.nodes.push_back((int)m.nodes.size());
-        m.nodes.push_back(nd);
+        add_skinned_node(m, scene, prim, prefix + "ink" + std::to_string(l), prefix + "ink" + std::to_string(l), skin_index,
+                         Value());
     }
 }
 
@@ -1367,21 +1367,12 @@ void write_abstractions(Writer& w, tinygltf::Scene& scene, const sp_rig* rig, in
             size_t f = (size_t)cv->first_point;
             w.skinned_attributes(prim, cv->point_count, rest + 3 * f, joints + 4 * f, weights + 4 * f);
             prim.mode = cv->closed ? TINYGLTF_MODE_LINE_LOOP : TINYGLTF_MODE_LINE_STRIP;
-            tinygltf::Mesh mesh;
-            mesh.name = prefix + ab->name + "/" + cv->name;
-            mesh.primitives.push_back(prim);
-            m.meshes.push_back(mesh);
-            tinygltf::Node nd;
-            nd.name = mesh.name;
-            nd.mesh = (int)m.meshes.size() - 1;
-            nd.skin = skin_index;
             Value::Object ex;
             ex["sp_abstraction"] = Value(std::string(ab->name));
             ex["sp_curve"] = Value(std::string(cv->name));
             ex["sp_correspondence"] = Value(std::string(ab->correspondence == SP_CORR_CLOSEST ? "closest" : "ordered"));
-            nd.extras = Value(std::move(ex));
-            scene.nodes.push_back((int)m.nodes.size());
-            m.nodes.push_back(nd);
+            std::string name = prefix + ab->name + "/" + cv->name;
+            add_skinned_node(m, scene, prim, name, name, skin_index, Value(std::move(ex)));
         }
     }
 }
