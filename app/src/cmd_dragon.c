@@ -80,6 +80,10 @@ int cmd_dragon(int argc, char** argv)
             cJSON_AddNumberToObject(s, "part", res.part);
         else
             cJSON_AddNullToObject(s, "part");
+        if (res.detail >= 0)
+            cJSON_AddNumberToObject(s, "detail", res.detail);
+        else
+            cJSON_AddNullToObject(s, "detail");
         cJSON* g = cJSON_AddArrayToObject(s, "ranked");
         for (int k = 0; k < res.guess_count; ++k) {
             cJSON* o = cJSON_CreateObject();
@@ -88,7 +92,10 @@ int cmd_dragon(int argc, char** argv)
             cJSON_AddItemToArray(g, o);
         }
         cJSON_AddNumberToObject(s, "ms", res.ms_total);
-        if (res.rejected)
+        sp_dragon_detail e;
+        if (res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e))
+            fprintf(stderr, "sketchpose dragon: %s: stroke %d kept as a detail on part %d\n", strokes, i, e.part);
+        else if (res.rejected)
             fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (%s)\n", strokes, i, sp_dragon_reject_name(res.reason));
     }
     char* text = NULL;

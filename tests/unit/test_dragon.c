@@ -2802,6 +2802,16 @@ static void details_ride_their_part(sp_dragon* d)
         ENSURE(e.id > sp_dragon_part_get(d, 1)->id);
     }
     ENSURE(!sp_dragon_detail_get(d, 4, &e) && !sp_dragon_detail_get(d, -1, &e));
+    // The report lists them with their parts.
+    char* text = NULL;
+    ENSURE(sp_dragon_report_json(d, &text, &err) == SP_OK);
+    cJSON* rj = cJSON_Parse(text);
+    free(text);
+    const cJSON* rd = cJSON_GetObjectItem(rj, "details");
+    ENSURE(cJSON_GetArraySize(rd) == 4);
+    for (int i = 0; i < 4; ++i)
+        ENSURE(jint(cJSON_GetArrayItem(rd, i), "part") == (i < 3 ? 0 : 1) && jint(cJSON_GetArrayItem(rd, i), "points") >= 20);
+    cJSON_Delete(rj);
     // Posed: each ink is where it was drawn, about as large (its box's centre
     // near the stroke's: at t = 0 the head is off its fit by its clip's first offsets).
     ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);

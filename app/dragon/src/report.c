@@ -116,6 +116,15 @@ static cJSON* report_tree(sp_dragon* d)
     cJSON_AddItemToObject(o, "parameters", params);
     cJSON_AddNumberToObject(o, "period_s", d->period);
     cJSON_AddItemToObject(o, "parts", parts);
+    cJSON* details = cJSON_AddArrayToObject(o, "details");
+    for (int i = 0; i < d->detail_n; ++i) {
+        sp_dragon_detail e;
+        sp_dragon_detail_get(d, i, &e);
+        cJSON* dj = cJSON_CreateObject();
+        cJSON_AddNumberToObject(dj, "part", e.part);
+        cJSON_AddNumberToObject(dj, "points", e.point_count);
+        cJSON_AddItemToArray(details, dj);
+    }
     d->posed = false;
     return o;
 }

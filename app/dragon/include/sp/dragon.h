@@ -307,7 +307,8 @@ const sp_clf* sp_dragon_model(const sp_dragon* d);
 /// solve reports combined, plus "parts": [{"category", "confidence", "name",
 /// "attached_to" (-1: free), "socket", "anchor_px" (null when free),
 /// "far_side", "mirrored", "outline_bbox_px" (the attached outline at t = 0),
-/// "stroke_bbox_px", "note", "report": {...}}]). Poses the dragon at t = 0.
+/// "stroke_bbox_px", "note", "report": {...}}], "details": [{"part", "points"}]).
+/// Poses the dragon at t = 0.
 /// *json: UTF-8 text, malloc'd, free() it; NULL on failure (out of memory).
 sp_result sp_dragon_report_json(const sp_dragon* d, char** json, sp_error* err);
 
