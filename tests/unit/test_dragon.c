@@ -2948,6 +2948,18 @@ static void details_ride_their_part(sp_dragon* d)
         ENSURE(total > 0 && dark >= total / 2);
         sp_image_free(&img);
     }
+    // At most SP_DRAGON_MAX_DETAILS (a kiosk runs all day): then a detail is refused and not kept.
+    sp_vec2 slo = s6[2][0], shi = s6[2][0];
+    for (int k = 1; k < n6[2]; ++k)
+        slo.x = fmin(slo.x, s6[2][k].x), slo.y = fmin(slo.y, s6[2][k].y), shi.x = fmax(shi.x, s6[2][k].x),
+        shi.y = fmax(shi.y, s6[2][k].y);
+    while (dragon_detail_keep(d, 0, s6[2], n6[2], slo, shi) >= 0)
+        ;
+    ENSURE(sp_dragon_detail_count(d) == SP_DRAGON_MAX_DETAILS);
+    ENSURE(sp_dragon_add_points(d, s6[2], n6[2], NULL, &res, &err) == SP_OK && res.reason == SP_DRAGON_DETAIL &&
+           res.detail == -1);
+    ENSURE(sp_dragon_pose_at(d, 0.3, &err) == SP_OK &&
+           sp_dragon_export(d, sp_test_tmp_path("dragon_ink_full.glb"), &err) == SP_OK);
     sp_dragon_clear(d);
     ENSURE(sp_dragon_detail_count(d) == 0 && !sp_dragon_undo(d));
     for (int k = 0; k < count; ++k)
@@ -3017,6 +3029,8 @@ static void test_details_on_parts(void)
     for (int k = 0; k < 200; ++k)
         shade[k] = (sp_vec2){spot.x - 15 + 30 * fabs(fmod(k * 0.37, 2.0) - 1), spot.y - 12 + 0.12 * k};
     ENSURE(sp_dragon_add_points(d, shade, 200, NULL, &res, &err) == SP_OK && res.reason == SP_DRAGON_DETAIL);
+    sp_dragon_detail e; // kept, resampled along its length to at most SP_DRAGON_DETAIL_POINTS
+    ENSURE(res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e) && e.point_count == SP_DRAGON_DETAIL_POINTS);
     details_ride_their_part(d);
     sp_dragon_destroy(d);
 }
