@@ -2948,6 +2948,15 @@ static void details_ride_their_part(sp_dragon* d)
         ENSURE(total > 0 && dark >= total / 2);
         sp_image_free(&img);
     }
+    // Redraw armed, a small stroke on the body is a detail of the body; its
+    // chip makes it the head in the last part's place and takes its ink back.
+    ENSURE(sp_dragon_add_points(d, s6[2], n6[2], &(sp_dragon_stroke_opts){.replace_last = true}, &res, &err) == SP_OK);
+    ENSURE(res.reason == SP_DRAGON_DETAIL && res.detail == 3 && sp_dragon_part_count(d) == 2);
+    ENSURE(sp_dragon_add_points(d, s6[2], n6[2],
+                                &(sp_dragon_stroke_opts){.category = "head", .replace_last = true, .replace_detail = true}, &res,
+                                &err) == SP_OK);
+    ENSURE(!res.rejected && sp_dragon_part_count(d) == 2 && sp_dragon_detail_count(d) == 3);
+    ENSURE(sp_dragon_part_get(d, 1)->stroke_points > 0 && !strcmp(sp_dragon_part_get(d, 1)->category, "head"));
     // At most SP_DRAGON_MAX_DETAILS (a kiosk runs all day): then a detail is refused and not kept.
     sp_vec2 slo = s6[2][0], shi = s6[2][0];
     for (int k = 1; k < n6[2]; ++k)

@@ -1,7 +1,7 @@
 // detail.c: details (an eye, spots, scales drawn on a part) kept as ink on
 // the part: each point bound to the part's mesh where it was drawn, so it
-// rides the part's animation and attachment (docs/DESIGN.md, "Details are
-// not parts").
+// rides the part's animation and attachment (docs/DESIGN.md, "Details ride
+// their part").
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -256,9 +256,28 @@ void dragon_details_prune(sp_dragon* d)
     d->detail_n = kept;
 }
 
+uint64_t dragon_detail_last_change(const sp_dragon* d)
+{
+    if (d->detail_n == 0) return 0;
+    uint64_t id = d->details[d->detail_n - 1]->id;
+    return d->part_n == 0 || id > d->parts[d->part_n - 1]->pub.id ? id : 0;
+}
+
 void dragon_detail_pop(sp_dragon* d)
 {
     if (d->detail_n > 0) detail_free(d->details[--d->detail_n]);
+}
+
+void dragon_detail_remove(sp_dragon* d, uint64_t id)
+{
+    int kept = 0;
+    for (int i = 0; i < d->detail_n; ++i) {
+        if (d->details[i]->id == id)
+            detail_free(d->details[i]);
+        else
+            d->details[kept++] = d->details[i];
+    }
+    d->detail_n = kept;
 }
 
 void dragon_details_clear(sp_dragon* d)

@@ -239,8 +239,12 @@ int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joi
 int dragon_detail_points(const sp_dragon* d, int i);
 /// Drops the details whose part is gone (replaced by a Redraw or a chip).
 void dragon_details_prune(sp_dragon* d);
-/// Drops the last detail (n > 0) or every detail.
+/// The last detail's id when it is the dragon's last change (its id is above
+/// the last part's: the last part always has the largest of the parts'), else 0.
+uint64_t dragon_detail_last_change(const sp_dragon* d);
+/// Drops the last detail (n > 0), the detail with this id (if any) or every detail.
 void dragon_detail_pop(sp_dragon* d);
+void dragon_detail_remove(sp_dragon* d, uint64_t id);
 void dragon_details_clear(sp_dragon* d);
 
 #endif

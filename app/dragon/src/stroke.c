@@ -801,8 +801,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     out->part = out->detail = -1;
     sp_dragon_stroke_opts o = opts ? *opts : (sp_dragon_stroke_opts){0};
     // A chip for a detail: the part takes the detail's place when the detail is the last change.
-    bool drop_detail = o.replace_detail && d->detail_n > 0 &&
-                       d->details[d->detail_n - 1]->id > (d->part_n > 0 ? d->parts[d->part_n - 1]->pub.id : 0);
+    uint64_t drop_detail = o.replace_detail ? dragon_detail_last_change(d) : 0;
     if (count < 0 || (count > 0 && !xy)) return sp_fail(err, SP_ERR_INVALID, "stroke: %d points", count);
     if (count > 0 && !sp_curve_is_valid(xy, count))
         return sp_fail(err, SP_ERR_INVALID, "stroke: a coordinate is not a finite number");
@@ -909,7 +908,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // wings turn to face the way it does.
     const part* last = d->parts[d->part_n - 1];
     if (last->t->lengthwise && last->pub.attached_to >= 0) parts_by_place(d, last->pub.attached_to, last->pub.id);
-    if (drop_detail) dragon_detail_pop(d);
+    if (drop_detail) dragon_detail_remove(d, drop_detail);
     out->part = d->part_n - 1;
     out->rejected = false;
     out->reason = SP_DRAGON_ACCEPTED;
@@ -943,8 +942,8 @@ sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_res
 
 bool sp_dragon_undo(sp_dragon* d)
 {
-    // A detail always comes after its part, so popping by id never leaves ink without its part.
-    if (d->detail_n > 0 && d->details[d->detail_n - 1]->id > (d->part_n > 0 ? d->parts[d->part_n - 1]->pub.id : 0)) {
+    // A detail always comes after its part, so taking back the last change never leaves ink without its part.
+    if (dragon_detail_last_change(d)) {
         dragon_detail_pop(d);
         return true;
     }
