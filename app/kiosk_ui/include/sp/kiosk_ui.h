@@ -146,7 +146,7 @@ typedef enum sp_kiosk_refusal {
 
 /// The answer to a FIT or REFIT job.
 typedef struct sp_kiosk_fit_result {
-    bool ok;                  ///< false: refused (a hint; the stroke is offered or fades; nothing else changes)
+    bool ok;                  ///< false: refused (a hint; the stroke is offered or fades; no part changes)
     sp_kiosk_refusal refusal; ///< !ok: why
     bool offer;               ///< !ok, FIT: the stroke can still become a part by a tap (it stays, with the parts row)
     bool kept;                ///< !ok, FIT: the stroke stays on the dragon as a detail (Undo takes it back as a change)

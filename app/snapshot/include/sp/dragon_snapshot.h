@@ -1,6 +1,7 @@
 /// dragon_snapshot.h: the whole dragon rendered headless to a PNG (the
 /// `sketchpose dragon --render` picture): every part shaded at time t, the
-/// details drawn on them in ink, the strokes in blue and the fitted outlines in yellow on the drawing canvas.
+/// details drawn on them in ink, the strokes in blue and the fitted outlines
+/// in yellow on the drawing canvas.
 ///
 ///     sp_dragon_snapshot_png(d, &(sp_dragon_snapshot_desc){.strokes = true, .outlines = true}, "out.png", &err);
 #ifndef SP_DRAGON_SNAPSHOT_H
