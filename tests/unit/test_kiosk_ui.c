@@ -755,6 +755,8 @@ static void test_detail_refused(void)
                          &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .offer = true, .offers = {"head", "wings", "tail"}});
     tap(ui, t + 200, SP_KT_UNDO);
     ENSURE(!sp_kiosk_ui_offering(ui) && !sp_kiosk_ui_next_job(ui, &j));
+    m = sp_kiosk_ui_message(ui); // the offer's hint went with it, before its time
+    ENSURE(!m || strcmp(m, sp_kiosk_text(SP_KTEXT_DETAIL)) != 0);
     sp_kiosk_ui_destroy(ui);
 }
 

@@ -498,6 +498,7 @@ static void set_hint(sp_kiosk_ui* ui, const char* text)
 {
     snprintf(ui->hint, sizeof ui->hint, "%s", text ? text : "");
     ui->hint_until = ui->now + ui->desc.hint_ms;
+    ui->hint_of_offer = ui->hint_of_row = false;
 }
 
 // Copies a category into a fixed label (GCC cannot tell that the two, both
@@ -548,8 +549,7 @@ static void end_offer(sp_kiosk_ui* ui, bool fade)
     ui->held_stroke.count = 0;
     ui->held_until = -1;
     ui->held_kept = false;
-    if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_UNRECOGNISED)) || !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DETAIL)))
-        ui->hint_until = -1;
+    if (ui->hint_of_offer) ui->hint_until = -1;
     if (ui->chips_offer)
         set_chips(ui, NULL, NULL, NULL);
     else
@@ -704,7 +704,7 @@ static bool inside(const sp_kiosk_rect* r, float x, float y)
 static void close_row(sp_kiosk_ui* ui)
 {
     ui->row_open = false;
-    if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_PICK_PART))) ui->hint_until = -1;
+    if (ui->hint_of_row) ui->hint_until = -1;
     layout_chips(ui);
 }
 
@@ -807,6 +807,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             ++ui->others;
             layout_chips(ui);
             set_hint(ui, sp_kiosk_text(SP_KTEXT_PICK_PART));
+            ui->hint_of_row = true;
         }
         break;
     default:
@@ -988,6 +989,7 @@ static void hold(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
     set_chip_list(ui, NULL, r->offers, 3, true);
     set_hint(ui, sp_kiosk_text(r->refusal == SP_KREF_DETAIL ? SP_KTEXT_DETAIL : SP_KTEXT_UNRECOGNISED));
     ui->hint_until = ui->held_until;
+    ui->hint_of_offer = true;
     ++ui->offered;
 }
 

@@ -218,6 +218,7 @@ typedef struct sp_kiosk_ui {
     bool held_kept; ///< the held stroke is also kept as a detail: Undo takes it back from the dragon too
     char hint[SP_KIOSK_TEXT_MAX];
     double hint_until;
+    bool hint_of_offer, hint_of_row;   ///< the hint is the held offer's / the opened row's: it goes when they do
     bool woke;                         ///< the finger now down touched during the idle countdown or on the attract screen
     char code[16];                     ///< the last save code
     char banner[2][SP_KIOSK_TEXT_MAX]; ///< the save banner: the code, then what it is for
