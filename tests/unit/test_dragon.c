@@ -813,10 +813,10 @@ static sp_mat4 gworld(gnode* nodes, int i)
     return n->world;
 }
 
-// Skinned vertices of skin `skin_index`'s mesh at time t of animation 0 (malloc'd, count by 3).
 static double* glb_pose_node(const glb* g, double t, int node_index, int* count);
 
-// The skinned vertices of the mesh with this skin (the first node that has it) at time t.
+// Skinned vertices of skin `skin_index`'s mesh (the first node that has it)
+// at time t of animation 0 (malloc'd, count by 3).
 static double* glb_pose(const glb* g, double t, int skin_index, int* count)
 {
     const cJSON* jn = cJSON_GetObjectItem(g->j, "nodes");
@@ -829,7 +829,8 @@ static double* glb_pose(const glb* g, double t, int skin_index, int* count)
     return glb_pose_node(g, t, node, count);
 }
 
-// The skinned points of node node_index's mesh (its first primitive) at time t.
+// The skinned points of node node_index's mesh (its first primitive) at
+// time t of animation 0 (malloc'd, count by 3).
 static double* glb_pose_node(const glb* g, double t, int node_index, int* count)
 {
     const cJSON* jn = cJSON_GetObjectItem(g->j, "nodes");
@@ -2742,12 +2743,6 @@ static void small_loop(sp_vec2 c, double r, sp_vec2 xy[40])
     }
 }
 
-// A small stroke drawn on a part is a detail of it (an eye on the head,
-// spots on the body): refused as such, with its guesses for the chips,
-// nothing added. Before, each became a tiny part: a head on the body, a
-// body or a head floating at the head. The same loop drawn apart from
-// every part, as large as a part, or chosen with a chip is a part; so is a
-// visitor's pair of legs drawn small on the body.
 // Ink point k of detail i on the canvas at the last pose_at.
 static sp_vec2 ink_px(const sp_dragon* d, int i, int k)
 {
@@ -2975,6 +2970,13 @@ static void details_ride_their_part(sp_dragon* d)
         free(s6[k]);
 }
 
+// A small stroke drawn on a part is a detail of it (an eye on the head,
+// spots on the body): refused as a part, with its guesses for the chips,
+// and kept as ink on the part (details_ride_their_part). Before, each
+// became a tiny part: a head on the body, a body or a head floating at the
+// head. The same loop drawn apart from every part, as large as a part, or
+// chosen with a chip is a part; so is a visitor's pair of legs drawn small
+// on the body.
 static void test_details_on_parts(void)
 {
     const char* path = real_db();
