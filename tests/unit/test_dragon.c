@@ -2957,8 +2957,11 @@ static void details_ride_their_part(sp_dragon* d)
     for (int k = 1; k < n6[2]; ++k)
         slo.x = fmin(slo.x, s6[2][k].x), slo.y = fmin(slo.y, s6[2][k].y), shi.x = fmax(shi.x, s6[2][k].x),
         shi.y = fmax(shi.y, s6[2][k].y);
-    while (dragon_detail_keep(d, 0, s6[2], n6[2], slo, shi) >= 0)
+    detail_hit hit = {0};
+    ENSURE(dragon_detail_of(d, s6[2], n6[2], slo, shi, -1, &hit) == 0);
+    while (dragon_detail_keep(d, &hit, s6[2], n6[2]) >= 0)
         ;
+    dragon_detail_hit_free(&hit);
     ENSURE(sp_dragon_detail_count(d) == SP_DRAGON_MAX_DETAILS);
     ENSURE(sp_dragon_add_points(d, s6[2], n6[2], NULL, &res, &err) == SP_OK && res.reason == SP_DRAGON_DETAIL &&
            res.detail == -1);

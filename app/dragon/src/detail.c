@@ -117,9 +117,10 @@ static int bind_points(const sp_rig* rig, const double* xyz, const sp_vec2* px, 
     return k;
 }
 
-int dragon_detail_keep(sp_dragon* d, int k, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi)
+int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n)
 {
-    if (k < 0 || k >= d->part_n || n < 2 || d->detail_n >= SP_DRAGON_MAX_DETAILS) return -1;
+    int k = hit->part;
+    if (k < 0 || k >= d->part_n || !hit->xyz || !hit->px || n < 2 || d->detail_n >= SP_DRAGON_MAX_DETAILS) return -1;
     const part* q = d->parts[k];
     const sp_rig* rig = &q->t->ch.rig;
     if (rig->vertex_count <= 0 || rig->triangle_count <= 0) return -1;
@@ -138,19 +139,8 @@ int dragon_detail_keep(sp_dragon* d, int k, const sp_vec2* pts, int n, sp_vec2 l
     e->tri = block;
     e->bary = (double*)(void*)(block + 4 * mm); // 4m uint32s keep the doubles aligned
     e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
-    // Where the part is shown at its fit; its size on the canvas sets how
-    // far off it a point may be bound (as the detail test).
-    double* xyz = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count);
-    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
-    if (xyz && px) {
-        dragon_mesh_on_canvas(d, q, &q->world_fit, xyz, px);
-        sp_vec2 a = px[0], b = px[0];
-        for (int v = 1; v < rig->vertex_count; ++v)
-            a.x = fmin(a.x, px[v].x), a.y = fmin(a.y, px[v].y), b.x = fmax(b.x, px[v].x), b.y = fmax(b.y, px[v].y);
-        double near = dragon_detail_near(hypot(b.x - a.x, b.y - a.y), hypot(hi.x - lo.x, hi.y - lo.y)) + 0.71;
-        e->n = isfinite(near) ? bind_points(rig, xyz, px, rs ? rs : pts, m, near, e) : 0;
-    }
-    free(xyz), free(px);
+    // On the mesh the detail test found it on, within the same tolerance.
+    e->n = bind_points(rig, hit->xyz, hit->px, rs ? rs : pts, m, hit->near, e);
     free(rs);
     if (e->n < 2) {
         detail_free(e);
@@ -192,11 +182,6 @@ void dragon_details_pose(sp_dragon* d)
             memcpy(e->normal + 3 * j, &(double[3]){nrm.x, nrm.y, nrm.z}, sizeof(double) * 3);
         }
     }
-}
-
-int dragon_detail_points(const sp_dragon* d, int i)
-{
-    return i >= 0 && i < d->detail_n ? d->details[i]->n : 0;
 }
 
 int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joints, float* weights)

@@ -199,34 +199,33 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
 /// The same test against part k only (false when k is not a body).
 bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
+/// Where a stroke lies on the part it is a detail of: the part, its mesh at
+/// its fit as shown (world and canvas, vertex_count each, malloc'd) and how
+/// near that mesh a point counts as on it (pixels).
+typedef struct detail_hit {
+    int part;
+    double* xyz;
+    sp_vec2* px;
+    double near;
+} detail_hit;
 /// The part that a stroke (pts: n canvas points, box [lo, hi]) is a detail
 /// of, or -1: the part drawn last whose projected mesh at its fit (as
 /// shown, after attachment) holds nearly all the stroke's points and whose
 /// box's diagonal is over eight times the stroke's (an eye on a head, spots on a
 /// body: docs/DESIGN.md, "Details are not parts"). Part `skip` (the one a
-/// Redraw replaces, or -1) does not count.
-int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip);
+/// Redraw replaces, or -1) does not count. hit (may be NULL) receives the
+/// mesh it was found on, for dragon_detail_keep; free it with dragon_detail_hit_free.
+int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
+void dragon_detail_hit_free(detail_hit* hit);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
-/// Part q's mesh evaluated at its fit, moved into the world by m, and
-/// projected on the canvas (xyz: vertex_count by 3, px: vertex_count).
-void dragon_mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px);
 
 // ---- detail.c ----------------------------------------------------------------------
 
-/// How near a part's mesh (on the canvas) a detail's point counts as on it:
-/// the smaller of these fractions of the part's box diagonal and the
-/// stroke's (a child's eye on a thin snout runs over its edge; a small part
-/// drawn at a body's edge reaches beyond it), pixels.
-static inline double dragon_detail_near(double mesh_diag, double stroke_diag)
-{
-    return mesh_diag * 0.04 < stroke_diag * 0.3 ? mesh_diag * 0.04 : stroke_diag * 0.3;
-}
-
-/// Keeps the stroke (pts: n canvas points, box [lo, hi]) as a detail of
-/// part k: its index, or -1 when the dragon holds SP_DRAGON_MAX_DETAILS, no
-/// two points lie on or near the part's mesh, or memory runs out.
-int dragon_detail_keep(sp_dragon* d, int k, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi);
+/// Keeps the stroke (pts: n canvas points) as a detail of the part and mesh
+/// dragon_detail_of found it on: its index, or -1 when the dragon holds
+/// SP_DRAGON_MAX_DETAILS, no two points lie on or near the mesh, or memory runs out.
+int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n);
 /// Poses every detail on its part's vertices at the last pose_at (after them).
 void dragon_details_pose(sp_dragon* d);
 /// Detail i's points in its part's bind space with their skin (for the
@@ -235,8 +234,6 @@ void dragon_details_pose(sp_dragon* d);
 /// barycentric coordinates, the four largest kept. Returns its part's index,
 /// -1 when the part does not show it (then nothing is written).
 int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joints, float* weights);
-/// Points of detail i.
-int dragon_detail_points(const sp_dragon* d, int i);
 /// Drops the details whose part is gone (replaced by a Redraw or a chip).
 void dragon_details_prune(sp_dragon* d);
 /// The last detail's id when it is the dragon's last change (its id is above

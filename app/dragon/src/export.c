@@ -98,8 +98,9 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
     char(*names)[SP_NAME_MAX + 16] = calloc((size_t)n, sizeof *names);
     // The details shown, as ink on their parts' skins: one block of points for all of them.
     int nd = d->detail_n, total = 0;
+    sp_dragon_detail e;
     for (int i = 0; i < nd; ++i)
-        total += dragon_detail_points(d, i);
+        total += sp_dragon_detail_get(d, i, &e) ? e.point_count : 0;
     sp_gltf_scene_line* lines = calloc((size_t)nd + 1, sizeof *lines);
     double* ink_rest = malloc(sizeof(double) * 3 * ((size_t)total + 1));
     uint16_t* ink_joints = malloc(sizeof(uint16_t) * 4 * ((size_t)total + 1));
@@ -135,15 +136,13 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
     for (int i = 0, used = 0, at = 0; i < n; ++i) {
         parts[i].lines = lines + used;
         for (int k = 0; k < nd; ++k) {
-            int m = dragon_detail_points(d, k);
             double* r = ink_rest + 3 * (size_t)at;
             uint16_t* j = ink_joints + 4 * (size_t)at;
             float* w = ink_weights + 4 * (size_t)at;
-            sp_dragon_detail e;
             if (!sp_dragon_detail_get(d, k, &e) || e.part != i || dragon_detail_skinned(d, k, r, j, w) != i) continue;
-            lines[used++] =
-                (sp_gltf_scene_line){.point_count = m, .rest = r, .joints = j, .weights = w, .color = {0.01f, 0.006f, 0.006f, 1}};
-            at += m;
+            lines[used++] = (sp_gltf_scene_line){
+                .point_count = e.point_count, .rest = r, .joints = j, .weights = w, .color = {0.01f, 0.006f, 0.006f, 1}};
+            at += e.point_count;
             ++parts[i].line_count;
         }
     }

@@ -86,7 +86,7 @@ sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* v
 
 // Part q's mesh at its fit moved by m into the world (xyz: vertex_count by
 // 3) and seen on the canvas (px).
-void dragon_mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px)
+static void mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px)
 {
     const sp_rig* rig = &q->t->ch.rig;
     sp_rig_eval_update(q->t->ev, q->p_fit, false);
@@ -110,7 +110,7 @@ static bool body_prepare(const sp_dragon* d, part* q)
         q->body_xyz = NULL, q->body_px = NULL;
         return false;
     }
-    dragon_mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px);
+    mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px);
     // Its surface: the triangles' area in the world. None (every triangle of
     // zero area, or nothing finite) means there is nothing to hold a part.
     double area = 0;
@@ -490,6 +490,12 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
 #define DETAIL_SIZE 0.12
 // The share of the stroke's points that must lie on the part.
 #define DETAIL_ON 0.9
+// How near the part's mesh a point counts as on it: the smaller of these
+// fractions of the part's box diagonal and the stroke's (a child's eye on a
+// thin snout runs over its edge; a small part drawn at a body's edge
+// reaches beyond it).
+#define DETAIL_NEAR 0.04
+#define DETAIL_NEAR_OWN 0.3
 // The stroke's points tested (evenly by index), enough to tell on from off.
 #define DETAIL_SAMPLES 32
 
@@ -520,7 +526,13 @@ static bool covered_near(const unsigned char* cells, int w, int h, sp_vec2 o, sp
     return false;
 }
 
-int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip)
+void dragon_detail_hit_free(detail_hit* hit)
+{
+    free(hit->xyz), free(hit->px);
+    hit->xyz = NULL, hit->px = NULL;
+}
+
+int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
@@ -540,11 +552,11 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
             free(xyz), free(px);
             return -1; // out of memory: not a detail, the stroke goes on as a part
         }
-        dragon_mesh_on_canvas(d, q, &q->world_fit, xyz, px); // as shown: after attachment
+        mesh_on_canvas(d, q, &q->world_fit, xyz, px); // as shown: after attachment
         sp_vec2 a, b;
         px_box(px, nv, &a, &b);
         int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0;
-        double near = dragon_detail_near(hypot(b.x - a.x, b.y - a.y), diag);
+        double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
         bool detail = diag <= DETAIL_SIZE * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
         // The window: the stroke's box grown by `near` (and a cell); none for
         // a mesh that is not finite or a window beyond reason.
@@ -561,6 +573,10 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
             detail = off <= (1 - DETAIL_ON) * m;
         }
         free(cells);
+        if (detail && hit) {
+            *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = near + 0.71};
+            return k;
+        }
         free(xyz), free(px);
         if (detail) return k;
     }

@@ -385,7 +385,6 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
     out->rejected = true;
     out->reason = why;
     out->part = -1;
-    if (why != SP_DRAGON_DETAIL) out->detail = -1;
     out->ms_total = sp_now_ms() - t0;
     return SP_OK;
 }
@@ -831,12 +830,13 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // A small stroke drawn on a part is a detail of it (an eye, spots,
     // shading): a tiny part there is not what was meant. It is kept as ink
     // on the part; its guesses stay, so a chip still makes it a part.
-    int host = -1;
+    detail_hit hit = {0};
     if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
-        (host = dragon_detail_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1)) >= 0)
+        dragon_detail_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit) >= 0)
         why = SP_DRAGON_DETAIL;
     if (why != SP_DRAGON_ACCEPTED) {
-        if (why == SP_DRAGON_DETAIL) out->detail = dragon_detail_keep(d, host, pts, n, lo, hi);
+        if (why == SP_DRAGON_DETAIL) out->detail = dragon_detail_keep(d, &hit, pts, n);
+        dragon_detail_hit_free(&hit);
         free(pts);
         offer_kin(d, &a, out);
         return reject(out, why, t0);
@@ -927,6 +927,7 @@ sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_res
 {
     if (d->part_n == 0 || !category) {
         memset(out, 0, sizeof *out);
+        out->detail = -1;
         return reject(out, SP_DRAGON_NOTHING_TO_REFIT, sp_now_ms());
     }
     part* last = d->parts[d->part_n - 1];
