@@ -564,18 +564,16 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     memset(&res, 0, sizeof res);
     sp_error err = {0};
     double t0 = sp_now_ms();
-    // A part chosen for a stroke kept as a detail takes the detail's place.
-    bool over_detail = forced && k->detail_held;
-    k->detail_held = false;
     sp_result rc = sp_dragon_add_points(
         k->dragon, k->scratch, s->count,
-        &(sp_dragon_stroke_opts){.category = forced, .replace_last = j->replace, .replace_detail = over_detail}, &res, &err);
+        &(sp_dragon_stroke_opts){.category = forced, .replace_last = j->replace, .replace_detail = j->replace_detail}, &res,
+        &err);
     double ms = sp_now_ms() - t0;
     k->stats.last_fit_ms = ms;
     k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
     answer_fit(k, rc, &res, &err, false, forced);
     if (rc == SP_OK && !res.rejected) keep_stroke(k, res.part, k->scratch, s->t, s->count);
-    if (rc == SP_OK && res.reason == SP_DRAGON_DETAIL && res.detail >= 0) ++k->rev, k->detail_held = !forced;
+    if (rc == SP_OK && res.reason == SP_DRAGON_DETAIL && res.detail >= 0) ++k->rev; // new ink to pose
 }
 
 static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
@@ -720,7 +718,6 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         break;
     case SP_KJOB_UNDO: {
         if (sp_dragon_undo(k->dragon)) ++k->rev, ++k->stats.undos;
-        k->detail_held = false;
         sp_kiosk_part_label l;
         last_label(k, &l);
         sp_kiosk_ui_parts_changed(k->ui, sp_dragon_part_count(k->dragon), &l);
@@ -730,7 +727,6 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         parts_left(k);
         sp_dragon_clear(k->dragon);
         ++k->rev, ++k->stats.clears;
-        k->detail_held = false;
         forget_strokes(k);
         sp_kiosk_ui_parts_changed(k->ui, 0, NULL);
         break;

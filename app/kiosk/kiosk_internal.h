@@ -82,7 +82,6 @@ struct sp_kiosk {
     kiosk_collector* collector;          // NULL: collection off (--no-collect) or closed
     int collect_stored, collect_dropped; // the collector's counts when it closed
     uint64_t rev;                        // grows with every change of the dragon
-    bool detail_held;                    // the last stroke was kept as a detail and is offered: a chip's part replaces it
     uint64_t posed_rev;                  // rev and time of the last pose_at
     double posed_t;
     bool posed;

@@ -757,6 +757,18 @@ static void test_detail_refused(void)
     ENSURE(!sp_kiosk_ui_offering(ui) && !sp_kiosk_ui_next_job(ui, &j));
     m = sp_kiosk_ui_message(ui); // the offer's hint went with it, before its time
     ENSURE(!m || strcmp(m, sp_kiosk_text(SP_KTEXT_DETAIL)) != 0);
+    // A chip for a stroke kept as a detail: the part takes the ink's place; for one only held, nothing to replace.
+    for (int kept = 1; kept >= 0; --kept) {
+        t = refused_stroke(ui, 50000 + 10000 * (1 - kept), 800, 200);
+        ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+        sp_kiosk_ui_fit_done(
+            ui,
+            &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .offer = true, .kept = kept, .offers = {"head", "wings", "tail"}});
+        tap(ui, t + 200, SP_KT_CHIP_GUESS1);
+        ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !strcmp(j.category, "head"));
+        ENSURE(j.replace_detail == (bool)kept);
+        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "head", .part_count = 2});
+    }
     sp_kiosk_ui_destroy(ui);
 }
 

@@ -587,6 +587,7 @@ static void take_offer(sp_kiosk_ui* ui, const char* category)
     sp_kiosk_job* j = queue_fit(ui, &ui->held_stroke);
     if (!j) return;
     copy_label(j->category, category);
+    j->replace_detail = ui->held_kept;
     ++ui->chosen;
     end_offer(ui, false);
 }

@@ -129,6 +129,7 @@ typedef struct sp_kiosk_job {
     sp_kiosk_job_kind kind;
     bool heavy;                        ///< FIT, REFIT, SAVE: do one per frame
     bool replace;                      ///< FIT: replace the last part
+    bool replace_detail;               ///< FIT with a category: the stroke was kept as a detail; the part takes its place
     const sp_kiosk_line* stroke;       ///< FIT: the stroke (pixels, with times)
     char category[SP_KIOSK_LABEL_MAX]; ///< REFIT; FIT: "" to classify, else the part the visitor chose for a refused stroke
     double t_ms;                       ///< when it was asked for
