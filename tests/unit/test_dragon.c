@@ -2767,6 +2767,56 @@ static int nearest_vertex(const sp_dragon* d, int p, const double* x)
     return best;
 }
 
+// Exports the dragon to `name` and plays its ink back from the file: the
+// largest distance (world units) from pose_at's ink, at three times of the
+// loop, over its `count` ink nodes (each named for the part of the detail
+// in order: `parts`[i], two digits); the validator must take the file.
+static double ink_played_back(sp_dragon* d, const char* name, int count, const int* parts)
+{
+    sp_error err = {0};
+    const char* glbf = sp_test_tmp_path(name);
+    ENSURE(sp_dragon_export(d, glbf, &err) == SP_OK);
+    glb g;
+    glb_read(glbf, &g);
+    const cJSON* off = cJSON_GetObjectItem(
+        cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(g.j, "scenes"), 0), "extras"),
+                            "sp_dragon"),
+        "world_offset");
+    int ink_nodes[8], found = 0;
+    ENSURE(count <= 8);
+    const cJSON* jn = cJSON_GetObjectItem(g.j, "nodes");
+    for (int i = 0; i < cJSON_GetArraySize(jn); ++i) {
+        const char* nm = cJSON_GetObjectItem(cJSON_GetArrayItem(jn, i), "name")->valuestring;
+        if (strstr(nm, "/ink")) {
+            char want[8];
+            ENSURE(found < count);
+            snprintf(want, sizeof want, "%02d_", parts[found]);
+            ENSURE(!strncmp(nm, want, 3));
+            ink_nodes[found++] = i;
+        }
+    }
+    ENSURE(found == count);
+    double worst = 0, period = sp_dragon_period(d);
+    sp_dragon_detail e;
+    for (int step = 0; step < 3; ++step) {
+        double t = step * 0.37 * period;
+        ENSURE(sp_dragon_pose_at(d, t, &err) == SP_OK);
+        for (int i = 0; i < count; ++i) {
+            int np;
+            double* x = glb_pose_node(&g, t, ink_nodes[i], &np);
+            ENSURE(sp_dragon_detail_get(d, i, &e) && e.xyz && np == e.point_count);
+            for (int k = 0; k < 3 * np; ++k)
+                worst = fmax(worst, fabs(x[k] - (e.xyz[k] + cJSON_GetArrayItem(off, k % 3)->valuedouble)));
+            free(x);
+        }
+    }
+    cJSON_Delete(g.j);
+    free(g.bin);
+    int v = validate(glbf);
+    if (v >= 0) ENSURE(v == 1);
+    return worst;
+}
+
 // Details are kept as ink that rides their part. The README's picture
 // (docs/img/kiosk_detail.json): the body and the head as the kiosk makes
 // them on the default database (this test's quick database classifies
@@ -2862,43 +2912,9 @@ static void details_ride_their_part(sp_dragon* d)
     // animation moves as pose_at does (within half a canvas pixel: a point
     // skinned by its corners' blended influences is not exactly the blend of
     // its skinned corners), and the validator takes it.
-    const char* glbf = sp_test_tmp_path("dragon_ink.glb");
-    ENSURE(sp_dragon_export(d, glbf, &err) == SP_OK);
-    glb g;
-    glb_read(glbf, &g);
-    const cJSON* off = cJSON_GetObjectItem(
-        cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(g.j, "scenes"), 0), "extras"),
-                            "sp_dragon"),
-        "world_offset");
-    int ink_nodes[4], found = 0;
-    const cJSON* jn = cJSON_GetObjectItem(g.j, "nodes");
-    for (int i = 0; i < cJSON_GetArraySize(jn); ++i) {
-        const char* name = cJSON_GetObjectItem(cJSON_GetArrayItem(jn, i), "name")->valuestring;
-        if (strstr(name, "/ink")) {
-            ENSURE(found < 4 && !strncmp(name, found < 3 ? "00_" : "01_", 3));
-            ink_nodes[found++] = i;
-        }
-    }
-    ENSURE(found == 4);
-    double worst = 0;
-    for (int step = 0; step < 3; ++step) {
-        double t = step * 0.37 * period;
-        ENSURE(sp_dragon_pose_at(d, t, &err) == SP_OK);
-        for (int i = 0; i < 4; ++i) {
-            int np;
-            double* x = glb_pose_node(&g, t, ink_nodes[i], &np);
-            ENSURE(sp_dragon_detail_get(d, i, &e) && e.xyz && np == e.point_count);
-            for (int k = 0; k < 3 * np; ++k)
-                worst = fmax(worst, fabs(x[k] - (e.xyz[k] + cJSON_GetArrayItem(off, k % 3)->valuedouble)));
-            free(x);
-        }
-    }
+    double worst = ink_played_back(d, "dragon_ink.glb", 4, (const int[]){0, 0, 0, 1});
     fprintf(stderr, "  the exported ink played back vs pose_at: %.2g world units (a canvas pixel is %.2g)\n", worst, 2.0 / 800);
     ENSURE(worst < 0.5 * 2.0 / 800);
-    cJSON_Delete(g.j);
-    free(g.bin);
-    int v = validate(glbf);
-    if (v >= 0) ENSURE(v == 1);
     // Undo takes back the last change: the eye, then a spot, then the head.
     ENSURE(sp_dragon_undo(d) && sp_dragon_detail_count(d) == 3 && sp_dragon_part_count(d) == 2);
     // A chip for the eye (kept again) makes it a head in its place.
@@ -3049,6 +3065,173 @@ static void test_details_on_parts(void)
     sp_dragon_destroy(d);
 }
 
+// A wavy line of 40 points from `from` along the unit direction dir, turned by `turn` radians.
+static void wavy_line(sp_vec2 from, sp_vec2 dir, double turn, double length, sp_vec2 out[40])
+{
+    sp_vec2 u = {cos(turn) * dir.x - sin(turn) * dir.y, sin(turn) * dir.x + cos(turn) * dir.y}, v = {-u.y, u.x};
+    for (int i = 0; i < 40; ++i) {
+        double t = i / 39.0, off = 10 * sin(t * 4 * M_PI) * (0.3 + t);
+        out[i] = sp_v2_add(from, sp_v2_add(sp_v2_scale(u, t * length), sp_v2_scale(v, off)));
+    }
+}
+
+// A stroke drawn out of a part, away from the body (fire from the mouth),
+// is a flourish: kept as ink on that part, its points off the mesh carried
+// in the air by the part's skin where the stroke leaves it. Before, each
+// line of fire became a tiny tail floating beside the head, a flame
+// outline a second head or wings. The README's dragon (docs/img/kiosk_detail.json:
+// its body and head), then fire from the head's snout, as a visitor draws it.
+static void test_flourishes_off_parts(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    sp_error err = {0};
+    sp_dragon_result res;
+    sp_dragon* d = new_dragon(path);
+    char file[1200];
+    snprintf(file, sizeof file, "%s/docs/img/kiosk_detail.json", SP_SOURCE_DIR);
+    sp_vec2* s6[8];
+    int n6[8], count = sp_fixture_session_strokes(file, s6, n6, 8);
+    ENSURE(count == 6);
+    int body = add_as(d, s6[0], n6[0], "torso"), head = add_as(d, s6[1], n6[1], "head");
+    ENSURE(sp_dragon_part_get(d, head)->attached_to == body);
+    // The snout as drawn: the head's stroke point farthest from the body's middle.
+    sp_vec2 bc = {0, 0}, tip = s6[1][0];
+    for (int k = 0; k < n6[0]; ++k)
+        bc = sp_v2_add(bc, sp_v2_scale(s6[0][k], 1.0 / n6[0]));
+    for (int k = 0; k < n6[1]; ++k)
+        if (sp_v2_len(sp_v2_sub(s6[1][k], bc)) > sp_v2_len(sp_v2_sub(tip, bc))) tip = s6[1][k];
+    sp_vec2 dir = sp_v2_scale(sp_v2_sub(tip, bc), 1 / sp_v2_len(sp_v2_sub(tip, bc)));
+    sp_vec2 fire[3][40];
+    for (int k = 0; k < 3; ++k) {
+        wavy_line(sp_v2_add(tip, sp_v2_scale(dir, 6)), dir, 0.25 * (k - 1), 150, fire[k]);
+        ENSURE(sp_dragon_add_points(d, fire[k], 40, NULL, &res, &err) == SP_OK);
+        fprintf(stderr, "  fire %d: %s, %.1f ms (pen-up to ink)\n", k, sp_dragon_reject_name(res.reason), res.ms_total);
+        ENSURE(res.rejected && res.reason == SP_DRAGON_DETAIL && res.detail == k && res.guess_count > 0);
+        ENSURE(sp_dragon_part_count(d) == 2 && sp_dragon_detail_count(d) == k + 1);
+    }
+    // At t = 0 each line is where it was drawn, at its size, mostly in the air.
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
+    sp_dragon_detail e;
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(sp_dragon_detail_get(d, i, &e) && e.part == head && e.xyz && e.point_count == 40);
+        sp_vec2 lo = {INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY}, slo = lo, shi = hi;
+        int air = 0;
+        for (int k = 0; k < e.point_count; ++k) {
+            sp_vec2 q = ink_px(d, i, k), s = fire[i][k];
+            lo.x = fmin(lo.x, q.x), lo.y = fmin(lo.y, q.y), hi.x = fmax(hi.x, q.x), hi.y = fmax(hi.y, q.y);
+            slo.x = fmin(slo.x, s.x), slo.y = fmin(slo.y, s.y), shi.x = fmax(shi.x, s.x), shi.y = fmax(shi.y, s.y);
+            air += e.normal[3 * k] == 0 && e.normal[3 * k + 1] == 0 && e.normal[3 * k + 2] == 0;
+        }
+        double off = hypot(0.5 * (lo.x + hi.x - slo.x - shi.x), 0.5 * (lo.y + hi.y - slo.y - shi.y));
+        double size = hypot(hi.x - lo.x, hi.y - lo.y) / hypot(shi.x - slo.x, shi.y - slo.y);
+        fprintf(stderr, "  fire %d on part %d: %d of %d points in the air, %.1f px from its stroke, %.2f its size\n", i, e.part,
+                air, e.point_count, off, size);
+        ENSURE(air >= 30 && off < 12 && size > 0.9 && size < 1.1);
+    }
+    // It rides the head: over the loop each line's first point moves as the
+    // head's vertex nearest it, and the line keeps its length (carried, not bent).
+    double period = sp_dragon_period(d), moved = 0, stretch = 0;
+    ENSURE(period > 0);
+    sp_camera cam = sp_dragon_camera(d);
+    int near_v[3];
+    sp_vec2 ink0[3], vtx0[3];
+    double len0[3];
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(sp_dragon_detail_get(d, i, &e));
+        near_v[i] = nearest_vertex(d, head, e.xyz);
+        const double* v = sp_dragon_part_xyz(d, head) + 3 * near_v[i];
+        ink0[i] = ink_px(d, i, 0), vtx0[i] = sp_camera_project(&cam, (sp_vec3){v[0], v[1], v[2]});
+        len0[i] = sp_v2_len(sp_v2_sub(ink_px(d, i, 39), ink0[i]));
+    }
+    for (int step = 1; step <= 4; ++step) {
+        ENSURE(sp_dragon_pose_at(d, step * period / 5, &err) == SP_OK);
+        for (int i = 0; i < 3; ++i) {
+            const double* v = sp_dragon_part_xyz(d, head) + 3 * near_v[i];
+            sp_vec2 dv = sp_v2_sub(sp_camera_project(&cam, (sp_vec3){v[0], v[1], v[2]}), vtx0[i]);
+            sp_vec2 di = sp_v2_sub(ink_px(d, i, 0), ink0[i]);
+            moved = fmax(moved, sp_v2_len(di));
+            ENSURE(sp_v2_len(sp_v2_sub(di, dv)) < 2.5);
+            stretch = fmax(stretch, fabs(sp_v2_len(sp_v2_sub(ink_px(d, i, 39), ink_px(d, i, 0))) / len0[i] - 1));
+        }
+    }
+    fprintf(stderr, "  the fire moves up to %.1f px over the loop, its lines' lengths within %.1f%%\n", moved, 100 * stretch);
+    ENSURE(moved > 3 && stretch < 0.1);
+    // The export: the points in the air skinned by their carrier play back as pose_at.
+    double worst = ink_played_back(d, "dragon_fire.glb", 3, (const int[]){1, 1, 1});
+    fprintf(stderr, "  the exported fire played back vs pose_at: %.2g world units (a canvas pixel is %.2g)\n", worst, 2.0 / 800);
+    ENSURE(worst < 0.5 * 2.0 / 800);
+    // The picture shows it in the air (dark pixels along the middle line as posed).
+    sp_image img = {0};
+    sp_error rerr = {0};
+    sp_result r = sp_dragon_snapshot_render(d, &(sp_dragon_snapshot_desc){0}, &img, &rerr);
+    if (r == SP_ERR_UNSUPPORTED) {
+        fprintf(stderr, "  note: no EGL here, no picture: %s\n", rerr.text);
+    } else {
+        ENSURE(r == SP_OK);
+        int dark = 0;
+        for (int k = 0; k < 40; ++k) {
+            sp_vec2 q = ink_px(d, 1, k);
+            int x = (int)lround(q.x), y = (int)lround(q.y), hit = 0;
+            for (int dy = -3; dy <= 3; ++dy)
+                for (int dx = -3; dx <= 3; ++dx) {
+                    if (x + dx < 0 || y + dy < 0 || x + dx >= img.width || y + dy >= img.height) continue;
+                    const uint8_t* px = img.rgba + 4 * ((size_t)(y + dy) * (size_t)img.width + (size_t)(x + dx));
+                    hit |= px[0] < 70 && px[1] < 70 && px[2] < 70;
+                }
+            dark += hit;
+        }
+        fprintf(stderr, "  %d of 40 points of the middle line dark in the picture\n", dark);
+        ENSURE(dark >= 36);
+        sp_image_free(&img);
+    }
+    // A puff drawn at the middle line's end, off the head's mesh but on its ink, rides the head too.
+    sp_vec2 puff[40], end = fire[1][39];
+    for (int k = 0; k < 40; ++k)
+        puff[k] = (sp_vec2){end.x + 25 * dir.x + 22 * cos(2 * M_PI * k / 39 + M_PI) * 1.2,
+                            end.y + 25 * dir.y + 18 * sin(2 * M_PI * k / 39)};
+    ENSURE(sp_dragon_add_points(d, puff, 40, NULL, &res, &err) == SP_OK);
+    fprintf(stderr, "  a puff at the fire's end: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason == SP_DRAGON_DETAIL && res.detail == 3 && sp_dragon_detail_get(d, 3, &e) && e.part == head);
+    // Undo takes back the puff and the fire, one at a time.
+    for (int k = 4; k > 0; --k)
+        ENSURE(sp_dragon_undo(d) && sp_dragon_detail_count(d) == k - 1 && sp_dragon_part_count(d) == 2);
+    // Not flourishes: the line drawn apart from the head, or out of the
+    // body (a tail), is a part or refused, never ink; so is fire from a
+    // head that has no body yet (parts drawn before their body are parts).
+    wavy_line(sp_v2_add(tip, sp_v2_scale(dir, 80)), dir, 0, 150, fire[0]);
+    ENSURE(sp_dragon_add_points(d, fire[0], 40, NULL, &res, &err) == SP_OK);
+    fprintf(stderr, "  the line 80 px from the snout: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason != SP_DRAGON_DETAIL && sp_dragon_detail_count(d) == 0);
+    if (!res.rejected) ENSURE(sp_dragon_undo(d));
+    sp_vec2 rear = s6[0][0];
+    for (int k = 0; k < n6[0]; ++k)
+        if (s6[0][k].x < rear.x) rear = s6[0][k];
+    wavy_line(sp_v2_add(rear, (sp_vec2){-4, 0}), (sp_vec2){-1, 0}, 0.2, 150, fire[0]);
+    ENSURE(sp_dragon_add_points(d, fire[0], 40, NULL, &res, &err) == SP_OK);
+    fprintf(stderr, "  the line out of the body's rear: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason != SP_DRAGON_DETAIL && sp_dragon_detail_count(d) == 0);
+    if (!res.rejected) ENSURE(sp_dragon_undo(d));
+    // A head drawn out of the body's front end while the dragon has none is
+    // its head, never a flourish of a part it touches (dragon_claims_socket);
+    // with its head there, that place is for fire.
+    const tpl* ht = d->parts[head]->t;
+    sp_vec2 flo = {tip.x, tip.y - 60}, fhi = {tip.x + 200, tip.y + 60};
+    ENSURE(!dragon_claims_socket(d, ht, flo, fhi));
+    ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == 1);
+    ENSURE(dragon_claims_socket(d, ht, flo, fhi));
+    ENSURE(
+        !dragon_claims_socket(d, ht, (sp_vec2){flo.x + 150, flo.y}, (sp_vec2){fhi.x + 150, fhi.y})); // beyond the snap distance
+    sp_dragon_clear(d);
+    head = add_as(d, s6[1], n6[1], "head");
+    ENSURE(sp_dragon_add_points(d, fire[1], 40, NULL, &res, &err) == SP_OK);
+    fprintf(stderr, "  fire from a head with no body: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason != SP_DRAGON_DETAIL && sp_dragon_detail_count(d) == 0);
+    for (int k = 0; k < count; ++k)
+        free(s6[k]);
+    sp_dragon_destroy(d);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -3074,5 +3257,6 @@ int main(int argc, char** argv)
                                    {"root_at_the_body", test_root_at_the_body},
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
+                                   {"flourishes_off_parts", test_flourishes_off_parts},
                                    {0}});
 }

@@ -60,14 +60,100 @@ static sp_vec3 face_normal(const double* xyz, const uint32_t* tr, double flip)
     return l > 0 && isfinite(l) ? sp_v3_scale(n, flip / l) : (sp_vec3){0, 0, flip};
 }
 
-// Binds the points to a mesh as shown (xyz: world, px: its vertices on the
-// canvas): each to the front-most triangle under it (nearest the viewer,
-// +z), or, off the mesh, to the nearest point of a triangle within `near`
-// pixels (not beyond it: a triangle seen edge-on on the canvas would fling
-// an extrapolated point far in depth). Returns how many were bound (kept
-// in order).
-static int bind_points(const sp_rig* rig, const double* xyz, const sp_vec2* px, const sp_vec2* pts, int m, double near, detail* e)
+// The joints that skin the point of triangle tr at barycentric b: its
+// corners' influences blended, the four largest kept and renormalised (the
+// export's skin takes four). Returns how many.
+static int blend_influences(const sp_rig* rig, const uint32_t* tr, const double* b, int joints[4], double weights[4])
 {
+    int jj[12];
+    double ww[12];
+    int m = 0;
+    for (int c = 0; c < 3; ++c)
+        for (int f = 0; f < 4; ++f) {
+            int jn = rig->joints4[4 * (size_t)tr[c] + (size_t)f];
+            double w = b[c] * rig->weights4[4 * (size_t)tr[c] + (size_t)f];
+            if (!(w > 0)) continue;
+            int s = 0;
+            while (s < m && jj[s] != jn)
+                ++s;
+            if (s == m) jj[m] = jn, ww[m++] = 0;
+            ww[s] += w;
+        }
+    double sum = 0;
+    int k = 0;
+    for (; k < 4; ++k) {
+        int big = -1;
+        for (int s = 0; s < m; ++s)
+            if (ww[s] > 0 && (big < 0 || ww[s] > ww[big])) big = s;
+        if (big < 0) break;
+        joints[k] = jj[big], weights[k] = ww[big], sum += ww[big], ww[big] = 0;
+    }
+    for (int f = 0; f < k; ++f)
+        weights[f] /= sum;
+    return k;
+}
+
+// The point of a projected mesh (xyz: world, px: canvas) under or nearest
+// canvas point p: under it, the front-most triangle's (nearest the viewer,
+// +z); else the nearest point of the nearest triangle. Its triangle (-1:
+// nothing finite) and barycentric coordinates w.
+static int mesh_point_at(const sp_rig* rig, const double* xyz, const sp_vec2* px, sp_vec2 p, double w[3])
+{
+    int face = -1;
+    bool on = false;
+    double best = INFINITY; // depth when on, distance when off
+    for (int f = 0; f < rig->triangle_count; ++f) {
+        const uint32_t* tr = rig->triangles + 3 * (size_t)f;
+        sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
+        double u[3];
+        if (!bary_of(p, a, b, c, u)) continue;
+        if (u[0] >= 0 && u[1] >= 0 && u[2] >= 0) {
+            double z = u[0] * xyz[3 * tr[0] + 2] + u[1] * xyz[3 * tr[1] + 2] + u[2] * xyz[3 * tr[2] + 2];
+            if (!on || z > best) on = true, best = z, face = f;
+        } else if (!on) {
+            double dist = sp_v2_len(sp_v2_sub(p, edge_nearest(p, a, b, c)));
+            if (dist < best) best = dist, face = f;
+        }
+    }
+    if (face < 0) return -1;
+    const uint32_t* tr = rig->triangles + 3 * (size_t)face;
+    sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
+    if (!bary_of(on ? p : edge_nearest(p, a, b, c), a, b, c, w)) return -1;
+    for (int j = 0; j < 3; ++j) // on its edge: rounding must not reach outside
+        w[j] = fmin(1, fmax(0, w[j]));
+    return face;
+}
+
+// The world position of canvas point p at the depth of world point A (the
+// pseudo-inverse of the projection's Jacobian at A: exact for the world's
+// orthographic camera). False when the projection there is degenerate.
+static bool canvas_to_world(const sp_camera* cam, sp_vec3 A, sp_vec2 p, sp_vec3* out)
+{
+    double J[6];
+    sp_camera_jacobian(cam, A, J);
+    double g0 = J[0] * J[0] + J[1] * J[1] + J[2] * J[2], g1 = J[0] * J[3] + J[1] * J[4] + J[2] * J[5];
+    double g2 = J[3] * J[3] + J[4] * J[4] + J[5] * J[5], det = g0 * g2 - g1 * g1;
+    if (!(fabs(det) > 1e-12) || !isfinite(det)) return false;
+    sp_vec2 dp = sp_v2_sub(p, sp_camera_project(cam, A));
+    double y0 = (g2 * dp.x - g1 * dp.y) / det, y1 = (-g1 * dp.x + g0 * dp.y) / det; // (J J^T)^-1 dp
+    *out = (sp_vec3){A.x + J[0] * y0 + J[3] * y1, A.y + J[1] * y0 + J[4] * y1, A.z + J[2] * y0 + J[5] * y1};
+    return isfinite(out->x) && isfinite(out->y) && isfinite(out->z);
+}
+
+// Binds the points to a mesh as shown (hit: the part's mesh in the world
+// and on the canvas): each to the front-most triangle under it (nearest the
+// viewer, +z), or, off the mesh, to the nearest point of a triangle within
+// `near` pixels (not beyond it: a triangle seen edge-on on the canvas would
+// fling an extrapolated point far in depth). A flourish's other points go
+// in the air (flip 0), at the depth of the mesh's point nearest their
+// middle, carried by the joints that skin that point. Returns how many were
+// bound (kept in order).
+static int bind_points(const sp_dragon* d, const part* q, const detail_hit* hit, const sp_vec2* pts, int m, detail* e)
+{
+    const sp_rig* rig = &q->t->ch.rig;
+    const double* xyz = hit->xyz;
+    const sp_vec2* px = hit->px;
+    double near = hit->near;
     double* best = malloc(sizeof(double) * 2 * (size_t)m); // per point: depth when on, distance when off
     int* face = malloc(sizeof(int) * (size_t)m);
     bool* on = calloc((size_t)m, sizeof(bool));
@@ -99,9 +185,40 @@ static int bind_points(const sp_rig* rig, const double* xyz, const sp_vec2* px, 
             }
         }
     }
+    // The points in the air, carried from the mesh's point nearest their
+    // middle: placed in the world at its depth, then in the rig's rest space
+    // by the inverse of its blended skin at the part's fit.
+    sp_vec2 mid = {0, 0};
+    int air = 0;
+    for (int i = 0; i < m; ++i)
+        if (face[i] < 0) mid = sp_v2_add(mid, pts[i]), ++air;
+    sp_vec3 A = {0, 0, 0};
+    sp_mat4 to_rest = sp_mat4_identity();
+    double w[3];
+    int af = hit->air && air > 0 ? mesh_point_at(rig, xyz, px, sp_v2_scale(mid, 1.0 / air), w) : -1;
+    e->carrier_n = 0;
+    if (af >= 0) {
+        const uint32_t* tr = rig->triangles + 3 * (size_t)af;
+        for (int j = 0; j < 3; ++j)
+            A = sp_v3_add(A, sp_v3_scale(vertex(xyz, tr[j]), w[j]));
+        e->carrier_n = blend_influences(rig, tr, w, e->carrier_joint, e->carrier_w);
+        sp_rig_eval_update(q->t->ev, q->p_fit, false);
+        sp_mat4 fit =
+            dragon_blended_skin(e->carrier_joint, e->carrier_w, e->carrier_n, sp_rig_eval_skin(q->t->ev), &q->world_fit);
+        if (e->carrier_n == 0 || !sp_mat4_inverse(&fit, &to_rest)) af = -1; // nothing carries them: left out
+    }
     int k = 0;
     for (int i = 0; i < m; ++i) {
-        if (face[i] < 0) continue; // off the mesh and not near it: left out of the ink
+        if (face[i] < 0) { // off the mesh and not near it
+            sp_vec3 W;
+            if (af < 0 || !canvas_to_world(&d->world, A, pts[i], &W)) continue; // not a flourish's: left out of the ink
+            sp_vec3 r = sp_mat4_point(&to_rest, W);
+            memset(e->tri + 3 * k, 0, sizeof(uint32_t) * 3);
+            memcpy(e->bary + 3 * k, &(double[3]){r.x, r.y, r.z}, sizeof(double) * 3);
+            e->drawn[k] = pts[i];
+            e->flip[k++] = 0;
+            continue;
+        }
         const uint32_t* tr = rig->triangles + 3 * (size_t)face[i];
         sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]], p = on[i] ? pts[i] : edge_nearest(pts[i], a, b, c);
         double w[3];
@@ -111,7 +228,7 @@ static int bind_points(const sp_rig* rig, const double* xyz, const sp_vec2* px, 
         memcpy(e->tri + 3 * k, tr, sizeof(uint32_t) * 3);
         memcpy(e->bary + 3 * k, w, sizeof w);
         e->flip[k] = face_normal(xyz, tr, 1).z >= 0 ? 1 : -1; // the side facing the canvas's viewer
-        ++k;
+        e->drawn[k++] = pts[i];
     }
     free(best), free(face), free(on);
     return k;
@@ -130,8 +247,8 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     detail* e = calloc(1, sizeof *e);
     sp_vec2* rs = m < n ? malloc(sizeof(sp_vec2) * (size_t)m) : NULL;
     size_t mm = (size_t)m;
-    // One block: tri (3m uint32), then bary (3m), flip (m), xyz (3m), normal (3m) doubles.
-    uint32_t* block = malloc(sizeof(uint32_t) * 4 * mm + sizeof(double) * 10 * mm);
+    // One block: tri (3m uint32), then bary (3m), flip (m), xyz (3m), normal (3m), drawn (2m) doubles.
+    uint32_t* block = malloc(sizeof(uint32_t) * 4 * mm + sizeof(double) * 12 * mm);
     if (!e || (m < n && !rs) || !block || (rs && sp_curve_resample(pts, n, false, m, rs) != SP_OK)) {
         free(e), free(rs), free(block);
         return -1;
@@ -139,8 +256,9 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     e->tri = block;
     e->bary = (double*)(void*)(block + 4 * mm); // 4m uint32s keep the doubles aligned
     e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
+    e->drawn = (sp_vec2*)(void*)(e->normal + 3 * mm);
     // On the mesh the detail test found it on, within the same tolerance.
-    e->n = bind_points(rig, hit->xyz, hit->px, rs ? rs : pts, m, hit->near, e);
+    e->n = bind_points(d, q, hit, rs ? rs : pts, m, e);
     free(rs);
     if (e->n < 2) {
         detail_free(e);
@@ -165,6 +283,20 @@ static const part* host_of(const sp_dragon* d, const detail* e, int* index)
     return NULL;
 }
 
+double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p)
+{
+    double best = INFINITY;
+    for (int i = 0; i < d->detail_n; ++i) {
+        const detail* e = d->details[i];
+        int k;
+        const part* q = e->host == host ? host_of(d, e, &k) : NULL;
+        if (!q || q->t != e->t || q->pub.mirrored != e->mirrored) continue; // not shown
+        for (int j = 0; j + 1 < e->n; ++j)
+            best = fmin(best, sp_v2_len(sp_v2_sub(p, segment_nearest(p, e->drawn[j], e->drawn[j + 1]))));
+    }
+    return best;
+}
+
 void dragon_details_pose(sp_dragon* d)
 {
     for (int i = 0; i < d->detail_n; ++i) {
@@ -172,7 +304,16 @@ void dragon_details_pose(sp_dragon* d)
         int k;
         const part* q = host_of(d, e, &k);
         e->shown = q && q->t == e->t && q->pub.mirrored == e->mirrored;
+        sp_mat4 carried = e->shown && e->carrier_n > 0 ? dragon_blended_skin(e->carrier_joint, e->carrier_w, e->carrier_n,
+                                                                             sp_rig_eval_skin(q->ev), &q->world_t)
+                                                       : sp_mat4_identity();
         for (int j = 0; e->shown && j < e->n; ++j) {
+            if (e->flip[j] == 0) { // in the air: no surface under it, so no normal
+                sp_vec3 r = sp_mat4_point(&carried, (sp_vec3){e->bary[3 * j], e->bary[3 * j + 1], e->bary[3 * j + 2]});
+                memcpy(e->xyz + 3 * j, &(double[3]){r.x, r.y, r.z}, sizeof(double) * 3);
+                memset(e->normal + 3 * j, 0, sizeof(double) * 3);
+                continue;
+            }
             const uint32_t* tr = e->tri + 3 * j;
             sp_vec3 s = {0, 0, 0};
             for (int c = 0; c < 3; ++c)
@@ -195,35 +336,23 @@ int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joi
     for (int j = 0; j < e->n; ++j) {
         const uint32_t* tr = e->tri + 3 * j;
         const double* b = e->bary + 3 * j;
-        uint16_t jj[12];
-        double ww[12];
-        int m = 0;
-        for (int c = 0; c < 3; ++c) {
+        int jn[4];
+        double w[4];
+        int c = e->carrier_n;
+        if (e->flip[j] == 0) { // in the air: its rest position, carried by the detail's joints
+            memcpy(rest + 3 * j, b, sizeof(double) * 3);
+            memcpy(jn, e->carrier_joint, sizeof jn), memcpy(w, e->carrier_w, sizeof w);
+        } else {
             for (int a = 0; a < 3; ++a)
-                rest[3 * j + a] = (c ? rest[3 * j + a] : 0) + b[c] * rig->rest[3 * (size_t)tr[c] + (size_t)a];
-            for (int f = 0; f < 4; ++f) {
-                uint16_t jn = rig->joints4[4 * (size_t)tr[c] + (size_t)f];
-                double w = b[c] * rig->weights4[4 * (size_t)tr[c] + (size_t)f];
-                if (!(w > 0)) continue;
-                int s = 0;
-                while (s < m && jj[s] != jn)
-                    ++s;
-                if (s == m) jj[m] = jn, ww[m++] = 0;
-                ww[s] += w;
-            }
+                rest[3 * j + a] = b[0] * rig->rest[3 * (size_t)tr[0] + (size_t)a] +
+                                  b[1] * rig->rest[3 * (size_t)tr[1] + (size_t)a] +
+                                  b[2] * rig->rest[3 * (size_t)tr[2] + (size_t)a];
+            c = blend_influences(rig, tr, b, jn, w);
         }
-        // The four largest influences, renormalised (the export's skin takes four).
-        double sum = 0;
         for (int f = 0; f < 4; ++f) {
-            int big = -1;
-            for (int s = 0; s < m; ++s)
-                if (ww[s] > 0 && (big < 0 || ww[s] > ww[big])) big = s;
-            joints[4 * j + f] = big >= 0 ? jj[big] : 0;
-            weights[4 * j + f] = big >= 0 ? (float)ww[big] : 0.0f;
-            if (big >= 0) sum += ww[big], ww[big] = 0;
+            joints[4 * j + f] = f < c ? (uint16_t)jn[f] : 0;
+            weights[4 * j + f] = f < c ? (float)w[f] : (float)(c == 0 && f == 0);
         }
-        for (int f = 0; f < 4; ++f)
-            weights[4 * j + f] = sum > 0 ? (float)(weights[4 * j + f] / sum) : (f == 0);
     }
     return k;
 }

@@ -120,16 +120,25 @@ typedef struct part {
 } part;
 
 // A detail (detail.c): a stroke kept as ink on a part, each point bound to
-// one of the part's triangles by barycentric coordinates.
+// one of the part's triangles by barycentric coordinates, or, off the mesh
+// (a flourish's), carried in the air by the part's skin where the stroke
+// leaves it.
 typedef struct detail {
     uint64_t id, host; // its own id and its part's
     const tpl* t;      // the part's template and facing when bound: shown only while the part has them
     bool mirrored;
     int n;
-    uint32_t* tri;        // n by 3 (one block with the arrays below)
-    double *bary, *flip;  // n by 3; n: +1 or -1, the triangle's winding towards the side drawn on
+    uint32_t* tri; // n by 3 (one block with the arrays below)
+    // n by 3: barycentric, or for a point in the air its position in the
+    // rig's rest space (what its carrier's blended skin matrix poses).
+    double* bary;
+    double* flip;         // n: +1 or -1, the triangle's winding towards the side drawn on; 0: in the air
     double *xyz, *normal; // posed at the last pose_at, n by 3
-    bool shown;           // posed and its part as bound
+    sp_vec2* drawn;       // n: where each point was drawn on the canvas
+    int carrier_n;        // the joints that carry the points in the air (at most four), and their weights
+    int carrier_joint[4];
+    double carrier_w[4];
+    bool shown; // posed and its part as bound
 } detail;
 
 struct sp_dragon {
@@ -167,6 +176,8 @@ sp_camera dragon_zoomed_view(const tpl* t, sp_vec2 lo, sp_vec2 hi);
 sp_camera dragon_mirrored_view(const sp_camera* view, double u);
 /// Part model space -> world, making the part's view and the world camera agree.
 sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* view);
+/// Skin matrices (skin) of n joints blended by their weights w, then world's.
+sp_mat4 dragon_blended_skin(const int* joints, const double* w, int n, const sp_mat4* skin, const sp_mat4* world);
 /// Part p's carrier in the world: its joints' skin matrices (skin, the body's
 /// evaluation) blended by its weights, then the body's model -> world.
 sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world);
@@ -177,6 +188,12 @@ sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4*
 /// that body's end, where the body's socket for its kind is: its box
 /// overlaps the body's on the canvas and reaches past that end.
 int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* out_of_end);
+/// Whether a stroke (box [lo, hi]) of template t's kind comes out of the
+/// end of the nearest body where that body's socket for its kind is (a
+/// head's or a tail's) while no part of its kind hangs on that body: the
+/// dragon's missing head drawn there is its head, never a flourish of the
+/// part it touches.
+bool dragon_claims_socket(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi);
 /// Which way a part that does not reach sideways (legs, wings) should face
 /// for a stroke in the box [lo, hi]: the way the dragon it is drawn at faces
 /// (the nearest body whose box is within the snap distance of the stroke's,
@@ -200,13 +217,15 @@ bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
 /// The same test against part k only (false when k is not a body).
 bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
 /// Where a stroke lies on the part it is a detail of: the part, its mesh at
-/// its fit as shown (world and canvas, vertex_count each, malloc'd) and how
-/// near that mesh a point counts as on it (pixels).
+/// its fit as shown (world and canvas, vertex_count each, malloc'd), how
+/// near that mesh a point counts as on it (pixels), and whether it is a
+/// flourish (its points off the mesh are kept, in the air).
 typedef struct detail_hit {
     int part;
     double* xyz;
     sp_vec2* px;
     double near;
+    bool air;
 } detail_hit;
 /// The part that a stroke (pts: n canvas points, box [lo, hi]) is a detail
 /// of, or -1: the part drawn last whose projected mesh at its fit (as
@@ -216,6 +235,14 @@ typedef struct detail_hit {
 /// Redraw replaces, or -1) does not count. hit (may be NULL) receives the
 /// mesh it was found on, for dragon_detail_keep; free it with dragon_detail_hit_free.
 int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
+/// The part that a stroke is drawn out of, away from the dragon's bodies,
+/// or -1 (fire from a mouth, a spade at a tail's tip, a crown on a head:
+/// docs/DESIGN.md, "Flourishes ride their part"): a part attached to a
+/// body, that the stroke comes near (its mesh or the ink drawn out of it),
+/// at least two thirds of the stroke's size, with every point of the
+/// stroke nearer it than any body and a share of them off its mesh. Part
+/// `skip` (or -1) does not count. hit as for dragon_detail_of, with air set.
+int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
 void dragon_detail_hit_free(detail_hit* hit);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
@@ -224,8 +251,11 @@ void dragon_relayout(sp_dragon* d);
 
 /// Keeps the stroke (pts: n canvas points) as a detail of the part and mesh
 /// dragon_detail_of found it on: its index, or -1 when the dragon holds
-/// SP_DRAGON_MAX_DETAILS, no two points lie on or near the mesh, or memory runs out.
+/// SP_DRAGON_MAX_DETAILS, fewer than two points can be bound, or memory runs out.
 int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n);
+/// The distance on the canvas from p to the ink kept on the part with this
+/// id, as drawn (INFINITY when it has none shown).
+double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p);
 /// Poses every detail on its part's vertices at the last pose_at (after them).
 void dragon_details_pose(sp_dragon* d);
 /// Detail i's points in its part's bind space with their skin (for the

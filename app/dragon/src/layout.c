@@ -263,13 +263,18 @@ static const dsocket* socket_hint(const part* q, const part* p, sp_vec3 anchor, 
     return best;
 }
 
-sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world)
+sp_mat4 dragon_blended_skin(const int* joints, const double* w, int n, const sp_mat4* skin, const sp_mat4* world)
 {
     sp_mat4 m = {{0}};
-    for (int e = 0; e < p->carrier_n; ++e)
+    for (int e = 0; e < n; ++e)
         for (int c = 0; c < 16; ++c)
-            m.m[c] += p->carrier_w[e] * skin[p->carrier_joint[e]].m[c];
-    return sp_mat4_mul(body_world, &m);
+            m.m[c] += w[e] * skin[joints[e]].m[c];
+    return sp_mat4_mul(world, &m);
+}
+
+sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world)
+{
+    return dragon_blended_skin(p->carrier_joint, p->carrier_w, p->carrier_n, skin, body_world);
 }
 
 // Attaches part i to body k at the surface point h: moves it there, and
@@ -532,29 +537,47 @@ void dragon_detail_hit_free(detail_hit* hit)
     hit->xyz = NULL, hit->px = NULL;
 }
 
+// Part k's mesh at its fit as shown (after attachment), in the world and on
+// the canvas (*xyz, *px: malloc'd, vertex_count each), and its box there
+// [a, b], when its stroke's box, grown as below, overlaps the stroke's box
+// [lo, hi]. 0: not near it (or no mesh); -1: out of memory.
+static int part_near_stroke(sp_dragon* d, int k, sp_vec2 lo, sp_vec2 hi, double** xyz, sp_vec2** px, sp_vec2* a, sp_vec2* b)
+{
+    const part* q = d->parts[k];
+    // Its stroke's box first (cheap): a part is shown about where it was
+    // drawn (its fit reaching a little beyond the stroke, its horns and
+    // spikes too), moved at most by the snap distance when it attaches.
+    double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]), g = snap_px(d) + 0.25 * qd;
+    sp_vec2 qlo = {q->stroke_box[0] - g, q->stroke_box[1] - g}, qhi = {q->stroke_box[2] + g, q->stroke_box[3] + g};
+    const sp_rig* rig = &q->t->ch.rig;
+    int nv = rig->vertex_count;
+    *xyz = NULL, *px = NULL;
+    if (!boxes_overlap(lo, hi, qlo, qhi) || nv <= 0 || rig->triangle_count <= 0) return 0;
+    *xyz = malloc(sizeof(double) * 3 * (size_t)nv);
+    *px = malloc(sizeof(sp_vec2) * (size_t)nv);
+    if (!*xyz || !*px) {
+        free(*xyz), free(*px);
+        *xyz = NULL, *px = NULL;
+        return -1;
+    }
+    mesh_on_canvas(d, q, &q->world_fit, *xyz, *px);
+    px_box(*px, nv, a, b);
+    return 1;
+}
+
 int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
         part* q = d->parts[k];
-        // Its stroke's box first (cheap): a part is shown about where it was
-        // drawn (its fit reaching a little beyond the stroke, its horns and
-        // spikes too), moved at most by the snap distance when it attaches.
-        double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]), g = snap_px(d) + 0.25 * qd;
-        sp_vec2 qlo = {q->stroke_box[0] - g, q->stroke_box[1] - g}, qhi = {q->stroke_box[2] + g, q->stroke_box[3] + g};
-        if (k == skip || n < 2 || !(diag <= 2 * DETAIL_SIZE * qd) || !boxes_overlap(lo, hi, qlo, qhi)) continue;
+        double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]);
+        if (k == skip || n < 2 || !(diag <= 2 * DETAIL_SIZE * qd)) continue;
         const sp_rig* rig = &q->t->ch.rig;
-        int nv = rig->vertex_count;
-        if (nv <= 0 || rig->triangle_count <= 0) continue;
-        double* xyz = malloc(sizeof(double) * 3 * (size_t)nv);
-        sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)nv);
-        if (!xyz || !px) {
-            free(xyz), free(px);
-            return -1; // out of memory: not a detail, the stroke goes on as a part
-        }
-        mesh_on_canvas(d, q, &q->world_fit, xyz, px); // as shown: after attachment
-        sp_vec2 a, b;
-        px_box(px, nv, &a, &b);
+        double* xyz;
+        sp_vec2 *px, a, b;
+        int got = part_near_stroke(d, k, lo, hi, &xyz, &px, &a, &b);
+        if (got < 0) return -1; // out of memory: not a detail, the stroke goes on as a part
+        if (got == 0) continue;
         int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0;
         double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
         bool detail = diag <= DETAIL_SIZE * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
@@ -583,27 +606,109 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
     return -1;
 }
 
+// A flourish (fire from a mouth, a spade at a tail's tip, a crown on a
+// head) is at most this multiple of its part's size on the canvas (box
+// diagonals; a child's fire is often larger than the head): larger, it is
+// a part of its own drawn there.
+#define FLOURISH_SIZE 1.5
+// How near its part's projected mesh (or the ink drawn out of it) a
+// flourish must come (a fraction of the part's box diagonal: a child's fire
+// starts a little off the snout).
+#define FLOURISH_TOUCH 0.08
+// The share of its points off the part: a stroke mostly over a part is
+// drawn over it, not out of it.
+#define FLOURISH_OUT 0.3
+
+// The distance from canvas point p to the nearest of n points px, or
+// `limit` when none is nearer.
+static double vertex_nearest(const sp_vec2* px, int n, sp_vec2 p, double limit)
+{
+    double best = limit * limit;
+    for (int v = 0; v < n; ++v) {
+        double dx = px[v].x - p.x, dy = px[v].y - p.y, d2 = dx * dx + dy * dy;
+        if (d2 < best) best = d2;
+    }
+    return sqrt(best);
+}
+
+int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+{
+    if (n < 2) return -1;
+    double diag = hypot(hi.x - lo.x, hi.y - lo.y);
+    for (int k = 0; k < d->part_n; ++k) // the bodies' meshes, for the distances below
+        if (k != skip && d->parts[k]->t->is_torso) body_prepare(d, d->parts[k]);
+    int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES;
+    for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
+        part* q = d->parts[k];
+        // Only a part of a dragon (attached to its body): a part floating free is not one to draw out of.
+        if (k == skip || q->pub.attached_to < 0) continue;
+        double* xyz;
+        sp_vec2 *px, a, b;
+        int got = part_near_stroke(d, k, lo, hi, &xyz, &px, &a, &b);
+        if (got < 0) return -1; // out of memory: not a flourish, the stroke goes on as a part
+        if (got == 0) continue;
+        int nv = q->t->ch.rig.vertex_count;
+        double pd = hypot(b.x - a.x, b.y - a.y), touch = FLOURISH_TOUCH * pd, nearest = INFINITY;
+        bool flourish = diag <= FLOURISH_SIZE * pd && isfinite(pd);
+        int out = 0;
+        // Every point nearer the part than any body: out of the part, not
+        // reaching for the body (a part drawn there would attach to it).
+        // Distances to the meshes' projected vertices: their triangles are
+        // a few pixels across, and this is some fifty times faster.
+        for (int s = 0; flourish && s < m; ++s) {
+            sp_vec2 x = pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)];
+            double dm = vertex_nearest(px, nv, x, INFINITY), dp = fmin(dm, dragon_ink_distance(d, q->pub.id, x));
+            for (int j = 0; flourish && j < d->part_n; ++j) {
+                const part* o = d->parts[j];
+                if (j != skip && o->t->is_torso && o->body_px)
+                    flourish = !(vertex_nearest(o->body_px, o->t->ch.rig.vertex_count, x, dp) < dp);
+            }
+            nearest = fmin(nearest, dp);
+            out += dm > touch;
+        }
+        if (flourish && nearest <= touch && out >= FLOURISH_OUT * m) {
+            if (hit) {
+                // Only points on the mesh are bound to it; the rest ride it in the air.
+                *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = 0.71, .air = true};
+                return k;
+            }
+            free(xyz), free(px);
+            return k;
+        }
+        free(xyz), free(px);
+    }
+    return -1;
+}
+
 // A socket farther than this from the body's middle (in half-lengths of the
 // body on the canvas) is at an end: a head's or a tail's, not the wings' or
 // the legs' (the shipped torso fitted to the visitors' tune bodies puts its
 // head socket at 0.7-0.95 on 9 of 11, its tail socket at 0.8-0.96).
 #define END_SOCKET 0.6
 
-int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* out_of_end)
+// The body whose box on the canvas ([blo, bhi]) is nearest canvas point c, or -1.
+static int nearest_body(sp_dragon* d, sp_vec2 c, sp_vec2* blo, sp_vec2* bhi)
 {
-    *out_of_end = false;
-    sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
-    const part* body = NULL;
+    int body = -1;
     double bd = INFINITY;
-    sp_vec2 blo = {0, 0}, bhi = {0, 0};
     for (int k = 0; k < d->part_n; ++k) {
         part* q = d->parts[k];
         sp_vec2 a, b;
         if (!q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) continue;
         double dist = box_distance(c, a, b);
-        if (dist < bd) bd = dist, body = q, blo = a, bhi = b;
+        if (dist < bd) bd = dist, body = k, *blo = a, *bhi = b;
     }
-    if (!body) return 0;
+    return body;
+}
+
+int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool* out_of_end)
+{
+    *out_of_end = false;
+    sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
+    sp_vec2 blo = {0, 0}, bhi = {0, 0};
+    int k = nearest_body(d, c, &blo, &bhi);
+    if (k < 0) return 0;
+    const part* body = d->parts[k];
     double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x);
     double side = c.x - mid;
     if (!(fabs(side) > 0.25 * half)) return 0; // over the body's middle: no side to face away from
@@ -619,6 +724,23 @@ int dragon_facing_hint(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi, bool*
     }
     *out_of_end = at_end && near_body_box(d, lo, hi, blo, bhi) && (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
     return (side > 0 ? 1 : -1) == natural ? 1 : -1;
+}
+
+bool dragon_claims_socket(sp_dragon* d, const tpl* t, sp_vec2 lo, sp_vec2 hi)
+{
+    sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5), blo = {0, 0}, bhi = {0, 0};
+    int k = nearest_body(d, c, &blo, &bhi);
+    const dsocket* so = k >= 0 ? kind_socket(d->parts[k], t->category, t->prefer) : NULL;
+    if (!so) return false;
+    for (int i = 0; i < d->part_n; ++i)
+        if (d->parts[i]->pub.attached_to == k && !strcmp(d->parts[i]->pub.category, t->category)) return false;
+    double mid = 0.5 * (blo.x + bhi.x), half = 0.5 * (bhi.x - blo.x), side = c.x - mid;
+    // The socket's end as the dragon faces (its heads and tails may say it
+    // is drawn mirrored); when nothing tells, either end.
+    int facing = body_facing(d, k);
+    double su = socket_u(d, d->parts[k], so, mid) * (facing == 1 ? -1 : 1);
+    return fabs(su) > END_SOCKET * half && (facing < 0 || su * side > 0) && near_body_box(d, lo, hi, blo, bhi) &&
+           (side > 0 ? hi.x > bhi.x : lo.x < blo.x);
 }
 
 int dragon_facing_at(sp_dragon* d, sp_vec2 lo, sp_vec2 hi)

@@ -792,6 +792,20 @@ static void give_back_fits(sp_dragon* d, uint64_t by)
         }
 }
 
+// A stroke (classified, not a Redraw) drawn out of a part of the dragon,
+// away from its body, is a flourish of that part (docs/DESIGN.md,
+// "Flourishes ride their part"): kept as ink on it (out->detail, -1 when
+// the dragon holds no more), like a detail, and refused as one.
+static bool kept_as_flourish(sp_dragon* d, const sp_dragon_stroke_opts* o, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi,
+                             sp_dragon_result* out)
+{
+    detail_hit hit = {0};
+    if (o->category || o->replace_last || !d->clf || dragon_flourish_of(d, pts, n, lo, hi, -1, &hit) < 0) return false;
+    out->detail = dragon_detail_keep(d, &hit, pts, n);
+    dragon_detail_hit_free(&hit);
+    return true;
+}
+
 sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
                                sp_dragon_result* out, sp_error* err)
 {
@@ -834,8 +848,10 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
         dragon_detail_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit) >= 0)
         why = SP_DRAGON_DETAIL;
+    bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
+    if (flourish) why = SP_DRAGON_DETAIL;
     if (why != SP_DRAGON_ACCEPTED) {
-        if (why == SP_DRAGON_DETAIL) out->detail = dragon_detail_keep(d, &hit, pts, n);
+        if (why == SP_DRAGON_DETAIL && !flourish) out->detail = dragon_detail_keep(d, &hit, pts, n);
         dragon_detail_hit_free(&hit);
         free(pts);
         offer_kin(d, &a, out);
@@ -869,16 +885,19 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
     }
     if (!o.category && d->clf && kiosk_refuses(pts, n, near, best.score, !best.t->is_torso && !best.t->family[0])) {
+        bool flourish = kept_as_flourish(d, &o, pts, n, lo, hi, out);
         free(pts);
         free(best.p);
-        return reject(out, SP_DRAGON_UNRECOGNISED, t0);
+        return reject(out, flourish ? SP_DRAGON_DETAIL : SP_DRAGON_UNRECOGNISED, t0);
     }
     prefer_line(d, &sk, lo, hi, &best);
     part* q = NULL;
     sp_result r = new_part(d, best.t, best.p, &best.rep, &best.view, best.mirrored, pts, n, confidence, &q, err);
     free(best.p);
-    free(pts);
-    if (r != SP_OK) return r;
+    if (r != SP_OK) {
+        free(pts);
+        return r;
+    }
     q->chosen = o.category != NULL;
     if (o.replace_last && d->part_n > 0) {
         give_back_fits(d, d->parts[d->part_n - 1]->pub.id);
@@ -891,6 +910,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
             part** np = realloc(d->parts, sizeof(part*) * (size_t)cap2);
             if (!np) {
                 dragon_part_free(q);
+                free(pts);
                 return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
             }
             d->parts = np, d->part_cap = cap2;
@@ -898,6 +918,23 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         d->parts[d->part_n++] = q;
     }
     dragon_relayout(d);
+    // A part that would float free, drawn out of a part of the dragon away
+    // from its body, is a flourish of that part (fire from the mouth taken
+    // for tails, a flame for a head, a puff of smoke for a body): kept as
+    // ink on it instead, its guesses offered as a detail's.
+    if (q->pub.attached_to < 0 && !o.category && d->clf && !o.replace_last && !dragon_claims_socket(d, q->t, lo, hi)) {
+        // Tested without the part (a body may have taken parts to itself).
+        --d->part_n;
+        dragon_relayout(d);
+        if (kept_as_flourish(d, &o, pts, n, lo, hi, out)) {
+            dragon_part_free(q);
+            free(pts);
+            return reject(out, SP_DRAGON_DETAIL, t0);
+        }
+        d->parts[d->part_n++] = q;
+        dragon_relayout(d);
+    }
+    free(pts);
     if (q->t->is_torso) parts_meet_body(d);
     if (!o.category && d->clf) {
         r = take_family_member(d, out, err);

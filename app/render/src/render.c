@@ -624,7 +624,9 @@ void sp_renderer_draw_curve3d_facing(sp_renderer* r, const double* xyz, const do
         for (; j < n; ++j) {
             sp_vec3 p = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
             sp_vec3 dir = sp_camera_view_dir(&r->cam, p);
-            if (!(sp_v3_dot(dir, (sp_vec3){normal[3 * j], normal[3 * j + 1], normal[3 * j + 2]}) < 0)) break;
+            sp_vec3 nrm = {normal[3 * j], normal[3 * j + 1], normal[3 * j + 2]};
+            bool air = nrm.x == 0 && nrm.y == 0 && nrm.z == 0; // no surface under it: seen from every side
+            if (!air && !(sp_v3_dot(dir, nrm) < 0)) break;
             sp_vec3 c = sp_mat4_point(&r->cam.view, p);
             double per_px = r->cam.kind == SP_CAMERA_ORTHOGRAPHIC ? 1.0 / r->cam.scale : fabs(c.z) / r->cam.scale;
             sp_vec3 q = sp_v3_sub(p, sp_v3_scale(dir, lift_px * per_px));

@@ -224,22 +224,25 @@ bool sp_dragon_undo(sp_dragon* d);
 /// Removes every part and detail.
 void sp_dragon_clear(sp_dragon* d);
 
-/// Details: a stroke refused as SP_DRAGON_DETAIL (an eye, spots, scales) is
+/// Details: a stroke refused as SP_DRAGON_DETAIL (an eye, spots, scales on
+/// a part; fire from a mouth, a spade at a tail's tip drawn out of one) is
 /// kept as ink on its part, at most SP_DRAGON_MAX_DETAILS of them. Each point
 /// is bound to the part's mesh where the visitor drew it (the front-most
 /// triangle under it at the fit as shown, barycentric; a point just off the
-/// mesh to the nearest triangle near it), so the ink rides the part's
-/// animation. A detail lives as long as its part: a Redraw or chip that
-/// replaces the part drops it; while a later part has the part fitted as
-/// another template or facing (legs made the other legs, a part turned) it
-/// is not shown. The export writes each detail shown as a line on its part's skin.
+/// mesh to the nearest triangle near it); a flourish's points off the mesh
+/// are carried in the air by the part's skin where the stroke leaves it. So
+/// the ink rides the part's animation. A detail lives as long as its part:
+/// a Redraw or chip that replaces the part drops it; while a later part has
+/// the part fitted as another template or facing (legs made the other legs,
+/// a part turned) it is not shown. The export writes each detail shown as a
+/// line on its part's skin.
 enum { SP_DRAGON_MAX_DETAILS = 256, SP_DRAGON_DETAIL_POINTS = 128 };
 typedef struct sp_dragon_detail {
     uint64_t id;          ///< unique for the dragon's lifetime, from the same counter as parts' (later = larger)
     int part;             ///< index of the part it is drawn on
     int point_count;      ///< points bound (2..SP_DRAGON_DETAIL_POINTS)
     const double* xyz;    ///< at the last pose_at: world, point_count by 3; NULL when not posed or not shown
-    const double* normal; ///< at the last pose_at: the surface's unit normal under each point, on the side it was drawn on
+    const double* normal; ///< at the last pose_at: unit surface normal under each point, to the side drawn on; 0 in the air
 } sp_dragon_detail;
 /// Number of details, oldest first.
 int sp_dragon_detail_count(const sp_dragon* d);

@@ -155,8 +155,8 @@ void sp_renderer_draw_dots(sp_renderer* r, const sp_vec2* px, int n, float radiu
 /// A 3D polyline (n by 3, world) projected with the frame's camera.
 void sp_renderer_draw_curve3d(sp_renderer* r, const double* xyz, int n, bool closed, float width, const float rgba[4]);
 /// Ink on a surface: the runs of consecutive points whose normal (n by 3,
-/// world) points towards the camera, depth-tested against the meshes drawn
-/// before it, the points lifted towards the camera by 1.5 widths (at least
+/// world) points towards the camera (a zero normal, ink in the air, faces
+/// every way), depth-tested against the meshes drawn before it, the points lifted towards the camera by 1.5 widths (at least
 /// 4 px) so that the ink does not sink into its own curved surface.
 void sp_renderer_draw_curve3d_facing(sp_renderer* r, const double* xyz, const double* normal, int n, float width,
                                      const float rgba[4]);
