@@ -140,14 +140,47 @@ static bool canvas_to_world(const sp_camera* cam, sp_vec3 A, sp_vec2 p, sp_vec3*
     return isfinite(out->x) && isfinite(out->y) && isfinite(out->z);
 }
 
+// The vertex whose canvas point (px, n of them) lies nearest p, the one
+// nearest the viewer (+z, xyz: world) among those within half a pixel of
+// that; -1 when none is finite.
+static int vertex_at(const sp_vec2* px, const double* xyz, int n, sp_vec2 p)
+{
+    double best = INFINITY;
+    for (int v = 0; v < n; ++v) {
+        double dx = px[v].x - p.x, dy = px[v].y - p.y;
+        best = fmin(best, dx * dx + dy * dy);
+    }
+    int front = -1;
+    double r = sqrt(best) + 0.5;
+    for (int v = 0; isfinite(best) && v < n; ++v) {
+        double dx = px[v].x - p.x, dy = px[v].y - p.y;
+        if (dx * dx + dy * dy <= r * r && (front < 0 || xyz[3 * v + 2] > xyz[3 * front + 2])) front = v;
+    }
+    return front;
+}
+
+// Canvas point p in the rig's rest space (*rest), carried from world point
+// A of part q's mesh at its fit, which the c joints (with weights w) skin:
+// placed in the world at A's depth, then taken back by the inverse of
+// their blended skin at the fit (q->t->ev evaluated there). False when
+// nothing carries it.
+static bool carry(const sp_dragon* d, const part* q, sp_vec3 A, const int* joints, const double* w, int c, sp_vec2 p,
+                  sp_vec3* rest)
+{
+    sp_mat4 fit = dragon_blended_skin(joints, w, c, sp_rig_eval_skin(q->t->ev), &q->world_fit), inv;
+    sp_vec3 W;
+    if (c <= 0 || !sp_mat4_inverse(&fit, &inv) || !canvas_to_world(&d->world, A, p, &W)) return false;
+    *rest = sp_mat4_point(&inv, W);
+    return true;
+}
+
 // Binds the points to a mesh as shown (hit: the part's mesh in the world
 // and on the canvas): each to the front-most triangle under it (nearest the
 // viewer, +z), or, off the mesh, to the nearest point of a triangle within
 // `near` pixels (not beyond it: a triangle seen edge-on on the canvas would
-// fling an extrapolated point far in depth). A flourish's other points go
-// in the air (flip 0), at the depth of the mesh's point nearest their
-// middle, carried by the joints that skin that point. Returns how many were
-// bound (kept in order).
+// fling an extrapolated point far in depth). A flourish's or an edge's
+// other points go in the air (flip 0), carried as hit->air says. Returns
+// how many were bound (kept in order).
 static int bind_points(const sp_dragon* d, const part* q, const detail_hit* hit, const sp_vec2* pts, int m, detail* e)
 {
     const sp_rig* rig = &q->t->ch.rig;
@@ -185,36 +218,40 @@ static int bind_points(const sp_dragon* d, const part* q, const detail_hit* hit,
             }
         }
     }
-    // The points in the air, carried from the mesh's point nearest their
-    // middle: placed in the world at its depth, then in the rig's rest space
-    // by the inverse of its blended skin at the part's fit.
+    // A flourish's points in the air are carried together from the mesh's
+    // point nearest their middle, so the stroke keeps its shape; an edge's
+    // each from the vertex nearest it, so it follows the body's bends.
     sp_vec2 mid = {0, 0};
     int air = 0;
     for (int i = 0; i < m; ++i)
         if (face[i] < 0) mid = sp_v2_add(mid, pts[i]), ++air;
     sp_vec3 A = {0, 0, 0};
-    sp_mat4 to_rest = sp_mat4_identity();
-    double w[3];
-    int af = hit->air && air > 0 ? mesh_point_at(rig, xyz, px, sp_v2_scale(mid, 1.0 / air), w) : -1;
-    e->carrier_n = 0;
-    if (af >= 0) {
-        const uint32_t* tr = rig->triangles + 3 * (size_t)af;
-        for (int j = 0; j < 3; ++j)
-            A = sp_v3_add(A, sp_v3_scale(vertex(xyz, tr[j]), w[j]));
-        e->carrier_n = blend_influences(rig, tr, w, e->carrier_joint, e->carrier_w);
-        sp_rig_eval_update(q->t->ev, q->p_fit, false);
-        sp_mat4 fit =
-            dragon_blended_skin(e->carrier_joint, e->carrier_w, e->carrier_n, sp_rig_eval_skin(q->t->ev), &q->world_fit);
-        if (e->carrier_n == 0 || !sp_mat4_inverse(&fit, &to_rest)) af = -1; // nothing carries them: left out
+    int cj[4] = {0}, cn = 0;
+    double cw[4] = {0}, aw[3];
+    if (hit->air == DETAIL_AIR_TOGETHER && air > 0) {
+        int af = mesh_point_at(rig, xyz, px, sp_v2_scale(mid, 1.0 / air), aw);
+        const uint32_t* tr = af >= 0 ? rig->triangles + 3 * (size_t)af : NULL;
+        for (int j = 0; tr && j < 3; ++j)
+            A = sp_v3_add(A, sp_v3_scale(vertex(xyz, tr[j]), aw[j]));
+        cn = tr ? blend_influences(rig, tr, aw, cj, cw) : 0;
     }
+    if (hit->air && air > 0) sp_rig_eval_update(q->t->ev, q->p_fit, false); // the skin at the fit, for carry()
     int k = 0;
     for (int i = 0; i < m; ++i) {
-        if (face[i] < 0) { // off the mesh and not near it
-            sp_vec3 W;
-            if (af < 0 || !canvas_to_world(&d->world, A, pts[i], &W)) continue; // not a flourish's: left out of the ink
-            sp_vec3 r = sp_mat4_point(&to_rest, W);
+        if (face[i] < 0) { // off the mesh and not near it: in the air, or left out of the ink
+            if (hit->air == DETAIL_AIR_EACH) {
+                int v = vertex_at(px, xyz, rig->vertex_count, pts[i]);
+                if (v < 0) continue;
+                A = vertex(xyz, (uint32_t)v);
+                cn = blend_influences(rig, (const uint32_t[3]){(uint32_t)v, (uint32_t)v, (uint32_t)v}, (const double[3]){1, 0, 0},
+                                      cj, cw);
+            }
+            sp_vec3 r;
+            if (!hit->air || !carry(d, q, A, cj, cw, cn, pts[i], &r)) continue;
             memset(e->tri + 3 * k, 0, sizeof(uint32_t) * 3);
             memcpy(e->bary + 3 * k, &(double[3]){r.x, r.y, r.z}, sizeof(double) * 3);
+            for (int f = 0; f < 4; ++f)
+                e->joint[4 * k + f] = f < cn ? (uint32_t)cj[f] : 0, e->weight[4 * k + f] = f < cn ? cw[f] : 0;
             e->drawn[k] = pts[i];
             e->flip[k++] = 0;
             continue;
@@ -247,16 +284,18 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     detail* e = calloc(1, sizeof *e);
     sp_vec2* rs = m < n ? malloc(sizeof(sp_vec2) * (size_t)m) : NULL;
     size_t mm = (size_t)m;
-    // One block: tri (3m uint32), then bary (3m), flip (m), xyz (3m), normal (3m), drawn (2m) doubles.
-    uint32_t* block = malloc(sizeof(uint32_t) * 4 * mm + sizeof(double) * 12 * mm);
+    // One block: tri (3m uint32, m spare), joint (4m uint32), then bary
+    // (3m), flip (m), xyz (3m), normal (3m), drawn (2m), weight (4m) doubles.
+    uint32_t* block = malloc(sizeof(uint32_t) * 8 * mm + sizeof(double) * 16 * mm);
     if (!e || (m < n && !rs) || !block || (rs && sp_curve_resample(pts, n, false, m, rs) != SP_OK)) {
         free(e), free(rs), free(block);
         return -1;
     }
-    e->tri = block;
-    e->bary = (double*)(void*)(block + 4 * mm); // 4m uint32s keep the doubles aligned
+    e->tri = block, e->joint = block + 4 * mm;
+    e->bary = (double*)(void*)(block + 8 * mm); // 8m uint32s keep the doubles aligned
     e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
     e->drawn = (sp_vec2*)(void*)(e->normal + 3 * mm);
+    e->weight = (double*)(void*)(e->drawn + mm);
     // On the mesh the detail test found it on, within the same tolerance.
     e->n = bind_points(d, q, hit, rs ? rs : pts, m, e);
     free(rs);
@@ -304,12 +343,11 @@ void dragon_details_pose(sp_dragon* d)
         int k;
         const part* q = host_of(d, e, &k);
         e->shown = q && q->t == e->t && q->pub.mirrored == e->mirrored;
-        sp_mat4 carried = e->shown && e->carrier_n > 0 ? dragon_blended_skin(e->carrier_joint, e->carrier_w, e->carrier_n,
-                                                                             sp_rig_eval_skin(q->ev), &q->world_t)
-                                                       : sp_mat4_identity();
         for (int j = 0; e->shown && j < e->n; ++j) {
-            if (e->flip[j] == 0) { // in the air: no surface under it, so no normal
-                sp_vec3 r = sp_mat4_point(&carried, (sp_vec3){e->bary[3 * j], e->bary[3 * j + 1], e->bary[3 * j + 2]});
+            if (e->flip[j] == 0) { // in the air: its joints carry it; no surface under it, so no normal
+                int jn[4] = {(int)e->joint[4 * j], (int)e->joint[4 * j + 1], (int)e->joint[4 * j + 2], (int)e->joint[4 * j + 3]};
+                sp_mat4 m = dragon_blended_skin(jn, e->weight + 4 * j, 4, sp_rig_eval_skin(q->ev), &q->world_t);
+                sp_vec3 r = sp_mat4_point(&m, (sp_vec3){e->bary[3 * j], e->bary[3 * j + 1], e->bary[3 * j + 2]});
                 memcpy(e->xyz + 3 * j, &(double[3]){r.x, r.y, r.z}, sizeof(double) * 3);
                 memset(e->normal + 3 * j, 0, sizeof(double) * 3);
                 continue;
@@ -338,10 +376,11 @@ int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joi
         const double* b = e->bary + 3 * j;
         int jn[4];
         double w[4];
-        int c = e->carrier_n;
-        if (e->flip[j] == 0) { // in the air: its rest position, carried by the detail's joints
+        int c = 4;
+        if (e->flip[j] == 0) { // in the air: its rest position and the joints that carry it
             memcpy(rest + 3 * j, b, sizeof(double) * 3);
-            memcpy(jn, e->carrier_joint, sizeof jn), memcpy(w, e->carrier_w, sizeof w);
+            for (int f = 0; f < 4; ++f)
+                jn[f] = (int)e->joint[4 * j + f], w[f] = e->weight[4 * j + f];
         } else {
             for (int a = 0; a < 3; ++a)
                 rest[3 * j + a] = b[0] * rig->rest[3 * (size_t)tr[0] + (size_t)a] +

@@ -130,15 +130,14 @@ typedef struct detail {
     int n;
     uint32_t* tri; // n by 3 (one block with the arrays below)
     // n by 3: barycentric, or for a point in the air its position in the
-    // rig's rest space (what its carrier's blended skin matrix poses).
+    // rig's rest space (what its joints' blended skin matrix poses).
     double* bary;
     double* flip;         // n: +1 or -1, the triangle's winding towards the side drawn on; 0: in the air
+    uint32_t* joint;      // n by 4: a point in the air's joints and their weights (0 for none)
+    double* weight;
     double *xyz, *normal; // posed at the last pose_at, n by 3
     sp_vec2* drawn;       // n: where each point was drawn on the canvas
-    int carrier_n;        // the joints that carry the points in the air (at most four), and their weights
-    int carrier_joint[4];
-    double carrier_w[4];
-    bool shown; // posed and its part as bound
+    bool shown;           // posed and its part as bound
 } detail;
 
 struct sp_dragon {
@@ -216,16 +215,21 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
 /// The same test against part k only (false when k is not a body).
 bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
+/// What becomes of a detail's points off its part's mesh: left out (a
+/// detail drawn on the part), carried in the air together from the mesh's
+/// point nearest their middle (a flourish: it keeps its shape), or each from
+/// the mesh vertex nearest it (an edge: it follows the body's bends).
+typedef enum detail_air { DETAIL_AIR_NONE, DETAIL_AIR_TOGETHER, DETAIL_AIR_EACH } detail_air;
 /// Where a stroke lies on the part it is a detail of: the part, its mesh at
 /// its fit as shown (world and canvas, vertex_count each, malloc'd), how
-/// near that mesh a point counts as on it (pixels), and whether it is a
-/// flourish (its points off the mesh are kept, in the air).
+/// near that mesh a point counts as on it (pixels), and what becomes of
+/// the points off it.
 typedef struct detail_hit {
     int part;
     double* xyz;
     sp_vec2* px;
     double near;
-    bool air;
+    detail_air air;
 } detail_hit;
 /// The part that a stroke (pts: n canvas points, box [lo, hi]) is a detail
 /// of, or -1: the part drawn last whose projected mesh at its fit (as
@@ -243,6 +247,15 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
 /// stroke nearer it than any body and a share of them off its mesh. Part
 /// `skip` (or -1) does not count. hit as for dragon_detail_of, with air set.
 int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
+/// The body that a stroke (an open line, not a loop) is drawn along the
+/// back of, or -1 (spikes, a mane: docs/DESIGN.md, "Spikes along the
+/// back"): every point of the
+/// stroke on the body's projected mesh at its fit or, beside its upper
+/// half, within 6% of the body's size of it, 30% of them off it, the stroke 0.25 to 0.75 of the
+/// body's size. Part `skip` (or -1) does not count. hit as for
+/// dragon_detail_of, its points off the mesh each carried from the vertex
+/// nearest it.
+int dragon_edge_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
 void dragon_detail_hit_free(detail_hit* hit);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);

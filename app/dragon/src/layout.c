@@ -669,13 +669,71 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         if (flourish && nearest <= touch && out >= FLOURISH_OUT * m) {
             if (hit) {
                 // Only points on the mesh are bound to it; the rest ride it in the air.
-                *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = 0.71, .air = true};
+                *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = 0.71, .air = DETAIL_AIR_TOGETHER};
                 return k;
             }
             free(xyz), free(px);
             return k;
         }
         free(xyz), free(px);
+    }
+    return -1;
+}
+
+// A stroke along a body's back (spikes, a mane) lies within this fraction
+// of the body's size on the canvas (its box's diagonal) of the body's mesh
+// everywhere, off it only beside its upper half: the parts visitors draw
+// at a body reach farther out of it, legs downwards (BENCHMARKS.md,
+// "Nineteenth pass").
+#define EDGE_BAND 0.06
+// At least this share of its points lie off the mesh (by more than
+// EDGE_OFF of the body's size: the vertices inside it are a few pixels
+// apart); mostly on it, it is drawn on the body (a detail or a part).
+#define EDGE_OUT 0.3
+#define EDGE_OFF 0.01
+// It runs along the body for at least this fraction of the body's size
+// (box diagonals): a small part drawn flat on the back is compact (the
+// on-body bench's wings at 0.3 of their size, 78 px against a body of 500).
+#define EDGE_MIN 0.25
+
+int dragon_edge_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+{
+    // A line along the back, not a loop: a closed shape on the body's edge is a part drawn there.
+    if (n < 2 || sp_stroke_is_loop(&(sp_stroke){.count = n, .points = (sp_vec2*)pts})) return -1;
+    double diag = hypot(hi.x - lo.x, hi.y - lo.y);
+    int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES;
+    for (int k = d->part_n - 1; k >= 0; --k) { // the body drawn last lies on top
+        part* q = d->parts[k];
+        sp_vec2 a, b;
+        if (k == skip || !q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) continue;
+        int nv = q->t->ch.rig.vertex_count;
+        double bd = hypot(b.x - a.x, b.y - a.y), band = EDGE_BAND * bd;
+        if (!(diag <= ON_BODY_SIZE * bd && diag >= EDGE_MIN * bd) ||
+            !boxes_overlap(lo, hi, (sp_vec2){a.x - band, a.y - band}, (sp_vec2){b.x + band, b.y + band}))
+            continue;
+        bool along = true;
+        int out = 0;
+        for (int s = 0; along && s < m; ++s) {
+            sp_vec2 x = pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)];
+            double dist = vertex_nearest(q->body_px, nv, x, INFINITY);
+            bool off = dist > EDGE_OFF * bd;
+            // Off the mesh only on the body's upper half, its back: legs drawn short under a body reach down.
+            along = dist <= band && (!off || x.y < 0.5 * (a.y + b.y));
+            out += off;
+        }
+        if (!along || out < EDGE_OUT * m) continue;
+        if (hit) { // the body's mesh at its fit (a body is shown where it was fitted), the hit's own copy
+            double* xyz = malloc(sizeof(double) * 3 * (size_t)nv);
+            sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)nv);
+            if (!xyz || !px) {
+                free(xyz), free(px);
+                return -1; // out of memory: not an edge, the stroke goes on as a part
+            }
+            memcpy(xyz, q->body_xyz, sizeof(double) * 3 * (size_t)nv);
+            memcpy(px, q->body_px, sizeof(sp_vec2) * (size_t)nv);
+            *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = 0.71, .air = DETAIL_AIR_EACH};
+        }
+        return k;
     }
     return -1;
 }
