@@ -653,8 +653,8 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         int out = 0;
         // Every point nearer the part than any body: out of the part, not
         // reaching for the body (a part drawn there would attach to it).
-        // Distances to the meshes' projected vertices: their triangles are
-        // a few pixels across, and this is some fifty times faster.
+        // Distances to the meshes' projected vertices, not their triangles:
+        // those are a few pixels across, and a head has some 30,000.
         for (int s = 0; flourish && s < m; ++s) {
             sp_vec2 x = pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)];
             double dm = vertex_nearest(px, nv, x, INFINITY), dp = fmin(dm, dragon_ink_distance(d, q->pub.id, x));

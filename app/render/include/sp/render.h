@@ -156,8 +156,9 @@ void sp_renderer_draw_dots(sp_renderer* r, const sp_vec2* px, int n, float radiu
 void sp_renderer_draw_curve3d(sp_renderer* r, const double* xyz, int n, bool closed, float width, const float rgba[4]);
 /// Ink on a surface: the runs of consecutive points whose normal (n by 3,
 /// world) points towards the camera (a zero normal, ink in the air, faces
-/// every way), depth-tested against the meshes drawn before it, the points lifted towards the camera by 1.5 widths (at least
-/// 4 px) so that the ink does not sink into its own curved surface.
+/// every way), depth-tested against the meshes drawn before it, the points
+/// lifted towards the camera by 1.5 widths (at least 4 px) so that the ink
+/// does not sink into its own curved surface.
 void sp_renderer_draw_curve3d_facing(sp_renderer* r, const double* xyz, const double* normal, int n, float width,
                                      const float rgba[4]);
 /// Every curve of an abstraction; xyz are its points in world space
