@@ -925,16 +925,18 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // for tails, a flame for a head, a puff of smoke for a body): kept as
     // ink on it instead, its guesses offered as a detail's.
     if (q->pub.attached_to < 0 && !o.category && d->clf && !o.replace_last && !dragon_claims_socket(d, q->t, lo, hi)) {
-        // Tested without the part (a body may have taken parts to itself).
+        // Tested without the part; only a body changes the others' layout
+        // (it may have taken parts to itself), so only a body is laid out again.
         --d->part_n;
-        dragon_relayout(d);
+        if (q->t->is_torso) dragon_relayout(d);
         if (kept_as_flourish(d, &o, pts, n, lo, hi, out)) {
             dragon_part_free(q);
             free(pts);
+            dragon_relayout(d); // the loop's period without it
             return reject(out, SP_DRAGON_DETAIL, t0);
         }
         d->parts[d->part_n++] = q;
-        dragon_relayout(d);
+        if (q->t->is_torso) dragon_relayout(d);
     }
     free(pts);
     if (q->t->is_torso) parts_meet_body(d);
