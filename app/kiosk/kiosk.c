@@ -462,7 +462,9 @@ static int stroke_guesses(const sp_kiosk* k, const sp_dragon_result* res, const 
 static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const char* tried)
 {
     ++k->stats.rejected;
-    sp_kiosk_fit_result r = {.ok = false, .refusal = rc == SP_OK ? refusal_of(res->reason) : SP_KREF_UNRECOGNISED};
+    sp_kiosk_fit_result r = {.ok = false,
+                             .refusal = rc == SP_OK ? refusal_of(res->reason) : SP_KREF_UNRECOGNISED,
+                             .part_count = sp_dragon_part_count(k->dragon)};
     r.kept = rc == SP_OK && res->reason == SP_DRAGON_DETAIL && res->detail >= 0;
     r.offer = rc == SP_OK && (res->reason == SP_DRAGON_UNRECOGNISED || res->reason == SP_DRAGON_NO_MODEL ||
                               res->reason == SP_DRAGON_FIT_FAILED || res->reason == SP_DRAGON_DETAIL);
@@ -553,7 +555,7 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     if (s->count > k->scratch_cap) {
         sp_vec2* p = realloc(k->scratch, sizeof *p * (size_t)s->count);
         if (!p) {
-            sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = false});
+            sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = false, .part_count = sp_dragon_part_count(k->dragon)});
             return;
         }
         k->scratch = p, k->scratch_cap = s->count;
@@ -564,6 +566,8 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     memset(&res, 0, sizeof res);
     sp_error err = {0};
     double t0 = sp_now_ms();
+    // The stroke continues the last one: what its first piece made goes first (the UI's join).
+    if (j->undo_first && sp_dragon_undo(k->dragon)) ++k->rev;
     sp_result rc = sp_dragon_add_points(
         k->dragon, k->scratch, s->count,
         &(sp_dragon_stroke_opts){.category = forced, .replace_last = j->replace, .replace_detail = j->replace_detail}, &res,

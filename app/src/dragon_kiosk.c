@@ -91,13 +91,17 @@ static double measure_ppm(GLFWwindow* win, int fb_w)
 
 static void push_event(app* a, const sp_kiosk_event* ev)
 {
-    int before = sp_kiosk_ui_of(a->k)->strokes_finished;
+    const sp_kiosk_ui* ui = sp_kiosk_ui_of(a->k);
+    int before = ui->strokes_finished, merged = ui->merged;
     sp_kiosk_input(a->k, ev);
     if (a->recording && ev->type != SP_KEV_FRAME && sp_kiosk_session_append(&a->rec, ev) != SP_OK) {
         fprintf(stderr, "%s: recording full or out of memory; recording stops here\n", k_cmd);
         a->recording = false;
     }
-    if (sp_kiosk_ui_of(a->k)->strokes_finished > before) {
+    if (ui->merged > merged && a->up_count > 0) {
+        // Drawn on before its first piece was fitted: one stroke, timed from its last pen-up.
+        a->up_wall[(a->up_head + a->up_count - 1) % 8] = sp_now_ms();
+    } else if (ui->strokes_finished > before) {
         a->up_wall[(a->up_head + a->up_count) % 8] = sp_now_ms();
         if (a->up_count < 8)
             ++a->up_count;
@@ -252,7 +256,8 @@ static void print_stats(const app* a, double start_ms)
     int stored = 0, dropped = 0;
     sp_kiosk_collect_counts(a->k, &stored, &dropped);
     printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d,\n", st->collected, stored, dropped);
-    printf(" \"others\": %d, \"others_chosen\": %d,\n", ui->others, ui->others_chosen);
+    printf(" \"others\": %d, \"others_chosen\": %d, \"joined\": %d, \"merged\": %d,\n", ui->others, ui->others_chosen, ui->joined,
+           ui->merged);
     // What a visitor reads on screen now (JSON-escaped).
     cJSON* hint = cJSON_CreateString(sp_kiosk_ui_hint_visible(ui) ? ui->hint : "");
     char* hint_text = hint ? cJSON_PrintUnformatted(hint) : NULL;
@@ -339,7 +344,7 @@ int main(int argc, char** argv)
                *size = NULL;
     const char* font = NULL;
     bool fullscreen = false, stats = false, no_collect = false;
-    double idle_s = 0;
+    double idle_s = 0, join_ms = 0;
     int lod = 0, msaa = -1, max_parts = 0;
     sp_opt opts[] = {
         {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)",
@@ -354,6 +359,8 @@ int main(int argc, char** argv)
         {"--export-dir", SP_OPT_STRING, &export_dir, "DIR", "where Save writes (default: dragon-exports)", false},
         {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen (default 90; < 0: never)",
          false},
+        {"--join-ms", SP_OPT_DOUBLE, &join_ms, "MS",
+         "a stroke begun this soon after the last one's pen-up, where it ended, continues it (default 200; < 0: never)", false},
         {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
         {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling (default: 4 on a GPU, 0 on software GL)", false},
         {"--lod", SP_OPT_INT, &lod, "N", "display triangles per part (default: 4000 on software GL, all on a GPU; -1: all)",
@@ -435,7 +442,8 @@ int main(int argc, char** argv)
                         .canvas_h = a.fb_h,
                         .ui = {.idle_ms = idle_s > 0   ? idle_s * 1000.0
                                           : idle_s < 0 ? -1
-                                                       : 0},
+                                                       : 0,
+                               .join_ms = join_ms},
                         .code_seed = script ? 1 : (uint64_t)time(NULL),
                         .lod_triangles = lod,
                         .max_parts = max_parts,

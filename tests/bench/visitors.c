@@ -1,6 +1,6 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
 //   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all]
-//            [--on-body [--gap PX] [--part-scale F]] [--json]
+//            [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
 // defaults to the whole set the build makes from designs.json and the Quick,
@@ -32,6 +32,15 @@
 // --gap PX drawn that far apart instead (their box PX beyond the body's).
 // --part-scale F draws the legs, heads, tails and wings F times their size
 // (a visitor's small parts on a large body; the body stays 500 px).
+// --pieces F [--pause MS] instead draws every part drawing through the
+// kiosk's UI (sp_kiosk_ui, 1280 x 800 at 96 dpi, a point every 8 ms) in two
+// pieces, as a finger that left the glass: broken at F of its points, the
+// second piece drawn from where the first ended, MS ms after its pen-up
+// (default 120); the UI's FIT jobs run on the pipeline as the kiosk runs
+// them (a drawing reaching under the toolbar moved the least that brings it
+// onto the canvas). F >= 1 draws it whole through the UI. Printed: the drawings that
+// ended as one part, the right one; the right part among others; only wrong
+// parts; nothing.
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>
@@ -43,6 +52,7 @@
 #include "bench.h"
 #include "sp/clock.h"
 #include "sp/dragon.h"
+#include "sp/kiosk_ui.h"
 #include "sp/partdb.h"
 #include "sp/sketch_io.h"
 #include "sp/sketch_sheet.h"
@@ -333,12 +343,123 @@ static int find(char** names, int n, const char* s)
     return -1;
 }
 
+// The database built in a temporary folder (no --db), removed.
+static void remove_tmp_db(const char* dir, const char* db)
+{
+    if (!db[0]) return;
+    char path[256];
+    snprintf(path, sizeof path, "%s-wal", db);
+    unlink(path);
+    snprintf(path, sizeof path, "%s-shm", db);
+    unlink(path);
+    unlink(db);
+    rmdir(dir);
+}
+
+// Runs the UI's queued jobs on the pipeline as the kiosk does (run_fit):
+// a FIT that continues the last stroke takes back what that made first.
+static void run_ui_jobs(sp_kiosk_ui* ui, sp_dragon* d)
+{
+    sp_kiosk_job j;
+    static sp_vec2 xy[SP_KIOSK_STROKE_MAX];
+    while (sp_kiosk_ui_next_job(ui, &j)) {
+        if (j.kind != SP_KJOB_FIT) continue;
+        for (int i = 0; i < j.stroke->count; ++i)
+            xy[i] = (sp_vec2){j.stroke->xy[2 * i], j.stroke->xy[2 * i + 1]};
+        if (j.undo_first) sp_dragon_undo(d);
+        sp_dragon_result res;
+        sp_error err = {0};
+        sp_result r = sp_dragon_add_points(d, xy, j.stroke->count,
+                                           &(sp_dragon_stroke_opts){.category = j.category[0] ? j.category : NULL,
+                                                                    .replace_last = j.replace,
+                                                                    .replace_detail = j.replace_detail},
+                                           &res, &err);
+        bool ok = r == SP_OK && !res.rejected && res.part >= 0;
+        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = ok,
+                                                        .kept = r == SP_OK && res.reason == SP_DRAGON_DETAIL && res.detail >= 0,
+                                                        .category = ok ? sp_dragon_part_get(d, res.part)->category : NULL,
+                                                        .part_count = sp_dragon_part_count(d)});
+    }
+}
+
+// Points i0..i1 of s moved by `by`, as a finger's down, moves and up from time t; returns the pen-up time.
+static double finger(sp_kiosk_ui* ui, const sp_stroke* s, sp_vec2 by, int i0, int i1, double t)
+{
+    for (int i = i0; i <= i1; ++i, t += 8) {
+        sp_kiosk_event_type ty = i == i0 ? SP_KEV_DOWN : i == i1 ? SP_KEV_UP : SP_KEV_MOVE;
+        sp_kiosk_ui_event(ui, &(sp_kiosk_event){ty, t, (float)(s->points[i].x + by.x), (float)(s->points[i].y + by.y), 0});
+    }
+    return t - 8;
+}
+
+// The least move that brings the stroke's box into the UI's canvas (the
+// window without the toolbar): a visitor draws where the canvas is.
+static sp_vec2 onto_canvas(const sp_kiosk_ui* ui, const sp_stroke* s)
+{
+    sp_vec2 lo, hi, by = {0, 0};
+    stroke_box(s, &lo, &hi);
+    const sp_kiosk_rect* c = &ui->canvas;
+    double m = 2, x1 = c->x + c->w - m, y1 = c->y + c->h - m;
+    if (hi.x > x1) by.x = x1 - hi.x;
+    if (lo.x + by.x < c->x + m) by.x = c->x + m - lo.x;
+    if (hi.y > y1) by.y = y1 - hi.y;
+    if (lo.y + by.y < c->y + m) by.y = c->y + m - lo.y;
+    return by;
+}
+
+// --pieces: each part drawing in two pieces through the UI (see the top).
+static void in_pieces(sp_dragon* d, const sp_dataset* ds, double frac, double pause, bool json, const char* half)
+{
+    int none = find(ds->categories, ds->category_count, NOT_A_PART);
+    int n = 0, one_right = 0, among = 0, wrong = 0, nothing = 0, joined = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        if (ds->samples[i].label == none) continue;
+        const char* label = ds->categories[ds->samples[i].label];
+        const sp_stroke* s = &ds->samples[i].sketch.strokes[0];
+        if (s->count < 4) continue;
+        sp_kiosk_ui* ui = NULL;
+        if (sp_kiosk_ui_create(NULL, &ui, NULL) != SP_OK) return;
+        sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+        // A tap leaves the attract screen.
+        sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_DOWN, 0, 640, 400, 0});
+        sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_UP, 50, 640, 400, 0});
+        int k = frac >= 1 ? s->count - 1 : (int)(frac * (s->count - 1));
+        k = k < 1 ? 1 : k;
+        sp_vec2 by = onto_canvas(ui, s);
+        double up = finger(ui, s, by, 0, k, 1000);
+        run_ui_jobs(ui, d);
+        if (k < s->count - 1) {
+            finger(ui, s, by, k, s->count - 1, up + pause);
+            run_ui_jobs(ui, d);
+        }
+        int parts = sp_dragon_part_count(d), right = 0;
+        for (int p = 0; p < parts; ++p)
+            right += !strcmp(sp_dragon_part_get(d, p)->category, label);
+        ++n;
+        one_right += parts == 1 && right == 1;
+        among += right > 0 && parts > 1;
+        wrong += parts > 0 && right == 0;
+        nothing += parts == 0;
+        joined += ui->joined;
+        sp_kiosk_ui_destroy(ui);
+        sp_dragon_clear(d);
+    }
+    if (json)
+        printf("[\n  {\"case\": \"%s parts in two pieces\", \"frac\": %g, \"pause_ms\": %g, \"n\": %d, \"one_right\": %d, "
+               "\"right_among_others\": %d, \"wrong\": %d, \"nothing\": %d, \"joined\": %d}\n]\n",
+               half, frac, pause, n, one_right, among, wrong, nothing, joined);
+    else
+        printf("%s half, %d part drawings %s: one part, the right one %d; the right part among others %d; only wrong parts "
+               "%d; nothing %d (pieces joined: %d)\n",
+               half, n, frac >= 1 ? "drawn whole through the UI" : "in two pieces", one_right, among, wrong, nothing, joined);
+}
+
 int main(int argc, char** argv)
 {
     const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_BINARY_DIR "/tests/data/visitors",
                *sheet = NULL;
     bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false, on_body = false;
-    double gap = 0;
+    double gap = 0, pieces = 0, pause = 120;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--half") && i + 1 < argc)
             half = argv[++i];
@@ -360,9 +481,13 @@ int main(int argc, char** argv)
             gap = atof(argv[++i]);
         else if (!strcmp(argv[i], "--part-scale") && i + 1 < argc && atof(argv[i + 1]) > 0)
             part_scale = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--pieces") && i + 1 < argc && atof(argv[i + 1]) > 0)
+            pieces = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--pause") && i + 1 < argc && atof(argv[i + 1]) >= 0)
+            pause = atof(argv[++i]);
         else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "usage: visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                            "[--list] [--fit-all] [--on-body [--gap PX] [--part-scale F]] [--json]\n");
+                            "[--list] [--fit-all] [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]\n");
             return 2;
         }
     }
@@ -402,6 +527,14 @@ int main(int argc, char** argv)
     if (!d || sp_dragon_preload(d, &err) != SP_OK) {
         fprintf(stderr, "visitors: %s\n", err.text);
         return 1;
+    }
+    if (pieces > 0) {
+        if (pieces < 1) printf("Broken at %g of its points, drawn on %g ms after\n", pieces, pause);
+        in_pieces(d, &ds, pieces, pause, json, half);
+        sp_dragon_destroy(d);
+        sp_dataset_free(&ds);
+        remove_tmp_db(tmp, tmp_db);
+        return 0;
     }
     outcome* out = calloc((size_t)ds.count + 1, sizeof *out);
     double* ms_c = malloc(sizeof(double) * ((size_t)ds.count + 1));
@@ -586,14 +719,6 @@ int main(int argc, char** argv)
     free(ms_t);
     sp_dragon_destroy(d);
     sp_dataset_free(&ds);
-    if (tmp_db[0]) {
-        char cmd[256];
-        snprintf(cmd, sizeof cmd, "%s-wal", tmp_db);
-        unlink(cmd);
-        snprintf(cmd, sizeof cmd, "%s-shm", tmp_db);
-        unlink(cmd);
-        unlink(tmp_db);
-        rmdir(tmp);
-    }
+    remove_tmp_db(tmp, tmp_db);
     return 0;
 }

@@ -3,7 +3,7 @@
 add_executable(sp-visitors-make tools/visitors_make.c)
 target_link_libraries(sp-visitors-make PRIVATE sp_render sp::classifier sp::solver PkgConfig::CJSON ${MATH_LIB})
 add_executable(bench_visitors bench/visitors.c)
-target_link_libraries(bench_visitors PRIVATE sp_test_fixtures sp_dragon sp_render)
+target_link_libraries(bench_visitors PRIVATE sp_test_fixtures sp_dragon sp_render sp_kiosk_ui)
 set_target_properties(bench_visitors PROPERTIES OUTPUT_NAME visitors RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests/bench)
 
 # The whole set, the Quick, Draw! drawings included, built into the build

@@ -1080,6 +1080,57 @@ static void test_collect(void)
     }
 }
 
+// A visitor's finger leaves the glass for a moment: the part drawn in two
+// pieces, 120 ms apart, is one part, collected as one stroke; the same two
+// pieces 700 ms apart are two strokes (a pause, not a slip).
+static void test_continued_stroke(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const stroke* st = NULL;
+    for (int i = 0; i < DRAGON_PART_COUNT && !st; ++i)
+        if (g_strokes[i].rank == 0 && g_strokes[i].n >= 20) st = &g_strokes[i];
+    ENSURE(st);
+    char db[1100];
+    e2e_db_copy("kiosk_continued.db", db, sizeof db);
+    const char* sc = sp_test_tmp_path("kiosk_continued.json");
+    script s = script_open(sc, 0);
+    script_event(&s, 0, "down", 640, 400);
+    script_event(&s, 60, "up", 640, 400);
+    int k = st->n * 3 / 5; // broken at three fifths, drawn on from the same point
+    double up = script_stroke(&s, 500, st->xy, k + 1, 4);
+    up = script_stroke(&s, up + 120, st->xy + k, st->n - k, 4);
+    script_press(&s, up + 1500, "start_over");
+    script_press(&s, up + 1700, "start_over");
+    up = script_stroke(&s, up + 2500, st->xy, k + 1, 4);
+    up = script_stroke(&s, up + 700, st->xy + k, st->n - k, 4);
+    script_end(&s, sc, up + 1500);
+    char args[2048];
+    snprintf(args, sizeof args, "--script '%s'", sc);
+    cJSON* stats = NULL;
+    ENSURE(run_kiosk_on(db, args, &stats) == 0 && stats);
+    fprintf(stderr, "  %s in two pieces: joined %g, merged %g, strokes %g, collected %g; apart: %g parts, %g refused\n",
+            st->category, num(stats, "joined"), num(stats, "merged"), num(stats, "strokes"), num(stats, "collected"),
+            num(stats, "parts"), num(stats, "rejected"));
+    ENSURE(num(stats, "pipeline_errors") == 0 && num(stats, "joined") == 1);
+    // Four fits: the first piece, the whole line, then each piece of the second try.
+    ENSURE(num(stats, "strokes") == 4 && num(stats, "parts") + num(stats, "rejected") >= 2);
+    cJSON_Delete(stats);
+    // The first visit's part, as the visitor left it: the whole line, its category.
+    cJSON* r = review(db);
+    ENSURE(r);
+    const cJSON* first = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(r, "sketches"), 0);
+    ENSURE(first && !strcmp(cJSON_GetObjectItemCaseSensitive(first, "category")->valuestring, st->category));
+    const cJSON* pts = cJSON_GetObjectItemCaseSensitive(first, "points");
+    int n = cJSON_GetArraySize(pts);
+    const cJSON* last = cJSON_GetArrayItem(pts, n - 1);
+    fprintf(stderr, "  collected: %d points (drawn %d)\n", n, st->n);
+    ENSURE(n >= st->n * 9 / 10 && n <= st->n + 1);
+    ENSURE(fabs(cJSON_GetArrayItem(last, 0)->valuedouble - st->xy[st->n - 1].x) < 1.5 &&
+           fabs(cJSON_GetArrayItem(last, 1)->valuedouble - st->xy[st->n - 1].y) < 1.5);
+    cJSON_Delete(r);
+}
+
 // Lines of a file that contain `what`.
 static int lines_with(const char* path, const char* what)
 {
@@ -1461,6 +1512,7 @@ int main(int argc, char** argv)
                                    {"db_replaced", test_db_replaced},
                                    {"full_dragon", test_full_dragon},
                                    {"visit", test_visit},
+                                   {"continued_stroke", test_continued_stroke},
                                    {"twenty_strokes", test_twenty_strokes},
                                    {"collect", test_collect},
                                    {"collect_read_only", test_collect_read_only},

@@ -71,11 +71,13 @@ static void fake_drain(sp_kiosk_ui* ui, fake* f)
         switch (j.kind) {
         case SP_KJOB_FIT: {
             // A refused stroke is offered with three guesses; a chosen one is fitted as told.
-            fake_log(f, j.replace ? 'R' : j.category[0] ? 'P' : 'F');
+            fake_log(f, j.replace ? 'R' : j.category[0] ? 'P' : j.undo_first ? 'J' : 'F');
+            if (j.undo_first && f->parts > 0) --f->parts, ++f->undos; // the fake keeps no details: it was a part
             int c = j.category[0] ? cat_index(j.category) : fake_classify(j.stroke);
             if (c < 0) {
                 ++f->rejects;
-                sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"head", "wings", "tail"}});
+                sp_kiosk_ui_fit_done(
+                    ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"head", "wings", "tail"}, .part_count = f->parts});
                 break;
             }
             ++f->fits;
@@ -772,6 +774,126 @@ static void test_detail_refused(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// A straight stroke of n points from (x, y) along (dx, dy) per point, 8 ms
+// apart; returns the pen-up time.
+static double line_stroke(sp_kiosk_ui* ui, double t, float x, float y, int n, float dx, float dy)
+{
+    send(ui, SP_KEV_DOWN, t, x, y);
+    for (int i = 1; i < n; ++i)
+        send(ui, SP_KEV_MOVE, t + 8 * i, x + dx * (float)i, y + dy * (float)i);
+    send(ui, SP_KEV_UP, t + 8 * (n - 1), x + dx * (float)(n - 1), y + dy * (float)(n - 1));
+    return t + 8 * (n - 1);
+}
+
+// A finger that leaves the glass for a moment, or draws on after a pause
+// for breath, draws one stroke: the pieces are fitted as one line.
+static void test_continued_stroke(void)
+{
+    fake f;
+    sp_kiosk_job j;
+    // Drawn on 100 ms after its pen-up, 4 px from its end: one FIT of the
+    // whole line, taking back the part the first piece made.
+    sp_kiosk_ui* ui = started(&f);
+    double t = line_stroke(ui, 1000, 200, 300, 30, 10, 0); // ends at (490, 300), 1.25 px/ms
+    frame(ui, &f, t + 16);
+    ENSURE(f.parts == 1 && ui->last_outcome == SP_KLAST_PART);
+    send(ui, SP_KEV_DOWN, t + 100, 494, 302);
+    ENSURE(ui->continuing && ui->stroke.count == 31); // shown as one line while it is drawn
+    for (int i = 1; i < 20; ++i)
+        send(ui, SP_KEV_MOVE, t + 100 + 8 * i, 494.0f + 10 * (float)i, 302);
+    send(ui, SP_KEV_UP, t + 260, 684, 302);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.undo_first && !j.replace);
+    ENSURE(j.stroke->count == 50 && j.stroke->xy[0] == 200 && j.stroke->xy[2 * 49] == 684);
+    ENSURE(j.stroke->t[29] < j.stroke->t[30]); // the times go on
+    ENSURE(!sp_kiosk_ui_next_job(ui, &j));
+    ENSURE(ui->joined == 1 && ui->merged == 0 && ui->strokes_finished == 2);
+    sp_kiosk_ui_destroy(ui);
+
+    // Not continued: too late, too far and not ahead of the pen, after a button, and with joining off.
+    const struct {
+        double gap;
+        float x, y;
+        bool play;
+    } apart[] = {{400, 494, 302, false}, {100, 490, 360, false}, {100, 330, 300, false}, {100, 494, 302, true}};
+    for (int c = 0; c < 5; ++c) {
+        ui = c < 4 ? started(&f) : started_with(&f, &(sp_kiosk_ui_desc){.join_ms = -1});
+        t = line_stroke(ui, 1000, 200, 300, 30, 10, 0);
+        frame(ui, &f, t + 16);
+        int k = c < 4 ? c : 0;
+        if (apart[k].play) tap(ui, t + 20, SP_KT_PLAY);
+        send(ui, SP_KEV_DOWN, t + apart[k].gap, apart[k].x, apart[k].y);
+        ENSURE(!ui->continuing && ui->stroke.count == 1);
+        line_stroke(ui, t + apart[k].gap, apart[k].x, apart[k].y, 20, 10, 10);
+        frame(ui, &f, t + apart[k].gap + 400);
+        ENSURE(f.parts == 2 && f.undos == 0 && ui->joined == 0);
+        sp_kiosk_ui_destroy(ui);
+    }
+    // Farther, but ahead of the pen by its speed: continued (150 px on at
+    // 1.25 px/ms after 150 ms: 8 mm plus 187 px).
+    ui = started(&f);
+    t = line_stroke(ui, 1000, 200, 300, 30, 10, 0);
+    frame(ui, &f, t + 16);
+    t = line_stroke(ui, t + 150, 640, 310, 10, 10, 0);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.undo_first && j.stroke->count == 40);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "tail", .part_count = 1});
+    // Continued again: a line drawn in three pieces is one.
+    line_stroke(ui, t + 80, 734, 312, 10, 10, 0);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.undo_first && j.stroke->count == 50 && ui->joined == 2);
+    sp_kiosk_ui_destroy(ui);
+
+    // Its job has not run yet: the waiting job fits the whole line, no undo.
+    ui = started(&f);
+    t = line_stroke(ui, 1000, 200, 300, 30, 10, 0);
+    t = line_stroke(ui, t + 50, 492, 300, 20, 10, 0);
+    ENSURE(ui->pending_count == 1 && ui->pending[ui->pending_head].count == 50 && ui->merged == 1);
+    frame(ui, &f, t + 16);
+    ENSURE(f.fits == 1 && f.undos == 0 && f.parts == 1 && !strcmp(f.log, "F"));
+    // A finger bouncing off at the end (a piece of 2 px): nothing changes, no tap hint.
+    send(ui, SP_KEV_DOWN, t + 60, 682, 300);
+    send(ui, SP_KEV_UP, t + 70, 684, 301);
+    ENSURE(!sp_kiosk_ui_next_job(ui, &j) && ui->taps == 1 && !sp_kiosk_ui_hint_visible(ui));
+    sp_kiosk_ui_destroy(ui);
+
+    // A refused first piece: its offer goes, the whole line is fitted (nothing to take back).
+    ui = started(&f);
+    t = refused_stroke(ui, 1000, 800, 200); // ends at (800, 440), going down
+    frame(ui, &f, t + 16);
+    ENSURE(sp_kiosk_ui_offering(ui) && ui->last_outcome == SP_KLAST_REFUSED);
+    line_stroke(ui, t + 90, 803, 446, 20, 12, 6);
+    ENSURE(!sp_kiosk_ui_offering(ui) && sp_kiosk_ui_fade(ui) == 0);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.undo_first && j.stroke->count == 37);
+    sp_kiosk_ui_destroy(ui);
+
+    // Kept as a detail: taken back first; refused then, the part count is the pipeline's.
+    ui = started(&f);
+    t = line_stroke(ui, 1000, 200, 300, 30, 10, 0);
+    frame(ui, &f, t + 16);
+    t = line_stroke(ui, t + 1000, 300, 500, 10, 8, 0);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && !j.undo_first);
+    sp_kiosk_ui_fit_done(
+        ui, &(sp_kiosk_fit_result){
+                .refusal = SP_KREF_DETAIL, .offer = true, .kept = true, .offers = {"head", "wings", "tail"}, .part_count = 1});
+    ENSURE(ui->last_outcome == SP_KLAST_DETAIL);
+    line_stroke(ui, t + 60, 375, 500, 10, 8, 0);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.undo_first && j.stroke->count == 20);
+    uint64_t rev = ui->revision;
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_UNRECOGNISED, .part_count = 1});
+    ENSURE(ui->part_count == 1 && ui->revision == rev + 1);
+    sp_kiosk_ui_destroy(ui);
+
+    // A Redraw's part: the whole line replaces it again (the part it replaced is gone).
+    ui = started(&f);
+    t = line_stroke(ui, 1000, 200, 300, 30, 10, 0);
+    frame(ui, &f, t + 16);
+    tap(ui, t + 500, SP_KT_REDRAW);
+    t = line_stroke(ui, t + 1000, 200, 500, 30, 10, 0);
+    frame(ui, &f, t + 16);
+    ENSURE(f.parts == 1 && !strcmp(f.log, "FR"));
+    line_stroke(ui, t + 80, 494, 500, 10, 10, 0);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.replace && !j.undo_first && j.stroke->count == 40);
+    sp_kiosk_ui_destroy(ui);
+}
+
 // Issue 16, item 7: the save banner says what the code is for (Save names
 // the .glb and the postcard by it, where staff find them).
 static void test_save_code(void)
@@ -1132,7 +1254,9 @@ static void test_stroke_flood(void)
     for (int k = 0; k < 10; ++k)
         frame(ui, &f, next_frame + 17 * k);
     ENSURE(ui->strokes_finished == n);
-    ENSURE(f.fits + f.rejects + ui->dropped_strokes == n);
+    // A stroke begun where the last one ended, 2 ms after it, continues it
+    // (merged into its waiting job when that has not run).
+    ENSURE(f.fits + f.rejects + ui->dropped_strokes + ui->merged == n);
     ENSURE(f.fits + f.rejects >= 3500); // ~one a frame
     ENSURE(ui->pending_count == 0 && ui->job_count == 0);
     sp_kiosk_ui_destroy(ui);
@@ -1412,6 +1536,7 @@ int main(int argc, char** argv)
                                    {"attract_stroke", test_attract_stroke},
                                    {"refused_stroke", test_refused_stroke},
                                    {"detail_refused", test_detail_refused},
+                                   {"continued_stroke", test_continued_stroke},
                                    {"parts_row", test_parts_row},
                                    {"other_chip", test_other_chip},
                                    {"start_over", test_start_over},

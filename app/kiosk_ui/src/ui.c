@@ -102,6 +102,8 @@ static sp_kiosk_ui_desc with_defaults(const sp_kiosk_ui_desc* d)
     if (!(o.banner_ms > 0)) o.banner_ms = 15000;
     if (!(o.confirm_ms > 0)) o.confirm_ms = 3000;
     if (!(o.tap_mm > 0)) o.tap_mm = 4;
+    if (o.join_ms == 0 || isnan(o.join_ms)) o.join_ms = 200;
+    if (!(o.join_mm > 0)) o.join_mm = 8;
     return o;
 }
 
@@ -114,7 +116,8 @@ sp_result sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc, sp_kiosk_ui** out, sp
     bool ok =
         line_alloc(&ui->stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->job_stroke, SP_KIOSK_STROKE_MAX, true) &&
         line_alloc(&ui->flash_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->fade_stroke, SP_KIOSK_STROKE_MAX, true) &&
-        line_alloc(&ui->held_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
+        line_alloc(&ui->held_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->last_stroke, SP_KIOSK_STROKE_MAX, true) &&
+        line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
         ok = ok && line_alloc(&ui->pending[i], SP_KIOSK_STROKE_MAX, true);
     if (!ok) {
@@ -137,6 +140,7 @@ void sp_kiosk_ui_destroy(sp_kiosk_ui* ui)
     line_free(&ui->flash_stroke);
     line_free(&ui->fade_stroke);
     line_free(&ui->held_stroke);
+    line_free(&ui->last_stroke);
     line_free(&ui->flash_outline);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
         line_free(&ui->pending[i]);
@@ -592,26 +596,113 @@ static void take_offer(sp_kiosk_ui* ui, const char* category)
     end_offer(ui, false);
 }
 
+// The stroke just queued (j) is the one a next stroke may continue.
+static void remember_last(sp_kiosk_ui* ui, const sp_kiosk_job* j)
+{
+    line_copy(&ui->last_stroke, &ui->stroke);
+    ui->last_up = ui->now;
+    ui->last_replace = j->replace;
+    ui->last_outcome = SP_KLAST_PENDING;
+}
+
+// Whether a stroke begun now at (x, y) continues the last stroke: soon
+// after its pen-up, where the finger would have got to: near its end, or
+// farther ahead along its last direction by its speed at the end.
+static bool continues_last(const sp_kiosk_ui* ui, float x, float y)
+{
+    const sp_kiosk_line* l = &ui->last_stroke;
+    double gap = ui->now - ui->last_up;
+    if (ui->last_outcome == SP_KLAST_NONE || ui->last_outcome == SP_KLAST_INFLIGHT || l->count < 2 || !(ui->desc.join_ms > 0) ||
+        !(gap >= 0 && gap <= ui->desc.join_ms))
+        return false;
+    int e = l->count - 1, b = e - 1;
+    while (b > 0 && l->t[e] - l->t[b - 1] <= 50) // its last 50 ms
+        --b;
+    float ex = l->xy[2 * e], ey = l->xy[2 * e + 1];
+    double d = hypot(x - ex, y - ey), near = mm(ui, ui->desc.join_mm);
+    if (d <= near) return true;
+    double vx = ex - l->xy[2 * b], vy = ey - l->xy[2 * b + 1], len = hypot(vx, vy), dt = l->t[e] - l->t[b];
+    if (!(len > 0) || !(dt > 0)) return false;
+    // A finger moves at most about half a metre a second.
+    double speed = fmin(len / dt, mm(ui, 0.5));
+    bool ahead = ((x - ex) * vx + (y - ey) * vy) / len >= cos(M_PI / 4) * d;
+    return ahead && d <= near + speed * gap;
+}
+
+// The stroke just finished (ui->stroke, the last one's points first)
+// continues the last stroke: the two are fitted as one. False when the
+// last stroke's job is being run (its answer is not in yet): then it is a
+// stroke of its own.
+static bool continue_last(sp_kiosk_ui* ui)
+{
+    const sp_kiosk_line* s = &ui->stroke;
+    switch (ui->last_outcome) {
+    case SP_KLAST_PENDING: { // its job has not run: it fits the whole line instead
+        int slot = (ui->pending_head + ui->pending_count - 1) % SP_KIOSK_PENDING_MAX;
+        line_copy(&ui->pending[slot], s);
+        line_copy(&ui->last_stroke, s);
+        ui->last_up = ui->now;
+        ++ui->joined, ++ui->merged;
+        return true;
+    }
+    case SP_KLAST_PART:
+    case SP_KLAST_DETAIL:
+    case SP_KLAST_REFUSED: {
+        // What the first piece made goes; a part a Redraw made is replaced
+        // again (the part it replaced is gone).
+        bool redrawn = ui->last_outcome == SP_KLAST_PART && ui->last_replace;
+        bool undo = !redrawn && ui->last_outcome != SP_KLAST_REFUSED;
+        end_offer(ui, false); // a refused first piece is part of the line drawn now
+        ui->fade_until = -1, ui->fade_stroke.count = 0;
+        set_chips(ui, NULL, NULL, NULL);
+        sp_kiosk_job* j = queue_fit(ui, s);
+        ui->last_outcome = SP_KLAST_NONE;
+        if (!j) return true;
+        j->replace = j->replace || redrawn;
+        j->undo_first = undo;
+        remember_last(ui, j);
+        ++ui->joined;
+        return true;
+    }
+    default:
+        return false;
+    }
+}
+
 static void finish_stroke(sp_kiosk_ui* ui)
 {
     sp_kiosk_line* s = &ui->stroke;
+    bool cont = ui->continuing;
+    ui->continuing = false;
+    // A continuation's own piece decides whether it was a tap.
+    int from = cont ? ui->continued_from : 0;
     float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int i = 0; i < s->count; ++i)
+    for (int i = from; i < s->count; ++i)
         for (int c = 0; c < 2; ++c)
             lo[c] = fminf(lo[c], s->xy[2 * i + c]), hi[c] = fmaxf(hi[c], s->xy[2 * i + c]);
-    double diag = s->count > 0 ? hypot(hi[0] - lo[0], hi[1] - lo[1]) : 0;
-    if (s->count < 2 || diag < mm(ui, ui->desc.tap_mm)) {
+    double diag = s->count > from ? hypot(hi[0] - lo[0], hi[1] - lo[1]) : 0;
+    if (s->count - from < 2 || diag < mm(ui, ui->desc.tap_mm)) {
+        s->count = 0;
+        if (cont) return; // a finger bouncing off the glass at the end: the last stroke stands
         ++ui->taps;
+        ui->last_outcome = SP_KLAST_NONE;
         // A touch that only stopped the countdown needs no lesson in drawing.
         if (!ui->woke) set_hint(ui, sp_kiosk_text(SP_KTEXT_TAP));
-        s->count = 0;
         return;
     }
     ++ui->strokes_finished;
+    if (cont && continue_last(ui)) {
+        s->count = 0;
+        return;
+    }
     // This is the last stroke now: chips and offers of earlier ones go.
     end_offer(ui, true);
     set_chips(ui, NULL, NULL, NULL);
-    queue_fit(ui, s);
+    sp_kiosk_job* j = queue_fit(ui, s);
+    if (j)
+        remember_last(ui, j);
+    else
+        ui->last_outcome = SP_KLAST_NONE;
     s->count = 0;
 }
 
@@ -622,6 +713,7 @@ static void finish_stroke(sp_kiosk_ui* ui)
 // the drawing view.
 static void fresh_canvas(sp_kiosk_ui* ui)
 {
+    ui->last_outcome = SP_KLAST_NONE;
     clear_overlays(ui);
     set_chips(ui, NULL, NULL, NULL);
     ui->hint[0] = 0;
@@ -689,6 +781,7 @@ static void add_point(sp_kiosk_ui* ui, float x, float y, bool last)
             s->t[m] = s->t[i];
         }
         s->count = m;
+        ui->continued_from = (ui->continued_from + 1) / 2;
         ui->stroke_spacing *= 2.0;
     }
     s->xy[2 * s->count] = x, s->xy[2 * s->count + 1] = y;
@@ -722,6 +815,7 @@ static void refit_last(sp_kiosk_ui* ui, const char* category)
 static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     ++ui->activations[t];
+    ui->last_outcome = SP_KLAST_NONE; // a button between two strokes: the next one is a stroke of its own
     if (!sp_kiosk_ui_target_enabled(ui, t)) {
         if (ui->part_count == 0 && t < SP_KT_CHIP_LABEL) set_hint(ui, sp_kiosk_text(SP_KTEXT_NEED_PART));
         return;
@@ -874,6 +968,13 @@ static void on_down(sp_kiosk_ui* ui, float x, float y)
     ui->capture = SP_KCAP_STROKE;
     ui->stroke.count = 0;
     ui->stroke_spacing = fmax(0.5, mm(ui, 0.3));
+    // Drawn on from where the last stroke ended: one line, shown as one while it is drawn.
+    ui->continuing = continues_last(ui, x, y);
+    ui->continued_from = 0;
+    if (ui->continuing) {
+        line_copy(&ui->stroke, &ui->last_stroke);
+        ui->continued_from = ui->stroke.count;
+    }
     add_point(ui, x, y, false);
 }
 
@@ -951,11 +1052,13 @@ bool sp_kiosk_ui_next_job(sp_kiosk_ui* ui, sp_kiosk_job* job)
             ui->pending_head = (ui->pending_head + 1) % SP_KIOSK_PENDING_MAX;
             --ui->pending_count;
             job->stroke = &ui->job_stroke;
+            if (ui->last_outcome == SP_KLAST_PENDING && ui->pending_count == 0) ui->last_outcome = SP_KLAST_INFLIGHT;
         }
         if (j->kind == SP_KJOB_FIT || j->kind == SP_KJOB_REFIT) {
             ui->fit_in_flight = true;
             ui->inflight_kind = j->kind;
             ui->inflight_replace = j->replace;
+            ui->inflight_undo = j->kind == SP_KJOB_FIT && j->undo_first;
         }
         return true;
     }
@@ -998,6 +1101,8 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
 {
     bool refit = ui->inflight_kind == SP_KJOB_REFIT;
     ui->fit_in_flight = false;
+    if (!refit && ui->last_outcome == SP_KLAST_INFLIGHT)
+        ui->last_outcome = r->ok ? SP_KLAST_PART : r->kept ? SP_KLAST_DETAIL : SP_KLAST_REFUSED;
     if (refit) ui->refit_queued = false;
     // Chips and offers are for the last stroke only: not when one drawn since waits.
     bool last = ui->pending_count == 0;
@@ -1008,6 +1113,10 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
         }
         // Still waiting for the replacement: a chip for this stroke, or the next stroke, replaces.
         if (ui->inflight_replace) ui->redraw_armed = true;
+        if (ui->inflight_undo) { // what the stroke's first piece made was taken back
+            ui->part_count = r->part_count;
+            ++ui->revision;
+        }
         bool any_offer = ui->row_count > 0;
         for (int i = 0; i < 3; ++i)
             any_offer = any_offer || (r->offers[i] && r->offers[i][0]);

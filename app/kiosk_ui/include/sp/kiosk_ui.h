@@ -100,6 +100,8 @@ typedef struct sp_kiosk_ui_desc {
     double banner_ms;     ///< the save code stays this long; 0: 15000
     double confirm_ms;    ///< Start over needs a second tap within this; 0: 3000
     double tap_mm;        ///< a stroke whose box diagonal is smaller is a tap, not a part; 0: 4
+    double join_ms;       ///< a stroke begun this soon after the last one's pen-up may continue it; 0: 200; < 0: never
+    double join_mm;       ///< ... when it begins this near the last one's end (plus its speed times the pause); 0: 8
     bool start_playing;   ///< animation on from the start (default: paused until Play)
 } sp_kiosk_ui_desc;
 
@@ -130,6 +132,7 @@ typedef struct sp_kiosk_job {
     bool heavy;                        ///< FIT, REFIT, SAVE: do one per frame
     bool replace;                      ///< FIT: replace the last part
     bool replace_detail;               ///< FIT with a category: the stroke was kept as a detail; the part takes its place
+    bool undo_first; ///< FIT: the stroke continues the last one: take back the last change (the part or detail it made) first
     const sp_kiosk_line* stroke;       ///< FIT: the stroke (pixels, with times)
     char category[SP_KIOSK_LABEL_MAX]; ///< REFIT; FIT: "" to classify, else the part the visitor chose for a refused stroke
     double t_ms;                       ///< when it was asked for
@@ -156,7 +159,7 @@ typedef struct sp_kiosk_fit_result {
     const char* hint;         ///< ok: a note shown beside the part (NULL: none; it replaces the waiting hint)
     const char* category;     ///< the fitted part's category
     const char* guesses[2];   ///< next two guesses (NULL or "" when none)
-    int part_count;           ///< parts after the job
+    int part_count;           ///< parts after the job (also when refused: an undo_first job may have taken one back)
     const float* outline;     ///< outline_count by 2: the fitted abstraction in pixels (flashed in yellow)
     int outline_count;
     const int* outline_breaks; ///< indices where a new curve of the outline starts (may be NULL)
@@ -194,6 +197,20 @@ typedef struct sp_kiosk_ui {
     float last_x, last_y;
     sp_kiosk_line stroke;  ///< the stroke being drawn (blue)
     double stroke_spacing; ///< current thinning distance, pixels
+    bool continuing;       ///< the stroke being drawn continues the last one (it starts with the last one's points)
+    int continued_from;    ///< points of the stroke being drawn that are the last one's
+    // The last stroke drawn (not a chip's), while a stroke may still continue it.
+    sp_kiosk_line last_stroke;
+    double last_up;    ///< its pen-up
+    bool last_replace; ///< it was a Redraw
+    enum {
+        SP_KLAST_NONE,     ///< no stroke to continue (anything else happened since)
+        SP_KLAST_PENDING,  ///< its FIT job waits (the newest pending stroke)
+        SP_KLAST_INFLIGHT, ///< its FIT job was handed out, not answered
+        SP_KLAST_PART,     ///< it made a part
+        SP_KLAST_DETAIL,   ///< it was kept as a detail
+        SP_KLAST_REFUSED,  ///< it was refused (nothing on the dragon)
+    } last_outcome;
     // Finished strokes waiting for FIT jobs (ring).
     sp_kiosk_line pending[SP_KIOSK_PENDING_MAX];
     int pending_head, pending_count;
@@ -206,6 +223,7 @@ typedef struct sp_kiosk_ui {
     bool fit_in_flight;       ///< a FIT/REFIT handed out and not answered yet
     sp_kiosk_job_kind inflight_kind;
     bool inflight_replace;
+    bool inflight_undo; ///< the FIT in flight takes back the last change first
     bool refit_queued, save_queued;
     // Results on screen.
     sp_kiosk_line flash_stroke, flash_outline; ///< shown until flash_until (the stroke kept after: the last part's)
@@ -242,6 +260,7 @@ typedef struct sp_kiosk_ui {
     double yaw, pitch; ///< orbit, radians (0, 0: the drawing view)
     // Counters (tests, logs).
     int strokes_finished, taps, activations[SP_KT_COUNT], resets;
+    int joined, merged;        ///< strokes that continued the last one; of them, merged into its waiting FIT job
     int offered, chosen;       ///< refused strokes held with offers; of them, made a part by a tap
     int others, others_chosen; ///< rows opened by "Other?"; of them, closed by re-fitting the part as another
 } sp_kiosk_ui;
