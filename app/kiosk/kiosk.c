@@ -760,12 +760,19 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         sp_error err = {0};
         if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK)
             fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
-        if (reloaded) ++k->stats.reloads, k->icons_loaded = false; // a curator may have changed the categories
+        if (reloaded) ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false; // a curator may have changed the parts
     }
     // The parts row, once the first frame is on screen (starting fast matters more).
     if (!k->heavy_done && !k->icons_loaded && k->updates >= 2) {
         kiosk_row_load(k);
         k->heavy_done = true;
+    }
+    // Then the parts, one a frame while no finger draws, so that a visit's
+    // first strokes do not wait for loading theirs.
+    if (!k->heavy_done && !k->parts_loaded && k->icons_loaded && k->ui->capture == SP_KCAP_NONE) {
+        sp_error err = {0};
+        sp_dragon_preload_step(k->dragon, &k->parts_loaded, &err);
+        k->heavy_done = !k->parts_loaded;
     }
     if (k->ui->mode == SP_KM_ATTRACT) kiosk_attract_update(k);
     // Pose the dragon at the animation clock (only when something moves).

@@ -99,6 +99,7 @@ struct sp_kiosk {
     part_icon icons[SP_KIOSK_ROW_MAX];
     int icon_count;
     bool icons_loaded;
+    bool parts_loaded; // every part of the database is loaded (sp_dragon_preload_step said so)
     // Bookkeeping.
     sp_kiosk_stats stats;
     uint64_t code_state;

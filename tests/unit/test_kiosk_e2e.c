@@ -1502,6 +1502,64 @@ static void test_detail_ink(void)
         free(xy[k]);
 }
 
+// The kiosk loads the database's parts one a frame while no finger draws
+// (the attract screen, a pause), so the first strokes of a visit do not
+// wait for loading theirs; never while a finger draws.
+static void test_parts_loaded_while_idle(void)
+{
+    six_strokes();
+    sp_error err = {0};
+    sp_dragon* all = NULL;
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = e2e_db(), .canvas_w = 1280, .canvas_h = 800}, &all, &err) == SP_OK);
+    ENSURE(sp_dragon_preload(all, &err) == SP_OK);
+    int want = sp_dragon_loaded_parts(all);
+    sp_dragon_destroy(all);
+    ENSURE(want >= DRAGON_PART_COUNT);
+    char db[1100];
+    e2e_db_copy("kiosk_idle.db", db, sizeof db);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_idle_ex", &gl, &t); // 500 ms of frames
+    if (!gl) SKIP("no headless OpenGL");
+    ENSURE(k);
+    const sp_dragon* d = sp_kiosk_dragon(k);
+    fprintf(stderr, "  after 30 idle frames: %d of %d parts loaded\n", sp_dragon_loaded_parts(d), want);
+    ENSURE(sp_dragon_loaded_parts(d) == want);
+    // A visit's strokes load nothing more.
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i) {
+        const stroke* s = &g_strokes[i];
+        for (int p = 0; p < s->n; ++p)
+            sp_kiosk_input(k, &(sp_kiosk_event){p == 0         ? SP_KEV_DOWN
+                                                : p + 1 < s->n ? SP_KEV_MOVE
+                                                               : SP_KEV_UP,
+                                                t + p, (float)s->xy[p].x, (float)s->xy[p].y, 0});
+        t += s->n;
+        updates_until(k, &t, t + 100);
+    }
+    ENSURE(sp_kiosk_stats_of(k)->parts_added + sp_kiosk_stats_of(k)->rejected == DRAGON_PART_COUNT);
+    ENSURE(sp_dragon_loaded_parts(d) == want);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+    // A finger down from the first frame on: nothing loads while it draws.
+    ENSURE(sp_headless_create(&gl, &err) == SP_OK);
+    k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db, .canvas_w = 1280, .canvas_h = 800, .no_attract_demo = true}, &err);
+    ENSURE(k);
+    const stroke* s = &g_strokes[0];
+    t = 0;
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, (float)s->xy[0].x, (float)s->xy[0].y, 0});
+    for (int f = 0; f < 40; ++f, t += 1000.0 / 60.0) {
+        const sp_vec2 p = s->xy[(f + 1) * (s->n - 1) / 40];
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, t, (float)p.x, (float)p.y, 0});
+        sp_kiosk_update(k, t);
+    }
+    ENSURE(sp_dragon_loaded_parts(sp_kiosk_dragon(k)) == 0);
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, t, (float)s->xy[s->n - 1].x, (float)s->xy[s->n - 1].y, 0});
+    updates_until(k, &t, t + 1000);
+    ENSURE(sp_dragon_loaded_parts(sp_kiosk_dragon(k)) == want);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -1517,6 +1575,7 @@ int main(int argc, char** argv)
                                    {"collect", test_collect},
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
+                                   {"parts_loaded_while_idle", test_parts_loaded_while_idle},
                                    {"collect_busy", test_collect_busy},
                                    {"collect_replaced", test_collect_replaced},
                                    {"body_after_parts", test_body_after_parts},

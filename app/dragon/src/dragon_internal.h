@@ -151,6 +151,7 @@ struct sp_dragon {
     sp_clf* clf;
     tpl** cache;
     int cache_n;
+    int preload_next; // sp_dragon_preload_step's cursor over the database's parts
     part** parts;
     int part_n, part_cap;
     uint64_t next_id;

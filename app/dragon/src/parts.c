@@ -265,6 +265,7 @@ void dragon_cache_clear(sp_dragon* d)
 // not make every next stroke pay for loading and preparing its part again.
 static void cache_prune(sp_dragon* d)
 {
+    d->preload_next = 0; // the database changed: what is left to load is counted again
     int kept = 0;
     for (int i = 0; i < d->cache_n; ++i) {
         tpl* t = d->cache[i];
@@ -370,6 +371,29 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
     return SP_OK;
 }
 
+static tpl* cached(const sp_dragon* d, const char* name)
+{
+    for (int k = 0; k < d->cache_n; ++k)
+        if (!strcmp(d->cache[k]->name, name)) return d->cache[k];
+    return NULL;
+}
+
+// Loads part `name` into the cache; NULL when it does not load (err says why).
+static tpl* cache_load(sp_dragon* d, const char* name, sp_error* err)
+{
+    tpl* t = tpl_load(d->db, NULL, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, err);
+    if (!t) return NULL;
+    tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
+    if (!c) {
+        dragon_tpl_release(t);
+        sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+        return NULL;
+    }
+    d->cache = c;
+    d->cache[d->cache_n++] = t;
+    return t;
+}
+
 // The templates of a category (loaded and cached), up to max_variants.
 int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int cap, sp_error* err)
 {
@@ -383,20 +407,8 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
     }
     if (sp_db_category_parts(d->db, category, &names, &n, err) != SP_OK) return 0;
     for (int i = 0; i < n && got < cap; ++i) {
-        tpl* t = NULL;
-        for (int k = 0; k < d->cache_n && !t; ++k)
-            if (!strcmp(d->cache[k]->name, names[i])) t = d->cache[k];
-        if (!t) {
-            t = tpl_load(d->db, NULL, names[i], d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, err);
-            if (!t) continue; // a part that does not load is skipped; err keeps why
-            tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
-            if (!c) {
-                dragon_tpl_release(t);
-                continue;
-            }
-            d->cache = c;
-            d->cache[d->cache_n++] = t;
-        }
+        tpl* t = cached(d, names[i]);
+        if (!t && !(t = cache_load(d, names[i], err))) continue; // a part that does not load is skipped; err keeps why
         out[got++] = t;
     }
     sp_db_free_strings(names, n);
@@ -410,17 +422,45 @@ tpl* dragon_category_first(sp_dragon* d, const char* category)
     return dragon_category_templates(d, category, t, 1, &lerr) == 1 ? t[0] : NULL;
 }
 
-sp_result sp_dragon_preload(sp_dragon* d, sp_error* err)
+sp_result sp_dragon_preload_step(sp_dragon* d, bool* done, sp_error* err)
 {
+    *done = true;
     if (!d->db) return SP_OK;
     char** cats = NULL;
     int n = 0;
     sp_result r = sp_db_categories(d->db, &cats, &n, err);
     if (r != SP_OK) return r;
-    for (int i = 0; i < n; ++i) {
-        tpl* got[16];
-        dragon_category_templates(d, cats[i], got, d->desc.max_variants < 16 ? d->desc.max_variants : 16, err);
+    // The database's parts in order (each category's first max_variants, as
+    // strokes use them); the first not loaded from the cursor on is loaded.
+    int cap = d->desc.max_variants < 16 ? d->desc.max_variants : 16, index = 0;
+    for (int i = 0; i < n && *done; ++i) {
+        char** names = NULL;
+        int m = 0;
+        sp_error lerr = {0};
+        if (sp_db_category_parts(d->db, cats[i], &names, &m, &lerr) != SP_OK) continue;
+        for (int k = 0; k < m && k < cap && *done; ++k, ++index)
+            if (index >= d->preload_next && !cached(d, names[k])) {
+                d->preload_next = index + 1; // tried once: a part that does not load is not tried again
+                cache_load(d, names[k], err);
+                *done = false;
+            }
+        sp_db_free_strings(names, m);
     }
     sp_db_free_strings(cats, n);
     return SP_OK;
+}
+
+int sp_dragon_loaded_parts(const sp_dragon* d)
+{
+    return d->cache_n;
+}
+
+sp_result sp_dragon_preload(sp_dragon* d, sp_error* err)
+{
+    d->preload_next = 0;
+    bool done = false;
+    sp_result r = SP_OK;
+    while (!done && r == SP_OK)
+        r = sp_dragon_preload_step(d, &done, err);
+    return r;
 }
