@@ -769,7 +769,8 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     }
     // Then the parts, one a frame while no finger draws, so that a visit's
     // first strokes do not wait for loading theirs.
-    if (!k->heavy_done && !k->parts_loaded && k->icons_loaded && k->ui->capture == SP_KCAP_NONE) {
+    if (!k->heavy_done && !k->parts_loaded && k->icons_loaded && k->ui->capture == SP_KCAP_NONE &&
+        (k->demo_prepared || k->ui->mode != SP_KM_ATTRACT)) { // the attract screen's demo first: it is what shows
         sp_error err = {0};
         sp_dragon_preload_step(k->dragon, &k->parts_loaded, &err);
         k->heavy_done = !k->parts_loaded;

@@ -78,7 +78,8 @@ static void prepare(sp_kiosk* k)
     if (sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
                                            .canvas_w = k->canvas_w,
                                            .canvas_h = k->canvas_h,
-                                           .solve = {.time_cap_ms = k->desc.fit_time_cap_ms}},
+                                           .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
+                                           .no_model = true}, // its strokes name their parts: loading the model took 290 ms
                          &k->demo, &err) != SP_OK)
         fprintf(stderr, "dragon-kiosk: attract screen without its demo: %s\n", err.text);
 }

@@ -1056,6 +1056,36 @@ static int dragon_signature(const sp_dragon* d, char* buf, size_t cap)
     return sp_dragon_part_count(d);
 }
 
+// A pipeline whose strokes name their parts (the attract screen's demo)
+// loads no model, also after the database changes; its strokes still fit.
+static void test_no_model(void)
+{
+    sp_db* db = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(test_db(), SP_DB_READONLY, &db, &err) == SP_OK);
+    char path[1200], cmd[6000];
+    snprintf(path, sizeof path, "%s", sp_test_tmp_path("no_model.db"));
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", test_db(), path);
+    ENSURE(system(cmd) == 0);
+    sp_dragon* d = NULL;
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .no_model = true}, &d, &err) ==
+           SP_OK);
+    ENSURE(sp_dragon_model(d) == NULL);
+    sp_vec2* xy;
+    int n = part_stroke(db, "torso_t", 5, 0.3, 640, 400, 400, &xy);
+    sp_dragon_result res;
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK && !res.rejected);
+    ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_NO_MODEL);
+    // The database replaced (a curator's new file): reopened, still no model.
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s.new' && mv '%s.new' '%s'", test_db(), path, path, path);
+    ENSURE(system(cmd) == 0);
+    bool reloaded = false;
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded && sp_dragon_model(d) == NULL);
+    free(xy);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 static void test_rejects_and_bad_strokes(void)
 {
     const char* path = test_db();
@@ -3357,6 +3387,7 @@ int main(int argc, char** argv)
                                    {"animation", test_animation},
                                    {"export", test_export},
                                    {"rejects_and_bad_strokes", test_rejects_and_bad_strokes},
+                                   {"no_model", test_no_model},
                                    {"undo_clear_refit", test_undo_clear_refit},
                                    {"live_update", test_live_update},
                                    {"command", test_command},

@@ -329,6 +329,7 @@ static sp_result open_own(sp_dragon* d, sp_error* err)
 // Takes the newest model of the (re)opened database; keeps the old one when it cannot be read.
 static void reload_model(sp_dragon* d)
 {
+    if (d->desc.no_model) return;
     sp_clf* clf = NULL;
     sp_error merr = {0};
     sp_result r = sp_db_load_model(d->db, &clf, NULL, &merr);

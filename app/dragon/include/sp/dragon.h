@@ -119,6 +119,7 @@ typedef struct sp_dragon_desc {
     int max_variants;      ///< parts of one category fitted per stroke, best kept; 0: 4
     double fps;            ///< key rate of the exported animation, per second; 0: 30
     int max_parts;         ///< a stroke beyond this many parts is rejected (a kiosk runs all day); 0: 48
+    bool no_model;         ///< every stroke names its category (the attract screen's demo): the model is never loaded
 } sp_dragon_desc;
 
 /// Why a stroke left the dragon unchanged.
