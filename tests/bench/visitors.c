@@ -37,10 +37,10 @@
 // pieces, as a finger that left the glass: broken at F of its points, the
 // second piece drawn from where the first ended, MS ms after its pen-up
 // (default 120); the UI's FIT jobs run on the pipeline as the kiosk runs
-// them (a drawing reaching under the toolbar moved the least that brings it
-// onto the canvas). F >= 1 draws it whole through the UI. Printed: the drawings that
-// ended as one part, the right one; the right part among others; only wrong
-// parts; nothing.
+// them (a drawing reaching under the toolbar moved the least that brings
+// it onto the canvas). F >= 1 draws it whole through the UI. Printed: the
+// drawings that ended as one part, the right one; the right part among
+// others; only wrong parts; nothing.
 // Tune on --half tune (the default); report --half report.
 #include <dirent.h>
 #include <math.h>

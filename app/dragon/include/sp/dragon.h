@@ -304,8 +304,8 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
 /// the others; otherwise each part is loaded by the first stroke that needs it.
 /// Parts that do not load are skipped (err says the last reason, SP_OK still).
 sp_result sp_dragon_preload(sp_dragon* d, sp_error* err);
-/// One step of it: loads the next part not loaded yet (or tried since the
-/// last change of the database) and returns; *done is true when no part
+/// One step of it: loads the next part neither loaded nor tried since the
+/// last change of the database, and returns; *done is true when no part
 /// was left to load (then nothing was done). A caller with frames to keep
 /// short (the kiosk, while nobody draws) loads one part a frame. A part
 /// that does not load is tried once (err says why, SP_OK still).
