@@ -145,13 +145,9 @@ static bool canvas_to_world(const sp_camera* cam, sp_vec3 A, sp_vec2 p, sp_vec3*
 // that; -1 when none is finite.
 static int vertex_at(const sp_vec2* px, const double* xyz, int n, sp_vec2 p)
 {
-    double best = INFINITY;
-    for (int v = 0; v < n; ++v) {
-        double dx = px[v].x - p.x, dy = px[v].y - p.y;
-        best = fmin(best, dx * dx + dy * dy);
-    }
+    double best = dragon_vertex_nearest(px, n, p, INFINITY);
     int front = -1;
-    double r = sqrt(best) + 0.5;
+    double r = best + 0.5;
     for (int v = 0; isfinite(best) && v < n; ++v) {
         double dx = px[v].x - p.x, dy = px[v].y - p.y;
         if (dx * dx + dy * dy <= r * r && (front < 0 || xyz[3 * v + 2] > xyz[3 * front + 2])) front = v;

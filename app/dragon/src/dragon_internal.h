@@ -178,6 +178,9 @@ sp_camera dragon_mirrored_view(const sp_camera* view, double u);
 sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* view);
 /// Skin matrices (skin) of n joints blended by their weights w, then world's.
 sp_mat4 dragon_blended_skin(const int* joints, const double* w, int n, const sp_mat4* skin, const sp_mat4* world);
+/// The distance from canvas point p to the nearest of n points px (a
+/// projected mesh's vertices), or `limit` when none is nearer.
+double dragon_vertex_nearest(const sp_vec2* px, int n, sp_vec2 p, double limit);
 /// Part p's carrier in the world: its joints' skin matrices (skin, the body's
 /// evaluation) blended by its weights, then the body's model -> world.
 sp_mat4 dragon_carrier_matrix(const part* p, const sp_mat4* skin, const sp_mat4* body_world);

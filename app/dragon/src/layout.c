@@ -619,9 +619,7 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
 // drawn over it, not out of it.
 #define FLOURISH_OUT 0.3
 
-// The distance from canvas point p to the nearest of n points px, or
-// `limit` when none is nearer.
-static double vertex_nearest(const sp_vec2* px, int n, sp_vec2 p, double limit)
+double dragon_vertex_nearest(const sp_vec2* px, int n, sp_vec2 p, double limit)
 {
     double best = limit * limit;
     for (int v = 0; v < n; ++v) {
@@ -657,11 +655,11 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         // those are a few pixels across, and a head has some 30,000.
         for (int s = 0; flourish && s < m; ++s) {
             sp_vec2 x = pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)];
-            double dm = vertex_nearest(px, nv, x, INFINITY), dp = fmin(dm, dragon_ink_distance(d, q->pub.id, x));
+            double dm = dragon_vertex_nearest(px, nv, x, INFINITY), dp = fmin(dm, dragon_ink_distance(d, q->pub.id, x));
             for (int j = 0; flourish && j < d->part_n; ++j) {
                 const part* o = d->parts[j];
                 if (j != skip && o->t->is_torso && o->body_px)
-                    flourish = !(vertex_nearest(o->body_px, o->t->ch.rig.vertex_count, x, dp) < dp);
+                    flourish = !(dragon_vertex_nearest(o->body_px, o->t->ch.rig.vertex_count, x, dp) < dp);
             }
             nearest = fmin(nearest, dp);
             out += dm > touch;
@@ -715,7 +713,7 @@ int dragon_edge_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 
         int out = 0;
         for (int s = 0; along && s < m; ++s) {
             sp_vec2 x = pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)];
-            double dist = vertex_nearest(q->body_px, nv, x, INFINITY);
+            double dist = dragon_vertex_nearest(q->body_px, nv, x, INFINITY);
             bool off = dist > EDGE_OFF * bd;
             // Off the mesh only on the body's upper half, its back: legs drawn short under a body reach down.
             along = dist <= band && (!off || x.y < 0.5 * (a.y + b.y));
