@@ -823,7 +823,9 @@ static void test_continued_stroke(void)
         if (apart[k].play) tap(ui, t + 20, SP_KT_PLAY);
         send(ui, SP_KEV_DOWN, t + apart[k].gap, apart[k].x, apart[k].y);
         ENSURE(!ui->continuing && ui->stroke.count == 1);
-        line_stroke(ui, t + apart[k].gap, apart[k].x, apart[k].y, 20, 10, 10);
+        for (int i = 1; i < 20; ++i) // the same stroke drawn on: 19 more points, 10 px apart down and right
+            send(ui, i + 1 < 20 ? SP_KEV_MOVE : SP_KEV_UP, t + apart[k].gap + 8 * i, apart[k].x + 10.0f * (float)i,
+                 apart[k].y + 10.0f * (float)i);
         frame(ui, &f, t + apart[k].gap + 400);
         ENSURE(f.parts == 2 && f.undos == 0 && ui->joined == 0);
         sp_kiosk_ui_destroy(ui);

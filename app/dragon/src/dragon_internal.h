@@ -253,12 +253,11 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
 int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
 /// The body that a stroke (an open line, not a loop) is drawn along the
 /// back of, or -1 (spikes, a mane: docs/DESIGN.md, "Spikes along the
-/// back"): every point of the
-/// stroke on the body's projected mesh at its fit or, beside its upper
-/// half, within 6% of the body's size of it, 30% of them off it, the stroke 0.25 to 0.75 of the
-/// body's size. Part `skip` (or -1) does not count. hit as for
-/// dragon_detail_of, its points off the mesh each carried from the vertex
-/// nearest it.
+/// back"): every point of the stroke on the body's projected mesh at its
+/// fit or, beside its upper half, within 6% of the body's size of it, 30%
+/// of them off it, the stroke 0.25 to 0.75 of the body's size. Part `skip`
+/// (or -1) does not count. hit as for dragon_detail_of, its points off the
+/// mesh each carried from the vertex nearest it.
 int dragon_edge_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
 void dragon_detail_hit_free(detail_hit* hit);
 /// Recomputes every attachment and the loop period (after any change of the parts).
