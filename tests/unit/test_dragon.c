@@ -3226,6 +3226,25 @@ static void test_flourishes_off_parts(void)
         ENSURE(dark >= 36);
         sp_image_free(&img);
     }
+    // The flourish test's "near the ink drawn out of it" measures to the ink
+    // where it is shown, also once its part has been laid out again and
+    // moved (attached elsewhere, or freed): here the head's layout shifted
+    // by 40 px. Before, it measured to where the ink had been drawn. (Shown
+    // at t = 0 the ink is a few pixels off its fit: the clips' first pose.)
+    part* hp = d->parts[head];
+    sp_mat4 laid = hp->world_fit, shift = sp_mat4_translate((sp_vec3){40 * 2.0 / 800, 0, 0});
+    double near_ink[2] = {0, 0};
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass) hp->world_fit = sp_mat4_mul(&shift, &laid);
+        ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
+        for (int k = 0; k < 40; ++k)
+            near_ink[pass] = fmax(near_ink[pass], dragon_ink_distance(d, hp->pub.id, ink_px(d, 1, k)));
+        fprintf(stderr, "  the middle line as shown at t = 0%s: within %.1f px of the ink the flourish test sees\n",
+                pass ? ", its head laid out 40 px away" : "", near_ink[pass]);
+    }
+    ENSURE(near_ink[0] < 10 && near_ink[1] < near_ink[0] + 2);
+    hp->world_fit = laid;
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
     // A puff drawn at the middle line's end, off the head's mesh but on its ink, rides the head too.
     sp_vec2 puff[40], end = fire[1][39];
     for (int k = 0; k < 40; ++k)

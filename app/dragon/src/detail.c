@@ -8,6 +8,7 @@
 
 #include "dragon_internal.h"
 #include "sp/curve.h"
+#include "sp/embed.h"
 
 static void detail_free(detail* e)
 {
@@ -302,6 +303,7 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     e->id = d->next_id++;
     e->host = q->pub.id;
     e->t = q->t;
+    e->fit0 = q->world_fit;
     e->mirrored = q->pub.mirrored;
     d->details[d->detail_n] = e;
     return d->detail_n++;
@@ -318,6 +320,14 @@ static const part* host_of(const sp_dragon* d, const detail* e, int* index)
     return NULL;
 }
 
+// Canvas point x moved by the world transform m (the canvas is the world's front view).
+static sp_vec2 moved_px(const sp_dragon* d, const sp_mat4* m, sp_vec2 x)
+{
+    sp_vec3 o, dir;
+    sp_camera_ray(&d->world, x, &o, &dir);
+    return sp_camera_project(&d->world, sp_mat4_point(m, o));
+}
+
 double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p)
 {
     double best = INFINITY;
@@ -326,8 +336,17 @@ double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p)
         int k;
         const part* q = e->host == host ? host_of(d, e, &k) : NULL;
         if (!q || q->t != e->t || q->pub.mirrored != e->mirrored) continue; // not shown
-        for (int j = 0; j + 1 < e->n; ++j)
-            best = fmin(best, sp_v2_len(sp_v2_sub(p, segment_nearest(p, e->drawn[j], e->drawn[j + 1]))));
+        // Its part laid out again since (attached elsewhere, or freed): the
+        // ink is shown where the part's move takes it, not where it was drawn.
+        sp_mat4 inv, m = {{0}};
+        bool moved = memcmp(&q->world_fit, &e->fit0, sizeof m) != 0 && sp_mat4_inverse(&e->fit0, &inv);
+        if (moved) m = sp_mat4_mul(&q->world_fit, &inv);
+        sp_vec2 a = moved ? moved_px(d, &m, e->drawn[0]) : e->drawn[0];
+        for (int j = 0; j + 1 < e->n; ++j) {
+            sp_vec2 b = moved ? moved_px(d, &m, e->drawn[j + 1]) : e->drawn[j + 1];
+            best = fmin(best, sp_v2_len(sp_v2_sub(p, segment_nearest(p, a, b))));
+            a = b;
+        }
     }
     return best;
 }

@@ -137,6 +137,7 @@ typedef struct detail {
     double* weight;
     double *xyz, *normal; // posed at the last pose_at, n by 3
     sp_vec2* drawn;       // n: where each point was drawn on the canvas
+    sp_mat4 fit0;         // the part's world_fit when drawn (a part laid out again since moves its ink with it)
     bool shown;           // posed and its part as bound
 } detail;
 
@@ -270,7 +271,8 @@ void dragon_relayout(sp_dragon* d);
 /// SP_DRAGON_MAX_DETAILS, fewer than two points can be bound, or memory runs out.
 int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n);
 /// The distance on the canvas from p to the ink kept on the part with this
-/// id, as drawn (INFINITY when it has none shown).
+/// id, as drawn, moved with the part when it was laid out again since
+/// (INFINITY when it has none shown).
 double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p);
 /// Poses every detail on its part's vertices at the last pose_at (after them).
 void dragon_details_pose(sp_dragon* d);
