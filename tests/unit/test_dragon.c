@@ -3399,6 +3399,160 @@ static void test_spikes_on_the_back(void)
     sp_dragon_destroy(d);
 }
 
+// ------------------------------------------------------------ a day at the kiosk, at random
+
+// One of the shapes visitors draw (a blob, a body, a line, spikes, a leg
+// pair, an eye, wings, a scribble, a circle), or a stroke no finger makes (a tap,
+// NaN, a point far off, a point repeated), at centre c, size `size` px,
+// turned by `turn`; returns the point count. *nan: it holds a NaN.
+static int storm_shape(sp_test_rng* r, sp_vec2 c, double size, double turn, sp_vec2* out, int cap, bool* nan)
+{
+    *nan = false;
+    int kind = (int)(sp_test_uniform(r) * 10), n = 0;
+    double ct = cos(turn), st = sin(turn), h = 0.5 * size;
+    for (int i = 0; i < cap; ++i) {
+        double u = (double)i / (cap - 1), a = 2 * PI * u, x, y;
+        switch (kind) {
+        case 0: // a blob
+            x = h * cos(a) * (1 + 0.15 * sin(5 * a)), y = 0.6 * h * sin(a);
+            break;
+        case 1: // a humped body
+            x = h * cos(a), y = 0.4 * h * sin(a) - (sin(a) > 0 ? 0.3 * h * sin(a) : 0);
+            break;
+        case 2: // a wavy line
+            x = h * (2 * u - 1), y = 0.15 * h * sin(3 * a);
+            break;
+        case 3: // spikes
+            x = h * (2 * u - 1), y = (i % 6 < 3 ? 0.2 : -0.2) * h;
+            break;
+        case 4: // a leg pair
+            x = h * (2 * u - 1), y = h * fabs(sin(2 * a)) - 0.5 * h;
+            break;
+        case 5: // an eye
+            x = 0.08 * h * cos(a), y = 0.08 * h * sin(a);
+            break;
+        case 6: // wings
+            x = h * cos(0.5 * a), y = -h * sin(0.5 * a) * (1 + 0.2 * fabs(sin(4 * a)));
+            break;
+        case 7: // a scribble
+            x = h * sp_test_range(r, -1, 1), y = h * sp_test_range(r, -1, 1);
+            break;
+        default: // a circle
+            x = h * cos(a), y = h * sin(a);
+            break;
+        }
+        out[n++] = (sp_vec2){c.x + ct * x - st * y, c.y + st * x + ct * y};
+    }
+    double bad = sp_test_uniform(r);
+    if (bad < 0.03) return 2; // a tap
+    if (bad < 0.05)
+        out[n / 2] = (sp_vec2){NAN, out[n / 2].y}, *nan = true; // NaN
+    else if (bad < 0.07)
+        out[n / 3] = (sp_vec2){1e12, -1e12}; // far off
+    else if (bad < 0.09)
+        for (int i = 0; i < n; ++i)
+            out[i] = out[0]; // one point, repeated
+    return n;
+}
+
+// Every part and its ink posed finite, attachments only to bodies.
+static void storm_check(sp_dragon* d, double t)
+{
+    sp_error err = {0};
+    int n = sp_dragon_part_count(d), nd = sp_dragon_detail_count(d);
+    ENSURE(n >= 0 && n <= 48 && nd >= 0 && nd <= SP_DRAGON_MAX_DETAILS);
+    for (int i = 0; i < n; ++i) {
+        const sp_dragon_part* p = sp_dragon_part_get(d, i);
+        ENSURE(p && p->attached_to >= -1 && p->attached_to < n && p->attached_to != i);
+        if (p->attached_to >= 0) ENSURE(sp_dragon_part_get(d, p->attached_to)->is_torso && !p->is_torso);
+        for (int k = 0; k < p->character->rig.param_count; ++k)
+            ENSURE(isfinite(p->params[k]));
+    }
+    ENSURE(sp_dragon_pose_at(d, t, &err) == SP_OK);
+    for (int i = 0; i < n; ++i) {
+        const double* x = sp_dragon_part_xyz(d, i);
+        int nv = sp_dragon_part_get(d, i)->character->rig.vertex_count;
+        for (int k = 0; k < 3 * nv; ++k)
+            ENSURE(isfinite(x[k]));
+    }
+    sp_dragon_detail e;
+    for (int i = 0; i < nd; ++i) {
+        ENSURE(sp_dragon_detail_get(d, i, &e) && e.part >= 0 && e.part < n);
+        for (int k = 0; e.xyz && k < 3 * e.point_count; ++k)
+            ENSURE(isfinite(e.xyz[k]));
+    }
+}
+
+// A kiosk's day in fast motion: strokes of every kind drawn anywhere, on
+// parts and beside them, chips (a forced category, a Redraw, a detail made a
+// part), Undo, Start over, the animation posed at random times, a report
+// and an export. The pipeline never fails, never poses a NaN, and hangs
+// parts only on bodies. SP_STORM_OPS and SP_STORM_SEED run it longer by hand.
+static void test_scene_storm(void)
+{
+    const char* path = real_db();
+    if (!path) SKIP("assets/ has no parts yet");
+    const char* env_ops = getenv("SP_STORM_OPS");
+    const char* env_seed = getenv("SP_STORM_SEED");
+    int ops = env_ops ? atoi(env_ops) : 240;
+    sp_test_rng r = {env_seed ? strtoull(env_seed, NULL, 10) : 7};
+    sp_error err = {0};
+    sp_dragon* d = NULL;
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800}, &d, &err) == SP_OK);
+    static const char* const cats[] = {"torso", "head", "wings", "tail", "front_legs", "hind_legs", "no_such_part"};
+    enum { CAP = 96 };
+    sp_vec2 pts[CAP];
+    int added = 0, details = 0, refused = 0, attached = 0, undos = 0, refits = 0;
+    for (int op = 0; op < ops; ++op) {
+        double u = sp_test_uniform(&r);
+        sp_dragon_result res;
+        int n = sp_dragon_part_count(d);
+        if (u < 0.72) { // a stroke: anywhere, or at a part already there
+            sp_vec2 c = {sp_test_range(&r, 0, 1280), sp_test_range(&r, 0, 800)};
+            if (n > 0 && sp_test_uniform(&r) < 0.6) {
+                const sp_dragon_part* p = sp_dragon_part_get(d, (int)(sp_test_uniform(&r) * n));
+                if (p->stroke_points > 0) c = p->stroke_xy[(int)(sp_test_uniform(&r) * p->stroke_points)];
+            }
+            bool nan;
+            int m = storm_shape(&r, c, sp_test_range(&r, 15, 700), sp_test_range(&r, -PI, PI), pts, CAP, &nan);
+            double w = sp_test_uniform(&r);
+            sp_dragon_stroke_opts o = {.category = w < 0.12 ? cats[(int)(sp_test_uniform(&r) * 7)] : NULL,
+                                       .replace_last = w > 0.9,
+                                       .replace_detail = w < 0.04};
+            sp_result rc = sp_dragon_add_points(d, pts, m, &o, &res, &err);
+            ENSURE(rc == (nan ? SP_ERR_INVALID : SP_OK)); // a NaN is refused as bad input, nothing changes
+            if (rc != SP_OK) continue;
+            added += !res.rejected, refused += res.rejected && res.reason != SP_DRAGON_DETAIL;
+            details += res.reason == SP_DRAGON_DETAIL;
+            if (!res.rejected) attached += sp_dragon_part_get(d, res.part)->attached_to >= 0;
+        } else if (u < 0.82) {
+            undos += sp_dragon_undo(d);
+        } else if (u < 0.92) { // a chip: the last part as another
+            sp_result rc = sp_dragon_refit_last(d, cats[(int)(sp_test_uniform(&r) * 7)], &res, &err);
+            ENSURE(rc == SP_OK || n == 0);
+            refits += rc == SP_OK && !res.rejected;
+        } else if (u < 0.94) {
+            sp_dragon_clear(d);
+        } else if (u < 0.97) {
+            char* json = NULL;
+            ENSURE(sp_dragon_report_json(d, &json, &err) == SP_OK && json);
+            cJSON* doc = cJSON_Parse(json);
+            ENSURE(doc);
+            cJSON_Delete(doc);
+            free(json);
+        }
+        storm_check(d, sp_test_range(&r, 0, 2 * fmax(1, sp_dragon_period(d))));
+    }
+    if (sp_dragon_part_count(d) > 0) ENSURE(sp_dragon_export(d, sp_test_tmp_path("storm.glb"), &err) == SP_OK);
+    fprintf(
+        stderr,
+        "  %d operations: %d parts added (%d attached), %d details, %d refused, %d undos, %d chips; %d parts, %d details left\n",
+        ops, added, attached, details, refused, undos, refits, sp_dragon_part_count(d), sp_dragon_detail_count(d));
+    // The storm went everywhere a visit goes.
+    if (!env_ops) ENSURE(added > 40 && attached > 5 && details > 3 && refused > 5 && undos > 5 && refits > 5);
+    sp_dragon_destroy(d);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -3426,6 +3580,7 @@ int main(int argc, char** argv)
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},
+                                   {"scene_storm", test_scene_storm},
                                    {"spikes_on_the_back", test_spikes_on_the_back},
                                    {0}});
 }
