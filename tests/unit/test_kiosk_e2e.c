@@ -1153,14 +1153,18 @@ static void test_collect_read_only(void)
     six_strokes();
     const char* reach = sp_test_reachable_dir("sp_kiosk");
     ENSURE(reach);
-    char dir[1024], db[1100], sc[1100], out[1100], errf[1100], cmd[8192];
+    char dir[1024], db[1100], sc[1100], out[1100], errf[1100], exe[1100], cmd[8192];
     snprintf(dir, sizeof dir, "%s", reach);
     ENSURE(chmod(dir, 0777) == 0); // the reader may create the database's -shm beside it
     snprintf(db, sizeof db, "%s/ro.db", dir);
     snprintf(sc, sizeof sc, "%s/session.json", dir);
     snprintf(out, sizeof out, "%s/stats.json", dir);
     snprintf(errf, sizeof errf, "%s/stderr.txt", dir);
-    snprintf(cmd, sizeof cmd, "cp '%s' '%s' && chmod 0444 '%s'", e2e_db(), db, db);
+    // The kiosk runs from there too: a clone under a folder others may not
+    // enter (root's home) keeps its build out of the child's reach.
+    snprintf(exe, sizeof exe, "%s/dragon-kiosk", dir);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s' && chmod 0444 '%s' && cp '%s' '%s' && chmod 0755 '%s'", e2e_db(), db, db,
+             SP_DRAGON_KIOSK, exe, exe);
     ENSURE(system(cmd) == 0);
     script s = script_open(sc, 0);
     script_event(&s, 0, "down", 640, 400);
@@ -1170,8 +1174,8 @@ static void test_collect_read_only(void)
     script_end(&s, sc, t + 2000);
     ENSURE(chmod(sc, 0644) == 0);
     snprintf(cmd, sizeof cmd,
-             "cd '%s' && xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --script '%s' --stats > '%s' 2> '%s'", dir,
-             SP_DRAGON_KIOSK, db, sc, out, errf);
+             "cd '%s' && xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --script '%s' --stats > '%s' 2> '%s'", dir, exe,
+             db, sc, out, errf);
     pid_t pid = fork();
     ENSURE(pid >= 0);
     if (pid == 0) {
