@@ -313,7 +313,7 @@ static void tail(path* P, sp_rng* r)
     if (closed) put_v(P, P->p[0]);
 }
 
-// ---- leg pairs: two limbs from a hip line, each with a foot (claws, round, boot); or one line ----------------
+// ---- leg pairs: two limbs, each with a foot (claws, round, boot), as one outline or limb by limb; or one line ---
 
 typedef struct limb {
     sp_vec2 c[5]; // hip to ankle
@@ -356,6 +356,48 @@ static void foot(path* P, sp_rng* r, const limb* L, int kind, double fl)
         break;
     }
     put_v(P, side_point(L, L->n - 1, -1));
+}
+
+// Where the limb's side (sgn as in side_point) crosses the height y; its nearest end when it does not.
+static double side_x_at(const limb* L, double sgn, double y)
+{
+    sp_vec2 prev = side_point(L, 0, sgn);
+    if (y <= prev.y) return prev.x;
+    for (int i = 1; i < L->n; ++i) {
+        sp_vec2 q = side_point(L, i, sgn);
+        if (y <= q.y && q.y > prev.y) return prev.x + (q.x - prev.x) * (y - prev.y) / (q.y - prev.y);
+        prev = q;
+    }
+    return prev.x;
+}
+
+// The pair as the one outline a hand traces round it: down the rear leg's back, its foot, up its front to the
+// crotch, down the front leg's back, its foot, up its front, and over the top (a haunch over hind legs, a
+// shoulder over front legs) back to the start. The limbs' sides above the crotch are inside the outline.
+// Limbs that converge or cross (a stride) still cross the line, as they overlap in a side view.
+static void legs_outline(path* P, sp_rng* r, const limb L[2], int kind, double fl, bool hind, double h)
+{
+    const limb* a = &L[0];
+    const limb* b = &L[1];
+    double cy = h * (hind ? U(r, 0.35, 0.55) : U(r, 0.15, 0.4));
+    for (int i = 0; i < a->n; ++i)
+        put_v(P, side_point(a, i, 1));
+    foot(P, r, a, kind, fl);
+    for (int i = a->n - 2; i >= 1; --i) {
+        sp_vec2 q = side_point(a, i, -1);
+        if (q.y > cy) put_v(P, q);
+    }
+    put(P, 0.5 * (side_x_at(a, -1, cy) + side_x_at(b, 1, cy)), cy);
+    for (int i = 1; i < b->n; ++i) {
+        sp_vec2 q = side_point(b, i, 1);
+        if (q.y > cy) put_v(P, q);
+    }
+    foot(P, r, b, kind, fl);
+    for (int i = b->n - 2; i >= 0; --i)
+        put_v(P, side_point(b, i, -1));
+    sp_vec2 s = P->p[0], e = P->p[P->n - 1];
+    double bulge = h * (hind ? U(r, 0.2, 0.5) : U(r, 0.0, 0.12));
+    quad_to(P, (sp_vec2){0.5 * (s.x + e.x), fmin(s.y, e.y) - 2 * bulge}, s);
 }
 
 static void legs(path* P, sp_rng* r, bool hind)
@@ -402,6 +444,11 @@ static void legs(path* P, sp_rng* r, bool hind)
         if (one) return;
         for (int i = 0; i < b->n; ++i) put_v(P, b->c[i]);
         put(P, b->c[b->n - 1].x + fl + w * 0.5, b->c[b->n - 1].y + 0.05);
+        return;
+    }
+    // Mostly the pair's outline; a quarter drawn limb by limb, each round on its own, as some hands do.
+    if (!one && chance(r, 0.75)) {
+        legs_outline(P, r, L, kind, fl, hind, h);
         return;
     }
     int count = one ? 1 : 2;

@@ -2451,10 +2451,10 @@ static sp_vec2* refused_doodle(sp_dragon* d, const char* rel, sp_dragon_result* 
 }
 
 // The refusal's mirror evidence (docs/DESIGN.md, "Refusal policy"): a
-// visitor's tree and sun (tune half), each its own mirror image about an
-// upright line and taken for a part drawn in profile, are refused, and the
-// tree turned a quarter is not; a neat pair of legs and a humped body, as
-// symmetric, stay parts.
+// visitor's tree (tune half), its own mirror image about an upright line and
+// taken for a part drawn in profile, is refused, and turned a quarter is not;
+// the sun, as symmetric, is refused; a neat pair of legs and a humped body,
+// as symmetric, stay parts.
 static void test_mirror_refusal(void)
 {
     const char* path = real_db();
@@ -2466,8 +2466,11 @@ static void test_mirror_refusal(void)
         int n;
         sp_dragon_result res;
         sp_vec2* xy = refused_doodle(d, doodles[k], &res, &n);
-        ENSURE(strcmp(res.guesses[0].category, "torso") != 0 && !strstr(res.guesses[0].category, "legs"));
         if (k == 0) {
+            // Taken for a part drawn in profile (the mirror weighs only
+            // there); the sun's first guess moves with the recipe's draw,
+            // and its rays' turn symmetry refuses it whatever it is taken for.
+            ENSURE(strcmp(res.guesses[0].category, "torso") != 0 && !strstr(res.guesses[0].category, "legs"));
             // The tree turned a quarter about its centre is no longer
             // symmetric about an upright line, and the rest of the evidence
             // takes it for a part: the mirror is what refuses it.

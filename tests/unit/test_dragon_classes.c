@@ -183,6 +183,8 @@ static void test_concepts(void)
         if (c == SP_CONCEPT_TAIL || c == SP_CONCEPT_FRONT_LEGS || c == SP_CONCEPT_HIND_LEGS) ENSURE(closed > N / 10 && closed < N * 9 / 10);
         if (c == SP_CONCEPT_HEAD || c == SP_CONCEPT_TORSO) ENSURE(closed > N / 2);
         if (c == SP_CONCEPT_TAIL) ENSURE(mean > 0.5); // long and thin
+        // A leg pair is mostly the one closed outline round both limbs, as a hand traces it, not limb by limb.
+        if (c == SP_CONCEPT_FRONT_LEGS || c == SP_CONCEPT_HIND_LEGS) ENSURE(closed > N / 2);
     }
 }
 
