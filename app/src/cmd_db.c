@@ -131,21 +131,27 @@ static int db_init(int argc, char** argv)
     db_common c = {0};
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
-    int synth = 0, concepts = 0, folds = 0;
+    int synth = 0, concepts = 0, concept_family = -1, folds = 0; // -1: not given
     bool no_train = false;
     clf_cli_opts o = {0};
-    sp_opt opts[] = {DB_COMMON_OPTS(c),
-                     {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
-                     {"--assets", SP_OPT_STRING, &assets, "DIR", "parts to build the default database from (default: the source tree's assets/)", false},
-                     {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
-                     {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category (default 60, -1 none)", false},
-                     {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
-                      "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder picks.json "
-                      "names, ../shared/data/quickdraw beside the clone)",
-                      false},
-                     {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
-                     {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
-                     CLF_CLI_OPTS(o)};
+    sp_opt opts[] = {
+        DB_COMMON_OPTS(c),
+        {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
+        {"--assets", SP_OPT_STRING, &assets, "DIR",
+         "parts to build the default database from (default: the source tree's assets/)", false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
+        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category (default 60, -1 none)", false},
+        {"--concept-family", SP_OPT_INT, &concept_family, "F",
+         "seed family of the concept sketches (default 1; another family is another draw of the same designs, as `synth "
+         "--concepts --seed F`)",
+         false},
+        {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
+         "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder "
+         "picks.json names, ../shared/data/quickdraw beside the clone)",
+         false},
+        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
+        {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
+        CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
     int rc = parse(argc, argv, cmd,
@@ -155,6 +161,10 @@ static int db_init(int argc, char** argv)
     if (rc >= 0) return rc;
     if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000) {
         fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000\n", cmd);
+        return SP_EXIT_USAGE;
+    }
+    if (concept_family != -1 && (concept_family < 1 || concept_family > 1000000)) {
+        fprintf(stderr, "%s: --concept-family must be 1 to 1000000\n", cmd);
         return SP_EXIT_USAGE;
     }
     sp_error err = {0};
@@ -175,7 +185,11 @@ static int db_init(int argc, char** argv)
             fprintf(stderr, "%s: %s/sketches/picks.json: the Quick, Draw! data is not where it says; building without the people's strokes "
                             "(--quickdraw DIR names it)\n", cmd, assets);
         r = sp_db_create_default(db_path(&c), assets,
-                                 &(sp_db_default_desc){.synth_per_part = synth, .concepts_per_category = concepts, .quickdraw_dir = quickdraw, .train = td},
+                                 &(sp_db_default_desc){.synth_per_part = synth,
+                                                       .concepts_per_category = concepts,
+                                                       .concept_family = concept_family < 0 ? 0 : concept_family,
+                                                       .quickdraw_dir = quickdraw,
+                                                       .train = td},
                                  &err);
     }
     if (r != SP_OK) return fail(cmd, &err);

@@ -291,9 +291,9 @@ static bool is_kiosk_part(const char* file)
 }
 
 // Concept sketches (sp/concept.h) for every category of the stored parts that
-// has a concept, seeds sp_handdraw_seed(category's family, i): the designs
+// has a concept, seeds sp_handdraw_seed(category's family from family_base, i): the designs
 // visitors draw that the parts' own shapes do not cover.
-static sp_result add_concepts(sp_db* db, int per_category, sp_error* err)
+static sp_result add_concepts(sp_db* db, int per_category, int family_base, sp_error* err)
 {
     char** cats = NULL;
     int ncat = 0;
@@ -303,7 +303,7 @@ static sp_result add_concepts(sp_db* db, int per_category, sp_error* err)
         if (c == SP_CONCEPT_COUNT) continue;
         sp_dataset ds;
         if ((r = db_dataset_one(&ds, cats[k], per_category, err)) != SP_OK) break;
-        uint64_t family = sp_handdraw_part_family(1, cats[k]);
+        uint64_t family = sp_handdraw_part_family((uint64_t)family_base, cats[k]);
         for (int i = 0; r == SP_OK && i < per_category; ++i) {
             r = sp_concept_sketch(c, sp_handdraw_seed(family, i), &ds.samples[i].sketch, err);
             ds.samples[i].label = 0, ds.samples[i].index = i;
@@ -335,7 +335,7 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
     }
     int nconcepts = c->d.concepts_per_category == 0 ? SP_DB_CONCEPTS_DEFAULT : c->d.concepts_per_category < 0 ? 0 : c->d.concepts_per_category;
-    if (r == SP_OK && nconcepts > 0) r = add_concepts(db, nconcepts, err);
+    if (r == SP_OK && nconcepts > 0) r = add_concepts(db, nconcepts, c->d.concept_family > 0 ? c->d.concept_family : 1, err);
     if (r == SP_OK) {
         sp_dataset human;
         if ((r = sp_db_people_strokes(c->assets, c->d.quickdraw_dir, &human, NULL, err)) == SP_OK && human.count > 0)

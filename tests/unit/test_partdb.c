@@ -23,6 +23,8 @@
 #include "fixtures.h"
 #include "mini_gltf.h"
 #include "sp/clock.h"
+#include "sp/concept.h"
+#include "sp/handdraw.h"
 #include "sp/partdb.h"
 #include "sp/synth.h"
 #include "test.h"
@@ -917,7 +919,7 @@ static void test_default_db(void)
     remove_db(p);
     sp_db* db = NULL;
     sp_error err = {0};
-    sp_db_default_desc dd = {.synth_per_part = 20, .concepts_per_category = 5, .train = quick_train(-1)};
+    sp_db_default_desc dd = {.synth_per_part = 20, .concepts_per_category = 5, .concept_family = 2, .train = quick_train(-1)};
     double t0 = sp_now_ms();
     sp_result r = sp_db_create_default(p, dir, &dd, &err);
     if (r != SP_OK) fprintf(stderr, "  default: %s\n", err.text);
@@ -937,6 +939,28 @@ static void test_default_db(void)
         ENSURE(counts[i] == (!strcmp(cats[i], "horns") ? 21 : !strcmp(cats[i], "tail") ? 27 : 25));
     sp_db_free_strings(cats, n);
     free(counts);
+    // They are the draw of the family asked for (another draw of the same designs), not the default family's.
+    sp_dataset ds;
+    ENSURE(sp_db_load_dataset(db, &ds, NULL, &err) == SP_OK);
+    for (uint64_t family = 1; family <= 2; ++family) {
+        sp_sketch want;
+        ENSURE(sp_concept_sketch(SP_CONCEPT_TAIL, sp_handdraw_seed(sp_handdraw_part_family(family, "tail"), 0), &want, &err) ==
+               SP_OK);
+        bool found = false;
+        for (int i = 0; i < ds.count && !found; ++i) {
+            const sp_sketch* s = &ds.samples[i].sketch;
+            if (strcmp(ds.categories[ds.samples[i].label], "tail") || s->stroke_count != 1 ||
+                s->strokes[0].count != want.strokes[0].count)
+                continue;
+            found = true;
+            for (int k = 0; k < want.strokes[0].count && found; ++k)
+                found = fabs(s->strokes[0].points[k].x - want.strokes[0].points[k].x) < 0.01 &&
+                        fabs(s->strokes[0].points[k].y - want.strokes[0].points[k].y) < 0.01;
+        }
+        ENSURE(found == (family == 2));
+        sp_sketch_free(&want);
+    }
+    sp_dataset_free(&ds);
     sp_db_close(db);
     ENSURE(sp_db_create_default(p, dir, &dd, &err) == SP_ERR_INVALID);
 }
@@ -1130,6 +1154,11 @@ static void test_default_db_cli(void)
              bin, p, assets, root);
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") && strchr(out, '\n') == out + strlen(out) - 1);
     struct stat st;
+    ENSURE(stat(p, &st) != 0);
+    // A concept family that is not one: one line, a usage exit, no database.
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --concept-family 0 2>&1", bin, p, assets);
+    ENSURE(run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
+           strchr(out, '\n') == out + strlen(out) - 1);
     ENSURE(stat(p, &st) != 0);
     // Two tails and a horn join.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>/dev/null", bin, p, assets);

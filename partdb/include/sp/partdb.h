@@ -302,15 +302,21 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err);
 sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err);
 
 /// The default database: every `*.glb`/`*.gltf` part of assets_dir (category
-/// from its sp_part extras; files without one, such as the paper's characters, are skipped), `synth_per_part` synthetic sketches each (0:
-/// SP_DB_SYNTH_DEFAULT), `concepts_per_category` concept sketches for each category
-/// that has a concept (0: SP_DB_CONCEPTS_DEFAULT; -1: none), the people's strokes
-/// that assets_dir/sketches/picks.json names (sp_db_people_strokes; built
-/// without them when the Quick, Draw! folder is not there and `quickdraw_dir`
-/// is NULL), and a trained model. Creates `path`; refuses an existing file.
+/// from its sp_part extras; files without one, such as the paper's characters,
+/// are skipped), `synth_per_part` synthetic sketches each (0:
+/// SP_DB_SYNTH_DEFAULT), `concepts_per_category` concept sketches for each
+/// category that has a concept (0: SP_DB_CONCEPTS_DEFAULT; -1: none), drawn
+/// from seed family `concept_family` (0: 1, the default database's own; as
+/// `sketchpose synth --concepts --seed F`: another family is another draw of
+/// the same designs, to measure a recipe over several draws), the people's
+/// strokes that assets_dir/sketches/picks.json names (sp_db_people_strokes;
+/// built without them when the Quick, Draw! folder is not there and
+/// `quickdraw_dir` is NULL), and a trained model. Creates `path`; refuses an
+/// existing file.
 typedef struct sp_db_default_desc {
     int synth_per_part;
     int concepts_per_category;
+    int concept_family;
     const char* quickdraw_dir; ///< NULL: the folder picks.json names
     sp_db_train_desc train;
 } sp_db_default_desc;
