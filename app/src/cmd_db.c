@@ -131,7 +131,7 @@ static int db_init(int argc, char** argv)
     db_common c = {0};
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
-    int synth = 0, concepts = 0, concept_family = -1, folds = 0; // -1: not given
+    int synth = 0, concepts = 0, concept_family = 1, folds = 0;
     bool no_train = false;
     clf_cli_opts o = {0};
     sp_opt opts[] = {
@@ -163,7 +163,7 @@ static int db_init(int argc, char** argv)
         fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000\n", cmd);
         return SP_EXIT_USAGE;
     }
-    if (concept_family != -1 && (concept_family < 1 || concept_family > 1000000)) {
+    if (concept_family < 1 || concept_family > 1000000) {
         fprintf(stderr, "%s: --concept-family must be 1 to 1000000\n", cmd);
         return SP_EXIT_USAGE;
     }
@@ -187,7 +187,7 @@ static int db_init(int argc, char** argv)
         r = sp_db_create_default(db_path(&c), assets,
                                  &(sp_db_default_desc){.synth_per_part = synth,
                                                        .concepts_per_category = concepts,
-                                                       .concept_family = concept_family < 0 ? 0 : concept_family,
+                                                       .concept_family = concept_family,
                                                        .quickdraw_dir = quickdraw,
                                                        .train = td},
                                  &err);
