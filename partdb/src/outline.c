@@ -95,46 +95,60 @@ void sp_raster_triangle(unsigned char* cells, int w, int h, const double a[2], c
         }
 }
 
-// 3x3 dilation (grow = true) or erosion of the inside.
-static bool morph(grid* g, bool grow)
+// 3x3 dilation (grow = true) or erosion of the inside, cells off the grid
+// empty. Separable (a row pass into `row`, then a column pass into `*spare`,
+// which then swaps with the grid's cells), which gives the same cells as the
+// 3x3 window and lets the compiler vectorise the rows: this ran a fifth of a
+// default database's build as nine bounds-checked reads a cell. The caller's
+// buffers (w * h each) serve every pass of a trace.
+static void morph(grid* g, bool grow, unsigned char* row, unsigned char** spare)
 {
-    unsigned char* out = malloc((size_t)g->w * (size_t)g->h);
-    if (!out) return false;
-    for (int y = 0; y < g->h; ++y)
-        for (int x = 0; x < g->w; ++x) {
-            int v = grow ? 0 : 1;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    int q = get(g, x + dx, y + dy);
-                    v = grow ? (v | q) : (v & q);
-                }
-            out[(size_t)y * (size_t)g->w + (size_t)x] = (unsigned char)v;
+    size_t w = (size_t)g->w, h = (size_t)g->h;
+    unsigned char* out = *spare;
+    for (size_t y = 0; y < h; ++y) {
+        const unsigned char* c = g->c + y * w;
+        unsigned char* r = row + y * w;
+        for (size_t x = 0; x < w; ++x) {
+            unsigned char l = x > 0 ? c[x - 1] : 0, m = c[x], n = x + 1 < w ? c[x + 1] : 0;
+            r[x] = grow ? (unsigned char)(l | m | n) : (unsigned char)(l & m & n);
         }
-    free(g->c);
+    }
+    for (size_t y = 0; y < h; ++y) {
+        const unsigned char* u = y > 0 ? row + (y - 1) * w : NULL;
+        const unsigned char* m = row + y * w;
+        const unsigned char* d = y + 1 < h ? row + (y + 1) * w : NULL;
+        unsigned char* o = out + y * w;
+        if (!u || !d) {
+            for (size_t x = 0; x < w; ++x)
+                o[x] = grow ? (unsigned char)((u ? u[x] : 0) | m[x] | (d ? d[x] : 0)) : 0;
+        } else if (grow) {
+            for (size_t x = 0; x < w; ++x)
+                o[x] = (unsigned char)(u[x] | m[x] | d[x]);
+        } else {
+            for (size_t x = 0; x < w; ++x)
+                o[x] = (unsigned char)(u[x] & m[x] & d[x]);
+        }
+    }
+    *spare = g->c;
     g->c = out;
-    return true;
 }
 
 // Labels 4-connected regions of cells equal to `value` into lab (region ids
 // from 1); returns the count (-1: out of memory) and writes each region's
-// size into *sizes (malloc'd, indexed by id).
-static int label(const grid* g, int value, int* lab, int** sizes)
+// size into *sizes (malloc'd, indexed by id). `stack`: w * h ints of the
+// caller's.
+static int label(const grid* g, int value, int* lab, int* stack, int** sizes)
 {
     size_t n = (size_t)g->w * (size_t)g->h;
-    int* stack = malloc(sizeof(int) * n);
     int count = 0;
     *sizes = NULL;
-    if (!stack) return -1;
     for (size_t i = 0; i < n; ++i)
         lab[i] = 0;
     for (size_t i = 0; i < n; ++i) {
         if (g->c[i] != value || lab[i]) continue;
         ++count;
         int* grown = realloc(*sizes, sizeof(int) * (size_t)(count + 1));
-        if (!grown) {
-            free(stack);
-            return -1;
-        }
+        if (!grown) return -1;
         *sizes = grown;
         int size = 0, top = 0;
         stack[top++] = (int)i;
@@ -153,7 +167,6 @@ static int label(const grid* g, int value, int* lab, int** sizes)
         }
         (*sizes)[count] = size;
     }
-    free(stack);
     return count;
 }
 
@@ -352,7 +365,8 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     double *xy = NULL, *cell = NULL, *acc = NULL, *nrm = NULL, *zv = NULL;
     candidate* cands = NULL;
     int ncand = 0;
-    int *lab = NULL, *sizes = NULL;
+    int *lab = NULL, *sizes = NULL, *stack = NULL;
+    unsigned char *rows = NULL, *spare = NULL;
     pt *poly = NULL, *tmp = NULL;
     sp_skin8 *bound = NULL, *tmp_skin = NULL;
     grid g = {0, 0, NULL};
@@ -392,18 +406,23 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
         sp_raster_triangle(g.c, g.w, g.h, cell + 2 * q[0], cell + 2 * q[1], cell + 2 * q[2]);
     }
     // Closing (dilate, erode) removes hairline gaps between touching pieces.
-    if (!morph(&g, true) || !morph(&g, true) || !morph(&g, false) || !morph(&g, false)) goto oom;
-    // Fill holes: everything not reachable from the border is inside.
     size_t ncell = (size_t)g.w * (size_t)g.h;
-    lab = malloc(sizeof(int) * ncell);
-    if (!lab || label(&g, 0, lab, &sizes) < 0) goto oom;
+    rows = malloc(ncell), spare = malloc(ncell);
+    if (!rows || !spare) goto oom;
+    morph(&g, true, rows, &spare), morph(&g, true, rows, &spare);
+    morph(&g, false, rows, &spare), morph(&g, false, rows, &spare);
+    free(rows), free(spare);
+    rows = spare = NULL;
+    // Fill holes: everything not reachable from the border is inside.
+    lab = malloc(sizeof(int) * ncell), stack = malloc(sizeof(int) * ncell);
+    if (!lab || !stack || label(&g, 0, lab, stack, &sizes) < 0) goto oom;
     int border = lab[0]; // the corner cell is always empty (margin)
     for (size_t i = 0; i < ncell; ++i)
         g.c[i] = lab[i] != border;
     free(sizes);
     sizes = NULL;
     // Keep the largest inside region; refuse a silhouette in several big pieces.
-    int regions = label(&g, 1, lab, &sizes);
+    int regions = label(&g, 1, lab, stack, &sizes);
     if (regions < 0) goto oom;
     int best = 1, second = 0;
     long long total = 0;
@@ -426,8 +445,8 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     }
     for (size_t i = 0; i < ncell; ++i)
         g.c[i] = lab[i] == best;
-    free(sizes), free(lab);
-    sizes = NULL, lab = NULL;
+    free(sizes), free(lab), free(stack);
+    sizes = NULL, lab = NULL, stack = NULL;
 
     int n = 0;
     poly = trace(&g, &n);
@@ -568,6 +587,6 @@ done:
     if (res != SP_OK) sp_abstraction_free(out);
     free(cands), free(zv);
     free(tmp_skin), free(bound), free(nrm), free(acc), free(tmp), free(poly), free(cell), free(xy), free(lab), free(sizes),
-        free(g.c);
+        free(stack), free(rows), free(spare), free(g.c);
     return res;
 }
