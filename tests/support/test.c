@@ -1,9 +1,10 @@
 #include "test.h"
 
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdbool.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 int sp_test_failures = 0;
@@ -79,21 +80,30 @@ static int run_one(const sp_test* t)
     return sp_test_failures > before ? 1 : 0;
 }
 
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 int sp_test_run(int argc, char** argv, const sp_test* tests)
 {
     int ran = 0, failed = 0, skipped = 0;
     for (const sp_test* t = tests; t->name; ++t) {
         if (argc > 1 && !strstr(t->name, argv[1])) continue;
+        double t0 = now_s();
         int rc = run_one(t);
+        double took = now_s() - t0; // the suite's slow parts, for keeping CI in budget
         ++ran;
         if (rc == 2) {
             ++skipped;
             printf("SKIP %s: %s\n", t->name, sp_test_skip_reason);
         } else if (rc == 1) {
             ++failed;
-            printf("FAIL %s\n", t->name);
+            printf("FAIL %s (%.1f s)\n", t->name, took);
         } else {
-            printf("ok   %s\n", t->name);
+            printf("ok   %s (%.1f s)\n", t->name, took);
         }
         fflush(stdout);
     }

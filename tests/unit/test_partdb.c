@@ -155,19 +155,6 @@ static void file_sha(const char* path, char hex[65])
     free(b);
 }
 
-// A database with tail_a and wings_a (30 synthetic sketches each), trained.
-static const char* base_db(const char* name)
-{
-    const char* path = sp_test_tmp_path(name);
-    remove_db(path);
-    sp_db* db = open_ok(path, SP_DB_CREATE);
-    add_ok(db, 0, 30);
-    add_ok(db, 1, 30);
-    train_ok(db, -1, NULL);
-    sp_db_close(db);
-    return path;
-}
-
 static void copy_file(const char* from, const char* to)
 {
     FILE* a = fopen(from, "rb");
@@ -179,6 +166,32 @@ static void copy_file(const char* from, const char* to)
         ENSURE(fwrite(buf, 1, n, b) == n);
     fclose(a);
     ENSURE(fclose(b) == 0);
+}
+
+// A database with tail_a and wings_a (30 synthetic sketches each), trained,
+// as a fresh file `name`. Built once a run and copied: the build is the same
+// every time, and built anew for each of ten tests it cost the sanitizer
+// build minutes of CI.
+static const char* base_db(const char* name)
+{
+    static char built[1024];
+    if (!built[0]) {
+        const char* b = sp_test_tmp_path("base_built.db");
+        remove_db(b);
+        sp_db* db = open_ok(b, SP_DB_CREATE);
+        add_ok(db, 0, 30);
+        add_ok(db, 1, 30);
+        train_ok(db, -1, NULL);
+        sp_db_close(db);
+        char wal[1100];
+        snprintf(wal, sizeof wal, "%s-wal", b);
+        ENSURE(access(wal, F_OK) != 0); // closed whole: the one file holds it all
+        snprintf(built, sizeof built, "%s", b);
+    }
+    const char* path = sp_test_tmp_path(name);
+    remove_db(path);
+    copy_file(built, path);
+    return path;
 }
 
 static const char* sketchpose_bin(void)
