@@ -169,9 +169,8 @@ static void copy_file(const char* from, const char* to)
 }
 
 // A database with tail_a and wings_a (30 synthetic sketches each), trained,
-// as a fresh file `name`. Built once a run and copied: the build is the same
-// every time, and built anew for each of ten tests it cost the sanitizer
-// build minutes of CI.
+// as a fresh file `name`. Built once a run and copied: every case starts
+// from the same file, and the build is the slow part under the sanitizers.
 static const char* base_db(const char* name)
 {
     static char built[1024];
