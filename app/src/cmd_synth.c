@@ -139,8 +139,7 @@ done:
 }
 
 // --concepts: `per_part` concept sketches of each of the six parts (seeds
-// sp_handdraw_seed(sp_handdraw_part_family(family, category), i): family 1
-// gives the default database's own), into
+// sp_concept_seed: family 1 gives the default database's own), into
 // OUT/<category>/concept-s<family>-<i>.json and/or one contact sheet.
 static int synth_concepts(int per_part, uint64_t family, bool clean, const char* out_dir, const char* sheet)
 {
@@ -159,7 +158,7 @@ static int synth_concepts(int per_part, uint64_t family, bool clean, const char*
         snprintf(cdir, sizeof cdir, "%s/%s", out_dir ? out_dir : ".", sp_concept_name((sp_concept)c));
         if (out_dir && sp_dir_make(cdir, &err) != SP_OK) goto fail;
         for (int i = 0; i < per_part; ++i, ++made) {
-            uint64_t sd = sp_handdraw_seed(sp_handdraw_part_family(family, sp_concept_name((sp_concept)c)), i);
+            uint64_t sd = sp_concept_seed((sp_concept)c, family, i);
             sp_result r = clean ? sp_concept_clean((sp_concept)c, sd, &sk[made], &err) : sp_concept_sketch((sp_concept)c, sd, &sk[made], &err);
             if (r != SP_OK) goto fail;
             snprintf(labels[made], sizeof labels[made], "%s %d", sp_concept_name((sp_concept)c), i);

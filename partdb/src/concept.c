@@ -526,6 +526,11 @@ sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error
     return SP_OK;
 }
 
+uint64_t sp_concept_seed(sp_concept c, uint64_t family, int i)
+{
+    return sp_handdraw_seed(sp_handdraw_part_family(family, sp_concept_name(c)), (uint64_t)i);
+}
+
 sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err)
 {
     sp_sketch clean;

@@ -10,7 +10,6 @@
 
 #include "db_internal.h"
 #include "sp/concept.h"
-#include "sp/handdraw.h"
 #include "sp/math.h"
 
 sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
@@ -291,7 +290,7 @@ static bool is_kiosk_part(const char* file)
 }
 
 // Concept sketches (sp/concept.h) for every category of the stored parts that
-// has a concept, seeds sp_handdraw_seed(category's family from family_base, i): the designs
+// has a concept, seed family `family_base` (sp_concept_seed): the designs
 // visitors draw that the parts' own shapes do not cover.
 static sp_result add_concepts(sp_db* db, int per_category, int family_base, sp_error* err)
 {
@@ -303,9 +302,8 @@ static sp_result add_concepts(sp_db* db, int per_category, int family_base, sp_e
         if (c == SP_CONCEPT_COUNT) continue;
         sp_dataset ds;
         if ((r = db_dataset_one(&ds, cats[k], per_category, err)) != SP_OK) break;
-        uint64_t family = sp_handdraw_part_family((uint64_t)family_base, cats[k]);
         for (int i = 0; r == SP_OK && i < per_category; ++i) {
-            r = sp_concept_sketch(c, sp_handdraw_seed(family, i), &ds.samples[i].sketch, err);
+            r = sp_concept_sketch(c, sp_concept_seed(c, (uint64_t)family_base, i), &ds.samples[i].sketch, err);
             ds.samples[i].label = 0, ds.samples[i].index = i;
             ds.count = i + (r == SP_OK);
         }

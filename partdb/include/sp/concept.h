@@ -44,6 +44,11 @@ sp_concept sp_concept_parse(const char* category);
 #define SP_CONCEPT_CANVAS_W 1280.0
 #define SP_CONCEPT_CANVAS_H 800.0
 
+/// The seed of the i-th concept sketch of `c` in seed family `family`:
+/// sp_handdraw_seed(sp_handdraw_part_family(family, its name), i). Family 1
+/// is the default database's own; `db init --concept-family F` and `synth
+/// --concepts --seed F` draw the same sketches through it.
+uint64_t sp_concept_seed(sp_concept c, uint64_t family, int i);
 /// The clean drawing of the design of `seed`: one stroke, a closed one
 /// repeating its first point at the end, its bounding box 340 px across the
 /// diagonal, centred on the canvas. SP_ERR_INVALID for an unknown concept.
