@@ -1,5 +1,5 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
-//   visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all]
+//   visitors [--half tune|report|fresh] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all]
 //            [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
@@ -41,7 +41,8 @@
 // it onto the canvas). F >= 1 draws it whole through the UI. Printed: the
 // drawings that ended as one part, the right one; the right part among
 // others; only wrong parts; nothing.
-// Tune on --half tune (the default); report --half report.
+// Tune on --half tune (the default) and --half fresh (drawings made after
+// the split by other hands); report --half report.
 #include <dirent.h>
 #include <math.h>
 #include <stdio.h>
@@ -486,13 +487,14 @@ int main(int argc, char** argv)
         else if (!strcmp(argv[i], "--pause") && i + 1 < argc && atof(argv[i + 1]) >= 0)
             pause = atof(argv[++i]);
         else if (strcmp(argv[i], "--json") != 0) {
-            fprintf(stderr, "usage: visitors [--half tune|report] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                            "[--list] [--fit-all] [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]\n");
+            fprintf(stderr,
+                    "usage: visitors [--half tune|report|fresh] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
+                    "[--list] [--fit-all] [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]\n");
             return 2;
         }
     }
-    if (strcmp(half, "tune") != 0 && strcmp(half, "report") != 0) {
-        fprintf(stderr, "visitors: --half is tune or report\n");
+    if (strcmp(half, "tune") != 0 && strcmp(half, "report") != 0 && strcmp(half, "fresh") != 0) {
+        fprintf(stderr, "visitors: --half is tune, report or fresh\n");
         return 2;
     }
     char dir[1024];
@@ -657,7 +659,7 @@ int main(int argc, char** argv)
                    t_build);
         printf("\n]\n");
     } else {
-        printf("Visitors' drawings, %s half (%s), database %s\n", half, dir, db_path);
+        printf("Visitors' drawings, %s %s (%s), database %s\n", half, strcmp(half, "fresh") ? "half" : "set", dir, db_path);
         printf("%-12s %4s %14s %14s %14s %14s %14s\n", "part", "n", "right part", "refused", "wrong part", "top 3",
                "first guess");
 #define PCT(a, b) ((b) > 0 ? 100.0 * (a) / (b) : 0.0)

@@ -40,8 +40,11 @@
 // Output: <out>/<half>/<label>/<name>.json (sketchpose-strokes, one stroke,
 // canvas 1280 x 800), half = tune or report: within each label, the
 // hand-placed drawings alternate tune, report, tune, ... in file order, and so
-// do the Quick, Draw! ones (README.md there says the same). The contact
-// sheets <out>/tune.png and <out>/report.png show every drawing with its name.
+// do the Quick, Draw! ones (README.md there says the same). A drawing with
+// "fresh": true (made by other hands after the split, to tune on) goes to
+// <out>/fresh instead and takes no turn in the alternation. The contact
+// sheets <out>/tune.png, <out>/report.png and <out>/fresh.png show every
+// drawing with its name.
 #include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
@@ -352,7 +355,7 @@ static int write_training(const cJSON* root, const char* qd_dir, const char* out
 
 typedef struct counter {
     char label[64];
-    int hand, qd;
+    int hand, qd, fresh;
 } counter;
 
 int main(int argc, char** argv)
@@ -470,8 +473,14 @@ int main(int argc, char** argv)
             if (ncnt == 32) return 1;
             snprintf(cnt[ncnt++].label, sizeof cnt[0].label, "%s", label);
         }
-        int idx = qd ? cnt[c].qd++ : cnt[c].hand++;
-        const char* half = idx % 2 == 0 ? "tune" : "report";
+        // A fresh drawing keeps out of the alternation, so the two halves stay as they were split.
+        const char* half = "fresh";
+        if (cJSON_IsTrue(cJSON_GetObjectItem(d, "fresh"))) {
+            cnt[c].fresh++;
+        } else {
+            int idx = qd ? cnt[c].qd++ : cnt[c].hand++;
+            half = idx % 2 == 0 ? "tune" : "report";
+        }
         char dir[1024], file[1200];
         snprintf(dir, sizeof dir, "%s/%s/%s", out_dir, half, label);
         if (mkdirs(dir) != 0) {
@@ -490,8 +499,9 @@ int main(int argc, char** argv)
     }
     cJSON_Delete(root);
     // Contact sheets, labelled with the file names, label by label.
-    for (int h = 0; h < 2; ++h) {
-        const char* half = h ? "report" : "tune";
+    static const char *const halves[] = {"tune", "report", "fresh"}, *const names[] = {"tune half", "report half", "fresh set"};
+    for (int h = 0; h < 3; ++h) {
+        const char* half = halves[h];
         sp_sheet_item items[512];
         static char labels[512][96];
         static sp_sketch sketches[512];
@@ -517,8 +527,7 @@ int main(int argc, char** argv)
         }
         char file[1100], title[192];
         snprintf(file, sizeof file, "%s/%s.png", out_dir, half);
-        snprintf(title, sizeof title, "visitors' drawings, %s half: %d drawings%s", half, n,
-                 skipped ? ", hand-placed only" : "");
+        snprintf(title, sizeof title, "visitors' drawings, %s: %d drawings%s", names[h], n, skipped ? ", hand-placed only" : "");
         sp_error err = {0};
         if (n > 0 && sp_sheet_write_png(items, n, &(sp_sheet_desc){.cell = 130, .cols = 12, .title = title}, file, &err) != SP_OK) {
             fprintf(stderr, "%s\n", err.text);
@@ -529,7 +538,8 @@ int main(int argc, char** argv)
     }
     printf("{\"written\": %d, \"quickdraw_left_out\": %d, \"labels\": {", written, skipped);
     for (int c = 0; c < ncnt; ++c)
-        printf("%s\"%s\": {\"hand\": %d, \"quickdraw\": %d}", c ? ", " : "", cnt[c].label, cnt[c].hand, cnt[c].qd);
+        printf("%s\"%s\": {\"hand\": %d, \"quickdraw\": %d, \"fresh\": %d}", c ? ", " : "", cnt[c].label, cnt[c].hand, cnt[c].qd,
+               cnt[c].fresh);
     printf("}}\n");
     return 0;
 }
