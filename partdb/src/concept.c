@@ -275,7 +275,7 @@ static void tail_end(path* P, sp_rng* r, int kind, sp_vec2 o, sp_vec2 u, double 
 static void tail(path* P, sp_rng* r)
 {
     enum { N = 40 };
-    double len = 2.5, amp = U(r, 0.0, 0.35), freq = U(r, 0.4, 1.6), ph = U(r, 0, 2 * M_PI), droop = U(r, -0.6, 0.8);
+    double len = U(r, 1.4, 2.8), amp = U(r, 0.0, 0.35), freq = U(r, 0.4, 1.6), ph = U(r, 0, 2 * M_PI), droop = U(r, -1.1, 1.3);
     sp_vec2 c[N + 1], nrm[N + 1];
     for (int i = 0; i <= N; ++i) {
         double s = (double)i / N;
@@ -296,7 +296,7 @@ static void tail(path* P, sp_rng* r)
         tail_end(P, r, end, c[N], u, es);
         return;
     }
-    double w0 = U(r, 0.12, 0.3), pw = U(r, 0.6, 1.4), wmin = end ? 0.04 : 0.0;
+    double w0 = U(r, 0.12, 0.42), pw = U(r, 0.6, 1.4), wmin = end ? 0.04 : 0.0;
     bool spiky = chance(r, 0.3), closed = chance(r, 0.5);
     int spike_from = N / 8, spike_step = 3 + (int)U(r, 0, 3);
     double spike_h = U(r, 0.1, 0.2);
