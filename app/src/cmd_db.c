@@ -131,7 +131,7 @@ static int db_init(int argc, char** argv)
     db_common c = {0};
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
-    int synth = 0, concepts = 0, concept_family = 1, folds = 0;
+    int synth = 0, concepts = 0, concept_family = 1, drawings = 0, folds = 0;
     bool no_train = false;
     clf_cli_opts o = {0};
     sp_opt opts[] = {
@@ -144,6 +144,9 @@ static int db_init(int argc, char** argv)
         {"--concept-family", SP_OPT_INT, &concept_family, "F",
          "seed family of the concept sketches (default 1; another family is another draw of the same designs, as `synth "
          "--concepts --seed F`)",
+         false},
+        {"--drawings", SP_OPT_INT, &drawings, "N",
+         "draws of each hand-placed design of assets/sketches/drawings.json (default 1, -1 none; seed family --concept-family)",
          false},
         {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
          "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder "
@@ -159,8 +162,8 @@ static int db_init(int argc, char** argv)
                    "export folder",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000) {
-        fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000\n", cmd);
+    if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000 || drawings < -1 || drawings > 100) {
+        fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000, --drawings -1 to 100\n", cmd);
         return SP_EXIT_USAGE;
     }
     if (concept_family < 1 || concept_family > 1000000) {
@@ -188,6 +191,7 @@ static int db_init(int argc, char** argv)
                                  &(sp_db_default_desc){.synth_per_part = synth,
                                                        .concepts_per_category = concepts,
                                                        .concept_family = concept_family,
+                                                       .drawn_per_design = drawings,
                                                        .quickdraw_dir = quickdraw,
                                                        .train = td},
                                  &err);

@@ -1,7 +1,8 @@
 // sketchpose synth: strokes of a random pose within bounds (tests, training);
 // with --style, passed through the hand-drawing model; with --parts DIR, a
 // labelled folder of hand-drawn sketches of every part in DIR; with
-// --concepts, the default recipe's concept sketches (sp/concept.h).
+// --concepts, the default recipe's concept sketches (sp/concept.h); with
+// --drawings, its draws of the hand-placed designs (sp_db_drawn_sketches).
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,8 +15,9 @@
 #include "sp/gltf.h"
 #include "sp/handdraw.h"
 #include "sp/math.h"
-#include "sp/sketch_sheet.h"
+#include "sp/partdb.h"
 #include "sp/sketch_io.h"
+#include "sp/sketch_sheet.h"
 #include "sp/synth.h"
 
 static bool has_opt(int argc, char** argv, const char* name)
@@ -186,6 +188,45 @@ done:
     return code;
 }
 
+// --drawings: `per_design` draws of each design of assets/sketches/drawings.json
+// (family: the default database's own is 1) as one contact sheet.
+static int synth_drawings(int per_design, uint64_t family, const char* sheet)
+{
+    char assets[1024];
+    snprintf(assets, sizeof assets, "%s/assets", SP_SOURCE_DIR);
+    sp_error err = {0};
+    sp_dataset ds;
+    int designs = 0;
+    if (sp_db_drawn_sketches(assets, per_design, family, &ds, &designs, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose synth: %s\n", err.text);
+        return SP_EXIT_INPUT;
+    }
+    int code = SP_EXIT_OK;
+    sp_sheet_item* items = calloc((size_t)(ds.count ? ds.count : 1), sizeof *items);
+    char(*labels)[48] = calloc((size_t)(ds.count ? ds.count : 1), sizeof *labels);
+    if (!items || !labels) {
+        sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
+        code = SP_EXIT_INPUT;
+    }
+    for (int i = 0; code == SP_EXIT_OK && i < ds.count; ++i) {
+        snprintf(labels[i], sizeof labels[i], "%s %d", ds.categories[ds.samples[i].label], ds.samples[i].index);
+        items[i] = (sp_sheet_item){.sketch = &ds.samples[i].sketch, .label = labels[i]};
+    }
+    char title[96];
+    snprintf(title, sizeof title, "hand-placed designs, %d draws each, seed family %llu", per_design, (unsigned long long)family);
+    if (code == SP_EXIT_OK &&
+        sp_sheet_write_png(items, ds.count, &(sp_sheet_desc){.cols = 12, .title = title}, sheet, &err) != SP_OK)
+        code = SP_EXIT_INPUT;
+    if (code == SP_EXIT_OK)
+        printf("{\"designs\": %d, \"sketches\": %d, \"seed\": %llu}\n", designs, ds.count, (unsigned long long)family);
+    else
+        fprintf(stderr, "sketchpose synth: %s\n", err.text);
+    free(items);
+    free(labels);
+    sp_dataset_free(&ds);
+    return code;
+}
+
 int cmd_synth(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *out = NULL, *truth = NULL, *size = NULL, *pose = NULL;
@@ -193,7 +234,7 @@ int cmd_synth(int argc, char** argv)
     const char *shape_name = NULL, *sheet = NULL;
     int seed = 0, per_part = 60;
     double amplitude = 0.7853981633974483, noise = 0, spikes = 0;
-    bool details = false, concepts = false;
+    bool details = false, concepts = false, drawings = false;
     const sp_opt opts[] = {
         {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
@@ -225,7 +266,11 @@ int cmd_synth(int argc, char** argv)
          "the default recipe's concept sketches of the six dragon parts (designs of its own, not the parts' shapes), "
          "--per-part each (--style normal, the default, or clean), into --out-dir D/<category>/ and/or --sheet",
          false},
-        {"--sheet", SP_OPT_STRING, &sheet, "S.png", "with --concepts: a labelled contact sheet of them", false},
+        {"--drawings", SP_OPT_FLAG, &drawings, "",
+         "the default recipe's draws of the hand-placed designs of assets/sketches/drawings.json, --per-part draws of each "
+         "(default 1), as --sheet",
+         false},
+        {"--sheet", SP_OPT_STRING, &sheet, "S.png", "with --concepts or --drawings: a labelled contact sheet of them", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose synth",
                           "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "
@@ -237,6 +282,16 @@ int cmd_synth(int argc, char** argv)
     if (style_name && (style = sp_handdraw_style_parse(style_name)) == SP_HANDDRAW_STYLE_COUNT) {
         fprintf(stderr, "sketchpose synth: --style must be normal, harsh or clean, got '%s'\n", style_name);
         return SP_EXIT_USAGE;
+    }
+    if (drawings) {
+        int per = has_opt(argc, argv, "--per-part") ? per_part : SP_DB_DRAWN_DEFAULT;
+        if (concepts || parts || rig_path || out || pose || truth || size || out_dir || !sheet || per < 1 || per > 100 ||
+            seed < 0) {
+            fprintf(stderr, "sketchpose synth: --drawings needs --sheet S.png, takes --per-part 1..100 and --seed F, and none of "
+                            "--concepts, --parts, --rig, --out, --out-dir, --pose, --truth, --size\n");
+            return SP_EXIT_USAGE;
+        }
+        return synth_drawings(per, (uint64_t)(seeded ? seed : 1), sheet);
     }
     if (concepts) {
         if (parts || rig_path || out || pose || truth || size || (!out_dir && !sheet)) {

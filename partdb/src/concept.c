@@ -509,20 +509,31 @@ sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error
     default: break;
     }
     // Facing, a tilt up to 17 degrees, a bounding-box diagonal of 340 px, centred on the canvas.
-    double mirror = chance(&r, 0.5) ? -1 : 1, turn = U(&r, -0.3, 0.3), cs = cos(turn), sn = sin(turn);
+    double mirror = chance(&r, 0.5) ? -1 : 1, turn = U(&r, -0.3, 0.3);
+    sp_result res = sp_concept_place(P.p, P.n, mirror, turn, out, err);
+    if (res == SP_ERR_INVALID)
+        return sp_fail(err, SP_ERR_INTERNAL, "concept %s: empty design (seed %llu)", k_names[c], (unsigned long long)seed);
+    return res;
+}
+
+sp_result sp_concept_place(sp_vec2* p, int n, double mirror, double turn, sp_sketch* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    double cs = cos(turn), sn = sin(turn);
     sp_vec2 lo = {INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY};
-    for (int i = 0; i < P.n; ++i) {
-        sp_vec2 q = {mirror * P.p[i].x, P.p[i].y};
-        P.p[i] = (sp_vec2){q.x * cs - q.y * sn, q.x * sn + q.y * cs};
-        lo.x = fmin(lo.x, P.p[i].x), lo.y = fmin(lo.y, P.p[i].y), hi.x = fmax(hi.x, P.p[i].x), hi.y = fmax(hi.y, P.p[i].y);
+    for (int i = 0; i < n; ++i) {
+        sp_vec2 q = {mirror * p[i].x, p[i].y};
+        p[i] = (sp_vec2){q.x * cs - q.y * sn, q.x * sn + q.y * cs};
+        lo.x = fmin(lo.x, p[i].x), lo.y = fmin(lo.y, p[i].y), hi.x = fmax(hi.x, p[i].x), hi.y = fmax(hi.y, p[i].y);
     }
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
-    if (P.n < 2 || !(diag > 0)) return sp_fail(err, SP_ERR_INTERNAL, "concept %s: empty design (seed %llu)", k_names[c], (unsigned long long)seed);
+    if (n < 2 || !(diag > 0)) return sp_fail(err, SP_ERR_INVALID, "a design with no extent");
     double s = 340 / diag;
-    for (int i = 0; i < P.n; ++i)
-        P.p[i] = (sp_vec2){SP_CONCEPT_CANVAS_W / 2 + (P.p[i].x - (lo.x + hi.x) / 2) * s, SP_CONCEPT_CANVAS_H / 2 + (P.p[i].y - (lo.y + hi.y) / 2) * s};
+    for (int i = 0; i < n; ++i)
+        p[i] = (sp_vec2){SP_CONCEPT_CANVAS_W / 2 + (p[i].x - (lo.x + hi.x) / 2) * s,
+                         SP_CONCEPT_CANVAS_H / 2 + (p[i].y - (lo.y + hi.y) / 2) * s};
     out->canvas_w = SP_CONCEPT_CANVAS_W, out->canvas_h = SP_CONCEPT_CANVAS_H;
-    if (sp_sketch_add_stroke(out, P.p, NULL, P.n) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    if (sp_sketch_add_stroke(out, p, NULL, n) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     return SP_OK;
 }
 

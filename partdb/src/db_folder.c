@@ -340,6 +340,14 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
             r = sp_db_add_sketches(db, &human, NULL, SP_DB_SOURCE_CURATED, "assets", NULL, err);
         sp_dataset_free(&human);
     }
+    int ndrawn = c->d.drawn_per_design == 0 ? SP_DB_DRAWN_DEFAULT : c->d.drawn_per_design;
+    if (r == SP_OK && ndrawn > 0) {
+        sp_dataset drawn;
+        uint64_t family = c->d.concept_family > 0 ? (uint64_t)c->d.concept_family : 1;
+        if ((r = sp_db_drawn_sketches(c->assets, ndrawn, family, &drawn, NULL, err)) == SP_OK && drawn.count > 0)
+            r = sp_db_add_sketches(db, &drawn, NULL, SP_DB_SOURCE_SYNTHETIC, "drawings", NULL, err);
+        sp_dataset_free(&drawn);
+    }
     if (r == SP_OK) {
         sp_db_train_desc td = c->d.train;
         if (!td.by) td.by = "assets";

@@ -68,6 +68,11 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
 sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* unused, int* kiosk, sp_error* err);
 /// A dataset of one category and n zeroed samples (count 0: the caller fills them in and counts).
 sp_result db_dataset_one(sp_dataset* out, const char* category, int n, sp_error* err);
+/// A dataset with no samples whose categories are the distinct string values
+/// of `key` over the objects of the JSON array `items`, sorted (as a labelled
+/// folder gives them). An item without a non-empty string there: SP_ERR_PARSE,
+/// *bad its index (from 0), err untouched, for the caller to name it.
+sp_result db_dataset_labels(const cJSON* items, const char* key, sp_dataset* out, int* bad, sp_error* err);
 /// Synthetic sketches of a part (amplitude 0: the default), label 0 in a one-category dataset.
 sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out, sp_error* err);
 

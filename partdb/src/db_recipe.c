@@ -12,6 +12,7 @@
 
 #include "db_internal.h"
 #include "sp/handdraw.h"
+#include "sp/math.h"
 
 // Pose amplitudes (radians): a visibly posed part, and the whole of its bounds.
 #define AMPLITUDE_NEAR 0.4
@@ -47,6 +48,33 @@ sp_result db_dataset_one(sp_dataset* out, const char* category, int n, sp_error*
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     }
     return SP_OK;
+}
+
+sp_result db_dataset_labels(const cJSON* items, const char* key, sp_dataset* out, int* bad, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    int n = cJSON_GetArraySize(items), ncat = 0;
+    const char** cats = calloc((size_t)(n ? n : 1), sizeof *cats);
+    if (!cats) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    sp_result r = SP_OK;
+    for (int i = 0; i < n; ++i) {
+        const char* c = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(items, i), key));
+        if (!c || !*c) {
+            *bad = i;
+            r = SP_ERR_PARSE;
+            break;
+        }
+        int k = 0;
+        while (k < ncat && strcmp(cats[k], c) != 0)
+            ++k;
+        if (k == ncat) cats[ncat++] = c;
+    }
+    if (r == SP_OK) qsort(cats, (size_t)ncat, sizeof *cats, sp_cmp_cstr);
+    for (int k = 0; r == SP_OK && k < ncat; ++k)
+        if (sp_dataset_add_category(out, cats[k]) < 0) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    free(cats);
+    if (r != SP_OK) sp_dataset_free(out);
+    return r;
 }
 
 sp_result db_synth_sketches(const sp_character* ch, int abstraction, int n, uint64_t seed, double amplitude, sp_dataset* out,

@@ -128,33 +128,16 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
     }
     const cJSON* picks = cJSON_GetObjectItemCaseSensitive(root, "picks");
     // Categories sorted, as a labelled folder would give them; strokes in the file's order.
-    int n = cJSON_GetArraySize(picks);
-    const char** cats = calloc((size_t)(n ? n : 1), sizeof *cats);
-    int ncat = 0;
-    if (!cats) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", assets_dir);
+    sp_dataset ds;
+    int bad = 0;
+    r = db_dataset_labels(picks, "category", &ds, &bad, err);
+    if (r == SP_ERR_PARSE) sp_fail(err, r, "%s/sketches/picks.json: a pick without \"category\"", assets_dir);
     const cJSON* p;
-    cJSON_ArrayForEach(p, picks)
-    {
-        if (r != SP_OK) break;
-        const char* c = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category"));
-        if (!c || !*c) {
-            r = sp_fail(err, SP_ERR_PARSE, "%s/sketches/picks.json: a pick without \"category\"", assets_dir);
-            break;
-        }
-        int k = 0;
-        while (k < ncat && strcmp(cats[k], c) != 0)
-            ++k;
-        if (k == ncat) cats[ncat++] = c;
-    }
-    if (r == SP_OK) qsort(cats, (size_t)ncat, sizeof *cats, sp_cmp_cstr);
-    sp_dataset ds = {0};
-    for (int k = 0; r == SP_OK && k < ncat; ++k)
-        if (sp_dataset_add_category(&ds, cats[k]) < 0) r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", assets_dir);
     data_file f = {.text = NULL};
-    for (int k = 0; r == SP_OK && k < ncat; ++k) {
+    for (int k = 0; r == SP_OK && k < ds.category_count; ++k) {
         cJSON_ArrayForEach(p, picks)
         {
-            if (strcmp(cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category")), cats[k]) != 0) continue;
+            if (strcmp(cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "category")), ds.categories[k]) != 0) continue;
             const char* file = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "file"));
             const char* key = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(p, "key_id"));
             const cJSON* line = cJSON_GetObjectItemCaseSensitive(p, "line");
@@ -178,7 +161,6 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
         }
     }
     free(f.text);
-    free(cats);
     cJSON_Delete(root);
     if (r != SP_OK) sp_dataset_free(&ds);
     else *out = ds;

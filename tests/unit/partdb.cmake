@@ -2,7 +2,7 @@
 # header for the test hook and helpers, and drives `sketchpose db` for the
 # command-line cases (skipped when the app is not built).
 find_package(SQLite3 REQUIRED)
-sp_unit_test(partdb LIBS sp::partdb SQLite::SQLite3 TIMEOUT 600)
+sp_unit_test(partdb LIBS sp::partdb SQLite::SQLite3 PkgConfig::CJSON TIMEOUT 600)
 target_include_directories(test_partdb PRIVATE ${PROJECT_SOURCE_DIR}/partdb/src)
 if(TARGET sketchpose)
   add_dependencies(test_partdb sketchpose)

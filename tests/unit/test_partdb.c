@@ -905,6 +905,150 @@ static void test_people_strokes(void)
     sp_dataset_free(&ds);
 }
 
+// Whether two sketches have the same points.
+static bool same_sketch(const sp_sketch* a, const sp_sketch* b)
+{
+    if (a->stroke_count != b->stroke_count) return false;
+    for (int k = 0; k < a->stroke_count; ++k) {
+        if (a->strokes[k].count != b->strokes[k].count) return false;
+        for (int j = 0; j < a->strokes[k].count; ++j)
+            if (a->strokes[k].points[j].x != b->strokes[k].points[j].x || a->strokes[k].points[j].y != b->strokes[k].points[j].y)
+                return false;
+    }
+    return true;
+}
+
+#define DRAWN_FIXTURE                                                                                                            \
+    "{\"name\": \"t-wave\", \"label\": \"tail\", \"closed\": false, \"points\": [[0, 50], [20, 40], [40, 60], [60, 40], [80, "   \
+    "60], "                                                                                                                      \
+    "[95, 45], [95, 45], [100, 55]]}, "                                                                                          \
+    "{\"name\": \"h-box\", \"label\": \"head\", \"closed\": true, \"points\": [[10, 90], [15, 40], [40, 20], [70, 25], [95, "    \
+    "40], "                                                                                                                      \
+    "[95, 40], [90, 55], [60, 60], [40, 70], [35, 90]]}, "                                                                       \
+    "{\"name\": \"t-hook\", \"label\": \"tail\", \"points\": [[0, 10], [50, 20], [90, 60], [70, 90], [60, 70]]}"
+
+// The hand-placed designs of the default recipe (assets/sketches/drawings.json):
+// order, seeds by name, checks, and the project's own file kept apart from
+// the visitors' evaluation set.
+static void test_drawn_sketches(void)
+{
+    char root[1024], assets[1100], f[1200];
+    snprintf(root, sizeof root, "%s", sp_test_tmp_path("drawn"));
+    snprintf(assets, sizeof assets, "%s/assets", root);
+    char cmd[2400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s/sketches'", root, assets);
+    ENSURE(system(cmd) == 0);
+    snprintf(f, sizeof f, "%s/sketches/drawings.json", assets);
+    sp_dataset ds, again, other;
+    sp_error err = {0};
+    int designs = -1;
+    // No file: nothing to add.
+    ENSURE(sp_db_drawn_sketches(assets, 3, 1, &ds, &designs, &err) == SP_OK && ds.count == 0 && designs == 0);
+    put_text(f, "{\"drawings\": [" DRAWN_FIXTURE "]}");
+    ENSURE(sp_db_drawn_sketches(assets, 0, 1, &ds, &designs, &err) == SP_OK && ds.count == 0);
+    ENSURE(sp_db_drawn_sketches(assets, 4, 1, &ds, &designs, &err) == SP_OK && designs == 3);
+    // Categories sorted; the file's order within each; every draw a stroke of concept-sketch size on the kiosk's canvas.
+    ENSURE(ds.count == 12 && ds.category_count == 2 && !strcmp(ds.categories[0], "head") && !strcmp(ds.categories[1], "tail"));
+    for (int i = 0; i < 12; ++i) {
+        const sp_sketch* s = &ds.samples[i].sketch;
+        ENSURE(ds.samples[i].label == (i >= 4 && i < 8 ? 0 : 1));
+        ENSURE(s->stroke_count >= 1 && s->canvas_w == SP_CONCEPT_CANVAS_W && s->canvas_h == SP_CONCEPT_CANVAS_H);
+        double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+        for (int k = 0; k < s->stroke_count; ++k)
+            for (int j = 0; j < s->strokes[k].count; ++j) {
+                sp_vec2 p = s->strokes[k].points[j];
+                ENSURE(isfinite(p.x) && isfinite(p.y));
+                lo[0] = fmin(lo[0], p.x), lo[1] = fmin(lo[1], p.y), hi[0] = fmax(hi[0], p.x), hi[1] = fmax(hi[1], p.y);
+            }
+        double diag = hypot(hi[0] - lo[0], hi[1] - lo[1]);
+        ENSURE(diag > 220 && diag < 480 && fabs((lo[0] + hi[0]) / 2 - 640) < 150 && fabs((lo[1] + hi[1]) / 2 - 400) < 150);
+    }
+    // Draws of one design differ; the same family draws the same bits; another family others.
+    ENSURE(!same_sketch(&ds.samples[0].sketch, &ds.samples[1].sketch));
+    ENSURE(sp_db_drawn_sketches(assets, 4, 1, &again, NULL, &err) == SP_OK && again.count == 12);
+    ENSURE(sp_db_drawn_sketches(assets, 4, 2, &other, NULL, &err) == SP_OK && other.count == 12);
+    for (int i = 0; i < 12; ++i) {
+        ENSURE(same_sketch(&ds.samples[i].sketch, &again.samples[i].sketch));
+        ENSURE(!same_sketch(&ds.samples[i].sketch, &other.samples[i].sketch));
+    }
+    sp_dataset_free(&again);
+    sp_dataset_free(&other);
+    // A design's draws depend on its name, not its place: one added first leaves the others' as they were.
+    put_text(f,
+             "{\"drawings\": [{\"name\": \"new\", \"label\": \"tail\", \"points\": [[0, 0], [100, 100]]}, " DRAWN_FIXTURE "]}");
+    ENSURE(sp_db_drawn_sketches(assets, 4, 1, &again, &designs, &err) == SP_OK && again.count == 16 && designs == 4);
+    for (int i = 0; i < 8; ++i)
+        ENSURE(same_sketch(&ds.samples[i].sketch, &again.samples[4 + i].sketch));
+    sp_dataset_free(&again);
+    sp_dataset_free(&ds);
+    // Malformed: one line naming the file (and the design), nothing returned.
+    struct {
+        const char* text;
+        const char* says;
+    } bad[] = {
+        {"{\"drawings\": 3}", "drawings.json: not a drawings file"},
+        {"[1, 2]", "drawings.json: not a drawings file"},
+        {"{\"drawings\": [{\"label\": \"tail\", \"points\": [[0, 0], [1, 1]]}]}", "drawings.json: drawing 1: wants"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"points\": [[0, 0]]}]}", "drawing 1: wants"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"closed\": 1, \"points\": [[0, 0], [1, 1]]}]}",
+         "drawing 1: wants"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"\", \"points\": [[0, 0], [1, 1]]}]}", "drawing 1: wants"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"points\": [[0, 0], [1, \"y\"]]}]}", "drawing \"a\": point 2"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"points\": [[0, 0], [1, 1, 1]]}]}", "drawing \"a\": point 2"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"points\": [[0, 0], [1e9, 1]]}]}", "drawing \"a\": point 2"},
+        {"{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"points\": [[5, 5], [5, 5], [5, 5]]}]}",
+         "drawing \"a\": its points have no extent"},
+        {"{\"drawings\": [", "drawings.json"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        put_text(f, bad[i].text);
+        memset(&err, 0, sizeof err);
+        sp_result r = sp_db_drawn_sketches(assets, 2, 1, &ds, NULL, &err);
+        if (r == SP_OK || !strstr(err.text, bad[i].says)) fprintf(stderr, "  case %zu: %d %s\n", i, r, err.text);
+        ENSURE(r != SP_OK && strstr(err.text, bad[i].says) && ds.count == 0);
+    }
+    char many[12000];
+    int at = snprintf(many, sizeof many, "{\"drawings\": [{\"name\": \"a\", \"label\": \"tail\", \"points\": [");
+    for (int i = 0; i < 300; ++i)
+        at += snprintf(many + at, sizeof many - (size_t)at, "%s[%d, %d]", i ? ", " : "", i % 100, i / 3);
+    snprintf(many + at, sizeof many - (size_t)at, "]}]}");
+    put_text(f, many);
+    ENSURE(sp_db_drawn_sketches(assets, 2, 1, &ds, NULL, &err) == SP_ERR_PARSE && strstr(err.text, "drawing 1: wants"));
+
+    // The project's own designs: the six parts, names unique, none of them a drawing of the visitors' evaluation set.
+    ENSURE(sp_db_drawn_sketches(sp_test_src_path("assets"), 1, 1, &ds, &designs, &err) == SP_OK);
+    fprintf(stderr, "  assets/sketches/drawings.json: %d designs in %d categories\n", designs, ds.category_count);
+    ENSURE(ds.category_count == SP_CONCEPT_COUNT && designs >= 20 * SP_CONCEPT_COUNT);
+    for (int k = 0; k < ds.category_count; ++k)
+        ENSURE(sp_concept_parse(ds.categories[k]) != SP_CONCEPT_COUNT);
+    sp_dataset_free(&ds);
+    cJSON *mine = NULL, *theirs = NULL;
+    char path[1200];
+    snprintf(path, sizeof path, "%s", sp_test_src_path("assets/sketches/drawings.json"));
+    ENSURE(db_read_json(path, &mine, &err) == SP_OK);
+    snprintf(path, sizeof path, "%s", sp_test_src_path("tests/data/visitors/designs.json"));
+    ENSURE(db_read_json(path, &theirs, &err) == SP_OK);
+    const cJSON *a, *b;
+    cJSON_ArrayForEach(a, cJSON_GetObjectItemCaseSensitive(mine, "drawings"))
+    {
+        const char* name = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(a, "name"));
+        char* pa = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(a, "points"));
+        ENSURE(name && pa);
+        for (const cJSON* c = a->next; c; c = c->next)
+            ENSURE(strcmp(name, cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(c, "name"))) != 0);
+        cJSON_ArrayForEach(b, cJSON_GetObjectItemCaseSensitive(theirs, "drawings"))
+        {
+            char* pb = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(b, "points"));
+            if (pb && !strcmp(pa, pb)) fprintf(stderr, "  %s is an evaluation drawing\n", name);
+            ENSURE(!pb || strcmp(pa, pb) != 0);
+            cJSON_free(pb);
+        }
+        cJSON_free(pa);
+    }
+    cJSON_Delete(mine);
+    cJSON_Delete(theirs);
+}
+
 // An assets folder of three fixture parts (tail, wings, horns) and the
 // people's strokes that its picks.json names (two tails and a horn), in the
 // temporary folder `name`; returns that folder.
@@ -1289,6 +1433,7 @@ int main(int argc, char** argv)
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
                                    {"people_strokes", test_people_strokes},
+                                   {"drawn_sketches", test_drawn_sketches},
                                    {"default_db", test_default_db},
                                    {"default_db_cli", test_default_db_cli},
                                    {"kiosk_collect", test_kiosk_collect},

@@ -495,8 +495,8 @@ static bool turns_onto_itself(const sp_vec2* pts, int n)
 // what is clearly not a part, in two halves. Before the fit
 // (refused_before_fit): scribbles, and regular polygons or stars. After it
 // (kiosk_refuses): strokes far from every part. Taps and tiny strokes never
-// get here. Constants tuned on the tune half of tests/data/visitors
-// (BENCHMARKS.md, "Visitors' drawings").
+// get here. Constants tuned on the tune half and the fresh set of
+// tests/data/visitors (BENCHMARKS.md, "Visitors' drawings").
 
 // A scribble (far more ink than its size, or crossing itself over and over)
 // or a shape with a polygon's or a star's symmetry.
@@ -533,7 +533,7 @@ static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bo
     // tree, a sun). Bodies and leg pairs are left out: a visitor's
     // oval or humped body and a neat pair of legs are symmetric too.
     double sym = profile ? fmax(0.0, MIRROR_GAP_SYMMETRIC - mirror_gap(pts, n)) : 0.0;
-    return near + 6.0 * fit + MIRROR_WEIGHT * sym > 1.26;
+    return near + 6.0 * fit + MIRROR_WEIGHT * sym > 1.23;
 }
 
 // The stroke path's decision: the classifier's answer becomes a category

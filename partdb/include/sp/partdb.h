@@ -311,12 +311,15 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
 /// the same designs, to measure a recipe over several draws), the people's
 /// strokes that assets_dir/sketches/picks.json names (sp_db_people_strokes;
 /// built without them when the Quick, Draw! folder is not there and
-/// `quickdraw_dir` is NULL), and a trained model. Creates `path`; refuses an
-/// existing file.
+/// `quickdraw_dir` is NULL), `drawn_per_design` sketches of each design of
+/// assets_dir/sketches/drawings.json (sp_db_drawn_sketches; 0:
+/// SP_DB_DRAWN_DEFAULT; -1: none; family `concept_family`), and a trained
+/// model. Creates `path`; refuses an existing file.
 typedef struct sp_db_default_desc {
     int synth_per_part;
     int concepts_per_category;
     int concept_family;
+    int drawn_per_design;
     const char* quickdraw_dir; ///< NULL: the folder picks.json names
     sp_db_train_desc train;
 } sp_db_default_desc;
@@ -333,6 +336,21 @@ sp_result sp_db_create_default(const char* path, const char* assets_dir, const s
 /// the data does not have (no such line or stroke, another key_id) is an
 /// error naming the file and line.
 sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir, sp_dataset* out, bool* missing, sp_error* err);
+/// Draws of each hand-placed design in the default database.
+#define SP_DB_DRAWN_DEFAULT 1
+/// The parts as other people designed them: assets_dir/sketches/drawings.json,
+/// `{"drawings": [{"name", "label", "closed": bool, "points": [[x, y]...]}...]}`
+/// (control points in the order drawn, in a 100 x 100 box, y down; a point
+/// written twice is a corner). Each design is drawn `per_design` times as one
+/// stroke: its control points moved a little, stretched, mirrored or not,
+/// tilted, joined by a centripetal Catmull-Rom spline, scaled and centred as a
+/// concept sketch, and passed through the hand-drawing model (normal style),
+/// seeded by `family` and the design's name. *out gets the labels as
+/// categories, sorted, and the sketches in the file's order; *designs (may be
+/// NULL) the designs read. No drawings.json, or per_design <= 0: an empty set.
+/// A malformed file or design is an error naming the file (and the design).
+sp_result sp_db_drawn_sketches(const char* assets_dir, int per_design, uint64_t family, sp_dataset* out, int* designs,
+                               sp_error* err);
 /// What sp_db_people_strokes would read, from picks.json alone (the data is not
 /// read): *picks, the strokes it names, and *missing, whether the data's
 /// folder is not there (SP_ERR_IO when `quickdraw_dir` names one that is not).
