@@ -1,6 +1,7 @@
 // drawn.c: the parts as other hands designed them (sp_db_drawn_sketches in
 // sp/partdb.h): hand-placed control points in assets/sketches/drawings.json,
-// each design drawn several times by the project's hand-drawing model.
+// each design drawn (once in the default recipe) by the project's hand-drawing
+// model.
 //
 // The concept grammar (concept.c) is one author's idea of each part, however
 // many seeds it takes; these are many people's ideas, one design each. They
