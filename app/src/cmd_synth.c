@@ -213,7 +213,8 @@ static int synth_drawings(int per_design, uint64_t family, const char* sheet)
         items[i] = (sp_sheet_item){.sketch = &ds.samples[i].sketch, .label = labels[i]};
     }
     char title[96];
-    snprintf(title, sizeof title, "hand-placed designs, %d draws each, seed family %llu", per_design, (unsigned long long)family);
+    snprintf(title, sizeof title, "hand-placed designs, draws of each: %d, seed family %llu", per_design,
+             (unsigned long long)family);
     if (code == SP_EXIT_OK &&
         sp_sheet_write_png(items, ds.count, &(sp_sheet_desc){.cols = 12, .title = title}, sheet, &err) != SP_OK)
         code = SP_EXIT_INPUT;

@@ -610,6 +610,22 @@ static void test_cli_synth_concepts(void)
     // The default database's count of them: a bad one is bad usage, before anything is built.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/never.db' --concepts 20000 2>/dev/null", bin, out);
     ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/never.db' --drawings 101 2>/dev/null", bin, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    // The hand-placed designs' draws as a sheet: one line of JSON naming how many; a sheet is required.
+    snprintf(cmd, sizeof cmd, "'%s' synth --drawings --per-part 2 --seed 3 --sheet '%s/drawn.png'", bin, out);
+    FILE* pipe = popen(cmd, "r");
+    char line[256] = "";
+    ENSURE(pipe && fgets(line, sizeof line, pipe) && pclose(pipe) == 0);
+    int designs = 0, sketches = 0;
+    ENSURE(sscanf(line, "{\"designs\": %d, \"sketches\": %d", &designs, &sketches) == 2 && designs >= 120 &&
+           sketches == 2 * designs);
+    snprintf(png, sizeof png, "%s/drawn.png", out);
+    ENSURE(stat(png, &st) == 0 && st.st_size > 1000);
+    snprintf(cmd, sizeof cmd, "'%s' synth --drawings 2>/dev/null", bin);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    snprintf(cmd, sizeof cmd, "'%s' synth --drawings --per-part 0 --sheet '%s/x.png' 2>/dev/null", bin, out);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2);
     snprintf(cmd, sizeof cmd, "%s/never.db", out);
     ENSURE(access(cmd, F_OK) != 0);
 }

@@ -905,14 +905,15 @@ static void test_people_strokes(void)
     sp_dataset_free(&ds);
 }
 
-// Whether two sketches have the same points.
-static bool same_sketch(const sp_sketch* a, const sp_sketch* b)
+// Whether two sketches have the same points, to within `tol` (0: exactly).
+static bool same_sketch(const sp_sketch* a, const sp_sketch* b, double tol)
 {
     if (a->stroke_count != b->stroke_count) return false;
     for (int k = 0; k < a->stroke_count; ++k) {
         if (a->strokes[k].count != b->strokes[k].count) return false;
         for (int j = 0; j < a->strokes[k].count; ++j)
-            if (a->strokes[k].points[j].x != b->strokes[k].points[j].x || a->strokes[k].points[j].y != b->strokes[k].points[j].y)
+            if (fabs(a->strokes[k].points[j].x - b->strokes[k].points[j].x) > tol ||
+                fabs(a->strokes[k].points[j].y - b->strokes[k].points[j].y) > tol)
                 return false;
     }
     return true;
@@ -964,12 +965,12 @@ static void test_drawn_sketches(void)
         ENSURE(diag > 220 && diag < 480 && fabs((lo[0] + hi[0]) / 2 - 640) < 150 && fabs((lo[1] + hi[1]) / 2 - 400) < 150);
     }
     // Draws of one design differ; the same family draws the same bits; another family others.
-    ENSURE(!same_sketch(&ds.samples[0].sketch, &ds.samples[1].sketch));
+    ENSURE(!same_sketch(&ds.samples[0].sketch, &ds.samples[1].sketch, 0));
     ENSURE(sp_db_drawn_sketches(assets, 4, 1, &again, NULL, &err) == SP_OK && again.count == 12);
     ENSURE(sp_db_drawn_sketches(assets, 4, 2, &other, NULL, &err) == SP_OK && other.count == 12);
     for (int i = 0; i < 12; ++i) {
-        ENSURE(same_sketch(&ds.samples[i].sketch, &again.samples[i].sketch));
-        ENSURE(!same_sketch(&ds.samples[i].sketch, &other.samples[i].sketch));
+        ENSURE(same_sketch(&ds.samples[i].sketch, &again.samples[i].sketch, 0));
+        ENSURE(!same_sketch(&ds.samples[i].sketch, &other.samples[i].sketch, 0));
     }
     sp_dataset_free(&again);
     sp_dataset_free(&other);
@@ -978,7 +979,7 @@ static void test_drawn_sketches(void)
              "{\"drawings\": [{\"name\": \"new\", \"label\": \"tail\", \"points\": [[0, 0], [100, 100]]}, " DRAWN_FIXTURE "]}");
     ENSURE(sp_db_drawn_sketches(assets, 4, 1, &again, &designs, &err) == SP_OK && again.count == 16 && designs == 4);
     for (int i = 0; i < 8; ++i)
-        ENSURE(same_sketch(&ds.samples[i].sketch, &again.samples[4 + i].sketch));
+        ENSURE(same_sketch(&ds.samples[i].sketch, &again.samples[4 + i].sketch, 0));
     sp_dataset_free(&again);
     sp_dataset_free(&ds);
     // Malformed: one line naming the file (and the design), nothing returned.
@@ -1075,7 +1076,14 @@ static void test_default_db(void)
     remove_db(p);
     sp_db* db = NULL;
     sp_error err = {0};
-    sp_db_default_desc dd = {.synth_per_part = 20, .concepts_per_category = 5, .concept_family = 2, .train = quick_train(-1)};
+    // Two hand-placed designs, a tail and a horn, drawn twice each (family 2, as the concepts).
+    char f[1200];
+    snprintf(f, sizeof f, "%s/sketches/drawings.json", dir);
+    put_text(f,
+             "{\"drawings\": [{\"name\": \"t\", \"label\": \"tail\", \"points\": [[0, 50], [50, 30], [100, 60]]}, "
+             "{\"name\": \"h\", \"label\": \"horns\", \"closed\": true, \"points\": [[0, 100], [50, 0], [50, 0], [100, 100]]}]}");
+    sp_db_default_desc dd = {
+        .synth_per_part = 20, .concepts_per_category = 5, .concept_family = 2, .drawn_per_design = 2, .train = quick_train(-1)};
     double t0 = sp_now_ms();
     sp_result r = sp_db_create_default(p, dir, &dd, &err);
     if (r != SP_OK) fprintf(stderr, "  default: %s\n", err.text);
@@ -1088,11 +1096,11 @@ static void test_default_db(void)
     ENSURE(sp_db_categories(db, &cats, &n, &err) == SP_OK && n == 3);
     sp_db_free_strings(cats, n);
     // Concept sketches join the categories that have a concept (tail, wings), not a curator's own (horns);
-    // the people's strokes join theirs.
+    // the people's strokes and the designs' draws join theirs.
     int* counts;
     ENSURE(sp_db_sketch_counts(db, &cats, &counts, &n, &err) == SP_OK && n == 3);
     for (int i = 0; i < n; ++i)
-        ENSURE(counts[i] == (!strcmp(cats[i], "horns") ? 21 : !strcmp(cats[i], "tail") ? 27 : 25));
+        ENSURE(counts[i] == (!strcmp(cats[i], "horns") ? 23 : !strcmp(cats[i], "tail") ? 29 : 25));
     sp_db_free_strings(cats, n);
     free(counts);
     // They are the draw of the family asked for (another draw of the same designs), not the default family's.
@@ -1116,6 +1124,17 @@ static void test_default_db(void)
         ENSURE(found == (family == 2));
         sp_sketch_free(&want);
     }
+    // The designs' draws are sp_db_drawn_sketches' of that family.
+    sp_dataset drawn;
+    ENSURE(sp_db_drawn_sketches(dir, 2, 2, &drawn, NULL, &err) == SP_OK && drawn.count == 4);
+    for (int j = 0; j < drawn.count; ++j) {
+        int hits = 0;
+        for (int i = 0; i < ds.count; ++i)
+            hits += !strcmp(ds.categories[ds.samples[i].label], drawn.categories[drawn.samples[j].label]) &&
+                    same_sketch(&ds.samples[i].sketch, &drawn.samples[j].sketch, 0.01);
+        ENSURE(hits == 1);
+    }
+    sp_dataset_free(&drawn);
     sp_dataset_free(&ds);
     sp_db_close(db);
     ENSURE(sp_db_create_default(p, dir, &dd, &err) == SP_ERR_INVALID);
