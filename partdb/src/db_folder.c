@@ -333,7 +333,9 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
     }
     int nconcepts = c->d.concepts_per_category == 0 ? SP_DB_CONCEPTS_DEFAULT : c->d.concepts_per_category < 0 ? 0 : c->d.concepts_per_category;
-    if (r == SP_OK && nconcepts > 0) r = add_concepts(db, nconcepts, c->d.concept_family > 0 ? c->d.concept_family : 1, err);
+    // The concepts' seed family also seeds the designs' draws, so that one family is one draw of the whole recipe.
+    int family = c->d.concept_family > 0 ? c->d.concept_family : 1;
+    if (r == SP_OK && nconcepts > 0) r = add_concepts(db, nconcepts, family, err);
     if (r == SP_OK) {
         sp_dataset human;
         if ((r = sp_db_people_strokes(c->assets, c->d.quickdraw_dir, &human, NULL, err)) == SP_OK && human.count > 0)
@@ -343,8 +345,7 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
     int ndrawn = c->d.drawn_per_design == 0 ? SP_DB_DRAWN_DEFAULT : c->d.drawn_per_design;
     if (r == SP_OK && ndrawn > 0) {
         sp_dataset drawn;
-        uint64_t family = c->d.concept_family > 0 ? (uint64_t)c->d.concept_family : 1;
-        if ((r = sp_db_drawn_sketches(c->assets, ndrawn, family, &drawn, NULL, err)) == SP_OK && drawn.count > 0)
+        if ((r = sp_db_drawn_sketches(c->assets, ndrawn, (uint64_t)family, &drawn, NULL, err)) == SP_OK && drawn.count > 0)
             r = sp_db_add_sketches(db, &drawn, NULL, SP_DB_SOURCE_SYNTHETIC, "drawings", NULL, err);
         sp_dataset_free(&drawn);
     }

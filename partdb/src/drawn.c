@@ -103,7 +103,8 @@ static sp_result design_wants(const char* path, int index, sp_error* err)
         path, index + 1, DRAWN_MAX_POINTS);
 }
 
-// Design `d`'s control points, checked; the error names the file and the design.
+// Design `d`'s control points, checked (its label was, with the others', by
+// db_dataset_labels); the error names the file and the design.
 static sp_result read_design(const char* path, int index, const cJSON* d, sp_vec2* ctrl, int* n, bool* closed, const char** label,
                              sp_error* err)
 {
@@ -112,7 +113,7 @@ static sp_result read_design(const char* path, int index, const cJSON* d, sp_vec
     *label = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(d, "label"));
     const char* name = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(d, "name"));
     int m = cJSON_GetArraySize(pts);
-    if (!name || !*label || !**label || !cJSON_IsArray(pts) || m < 2 || m > DRAWN_MAX_POINTS || (cl && !cJSON_IsBool(cl)))
+    if (!name || !cJSON_IsArray(pts) || m < 2 || m > DRAWN_MAX_POINTS || (cl && !cJSON_IsBool(cl)))
         return design_wants(path, index, err);
     *closed = cJSON_IsTrue(cl);
     *n = 0;
