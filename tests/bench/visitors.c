@@ -66,6 +66,8 @@ typedef struct outcome {
     bool top1, top3;          // the right category first / among the guesses (refusal aside)
     double ms_classify, ms_total;
     const char* reason;
+    double far;              // sp_dragon_result.far_score (NaN: not measured)
+    char guess[SP_NAME_MAX]; // the chips' first guess: what a stroke refused as far from every part would have become
 } outcome;
 
 static void stroke_box(const sp_stroke* s, sp_vec2* lo, sp_vec2* hi)
@@ -455,12 +457,47 @@ static void in_pieces(sp_dragon* d, const sp_dataset* ds, double frac, double pa
                half, n, frac >= 1 ? "drawn whole through the UI" : "in two pieces", one_right, among, wrong, nothing, joined);
 }
 
+// "1.2,1.23,1.26" -> limits; 0 when malformed (a value not a positive number, more than cap).
+static int parse_limits(const char* text, double* limits, int cap)
+{
+    int n = 0;
+    for (const char* p = text; *p;) {
+        char* end;
+        double v = strtod(p, &end);
+        if (end == p || !(v > 0) || !isfinite(v) || n == cap || (*end && *end != ',')) return 0;
+        limits[n++] = v;
+        p = *end ? end + 1 : end;
+    }
+    return n;
+}
+
+// What the half would give with the far-from-every-part limit at `limit`
+// instead of SP_DRAGON_FAR_LIMIT: each stroke's far score decides it anew
+// (a stroke refused for another reason, or before its fit, stays refused;
+// one accepted only past the limit becomes its chips' first guess).
+static void at_limit(const sp_dataset* ds, const outcome* out, int none, double limit, int* right, int* refused, int* non)
+{
+    *right = *refused = *non = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        const outcome* o = &out[i];
+        bool ref = isfinite(o->far) ? o->far > limit : o->refused;
+        const char* answer = o->refused ? o->guess : o->answer;
+        if (ds->samples[i].label == none)
+            *non += ref;
+        else {
+            *refused += ref;
+            *right += !ref && !strcmp(answer, ds->categories[ds->samples[i].label]);
+        }
+    }
+}
+
 int main(int argc, char** argv)
 {
     const char *half = "tune", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets", *data = SP_BINARY_DIR "/tests/data/visitors",
                *sheet = NULL;
     bool json = sp_bench_json_flag(argc, argv), list = false, fit_all = false, on_body = false;
-    double gap = 0, pieces = 0, pause = 120;
+    double gap = 0, pieces = 0, pause = 120, limits[32];
+    int n_limits = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--half") && i + 1 < argc)
             half = argv[++i];
@@ -486,10 +523,13 @@ int main(int argc, char** argv)
             pieces = atof(argv[++i]);
         else if (!strcmp(argv[i], "--pause") && i + 1 < argc && atof(argv[i + 1]) >= 0)
             pause = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--limits") && i + 1 < argc && (n_limits = parse_limits(argv[i + 1], limits, 32)) > 0)
+            ++i;
         else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr,
                     "usage: visitors [--half tune|report|fresh] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                    "[--list] [--fit-all] [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]\n");
+                    "[--list] [--fit-all] [--limits L,L...] [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] "
+                    "[--json]\n");
             return 2;
         }
     }
@@ -558,6 +598,13 @@ int main(int argc, char** argv)
         o->refused = res.rejected;
         o->reason = sp_dragon_reject_name(res.reason);
         if (!res.rejected) snprintf(o->answer, sizeof o->answer, "%s", sp_dragon_part_get(d, res.part)->category);
+        o->far = res.far_score;
+        if (res.guess_count > 0) snprintf(o->guess, sizeof o->guess, "%s", res.guesses[0].category);
+        if (isfinite(o->far) && o->refused != (o->far > SP_DRAGON_FAR_LIMIT)) {
+            fprintf(stderr, "visitors: %s drawing %d: far score %.4f, yet %s\n", label, i, o->far,
+                    o->refused ? "refused" : "accepted");
+            return 1;
+        }
         for (int k = 0; k < res.guess_count; ++k)
             o->top3 |= !strcmp(res.guesses[k].category, label);
         o->top1 = res.guess_count > 0 && !strcmp(res.guesses[0].category, label);
@@ -649,6 +696,12 @@ int main(int argc, char** argv)
             "  {\"case\": \"%s parts\", \"n\": %d, \"right\": %d, \"refused\": %d, \"wrong\": %d, \"top1\": %d, \"top3\": %d},\n",
             half, pn, pr, pref, pw, p1, p3);
         if (none >= 0) printf("  {\"case\": \"%s not a part\", \"n\": %d, \"refused\": %d},\n", half, n[none], refused[none]);
+        for (int k = 0; k < n_limits; ++k) {
+            int r, f, nr;
+            at_limit(&ds, out, none, limits[k], &r, &f, &nr);
+            printf("  {\"case\": \"%s far limit %g\", \"right\": %d, \"refused\": %d, \"non_parts_refused\": %d},\n", half,
+                   limits[k], r, f, nr);
+        }
         printf("  {\"case\": \"%s classify\", \"ms_median\": %.3f, \"ms_p90\": %.3f, \"runs\": %d, \"target_ms\": 10},\n", half,
                mc, mc90, n_ms);
         printf("  {\"case\": \"%s pen-up to part\", \"ms_median\": %.3f, \"ms_p90\": %.3f, \"runs\": %d, \"target_ms\": 50}",
@@ -679,6 +732,14 @@ int main(int argc, char** argv)
                "to part %.2f "
                "median, %.2f p90 (target 50)\n",
                n_ms, mc, mc90, mt, mt90);
+        if (n_limits > 0)
+            printf("far-from-every-part limit (the kiosk's %g): right parts / parts refused / non-parts refused\n",
+                   SP_DRAGON_FAR_LIMIT);
+        for (int k = 0; k < n_limits; ++k) {
+            int r, f, nr;
+            at_limit(&ds, out, none, limits[k], &r, &f, &nr);
+            printf("  %-8g %4d / %d / %d\n", limits[k], r, f, nr);
+        }
 #undef PCT
         if (on_body && part_scale != 1) printf("Parts drawn at a dragon at %g times the size below\n", part_scale);
         if (on_body) {

@@ -1855,12 +1855,19 @@ static void test_visitors_policy(void)
     sp_error err = {0};
     ENSURE(sp_dataset_load(dir, &ds, &err) == SP_OK);
     sp_dragon* d = new_dragon(path);
-    int parts = 0, right = 0, refused = 0, top3 = 0, non = 0, non_refused = 0, reranked = 0, kin_added = 0;
+    int parts = 0, right = 0, refused = 0, top3 = 0, non = 0, non_refused = 0, reranked = 0, kin_added = 0, scored = 0, far = 0;
     for (int i = 0; i < ds.count; ++i) {
         const char* label = ds.categories[ds.samples[i].label];
         const sp_stroke* stroke = &ds.samples[i].sketch.strokes[0];
         sp_dragon_result res;
         ENSURE(sp_dragon_add_stroke(d, stroke, NULL, &res, &err) == SP_OK);
+        // The far score, where measured, is what refused the stroke or let it through (what `visitors --limits` sweeps).
+        if (isfinite(res.far_score)) {
+            ++scored;
+            ENSURE(res.rejected == (res.far_score > SP_DRAGON_FAR_LIMIT));
+            ENSURE(!res.rejected || res.reason == SP_DRAGON_UNRECOGNISED);
+            far += res.rejected;
+        }
         if (!strcmp(label, "not_a_part")) {
             ++non;
             non_refused += res.rejected;
@@ -1894,6 +1901,8 @@ static void test_visitors_policy(void)
             parts, right, refused, top3, non_refused, non, reranked, kin_added);
     ENSURE(reranked > 0);  // the fit's evidence decides some strokes
     ENSURE(kin_added > 0); // and the legs' kin some chips
+    fprintf(stderr, "  far score measured for %d of %d strokes, %d refused by it\n", scored, ds.count, far);
+    ENSURE(scored >= ds.count / 2 && far > 0 && far < scored);
     // Without ../shared/data the set (and the model's training) lacks the Quick, Draw! strokes: the hand-placed drawings remain.
     char qd[1100];
     snprintf(qd, sizeof qd, "%s/quickdraw", SP_SHARED_DATA);
@@ -1909,13 +1918,14 @@ static void test_visitors_policy(void)
     for (int i = 0; i < 200; ++i)
         scribble[i] = (sp_vec2){600 + (i % 2 ? 120 : 0) + 5 * sin(i * 0.7), 380 + i * 0.4};
     sp_dragon_result res;
-    ENSURE(sp_dragon_add_points(d, tap, 2, NULL, &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_TOO_SHORT);
+    ENSURE(sp_dragon_add_points(d, tap, 2, NULL, &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_TOO_SHORT &&
+           isnan(res.far_score));
     ENSURE(sp_dragon_add_points(d, tiny, 3, NULL, &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_TOO_SHORT);
     ENSURE(sp_dragon_add_points(d, scribble, 200, NULL, &res, &err) == SP_OK && res.rejected &&
-           res.reason == SP_DRAGON_UNRECOGNISED);
-    // Forced categories (a chip tap) are never refused.
+           res.reason == SP_DRAGON_UNRECOGNISED && isnan(res.far_score)); // refused before its fit
+    // Forced categories (a chip tap) are never refused, nor measured.
     ENSURE(sp_dragon_add_points(d, scribble, 200, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK &&
-           !res.rejected);
+           !res.rejected && isnan(res.far_score));
     sp_dragon_destroy(d);
     sp_dataset_free(&ds);
 }

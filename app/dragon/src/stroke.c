@@ -494,9 +494,9 @@ static bool turns_onto_itself(const sp_vec2* pts, int n)
 // that looks anything like a part becomes the best guess; refused are only
 // what is clearly not a part, in two halves. Before the fit
 // (refused_before_fit): scribbles, and regular polygons or stars. After it
-// (kiosk_refuses): strokes far from every part. Taps and tiny strokes never
-// get here. Constants tuned on the tune half and the fresh set of
-// tests/data/visitors (BENCHMARKS.md, "Visitors' drawings").
+// (far_score above SP_DRAGON_FAR_LIMIT): strokes far from every part. Taps
+// and tiny strokes never get here. Constants tuned on the tune half and the
+// fresh set of tests/data/visitors (BENCHMARKS.md, "Visitors' drawings").
 
 // A scribble (far more ink than its size, or crossing itself over and over)
 // or a shape with a polygon's or a star's symmetry.
@@ -521,19 +521,20 @@ static bool refused_before_fit(const sp_vec2* pts, int n)
     return crossings > 12 || turns_onto_itself(pts, n);
 }
 
-// Far from every part: `near`, the classifier's nearest-drawing distance in
-// units of the model's calibrated reject distance, weighed together with
-// how badly the best guess's part takes the stroke (`fit`: the fit's mean
-// error over the stroke's diagonal) and, when that part is drawn in profile
-// (`profile`), how nearly the stroke is its own mirror image.
-static bool kiosk_refuses(const sp_vec2* pts, int n, double near, double fit, bool profile)
+// How far from every part (refused above SP_DRAGON_FAR_LIMIT): `near`, the
+// classifier's nearest-drawing distance in units of the model's calibrated
+// reject distance, weighed together with how badly the best guess's part
+// takes the stroke (`fit`: the fit's mean error over the stroke's diagonal)
+// and, when that part is drawn in profile (`profile`), how nearly the stroke
+// is its own mirror image.
+static double far_score(const sp_vec2* pts, int n, double near, double fit, bool profile)
 {
     // A part drawn in profile (a head, a tail, a wing) is seldom its own
     // mirror image about an upright line; much else a visitor draws is (a
     // tree, a sun). Bodies and leg pairs are left out: a visitor's
     // oval or humped body and a neat pair of legs are symmetric too.
     double sym = profile ? fmax(0.0, MIRROR_GAP_SYMMETRIC - mirror_gap(pts, n)) : 0.0;
-    return near + 6.0 * fit + MIRROR_WEIGHT * sym > 1.23;
+    return near + 6.0 * fit + MIRROR_WEIGHT * sym;
 }
 
 // The stroke path's decision: the classifier's answer becomes a category
@@ -812,6 +813,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     double t0 = sp_now_ms();
     memset(out, 0, sizeof *out);
     out->part = out->detail = -1;
+    out->far_score = NAN;
     sp_dragon_stroke_opts o = opts ? *opts : (sp_dragon_stroke_opts){0};
     // A chip for a detail: the part takes the detail's place when the detail is the last change.
     uint64_t drop_detail = o.replace_detail ? dragon_detail_last_change(d) : 0;
@@ -886,7 +888,8 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         if (not_finite > 0) out->note = SP_DRAGON_NOTE_NOT_FINITE;
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
     }
-    if (!o.category && d->clf && kiosk_refuses(pts, n, near, best.score, !best.t->is_torso && !best.t->family[0])) {
+    if (!o.category && d->clf) out->far_score = far_score(pts, n, near, best.score, !best.t->is_torso && !best.t->family[0]);
+    if (out->far_score > SP_DRAGON_FAR_LIMIT) {
         bool flourish = kept_as_flourish(d, &o, pts, n, lo, hi, out);
         free(pts);
         free(best.p);
@@ -969,6 +972,7 @@ sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_res
     if (d->part_n == 0 || !category) {
         memset(out, 0, sizeof *out);
         out->detail = -1;
+        out->far_score = NAN;
         return reject(out, SP_DRAGON_NOTHING_TO_REFIT, sp_now_ms());
     }
     part* last = d->parts[d->part_n - 1];

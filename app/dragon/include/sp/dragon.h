@@ -188,7 +188,16 @@ typedef struct sp_dragon_result {
     int part;                             ///< index of the new (or replaced) part, -1 when rejected
     int detail;                           ///< SP_DRAGON_DETAIL: the detail kept as ink, -1 when none (full, nothing bound)
     double ms_classify, ms_fit, ms_total; ///< wall-clock, milliseconds
+    /// How far the stroke is from every part, as the refusal policy weighs it
+    /// (docs/DESIGN.md, "Refusal policy"): refused as unrecognised above
+    /// SP_DRAGON_FAR_LIMIT. NaN when not measured: a forced category, no model,
+    /// or a stroke decided before its best guess was fitted (a tap, a
+    /// scribble, a polygon, a detail). For benchmarks that sweep the limit.
+    double far_score;
 } sp_dragon_result;
+
+/// The refusal policy's limit on sp_dragon_result.far_score.
+#define SP_DRAGON_FAR_LIMIT 1.23
 
 /// How to treat one stroke. Zero (or a NULL pointer) means: classify, append.
 typedef struct sp_dragon_stroke_opts {
