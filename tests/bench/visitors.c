@@ -464,7 +464,7 @@ static int parse_limits(const char* text, double* limits, int cap)
     for (const char* p = text; *p;) {
         char* end;
         double v = strtod(p, &end);
-        if (end == p || !(v > 0) || !isfinite(v) || n == cap || (*end && *end != ',')) return 0;
+        if (end == p || !(v > 0) || !isfinite(v) || n == cap || (*end && (*end != ',' || !end[1]))) return 0;
         limits[n++] = v;
         p = *end ? end + 1 : end;
     }
