@@ -547,8 +547,13 @@ sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_erro
     sp_sketch clean;
     sp_result res = sp_concept_clean(c, seed, &clean, err);
     if (res != SP_OK) return res;
-    sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
-    res = sp_handdraw_apply(&clean, &hp, seed * 0xC2B2AE3D27D4EB4Full + 0x27D4EB2F165667C5ull, out, NULL, err);
+    res = sp_concept_draw(&clean, seed, out, err);
     sp_sketch_free(&clean);
     return res;
+}
+
+sp_result sp_concept_draw(const sp_sketch* clean, uint64_t seed, sp_sketch* out, sp_error* err)
+{
+    sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
+    return sp_handdraw_apply(clean, &hp, seed * 0xC2B2AE3D27D4EB4Full + 0x27D4EB2F165667C5ull, out, NULL, err);
 }

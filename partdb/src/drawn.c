@@ -181,9 +181,8 @@ sp_result sp_db_drawn_sketches(const char* assets_dir, int per_design, uint64_t 
                     sp_fail(err, r, "%s: drawing \"%s\": its points have no extent", path, name);
                 break;
             }
-            sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
             sp_sample smp = {.label = k, .index = per_cat[k]++};
-            r = sp_handdraw_apply(&clean, &hp, seed * 0xC2B2AE3D27D4EB4Full + 0x27D4EB2F165667C5ull, &smp.sketch, NULL, err);
+            r = sp_concept_draw(&clean, seed, &smp.sketch, err);
             sp_sketch_free(&clean);
             if (r == SP_OK && sp_dataset_add_sample(&ds, &smp) != SP_OK) {
                 sp_sketch_free(&smp.sketch);

@@ -607,7 +607,7 @@ int main(int argc, char** argv)
         }
         for (int k = 0; k < res.guess_count; ++k)
             o->top3 |= !strcmp(res.guesses[k].category, label);
-        o->top1 = res.guess_count > 0 && !strcmp(res.guesses[0].category, label);
+        o->top1 = !strcmp(o->guess, label); // "" when there were no guesses
         o->ms_classify = res.ms_classify;
         o->ms_total = res.ms_total;
         // Every stroke that reached the classifier counts for the timing (taps stop before it).

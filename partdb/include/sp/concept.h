@@ -61,6 +61,10 @@ sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error
 sp_result sp_concept_place(sp_vec2* p, int n, double mirror, double turn, sp_sketch* out, sp_error* err);
 /// The same design through the hand-drawing model (normal style), with timestamps.
 sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
+/// A placed sketch (sp_concept_clean's, sp_concept_place's) through the
+/// hand-drawing model (normal style), seeded by `seed`, as sp_concept_sketch
+/// draws its own: the recipe's designs are drawn by the same hand.
+sp_result sp_concept_draw(const sp_sketch* clean, uint64_t seed, sp_sketch* out, sp_error* err);
 
 #ifdef __cplusplus
 }
