@@ -174,16 +174,15 @@ static int db_init(int argc, char** argv)
     sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};
     if (clf_cli_tty()) td.clf.progress = clf_cli_progress;
     sp_result r;
-    int npeople = -1;
     if (from) r = sp_db_create_from_export(db_path(&c), from, no_train ? NULL : &td, c.by, &err);
     else {
         char def[1024];
         snprintf(def, sizeof def, "%s/assets", SP_SOURCE_DIR);
         if (!assets) assets = def;
-        // How many people's strokes join, or that they cannot.
+        // Whether the people's strokes can join.
         bool missing = false;
-        if ((r = sp_db_people_source(assets, quickdraw, &npeople, &missing, &err)) != SP_OK) return fail(cmd, &err);
-        if (missing) npeople = 0;
+        int picks = 0;
+        if ((r = sp_db_people_source(assets, quickdraw, &picks, &missing, &err)) != SP_OK) return fail(cmd, &err);
         if (missing)
             fprintf(stderr, "%s: %s/sketches/picks.json: the Quick, Draw! data is not where it says; building without the people's strokes "
                             "(--quickdraw DIR names it)\n", cmd, assets);
@@ -199,17 +198,27 @@ static int db_init(int argc, char** argv)
     if (r != SP_OK) return fail(cmd, &err);
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
-    sp_db_part_info* parts;
-    int n;
-    char *models = NULL;
-    if (sp_db_list_parts(db, &parts, &n, &err) != SP_OK || sp_db_models_json(db, &models, &err) != SP_OK) {
+    sp_db_part_info* parts = NULL;
+    int n = 0;
+    char* models = NULL;
+    // What the default recipe stored, by maker.
+    int nparts = 0, nconcepts = 0, ndesigns = 0, npeople = 0;
+    if (sp_db_list_parts(db, &parts, &n, &err) != SP_OK || sp_db_models_json(db, &models, &err) != SP_OK ||
+        (!from && (sp_db_sketch_count_by(db, SP_DB_SOURCE_SYNTHETIC, SP_DB_BY_ASSETS, &nparts, &err) != SP_OK ||
+                   sp_db_sketch_count_by(db, SP_DB_SOURCE_SYNTHETIC, SP_DB_BY_CONCEPTS, &nconcepts, &err) != SP_OK ||
+                   sp_db_sketch_count_by(db, SP_DB_SOURCE_SYNTHETIC, SP_DB_BY_DRAWINGS, &ndesigns, &err) != SP_OK ||
+                   sp_db_sketch_count_by(db, SP_DB_SOURCE_CURATED, SP_DB_BY_ASSETS, &npeople, &err) != SP_OK))) {
+        free(parts);
+        free(models);
         sp_db_close(db);
         return fail(cmd, &err);
     }
     printf("{\"db\": ");
     clf_cli_json_str(stdout, db_path(&c));
     printf(", \"parts\": %d", n);
-    if (npeople >= 0) printf(", \"people_strokes\": %d", npeople);
+    if (!from)
+        printf(", \"part_sketches\": %d, \"concept_sketches\": %d, \"design_sketches\": %d, \"people_strokes\": %d", nparts,
+               nconcepts, ndesigns, npeople);
     printf(", \"models\": %s}\n", models);
     free(parts);
     free(models);

@@ -307,7 +307,7 @@ static sp_result add_concepts(sp_db* db, int per_category, int family_base, sp_e
             ds.samples[i].label = 0, ds.samples[i].index = i;
             ds.count = i + (r == SP_OK);
         }
-        if (r == SP_OK) r = sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_SYNTHETIC, "concepts", NULL, err);
+        if (r == SP_OK) r = sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_SYNTHETIC, SP_DB_BY_CONCEPTS, NULL, err);
         sp_dataset_free(&ds);
     }
     sp_db_free_strings(cats, ncat);
@@ -329,7 +329,7 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
         char file[1024];
         snprintf(file, sizeof file, "%s/%s", c->assets, c->names[i]);
         if (!is_kiosk_part(file)) continue;
-        sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = "assets"};
+        sp_db_part_desc pd = {.synth_sketches = c->d.synth_per_part, .seed = (uint64_t)i + 1, .added_by = SP_DB_BY_ASSETS};
         r = sp_db_add_part_file(db, file, &pd, NULL, err);
     }
     int nconcepts = c->d.concepts_per_category == 0 ? SP_DB_CONCEPTS_DEFAULT : c->d.concepts_per_category < 0 ? 0 : c->d.concepts_per_category;
@@ -339,19 +339,19 @@ static sp_result fill_default(sp_db* db, const void* vctx, sp_error* err)
     if (r == SP_OK) {
         sp_dataset human;
         if ((r = sp_db_people_strokes(c->assets, c->d.quickdraw_dir, &human, NULL, err)) == SP_OK && human.count > 0)
-            r = sp_db_add_sketches(db, &human, NULL, SP_DB_SOURCE_CURATED, "assets", NULL, err);
+            r = sp_db_add_sketches(db, &human, NULL, SP_DB_SOURCE_CURATED, SP_DB_BY_ASSETS, NULL, err);
         sp_dataset_free(&human);
     }
     int ndrawn = c->d.drawn_per_design == 0 ? SP_DB_DRAWN_DEFAULT : c->d.drawn_per_design;
     if (r == SP_OK && ndrawn > 0) {
         sp_dataset drawn;
         if ((r = sp_db_drawn_sketches(c->assets, ndrawn, (uint64_t)family, &drawn, NULL, err)) == SP_OK && drawn.count > 0)
-            r = sp_db_add_sketches(db, &drawn, NULL, SP_DB_SOURCE_SYNTHETIC, "drawings", NULL, err);
+            r = sp_db_add_sketches(db, &drawn, NULL, SP_DB_SOURCE_SYNTHETIC, SP_DB_BY_DRAWINGS, NULL, err);
         sp_dataset_free(&drawn);
     }
     if (r == SP_OK) {
         sp_db_train_desc td = c->d.train;
-        if (!td.by) td.by = "assets";
+        if (!td.by) td.by = SP_DB_BY_ASSETS;
         r = sp_db_train(db, &td, NULL, err);
     }
     return r;

@@ -177,6 +177,20 @@ sp_result sp_db_sketch_counts(sp_db* db, char*** categories, int** counts, int* 
     return SP_OK;
 }
 
+sp_result sp_db_sketch_count_by(sp_db* db, sp_db_source source, const char* by, int* count, sp_error* err)
+{
+    *count = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT count(*) FROM sketches WHERE source = ?1 AND added_by = ?2", &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, sp_db_source_name(source), -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 2, by, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) *count = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW ? SP_OK : db_fail(db, rc, "counting sketches", err);
+}
+
 static int find_cat(char** cats, int n, const char* c)
 {
     int lo = 0, hi = n - 1;

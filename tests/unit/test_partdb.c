@@ -1335,11 +1335,18 @@ static void test_default_db_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
            strchr(out, '\n') == out + strlen(out) - 1);
     ENSURE(stat(p, &st) != 0);
-    // Two tails and a horn join.
-    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>/dev/null", bin, p, assets);
+    // Two tails and a horn join, and the JSON counts each maker's sketches: 3 parts x 8, tail and wings concepts x 2
+    // (horns have none), the one design twice.
+    char f[1200];
+    snprintf(f, sizeof f, "%s/sketches/drawings.json", assets);
+    put_text(f, "{\"drawings\": [{\"name\": \"t\", \"label\": \"tail\", \"points\": [[0, 50], [50, 30], [100, 60]]}]}");
+    snprintf(cmd, sizeof cmd,
+             "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --drawings 2 --folds -1 --words 32 2>/dev/null", bin, p,
+             assets);
     int rc = run(cmd, out, sizeof out);
     if (rc != 0) fprintf(stderr, "  db init: %d %s\n", rc, out);
-    ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3"));
+    ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3") && strstr(out, "\"part_sketches\": 24") &&
+           strstr(out, "\"concept_sketches\": 4") && strstr(out, "\"design_sketches\": 2"));
     // The data moved away: built without them, with a warning that names picks.json.
     remove_db(p);
     snprintf(cmd, sizeof cmd, "rm -rf '%s/qd' && '%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>&1 >/dev/null",

@@ -182,6 +182,15 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
 /// Number of training sketches per category (kiosk sketches only when approved): parallel arrays (free with sp_db_free_strings /
 /// free()).
 sp_result sp_db_sketch_counts(sp_db* db, char*** categories, int** counts, int* count, sp_error* err);
+/// Number of stored sketches from `source` added by `by`: a curator's name, or
+/// one of the default recipe's makers below.
+sp_result sp_db_sketch_count_by(sp_db* db, sp_db_source source, const char* by, int* count, sp_error* err);
+/// Who adds the default recipe's sketches (sp_db_create_default): the parts'
+/// own synthetic sketches and the people's strokes (curated) are by "assets",
+/// the concept sketches and the designs' draws (both synthetic) by their own.
+#define SP_DB_BY_ASSETS "assets"
+#define SP_DB_BY_CONCEPTS "concepts"
+#define SP_DB_BY_DRAWINGS "drawings"
 /// The training set: the stored sketches of the current part categories as a
 /// dataset (categories = sp_db_categories), kiosk sketches only when approved
 /// (the newest SP_DB_KIOSK_TRAIN_MAX per category); `unused` (may be NULL)
