@@ -909,6 +909,18 @@ static void test_save_code(void)
     ENSURE(strstr(ui->banner[0], "K7QX") && !strcmp(ui->banner[1], sp_kiosk_text(SP_KTEXT_CODE_USE)));
     ENSURE(contains_word(ui->banner[1], "code") && contains_word(ui->banner[1], "guide") &&
            contains_word(ui->banner[1], "find") && contains_word(ui->banner[1], "postcard"));
+    // The same dragon saves once; a stroke kept on it as ink (an eye) is a
+    // change, so the next Save writes it again.
+    tap(ui, t + 300, SP_KT_SAVE);
+    frame(ui, &f, t + 400);
+    ENSURE(f.saves == 1);
+    t = refused_stroke(ui, t + 1000, 800, 200);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .kept = true, .part_count = 1});
+    tap(ui, t + 200, SP_KT_SAVE);
+    frame(ui, &f, t + 300);
+    ENSURE(f.saves == 2 && ui->part_count == 1);
     sp_kiosk_ui_destroy(ui);
 }
 

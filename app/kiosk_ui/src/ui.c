@@ -1113,7 +1113,9 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
         }
         // Still waiting for the replacement: a chip for this stroke, or the next stroke, replaces.
         if (ui->inflight_replace) ui->redraw_armed = true;
-        if (ui->inflight_undo) { // what the stroke's first piece made was taken back
+        // The dragon changed all the same: what the stroke's first piece made was
+        // taken back, or the stroke stays on it as ink (a save must see either).
+        if (ui->inflight_undo || r->kept) {
             ui->part_count = r->part_count;
             ++ui->revision;
         }
