@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "db_internal.h"
-#include "sp/curve.h"
 
 static const char* const k_status[SP_DB_STATUS_COUNT] = {"pending", "approved", "rejected"};
 
@@ -32,13 +31,12 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
     if (!stroke || stroke->count < 2 || stroke->count > 65536)
         return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: %d points (2..65536); sketch dropped", db->path,
                        stroke ? stroke->count : 0);
-    bool finite = sp_curve_is_valid(stroke->points, stroke->count) && isfinite(canvas_w) && isfinite(canvas_h);
-    for (int i = 0; finite && stroke->t && i < stroke->count; ++i)
-        finite = isfinite(stroke->t[i]);
-    if (!finite)
-        return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: a coordinate is not a finite number; sketch dropped", db->path);
-    sp_sketch sk = {.canvas_w = canvas_w, .canvas_h = canvas_h, .stroke_count = 1, .strokes = (sp_stroke*)stroke};
-    char* json = db_sketch_json(&sk);
+    sp_sample smp = {.sketch = {.canvas_w = canvas_w, .canvas_h = canvas_h, .stroke_count = 1, .strokes = (sp_stroke*)stroke}};
+    sp_error why = {0};
+    char what[sizeof why.text];
+    snprintf(what, sizeof what, "%s: kiosk sketch", db->path);
+    if (db_sample_ok(&smp, what, &why) != SP_OK) return sp_fail(err, SP_ERR_INVALID, "%s; sketch dropped", why.text);
+    char* json = db_sketch_json(&smp.sketch);
     if (!json) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: kiosk sketch: out of memory; sketch dropped", db->path);
     // The UI thread must not wait: a short busy timeout, and a commit that
     // does not wait for the disk (WAL with synchronous NORMAL stays consistent
@@ -68,8 +66,8 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
     if (!db->readonly) sqlite3_exec(db->h, "PRAGMA synchronous = FULL", NULL, NULL, NULL);
     sp_db_set_busy_timeout(db, busy);
     free(json);
-    if (r != SP_OK) {
-        if (id) *id = 0;
+    if (r != SP_OK && id) *id = 0;
+    if (r != SP_OK && err) {
         char why[sizeof err->text];
         snprintf(why, sizeof why, "%s", err->text);
         sp_fail(err, r, "%s; sketch dropped", why);

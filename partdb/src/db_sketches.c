@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "db_internal.h"
+#include "sp/sketch_io.h"
 
 const char* sp_db_source_name(sp_db_source s)
 {
@@ -55,9 +56,21 @@ sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err)
     }
     if (smp->sketch.stroke_count == 0 || sp_sketch_point_count(&smp->sketch) == 0)
         return sp_fail(err, SP_ERR_INVALID, "%s: empty drawing (no strokes)", what);
-    if (!sp_sketch_is_valid(&smp->sketch)) return sp_fail(err, SP_ERR_INVALID, "%s: non-finite coordinates", what);
-    for (int i = 0; i < smp->sketch.stroke_count; ++i)
-        if (smp->sketch.strokes[i].count < 1) return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d is empty", what, i);
+    const sp_sketch* sk = &smp->sketch;
+    if (!sp_sketch_is_valid(sk) || !isfinite(sk->canvas_w) || !isfinite(sk->canvas_h))
+        return sp_fail(err, SP_ERR_INVALID, "%s: a coordinate or time is not a finite number", what);
+    // Stored, it must read back: one sketch beyond the readers' limits would
+    // stop every training run and review page that reaches it.
+    if (sk->canvas_w < 0 || sk->canvas_h < 0 || sk->canvas_w > SP_SKETCH_CANVAS_MAX || sk->canvas_h > SP_SKETCH_CANVAS_MAX)
+        return sp_fail(err, SP_ERR_INVALID, "%s: canvas %g x %g (0 to %g a side)", what, sk->canvas_w, sk->canvas_h,
+                       SP_SKETCH_CANVAS_MAX);
+    for (int i = 0; i < sk->stroke_count; ++i) {
+        const sp_stroke* k = &sk->strokes[i];
+        if (k->count < 1) return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d is empty", what, i);
+        for (int j = 0; j < k->count; ++j)
+            if (fabs(k->points[j].x) > SP_SKETCH_COORD_MAX || fabs(k->points[j].y) > SP_SKETCH_COORD_MAX)
+                return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d point %d is beyond %g", what, i, j, SP_SKETCH_COORD_MAX);
+    }
     return SP_OK;
 }
 

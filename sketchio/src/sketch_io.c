@@ -164,7 +164,8 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
     if (canvas) {
         double w = 0, h = 0;
         if (!cJSON_IsArray(canvas) || cJSON_GetArraySize(canvas) != 2 || !json_number(cJSON_GetArrayItem(canvas, 0), &w) ||
-            !json_number(cJSON_GetArrayItem(canvas, 1), &h) || w < 0 || h < 0 || w > 1e6 || h > 1e6) {
+            !json_number(cJSON_GetArrayItem(canvas, 1), &h) || w < 0 || h < 0 || w > SP_SKETCH_CANVAS_MAX ||
+            h > SP_SKETCH_CANVAS_MAX) {
             rc = sp_fail(err, SP_ERR_INVALID, "%s: \"canvas\" must be [width, height] with 0 <= sizes <= 1e6", name);
             goto done;
         }
@@ -214,8 +215,8 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
                 rc = sp_fail(err, SP_ERR_PARSE, "%s: stroke %d point %d is not [x, y]", name, si, k);
                 goto done;
             }
-            if (!json_number(cJSON_GetArrayItem(q, 0), &x) || !json_number(cJSON_GetArrayItem(q, 1), &y) || fabs(x) > 1e9 ||
-                fabs(y) > 1e9) {
+            if (!json_number(cJSON_GetArrayItem(q, 0), &x) || !json_number(cJSON_GetArrayItem(q, 1), &y) ||
+                fabs(x) > SP_SKETCH_COORD_MAX || fabs(y) > SP_SKETCH_COORD_MAX) {
                 rc = sp_fail(err, SP_ERR_INVALID, "%s: stroke %d point %d is not finite (or beyond 1e9)", name, si, k);
                 goto done;
             }
@@ -387,7 +388,8 @@ static sp_result ndjson_drawing(const cJSON* drawing, const char* name, int line
         const cJSON* t = tt ? tt->child : NULL;
         for (int k = 0; k < n; ++k, x = x->next, y = y->next) {
             double vx, vy;
-            if (!json_number(x, &vx) || !json_number(y, &vy) || fabs(vx) > 1e9 || fabs(vy) > 1e9) {
+            if (!json_number(x, &vx) || !json_number(y, &vy) || fabs(vx) > SP_SKETCH_COORD_MAX ||
+                fabs(vy) > SP_SKETCH_COORD_MAX) {
                 rc = sp_fail(err, SP_ERR_INVALID, "%s:%d: stroke %d point %d is not a finite number pair", name, line, si, k);
                 goto done;
             }
@@ -492,7 +494,7 @@ typedef struct svg_ctx {
 
 static sp_result svg_point(svg_ctx* c, double x, double y)
 {
-    if (!isfinite(x) || !isfinite(y) || fabs(x) > 1e9 || fabs(y) > 1e9)
+    if (!isfinite(x) || !isfinite(y) || fabs(x) > SP_SKETCH_COORD_MAX || fabs(y) > SP_SKETCH_COORD_MAX)
         return sp_fail(c->err, SP_ERR_INVALID, "%s: coordinate out of range", c->name);
     if (c->total >= SP_SKETCH_MAX_POINTS)
         return sp_fail(c->err, SP_ERR_UNSUPPORTED, "%s: more than %d points after flattening", c->name, SP_SKETCH_MAX_POINTS);
@@ -504,7 +506,7 @@ static sp_result svg_point(svg_ctx* c, double x, double y)
         c->cap = cap;
     }
     sp_vec2 p = affine_apply(c->m, x, y);
-    if (!sp_v2_is_valid(p) || fabs(p.x) > 1e9 || fabs(p.y) > 1e9)
+    if (!sp_v2_is_valid(p) || fabs(p.x) > SP_SKETCH_COORD_MAX || fabs(p.y) > SP_SKETCH_COORD_MAX)
         return sp_fail(c->err, SP_ERR_INVALID, "%s: transformed coordinate out of range", c->name);
     c->pts[c->n++] = p;
     ++c->total;

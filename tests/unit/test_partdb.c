@@ -725,6 +725,9 @@ static void test_bad_input(void)
     sp_dataset ds = one_sketch("tail");
     ds.samples[0].sketch.strokes[0].points[1].x = NAN;
     ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "t", NULL, &err) == SP_ERR_INVALID);
+    ds.samples[0].sketch.strokes[0].points[1].x = -3e9; // finite, but no reader would take it back
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "t", NULL, &err) == SP_ERR_INVALID &&
+           strstr(err.text, "beyond"));
     sp_dataset_free(&ds);
     ds = one_sketch("no/slash");
     ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "t", NULL, &err) == SP_ERR_INVALID);
@@ -1215,6 +1218,19 @@ static void test_kiosk_collect(void)
     st = visitor_stroke(0, pts, t);
     st.count = 1;
     ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_INVALID);
+    // Finite but beyond what a stroke file may hold: stored, it would stop every review page and training run that reads it.
+    st = visitor_stroke(0, pts, t);
+    pts[3].x = 2e9;
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_INVALID &&
+           strstr(err.text, "beyond") && strstr(err.text, "dropped"));
+    st = visitor_stroke(0, pts, t);
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 2e6, 800, NULL, &err) == SP_ERR_INVALID && strstr(err.text, "canvas"));
+    t[5] = INFINITY;
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_INVALID &&
+           strstr(err.text, "time is not a finite"));
+    // No error to fill: the same answer, nothing written through NULL.
+    ENSURE(sp_db_collect_kiosk_sketch(kiosk, "tail", &st, 1280, 800, NULL, NULL) == SP_ERR_INVALID);
+    ENSURE(sp_db_kiosk_counts(kiosk, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 3);
     // A busy database drops the sketch within the collect timeout; a read-only one drops it at once.
     sqlite3* other;
     ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
@@ -1229,6 +1245,7 @@ static void test_kiosk_collect(void)
     sqlite3_exec(other, "ROLLBACK", NULL, NULL, NULL);
     sqlite3_close(other);
     ENSURE(sp_db_collect_kiosk_sketch(reader, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_IO && strstr(err.text, "read-only"));
+    ENSURE(sp_db_collect_kiosk_sketch(reader, "tail", &st, 1280, 800, NULL, NULL) == SP_ERR_IO);
     // A full disk drops it too.
     sp_db_close(kiosk);
     ENSURE(on_full_disk(p, collect_many));

@@ -171,8 +171,9 @@ const char* sp_db_source_name(sp_db_source s);
 
 /// Stores drawings of a dataset in one transaction; sample i goes under
 /// `data->categories[label]` (every sample needs strokes or a raster; empty or
-/// non-finite drawings refuse the whole set). `png` (may be NULL) gives the
-/// original PNG bytes of raster samples, kept for export.
+/// non-finite drawings, and ones beyond the stroke files' limits, refuse the
+/// whole set). `png` (may be NULL) gives the original PNG bytes of raster
+/// samples, kept for export.
 typedef struct sp_db_png {
     const void* bytes;
     size_t size;
@@ -216,13 +217,15 @@ const char* sp_db_status_name(sp_db_status s);
 /// Stores one stroke a visitor left on the kiosk as a `kiosk` sketch, pending
 /// review, under `category` (the label the visitor left it with): the points
 /// (pixels) and, when given, their times (ms); nothing else about the visit.
-/// Made for the kiosk's UI thread: it waits at most SP_DB_COLLECT_BUSY_MS for
-/// another writer and commits without waiting for the disk (a power cut may
-/// lose the last strokes, never the database). A busy, read-only or full
+/// Made for a kiosk that must not wait (its collector thread): it waits at
+/// most SP_DB_COLLECT_BUSY_MS for another writer and commits without waiting
+/// for the disk (a power cut may lose the last strokes, never the database). A busy, read-only or full
 /// database keeps nothing and returns SP_ERR_BUSY or SP_ERR_IO with one line
 /// for the kiosk's log; so do a category that is not a plain name and a
-/// stroke with fewer than 2 points, more than 65536 or non-finite ones
-/// (SP_ERR_INVALID). *id (may be NULL) gets the new sketch's id.
+/// stroke with fewer than 2 points, more than 65536, non-finite ones or ones
+/// beyond SP_SKETCH_COORD_MAX (or a canvas beyond SP_SKETCH_CANVAS_MAX), which
+/// no reader would take back (SP_ERR_INVALID). *id (may be NULL) gets the new
+/// sketch's id.
 sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_stroke* stroke, double canvas_w, double canvas_h,
                                      int64_t* id, sp_error* err);
 

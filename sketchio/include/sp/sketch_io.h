@@ -33,6 +33,10 @@ extern "C" {
 
 /// Most points one sketch may hold (all strokes together).
 #define SP_SKETCH_MAX_POINTS 1000000
+/// Largest |x| or |y| a stroke file may hold, and largest canvas side: what
+/// every reader accepts, so what the database stores must keep to them too.
+#define SP_SKETCH_COORD_MAX 1e9
+#define SP_SKETCH_CANVAS_MAX 1e6
 /// Largest PNG side accepted (checked from the header, before decoding).
 #define SP_RASTER_MAX_SIDE 8192
 /// Largest file any reader loads into memory (bytes).
