@@ -182,7 +182,9 @@ sp_result sp_db_drawn_sketches(const char* assets_dir, int per_design, uint64_t 
                 break;
             }
             sp_sample smp = {.label = k, .index = per_cat[k]++};
-            r = sp_concept_draw(&clean, seed, &smp.sketch, err);
+            sp_error why = {0};
+            if ((r = sp_concept_draw(&clean, seed, &smp.sketch, &why)) != SP_OK)
+                sp_fail(err, r, "%s: drawing \"%s\": %s", path, name, why.text);
             sp_sketch_free(&clean);
             if (r == SP_OK && sp_dataset_add_sample(&ds, &smp) != SP_OK) {
                 sp_sketch_free(&smp.sketch);

@@ -157,6 +157,7 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
             if (sp_dataset_add_sample(&ds, &smp) != SP_OK) {
                 sp_sketch_free(&smp.sketch);
                 r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", fp);
+                break;
             }
         }
     }

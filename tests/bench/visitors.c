@@ -179,6 +179,7 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
         if (kind < 0) continue;
         const sp_stroke* legs = &ds->samples[i].sketch.strokes[0];
         sp_dragon_result res;
+        // Once a drawing; n counts each drawing once a facing, so both print it twice.
         alone[kind] += !alone_out[i].refused && !strcmp(alone_out[i].answer, label);
         for (int facing = 0; facing < 2; ++facing, ++m)
             for (int end = 0; end < 2; ++end) { // 0: the legs' own end, 1: the other
@@ -209,7 +210,8 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
         for (int k = 0; k < 2; ++k)
             printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d, "
                    "\"as_legs\": %d, \"facing_the_dragon\": %d},\n",
-                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], alone[k], own[k], other[k], as_legs[k], faced[k]);
+                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], 2 * alone[k], own[k], other[k], as_legs[k],
+                   faced[k]);
         return;
     }
     printf("Legs drawn at a dragon (%s; facing right, then left): became their own kind\n",
@@ -357,6 +359,12 @@ static void remove_tmp_db(const char* dir, const char* db)
     unlink(path);
     unlink(db);
     rmdir(dir);
+}
+
+static int fail_tmp(const char* dir, const char* db)
+{
+    remove_tmp_db(dir, db);
+    return 1;
 }
 
 // Runs the UI's queued jobs on the pipeline as the kiosk does (run_fit):
@@ -559,7 +567,7 @@ int main(int argc, char** argv)
         double t0 = sp_now_ms();
         if (sp_db_create_default(db_path, assets, NULL, &err) != SP_OK) {
             fprintf(stderr, "visitors: %s\n", err.text);
-            return 1;
+            return fail_tmp(tmp, tmp_db);
         }
         t_build = sp_now_ms() - t0;
         fprintf(stderr, "visitors: built %s by the default recipe in %.1f s\n", db_path, t_build / 1000);
@@ -568,10 +576,10 @@ int main(int argc, char** argv)
     sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .assets_dir = assets, .canvas_w = 1280, .canvas_h = 800}, &d, &err);
     if (!d || sp_dragon_preload(d, &err) != SP_OK) {
         fprintf(stderr, "visitors: %s\n", err.text);
-        return 1;
+        return fail_tmp(tmp, tmp_db);
     }
     if (pieces > 0) {
-        if (pieces < 1) printf("Broken at %g of its points, drawn on %g ms after\n", pieces, pause);
+        if (pieces < 1 && !json) printf("Broken at %g of its points, drawn on %g ms after\n", pieces, pause);
         in_pieces(d, &ds, pieces, pause, json, half);
         sp_dragon_destroy(d);
         sp_dataset_free(&ds);
@@ -588,11 +596,11 @@ int main(int argc, char** argv)
         sp_dragon_result res;
         if (s->stroke_count != 1) {
             fprintf(stderr, "visitors: drawing %d of %s has %d strokes (one expected)\n", i, label, s->stroke_count);
-            return 1;
+            return fail_tmp(tmp, tmp_db);
         }
         if (sp_dragon_add_stroke(d, &s->strokes[0], NULL, &res, &err) != SP_OK) {
             fprintf(stderr, "visitors: %s drawing %d: %s\n", label, i, err.text);
-            return 1;
+            return fail_tmp(tmp, tmp_db);
         }
         outcome* o = &out[i];
         o->refused = res.rejected;
@@ -603,7 +611,7 @@ int main(int argc, char** argv)
         if (isfinite(o->far) && o->refused != (o->far > SP_DRAGON_FAR_LIMIT)) {
             fprintf(stderr, "visitors: %s drawing %d: far score %.4f, yet %s\n", label, i, o->far,
                     o->refused ? "refused" : "accepted");
-            return 1;
+            return fail_tmp(tmp, tmp_db);
         }
         for (int k = 0; k < res.guess_count; ++k)
             o->top3 |= !strcmp(res.guesses[k].category, label);
