@@ -660,7 +660,10 @@ static void run_save(sp_kiosk* k)
         snprintf(tmp, sizeof tmp, "%s/.%s.tmp.png", k->export_dir, code);
         if (r == SP_OK) r = sp_image_write_png(&img, tmp, &err);
         if (r == SP_OK && rename(tmp, png) != 0) r = sp_fail(&err, SP_ERR_IO, "%s: cannot rename (%s)", png, strerror(errno));
-        if (r != SP_OK) unlink(tmp);
+        if (r != SP_OK) {
+            unlink(tmp);
+            unlink(glb); // the visitor gets no code, so no file may carry it
+        }
     }
     sp_image_free(&img);
     if (r == SP_OK) {

@@ -1506,6 +1506,51 @@ static void test_detail_ink(void)
         free(xy[k]);
 }
 
+// A save whose postcard cannot be written fails whole: the .glb already in
+// place is taken back, so no file in the export folder names a code the
+// visitor was never given (and the code stays free for the next save).
+static void test_save_fails_whole(void)
+{
+    six_strokes();
+    char db[1100], cmd[2400], glb[1200], png[1200];
+    e2e_db_copy("kiosk_savefail.db", db, sizeof db);
+    const char* ex = sp_test_tmp_path("kiosk_savefail_ex");
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", ex);
+    ENSURE(system(cmd) == 0);
+    for (int pass = 0; pass < 2; ++pass) {
+        sp_headless* gl = NULL;
+        double t = 0;
+        sp_kiosk* k = inproc_kiosk(db, "kiosk_savefail_ex", &gl, &t);
+        if (!gl) SKIP("no headless OpenGL");
+        ENSURE(k);
+        const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+        const stroke* s = &g_strokes[0];
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, (float)s->xy[0].x, (float)s->xy[0].y, 0});
+        for (int i = 1; i < s->n; ++i)
+            sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, t + 4 * i, (float)s->xy[i].x, (float)s->xy[i].y, 0});
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, t + 4 * s->n, (float)s->xy[s->n - 1].x, (float)s->xy[s->n - 1].y, 0});
+        updates_until(k, &t, t + 4 * s->n + 1500);
+        ENSURE(st->parts == 1);
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_SAVE});
+        updates_until(k, &t, t + 1500);
+        if (pass == 0) {
+            // The same kiosk start gives the same first free code: make its postcard's name a folder.
+            ENSURE(st->saves == 1 && st->save_failures == 0);
+            snprintf(glb, sizeof glb, "%s.glb", sp_kiosk_last_save(k));
+            snprintf(png, sizeof png, "%s.png", sp_kiosk_last_save(k));
+            ENSURE(access(glb, F_OK) == 0 && unlink(glb) == 0 && unlink(png) == 0 && mkdir(png, 0755) == 0);
+        } else {
+            fprintf(stderr, "  saves %d, failures %d; %s %s\n", st->saves, st->save_failures, glb,
+                    access(glb, F_OK) == 0 ? "left behind" : "taken back");
+            ENSURE(st->saves == 0 && st->save_failures == 1 && access(glb, F_OK) != 0);
+            snprintf(cmd, sizeof cmd, "test -z \"$(ls -A '%s' | grep -v '^%s$')\"", ex, strrchr(png, '/') + 1);
+            ENSURE(system(cmd) == 0); // no temporary file either
+        }
+        sp_kiosk_destroy(k);
+        sp_headless_destroy(gl);
+    }
+}
+
 // The kiosk loads the database's parts one a frame while no finger draws
 // (the attract screen, a pause), so the first strokes of a visit do not
 // wait for loading theirs; never while a finger draws.
@@ -1584,5 +1629,6 @@ int main(int argc, char** argv)
                                    {"collect_replaced", test_collect_replaced},
                                    {"body_after_parts", test_body_after_parts},
                                    {"detail_ink", test_detail_ink},
+                                   {"save_fails_whole", test_save_fails_whole},
                                    {0}});
 }
