@@ -657,6 +657,29 @@ static bool replace_before_body(sp_dragon* d, int i, fit_choice* f, float confid
     return true;
 }
 
+// Part i leaves d->parts while the others decide without it (as a body its
+// own fit would hint its own facing): their attachments follow the
+// renumbering, and one to part i is none meanwhile; `saved` (part_n ints)
+// keeps them for part_return.
+static void part_lift(sp_dragon* d, int i, int* saved)
+{
+    for (int k = 0; k < d->part_n; ++k) {
+        int a = saved[k] = d->parts[k]->pub.attached_to;
+        d->parts[k]->pub.attached_to = a == i ? -1 : a > i ? a - 1 : a;
+    }
+    memmove(&d->parts[i], &d->parts[i + 1], sizeof(part*) * (size_t)(d->part_n - i - 1));
+    --d->part_n;
+}
+
+static void part_return(sp_dragon* d, int i, part* p, const int* saved)
+{
+    memmove(&d->parts[i + 1], &d->parts[i], sizeof(part*) * (size_t)(d->part_n - i));
+    d->parts[i] = p;
+    ++d->part_n;
+    for (int k = 0; k < d->part_n; ++k)
+        d->parts[k]->pub.attached_to = saved[k];
+}
+
 // Part i, taken by the classifier for a body when it was drawn alone, lies
 // on the body just drawn (dragon_on_body): decided again as if drawn after
 // that body (the on-body rule of rerank_by_fit), so the tail a visitor
@@ -677,15 +700,14 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
     double near = 0.0;
     sp_clf_answer a;
     if (classify_and_decide(d, &sk, NULL, &res, category, &confidence, &near, &a) != SP_DRAGON_ACCEPTED) return false;
-    // Off the canvas while it is fitted: as a body it would hint its own facing.
-    memmove(&d->parts[i], &d->parts[i + 1], sizeof(part*) * (size_t)(d->part_n - i - 1));
-    --d->part_n;
+    int* saved = malloc(sizeof *saved * (size_t)d->part_n);
+    if (!saved) return false;
+    part_lift(d, i, saved);
     fit_choice f;
     int not_finite = 0;
     bool any_part = false, fitted = rerank_by_fit(d, &sk, lo, hi, true, &res, category, &confidence, &f, &not_finite, &any_part);
-    memmove(&d->parts[i + 1], &d->parts[i], sizeof(part*) * (size_t)(d->part_n - i));
-    d->parts[i] = old;
-    ++d->part_n;
+    part_return(d, i, old, saved);
+    free(saved);
     if (!fitted) return false;
     if (f.t->is_torso) {
         free(f.p);
