@@ -1,8 +1,10 @@
 #include "report.h"
+#include "sp/sketch_io.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "pose_io.h"
@@ -76,15 +78,23 @@ sp_result sp_json_write_file(const char* path, const cJSON* j, sp_error* err)
     }
     char* s = cJSON_Print(j);
     if (!s) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while writing JSON", path);
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp%d", path, (int)getpid());
-    FILE* f = fopen(tmp, "wb");
-    bool ok = f && fputs(s, f) >= 0 && fputc('\n', f) != EOF;
-    if (f && fclose(f) != 0) ok = false;
+    size_t n = strlen(s);
+    s[n] = '\n'; // cJSON_Print's terminator becomes the file's last newline
+    sp_result r = sp_file_write(path, s, n + 1, err);
     free(s);
-    if (!ok || rename(tmp, path) != 0) {
-        remove(tmp);
-        return sp_fail(err, SP_ERR_IO, "%s: cannot write the file", path);
+    return r;
+}
+
+void sp_outputs_add(sp_outputs* o, const char* path)
+{
+    if (path && o->count < (int)(sizeof o->paths / sizeof o->paths[0])) o->paths[o->count++] = path;
+}
+
+void sp_outputs_undo(sp_outputs* o)
+{
+    for (int i = 0; i < o->count; ++i) {
+        struct stat st;
+        if (lstat(o->paths[i], &st) == 0 && S_ISREG(st.st_mode)) unlink(o->paths[i]);
     }
-    return SP_OK;
+    o->count = 0;
 }

@@ -18,6 +18,17 @@ cJSON* sp_report_json(const sp_solve_report* rep, const sp_abstraction* ab, cons
 cJSON* sp_report_to_json(const sp_solve_report* rep, const sp_rig* rig, const sp_abstraction* ab, const double* p);
 /// Writes JSON to a file, all or nothing (temp file + rename). "-" writes to stdout.
 sp_result sp_json_write_file(const char* path, const cJSON* j, sp_error* err);
+/// What a command has written, taken back when a later output fails, so that
+/// a command that fails leaves none of its outputs (each is written whole).
+typedef struct sp_outputs {
+    const char* paths[8];
+    int count;
+} sp_outputs;
+/// Records `path` as written by this command.
+void sp_outputs_add(sp_outputs* o, const char* path);
+/// Removes what was recorded: regular files only ("-", a FIFO or a device
+/// that was written into stays).
+void sp_outputs_undo(sp_outputs* o);
 /// Prints JSON on stdout followed by a newline.
 void sp_json_print(const cJSON* j);
 

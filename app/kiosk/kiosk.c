@@ -640,30 +640,20 @@ static void run_save(sp_kiosk* k)
     sp_error err = {0};
     char code[8];
     next_code(k, code);
-    char glb[1200], png[1200], tmp[1300];
+    char glb[1200], png[1200];
     snprintf(glb, sizeof glb, "%s/%s.glb", k->export_dir, code);
     snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
     sp_image img = {0};
-    // Written beside and renamed into place: a visitor's code never names half a file.
+    // Each file is written whole (sp_file_write): a visitor's code never names half a file.
     sp_result r = make_dirs(k->export_dir, &err);
-    if (r == SP_OK) {
-        snprintf(tmp, sizeof tmp, "%s/.%s.tmp.glb", k->export_dir, code);
-        r = sp_dragon_export(k->dragon, tmp, &err);
-        if (r == SP_OK && rename(tmp, glb) != 0) r = sp_fail(&err, SP_ERR_IO, "%s: cannot rename (%s)", glb, strerror(errno));
-        if (r != SP_OK) unlink(tmp);
-    }
+    if (r == SP_OK) r = sp_dragon_export(k->dragon, glb, &err);
     if (r == SP_OK) {
         // The export evaluates poses of its own: pose the dragon again for the picture.
         r = sp_dragon_pose_at(k->dragon, k->ui->anim_ms / 1000.0, &err);
         k->posed = false;
         if (r == SP_OK) r = kiosk_postcard(k, code, &img, &err);
-        snprintf(tmp, sizeof tmp, "%s/.%s.tmp.png", k->export_dir, code);
-        if (r == SP_OK) r = sp_image_write_png(&img, tmp, &err);
-        if (r == SP_OK && rename(tmp, png) != 0) r = sp_fail(&err, SP_ERR_IO, "%s: cannot rename (%s)", png, strerror(errno));
-        if (r != SP_OK) {
-            unlink(tmp);
-            unlink(glb); // the visitor gets no code, so no file may carry it
-        }
+        if (r == SP_OK) r = sp_image_write_png(&img, png, &err);
+        if (r != SP_OK) unlink(glb); // the visitor gets no code, so no file may carry it
     }
     sp_image_free(&img);
     if (r == SP_OK) {

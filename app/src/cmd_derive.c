@@ -10,8 +10,9 @@
 
 #include "cli.h"
 #include "commands.h"
-#include "sp/part_preview.h"
+#include "report.h"
 #include "sp/derive.h"
+#include "sp/part_preview.h"
 
 static const char* k_cmd = "sketchpose derive";
 
@@ -66,7 +67,12 @@ int cmd_derive(int argc, char** argv)
         fprintf(stderr, "%s: preview: %s\n", k_cmd, err.text);
         goto done;
     }
-    if (sp_gltf_save(&part, NULL, out_path, &err) != SP_OK || (preview && sp_image_write_png(&sheet, preview, &err) != SP_OK)) {
+    if (sp_gltf_save(&part, NULL, out_path, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+        goto done;
+    }
+    if (preview && sp_image_write_png(&sheet, preview, &err) != SP_OK) {
+        sp_outputs_undo(&(sp_outputs){.paths = {out_path}, .count = 1}); // a failed command leaves no part behind
         fprintf(stderr, "%s: %s\n", k_cmd, err.text);
         goto done;
     }

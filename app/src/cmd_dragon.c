@@ -63,6 +63,7 @@ int cmd_dragon(int argc, char** argv)
     }
     int exit_code = SP_EXIT_INPUT;
     cJSON* j = NULL;
+    sp_outputs written = {.count = 0};
     cJSON* list = cJSON_CreateArray();
     for (int i = 0; i < sk.stroke_count; ++i) {
         sp_dragon_result res;
@@ -114,8 +115,10 @@ int cmd_dragon(int argc, char** argv)
         goto done;
     }
     if (report && sp_json_write_file(report, j, &err) != SP_OK) goto fail;
+    sp_outputs_add(&written, report);
     sp_json_print(j);
     if (out && sp_dragon_export(d, out, &err) != SP_OK) goto fail;
+    sp_outputs_add(&written, out);
     if (render) {
         sp_dragon_snapshot_desc sd = {.t = at, .strokes = true, .outlines = true};
         if (sp_dragon_snapshot_png(d, &sd, render, &err) != SP_OK) goto fail;
@@ -123,6 +126,7 @@ int cmd_dragon(int argc, char** argv)
     exit_code = SP_EXIT_OK;
     goto done;
 fail:
+    sp_outputs_undo(&written);
     fprintf(stderr, "sketchpose dragon: %s\n", err.text);
 done:
     cJSON_Delete(list);

@@ -29,11 +29,11 @@ bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
 }
 
 // --out and --render of the rig at p.
-static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_solve_outputs* o, sp_error* err)
+static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_solve_outputs* o, sp_outputs* done, sp_error* err)
 {
     sp_rig_posed v;
     sp_result r = sp_rig_handle_posed(s->rig, s->abstraction, p, &s->cam, &v, err);
-    if (r == SP_OK && o->out) r = sp_rig_posed_save(&v, o->out, err);
+    if (r == SP_OK && o->out && (r = sp_rig_posed_save(&v, o->out, err)) == SP_OK) sp_outputs_add(done, o->out);
     if (r == SP_OK && o->render) {
         sp_snapshot_desc d = {.character = v.character,
                               .params = v.params,
@@ -50,10 +50,13 @@ static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_so
 bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double* p, const sp_solve_outputs* o)
 {
     sp_error err = {0};
+    sp_outputs done = {.count = 0};
     sp_result r = o->report ? sp_json_write_file(o->report, report, &err) : SP_OK;
+    if (r == SP_OK) sp_outputs_add(&done, o->report);
     sp_json_print(report);
-    if (r == SP_OK && (o->out || o->render)) r = write_posed(s, p, o, &err);
+    if (r == SP_OK && (o->out || o->render)) r = write_posed(s, p, o, &done, &err);
     if (r != SP_OK) {
+        sp_outputs_undo(&done);
         fprintf(stderr, "%s: %s\n", s->cmd, err.text);
         return false;
     }

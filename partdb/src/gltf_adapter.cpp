@@ -29,6 +29,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpedantic"
 #include "gltf_internal.h"
+#include "sp/sketch_io.h"
 #pragma GCC diagnostic pop
 
 namespace
@@ -1624,15 +1625,10 @@ std::string serialize(const sp_character* ch, const double* params, bool binary)
 
 } // namespace
 
-// The serialised file to disk, with a one-line error naming it.
+// The serialised file to disk, whole or not at all, with a one-line error naming it.
 static sp_result write_file(const char* path, const std::string& bytes, sp_error* err)
 {
-    FILE* f = fopen(path, "wb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-    bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    ok = (fclose(f) == 0) && ok;
-    if (!ok) return sp_fail(err, SP_ERR_IO, "%s: write error: %s", path, strerror(errno));
-    return SP_OK;
+    return sp_file_write(path, bytes.data(), bytes.size(), err);
 }
 
 extern "C" sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err)

@@ -7,14 +7,80 @@
 #include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 // ---------------------------------------------------------------------------
 // Files
+
+static bool write_all(int fd, const void* data, size_t size)
+{
+    const char* p = data;
+    while (size > 0) {
+        ssize_t w = write(fd, p, size);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return false;
+        p += w, size -= (size_t)w;
+    }
+    return true;
+}
+
+// Straight into what `path` names when it is not a regular file (a FIFO, a device).
+static sp_result write_into(const char* path, const void* data, size_t size, sp_error* err)
+{
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+    if (fd < 0) return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    bool ok = write_all(fd, data, size);
+    int e = errno;
+    if (close(fd) != 0 && ok) ok = false, e = errno;
+    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write error (%s)", path, strerror(e));
+}
+
+sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err)
+{
+    static atomic_uint serial; // temporary names unique across threads too
+    struct stat st;
+    char* real = NULL;
+    const char* target = path;
+    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
+        if (!(real = realpath(path, NULL))) return write_into(path, data, size, err); // a dangling link: create what it names
+        target = real;
+    }
+    bool exists = stat(target, &st) == 0;
+    if (exists && S_ISDIR(st.st_mode)) {
+        free(real);
+        return sp_fail(err, SP_ERR_IO, "%s: is a folder, not a file", path);
+    }
+    if (exists && !S_ISREG(st.st_mode)) {
+        sp_result r = write_into(target, data, size, err);
+        free(real);
+        return r;
+    }
+    size_t n = strlen(target) + 48;
+    char* tmp = malloc(n);
+    if (!tmp) {
+        free(real);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    snprintf(tmp, n, "%s.tmp%ld-%u", target, (long)getpid(), atomic_fetch_add(&serial, 1u));
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+    int e = errno;
+    bool ok = fd >= 0;
+    if (ok && exists) fchmod(fd, st.st_mode & 07777); // a file replaced keeps its permissions
+    if (ok && !write_all(fd, data, size)) ok = false, e = errno;
+    if (fd >= 0 && close(fd) != 0 && ok) ok = false, e = errno;
+    if (ok && rename(tmp, target) != 0) ok = false, e = errno;
+    if (!ok && fd >= 0) unlink(tmp);
+    free(tmp);
+    free(real);
+    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(e));
+}
 
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err)
 {
@@ -265,8 +331,11 @@ sp_result sp_sketch_read_json(const char* path, sp_sketch* out, sp_error* err)
 sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* err)
 {
     if (!sp_sketch_is_valid(s)) return sp_fail(err, SP_ERR_INVALID, "%s: sketch has non-finite values", path);
-    FILE* f = fopen(path, "wb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    // Made in memory and written whole (sp_file_write): a failed write leaves no half a file.
+    char* text = NULL;
+    size_t len = 0;
+    FILE* f = open_memstream(&text, &len);
+    if (!f) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     bool all_t = s->stroke_count > 0;
     for (int i = 0; i < s->stroke_count; ++i)
         if (!s->strokes[i].t) all_t = false;
@@ -288,8 +357,13 @@ sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* e
     }
     fprintf(f, "%s]}\n", s->stroke_count ? "\n" : "");
     bool bad = ferror(f) != 0;
-    if (fclose(f) != 0 || bad) return sp_fail(err, SP_ERR_IO, "%s: write failed", path);
-    return SP_OK;
+    if (fclose(f) != 0 || bad) {
+        free(text);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    }
+    sp_result r = sp_file_write(path, text, len, err);
+    free(text);
+    return r;
 }
 
 // ---------------------------------------------------------------------------

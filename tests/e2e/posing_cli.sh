@@ -47,6 +47,15 @@ for key in '"ms"' '"iterations"' '"icp_rounds"' '"stopped"' '"energy_before"' '"
 done
 grep -q '"stopped":' "$WORK/out" || fail "pose prints no report on stdout"
 
+# An output that cannot be written fails the command, and it leaves none of
+# its outputs (each written whole, the ones before taken back).
+rm -f "$WORK/left.glb" "$WORK/left.json"
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/left.glb" --report "$WORK/left.json" --render "$WORK/nowhere/x.png"
+one_line_naming nowhere/x.png
+[ -e "$WORK/left.glb" ] && fail "pose left its .glb after --render failed"
+[ -e "$WORK/left.json" ] && fail "pose left its report after --render failed"
+ls "$WORK" | grep -q 'tmp' && fail "pose left a temporary file: $(ls "$WORK" | grep tmp)"
+
 # Bad strokes: one clear line naming the file, exit 1.
 strokes "$WORK/empty.json"
 expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/empty.json"

@@ -4,7 +4,12 @@
 // offscreen through EGL, read back and compared with the projection of its
 // vertices; overlays must show their colours where they were drawn. No GL
 // context is a failure, not a skip: EGL (Mesa) is present here and in CI.
+#include <signal.h>
 #include <stdint.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "fixtures.h"
 #include "sp/headless.h"
@@ -508,6 +513,98 @@ static void test_png_roundtrip(void)
     sp_image_free(&back);
 }
 
+// Reads a whole file into buf (at most cap bytes); its size, -1 when it cannot be read.
+static long slurp(const char* path, char* buf, long cap)
+{
+    FILE* f = fopen(path, "rb");
+    if (!f) return -1;
+    long n = (long)fread(buf, 1, (size_t)cap, f);
+    fclose(f);
+    return n;
+}
+
+// Files left in the folder of `path` whose names start with its own name and
+// differ from it (a writer's temporary files).
+static int leftovers(const char* path)
+{
+    char dir[1024], cmd[2300];
+    snprintf(dir, sizeof dir, "%s", path);
+    char* slash = strrchr(dir, '/');
+    ENSURE(slash);
+    *slash = 0;
+    snprintf(cmd, sizeof cmd, "ls -A '%s' | grep -c -F '%s.' ", dir, slash + 1);
+    FILE* p = popen(cmd, "r");
+    int n = -1;
+    ENSURE(p && fscanf(p, "%d", &n) == 1);
+    pclose(p);
+    return n;
+}
+
+// A write that fails (here a file size limit, as on a full disk) leaves the
+// old file as it was and no truncated or temporary one: the PNG, and the
+// same writer under the JSON, glTF and stroke files (sp_file_write). A
+// symbolic link stays one, and a FIFO is written into, not replaced.
+static void test_png_write_whole(void)
+{
+    sp_image img = {0};
+    ENSURE(sp_image_alloc(&img, 256, 256) == SP_OK);
+    uint32_t z = 12345; // noise: a PNG of about 256 KB, far beyond the limit below
+    for (int i = 0; i < 256 * 256 * 4; ++i)
+        img.rgba[i] = (uint8_t)((z = z * 1664525u + 1013904223u) >> 24);
+    sp_error err = {0};
+    const char* path = sp_test_tmp_path("whole.png");
+    ENSURE(sp_image_write_png(&img, path, &err) == SP_OK);
+    static char before[1 << 20], after[1 << 20];
+    long n0 = slurp(path, before, sizeof before);
+    ENSURE(n0 > 65536);
+    for (int i = 0; i < 256 * 256 * 4; ++i)
+        img.rgba[i] ^= 0x5a;
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit rl = {.rlim_cur = 16384, .rlim_max = RLIM_INFINITY};
+        if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(3);
+        sp_error e = {0};
+        sp_result r = sp_image_write_png(&img, path, &e);
+        fprintf(stderr, "  under a 16 KB file limit: %s\n", r == SP_OK ? "written" : e.text);
+        _exit(r == SP_ERR_IO && strstr(e.text, "whole.png") && strstr(e.text, "too large") ? 0 : 1);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(slurp(path, after, sizeof after) == n0 && !memcmp(before, after, (size_t)n0));
+    ENSURE(leftovers(path) == 0);
+    // Through a symbolic link: the target is written, the link stays.
+    const char* link = sp_test_tmp_path("whole_link.png");
+    unlink(link);
+    ENSURE(symlink(path, link) == 0);
+    ENSURE(sp_image_write_png(&img, link, &err) == SP_OK);
+    struct stat st;
+    ENSURE(lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
+    ENSURE(slurp(path, after, sizeof after) > 65536 && memcmp(before, after, 64 * 1024) != 0);
+    // Into a FIFO: a reader gets every byte, and the FIFO is still one.
+    const char* fifo = sp_test_tmp_path("whole.fifo");
+    unlink(fifo);
+    ENSURE(mkfifo(fifo, 0600) == 0);
+    pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        long n = slurp(fifo, after, sizeof after);
+        _exit(n == slurp(path, before, sizeof before) && !memcmp(before, after, (size_t)n) ? 0 : 1);
+    }
+    ENSURE(sp_image_write_png(&img, fifo, &err) == SP_OK);
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(lstat(fifo, &st) == 0 && S_ISFIFO(st.st_mode));
+    // A folder is not a file.
+    const char* dir = sp_test_tmp_path("whole_dir");
+    mkdir(dir, 0755);
+    ENSURE(sp_image_write_png(&img, dir, &err) == SP_ERR_IO && strstr(err.text, "folder"));
+    rmdir(dir);
+    unlink(fifo);
+    unlink(link);
+    sp_image_free(&img);
+}
+
 static void test_projection_matches_camera(void)
 {
     // Pure math: NDC of the GL projection equals sp_camera_project mapped to NDC.
@@ -539,6 +636,7 @@ int main(int argc, char** argv)
     int rc = sp_test_run(argc, argv,
                          (sp_test[]){{"projection_matches_camera", test_projection_matches_camera},
                                      {"png_roundtrip", test_png_roundtrip},
+                                     {"png_write_whole", test_png_write_whole},
                                      {"mesh_orthographic", test_mesh_orthographic},
                                      {"mesh_perspective", test_mesh_perspective},
                                      {"viewport_scale", test_viewport_scale},

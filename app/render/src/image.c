@@ -1,5 +1,6 @@
 // image.c: PNG in and out through stb_image / stb_image_write (Debian libstb-dev).
 #include "sp/image.h"
+#include "sp/sketch_io.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -67,9 +68,13 @@ uint8_t* sp_image_at(const sp_image* img, int x, int y)
 sp_result sp_image_write_png(const sp_image* img, const char* path, sp_error* err)
 {
     assert(img && img->rgba && path);
-    if (!stbi_write_png(path, img->width, img->height, 4, img->rgba, img->width * 4))
-        return sp_fail(err, SP_ERR_IO, "%s: cannot write PNG", path);
-    return SP_OK;
+    // Encoded in memory and written whole: stbi_write_png does not check its writes.
+    int len = 0;
+    unsigned char* png = stbi_write_png_to_mem(img->rgba, img->width * 4, img->width, img->height, 4, &len);
+    if (!png) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while encoding the PNG", path);
+    sp_result r = sp_file_write(path, png, (size_t)len, err);
+    STBIW_FREE(png);
+    return r;
 }
 
 sp_result sp_image_read_png(const char* path, sp_image* img, sp_error* err)

@@ -97,6 +97,14 @@ sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 /// Reads a whole drawing file into *out (malloc'd, NUL-terminated, *len
 /// bytes without the NUL): regular files of at most SP_SKETCH_MAX_FILE_BYTES.
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
+/// Writes `size` bytes to `path` whole or not at all: into a temporary file
+/// beside it (the old file's permissions, else 0666 less the umask), renamed
+/// into place once every byte is written, so that a failed write (a full disk, a size limit) leaves the old file as
+/// it was and no truncated one. A symbolic link is followed (its target is
+/// replaced, the link stays); a path that is not a regular file (a FIFO, a
+/// device such as /dev/stdout) is written into directly. One line in `err`
+/// names the path and the system's reason.
+sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err);
 /// True when `path`'s extension (after its last '.', in its last component) is `ext`, ignoring case.
 bool sp_path_ext_is(const char* path, const char* ext);
 /// The names in folder `dir`, sorted bytewise so that every machine reads a
