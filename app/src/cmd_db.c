@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "clf_cli.h"
 #include "cli.h"
@@ -226,6 +227,27 @@ static int db_init(int argc, char** argv)
     return SP_EXIT_OK;
 }
 
+// Whether a file can be made at `path`: it is not a folder, and its folder
+// exists and may be written. One line and false when not.
+static bool preview_writable(const char* cmd, const char* path)
+{
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", path);
+    char* slash = strrchr(dir, '/');
+    if (slash) *slash = 0;
+    const char* d = !slash ? "." : dir[0] ? dir : "/";
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "%s: %s: is a folder, not a file; nothing stored\n", cmd, path);
+        return false;
+    }
+    if (stat(d, &st) != 0 || !S_ISDIR(st.st_mode) || access(d, W_OK) != 0) {
+        fprintf(stderr, "%s: %s: its folder %s is not there or not writable; nothing stored\n", cmd, path, d);
+        return false;
+    }
+    return true;
+}
+
 static int db_add_part(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-part";
@@ -265,7 +287,8 @@ static int db_add_part(int argc, char** argv)
     if (no_selftest) d.selftest_seeds = -1;
     sp_error err = {0};
     if (preview) {
-        // A renderer first: without one nothing is stored.
+        // A renderer and a place for the picture first: without them nothing is stored.
+        if (!preview_writable(cmd, preview)) return SP_EXIT_INPUT;
         sp_headless* gl;
         sp_headless_create(&gl, &err);
         if (!gl) return fail(cmd, &err);
@@ -276,8 +299,17 @@ static int db_add_part(int argc, char** argv)
     sp_db_part_info info;
     sp_result r = sp_db_add_part_file(db, pos[0], &d, &info, &err);
     sp_character part = {0};
-    if (r == SP_OK && preview && (r = sp_db_load_part(db, info.name, &part, &err)) == SP_OK)
-        r = sp_part_preview_png(&part, sp_rig_find_abstraction(&part.rig, info.abstraction), preview, &err);
+    if (r == SP_OK && preview) {
+        if ((r = sp_db_load_part(db, info.name, &part, &err)) == SP_OK)
+            r = sp_part_preview_png(&part, sp_rig_find_abstraction(&part.rig, info.abstraction), preview, &err);
+        // The picture failed after all (a full disk): the part goes again, so that a refused part leaves none behind.
+        sp_error rm = {0};
+        if (r != SP_OK && sp_db_remove_part(db, info.name, c.by, &rm) == SP_OK) {
+            char why[sizeof err.text];
+            snprintf(why, sizeof why, "%s", err.text);
+            sp_fail(&err, r, "%s; part %s not kept", why, info.name);
+        }
+    }
     sp_character_free(&part);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);

@@ -536,6 +536,30 @@ static void test_cli(void)
     ENSURE(cJSON_IsObject(j) && cJSON_GetArraySize(cJSON_GetObjectItem(j, "derived")) == 0);
     ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(j, "abstraction")), "outline"));
     cJSON_Delete(j);
+    // A preview that cannot be written keeps no part: a folder that is not
+    // there (seen before storing), or a link into one (seen only when the
+    // picture is written: the part goes again).
+    char dangling[1024];
+    snprintf(dangling, sizeof dangling, "%s", sp_test_tmp_path("dangling.png"));
+    unlink(dangling);
+    ENSURE(symlink("/nonexistent-sp-folder/p.png", dangling) == 0);
+    const char* previews[2][2] = {{"lizard_nodir", sp_test_tmp_path("nowhere/p.png")}, {"lizard_link", dangling}};
+    for (int i = 0; i < 2; ++i) {
+        char errf[1024];
+        snprintf(errf, sizeof errf, "%s", sp_test_tmp_path("add_part_err.txt"));
+        snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --name %s --synth 8 --preview '%s' 2>'%s'", bin, db, out,
+                 previews[i][0], previews[i][1], errf);
+        ENSURE(run(cmd, NULL) == 1);
+        snprintf(cmd, sizeof cmd, "cat '%s'", errf);
+        ENSURE(run(cmd, &text) == 0);
+        fprintf(stderr, "  %s", text);
+        ENSURE(strstr(text, i == 0 ? "nothing stored" : "not kept") && strchr(text, '\n') == text + strlen(text) - 1);
+        free(text);
+    }
+    snprintf(cmd, sizeof cmd, "'%s' db list --db '%s'", bin, db);
+    ENSURE(run(cmd, &text) == 0 && strstr(text, "lizard_again") && !strstr(text, "lizard_nodir") && !strstr(text, "lizard_link"));
+    free(text);
+    unlink(dangling);
 }
 
 // ---- the outline on the rendered silhouette ---------------------------------------
