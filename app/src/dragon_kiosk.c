@@ -23,6 +23,7 @@
 #include "sp/dragon.h"
 #include "sp/kiosk_session.h"
 #include "sp/kiosk_text.h"
+#include "sp/partdb.h"
 
 static const char* const k_cmd = "dragon-kiosk";
 
@@ -470,6 +471,30 @@ int main(int argc, char** argv)
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
+    // A database without parts gives a visitor nothing to draw; one without a model recognises no stroke.
+    const char* dbp = db ? db : sp_db_default_path();
+    sp_db* pdb = NULL;
+    char** cats = NULL;
+    int ncat = 0;
+    if (sp_db_open(dbp, SP_DB_READONLY, &pdb, &err) == SP_OK && sp_db_categories(pdb, &cats, &ncat, &err) == SP_OK && ncat == 0) {
+        fprintf(stderr,
+                "%s: %s: no parts to draw (add them with `sketchpose db add-part`, or name a file that is not there to build "
+                "the default database)\n",
+                k_cmd, dbp);
+        sp_db_close(pdb);
+        sp_kiosk_destroy(a.k);
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
+    }
+    sp_db_free_strings(cats, ncat);
+    sp_db_close(pdb);
+    if (!sp_dragon_model(sp_kiosk_dragon(a.k)))
+        fprintf(stderr,
+                "%s: %s: no trained model: strokes are refused and the parts row alone makes parts (`sketchpose db train` "
+                "makes one)\n",
+                k_cmd, dbp);
     glfwSetWindowUserPointer(win, &a);
     relayout(&a);
     glfwSetMouseButtonCallback(win, cb_button);

@@ -389,6 +389,14 @@ sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* er
                     SP_DB_SCHEMA_VERSION);
         goto fail;
     }
+    // Only SP_DB_CREATE makes a database: an existing empty file (a typo'd
+    // path, a truncated copy) opened for writing is refused, not given a schema.
+    int tables = 0;
+    if (!ro && exists && v == 0 && !(flags & SP_DB_CREATE) &&
+        pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables) == SQLITE_OK && tables == 0) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: not a sketchpose database (an empty file; `sketchpose db init` makes one)", path);
+        goto fail;
+    }
     if (!ro) {
         // WAL: readers (the kiosk) never block the curator and never see a half-written change.
         sqlite3_stmt* jm = NULL;

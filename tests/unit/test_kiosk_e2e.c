@@ -1551,6 +1551,39 @@ static void test_save_fails_whole(void)
     }
 }
 
+// A database that gives a visitor nothing to draw stops the kiosk at start
+// with one line, the file as it was: an empty file (not made a database),
+// and a database without parts.
+static void test_nothing_to_draw(void)
+{
+    NEED_XVFB();
+    char sc[1100], db[1100];
+    snprintf(sc, sizeof sc, "%s", sp_test_tmp_path("kiosk_nothing.json"));
+    script s = script_open(sc, 0);
+    script_end(&s, sc, 500);
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_nothing.db"));
+    char args[1300];
+    snprintf(args, sizeof args, "--script '%s'", sc);
+    const char* errf = sp_test_tmp_path("kiosk_stderr.txt");
+    for (int v = 0; v < 2; ++v) {
+        unlink(db);
+        FILE* f = fopen(db, "wb");
+        ENSURE(f && fclose(f) == 0);
+        if (v == 1) {
+            sp_db* h = NULL;
+            sp_error err = {0};
+            ENSURE(sp_db_open(db, SP_DB_CREATE, &h, &err) == SP_OK);
+            sp_db_close(h);
+        }
+        struct stat before, after;
+        ENSURE(stat(db, &before) == 0);
+        ENSURE(run_kiosk_on(db, args, NULL) == 1);
+        ENSURE(lines_with(errf, v == 0 ? "empty file" : "no parts to draw") == 1);
+        ENSURE(stat(db, &after) == 0 && after.st_size == before.st_size);
+    }
+    unlink(db);
+}
+
 // The kiosk loads the database's parts one a frame while no finger draws
 // (the attract screen, a pause), so the first strokes of a visit do not
 // wait for loading theirs; never while a finger draws.
@@ -1630,5 +1663,6 @@ int main(int argc, char** argv)
                                    {"body_after_parts", test_body_after_parts},
                                    {"detail_ink", test_detail_ink},
                                    {"save_fails_whole", test_save_fails_whole},
+                                   {"nothing_to_draw", test_nothing_to_draw},
                                    {0}});
 }

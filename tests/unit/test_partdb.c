@@ -675,6 +675,16 @@ static void test_schema_versions(void)
     ENSURE(sqlite3_exec(h, "CREATE TABLE foo(x)", NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(h);
     ENSURE(sp_db_open(q, 0, &db, &err) == SP_ERR_INVALID && strstr(err.text, "not a sketchpose database"));
+    // An empty file (a typo'd path, a truncated copy) opened for writing is
+    // refused and stays empty; only SP_DB_CREATE makes a database of it.
+    remove_db(q);
+    ENSURE(db_write_file(q, "", 0, &err) == SP_OK);
+    ENSURE(sp_db_open(q, 0, &db, &err) == SP_ERR_INVALID && strstr(err.text, "empty file"));
+    struct stat st;
+    ENSURE(stat(q, &st) == 0 && st.st_size == 0);
+    ENSURE(sp_db_open(q, SP_DB_CREATE, &db, &err) == SP_OK);
+    sp_db_close(db);
+    remove_db(q);
 }
 
 static void test_bad_input(void)
