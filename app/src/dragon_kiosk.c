@@ -338,6 +338,29 @@ static void mark_path(const char* shot, const char* name, char* out, size_t cap)
     snprintf(out, cap, "%.*s-%s.png", (int)stem, shot, name);
 }
 
+// A database that is there must have parts to draw: checked before any
+// window opens, one line when not. One not there is built by the default
+// recipe (sp_kiosk_create).
+static bool has_parts(const char* path)
+{
+    if (access(path, F_OK) != 0) return true;
+    sp_error err = {0};
+    sp_db* db = NULL;
+    char** cats = NULL;
+    int n = 0;
+    bool ok = sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK && sp_db_categories(db, &cats, &n, &err) == SP_OK;
+    if (!ok)
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+    else if (n == 0)
+        fprintf(stderr,
+                "%s: %s: no parts to draw (add them with `sketchpose db add-part`, or name a file that is not there to build "
+                "the default database)\n",
+                k_cmd, path);
+    sp_db_free_strings(cats, n);
+    sp_db_close(db);
+    return ok && n > 0;
+}
+
 int main(int argc, char** argv)
 {
     double start = sp_now_ms();
@@ -388,6 +411,10 @@ int main(int argc, char** argv)
             return SP_EXIT_INPUT;
         }
         if (!size && session.canvas_w > 0 && !session.unit_coords) win_w = session.canvas_w, win_h = session.canvas_h;
+    }
+    if (!has_parts(db ? db : sp_db_default_path())) {
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
     }
     glfwSetErrorCallback(cb_error);
     if (!glfwInit()) {
@@ -471,30 +498,11 @@ int main(int argc, char** argv)
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
-    // A database without parts gives a visitor nothing to draw; one without a model recognises no stroke.
-    const char* dbp = db ? db : sp_db_default_path();
-    sp_db* pdb = NULL;
-    char** cats = NULL;
-    int ncat = 0;
-    if (sp_db_open(dbp, SP_DB_READONLY, &pdb, &err) == SP_OK && sp_db_categories(pdb, &cats, &ncat, &err) == SP_OK && ncat == 0) {
-        fprintf(stderr,
-                "%s: %s: no parts to draw (add them with `sketchpose db add-part`, or name a file that is not there to build "
-                "the default database)\n",
-                k_cmd, dbp);
-        sp_db_close(pdb);
-        sp_kiosk_destroy(a.k);
-        glfwDestroyWindow(win);
-        glfwTerminate();
-        sp_kiosk_session_free(&session);
-        return SP_EXIT_INPUT;
-    }
-    sp_db_free_strings(cats, ncat);
-    sp_db_close(pdb);
     if (!sp_dragon_model(sp_kiosk_dragon(a.k)))
         fprintf(stderr,
                 "%s: %s: no trained model: strokes are refused and the parts row alone makes parts (`sketchpose db train` "
                 "makes one)\n",
-                k_cmd, dbp);
+                k_cmd, db ? db : sp_db_default_path());
     glfwSetWindowUserPointer(win, &a);
     relayout(&a);
     glfwSetMouseButtonCallback(win, cb_button);
