@@ -1,5 +1,6 @@
 // cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -733,8 +734,9 @@ static bool parse_ids(const char* cmd, const sp_str_list* l, int first, int coun
     for (int i = 0; i < count; ++i) {
         const char* v = l->items[first + i];
         char* end = NULL;
+        errno = 0;
         long long x = strtoll(v, &end, 10);
-        if (end == v || *end || x <= 0) {
+        if (end == v || *end || x <= 0 || errno == ERANGE) {
             fprintf(stderr, "%s: '%s' is not a kiosk sketch id (a positive number); nothing was changed\n", cmd, v);
             return false;
         }

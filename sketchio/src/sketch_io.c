@@ -202,6 +202,14 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
     const char* end = NULL;
     cJSON* root = cJSON_ParseWithLengthOpts(text, len, &end, false);
     if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d", name, line_of(text, len, end));
+    // Anything but white space after the document means the file is not what it seems (two files joined, a bad edit).
+    while (end && end < text + len && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r' || *end == 0))
+        ++end;
+    if (end && end < text + len) {
+        int line = line_of(text, len, end);
+        cJSON_Delete(root);
+        return sp_fail(err, SP_ERR_PARSE, "%s: text after the JSON document, line %d", name, line);
+    }
     sp_result rc = SP_OK;
     sp_sketch s = {0};
     sp_vec2* pts = NULL;

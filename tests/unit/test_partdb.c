@@ -754,8 +754,12 @@ static void test_bad_input(void)
     } sk[] = {
         {"s_empty.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [100, 100], \"strokes\": []}"},
         {"s_trunc.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], [3"},
-        {"s_nan.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": [[1, 2], [NaN, 3]]}]}"},
-        {"s_version.json", "{\"format\": \"sketchpose-strokes\", \"version\": 7, \"canvas\": [9, 9], \"strokes\": [{\"points\": [[1, 2], [2, 3]]}]}"},
+        {"s_nan.json", "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": [[1, "
+                       "2], [NaN, 3]]}]}"},
+        {"s_version.json", "{\"format\": \"sketchpose-strokes\", \"version\": 7, \"canvas\": [9, 9], \"strokes\": [{\"points\": "
+                           "[[1, 2], [2, 3]]}]}"},
+        {"s_trailing.json",
+         "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], [2, 3]]}]}\n}{ oops"},
         {"s_bad.svg", "<svg><path d=\"M 10 10 L zz\"/></svg>"},
         {"s_notpng.png", "this is not a png"},
         {"s_bad.ndjson", "{\"word\": \"cat\", \"drawing\": [[[1, 2], [3]]]}\n"},
@@ -772,6 +776,7 @@ static void test_bad_input(void)
         int st = pclose(pp);
         fprintf(stderr, "  %-15s -> exit %d: %s", sk[i].name, WEXITSTATUS(st), line);
         ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && strstr(line, "sketchpose db add-sketch: "));
+        ENSURE(!strstr(sk[i].name, "trailing") || strstr(line, "text after the JSON document, line 2"));
     }
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' 2>/dev/null >/dev/null", bin, p, sp_test_tmp_path("b_cycle.gltf"));
@@ -1415,6 +1420,8 @@ static void test_kiosk_review_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "no kiosk sketch 424242") && !strchr(strchr(out, '\n') + 1, '\n'));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject nine 2>&1 >/dev/null", bin, p);
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "'nine' is not a kiosk sketch id"));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve 99999999999999999999 2>&1 >/dev/null", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "'99999999999999999999' is not a kiosk sketch id"));
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     // A database in use: one clear line, exit 1, nothing lost.
