@@ -341,6 +341,24 @@ sp_result db_migrate(sp_db* db, int target, sp_error* err)
     return db_commit(db, err);
 }
 
+// Opens `path` read-only as an SQLite URI with immutable=1 (no locks, no
+// -shm): what the URI needs escaped is escaped.
+static int open_immutable(const char* path, sqlite3** h)
+{
+    size_t n = strlen(path);
+    char* uri = malloc(3 * n + 32);
+    if (!uri) return SQLITE_NOMEM;
+    char* o = uri + sprintf(uri, "file:");
+    while (path[0] == '/' && path[1] == '/') // "file://" would begin an authority
+        ++path;
+    for (const char* c = path; *c; ++c)
+        o += (*c == '%' || *c == '?' || *c == '#') ? sprintf(o, "%%%02X", (unsigned char)*c) : sprintf(o, "%c", *c);
+    sprintf(o, "?immutable=1");
+    int rc = sqlite3_open_v2(uri, h, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_FULLMUTEX, NULL);
+    free(uri);
+    return rc;
+}
+
 sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err)
 {
     *out = NULL;
@@ -374,7 +392,18 @@ sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* er
     sqlite3_extended_result_codes(db->h, 1);
     sqlite3_busy_timeout(db->h, db->busy_ms);
     int v = 0;
-    if ((rc = pragma_int(db, "PRAGMA user_version", &v)) != SQLITE_OK) {
+    rc = pragma_int(db, "PRAGMA user_version", &v);
+    if (ro && (rc & 0xff) == SQLITE_READONLY) {
+        // A WAL database read where this user may not make its -shm (a folder
+        // of someone else's): read it as a file no one changes meanwhile.
+        sqlite3_close(db->h);
+        db->h = NULL;
+        if ((rc = open_immutable(path, &db->h)) == SQLITE_OK) {
+            sqlite3_extended_result_codes(db->h, 1);
+            rc = pragma_int(db, "PRAGMA user_version", &v);
+        }
+    }
+    if (rc != SQLITE_OK) {
         r = db_fail(db, rc, "reading the schema version", err);
         goto fail;
     }

@@ -626,6 +626,47 @@ static void test_unreachable(void)
     ENSURE(sp_db_open(p, SP_DB_READONLY, &d, &e) == SP_ERR_IO && strstr(e.text, "no such database"));
 }
 
+// A database in a folder this user may read but not write (someone else's):
+// read-only commands still read it, though SQLite cannot make its -shm there;
+// a writer is refused with one line (root's child drops its rights).
+static void test_read_only_folder(void)
+{
+    const char* dir = sp_test_reachable_dir("sp_partdb_ro");
+    ENSURE(dir);
+    char p[1024];
+    snprintf(p, sizeof p, "%s/shared.db", dir);
+    copy_file(base_db("ro_folder.db"), p);
+    ENSURE(chmod(p, 0644) == 0 && chmod(dir, geteuid() == 0 ? 0755 : 0555) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
+        sp_db* d = NULL;
+        sp_error e = {0};
+        char** cats = NULL;
+        int n = 0;
+        sp_result r = sp_db_open(p, SP_DB_READONLY, &d, &e);
+        if (r == SP_OK) r = sp_db_categories(d, &cats, &n, &e);
+        fprintf(stderr, "  read-only folder, reader: %s, %d categories\n", r == SP_OK ? "ok" : e.text, n);
+        sp_db_free_strings(cats, n);
+        sp_db_close(d);
+        if (r != SP_OK || n != 2) _exit(6);
+        r = sp_db_open(p, 0, &d, &e);
+        fprintf(stderr, "  read-only folder, writer: %s\n", e.text);
+        _exit(r == SP_ERR_IO && strstr(e.text, "shared.db") ? 0 : 7);
+    }
+    int st;
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+    ENSURE(chmod(dir, 0755) == 0);
+    ENSURE(WEXITSTATUS(st) == 0);
+    struct stat sb;
+    char side[1100];
+    snprintf(side, sizeof side, "%s-shm", p);
+    ENSURE(stat(side, &sb) != 0); // the reader left nothing beside it
+    remove_db(p);
+    ENSURE(rmdir(dir) == 0);
+}
+
 static void test_schema_versions(void)
 {
     char p[1024];
@@ -1489,6 +1530,7 @@ int main(int argc, char** argv)
                                    {"two_writers", test_two_writers},
                                    {"read_only_and_full", test_read_only_and_full},
                                    {"unreachable", test_unreachable},
+                                   {"read_only_folder", test_read_only_folder},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
