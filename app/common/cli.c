@@ -58,7 +58,9 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             }
             continue;
         }
-        if (i + 1 >= argc) {
+        // An option's value never starts with "--": "--out --no-shadow" lost
+        // the value, it does not name a file "--no-shadow" ("-1" stays a value).
+        if (i + 1 >= argc || !strncmp(argv[i + 1], "--", 2)) {
             fprintf(stderr, "%s: %s needs a value (%s)\n", cmd, o->name, o->arg);
             return 2;
         }

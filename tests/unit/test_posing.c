@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "fixtures.h"
 #include "posing.h"
 #include "rig_handle.h"
@@ -415,6 +416,25 @@ static void test_rig_handle(void)
     sp_rig_handle_free(g);
 }
 
+// The shared option parser: a value that starts with "--" is a missing value
+// (it was taken as the value: `--out --no-shadow` wrote "--no-shadow"), "-1" is one.
+static void test_cli_missing_value(void)
+{
+    const char *out = NULL, *rig = NULL;
+    bool flag = false;
+    int n = 0;
+    sp_opt opts[] = {{"--out", SP_OPT_STRING, &out, "X.png", "", false},
+                     {"--rig", SP_OPT_STRING, &rig, "R", "", false},
+                     {"--flag", SP_OPT_FLAG, &flag, "", "", false},
+                     {"--n", SP_OPT_INT, &n, "N", "", false}};
+    char* a1[] = {"t", "--rig", "X", "--out", "--flag"};
+    ENSURE(sp_cli_parse(5, a1, "t", "", opts, 4) == 2 && out == NULL && !flag);
+    char* a2[] = {"t", "--out", "--rig", "o/x.glb"};
+    ENSURE(sp_cli_parse(4, a2, "t", "", opts, 4) == 2 && out == NULL);
+    char* a3[] = {"t", "--n", "-1", "--out", "-"};
+    ENSURE(sp_cli_parse(5, a3, "t", "", opts, 4) == -1 && n == -1 && out && !strcmp(out, "-"));
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -424,5 +444,6 @@ int main(int argc, char** argv)
                                    {"drawover_cesiumman", test_drawover_cesiumman},
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
+                                   {"cli_missing_value", test_cli_missing_value},
                                    {0}});
 }
