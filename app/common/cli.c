@@ -106,3 +106,17 @@ bool sp_cli_parse_size(const char* s, int* w, int* h)
     *h = (int)b;
     return true;
 }
+
+bool sp_cli_check_int(const char* cmd, const char* name, int v, int lo, int hi)
+{
+    if (v >= lo && v <= hi) return true;
+    fprintf(stderr, "%s: %s must be %d..%d, got %d\n", cmd, name, lo, hi, v);
+    return false;
+}
+
+bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo, bool lo_open, double hi)
+{
+    if ((lo_open ? v > lo : v >= lo) && v <= hi) return true;
+    fprintf(stderr, "%s: %s must be in %s%.10g, %.10g], got %g\n", cmd, name, lo_open ? "(" : "[", lo, hi, v);
+    return false;
+}

@@ -435,6 +435,25 @@ static void test_cli_missing_value(void)
     ENSURE(sp_cli_parse(5, a3, "t", "", opts, 4) == -1 && n == -1 && out && !strcmp(out, "-"));
 }
 
+// The solve's limits on the command line: out of range is bad usage (it
+// silently became the default).
+static void test_pose_option_ranges(void)
+{
+    char cmd[2048];
+    const char* bad[] = {"--max-iterations 0", "--max-iterations -1",  "--max-ms 0",
+                         "--max-ms -1",        "--representatives -5", "--representatives 0"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' pose --rig r.glb --strokes s.json %s 2>/dev/null", SP_SKETCHPOSE, bad[i]);
+        ENSURE(run(cmd) == 2);
+    }
+    snprintf(cmd, sizeof cmd, "'%s' drawover --rig r.glb --on a.json --to b.json --max-ms -1 2>/dev/null", SP_SKETCHPOSE);
+    ENSURE(run(cmd) == 2);
+    // In range the command runs (and fails on the missing rig: exit 1).
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig /nonexistent.glb --strokes s.json --max-iterations 5 --max-ms 10 2>/dev/null",
+             SP_SKETCHPOSE);
+    ENSURE(run(cmd) == 1);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -445,5 +464,6 @@ int main(int argc, char** argv)
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
                                    {"cli_missing_value", test_cli_missing_value},
+                                   {"pose_option_ranges", test_pose_option_ranges},
                                    {0}});
 }
