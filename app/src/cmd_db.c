@@ -82,11 +82,11 @@ static sp_db* open_db(const char* cmd, const db_common* c, unsigned flags)
 {
     sp_db* db = NULL;
     sp_error err = {0};
-    if (sp_db_open(db_path(c), flags, &db, &err) != SP_OK) {
+    // The timeout applies to the open too: a locked database is waited for there first.
+    if (sp_db_open_wait(db_path(c), flags, c->busy_s > 0 ? (int)(c->busy_s * 1000) : -1, &db, &err) != SP_OK) {
         fprintf(stderr, "%s: %s\n", cmd, err.text);
         return NULL;
     }
-    if (c->busy_s > 0) sp_db_set_busy_timeout(db, (int)(c->busy_s * 1000));
     return db;
 }
 
