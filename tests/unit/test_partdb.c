@@ -1417,6 +1417,11 @@ static void test_kiosk_review_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "database is busy") && !strchr(strchr(out, '\n') + 1, '\n'));
     sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
     sqlite3_close(other);
+    // Results that cannot be written (a full disk) are an error, not success.
+    snprintf(cmd, sizeof cmd, "'%s' db list --db '%s' 2>&1 >/dev/full", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "sketchpose: stdout: write error (No space left on device)"));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' 2>&1 >/dev/full", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "stdout: write error"));
     // Locked outright (a rollback-journal write): --busy-timeout holds from the
     // open on (the open waited the default 5 s and named it).
     ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
