@@ -58,7 +58,9 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             }
             continue;
         }
-        if (i + 1 >= argc) {
+        // An option's value never starts with "--": "--out --no-shadow" lost
+        // the value, it does not name a file "--no-shadow" ("-1" stays a value).
+        if (i + 1 >= argc || !strncmp(argv[i + 1], "--", 2)) {
             fprintf(stderr, "%s: %s needs a value (%s)\n", cmd, o->name, o->arg);
             return 2;
         }
@@ -103,4 +105,18 @@ bool sp_cli_parse_size(const char* s, int* w, int* h)
     *w = (int)a;
     *h = (int)b;
     return true;
+}
+
+bool sp_cli_check_int(const char* cmd, const char* name, int v, int lo, int hi)
+{
+    if (v >= lo && v <= hi) return true;
+    fprintf(stderr, "%s: %s must be %d..%d, got %d\n", cmd, name, lo, hi, v);
+    return false;
+}
+
+bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo, bool lo_open, double hi)
+{
+    if ((lo_open ? v > lo : v >= lo) && v <= hi) return true;
+    fprintf(stderr, "%s: %s must be in %s%.10g, %.10g], got %g\n", cmd, name, lo_open ? "(" : "[", lo, hi, v);
+    return false;
 }

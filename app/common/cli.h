@@ -9,6 +9,7 @@
 #ifndef SP_CLI_H
 #define SP_CLI_H
 
+#include <limits.h>
 #include <stdbool.h>
 
 typedef enum sp_opt_kind {
@@ -39,6 +40,16 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
 
 /// Parses "WxH" into two positive ints; false if malformed.
 bool sp_cli_parse_size(const char* s, int* w, int* h);
+
+/// Out-of-range check of a parsed option: true when lo <= v <= hi, else
+/// prints "<cmd>: <name> must be lo..hi, got v" and returns false (exit 2).
+bool sp_cli_check_int(const char* cmd, const char* name, int v, int lo, int hi);
+/// The same for a number in [lo, hi], or (lo, hi] when lo_open.
+bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo, bool lo_open, double hi);
+
+/// Initial value of an int option whose "not given" must differ from every
+/// value a user can type (sp_cli_parse refuses INT_MIN).
+#define SP_CLI_UNSET INT_MIN
 
 /// Exit codes (DESIGN.md).
 enum { SP_EXIT_OK = 0, SP_EXIT_INPUT = 1, SP_EXIT_USAGE = 2 };

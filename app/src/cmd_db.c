@@ -84,11 +84,11 @@ static sp_db* open_db(const char* cmd, const db_common* c, unsigned flags)
 {
     sp_db* db = NULL;
     sp_error err = {0};
-    if (sp_db_open(db_path(c), flags, &db, &err) != SP_OK) {
+    // The timeout applies to the open too: a locked database is waited for there first.
+    if (sp_db_open_wait(db_path(c), flags, c->busy_s > 0 ? (int)(c->busy_s * 1000) : -1, &db, &err) != SP_OK) {
         fprintf(stderr, "%s: %s\n", cmd, err.text);
         return NULL;
     }
-    if (c->busy_s > 0) sp_db_set_busy_timeout(db, (int)(c->busy_s * 1000));
     return db;
 }
 
@@ -164,6 +164,7 @@ static int db_init(int argc, char** argv)
                    "export folder",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
+    if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
     if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000 || drawings < -1 || drawings > 100) {
         fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000, --drawings -1 to 100\n", cmd);
         return SP_EXIT_USAGE;
@@ -269,7 +270,8 @@ static int db_add_part(int argc, char** argv)
          "a derived part's sketch view: auto (default), -z, +z, -x, +x (see `sketchpose derive --help`)", false},
         {"--preview", SP_OPT_STRING, &preview, "out.png",
          "render the stored part at rest and in three random poses, its abstraction overlaid", false},
-        {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it (default 60, -1 none)", false},
+        {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it, -1 (none) to 10000 (default 60)",
+         false},
         {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
     const char* pos[1];
     int npos;
@@ -280,6 +282,11 @@ static int db_add_part(int argc, char** argv)
         "writes nothing",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
+    // As `db init --synth`: -1 is none, 0 the default.
+    if (d.synth_sketches < -1 || d.synth_sketches > 10000) {
+        fprintf(stderr, "%s: --synth must be -1 (none) to 10000\n", cmd);
+        return SP_EXIT_USAGE;
+    }
     if (view && !sp_derive_view_parse(view, &d.view)) {
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
@@ -648,6 +655,7 @@ static int db_train(int argc, char** argv)
     int rc = parse(argc, argv, cmd, "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
+    if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
     sp_db* db = open_db(cmd, &c, 0);
     if (!db) return SP_EXIT_INPUT;
     sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};

@@ -50,7 +50,8 @@ int cmd_eval(int argc, char** argv)
     int folds = 0;
     clf_cli_opts o = {0};
     sp_opt opts[] = {
-        {"--model", SP_OPT_STRING, &model, "M", "trained model (required unless --folds)", false},
+        {"--model", SP_OPT_STRING, &model, "M",
+         "trained model (required unless --folds; with --folds, the folds train with its options)", false},
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder to evaluate on", true},
         {"--folds", SP_OPT_INT, &folds, "K", "K-fold cross-validation on DIR (fold = drawing index mod K)", false},
         CLF_CLI_OPTS(o),
@@ -63,6 +64,7 @@ int cmd_eval(int argc, char** argv)
         fprintf(stderr, "sketchpose eval: give --model M, or --folds K to cross-validate (see --help)\n");
         return SP_EXIT_USAGE;
     }
+    if (!clf_cli_check("sketchpose eval", &o)) return SP_EXIT_USAGE;
     if (folds != 0 && (folds < 2 || folds > 100)) {
         fprintf(stderr, "sketchpose eval: --folds must be 2..100\n");
         return SP_EXIT_USAGE;

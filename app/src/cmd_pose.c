@@ -1,6 +1,7 @@
 // sketchpose pose: redraw posing. Fits the rig (a glTF character or a
 // black-box plugin) to strokes drawn in its sketch view and writes the
 // posed .glb, a PNG and the solve report.
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -13,8 +14,12 @@ int cmd_pose(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *start = NULL;
     sp_solve_desc desc = {0};
+    // Not given: the solver's defaults; given, a value in range.
+    int reps = SP_CLI_UNSET, iters = SP_CLI_UNSET;
+    double cap_ms = NAN;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
+         true},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
         {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the strokes (sketchpose-strokes JSON)", true},
         {"--start", SP_OPT_STRING, &start, "p.json", "start pose (default: the rig's stored pose)", false},
@@ -24,13 +29,21 @@ int cmd_pose(int argc, char** argv)
         {"--lambda-pose", SP_OPT_DOUBLE, &desc.lambda_pose, "L", "weight of W_pose (default 0.5; negative: off)", false},
         {"--lambda-plane", SP_OPT_DOUBLE, &desc.lambda_plane, "L", "weight of W_plane (default 0.01; negative: off)", false},
         {"--lambda-dist", SP_OPT_DOUBLE, &desc.lambda_dist, "L", "weight of W_dist (default 0.001; negative: off)", false},
-        {"--representatives", SP_OPT_INT, &desc.representatives, "K", "coarsening: representative vertices (default 200)", false},
-        {"--max-iterations", SP_OPT_INT, &desc.max_iterations, "N", "Gauss-Newton iterations at most (default 300)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &desc.time_cap_ms, "MS", "time cap of the solve (default 3000)", false},
+        {"--representatives", SP_OPT_INT, &reps, "K", "coarsening: representative vertices, 1..100000 (default 200)", false},
+        {"--max-iterations", SP_OPT_INT, &iters, "N", "Gauss-Newton iterations at most, 1..1000000 (default 300)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, ms in (0, 3600000] (default 3000)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose pose", "Redraw posing: fits the rig's abstraction to the strokes.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    const char* cmd = "sketchpose pose";
+    if ((reps != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--representatives", reps, 1, 100000)) ||
+        (iters != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--max-iterations", iters, 1, 1000000)) ||
+        (!isnan(cap_ms) && !sp_cli_check_double(cmd, "--max-ms", cap_ms, 0, true, 3.6e6)))
+        return SP_EXIT_USAGE;
+    if (reps != SP_CLI_UNSET) desc.representatives = reps;
+    if (iters != SP_CLI_UNSET) desc.max_iterations = iters;
+    if (!isnan(cap_ms)) desc.time_cap_ms = cap_ms;
     sp_error err = {0};
     sp_rig_handle* rig = NULL;
     sp_sketch sk = {0};

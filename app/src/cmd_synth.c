@@ -246,7 +246,7 @@ int cmd_synth(int argc, char** argv)
         {"--out", SP_OPT_STRING, &out, "S.json", "stroke file to write (required unless --parts)", false},
         {"--truth", SP_OPT_STRING, &truth, "p.json", "also write the pose's parameters", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "canvas size (default: the rig's sketch view)", false},
-        {"--noise", SP_OPT_DOUBLE, &noise, "PX", "Gaussian jitter of the stroke points, pixels (default 0)", false},
+        {"--noise", SP_OPT_DOUBLE, &noise, "PX", "Gaussian jitter of the stroke points, pixels in [0, 8192] (default 0)", false},
         {"--style", SP_OPT_STRING, &style_name, "S",
          "hand-drawing model: normal, harsh or clean (default: none; with --parts: normal)", false},
         {"--parts", SP_OPT_STRING, &parts, "DIR",
@@ -344,10 +344,13 @@ int cmd_synth(int argc, char** argv)
         fprintf(stderr, "sketchpose synth: --size expects WxH with sides 16..8192, got '%s'\n", size);
         return SP_EXIT_USAGE;
     }
-    if (amplitude < 0 || noise < 0) {
-        fprintf(stderr, "sketchpose synth: --amplitude and --noise must not be negative\n");
+    if (amplitude < 0) {
+        fprintf(stderr, "sketchpose synth: --amplitude must not be negative\n");
         return SP_EXIT_USAGE;
     }
+    // At most the largest canvas side (--size): jitter beyond the canvas is
+    // no drawing, and 1e300 px wrote strokes that readers refuse.
+    if (!sp_cli_check_double("sketchpose synth", "--noise", noise, 0, false, 8192)) return SP_EXIT_USAGE;
     if (style != SP_HANDDRAW_STYLE_COUNT && sp_rig_path_is_plugin(rig_path)) {
         fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
         return SP_EXIT_USAGE;

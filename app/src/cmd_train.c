@@ -24,6 +24,7 @@ int cmd_train(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, "sketchpose train", "train a sketch classifier on a labelled folder", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!clf_cli_check("sketchpose train", &o)) return SP_EXIT_USAGE;
     if (!(cal_q > 0 && cal_q <= 1)) {
         fprintf(stderr, "sketchpose train: --calibrate-quantile must be in (0, 1]\n");
         return SP_EXIT_USAGE;

@@ -369,7 +369,8 @@ int main(int argc, char** argv)
     const char* font = NULL;
     bool fullscreen = false, stats = false, no_collect = false;
     double idle_s = 0, join_ms = 0;
-    int lod = 0, msaa = -1, max_parts = 0;
+    // SP_CLI_UNSET: not given (the kiosk's defaults); given, a value in range.
+    int lod = SP_CLI_UNSET, msaa = SP_CLI_UNSET, max_parts = SP_CLI_UNSET;
     sp_opt opts[] = {
         {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)",
          false},
@@ -386,11 +387,11 @@ int main(int argc, char** argv)
         {"--join-ms", SP_OPT_DOUBLE, &join_ms, "MS",
          "a stroke begun this soon after the last one's pen-up, where it ended, continues it (default 200; < 0: never)", false},
         {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
-        {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling (default: 4 on a GPU, 0 on software GL)", false},
-        {"--lod", SP_OPT_INT, &lod, "N", "display triangles per part (default: 4000 on software GL, all on a GPU; -1: all)",
-         false},
-        {"--max-parts", SP_OPT_INT, &max_parts, "N", "parts a dragon may have before new strokes are refused (default 48)",
-         false},
+        {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling, samples 0..16 (default: 4 on a GPU, 0 on software GL)", false},
+        {"--lod", SP_OPT_INT, &lod, "N",
+         "display triangles per part, 1..10000000 or -1: all (default: 4000 on software GL, all on a GPU)", false},
+        {"--max-parts", SP_OPT_INT, &max_parts, "N",
+         "parts a dragon may have before new strokes are refused, 1..1000 (default 48)", false},
         {"--no-collect", SP_OPT_FLAG, &no_collect, "",
          "keep no visitors' strokes (default: each part left on the canvas is stored in the database for review)", false},
         {"--stats", SP_OPT_FLAG, &stats, "", "print counters and timings as JSON at the end", false},
@@ -398,6 +399,16 @@ int main(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, k_cmd, "The dragon kiosk: draw a part in one line, see it come alive.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (lod != SP_CLI_UNSET && lod != -1 && (lod < 1 || lod > 10000000)) {
+        fprintf(stderr, "%s: --lod must be -1 (all) or 1..10000000, got %d\n", k_cmd, lod);
+        return SP_EXIT_USAGE;
+    }
+    if ((msaa != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--msaa", msaa, 0, 16)) ||
+        (max_parts != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--max-parts", max_parts, 1, 1000)))
+        return SP_EXIT_USAGE;
+    if (lod == SP_CLI_UNSET) lod = 0;
+    if (msaa == SP_CLI_UNSET) msaa = -1; // 4, or 1 on a software rasteriser (below)
+    if (max_parts == SP_CLI_UNSET) max_parts = 0;
     int win_w = 1280, win_h = 800;
     if (size && !sp_cli_parse_size(size, &win_w, &win_h)) {
         fprintf(stderr, "%s: --size expects WxH, got '%s'\n", k_cmd, size);

@@ -1,7 +1,9 @@
 // sketchpose: the command line. Dispatches to cmd_<name>() (commands.h).
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "cli.h"
 #include "commands.h"
 
 typedef struct command {
@@ -21,6 +23,17 @@ static void usage(FILE* f)
         fprintf(f, "  %-10s %s\n", k_commands[i].name, k_commands[i].help);
 }
 
+// The commands print their results on stdout: a write that failed (a full
+// disk, a closed file) must not end as success. An earlier failure keeps its code.
+static int finish(int rc)
+{
+    errno = 0;
+    if (fflush(stdout) == 0 && !ferror(stdout)) return rc;
+    int e = errno;
+    fprintf(stderr, "sketchpose: stdout: write error (%s)\n", e ? strerror(e) : "an earlier write failed");
+    return rc == SP_EXIT_OK ? SP_EXIT_INPUT : rc;
+}
+
 int main(int argc, char** argv)
 {
     if (argc < 2) {
@@ -29,10 +42,10 @@ int main(int argc, char** argv)
     }
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
         usage(stdout);
-        return 0;
+        return finish(SP_EXIT_OK);
     }
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; ++i)
-        if (!strcmp(argv[1], k_commands[i].name)) return k_commands[i].run(argc - 1, argv + 1);
+        if (!strcmp(argv[1], k_commands[i].name)) return finish(k_commands[i].run(argc - 1, argv + 1));
     fprintf(stderr, "sketchpose: unknown command '%s' (try sketchpose --help)\n", argv[1]);
     return 2;
 }

@@ -361,6 +361,11 @@ static int open_immutable(const char* path, sqlite3** h)
 
 sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err)
 {
+    return sp_db_open_wait(path, flags, -1, out, err);
+}
+
+sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db** out, sp_error* err)
+{
     *out = NULL;
     bool ro = (flags & SP_DB_READONLY) != 0;
     struct stat st;
@@ -380,7 +385,7 @@ sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* er
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     }
     db->readonly = ro;
-    db->busy_ms = SP_DB_BUSY_MS_DEFAULT;
+    db->busy_ms = busy_ms >= 0 ? busy_ms : SP_DB_BUSY_MS_DEFAULT;
     int oflags = ro ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | ((flags & SP_DB_CREATE) ? SQLITE_OPEN_CREATE : 0);
     int rc = sqlite3_open_v2(path, &db->h, oflags | SQLITE_OPEN_FULLMUTEX, NULL);
     sp_result r = SP_OK;

@@ -786,6 +786,55 @@ static void test_cli_train_calibrate(void)
     unlink(model);
 }
 
+// Out-of-range training and sketch options are bad usage, one line naming the
+// option, before any data is read (they silently became defaults, or ran for hours).
+static void test_cli_option_ranges(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char db[1024], cmd[4096];
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("ranges.db"));
+    unlink(db);
+    const char* clf[] = {"--knn -3",
+                         "--knn 65",
+                         "--soft -1",
+                         "--pyramid 10",
+                         "--pyramid -1",
+                         "--reject-quantile 2",
+                         "--reject-quantile -1",
+                         "--threads -1",
+                         "--threads 10000",
+                         "--seed -1",
+                         "--words 100000000",
+                         "--words -5"};
+    const char* how[] = {"train --data /nonexistent --model /nonexistent/m", "eval --data /nonexistent --folds 3",
+                         "db init --db '%s'", "db train --db '%s'"};
+    for (size_t i = 0; i < sizeof clf / sizeof clf[0]; ++i) { // each command in turn: they share the check
+        char sub[1200], line[512] = "", name[64];
+        snprintf(sub, sizeof sub, how[i % 4], db);
+        snprintf(cmd, sizeof cmd, "'%s' %s %s 2>&1 >/dev/null", bin, sub, clf[i]);
+        FILE* p = popen(cmd, "r");
+        ENSURE(p && fgets(line, sizeof line, p));
+        int rc = pclose(p);
+        snprintf(name, sizeof name, "%.*s must be", (int)strcspn(clf[i], " "), clf[i]);
+        if (WEXITSTATUS(rc) != 2 || !strstr(line, name)) fprintf(stderr, "  %s: %d %s", cmd, WEXITSTATUS(rc), line);
+        ENSURE(WEXITSTATUS(rc) == 2 && strstr(line, name));
+    }
+    const char* other[] = {"db add-part /nonexistent/p.glb --db '%s' --synth -5",
+                           "db add-part /nonexistent/p.glb --db '%s' --synth 100000000", "db init --db '%s' --synth -5",
+                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise 1e300",
+                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1"};
+    for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
+        char sub[1200];
+        snprintf(sub, sizeof sub, other[i], db);
+        snprintf(cmd, sizeof cmd, "'%s' %s 2>/dev/null", bin, sub);
+        int rc = system(cmd);
+        if (WEXITSTATUS(rc) != 2) fprintf(stderr, "  %s: %d\n", cmd, WEXITSTATUS(rc));
+        ENSURE(WEXITSTATUS(rc) == 2);
+    }
+    ENSURE(access(db, F_OK) != 0); // refused before anything was written
+}
+
 // ---- the dragon-part classifier --------------------------------------------------
 
 // Issue 5's criteria on a smaller set (the full 600/200 figures with 300
@@ -869,6 +918,7 @@ int main(int argc, char** argv)
                                    {"cli_synth_concepts", test_cli_synth_concepts},
                                    {"calibrate_reject", test_calibrate_reject},
                                    {"cli_train_calibrate", test_cli_train_calibrate},
+                                   {"cli_option_ranges", test_cli_option_ranges},
                                    {"dragon_accuracy_and_rejection", test_dragon_accuracy_and_rejection},
                                    {"zz_cleanup", test_cleanup},
                                    {0}});

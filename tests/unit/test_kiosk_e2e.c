@@ -1644,6 +1644,25 @@ static void test_parts_loaded_while_idle(void)
     sp_headless_destroy(gl);
 }
 
+// Out-of-range display options are bad usage, one line, before any window
+// (they silently fell back to defaults). No display: a check that slipped
+// would fail to open the window (exit 1), not hang.
+static void test_option_ranges(void)
+{
+    const char* bad[] = {"--max-parts 0", "--max-parts -1", "--lod -5", "--lod 0", "--msaa 64", "--msaa -1"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        char cmd[2048], line[512] = "", name[64];
+        snprintf(cmd, sizeof cmd, "env -u DISPLAY -u WAYLAND_DISPLAY '%s' --db /nonexistent/k.db %s 2>&1 >/dev/null",
+                 SP_DRAGON_KIOSK, bad[i]);
+        FILE* p = popen(cmd, "r");
+        ENSURE(p && fgets(line, sizeof line, p));
+        int rc = pclose(p);
+        snprintf(name, sizeof name, "%.*s must be", (int)strcspn(bad[i], " "), bad[i]);
+        if (WEXITSTATUS(rc) != 2 || !strstr(line, name)) fprintf(stderr, "  %s: %d %s", bad[i], WEXITSTATUS(rc), line);
+        ENSURE(WEXITSTATUS(rc) == 2 && strstr(line, name));
+    }
+}
+
 int main(int argc, char** argv)
 {
     signal(SIGPIPE, SIG_IGN);
@@ -1666,5 +1685,6 @@ int main(int argc, char** argv)
                                    {"detail_ink", test_detail_ink},
                                    {"save_fails_whole", test_save_fails_whole},
                                    {"nothing_to_draw", test_nothing_to_draw},
+                                   {"option_ranges", test_option_ranges},
                                    {0}});
 }

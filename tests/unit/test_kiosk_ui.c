@@ -1436,6 +1436,17 @@ static void test_session_errors(void)
          "a mark needs"},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [0, 5], \"events\": []}", "\"canvas\""},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"coords\": \"mm\", \"events\": []}", "\"coords\""},
+        // A window the X server refuses (the kiosk's --size limit), a replay of hours.
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [8193, 800], \"events\": []}",
+         "\"canvas\" must be [width, height] in pixels (1..8192)"},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"end_ms\": 1e9, \"events\": []}",
+         "\"end_ms\" must be a number of ms in [0, 3600000]"},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 1, \"type\": \"frame\"}, "
+         "{\"t\": 3600001, \"type\": \"frame\"}]}",
+         "events[1]: t = 3.6e+06 is past 3600000 ms"},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [{\"t\": 3599000, \"type\": \"stroke\", "
+         "\"dt\": 60000, \"points\": [[1, 2], [3, 4]]}]}",
+         "events[0]: the stroke ends at"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         sp_kiosk_session s = {0};

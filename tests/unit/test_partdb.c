@@ -1475,6 +1475,23 @@ static void test_kiosk_review_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "database is busy") && !strchr(strchr(out, '\n') + 1, '\n'));
     sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
     sqlite3_close(other);
+    // Results that cannot be written (a full disk) are an error, not success.
+    snprintf(cmd, sizeof cmd, "'%s' db list --db '%s' 2>&1 >/dev/full", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "sketchpose: stdout: write error (No space left on device)"));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' 2>&1 >/dev/full", bin, p);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "stdout: write error"));
+    // Locked outright (a rollback-journal write): --busy-timeout holds from the
+    // open on (the open waited the default 5 s and named it).
+    ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
+    ENSURE(sqlite3_exec(other,
+                        "PRAGMA journal_mode = DELETE; BEGIN EXCLUSIVE; INSERT INTO log(by, action) VALUES ('other', 'hold')",
+                        NULL, NULL, NULL) == SQLITE_OK);
+    snprintf(cmd, sizeof cmd, "'%s' db list --db '%s' --busy-timeout 0.2 2>&1 >/dev/null", bin, p);
+    double t0 = sp_now_ms();
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "more than 0.2 s"));
+    ENSURE(sp_now_ms() - t0 < 3000);
+    sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
+    sqlite3_close(other);
     ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'") == 2);
     // Approve, reject the other, train: the new model's training set has it.
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld", bin, p, (long long)id);

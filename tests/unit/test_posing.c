@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "fixtures.h"
 #include "posing.h"
 #include "rig_handle.h"
@@ -415,6 +416,44 @@ static void test_rig_handle(void)
     sp_rig_handle_free(g);
 }
 
+// The shared option parser: a value that starts with "--" is a missing value
+// (it was taken as the value: `--out --no-shadow` wrote "--no-shadow"), "-1" is one.
+static void test_cli_missing_value(void)
+{
+    const char *out = NULL, *rig = NULL;
+    bool flag = false;
+    int n = 0;
+    sp_opt opts[] = {{"--out", SP_OPT_STRING, &out, "X.png", "", false},
+                     {"--rig", SP_OPT_STRING, &rig, "R", "", false},
+                     {"--flag", SP_OPT_FLAG, &flag, "", "", false},
+                     {"--n", SP_OPT_INT, &n, "N", "", false}};
+    char* a1[] = {"t", "--rig", "X", "--out", "--flag"};
+    ENSURE(sp_cli_parse(5, a1, "t", "", opts, 4) == 2 && out == NULL && !flag);
+    char* a2[] = {"t", "--out", "--rig", "o/x.glb"};
+    ENSURE(sp_cli_parse(4, a2, "t", "", opts, 4) == 2 && out == NULL);
+    char* a3[] = {"t", "--n", "-1", "--out", "-"};
+    ENSURE(sp_cli_parse(5, a3, "t", "", opts, 4) == -1 && n == -1 && out && !strcmp(out, "-"));
+}
+
+// The solve's limits on the command line: out of range is bad usage (it
+// silently became the default).
+static void test_pose_option_ranges(void)
+{
+    char cmd[2048];
+    const char* bad[] = {"--max-iterations 0", "--max-iterations -1",  "--max-ms 0",
+                         "--max-ms -1",        "--representatives -5", "--representatives 0"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' pose --rig r.glb --strokes s.json %s 2>/dev/null", SP_SKETCHPOSE, bad[i]);
+        ENSURE(run(cmd) == 2);
+    }
+    snprintf(cmd, sizeof cmd, "'%s' drawover --rig r.glb --on a.json --to b.json --max-ms -1 2>/dev/null", SP_SKETCHPOSE);
+    ENSURE(run(cmd) == 2);
+    // In range the command runs (and fails on the missing rig: exit 1).
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig /nonexistent.glb --strokes s.json --max-iterations 5 --max-ms 10 2>/dev/null",
+             SP_SKETCHPOSE);
+    ENSURE(run(cmd) == 1);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -424,5 +463,7 @@ int main(int argc, char** argv)
                                    {"drawover_cesiumman", test_drawover_cesiumman},
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
+                                   {"cli_missing_value", test_cli_missing_value},
+                                   {"pose_option_ranges", test_pose_option_ranges},
                                    {0}});
 }

@@ -56,6 +56,9 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
     double t;
     if (!num(e, "t", &t) || t < 0)
         return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: \"t\" must be a number >= 0 (ms)", name, i);
+    if (t > SP_KIOSK_SESSION_MAX_MS)
+        return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: t = %g is past %.0f ms (1 hour), the longest session", name, i, t,
+                       SP_KIOSK_SESSION_MAX_MS);
     if (t < *last_t)
         return sp_fail(err, SP_ERR_INVALID, "%s: events[%d]: t = %g goes back in time (previous %g)", name, i, t, *last_t);
     *last_t = t;
@@ -88,6 +91,10 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
             ++k;
         }
         *last_t = t + dt * (n - 1);
+        if (*last_t > SP_KIOSK_SESSION_MAX_MS)
+            return sp_fail(err, SP_ERR_INVALID,
+                           "%s: events[%d]: the stroke ends at %g ms, past %.0f ms (1 hour), the longest session", name, i,
+                           *last_t, SP_KIOSK_SESSION_MAX_MS);
         return SP_OK;
     }
     if (strcmp(tname, "mark") == 0) {
@@ -165,8 +172,10 @@ sp_result sp_kiosk_session_parse(const char* text, size_t len, const char* name,
         const cJSON* w = cJSON_GetArrayItem(canvas, 0);
         const cJSON* h = cJSON_GetArrayItem(canvas, 1);
         if (!cJSON_IsArray(canvas) || !cJSON_IsNumber(w) || !cJSON_IsNumber(h) ||
-            !(w->valuedouble >= 1 && w->valuedouble <= 65536) || !(h->valuedouble >= 1 && h->valuedouble <= 65536)) {
-            r = sp_fail(err, SP_ERR_INVALID, "%s: \"canvas\" must be [width, height] in pixels (1..65536)", name);
+            !(w->valuedouble >= 1 && w->valuedouble <= SP_KIOSK_SESSION_MAX_CANVAS) ||
+            !(h->valuedouble >= 1 && h->valuedouble <= SP_KIOSK_SESSION_MAX_CANVAS)) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: \"canvas\" must be [width, height] in pixels (1..%d)", name,
+                        SP_KIOSK_SESSION_MAX_CANVAS);
             goto done;
         }
         s.canvas_w = (int)w->valuedouble, s.canvas_h = (int)h->valuedouble;
@@ -199,8 +208,9 @@ sp_result sp_kiosk_session_parse(const char* text, size_t len, const char* name,
     }
     s.end_ms = last_t;
     if (cJSON_GetObjectItemCaseSensitive(root, "end_ms")) {
-        if (!num(root, "end_ms", &v) || v < 0 || v > 1e9) {
-            r = sp_fail(err, SP_ERR_INVALID, "%s: \"end_ms\" must be a number of ms in [0, 1e9]", name);
+        if (!num(root, "end_ms", &v) || v < 0 || v > SP_KIOSK_SESSION_MAX_MS) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: \"end_ms\" must be a number of ms in [0, %.0f] (1 hour)", name,
+                        SP_KIOSK_SESSION_MAX_MS);
             goto done;
         }
         if (v > s.end_ms) s.end_ms = v;

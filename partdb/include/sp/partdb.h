@@ -76,6 +76,10 @@ const char* sp_db_default_path(void);
 /// SP_DB_CREATE, a file that is not an SQLite database, a newer schema, a file
 /// that cannot be written (unless SP_DB_READONLY) are refused with one line.
 sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err);
+/// sp_db_open with a busy timeout of busy_ms (< 0: the default) from the open
+/// on: a database another process holds locked (a rollback-journal write)
+/// makes the open itself wait.
+sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db** out, sp_error* err);
 /// Closes (NULL is fine). The WAL is checkpointed into the main file.
 void sp_db_close(sp_db* db);
 /// Sets how long a write waits for another writer (milliseconds, >= 0).

@@ -30,6 +30,13 @@
 #include "sp/kiosk_event.h"
 #include "sp/result.h"
 
+/// Largest "canvas" side, pixels: the kiosk's --size limit (a bigger window
+/// the X server refuses).
+#define SP_KIOSK_SESSION_MAX_CANVAS 8192
+/// Latest event time and "end_ms" of a session, ms (1 hour): a replay runs
+/// 60 frames per virtual second, so this keeps one within minutes.
+#define SP_KIOSK_SESSION_MAX_MS 3600000.0
+
 /// Most events one session may hold (after expanding "stroke" shorthands).
 #define SP_KIOSK_SESSION_MAX_EVENTS 20000000
 
