@@ -1,6 +1,7 @@
 // sketchpose animate: the paper's redraw-posing animations (its Figure 1
 // run cycle, Figure 3 fall). Each key's strokes are solved starting from the
 // previous key's pose; the keys become one glTF animation.
+#include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,14 +11,17 @@
 #include "posing.h"
 #include "solve_cmd.h"
 
-// "0,0.5,1.2" -> times; false if malformed or not increasing.
+// "0,0.5,1.2" -> times; false if malformed or not increasing. The .glb
+// stores times as floats: 1e300 would overflow and 1e-300 fall to 0, and the
+// file would not load again, so they must increase as floats too.
 static bool parse_times(const char* s, double* t, int n)
 {
     const char* at = s;
     for (int i = 0; i < n; ++i) {
         char* end = NULL;
         t[i] = strtod(at, &end);
-        if (end == at || !isfinite(t[i]) || t[i] < 0 || (i > 0 && !(t[i] > t[i - 1]))) return false;
+        if (end == at || !isfinite(t[i]) || t[i] < 0 || t[i] > FLT_MAX || (i > 0 && !((float)t[i] > (float)t[i - 1])))
+            return false;
         at = end;
         if (i + 1 < n) {
             if (*at != ',') return false;
@@ -47,7 +51,10 @@ int cmd_animate(int argc, char** argv)
     if (!times) return SP_EXIT_INPUT;
     for (int k = 0; k < n; ++k) times[k] = k;
     if (times_s && !parse_times(times_s, times, n)) {
-        fprintf(stderr, "sketchpose animate: --times needs %d increasing non-negative numbers separated by commas, got '%s'\n", n, times_s);
+        fprintf(stderr,
+                "sketchpose animate: --times needs %d non-negative numbers separated by commas, at most %g and increasing "
+                "in single precision (the .glb stores floats), got '%s'\n",
+                n, FLT_MAX, times_s);
         free(times);
         return SP_EXIT_USAGE;
     }

@@ -9,6 +9,7 @@
 #include <tiny_gltf.h>
 
 #include <cjson/cJSON.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -121,6 +122,189 @@ bool no_write(std::string*, const std::string&, const std::vector<unsigned char>
     return false;
 }
 
+// What the document's "buffers" say, read with cJSON beside tinygltf: its
+// messages name neither the buffer nor the numbers, and the file callback
+// must know a buffer's byteLength before it allocates.
+struct BufferDecl {
+    bool has_uri = false;
+    std::string uri;
+    double byte_length = -1; // -1: missing or not a number
+};
+
+struct LoadContext {
+    const char* what = "";
+    std::vector<BufferDecl> buffers;
+    bool scanned = false;
+    std::string message; // set by read_buffer_file: says better what went wrong
+};
+
+void scan_buffers(LoadContext& cx, const unsigned char* json, size_t len)
+{
+    cx.scanned = true;
+    cJSON* root = cJSON_ParseWithLength(reinterpret_cast<const char*>(json), len);
+    const cJSON* bufs = cJSON_GetObjectItemCaseSensitive(root, "buffers");
+    if (!cJSON_IsArray(bufs)) bufs = nullptr;
+    const cJSON* b;
+    cJSON_ArrayForEach(b, bufs)
+    {
+        BufferDecl d;
+        const cJSON* uri = cJSON_GetObjectItemCaseSensitive(b, "uri");
+        const cJSON* bl = cJSON_GetObjectItemCaseSensitive(b, "byteLength");
+        d.has_uri = cJSON_IsString(uri) && uri->valuestring[0];
+        if (d.has_uri) d.uri = uri->valuestring;
+        if (cJSON_IsNumber(bl)) d.byte_length = bl->valuedouble;
+        cx.buffers.push_back(d);
+    }
+    cJSON_Delete(root);
+}
+
+// The JSON text of a .gltf, or of a .glb's first chunk (check_glb has run).
+void scan_buffers_of(LoadContext& cx, const unsigned char* data, size_t size)
+{
+    if (size >= 20 && !memcmp(data, "glTF", 4))
+        scan_buffers(cx, data + 20, std::min((size_t)le32(data + 12), size - 20));
+    else
+        scan_buffers(cx, data, size);
+}
+
+bool is_data_uri(const std::string& uri)
+{
+    return uri.compare(0, 5, "data:") == 0;
+}
+
+// As tinygltf decodes a buffer's uri into a file name.
+std::string url_decode(const std::string& s)
+{
+    auto hex = [](char c) {
+        return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
+    };
+    std::string r;
+    for (size_t i = 0; i < s.size(); ++i) {
+        if (s[i] == '+')
+            r += ' ';
+        else if (s[i] == '%' && i + 2 < s.size()) {
+            r += (char)(hex(s[i + 1]) << 4 | hex(s[i + 2]));
+            i += 2;
+        } else
+            r += s[i];
+    }
+    return r;
+}
+
+// tinygltf's own reader sizes its vector by seeking to the end, which for a
+// directory gives 2^63 - 1 and an attempt to allocate that. Ours reads only a
+// regular file, and only as many bytes as the buffer that names it declares.
+bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user)
+{
+    LoadContext& cx = *static_cast<LoadContext*>(user);
+    int index = -1;
+    for (size_t i = 0; i < cx.buffers.size() && index < 0; ++i) {
+        const BufferDecl& b = cx.buffers[i];
+        if (!b.has_uri || is_data_uri(b.uri)) continue;
+        std::string name = url_decode(b.uri);
+        if (path == name || (path.size() > name.size() && path.compare(path.size() - name.size(), name.size(), name) == 0 &&
+                             path[path.size() - name.size() - 1] == '/'))
+            index = (int)i;
+    }
+    char who[64] = "";
+    if (index >= 0) snprintf(who, sizeof who, "buffer %d: ", index);
+    char msg[1024] = "";
+    struct stat st;
+    FILE* f = nullptr;
+    if (stat(path.c_str(), &st) != 0)
+        snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(errno));
+    else if (S_ISDIR(st.st_mode))
+        snprintf(msg, sizeof msg, "%s: %s%s is a directory, not a buffer file", cx.what, who, path.c_str());
+    else if (!S_ISREG(st.st_mode))
+        snprintf(msg, sizeof msg, "%s: %s%s is not a regular file", cx.what, who, path.c_str());
+    else if (index >= 0 && (double)st.st_size != cx.buffers[(size_t)index].byte_length)
+        snprintf(msg, sizeof msg, "%s: %s%s has %lld bytes, but the buffer's byteLength is %.17g", cx.what, who, path.c_str(),
+                 (long long)st.st_size, cx.buffers[(size_t)index].byte_length);
+    else if (st.st_size > 0x7fffffff)
+        snprintf(msg, sizeof msg, "%s: %s%s is over 2 GiB (not supported)", cx.what, who, path.c_str());
+    else if (!(f = fopen(path.c_str(), "rb")))
+        snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(errno));
+    if (!f) {
+        if (cx.message.empty()) cx.message = msg;
+        if (err) *err += msg;
+        return false;
+    }
+    out->resize((size_t)st.st_size);
+    size_t got = out->empty() ? 0 : fread(out->data(), 1, out->size(), f);
+    fclose(f);
+    if (got != out->size()) {
+        snprintf(msg, sizeof msg, "%s: %s%s: read error", cx.what, who, path.c_str());
+        if (cx.message.empty()) cx.message = msg;
+        if (err) *err += msg;
+        return false;
+    }
+    return true;
+}
+
+// Decoded size of a base64 data URI's payload, or -1 when it is not base64.
+long long data_uri_bytes(const std::string& uri)
+{
+    size_t comma = uri.find(',');
+    if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos) return -1;
+    size_t n = 0, pad = 0;
+    for (size_t i = comma + 1; i < uri.size(); ++i) {
+        char c = uri[i];
+        if (c == '=' && i + 2 >= uri.size())
+            ++pad;
+        else if (isalnum((unsigned char)c) || c == '+' || c == '/')
+            ++n;
+        else
+            return -1;
+    }
+    if ((n + pad) % 4) return -1;
+    return (long long)((n + pad) / 4 * 3 - pad);
+}
+
+// A data URI's payload can be megabytes of base64: a message keeps its
+// media type only.
+std::string without_data_payloads(std::string line)
+{
+    for (size_t at = line.find("data:"); at != std::string::npos; at = line.find("data:", at + 5)) {
+        size_t comma = line.find(',', at);
+        if (comma == std::string::npos) break;
+        size_t end = comma + 1;
+        while (end < line.size() && line[end] != ' ' && line[end] != '\'' && line[end] != '"')
+            ++end;
+        if (end - comma > 4) line.replace(comma + 1, end - comma - 1, "...");
+    }
+    return line;
+}
+
+// tinygltf's first error line, said as we say things: which buffer and why.
+std::string explain(LoadContext& cx, const unsigned char* data, size_t size, const std::string& line)
+{
+    char msg[512];
+    if (line.find("'uri' is missing from non binary glTF file buffer") != std::string::npos) {
+        if (!cx.scanned) scan_buffers_of(cx, data, size);
+        for (size_t i = 0; i < cx.buffers.size(); ++i)
+            if (!cx.buffers[i].has_uri) {
+                snprintf(msg, sizeof msg, "buffer %zu has no uri (only a .glb's own buffer may leave it out)", i);
+                return msg;
+            }
+    }
+    const char* head = "Failed to decode 'uri' : ";
+    if (line.compare(0, strlen(head), head) == 0) {
+        if (!cx.scanned) scan_buffers_of(cx, data, size);
+        for (size_t i = 0; i < cx.buffers.size(); ++i) {
+            const BufferDecl& b = cx.buffers[i];
+            if (!b.has_uri || !is_data_uri(b.uri) || line.compare(strlen(head), b.uri.size(), b.uri) != 0) continue;
+            long long n = data_uri_bytes(b.uri);
+            if (n < 0)
+                snprintf(msg, sizeof msg, "buffer %zu: its data URI is not valid base64", i);
+            else
+                snprintf(msg, sizeof msg, "buffer %zu: its data URI holds %lld bytes, but its byteLength is %.17g", i, n,
+                         b.byte_length);
+            return msg;
+        }
+    }
+    return without_data_payloads(line);
+}
+
 void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size, const char* what, const std::string& base_dir,
                  bool use_fs, sp_character* ch)
 {
@@ -128,21 +312,34 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(skip_image, nullptr);
     loader.SetStoreOriginalJSONForExtrasAndExtensions(true);
-    if (!use_fs) loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, no_expand, no_read, no_write, nullptr});
+    LoadContext cx;
+    cx.what = what;
+    if (use_fs)
+        loader.SetFsCallbacks(tinygltf::FsCallbacks{tinygltf::FileExists, tinygltf::ExpandFilePath, read_buffer_file,
+                                                    tinygltf::WriteWholeFile, &cx});
+    else
+        loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, no_expand, no_read, no_write, nullptr});
     std::string terr, twarn;
     bool ok;
     if (size >= 4 && !memcmp(data, "glTF", 4)) {
         size_t total = check_glb(data, size, what);
+        if (use_fs) scan_buffers_of(cx, data, total);
         ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, data, (unsigned)total, base_dir);
     } else {
         size_t i = 0;
         while (i < size && (data[i] == ' ' || data[i] == '\n' || data[i] == '\r' || data[i] == '\t'))
             ++i;
         if (i == size) fail(SP_ERR_PARSE, "%s: empty file", what);
-        if (data[i] != '{') fail(SP_ERR_PARSE, "%s: neither glTF JSON nor a .glb", what);
+        if (data[i] != '{') {
+            if (strchr("[\"-0123456789tfn", data[i]))
+                fail(SP_ERR_PARSE, "%s: the top level is not a JSON object (glTF JSON is one)", what);
+            fail(SP_ERR_PARSE, "%s: neither glTF JSON nor a .glb", what);
+        }
+        if (use_fs) scan_buffers_of(cx, data, size);
         ok = loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char*>(data), (unsigned)size, base_dir);
     }
     if (!ok) {
+        if (!cx.message.empty()) fail(SP_ERR_IO, "%s", cx.message.c_str());
         std::string line = first_line(terr);
         if (line.empty()) line = first_line(twarn);
         if (line.empty()) line = "not a valid glTF 2.0 file";
@@ -150,9 +347,9 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
         if (line.find("File not found") != std::string::npos || line.find("Failed to load") != std::string::npos ||
             line.find("cannot be resolved") != std::string::npos)
             code = SP_ERR_IO;
-        fail(code, "%s: %s", what, line.c_str());
+        fail(code, "%s: %s", what, explain(cx, data, size, line).c_str());
     }
-    if (!twarn.empty()) sp_character_warn(ch, "glTF: %s", first_line(twarn).c_str());
+    if (!twarn.empty()) sp_character_warn(ch, "glTF: %s", without_data_payloads(first_line(twarn)).c_str());
 }
 
 // ---- accessors ------------------------------------------------------------
@@ -673,7 +870,12 @@ struct Importer {
             const tinygltf::Mesh& mesh = m.meshes[(size_t)nd.mesh];
             for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
                 const tinygltf::Primitive& prim = mesh.primitives[pi];
-                int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+                // tinygltf takes any integer; an unknown mode would otherwise
+                // be skipped quietly and surface later as a missing mesh.
+                if (prim.mode < TINYGLTF_MODE_POINTS || prim.mode > TINYGLTF_MODE_TRIANGLE_FAN)
+                    fail(SP_ERR_INVALID, "%s: mesh %d primitive %zu: mode %d is not a glTF primitive mode", what, nd.mesh, pi,
+                         prim.mode);
+                int mode = prim.mode;
                 // POINTS: skinned vertices without faces (what we export for a mesh without triangles).
                 bool triangles = mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
                                  mode == TINYGLTF_MODE_TRIANGLE_FAN || mode == TINYGLTF_MODE_POINTS;

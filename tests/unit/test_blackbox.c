@@ -4,6 +4,7 @@
 // errors, recovery of seeded targets on the `face` plugin with bounds
 // honoured, and the commands on a plugin (`sketchpose synth/pose/inspect/
 // render/export --rig face.so`; drawover and animate refuse one).
+#include <elf.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
@@ -502,6 +503,35 @@ static void test_plugin_errors(void)
     sp_blackbox_destroy(bb);
 }
 
+// A plugin cut short: dlopen would map segments past the end of the file and
+// die of SIGBUS touching them, so the loader refuses it first.
+static void test_plugin_truncated(void)
+{
+    FILE* in = fopen(SP_FACE_PLUGIN, "rb");
+    ENSURE(in);
+    static unsigned char so[1 << 20];
+    size_t n = fread(so, 1, sizeof so, in);
+    fclose(in);
+    ENSURE(n > 20000 && n < sizeof so);
+    const size_t cuts[] = {10, 64, 500, 1000, 4096, 20000, n / 2, n - 1};
+    for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; i++) {
+        char path[64];
+        snprintf(path, sizeof path, "face_cut_%zu.so", cuts[i]);
+        const char* cut = sp_test_tmp_path(path);
+        FILE* f = fopen(cut, "wb");
+        ENSURE(f && fwrite(so, 1, cuts[i], f) == cuts[i]);
+        fclose(f);
+        expect_load_error(cut, SP_ERR_PARSE, "not a complete shared object (truncated?)", NULL);
+    }
+    // An ELF of no known class is refused by name, not handed to dlopen.
+    so[EI_CLASS] = 7;
+    const char* odd = sp_test_tmp_path("face_class7.so");
+    FILE* f = fopen(odd, "wb");
+    ENSURE(f && fwrite(so, 1, n, f) == n);
+    fclose(f);
+    expect_load_error(odd, SP_ERR_PARSE, "ELF class 7", NULL);
+}
+
 // A rig whose evaluation breaks during a solve: a one-line error, no NaN pose.
 static void test_nan_during_solve(void)
 {
@@ -742,6 +772,7 @@ int main(int argc, char** argv)
                                    {"face_no_inversions", test_face_no_inversions},
                                    {"threads_bit_identical", test_threads_bit_identical},
                                    {"plugin_errors", test_plugin_errors},
+                                   {"plugin_truncated", test_plugin_truncated},
                                    {"nan_during_solve", test_nan_during_solve},
                                    {"face_bounds", test_face_bounds},
                                    {"face_recovery", test_face_recovery},

@@ -543,6 +543,72 @@ static void test_bad_input(void)
     sp_character_free(&ch);
 }
 
+// mini_gltf's text with the first `from` replaced by `to`, written to name.
+static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
+{
+    char* text = mini_gltf(d);
+    char* at = strstr(text, from);
+    ENSURE(at);
+    size_t head = (size_t)(at - text), nf = strlen(from), nt = strlen(to), n = strlen(text) - nf + nt;
+    char* out = malloc(n + 1);
+    memcpy(out, text, head);
+    memcpy(out + head, to, nt);
+    strcpy(out + head + nt, at + nf);
+    const char* path = sp_test_tmp_path(name);
+    ENSURE(mini_write(path, out, n));
+    free(text), free(out);
+    return path;
+}
+
+// Buffers, primitives and the top level that are wrong say what is wrong
+// (not "out of memory" or "neither glTF JSON nor a .glb"), and a message
+// never carries a data URI's base64.
+static void test_says_what_is_wrong(void)
+{
+    ensure_fails(write_edited("buf_dir.gltf", &(mini_desc){.uri = "NAME"}, "NAME", "."), "buf_dir.gltf", "buffer 0: ");
+    ensure_fails(sp_test_tmp_path("buf_dir.gltf"), "buf_dir.gltf", "is a directory");
+    // An external file of the wrong size is refused before it is read.
+    const char* bin = sp_test_tmp_path("short.bin");
+    ENSURE(mini_write(bin, "0123456789", 10));
+    ensure_fails(write_edited("buf_short.gltf", &(mini_desc){.uri = "NAME"}, "NAME", strrchr(bin, '/') + 1), "buf_short.gltf",
+                 "has 10 bytes, but the buffer's byteLength is 300");
+    ensure_fails(write_edited("buf_no_uri.gltf", &(mini_desc){.uri = "NAME"}, ", \"uri\": \"NAME\"", ""), "buf_no_uri.gltf",
+                 "buffer 0 has no uri");
+    const char* len = write_edited("buf_len.gltf", &(mini_desc){0}, "\"byteLength\": 300", "\"byteLength\": 301");
+    ensure_fails(len, "buf_len.gltf", "buffer 0: its data URI holds 300 bytes, but its byteLength is 301");
+    ensure_fails(write_edited("buf_b64.gltf", &(mini_desc){0}, "base64,", "base64,!"), "buf_b64.gltf",
+                 "buffer 0: its data URI is not valid base64");
+    ensure_fails(write_edited("mode99.gltf", &(mini_desc){0}, "\"mode\": 4", "\"mode\": 99"), "mode99.gltf",
+                 "mesh 0 primitive 0: mode 99 is not a glTF primitive mode");
+    ensure_fails(write_edited("no_position.gltf", &(mini_desc){0}, "\"POSITION\": 0, ", ""), "no_position.gltf",
+                 "mesh 0 primitive 0 has no POSITION");
+    const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
+    for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
+        const char* p = sp_test_tmp_path("top.gltf");
+        ENSURE(mini_write(p, tops[i], strlen(tops[i])));
+        ensure_fails(p, "top.gltf", "the top level is not a JSON object");
+    }
+    // Where the buffer cannot be told (two "buffers" keys: cJSON reads the
+    // first, tinygltf the second), tinygltf's own words are kept, with the
+    // data URI cut to its media type.
+    const char* dup = write_edited("buf_dup.gltf", &(mini_desc){0}, "{", "{\"buffers\": [], ");
+    char* text = malloc(4096);
+    FILE* f = fopen(dup, "rb");
+    ENSURE(f);
+    size_t n = fread(text, 1, 4095, f);
+    fclose(f);
+    text[n] = 0;
+    char* at = strstr(text, "\"byteLength\": 300");
+    ENSURE(at);
+    at[16] = '1';
+    sp_character ch;
+    sp_error err = {0};
+    ENSURE(sp_gltf_load_memory(text, n, "dup.gltf", &ch, &err) != SP_OK);
+    printf("  %s\n", err.text);
+    ENSURE(strstr(err.text, "data:application/octet-stream;base64,...") && !strstr(err.text, "AAAA"));
+    free(text);
+}
+
 // Random byte flips of a valid file must never crash (a tiny in-test fuzz).
 static void test_mutations(void)
 {
@@ -603,6 +669,7 @@ int main(int argc, char** argv)
                                    {"part_round_trip", test_part_round_trip},
                                    {"part_bad", test_part_bad},
                                    {"bad_input", test_bad_input},
+                                   {"says_what_is_wrong", test_says_what_is_wrong},
                                    {"mutations", test_mutations},
                                    {0}});
 }

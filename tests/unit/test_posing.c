@@ -69,6 +69,12 @@ static void test_animation_from_keys(void)
     sp_animation bad;
     double t2[2] = {1.0, 1.0};
     ENSURE(sp_animation_from_keys(&rig, keys, t2, 2, "bad", &bad, &err) == SP_ERR_INVALID);
+    // So are times a float channel cannot hold: overflow, underflow to equal, NaN.
+    double t3[3][2] = {{0, 1e300}, {0, 1e-300}, {NAN, 1}};
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(sp_animation_from_keys(&rig, keys, t3[i], 2, "bad", &bad, &err) == SP_ERR_INVALID);
+        printf("  %s\n", err.text);
+    }
     rig.animations = malloc(sizeof(sp_animation));
     rig.animations[0] = an;
     rig.animation_count = 1;
@@ -272,6 +278,43 @@ static void test_animate_cli_cesiumman(void)
     sp_character_free(&ch);
 }
 
+// `animate --times` refuses times the .glb cannot store as floats (it used to
+// write a file that would not load again); fine times still load back.
+static void test_animate_cli_times(void)
+{
+    const char* rig = sp_test_src_path("tests/e2e/data/two_bone_extras.gltf");
+    char a[1024], b[1024], out[1024], log[1024], cmd[8192];
+    snprintf(a, sizeof a, "%s", sp_test_tmp_path("times_a.json"));
+    snprintf(b, sizeof b, "%s", sp_test_tmp_path("times_b.json"));
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("times.glb"));
+    snprintf(log, sizeof log, "%s", sp_test_tmp_path("times_err.txt"));
+    for (int k = 0; k < 2; ++k) {
+        snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed %d --out %s > /dev/null", SP_SKETCHPOSE, rig, 1 + k, k ? b : a);
+        ENSURE(run(cmd) == 0);
+    }
+    const char* bad[] = {"0,1e300", "0,1e-300", "1e39,1e40", "0,inf"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        remove(out);
+        snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s %s --times %s --out %s > /dev/null 2> %s", SP_SKETCHPOSE, rig,
+                 a, b, bad[i], out, log);
+        ENSURE(run(cmd) == 2);
+        char text[1024] = {0};
+        FILE* f = fopen(log, "rb");
+        ENSURE(f && fread(text, 1, sizeof text - 1, f) > 0);
+        fclose(f);
+        printf("  %s", text);
+        ENSURE(strstr(text, "--times") && strstr(text, bad[i]));
+        ENSURE(fopen(out, "rb") == NULL);
+    }
+    snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s %s --times 0,3e38 --out %s > /dev/null", SP_SKETCHPOSE, rig, a, b,
+             out);
+    ENSURE(run(cmd) == 0);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(out, &ch, &err) == SP_OK);
+    sp_character_free(&ch);
+}
+
 // `synth --noise`: every coordinate moved by seeded Gaussian noise of the
 // given deviation; the same seed, the same drawing.
 static void test_synth_jitter(void)
@@ -460,6 +503,7 @@ int main(int argc, char** argv)
                        (sp_test[]){{"animation_from_keys", test_animation_from_keys},
                                    {"drawover_fixture", test_drawover_fixture},
                                    {"animate_cli_cesiumman", test_animate_cli_cesiumman},
+                                   {"animate_cli_times", test_animate_cli_times},
                                    {"drawover_cesiumman", test_drawover_cesiumman},
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},

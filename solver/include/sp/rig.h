@@ -200,7 +200,8 @@ void sp_rig_params_from_trs(const sp_rig* rig, int joint, sp_vec3 t, sp_quat r, 
 /// per-joint local TRS arrays, which the caller pre-fills (e.g. with rest).
 void sp_animation_sample(const sp_animation* anim, double t, sp_vec3* trans, sp_quat* rot, sp_vec3* scale);
 /// A glTF-style animation that passes through key poses: keys is nkeys by
-/// rig->param_count, times nkeys seconds (increasing). Every joint with
+/// rig->param_count, times nkeys seconds (finite, increasing as floats, as the
+/// channels store them). Every joint with
 /// parameters gets LINEAR channels for the paths its parameters touch
 /// (rotation, translation, scale), sampled from sp_rig_local_trs at each key.
 sp_result sp_animation_from_keys(const sp_rig* rig, const double* keys, const double* times, int nkeys, const char* name,
