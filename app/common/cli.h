@@ -38,7 +38,7 @@ typedef struct sp_opt {
 /// 0 after printing --help, 2 after printing a usage error to stderr.
 int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts);
 
-/// Parses "WxH" into two positive ints; false if malformed.
+/// Parses "WxH" into two ints of 16..8192; false if malformed or out of range.
 bool sp_cli_parse_size(const char* s, int* w, int* h);
 
 /// Out-of-range check of a parsed option: true when lo <= v <= hi, else

@@ -72,7 +72,7 @@ int cmd_render(int argc, char** argv)
     if (rc >= 0) return rc;
     int w = 640, h = 480;
     if (size && !sp_cli_parse_size(size, &w, &h)) {
-        fprintf(stderr, "sketchpose render: --size wants WxH, e.g. 640x480, got '%s'\n", size);
+        fprintf(stderr, "sketchpose render: --size wants WxH with sides 16..8192, e.g. 640x480, got '%s'\n", size);
         return SP_EXIT_USAGE;
     }
     if (line_width < 0 || !isfinite(line_width) || !isfinite(yaw) || !isfinite(pitch) || fabs(pitch) > 89.0) {

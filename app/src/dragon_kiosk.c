@@ -411,7 +411,7 @@ int main(int argc, char** argv)
     if (max_parts == SP_CLI_UNSET) max_parts = 0;
     int win_w = 1280, win_h = 800;
     if (size && !sp_cli_parse_size(size, &win_w, &win_h)) {
-        fprintf(stderr, "%s: --size expects WxH, got '%s'\n", k_cmd, size);
+        fprintf(stderr, "%s: --size expects WxH with sides 16..8192, got '%s'\n", k_cmd, size);
         return SP_EXIT_USAGE;
     }
     sp_kiosk_session session = {0};

@@ -56,6 +56,10 @@ one_line_naming nowhere/x.png
 [ -e "$WORK/left.json" ] && fail "pose left its report after --render failed"
 ls "$WORK" | grep -q 'tmp' && fail "pose left a temporary file: $(ls "$WORK" | grep tmp)"
 
+# A picture size out of range says the range.
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 1x1
+one_line_naming "16..8192"
+
 # Bad strokes: one clear line naming the file, exit 1.
 strokes "$WORK/empty.json"
 expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/empty.json"
