@@ -590,20 +590,36 @@ static void test_read_only_and_full(void)
     sp_dataset_free(&ds);
 }
 
+// A copy of the base database (as `copy_of`) named `name` in a fresh folder
+// that other users may reach; its path in p, the folder returned.
+static const char* base_db_in_folder(const char* tag, const char* name, const char* copy_of, char p[1024])
+{
+    const char* dir = sp_test_reachable_dir(tag);
+    ENSURE(dir);
+    snprintf(p, 1024, "%s/%s", dir, name);
+    copy_file(base_db(copy_of), p);
+    return dir;
+}
+
+// fork(); the child runs as nobody when the test runs as root (root ignores
+// permissions), exiting 5 if it cannot drop them.
+static pid_t fork_unprivileged(void)
+{
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0 && geteuid() == 0 && setuid(65534) != 0) _exit(5);
+    return pid;
+}
+
 // A database behind a folder the user may not enter: "permission denied",
 // not "no such database" (root ignores permissions: its child drops them).
 static void test_unreachable(void)
 {
-    const char* dir = sp_test_reachable_dir("sp_partdb");
-    ENSURE(dir);
     char p[1024];
-    snprintf(p, sizeof p, "%s/x.db", dir);
-    copy_file(base_db("unreachable.db"), p);
+    const char* dir = base_db_in_folder("sp_partdb", "x.db", "unreachable.db", p);
     ENSURE(chmod(dir, geteuid() == 0 ? 0700 : 0) == 0);
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    pid_t pid = fork_unprivileged();
     if (pid == 0) {
-        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
         int code = 0;
         for (int k = 0; k < 2; ++k) {
             sp_db* d = NULL;
@@ -631,16 +647,11 @@ static void test_unreachable(void)
 // a writer is refused with one line (root's child drops its rights).
 static void test_read_only_folder(void)
 {
-    const char* dir = sp_test_reachable_dir("sp_partdb_ro");
-    ENSURE(dir);
     char p[1024];
-    snprintf(p, sizeof p, "%s/shared.db", dir);
-    copy_file(base_db("ro_folder.db"), p);
+    const char* dir = base_db_in_folder("sp_partdb_ro", "shared.db", "ro_folder.db", p);
     ENSURE(chmod(p, 0644) == 0 && chmod(dir, geteuid() == 0 ? 0755 : 0555) == 0);
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    pid_t pid = fork_unprivileged();
     if (pid == 0) {
-        if (geteuid() == 0 && setuid(65534) != 0) _exit(5);
         sp_db* d = NULL;
         sp_error e = {0};
         char** cats = NULL;
