@@ -462,6 +462,8 @@ static int stroke_guesses(const sp_kiosk* k, const sp_dragon_result* res, const 
 static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, const char* tried)
 {
     ++k->stats.rejected;
+    if (rc == SP_OK && res->reason == SP_DRAGON_NO_PART && sp_dragon_part_error(k->dragon)[0])
+        fprintf(stderr, "dragon-kiosk: no part to make of that stroke: %s\n", sp_dragon_part_error(k->dragon));
     sp_kiosk_fit_result r = {.ok = false,
                              .refusal = rc == SP_OK ? refusal_of(res->reason) : SP_KREF_UNRECOGNISED,
                              .part_count = sp_dragon_part_count(k->dragon)};
@@ -766,6 +768,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         (k->demo_prepared || k->ui->mode != SP_KM_ATTRACT)) { // the attract screen's demo first: it is what shows
         sp_error err = {0};
         sp_dragon_preload_step(k->dragon, &k->parts_loaded, &err);
+        if (err.text[0]) fprintf(stderr, "dragon-kiosk: %s\n", err.text); // a part that does not load is skipped
         k->heavy_done = !k->parts_loaded;
     }
     if (k->ui->mode == SP_KM_ATTRACT) kiosk_attract_update(k);

@@ -96,6 +96,8 @@ int cmd_dragon(int argc, char** argv)
         sp_dragon_detail e;
         if (res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e))
             fprintf(stderr, "sketchpose dragon: %s: stroke %d kept as a detail on part %d\n", strokes, i, e.part);
+        else if (res.rejected && res.reason == SP_DRAGON_NO_PART && sp_dragon_part_error(d)[0])
+            fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (no_part: %s)\n", strokes, i, sp_dragon_part_error(d));
         else if (res.rejected)
             fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (%s)\n", strokes, i, sp_dragon_reject_name(res.reason));
     }

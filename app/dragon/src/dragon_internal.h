@@ -153,6 +153,12 @@ struct sp_dragon {
     tpl** cache;
     int cache_n;
     int preload_next; // sp_dragon_preload_step's cursor over the database's parts
+    // Parts that did not load since the last change of the database, and why:
+    // not parsed again by every stroke that needs their category, and a
+    // stroke they leave without a part can say why (sp_dragon_part_error).
+    struct dragon_failed* failed;
+    int failed_n;
+    char part_error[512]; // why a part the last stroke needed did not load; "" when none
     part** parts;
     int part_n, part_cap;
     uint64_t next_id;

@@ -251,6 +251,11 @@ void dragon_part_free(part* p)
     free(p);
 }
 
+struct dragon_failed {
+    char name[SP_NAME_MAX];
+    char why[512];
+};
+
 void dragon_cache_clear(sp_dragon* d)
 {
     for (int i = 0; i < d->cache_n; ++i)
@@ -258,6 +263,9 @@ void dragon_cache_clear(sp_dragon* d)
     free(d->cache);
     d->cache = NULL;
     d->cache_n = 0;
+    free(d->failed);
+    d->failed = NULL;
+    d->failed_n = 0;
 }
 
 // After a change of the database: keeps the loaded parts whose stored bytes
@@ -266,6 +274,7 @@ void dragon_cache_clear(sp_dragon* d)
 static void cache_prune(sp_dragon* d)
 {
     d->preload_next = 0; // the database changed: what is left to load is counted again
+    d->failed_n = 0;     // and a part that did not load may load now
     int kept = 0;
     for (int i = 0; i < d->cache_n; ++i) {
         tpl* t = d->cache[i];
@@ -379,11 +388,36 @@ static tpl* cached(const sp_dragon* d, const char* name)
     return NULL;
 }
 
+static const struct dragon_failed* failed_before(const sp_dragon* d, const char* name)
+{
+    for (int k = 0; k < d->failed_n; ++k)
+        if (!strcmp(d->failed[k].name, name)) return &d->failed[k];
+    return NULL;
+}
+
+// Remembers that part `name` did not load, and why (with no memory to
+// remember it, it is simply tried again).
+static void fail_part(sp_dragon* d, const char* name, const char* why)
+{
+    snprintf(d->part_error, sizeof d->part_error, "%s", why);
+    struct dragon_failed* f = realloc(d->failed, sizeof *f * (size_t)(d->failed_n + 1));
+    if (!f) return;
+    d->failed = f;
+    f += d->failed_n++;
+    snprintf(f->name, sizeof f->name, "%s", name);
+    snprintf(f->why, sizeof f->why, "%s", why);
+}
+
 // Loads part `name` into the cache; NULL when it does not load (err says why).
 static tpl* cache_load(sp_dragon* d, const char* name, sp_error* err)
 {
-    tpl* t = tpl_load(d->db, NULL, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, err);
-    if (!t) return NULL;
+    sp_error lerr = {0};
+    tpl* t = tpl_load(d->db, NULL, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, &lerr);
+    if (!t) {
+        fail_part(d, name, lerr.text);
+        sp_fail(err, SP_ERR_PARSE, "%s", lerr.text);
+        return NULL;
+    }
     tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
     if (!c) {
         dragon_tpl_release(t);
@@ -409,6 +443,12 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
     if (sp_db_category_parts(d->db, category, &names, &n, err) != SP_OK) return 0;
     for (int i = 0; i < n && got < cap; ++i) {
         tpl* t = cached(d, names[i]);
+        const struct dragon_failed* f = t ? NULL : failed_before(d, names[i]);
+        if (f) { // skipped, as it was when it failed
+            snprintf(d->part_error, sizeof d->part_error, "%s", f->why);
+            sp_fail(err, SP_ERR_PARSE, "%s", f->why);
+            continue;
+        }
         if (!t && !(t = cache_load(d, names[i], err))) continue; // a part that does not load is skipped; err keeps why
         out[got++] = t;
     }
@@ -440,7 +480,7 @@ sp_result sp_dragon_preload_step(sp_dragon* d, bool* done, sp_error* err)
         sp_error lerr = {0};
         if (sp_db_category_parts(d->db, cats[i], &names, &m, &lerr) != SP_OK) continue;
         for (int k = 0; k < m && k < cap && *done; ++k, ++index)
-            if (index >= d->preload_next && !cached(d, names[k])) {
+            if (index >= d->preload_next && !cached(d, names[k]) && !failed_before(d, names[k])) {
                 d->preload_next = index + 1; // tried once: a part that does not load is not tried again
                 cache_load(d, names[k], err);
                 *done = false;
@@ -454,6 +494,11 @@ sp_result sp_dragon_preload_step(sp_dragon* d, bool* done, sp_error* err)
 int sp_dragon_loaded_parts(const sp_dragon* d)
 {
     return d->cache_n;
+}
+
+const char* sp_dragon_part_error(const sp_dragon* d)
+{
+    return d->part_error;
 }
 
 sp_result sp_dragon_preload(sp_dragon* d, sp_error* err)

@@ -836,6 +836,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     memset(out, 0, sizeof *out);
     out->part = out->detail = -1;
     out->far_score = NAN;
+    d->part_error[0] = '\0';
     sp_dragon_stroke_opts o = opts ? *opts : (sp_dragon_stroke_opts){0};
     // A chip for a detail: the part takes the detail's place when the detail is the last change.
     uint64_t drop_detail = o.replace_detail ? dragon_detail_last_change(d) : 0;

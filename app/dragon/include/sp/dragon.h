@@ -321,6 +321,11 @@ sp_result sp_dragon_preload(sp_dragon* d, sp_error* err);
 sp_result sp_dragon_preload_step(sp_dragon* d, bool* done, sp_error* err);
 /// How many of the database's parts are loaded now.
 int sp_dragon_loaded_parts(const sp_dragon* d);
+/// Why a database part that the last stroke needed (or the last preload
+/// step tried) did not load, naming it; "" when none failed. A category
+/// whose parts all fail gives SP_DRAGON_NO_PART, and this says why. A part
+/// that does not load is not tried again until the database changes.
+const char* sp_dragon_part_error(const sp_dragon* d);
 /// The categories the current model knows (for hints); NULL when there is no model.
 const sp_clf* sp_dragon_model(const sp_dragon* d);
 
