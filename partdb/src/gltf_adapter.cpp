@@ -191,28 +191,49 @@ std::string url_decode(const std::string& s)
     return r;
 }
 
+// The external buffer whose uri names the file at `path`, or -1 (an image).
+int buffer_of_path(const LoadContext& cx, const std::string& path)
+{
+    for (size_t i = 0; i < cx.buffers.size(); ++i) {
+        const BufferDecl& b = cx.buffers[i];
+        if (!b.has_uri || is_data_uri(b.uri)) continue;
+        std::string name = url_decode(b.uri);
+        if (path == name || (path.size() > name.size() && path.compare(path.size() - name.size(), name.size(), name) == 0 &&
+                             path[path.size() - name.size() - 1] == '/'))
+            return (int)i;
+    }
+    return -1;
+}
+
+// tinygltf looks for a file next to the glTF, then in the working directory,
+// and of a missing one says only "File not found". A buffer's file is said to
+// exist beside the glTF, so that read_buffer_file tries exactly that one (a
+// relative uri is relative to the glTF, not to where we run) and says which
+// buffer is missing.
+bool buffer_file_exists(const std::string& path, void* user)
+{
+    const LoadContext& cx = *static_cast<const LoadContext*>(user);
+    return buffer_of_path(cx, path) >= 0 || tinygltf::FileExists(path, nullptr);
+}
+
 // tinygltf's own reader sizes its vector by seeking to the end, which for a
 // directory gives 2^63 - 1 and an attempt to allocate that. Ours reads only a
 // regular file, and only as many bytes as the buffer that names it declares.
 bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user)
 {
     LoadContext& cx = *static_cast<LoadContext*>(user);
-    int index = -1;
-    for (size_t i = 0; i < cx.buffers.size() && index < 0; ++i) {
-        const BufferDecl& b = cx.buffers[i];
-        if (!b.has_uri || is_data_uri(b.uri)) continue;
-        std::string name = url_decode(b.uri);
-        if (path == name || (path.size() > name.size() && path.compare(path.size() - name.size(), name.size(), name) == 0 &&
-                             path[path.size() - name.size() - 1] == '/'))
-            index = (int)i;
-    }
+    int index = buffer_of_path(cx, path);
     char who[64] = "";
     if (index >= 0) snprintf(who, sizeof who, "buffer %d: ", index);
     char msg[1024] = "";
     struct stat st;
     FILE* f = nullptr;
-    if (stat(path.c_str(), &st) != 0)
-        snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(errno));
+    int stat_errno = stat(path.c_str(), &st) != 0 ? errno : 0;
+    if (index >= 0 && (stat_errno == ENOENT || stat_errno == ENOTDIR))
+        snprintf(msg, sizeof msg, "%s: buffer %d (uri '%s'): file not found (%s)", cx.what, index,
+                 cx.buffers[(size_t)index].uri.c_str(), path.c_str());
+    else if (stat_errno)
+        snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(stat_errno));
     else if (S_ISDIR(st.st_mode))
         snprintf(msg, sizeof msg, "%s: %s%s is a directory, not a buffer file", cx.what, who, path.c_str());
     else if (!S_ISREG(st.st_mode))
@@ -315,8 +336,8 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
     LoadContext cx;
     cx.what = what;
     if (use_fs)
-        loader.SetFsCallbacks(tinygltf::FsCallbacks{tinygltf::FileExists, tinygltf::ExpandFilePath, read_buffer_file,
-                                                    tinygltf::WriteWholeFile, &cx});
+        loader.SetFsCallbacks(
+            tinygltf::FsCallbacks{buffer_file_exists, tinygltf::ExpandFilePath, read_buffer_file, tinygltf::WriteWholeFile, &cx});
     else
         loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, no_expand, no_read, no_write, nullptr});
     std::string terr, twarn;

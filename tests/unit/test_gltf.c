@@ -5,9 +5,12 @@
 //
 // `test_gltf --write-corpus DIR` writes the hand-made seed files (fuzz corpus,
 // CLI fixture) instead of running tests.
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "fixtures.h"
 #include "gltf_internal.h"
@@ -572,6 +575,25 @@ static void test_says_what_is_wrong(void)
     ENSURE(mini_write(bin, "0123456789", 10));
     ensure_fails(write_edited("buf_short.gltf", &(mini_desc){.uri = "NAME"}, "NAME", strrchr(bin, '/') + 1), "buf_short.gltf",
                  "has 10 bytes, but the buffer's byteLength is 300");
+    // A missing file says which buffer, and it is looked for beside the glTF
+    // only: not in the working directory, even when one of that name is there.
+    ensure_fails(write_mini("buf_missing.gltf", &(mini_desc){.uri = "missing.bin"}), "buf_missing.gltf",
+                 "buffer 0 (uri 'missing.bin'): file not found");
+    char near_bin[1024], far_dir[1024], far_gltf[2048], cwd[1024];
+    snprintf(near_bin, sizeof near_bin, "%s", sp_test_tmp_path("near.bin"));
+    snprintf(far_dir, sizeof far_dir, "%s", sp_test_tmp_path("far"));
+    snprintf(far_gltf, sizeof far_gltf, "%s/far.gltf", far_dir);
+    static const char zeros[300] = {0};
+    ENSURE(mini_write(near_bin, zeros, sizeof zeros));
+    ENSURE(mkdir(far_dir, 0755) == 0 || errno == EEXIST);
+    char* far_text = mini_gltf(&(mini_desc){.uri = strrchr(near_bin, '/') + 1});
+    ENSURE(mini_write(far_gltf, far_text, strlen(far_text)));
+    free(far_text);
+    ENSURE(getcwd(cwd, sizeof cwd));
+    *strrchr(near_bin, '/') = 0; // its folder
+    ENSURE(chdir(near_bin) == 0);
+    ensure_fails(far_gltf, "far.gltf", "_near.bin'): file not found");
+    ENSURE(chdir(cwd) == 0);
     ensure_fails(write_edited("buf_no_uri.gltf", &(mini_desc){.uri = "NAME"}, ", \"uri\": \"NAME\"", ""), "buf_no_uri.gltf",
                  "buffer 0 has no uri");
     const char* len = write_edited("buf_len.gltf", &(mini_desc){0}, "\"byteLength\": 300", "\"byteLength\": 301");
