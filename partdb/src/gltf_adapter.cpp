@@ -657,6 +657,32 @@ void material_color(const tinygltf::Model& m, int material, const char* what, fl
             rgba[c] *= SP_GLTF_TEXTURE_GREY;
 }
 
+// glTF requires an inverse bind matrix to be finite with a fourth row of
+// [0, 0, 0, 1]; one that is not (e.g. all zeros) would throw the joint's
+// vertices to the origin or to NaN, so it is refused. Within 1e-5 of that row
+// is exporter rounding, made exact. A singular matrix is legal but flattens
+// every vertex the joint moves: a warning.
+void check_inverse_bind(sp_mat4& a, int skin, size_t k, const tinygltf::Model& m, const char* what, sp_character* ch)
+{
+    int node = m.skins[(size_t)skin].joints[k];
+    const std::string& name = m.nodes[(size_t)node].name;
+    char who[160];
+    snprintf(who, sizeof who, "skin %d joint %zu (node %d%s%.64s%s)", skin, k, node, name.empty() ? "" : " '", name.c_str(),
+             name.empty() ? "" : "'");
+    for (int c = 0; c < 16; ++c)
+        if (!std::isfinite(a.m[c])) fail(SP_ERR_INVALID, "%s: %s: its inverse bind matrix has a non-finite element", what, who);
+    const double tol = 1e-5;
+    if (!(std::fabs(a.m[3]) <= tol && std::fabs(a.m[7]) <= tol && std::fabs(a.m[11]) <= tol && std::fabs(a.m[15] - 1) <= tol))
+        fail(SP_ERR_INVALID, "%s: %s: its inverse bind matrix has the fourth row [%g, %g, %g, %g], not [0, 0, 0, 1]", what, who,
+             a.m[3], a.m[7], a.m[11], a.m[15]);
+    a.m[3] = a.m[7] = a.m[11] = 0, a.m[15] = 1;
+    sp_vec3 c0 = sp_v3(a.m[0], a.m[1], a.m[2]), c1 = sp_v3(a.m[4], a.m[5], a.m[6]), c2 = sp_v3(a.m[8], a.m[9], a.m[10]);
+    // Relative to the columns' lengths, so that a file's unit does not matter.
+    double det = sp_v3_dot(c0, sp_v3_cross(c1, c2));
+    if (!(std::fabs(det) > 1e-6 * sp_v3_len(c0) * sp_v3_len(c1) * sp_v3_len(c2)))
+        sp_character_warn(ch, "%s: its inverse bind matrix is singular: the vertices it moves are flattened", who);
+}
+
 struct Importer {
     const tinygltf::Model& m;
     const char* what;
@@ -785,9 +811,11 @@ struct Importer {
             expect(v, 16, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
             if (v.count < sk.joints.size())
                 fail(SP_ERR_INVALID, "%s: skin %d has fewer inverse bind matrices than joints", what, skin);
-            for (size_t k = 0; k < sk.joints.size(); ++k)
+            for (size_t k = 0; k < sk.joints.size(); ++k) {
                 for (int c = 0; c < 16; ++c)
                     ibm[k].m[c] = read_comp(v, k, c);
+                check_inverse_bind(ibm[k], skin, k, m, what, ch);
+            }
         }
 
         // Rig joints: skin joints and their ancestors, depth first from the

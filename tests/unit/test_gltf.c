@@ -631,6 +631,45 @@ static void test_says_what_is_wrong(void)
     free(text);
 }
 
+// Inverse bind matrices glTF forbids (not finite, a fourth row other than
+// [0, 0, 0, 1], e.g. all zeros) are refused naming the skin and the joint;
+// a singular one is legal, so it loads, with a warning.
+static void test_inverse_bind(void)
+{
+    static const float zero[16] = {0};
+    static const float not_finite[16] = {1, 0, 0, 0, 0, NAN, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    static const float projective[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 2};
+    bad_mini("ibm_zero.gltf", (mini_desc){.ibm1 = zero},
+             "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix has the fourth row [0, 0, 0, 0], not [0, 0, 0, 1]");
+    bad_mini("ibm_nan.gltf", (mini_desc){.ibm1 = not_finite},
+             "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix has a non-finite element");
+    bad_mini("ibm_w2.gltf", (mini_desc){.ibm1 = projective}, "has the fourth row [0, 0, 0, 2]");
+
+    // Float rounding in the fourth row is made exact.
+    static const float rounded[16] = {1, 0, 0, 1e-7f, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1.0000001f};
+    sp_character ch = load_ok(write_mini("ibm_rounded.gltf", &(mini_desc){.ibm1 = rounded}));
+    const sp_mat4* b = &ch.rig.joints[1].inverse_bind;
+    ENSURE(!strcmp(ch.rig.joints[1].name, "tip") && b->m[3] == 0 && b->m[15] == 1 && b->m[13] == -1);
+    ENSURE(ch.warning_count == 0);
+    sp_character_free(&ch);
+
+    // Singular but legal: every vertex the tip moves lands on one point.
+    static const float flat[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 1};
+    ch = load_ok(write_mini("ibm_flat.gltf", &(mini_desc){.ibm1 = flat}));
+    ENSURE(ch.warning_count == 1 && has_warning(&ch, "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix is singular"));
+    sp_character_free(&ch);
+    // Not singular: a file in millimetres, a shear with a non-uniform scale.
+    static const float small[16] = {1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, -1e-3f, 0, 1};
+    static const float sheared[16] = {2, 0, 0, 0, 0.5f, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    const float* fine[] = {small, sheared};
+    for (int i = 0; i < 2; ++i) {
+        ch = load_ok(write_mini("ibm_fine.gltf", &(mini_desc){.ibm1 = fine[i]}));
+        if (ch.warning_count) printf("  unexpected warning: %s\n", ch.warnings[0]);
+        ENSURE(ch.warning_count == 0);
+        sp_character_free(&ch);
+    }
+}
+
 // Random byte flips of a valid file must never crash (a tiny in-test fuzz).
 static void test_mutations(void)
 {
@@ -692,6 +731,7 @@ int main(int argc, char** argv)
                                    {"part_bad", test_part_bad},
                                    {"bad_input", test_bad_input},
                                    {"says_what_is_wrong", test_says_what_is_wrong},
+                                   {"inverse_bind", test_inverse_bind},
                                    {"mutations", test_mutations},
                                    {0}});
 }
