@@ -466,6 +466,9 @@ void expect(const View& v, int type_ncomp, std::initializer_list<int> comps, boo
         fail(SP_ERR_INVALID, "%s: %s (accessor %d) has the wrong type or component type", what, usage, v.index);
     if (need_normalized_ints && v.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && !v.normalized)
         fail(SP_ERR_INVALID, "%s: %s (accessor %d) must be float or normalized integers", what, usage, v.index);
+    // Why: read as fractions, joint numbers and indices would all become 0.
+    if (!need_normalized_ints && v.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && v.normalized)
+        fail(SP_ERR_INVALID, "%s: %s (accessor %d) holds integers and must not be normalized", what, usage, v.index);
 }
 
 // ---- node graph -----------------------------------------------------------

@@ -604,6 +604,12 @@ static void test_says_what_is_wrong(void)
                  "mesh 0 primitive 0: mode 99 is not a glTF primitive mode");
     ensure_fails(write_edited("no_position.gltf", &(mini_desc){0}, "\"POSITION\": 0, ", ""), "no_position.gltf",
                  "mesh 0 primitive 0 has no POSITION");
+    ensure_fails(
+        write_edited("joints_norm.gltf", &(mini_desc){0}, "{\"bufferView\": 1, ", "{\"bufferView\": 1, \"normalized\": true, "),
+        "joints_norm.gltf", "mesh 0 primitive 0 JOINTS_0 (accessor 1) holds integers and must not be normalized");
+    ensure_fails(
+        write_edited("indices_norm.gltf", &(mini_desc){0}, "{\"bufferView\": 3, ", "{\"bufferView\": 3, \"normalized\": true, "),
+        "indices_norm.gltf", "mesh 0 primitive 0 indices (accessor 3) holds integers and must not be normalized");
     const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         const char* p = sp_test_tmp_path("top.gltf");
