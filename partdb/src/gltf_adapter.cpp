@@ -694,6 +694,16 @@ struct Importer {
     std::vector<int> order;                    // reachable nodes, depth first
     std::vector<int> node2joint;               // node -> rig joint or -1
     std::map<int, std::vector<int>> skin_maps; // skin -> (skin joint -> rig joint)
+    bool warned_influences = false;
+
+    // We skin with 4 joints a vertex: a second set is dropped, and only a
+    // word here says so (renormalising the first set's weights hides it).
+    void warn_extra_influences(const tinygltf::Primitive& prim, int mesh, int pi)
+    {
+        if (warned_influences || (!prim.attributes.count("JOINTS_1") && !prim.attributes.count("WEIGHTS_1"))) return;
+        sp_character_warn(ch, "mesh %d primitive %d: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)", mesh, pi);
+        warned_influences = true;
+    }
 
     void check_graph()
     {
@@ -952,6 +962,7 @@ struct Importer {
                     continue;
                 }
                 Skinned s;
+                warn_extra_influences(prim, nd.mesh, (int)pi);
                 read_skinned(m, prim, nd.mesh, (int)pi, skin_map(skin), skin, what, s);
                 size_t nv = s.rest.size() / 3, base = rest.size() / 3;
                 if (base + nv > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
@@ -1019,6 +1030,7 @@ struct Importer {
         if (nd.skin >= 0 && nd.skin != skin) use_skin = nd.skin;
         if (m.skins[(size_t)use_skin].joints.empty()) fail(SP_ERR_INVALID, "%s: skin %d has no joints", what, use_skin);
         Skinned s;
+        warn_extra_influences(prim, mesh, pi);
         read_skinned(m, prim, mesh, pi, skin_map(use_skin), use_skin, what, s);
         size_t nv = s.rest.size() / 3;
         std::vector<uint32_t> idx = read_indices(m, prim, mesh, pi, nv, what);

@@ -77,6 +77,23 @@ static const char* write_mini(const char* name, const mini_desc* d)
     return path;
 }
 
+// mini_gltf's text with the first `from` replaced by `to`, written to name.
+static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
+{
+    char* text = mini_gltf(d);
+    char* at = strstr(text, from);
+    ENSURE(at);
+    size_t head = (size_t)(at - text), nf = strlen(from), nt = strlen(to), n = strlen(text) - nf + nt;
+    char* out = malloc(n + 1);
+    memcpy(out, text, head);
+    memcpy(out + head, to, nt);
+    strcpy(out + head + nt, at + nf);
+    const char* path = sp_test_tmp_path(name);
+    ENSURE(mini_write(path, out, n));
+    free(text), free(out);
+    return path;
+}
+
 // Skinned mesh vertices of ch at p (malloc'd, vertex_count by 3).
 static double* skin_mesh(const sp_rig* rig, const double* p)
 {
@@ -332,6 +349,11 @@ static void test_mini_plain(void)
     ch = load_ok(write_mini("strip.gltf", &s));
     ENSURE(ch.rig.triangle_count == 2 && ch.rig.joint_count == 2);
     sp_character_free(&ch);
+    // A second set of joints and weights: ignored, with a word.
+    ch = load_ok(write_edited("influences8.gltf", &(mini_desc){0}, "\"WEIGHTS_0\": 2}",
+                              "\"WEIGHTS_0\": 2, \"JOINTS_1\": 1, \"WEIGHTS_1\": 2}"));
+    ENSURE(has_warning(&ch, "mesh 0 primitive 0: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)"));
+    sp_character_free(&ch);
 }
 
 static void test_mini_extras(void)
@@ -544,23 +566,6 @@ static void test_bad_input(void)
     }
     free(glb);
     sp_character_free(&ch);
-}
-
-// mini_gltf's text with the first `from` replaced by `to`, written to name.
-static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
-{
-    char* text = mini_gltf(d);
-    char* at = strstr(text, from);
-    ENSURE(at);
-    size_t head = (size_t)(at - text), nf = strlen(from), nt = strlen(to), n = strlen(text) - nf + nt;
-    char* out = malloc(n + 1);
-    memcpy(out, text, head);
-    memcpy(out + head, to, nt);
-    strcpy(out + head + nt, at + nf);
-    const char* path = sp_test_tmp_path(name);
-    ENSURE(mini_write(path, out, n));
-    free(text), free(out);
-    return path;
 }
 
 // Buffers, primitives and the top level that are wrong say what is wrong
