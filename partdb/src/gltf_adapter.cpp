@@ -191,28 +191,49 @@ std::string url_decode(const std::string& s)
     return r;
 }
 
+// The external buffer whose uri names the file at `path`, or -1 (an image).
+int buffer_of_path(const LoadContext& cx, const std::string& path)
+{
+    for (size_t i = 0; i < cx.buffers.size(); ++i) {
+        const BufferDecl& b = cx.buffers[i];
+        if (!b.has_uri || is_data_uri(b.uri)) continue;
+        std::string name = url_decode(b.uri);
+        if (path == name || (path.size() > name.size() && path.compare(path.size() - name.size(), name.size(), name) == 0 &&
+                             path[path.size() - name.size() - 1] == '/'))
+            return (int)i;
+    }
+    return -1;
+}
+
+// tinygltf looks for a file next to the glTF, then in the working directory,
+// and of a missing one says only "File not found". A buffer's file is said to
+// exist beside the glTF, so that read_buffer_file tries exactly that one (a
+// relative uri is relative to the glTF, not to where we run) and says which
+// buffer is missing.
+bool buffer_file_exists(const std::string& path, void* user)
+{
+    const LoadContext& cx = *static_cast<const LoadContext*>(user);
+    return buffer_of_path(cx, path) >= 0 || tinygltf::FileExists(path, nullptr);
+}
+
 // tinygltf's own reader sizes its vector by seeking to the end, which for a
 // directory gives 2^63 - 1 and an attempt to allocate that. Ours reads only a
 // regular file, and only as many bytes as the buffer that names it declares.
 bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user)
 {
     LoadContext& cx = *static_cast<LoadContext*>(user);
-    int index = -1;
-    for (size_t i = 0; i < cx.buffers.size() && index < 0; ++i) {
-        const BufferDecl& b = cx.buffers[i];
-        if (!b.has_uri || is_data_uri(b.uri)) continue;
-        std::string name = url_decode(b.uri);
-        if (path == name || (path.size() > name.size() && path.compare(path.size() - name.size(), name.size(), name) == 0 &&
-                             path[path.size() - name.size() - 1] == '/'))
-            index = (int)i;
-    }
+    int index = buffer_of_path(cx, path);
     char who[64] = "";
     if (index >= 0) snprintf(who, sizeof who, "buffer %d: ", index);
     char msg[1024] = "";
     struct stat st;
     FILE* f = nullptr;
-    if (stat(path.c_str(), &st) != 0)
-        snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(errno));
+    int stat_errno = stat(path.c_str(), &st) != 0 ? errno : 0;
+    if (index >= 0 && (stat_errno == ENOENT || stat_errno == ENOTDIR))
+        snprintf(msg, sizeof msg, "%s: buffer %d (uri '%s'): file not found (%s)", cx.what, index,
+                 cx.buffers[(size_t)index].uri.c_str(), path.c_str());
+    else if (stat_errno)
+        snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(stat_errno));
     else if (S_ISDIR(st.st_mode))
         snprintf(msg, sizeof msg, "%s: %s%s is a directory, not a buffer file", cx.what, who, path.c_str());
     else if (!S_ISREG(st.st_mode))
@@ -315,8 +336,8 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
     LoadContext cx;
     cx.what = what;
     if (use_fs)
-        loader.SetFsCallbacks(tinygltf::FsCallbacks{tinygltf::FileExists, tinygltf::ExpandFilePath, read_buffer_file,
-                                                    tinygltf::WriteWholeFile, &cx});
+        loader.SetFsCallbacks(
+            tinygltf::FsCallbacks{buffer_file_exists, tinygltf::ExpandFilePath, read_buffer_file, tinygltf::WriteWholeFile, &cx});
     else
         loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, no_expand, no_read, no_write, nullptr});
     std::string terr, twarn;
@@ -445,6 +466,9 @@ void expect(const View& v, int type_ncomp, std::initializer_list<int> comps, boo
         fail(SP_ERR_INVALID, "%s: %s (accessor %d) has the wrong type or component type", what, usage, v.index);
     if (need_normalized_ints && v.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && !v.normalized)
         fail(SP_ERR_INVALID, "%s: %s (accessor %d) must be float or normalized integers", what, usage, v.index);
+    // Why: read as fractions, joint numbers and indices would all become 0.
+    if (!need_normalized_ints && v.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && v.normalized)
+        fail(SP_ERR_INVALID, "%s: %s (accessor %d) holds integers and must not be normalized", what, usage, v.index);
 }
 
 // ---- node graph -----------------------------------------------------------
@@ -636,6 +660,32 @@ void material_color(const tinygltf::Model& m, int material, const char* what, fl
             rgba[c] *= SP_GLTF_TEXTURE_GREY;
 }
 
+// glTF requires an inverse bind matrix to be finite with a fourth row of
+// [0, 0, 0, 1]; one that is not (e.g. all zeros) would throw the joint's
+// vertices to the origin or to NaN, so it is refused. Within 1e-5 of that row
+// is exporter rounding, made exact. A singular matrix is legal but flattens
+// every vertex the joint moves: a warning.
+void check_inverse_bind(sp_mat4& a, int skin, size_t k, const tinygltf::Model& m, const char* what, sp_character* ch)
+{
+    int node = m.skins[(size_t)skin].joints[k];
+    const std::string& name = m.nodes[(size_t)node].name;
+    char who[160];
+    snprintf(who, sizeof who, "skin %d joint %zu (node %d%s%.64s%s)", skin, k, node, name.empty() ? "" : " '", name.c_str(),
+             name.empty() ? "" : "'");
+    for (int c = 0; c < 16; ++c)
+        if (!std::isfinite(a.m[c])) fail(SP_ERR_INVALID, "%s: %s: its inverse bind matrix has a non-finite element", what, who);
+    const double tol = 1e-5;
+    if (!(std::fabs(a.m[3]) <= tol && std::fabs(a.m[7]) <= tol && std::fabs(a.m[11]) <= tol && std::fabs(a.m[15] - 1) <= tol))
+        fail(SP_ERR_INVALID, "%s: %s: its inverse bind matrix has the fourth row [%g, %g, %g, %g], not [0, 0, 0, 1]", what, who,
+             a.m[3], a.m[7], a.m[11], a.m[15]);
+    a.m[3] = a.m[7] = a.m[11] = 0, a.m[15] = 1;
+    sp_vec3 c0 = sp_v3(a.m[0], a.m[1], a.m[2]), c1 = sp_v3(a.m[4], a.m[5], a.m[6]), c2 = sp_v3(a.m[8], a.m[9], a.m[10]);
+    // Relative to the columns' lengths, so that a file's unit does not matter.
+    double det = sp_v3_dot(c0, sp_v3_cross(c1, c2));
+    if (!(std::fabs(det) > 1e-6 * sp_v3_len(c0) * sp_v3_len(c1) * sp_v3_len(c2)))
+        sp_character_warn(ch, "%s: its inverse bind matrix is singular: the vertices it moves are flattened", who);
+}
+
 struct Importer {
     const tinygltf::Model& m;
     const char* what;
@@ -644,6 +694,16 @@ struct Importer {
     std::vector<int> order;                    // reachable nodes, depth first
     std::vector<int> node2joint;               // node -> rig joint or -1
     std::map<int, std::vector<int>> skin_maps; // skin -> (skin joint -> rig joint)
+    bool warned_influences = false;
+
+    // We skin with 4 joints a vertex: a second set is dropped, and only a
+    // word here says so (renormalising the first set's weights hides it).
+    void warn_extra_influences(const tinygltf::Primitive& prim, int mesh, int pi)
+    {
+        if (warned_influences || (!prim.attributes.count("JOINTS_1") && !prim.attributes.count("WEIGHTS_1"))) return;
+        sp_character_warn(ch, "mesh %d primitive %d: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)", mesh, pi);
+        warned_influences = true;
+    }
 
     void check_graph()
     {
@@ -764,9 +824,11 @@ struct Importer {
             expect(v, 16, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
             if (v.count < sk.joints.size())
                 fail(SP_ERR_INVALID, "%s: skin %d has fewer inverse bind matrices than joints", what, skin);
-            for (size_t k = 0; k < sk.joints.size(); ++k)
+            for (size_t k = 0; k < sk.joints.size(); ++k) {
                 for (int c = 0; c < 16; ++c)
                     ibm[k].m[c] = read_comp(v, k, c);
+                check_inverse_bind(ibm[k], skin, k, m, what, ch);
+            }
         }
 
         // Rig joints: skin joints and their ancestors, depth first from the
@@ -900,6 +962,7 @@ struct Importer {
                     continue;
                 }
                 Skinned s;
+                warn_extra_influences(prim, nd.mesh, (int)pi);
                 read_skinned(m, prim, nd.mesh, (int)pi, skin_map(skin), skin, what, s);
                 size_t nv = s.rest.size() / 3, base = rest.size() / 3;
                 if (base + nv > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
@@ -967,6 +1030,7 @@ struct Importer {
         if (nd.skin >= 0 && nd.skin != skin) use_skin = nd.skin;
         if (m.skins[(size_t)use_skin].joints.empty()) fail(SP_ERR_INVALID, "%s: skin %d has no joints", what, use_skin);
         Skinned s;
+        warn_extra_influences(prim, mesh, pi);
         read_skinned(m, prim, mesh, pi, skin_map(use_skin), use_skin, what, s);
         size_t nv = s.rest.size() / 3;
         std::vector<uint32_t> idx = read_indices(m, prim, mesh, pi, nv, what);

@@ -28,6 +28,7 @@ typedef struct mini_desc {
     bool strip;        ///< TRIANGLE_STRIP instead of indexed TRIANGLES
     bool byte_joints;  ///< JOINTS_0 as UNSIGNED_BYTE (in a separate view)
     const char* part;  ///< with extras: the scene's sp_part JSON (NULL: a tail attached by the short form)
+    const float* ibm1; ///< 16 floats, column-major: the tip's inverse bind matrix (NULL: translate by -1 in y)
 } mini_desc;
 
 static void mini_base64(const unsigned char* d, size_t n, char* out)
@@ -62,6 +63,7 @@ static char* mini_gltf(const mini_desc* d)
     if (d->zero_weights) w[12] = 0;
     uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
     float ibm[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    if (d->ibm1) memcpy(ibm + 16, d->ibm1, sizeof(float) * 16);
     uint8_t jb[16];
     for (int i = 0; i < 16; ++i)
         jb[i] = (uint8_t)jn[i];

@@ -5,9 +5,12 @@
 //
 // `test_gltf --write-corpus DIR` writes the hand-made seed files (fuzz corpus,
 // CLI fixture) instead of running tests.
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "fixtures.h"
 #include "gltf_internal.h"
@@ -71,6 +74,23 @@ static const char* write_mini(const char* name, const mini_desc* d)
     char* text = mini_gltf(d);
     ENSURE(mini_write(path, text, strlen(text)));
     free(text);
+    return path;
+}
+
+// mini_gltf's text with the first `from` replaced by `to`, written to name.
+static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
+{
+    char* text = mini_gltf(d);
+    char* at = strstr(text, from);
+    ENSURE(at);
+    size_t head = (size_t)(at - text), nf = strlen(from), nt = strlen(to), n = strlen(text) - nf + nt;
+    char* out = malloc(n + 1);
+    memcpy(out, text, head);
+    memcpy(out + head, to, nt);
+    strcpy(out + head + nt, at + nf);
+    const char* path = sp_test_tmp_path(name);
+    ENSURE(mini_write(path, out, n));
+    free(text), free(out);
     return path;
 }
 
@@ -329,6 +349,11 @@ static void test_mini_plain(void)
     ch = load_ok(write_mini("strip.gltf", &s));
     ENSURE(ch.rig.triangle_count == 2 && ch.rig.joint_count == 2);
     sp_character_free(&ch);
+    // A second set of joints and weights: ignored, with a word.
+    ch = load_ok(write_edited("influences8.gltf", &(mini_desc){0}, "\"WEIGHTS_0\": 2}",
+                              "\"WEIGHTS_0\": 2, \"JOINTS_1\": 1, \"WEIGHTS_1\": 2}"));
+    ENSURE(has_warning(&ch, "mesh 0 primitive 0: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)"));
+    sp_character_free(&ch);
 }
 
 static void test_mini_extras(void)
@@ -543,23 +568,6 @@ static void test_bad_input(void)
     sp_character_free(&ch);
 }
 
-// mini_gltf's text with the first `from` replaced by `to`, written to name.
-static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
-{
-    char* text = mini_gltf(d);
-    char* at = strstr(text, from);
-    ENSURE(at);
-    size_t head = (size_t)(at - text), nf = strlen(from), nt = strlen(to), n = strlen(text) - nf + nt;
-    char* out = malloc(n + 1);
-    memcpy(out, text, head);
-    memcpy(out + head, to, nt);
-    strcpy(out + head + nt, at + nf);
-    const char* path = sp_test_tmp_path(name);
-    ENSURE(mini_write(path, out, n));
-    free(text), free(out);
-    return path;
-}
-
 // Buffers, primitives and the top level that are wrong say what is wrong
 // (not "out of memory" or "neither glTF JSON nor a .glb"), and a message
 // never carries a data URI's base64.
@@ -572,6 +580,25 @@ static void test_says_what_is_wrong(void)
     ENSURE(mini_write(bin, "0123456789", 10));
     ensure_fails(write_edited("buf_short.gltf", &(mini_desc){.uri = "NAME"}, "NAME", strrchr(bin, '/') + 1), "buf_short.gltf",
                  "has 10 bytes, but the buffer's byteLength is 300");
+    // A missing file says which buffer, and it is looked for beside the glTF
+    // only: not in the working directory, even when one of that name is there.
+    ensure_fails(write_mini("buf_missing.gltf", &(mini_desc){.uri = "missing.bin"}), "buf_missing.gltf",
+                 "buffer 0 (uri 'missing.bin'): file not found");
+    char near_bin[1024], far_dir[1024], far_gltf[2048], cwd[1024];
+    snprintf(near_bin, sizeof near_bin, "%s", sp_test_tmp_path("near.bin"));
+    snprintf(far_dir, sizeof far_dir, "%s", sp_test_tmp_path("far"));
+    snprintf(far_gltf, sizeof far_gltf, "%s/far.gltf", far_dir);
+    static const char zeros[300] = {0};
+    ENSURE(mini_write(near_bin, zeros, sizeof zeros));
+    ENSURE(mkdir(far_dir, 0755) == 0 || errno == EEXIST);
+    char* far_text = mini_gltf(&(mini_desc){.uri = strrchr(near_bin, '/') + 1});
+    ENSURE(mini_write(far_gltf, far_text, strlen(far_text)));
+    free(far_text);
+    ENSURE(getcwd(cwd, sizeof cwd));
+    *strrchr(near_bin, '/') = 0; // its folder
+    ENSURE(chdir(near_bin) == 0);
+    ensure_fails(far_gltf, "far.gltf", "_near.bin'): file not found");
+    ENSURE(chdir(cwd) == 0);
     ensure_fails(write_edited("buf_no_uri.gltf", &(mini_desc){.uri = "NAME"}, ", \"uri\": \"NAME\"", ""), "buf_no_uri.gltf",
                  "buffer 0 has no uri");
     const char* len = write_edited("buf_len.gltf", &(mini_desc){0}, "\"byteLength\": 300", "\"byteLength\": 301");
@@ -582,6 +609,12 @@ static void test_says_what_is_wrong(void)
                  "mesh 0 primitive 0: mode 99 is not a glTF primitive mode");
     ensure_fails(write_edited("no_position.gltf", &(mini_desc){0}, "\"POSITION\": 0, ", ""), "no_position.gltf",
                  "mesh 0 primitive 0 has no POSITION");
+    ensure_fails(
+        write_edited("joints_norm.gltf", &(mini_desc){0}, "{\"bufferView\": 1, ", "{\"bufferView\": 1, \"normalized\": true, "),
+        "joints_norm.gltf", "mesh 0 primitive 0 JOINTS_0 (accessor 1) holds integers and must not be normalized");
+    ensure_fails(
+        write_edited("indices_norm.gltf", &(mini_desc){0}, "{\"bufferView\": 3, ", "{\"bufferView\": 3, \"normalized\": true, "),
+        "indices_norm.gltf", "mesh 0 primitive 0 indices (accessor 3) holds integers and must not be normalized");
     const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         const char* p = sp_test_tmp_path("top.gltf");
@@ -607,6 +640,45 @@ static void test_says_what_is_wrong(void)
     printf("  %s\n", err.text);
     ENSURE(strstr(err.text, "data:application/octet-stream;base64,...") && !strstr(err.text, "AAAA"));
     free(text);
+}
+
+// Inverse bind matrices glTF forbids (not finite, a fourth row other than
+// [0, 0, 0, 1], e.g. all zeros) are refused naming the skin and the joint;
+// a singular one is legal, so it loads, with a warning.
+static void test_inverse_bind(void)
+{
+    static const float zero[16] = {0};
+    static const float not_finite[16] = {1, 0, 0, 0, 0, NAN, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    static const float projective[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 2};
+    bad_mini("ibm_zero.gltf", (mini_desc){.ibm1 = zero},
+             "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix has the fourth row [0, 0, 0, 0], not [0, 0, 0, 1]");
+    bad_mini("ibm_nan.gltf", (mini_desc){.ibm1 = not_finite},
+             "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix has a non-finite element");
+    bad_mini("ibm_w2.gltf", (mini_desc){.ibm1 = projective}, "has the fourth row [0, 0, 0, 2]");
+
+    // Float rounding in the fourth row is made exact.
+    static const float rounded[16] = {1, 0, 0, 1e-7f, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1.0000001f};
+    sp_character ch = load_ok(write_mini("ibm_rounded.gltf", &(mini_desc){.ibm1 = rounded}));
+    const sp_mat4* b = &ch.rig.joints[1].inverse_bind;
+    ENSURE(!strcmp(ch.rig.joints[1].name, "tip") && b->m[3] == 0 && b->m[15] == 1 && b->m[13] == -1);
+    ENSURE(ch.warning_count == 0);
+    sp_character_free(&ch);
+
+    // Singular but legal: every vertex the tip moves lands on one point.
+    static const float flat[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 1};
+    ch = load_ok(write_mini("ibm_flat.gltf", &(mini_desc){.ibm1 = flat}));
+    ENSURE(ch.warning_count == 1 && has_warning(&ch, "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix is singular"));
+    sp_character_free(&ch);
+    // Not singular: a file in millimetres, a shear with a non-uniform scale.
+    static const float small[16] = {1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, -1e-3f, 0, 1};
+    static const float sheared[16] = {2, 0, 0, 0, 0.5f, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    const float* fine[] = {small, sheared};
+    for (int i = 0; i < 2; ++i) {
+        ch = load_ok(write_mini("ibm_fine.gltf", &(mini_desc){.ibm1 = fine[i]}));
+        if (ch.warning_count) printf("  unexpected warning: %s\n", ch.warnings[0]);
+        ENSURE(ch.warning_count == 0);
+        sp_character_free(&ch);
+    }
 }
 
 // Random byte flips of a valid file must never crash (a tiny in-test fuzz).
@@ -670,6 +742,7 @@ int main(int argc, char** argv)
                                    {"part_bad", test_part_bad},
                                    {"bad_input", test_bad_input},
                                    {"says_what_is_wrong", test_says_what_is_wrong},
+                                   {"inverse_bind", test_inverse_bind},
                                    {"mutations", test_mutations},
                                    {0}});
 }

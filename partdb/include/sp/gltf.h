@@ -9,11 +9,13 @@
 ///     sp_gltf_save(&ch, ch.pose, "posed.glb", &err);
 ///     sp_character_free(&ch);
 ///
-/// The loader reads .gltf (external or data: URI buffers) and .glb, the
-/// sketch-abstraction conventions of DESIGN.md (skinned LINE_STRIP/LINE_LOOP
-/// curves with `sp_abstraction` extras, `sp_dofs` on joints, `sp_part` on the
-/// scene, the scene camera), renormalises skin weights and records a warning,
-/// and for a file without our extras derives a stick-figure abstraction
+/// The loader reads .gltf (data: URI buffers, or external ones beside the
+/// file) and .glb, the sketch-abstraction conventions of DESIGN.md (skinned
+/// LINE_STRIP/LINE_LOOP curves with `sp_abstraction` extras, `sp_dofs` on
+/// joints, `sp_part` on the scene, the scene camera), renormalises skin
+/// weights and records a warning, refuses inverse bind matrices glTF forbids
+/// (not finite, a fourth row other than [0, 0, 0, 1]) and warns of singular
+/// ones, and for a file without our extras derives a stick-figure abstraction
 /// ("stick", a curve per bone chain, ordered) and default rotation DOFs.
 /// The saver writes a fresh .glb (or .gltf with embedded buffers, by file
 /// extension) from the structs: parameters baked into the joint nodes, the
