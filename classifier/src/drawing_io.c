@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "cv_adapter.h"
+#include "png_check.h"
 #include "sp/classifier.h"
 #include "sp/math.h"
 
@@ -38,6 +39,11 @@ sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
     size_t len;
     sp_result rc = sp_sketch_file_read(path, &bytes, &len, err);
     if (rc != SP_OK) return rc;
+    const char* why = NULL;
+    if (!sp_png_decodes((const unsigned char*)bytes, len, &why)) {
+        free(bytes);
+        return sp_fail(err, SP_ERR_PARSE, "%s: PNG data corrupt or truncated (%s)", path, why && *why ? why : "undecodable");
+    }
     rc = sp_cv_decode_grey((const unsigned char*)bytes, len, path, &out->pixels, &out->w, &out->h, err);
     free(bytes);
     if (rc == SP_OK && (out->w != (int)w || out->h != (int)h)) {

@@ -1,5 +1,6 @@
 // test_classifier.c: sketch readers, descriptors, training, model files.
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -355,6 +356,24 @@ static void test_png(void)
     fwrite(buf, 1, 60, fp);
     fclose(fp);
     ENSURE(sp_raster_read_png(broken, &r, &err) != SP_OK && contains(err.text, "broken.png"));
+    // It says so in our one line: nothing of libpng's on stderr (OpenCV's
+    // decoder used to print "libpng error: ..." first), also for a file cut short.
+    const char* cut = sp_test_tmp_path("cut.png");
+    fp = fopen(cut, "wb");
+    fwrite(buf, 1, n / 2, fp);
+    fclose(fp);
+    const char* said = sp_test_tmp_path("png_stderr.txt");
+    fflush(stderr);
+    int saved = dup(2), to = open(said, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ENSURE(saved >= 0 && to >= 0 && dup2(to, 2) == 2);
+    sp_result rb = sp_raster_read_png(broken, &r, &err), rc = sp_raster_read_png(cut, &r, &err);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved), close(to);
+    ENSURE(rb == SP_ERR_PARSE && rc == SP_ERR_PARSE && contains(err.text, "cut.png") &&
+           contains(err.text, "corrupt or truncated"));
+    struct stat st;
+    ENSURE(stat(said, &st) == 0 && st.st_size == 0);
 
     // A blank (all white) PNG has nothing to describe.
     unsigned char white[64 * 64];
