@@ -199,8 +199,9 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
     FILE* f = fopen(path, "wb");
     if (!f) return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
     bool ok = fwrite(data, 1, size, f) == size;
-    ok = (fclose(f) == 0) && ok;
-    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (disk full?)", path);
+    int e = errno; // why: a full disk (ENOSPC) is not a file-size limit (EFBIG)
+    if (fclose(f) != 0 && ok) ok = false, e = errno;
+    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (%s)", path, strerror(e));
 }
 
 sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
