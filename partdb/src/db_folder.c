@@ -157,6 +157,8 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
         db_str_json(&m, (const char*)sqlite3_column_text(st, 5));
         db_str_printf(&m, "}");
     }
+    // A read error ends the loop as the last row does: an export without the rows after it is no export.
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading the parts", err);
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
     db_str_printf(&m, "], \"sketches\": [");
@@ -202,6 +204,7 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
         }
         db_str_printf(&m, "}");
     }
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading the sketches", err);
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
     db_str_printf(&m, "]}\n");

@@ -1573,6 +1573,17 @@ static bool export_cut_short(const char* p, const char* dir, off_t limit, const 
     return past_limit(p, SP_DB_READONLY, limit, export_to, want);
 }
 
+// SQLite's progress calls counted; the one numbered stop_at (0: none) interrupts the statement.
+typedef struct progress {
+    int calls, stop_at;
+} progress;
+
+static int on_progress(void* p)
+{
+    progress* g = p;
+    return ++g->calls == g->stop_at;
+}
+
 // An export is whole or absent: one that fails part-way leaves neither DIR
 // nor its temporary folder, an empty DIR stays as it was, and a DIR that is
 // not empty is refused untouched (an export never merges into another).
@@ -1609,6 +1620,22 @@ static void test_export_whole(void)
     fprintf(stderr, "  over an export: %s\n", err.text);
     snprintf(cmd, sizeof cmd, "%s/", full); // the same folder, written with a '/'
     ENSURE(sp_db_export(db, cmd, &err) == SP_ERR_INVALID && strstr(err.text, "not empty"));
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after));
+    // A read failing part-way through the rows (interrupted here, three
+    // quarters of the way through a whole export's SQLite steps) fails it too.
+    progress g = {0};
+    sqlite3_progress_handler(((struct sp_db*)db)->h, 20, on_progress, &g);
+    snprintf(cmd, sizeof cmd, "%s/counted", parent);
+    ENSURE(sp_db_export(db, cmd, &err) == SP_OK);
+    snprintf(cmd, sizeof cmd, "rm -r '%s/counted'", parent);
+    ENSURE(system(cmd) == 0);
+    g.stop_at = g.calls * 3 / 4, g.calls = 0;
+    ENSURE(g.stop_at > 0);
+    ENSURE(sp_db_export(db, dir, &err) == SP_ERR_INTERNAL && strstr(err.text, "no export was written") &&
+           !strchr(err.text, '\n'));
+    fprintf(stderr, "  read cut short: %s\n", err.text);
+    sqlite3_progress_handler(((struct sp_db*)db)->h, 0, NULL, NULL);
     tree_listing(parent, after, sizeof after);
     ENSURE(!strcmp(before, after));
     // The empty folder takes a whole export and keeps its permissions.
