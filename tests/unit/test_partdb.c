@@ -686,6 +686,60 @@ static void test_read_only_folder(void)
     ENSURE(rmdir(dir) == 0);
 }
 
+// A WAL database whose -wal and -shm a writer that crashed left behind, owned
+// by another user (root) and not writable by this one, in a folder and beside
+// a database file everyone may write: readers still read it (the WAL's rows
+// too); a writer is refused with one line naming the -wal file and its owner,
+// not "the database is read-only". Needs root to own files as another user.
+static void test_foreign_wal(void)
+{
+    if (geteuid() != 0) SKIP("needs root (to leave -wal and -shm owned by another user)");
+    char p[1024], side[1100];
+    const char* dir = base_db_in_folder("sp_partdb_wal", "shared.db", "foreign_wal.db", p);
+    ENSURE(chmod(p, 0666) == 0 && chmod(dir, 0777) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) { // the writer that crashed: one change in the WAL, no close to fold it in
+        sp_db* d = NULL;
+        sp_error e = {0};
+        if (sp_db_open(p, 0, &d, &e) != SP_OK || sp_db_log(d, "crashed", "note", "foreign_wal", NULL, &e) != SP_OK) _exit(6);
+        raise(SIGKILL);
+    }
+    int st;
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFSIGNALED(st));
+    for (int k = 0; k < 2; ++k) {
+        snprintf(side, sizeof side, "%s-%s", p, k ? "shm" : "wal");
+        ENSURE(chmod(side, 0644) == 0);
+    }
+    pid = fork_unprivileged();
+    if (pid == 0) {
+        sp_db* d = NULL;
+        sp_error e = {0};
+        char* log = NULL;
+        sp_result r = sp_db_open(p, SP_DB_READONLY, &d, &e);
+        if (r == SP_OK) r = sp_db_log_json(d, "foreign_wal", &log, &e);
+        fprintf(stderr, "  foreign -wal, reader: %s\n", r == SP_OK ? log : e.text);
+        bool read = r == SP_OK && strstr(log, "crashed");
+        free(log);
+        sp_db_close(d);
+        if (!read) _exit(6);
+        sp_dataset ds = one_sketch("tail");
+        if ((r = sp_db_open(p, 0, &d, &e)) == SP_OK) r = sp_db_add_sketches(d, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &e);
+        fprintf(stderr, "  foreign -wal, writer: %s\n", e.text);
+        sp_db_close(d);
+        sp_dataset_free(&ds);
+        char want[1100];
+        snprintf(want, sizeof want, "%s-wal: not writable by this user (owned by uid 0", p);
+        _exit(r == SP_ERR_IO && strstr(e.text, want) == e.text && !strchr(e.text, '\n') ? 0 : 7);
+    }
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+    ENSURE(WEXITSTATUS(st) == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM log WHERE by = 'crashed'") == 1);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 0);
+    remove_db(p);
+    ENSURE(rmdir(dir) == 0);
+}
+
 static void test_schema_versions(void)
 {
     char p[1024];
@@ -1670,6 +1724,7 @@ int main(int argc, char** argv)
                                    {"read_only_and_full", test_read_only_and_full},
                                    {"unreachable", test_unreachable},
                                    {"read_only_folder", test_read_only_folder},
+                                   {"foreign_wal", test_foreign_wal},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
