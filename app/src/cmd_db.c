@@ -677,7 +677,9 @@ static int db_export(int argc, char** argv)
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "write DIR/parts/*.glb, DIR/sketches/<category>/* and DIR/manifest.json (what `db init --from DIR` reads)",
+    int rc = parse(argc, argv, cmd,
+                   "write DIR/parts/*.glb, DIR/sketches/<category>/* and DIR/manifest.json (what `db init --from DIR` reads); "
+                   "DIR new or empty, written whole or not at all",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "DIR");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);

@@ -1,11 +1,13 @@
 // db.c: opening the database, the schema and its migrations, transactions,
 // the busy message, the generation counter and the curator log.
 #include <errno.h>
+#include <fcntl.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "db_internal.h"
 
@@ -199,8 +201,35 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
     FILE* f = fopen(path, "wb");
     if (!f) return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
     bool ok = fwrite(data, 1, size, f) == size;
-    ok = (fclose(f) == 0) && ok;
-    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (disk full?)", path);
+    int e = errno; // why: a full disk (ENOSPC) is not a file-size limit (EFBIG)
+    if (fclose(f) != 0 && ok) ok = false, e = errno;
+    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (%s)", path, strerror(e));
+}
+
+// SQLite opens a WAL database's -wal or -shm that this user may not write
+// (another user's, left by their process) read-only, and every write then
+// fails as SQLITE_READONLY, which reads as though the database file were.
+// True (err set, naming the file and its owner) when that is the cause.
+static bool side_file_unwritable(const char* path, const char* doing, sp_error* err)
+{
+    for (int k = 0; k < 2; ++k) {
+        size_t n = strlen(path) + 5;
+        char* side = malloc(n);
+        if (!side) return false;
+        snprintf(side, n, "%s-%s", path, k ? "shm" : "wal");
+        struct stat st;
+        bool theirs =
+            stat(side, &st) == 0 && faccessat(AT_FDCWD, side, W_OK, AT_EACCESS) != 0 && (errno == EACCES || errno == EPERM);
+        if (theirs)
+            sp_fail(
+                err, SP_ERR_IO,
+                "%s: not writable by this user (owned by uid %ld, mode %03o) while %s; nothing was changed (run as its owner, or "
+                "have them make it writable)",
+                side, (long)st.st_uid, (unsigned)(st.st_mode & 0777), doing);
+        free(side);
+        if (theirs) return true;
+    }
+    return false;
 }
 
 sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
@@ -214,6 +243,7 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
                        db->busy_ms / 1000.0, doing);
     case SQLITE_FULL: return sp_fail(err, SP_ERR_IO, "%s: disk full while %s; nothing was changed", p, doing);
     case SQLITE_READONLY:
+        if (!db->readonly && side_file_unwritable(p, doing, err)) return SP_ERR_IO;
         return sp_fail(err, SP_ERR_IO, "%s: the database is read-only (file permissions or opened read-only) while %s; nothing was changed",
                        p, doing);
     case SQLITE_NOMEM: return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while %s", p, doing);

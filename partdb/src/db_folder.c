@@ -1,6 +1,7 @@
 // db_folder.c: export to and import from a folder, and the default database
 // built from assets/.
 #include <cjson/cJSON.h>
+#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,11 +13,123 @@
 #include "sp/concept.h"
 #include "sp/math.h"
 
-sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
+// ---- export ----------------------------------------------------------------------
+// An export is written into a fresh folder beside DIR (same parent, so that
+// rename(2) is atomic) and renamed to DIR only when every file and the
+// manifest are written: `db init --from DIR` reads whatever DIR holds as a
+// whole export, so a failed one must leave nothing there.
+
+typedef struct export_dir {
+    char final[832]; // DIR, a symbolic link resolved, no trailing '/'; at most 800 characters
+    char tmp[900];   // the folder being written
+    struct stat had; // DIR's own stat when it exists (empty), for its permissions
+    bool exists;
+} export_dir;
+
+// Removes a folder the export made and everything in it; symbolic links are
+// not followed (the export makes none).
+static void remove_tree(const char* path)
+{
+    DIR* d = opendir(path);
+    struct dirent* e;
+    while (d && (e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+        char sub[1400];
+        snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
+        struct stat st;
+        if (lstat(sub, &st) == 0 && S_ISDIR(st.st_mode))
+            remove_tree(sub);
+        else
+            unlink(sub);
+    }
+    if (d) closedir(d);
+    rmdir(path);
+}
+
+static sp_result not_empty(const char* dir, sp_error* err)
+{
+    return sp_fail(err, SP_ERR_INVALID,
+                   "%s: exists and is not empty (an export goes into a new or empty folder, never over another)", dir);
+}
+
+static bool dir_is_empty(const char* dir)
+{
+    DIR* d = opendir(dir);
+    struct dirent* e;
+    bool empty = d != NULL;
+    while (empty && (e = readdir(d)))
+        empty = !strcmp(e->d_name, ".") || !strcmp(e->d_name, "..");
+    if (d) closedir(d);
+    return empty;
+}
+
+// Checks DIR (absent, or an empty folder) and makes the temporary folder beside it.
+static sp_result export_begin(const char* dir, export_dir* ex, sp_error* err)
+{
+    memset(ex, 0, sizeof *ex);
+    size_t n = strlen(dir);
+    while (n > 1 && dir[n - 1] == '/') // "out/" names out, whose sibling is out.partial-...
+        --n;
+    // Room for sketches/<category>/<source>-<id>.json below the temporary folder's name.
+    if (n == 0 || n > 800)
+        return sp_fail(err, SP_ERR_INVALID, "%s: not a usable folder name (empty or over 800 characters)", dir);
+    snprintf(ex->final, sizeof ex->final, "%.*s", (int)n, dir);
+    struct stat st;
+    if (lstat(ex->final, &st) == 0 && S_ISLNK(st.st_mode)) {
+        // A link to a folder stays a link: the folder it names is the one replaced.
+        char* real = realpath(ex->final, NULL);
+        if (!real) return sp_fail(err, SP_ERR_IO, "%s: a symbolic link to nothing usable (%s)", dir, strerror(errno));
+        if (strlen(real) > 800) {
+            free(real);
+            return sp_fail(err, SP_ERR_INVALID, "%s: the folder it names has a name over 800 characters", dir);
+        }
+        snprintf(ex->final, sizeof ex->final, "%s", real);
+        free(real);
+    }
+    if (stat(ex->final, &ex->had) == 0) {
+        if (!S_ISDIR(ex->had.st_mode)) return sp_fail(err, SP_ERR_INVALID, "%s: exists and is not a folder", dir);
+        if (!dir_is_empty(ex->final)) return not_empty(dir, err);
+        ex->exists = true;
+    } else if (errno != ENOENT) {
+        return sp_fail(err, SP_ERR_IO, "%s: cannot reach the folder (%s)", dir, strerror(errno));
+    }
+    for (int k = 0; k < 100; ++k) {
+        snprintf(ex->tmp, sizeof ex->tmp, "%s.partial-%ld-%d", ex->final, (long)getpid(), k);
+        if (mkdir(ex->tmp, 0777) == 0) return SP_OK;
+        if (errno != EEXIST) break;
+    }
+    return sp_fail(err, SP_ERR_IO, "%s: cannot create a folder beside it to write the export in (%s)", dir, strerror(errno));
+}
+
+// Puts the finished export in place, or takes the temporary folder back. A
+// message about a file in the temporary folder names it as it would be in DIR.
+static sp_result export_end(export_dir* ex, sp_result r, sp_error* err)
+{
+    if (r == SP_OK) {
+        if (ex->exists) chmod(ex->tmp, ex->had.st_mode & 07777); // an empty folder replaced keeps its permissions
+        // rename(2) replaces an empty folder and refuses one that is not, so
+        // files put into DIR meanwhile are never lost.
+        if (rename(ex->tmp, ex->final) == 0) return SP_OK;
+        r = errno == ENOTEMPTY || errno == EEXIST
+                ? not_empty(ex->final, err)
+                : sp_fail(err, SP_ERR_IO, "%s: cannot put the export in place (%s)", ex->final, strerror(errno));
+    } else if (err) {
+        size_t n = strlen(ex->tmp);
+        char was[sizeof err->text];
+        memcpy(was, err->text, sizeof was);
+        if (!strncmp(was, ex->tmp, n))
+            sp_fail(err, r, "%s%s; no export was written", ex->final, was + n);
+        else
+            sp_fail(err, r, "%s; %s: no export was written", was, ex->final);
+    }
+    remove_tree(ex->tmp);
+    return r;
+}
+
+static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
 {
     char path[1024];
-    sp_result r = sp_dir_make(dir, err);
-    if (r != SP_OK) return r;
+    sp_result r;
     snprintf(path, sizeof path, "%s/parts", dir);
     if ((r = sp_dir_make(path, err)) != SP_OK) return r;
     snprintf(path, sizeof path, "%s/sketches", dir);
@@ -44,6 +157,8 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
         db_str_json(&m, (const char*)sqlite3_column_text(st, 5));
         db_str_printf(&m, "}");
     }
+    // A read error ends the loop as the last row does: an export without the rows after it is no export.
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading the parts", err);
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
     db_str_printf(&m, "], \"sketches\": [");
@@ -89,6 +204,7 @@ sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
         }
         db_str_printf(&m, "}");
     }
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading the sketches", err);
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
     db_str_printf(&m, "]}\n");
@@ -102,6 +218,14 @@ out:
     free(m.s);
     db_rollback(db);
     return r;
+}
+
+sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err)
+{
+    export_dir ex;
+    sp_result r = export_begin(dir, &ex, err);
+    if (r != SP_OK) return r;
+    return export_end(&ex, export_rows(db, ex.tmp, err), err);
 }
 
 static sp_db_source parse_source(const char* s)

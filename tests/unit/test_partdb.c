@@ -511,29 +511,37 @@ static void test_two_writers(void)
     sp_dataset_free(&ds);
 }
 
-// Runs write(db) in a child whose files may not grow past their size now (a
-// full disk); true when it failed there with SP_ERR_IO and a message.
-static bool on_full_disk(const char* path, sp_result (*write)(sp_db*, sp_error*))
+// Runs write(db) in a child whose files may not grow past `limit` bytes (a
+// full disk), the database opened with `flags`; true when it failed there
+// with SP_ERR_IO and a one-line message that starts with `starts` (NULL: any).
+static bool past_limit(const char* path, unsigned flags, off_t limit, sp_result (*write)(sp_db*, sp_error*), const char* starts)
 {
-    struct stat fs;
-    ENSURE(stat(path, &fs) == 0);
     pid_t pid = fork();
     ENSURE(pid >= 0);
     if (pid == 0) {
         signal(SIGXFSZ, SIG_IGN);
         sp_db* d = NULL;
         sp_error e = {0};
-        if (sp_db_open(path, 0, &d, &e) != SP_OK) _exit(3);
-        struct rlimit rl = {(rlim_t)fs.st_size, (rlim_t)fs.st_size};
+        if (sp_db_open(path, flags, &d, &e) != SP_OK) _exit(3);
+        struct rlimit rl = {(rlim_t)limit, (rlim_t)limit};
         setrlimit(RLIMIT_FSIZE, &rl);
         sp_result r = write(d, &e);
         fprintf(stderr, "  disk full: %s\n", e.text);
         sp_db_close(d);
-        _exit(r == SP_ERR_IO && e.text[0] ? 0 : 6);
+        bool said = e.text[0] && !strchr(e.text, '\n') && (!starts || strstr(e.text, starts) == e.text);
+        _exit(r == SP_ERR_IO && said ? 0 : 6);
     }
     int st;
     ENSURE(waitpid(pid, &st, 0) == pid);
     return WIFEXITED(st) && WEXITSTATUS(st) == 0;
+}
+
+// past_limit at the database file's size now: it may not grow.
+static bool on_full_disk(const char* path, sp_result (*write)(sp_db*, sp_error*))
+{
+    struct stat fs;
+    ENSURE(stat(path, &fs) == 0);
+    return past_limit(path, 0, fs.st_size, write, NULL);
 }
 
 static sp_result add_big_part(sp_db* db, sp_error* err)
@@ -674,6 +682,60 @@ static void test_read_only_folder(void)
     char side[1100];
     snprintf(side, sizeof side, "%s-shm", p);
     ENSURE(stat(side, &sb) != 0); // the reader left nothing beside it
+    remove_db(p);
+    ENSURE(rmdir(dir) == 0);
+}
+
+// A WAL database whose -wal and -shm a writer that crashed left behind, owned
+// by another user (root) and not writable by this one, in a folder and beside
+// a database file everyone may write: readers still read it (the WAL's rows
+// too); a writer is refused with one line naming the -wal file and its owner,
+// not "the database is read-only". Needs root to own files as another user.
+static void test_foreign_wal(void)
+{
+    if (geteuid() != 0) SKIP("needs root (to leave -wal and -shm owned by another user)");
+    char p[1024], side[1100];
+    const char* dir = base_db_in_folder("sp_partdb_wal", "shared.db", "foreign_wal.db", p);
+    ENSURE(chmod(p, 0666) == 0 && chmod(dir, 0777) == 0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) { // the writer that crashed: one change in the WAL, no close to fold it in
+        sp_db* d = NULL;
+        sp_error e = {0};
+        if (sp_db_open(p, 0, &d, &e) != SP_OK || sp_db_log(d, "crashed", "note", "foreign_wal", NULL, &e) != SP_OK) _exit(6);
+        raise(SIGKILL);
+    }
+    int st;
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFSIGNALED(st));
+    for (int k = 0; k < 2; ++k) {
+        snprintf(side, sizeof side, "%s-%s", p, k ? "shm" : "wal");
+        ENSURE(chmod(side, 0644) == 0);
+    }
+    pid = fork_unprivileged();
+    if (pid == 0) {
+        sp_db* d = NULL;
+        sp_error e = {0};
+        char* log = NULL;
+        sp_result r = sp_db_open(p, SP_DB_READONLY, &d, &e);
+        if (r == SP_OK) r = sp_db_log_json(d, "foreign_wal", &log, &e);
+        fprintf(stderr, "  foreign -wal, reader: %s\n", r == SP_OK ? log : e.text);
+        bool read = r == SP_OK && strstr(log, "crashed");
+        free(log);
+        sp_db_close(d);
+        if (!read) _exit(6);
+        sp_dataset ds = one_sketch("tail");
+        if ((r = sp_db_open(p, 0, &d, &e)) == SP_OK) r = sp_db_add_sketches(d, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &e);
+        fprintf(stderr, "  foreign -wal, writer: %s\n", e.text);
+        sp_db_close(d);
+        sp_dataset_free(&ds);
+        char want[1100];
+        snprintf(want, sizeof want, "%s-wal: not writable by this user (owned by uid 0", p);
+        _exit(r == SP_ERR_IO && strstr(e.text, want) == e.text && !strchr(e.text, '\n') ? 0 : 7);
+    }
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+    ENSURE(WEXITSTATUS(st) == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM log WHERE by = 'crashed'") == 1);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 0);
     remove_db(p);
     ENSURE(rmdir(dir) == 0);
 }
@@ -1539,6 +1601,108 @@ static void test_kiosk_review_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "bad-stroke.json") && !strchr(strchr(out, '\n') + 1, '\n'));
 }
 
+// Everything under dir (names, sizes, modes, times of change), one entry a
+// line: equal listings mean a folder was left exactly as it was.
+static void tree_listing(const char* dir, char* out, size_t cap)
+{
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "cd '%s' && find . -mindepth 1 -printf '%%p %%s %%m %%T@ %%C@\\n' | sort", dir);
+    ENSURE(run(cmd, out, cap) == 0);
+}
+
+static const char* g_export_to; // where export_to writes: past_limit takes no context
+
+static sp_result export_to(sp_db* db, sp_error* err)
+{
+    return sp_db_export(db, g_export_to, err);
+}
+
+// Exports db p into dir with room for files up to `limit` bytes; true when
+// it failed part-way at dir/`file`.
+static bool export_cut_short(const char* p, const char* dir, off_t limit, const char* file)
+{
+    char want[1400];
+    snprintf(want, sizeof want, "%s/%s", dir, file);
+    g_export_to = dir;
+    return past_limit(p, SP_DB_READONLY, limit, export_to, want);
+}
+
+// SQLite's progress calls counted; the one numbered stop_at (0: none) interrupts the statement.
+typedef struct progress {
+    int calls, stop_at;
+} progress;
+
+static int on_progress(void* p)
+{
+    progress* g = p;
+    return ++g->calls == g->stop_at;
+}
+
+// An export is whole or absent: one that fails part-way leaves neither DIR
+// nor its temporary folder, an empty DIR stays as it was, and a DIR that is
+// not empty is refused untouched (an export never merges into another).
+static void test_export_whole(void)
+{
+    char p[1024], parent[1024], dir[1100], full[1100], cmd[2400];
+    snprintf(p, sizeof p, "%s", base_db("export_whole.db"));
+    snprintf(parent, sizeof parent, "%s", sp_test_tmp_path("export_whole"));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", parent);
+    ENSURE(system(cmd) == 0 && mkdir(parent, 0755) == 0);
+    snprintf(dir, sizeof dir, "%s/out", parent);
+    snprintf(full, sizeof full, "%s/full", parent);
+    // Parts are written first, by name: room for tail_a.glb, not wings_a.glb.
+    int tail = scalar(p, "SELECT bytes FROM parts WHERE name = 'tail_a'");
+    ENSURE(tail < scalar(p, "SELECT bytes FROM parts WHERE name = 'wings_a'"));
+    static char before[1 << 16], after[1 << 16];
+    tree_listing(parent, before, sizeof before);
+    ENSURE(!before[0]);
+    ENSURE(export_cut_short(p, dir, tail, "parts/wings_a.glb"));
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after)); // no DIR, no DIR.partial-*
+    // An empty DIR is a fine place for an export, and stays as it was when the export fails.
+    ENSURE(mkdir(dir, 0750) == 0);
+    tree_listing(parent, before, sizeof before);
+    ENSURE(export_cut_short(p, dir, tail, "parts/wings_a.glb"));
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after));
+    // A complete export in a folder of its own is refused as a DIR, and left as it was.
+    sp_db* db = open_ok(p, SP_DB_READONLY);
+    sp_error err = {0};
+    ENSURE(sp_db_export(db, full, &err) == SP_OK);
+    tree_listing(parent, before, sizeof before);
+    ENSURE(sp_db_export(db, full, &err) == SP_ERR_INVALID && strstr(err.text, full) == err.text && strstr(err.text, "not empty"));
+    fprintf(stderr, "  over an export: %s\n", err.text);
+    snprintf(cmd, sizeof cmd, "%s/", full); // the same folder, written with a '/'
+    ENSURE(sp_db_export(db, cmd, &err) == SP_ERR_INVALID && strstr(err.text, "not empty"));
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after));
+    // A read failing part-way through the rows (interrupted here, three
+    // quarters of the way through a whole export's SQLite steps) fails it too.
+    progress g = {0};
+    sqlite3_progress_handler(((struct sp_db*)db)->h, 20, on_progress, &g);
+    snprintf(cmd, sizeof cmd, "%s/counted", parent);
+    ENSURE(sp_db_export(db, cmd, &err) == SP_OK);
+    snprintf(cmd, sizeof cmd, "rm -r '%s/counted'", parent);
+    ENSURE(system(cmd) == 0);
+    g.stop_at = g.calls * 3 / 4, g.calls = 0;
+    ENSURE(g.stop_at > 0);
+    ENSURE(sp_db_export(db, dir, &err) == SP_ERR_INTERNAL && strstr(err.text, "no export was written") &&
+           !strchr(err.text, '\n'));
+    fprintf(stderr, "  read cut short: %s\n", err.text);
+    sqlite3_progress_handler(((struct sp_db*)db)->h, 0, NULL, NULL);
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after));
+    // The empty folder takes a whole export and keeps its permissions.
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
+    sp_db_close(db);
+    struct stat st;
+    ENSURE(stat(dir, &st) == 0 && (st.st_mode & 0777) == 0750);
+    snprintf(cmd, sizeof cmd, "diff -r '%s' '%s'", dir, full);
+    ENSURE(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", parent);
+    ENSURE(system(cmd) == 0);
+}
+
 int main(int argc, char** argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write-parts")) {
@@ -1552,6 +1716,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"sha256", test_sha256},
                                    {"round_trip", test_round_trip},
+                                   {"export_whole", test_export_whole},
                                    {"curator_category", test_curator_category},
                                    {"crash_add_part", test_crash_add_part},
                                    {"crash_train", test_crash_train},
@@ -1559,6 +1724,7 @@ int main(int argc, char** argv)
                                    {"read_only_and_full", test_read_only_and_full},
                                    {"unreachable", test_unreachable},
                                    {"read_only_folder", test_read_only_folder},
+                                   {"foreign_wal", test_foreign_wal},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},

@@ -311,7 +311,10 @@ sp_result sp_db_part_summary_json(sp_db* db, const char* name, char** json, sp_e
 sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err);
 
 /// Writes DIR/parts/<name>.glb, DIR/sketches/<category>/<source>-<id>.{json,png}
-/// and DIR/manifest.json (names, categories, curators). DIR is created.
+/// and DIR/manifest.json (names, categories, curators), whole or not at all:
+/// into DIR.partial-<pid>-<k> beside it, renamed to DIR once complete and
+/// removed on failure. DIR must be absent or an empty folder (replaced, its
+/// permissions kept); any other DIR is SP_ERR_INVALID, left untouched.
 sp_result sp_db_export(sp_db* db, const char* dir, sp_error* err);
 /// Adds every part and sketch of an export folder (parts validated as by
 /// sp_db_add_part, no synthetic sketches added: the folder has them).
