@@ -82,6 +82,16 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
     return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(e));
 }
 
+sp_result sp_file_write_printed(const char* path, FILE* f, char** text, size_t* len, sp_error* err)
+{
+    bool bad = ferror(f) != 0;
+    bad = fclose(f) != 0 || bad; // fclose sets *text and *len
+    sp_result r = bad ? sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path) : sp_file_write(path, *text, *len, err);
+    free(*text);
+    *text = NULL;
+    return r;
+}
+
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err)
 {
     *out = NULL;
@@ -364,14 +374,7 @@ sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* e
         fprintf(f, "}");
     }
     fprintf(f, "%s]}\n", s->stroke_count ? "\n" : "");
-    bool bad = ferror(f) != 0;
-    if (fclose(f) != 0 || bad) {
-        free(text);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    }
-    sp_result r = sp_file_write(path, text, len, err);
-    free(text);
-    return r;
+    return sp_file_write_printed(path, f, &text, &len, err);
 }
 
 // ---------------------------------------------------------------------------

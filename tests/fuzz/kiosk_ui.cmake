@@ -10,7 +10,7 @@ endif()
 file(GLOB SP_FUZZ_UI_SRC CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/app/kiosk_ui/src/*.c)
 add_library(sp_kiosk_ui_fuzz STATIC ${SP_FUZZ_UI_SRC})
 target_include_directories(sp_kiosk_ui_fuzz PUBLIC ${PROJECT_SOURCE_DIR}/app/kiosk_ui/include)
-target_link_libraries(sp_kiosk_ui_fuzz PUBLIC sp::solver sp_flags PRIVATE PkgConfig::CJSON ${MATH_LIB})
+target_link_libraries(sp_kiosk_ui_fuzz PUBLIC sp::solver sp_flags PRIVATE sp::sketchio PkgConfig::CJSON ${MATH_LIB})
 # UBSan too: the state machine is arithmetic on times and pixels (NaN, overflow).
 set(SP_FUZZ_UI_SAN -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 target_compile_options(sp_kiosk_ui_fuzz PRIVATE -fsanitize=fuzzer-no-link ${SP_FUZZ_UI_SAN})

@@ -1,9 +1,15 @@
 // The kiosk's UI state machine without a GPU: flow, layout and hit testing
 // at several screens, idle timeout, tap storms, stroke floods, session files
 // and record -> replay. A small fake pipeline answers the UI's jobs.
+#include <dirent.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "fixtures.h"
 #include "sp/kiosk_lod.h"
@@ -1336,6 +1342,55 @@ static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t see
     *out = ui;
 }
 
+// The whole file as text (malloc'd, NUL-terminated).
+static char* file_text(const char* path, size_t* n)
+{
+    FILE* f = fopen(path, "rb");
+    ENSURE(f);
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char* t = malloc((size_t)len + 1);
+    ENSURE(t && fread(t, 1, (size_t)len, f) == (size_t)len);
+    fclose(f);
+    t[len] = '\0';
+    *n = (size_t)len;
+    return t;
+}
+
+// A recording written again past a file-size limit (a full disk) fails and
+// leaves the one already there byte for byte, with no temporary beside it.
+static void recording_written_whole(const char* path, const sp_kiosk_session* rec)
+{
+    size_t n0;
+    char* before = file_text(path, &n0);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit lim = {(rlim_t)n0 / 2, (rlim_t)n0 / 2};
+        sp_error e = {0};
+        sp_kiosk_session twice = *rec;
+        twice.end_ms += 1; // other bytes: a write that got through would show
+        _exit(setrlimit(RLIMIT_FSIZE, &lim) == 0 && sp_kiosk_session_write(path, &twice, &e) == SP_ERR_IO ? 0 : 1);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    size_t n1;
+    char* after = file_text(path, &n1);
+    ENSURE(n1 == n0 && memcmp(before, after, n0) == 0);
+    free(before), free(after);
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", path);
+    *strrchr(dir, '/') = '\0';
+    DIR* d = opendir(dir);
+    ENSURE(d);
+    const char* base = strrchr(path, '/') + 1;
+    for (struct dirent* e; (e = readdir(d));)
+        ENSURE(strncmp(e->d_name, base, strlen(base)) != 0 || !strcmp(e->d_name, base)); // no temporary left
+    closedir(d);
+}
+
 static void test_record_replay(void)
 {
     const char* script = sp_test_tmp_path("script.json");
@@ -1379,6 +1434,7 @@ static void test_record_replay(void)
     ENSURE(a->activations[SP_KT_TURN] == 2);
     const char* recorded = sp_test_tmp_path("recorded.json");
     ENSURE(sp_kiosk_session_write(recorded, &rec, &err) == SP_OK);
+    recording_written_whole(recorded, &rec);
     sp_kiosk_session back = {0};
     ENSURE(sp_kiosk_session_read(recorded, &back, &err) == SP_OK);
     ENSURE(back.count == rec.count && back.canvas_w == 1280);

@@ -1,6 +1,7 @@
 // session.c: kiosk sessions as JSON (cJSON to read, plain stdio to write:
-// a 2,000-stroke soak session is ~100k events, one line each).
+// a 2,000-stroke soak session is ~100k events, one line each; written whole).
 #include "sp/kiosk_session.h"
+#include "sp/sketch_io.h"
 
 #include <errno.h>
 #include <math.h>
@@ -261,8 +262,12 @@ sp_result sp_kiosk_session_read(const char* path, sp_kiosk_session* out, sp_erro
 
 sp_result sp_kiosk_session_write(const char* path, const sp_kiosk_session* s, sp_error* err)
 {
-    FILE* f = fopen(path, "wb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    // Made in memory and written whole (sp_file_write): a recording cut short
+    // by a full disk would not replay, and would have replaced the old one.
+    char* text = NULL;
+    size_t len = 0;
+    FILE* f = open_memstream(&text, &len);
+    if (!f) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     double end = s->end_ms;
     fprintf(f,
             "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [%d, %d], \"px_per_mm\": %.6g, \"coords\": "
@@ -290,9 +295,7 @@ sp_result sp_kiosk_session_write(const char* path, const sp_kiosk_session* s, sp
         }
     }
     fprintf(f, "\n ],\n \"end_ms\": %.3f}\n", end);
-    bool bad = ferror(f) != 0;
-    if (fclose(f) != 0 || bad) return sp_fail(err, SP_ERR_IO, "%s: write failed (disk full?)", path);
-    return SP_OK;
+    return sp_file_write_printed(path, f, &text, &len, err);
 }
 
 sp_kiosk_event sp_kiosk_session_map(const sp_kiosk_session* s, const sp_kiosk_event* ev, int fb_w, int fb_h)

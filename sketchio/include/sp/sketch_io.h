@@ -23,6 +23,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "sp/result.h"
 #include "sp/sketch.h"
@@ -105,6 +106,10 @@ sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_erro
 /// device such as /dev/stdout) is written into directly. One line in `err`
 /// names the path and the system's reason.
 sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err);
+/// For writers that print their file: closes f, an open_memstream(3) over
+/// *text and *len, and writes what was printed with sp_file_write, then frees
+/// *text. A failed print is SP_ERR_NO_MEMORY naming path.
+sp_result sp_file_write_printed(const char* path, FILE* f, char** text, size_t* len, sp_error* err);
 /// True when `path`'s extension (after its last '.', in its last component) is `ext`, ignoring case.
 bool sp_path_ext_is(const char* path, const char* ext);
 /// The names in folder `dir`, sorted bytewise so that every machine reads a
