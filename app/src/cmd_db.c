@@ -92,6 +92,34 @@ static sp_db* open_db(const char* cmd, const db_common* c, unsigned flags)
     return db;
 }
 
+// Whether the database file is there before a command that may create it.
+static bool db_exists(const db_common* c)
+{
+    struct stat st;
+    return stat(db_path(c), &st) == 0 || errno != ENOENT;
+}
+
+// A database the failed command created, into which nothing was ever stored
+// (its generation is still the schema's first), goes again: a mistyped --db
+// must not leave an empty database behind. Any row another process added
+// meanwhile would have counted a generation, and keeps the file.
+static void drop_if_unused(const db_common* c, bool existed)
+{
+    if (existed) return;
+    sp_db* db = NULL;
+    sp_error err = {0};
+    if (sp_db_open(db_path(c), SP_DB_READONLY, &db, &err) != SP_OK) return;
+    bool unused = sp_db_generation(db) == 1;
+    sp_db_close(db);
+    if (!unused) return;
+    char side[1100];
+    remove(db_path(c));
+    snprintf(side, sizeof side, "%s-wal", db_path(c));
+    remove(side);
+    snprintf(side, sizeof side, "%s-shm", db_path(c));
+    remove(side);
+}
+
 static int fail(const char* cmd, const sp_error* err)
 {
     fprintf(stderr, "%s: %s\n", cmd, err->text);
@@ -302,6 +330,7 @@ static int db_add_part(int argc, char** argv)
         if (!gl) return fail(cmd, &err);
         sp_headless_destroy(gl);
     }
+    bool existed = db_exists(&c);
     sp_db* db = open_db(cmd, &c, SP_DB_CREATE);
     if (!db) return SP_EXIT_INPUT;
     sp_db_part_info info;
@@ -320,7 +349,10 @@ static int db_add_part(int argc, char** argv)
     }
     sp_character_free(&part);
     sp_db_close(db);
-    if (r != SP_OK) return fail(cmd, &err);
+    if (r != SP_OK) {
+        drop_if_unused(&c, existed);
+        return fail(cmd, &err);
+    }
     print_part(&info, true);
     printf("\n");
     return SP_EXIT_OK;
@@ -487,6 +519,7 @@ static int db_add_sketch(int argc, char** argv)
         r = is_dir(pos[i]) ? add_folder(&s, pos[i], category, &err) : add_file(&s, pos[i], category, &err);
     int added = 0;
     sp_db* db = NULL;
+    bool existed = db_exists(&c);
     if (r == SP_OK) {
         db = open_db(cmd, &c, SP_DB_CREATE);
         if (!db) r = SP_ERR_IO;
@@ -508,6 +541,7 @@ static int db_add_sketch(int argc, char** argv)
         printf("}}\n");
     }
     sp_db_close(db);
+    if (exit_code != SP_EXIT_OK) drop_if_unused(&c, existed);
     for (int i = 0; i < s.ds.count; ++i)
         free((void*)s.png[i].bytes);
     free(s.png);

@@ -898,6 +898,22 @@ static void test_bad_input(void)
     ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1);
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
+    // A failed add into a database the command would create leaves none behind
+    // (a part that does not load; a sketch whose category the database refuses).
+    char fresh[1100];
+    snprintf(fresh, sizeof fresh, "%s", sp_test_tmp_path("never_made.db"));
+    unlink(fresh);
+    const char* one = sp_test_tmp_path("s_one.json");
+    const char* one_text = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": "
+                           "[[1, 2], [2, 3]]}]}";
+    ENSURE(db_write_file(one, one_text, strlen(one_text), &err) == SP_OK);
+    const char* tries[2][2] = {{"add-part", sp_test_tmp_path("b_cycle.gltf")}, {"add-sketch --category 'not plain'", one}};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db %s --db '%s' '%s' 2>/dev/null >/dev/null", bin, tries[i][0], fresh, tries[i][1]);
+        st = system(cmd);
+        struct stat fs;
+        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && stat(fresh, &fs) != 0 && errno == ENOENT);
+    }
 }
 
 static void test_generation(void)
@@ -1706,6 +1722,12 @@ static void test_export_whole(void)
 int main(int argc, char** argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write-parts")) {
+        // Checked here: a failed check outside sp_test_run has nowhere to return to.
+        struct stat st;
+        if (stat(argv[2], &st) != 0 || !S_ISDIR(st.st_mode) || access(argv[2], W_OK) != 0) {
+            fprintf(stderr, "test_partdb --write-parts: %s: not a folder this user may write\n", argv[2]);
+            return 1;
+        }
         for (int i = 0; i < 4; ++i) {
             char f[1100];
             snprintf(f, sizeof f, "%s/%s.glb", argv[2], k_parts[i].name);
