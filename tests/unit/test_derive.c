@@ -452,16 +452,14 @@ static void test_refusals(void)
         char png[1100];
         snprintf(png, sizeof png, "%s.png", out);
         ENSURE(access(png, F_OK) != 0);
-        // add-part refuses the same and stores nothing.
+        // add-part refuses the same and stores nothing: the database it
+        // would have created is not left behind either.
         char db[1024];
         snprintf(db, sizeof db, "%s", sp_test_tmp_path("refused.db"));
         unlink(db);
         snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' --category x '%s' 2>/dev/null", bin, db, cases[i][0]);
         ENSURE(run(cmd, NULL) == 1);
-        snprintf(cmd, sizeof cmd, "'%s' db list --db '%s'", bin, db);
-        char* list = NULL;
-        ENSURE(run(cmd, &list) == 0 && list && strstr(list, "\"parts\": []"));
-        free(list);
+        ENSURE(access(db, F_OK) != 0);
     }
 }
 
