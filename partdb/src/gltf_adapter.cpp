@@ -124,7 +124,8 @@ bool no_write(std::string*, const std::string&, const std::vector<unsigned char>
 
 // What the document's "buffers" say, read with cJSON beside tinygltf: its
 // messages name neither the buffer nor the numbers, and the file callback
-// must know a buffer's byteLength before it allocates.
+// must know a buffer's byteLength before it allocates. Also the nodes that
+// give both a matrix and a TRS, which tinygltf reads as the matrix alone.
 struct BufferDecl {
     bool has_uri = false;
     std::string uri;
@@ -134,6 +135,7 @@ struct BufferDecl {
 struct LoadContext {
     const char* what = "";
     std::vector<BufferDecl> buffers;
+    std::vector<int> matrix_and_trs; // nodes with both (tinygltf keeps only the matrix)
     bool scanned = false;
     std::string message; // set by read_buffer_file: says better what went wrong
 };
@@ -154,6 +156,16 @@ void scan_buffers(LoadContext& cx, const unsigned char* json, size_t len)
         if (d.has_uri) d.uri = uri->valuestring;
         if (cJSON_IsNumber(bl)) d.byte_length = bl->valuedouble;
         cx.buffers.push_back(d);
+    }
+    const cJSON* nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
+    if (!cJSON_IsArray(nodes)) nodes = nullptr;
+    int i = 0;
+    const cJSON* n;
+    cJSON_ArrayForEach(n, nodes)
+    {
+        auto has = [n](const char* key) { return cJSON_GetObjectItemCaseSensitive(n, key) != nullptr; };
+        if (has("matrix") && (has("translation") || has("rotation") || has("scale"))) cx.matrix_and_trs.push_back(i);
+        ++i;
     }
     cJSON_Delete(root);
 }
@@ -344,7 +356,7 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
     bool ok;
     if (size >= 4 && !memcmp(data, "glTF", 4)) {
         size_t total = check_glb(data, size, what);
-        if (use_fs) scan_buffers_of(cx, data, total);
+        scan_buffers_of(cx, data, total);
         ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, data, (unsigned)total, base_dir);
     } else {
         size_t i = 0;
@@ -356,7 +368,7 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
                 fail(SP_ERR_PARSE, "%s: the top level is not a JSON object (glTF JSON is one)", what);
             fail(SP_ERR_PARSE, "%s: neither glTF JSON nor a .glb", what);
         }
-        if (use_fs) scan_buffers_of(cx, data, size);
+        scan_buffers_of(cx, data, size);
         ok = loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char*>(data), (unsigned)size, base_dir);
     }
     if (!ok) {
@@ -371,6 +383,12 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
         fail(code, "%s: %s", what, explain(cx, data, size, line).c_str());
     }
     if (!twarn.empty()) sp_character_warn(ch, "glTF: %s", without_data_payloads(first_line(twarn)).c_str());
+    // glTF forbids both, and viewers differ in which they use: ours is said.
+    for (int n : cx.matrix_and_trs) {
+        const std::string& name = (size_t)n < model.nodes.size() ? model.nodes[(size_t)n].name : std::string();
+        sp_character_warn(ch, "node %d%s%.64s%s has both a matrix and translation/rotation/scale: the matrix is used", n,
+                          name.empty() ? "" : " '", name.c_str(), name.empty() ? "" : "'");
+    }
 }
 
 // ---- accessors ------------------------------------------------------------
@@ -983,6 +1001,13 @@ struct Importer {
                     View cv = view_accessor(m, cit->second, what, usage);
                     if ((cv.ncomp != 3 && cv.ncomp != 4) || cv.count != nv)
                         fail(SP_ERR_INVALID, "%s: %s has the wrong type or count", what, usage);
+                    // Why: integers read as 0-255 would all clamp to white.
+                    bool unorm =
+                        (cv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || cv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                        cv.normalized;
+                    if (cv.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && !unorm)
+                        fail(SP_ERR_INVALID, "%s: %s (accessor %d) must be float or normalized unsigned bytes or shorts", what,
+                             usage, cv.index);
                     for (size_t i = 0; i < nv; ++i)
                         for (int c = 0; c < cv.ncomp; ++c) {
                             double x = read_comp(cv, i, c);

@@ -615,6 +615,9 @@ static void test_says_what_is_wrong(void)
     ensure_fails(
         write_edited("indices_norm.gltf", &(mini_desc){0}, "{\"bufferView\": 3, ", "{\"bufferView\": 3, \"normalized\": true, "),
         "indices_norm.gltf", "mesh 0 primitive 0 indices (accessor 3) holds integers and must not be normalized");
+    ensure_fails(write_edited("color_ints.gltf", &(mini_desc){0}, "\"WEIGHTS_0\": 2}", "\"WEIGHTS_0\": 2, \"COLOR_0\": 1}"),
+                 "color_ints.gltf",
+                 "mesh 0 primitive 0 COLOR_0 (accessor 1) must be float or normalized unsigned bytes or shorts");
     const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         const char* p = sp_test_tmp_path("top.gltf");
@@ -679,6 +682,12 @@ static void test_inverse_bind(void)
         ENSURE(ch.warning_count == 0);
         sp_character_free(&ch);
     }
+    // A node with both a matrix and a TRS (glTF forbids it): the matrix is used, and said so.
+    ch = load_ok(write_edited("matrix_and_trs.gltf", &(mini_desc){0}, "\"translation\": [0, 1, 0]",
+                              "\"translation\": [0, 5, 0], \"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 1]"));
+    ENSURE(ch.warning_count == 1 &&
+           has_warning(&ch, "node 1 'tip' has both a matrix and translation/rotation/scale: the matrix is used"));
+    sp_character_free(&ch);
 }
 
 // Random byte flips of a valid file must never crash (a tiny in-test fuzz).
