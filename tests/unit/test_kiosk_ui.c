@@ -1524,6 +1524,20 @@ static void test_session_errors(void)
     ENSURE_NEAR(e.y, 200, 1e-4);
     ENSURE(s.end_ms == 1);
     sp_kiosk_session_free(&s);
+    // Pixels of a landscape recording replayed on a portrait screen: one
+    // scale, the canvas centred, so that a drawn square stays a square.
+    const char* px =
+        "{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"canvas\": [1280, 800], \"events\": "
+        "[{\"t\": 1, \"type\": \"down\", \"x\": 0, \"y\": 0}, {\"t\": 2, \"type\": \"up\", \"x\": 1280, \"y\": 800}]}";
+    ENSURE(sp_kiosk_session_parse(px, strlen(px), "px.json", &s, &err) == SP_OK);
+    sp_kiosk_event a = sp_kiosk_session_map(&s, &s.events[0], 800, 1280);
+    sp_kiosk_event b = sp_kiosk_session_map(&s, &s.events[1], 800, 1280);
+    ENSURE_NEAR(a.x, 0, 1e-3);
+    ENSURE_NEAR(a.y, 390, 1e-3);
+    ENSURE_NEAR(b.x, 800, 1e-3);
+    ENSURE_NEAR(b.y, 890, 1e-3);
+    ENSURE_NEAR((b.x - a.x) / (b.y - a.y), 1280.0 / 800.0, 1e-4);
+    sp_kiosk_session_free(&s);
 }
 
 // A UV sphere of (rings x segs) quads, two triangles each.

@@ -305,7 +305,12 @@ sp_kiosk_event sp_kiosk_session_map(const sp_kiosk_session* s, const sp_kiosk_ev
     if (s->unit_coords) {
         o.x = ev->x * (float)fb_w, o.y = ev->y * (float)fb_h;
     } else if (s->canvas_w > 0 && s->canvas_h > 0 && (s->canvas_w != fb_w || s->canvas_h != fb_h)) {
-        o.x = ev->x * (float)fb_w / (float)s->canvas_w, o.y = ev->y * (float)fb_h / (float)s->canvas_h;
+        // One scale for both axes, the canvas centred: a drawing replayed on a
+        // screen of another shape keeps its shape (stretched, a recorded tree
+        // became a pair of wings on a portrait screen).
+        double k = fmin((double)fb_w / s->canvas_w, (double)fb_h / s->canvas_h);
+        o.x = (float)(ev->x * k + 0.5 * (fb_w - s->canvas_w * k));
+        o.y = (float)(ev->y * k + 0.5 * (fb_h - s->canvas_h * k));
     }
     return o;
 }

@@ -19,7 +19,9 @@
 /// saves a screenshot there (beside --screenshot, "-<name>" added to its
 /// name); names are 1-32 of [A-Za-z0-9_-]. `coords` "unit" means x, y are
 /// fractions of the framebuffer; "pixels" (default) are scaled from `canvas`
-/// to the framebuffer when they differ. `end_ms` (default: the last event's
+/// to the framebuffer when they differ, by one scale for both axes with the
+/// canvas centred, so that drawings keep their shape on a screen of another
+/// shape. `end_ms` (default: the last event's
 /// time) is when the replay stops and takes its screenshot and export.
 #ifndef SP_KIOSK_SESSION_H
 #define SP_KIOSK_SESSION_H
