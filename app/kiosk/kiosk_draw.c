@@ -79,12 +79,12 @@ static sp_camera scene_camera(sp_kiosk* k, bool orbit, bool* any, sp_vec3* lo, s
 }
 
 // The parts and the details drawn on them (ink `ink` pixels wide).
-static void draw_dragon(sp_kiosk* k, bool hide_last, float ink)
+static void draw_dragon(sp_kiosk* k, const mesh_cache* meshes, bool hide_last, float ink)
 {
     int n = sp_dragon_part_count(k->dragon);
     for (int i = 0; i < n; ++i) {
         if (hide_last && i == n - 1) continue;
-        sp_render_mesh* m = mesh_cache_get(&k->meshes, sp_dragon_part_get(k->dragon, i)->id);
+        sp_render_mesh* m = mesh_cache_get(meshes, sp_dragon_part_get(k->dragon, i)->id);
         if (m) sp_renderer_draw_mesh(k->r, m, NULL);
     }
     for (int i = 0; i < sp_dragon_detail_count(k->dragon); ++i) {
@@ -340,7 +340,7 @@ void kiosk_draw_frame(sp_kiosk* k, int w, int h)
         kiosk_attract_draw_scene(k);
     } else {
         if (any) sp_renderer_draw_ground_shadow(k->r, lo, hi, 0);
-        draw_dragon(k, sp_kiosk_ui_flashing(ui), 0.8f * ui->line_px);
+        draw_dragon(k, &k->meshes, sp_kiosk_ui_flashing(ui), 0.8f * ui->line_px);
         // Strokes and outlines belong to the drawing view only.
         if (ui->yaw == 0 && ui->pitch == 0) {
             float lw = ui->line_px;
@@ -380,13 +380,23 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
     sp_render_target* t;
     sp_render_target_create(W, H, 0, &t, err);
     if (!t) return SP_ERR_INTERNAL;
+    // The postcard is kept: full meshes, not the window's coarse ones (sized
+    // for the canvas on a software rasteriser, they show holes in the wings
+    // and steps along the legs at 1200x800).
+    mesh_cache full = {0};
+    const mesh_cache* meshes = &k->meshes;
+    if (k->meshes.lod_triangles > 0) {
+        mesh_cache_sync(&full, k->r, k->dragon, true);
+        meshes = &full;
+    }
     sp_render_target_bind(t);
     sp_renderer_begin(k->r, &cam, W, H);
     sp_renderer_clear(k->r, (const float[4]){0.98f, 0.95f, 0.86f, 1}, (const float[4]){0.85f, 0.78f, 0.62f, 1});
     sp_renderer_draw_ground_shadow(k->r, lo, hi, 0);
     // The ink as thick on the dragon as on the canvas it was drawn on.
-    draw_dragon(k, false, (float)(0.8 * k->ui->line_px * cam.scale / kiosk_fb_camera(k).scale));
+    draw_dragon(k, meshes, false, (float)(0.8 * k->ui->line_px * cam.scale / kiosk_fb_camera(k).scale));
     sp_renderer_end(k->r);
+    mesh_cache_free(&full);
     sp_draw2d_begin(k->d2, W, H);
     sp_draw2d_rect(k->d2, 12, 12, W - 24.0f, H - 24.0f, 18, 5, k_ink);
     sp_draw2d_text(k->d2, sp_kiosk_text(SP_KTEXT_POSTCARD_TITLE), 48, H - 70.0f, 52, SP_ALIGN_LEFT, k_ink);

@@ -506,6 +506,24 @@ static void test_dragon_session(void)
     snprintf(path, sizeof path, "%s/%s.png", exports, code->valuestring);
     load_png(path, &card);
     ENSURE(card.width == 1200 && card.height == 800);
+    // The postcard is kept: drawn from full meshes whatever the window's
+    // display meshes (before, --lod's coarse ones showed holes and steps).
+    char sc2[1024], exports_coarse[1024]; // sp_test_tmp_path's buffers are reused
+    snprintf(sc2, sizeof sc2, "%s", sp_test_tmp_path("kiosk_dragon.json"));
+    snprintf(exports_coarse, sizeof exports_coarse, "%s", sp_test_tmp_path("kiosk_exports_coarse"));
+    snprintf(args, sizeof args, "--script '%s' --export-dir '%s' --lod 400", sc2, exports_coarse);
+    cJSON* st2 = NULL;
+    ENSURE(run_kiosk(args, &st2) == 0 && st2);
+    const cJSON* code2 = cJSON_GetObjectItemCaseSensitive(st2, "code");
+    ENSURE(cJSON_IsString(code2));
+    sp_image card2 = {0};
+    snprintf(path, sizeof path, "%s/%s.png", exports_coarse, code2->valuestring);
+    load_png(path, &card2);
+    double dcard = image_difference(&card, &card2);
+    fprintf(stderr, "  postcard with --lod 400 vs the default: %.3f%% of the pixels differ\n", 100 * dcard);
+    ENSURE(dcard == 0);
+    sp_image_free(&card2);
+    cJSON_Delete(st2);
     sp_image_free(&card);
     sp_image_free(&img);
     sp_image_free(&fin);
