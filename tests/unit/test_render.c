@@ -15,6 +15,7 @@
 #include "sp/headless.h"
 #include "sp/image.h"
 #include "sp/render.h"
+#include "sp/sketch_sheet.h"
 #include "test.h"
 
 enum { W = 320, H = 240 };
@@ -631,6 +632,30 @@ static void test_projection_matches_camera(void)
     scene_free(&s);
 }
 
+// A contact sheet's label wider than its cell is drawn smaller, not cut:
+// names that differ only at their end (the visitors' "hind-legs-walking",
+// "hind-legs-walk-long") stay told apart, and no ink leaves the cell.
+static void test_sheet_labels(void)
+{
+    const char* labels[2] = {"hind-legs-walking-2a", "hind-legs-walking-2b"};
+    sp_image img[2] = {{0}};
+    for (int i = 0; i < 2; ++i) {
+        sp_sheet_item it = {.label = labels[i]};
+        sp_error err = {0};
+        ENSURE(sp_sheet_render(&it, 1, &(sp_sheet_desc){.cell = 170}, &img[i], &err) == SP_OK);
+        for (int y = 170; y < img[i].height; ++y)
+            for (int x = 165; x < 169; ++x)
+                ENSURE(sp_image_at(&img[i], x, y)[0] > 200); // paper right of the text
+    }
+    long differ = 0;
+    for (int y = 0; y < img[0].height; ++y)
+        for (int x = 0; x < img[0].width; ++x)
+            differ += sp_image_at(&img[0], x, y)[0] != sp_image_at(&img[1], x, y)[0];
+    ENSURE(differ > 0);
+    sp_image_free(&img[0]);
+    sp_image_free(&img[1]);
+}
+
 int main(int argc, char** argv)
 {
     int rc = sp_test_run(argc, argv,
@@ -644,6 +669,7 @@ int main(int argc, char** argv)
                                      {"abstraction_overlay", test_abstraction_overlay},
                                      {"polyline", test_polyline},
                                      {"ink_on_surface", test_ink_on_surface},
+                                     {"sheet_labels", test_sheet_labels},
                                      {0}});
     sp_renderer_destroy(g_r);
     sp_headless_destroy(g_gl);

@@ -64,15 +64,24 @@ static void dot(sp_image* img, sp_vec2 p, double rad, rgb c)
             blend(img, x, y, c, (float)(rad + 0.5 - hypot(x + 0.5 - p.x, y + 0.5 - p.y)));
 }
 
-// ASCII text with stb_easy_font's quads, scaled; clipped to max_w pixels.
+// ASCII text with stb_easy_font's quads, scaled; a text wider than max_w
+// pixels is drawn smaller (down to 0.65 of scale), and only then cut, ending
+// in "..": a name cut silently reads as another name.
 static void text(sp_image* img, double x, double y, const char* s, double scale, double max_w, rgb c)
 {
     if (!s || !*s) return;
-    char buf[64]; // stb_easy_font needs about 270 bytes of quads a character
+    char buf[128]; // stb_easy_font needs about 270 bytes of quads a character
     snprintf(buf, sizeof buf, "%s", s);
-    while (strlen(buf) > 1 && stb_easy_font_width(buf) * scale > max_w)
-        buf[strlen(buf) - 1] = 0;
-    char vb[64 * 300];
+    double w = stb_easy_font_width(buf);
+    if (w * scale > max_w) scale = fmax(0.65 * scale, max_w / w);
+    if (w * scale > max_w) {
+        size_t n = strlen(buf);
+        while (n > 3 && stb_easy_font_width(buf) * scale > max_w) {
+            buf[--n] = 0;
+            buf[n - 2] = buf[n - 1] = '.';
+        }
+    }
+    char vb[128 * 300];
     int quads = stb_easy_font_print(0, 0, buf, NULL, vb, (int)sizeof vb);
     for (int q = 0; q < quads; ++q) {
         const float* v0 = (const float*)(vb + (size_t)q * 4 * 16);
