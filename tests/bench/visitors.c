@@ -772,7 +772,7 @@ int main(int argc, char** argv)
                                        .highlight = part ? out[i].refused || strcmp(out[i].answer, label) != 0 : !out[i].refused};
         }
         char title[256];
-        snprintf(title, sizeof title, "%s half: red = refused, wrong, or not a part", half);
+        snprintf(title, sizeof title, "%s half: red = a part refused or taken for another, or a doodle taken for a part", half);
         if (sp_sheet_write_png(items, ds.count, &(sp_sheet_desc){.cols = 10, .cell = 170, .title = title}, sheet, &err) != SP_OK)
             fprintf(stderr, "visitors: %s\n", err.text);
         free(items);
