@@ -163,7 +163,7 @@ static int db_init(int argc, char** argv)
     const char *assets = NULL, *quickdraw = NULL;
     int synth = 0, concepts = 0, concept_family = 1, drawings = 0, folds = 0;
     bool no_train = false;
-    clf_cli_opts o = {0};
+    clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
         {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
@@ -680,7 +680,7 @@ static int db_train(int argc, char** argv)
     const char* cmd = "sketchpose db train";
     db_common c = {0};
     int folds = 0;
-    clf_cli_opts o = {0};
+    clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c),
                      {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report (default 3, -1 none)", false},
                      CLF_CLI_OPTS(o)};
