@@ -32,8 +32,10 @@ typedef struct db_common {
 
 static const char* db_path(const db_common* c) { return c->db ? c->db : sp_db_default_path(); }
 
-// Splits argv into options (for sp_cli_parse) and positional values.
-static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char** kept, const char** pos, int* npos, int maxpos)
+// Splits argv into options (for sp_cli_parse) and positional values; -1
+// with *extra the first value past maxpos.
+static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char** kept, const char** pos, int* npos, int maxpos,
+                      const char** extra)
 {
     int nk = 0;
     *npos = 0;
@@ -43,7 +45,10 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
         for (int j = 0; j < nopts; ++j)
             if (!strcmp(argv[i], opts[j].name)) o = &opts[j];
         if (strncmp(argv[i], "--", 2) != 0 && strcmp(argv[i], "-h") != 0) {
-            if (*npos >= maxpos) return -1;
+            if (*npos >= maxpos) {
+                *extra = argv[i];
+                return -1;
+            }
             pos[(*npos)++] = argv[i];
             continue;
         }
@@ -64,9 +69,13 @@ static int parse(int argc, char** argv, const char* cmd, const char* summary, co
         fprintf(stderr, "%s: too many arguments\n", cmd);
         return SP_EXIT_USAGE;
     }
-    int nk = split_args(argc, argv, opts, nopts, kept, pos, npos, maxpos);
+    const char* extra = NULL;
+    int nk = split_args(argc, argv, opts, nopts, kept, pos, npos, maxpos, &extra);
     if (nk < 0) {
-        fprintf(stderr, "%s: too many %s (at most %d)\n", cmd, posname, maxpos);
+        if (maxpos == 0)
+            fprintf(stderr, "%s: unexpected argument '%s' (it takes none; see --help)\n", cmd, extra);
+        else
+            fprintf(stderr, "%s: unexpected argument '%s' (at most %d %s; see --help)\n", cmd, extra, maxpos, posname);
         return SP_EXIT_USAGE;
     }
     char full[256];

@@ -914,6 +914,16 @@ static void test_bad_input(void)
         struct stat fs;
         ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && stat(fresh, &fs) != 0 && errno == ENOENT);
     }
+    // A value a subcommand does not take is bad usage naming it (it printed "too many  (at most 0)").
+    const char* sub[2] = {"list", "show head"};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db %s extra --db '%s' 2>&1 >/dev/null", bin, sub[i], p);
+        FILE* pp = popen(cmd, "r");
+        char line[600] = "";
+        if (!fgets(line, sizeof line, pp)) line[0] = 0;
+        st = pclose(pp);
+        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 2 && strstr(line, "unexpected argument 'extra'"));
+    }
 }
 
 static void test_generation(void)
