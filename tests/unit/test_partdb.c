@@ -1502,6 +1502,9 @@ static void test_default_db_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") && strchr(out, '\n') == out + strlen(out) - 1);
     struct stat st;
     ENSURE(stat(p, &st) != 0);
+    // A folder that is not there: the error names the database given, not the file built beside it.
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/nowhere/x.db' --assets '%s' 2>&1", bin, root, assets);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere/x.db: cannot open") && !strstr(out, ".building-"));
     // A concept family that is not one: one line, a usage exit, no database.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --concept-family 0 2>&1", bin, p, assets);
     ENSURE(run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
