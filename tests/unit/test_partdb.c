@@ -1487,6 +1487,32 @@ static int run(const char* cmd, char* out, size_t cap)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+// `sketchpose --help` names every subcommand `db --help` lists (it lacked log and review).
+static void test_db_help_lists_all(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char cmd[2048], top[8192], sub[8192];
+    snprintf(cmd, sizeof cmd, "'%s' --help", bin);
+    ENSURE(run(cmd, top, sizeof top) == 0);
+    const char* dbline = strstr(top, "\n  db ");
+    ENSURE(dbline);
+    char line[1024];
+    snprintf(line, sizeof line, "%.*s", (int)strcspn(dbline + 1, "\n"), dbline + 1);
+    snprintf(cmd, sizeof cmd, "'%s' db --help", bin);
+    ENSURE(run(cmd, sub, sizeof sub) == 0);
+    int n = 0;
+    for (const char* q = strstr(sub, "subcommands:\n"); q && (q = strstr(q, "\n  ")) != NULL; ++n) {
+        char name[64], word[80];
+        q += 3;
+        snprintf(name, sizeof name, "%.*s", (int)strcspn(q, " \n"), q);
+        snprintf(word, sizeof word, " %s", name);
+        if (!strstr(line, word)) fprintf(stderr, "  '%s' not in: %s\n", name, line);
+        ENSURE(strstr(line, word));
+    }
+    ENSURE(n >= 11);
+}
+
 // db init through the command line: it says how many people's strokes joined,
 // and a --quickdraw folder that is not there is one line, exit 1, no database.
 static void test_default_db_cli(void)
@@ -1767,6 +1793,7 @@ int main(int argc, char** argv)
                                    {"drawn_sketches", test_drawn_sketches},
                                    {"default_db", test_default_db},
                                    {"default_db_cli", test_default_db_cli},
+                                   {"db_help_lists_all", test_db_help_lists_all},
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
