@@ -178,14 +178,16 @@ static int db_init(int argc, char** argv)
         {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts to build the default database from (default: the source tree's assets/)", false},
-        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
-        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category (default 60, -1 none)", false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part, -1 (none) to 10000 (default 60)", false},
+        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category, -1 (none) to 10000 (default 60)",
+         false},
         {"--concept-family", SP_OPT_INT, &concept_family, "F",
          "seed family of the concept sketches (default 1; another family is another draw of the same designs, as `synth "
          "--concepts --seed F`)",
          false},
         {"--drawings", SP_OPT_INT, &drawings, "N",
-         "draws of each hand-placed design of assets/sketches/drawings.json (default 1, -1 none; seed family --concept-family)",
+         "draws of each hand-placed design of assets/sketches/drawings.json, -1 (none) to 100 (default 1; seed family "
+         "--concept-family)",
          false},
         {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
          "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder "
