@@ -1513,6 +1513,23 @@ static void test_detail_ink(void)
         free(xy[k]);
 }
 
+// README's refused session (three marks) with --screenshot in a folder that is
+// not there: exit 1 and one line, not one a mark and another at the end.
+static void test_screenshot_unwritable(void)
+{
+    NEED_XVFB();
+    char args[2400];
+    snprintf(args, sizeof args, "--script '%s' --screenshot /nonexistent-sp/out.png",
+             sp_test_src_path("docs/img/kiosk_refused.json"));
+    ENSURE(run_kiosk(args, NULL) == 1);
+    char cmd[1400], out[64] = "";
+    snprintf(cmd, sizeof cmd, "grep -c nonexistent-sp '%s'", sp_test_tmp_path("kiosk_stderr.txt"));
+    FILE* p = popen(cmd, "r");
+    ENSURE(p && fgets(out, sizeof out, p));
+    pclose(p);
+    ENSURE(atoi(out) == 1);
+}
+
 // A save whose postcard cannot be written fails whole: the .glb already in
 // place is taken back, so no file in the export folder names a code the
 // visitor was never given (and the code stays free for the next save).
@@ -1684,6 +1701,7 @@ int main(int argc, char** argv)
                                    {"collect_replaced", test_collect_replaced},
                                    {"body_after_parts", test_body_after_parts},
                                    {"detail_ink", test_detail_ink},
+                                   {"screenshot_unwritable", test_screenshot_unwritable},
                                    {"save_fails_whole", test_save_fails_whole},
                                    {"nothing_to_draw", test_nothing_to_draw},
                                    {"option_ranges", test_option_ranges},
