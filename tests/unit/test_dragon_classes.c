@@ -814,9 +814,11 @@ static void test_cli_option_ranges(void)
         ENSURE(WEXITSTATUS(rc) == 2 && strstr(line, name));
     }
     const char* other[] = {"db add-part /nonexistent/p.glb --db '%s' --synth -5",
-                           "db add-part /nonexistent/p.glb --db '%s' --synth 100000000", "db init --db '%s' --synth -5",
+                           "db add-part /nonexistent/p.glb --db '%s' --synth 100000000",
+                           "db init --db '%s' --synth -5",
                            "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise 1e300",
-                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1"};
+                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1",
+                           "synth --rig /nonexistent/r.glb --seed -1 --out '%s.json'"};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
         char sub[1200];
         snprintf(sub, sizeof sub, other[i], db);
