@@ -869,13 +869,17 @@ static int db_review(int argc, char** argv)
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
     sp_db_kiosk_sketch* ks = NULL;
-    int n = 0, counts[SP_DB_STATUS_COUNT];
+    int listed = 0, counts[SP_DB_STATUS_COUNT];
+    // One more than a page, to know whether this page is the last (next_after null).
+    int ask = limit > 0 && limit < INT_MAX ? limit + 1 : limit;
     if (sp_db_kiosk_counts(db, counts, &err) != SP_OK ||
-        sp_db_kiosk_list(db, &(sp_db_kiosk_query){.statuses = mask, .limit = limit, .after = after}, &ks, &n, &err) != SP_OK) {
+        sp_db_kiosk_list(db, &(sp_db_kiosk_query){.statuses = mask, .limit = ask, .after = after}, &ks, &listed, &err) != SP_OK) {
         sp_db_close(db);
         return fail(cmd, &err);
     }
     sp_db_close(db);
+    bool more = limit > 0 && listed > limit;
+    int n = more ? limit : listed;
     int code = SP_EXIT_OK;
     if (sheet) {
         sp_sheet_item* items = calloc((size_t)(n > 0 ? n : 1), sizeof *items);
@@ -908,12 +912,12 @@ static int db_review(int argc, char** argv)
         }
         printf("], \"counts\": {\"pending\": %d, \"approved\": %d, \"rejected\": %d}, \"next_after\": ", counts[SP_DB_PENDING],
                counts[SP_DB_APPROVED], counts[SP_DB_REJECTED]);
-        if (limit > 0 && n == limit)
+        if (more)
             printf("%lld}\n", (long long)ks[n - 1].id);
         else
             printf("null}\n");
     }
-    sp_db_kiosk_free(ks, n);
+    sp_db_kiosk_free(ks, listed);
     return code;
 }
 

@@ -1577,6 +1577,13 @@ static void test_kiosk_review_cli(void)
     ENSURE(strstr(out, "{\"sketches\": [{\"id\": ") && strstr(out, want) && strstr(out, "\"points\": [[303, 403]"));
     ENSURE(strstr(out, "\"counts\": {\"pending\": 2, \"approved\": 0, \"rejected\": 0}"));
     ENSURE(strstr(out, "{\"id\": ") < strstr(out, want)); // oldest first: the other one is listed before
+    // Pages: next_after is the next page's --after, null on the last page (also when that page is full).
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1", bin, p);
+    snprintf(want, sizeof want, "\"next_after\": %lld}", (long long)first);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, want));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1 --after %lld", bin, p, (long long)first);
+    snprintf(want, sizeof want, "{\"id\": %lld,", (long long)id);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, want) && strstr(out, "\"next_after\": null}"));
     // The contact sheet.
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --sheet '%s' >/dev/null", bin, p, sp_test_tmp_path("review.png"));
     ENSURE(run(cmd, out, sizeof out) == 0);
