@@ -14,9 +14,13 @@ static void print_help(const char* cmd, const char* summary, const sp_opt* opts,
         printf(opts[i].required ? " %s%s%s" : " [%s%s%s]", opts[i].name, a, opts[i].kind == SP_OPT_FLAG ? "" : opts[i].arg);
     }
     printf("\n\n%s\n\noptions:\n", summary);
-    for (int i = 0; i < nopts; ++i)
-        printf("  %-12s %-12s %s%s\n", opts[i].name, opts[i].kind == SP_OPT_FLAG ? "" : opts[i].arg, opts[i].help,
-               opts[i].required ? " (required)" : "");
+    for (int i = 0; i < nopts; ++i) {
+        // Name and value padded together, so that a long name ("--representatives K")
+        // does not push its help past the column.
+        char head[128];
+        snprintf(head, sizeof head, "%-12s %s", opts[i].name, opts[i].kind == SP_OPT_FLAG ? "" : opts[i].arg);
+        printf("  %-25s %s%s\n", head, opts[i].help, opts[i].required ? " (required)" : "");
+    }
     printf("  %-12s %-12s %s\n", "--help", "", "show this help");
 }
 

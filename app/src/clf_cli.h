@@ -4,6 +4,7 @@
 #ifndef SP_CLF_CLI_H
 #define SP_CLF_CLI_H
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -12,12 +13,31 @@
 #include "sp/classifier.h"
 #include "sp/handdraw.h"
 
-/// Training options as flags; zero values mean the library defaults.
+/// Training options as flags; zero values mean the library defaults, except
+/// the range-checked ones, which start "not given" (clf_cli_opts_unset).
 typedef struct clf_cli_opts {
     int words, knn, augment, soft, threads, seed, pyramid;
     bool no_pyramid, no_tfidf, no_hellinger, no_mirror, handdraw;
     double reject_quantile, shape_weight, picture_weight;
 } clf_cli_opts;
+
+/// The options before parsing: a range-checked number not given is SP_CLI_UNSET
+/// (NaN for the quantile), so that a typed 0 is out of its range, not the default.
+static inline clf_cli_opts clf_cli_opts_unset(void)
+{
+    return (clf_cli_opts){.words = SP_CLI_UNSET,
+                          .knn = SP_CLI_UNSET,
+                          .soft = SP_CLI_UNSET,
+                          .threads = SP_CLI_UNSET,
+                          .pyramid = SP_CLI_UNSET,
+                          .reject_quantile = NAN};
+}
+
+/// An int option as the library takes it: not given is 0, its default.
+static inline int clf_cli_int(int v)
+{
+    return v == SP_CLI_UNSET ? 0 : v;
+}
 
 #define CLF_CLI_OPTS(o)                                                                                         \
     {"--words", SP_OPT_INT, &(o).words, "N", "vocabulary size, 1..20000 (default 500)", false},                          \
@@ -37,16 +57,16 @@ typedef struct clf_cli_opts {
         {"--threads", SP_OPT_INT, &(o).threads, "T", "worker threads, 1..256 (default 2)", false}
 
 /// Refuses out-of-range training options with one line naming the option
-/// (a zero is "not given": the library's default). False: exit 2.
+/// (not given: the library's default; a typed 0 is out of range). False: exit 2.
 static inline bool clf_cli_check(const char* cmd, const clf_cli_opts* o)
 {
     // 20000 words: a vocabulary 40 times the default; k-means on more runs for hours.
-    return (!o->words || sp_cli_check_int(cmd, "--words", o->words, 1, 20000)) &&
-           (!o->knn || sp_cli_check_int(cmd, "--knn", o->knn, 1, 64)) &&
-           (!o->soft || sp_cli_check_int(cmd, "--soft", o->soft, 1, 16)) &&
-           (!o->pyramid || sp_cli_check_int(cmd, "--pyramid", o->pyramid, 1, 2)) &&
-           (!o->reject_quantile || sp_cli_check_double(cmd, "--reject-quantile", o->reject_quantile, 0, true, 1)) &&
-           (!o->threads || sp_cli_check_int(cmd, "--threads", o->threads, 1, 256)) &&
+    return (o->words == SP_CLI_UNSET || sp_cli_check_int(cmd, "--words", o->words, 1, 20000)) &&
+           (o->knn == SP_CLI_UNSET || sp_cli_check_int(cmd, "--knn", o->knn, 1, 64)) &&
+           (o->soft == SP_CLI_UNSET || sp_cli_check_int(cmd, "--soft", o->soft, 1, 16)) &&
+           (o->pyramid == SP_CLI_UNSET || sp_cli_check_int(cmd, "--pyramid", o->pyramid, 1, 2)) &&
+           (isnan(o->reject_quantile) || sp_cli_check_double(cmd, "--reject-quantile", o->reject_quantile, 0, true, 1)) &&
+           (o->threads == SP_CLI_UNSET || sp_cli_check_int(cmd, "--threads", o->threads, 1, 256)) &&
            sp_cli_check_int(cmd, "--seed", o->seed, 0, INT_MAX);
 }
 
@@ -62,19 +82,19 @@ static inline sp_result clf_cli_handdraw(void* user, const sp_sketch* in, int sa
 static inline sp_clf_desc clf_cli_desc(const clf_cli_opts* o)
 {
     sp_clf_desc d = {0};
-    d.words = o->words;
-    d.knn = o->knn;
-    d.soft_neighbours = o->soft;
+    d.words = clf_cli_int(o->words);
+    d.knn = clf_cli_int(o->knn);
+    d.soft_neighbours = clf_cli_int(o->soft);
     d.augment = o->augment;
-    d.pyramid = o->no_pyramid ? -1 : o->pyramid;
+    d.pyramid = o->no_pyramid ? -1 : clf_cli_int(o->pyramid);
     d.tfidf = o->no_tfidf ? -1 : 0;
     d.hellinger = o->no_hellinger ? -1 : 0;
     d.mirror = o->no_mirror ? -1 : 0;
-    d.reject_quantile = o->reject_quantile;
+    d.reject_quantile = isnan(o->reject_quantile) ? 0 : o->reject_quantile;
     d.shape_weight = o->shape_weight;
     d.picture_weight = o->picture_weight;
     d.seed = (uint32_t)o->seed;
-    d.threads = o->threads;
+    d.threads = clf_cli_int(o->threads);
     if (o->handdraw) d.augment_fn = clf_cli_handdraw;
     return d;
 }

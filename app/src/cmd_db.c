@@ -32,8 +32,10 @@ typedef struct db_common {
 
 static const char* db_path(const db_common* c) { return c->db ? c->db : sp_db_default_path(); }
 
-// Splits argv into options (for sp_cli_parse) and positional values.
-static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char** kept, const char** pos, int* npos, int maxpos)
+// Splits argv into options (for sp_cli_parse) and positional values; -1
+// with *extra the first value past maxpos.
+static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char** kept, const char** pos, int* npos, int maxpos,
+                      const char** extra)
 {
     int nk = 0;
     *npos = 0;
@@ -43,7 +45,10 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
         for (int j = 0; j < nopts; ++j)
             if (!strcmp(argv[i], opts[j].name)) o = &opts[j];
         if (strncmp(argv[i], "--", 2) != 0 && strcmp(argv[i], "-h") != 0) {
-            if (*npos >= maxpos) return -1;
+            if (*npos >= maxpos) {
+                *extra = argv[i];
+                return -1;
+            }
             pos[(*npos)++] = argv[i];
             continue;
         }
@@ -64,9 +69,13 @@ static int parse(int argc, char** argv, const char* cmd, const char* summary, co
         fprintf(stderr, "%s: too many arguments\n", cmd);
         return SP_EXIT_USAGE;
     }
-    int nk = split_args(argc, argv, opts, nopts, kept, pos, npos, maxpos);
+    const char* extra = NULL;
+    int nk = split_args(argc, argv, opts, nopts, kept, pos, npos, maxpos, &extra);
     if (nk < 0) {
-        fprintf(stderr, "%s: too many %s (at most %d)\n", cmd, posname, maxpos);
+        if (maxpos == 0)
+            fprintf(stderr, "%s: unexpected argument '%s' (it takes none; see --help)\n", cmd, extra);
+        else
+            fprintf(stderr, "%s: unexpected argument '%s' (at most %d %s; see --help)\n", cmd, extra, maxpos, posname);
         return SP_EXIT_USAGE;
     }
     char full[256];
@@ -163,20 +172,22 @@ static int db_init(int argc, char** argv)
     const char *assets = NULL, *quickdraw = NULL;
     int synth = 0, concepts = 0, concept_family = 1, drawings = 0, folds = 0;
     bool no_train = false;
-    clf_cli_opts o = {0};
+    clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
         {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts to build the default database from (default: the source tree's assets/)", false},
-        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part (default 60)", false},
-        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category (default 60, -1 none)", false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part, -1 (none) to 10000 (default 60)", false},
+        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category, -1 (none) to 10000 (default 60)",
+         false},
         {"--concept-family", SP_OPT_INT, &concept_family, "F",
          "seed family of the concept sketches (default 1; another family is another draw of the same designs, as `synth "
          "--concepts --seed F`)",
          false},
         {"--drawings", SP_OPT_INT, &drawings, "N",
-         "draws of each hand-placed design of assets/sketches/drawings.json (default 1, -1 none; seed family --concept-family)",
+         "draws of each hand-placed design of assets/sketches/drawings.json, -1 (none) to 100 (default 1; seed family "
+         "--concept-family)",
          false},
         {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
          "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder "
@@ -680,7 +691,7 @@ static int db_train(int argc, char** argv)
     const char* cmd = "sketchpose db train";
     db_common c = {0};
     int folds = 0;
-    clf_cli_opts o = {0};
+    clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c),
                      {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report (default 3, -1 none)", false},
                      CLF_CLI_OPTS(o)};
@@ -858,13 +869,17 @@ static int db_review(int argc, char** argv)
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
     sp_db_kiosk_sketch* ks = NULL;
-    int n = 0, counts[SP_DB_STATUS_COUNT];
+    int listed = 0, counts[SP_DB_STATUS_COUNT];
+    // One more than a page, to know whether this page is the last (next_after null).
+    int ask = limit > 0 && limit < INT_MAX ? limit + 1 : limit;
     if (sp_db_kiosk_counts(db, counts, &err) != SP_OK ||
-        sp_db_kiosk_list(db, &(sp_db_kiosk_query){.statuses = mask, .limit = limit, .after = after}, &ks, &n, &err) != SP_OK) {
+        sp_db_kiosk_list(db, &(sp_db_kiosk_query){.statuses = mask, .limit = ask, .after = after}, &ks, &listed, &err) != SP_OK) {
         sp_db_close(db);
         return fail(cmd, &err);
     }
     sp_db_close(db);
+    bool more = limit > 0 && listed > limit;
+    int n = more ? limit : listed;
     int code = SP_EXIT_OK;
     if (sheet) {
         sp_sheet_item* items = calloc((size_t)(n > 0 ? n : 1), sizeof *items);
@@ -897,12 +912,12 @@ static int db_review(int argc, char** argv)
         }
         printf("], \"counts\": {\"pending\": %d, \"approved\": %d, \"rejected\": %d}, \"next_after\": ", counts[SP_DB_PENDING],
                counts[SP_DB_APPROVED], counts[SP_DB_REJECTED]);
-        if (limit > 0 && n == limit)
+        if (more)
             printf("%lld}\n", (long long)ks[n - 1].id);
         else
             printf("null}\n");
     }
-    sp_db_kiosk_free(ks, n);
+    sp_db_kiosk_free(ks, listed);
     return code;
 }
 

@@ -2,6 +2,7 @@
 // file is one part, in order: classified, instantiated, fitted where it was
 // drawn, attached where it touches a body; the dragon is written as one
 // animated .glb, a PNG and the report (DESIGN.md "dragon --report").
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +22,7 @@
 int cmd_dragon(int argc, char** argv)
 {
     const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = SP_SOURCE_DIR "/assets";
-    double max_ms = 0, at = 0;
+    double max_ms = NAN, at = 0; // NAN: not given
     const sp_opt opts[] = {
         {"--db", SP_OPT_STRING, &db_path, "DB", "the part database (created from --assets when missing)", true},
         {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the strokes, one per part, in drawing order (sketchpose-strokes JSON)",
@@ -31,13 +32,14 @@ int cmd_dragon(int argc, char** argv)
         {"--report", SP_OPT_STRING, &report, "report.json", "write the report (also printed on stdout)", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts for a database that does not exist yet (default: the source tree's assets/)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve (default 250)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve, ms in (0, 3600000] (default 250)", false},
         {"--time", SP_OPT_DOUBLE, &at, "S", "animation time of the render, seconds (default 0: as fitted)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose dragon",
                           "The kiosk pipeline without a window: one part per stroke, one animated dragon.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!isnan(max_ms) && !sp_cli_check_double("sketchpose dragon", "--max-ms", max_ms, 0, true, 3.6e6)) return SP_EXIT_USAGE;
     sp_error err = {0};
     sp_sketch sk = {0};
     if (sp_sketch_read_json(strokes, &sk, &err) != SP_OK) {
@@ -52,10 +54,12 @@ int cmd_dragon(int argc, char** argv)
     int w = sk.canvas_w >= 1 && sk.canvas_w <= 16384 ? (int)sk.canvas_w : 0,
         h = sk.canvas_h >= 1 && sk.canvas_h <= 16384 ? (int)sk.canvas_h : 0;
     sp_dragon* d;
-    sp_dragon_create(
-        &(sp_dragon_desc){
-            .db_path = db_path, .assets_dir = assets, .canvas_w = w, .canvas_h = h, .solve = {.time_cap_ms = max_ms}},
-        &d, &err);
+    sp_dragon_create(&(sp_dragon_desc){.db_path = db_path,
+                                       .assets_dir = assets,
+                                       .canvas_w = w,
+                                       .canvas_h = h,
+                                       .solve = {.time_cap_ms = isnan(max_ms) ? 0 : max_ms}},
+                     &d, &err);
     if (!d) {
         fprintf(stderr, "sketchpose dragon: %s\n", err.text);
         sp_sketch_free(&sk);

@@ -48,7 +48,7 @@ int cmd_eval(int argc, char** argv)
     const char* data = NULL;
     const char* model = NULL;
     int folds = 0;
-    clf_cli_opts o = {0};
+    clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         {"--model", SP_OPT_STRING, &model, "M",
          "trained model (required unless --folds; with --folds, the folds train with its options)", false},

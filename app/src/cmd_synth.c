@@ -239,7 +239,7 @@ int cmd_synth(int argc, char** argv)
     const sp_opt opts[] = {
         {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
-        {"--seed", SP_OPT_INT, &seed, "N", "random seed (required unless --pose)", false},
+        {"--seed", SP_OPT_INT, &seed, "N", "random seed, not negative (required unless --pose)", false},
         {"--pose", SP_OPT_STRING, &pose, "p.json", "draw this pose instead of a random one", false},
         {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A",
          "largest change per rotation from rest, radians (default 0.785; with --parts 0.4)", false},
@@ -337,6 +337,10 @@ int cmd_synth(int argc, char** argv)
     }
     if (!seeded && !pose) {
         fprintf(stderr, "sketchpose synth: missing --seed N or --pose p.json (see --help)\n");
+        return SP_EXIT_USAGE;
+    }
+    if (seed < 0) { // as with --parts and --concepts: -1 was silently seed 4294967295
+        fprintf(stderr, "sketchpose synth: --seed must not be negative, got %d\n", seed);
         return SP_EXIT_USAGE;
     }
     int w = 0, h = 0;

@@ -12,7 +12,7 @@ int cmd_train(int argc, char** argv)
     const char* model = NULL;
     const char* calibrate = NULL;
     double cal_q = 0.96;
-    clf_cli_opts o = {0};
+    clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder: DIR/<category>/*.{json,svg,png}, DIR/<category>.ndjson", true},
         {"--model", SP_OPT_STRING, &model, "M", "model file to write", true},

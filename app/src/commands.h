@@ -16,10 +16,10 @@
     X(pose, "redraw posing: fit the rig to strokes; posed .glb, PNG, report")                                                    \
     X(drawover, "draw-over posing: curves drawn over the character, then redrawn")                                               \
     X(animate, "key poses from stroke files, solved in sequence, as one glTF animation")                                         \
-    X(demo, "headless demo: strokes of a pose in, a render and a posed .glb out")                                                \
+    X(demo, "headless demo: the kiosk without a window; hand-drawn parts in, an animated dragon (.glb, PNG, report) out")        \
     X(dragon, "the kiosk pipeline without a window: one part per stroke; animated .glb, PNG, report")                            \
     X(derive, "a kiosk part (outline, parameters, attachment, clip) from any rigged glTF; .glb, preview PNG")                    \
-    X(db, "the curators' part database: init, add-part, add-sketch, list, show, remove, check, train, export")
+    X(db, "the curators' part database: init, add-part, add-sketch, list, show, remove, check, train, export, log, review")
 
 #define SP_DECLARE_CMD(name, help) int cmd_##name(int argc, char** argv);
 SP_COMMANDS(SP_DECLARE_CMD)

@@ -553,7 +553,9 @@ int main(int argc, char** argv)
             if (n++ == 0) first_frame_ms = sp_now_ms() - start;
             glfwPollEvents();
             for (; mi < session.mark_count && session.marks[mi].t_ms <= target; ++mi) {
-                if (!shot) continue;
+                // After the first failed screenshot no more are tried: one line
+                // says why, not one a mark (the replay still ends, --export and --record too).
+                if (!shot || exit_code != SP_EXIT_OK) continue;
                 char path[2048];
                 mark_path(shot, session.marks[mi].name, path, sizeof path);
                 if (sp_kiosk_screenshot(a.k, path, &err) != SP_OK) {
@@ -573,7 +575,7 @@ int main(int argc, char** argv)
             if (n++ == 0) first_frame_ms = sp_now_ms() - start;
         }
     }
-    if (shot && sp_kiosk_screenshot(a.k, shot, &err) != SP_OK) {
+    if (shot && exit_code == SP_EXIT_OK && sp_kiosk_screenshot(a.k, shot, &err) != SP_OK) {
         fprintf(stderr, "%s: %s\n", k_cmd, err.text);
         exit_code = SP_EXIT_INPUT;
     }

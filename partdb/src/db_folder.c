@@ -386,6 +386,12 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     snprintf(tmp, sizeof tmp, "%s.building-%ld", path, (long)getpid());
     sp_db* db = NULL;
     sp_result r = sp_db_open(tmp, SP_DB_CREATE, &db, err);
+    size_t tl = strlen(tmp);
+    if (r != SP_OK && err && !strncmp(err->text, tmp, tl)) {
+        // The user named `path`; the temporary name beside it would only puzzle them.
+        sp_error why = *err;
+        sp_fail(err, r, "%s%s", path, why.text + tl);
+    }
     if (r == SP_OK) r = fill(db, ctx, err);
     sp_db_close(db);
     if (r == SP_OK && link(tmp, path) != 0)

@@ -1783,7 +1783,9 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
     Value::Object pose;
     pose["parameters"] = Value(std::move(params));
     Value::Object sx;
-    sx["sp_pose"] = Value(std::move(pose));
+    // Why not always: tinygltf writes an empty object as null, which the loader
+    // warns of; a rig without parameters (a baked black box) has no pose to keep.
+    if (rig->param_count > 0) sx["sp_pose"] = Value(std::move(pose));
     if (ch->has_part) {
         cJSON* part = nullptr;
         sp_error e = {};
@@ -1792,7 +1794,7 @@ tinygltf::Model build_model(const sp_character* ch, const double* params_in)
         std::unique_ptr<cJSON, void (*)(cJSON*)> owner(part, cJSON_Delete); // freed also when from_cjson throws
         sx["sp_part"] = from_cjson(part);
     }
-    scene.extras = Value(std::move(sx));
+    if (!sx.empty()) scene.extras = Value(std::move(sx)); // an empty object would be written as null
     scene.name = "sketchpose";
     m.scenes.push_back(scene);
     m.defaultScene = 0;

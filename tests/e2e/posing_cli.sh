@@ -40,6 +40,9 @@ for c in synth pose drawover animate; do
     expect 0 "$SP" "$c" --help
     expect 2 "$SP" "$c" --bogus
 done
+# Every option's help starts in one column, long names ("--representatives K") too.
+"$SP" pose --help | awk '/^  --/ && (substr($0, 28, 1) != " " || substr($0, 29, 1) == " ") { bad = 1; print } END { exit bad }' >"$WORK/cols" ||
+    fail "pose --help: option help out of its column: $(cat "$WORK/cols")"
 expect 0 "$SP" synth --rig "$RIG" --seed 4 --out "$WORK/s.json" --truth "$WORK/t.json"
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/posed.glb" --report "$WORK/r.json"
 for key in '"ms"' '"iterations"' '"icp_rounds"' '"stopped"' '"energy_before"' '"energy_after"' '"mean_error_px"' '"max_error_px"' '"bbox_diagonal_px"' '"curves"' '"parameters"'; do

@@ -1474,6 +1474,15 @@ static void test_command(void)
     ENSURE(WEXITSTATUS(system(cmd)) == 1);
     snprintf(cmd, sizeof cmd, "'%s' dragon --strokes '%s' 2>/dev/null", SP_SKETCHPOSE, strokes);
     ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    // --max-ms out of (0, 3600000] is bad usage, as for pose (it was the default)
+    for (int i = 0; i < 2; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' --max-ms %s 2>&1 >/dev/null | grep -q 'max-ms must be'",
+                 SP_SKETCHPOSE, path, strokes, i ? "-5" : "0");
+        ENSURE(system(cmd) == 0);
+        snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' --max-ms %s >/dev/null 2>&1", SP_SKETCHPOSE, path,
+                 strokes, i ? "-5" : "0");
+        ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    }
 }
 
 // The shipped parts (assets/*.glb), once they exist: a default database built

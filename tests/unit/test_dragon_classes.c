@@ -795,18 +795,11 @@ static void test_cli_option_ranges(void)
     char db[1024], cmd[4096];
     snprintf(db, sizeof db, "%s", sp_test_tmp_path("ranges.db"));
     unlink(db);
-    const char* clf[] = {"--knn -3",
-                         "--knn 65",
-                         "--soft -1",
-                         "--pyramid 10",
-                         "--pyramid -1",
-                         "--reject-quantile 2",
-                         "--reject-quantile -1",
-                         "--threads -1",
-                         "--threads 10000",
-                         "--seed -1",
-                         "--words 100000000",
-                         "--words -5"};
+    const char* clf[] = {"--knn -3", "--knn 65", "--soft -1", "--pyramid 10", "--pyramid -1", "--reject-quantile 2",
+                         "--reject-quantile -1", "--threads -1", "--threads 10000", "--seed -1", "--words 100000000",
+                         "--words -5",
+                         // a typed 0 is out of range too, not the default
+                         "--words 0", "--knn 0", "--soft 0", "--pyramid 0", "--reject-quantile 0", "--threads 0"};
     const char* how[] = {"train --data /nonexistent --model /nonexistent/m", "eval --data /nonexistent --folds 3",
                          "db init --db '%s'", "db train --db '%s'"};
     for (size_t i = 0; i < sizeof clf / sizeof clf[0]; ++i) { // each command in turn: they share the check
@@ -821,9 +814,11 @@ static void test_cli_option_ranges(void)
         ENSURE(WEXITSTATUS(rc) == 2 && strstr(line, name));
     }
     const char* other[] = {"db add-part /nonexistent/p.glb --db '%s' --synth -5",
-                           "db add-part /nonexistent/p.glb --db '%s' --synth 100000000", "db init --db '%s' --synth -5",
+                           "db add-part /nonexistent/p.glb --db '%s' --synth 100000000",
+                           "db init --db '%s' --synth -5",
                            "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise 1e300",
-                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1"};
+                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1",
+                           "synth --rig /nonexistent/r.glb --seed -1 --out '%s.json'"};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
         char sub[1200];
         snprintf(sub, sizeof sub, other[i], db);

@@ -1531,6 +1531,32 @@ static void test_detail_ink(void)
         free(xy[k]);
 }
 
+// README's refused session (three marks) with --screenshot in a folder that is
+// not there: exit 1 and one line, not one a mark and another at the end.
+static void test_screenshot_unwritable(void)
+{
+    NEED_XVFB();
+    // The kiosk's own exit status through a file: xvfb-run sometimes fails to
+    // remove its temporary folder afterwards and exits 5 in its place.
+    const char* rcf = sp_test_tmp_path("kiosk_shot_rc.txt");
+    const char* errf = sp_test_tmp_path("kiosk_shot_err.txt");
+    char cmd[4096], out[64] = "";
+    snprintf(cmd, sizeof cmd,
+             "xvfb-run -a -s '-screen 0 1600x1000x24' sh -c \"'%s' --db '%s' --no-collect --script '%s' --screenshot "
+             "/nonexistent-sp/out.png 2> '%s' > /dev/null; echo \\$? > '%s'\"",
+             SP_DRAGON_KIOSK, e2e_db(), sp_test_src_path("docs/img/kiosk_refused.json"), errf, rcf);
+    if (system(cmd) != 0) fprintf(stderr, "  (xvfb-run did not end cleanly)\n");
+    FILE* f = fopen(rcf, "r");
+    ENSURE(f && fgets(out, sizeof out, f));
+    fclose(f);
+    ENSURE(atoi(out) == 1);
+    snprintf(cmd, sizeof cmd, "grep -c nonexistent-sp '%s'", errf);
+    FILE* p = popen(cmd, "r");
+    ENSURE(p && fgets(out, sizeof out, p));
+    pclose(p);
+    ENSURE(atoi(out) == 1);
+}
+
 // A save whose postcard cannot be written fails whole: the .glb already in
 // place is taken back, so no file in the export folder names a code the
 // visitor was never given (and the code stays free for the next save).
@@ -1702,6 +1728,7 @@ int main(int argc, char** argv)
                                    {"collect_replaced", test_collect_replaced},
                                    {"body_after_parts", test_body_after_parts},
                                    {"detail_ink", test_detail_ink},
+                                   {"screenshot_unwritable", test_screenshot_unwritable},
                                    {"save_fails_whole", test_save_fails_whole},
                                    {"nothing_to_draw", test_nothing_to_draw},
                                    {"option_ranges", test_option_ranges},

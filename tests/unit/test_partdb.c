@@ -914,6 +914,16 @@ static void test_bad_input(void)
         struct stat fs;
         ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && stat(fresh, &fs) != 0 && errno == ENOENT);
     }
+    // A value a subcommand does not take is bad usage naming it (it printed "too many  (at most 0)").
+    const char* sub[2] = {"list", "show head"};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db %s extra --db '%s' 2>&1 >/dev/null", bin, sub[i], p);
+        FILE* pp = popen(cmd, "r");
+        char line[600] = "";
+        if (!fgets(line, sizeof line, pp)) line[0] = 0;
+        st = pclose(pp);
+        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 2 && strstr(line, "unexpected argument 'extra'"));
+    }
 }
 
 static void test_generation(void)
@@ -1477,6 +1487,32 @@ static int run(const char* cmd, char* out, size_t cap)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+// `sketchpose --help` names every subcommand `db --help` lists (it lacked log and review).
+static void test_db_help_lists_all(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char cmd[2048], top[8192], sub[8192];
+    snprintf(cmd, sizeof cmd, "'%s' --help", bin);
+    ENSURE(run(cmd, top, sizeof top) == 0);
+    const char* dbline = strstr(top, "\n  db ");
+    ENSURE(dbline);
+    char line[1024];
+    snprintf(line, sizeof line, "%.*s", (int)strcspn(dbline + 1, "\n"), dbline + 1);
+    snprintf(cmd, sizeof cmd, "'%s' db --help", bin);
+    ENSURE(run(cmd, sub, sizeof sub) == 0);
+    int n = 0;
+    for (const char* q = strstr(sub, "subcommands:\n"); q && (q = strstr(q, "\n  ")) != NULL; ++n) {
+        char name[64], word[80];
+        q += 3;
+        snprintf(name, sizeof name, "%.*s", (int)strcspn(q, " \n"), q);
+        snprintf(word, sizeof word, " %s", name);
+        if (!strstr(line, word)) fprintf(stderr, "  '%s' not in: %s\n", name, line);
+        ENSURE(strstr(line, word));
+    }
+    ENSURE(n >= 11);
+}
+
 // db init through the command line: it says how many people's strokes joined,
 // and a --quickdraw folder that is not there is one line, exit 1, no database.
 static void test_default_db_cli(void)
@@ -1492,6 +1528,9 @@ static void test_default_db_cli(void)
     ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") && strchr(out, '\n') == out + strlen(out) - 1);
     struct stat st;
     ENSURE(stat(p, &st) != 0);
+    // A folder that is not there: the error names the database given, not the file built beside it.
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/nowhere/x.db' --assets '%s' 2>&1", bin, root, assets);
+    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere/x.db: cannot open") && !strstr(out, ".building-"));
     // A concept family that is not one: one line, a usage exit, no database.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --concept-family 0 2>&1", bin, p, assets);
     ENSURE(run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
@@ -1538,6 +1577,13 @@ static void test_kiosk_review_cli(void)
     ENSURE(strstr(out, "{\"sketches\": [{\"id\": ") && strstr(out, want) && strstr(out, "\"points\": [[303, 403]"));
     ENSURE(strstr(out, "\"counts\": {\"pending\": 2, \"approved\": 0, \"rejected\": 0}"));
     ENSURE(strstr(out, "{\"id\": ") < strstr(out, want)); // oldest first: the other one is listed before
+    // Pages: next_after is the next page's --after, null on the last page (also when that page is full).
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1", bin, p);
+    snprintf(want, sizeof want, "\"next_after\": %lld}", (long long)first);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, want));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1 --after %lld", bin, p, (long long)first);
+    snprintf(want, sizeof want, "{\"id\": %lld,", (long long)id);
+    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, want) && strstr(out, "\"next_after\": null}"));
     // The contact sheet.
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --sheet '%s' >/dev/null", bin, p, sp_test_tmp_path("review.png"));
     ENSURE(run(cmd, out, sizeof out) == 0);
@@ -1754,6 +1800,7 @@ int main(int argc, char** argv)
                                    {"drawn_sketches", test_drawn_sketches},
                                    {"default_db", test_default_db},
                                    {"default_db_cli", test_default_db_cli},
+                                   {"db_help_lists_all", test_db_help_lists_all},
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},

@@ -437,6 +437,13 @@ static void test_rig_handle(void)
     ENSURE(sp_gltf_load(glb, &back, &err) == SP_OK);
     ENSURE(back.rig.vertex_count == d->vertex_count && back.rig.abstraction_count == 1 &&
            !strcmp(back.rig.abstractions[0].name, "face"));
+    // No parameters, no stored pose: it read back as "sp_pose.parameters is not a JSON object".
+    if (back.warning_count) fprintf(stderr, "  baked face read back: %s\n", back.warnings[0]);
+    ENSURE(back.warning_count == 0);
+    cJSON* gj = sp_fixture_glb_json(glb); // nor a scene "extras": null
+    const cJSON* scene0 = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(gj, "scenes"), 0);
+    ENSURE(scene0 && !cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(scene0, "extras")));
+    cJSON_Delete(gj);
     sp_character_free(&back);
 
     // A glTF character as it is; a curve a command adds is shown, not saved.
