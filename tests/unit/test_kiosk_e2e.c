@@ -177,6 +177,26 @@ static bool have_xvfb(void)
     return system("command -v xvfb-run >/dev/null 2>&1") == 0;
 }
 
+// The xvfb-run command line, with its X authority file in `dir`: left to
+// itself xvfb-run makes a temporary folder for it, and now and then fails
+// to remove it afterwards and exits 5 in place of the kiosk's status.
+static const char* xvfb_run_in(const char* dir)
+{
+    static char cmd[1400];
+    static int calls;
+    snprintf(cmd, sizeof cmd, "xvfb-run -a -f '%s/xauth-%ld-%d' -s '-screen 0 1600x1000x24'", dir, (long)getpid(), ++calls);
+    return cmd;
+}
+
+// The same with the authority file among the test's temporary files.
+static const char* xvfb_run(void)
+{
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("x"));
+    *strrchr(dir, '/') = '\0';
+    return xvfb_run_in(dir);
+}
+
 // The kiosk's --stats file as JSON, or NULL (said on stderr).
 static cJSON* read_stats(const char* path)
 {
@@ -201,8 +221,7 @@ static int run_kiosk_on(const char* db, const char* args, cJSON** stats)
     const char* out = sp_test_tmp_path("kiosk_stats.json");
     const char* errf = sp_test_tmp_path("kiosk_stderr.txt");
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --stats %s > '%s' 2> '%s'", SP_DRAGON_KIOSK,
-             db, args, out, errf);
+    snprintf(cmd, sizeof cmd, "%s '%s' --db '%s' --stats %s > '%s' 2> '%s'", xvfb_run(), SP_DRAGON_KIOSK, db, args, out, errf);
     double t0 = wall_s();
     int rc = system(cmd);
     rc = WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
@@ -686,8 +705,7 @@ static void test_db_replaced(void)
 
     // Not run_kiosk: this one runs on the live copy.
     const char* out = sp_test_tmp_path("kiosk_swap_stats.json");
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --stats %s > '%s'", SP_DRAGON_KIOSK, live,
-             args, out);
+    snprintf(cmd, sizeof cmd, "%s '%s' --db '%s' --stats %s > '%s'", xvfb_run(), SP_DRAGON_KIOSK, live, args, out);
     int rc = system(cmd);
     FILE* flag = fopen(stop, "w");
     if (flag) fclose(flag);
@@ -1191,9 +1209,8 @@ static void test_collect_read_only(void)
     t = part_stroke_at(&s, t, &g_strokes[3], 0, 0);
     script_end(&s, sc, t + 2000);
     ENSURE(chmod(sc, 0644) == 0);
-    snprintf(cmd, sizeof cmd,
-             "cd '%s' && xvfb-run -a -s '-screen 0 1600x1000x24' '%s' --db '%s' --script '%s' --stats > '%s' 2> '%s'", dir, exe,
-             db, sc, out, errf);
+    snprintf(cmd, sizeof cmd, "cd '%s' && %s '%s' --db '%s' --script '%s' --stats > '%s' 2> '%s'", dir, xvfb_run_in(dir), exe, db,
+             sc, out, errf);
     pid_t pid = fork();
     ENSURE(pid >= 0);
     if (pid == 0) {
@@ -1536,21 +1553,12 @@ static void test_detail_ink(void)
 static void test_screenshot_unwritable(void)
 {
     NEED_XVFB();
-    // The kiosk's own exit status through a file: xvfb-run sometimes fails to
-    // remove its temporary folder afterwards and exits 5 in its place.
-    const char* rcf = sp_test_tmp_path("kiosk_shot_rc.txt");
-    const char* errf = sp_test_tmp_path("kiosk_shot_err.txt");
-    char cmd[4096], out[64] = "";
-    snprintf(cmd, sizeof cmd,
-             "xvfb-run -a -s '-screen 0 1600x1000x24' sh -c \"'%s' --db '%s' --no-collect --script '%s' --screenshot "
-             "/nonexistent-sp/out.png 2> '%s' > /dev/null; echo \\$? > '%s'\"",
-             SP_DRAGON_KIOSK, e2e_db(), sp_test_src_path("docs/img/kiosk_refused.json"), errf, rcf);
-    if (system(cmd) != 0) fprintf(stderr, "  (xvfb-run did not end cleanly)\n");
-    FILE* f = fopen(rcf, "r");
-    ENSURE(f && fgets(out, sizeof out, f));
-    fclose(f);
-    ENSURE(atoi(out) == 1);
-    snprintf(cmd, sizeof cmd, "grep -c nonexistent-sp '%s'", errf);
+    char args[2400];
+    snprintf(args, sizeof args, "--script '%s' --screenshot /nonexistent-sp/out.png",
+             sp_test_src_path("docs/img/kiosk_refused.json"));
+    ENSURE(run_kiosk(args, NULL) == 1);
+    char cmd[1400], out[64] = "";
+    snprintf(cmd, sizeof cmd, "grep -c nonexistent-sp '%s'", sp_test_tmp_path("kiosk_stderr.txt"));
     FILE* p = popen(cmd, "r");
     ENSURE(p && fgets(out, sizeof out, p));
     pclose(p);
