@@ -743,7 +743,15 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     sp_kiosk_ui_event(k->ui, &(sp_kiosk_event){SP_KEV_FRAME, t_ms, 0, 0, 0});
     k->heavy_done = false;
     sp_kiosk_job j;
-    while (!k->heavy_done && sp_kiosk_ui_next_job(k->ui, &j)) {
+    sp_kiosk_job_kind next;
+    if (sp_kiosk_ui_peek_job(k->ui) != SP_KJOB_SAVE) k->save_shown = false; // a save dropped meanwhile (Start over)
+    while (!k->heavy_done && (next = sp_kiosk_ui_peek_job(k->ui)) != SP_KJOB_NONE) {
+        // A save stops the window for about half a second (BENCHMARKS.md):
+        // one frame first, so that the tap shows ("Saving your dragon...").
+        bool shown = k->save_shown;
+        k->save_shown = next == SP_KJOB_SAVE && !shown;
+        if (k->save_shown) break;
+        if (!sp_kiosk_ui_next_job(k->ui, &j)) break;
         run_job(k, &j);
         k->heavy_done = j.heavy;
     }

@@ -106,6 +106,7 @@ struct sp_kiosk {
     char last_save[1100];
     double last_reload_check;
     bool heavy_done; // a heavy job ran in this update
+    bool save_shown; // a frame was drawn since the Save job was queued (its hint and the Save button's state)
     sp_vec2* scratch;
     int scratch_cap;
     float* outline_px;

@@ -10,7 +10,7 @@
 // first stroke of each part after start, and all of them; the paper's solve
 // alone took 100 ms; target 50 ms), frames of the attract
 // screen, of an empty canvas, of six animated parts and of 20 (target 33 ms),
-// pen-up to part with 6-19 parts on screen, and the frame of a Save (no target).
+// pen-up to part with 6-19 parts on screen, and a Save's tap to its code (no target).
 // Without --db it builds the test database of tests/support/kiosk_parts.h.
 #include <math.h>
 #include <stdio.h>
@@ -336,10 +336,14 @@ int main(int argc, char** argv)
             for (int f = 0; f < 60; ++f) // the flash ends, the part shows
                 frame(k, t += step);
         }
-        // The frame that saves six parts: the .glb, the postcard drawn and its PNG.
+        // Save with six parts: from the tap to the code on screen (a frame
+        // that shows the tap, then the one that writes the .glb, draws the
+        // postcard and writes its PNG).
+        int saved = sp_kiosk_stats_of(k)->saves + sp_kiosk_stats_of(k)->save_failures;
         double s0 = sp_now_ms();
         press(k, t += step, SP_KT_SAVE);
-        frame(k, t += step);
+        for (int f = 0; f < 4 && sp_kiosk_stats_of(k)->saves + sp_kiosk_stats_of(k)->save_failures == saved; ++f)
+            frame(k, t += step);
         save_ms[nsave++] = sp_now_ms() - s0;
         for (int f = 0; f < 30; ++f) // the code banner
             frame(k, t += step);
@@ -366,7 +370,7 @@ int main(int argc, char** argv)
     snprintf(r.extra, sizeof r.extra, "\"collected\": %d", sp_kiosk_stats_of(k)->collected);
     rows[nr++] = r;
     free(clear_ms);
-    r = (sp_bench_row){"frame: Save with six parts (.glb, postcard, PNG)", 0, 0, nsave, -1, -1, ""};
+    r = (sp_bench_row){"Save with six parts: tap to code on screen", 0, 0, nsave, -1, -1, ""};
     sp_bench_stats(save_ms, nsave, &r.ms_median, &r.ms_p90);
     snprintf(r.extra, sizeof r.extra, "\"saves\": %d, \"save_failures\": %d", sp_kiosk_stats_of(k)->saves,
              sp_kiosk_stats_of(k)->save_failures);

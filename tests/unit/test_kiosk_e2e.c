@@ -30,6 +30,7 @@
 #include "sp/dragon.h"
 #include "sp/headless.h"
 #include "sp/image.h"
+#include "sp/kiosk_text.h"
 #include "test.h"
 
 static double hue_of(const uint8_t* p, double* sat, double* val)
@@ -1585,6 +1586,14 @@ static void test_save_fails_whole(void)
         const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
         draw_part(k, &t, &g_strokes[0]);
         sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_SAVE});
+        // The tap shows for a frame ("Saving your dragon...") before the save stops the window.
+        sp_kiosk_update(k, t += 1000.0 / 60.0);
+        const sp_kiosk_ui* ui = sp_kiosk_ui_of(k);
+        ENSURE(st->saves == 0 && st->save_failures == 0 && ui->save_queued && sp_kiosk_ui_hint_visible(ui) &&
+               !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_SAVING)));
+        sp_kiosk_update(k, t += 1000.0 / 60.0);
+        ENSURE(st->saves + st->save_failures == 1 && !ui->save_queued);
+        ENSURE(pass == 1 ? sp_kiosk_ui_hint_visible(ui) : !sp_kiosk_ui_hint_visible(ui) && sp_kiosk_ui_banner_visible(ui));
         updates_until(k, &t, t + 1500);
         if (pass == 0) {
             // The same kiosk start gives the same first free code: make its postcard's name a folder.

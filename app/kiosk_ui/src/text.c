@@ -44,6 +44,7 @@ static const char* const k_text[SP_KTEXT_COUNT] = {
     // code in the kiosk's export folder, where staff find them.
     [SP_KTEXT_CODE_USE] = "Keep this code: a guide can find your dragon's postcard with it",
     [SP_KTEXT_SAVE_FAILED] = "Sorry, saving did not work. Please ask a guide",
+    [SP_KTEXT_SAVING] = "Saving your dragon...",
     [SP_KTEXT_COUNTDOWN] = "Still drawing? Touch the screen",
     [SP_KTEXT_LOADING] = "Getting the dragon parts ready...",
     [SP_KTEXT_POSTCARD_TITLE] = "My dragon",

@@ -878,6 +878,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             ui->banner_until = ui->now + ui->desc.banner_ms; // same dragon: same code, no new files
         } else if (push_job(ui, SP_KJOB_SAVE)) {
             ui->save_queued = true;
+            set_hint(ui, sp_kiosk_text(SP_KTEXT_SAVING));
         }
         break;
     case SP_KT_CHIP_LABEL:
@@ -1039,6 +1040,15 @@ void sp_kiosk_ui_event(sp_kiosk_ui* ui, const sp_kiosk_event* ev)
 
 // ------------------------------------------------------------------ results
 
+sp_kiosk_job_kind sp_kiosk_ui_peek_job(const sp_kiosk_ui* ui)
+{
+    for (int i = 0; i < ui->job_count; ++i) {
+        const sp_kiosk_job* j = &ui->jobs[(ui->job_head + i) % SP_KIOSK_JOBS_MAX];
+        if (j->kind != SP_KJOB_NONE) return j->kind;
+    }
+    return SP_KJOB_NONE;
+}
+
 bool sp_kiosk_ui_next_job(sp_kiosk_ui* ui, sp_kiosk_job* job)
 {
     while (ui->job_count > 0) {
@@ -1188,6 +1198,7 @@ void sp_kiosk_ui_saved(sp_kiosk_ui* ui, bool ok, const char* code)
         ui->banner_until = ui->now + ui->desc.banner_ms;
         snprintf(ui->banner[0], sizeof ui->banner[0], "%s %s", sp_kiosk_text(SP_KTEXT_SAVED), ui->code);
         snprintf(ui->banner[1], sizeof ui->banner[1], "%s", sp_kiosk_text(SP_KTEXT_CODE_USE));
+        if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_SAVING))) ui->hint_until = -1; // the banner says it now
     } else {
         set_hint(ui, sp_kiosk_text(SP_KTEXT_SAVE_FAILED));
     }

@@ -56,6 +56,7 @@ typedef enum sp_kiosk_text_id {
     SP_KTEXT_SAVED,                 ///< the save banner's first line, before the code
     SP_KTEXT_CODE_USE,              ///< the save banner's second line: what the code is for
     SP_KTEXT_SAVE_FAILED,           ///< saving failed
+    SP_KTEXT_SAVING,                ///< Save tapped: shown while the dragon and its postcard are written
     SP_KTEXT_COUNTDOWN,             ///< under the idle countdown
     SP_KTEXT_LOADING,               ///< the first start, while the database is built
     SP_KTEXT_POSTCARD_TITLE,        ///< on the saved postcard

@@ -280,6 +280,8 @@ void sp_kiosk_ui_resize(sp_kiosk_ui* ui, int width, int height, double px_per_mm
 void sp_kiosk_ui_event(sp_kiosk_ui* ui, const sp_kiosk_event* ev);
 /// The next job in order; false when there is none.
 bool sp_kiosk_ui_next_job(sp_kiosk_ui* ui, sp_kiosk_job* job);
+/// The kind of the job sp_kiosk_ui_next_job would give (SP_KJOB_NONE when none).
+sp_kiosk_job_kind sp_kiosk_ui_peek_job(const sp_kiosk_ui* ui);
 /// Reports a FIT or REFIT job's result.
 void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r);
 /// Reports the parts after UNDO or CLEAR (label NULL or label->category NULL: no part left).
