@@ -139,18 +139,6 @@ const char* db_who(const char* by)
     return u && *u ? u : "unknown";
 }
 
-bool db_name_ok(const char* s)
-{
-    size_t n = s ? strlen(s) : 0;
-    if (n == 0 || n >= SP_NAME_MAX || s[0] == '.') return false;
-    for (size_t i = 0; i < n; ++i) {
-        char c = s[i];
-        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.'))
-            return false;
-    }
-    return true;
-}
-
 sp_result db_read_json(const char* path, cJSON** root, sp_error* err)
 {
     void* text;

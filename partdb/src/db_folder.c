@@ -12,6 +12,7 @@
 #include "db_internal.h"
 #include "sp/concept.h"
 #include "sp/math.h"
+#include "sp/part.h"
 
 // ---- export ----------------------------------------------------------------------
 // An export is written into a fresh folder beside DIR (same parent, so that
@@ -311,7 +312,7 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
         cJSON_ArrayForEach(it, sketches)
         {
             const char *file = jstr(it, "file"), *cat = jstr(it, "category");
-            if (!file || !cat || strstr(file, "..") || !db_name_ok(cat)) {
+            if (!file || !cat || strstr(file, "..") || !sp_part_name_is_plain(cat)) {
                 r = sp_fail(err, SP_ERR_PARSE, "%s/manifest.json: a sketch entry without a file or a plain category", dir);
                 break;
             }

@@ -46,8 +46,6 @@ sp_result db_prepare(sp_db* db, const char* sql, sqlite3_stmt** st, sp_error* er
 sp_result db_log_row(sp_db* db, const char* by, const char* action, const char* subject, const char* details, sp_error* err);
 /// The curator's name: `by` if given, else $USER, else "unknown".
 const char* db_who(const char* by);
-/// True for names that are safe as file and folder names: [A-Za-z0-9_.-], 1..63, not starting with '.'.
-bool db_name_ok(const char* s);
 
 /// Inserts one sketch (strokes or raster) inside the caller's transaction.
 sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source, int64_t part_id, const sp_sample* smp,

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "db_internal.h"
+#include "sp/part.h"
 
 static const char* const k_status[SP_DB_STATUS_COUNT] = {"pending", "approved", "rejected"};
 
@@ -25,7 +26,7 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
                                      int64_t* id, sp_error* err)
 {
     if (id) *id = 0;
-    if (!db_name_ok(category))
+    if (!sp_part_name_is_plain(category))
         return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: category '%s' is not a plain name; sketch dropped", db->path,
                        category ? category : "");
     if (!stroke || stroke->count < 2 || stroke->count > 65536)

@@ -6,6 +6,7 @@
 
 #include "db_internal.h"
 #include "sp/handdraw.h"
+#include "sp/part.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
 
@@ -104,7 +105,8 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
     if (rig->vertex_count == 0 || rig->triangle_count == 0) add_reason(reasons, sizeof reasons, "no triangle mesh");
     const char* category = d && d->category ? d->category : part_name(ch.part.category);
     if (!category) add_reason(reasons, sizeof reasons, "no category (give --category or the scene's extras.sp_part.category)");
-    else if (!db_name_ok(category)) add_reason(reasons, sizeof reasons, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", category);
+    else if (!sp_part_name_is_plain(category))
+        add_reason(reasons, sizeof reasons, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", category);
     int a = pick_abstraction(&ch, d);
     if (a < 0) add_reason(reasons, sizeof reasons, "no sketch abstraction%s%s", d && d->abstraction ? " named " : "",
                           d && d->abstraction ? d->abstraction : "");
@@ -250,7 +252,7 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
                           sp_db_part_info* info_out, sp_error* err)
 {
     sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
-    if (!d.name || !db_name_ok(d.name))
+    if (!d.name || !sp_part_name_is_plain(d.name))
         return sp_fail(err, SP_ERR_INVALID, "part name '%s' is not a plain name ([A-Za-z0-9_.-], < 64 chars)", d.name ? d.name : "");
     sp_db_part_info info;
     sp_character ch = {0};

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "db_internal.h"
+#include "sp/part.h"
 #include "sp/sketch_io.h"
 
 const char* sp_db_source_name(sp_db_source s)
@@ -118,7 +119,7 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
         char what[96];
         snprintf(what, sizeof what, "drawing %d", i);
         if (s->label < 0 || s->label >= data->category_count) return sp_fail(err, SP_ERR_INVALID, "%s: no category", what);
-        if (!db_name_ok(data->categories[s->label]))
+        if (!sp_part_name_is_plain(data->categories[s->label]))
             return sp_fail(err, SP_ERR_INVALID, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", data->categories[s->label]);
         sp_result r = db_sample_ok(s, what, err);
         if (r != SP_OK) return r;

@@ -584,8 +584,12 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         return sp_fail(err, SP_ERR_INVALID, "abstraction '%s': a derived part's sketches show its outline or its stick figure",
                        abstraction);
     const char* category = d.category ? d.category : src->part.category[0] ? src->part.category : NULL;
-    if (category && (!*category || strlen(category) >= SP_NAME_MAX))
-        return sp_fail(err, SP_ERR_INVALID, "category '%s': a name of 1 to %d characters", category, SP_NAME_MAX - 1);
+    // Refused here, as the part database would refuse it later (after the work).
+    if (category && !sp_part_name_is_plain(category))
+        return sp_fail(err, SP_ERR_INVALID,
+                       "category '%s': not a plain name ([A-Za-z0-9_.-], 1 to %d characters, not starting with '.'), as the "
+                       "part database takes it",
+                       category, SP_NAME_MAX - 1);
 
     work w = {0};
     w.src = src;

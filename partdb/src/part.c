@@ -340,3 +340,15 @@ sp_result sp_part_copy(const sp_part* src, sp_part* dst, sp_error* err)
     sp_part_free(dst);
     return sp_fail(err, SP_ERR_NO_MEMORY, "sp_part: out of memory");
 }
+
+bool sp_part_name_is_plain(const char* s)
+{
+    size_t n = s ? strlen(s) : 0;
+    if (n == 0 || n >= SP_NAME_MAX || s[0] == '.') return false;
+    for (size_t i = 0; i < n; ++i) {
+        char c = s[i];
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.'))
+            return false;
+    }
+    return true;
+}

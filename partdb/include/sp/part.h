@@ -85,6 +85,10 @@ sp_result sp_part_write_json(const sp_part* part, char** json, sp_error* err);
 sp_result sp_part_copy(const sp_part* src, sp_part* dst, sp_error* err);
 /// Frees what the part owns and zeroes it.
 void sp_part_free(sp_part* part);
+/// Whether s is a plain name, as the part database takes part names and
+/// categories (they name files and folders of an export): [A-Za-z0-9_.-], 1
+/// to SP_NAME_MAX - 1 characters, not starting with '.'.
+bool sp_part_name_is_plain(const char* s);
 
 #ifdef __cplusplus
 }
