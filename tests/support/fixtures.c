@@ -158,14 +158,25 @@ cJSON* sp_fixture_glb_json(const char* path)
     return j;
 }
 
-cJSON* sp_fixture_json_file(const char* path)
+char* sp_fixture_file_text(const char* path, size_t* n)
 {
     FILE* f = fopen(path, "rb");
     ENSURE(f);
-    char* text = calloc(1, 1 << 22);
-    ENSURE(text);
-    size_t got = fread(text, 1, (1 << 22) - 1, f);
+    ENSURE(fseek(f, 0, SEEK_END) == 0);
+    long len = ftell(f);
+    ENSURE(len >= 0 && fseek(f, 0, SEEK_SET) == 0);
+    char* t = malloc((size_t)len + 1);
+    ENSURE(t && fread(t, 1, (size_t)len, f) == (size_t)len);
     fclose(f);
+    t[len] = '\0';
+    if (n) *n = (size_t)len;
+    return t;
+}
+
+cJSON* sp_fixture_json_file(const char* path)
+{
+    size_t got = 0;
+    char* text = sp_fixture_file_text(path, &got);
     ENSURE(got > 0);
     cJSON* j = cJSON_Parse(text);
     free(text);

@@ -42,7 +42,11 @@ void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplit
 /// no GLB or its JSON does not parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_glb_json(const char* path);
 
-/// A JSON file (up to 4 MiB), parsed (fails the running test when it does
+/// A whole file as text (malloc'd, NUL-terminated; *n its bytes, n may be
+/// NULL); fails the running test when it does not read.
+char* sp_fixture_file_text(const char* path, size_t* n);
+
+/// A JSON file, parsed (fails the running test when it does
 /// not read or parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_json_file(const char* path);
 

@@ -1242,14 +1242,11 @@ static void test_corrupt_part(void)
     snprintf(log, sizeof log, "%s", sp_test_tmp_path("dragon_corrupt.txt"));
     snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' > /dev/null 2> '%s'", SP_SKETCHPOSE, path, strokes, log);
     ENSURE(system(cmd) != 0);
-    FILE* f = fopen(log, "rb");
-    ENSURE(f);
-    char text[4096] = {0};
-    size_t got = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    fprintf(stderr, "%.*s", (int)got, text);
+    char* text = sp_fixture_file_text(log, NULL);
+    fprintf(stderr, "%s", text);
     ENSURE(strstr(text, "stroke 0 left out (no_part: ") && strstr(text, "does not match its checksum") &&
            strstr(text, "no stroke became a part"));
+    free(text);
     free(tail), free(torso);
     remove_db(path);
 }

@@ -401,20 +401,12 @@ static double write_dragon_script(const char* path, double* t_flash, double* t_e
     end = t + 5000;
     script_close(&s);
     // end_ms goes in the header: rewrite it (the file is small).
-    FILE* f = fopen(path, "rb");
-    ENSURE(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char* text = malloc((size_t)n + 1);
-    ENSURE(fread(text, 1, (size_t)n, f) == (size_t)n);
-    text[n] = 0;
-    fclose(f);
+    char* text = sp_fixture_file_text(path, NULL);
     char head[64];
     snprintf(head, sizeof head, "\"end_ms\": %.0f,", end);
     char* at = strstr(text, "\"end_ms\": 0,");
     ENSURE(at);
-    f = fopen(path, "wb");
+    FILE* f = fopen(path, "wb");
     fwrite(text, 1, (size_t)(at - text), f);
     fputs(head, f);
     fputs(at + strlen("\"end_ms\": 0,"), f);

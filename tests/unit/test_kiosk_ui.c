@@ -1342,28 +1342,12 @@ static void run_session(const sp_kiosk_session* s, double frame_ms, uint64_t see
     *out = ui;
 }
 
-// The whole file as text (malloc'd, NUL-terminated).
-static char* file_text(const char* path, size_t* n)
-{
-    FILE* f = fopen(path, "rb");
-    ENSURE(f);
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char* t = malloc((size_t)len + 1);
-    ENSURE(t && fread(t, 1, (size_t)len, f) == (size_t)len);
-    fclose(f);
-    t[len] = '\0';
-    *n = (size_t)len;
-    return t;
-}
-
 // A recording written again past a file-size limit (a full disk) fails and
 // leaves the one already there byte for byte, with no temporary beside it.
 static void recording_written_whole(const char* path, const sp_kiosk_session* rec)
 {
     size_t n0;
-    char* before = file_text(path, &n0);
+    char* before = sp_fixture_file_text(path, &n0);
     pid_t pid = fork();
     ENSURE(pid >= 0);
     if (pid == 0) {
@@ -1377,7 +1361,7 @@ static void recording_written_whole(const char* path, const sp_kiosk_session* re
     int status = 0;
     ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
     size_t n1;
-    char* after = file_text(path, &n1);
+    char* after = sp_fixture_file_text(path, &n1);
     ENSURE(n1 == n0 && memcmp(before, after, n0) == 0);
     free(before), free(after);
     char dir[1024];
