@@ -11,24 +11,24 @@
 #include "posing.h"
 #include "solve_cmd.h"
 
-// "0,0.5,1.2" -> times; false if malformed or not increasing. The .glb
-// stores times as floats: 1e300 would overflow and 1e-300 fall to 0, and the
-// file would not load again, so they must increase as floats too.
+// "0,0.5,1.2" -> times; false if malformed, negative or not times an
+// animation can store (sp_animation_check_times: the .glb stores floats, so
+// 1e300 would overflow, 1e-300 fall to 0, and the file would not load again).
 static bool parse_times(const char* s, double* t, int n)
 {
     const char* at = s;
     for (int i = 0; i < n; ++i) {
         char* end = NULL;
         t[i] = strtod(at, &end);
-        if (end == at || !isfinite(t[i]) || t[i] < 0 || t[i] > FLT_MAX || (i > 0 && !((float)t[i] > (float)t[i - 1])))
-            return false;
+        if (end == at || !(t[i] >= 0)) return false;
         at = end;
         if (i + 1 < n) {
             if (*at != ',') return false;
             ++at;
         }
     }
-    return *at == 0;
+    sp_error ignored = {0}; // the caller's message says what times are wanted
+    return *at == 0 && sp_animation_check_times(t, n, &ignored) == SP_OK;
 }
 
 int cmd_animate(int argc, char** argv)

@@ -434,20 +434,27 @@ void sp_animation_sample(const sp_animation* anim, double t, sp_vec3* trans, sp_
     }
 }
 
+sp_result sp_animation_check_times(const double* times, int n, sp_error* err)
+{
+    // Channels store times as floats: they must fit one and still increase.
+    for (int k = 0; k < n; ++k)
+        if (!isfinite(times[k]) || fabs(times[k]) > FLT_MAX)
+            return sp_fail(err, SP_ERR_INVALID, "key time %d (%g) is not a finite single-precision number", k, times[k]);
+    for (int k = 1; k < n; ++k)
+        if (!((float)times[k] > (float)times[k - 1]))
+            return sp_fail(err, SP_ERR_INVALID, "key times must increase in single precision (key %d: %.9g after %.9g)", k,
+                           times[k], times[k - 1]);
+    return SP_OK;
+}
+
 sp_result sp_animation_from_keys(const sp_rig* rig, const double* keys, const double* times, int nkeys, const char* name,
                                  sp_animation* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
     snprintf(out->name, sizeof out->name, "%s", name);
     if (nkeys < 1) return sp_fail(err, SP_ERR_INVALID, "an animation needs at least one key");
-    // Channels store times as floats: they must fit one and still increase.
-    for (int k = 0; k < nkeys; ++k)
-        if (!isfinite(times[k]) || fabs(times[k]) > FLT_MAX)
-            return sp_fail(err, SP_ERR_INVALID, "key time %d (%g) is not a finite single-precision number", k, times[k]);
-    for (int k = 1; k < nkeys; ++k)
-        if (!((float)times[k] > (float)times[k - 1]))
-            return sp_fail(err, SP_ERR_INVALID, "key times must increase in single precision (key %d: %.9g after %.9g)", k,
-                           times[k], times[k - 1]);
+    sp_result r = sp_animation_check_times(times, nkeys, err);
+    if (r != SP_OK) return r;
     // Up to three channels per joint with parameters.
     out->channels = calloc((size_t)rig->joint_count * 3, sizeof(sp_anim_channel));
     if (!out->channels) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");

@@ -199,6 +199,10 @@ void sp_rig_params_from_trs(const sp_rig* rig, int joint, sp_vec3 t, sp_quat r, 
 /// Samples an animation at time t (seconds, clamped to its range) into
 /// per-joint local TRS arrays, which the caller pre-fills (e.g. with rest).
 void sp_animation_sample(const sp_animation* anim, double t, sp_vec3* trans, sp_quat* rot, sp_vec3* scale);
+/// Whether n key times can be an animation's: finite, at most FLT_MAX in
+/// magnitude and increasing in single precision (glTF stores float times).
+/// SP_ERR_INVALID (one line naming the key) when not.
+sp_result sp_animation_check_times(const double* times, int n, sp_error* err);
 /// A glTF-style animation that passes through key poses: keys is nkeys by
 /// rig->param_count, times nkeys seconds (finite, increasing as floats, as the
 /// channels store them). Every joint with
