@@ -1,8 +1,10 @@
 // db_folder.c: export to and import from a folder, and the default database
 // built from assets/.
+#define _XOPEN_SOURCE 700 // nftw
 #include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
+#include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,24 +29,18 @@ typedef struct export_dir {
     bool exists;
 } export_dir;
 
-// Removes a folder the export made and everything in it; symbolic links are
-// not followed (the export makes none).
+static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    remove(path);
+    return 0; // on past what cannot be removed: the rest still goes
+}
+
+// Removes a folder the export made and everything in it, deepest first;
+// symbolic links are not followed (the export makes none).
 static void remove_tree(const char* path)
 {
-    DIR* d = opendir(path);
-    struct dirent* e;
-    while (d && (e = readdir(d))) {
-        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-        char sub[1400];
-        snprintf(sub, sizeof sub, "%s/%s", path, e->d_name);
-        struct stat st;
-        if (lstat(sub, &st) == 0 && S_ISDIR(st.st_mode))
-            remove_tree(sub);
-        else
-            unlink(sub);
-    }
-    if (d) closedir(d);
-    rmdir(path);
+    nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
 static sp_result not_empty(const char* dir, sp_error* err)
