@@ -14,12 +14,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "feat.h"
 #include "cv_adapter.h"
+#include "feat.h"
 #include "kmeans.h"
 #include "picture.h"
 #include "shape.h"
 #include "sp/math.h"
+#include "sp/sketch_io.h"
 
 struct sp_clf {
     sp_clf_desc desc; // resolved, progress NULL
@@ -1210,9 +1211,12 @@ static void put_f64(wbuf* b, double v)
     put(b, &v, 8);
 }
 
-sp_result sp_clf_save(const sp_clf* c, const char* path, sp_error* err)
+sp_result sp_clf_to_bytes(const sp_clf* c, void** bytes, size_t* size, sp_error* err)
 {
+    *bytes = NULL, *size = 0;
     wbuf b = {0};
+    const size_t head = 24; // magic, version, byte order, body length: filled in once the body is known
+    put(&b, (const unsigned char[24]){0}, head);
     const sp_clf_desc* d = &c->desc;
     int32_t ints[] = {d->words, d->vocab_samples, d->kmeans_iterations, d->soft_neighbours, d->knn, d->pyramid,
                       d->tfidf, d->hellinger, d->mirror, d->augment, (int32_t)d->seed,
@@ -1252,22 +1256,29 @@ sp_result sp_clf_save(const sp_clf* c, const char* path, sp_error* err)
     put_f32(&b, c->pic_bandwidth);
     put(&b, c->pics, sizeof(float) * (size_t)c->pic_count * SP_PICTURE_DIM);
     put(&b, c->pic_labels, sizeof(int32_t) * (size_t)c->pic_count);
+    uint32_t version = SP_CLF_FILE_VERSION, bom = SP_CLF_BOM;
+    uint64_t len = b.n - head, sum = b.oom ? 0 : fnv1a(b.p + head, len);
+    put(&b, &sum, 8);
     if (b.oom) {
         free(b.p);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "classifier model: out of memory");
     }
-    FILE* f = fopen(path, "wb");
-    if (!f) {
-        free(b.p);
-        return sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
-    }
-    uint32_t version = SP_CLF_FILE_VERSION, bom = SP_CLF_BOM;
-    uint64_t len = b.n, sum = fnv1a(b.p, b.n);
-    bool ok = fwrite(k_magic, 8, 1, f) == 1 && fwrite(&version, 4, 1, f) == 1 && fwrite(&bom, 4, 1, f) == 1 &&
-              fwrite(&len, 8, 1, f) == 1 && fwrite(b.p, 1, b.n, f) == b.n && fwrite(&sum, 8, 1, f) == 1;
-    free(b.p);
-    if (fclose(f) != 0 || !ok) return sp_fail(err, SP_ERR_IO, "%s: write failed", path);
+    memcpy(b.p, k_magic, 8);
+    memcpy(b.p + 8, &version, 4);
+    memcpy(b.p + 12, &bom, 4);
+    memcpy(b.p + 16, &len, 8);
+    *bytes = b.p, *size = b.n;
     return SP_OK;
+}
+
+sp_result sp_clf_save(const sp_clf* c, const char* path, sp_error* err)
+{
+    void* bytes;
+    size_t size;
+    sp_result r = sp_clf_to_bytes(c, &bytes, &size, err);
+    if (r == SP_OK) r = sp_file_write(path, bytes, size, err); // whole: a model file is never left half replaced
+    free(bytes);
+    return r;
 }
 
 typedef struct rbuf {
@@ -1322,58 +1333,32 @@ static sp_result get_rows(rbuf* b, int count, int dim, int categories, float** r
     return b->bad || !all_finite(*rows, (size_t)dim * (size_t)count) ? SP_ERR_PARSE : SP_OK;
 }
 
-sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
+sp_result sp_clf_from_bytes(const void* bytes, size_t size, const char* what, sp_clf** out, sp_error* err)
 {
     *out = NULL;
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
-    unsigned char hdr[24];
-    size_t got = fread(hdr, 1, sizeof hdr, f);
-    if (got < 8 || memcmp(hdr, k_magic, 8) != 0) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_PARSE, "%s: not a sketchpose classifier model", path);
-    }
-    if (got < sizeof hdr) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_PARSE, "%s: model file truncated (header)", path);
-    }
+    const unsigned char* hdr = bytes;
+    if (size < 8 || memcmp(hdr, k_magic, 8) != 0)
+        return sp_fail(err, SP_ERR_PARSE, "%s: not a sketchpose classifier model", what);
+    if (size < 24) return sp_fail(err, SP_ERR_PARSE, "%s: model file truncated (header)", what);
     uint32_t version, bom;
     uint64_t len;
     memcpy(&version, hdr + 8, 4);
     memcpy(&bom, hdr + 12, 4);
     memcpy(&len, hdr + 16, 8);
-    if (bom != SP_CLF_BOM) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model written on a machine of other byte order", path);
-    }
-    if (version < 1 || version > SP_CLF_FILE_VERSION) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model format version %u, this build reads versions 1 to %d (retrain)", path,
+    if (bom != SP_CLF_BOM) return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model written on a machine of other byte order", what);
+    if (version < 1 || version > SP_CLF_FILE_VERSION)
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: model format version %u, this build reads versions 1 to %d (retrain)", what,
                        version, SP_CLF_FILE_VERSION);
-    }
-    if (len > (uint64_t)1 << 32) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_PARSE, "%s: model header claims %llu bytes (corrupt)", path, (unsigned long long)len);
-    }
-    unsigned char* p = malloc((size_t)len + 8);
-    if (!p) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    }
-    got = fread(p, 1, (size_t)len + 8, f);
-    int extra = fgetc(f);
-    fclose(f);
-    if (got < len + 8) {
-        free(p);
-        return sp_fail(err, SP_ERR_PARSE, "%s: model file truncated (%zu of %llu bytes)", path, got + 24,
+    if (len > (uint64_t)1 << 32)
+        return sp_fail(err, SP_ERR_PARSE, "%s: model header claims %llu bytes (corrupt)", what, (unsigned long long)len);
+    if (size - 24 < len + 8)
+        return sp_fail(err, SP_ERR_PARSE, "%s: model file truncated (%zu of %llu bytes)", what, size,
                        (unsigned long long)len + 32);
-    }
+    const unsigned char* p = hdr + 24;
     uint64_t sum;
     memcpy(&sum, p + len, 8);
-    if (extra != EOF || sum != fnv1a(p, (size_t)len)) {
-        free(p);
-        return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (checksum mismatch)", path);
-    }
+    if (size - 24 != len + 8 || sum != fnv1a(p, (size_t)len))
+        return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (checksum mismatch)", what);
     rbuf b = {p, (size_t)len, 0, false};
     sp_clf* c = calloc(1, sizeof *c);
     sp_result rc = SP_OK;
@@ -1447,7 +1432,6 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
     }
     if (b.bad || b.at != b.n || !(c->bandwidth > 0) || isnan(c->reject)) goto corrupt;
     if (!all_finite(c->vocab, (size_t)c->words * SP_FEAT_DIM) || (c->idf && !all_finite(c->idf, (size_t)c->words))) goto corrupt;
-    free(p);
     if ((rc = build_vocab_index(c, err)) != SP_OK || (rc = build_hist_index(c, err)) != SP_OK) {
         sp_clf_destroy(c);
         return rc;
@@ -1457,11 +1441,42 @@ sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
 bad_rows:
     if (rc == SP_ERR_NO_MEMORY) goto oom;
 corrupt:
-    free(p);
     sp_clf_destroy(c);
-    return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (inconsistent contents)", path);
+    return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (inconsistent contents)", what);
 oom:
-    free(p);
     sp_clf_destroy(c);
-    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+}
+
+sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
+{
+    *out = NULL;
+    FILE* f = fopen(path, "rb");
+    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    // Read in growing blocks: a model's size is not known before its header,
+    // and a FIFO or a device has none.
+    unsigned char* data = NULL;
+    size_t n = 0, cap = 0;
+    bool oom = false;
+    for (;;) {
+        if (n == cap) {
+            if (cap > ((size_t)1 << 32) + 32) break; // more than any model holds: refused as corrupt below
+            unsigned char* g = realloc(data, cap = cap ? 2 * cap : 1 << 16);
+            if (!g) {
+                oom = true;
+                break;
+            }
+            data = g;
+        }
+        size_t got = fread(data + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) break;
+    }
+    bool failed = ferror(f) != 0;
+    fclose(f);
+    sp_result r = oom      ? sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path)
+                  : failed ? sp_fail(err, SP_ERR_IO, "%s: read error", path)
+                           : sp_clf_from_bytes(data, n, path, out, err);
+    free(data);
+    return r;
 }

@@ -4,52 +4,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "db_internal.h"
 #include "sp/clock.h"
 #include "sp/handdraw.h"
-
-// The classifier reads and writes model files; the database keeps the file's
-// bytes as they are (its own version header and checksum included), going
-// through a private temporary file.
-static sp_result temp_path(char* buf, size_t cap, int* fd, sp_error* err)
-{
-    const char* dir = getenv("TMPDIR");
-    snprintf(buf, cap, "%s/sp-model-XXXXXX", dir && *dir ? dir : "/tmp");
-    *fd = mkstemp(buf);
-    return *fd >= 0 ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: cannot create a temporary file", buf);
-}
-
-static sp_result model_to_bytes(const sp_clf* clf, void** bytes, size_t* size, sp_error* err)
-{
-    char path[512];
-    int fd;
-    sp_result r = temp_path(path, sizeof path, &fd, err);
-    if (r != SP_OK) return r;
-    close(fd);
-    r = sp_clf_save(clf, path, err);
-    if (r == SP_OK) r = db_read_file(path, bytes, size, err);
-    unlink(path);
-    return r;
-}
-
-static sp_result model_from_bytes(const void* bytes, size_t size, const char* what, sp_clf** out, sp_error* err)
-{
-    char path[512];
-    int fd;
-    sp_result r = temp_path(path, sizeof path, &fd, err);
-    if (r != SP_OK) return r;
-    close(fd);
-    r = db_write_file(path, bytes, size, err);
-    if (r == SP_OK) {
-        sp_error e = {0};
-        r = sp_clf_load(path, out, &e);
-        if (r != SP_OK) sp_fail(err, r, "%s: stored model: %s", what, e.text);
-    }
-    unlink(path);
-    return r;
-}
 
 static double now_s(void)
 {
@@ -184,7 +142,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
         if (r != SP_OK) goto done;
     }
     t_train = now_s() - t_train;
-    if ((r = model_to_bytes(clf, &bytes, &size, err)) != SP_OK) goto done;
+    if ((r = sp_clf_to_bytes(clf, &bytes, &size, err)) != SP_OK) goto done;
     sp_clf_desc resolved = sp_clf_get_desc(clf);
     opts = desc_json(&resolved);
     db_str cb = {0};
@@ -284,7 +242,8 @@ sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err)
         snprintf(what, sizeof what, "%s: model %lld", db->path, (long long)sqlite3_column_int64(st, 0));
         if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0)
             r = sp_fail(err, SP_ERR_PARSE, "%s: stored bytes do not match the checksum", what);
-        else r = model_from_bytes(b, n, what, out, err);
+        else
+            r = sp_clf_from_bytes(b, n, what, out, err);
         if (r == SP_OK && id) *id = sqlite3_column_int64(st, 0);
     } else if (rc == SQLITE_DONE) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: no trained model (run `sketchpose db train`)", db->path);

@@ -128,10 +128,16 @@ sp_result sp_clf_calibrate_reject(sp_clf* clf, const sp_dataset* held_out, const
                                   float* distances, int* count, sp_error* err);
 /// The reject threshold (histogram distance; INFINITY: never rejects).
 float sp_clf_reject_distance(const sp_clf* clf);
-/// Saves with a version header and a checksum.
+/// Saves with a version header and a checksum, written whole (sp_file_write).
 sp_result sp_clf_save(const sp_clf* clf, const char* path, sp_error* err);
 /// Loads a model; a corrupt, truncated or other-version file is refused with a clear message.
 sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err);
+/// The model file's bytes in memory (*bytes malloc'd, the caller frees), for
+/// stores that keep models themselves (the part database).
+sp_result sp_clf_to_bytes(const sp_clf* clf, void** bytes, size_t* size, sp_error* err);
+/// A model from a model file's bytes; messages begin with `what` (a path, or
+/// "DB: model 3").
+sp_result sp_clf_from_bytes(const void* bytes, size_t size, const char* what, sp_clf** out, sp_error* err);
 /// Frees the model (NULL is fine).
 void sp_clf_destroy(sp_clf* clf);
 
