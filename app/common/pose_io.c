@@ -1,6 +1,8 @@
 // pose_io.c: reading and writing pose files (see pose_io.h).
 #include "pose_io.h"
 
+#include "sp/sketch_io.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -107,14 +109,15 @@ sp_result sp_pose_write(const char* path, const sp_param* params, int count, con
     cJSON* root = sp_pose_to_json(params, count, p);
     char* text = root ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
-    if (!text) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    FILE* f = fopen(path, "wb");
-    if (!f) {
+    size_t n = text ? strlen(text) : 0;
+    char* line = text ? realloc(text, n + 2) : NULL;
+    if (!line) {
         free(text);
-        return sp_fail(err, SP_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     }
-    bool ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    ok = fclose(f) == 0 && ok;
-    free(text);
-    return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write error", path);
+    line[n] = '\n';
+    // Written whole: a pose file the user had is never left half overwritten.
+    sp_result r = sp_file_write(path, line, n + 1, err);
+    free(line);
+    return r;
 }

@@ -4,11 +4,16 @@
 // rig handle on both kinds of rig.
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "fixtures.h"
+#include "pose_io.h"
 #include "posing.h"
 #include "rig_handle.h"
 #include "sp/blackbox.h"
@@ -504,6 +509,49 @@ static void test_pose_option_ranges(void)
     ENSURE(run(cmd) == 1);
 }
 
+// A pose file is written whole (`synth --truth`): a write that fails part-way
+// (here a file size limit, as on a full disk) leaves the old file as it was.
+static void test_pose_file_whole(void)
+{
+    sp_param params[40];
+    double p[40];
+    memset(params, 0, sizeof params);
+    for (int i = 0; i < 40; ++i) {
+        snprintf(params[i].name, sizeof params[i].name, "joint_%02d.rx", i);
+        params[i].min = -1, params[i].max = 1;
+        p[i] = 0.01 * i;
+    }
+    const char* path = sp_test_tmp_path("whole_pose.json");
+    sp_error err = {0};
+    ENSURE(sp_pose_write(path, params, 2, p, &err) == SP_OK);
+    double back[2] = {0};
+    ENSURE(sp_pose_read(path, params, 2, back, NULL, &err) == SP_OK && back[1] == p[1]);
+    FILE* f = fopen(path, "rb");
+    char before[4096];
+    size_t n = f ? fread(before, 1, sizeof before, f) : 0;
+    if (f) fclose(f);
+    ENSURE(n > 10 && n < 256);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit rl = {.rlim_cur = 256, .rlim_max = RLIM_INFINITY};
+        if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(3);
+        sp_error e = {0};
+        sp_result r = sp_pose_write(path, params, 40, p, &e); // about 1 KB
+        fprintf(stderr, "  under a 256-byte file limit: %s\n", r == SP_OK ? "written" : e.text);
+        _exit(r == SP_ERR_IO && strstr(e.text, "whole_pose.json") ? 0 : 1);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    char after[4096];
+    f = fopen(path, "rb");
+    size_t m = f ? fread(after, 1, sizeof after, f) : 0;
+    if (f) fclose(f);
+    ENSURE(m == n && !memcmp(before, after, n));
+    unlink(path);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -516,5 +564,6 @@ int main(int argc, char** argv)
                                    {"rig_handle", test_rig_handle},
                                    {"cli_missing_value", test_cli_missing_value},
                                    {"pose_option_ranges", test_pose_option_ranges},
+                                   {"pose_file_whole", test_pose_file_whole},
                                    {0}});
 }
