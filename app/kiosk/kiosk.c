@@ -626,15 +626,17 @@ static sp_result make_dirs(const char* dir, sp_error* err)
 {
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", dir);
-    for (char* p = buf + 1; *p; ++p) {
-        if (*p != '/') continue;
+    if (!buf[0]) return sp_fail(err, SP_ERR_INVALID, "the export folder is not named");
+    for (char* p = buf + 1;; ++p) { // each folder on the way, then dir itself
+        if (*p && *p != '/') continue;
+        char c = *p;
         *p = 0;
-        if (mkdir(buf, 0755) != 0 && errno != EEXIST)
+        if (mkdir(buf, 0755) == 0)
+            sp_path_sync_folder(buf); // a folder made for the saves survives a power cut with them
+        else if (errno != EEXIST)
             return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-        *p = '/';
+        if (!(*p = c)) return SP_OK;
     }
-    if (mkdir(buf, 0755) != 0 && errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-    return SP_OK;
 }
 
 static void run_save(sp_kiosk* k)

@@ -4,6 +4,7 @@
 #include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +16,7 @@
 #include "sp/concept.h"
 #include "sp/math.h"
 #include "sp/part.h"
+#include "sp/sketch_io.h"
 
 // ---- export ----------------------------------------------------------------------
 // An export is written into a fresh folder beside DIR (same parent, so that
@@ -41,6 +43,25 @@ static int remove_entry(const char* path, const struct stat* st, int flag, struc
 static void remove_tree(const char* path)
 {
     nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+static int sync_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
+{
+    (void)st, (void)ftw;
+    int fd = open(path, O_RDONLY | O_CLOEXEC | (flag == FTW_DP ? O_DIRECTORY : 0));
+    bool ok = fd >= 0 && (fsync(fd) == 0 || errno == EINVAL);
+    int e = errno;
+    if (fd >= 0) close(fd);
+    errno = e; // what sync_tree's caller reports
+    return ok ? 0 : 1;
+}
+
+// Every file and folder of the export on disk before it gets its name, so
+// that after a power cut DIR is a whole export or absent, never one with
+// empty files.
+static bool sync_tree(const char* path)
+{
+    return nftw(path, sync_entry, 16, FTW_DEPTH | FTW_PHYS) == 0;
 }
 
 static sp_result not_empty(const char* dir, sp_error* err)
@@ -104,12 +125,19 @@ static sp_result export_end(export_dir* ex, sp_result r, sp_error* err)
 {
     if (r == SP_OK) {
         if (ex->exists) chmod(ex->tmp, ex->had.st_mode & 07777); // an empty folder replaced keeps its permissions
-        // rename(2) replaces an empty folder and refuses one that is not, so
-        // files put into DIR meanwhile are never lost.
-        if (rename(ex->tmp, ex->final) == 0) return SP_OK;
-        r = errno == ENOTEMPTY || errno == EEXIST
-                ? not_empty(ex->final, err)
-                : sp_fail(err, SP_ERR_IO, "%s: cannot put the export in place (%s)", ex->final, strerror(errno));
+        if (!sync_tree(ex->tmp)) {
+            r = sp_fail(err, SP_ERR_IO, "%s: cannot write the export to disk (%s); no export was written", ex->final,
+                        strerror(errno));
+        } else if (rename(ex->tmp, ex->final) == 0) {
+            // rename(2) replaces an empty folder and refuses one that is not,
+            // so files put into DIR meanwhile are never lost.
+            sp_path_sync_folder(ex->final);
+            return SP_OK;
+        } else {
+            r = errno == ENOTEMPTY || errno == EEXIST
+                    ? not_empty(ex->final, err)
+                    : sp_fail(err, SP_ERR_IO, "%s: cannot put the export in place (%s)", ex->final, strerror(errno));
+        }
     } else if (err) {
         size_t n = strlen(ex->tmp);
         char was[sizeof err->text];
@@ -393,6 +421,8 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     sp_db_close(db);
     if (r == SP_OK && link(tmp, path) != 0)
         r = sp_fail(err, errno == EEXIST ? SP_ERR_BUSY : SP_ERR_IO, "%s: %s", path, strerror(errno));
+    else if (r == SP_OK)
+        sp_path_sync_folder(path); // SQLite synced the file; its new name too
     unlink(tmp);
     char side[1100];
     snprintf(side, sizeof side, "%s-wal", tmp);

@@ -42,6 +42,27 @@ static sp_result write_into(const char* path, const void* data, size_t size, sp_
     return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write error (%s)", path, strerror(e));
 }
 
+bool sp_path_sync_folder(const char* path)
+{
+    size_t n = strlen(path);
+    char* dir = malloc(n + 2);
+    if (!dir) return false;
+    memcpy(dir, path, n + 1);
+    while (n > 1 && dir[n - 1] == '/') // "out/" is held by the folder out is in
+        dir[--n] = 0;
+    char* slash = strrchr(dir, '/');
+    if (!slash)
+        strcpy(dir, ".");
+    else
+        slash[slash == dir] = 0; // "/x" is held by "/"
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    free(dir);
+    if (fd < 0) return false;
+    bool ok = fsync(fd) == 0 || errno == EINVAL; // EINVAL: a file system that cannot sync folders
+    close(fd);
+    return ok;
+}
+
 sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err)
 {
     static atomic_uint serial; // temporary names unique across threads too
@@ -74,8 +95,12 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
     bool ok = fd >= 0;
     if (ok && exists) fchmod(fd, st.st_mode & 07777); // a file replaced keeps its permissions
     if (ok && !write_all(fd, data, size)) ok = false, e = errno;
+    // Synced before the rename: after a power cut the name then holds the
+    // old file or the whole new one, never an empty one.
+    if (ok && fsync(fd) != 0 && errno != EINVAL) ok = false, e = errno;
     if (fd >= 0 && close(fd) != 0 && ok) ok = false, e = errno;
     if (ok && rename(tmp, target) != 0) ok = false, e = errno;
+    if (ok) sp_path_sync_folder(target); // the new name itself survives a power cut (a saved dragon's code)
     if (!ok && fd >= 0) unlink(tmp);
     free(tmp);
     free(real);

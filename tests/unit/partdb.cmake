@@ -7,3 +7,6 @@ target_include_directories(test_partdb PRIVATE ${PROJECT_SOURCE_DIR}/partdb/src)
 if(TARGET sketchpose)
   add_dependencies(test_partdb sketchpose)
 endif()
+# test_partdb's `durable` case records fsync, rename and link through the
+# linker (a write's order of calls is what makes it survive a power cut).
+target_link_options(test_partdb PRIVATE -Wl,--wrap=fsync,--wrap=rename,--wrap=link)

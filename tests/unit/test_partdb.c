@@ -7,8 +7,11 @@
 // The parts are fixture rigs (tests/support/fixtures.h) saved as GLB with an
 // sp_part category, so the test does not depend on assets/.
 // `test_partdb --write-parts DIR` writes them for trying the CLI by hand.
+#define _XOPEN_SOURCE 700 // nftw
 #include <errno.h>
 #include <fcntl.h>
+#include <ftw.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <sqlite3.h>
@@ -26,6 +29,7 @@
 #include "sp/concept.h"
 #include "sp/handdraw.h"
 #include "sp/partdb.h"
+#include "sp/sketch_io.h"
 #include "sp/synth.h"
 #include "test.h"
 
@@ -1765,6 +1769,206 @@ static void test_export_whole(void)
     ENSURE(system(cmd) == 0);
 }
 
+// Models go between the classifier and the database in memory: training and
+// loading work with no usable temporary folder (a kiosk whose /tmp is full or
+// read-only), and a damaged stored model is named by its database and id.
+static void test_model_in_memory(void)
+{
+    const char* p = base_db("model_memory.db");
+    char* was = getenv("TMPDIR") ? strdup(getenv("TMPDIR")) : NULL;
+    setenv("TMPDIR", "/nonexistent/sp-no-tmp", 1);
+    sp_db* db = open_ok(p, 0);
+    train_ok(db, -1, NULL);
+    sp_clf* clf = NULL;
+    sp_error err = {0};
+    int64_t id = 0;
+    ENSURE(sp_db_load_model(db, &clf, &id, &err) == SP_OK && clf && id > 0);
+    sp_clf_destroy(clf);
+    sp_db_close(db);
+    if (was)
+        setenv("TMPDIR", was, 1);
+    else
+        unsetenv("TMPDIR");
+    free(was);
+    // A stored model whose bytes still match their checksum but do not parse.
+    char sql[256];
+    snprintf(sql, sizeof sql, "UPDATE models SET model = X'00', sha256 = '%s' WHERE id = %lld",
+             "6e340b9cffb37a989ca544e6bb780a2c78901d3fb33738768511a30617afa01d", (long long)id);
+    db = open_ok(p, 0);
+    ENSURE(sqlite3_exec(((struct sp_db*)db)->h, sql, NULL, NULL, NULL) == SQLITE_OK);
+    ENSURE(sp_db_load_model(db, &clf, NULL, &err) == SP_ERR_PARSE && !clf);
+    fprintf(stderr, "  %s\n", err.text);
+    char want[1200];
+    snprintf(want, sizeof want, "%s: model %lld: not a sketchpose classifier model", p, (long long)id);
+    ENSURE(!strcmp(err.text, want));
+    sp_db_close(db);
+}
+
+// ---- durability ----------------------------------------------------------------------
+// What makes a write survive a power cut, recorded through the linker's
+// --wrap (partdb.cmake): each fsync(2) by the path its descriptor names, each
+// rename(2) and link(2) by absolute paths, in order.
+
+typedef struct sync_event {
+    char kind; // 'f' fsync, 'r' rename, 'l' link
+    char path[1100], to[1100];
+} sync_event;
+
+static struct {
+    bool on;
+    int n;
+    sync_event ev[4096];
+} g_sync;
+
+int __real_fsync(int fd);
+int __real_rename(const char* from, const char* to);
+int __real_link(const char* from, const char* to);
+
+// `p` made absolute by its folder (which exists; p itself may not any more).
+static void absolute(const char* p, char out[1100])
+{
+    char dir[1100], real[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", p);
+    char* slash = strrchr(dir, '/');
+    const char* base = slash ? slash + 1 : p;
+    if (slash) *slash = 0;
+    if (!realpath(slash ? (dir[0] ? dir : "/") : ".", real)) snprintf(real, sizeof real, "?");
+    snprintf(out, 1100, "%.900s/%.190s", strcmp(real, "/") ? real : "", base); // test paths are far shorter
+}
+
+static sync_event* sync_record(char kind)
+{
+    if (!g_sync.on || g_sync.n == (int)(sizeof g_sync.ev / sizeof g_sync.ev[0])) return NULL;
+    sync_event* e = &g_sync.ev[g_sync.n++];
+    memset(e, 0, sizeof *e);
+    e->kind = kind;
+    return e;
+}
+
+int __wrap_fsync(int fd)
+{
+    sync_event* e = sync_record('f');
+    if (e) {
+        char link[64];
+        snprintf(link, sizeof link, "/proc/self/fd/%d", fd);
+        ssize_t n = readlink(link, e->path, sizeof e->path - 1);
+        e->path[n > 0 ? n : 0] = 0;
+    }
+    return __real_fsync(fd);
+}
+
+// rename(2) or link(2): recorded once it has given `to` its name.
+static int record_naming(char kind, const char* from, const char* to, int (*real)(const char*, const char*))
+{
+    char a[1100], b[1100];
+    absolute(from, a), absolute(to, b);
+    int r = real(from, to);
+    sync_event* e = r == 0 ? sync_record(kind) : NULL;
+    if (e) memcpy(e->path, a, sizeof a), memcpy(e->to, b, sizeof b);
+    return r;
+}
+
+int __wrap_rename(const char* from, const char* to)
+{
+    return record_naming('r', from, to, __real_rename);
+}
+
+int __wrap_link(const char* from, const char* to)
+{
+    return record_naming('l', from, to, __real_link);
+}
+
+static int synced_before(const char* path, int before)
+{
+    for (int i = 0; i < before; ++i)
+        if (g_sync.ev[i].kind == 'f' && !strcmp(g_sync.ev[i].path, path)) return 1;
+    return 0;
+}
+
+// The event that gave `target` its name (kind 'r' or 'l'); its folder must be synced after it.
+static int named_durably(const char* target, char kind)
+{
+    char abs[1100], parent[1100];
+    absolute(target, abs);
+    snprintf(parent, sizeof parent, "%s", abs);
+    *strrchr(parent, '/') = 0;
+    for (int i = 0; i < g_sync.n; ++i) {
+        if (g_sync.ev[i].kind != kind || strcmp(g_sync.ev[i].to, abs)) continue;
+        for (int j = i + 1; j < g_sync.n; ++j)
+            if (g_sync.ev[j].kind == 'f' && !strcmp(g_sync.ev[j].path, parent[0] ? parent : "/")) return i;
+        fprintf(stderr, "  %s: its folder was not synced after it got its name\n", abs);
+        return -1;
+    }
+    fprintf(stderr, "  %s: never got its name by %s\n", abs, kind == 'r' ? "rename" : "link");
+    return -1;
+}
+
+static struct {
+    const char *final, *tmp;
+    int at, missing;
+} g_tree;
+
+static int tree_entry_synced(const char* path, const struct stat* st, int flag, struct FTW* ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    char was[1100];
+    snprintf(was, sizeof was, "%s%s", g_tree.tmp, path + strlen(g_tree.final));
+    if (!synced_before(was, g_tree.at)) {
+        fprintf(stderr, "  %s: not synced before the export took its name\n", path);
+        ++g_tree.missing;
+    }
+    return 0;
+}
+
+// Files written whole are synced before their rename and their folder after
+// it, so that after a power cut a name holds the old file or the whole new
+// one: sp_file_write (new and over an old file), a classifier model, a whole
+// export folder (every file and folder in it), and a database built beside
+// its name and linked into place.
+static void test_durable(void)
+{
+    char db_path[1024], parent[1024], cmd[2400];
+    snprintf(db_path, sizeof db_path, "%s", base_db("durable.db"));
+    snprintf(parent, sizeof parent, "%s", sp_test_tmp_path("durable"));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", parent);
+    ENSURE(system(cmd) == 0 && mkdir(parent, 0755) == 0);
+    char file[1100], model[1100], dir[1100], built[1100];
+    snprintf(file, sizeof file, "%s/file.txt", parent);
+    snprintf(model, sizeof model, "%s/model.spclf", parent);
+    snprintf(dir, sizeof dir, "%s/export", parent);
+    snprintf(built, sizeof built, "%s/built.db", parent);
+    sp_error err = {0};
+    sp_db* db = open_ok(db_path, SP_DB_READONLY);
+    sp_clf* clf = NULL;
+    ENSURE(sp_db_load_model(db, &clf, NULL, &err) == SP_OK);
+
+    g_sync.on = true, g_sync.n = 0;
+    ENSURE(sp_file_write(file, "one\n", 4, &err) == SP_OK);
+    int i = named_durably(file, 'r');
+    ENSURE(i >= 0 && synced_before(g_sync.ev[i].path, i));
+    g_sync.n = 0;
+    ENSURE(sp_file_write(file, "two\n", 4, &err) == SP_OK); // over the old file
+    ENSURE((i = named_durably(file, 'r')) >= 0 && synced_before(g_sync.ev[i].path, i));
+    g_sync.n = 0;
+    ENSURE(sp_clf_save(clf, model, &err) == SP_OK);
+    ENSURE((i = named_durably(model, 'r')) >= 0 && synced_before(g_sync.ev[i].path, i));
+    g_sync.n = 0;
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
+    ENSURE((i = named_durably(dir, 'r')) >= 0);
+    g_tree.final = dir, g_tree.tmp = g_sync.ev[i].path, g_tree.at = i, g_tree.missing = 0;
+    ENSURE(synced_before(g_tree.tmp, i)); // the folder's own entries
+    ENSURE(nftw(dir, tree_entry_synced, 16, FTW_PHYS) == 0 && g_tree.missing == 0);
+    g_sync.n = 0;
+    ENSURE(sp_db_create_from_export(built, dir, NULL, "test", &err) == SP_OK);
+    ENSURE(named_durably(built, 'l') >= 0);
+    g_sync.on = false;
+
+    sp_clf_destroy(clf);
+    sp_db_close(db);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", parent);
+    ENSURE(system(cmd) == 0);
+}
+
 int main(int argc, char** argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write-parts")) {
@@ -1785,6 +1989,8 @@ int main(int argc, char** argv)
                        (sp_test[]){{"sha256", test_sha256},
                                    {"round_trip", test_round_trip},
                                    {"export_whole", test_export_whole},
+                                   {"durable", test_durable},
+                                   {"model_in_memory", test_model_in_memory},
                                    {"curator_category", test_curator_category},
                                    {"crash_add_part", test_crash_add_part},
                                    {"crash_train", test_crash_train},

@@ -98,10 +98,16 @@ sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 /// Reads a whole drawing file into *out (malloc'd, NUL-terminated, *len
 /// bytes without the NUL): regular files of at most SP_SKETCH_MAX_FILE_BYTES.
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
+/// Syncs the folder that holds `path` (fsync(2) on the folder), so that a name
+/// just made there by rename(2), link(2) or mkdir(2) survives a power cut.
+/// False when the folder cannot be opened or synced; a file system that
+/// cannot sync folders counts as done.
+bool sp_path_sync_folder(const char* path);
 /// Writes `size` bytes to `path` whole or not at all: into a temporary file
-/// beside it (the old file's permissions, else 0666 less the umask), renamed
-/// into place once every byte is written, so that a failed write (a full disk, a size limit) leaves the old file as
-/// it was and no truncated one. A symbolic link is followed (its target is
+/// beside it (the old file's permissions, else 0666 less the umask), synced
+/// and renamed into place once every byte is written, so that a failed write
+/// (a full disk, a size limit) or a power cut leaves the old file as it was
+/// and no truncated one; the folder is synced after the rename. A symbolic link is followed (its target is
 /// replaced, the link stays); a path that is not a regular file (a FIFO, a
 /// device such as /dev/stdout) is written into directly. One line in `err`
 /// names the path and the system's reason.
