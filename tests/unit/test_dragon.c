@@ -1042,6 +1042,38 @@ static void test_export(void)
         fprintf(stderr, "  note: no EGL here, no picture: %s\n", rerr.text);
     else
         ENSURE(r == SP_OK);
+    // A stroke shows also where its fitted outline lies right on it (the
+    // stroke points within 1.5 px of an outline point, in the canvas).
+    sp_image img = {0};
+    if (r == SP_OK &&
+        sp_dragon_snapshot_render(d, &(sp_dragon_snapshot_desc){.strokes = true, .outlines = true}, &img, &rerr) == SP_OK) {
+        int shown = 0, total = 0;
+        const sp_camera cam = sp_dragon_camera(d);
+        for (int i = 0; i < sp_dragon_part_count(d); ++i) {
+            const sp_dragon_part* p = sp_dragon_part_get(d, i);
+            const sp_abstraction* ab = &p->character->rig.abstractions[p->abstraction];
+            const double* o = sp_dragon_part_outline(d, i);
+            for (int k = 0; k < p->stroke_points; ++k) {
+                double best = INFINITY;
+                for (int j = 0; j < ab->point_count; ++j) {
+                    sp_vec2 q = sp_camera_project(&cam, sp_v3(o[3 * j], o[3 * j + 1], o[3 * j + 2]));
+                    best = fmin(best, hypot(q.x - p->stroke_xy[k].x, q.y - p->stroke_xy[k].y));
+                }
+                if (best > 1.5) continue;
+                int x = (int)lround(p->stroke_xy[k].x), y = (int)lround(p->stroke_xy[k].y), found = 0;
+                for (int dy = -5; dy <= 5; ++dy)
+                    for (int dx = -5; dx <= 5; ++dx) {
+                        if (x + dx < 0 || y + dy < 0 || x + dx >= img.width || y + dy >= img.height) continue;
+                        const uint8_t* px = img.rgba + 4 * ((size_t)(y + dy) * (size_t)img.width + (size_t)(x + dx));
+                        found |= px[2] > 180 && px[0] < 90 && px[1] < 140; // the strokes' blue
+                    }
+                shown += found, ++total;
+            }
+        }
+        fprintf(stderr, "  %d of %d stroke points on their outline blue in the picture\n", shown, total);
+        ENSURE(total >= 20 && shown >= total * 95 / 100);
+    }
+    sp_image_free(&img);
     sp_dragon_destroy(d);
     sp_db_close(db);
 }

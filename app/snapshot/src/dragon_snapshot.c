@@ -48,7 +48,7 @@ sp_result sp_dragon_snapshot_render(sp_dragon* d, const sp_dragon_snapshot_desc*
     }
     for (int i = 0; o.strokes && i < n; ++i) {
         const sp_dragon_part* p = sp_dragon_part_get(d, i);
-        sp_renderer_draw_polyline(r, p->stroke_xy, p->stroke_points, false, line * 1.2f, SP_COLOR_STROKE);
+        sp_renderer_draw_polyline(r, p->stroke_xy, p->stroke_points, false, SP_STROKE_UNDER_FIT * line, SP_COLOR_STROKE);
     }
     for (int i = 0; o.outlines && i < n; ++i) {
         const sp_dragon_part* p = sp_dragon_part_get(d, i);

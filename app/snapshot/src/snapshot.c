@@ -58,7 +58,7 @@ sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error*
     }
     float line = (float)fmax(2.0, cam->height / 160.0);
     draw_sketch(r, d->ghost, line, (const float[4]){0.45f, 0.45f, 0.5f, 0.9f});
-    draw_sketch(r, d->strokes, line * 1.2f, SP_COLOR_STROKE);
+    draw_sketch(r, d->strokes, SP_STROKE_UNDER_FIT * line, SP_COLOR_STROKE);
     const sp_abstraction* abs[2] = {d->abstraction >= 0 && d->abstraction < rig->abstraction_count ? &rig->abstractions[d->abstraction] : NULL,
                                     d->extra_abstraction};
     for (int k = 0; k < 2; ++k) {

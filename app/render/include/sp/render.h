@@ -54,6 +54,9 @@ extern "C" {
 #define SP_COLOR_STROKE ((const float[4]){0.15f, 0.35f, 0.95f, 1.0f})   ///< the user's strokes
 #define SP_COLOR_ABSTRACTION ((const float[4]){1.0f, 0.8f, 0.1f, 1.0f}) ///< fitted abstraction curves
 #define SP_COLOR_OUTLINE ((const float[4]){0.08f, 0.08f, 0.1f, 0.85f})  ///< dark halo under light lines
+/// A user's strokes are drawn this much wider than the fitted curves over
+/// them, so a stroke the fit follows exactly still shows a blue rim.
+#define SP_STROKE_UNDER_FIT 1.8f
 #define SP_COLOR_INK ((const float[4]){0.1f, 0.07f, 0.07f, 1.0f})       ///< details drawn on the dragon (eyes, spots)
 #define SP_COLOR_BACKGROUND_TOP ((const float[4]){0.93f, 0.94f, 0.96f, 1.0f})
 #define SP_COLOR_BACKGROUND_BOTTOM ((const float[4]){0.68f, 0.72f, 0.79f, 1.0f})
