@@ -78,12 +78,19 @@ void sp_bounds(const double* xyz, int n, sp_vec3* lo, sp_vec3* hi)
 {
     *lo = (sp_vec3){0, 0, 0};
     *hi = (sp_vec3){0, 0, 0};
-    for (int i = 0; i < n; ++i) {
-        sp_vec3 p = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-        if (i == 0) *lo = *hi = p;
-        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), lo->z = fmin(lo->z, p.z);
-        hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y), hi->z = fmax(hi->z, p.z);
-    }
+    if (n <= 0) return;
+    // Comparisons, not fmin / fmax: those are libm calls, and they were a
+    // quarter of a dragon export (the bounds of every vertex at every key).
+    // A NaN coordinate fails both tests and is passed over, as fmin does.
+    double a[3] = {INFINITY, INFINITY, INFINITY}, b[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < 3 * (size_t)n; i += 3)
+        for (int c = 0; c < 3; ++c) {
+            a[c] = xyz[i + c] < a[c] ? xyz[i + c] : a[c];
+            b[c] = xyz[i + c] > b[c] ? xyz[i + c] : b[c];
+        }
+    for (int c = 0; c < 3; ++c)
+        if (a[c] > b[c]) a[c] = b[c] = NAN; // no number at all
+    *lo = (sp_vec3){a[0], a[1], a[2]}, *hi = (sp_vec3){b[0], b[1], b[2]};
 }
 
 sp_camera sp_camera_frame(sp_camera_kind kind, sp_vec3 lo, sp_vec3 hi, sp_vec3 forward, sp_vec3 up, int width, int height)

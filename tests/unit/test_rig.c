@@ -411,18 +411,36 @@ static void test_regularisers_closed_form(void)
     check_regularisers(true);
 }
 
+// Bounds of points: the box, a NaN coordinate passed over (as fmin and fmax
+// do), a coordinate with no number NaN, no points the zero box.
+static void test_bounds(void)
+{
+    sp_vec3 lo, hi;
+    const double xyz[] = {1, -2, 3, -4, 5, NAN, 0.5, NAN, -6, 2, 0, 9};
+    sp_bounds(xyz, 4, &lo, &hi);
+    ENSURE(lo.x == -4 && lo.y == -2 && lo.z == -6 && hi.x == 2 && hi.y == 5 && hi.z == 9);
+    sp_bounds(xyz + 3, 1, &lo, &hi);
+    ENSURE(lo.x == -4 && hi.y == 5 && isnan(lo.z) && isnan(hi.z));
+    const double first_nan[] = {NAN, 1, 1, 3, 2, 2};
+    sp_bounds(first_nan, 2, &lo, &hi);
+    ENSURE(lo.x == 3 && hi.x == 3 && lo.y == 1 && hi.y == 2);
+    sp_bounds(xyz, 0, &lo, &hi);
+    ENSURE(lo.x == 0 && lo.y == 0 && lo.z == 0 && hi.x == 0 && hi.y == 0 && hi.z == 0);
+}
+
 int main(int argc, char** argv)
 {
-    return sp_test_run(argc, argv, (sp_test[]){
-        {"jacobian_chain", test_jacobian_chain},
-        {"jacobian_tree", test_jacobian_tree},
-        {"defaults_give_rest", test_defaults_give_rest},
-        {"fk_naive", test_fk_naive},
-        {"params_from_trs_roundtrip", test_params_from_trs_roundtrip},
-        {"finalize_checks", test_finalize_checks},
-        {"clamp", test_clamp},
-        {"cameras", test_cameras},
-        {"animation_sampling", test_animation_sampling},
-        {"regularisers_closed_form", test_regularisers_closed_form},
-        {0}});
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"jacobian_chain", test_jacobian_chain},
+                                   {"jacobian_tree", test_jacobian_tree},
+                                   {"defaults_give_rest", test_defaults_give_rest},
+                                   {"fk_naive", test_fk_naive},
+                                   {"params_from_trs_roundtrip", test_params_from_trs_roundtrip},
+                                   {"finalize_checks", test_finalize_checks},
+                                   {"clamp", test_clamp},
+                                   {"cameras", test_cameras},
+                                   {"animation_sampling", test_animation_sampling},
+                                   {"regularisers_closed_form", test_regularisers_closed_form},
+                                   {"bounds", test_bounds},
+                                   {0}});
 }
