@@ -57,16 +57,6 @@ static void on_signal(int sig)
     g_quit = 1;
 }
 
-static long rss_kb(void)
-{
-    FILE* f = fopen("/proc/self/statm", "r");
-    long pages = 0, res = 0;
-    if (!f) return 0;
-    if (fscanf(f, "%ld %ld", &pages, &res) != 2) res = 0;
-    fclose(f);
-    return res * (sysconf(_SC_PAGESIZE) / 1024);
-}
-
 // Pixels per millimetre of the framebuffer: the monitor's physical size
 // when it reports a plausible one, else 96 dpi times the content scale.
 static double measure_ppm(GLFWwindow* win, int fb_w)
@@ -218,7 +208,7 @@ static void frame(app* a, double t, bool render)
         a->frame_ms[f] = w1 - w0, a->update_ms[f] = wu - w0, a->draw_ms[f] = wd - wu, a->swap_ms[f] = w1 - wd;
     }
     if (st->strokes >= a->rss_next_stroke && a->rss_n < 512) {
-        a->rss_kb[a->rss_n++] = rss_kb();
+        a->rss_kb[a->rss_n++] = sp_rss_kb();
         a->rss_next_stroke += 100;
     }
 }

@@ -787,6 +787,20 @@ static sp_result train_shapes(sp_clf* c, const sp_dataset* data, const unsigned 
     return SP_OK;
 }
 
+// Runs pass 1 or 2 of training over `count` jobs (see train_job). Only running
+// out of memory or a library failure stops it: the first job that did names its drawing.
+static sp_result train_pass(train_ctx* t, int pass, int count, sp_error* err)
+{
+    t->pass = pass;
+    atomic_store(&t->done, 0);
+    int bad = sp_parallel_for(count, t->clf->desc.threads, train_job, t);
+    if (!bad) return SP_OK;
+    for (int i = 0; i < t->job_count; ++i)
+        if (t->status[i] == (sp_result)bad)
+            return sp_fail(err, (sp_result)bad, "training drawing %d: %s", t->jobs[i].sample, t->errs[i].text);
+    return sp_fail(err, (sp_result)bad, "training: %s", sp_result_name((sp_result)bad));
+}
+
 // Leave-one-out queries for the picture evidence's bandwidth at most: the
 // median nearest distance of a few hundred drawings is as good as of all.
 #define PICTURE_LOO_MAX 512
@@ -870,6 +884,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     *out = NULL;
     sp_clf* c = calloc(1, sizeof *c);
     train_ctx t = {.data = data, .clf = c};
+    atomic_init(&t.done, 0);
     job* jobs = NULL;
     sp_result rc = SP_OK;
     float* sample = NULL;
@@ -917,17 +932,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     if (!t.sample || !t.sample_n || !t.status || !t.errs) goto oom;
 
     // Pass 1: a sample of descriptors for the vocabulary.
-    t.pass = 1;
-    atomic_init(&t.done, 0);
-    int bad = sp_parallel_for(n1, c->desc.threads, train_job, &t);
-    if (bad) {
-        for (int i = 0; i < nj; ++i)
-            if (t.status[i] == (sp_result)bad) {
-                rc = sp_fail(err, (sp_result)bad, "training drawing %d: %s", jobs[i].sample, t.errs[i].text);
-                break;
-            }
-        goto fail;
-    }
+    if ((rc = train_pass(&t, 1, n1, err)) != SP_OK) goto fail;
     int total = 0;
     for (int i = 0; i < nj; ++i)
         total += t.status[i] == SP_OK ? t.sample_n[i] : 0;
@@ -979,17 +984,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     c->hist_dim = c->words * pyramid_cells(c->desc.pyramid);
     t.raw = malloc(sizeof(float) * (size_t)nj * c->hist_dim);
     if (!t.raw) goto oom;
-    t.pass = 2;
-    atomic_store(&t.done, 0);
-    bad = sp_parallel_for(nj, c->desc.threads, train_job, &t);
-    if (bad) {
-        for (int i = 0; i < nj; ++i)
-            if (t.status[i] == (sp_result)bad) {
-                rc = sp_fail(err, (sp_result)bad, "training drawing %d: %s", jobs[i].sample, t.errs[i].text);
-                break;
-            }
-        goto fail;
-    }
+    if ((rc = train_pass(&t, 2, nj, err)) != SP_OK) goto fail;
     int n = 0;
     for (int i = 0; i < nj; ++i)
         n += t.status[i] == SP_OK;

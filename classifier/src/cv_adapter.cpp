@@ -4,7 +4,6 @@
 #include "cv_adapter.h"
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <dlfcn.h>
@@ -79,18 +78,16 @@ extern "C" sp_result sp_cv_draw_polylines(const float* xy, const int* counts, in
     SP_CV_FIREWALL(err, "rasterise")
 }
 
-extern "C" sp_result sp_cv_decode_grey(const unsigned char* bytes, size_t len, const char* name, unsigned char** pixels, int* w,
-                                       int* h, sp_error* err)
+extern "C" sp_result sp_cv_grey(const void* samples, int w, int h, int channels, bool wide, const char* name,
+                                unsigned char** pixels, sp_error* err)
 {
     *pixels = nullptr;
     try {
-        cv::Mat buf(1, (int)len, CV_8UC1, const_cast<unsigned char*>(bytes));
-        cv::Mat img = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
-        if (img.empty()) return sp_fail(err, SP_ERR_PARSE, "%s: not a decodable image", name);
-        if (img.depth() != CV_8U) {
+        if (channels < 1 || channels > 4) return sp_fail(err, SP_ERR_INVALID, "%s: %d channels", name, channels);
+        cv::Mat img(h, w, CV_MAKETYPE(wide ? CV_16U : CV_8U, channels), const_cast<void*>(samples));
+        if (wide) {
             cv::Mat tmp;
-            double s = img.depth() == CV_16U ? 1.0 / 257.0 : 1.0;
-            img.convertTo(tmp, CV_8U, s);
+            img.convertTo(tmp, CV_8U, 1.0 / 257.0);
             img = tmp;
         }
         cv::Mat grey;
@@ -101,14 +98,14 @@ extern "C" sp_result sp_cv_decode_grey(const unsigned char* bytes, size_t len, c
             cv::split(img, ch);
             cv::Mat rgb, g;
             cv::merge(std::vector<cv::Mat>{ch[0], ch[1], ch[2]}, rgb);
-            cv::cvtColor(rgb, g, cv::COLOR_BGR2GRAY);
+            cv::cvtColor(rgb, g, cv::COLOR_RGB2GRAY);
             cv::Mat gf, af;
             g.convertTo(gf, CV_32F);
             ch[3].convertTo(af, CV_32F, 1.0 / 255.0);
             cv::Mat outf = gf.mul(af) + (1.0 - af) * 255.0;
             outf.convertTo(grey, CV_8U);
         } else if (img.channels() == 3) {
-            cv::cvtColor(img, grey, cv::COLOR_BGR2GRAY);
+            cv::cvtColor(img, grey, cv::COLOR_RGB2GRAY);
         } else if (img.channels() == 2) {
             std::vector<cv::Mat> ch;
             cv::split(img, ch);
@@ -126,8 +123,6 @@ extern "C" sp_result sp_cv_decode_grey(const unsigned char* bytes, size_t len, c
         if (!p) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
         std::memcpy(p, grey.data, n);
         *pixels = p;
-        *w = grey.cols;
-        *h = grey.rows;
         return SP_OK;
     }
     SP_CV_FIREWALL(err, name)

@@ -6,6 +6,7 @@
 #ifndef SP_CV_ADAPTER_H
 #define SP_CV_ADAPTER_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "sp/result.h"
@@ -20,10 +21,12 @@ extern "C" {
 sp_result sp_cv_draw_polylines(const float* xy, const int* counts, int polylines, int size, int thickness, unsigned char* out,
                                sp_error* err);
 
-/// Decodes image bytes (PNG) into grey pixels, alpha composited over white.
-/// *pixels is malloc'd (free()), w*h bytes.
-sp_result sp_cv_decode_grey(const unsigned char* bytes, size_t len, const char* name, unsigned char** pixels, int* w, int* h,
-                            sp_error* err);
+/// Grey pixels of a decoded image, alpha composited over white. samples: w*h
+/// pixels of `channels` (1 grey, 2 grey and alpha, 3 RGB, 4 RGBA) interleaved,
+/// 8 bits each, or 16 when wide (scaled to 8 by 1/257). *pixels is malloc'd
+/// (free()), w*h bytes. `name` is for messages.
+sp_result sp_cv_grey(const void* samples, int w, int h, int channels, bool wide, const char* name, unsigned char** pixels,
+                     sp_error* err);
 
 /// Fits the ink of a grey raster (0 = ink, 255 = paper) into the box [pad, pad+fit) of a
 /// `size` x `size` image keeping aspect, centred, ink white on black (like sp_cv_draw_polylines).

@@ -1,6 +1,7 @@
-// drawing_io.c: the drawings that need a decoder (PNG, through OpenCV), any
-// drawing by its extension, and labelled folders (which may hold PNGs). The
-// stroke files themselves are read by sketchio (sp/sketch_io.h).
+// drawing_io.c: the drawings that need a decoder (PNG: stb_image decodes it,
+// OpenCV makes it grey), any drawing by its extension, and labelled folders
+// (which may hold PNGs). The stroke files themselves are read by sketchio
+// (sp/sketch_io.h).
 #include <errno.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -9,7 +10,7 @@
 #include <sys/stat.h>
 
 #include "cv_adapter.h"
-#include "png_check.h"
+#include "png_decode.h"
 #include "sp/classifier.h"
 #include "sp/math.h"
 
@@ -39,17 +40,21 @@ sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
     size_t len;
     sp_result rc = sp_sketch_file_read(path, &bytes, &len, err);
     if (rc != SP_OK) return rc;
+    // Why stb and not OpenCV's decoder: it is quiet (see png_decode.h), and
+    // the pixels it gives go straight to the grey conversion: one decode.
     const char* why = NULL;
-    if (!sp_png_decodes((const unsigned char*)bytes, len, &why)) {
-        free(bytes);
-        return sp_fail(err, SP_ERR_PARSE, "%s: PNG data corrupt or truncated (%s)", path, why && *why ? why : "undecodable");
-    }
-    rc = sp_cv_decode_grey((const unsigned char*)bytes, len, path, &out->pixels, &out->w, &out->h, err);
+    sp_png_image img;
+    bool decoded = sp_png_decode((const unsigned char*)bytes, len, &img, &why);
     free(bytes);
-    if (rc == SP_OK && (out->w != (int)w || out->h != (int)h)) {
-        sp_raster_free(out);
+    if (!decoded)
+        return sp_fail(err, SP_ERR_PARSE, "%s: PNG data corrupt or truncated (%s)", path, why && *why ? why : "undecodable");
+    if (img.w != (int)w || img.h != (int)h) {
+        sp_png_image_free(&img);
         return sp_fail(err, SP_ERR_PARSE, "%s: decoded size differs from the PNG header", path);
     }
+    rc = sp_cv_grey(img.samples, img.w, img.h, img.channels, img.wide, path, &out->pixels, err);
+    if (rc == SP_OK) out->w = img.w, out->h = img.h;
+    sp_png_image_free(&img);
     return rc;
 }
 

@@ -464,17 +464,35 @@ sp_result sp_db_list_parts(sp_db* db, sp_db_part_info** parts, int* count, sp_er
     return SP_OK;
 }
 
-sp_result sp_db_part(sp_db* db, const char* name, sp_db_part_info* info, sp_error* err)
+// The row of part `name` that `sql` selects (its one parameter is the name),
+// stepped and ready to read; the caller finalizes it. No such part, or a failed
+// read, finalizes it here and says which.
+static sp_result part_row(sp_db* db, const char* sql, const char* name, sqlite3_stmt** row, sp_error* err)
 {
+    *row = NULL;
     sqlite3_stmt* st;
-    sp_result r = db_prepare(db, "SELECT " PART_COLS " FROM parts p WHERE p.name = ?", &st, err);
+    sp_result r = db_prepare(db, sql, &st, err);
     if (r != SP_OK) return r;
     sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
     int rc = sqlite3_step(st);
-    if (rc == SQLITE_ROW) read_info(st, info);
+    if (rc == SQLITE_ROW) {
+        *row = st;
+        return SP_OK;
+    }
+    r = rc == SQLITE_DONE ? sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name)
+                          : db_fail(db, rc, "reading a part", err);
     sqlite3_finalize(st);
-    if (rc == SQLITE_DONE) return sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
-    return rc == SQLITE_ROW ? SP_OK : db_fail(db, rc, "reading a part", err);
+    return r;
+}
+
+sp_result sp_db_part(sp_db* db, const char* name, sp_db_part_info* info, sp_error* err)
+{
+    sqlite3_stmt* st;
+    sp_result r = part_row(db, "SELECT " PART_COLS " FROM parts p WHERE p.name = ?", name, &st, err);
+    if (r != SP_OK) return r;
+    read_info(st, info);
+    sqlite3_finalize(st);
+    return SP_OK;
 }
 
 sp_result sp_db_part_bytes(sp_db* db, const char* name, void** glb, size_t* size, sp_error* err)
@@ -482,30 +500,23 @@ sp_result sp_db_part_bytes(sp_db* db, const char* name, void** glb, size_t* size
     *glb = NULL;
     *size = 0;
     sqlite3_stmt* st;
-    sp_result r = db_prepare(db, "SELECT gltf, sha256 FROM parts WHERE name = ?", &st, err);
+    sp_result r = part_row(db, "SELECT gltf, sha256 FROM parts WHERE name = ?", name, &st, err);
     if (r != SP_OK) return r;
-    sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(st);
-    if (rc == SQLITE_ROW) {
-        size_t n = (size_t)sqlite3_column_bytes(st, 0);
-        const void* src = sqlite3_column_blob(st, 0);
-        char want[65], got[65];
-        copy_name(want, sizeof want, (const char*)sqlite3_column_text(st, 1));
-        sp_sha256_hex(src, n, got);
-        void* buf = malloc(n ? n : 1);
-        if (!buf) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-        else if (strcmp(want, got) != 0) {
-            free(buf);
-            r = sp_fail(err, SP_ERR_PARSE, "%s: part '%s': stored glTF does not match its checksum", db->path, name);
-        } else {
-            memcpy(buf, src, n);
-            *glb = buf;
-            *size = n;
-        }
-    } else if (rc == SQLITE_DONE) {
-        r = sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
+    size_t n = (size_t)sqlite3_column_bytes(st, 0);
+    const void* src = sqlite3_column_blob(st, 0);
+    char want[65], got[65];
+    copy_name(want, sizeof want, (const char*)sqlite3_column_text(st, 1));
+    sp_sha256_hex(src, n, got);
+    void* buf = malloc(n ? n : 1);
+    if (!buf)
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    else if (strcmp(want, got) != 0) {
+        free(buf);
+        r = sp_fail(err, SP_ERR_PARSE, "%s: part '%s': stored glTF does not match its checksum", db->path, name);
     } else {
-        r = db_fail(db, rc, "reading a part", err);
+        memcpy(buf, src, n);
+        *glb = buf;
+        *size = n;
     }
     sqlite3_finalize(st);
     return r;
@@ -568,17 +579,9 @@ sp_result sp_db_part_summary_json(sp_db* db, const char* name, char** json, sp_e
 {
     *json = NULL;
     sqlite3_stmt* st;
-    sp_result r = db_prepare(db, "SELECT summary FROM parts WHERE name = ?", &st, err);
+    sp_result r = part_row(db, "SELECT summary FROM parts WHERE name = ?", name, &st, err);
     if (r != SP_OK) return r;
-    sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
-    int rc = sqlite3_step(st);
-    if (rc == SQLITE_ROW) {
-        if (!(*json = strdup((const char*)sqlite3_column_text(st, 0)))) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-    } else if (rc == SQLITE_DONE) {
-        r = sp_fail(err, SP_ERR_INVALID, "%s: no part named '%s'", db->path, name);
-    } else {
-        r = db_fail(db, rc, "reading a part", err);
-    }
+    if (!(*json = strdup((const char*)sqlite3_column_text(st, 0)))) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     sqlite3_finalize(st);
     return r;
 }

@@ -1239,17 +1239,12 @@ bool ends_with_ci(const char* s, const char* suffix)
     return a >= b && strcasecmp(s + a - b, suffix) == 0;
 }
 
-} // namespace
-
-extern "C" sp_result sp_gltf_load_memory(const void* data, size_t size, const char* what, sp_character* out, sp_error* err)
+// The exception firewall of the readers (STYLE.md): nothing thrown leaves for C,
+// and a character half read is freed. A Failure's text names the file already.
+template <class Body> sp_result read_firewall(const char* what, sp_character* out, sp_error* err, Body body)
 {
-    memset(out, 0, sizeof *out);
-    if (!what) what = "glTF";
     try {
-        tinygltf::Model model;
-        parse_model(model, static_cast<const unsigned char*>(data), size, what, "", false, out);
-        import(model, what, out);
-        return SP_OK;
+        return body();
     } catch (const Failure& f) {
         sp_character_free(out);
         return sp_fail(err, f.code, "%s", f.text.c_str());
@@ -1262,10 +1257,24 @@ extern "C" sp_result sp_gltf_load_memory(const void* data, size_t size, const ch
     }
 }
 
+} // namespace
+
+extern "C" sp_result sp_gltf_load_memory(const void* data, size_t size, const char* what, sp_character* out, sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    if (!what) what = "glTF";
+    return read_firewall(what, out, err, [&] {
+        tinygltf::Model model;
+        parse_model(model, static_cast<const unsigned char*>(data), size, what, "", false, out);
+        import(model, what, out);
+        return SP_OK;
+    });
+}
+
 extern "C" sp_result sp_gltf_load(const char* path, sp_character* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    try {
+    return read_firewall(path, out, err, [&] {
         FILE* f = fopen(path, "rb");
         if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
         std::vector<unsigned char> bytes;
@@ -1283,16 +1292,7 @@ extern "C" sp_result sp_gltf_load(const char* path, sp_character* out, sp_error*
         parse_model(model, bytes.data(), bytes.size(), path, dir, true, out);
         import(model, path, out);
         return SP_OK;
-    } catch (const Failure& f) {
-        sp_character_free(out);
-        return sp_fail(err, f.code, "%s", f.text.c_str());
-    } catch (const std::bad_alloc&) {
-        sp_character_free(out);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    } catch (...) {
-        sp_character_free(out);
-        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF reader", path);
-    }
+    });
 }
 
 // ---- export ---------------------------------------------------------------
@@ -1916,6 +1916,20 @@ std::string serialize(const sp_character* ch, const double* params, bool binary)
     return os.str();
 }
 
+// The exception firewall of the writers: every message starts with `what`, the file or "glb".
+template <class Body> sp_result write_firewall(const char* what, sp_error* err, Body body)
+{
+    try {
+        return body();
+    } catch (const Failure& f) {
+        return sp_fail(err, f.code, "%s: %s", what, f.text.c_str());
+    } catch (const std::bad_alloc&) {
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    } catch (...) {
+        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF writer", what);
+    }
+}
+
 } // namespace
 
 // The serialised file to disk, whole or not at all, with a one-line error naming it.
@@ -1926,23 +1940,17 @@ static sp_result write_file(const char* path, const std::string& bytes, sp_error
 
 extern "C" sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err)
 {
-    try {
+    return write_firewall(path, err, [&] {
         std::string bytes = serialize(ch, params, ends_with_ci(path, ".glb"));
         return write_file(path, bytes, err);
-    } catch (const Failure& f) {
-        return sp_fail(err, f.code, "%s: %s", path, f.text.c_str());
-    } catch (const std::bad_alloc&) {
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    } catch (...) {
-        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF writer", path);
-    }
+    });
 }
 
 extern "C" sp_result sp_gltf_save_memory(const sp_character* ch, const double* params, void** data, size_t* size, sp_error* err)
 {
     *data = nullptr;
     *size = 0;
-    try {
+    return write_firewall("glb", err, [&] {
         std::string bytes = serialize(ch, params, true);
         void* p = malloc(bytes.size());
         if (!p) throw std::bad_alloc();
@@ -1950,18 +1958,12 @@ extern "C" sp_result sp_gltf_save_memory(const sp_character* ch, const double* p
         *data = p;
         *size = bytes.size();
         return SP_OK;
-    } catch (const Failure& f) {
-        return sp_fail(err, f.code, "glb: %s", f.text.c_str());
-    } catch (const std::bad_alloc&) {
-        return sp_fail(err, SP_ERR_NO_MEMORY, "glb: out of memory");
-    } catch (...) {
-        return sp_fail(err, SP_ERR_INTERNAL, "glb: internal error in the glTF writer");
-    }
+    });
 }
 
 extern "C" sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const char* path, sp_error* err)
 {
-    try {
+    return write_firewall(path, err, [&] {
         tinygltf::Model m = build_scene(desc);
         tinygltf::TinyGLTF writer;
         std::ostringstream os;
@@ -1970,11 +1972,5 @@ extern "C" sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const ch
             fail(SP_ERR_INTERNAL, "tinygltf could not serialise the scene");
         std::string bytes = os.str();
         return write_file(path, bytes, err);
-    } catch (const Failure& f) {
-        return sp_fail(err, f.code, "%s: %s", path, f.text.c_str());
-    } catch (const std::bad_alloc&) {
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    } catch (...) {
-        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF writer", path);
-    }
+    });
 }

@@ -231,6 +231,42 @@ static bool json_number(const cJSON* j, double* v)
     return isfinite(*v);
 }
 
+// Scratch for the stroke being read: its values are checked here first, and
+// sp_sketch_add_stroke copies them, so a bad value midway leaves no half a stroke.
+typedef struct stroke_scratch {
+    sp_vec2* pts;
+    double* ts; // NULL when the stroke has no times
+} stroke_scratch;
+
+// Room for n points, and n times when with_t; false when out of memory.
+static bool scratch_resize(stroke_scratch* b, int n, bool with_t)
+{
+    free(b->pts);
+    free(b->ts);
+    b->pts = malloc(sizeof *b->pts * (size_t)(n ? n : 1));
+    b->ts = with_t ? malloc(sizeof *b->ts * (size_t)(n ? n : 1)) : NULL;
+    return b->pts && (!with_t || b->ts);
+}
+
+// The end of a read: the scratch is freed, and the sketch is handed over only when all of it was read.
+static sp_result scratch_finish(stroke_scratch* b, sp_result rc, sp_sketch* s, sp_sketch* out)
+{
+    free(b->pts);
+    free(b->ts);
+    if (rc != SP_OK)
+        sp_sketch_free(s);
+    else
+        *out = *s;
+    return rc;
+}
+
+// One stroke into s, with every reader's message for the one way it can fail.
+static sp_result add_stroke(sp_sketch* s, const sp_vec2* pts, const double* ts, int n, const char* name, sp_error* err)
+{
+    if (sp_sketch_add_stroke(s, pts, ts, n) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+    return SP_OK;
+}
+
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
@@ -247,8 +283,7 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
     }
     sp_result rc = SP_OK;
     sp_sketch s = {0};
-    sp_vec2* pts = NULL;
-    double* ts = NULL;
+    stroke_scratch b = {0};
     const cJSON* fmt = cJSON_GetObjectItemCaseSensitive(root, "format");
     const cJSON* ver = cJSON_GetObjectItemCaseSensitive(root, "version");
     const cJSON* canvas = cJSON_GetObjectItemCaseSensitive(root, "canvas");
@@ -306,11 +341,7 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
             goto done;
         }
         bool has_t = t && cJSON_IsArray(t);
-        free(pts);
-        free(ts);
-        pts = malloc(sizeof *pts * (size_t)(n ? n : 1));
-        ts = has_t ? malloc(sizeof *ts * (size_t)(n ? n : 1)) : NULL;
-        if (!pts || (has_t && !ts)) {
+        if (!scratch_resize(&b, n, has_t)) {
             rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
             goto done;
         }
@@ -329,34 +360,25 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
                 rc = sp_fail(err, SP_ERR_INVALID, "%s: stroke %d point %d is not finite (or beyond 1e9)", name, si, k);
                 goto done;
             }
-            pts[k++] = (sp_vec2){x, y};
+            b.pts[k++] = (sp_vec2){x, y};
         }
         if (has_t) {
             k = 0;
             cJSON_ArrayForEach(q, t)
             {
-                if (!json_number(q, &ts[k])) {
+                if (!json_number(q, &b.ts[k])) {
                     rc = sp_fail(err, SP_ERR_INVALID, "%s: stroke %d time %d is not a finite number", name, si, k);
                     goto done;
                 }
                 ++k;
             }
         }
-        if (sp_sketch_add_stroke(&s, pts, ts, n) != SP_OK) {
-            rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
-            goto done;
-        }
+        if ((rc = add_stroke(&s, b.pts, b.ts, n, name, err)) != SP_OK) goto done;
         ++si;
     }
 done:
-    free(pts);
-    free(ts);
     cJSON_Delete(root);
-    if (rc != SP_OK)
-        sp_sketch_free(&s);
-    else
-        *out = s;
-    return rc;
+    return scratch_finish(&b, rc, &s, out);
 }
 
 sp_result sp_sketch_read_json(const char* path, sp_sketch* out, sp_error* err)
@@ -464,8 +486,7 @@ void sp_dataset_free(sp_dataset* ds)
 static sp_result ndjson_drawing(const cJSON* drawing, const char* name, int line, sp_sketch* out, sp_error* err)
 {
     sp_sketch s = {0};
-    sp_vec2* pts = NULL;
-    double* ts = NULL;
+    stroke_scratch b = {0};
     sp_result rc = SP_OK;
     int total = 0, si = 0;
     const cJSON* st;
@@ -485,11 +506,7 @@ static sp_result ndjson_drawing(const cJSON* drawing, const char* name, int line
             goto done;
         }
         total += n;
-        free(pts);
-        free(ts);
-        pts = malloc(sizeof *pts * (size_t)(n ? n : 1));
-        ts = tt ? malloc(sizeof *ts * (size_t)(n ? n : 1)) : NULL;
-        if (!pts || (tt && !ts)) {
+        if (!scratch_resize(&b, n, tt != NULL)) {
             rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
             goto done;
         }
@@ -503,29 +520,20 @@ static sp_result ndjson_drawing(const cJSON* drawing, const char* name, int line
                 rc = sp_fail(err, SP_ERR_INVALID, "%s:%d: stroke %d point %d is not a finite number pair", name, line, si, k);
                 goto done;
             }
-            pts[k] = (sp_vec2){vx, vy};
+            b.pts[k] = (sp_vec2){vx, vy};
             if (t) {
-                if (!json_number(t, &ts[k])) {
+                if (!json_number(t, &b.ts[k])) {
                     rc = sp_fail(err, SP_ERR_INVALID, "%s:%d: stroke %d time %d is not finite", name, line, si, k);
                     goto done;
                 }
                 t = t->next;
             }
         }
-        if (sp_sketch_add_stroke(&s, pts, ts, n) != SP_OK) {
-            rc = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
-            goto done;
-        }
+        if ((rc = add_stroke(&s, b.pts, b.ts, n, name, err)) != SP_OK) goto done;
         ++si;
     }
 done:
-    free(pts);
-    free(ts);
-    if (rc != SP_OK)
-        sp_sketch_free(&s);
-    else
-        *out = s;
-    return rc;
+    return scratch_finish(&b, rc, &s, out);
 }
 
 sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, const char* name, int label, sp_error* err)
@@ -625,9 +633,7 @@ static sp_result svg_point(svg_ctx* c, double x, double y)
 
 static sp_result svg_flush(svg_ctx* c)
 {
-    sp_result rc = SP_OK;
-    if (c->n > 0 && sp_sketch_add_stroke(c->out, c->pts, NULL, c->n) != SP_OK)
-        rc = sp_fail(c->err, SP_ERR_NO_MEMORY, "%s: out of memory", c->name);
+    sp_result rc = c->n > 0 ? add_stroke(c->out, c->pts, NULL, c->n, c->name, c->err) : SP_OK;
     c->n = 0;
     return rc;
 }

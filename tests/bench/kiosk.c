@@ -89,16 +89,6 @@ static void press(sp_kiosk* k, double t, sp_kiosk_target target)
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, target});
 }
 
-static long rss_kb(void)
-{
-    FILE* f = fopen("/proc/self/statm", "r");
-    long pages = 0, res = 0;
-    if (!f) return 0;
-    if (fscanf(f, "%ld %ld", &pages, &res) != 2) res = 0;
-    fclose(f);
-    return res * (sysconf(_SC_PAGESIZE) / 1024);
-}
-
 // n strokes in one session: the six parts drawn again and again, shifted a
 // little each time, with Undo, Start over and Save mixed in.
 static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row* row)
@@ -138,7 +128,7 @@ static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row*
         // Memory is compared in the same state, right after each Start over
         // (between them it grows with the parts on screen, as it should).
         if (cleared) {
-            long r = rss_kb();
+            long r = sp_rss_kb();
             if (!warm && i + 1 >= (n >= 400 ? 200 : n / 2))
                 warm = r;
             else if (warm && r > peak)
@@ -148,7 +138,7 @@ static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row*
         }
     }
     free(xy);
-    long end = rss_kb();
+    long end = sp_rss_kb();
     if (!peak) peak = warm;
     double ms = (sp_now_ms() - t0) / n;
     *row = (sp_bench_row){"soak: ms per stroke", ms, ms, n, -1, -1, ""};

@@ -1,8 +1,10 @@
-/// sp/clock.h: the one monotonic clock every module times itself with.
+/// sp/clock.h: the one monotonic clock every module times itself with, and
+/// the one gauge of the process's memory (so the kiosk's live statistics and
+/// its soak benchmark report the same quantity).
 ///
 ///     double t0 = sp_now_ms();
 ///     ...
-///     printf("%.1f ms\n", sp_now_ms() - t0);
+///     printf("%.1f ms, %ld KiB resident\n", sp_now_ms() - t0, sp_rss_kb());
 #ifndef SP_CLOCK_H
 #define SP_CLOCK_H
 
@@ -12,6 +14,9 @@ extern "C" {
 
 /// Milliseconds on CLOCK_MONOTONIC (an arbitrary origin: differences only).
 double sp_now_ms(void);
+
+/// Resident memory of this process in KiB, from /proc/self/statm (0 where it cannot be read).
+long sp_rss_kb(void);
 
 #ifdef __cplusplus
 }
