@@ -169,7 +169,10 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
         goto done;
     }
     char sha[65];
-    sp_sha256_hex(bytes, size, sha);
+    if (!sp_sha256_hex(bytes, size, sha)) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        goto done;
+    }
     // Store, unless the parts changed while we trained (the model would not match them).
     if ((r = db_begin(db, err)) != SP_OK) goto done;
     {
@@ -238,9 +241,10 @@ sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err)
         const void* b = sqlite3_column_blob(st, 1);
         size_t n = (size_t)sqlite3_column_bytes(st, 1);
         char sha[65], what[600];
-        sp_sha256_hex(b, n, sha);
         snprintf(what, sizeof what, "%s: model %lld", db->path, (long long)sqlite3_column_int64(st, 0));
-        if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0)
+        if (!sp_sha256_hex(b, n, sha))
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+        else if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0)
             r = sp_fail(err, SP_ERR_PARSE, "%s: stored bytes do not match the checksum", what);
         else
             r = sp_clf_from_bytes(b, n, what, out, err);
@@ -314,8 +318,10 @@ sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err)
         const void* b = sqlite3_column_blob(st, 1);
         size_t n = (size_t)sqlite3_column_bytes(st, 1);
         char sha[65];
-        sp_sha256_hex(b, n, sha);
-        if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0) problem(&pb, &np, "part %s: checksum mismatch", name);
+        if (!sp_sha256_hex(b, n, sha))
+            problem(&pb, &np, "part %s: checksum not computed (out of memory)", name);
+        else if (strcmp(sha, (const char*)sqlite3_column_text(st, 2)) != 0)
+            problem(&pb, &np, "part %s: checksum mismatch", name);
         if ((sqlite3_int64)n != sqlite3_column_int64(st, 3)) problem(&pb, &np, "part %s: size mismatch", name);
         sp_character ch = {0};
         sp_error e = {0};

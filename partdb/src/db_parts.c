@@ -165,7 +165,10 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
     info->abstractions = rig->abstraction_count;
     info->animations = rig->animation_count;
     info->bytes = size;
-    sp_sha256_hex(glb, size, info->sha256);
+    if (!sp_sha256_hex(glb, size, info->sha256)) {
+        sp_character_free(&ch);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
     if (abstraction_out) *abstraction_out = a;
     if (keep) *keep = ch;
     else sp_character_free(&ch);
@@ -506,8 +509,7 @@ sp_result sp_db_part_bytes(sp_db* db, const char* name, void** glb, size_t* size
     const void* src = sqlite3_column_blob(st, 0);
     char want[65], got[65];
     copy_name(want, sizeof want, (const char*)sqlite3_column_text(st, 1));
-    sp_sha256_hex(src, n, got);
-    void* buf = malloc(n ? n : 1);
+    void* buf = sp_sha256_hex(src, n, got) ? malloc(n ? n : 1) : NULL;
     if (!buf)
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     else if (strcmp(want, got) != 0) {

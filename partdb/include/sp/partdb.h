@@ -388,8 +388,9 @@ sp_result sp_db_log(sp_db* db, const char* by, const char* action, const char* s
 /// (subject NULL: all entries) (malloc'd, free()).
 sp_result sp_db_log_json(sp_db* db, const char* subject, char** json, sp_error* err);
 
-/// Hex SHA-256 of bytes (hex: 65 chars with the NUL).
-void sp_sha256_hex(const void* data, size_t size, char hex[65]);
+/// Hex SHA-256 of bytes (hex: 65 chars with the NUL). False, hex empty, only
+/// when libcrypto has no memory for its context: callers refuse the bytes.
+bool sp_sha256_hex(const void* data, size_t size, char hex[65]);
 
 #ifdef __cplusplus
 }
