@@ -37,6 +37,10 @@ static int coarsen(const double* rest_in, int n, int k, int* reps)
     struct FLANNParameters ip = DEFAULT_FLANN_PARAMETERS;
     ip.algorithm = FLANN_INDEX_KDTREE_SINGLE;
     ip.checks = -1; // exact search
+    // One thread: FLANN's default searches with OpenMP on every core, whose
+    // idle threads then spin (a third of `sketchpose dragon`'s CPU, taken
+    // from the kiosk's UI thread) for a search of a few hundred centres.
+    ip.cores = 1;
     ip.log_level = FLANN_LOG_NONE;
     ip.random_seed = 12345;
     float speedup = 0;
