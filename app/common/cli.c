@@ -124,3 +124,8 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
     fprintf(stderr, "%s: %s must be in %s%.10g, %.10g], got %g\n", cmd, name, lo_open ? "(" : "[", lo, hi, v);
     return false;
 }
+
+bool sp_cli_check_max_ms(const char* cmd, double ms)
+{
+    return isnan(ms) || sp_cli_check_double(cmd, "--max-ms", ms, 0, true, SP_CLI_MAX_MS);
+}

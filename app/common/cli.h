@@ -47,6 +47,15 @@ bool sp_cli_check_int(const char* cmd, const char* name, int v, int lo, int hi);
 /// The same for a number in [lo, hi], or (lo, hi] when lo_open.
 bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo, bool lo_open, double hi);
 
+/// The longest solve time cap a command takes (--max-ms), ms: one hour.
+#define SP_CLI_MAX_MS 3600000.0
+/// Its range as --help words it (beside SP_CLI_MAX_MS, so that they agree).
+#define SP_CLI_MAX_MS_RANGE "ms in (0, 3600000]"
+/// --max-ms of pose, drawover and dragon: NAN (not given) passes, else ms in
+/// (0, SP_CLI_MAX_MS]; false after the usage line. One check, so that the
+/// three commands say the same range.
+bool sp_cli_check_max_ms(const char* cmd, double ms);
+
 /// Initial value of an int option whose "not given" must differ from every
 /// value a user can type (sp_cli_parse refuses INT_MIN).
 #define SP_CLI_UNSET INT_MIN

@@ -65,12 +65,12 @@ int cmd_drawover(int argc, char** argv)
         {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: --on grey, --to blue, the fitted curves yellow", false},
         {"--report", SP_OPT_STRING, &report, "report.json", "write the solve report (also printed on stdout)", false},
         {"--lambda-dist", SP_OPT_DOUBLE, &desc.lambda_dist, "L", "weight of W_dist, locality (default 0.001)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, ms in (0, 3600000] (default 3000)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose drawover", "Draw-over posing: redraw curves drawn over the character.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (!isnan(cap_ms) && !sp_cli_check_double("sketchpose drawover", "--max-ms", cap_ms, 0, true, 3.6e6)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_max_ms("sketchpose drawover", cap_ms)) return SP_EXIT_USAGE;
     if (!isnan(cap_ms)) desc.time_cap_ms = cap_ms;
     sp_rig_handle* rig = NULL;
     sp_error err = {0};

@@ -31,7 +31,7 @@ int cmd_pose(int argc, char** argv)
         {"--lambda-dist", SP_OPT_DOUBLE, &desc.lambda_dist, "L", "weight of W_dist (default 0.001; negative: off)", false},
         {"--representatives", SP_OPT_INT, &reps, "K", "coarsening: representative vertices, 1..100000 (default 200)", false},
         {"--max-iterations", SP_OPT_INT, &iters, "N", "Gauss-Newton iterations at most, 1..1000000 (default 300)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, ms in (0, 3600000] (default 3000)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose pose", "Redraw posing: fits the rig's abstraction to the strokes.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
@@ -39,7 +39,7 @@ int cmd_pose(int argc, char** argv)
     const char* cmd = "sketchpose pose";
     if ((reps != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--representatives", reps, 1, 100000)) ||
         (iters != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--max-iterations", iters, 1, 1000000)) ||
-        (!isnan(cap_ms) && !sp_cli_check_double(cmd, "--max-ms", cap_ms, 0, true, 3.6e6)))
+        !sp_cli_check_max_ms(cmd, cap_ms))
         return SP_EXIT_USAGE;
     if (reps != SP_CLI_UNSET) desc.representatives = reps;
     if (iters != SP_CLI_UNSET) desc.max_iterations = iters;

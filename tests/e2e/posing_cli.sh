@@ -59,6 +59,12 @@ one_line_naming nowhere/x.png
 [ -e "$WORK/left.json" ] && fail "pose left its report after --render failed"
 ls "$WORK" | grep -q 'tmp' && fail "pose left a temporary file: $(ls "$WORK" | grep tmp)"
 
+# --max-ms: one range, worded alike by the commands that take it.
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-ms 0
+one_line_naming "sketchpose pose: --max-ms must be in (0, 3600000\], got 0"
+expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --max-ms -5
+one_line_naming "sketchpose drawover: --max-ms must be in (0, 3600000\], got -5"
+
 # A picture size out of range says the range.
 expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 1x1
 one_line_naming "16..8192"
