@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -122,6 +123,29 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
 {
     if ((lo_open ? v > lo : v >= lo) && v <= hi) return true;
     fprintf(stderr, "%s: %s must be in %s%.10g, %.10g], got %g\n", cmd, name, lo_open ? "(" : "[", lo, hi, v);
+    return false;
+}
+
+// Case-insensitive suffix, without strcasecmp (not C11).
+static bool ends_with_ci(const char* s, const char* suffix)
+{
+    size_t n = strlen(s), k = strlen(suffix);
+    if (n < k) return false;
+    for (size_t i = 0; i < k; ++i)
+        if (tolower((unsigned char)s[n - k + i]) != tolower((unsigned char)suffix[i])) return false;
+    return true;
+}
+
+bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind)
+{
+    if (!path) return true;
+    if (kind == SP_CLI_OUT_GLTF) {
+        if (ends_with_ci(path, ".glb") || ends_with_ci(path, ".gltf")) return true;
+        fprintf(stderr, "%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'\n", cmd, name, path);
+    } else {
+        if (ends_with_ci(path, ".png")) return true;
+        fprintf(stderr, "%s: %s writes a PNG: the file name must end in .png, got '%s'\n", cmd, name, path);
+    }
     return false;
 }
 

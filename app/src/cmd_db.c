@@ -322,6 +322,7 @@ static int db_add_part(int argc, char** argv)
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
     // As `db init --synth`: -1 is none, 0 the default.
+    if (!sp_cli_check_out(cmd, "--preview", preview, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     if (d.synth_sketches < -1 || d.synth_sketches > 10000) {
         fprintf(stderr, "%s: --synth must be -1 (none) to 10000\n", cmd);
         return SP_EXIT_USAGE;
@@ -824,6 +825,7 @@ static int db_review(int argc, char** argv)
               "approve, reject or relabel them; an unknown id changes nothing",
               opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out(cmd, "--sheet", sheet, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     int actions = (approve.count > 0) + (reject.count > 0) + (relabel.count > 0);
     if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2) || limit < 0 || after < 0) {
         fprintf(

@@ -39,7 +39,10 @@ int cmd_dragon(int argc, char** argv)
                           "The kiosk pipeline without a window: one part per stroke, one animated dragon.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (!sp_cli_check_max_ms("sketchpose dragon", max_ms)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_max_ms("sketchpose dragon", max_ms) ||
+        !sp_cli_check_out("sketchpose dragon", "--out", out, SP_CLI_OUT_GLTF) ||
+        !sp_cli_check_out("sketchpose dragon", "--render", render, SP_CLI_OUT_PNG))
+        return SP_EXIT_USAGE;
     sp_error err = {0};
     sp_sketch sk = {0};
     if (sp_sketch_read_json(strokes, &sk, &err) != SP_OK) {

@@ -70,7 +70,10 @@ int cmd_drawover(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, "sketchpose drawover", "Draw-over posing: redraw curves drawn over the character.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (!sp_cli_check_max_ms("sketchpose drawover", cap_ms)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_max_ms("sketchpose drawover", cap_ms) ||
+        !sp_cli_check_out("sketchpose drawover", "--out", out, SP_CLI_OUT_GLTF) ||
+        !sp_cli_check_out("sketchpose drawover", "--render", render, SP_CLI_OUT_PNG))
+        return SP_EXIT_USAGE;
     if (!isnan(cap_ms)) desc.time_cap_ms = cap_ms;
     sp_rig_handle* rig = NULL;
     sp_error err = {0};

@@ -39,7 +39,8 @@ int cmd_pose(int argc, char** argv)
     const char* cmd = "sketchpose pose";
     if ((reps != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--representatives", reps, 1, 100000)) ||
         (iters != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--max-iterations", iters, 1, 1000000)) ||
-        !sp_cli_check_max_ms(cmd, cap_ms))
+        !sp_cli_check_max_ms(cmd, cap_ms) || !sp_cli_check_out(cmd, "--out", out, SP_CLI_OUT_GLTF) ||
+        !sp_cli_check_out(cmd, "--render", render, SP_CLI_OUT_PNG))
         return SP_EXIT_USAGE;
     if (reps != SP_CLI_UNSET) desc.representatives = reps;
     if (iters != SP_CLI_UNSET) desc.max_iterations = iters;

@@ -70,6 +70,7 @@ int cmd_render(int argc, char** argv)
                      "render a rig posed by a pose file (else its stored pose), with an abstraction overlaid in yellow, to PNG",
                      opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out("sketchpose render", "--out", out_path, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     int w = 640, h = 480;
     if (size && !sp_cli_parse_size(size, &w, &h)) {
         fprintf(stderr, "sketchpose render: --size wants WxH with sides 16..8192, e.g. 640x480, got '%s'\n", size);

@@ -399,6 +399,9 @@ int main(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, k_cmd, "The dragon kiosk: draw a part in one line, see it come alive.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out(k_cmd, "--screenshot", shot, SP_CLI_OUT_PNG) ||
+        !sp_cli_check_out(k_cmd, "--export", out_glb, SP_CLI_OUT_GLTF))
+        return SP_EXIT_USAGE;
     if (lod != SP_CLI_UNSET && lod != -1 && (lod < 1 || lod > 10000000)) {
         fprintf(stderr, "%s: --lod must be -1 (all) or 1..10000000, got %d\n", k_cmd, lod);
         return SP_EXIT_USAGE;

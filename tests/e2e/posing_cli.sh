@@ -65,6 +65,31 @@ one_line_naming "sketchpose pose: --max-ms must be in (0, 3600000\], got 0"
 expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --max-ms -5
 one_line_naming "sketchpose drawover: --max-ms must be in (0, 3600000\], got -5"
 
+# Outputs are glTF or PNG by their names: another name is bad usage, one
+# line naming the option, before any solve, and no file is made (--out x.txt
+# got glTF JSON, --render x.jpg a PNG).
+refused_out() { # refused_out FILE OPTION: the last command wrote nothing and said why
+    one_line_naming ": $2 writes .*got '.*$1'"
+    [ -e "$WORK/$1" ] && fail "a refused $2 wrote $1"
+}
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/p.txt"
+refused_out p.txt --out
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/p.glb" --render "$WORK/p.jpg"
+refused_out p.jpg --render
+[ -e "$WORK/p.glb" ] && fail "pose wrote --out although --render was refused"
+expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --render "$WORK/d.jpeg"
+refused_out d.jpeg --render
+expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --out "$WORK/d.fbx"
+refused_out d.fbx --out
+expect 2 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/a.json"
+refused_out a.json --out
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/r.jpg"
+refused_out r.jpg --out
+expect 2 "$SP" synth --drawings --sheet "$WORK/sheet.svg"
+refused_out sheet.svg --sheet
+expect 0 "$SP" render --rig "$RIG" --out "$WORK/R.PNG" --size 64x48
+[ -s "$WORK/R.PNG" ] || fail "render --out R.PNG wrote nothing"
+
 # A picture size out of range says the range.
 expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 1x1
 one_line_naming "16..8192"

@@ -1404,7 +1404,17 @@ static void test_live_update(void)
     sp_dragon_destroy(d);
 }
 
-// A JSON file parsed (ENSURE'd readable, at most 4 MB, and valid).
+// Bad usage of `sketchpose dragon`: exit 2 and one line on stderr holding `want`.
+static void dragon_usage_error(const char* args, const char* want)
+{
+    char cmd[6000], err[2048];
+    snprintf(cmd, sizeof cmd, "'%s' dragon %s 2>&1 >/dev/null", SP_SKETCHPOSE, args);
+    int rc = sp_fixture_run(cmd, err, sizeof err);
+    if (rc != 2 || !strstr(err, want) || strchr(err, '\n') != err + strlen(err) - 1)
+        fprintf(stderr, "  dragon %s: exit %d, wanted 2 and one line with '%s': %s\n", args, rc, want, err);
+    ENSURE(rc == 2 && strstr(err, want) && strchr(err, '\n') == err + strlen(err) - 1);
+}
+
 // `sketchpose dragon`: a stroke file in, a .glb, a PNG and the report out.
 static void test_command(void)
 {
@@ -1479,6 +1489,19 @@ static void test_command(void)
         snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' --max-ms %s >/dev/null 2>&1", SP_SKETCHPOSE, path,
                  strokes, i ? "-5" : "0");
         ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    }
+    // Outputs by their names: --out other than .glb/.gltf and --render other
+    // than .png are bad usage before any work, and nothing is written (the
+    // .txt got glTF JSON before, the .jpg a PNG).
+    const char* bad_out[2][3] = {{"--out", "dragon_cmd.txt", "--out writes glTF"},
+                                 {"--render", "dragon_cmd.jpg", "--render writes a PNG"}};
+    for (int i = 0; i < 2; ++i) {
+        char bad[1024], args[4000];
+        snprintf(bad, sizeof bad, "%s", sp_test_tmp_path(bad_out[i][1]));
+        unlink(bad);
+        snprintf(args, sizeof args, "--db '%s' --strokes '%s' %s '%s'", path, strokes, bad_out[i][0], bad);
+        dragon_usage_error(args, bad_out[i][2]);
+        ENSURE(stat(bad, &st) != 0);
     }
 }
 
