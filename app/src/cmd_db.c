@@ -1,6 +1,7 @@
 // cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,10 +26,18 @@ typedef struct db_common {
     const char* by;
 } db_common;
 
-#define DB_COMMON_OPTS(c)                                                                                                \
-    {"--db", SP_OPT_STRING, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},            \
-        {"--busy-timeout", SP_OPT_DOUBLE, &(c).busy_s, "S", "seconds to wait for another writer (default 5)", false}, \
-        {"--by", SP_OPT_STRING, &(c).by, "WHO", "curator's name for the log (default $USER)", false}
+#define DB_COMMON_OPTS(c)                                                                                                        \
+    {"--db", SP_OPT_STRING, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},                     \
+        {"--busy-timeout", SP_OPT_DOUBLE, &(c).busy_s, "S", "seconds to wait for another writer, 0..86400 (default 5)", false},  \
+    {                                                                                                                            \
+        "--by", SP_OPT_STRING, &(c).by, "WHO", "curator's name for the log (default $USER)", false                               \
+    }
+
+// Before parsing: --busy-timeout not given (NAN), the library's default.
+static db_common db_common_unset(void)
+{
+    return (db_common){.busy_s = NAN};
+}
 
 static const char* db_path(const db_common* c) { return c->db ? c->db : sp_db_default_path(); }
 
@@ -61,8 +70,8 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
     return nk;
 }
 
-static int parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts, const char** pos, int* npos,
-                 int minpos, int maxpos, const char* posname)
+static int parse(int argc, char** argv, const char* cmd, const db_common* c, const char* summary, const sp_opt* opts, int nopts,
+                 const char** pos, int* npos, int minpos, int maxpos, const char* posname)
 {
     char* kept[512];
     if (argc > 512) {
@@ -82,6 +91,8 @@ static int parse(int argc, char** argv, const char* cmd, const char* summary, co
     snprintf(full, sizeof full, "%s%s%s", cmd, maxpos ? " " : "", maxpos ? posname : "");
     int rc = sp_cli_parse(nk, kept, full, summary, opts, nopts);
     if (rc >= 0) return rc;
+    // A day at most: beyond, the milliseconds overflow an int. 0 waits not at all.
+    if (!isnan(c->busy_s) && !sp_cli_check_double(cmd, "--busy-timeout", c->busy_s, 0, false, 86400)) return SP_EXIT_USAGE;
     if (*npos < minpos) {
         fprintf(stderr, "%s: missing %s (see --help)\n", cmd, posname);
         return SP_EXIT_USAGE;
@@ -94,7 +105,7 @@ static sp_db* open_db(const char* cmd, const db_common* c, unsigned flags)
     sp_db* db = NULL;
     sp_error err = {0};
     // The timeout applies to the open too: a locked database is waited for there first.
-    if (sp_db_open_wait(db_path(c), flags, c->busy_s > 0 ? (int)(c->busy_s * 1000) : -1, &db, &err) != SP_OK) {
+    if (sp_db_open_wait(db_path(c), flags, isnan(c->busy_s) ? -1 : (int)lround(c->busy_s * 1000), &db, &err) != SP_OK) {
         fprintf(stderr, "%s: %s\n", cmd, err.text);
         return NULL;
     }
@@ -167,7 +178,7 @@ static void print_part(const sp_db_part_info* p, bool derived)
 static int db_init(int argc, char** argv)
 {
     const char* cmd = "sketchpose db init";
-    db_common c = {0};
+    db_common c = db_common_unset();
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
     int synth = 0, concepts = 0, concept_family = 1, drawings = 0, folds = 0;
@@ -198,10 +209,11 @@ static int db_init(int argc, char** argv)
         CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "create a database: the default one from assets/ (parts, synthetic sketches, a trained model), or one rebuilt from an "
-                   "export folder",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    int rc = parse(
+        argc, argv, cmd, &c,
+        "create a database: the default one from assets/ (parts, synthetic sketches, a trained model), or one rebuilt from an "
+        "export folder",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
     if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000 || drawings < -1 || drawings > 100) {
@@ -292,7 +304,7 @@ static bool preview_writable(const char* cmd, const char* path)
 static int db_add_part(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-part";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_db_part_desc d = {0};
     bool no_selftest = false;
     const char *view = NULL, *preview = NULL;
@@ -315,7 +327,7 @@ static int db_add_part(int argc, char** argv)
     const char* pos[1];
     int npos;
     int rc = parse(
-        argc, argv, cmd,
+        argc, argv, cmd, &c,
         "validate a rigged part (loads, skin, abstraction, bounded parameters, solver self-test) and store it with synthetic "
         "sketches; a rigged glTF without sketchpose extras first gets them derived (as `sketchpose derive`); a refused part "
         "writes nothing",
@@ -500,7 +512,7 @@ static sp_result add_folder(sketch_set* s, const char* dir, const char* only, sp
 static int db_add_sketch(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-sketch";
-    db_common c = {0};
+    db_common c = db_common_unset();
     const char* category = NULL;
     const char* source = NULL;
     sp_opt opts[] = {DB_COMMON_OPTS(c),
@@ -508,10 +520,11 @@ static int db_add_sketch(int argc, char** argv)
                      {"--source", SP_OPT_STRING, &source, "S", "curated (default) or kiosk", false}};
     const char* pos[256];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "add example sketches: JSON strokes, Quick, Draw! .ndjson, SVG, PNG, or labelled folders DIR/<category>/...; all or "
-                   "nothing",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 256, "FILES...");
+    int rc = parse(
+        argc, argv, cmd, &c,
+        "add example sketches: JSON strokes, Quick, Draw! .ndjson, SVG, PNG, or labelled folders DIR/<category>/...; all or "
+        "nothing",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 256, "FILES...");
     if (rc >= 0) return rc;
     sp_db_source src = SP_DB_SOURCE_CURATED;
     if (source && !strcmp(source, "kiosk")) src = SP_DB_SOURCE_KIOSK;
@@ -564,11 +577,12 @@ static int db_add_sketch(int argc, char** argv)
 static int db_list(int argc, char** argv)
 {
     const char* cmd = "sketchpose db list";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "parts (category, vertex and parameter counts), sketch counts per category and models, as JSON", opts,
+    int rc = parse(argc, argv, cmd, &c,
+                   "parts (category, vertex and parameter counts), sketch counts per category and models, as JSON", opts,
                    (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
@@ -612,12 +626,12 @@ static int db_list(int argc, char** argv)
 static int db_show(int argc, char** argv)
 {
     const char* cmd = "sketchpose db show";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "one part: summary, parameters, abstractions and its log, as JSON", opts, (int)(sizeof opts / sizeof opts[0]),
-                   pos, &npos, 1, 1, "NAME");
+    int rc = parse(argc, argv, cmd, &c, "one part: summary, parameters, abstractions and its log, as JSON", opts,
+                   (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "NAME");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
@@ -642,11 +656,11 @@ static int db_show(int argc, char** argv)
 static int db_remove(int argc, char** argv)
 {
     const char* cmd = "sketchpose db remove";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "remove a part and its synthetic sketches (curated sketches stay)", opts,
+    int rc = parse(argc, argv, cmd, &c, "remove a part and its synthetic sketches (curated sketches stay)", opts,
                    (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "NAME");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, 0);
@@ -664,14 +678,15 @@ static int db_remove(int argc, char** argv)
 static int db_check(int argc, char** argv)
 {
     const char* cmd = "sketchpose db check";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "SQLite integrity and foreign keys, every part loads and matches its checksum, every sketch parses, the newest model "
-                   "matches the part categories; JSON; exit 1 on any problem",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    int rc = parse(
+        argc, argv, cmd, &c,
+        "SQLite integrity and foreign keys, every part loads and matches its checksum, every sketch parses, the newest model "
+        "matches the part categories; JSON; exit 1 on any problem",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, 0); // writable: an older schema gets migrated
     if (!db) return SP_EXIT_INPUT;
@@ -690,7 +705,7 @@ static int db_check(int argc, char** argv)
 static int db_train(int argc, char** argv)
 {
     const char* cmd = "sketchpose db train";
-    db_common c = {0};
+    db_common c = db_common_unset();
     int folds = 0;
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c),
@@ -698,7 +713,8 @@ static int db_train(int argc, char** argv)
                      CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
+    int rc = parse(argc, argv, cmd, &c,
+                   "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
@@ -719,11 +735,11 @@ static int db_train(int argc, char** argv)
 static int db_export(int argc, char** argv)
 {
     const char* cmd = "sketchpose db export";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
+    int rc = parse(argc, argv, cmd, &c,
                    "write DIR/parts/*.glb, DIR/sketches/<category>/* and DIR/manifest.json (what `db init --from DIR` reads); "
                    "DIR new or empty, written whole or not at all",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "DIR");
@@ -743,11 +759,11 @@ static int db_export(int argc, char** argv)
 static int db_log(int argc, char** argv)
 {
     const char* cmd = "sketchpose db log";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "the curator log (append-only), oldest first, as JSON; NAME: only entries about it", opts,
+    int rc = parse(argc, argv, cmd, &c, "the curator log (append-only), oldest first, as JSON; NAME: only entries about it", opts,
                    (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 1, "[NAME]");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
@@ -804,7 +820,7 @@ static bool parse_ids(const char* cmd, const sp_str_list* l, int first, int coun
 static int db_review(int argc, char** argv)
 {
     const char* cmd = "sketchpose db review";
-    db_common c = {0};
+    db_common c = db_common_unset();
     const char *status = "pending", *sheet = NULL;
     int limit = 100, after = 0;
     sp_str_list approve = {0}, reject = {0}, relabel = {0};
@@ -820,7 +836,7 @@ static int db_review(int argc, char** argv)
     const char* pos[1];
     int npos;
     int rc =
-        parse(argc, argv, cmd,
+        parse(argc, argv, cmd, &c,
               "the visitors' strokes the kiosk collected: list them as JSON (pending ones by default, oldest first), draw them, "
               "approve, reject or relabel them; an unknown id changes nothing",
               opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");

@@ -90,6 +90,21 @@ refused_out sheet.svg --sheet
 expect 0 "$SP" render --rig "$RIG" --out "$WORK/R.PNG" --size 64x48
 [ -s "$WORK/R.PNG" ] || fail "render --out R.PNG wrote nothing"
 
+# Numbers: the parser refuses what is not one finite number; ranges name
+# themselves. A typed 0 weight turns its term off (it was the default weight).
+for v in nan inf -inf 1.5x 1e999 ''; do
+    expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --lambda-pose "$v"
+    one_line_naming "lambda-pose expects a finite number, got '$v'"
+done
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 12abc
+one_line_naming "max-iterations expects an integer, got '12abc'"
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --lambda-pose 0 --report "$WORK/l0.json"
+tr -d ' \t\n' <"$WORK/l0.json" | grep -q '"terms_after":{[^}]*"pose":0,' || fail "--lambda-pose 0 kept W_pose"
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/lw.png" --line-width 0
+one_line_naming "line-width must be in (0, 256\], got 0"
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/lw.png" --pitch 90
+one_line_naming "pitch must be in \[-89, 89\], got 90"
+
 # A picture size out of range says the range.
 expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 1x1
 one_line_naming "16..8192"

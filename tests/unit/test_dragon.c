@@ -1490,6 +1490,18 @@ static void test_command(void)
                  strokes, i ? "-5" : "0");
         ENSURE(WEXITSTATUS(system(cmd)) == 2);
     }
+    // --time: [0, 3600] s (a negative time was taken as one counted back from
+    // a loop); what is not a finite number is refused by the parser.
+    const char* bad_time[][2] = {{"-1", "--time must be in [0, 3600], got -1"},
+                                 {"3601", "--time must be in [0, 3600], got 3601"},
+                                 {"nan", "--time expects a finite number, got 'nan'"},
+                                 {"-inf", "--time expects a finite number, got '-inf'"},
+                                 {"1.5x", "--time expects a finite number, got '1.5x'"}};
+    for (int i = 0; i < 5; ++i) {
+        char args[4000];
+        snprintf(args, sizeof args, "--db '%s' --strokes '%s' --time %s", path, strokes, bad_time[i][0]);
+        dragon_usage_error(args, bad_time[i][1]);
+    }
     // Outputs by their names: --out other than .glb/.gltf and --render other
     // than .png are bad usage before any work, and nothing is written (the
     // .txt got glTF JSON before, the .jpg a PNG).

@@ -1703,13 +1703,14 @@ static void test_parts_loaded_while_idle(void)
 // would fail to open the window (exit 1), not hang.
 static void test_option_ranges(void)
 {
-    // Outputs by their names too: a screenshot that is not .png, an export
+    // A typed 0 --idle is no timeout to ask for. Outputs by their names too: a screenshot that is not .png, an export
     // that is not .glb/.gltf (they got a PNG and glTF).
     const char* bad[][2] = {{"--max-parts 0", "--max-parts must be"},
                             {"--max-parts -1", "--max-parts must be"},
                             {"--lod -5", "--lod must be"},
                             {"--lod 0", "--lod must be"},
                             {"--msaa 64", "--msaa must be"},
+                            {"--idle 0", "--idle must be"}, // it was the default, 90 s
                             {"--msaa -1", "--msaa must be"},
                             {"--screenshot shot.jpg", "--screenshot writes a PNG"},
                             {"--export dragon.obj", "--export writes glTF"}};

@@ -1502,6 +1502,31 @@ static void test_db_help_lists_all(void)
     ENSURE(n >= 11);
 }
 
+// Number options out of their range (--augment past the classifier's 16,
+// which it cut silently; a negative --busy-timeout, which was the default)
+// are bad usage, one line naming the option and the range, with the
+// database untouched.
+static void test_number_options_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024], cmd[4096], out[65536];
+    snprintf(p, sizeof p, "%s", base_db("numbers.db"));
+    char before[65], after[65];
+    file_sha(p, before);
+    const char* bad[][2] = {{"train --augment 17", "--augment must be 0..16, got 17"},
+                            {"train --augment -1", "--augment must be 0..16, got -1"},
+                            {"list --busy-timeout -1", "--busy-timeout must be in [0, 86400], got -1"}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db %s --db '%s' 2>&1 >/dev/null", bin, bad[i][0], p);
+        int rc = sp_fixture_run(cmd, out, sizeof out);
+        if (rc != 2 || !strstr(out, bad[i][1])) fprintf(stderr, "  db %s: exit %d: %s", bad[i][0], rc, out);
+        ENSURE(rc == 2 && strstr(out, bad[i][1]) && strchr(out, '\n') == out + strlen(out) - 1);
+    }
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+}
+
 // db init through the command line: it says how many people's strokes joined,
 // and a --quickdraw folder that is not there is one line, exit 1, no database.
 static void test_default_db_cli(void)
@@ -1803,5 +1828,6 @@ int main(int argc, char** argv)
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
+                                   {"number_options_cli", test_number_options_cli},
                                    {0}});
 }
