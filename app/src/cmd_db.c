@@ -173,6 +173,40 @@ static void print_part(const sp_db_part_info* p, bool derived)
     printf("}");
 }
 
+// ---- option values ---------------------------------------------------------------
+
+// A count of sketches to make, where a typed 0 asks for none as -1 does (it
+// was the library's default: 60 sketches for a curator who asked for none).
+// Not given (SP_CLI_UNSET): the library's 0, its default. Else -1..hi, or one
+// line naming the option and the range, false (exit 2).
+static bool count_opt(const char* cmd, const char* name, int* v, int hi)
+{
+    if (*v == SP_CLI_UNSET) {
+        *v = 0;
+        return true;
+    }
+    if (*v < -1 || *v > hi) {
+        fprintf(stderr, "%s: %s must be -1 or 0 (none) to %d, got %d\n", cmd, name, hi, *v);
+        return false;
+    }
+    if (*v == 0) *v = -1;
+    return true;
+}
+
+// --folds of the training report: -1 or 0 none (a typed 0 was 3 folds), or
+// 2..100 as `eval --folds` (1 fold holds out every drawing). Not given: the
+// library's 0, 3 folds. Else one line, false (exit 2).
+static bool folds_opt(const char* cmd, int* v)
+{
+    if (*v == SP_CLI_UNSET || *v == -1 || *v == 0) {
+        *v = *v == SP_CLI_UNSET ? 0 : -1;
+        return true;
+    }
+    if (*v >= 2 && *v <= 100) return true;
+    fprintf(stderr, "%s: --folds must be -1 or 0 (none), or 2..100, got %d\n", cmd, *v);
+    return false;
+}
+
 // ---- subcommands ---------------------------------------------------------------
 
 static int db_init(int argc, char** argv)
@@ -181,7 +215,8 @@ static int db_init(int argc, char** argv)
     db_common c = db_common_unset();
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
-    int synth = 0, concepts = 0, concept_family = 1, drawings = 0, folds = 0;
+    // Not given: the library's defaults (count_opt, folds_opt).
+    int synth = SP_CLI_UNSET, concepts = SP_CLI_UNSET, concept_family = 1, drawings = SP_CLI_UNSET, folds = SP_CLI_UNSET;
     bool no_train = false;
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
@@ -189,22 +224,23 @@ static int db_init(int argc, char** argv)
         {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts to build the default database from (default: the source tree's assets/)", false},
-        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part, -1 (none) to 10000 (default 60)", false},
-        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category, -1 (none) to 10000 (default 60)",
-         false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part, -1 or 0 (none) to 10000 (default 60)", false},
+        {"--concepts", SP_OPT_INT, &concepts, "N",
+         "concept sketches per dragon-part category, -1 or 0 (none) to 10000 (default 60)", false},
         {"--concept-family", SP_OPT_INT, &concept_family, "F",
          "seed family of the concept sketches (default 1; another family is another draw of the same designs, as `synth "
          "--concepts --seed F`)",
          false},
         {"--drawings", SP_OPT_INT, &drawings, "N",
-         "draws of each hand-placed design of assets/sketches/drawings.json, -1 (none) to 100 (default 1; seed family "
+         "draws of each hand-placed design of assets/sketches/drawings.json, -1 or 0 (none) to 100 (default 1; seed family "
          "--concept-family)",
          false},
         {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
          "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder "
          "picks.json names, ../shared/data/quickdraw beside the clone)",
          false},
-        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
+        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report, 2..100 (default 3; -1 or 0: none)",
+         false},
         {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
         CLF_CLI_OPTS(o)};
     const char* pos[1];
@@ -216,10 +252,9 @@ static int db_init(int argc, char** argv)
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
-    if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000 || drawings < -1 || drawings > 100) {
-        fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000, --drawings -1 to 100\n", cmd);
+    if (!count_opt(cmd, "--synth", &synth, 10000) || !count_opt(cmd, "--concepts", &concepts, 10000) ||
+        !count_opt(cmd, "--drawings", &drawings, 100) || !folds_opt(cmd, &folds))
         return SP_EXIT_USAGE;
-    }
     if (concept_family < 1 || concept_family > 1000000) {
         fprintf(stderr, "%s: --concept-family must be 1 to 1000000\n", cmd);
         return SP_EXIT_USAGE;
@@ -308,6 +343,7 @@ static int db_add_part(int argc, char** argv)
     sp_db_part_desc d = {0};
     bool no_selftest = false;
     const char *view = NULL, *preview = NULL;
+    int synth = SP_CLI_UNSET;
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
         {"--category", SP_OPT_STRING, &d.category, "C", "category (default: the part's extras.sp_part.category)", false},
@@ -321,8 +357,7 @@ static int db_add_part(int argc, char** argv)
          "a derived part's sketch view: auto (default), -z, +z, -x, +x (see `sketchpose derive --help`)", false},
         {"--preview", SP_OPT_STRING, &preview, "out.png",
          "render the stored part at rest and in three random poses, its abstraction overlaid", false},
-        {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it, -1 (none) to 10000 (default 60)",
-         false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches stored with it, -1 or 0 (none) to 10000 (default 60)", false},
         {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
     const char* pos[1];
     int npos;
@@ -333,12 +368,9 @@ static int db_add_part(int argc, char** argv)
         "writes nothing",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
-    // As `db init --synth`: -1 is none, 0 the default.
-    if (!sp_cli_check_out(cmd, "--preview", preview, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
-    if (d.synth_sketches < -1 || d.synth_sketches > 10000) {
-        fprintf(stderr, "%s: --synth must be -1 (none) to 10000\n", cmd);
+    if (!sp_cli_check_out(cmd, "--preview", preview, SP_CLI_OUT_PNG) || !count_opt(cmd, "--synth", &synth, 10000))
         return SP_EXIT_USAGE;
-    }
+    d.synth_sketches = synth;
     if (view && !sp_derive_view_parse(view, &d.view)) {
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
@@ -706,18 +738,19 @@ static int db_train(int argc, char** argv)
 {
     const char* cmd = "sketchpose db train";
     db_common c = db_common_unset();
-    int folds = 0;
+    int folds = SP_CLI_UNSET; // not given: the library's 3 (folds_opt)
     clf_cli_opts o = clf_cli_opts_unset();
-    sp_opt opts[] = {DB_COMMON_OPTS(c),
-                     {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report (default 3, -1 none)", false},
-                     CLF_CLI_OPTS(o)};
+    sp_opt opts[] = {
+        DB_COMMON_OPTS(c),
+        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report, 2..100 (default 3; -1 or 0: none)", false},
+        CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
     int rc = parse(argc, argv, cmd, &c,
                    "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
+    if (!clf_cli_check(cmd, &o) || !folds_opt(cmd, &folds)) return SP_EXIT_USAGE;
     sp_db* db = open_db(cmd, &c, 0);
     if (!db) return SP_EXIT_INPUT;
     sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};

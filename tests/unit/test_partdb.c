@@ -1503,18 +1503,28 @@ static void test_db_help_lists_all(void)
 }
 
 // Number options out of their range (--augment past the classifier's 16,
-// which it cut silently; a negative --busy-timeout, which was the default)
-// are bad usage, one line naming the option and the range, with the
-// database untouched.
+// which it cut silently; a negative --busy-timeout, which was the default;
+// sketch counts, --folds 1) are bad usage, one line naming the option and
+// the range, with the database untouched. A typed 0 sketch count is none, as
+// -1 (it was the default: 60 sketches).
 static void test_number_options_cli(void)
 {
     const char* bin = sketchpose_bin();
     if (!bin) SKIP("sketchpose not built");
     char p[1024], cmd[4096], out[65536];
-    snprintf(p, sizeof p, "%s", base_db("numbers.db"));
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("numbers.db"));
+    remove_db(p);
+    snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --synth 0 --no-selftest", bin, p, part_file(0));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 1 && scalar(p, "SELECT count(*) FROM sketches") == 0);
     char before[65], after[65];
     file_sha(p, before);
-    const char* bad[][2] = {{"train --augment 17", "--augment must be 0..16, got 17"},
+    const char* bad[][2] = {{"add-part x.glb --synth -2", "--synth must be -1 or 0 (none) to 10000, got -2"},
+                            {"init --concepts 10001", "--concepts must be -1 or 0 (none) to 10000, got 10001"},
+                            {"init --drawings 101", "--drawings must be -1 or 0 (none) to 100, got 101"},
+                            {"init --folds 1", "--folds must be -1 or 0 (none), or 2..100, got 1"},
+                            {"train --folds 101", "--folds must be -1 or 0 (none), or 2..100, got 101"},
+                            {"train --augment 17", "--augment must be 0..16, got 17"},
                             {"train --augment -1", "--augment must be 0..16, got -1"},
                             {"list --busy-timeout -1", "--busy-timeout must be in [0, 86400], got -1"}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
