@@ -541,6 +541,38 @@ static sp_result add_folder(sketch_set* s, const char* dir, const char* only, sp
     return r;
 }
 
+// One warning line per stored category that no part of the database has:
+// training uses such sketches only once a part of it is added (it reported
+// them as unused drawings, and nothing said why). Stored all the same: a
+// curator may add the sketches before the part.
+static void warn_partless(const char* cmd, sp_db* db, const sp_dataset* ds, const int* per)
+{
+    char** cats = NULL;
+    int n = 0;
+    sp_error err = {0};
+    if (sp_db_categories(db, &cats, &n, &err) != SP_OK) {
+        fprintf(stderr, "%s: warning: %s\n", cmd, err.text);
+        return;
+    }
+    char have[1024] = "";
+    for (int i = 0; i < n; ++i) {
+        size_t len = strlen(have);
+        snprintf(have + len, sizeof have - len, "%s%s", i ? ", " : "", cats[i]);
+    }
+    for (int k = 0; k < ds->category_count; ++k) {
+        bool known = false;
+        for (int i = 0; i < n && !known; ++i)
+            known = !strcmp(cats[i], ds->categories[k]);
+        if (per[k] > 0 && !known)
+            fprintf(stderr,
+                    "%s: warning: no part of category '%s' in %s (%s%s); its %d sketch%s stored, unused by training until one is "
+                    "added\n",
+                    cmd, ds->categories[k], sp_db_path(db), n ? "its part categories: " : "it has no parts", have, per[k],
+                    per[k] == 1 ? " is" : "es are");
+    }
+    sp_db_free_strings(cats, n);
+}
+
 static int db_add_sketch(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-sketch";
@@ -585,10 +617,11 @@ static int db_add_sketch(int argc, char** argv)
     int exit_code = SP_EXIT_OK;
     if (r != SP_OK) exit_code = db || err.text[0] ? fail(cmd, &err) : SP_EXIT_INPUT;
     else {
-        printf("{\"added\": %d, \"categories\": {", added);
         int* per = calloc((size_t)(s.ds.category_count + 1), sizeof(int));
         for (int i = 0; per && i < s.ds.count; ++i)
             per[s.ds.samples[i].label]++;
+        if (per) warn_partless(cmd, db, &s.ds, per);
+        printf("{\"added\": %d, \"categories\": {", added);
         for (int k = 0; per && k < s.ds.category_count; ++k) {
             printf("%s", k ? ", " : "");
             clf_cli_json_str(stdout, s.ds.categories[k]);

@@ -1537,6 +1537,33 @@ static void test_number_options_cli(void)
     ENSURE(!strcmp(before, after));
 }
 
+// A sketch of a category no part has is stored (a curator may add the
+// sketch before the part) with one warning line naming the category and the
+// database's part categories; it was stored silently, and training later
+// counted it among unused drawings. A category with a part gets no warning.
+static void test_add_sketch_partless_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024], cmd[4096], out[65536];
+    snprintf(p, sizeof p, "%s", base_db("partless.db"));
+    const char* one = sp_test_tmp_path("partless.json");
+    const char* text = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": "
+                       "[[1, 2], [2, 3]]}]}";
+    sp_error err = {0};
+    ENSURE(db_write_file(one, text, strlen(text), &err) == SP_OK);
+    int before = scalar(p, "SELECT count(*) FROM sketches");
+    snprintf(cmd, sizeof cmd, "'%s' db add-sketch --db '%s' --category horns '%s' 2>&1 >/dev/null", bin, p, one);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    fprintf(stderr, "  %s", out);
+    ENSURE(strstr(out, "warning: no part of category 'horns'") && strstr(out, "its part categories: tail, wings") &&
+           strchr(out, '\n') == out + strlen(out) - 1);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == before + 1);
+    snprintf(cmd, sizeof cmd, "'%s' db add-sketch --db '%s' --category tail '%s' 2>&1 >/dev/null", bin, p, one);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && out[0] == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == before + 2);
+}
+
 // db init through the command line: it says how many people's strokes joined,
 // and a --quickdraw folder that is not there is one line, exit 1, no database.
 static void test_default_db_cli(void)
@@ -1839,5 +1866,6 @@ int main(int argc, char** argv)
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
                                    {"number_options_cli", test_number_options_cli},
+                                   {"add_sketch_partless_cli", test_add_sketch_partless_cli},
                                    {0}});
 }
