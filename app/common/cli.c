@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static void print_help(const char* cmd, const char* summary, const sp_opt* opts, int nopts)
 {
@@ -139,12 +140,22 @@ static bool ends_with_ci(const char* s, const char* suffix)
 bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind)
 {
     if (!path) return true;
+    // A pipe or a device has no file name to say a format, and the writers
+    // write into one (`render --out /dev/stdout | ...`); /dev/stdout redirected
+    // to a file is a regular file by stat, hence the prefix.
+    struct stat st;
+    if (!strncmp(path, "/dev/", 5) || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)))) return true;
     if (kind == SP_CLI_OUT_GLTF) {
         if (ends_with_ci(path, ".glb") || ends_with_ci(path, ".gltf")) return true;
         fprintf(stderr, "%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'\n", cmd, name, path);
-    } else {
+    } else if (kind == SP_CLI_OUT_PNG) {
         if (ends_with_ci(path, ".png")) return true;
         fprintf(stderr, "%s: %s writes a PNG: the file name must end in .png, got '%s'\n", cmd, name, path);
+    } else {
+        // The drawing readers (classify, db add-sketch, labelled folders) tell
+        // a stroke file from SVG, PNG and ndjson by this name.
+        if (ends_with_ci(path, ".json")) return true;
+        fprintf(stderr, "%s: %s writes a stroke file (JSON): the file name must end in .json, got '%s'\n", cmd, name, path);
     }
     return false;
 }

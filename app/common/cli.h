@@ -50,14 +50,17 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
 /// What an output file holds. The file name's extension says which, so a
 /// command checks it before any work (sp_cli_check_out).
 typedef enum sp_cli_out_kind {
-    SP_CLI_OUT_GLTF, ///< .glb (binary glTF) or .gltf (JSON, buffers embedded), either case
-    SP_CLI_OUT_PNG,  ///< .png, either case
+    SP_CLI_OUT_GLTF,    ///< .glb (binary glTF) or .gltf (JSON, buffers embedded), either case
+    SP_CLI_OUT_PNG,     ///< .png, either case
+    SP_CLI_OUT_STROKES, ///< a stroke file (sketchpose-strokes JSON): .json, either case
 } sp_cli_out_kind;
 
 /// Usage check of an output option: NULL (not given) passes; a name that
 /// does not end as `kind` wants prints "<cmd>: <name> writes glTF: the file
 /// name must end in .glb or .gltf, got 'x.txt'" and returns false (exit 2,
 /// nothing written), where the writer would have put glTF JSON into x.txt.
+/// A path under /dev/ (/dev/stdout) or naming a FIFO or a device passes: it
+/// is written into as it is (glTF as JSON unless it ends in .glb).
 bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind);
 
 /// The longest solve time cap a command takes (--max-ms), ms: one hour.

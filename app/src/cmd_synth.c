@@ -278,7 +278,9 @@ int cmd_synth(int argc, char** argv)
                           "with --parts DIR --out-dir D, a labelled folder of hand-drawn sketches of every part (seed family --seed).",
                           opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (!sp_cli_check_out("sketchpose synth", "--sheet", sheet, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_out("sketchpose synth", "--sheet", sheet, SP_CLI_OUT_PNG) ||
+        !sp_cli_check_out("sketchpose synth", "--out", out, SP_CLI_OUT_STROKES))
+        return SP_EXIT_USAGE;
     bool seeded = has_opt(argc, argv, "--seed");
     sp_handdraw_style style = SP_HANDDRAW_STYLE_COUNT;
     if (style_name && (style = sp_handdraw_style_parse(style_name)) == SP_HANDDRAW_STYLE_COUNT) {

@@ -89,6 +89,12 @@ expect 2 "$SP" synth --drawings --sheet "$WORK/sheet.svg"
 refused_out sheet.svg --sheet
 expect 0 "$SP" render --rig "$RIG" --out "$WORK/R.PNG" --size 64x48
 [ -s "$WORK/R.PNG" ] || fail "render --out R.PNG wrote nothing"
+# A stroke file is .json: the drawing readers take a .svg for SVG.
+expect 2 "$SP" synth --rig "$RIG" --seed 1 --out "$WORK/s.svg"
+refused_out s.svg --out
+# A device or a pipe has no name to say a format; it is written into.
+"$SP" render --rig "$RIG" --out /dev/stdout --size 64x48 >"$WORK/piped" 2>"$WORK/err" || fail "render --out /dev/stdout: $(cat "$WORK/err")"
+[ "$(head -c 4 "$WORK/piped" | tail -c 3)" = PNG ] || fail "render --out /dev/stdout wrote no PNG"
 
 # Numbers: the parser refuses what is not one finite number; ranges name
 # themselves. A typed 0 weight turns its term off (it was the default weight).
