@@ -77,8 +77,13 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             *(const char**)o->out = v;
         } else if (o->kind == SP_OPT_INT) {
             long x = strtol(v, &end, 10);
-            if (errno || end == v || *end || x < -2147483647L || x > 2147483647L) {
+            if (end == v || *end) {
                 fprintf(stderr, "%s: %s expects an integer, got '%s'\n", cmd, o->name, v);
+                return 2;
+            }
+            // An integer all the same: say so, not that it is none.
+            if (errno || x < -2147483647L || x > 2147483647L) {
+                fprintf(stderr, "%s: %s is out of range (see --help), got '%s'\n", cmd, o->name, v);
                 return 2;
             }
             *(int*)o->out = (int)x;

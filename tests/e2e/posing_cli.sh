@@ -104,6 +104,8 @@ for v in nan inf -inf 1.5x 1e999 ''; do
 done
 expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 12abc
 one_line_naming "max-iterations expects an integer, got '12abc'"
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 99999999999
+one_line_naming "max-iterations is out of range (see --help), got '99999999999'"
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --lambda-pose 0 --report "$WORK/l0.json"
 tr -d ' \t\n' <"$WORK/l0.json" | grep -q '"terms_after":{[^}]*"pose":0,' || fail "--lambda-pose 0 kept W_pose"
 expect 2 "$SP" render --rig "$RIG" --out "$WORK/lw.png" --line-width 0
