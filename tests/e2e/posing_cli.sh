@@ -89,6 +89,13 @@ expect 2 "$SP" synth --drawings --sheet "$WORK/sheet.svg"
 refused_out sheet.svg --sheet
 expect 0 "$SP" render --rig "$RIG" --out "$WORK/R.PNG" --size 64x48
 [ -s "$WORK/R.PNG" ] || fail "render --out R.PNG wrote nothing"
+# An option synth's mode does not use is bad usage naming it (--per-part 5
+# with --rig drew one drawing, silently).
+expect 2 "$SP" synth --rig "$RIG" --seed 1 --out "$WORK/pp.json" --per-part 5
+one_line_naming "synth: --per-part does not apply to --rig"
+[ -e "$WORK/pp.json" ] && fail "synth wrote pp.json with an option it does not take"
+expect 2 "$SP" synth --concepts --sheet "$WORK/c.png" --shape top
+one_line_naming "synth: --shape does not apply to --concepts"
 # A stroke file is .json: the drawing readers take a .svg for SVG.
 expect 2 "$SP" synth --rig "$RIG" --seed 1 --out "$WORK/s.svg"
 refused_out s.svg --out
