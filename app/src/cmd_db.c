@@ -216,7 +216,8 @@ static int db_init(int argc, char** argv)
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
     // Not given: the library's defaults (count_opt, folds_opt).
-    int synth = SP_CLI_UNSET, concepts = SP_CLI_UNSET, concept_family = 1, drawings = SP_CLI_UNSET, folds = SP_CLI_UNSET;
+    int synth = SP_CLI_UNSET, concepts = SP_CLI_UNSET, concept_family = SP_CLI_UNSET, drawings = SP_CLI_UNSET,
+        folds = SP_CLI_UNSET;
     bool no_train = false;
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
@@ -251,10 +252,24 @@ static int db_init(int argc, char** argv)
         "export folder",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
+    // The options of the other way to make a database were ignored.
+    const char* other = !from                            ? (no_train ? "--no-train" : NULL)
+                        : synth != SP_CLI_UNSET          ? "--synth"
+                        : concepts != SP_CLI_UNSET       ? "--concepts"
+                        : drawings != SP_CLI_UNSET       ? "--drawings"
+                        : concept_family != SP_CLI_UNSET ? "--concept-family"
+                        : assets                         ? "--assets"
+                        : quickdraw                      ? "--quickdraw"
+                                                         : NULL;
+    if (other) {
+        fprintf(stderr, "%s: %s does not apply %s --from DIR\n", cmd, other, from ? "with" : "without");
+        return SP_EXIT_USAGE;
+    }
     if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
     if (!count_opt(cmd, "--synth", &synth, 10000) || !count_opt(cmd, "--concepts", &concepts, 10000) ||
         !count_opt(cmd, "--drawings", &drawings, 100) || !folds_opt(cmd, &folds))
         return SP_EXIT_USAGE;
+    if (concept_family == SP_CLI_UNSET) concept_family = 1;
     if (concept_family < 1 || concept_family > 1000000) {
         fprintf(stderr, "%s: --concept-family must be 1 to 1000000\n", cmd);
         return SP_EXIT_USAGE;

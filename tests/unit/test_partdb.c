@@ -1504,7 +1504,8 @@ static void test_db_help_lists_all(void)
 
 // Number options out of their range (--augment past the classifier's 16,
 // which it cut silently; a negative --busy-timeout, which was the default;
-// sketch counts, --folds 1) are bad usage, one line naming the option and
+// sketch counts, --folds 1) and db init options of the other way to make a
+// database (ignored before) are bad usage, one line naming the option and
 // the range, with the database untouched. A typed 0 sketch count is none, as
 // -1 (it was the default: 60 sketches).
 static void test_number_options_cli(void)
@@ -1524,6 +1525,9 @@ static void test_number_options_cli(void)
                             {"init --drawings 101", "--drawings must be -1 or 0 (none) to 100, got 101"},
                             {"init --folds 1", "--folds must be -1 or 0 (none), or 2..100, got 1"},
                             {"train --folds 101", "--folds must be -1 or 0 (none), or 2..100, got 101"},
+                            {"init --from x --synth 5", "--synth does not apply with --from DIR"},
+                            {"init --from x --assets y", "--assets does not apply with --from DIR"},
+                            {"init --no-train", "--no-train does not apply without --from DIR"},
                             {"train --augment 17", "--augment must be 0..16, got 17"},
                             {"train --augment -1", "--augment must be 0..16, got -1"},
                             {"list --busy-timeout -1", "--busy-timeout must be in [0, 86400], got -1"}};
