@@ -819,7 +819,10 @@ static void test_cli_option_ranges(void)
         "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1",
         "synth --rig /nonexistent/r.glb --seed -1 --out '%s.json'",
         // ignored without --calibrate (the training set's threshold, silently)
-        "train --data /nonexistent --model '%s.clf' --calibrate-quantile 0.5", "db init --db '%s' --augment 17"};
+        "train --data /nonexistent --model '%s.clf' --calibrate-quantile 0.5", "db init --db '%s' --augment 17",
+        // a model keeps its training options: they were ignored
+        "eval --model '%s.clf' --data /nonexistent --words 64", "eval --model '%s.clf' --data /nonexistent --folds 3 --knn 4",
+        "eval --model '%s.clf' --data /nonexistent --handdraw"};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
         char sub[1200];
         snprintf(sub, sizeof sub, other[i], db);
