@@ -902,8 +902,8 @@ static int db_review(int argc, char** argv)
 {
     const char* cmd = "sketchpose db review";
     db_common c = db_common_unset();
-    const char *status = "pending", *sheet = NULL;
-    int limit = 100, after = 0;
+    const char *status = NULL, *sheet = NULL;       // status NULL: pending
+    int limit = SP_CLI_UNSET, after = SP_CLI_UNSET; // not given: 100, 0
     sp_str_list approve = {0}, reject = {0}, relabel = {0};
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
@@ -924,6 +924,15 @@ static int db_review(int argc, char** argv)
     if (rc >= 0) return rc;
     if (!sp_cli_check_out(cmd, "--sheet", sheet, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     int actions = (approve.count > 0) + (reject.count > 0) + (relabel.count > 0);
+    // The listing's options were ignored by an action.
+    const char* listing = status ? "--status" : limit != SP_CLI_UNSET ? "--limit" : after != SP_CLI_UNSET ? "--after" : NULL;
+    if (actions && listing) {
+        fprintf(stderr, "%s: %s chooses what is listed; it does not apply to --approve, --reject or --relabel\n", cmd, listing);
+        return SP_EXIT_USAGE;
+    }
+    if (!status) status = "pending";
+    if (limit == SP_CLI_UNSET) limit = 100;
+    if (after == SP_CLI_UNSET) after = 0;
     if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2) || limit < 0 || after < 0) {
         fprintf(
             stderr,

@@ -1528,6 +1528,8 @@ static void test_number_options_cli(void)
                             {"init --from x --synth 5", "--synth does not apply with --from DIR"},
                             {"init --from x --assets y", "--assets does not apply with --from DIR"},
                             {"init --no-train", "--no-train does not apply without --from DIR"},
+                            {"review --approve 1 --limit 5", "--limit chooses what is listed; it does not apply"},
+                            {"review --relabel 1 tail --status all", "--status chooses what is listed; it does not apply"},
                             {"train --augment 17", "--augment must be 0..16, got 17"},
                             {"train --augment -1", "--augment must be 0..16, got -1"},
                             {"list --busy-timeout -1", "--busy-timeout must be in [0, 86400], got -1"}};
