@@ -1,10 +1,12 @@
 #include "cli.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static void print_help(const char* cmd, const char* summary, const sp_opt* opts, int nopts)
 {
@@ -75,8 +77,13 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             *(const char**)o->out = v;
         } else if (o->kind == SP_OPT_INT) {
             long x = strtol(v, &end, 10);
-            if (errno || end == v || *end || x < -2147483647L || x > 2147483647L) {
+            if (end == v || *end) {
                 fprintf(stderr, "%s: %s expects an integer, got '%s'\n", cmd, o->name, v);
+                return 2;
+            }
+            // An integer all the same: say so, not that it is none.
+            if (errno || x < -2147483647L || x > 2147483647L) {
+                fprintf(stderr, "%s: %s is out of range (see --help), got '%s'\n", cmd, o->name, v);
                 return 2;
             }
             *(int*)o->out = (int)x;
@@ -123,4 +130,42 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
     if ((lo_open ? v > lo : v >= lo) && v <= hi) return true;
     fprintf(stderr, "%s: %s must be in %s%.10g, %.10g], got %g\n", cmd, name, lo_open ? "(" : "[", lo, hi, v);
     return false;
+}
+
+// Case-insensitive suffix, without strcasecmp (not C11).
+static bool ends_with_ci(const char* s, const char* suffix)
+{
+    size_t n = strlen(s), k = strlen(suffix);
+    if (n < k) return false;
+    for (size_t i = 0; i < k; ++i)
+        if (tolower((unsigned char)s[n - k + i]) != tolower((unsigned char)suffix[i])) return false;
+    return true;
+}
+
+bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind)
+{
+    if (!path) return true;
+    // A pipe or a device has no file name to say a format, and the writers
+    // write into one (`render --out /dev/stdout | ...`); /dev/stdout redirected
+    // to a file is a regular file by stat, hence the prefix.
+    struct stat st;
+    if (!strncmp(path, "/dev/", 5) || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)))) return true;
+    if (kind == SP_CLI_OUT_GLTF) {
+        if (ends_with_ci(path, ".glb") || ends_with_ci(path, ".gltf")) return true;
+        fprintf(stderr, "%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'\n", cmd, name, path);
+    } else if (kind == SP_CLI_OUT_PNG) {
+        if (ends_with_ci(path, ".png")) return true;
+        fprintf(stderr, "%s: %s writes a PNG: the file name must end in .png, got '%s'\n", cmd, name, path);
+    } else {
+        // The drawing readers (classify, db add-sketch, labelled folders) tell
+        // a stroke file from SVG, PNG and ndjson by this name.
+        if (ends_with_ci(path, ".json")) return true;
+        fprintf(stderr, "%s: %s writes a stroke file (JSON): the file name must end in .json, got '%s'\n", cmd, name, path);
+    }
+    return false;
+}
+
+bool sp_cli_check_max_ms(const char* cmd, double ms)
+{
+    return isnan(ms) || sp_cli_check_double(cmd, "--max-ms", ms, 0, true, SP_CLI_MAX_MS);
 }

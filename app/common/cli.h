@@ -47,6 +47,31 @@ bool sp_cli_check_int(const char* cmd, const char* name, int v, int lo, int hi);
 /// The same for a number in [lo, hi], or (lo, hi] when lo_open.
 bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo, bool lo_open, double hi);
 
+/// What an output file holds. The file name's extension says which, so a
+/// command checks it before any work (sp_cli_check_out).
+typedef enum sp_cli_out_kind {
+    SP_CLI_OUT_GLTF,    ///< .glb (binary glTF) or .gltf (JSON, buffers embedded), either case
+    SP_CLI_OUT_PNG,     ///< .png, either case
+    SP_CLI_OUT_STROKES, ///< a stroke file (sketchpose-strokes JSON): .json, either case
+} sp_cli_out_kind;
+
+/// Usage check of an output option: NULL (not given) passes; a name that
+/// does not end as `kind` wants prints "<cmd>: <name> writes glTF: the file
+/// name must end in .glb or .gltf, got 'x.txt'" and returns false (exit 2,
+/// nothing written), where the writer would have put glTF JSON into x.txt.
+/// A path under /dev/ (/dev/stdout) or naming a FIFO or a device passes: it
+/// is written into as it is (glTF as JSON unless it ends in .glb).
+bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind);
+
+/// The longest solve time cap a command takes (--max-ms), ms: one hour.
+#define SP_CLI_MAX_MS 3600000.0
+/// Its range as --help words it (beside SP_CLI_MAX_MS, so that they agree).
+#define SP_CLI_MAX_MS_RANGE "ms in (0, 3600000]"
+/// --max-ms of pose, drawover and dragon: NAN (not given) passes, else ms in
+/// (0, SP_CLI_MAX_MS]; false after the usage line. One check, so that the
+/// three commands say the same range.
+bool sp_cli_check_max_ms(const char* cmd, double ms);
+
 /// Initial value of an int option whose "not given" must differ from every
 /// value a user can type (sp_cli_parse refuses INT_MIN).
 #define SP_CLI_UNSET INT_MIN

@@ -39,22 +39,45 @@ static inline int clf_cli_int(int v)
     return v == SP_CLI_UNSET ? 0 : v;
 }
 
-#define CLF_CLI_OPTS(o)                                                                                         \
-    {"--words", SP_OPT_INT, &(o).words, "N", "vocabulary size, 1..20000 (default 500)", false},                          \
-        {"--knn", SP_OPT_INT, &(o).knn, "K", "neighbours voting, 1..64 (default 8)", false},                          \
-        {"--soft", SP_OPT_INT, &(o).soft, "N", "words per descriptor, soft assignment, 1..16 (default 4)", false},    \
-        {"--augment", SP_OPT_INT, &(o).augment, "N", "jittered copies per training drawing (default 0)", false}, \
-        {"--handdraw", SP_OPT_FLAG, &(o).handdraw, "", "--augment copies from the hand-drawing model instead of affine jitter", false}, \
-        {"--no-pyramid", SP_OPT_FLAG, &(o).no_pyramid, "", "no 2x2 spatial pyramid", false},                 \
-        {"--pyramid", SP_OPT_INT, &(o).pyramid, "L", "pyramid levels past the whole drawing: 1 = 2x2 (default), 2 = also 4x4 (none: --no-pyramid)", false}, \
-        {"--no-tfidf", SP_OPT_FLAG, &(o).no_tfidf, "", "no tf-idf word weights", false},                               \
-        {"--no-hellinger", SP_OPT_FLAG, &(o).no_hellinger, "", "plain L2 between histograms", false},        \
-        {"--no-mirror", SP_OPT_FLAG, &(o).no_mirror, "", "do not add mirrored training drawings", false},    \
-        {"--reject-quantile", SP_OPT_DOUBLE, &(o).reject_quantile, "Q", "reject threshold quantile, in (0, 1] (default 0.98)", false}, \
-        {"--shape-weight", SP_OPT_DOUBLE, &(o).shape_weight, "W", "global shape evidence weight (0: none; part databases 0.75; < 0: none)", false}, \
-        {"--picture-weight", SP_OPT_DOUBLE, &(o).picture_weight, "W", "whole-drawing picture evidence weight (0: the default, 0.3; < 0: none)", false}, \
-        {"--seed", SP_OPT_INT, &(o).seed, "S", "random seed, not negative (default 1)", false},                              \
-        {"--threads", SP_OPT_INT, &(o).threads, "T", "worker threads, 1..256 (default 2)", false}
+#define CLF_CLI_OPTS(o)                                                                                                          \
+    {"--words", SP_OPT_INT, &(o).words, "N", "vocabulary size, 1..20000 (default 500)", false},                                  \
+        {"--knn", SP_OPT_INT, &(o).knn, "K", "neighbours voting, 1..64 (default 8)", false},                                     \
+        {"--soft", SP_OPT_INT, &(o).soft, "N", "words per descriptor, soft assignment, 1..16 (default 4)", false},               \
+        {"--augment", SP_OPT_INT, &(o).augment, "N", "jittered copies per training drawing, 0..16 (default 0)", false},          \
+        {"--handdraw", SP_OPT_FLAG, &(o).handdraw, "", "--augment copies from the hand-drawing model instead of affine jitter",  \
+         false},                                                                                                                 \
+        {"--no-pyramid", SP_OPT_FLAG, &(o).no_pyramid, "", "no 2x2 spatial pyramid", false},                                     \
+        {"--pyramid",                                                                                                            \
+         SP_OPT_INT,                                                                                                             \
+         &(o).pyramid,                                                                                                           \
+         "L",                                                                                                                    \
+         "pyramid levels past the whole drawing: 1 = 2x2 (default), 2 = also 4x4 (none: --no-pyramid)",                          \
+         false},                                                                                                                 \
+        {"--no-tfidf", SP_OPT_FLAG, &(o).no_tfidf, "", "no tf-idf word weights", false},                                         \
+        {"--no-hellinger", SP_OPT_FLAG, &(o).no_hellinger, "", "plain L2 between histograms", false},                            \
+        {"--no-mirror", SP_OPT_FLAG, &(o).no_mirror, "", "do not add mirrored training drawings", false},                        \
+        {"--reject-quantile",                                                                                                    \
+         SP_OPT_DOUBLE,                                                                                                          \
+         &(o).reject_quantile,                                                                                                   \
+         "Q",                                                                                                                    \
+         "reject threshold quantile, in (0, 1] (default 0.98)",                                                                  \
+         false},                                                                                                                 \
+        {"--shape-weight",                                                                                                       \
+         SP_OPT_DOUBLE,                                                                                                          \
+         &(o).shape_weight,                                                                                                      \
+         "W",                                                                                                                    \
+         "global shape evidence weight (0: none; part databases 0.75; < 0: none)",                                               \
+         false},                                                                                                                 \
+        {"--picture-weight",                                                                                                     \
+         SP_OPT_DOUBLE,                                                                                                          \
+         &(o).picture_weight,                                                                                                    \
+         "W",                                                                                                                    \
+         "whole-drawing picture evidence weight (0: the default, 0.3; < 0: none)",                                               \
+         false},                                                                                                                 \
+        {"--seed", SP_OPT_INT, &(o).seed, "S", "random seed, not negative (default 1)", false},                                  \
+    {                                                                                                                            \
+        "--threads", SP_OPT_INT, &(o).threads, "T", "worker threads, 1..256 (default 2)", false                                  \
+    }
 
 /// Refuses out-of-range training options with one line naming the option
 /// (not given: the library's default; a typed 0 is out of range). False: exit 2.
@@ -65,6 +88,8 @@ static inline bool clf_cli_check(const char* cmd, const clf_cli_opts* o)
            (o->knn == SP_CLI_UNSET || sp_cli_check_int(cmd, "--knn", o->knn, 1, 64)) &&
            (o->soft == SP_CLI_UNSET || sp_cli_check_int(cmd, "--soft", o->soft, 1, 16)) &&
            (o->pyramid == SP_CLI_UNSET || sp_cli_check_int(cmd, "--pyramid", o->pyramid, 1, 2)) &&
+           // 16: the classifier's own cap (classifier.c), which cut more, and negatives, silently.
+           sp_cli_check_int(cmd, "--augment", o->augment, 0, 16) &&
            (isnan(o->reject_quantile) || sp_cli_check_double(cmd, "--reject-quantile", o->reject_quantile, 0, true, 1)) &&
            (o->threads == SP_CLI_UNSET || sp_cli_check_int(cmd, "--threads", o->threads, 1, 256)) &&
            sp_cli_check_int(cmd, "--seed", o->seed, 0, INT_MAX);

@@ -46,6 +46,7 @@ int cmd_animate(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, "sketchpose animate", "Key poses from strokes, solved in sequence, as one glTF animation.",
                           opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out("sketchpose animate", "--out", out, SP_CLI_OUT_GLTF)) return SP_EXIT_USAGE;
     int n = keys.count;
     double* times = malloc(sizeof(double) * (size_t)n);
     if (!times) return SP_EXIT_INPUT;

@@ -1,6 +1,7 @@
 // cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,10 +26,18 @@ typedef struct db_common {
     const char* by;
 } db_common;
 
-#define DB_COMMON_OPTS(c)                                                                                                \
-    {"--db", SP_OPT_STRING, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},            \
-        {"--busy-timeout", SP_OPT_DOUBLE, &(c).busy_s, "S", "seconds to wait for another writer (default 5)", false}, \
-        {"--by", SP_OPT_STRING, &(c).by, "WHO", "curator's name for the log (default $USER)", false}
+#define DB_COMMON_OPTS(c)                                                                                                        \
+    {"--db", SP_OPT_STRING, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},                     \
+        {"--busy-timeout", SP_OPT_DOUBLE, &(c).busy_s, "S", "seconds to wait for another writer, 0..86400 (default 5)", false},  \
+    {                                                                                                                            \
+        "--by", SP_OPT_STRING, &(c).by, "WHO", "curator's name for the log (default $USER)", false                               \
+    }
+
+// Before parsing: --busy-timeout not given (NAN), the library's default.
+static db_common db_common_unset(void)
+{
+    return (db_common){.busy_s = NAN};
+}
 
 static const char* db_path(const db_common* c) { return c->db ? c->db : sp_db_default_path(); }
 
@@ -61,8 +70,8 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
     return nk;
 }
 
-static int parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts, const char** pos, int* npos,
-                 int minpos, int maxpos, const char* posname)
+static int parse(int argc, char** argv, const char* cmd, const db_common* c, const char* summary, const sp_opt* opts, int nopts,
+                 const char** pos, int* npos, int minpos, int maxpos, const char* posname)
 {
     char* kept[512];
     if (argc > 512) {
@@ -82,6 +91,8 @@ static int parse(int argc, char** argv, const char* cmd, const char* summary, co
     snprintf(full, sizeof full, "%s%s%s", cmd, maxpos ? " " : "", maxpos ? posname : "");
     int rc = sp_cli_parse(nk, kept, full, summary, opts, nopts);
     if (rc >= 0) return rc;
+    // A day at most: beyond, the milliseconds overflow an int. 0 waits not at all.
+    if (!isnan(c->busy_s) && !sp_cli_check_double(cmd, "--busy-timeout", c->busy_s, 0, false, 86400)) return SP_EXIT_USAGE;
     if (*npos < minpos) {
         fprintf(stderr, "%s: missing %s (see --help)\n", cmd, posname);
         return SP_EXIT_USAGE;
@@ -94,7 +105,7 @@ static sp_db* open_db(const char* cmd, const db_common* c, unsigned flags)
     sp_db* db = NULL;
     sp_error err = {0};
     // The timeout applies to the open too: a locked database is waited for there first.
-    if (sp_db_open_wait(db_path(c), flags, c->busy_s > 0 ? (int)(c->busy_s * 1000) : -1, &db, &err) != SP_OK) {
+    if (sp_db_open_wait(db_path(c), flags, isnan(c->busy_s) ? -1 : (int)lround(c->busy_s * 1000), &db, &err) != SP_OK) {
         fprintf(stderr, "%s: %s\n", cmd, err.text);
         return NULL;
     }
@@ -162,15 +173,51 @@ static void print_part(const sp_db_part_info* p, bool derived)
     printf("}");
 }
 
+// ---- option values ---------------------------------------------------------------
+
+// A count of sketches to make, where a typed 0 asks for none as -1 does (it
+// was the library's default: 60 sketches for a curator who asked for none).
+// Not given (SP_CLI_UNSET): the library's 0, its default. Else -1..hi, or one
+// line naming the option and the range, false (exit 2).
+static bool count_opt(const char* cmd, const char* name, int* v, int hi)
+{
+    if (*v == SP_CLI_UNSET) {
+        *v = 0;
+        return true;
+    }
+    if (*v < -1 || *v > hi) {
+        fprintf(stderr, "%s: %s must be -1 or 0 (none) to %d, got %d\n", cmd, name, hi, *v);
+        return false;
+    }
+    if (*v == 0) *v = -1;
+    return true;
+}
+
+// --folds of the training report: -1 or 0 none (a typed 0 was 3 folds), or
+// 2..100 as `eval --folds` (1 fold holds out every drawing). Not given: the
+// library's 0, 3 folds. Else one line, false (exit 2).
+static bool folds_opt(const char* cmd, int* v)
+{
+    if (*v == SP_CLI_UNSET || *v == -1 || *v == 0) {
+        *v = *v == SP_CLI_UNSET ? 0 : -1;
+        return true;
+    }
+    if (*v >= 2 && *v <= 100) return true;
+    fprintf(stderr, "%s: --folds must be -1 or 0 (none), or 2..100, got %d\n", cmd, *v);
+    return false;
+}
+
 // ---- subcommands ---------------------------------------------------------------
 
 static int db_init(int argc, char** argv)
 {
     const char* cmd = "sketchpose db init";
-    db_common c = {0};
+    db_common c = db_common_unset();
     const char* from = NULL;
     const char *assets = NULL, *quickdraw = NULL;
-    int synth = 0, concepts = 0, concept_family = 1, drawings = 0, folds = 0;
+    // Not given: the library's defaults (count_opt, folds_opt).
+    int synth = SP_CLI_UNSET, concepts = SP_CLI_UNSET, concept_family = SP_CLI_UNSET, drawings = SP_CLI_UNSET,
+        folds = SP_CLI_UNSET;
     bool no_train = false;
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
@@ -178,36 +225,51 @@ static int db_init(int argc, char** argv)
         {"--from", SP_OPT_STRING, &from, "DIR", "rebuild from a folder written by `db export`", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts to build the default database from (default: the source tree's assets/)", false},
-        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part, -1 (none) to 10000 (default 60)", false},
-        {"--concepts", SP_OPT_INT, &concepts, "N", "concept sketches per dragon-part category, -1 (none) to 10000 (default 60)",
-         false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches per part, -1 or 0 (none) to 10000 (default 60)", false},
+        {"--concepts", SP_OPT_INT, &concepts, "N",
+         "concept sketches per dragon-part category, -1 or 0 (none) to 10000 (default 60)", false},
         {"--concept-family", SP_OPT_INT, &concept_family, "F",
          "seed family of the concept sketches (default 1; another family is another draw of the same designs, as `synth "
          "--concepts --seed F`)",
          false},
         {"--drawings", SP_OPT_INT, &drawings, "N",
-         "draws of each hand-placed design of assets/sketches/drawings.json, -1 (none) to 100 (default 1; seed family "
+         "draws of each hand-placed design of assets/sketches/drawings.json, -1 or 0 (none) to 100 (default 1; seed family "
          "--concept-family)",
          false},
         {"--quickdraw", SP_OPT_STRING, &quickdraw, "DIR",
          "the Quick, Draw! data that the people's strokes (assets/sketches/picks.json) are read from (default: the folder "
          "picks.json names, ../shared/data/quickdraw beside the clone)",
          false},
-        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report (default 3, -1 none)", false},
+        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds of the training report, 2..100 (default 3; -1 or 0: none)",
+         false},
         {"--no-train", SP_OPT_FLAG, &no_train, "", "(with --from) do not train a model", false},
         CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "create a database: the default one from assets/ (parts, synthetic sketches, a trained model), or one rebuilt from an "
-                   "export folder",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    int rc = parse(
+        argc, argv, cmd, &c,
+        "create a database: the default one from assets/ (parts, synthetic sketches, a trained model), or one rebuilt from an "
+        "export folder",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
-    if (synth < -1 || synth > 10000 || concepts < -1 || concepts > 10000 || drawings < -1 || drawings > 100) {
-        fprintf(stderr, "%s: --synth and --concepts must be -1 (none) to 10000, --drawings -1 to 100\n", cmd);
+    // The options of the other way to make a database were ignored.
+    const char* other = !from                            ? (no_train ? "--no-train" : NULL)
+                        : synth != SP_CLI_UNSET          ? "--synth"
+                        : concepts != SP_CLI_UNSET       ? "--concepts"
+                        : drawings != SP_CLI_UNSET       ? "--drawings"
+                        : concept_family != SP_CLI_UNSET ? "--concept-family"
+                        : assets                         ? "--assets"
+                        : quickdraw                      ? "--quickdraw"
+                                                         : NULL;
+    if (other) {
+        fprintf(stderr, "%s: %s does not apply %s --from DIR\n", cmd, other, from ? "with" : "without");
         return SP_EXIT_USAGE;
     }
+    if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
+    if (!count_opt(cmd, "--synth", &synth, 10000) || !count_opt(cmd, "--concepts", &concepts, 10000) ||
+        !count_opt(cmd, "--drawings", &drawings, 100) || !folds_opt(cmd, &folds))
+        return SP_EXIT_USAGE;
+    if (concept_family == SP_CLI_UNSET) concept_family = 1;
     if (concept_family < 1 || concept_family > 1000000) {
         fprintf(stderr, "%s: --concept-family must be 1 to 1000000\n", cmd);
         return SP_EXIT_USAGE;
@@ -292,10 +354,11 @@ static bool preview_writable(const char* cmd, const char* path)
 static int db_add_part(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-part";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_db_part_desc d = {0};
     bool no_selftest = false;
     const char *view = NULL, *preview = NULL;
+    int synth = SP_CLI_UNSET;
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
         {"--category", SP_OPT_STRING, &d.category, "C", "category (default: the part's extras.sp_part.category)", false},
@@ -309,23 +372,20 @@ static int db_add_part(int argc, char** argv)
          "a derived part's sketch view: auto (default), -z, +z, -x, +x (see `sketchpose derive --help`)", false},
         {"--preview", SP_OPT_STRING, &preview, "out.png",
          "render the stored part at rest and in three random poses, its abstraction overlaid", false},
-        {"--synth", SP_OPT_INT, &d.synth_sketches, "N", "synthetic sketches stored with it, -1 (none) to 10000 (default 60)",
-         false},
+        {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches stored with it, -1 or 0 (none) to 10000 (default 60)", false},
         {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
     const char* pos[1];
     int npos;
     int rc = parse(
-        argc, argv, cmd,
+        argc, argv, cmd, &c,
         "validate a rigged part (loads, skin, abstraction, bounded parameters, solver self-test) and store it with synthetic "
         "sketches; a rigged glTF without sketchpose extras first gets them derived (as `sketchpose derive`); a refused part "
         "writes nothing",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
-    // As `db init --synth`: -1 is none, 0 the default.
-    if (d.synth_sketches < -1 || d.synth_sketches > 10000) {
-        fprintf(stderr, "%s: --synth must be -1 (none) to 10000\n", cmd);
+    if (!sp_cli_check_out(cmd, "--preview", preview, SP_CLI_OUT_PNG) || !count_opt(cmd, "--synth", &synth, 10000))
         return SP_EXIT_USAGE;
-    }
+    d.synth_sketches = synth;
     if (view && !sp_derive_view_parse(view, &d.view)) {
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
@@ -496,10 +556,42 @@ static sp_result add_folder(sketch_set* s, const char* dir, const char* only, sp
     return r;
 }
 
+// One warning line per stored category that no part of the database has:
+// training uses such sketches only once a part of it is added (it reported
+// them as unused drawings, and nothing said why). Stored all the same: a
+// curator may add the sketches before the part.
+static void warn_partless(const char* cmd, sp_db* db, const sp_dataset* ds, const int* per)
+{
+    char** cats = NULL;
+    int n = 0;
+    sp_error err = {0};
+    if (sp_db_categories(db, &cats, &n, &err) != SP_OK) {
+        fprintf(stderr, "%s: warning: %s\n", cmd, err.text);
+        return;
+    }
+    char have[1024] = "";
+    for (int i = 0; i < n; ++i) {
+        size_t len = strlen(have);
+        snprintf(have + len, sizeof have - len, "%s%s", i ? ", " : "", cats[i]);
+    }
+    for (int k = 0; k < ds->category_count; ++k) {
+        bool known = false;
+        for (int i = 0; i < n && !known; ++i)
+            known = !strcmp(cats[i], ds->categories[k]);
+        if (per[k] > 0 && !known)
+            fprintf(stderr,
+                    "%s: warning: no part of category '%s' in %s (%s%s); its %d sketch%s stored, unused by training until one is "
+                    "added\n",
+                    cmd, ds->categories[k], sp_db_path(db), n ? "its part categories: " : "it has no parts", have, per[k],
+                    per[k] == 1 ? " is" : "es are");
+    }
+    sp_db_free_strings(cats, n);
+}
+
 static int db_add_sketch(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-sketch";
-    db_common c = {0};
+    db_common c = db_common_unset();
     const char* category = NULL;
     const char* source = NULL;
     sp_opt opts[] = {DB_COMMON_OPTS(c),
@@ -507,10 +599,11 @@ static int db_add_sketch(int argc, char** argv)
                      {"--source", SP_OPT_STRING, &source, "S", "curated (default) or kiosk", false}};
     const char* pos[256];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "add example sketches: JSON strokes, Quick, Draw! .ndjson, SVG, PNG, or labelled folders DIR/<category>/...; all or "
-                   "nothing",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 256, "FILES...");
+    int rc = parse(
+        argc, argv, cmd, &c,
+        "add example sketches: JSON strokes, Quick, Draw! .ndjson, SVG, PNG, or labelled folders DIR/<category>/...; all or "
+        "nothing",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 256, "FILES...");
     if (rc >= 0) return rc;
     sp_db_source src = SP_DB_SOURCE_CURATED;
     if (source && !strcmp(source, "kiosk")) src = SP_DB_SOURCE_KIOSK;
@@ -539,10 +632,11 @@ static int db_add_sketch(int argc, char** argv)
     int exit_code = SP_EXIT_OK;
     if (r != SP_OK) exit_code = db || err.text[0] ? fail(cmd, &err) : SP_EXIT_INPUT;
     else {
-        printf("{\"added\": %d, \"categories\": {", added);
         int* per = calloc((size_t)(s.ds.category_count + 1), sizeof(int));
         for (int i = 0; per && i < s.ds.count; ++i)
             per[s.ds.samples[i].label]++;
+        if (per) warn_partless(cmd, db, &s.ds, per);
+        printf("{\"added\": %d, \"categories\": {", added);
         for (int k = 0; per && k < s.ds.category_count; ++k) {
             printf("%s", k ? ", " : "");
             clf_cli_json_str(stdout, s.ds.categories[k]);
@@ -563,11 +657,12 @@ static int db_add_sketch(int argc, char** argv)
 static int db_list(int argc, char** argv)
 {
     const char* cmd = "sketchpose db list";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "parts (category, vertex and parameter counts), sketch counts per category and models, as JSON", opts,
+    int rc = parse(argc, argv, cmd, &c,
+                   "parts (category, vertex and parameter counts), sketch counts per category and models, as JSON", opts,
                    (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
@@ -611,12 +706,12 @@ static int db_list(int argc, char** argv)
 static int db_show(int argc, char** argv)
 {
     const char* cmd = "sketchpose db show";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "one part: summary, parameters, abstractions and its log, as JSON", opts, (int)(sizeof opts / sizeof opts[0]),
-                   pos, &npos, 1, 1, "NAME");
+    int rc = parse(argc, argv, cmd, &c, "one part: summary, parameters, abstractions and its log, as JSON", opts,
+                   (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "NAME");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
@@ -641,11 +736,11 @@ static int db_show(int argc, char** argv)
 static int db_remove(int argc, char** argv)
 {
     const char* cmd = "sketchpose db remove";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "remove a part and its synthetic sketches (curated sketches stay)", opts,
+    int rc = parse(argc, argv, cmd, &c, "remove a part and its synthetic sketches (curated sketches stay)", opts,
                    (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "NAME");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, 0);
@@ -663,14 +758,15 @@ static int db_remove(int argc, char** argv)
 static int db_check(int argc, char** argv)
 {
     const char* cmd = "sketchpose db check";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
-                   "SQLite integrity and foreign keys, every part loads and matches its checksum, every sketch parses, the newest model "
-                   "matches the part categories; JSON; exit 1 on any problem",
-                   opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
+    int rc = parse(
+        argc, argv, cmd, &c,
+        "SQLite integrity and foreign keys, every part loads and matches its checksum, every sketch parses, the newest model "
+        "matches the part categories; JSON; exit 1 on any problem",
+        opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, 0); // writable: an older schema gets migrated
     if (!db) return SP_EXIT_INPUT;
@@ -689,18 +785,20 @@ static int db_check(int argc, char** argv)
 static int db_train(int argc, char** argv)
 {
     const char* cmd = "sketchpose db train";
-    db_common c = {0};
-    int folds = 0;
+    db_common c = db_common_unset();
+    int folds = SP_CLI_UNSET; // not given: the library's 3 (folds_opt)
     clf_cli_opts o = clf_cli_opts_unset();
-    sp_opt opts[] = {DB_COMMON_OPTS(c),
-                     {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report (default 3, -1 none)", false},
-                     CLF_CLI_OPTS(o)};
+    sp_opt opts[] = {
+        DB_COMMON_OPTS(c),
+        {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report, 2..100 (default 3; -1 or 0: none)", false},
+        CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
+    int rc = parse(argc, argv, cmd, &c,
+                   "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    if (!clf_cli_check(cmd, &o)) return SP_EXIT_USAGE;
+    if (!clf_cli_check(cmd, &o) || !folds_opt(cmd, &folds)) return SP_EXIT_USAGE;
     sp_db* db = open_db(cmd, &c, 0);
     if (!db) return SP_EXIT_INPUT;
     sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by};
@@ -718,11 +816,11 @@ static int db_train(int argc, char** argv)
 static int db_export(int argc, char** argv)
 {
     const char* cmd = "sketchpose db export";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd,
+    int rc = parse(argc, argv, cmd, &c,
                    "write DIR/parts/*.glb, DIR/sketches/<category>/* and DIR/manifest.json (what `db init --from DIR` reads); "
                    "DIR new or empty, written whole or not at all",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "DIR");
@@ -742,11 +840,11 @@ static int db_export(int argc, char** argv)
 static int db_log(int argc, char** argv)
 {
     const char* cmd = "sketchpose db log";
-    db_common c = {0};
+    db_common c = db_common_unset();
     sp_opt opts[] = {DB_COMMON_OPTS(c)};
     const char* pos[1];
     int npos;
-    int rc = parse(argc, argv, cmd, "the curator log (append-only), oldest first, as JSON; NAME: only entries about it", opts,
+    int rc = parse(argc, argv, cmd, &c, "the curator log (append-only), oldest first, as JSON; NAME: only entries about it", opts,
                    (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 1, "[NAME]");
     if (rc >= 0) return rc;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
@@ -803,9 +901,9 @@ static bool parse_ids(const char* cmd, const sp_str_list* l, int first, int coun
 static int db_review(int argc, char** argv)
 {
     const char* cmd = "sketchpose db review";
-    db_common c = {0};
-    const char *status = "pending", *sheet = NULL;
-    int limit = 100, after = 0;
+    db_common c = db_common_unset();
+    const char *status = NULL, *sheet = NULL;       // status NULL: pending
+    int limit = SP_CLI_UNSET, after = SP_CLI_UNSET; // not given: 100, 0
     sp_str_list approve = {0}, reject = {0}, relabel = {0};
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
@@ -819,12 +917,22 @@ static int db_review(int argc, char** argv)
     const char* pos[1];
     int npos;
     int rc =
-        parse(argc, argv, cmd,
+        parse(argc, argv, cmd, &c,
               "the visitors' strokes the kiosk collected: list them as JSON (pending ones by default, oldest first), draw them, "
               "approve, reject or relabel them; an unknown id changes nothing",
               opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out(cmd, "--sheet", sheet, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     int actions = (approve.count > 0) + (reject.count > 0) + (relabel.count > 0);
+    // The listing's options were ignored by an action.
+    const char* listing = status ? "--status" : limit != SP_CLI_UNSET ? "--limit" : after != SP_CLI_UNSET ? "--after" : NULL;
+    if (actions && listing) {
+        fprintf(stderr, "%s: %s chooses what is listed; it does not apply to --approve, --reject or --relabel\n", cmd, listing);
+        return SP_EXIT_USAGE;
+    }
+    if (!status) status = "pending";
+    if (limit == SP_CLI_UNSET) limit = 100;
+    if (after == SP_CLI_UNSET) after = 0;
     if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2) || limit < 0 || after < 0) {
         fprintf(
             stderr,

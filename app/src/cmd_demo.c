@@ -3,7 +3,8 @@
 // part database (created from assets/ when missing), one hand-drawn stroke
 // per dragon part placed like a dragon on the kiosk's canvas, classified,
 // fitted and attached by the kiosk pipeline; writes the strokes, a render,
-// the animated .glb and the report, and says where.
+// the animated .glb and the report, and says where: that result on stdout,
+// the progress on the way (the database built, each part's tries) on stderr.
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -177,14 +178,16 @@ int cmd_demo(int argc, char** argv)
     struct stat st;
     bool created = stat(path, &st) != 0;
     if (created) {
-        printf("creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
+        fprintf(stderr, "creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
         int picks;
         bool missing = false;
         if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
-            printf("note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's strokes "
-                   "(fewer visitors' drawings recognised)\n", assets);
+            fprintf(stderr,
+                    "note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's "
+                    "strokes "
+                    "(fewer visitors' drawings recognised)\n",
+                    assets);
     }
-    fflush(stdout);
     if (sp_db_open_or_create_default(path, assets, SP_DB_READONLY, &db, &err) != SP_OK) {
         fprintf(stderr, "sketchpose demo: %s\n", err.text);
         return SP_EXIT_INPUT;
@@ -237,9 +240,9 @@ int cmd_demo(int argc, char** argv)
             }
             if (right) {
                 placed = true;
-                printf("  %-10s drawn %d time%s, recognised (%.0f%%), fitted in %.0f ms%s\n", k_layout[li].category, t + 1,
-                       t ? "s" : "", 100.0 * res.guesses[0].confidence, res.ms_fit,
-                       sp_dragon_part_get(d, res.part)->attached_to >= 0 ? ", on the body" : "");
+                fprintf(stderr, "  %-10s drawn %d time%s, recognised (%.0f%%), fitted in %.0f ms%s\n", k_layout[li].category,
+                        t + 1, t ? "s" : "", 100.0 * res.guesses[0].confidence, res.ms_fit,
+                        sp_dragon_part_get(d, res.part)->attached_to >= 0 ? ", on the body" : "");
                 if (sp_sketch_add_stroke(&drawn, xy, NULL, n) != SP_OK) {
                     free(xy);
                     goto oom;
@@ -248,7 +251,7 @@ int cmd_demo(int argc, char** argv)
             free(xy);
             if (r != SP_OK) goto fail;
         }
-        if (!placed) printf("  %-10s not recognised in %d tries: left out\n", k_layout[li].category, DEMO_TRIES);
+        if (!placed) fprintf(stderr, "  %-10s not recognised in %d tries: left out\n", k_layout[li].category, DEMO_TRIES);
     }
     if (sp_dragon_part_count(d) == 0) {
         fprintf(stderr, "sketchpose demo: no part was recognised; is the model in %s trained?\n", path);

@@ -32,14 +32,20 @@ int cmd_dragon(int argc, char** argv)
         {"--report", SP_OPT_STRING, &report, "report.json", "write the report (also printed on stdout)", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts for a database that does not exist yet (default: the source tree's assets/)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve, ms in (0, 3600000] (default 250)", false},
-        {"--time", SP_OPT_DOUBLE, &at, "S", "animation time of the render, seconds (default 0: as fitted)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve, " SP_CLI_MAX_MS_RANGE " (default 250)", false},
+        {"--time", SP_OPT_DOUBLE, &at, "S", "animation time of the render, seconds in [0, 3600] (default 0: as fitted)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose dragon",
                           "The kiosk pipeline without a window: one part per stroke, one animated dragon.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (!isnan(max_ms) && !sp_cli_check_double("sketchpose dragon", "--max-ms", max_ms, 0, true, 3.6e6)) return SP_EXIT_USAGE;
+    // --time: the animation loops every few seconds, so an hour reaches every
+    // picture; a negative time was taken as a time counted back from a loop.
+    if (!sp_cli_check_max_ms("sketchpose dragon", max_ms) ||
+        !sp_cli_check_double("sketchpose dragon", "--time", at, 0, false, 3600) ||
+        !sp_cli_check_out("sketchpose dragon", "--out", out, SP_CLI_OUT_GLTF) ||
+        !sp_cli_check_out("sketchpose dragon", "--render", render, SP_CLI_OUT_PNG))
+        return SP_EXIT_USAGE;
     sp_error err = {0};
     sp_sketch sk = {0};
     if (sp_sketch_read_json(strokes, &sk, &err) != SP_OK) {

@@ -56,7 +56,7 @@ int cmd_drawover(int argc, char** argv)
 {
     const char *rig_path = NULL, *on_path = NULL, *to_path = NULL, *out = NULL, *render = NULL, *report = NULL;
     sp_solve_desc desc = {0};
-    double cap_ms = NAN; // not given: the solver's default
+    double cap_ms = NAN, lambda_dist = NAN; // not given: the solver's defaults
     const sp_opt opts[] = {
         {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
         {"--on", SP_OPT_STRING, &on_path, "S1.json", "strokes drawn over the character in its view", true},
@@ -64,14 +64,19 @@ int cmd_drawover(int argc, char** argv)
         {"--out", SP_OPT_STRING, &out, "posed.glb", "write the posed character", false},
         {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: --on grey, --to blue, the fitted curves yellow", false},
         {"--report", SP_OPT_STRING, &report, "report.json", "write the solve report (also printed on stdout)", false},
-        {"--lambda-dist", SP_OPT_DOUBLE, &desc.lambda_dist, "L", "weight of W_dist, locality (default 0.001)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, ms in (0, 3600000] (default 3000)", false},
+        {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L", "weight of W_dist, locality (default 0.001; 0 or negative: off)",
+         false},
+        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose drawover", "Draw-over posing: redraw curves drawn over the character.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
-    if (!isnan(cap_ms) && !sp_cli_check_double("sketchpose drawover", "--max-ms", cap_ms, 0, true, 3.6e6)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_max_ms("sketchpose drawover", cap_ms) ||
+        !sp_cli_check_out("sketchpose drawover", "--out", out, SP_CLI_OUT_GLTF) ||
+        !sp_cli_check_out("sketchpose drawover", "--render", render, SP_CLI_OUT_PNG))
+        return SP_EXIT_USAGE;
     if (!isnan(cap_ms)) desc.time_cap_ms = cap_ms;
+    desc.lambda_dist = sp_solve_cmd_lambda(lambda_dist);
     sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_sketch on = {0}, to = {0};

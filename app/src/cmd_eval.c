@@ -1,5 +1,6 @@
 // cmd_eval.c: sketchpose eval --model M --data DIR [--folds K]
 #include <stdlib.h>
+#include <string.h>
 
 #include "clf_cli.h"
 #include "sp/classifier.h"
@@ -69,6 +70,16 @@ int cmd_eval(int argc, char** argv)
         fprintf(stderr, "sketchpose eval: --folds must be 2..100\n");
         return SP_EXIT_USAGE;
     }
+    // A model keeps its training options, so with --model the training options
+    // (opts[3..], CLF_CLI_OPTS) were ignored; all but --handdraw with --folds,
+    // which a model does not keep.
+    for (int j = 3; model && j < (int)(sizeof opts / sizeof opts[0]); ++j)
+        for (int i = 1; i < argc; ++i)
+            if (!strcmp(argv[i], opts[j].name) && (strcmp(argv[i], "--handdraw") != 0 || folds == 0)) {
+                fprintf(stderr, "sketchpose eval: %s does not apply with --model M%s\n", argv[i],
+                        strcmp(argv[i], "--handdraw") ? " (the model keeps its own training options)" : " without --folds");
+                return SP_EXIT_USAGE;
+            }
     sp_error err = {0};
     sp_dataset ds;
     if (sp_dataset_load(data, &ds, &err) != SP_OK) {

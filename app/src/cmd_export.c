@@ -1,6 +1,6 @@
 // cmd_export.c: `sketchpose export --rig R [--pose p.json] --out X.glb`:
 // writes the rig posed by a pose file (default: the pose stored in R) as
-// .glb, or .gltf with embedded buffers when --out ends otherwise. A
+// .glb, or .gltf with embedded buffers (any other name is bad usage). A
 // black-box plugin is written as its posed mesh, static (as `pose --out`).
 #include <cjson/cJSON.h>
 #include <stdio.h>
@@ -27,6 +27,7 @@ int cmd_export(int argc, char** argv)
                           "Write a rig posed by a pose file as glTF (parameters baked into the joints).", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out("sketchpose export", "--out", out_path, SP_CLI_OUT_GLTF)) return SP_EXIT_USAGE;
     sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_rig_posed posed = {0};

@@ -16,7 +16,7 @@ int cmd_pose(int argc, char** argv)
     sp_solve_desc desc = {0};
     // Not given: the solver's defaults; given, a value in range.
     int reps = SP_CLI_UNSET, iters = SP_CLI_UNSET;
-    double cap_ms = NAN;
+    double cap_ms = NAN, lambda_pose = NAN, lambda_plane = NAN, lambda_dist = NAN;
     const sp_opt opts[] = {
         {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
          true},
@@ -26,12 +26,12 @@ int cmd_pose(int argc, char** argv)
         {"--out", SP_OPT_STRING, &out, "posed.glb", "write the posed character", false},
         {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: strokes blue, fitted abstraction yellow", false},
         {"--report", SP_OPT_STRING, &report, "report.json", "write the solve report (also printed on stdout)", false},
-        {"--lambda-pose", SP_OPT_DOUBLE, &desc.lambda_pose, "L", "weight of W_pose (default 0.5; negative: off)", false},
-        {"--lambda-plane", SP_OPT_DOUBLE, &desc.lambda_plane, "L", "weight of W_plane (default 0.01; negative: off)", false},
-        {"--lambda-dist", SP_OPT_DOUBLE, &desc.lambda_dist, "L", "weight of W_dist (default 0.001; negative: off)", false},
+        {"--lambda-pose", SP_OPT_DOUBLE, &lambda_pose, "L", "weight of W_pose (default 0.5; 0 or negative: off)", false},
+        {"--lambda-plane", SP_OPT_DOUBLE, &lambda_plane, "L", "weight of W_plane (default 0.01; 0 or negative: off)", false},
+        {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L", "weight of W_dist (default 0.001; 0 or negative: off)", false},
         {"--representatives", SP_OPT_INT, &reps, "K", "coarsening: representative vertices, 1..100000 (default 200)", false},
         {"--max-iterations", SP_OPT_INT, &iters, "N", "Gauss-Newton iterations at most, 1..1000000 (default 300)", false},
-        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, ms in (0, 3600000] (default 3000)", false},
+        {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose pose", "Redraw posing: fits the rig's abstraction to the strokes.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
@@ -39,8 +39,12 @@ int cmd_pose(int argc, char** argv)
     const char* cmd = "sketchpose pose";
     if ((reps != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--representatives", reps, 1, 100000)) ||
         (iters != SP_CLI_UNSET && !sp_cli_check_int(cmd, "--max-iterations", iters, 1, 1000000)) ||
-        (!isnan(cap_ms) && !sp_cli_check_double(cmd, "--max-ms", cap_ms, 0, true, 3.6e6)))
+        !sp_cli_check_max_ms(cmd, cap_ms) || !sp_cli_check_out(cmd, "--out", out, SP_CLI_OUT_GLTF) ||
+        !sp_cli_check_out(cmd, "--render", render, SP_CLI_OUT_PNG))
         return SP_EXIT_USAGE;
+    desc.lambda_pose = sp_solve_cmd_lambda(lambda_pose);
+    desc.lambda_plane = sp_solve_cmd_lambda(lambda_plane);
+    desc.lambda_dist = sp_solve_cmd_lambda(lambda_dist);
     if (reps != SP_CLI_UNSET) desc.representatives = reps;
     if (iters != SP_CLI_UNSET) desc.max_iterations = iters;
     if (!isnan(cap_ms)) desc.time_cap_ms = cap_ms;

@@ -50,17 +50,19 @@ static void orbit_camera(sp_camera* cam, sp_vec3 c, double yaw, double pitch)
 int cmd_render(int argc, char** argv)
 {
     const char *rig_path = NULL, *pose_path = NULL, *abs_name = NULL, *out_path = NULL, *size = NULL;
-    double line_width = 0, yaw = 0, pitch = 0;
+    double line_width = NAN, yaw = 0, pitch = 0; // NAN: not given
     bool no_shadow = false;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
+        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
+         true},
         {"--pose", SP_OPT_STRING, &pose_path, "p.json", "pose file {\"parameters\": {...}} (default: the rig's stored pose)",
          false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "abstraction to overlay (default: the first; 'none': no overlay)",
          false},
         {"--out", SP_OPT_STRING, &out_path, "X.png", "the PNG to write", true},
         {"--size", SP_OPT_STRING, &size, "WxH", "image size in pixels (default 640x480)", false},
-        {"--line-width", SP_OPT_DOUBLE, &line_width, "PX", "overlay line width (default: scales with the image)", false},
+        {"--line-width", SP_OPT_DOUBLE, &line_width, "PX",
+         "overlay line width, pixels in (0, 256] (default: scales with the image)", false},
         {"--yaw", SP_OPT_DOUBLE, &yaw, "DEG", "orbit the sketch camera about the vertical axis (default 0)", false},
         {"--pitch", SP_OPT_DOUBLE, &pitch, "DEG", "then tilt it, positive looks from above (default 0)", false},
         {"--no-shadow", SP_OPT_FLAG, &no_shadow, NULL, "no ground shadow", false},
@@ -70,15 +72,16 @@ int cmd_render(int argc, char** argv)
                      "render a rig posed by a pose file (else its stored pose), with an abstraction overlaid in yellow, to PNG",
                      opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out("sketchpose render", "--out", out_path, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     int w = 640, h = 480;
     if (size && !sp_cli_parse_size(size, &w, &h)) {
         fprintf(stderr, "sketchpose render: --size wants WxH with sides 16..8192, e.g. 640x480, got '%s'\n", size);
         return SP_EXIT_USAGE;
     }
-    if (line_width < 0 || !isfinite(line_width) || !isfinite(yaw) || !isfinite(pitch) || fabs(pitch) > 89.0) {
-        fprintf(stderr, "sketchpose render: --line-width must be positive, --yaw finite, --pitch within +-89\n");
+    // A typed 0 was the default width; the parser already refuses what is not finite.
+    if ((!isnan(line_width) && !sp_cli_check_double("sketchpose render", "--line-width", line_width, 0, true, 256)) ||
+        !sp_cli_check_double("sketchpose render", "--pitch", pitch, -89, false, 89))
         return SP_EXIT_USAGE;
-    }
 
     sp_error err = {0};
     sp_rig_handle* handle = NULL;
@@ -165,7 +168,7 @@ int cmd_render(int argc, char** argv)
         goto done;
     }
 
-    float lw = line_width > 0 ? (float)line_width : (float)fmax(2.0, fmin(w, h) / 150.0);
+    float lw = !isnan(line_width) ? (float)line_width : (float)fmax(2.0, fmin(w, h) / 150.0);
     sp_render_target_bind(target);
     sp_renderer_begin(r, &cam, w, h);
     sp_renderer_clear(r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);

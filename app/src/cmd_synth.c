@@ -27,6 +27,24 @@ static bool has_opt(int argc, char** argv, const char* name)
     return false;
 }
 
+// Whether every option in argv is one of `taken` (NULL-terminated); else one
+// line naming the first that is not and false (exit 2). An option a mode
+// does not use was ignored: --per-part 5 with --rig still drew one drawing.
+static bool takes_only(int argc, char** argv, const char* mode, const char* const* taken)
+{
+    for (int i = 1; i < argc; ++i) {
+        if (strncmp(argv[i], "--", 2) != 0) continue; // a value (sp_cli_parse keeps "--" out of values)
+        bool ok = false;
+        for (const char* const* t = taken; *t && !ok; ++t)
+            ok = !strcmp(argv[i], *t);
+        if (!ok) {
+            fprintf(stderr, "sketchpose synth: %s does not apply to %s (see --help)\n", argv[i], mode);
+            return false;
+        }
+    }
+    return true;
+}
+
 static void json_str(const char* s)
 {
     putchar('"');
@@ -278,6 +296,9 @@ int cmd_synth(int argc, char** argv)
                           "with --parts DIR --out-dir D, a labelled folder of hand-drawn sketches of every part (seed family --seed).",
                           opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out("sketchpose synth", "--sheet", sheet, SP_CLI_OUT_PNG) ||
+        !sp_cli_check_out("sketchpose synth", "--out", out, SP_CLI_OUT_STROKES))
+        return SP_EXIT_USAGE;
     bool seeded = has_opt(argc, argv, "--seed");
     sp_handdraw_style style = SP_HANDDRAW_STYLE_COUNT;
     if (style_name && (style = sp_handdraw_style_parse(style_name)) == SP_HANDDRAW_STYLE_COUNT) {
@@ -292,6 +313,8 @@ int cmd_synth(int argc, char** argv)
                             "--concepts, --parts, --rig, --out, --out-dir, --pose, --truth, --size\n");
             return SP_EXIT_USAGE;
         }
+        static const char* const taken[] = {"--drawings", "--per-part", "--seed", "--sheet", NULL};
+        if (!takes_only(argc, argv, "--drawings", taken)) return SP_EXIT_USAGE;
         return synth_drawings(per, (uint64_t)(seeded ? seed : 1), sheet);
     }
     if (concepts) {
@@ -305,6 +328,8 @@ int cmd_synth(int argc, char** argv)
             fprintf(stderr, "sketchpose synth: --per-part must be 1..10000 with --concepts, --seed not negative, --style normal or clean\n");
             return SP_EXIT_USAGE;
         }
+        static const char* const taken[] = {"--concepts", "--per-part", "--seed", "--style", "--out-dir", "--sheet", NULL};
+        if (!takes_only(argc, argv, "--concepts", taken)) return SP_EXIT_USAGE;
         return synth_concepts(per_part, (uint64_t)(seeded ? seed : 1), style == SP_HANDDRAW_CLEAN, out_dir, sheet);
     }
     if (parts) {
@@ -329,12 +354,18 @@ int cmd_synth(int argc, char** argv)
             return SP_EXIT_USAGE;
         }
         hd.shape = (sp_handdraw_shape)k;
+        static const char* const taken[] = {"--parts",     "--out-dir", "--per-part", "--seed",   "--style", "--abstraction",
+                                            "--amplitude", "--shape",   "--details",  "--spikes", NULL};
+        if (!takes_only(argc, argv, "--parts", taken)) return SP_EXIT_USAGE;
         return synth_parts(parts, abs_name, per_part, (uint64_t)(seeded ? seed : 1), &hd, out_dir);
     }
     if (!rig_path || !out || out_dir) {
         fprintf(stderr, "sketchpose synth: missing --rig R.gltf and --out S.json (or use --parts DIR --out-dir D; see --help)\n");
         return SP_EXIT_USAGE;
     }
+    static const char* const taken[] = {"--rig",   "--abstraction", "--seed",  "--pose",  "--amplitude", "--out",
+                                        "--truth", "--size",        "--noise", "--style", NULL};
+    if (!takes_only(argc, argv, "--rig", taken)) return SP_EXIT_USAGE;
     if (!seeded && !pose) {
         fprintf(stderr, "sketchpose synth: missing --seed N or --pose p.json (see --help)\n");
         return SP_EXIT_USAGE;

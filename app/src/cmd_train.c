@@ -11,7 +11,7 @@ int cmd_train(int argc, char** argv)
     const char* data = NULL;
     const char* model = NULL;
     const char* calibrate = NULL;
-    double cal_q = 0.96;
+    double cal_q = NAN; // not given: 0.96
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder: DIR/<category>/*.{json,svg,png}, DIR/<category>.ndjson", true},
@@ -25,10 +25,13 @@ int cmd_train(int argc, char** argv)
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
     if (!clf_cli_check("sketchpose train", &o)) return SP_EXIT_USAGE;
-    if (!(cal_q > 0 && cal_q <= 1)) {
-        fprintf(stderr, "sketchpose train: --calibrate-quantile must be in (0, 1]\n");
+    // Without --calibrate the quantile was ignored: the training set's threshold, silently.
+    if (!isnan(cal_q) && !calibrate) {
+        fprintf(stderr, "sketchpose train: --calibrate-quantile applies only with --calibrate DIR\n");
         return SP_EXIT_USAGE;
     }
+    if (isnan(cal_q)) cal_q = 0.96;
+    if (!sp_cli_check_double("sketchpose train", "--calibrate-quantile", cal_q, 0, true, 1)) return SP_EXIT_USAGE;
     double t0 = sp_now_ms();
     sp_error err = {0};
     sp_dataset ds;

@@ -358,7 +358,7 @@ int main(int argc, char** argv)
                *size = NULL;
     const char* font = NULL;
     bool fullscreen = false, stats = false, no_collect = false;
-    double idle_s = 0, join_ms = 0;
+    double idle_s = NAN, join_ms = NAN; // not given: the kiosk's defaults
     // SP_CLI_UNSET: not given (the kiosk's defaults); given, a value in range.
     int lod = SP_CLI_UNSET, msaa = SP_CLI_UNSET, max_parts = SP_CLI_UNSET;
     sp_opt opts[] = {
@@ -372,10 +372,11 @@ int main(int argc, char** argv)
         {"--screenshot", SP_OPT_STRING, &shot, "out.png", "PNG of the last frame (and of every script mark)", false},
         {"--export", SP_OPT_STRING, &out_glb, "out.glb", "glTF of the dragon at the end", false},
         {"--export-dir", SP_OPT_STRING, &export_dir, "DIR", "where Save writes (default: dragon-exports)", false},
-        {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen (default 90; < 0: never)",
+        {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen, > 0 (default 90; < 0: never)",
          false},
         {"--join-ms", SP_OPT_DOUBLE, &join_ms, "MS",
-         "a stroke begun this soon after the last one's pen-up, where it ended, continues it (default 200; < 0: never)", false},
+         "a stroke begun this soon after the last one's pen-up, where it ended, continues it (default 200; 0 or < 0: never)",
+         false},
         {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
         {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling, samples 0..16 (default: 4 on a GPU, 0 on software GL)", false},
         {"--lod", SP_OPT_INT, &lod, "N",
@@ -389,6 +390,9 @@ int main(int argc, char** argv)
     int rc = sp_cli_parse(argc, argv, k_cmd, "The dragon kiosk: draw a part in one line, see it come alive.", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (!sp_cli_check_out(k_cmd, "--screenshot", shot, SP_CLI_OUT_PNG) ||
+        !sp_cli_check_out(k_cmd, "--export", out_glb, SP_CLI_OUT_GLTF))
+        return SP_EXIT_USAGE;
     if (lod != SP_CLI_UNSET && lod != -1 && (lod < 1 || lod > 10000000)) {
         fprintf(stderr, "%s: --lod must be -1 (all) or 1..10000000, got %d\n", k_cmd, lod);
         return SP_EXIT_USAGE;
@@ -396,6 +400,11 @@ int main(int argc, char** argv)
     if ((msaa != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--msaa", msaa, 0, 16)) ||
         (max_parts != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--max-parts", max_parts, 1, 1000)))
         return SP_EXIT_USAGE;
+    // A typed 0 was the default (90 s): no timeout is asked for by a negative value.
+    if (idle_s == 0) {
+        fprintf(stderr, "%s: --idle must be more than 0 seconds, or negative: never\n", k_cmd);
+        return SP_EXIT_USAGE;
+    }
     if (lod == SP_CLI_UNSET) lod = 0;
     if (msaa == SP_CLI_UNSET) msaa = -1; // 4, or 1 on a software rasteriser (below)
     if (max_parts == SP_CLI_UNSET) max_parts = 0;
@@ -469,10 +478,13 @@ int main(int argc, char** argv)
                         .font_path = font,
                         .canvas_w = a.fb_w,
                         .canvas_h = a.fb_h,
-                        .ui = {.idle_ms = idle_s > 0   ? idle_s * 1000.0
-                                          : idle_s < 0 ? -1
-                                                       : 0,
-                               .join_ms = join_ms},
+                        .ui = {.idle_ms = isnan(idle_s) ? 0
+                                          : idle_s > 0  ? idle_s * 1000.0
+                                                        : -1,
+                               // A typed 0 ms joins nothing: never (it was the default, 200).
+                               .join_ms = isnan(join_ms) ? 0
+                                          : join_ms > 0  ? join_ms
+                                                         : -1},
                         .code_seed = script ? 1 : (uint64_t)time(NULL),
                         .lod_triangles = lod,
                         .max_parts = max_parts,

@@ -1,6 +1,7 @@
 // solve_cmd.c: the solve-report-write path of the posing commands (see solve_cmd.h).
 #include "solve_cmd.h"
 
+#include <math.h>
 #include <stdio.h>
 
 #include "report.h"
@@ -62,6 +63,11 @@ bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double
     }
     if (o->note && o->note[0]) fprintf(stderr, "%s: %s\n", s->cmd, o->note);
     return true;
+}
+
+double sp_solve_cmd_lambda(double typed)
+{
+    return isnan(typed) ? 0 : typed > 0 ? typed : -1;
 }
 
 void sp_solve_cmd_end(sp_solve_cmd* s)

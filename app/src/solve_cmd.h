@@ -50,6 +50,11 @@ typedef struct sp_solve_outputs {
 /// at p to --out and --render, then the note. False after printing why.
 bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double* p, const sp_solve_outputs* o);
 
+/// The solver's weight (sp_solve_desc.lambda_*) for a --lambda-* option:
+/// NAN (not given) is 0, the solver's default; a typed 0 or less turns the
+/// term off (a typed 0 was the default weight, 0.5 for W_pose).
+double sp_solve_cmd_lambda(double typed);
+
 /// Destroys the solver.
 void sp_solve_cmd_end(sp_solve_cmd* s);
 

@@ -58,6 +58,16 @@ grep -q '"name":	"root.s"' "$WORK/out" || fail "the export lost root.s"
 expect 0 "$SP" export --rig "$DATA/two_bone.gltf" --out "$WORK/plain.gltf"
 expect 0 "$SP" inspect --rig "$WORK/plain.gltf"
 
+# The file name says the format: anything but .glb or .gltf (either case) is
+# bad usage, one line, and nothing is written (x.txt got glTF JSON before).
+for bad in x.txt x.obj x.glb.bak noext; do
+    expect 2 "$SP" export --rig "$DATA/two_bone_extras.gltf" --out "$WORK/$bad"
+    one_line_naming "export: --out writes glTF: the file name must end in .glb or .gltf, got '.*$bad'"
+    [ -e "$WORK/$bad" ] && fail "a refused export wrote $bad"
+done
+expect 0 "$SP" export --rig "$DATA/two_bone_extras.gltf" --out "$WORK/UPPER.GLB"
+[ "$(head -c 4 "$WORK/UPPER.GLB")" = glTF ] || fail "--out UPPER.GLB is not a binary glTF"
+
 # Bad pose files: exit 1, one line naming the file and the problem.
 printf '{"parameters": {"root.nope": 1}}' >"$WORK/unknown.json"
 expect 1 "$SP" export --rig "$DATA/two_bone_extras.gltf" --pose "$WORK/unknown.json" --out "$WORK/x.glb"

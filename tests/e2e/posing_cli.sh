@@ -59,6 +59,67 @@ one_line_naming nowhere/x.png
 [ -e "$WORK/left.json" ] && fail "pose left its report after --render failed"
 ls "$WORK" | grep -q 'tmp' && fail "pose left a temporary file: $(ls "$WORK" | grep tmp)"
 
+# --max-ms: one range, worded alike by the commands that take it.
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-ms 0
+one_line_naming "sketchpose pose: --max-ms must be in (0, 3600000\], got 0"
+expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --max-ms -5
+one_line_naming "sketchpose drawover: --max-ms must be in (0, 3600000\], got -5"
+
+# Outputs are glTF or PNG by their names: another name is bad usage, one
+# line naming the option, before any solve, and no file is made (--out x.txt
+# got glTF JSON, --render x.jpg a PNG).
+refused_out() { # refused_out FILE OPTION: the last command wrote nothing and said why
+    one_line_naming ": $2 writes .*got '.*$1'"
+    [ -e "$WORK/$1" ] && fail "a refused $2 wrote $1"
+}
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/p.txt"
+refused_out p.txt --out
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/p.glb" --render "$WORK/p.jpg"
+refused_out p.jpg --render
+[ -e "$WORK/p.glb" ] && fail "pose wrote --out although --render was refused"
+expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --render "$WORK/d.jpeg"
+refused_out d.jpeg --render
+expect 2 "$SP" drawover --rig "$RIG" --on "$WORK/s.json" --to "$WORK/s.json" --out "$WORK/d.fbx"
+refused_out d.fbx --out
+expect 2 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/a.json"
+refused_out a.json --out
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/r.jpg"
+refused_out r.jpg --out
+expect 2 "$SP" synth --drawings --sheet "$WORK/sheet.svg"
+refused_out sheet.svg --sheet
+expect 0 "$SP" render --rig "$RIG" --out "$WORK/R.PNG" --size 64x48
+[ -s "$WORK/R.PNG" ] || fail "render --out R.PNG wrote nothing"
+# An option synth's mode does not use is bad usage naming it (--per-part 5
+# with --rig drew one drawing, silently).
+expect 2 "$SP" synth --rig "$RIG" --seed 1 --out "$WORK/pp.json" --per-part 5
+one_line_naming "synth: --per-part does not apply to --rig"
+[ -e "$WORK/pp.json" ] && fail "synth wrote pp.json with an option it does not take"
+expect 2 "$SP" synth --concepts --sheet "$WORK/c.png" --shape top
+one_line_naming "synth: --shape does not apply to --concepts"
+# A stroke file is .json: the drawing readers take a .svg for SVG.
+expect 2 "$SP" synth --rig "$RIG" --seed 1 --out "$WORK/s.svg"
+refused_out s.svg --out
+# A device or a pipe has no name to say a format; it is written into.
+"$SP" render --rig "$RIG" --out /dev/stdout --size 64x48 >"$WORK/piped" 2>"$WORK/err" || fail "render --out /dev/stdout: $(cat "$WORK/err")"
+[ "$(head -c 4 "$WORK/piped" | tail -c 3)" = PNG ] || fail "render --out /dev/stdout wrote no PNG"
+
+# Numbers: the parser refuses what is not one finite number; ranges name
+# themselves. A typed 0 weight turns its term off (it was the default weight).
+for v in nan inf -inf 1.5x 1e999 ''; do
+    expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --lambda-pose "$v"
+    one_line_naming "lambda-pose expects a finite number, got '$v'"
+done
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 12abc
+one_line_naming "max-iterations expects an integer, got '12abc'"
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 99999999999
+one_line_naming "max-iterations is out of range (see --help), got '99999999999'"
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --lambda-pose 0 --report "$WORK/l0.json"
+tr -d ' \t\n' <"$WORK/l0.json" | grep -q '"terms_after":{[^}]*"pose":0,' || fail "--lambda-pose 0 kept W_pose"
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/lw.png" --line-width 0
+one_line_naming "line-width must be in (0, 256\], got 0"
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/lw.png" --pitch 90
+one_line_naming "pitch must be in \[-89, 89\], got 90"
+
 # A picture size out of range says the range.
 expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 1x1
 one_line_naming "16..8192"

@@ -52,3 +52,9 @@ add_test(NAME public_headers_fails_foreign COMMAND public_headers ${sp_lint_dir}
 set_tests_properties(public_headers_fails_foreign PROPERTIES PASS_REGULAR_EXPRESSION
   "foreign.h:2: includes <GLFW/glfw3.h>.*foreign.h:3: names cJSON .*foreign.h:4: names a C\\+\\+ scope")
 add_test(NAME public_headers_passes_comments COMMAND public_headers ${sp_lint_dir}/clean.h)
+
+# --max-ms has one range check (sp_cli_check_max_ms, app/common/cli.c) that
+# pose, drawover and dragon call; a command's own copy of the range would
+# drift from the others' (it was written three times).
+add_test(NAME cli_max_ms_checked_once
+         COMMAND sh -c "! grep -n 'sp_cli_check_double([^;]*--max-ms' ${PROJECT_SOURCE_DIR}/app/src/*.c")

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 
 #include <cjson/cJSON.h>
 
@@ -171,6 +172,16 @@ char* sp_fixture_file_text(const char* path, size_t* n)
     t[len] = '\0';
     if (n) *n = (size_t)len;
     return t;
+}
+
+int sp_fixture_run(const char* cmd, char* out, size_t cap)
+{
+    FILE* p = popen(cmd, "r");
+    ENSURE(p);
+    size_t n = fread(out, 1, cap - 1, p);
+    out[n] = 0;
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
 cJSON* sp_fixture_json_file(const char* path)

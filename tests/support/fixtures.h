@@ -46,6 +46,11 @@ struct cJSON* sp_fixture_glb_json(const char* path);
 /// NULL); fails the running test when it does not read.
 char* sp_fixture_file_text(const char* path, size_t* n);
 
+/// Runs a shell command (popen): its stdout in out, cut to cap - 1 bytes
+/// and NUL-terminated; returns its exit status (-1 when it did not exit).
+/// Fails the running test when the command cannot be started.
+int sp_fixture_run(const char* cmd, char* out, size_t cap);
+
 /// A JSON file, parsed (fails the running test when it does
 /// not read or parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_json_file(const char* path);

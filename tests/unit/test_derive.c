@@ -514,6 +514,33 @@ static void test_cli(void)
     ENSURE(run(cmd, NULL) == 2);
     snprintf(cmd, sizeof cmd, "'%s' derive --help", bin);
     ENSURE(run(cmd, NULL) == 0);
+    // Outputs by their names (a .obj got glTF, a .jpg a PNG): bad usage, one
+    // line naming the option, nothing written, no part stored.
+    char bad[1024], bad_db[1024];
+    snprintf(bad, sizeof bad, "%s", sp_test_tmp_path("cli_bad.obj"));
+    snprintf(bad_db, sizeof bad_db, "%s", sp_test_tmp_path("cli_bad.db"));
+    const char* bad_outs[3][2] = {{"derive --rig '%s' --out '%s'", "--out writes glTF"},
+                                  {"derive --rig '%s' --out '%s.glb' --preview '%s.jpg'", "--preview writes a PNG"},
+                                  {"db add-part --db '%s' '%s' --preview '%s.jpg'", "--preview writes a PNG"}};
+    for (int i = 0; i < 3; ++i) {
+        char args[4000];
+        if (i < 2)
+            snprintf(args, sizeof args, bad_outs[i][0], src, bad, bad);
+        else
+            snprintf(args, sizeof args, bad_outs[i][0], bad_db, src, bad);
+        snprintf(cmd, sizeof cmd, "( '%s' %s 2>&1 )", bin, args); // stderr into run()'s capture
+        unlink(bad), unlink(bad_db);
+        int rc = run(cmd, &text);
+        fprintf(stderr, "  %s -> %d: %s", bad_outs[i][1], rc, text ? text : "");
+        ENSURE(rc == 2 && text && strstr(text, bad_outs[i][1]) && strchr(text, '\n') == text + strlen(text) - 1);
+        free(text);
+        struct stat st;
+        ENSURE(stat(bad, &st) != 0 && stat(bad_db, &st) != 0);
+        for (int k = 0; k < 2; ++k) {
+            snprintf(args, sizeof args, "%s%s", bad, k ? ".glb" : ".jpg");
+            ENSURE(stat(args, &st) != 0);
+        }
+    }
     // db add-part derives the same file: JSON as before plus "derived"; --abstraction stick.
     char db[1024];
     snprintf(db, sizeof db, "%s", sp_test_tmp_path("cli.db"));

@@ -1436,7 +1436,17 @@ static void test_live_update(void)
     sp_dragon_destroy(d);
 }
 
-// A JSON file parsed (ENSURE'd readable, at most 4 MB, and valid).
+// Bad usage of `sketchpose dragon`: exit 2 and one line on stderr holding `want`.
+static void dragon_usage_error(const char* args, const char* want)
+{
+    char cmd[6000], err[2048];
+    snprintf(cmd, sizeof cmd, "'%s' dragon %s 2>&1 >/dev/null", SP_SKETCHPOSE, args);
+    int rc = sp_fixture_run(cmd, err, sizeof err);
+    if (rc != 2 || !strstr(err, want) || strchr(err, '\n') != err + strlen(err) - 1)
+        fprintf(stderr, "  dragon %s: exit %d, wanted 2 and one line with '%s': %s\n", args, rc, want, err);
+    ENSURE(rc == 2 && strstr(err, want) && strchr(err, '\n') == err + strlen(err) - 1);
+}
+
 // `sketchpose dragon`: a stroke file in, a .glb, a PNG and the report out.
 static void test_command(void)
 {
@@ -1512,6 +1522,31 @@ static void test_command(void)
                  strokes, i ? "-5" : "0");
         ENSURE(WEXITSTATUS(system(cmd)) == 2);
     }
+    // --time: [0, 3600] s (a negative time was taken as one counted back from
+    // a loop); what is not a finite number is refused by the parser.
+    const char* bad_time[][2] = {{"-1", "--time must be in [0, 3600], got -1"},
+                                 {"3601", "--time must be in [0, 3600], got 3601"},
+                                 {"nan", "--time expects a finite number, got 'nan'"},
+                                 {"-inf", "--time expects a finite number, got '-inf'"},
+                                 {"1.5x", "--time expects a finite number, got '1.5x'"}};
+    for (int i = 0; i < 5; ++i) {
+        char args[4000];
+        snprintf(args, sizeof args, "--db '%s' --strokes '%s' --time %s", path, strokes, bad_time[i][0]);
+        dragon_usage_error(args, bad_time[i][1]);
+    }
+    // Outputs by their names: --out other than .glb/.gltf and --render other
+    // than .png are bad usage before any work, and nothing is written (the
+    // .txt got glTF JSON before, the .jpg a PNG).
+    const char* bad_out[2][3] = {{"--out", "dragon_cmd.txt", "--out writes glTF"},
+                                 {"--render", "dragon_cmd.jpg", "--render writes a PNG"}};
+    for (int i = 0; i < 2; ++i) {
+        char bad[1024], args[4000];
+        snprintf(bad, sizeof bad, "%s", sp_test_tmp_path(bad_out[i][1]));
+        unlink(bad);
+        snprintf(args, sizeof args, "--db '%s' --strokes '%s' %s '%s'", path, strokes, bad_out[i][0], bad);
+        dragon_usage_error(args, bad_out[i][2]);
+        ENSURE(stat(bad, &st) != 0);
+    }
 }
 
 // The shipped parts (assets/*.glb), once they exist: a default database built
@@ -1521,23 +1556,25 @@ static void test_command(void)
 // .glb valid.
 static void check_demo(const char* db_path)
 {
-    char dir[1024], cmd[4000], glb[1200], png[1200], strokes[1200], log[1200];
+    char dir[1024], cmd[4000], glb[1200], png[1200], strokes[1200], log[1200], progress[1200];
     snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("dragon_demo"));
     snprintf(glb, sizeof glb, "%s/dragon.glb", dir);
     snprintf(png, sizeof png, "%s/dragon.png", dir);
     snprintf(strokes, sizeof strokes, "%s/strokes.json", dir);
     snprintf(log, sizeof log, "%s", sp_test_tmp_path("dragon_demo.txt"));
+    snprintf(progress, sizeof progress, "%s", sp_test_tmp_path("dragon_demo_progress.txt"));
     unlink(glb), unlink(png), unlink(strokes);
-    snprintf(cmd, sizeof cmd, "'%s' demo --db '%s' --out '%s' > '%s' 2>&1", SP_SKETCHPOSE, db_path, dir, log);
+    snprintf(cmd, sizeof cmd, "'%s' demo --db '%s' --out '%s' > '%s' 2> '%s'", SP_SKETCHPOSE, db_path, dir, log, progress);
     ENSURE(system(cmd) == 0);
-    FILE* f = fopen(log, "rb");
-    ENSURE(f);
-    char text[8192] = {0};
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    (void)n;
-    fprintf(stderr, "%s", text);
+    // stdout is the result, what was made and where; the parts' progress is on
+    // stderr (it was mixed into stdout).
+    char* text = sp_fixture_file_text(log, NULL);
+    char* prog = sp_fixture_file_text(progress, NULL);
+    fprintf(stderr, "%s%s", prog, text);
     ENSURE(strstr(text, "a dragon of 8 parts") && strstr(text, glb) && strstr(text, png));
+    ENSURE(!strstr(text, "recognised (") && strstr(prog, "  torso ") && strstr(prog, "recognised ("));
+    free(text);
+    free(prog);
     struct stat st;
     ENSURE(stat(png, &st) == 0 && st.st_size > 10000);
     sp_sketch sk = {0};

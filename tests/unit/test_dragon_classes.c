@@ -813,12 +813,16 @@ static void test_cli_option_ranges(void)
         if (WEXITSTATUS(rc) != 2 || !strstr(line, name)) fprintf(stderr, "  %s: %d %s", cmd, WEXITSTATUS(rc), line);
         ENSURE(WEXITSTATUS(rc) == 2 && strstr(line, name));
     }
-    const char* other[] = {"db add-part /nonexistent/p.glb --db '%s' --synth -5",
-                           "db add-part /nonexistent/p.glb --db '%s' --synth 100000000",
-                           "db init --db '%s' --synth -5",
-                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise 1e300",
-                           "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1",
-                           "synth --rig /nonexistent/r.glb --seed -1 --out '%s.json'"};
+    const char* other[] = {
+        "db add-part /nonexistent/p.glb --db '%s' --synth -5", "db add-part /nonexistent/p.glb --db '%s' --synth 100000000",
+        "db init --db '%s' --synth -5", "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise 1e300",
+        "synth --rig /nonexistent/r.glb --seed 1 --out '%s.json' --noise -1",
+        "synth --rig /nonexistent/r.glb --seed -1 --out '%s.json'",
+        // ignored without --calibrate (the training set's threshold, silently)
+        "train --data /nonexistent --model '%s.clf' --calibrate-quantile 0.5", "db init --db '%s' --augment 17",
+        // a model keeps its training options: they were ignored
+        "eval --model '%s.clf' --data /nonexistent --words 64", "eval --model '%s.clf' --data /nonexistent --folds 3 --knn 4",
+        "eval --model '%s.clf' --data /nonexistent --handdraw"};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; ++i) {
         char sub[1200];
         snprintf(sub, sizeof sub, other[i], db);

@@ -1703,16 +1703,26 @@ static void test_parts_loaded_while_idle(void)
 // would fail to open the window (exit 1), not hang.
 static void test_option_ranges(void)
 {
-    const char* bad[] = {"--max-parts 0", "--max-parts -1", "--lod -5", "--lod 0", "--msaa 64", "--msaa -1"};
+    // A typed 0 --idle is no timeout to ask for. Outputs by their names too: a screenshot that is not .png, an export
+    // that is not .glb/.gltf (they got a PNG and glTF).
+    const char* bad[][2] = {{"--max-parts 0", "--max-parts must be"},
+                            {"--max-parts -1", "--max-parts must be"},
+                            {"--lod -5", "--lod must be"},
+                            {"--lod 0", "--lod must be"},
+                            {"--msaa 64", "--msaa must be"},
+                            {"--idle 0", "--idle must be"}, // it was the default, 90 s
+                            {"--msaa -1", "--msaa must be"},
+                            {"--screenshot shot.jpg", "--screenshot writes a PNG"},
+                            {"--export dragon.obj", "--export writes glTF"}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
-        char cmd[2048], line[512] = "", name[64];
+        char cmd[2048], line[512] = "";
         snprintf(cmd, sizeof cmd, "env -u DISPLAY -u WAYLAND_DISPLAY '%s' --db /nonexistent/k.db %s 2>&1 >/dev/null",
-                 SP_DRAGON_KIOSK, bad[i]);
+                 SP_DRAGON_KIOSK, bad[i][0]);
         FILE* p = popen(cmd, "r");
         ENSURE(p && fgets(line, sizeof line, p));
         int rc = pclose(p);
-        snprintf(name, sizeof name, "%.*s must be", (int)strcspn(bad[i], " "), bad[i]);
-        if (WEXITSTATUS(rc) != 2 || !strstr(line, name)) fprintf(stderr, "  %s: %d %s", bad[i], WEXITSTATUS(rc), line);
+        const char* name = bad[i][1];
+        if (WEXITSTATUS(rc) != 2 || !strstr(line, name)) fprintf(stderr, "  %s: %d %s", bad[i][0], WEXITSTATUS(rc), line);
         ENSURE(WEXITSTATUS(rc) == 2 && strstr(line, name));
     }
 }

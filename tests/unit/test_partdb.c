@@ -1480,17 +1480,6 @@ static void test_kiosk_migration(void)
     sp_db_close(db);
 }
 
-// Runs a command, returns its exit status; its stdout (first `cap` bytes) in out.
-static int run(const char* cmd, char* out, size_t cap)
-{
-    FILE* pp = popen(cmd, "r");
-    ENSURE(pp);
-    size_t n = fread(out, 1, cap - 1, pp);
-    out[n] = 0;
-    int st = pclose(pp);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 // `sketchpose --help` names every subcommand `db --help` lists (it lacked log and review).
 static void test_db_help_lists_all(void)
 {
@@ -1498,13 +1487,13 @@ static void test_db_help_lists_all(void)
     if (!bin) SKIP("sketchpose not built");
     char cmd[2048], top[8192], sub[8192];
     snprintf(cmd, sizeof cmd, "'%s' --help", bin);
-    ENSURE(run(cmd, top, sizeof top) == 0);
+    ENSURE(sp_fixture_run(cmd, top, sizeof top) == 0);
     const char* dbline = strstr(top, "\n  db ");
     ENSURE(dbline);
     char line[1024];
     snprintf(line, sizeof line, "%.*s", (int)strcspn(dbline + 1, "\n"), dbline + 1);
     snprintf(cmd, sizeof cmd, "'%s' db --help", bin);
-    ENSURE(run(cmd, sub, sizeof sub) == 0);
+    ENSURE(sp_fixture_run(cmd, sub, sizeof sub) == 0);
     int n = 0;
     for (const char* q = strstr(sub, "subcommands:\n"); q && (q = strstr(q, "\n  ")) != NULL; ++n) {
         char name[64], word[80];
@@ -1515,6 +1504,74 @@ static void test_db_help_lists_all(void)
         ENSURE(strstr(line, word));
     }
     ENSURE(n >= 11);
+}
+
+// Number options out of their range (--augment past the classifier's 16,
+// which it cut silently; a negative --busy-timeout, which was the default;
+// sketch counts, --folds 1) and db init options of the other way to make a
+// database (ignored before) are bad usage, one line naming the option and
+// the range, with the database untouched. A typed 0 sketch count is none, as
+// -1 (it was the default: 60 sketches).
+static void test_number_options_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024], cmd[4096], out[65536];
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("numbers.db"));
+    remove_db(p);
+    snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --synth 0 --no-selftest", bin, p, part_file(0));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 1 && scalar(p, "SELECT count(*) FROM sketches") == 0);
+    char before[65], after[65];
+    file_sha(p, before);
+    const char* bad[][2] = {{"add-part x.glb --synth -2", "--synth must be -1 or 0 (none) to 10000, got -2"},
+                            {"init --concepts 10001", "--concepts must be -1 or 0 (none) to 10000, got 10001"},
+                            {"init --drawings 101", "--drawings must be -1 or 0 (none) to 100, got 101"},
+                            {"init --folds 1", "--folds must be -1 or 0 (none), or 2..100, got 1"},
+                            {"train --folds 101", "--folds must be -1 or 0 (none), or 2..100, got 101"},
+                            {"init --from x --synth 5", "--synth does not apply with --from DIR"},
+                            {"init --from x --assets y", "--assets does not apply with --from DIR"},
+                            {"init --no-train", "--no-train does not apply without --from DIR"},
+                            {"review --approve 1 --limit 5", "--limit chooses what is listed; it does not apply"},
+                            {"review --relabel 1 tail --status all", "--status chooses what is listed; it does not apply"},
+                            {"train --augment 17", "--augment must be 0..16, got 17"},
+                            {"train --augment -1", "--augment must be 0..16, got -1"},
+                            {"list --busy-timeout -1", "--busy-timeout must be in [0, 86400], got -1"}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db %s --db '%s' 2>&1 >/dev/null", bin, bad[i][0], p);
+        int rc = sp_fixture_run(cmd, out, sizeof out);
+        if (rc != 2 || !strstr(out, bad[i][1])) fprintf(stderr, "  db %s: exit %d: %s", bad[i][0], rc, out);
+        ENSURE(rc == 2 && strstr(out, bad[i][1]) && strchr(out, '\n') == out + strlen(out) - 1);
+    }
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+}
+
+// A sketch of a category no part has is stored (a curator may add the
+// sketch before the part) with one warning line naming the category and the
+// database's part categories; it was stored silently, and training later
+// counted it among unused drawings. A category with a part gets no warning.
+static void test_add_sketch_partless_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024], cmd[4096], out[65536];
+    snprintf(p, sizeof p, "%s", base_db("partless.db"));
+    const char* one = sp_test_tmp_path("partless.json");
+    const char* text = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": "
+                       "[[1, 2], [2, 3]]}]}";
+    sp_error err = {0};
+    ENSURE(db_write_file(one, text, strlen(text), &err) == SP_OK);
+    int before = scalar(p, "SELECT count(*) FROM sketches");
+    snprintf(cmd, sizeof cmd, "'%s' db add-sketch --db '%s' --category horns '%s' 2>&1 >/dev/null", bin, p, one);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    fprintf(stderr, "  %s", out);
+    ENSURE(strstr(out, "warning: no part of category 'horns'") && strstr(out, "its part categories: tail, wings") &&
+           strchr(out, '\n') == out + strlen(out) - 1);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == before + 1);
+    snprintf(cmd, sizeof cmd, "'%s' db add-sketch --db '%s' --category tail '%s' 2>&1 >/dev/null", bin, p, one);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && out[0] == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == before + 2);
 }
 
 // db init through the command line: it says how many people's strokes joined,
@@ -1529,15 +1586,16 @@ static void test_default_db_cli(void)
     remove_db(p);
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 --quickdraw '%s/nowhere' 2>&1",
              bin, p, assets, root);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") && strchr(out, '\n') == out + strlen(out) - 1);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") &&
+           strchr(out, '\n') == out + strlen(out) - 1);
     struct stat st;
     ENSURE(stat(p, &st) != 0);
     // A folder that is not there: the error names the database given, not the file built beside it.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/nowhere/x.db' --assets '%s' 2>&1", bin, root, assets);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere/x.db: cannot open") && !strstr(out, ".building-"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere/x.db: cannot open") && !strstr(out, ".building-"));
     // A concept family that is not one: one line, a usage exit, no database.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --concept-family 0 2>&1", bin, p, assets);
-    ENSURE(run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
            strchr(out, '\n') == out + strlen(out) - 1);
     ENSURE(stat(p, &st) != 0);
     // Two tails and a horn join, and the JSON counts each maker's sketches: 3 parts x 8, tail and wings concepts x 2
@@ -1548,7 +1606,7 @@ static void test_default_db_cli(void)
     snprintf(cmd, sizeof cmd,
              "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --drawings 2 --folds -1 --words 32 2>/dev/null", bin, p,
              assets);
-    int rc = run(cmd, out, sizeof out);
+    int rc = sp_fixture_run(cmd, out, sizeof out);
     if (rc != 0) fprintf(stderr, "  db init: %d %s\n", rc, out);
     ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3") && strstr(out, "\"part_sketches\": 24") &&
            strstr(out, "\"concept_sketches\": 4") && strstr(out, "\"design_sketches\": 2"));
@@ -1556,7 +1614,8 @@ static void test_default_db_cli(void)
     remove_db(p);
     snprintf(cmd, sizeof cmd, "rm -rf '%s/qd' && '%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>&1 >/dev/null",
              root, bin, p, assets);
-    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "sketches/picks.json: the Quick, Draw! data is not where it says"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 &&
+           strstr(out, "sketches/picks.json: the Quick, Draw! data is not where it says"));
     ENSURE(stat(p, &st) == 0);
 }
 
@@ -1574,7 +1633,7 @@ static void test_kiosk_review_cli(void)
     sp_db_close(kiosk);
     char cmd[4096], out[65536];
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s'", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 0);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     char want[128];
     snprintf(want, sizeof want, "{\"id\": %lld, \"category\": \"wings\", \"status\": \"pending\", \"created_at\": \"",
              (long long)id);
@@ -1584,24 +1643,31 @@ static void test_kiosk_review_cli(void)
     // Pages: next_after is the next page's --after, null on the last page (also when that page is full).
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1", bin, p);
     snprintf(want, sizeof want, "\"next_after\": %lld}", (long long)first);
-    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, want));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, want));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1 --after %lld", bin, p, (long long)first);
     snprintf(want, sizeof want, "{\"id\": %lld,", (long long)id);
-    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, want) && strstr(out, "\"next_after\": null}"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, want) && strstr(out, "\"next_after\": null}"));
     // The contact sheet.
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --sheet '%s' >/dev/null", bin, p, sp_test_tmp_path("review.png"));
-    ENSURE(run(cmd, out, sizeof out) == 0);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     struct stat fs;
     ENSURE(stat(sp_test_tmp_path("review.png"), &fs) == 0 && fs.st_size > 1000);
+    // A sheet not named .png is bad usage, one line, and no file (it got a PNG).
+    unlink(sp_test_tmp_path("review.jpg"));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --sheet '%s' 2>&1 >/dev/null", bin, p, sp_test_tmp_path("review.jpg"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "--sheet writes a PNG") &&
+           strchr(out, '\n') == out + strlen(out) - 1);
+    ENSURE(stat(sp_test_tmp_path("review.jpg"), &fs) != 0);
     // An unknown id: one line, exit 1, nothing changed.
     char before[65], after[65];
     file_sha(p, before);
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld 424242 2>&1 >/dev/null", bin, p, (long long)id);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "no kiosk sketch 424242") && !strchr(strchr(out, '\n') + 1, '\n'));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "no kiosk sketch 424242") &&
+           !strchr(strchr(out, '\n') + 1, '\n'));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject nine 2>&1 >/dev/null", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "'nine' is not a kiosk sketch id"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "'nine' is not a kiosk sketch id"));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve 99999999999999999999 2>&1 >/dev/null", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "'99999999999999999999' is not a kiosk sketch id"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "'99999999999999999999' is not a kiosk sketch id"));
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     // A database in use: one clear line, exit 1, nothing lost.
@@ -1611,14 +1677,14 @@ static void test_kiosk_review_cli(void)
            SQLITE_OK);
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --busy-timeout 0.2 --approve %lld 2>&1 >/dev/null", bin, p,
              (long long)id);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "database is busy") && !strchr(strchr(out, '\n') + 1, '\n'));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "database is busy") && !strchr(strchr(out, '\n') + 1, '\n'));
     sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
     sqlite3_close(other);
     // Results that cannot be written (a full disk) are an error, not success.
     snprintf(cmd, sizeof cmd, "'%s' db list --db '%s' 2>&1 >/dev/full", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "sketchpose: stdout: write error (No space left on device)"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "sketchpose: stdout: write error (No space left on device)"));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' 2>&1 >/dev/full", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "stdout: write error"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "stdout: write error"));
     // Locked outright (a rollback-journal write): --busy-timeout holds from the
     // open on (the open waited the default 5 s and named it).
     ENSURE(sqlite3_open(p, &other) == SQLITE_OK);
@@ -1627,20 +1693,21 @@ static void test_kiosk_review_cli(void)
                         NULL, NULL, NULL) == SQLITE_OK);
     snprintf(cmd, sizeof cmd, "'%s' db list --db '%s' --busy-timeout 0.2 2>&1 >/dev/null", bin, p);
     double t0 = sp_now_ms();
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "more than 0.2 s"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "more than 0.2 s"));
     ENSURE(sp_now_ms() - t0 < 3000);
     sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
     sqlite3_close(other);
     ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'") == 2);
     // Approve, reject the other, train: the new model's training set has it.
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld", bin, p, (long long)id);
-    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "\"approved\": ["));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"approved\": ["));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %lld >/dev/null", bin, p, (long long)first);
-    ENSURE(run(cmd, out, sizeof out) == 0);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --status approved", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "\"status\": \"approved\"") && strstr(out, "\"category\": \"wings\""));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"status\": \"approved\"") &&
+           strstr(out, "\"category\": \"wings\""));
     snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --words 64 --folds -1", bin, p);
-    ENSURE(run(cmd, out, sizeof out) == 0);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     fprintf(stderr, "  train: %.160s\n", out);
     ENSURE(strstr(out, "\"kiosk_sketches\": 1,"));
     sp_db* db = open_ok(p, SP_DB_READONLY);
@@ -1660,11 +1727,11 @@ static void test_kiosk_review_cli(void)
     // The database's current model classifies (classify --db); a bad stroke file is one line and exit 1.
     snprintf(cmd, sizeof cmd, "'%s' classify --db '%s' --strokes '%s/tests/data/visitors/tune/tail/tail-wavy-line.json'", bin, p,
              SP_SOURCE_DIR);
-    ENSURE(run(cmd, out, sizeof out) == 0 && strstr(out, "{\"ranked\": [{\"category\": "));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "{\"ranked\": [{\"category\": "));
     const char* badf = sp_test_tmp_path("bad-stroke.json");
     ENSURE(db_write_file(badf, "{\"format\": \"sketchpose-strokes\", \"strokes\": [", 40, &err) == SP_OK);
     snprintf(cmd, sizeof cmd, "'%s' classify --db '%s' --strokes '%s' 2>&1 >/dev/null", bin, p, badf);
-    ENSURE(run(cmd, out, sizeof out) == 1 && strstr(out, "bad-stroke.json") && !strchr(strchr(out, '\n') + 1, '\n'));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "bad-stroke.json") && !strchr(strchr(out, '\n') + 1, '\n'));
 }
 
 // Everything under dir (names, sizes, modes, times of change), one entry a
@@ -1673,7 +1740,7 @@ static void tree_listing(const char* dir, char* out, size_t cap)
 {
     char cmd[1200];
     snprintf(cmd, sizeof cmd, "cd '%s' && find . -mindepth 1 -printf '%%p %%s %%m %%T@ %%C@\\n' | sort", dir);
-    ENSURE(run(cmd, out, cap) == 0);
+    ENSURE(sp_fixture_run(cmd, out, cap) == 0);
 }
 
 static const char* g_export_to; // where export_to writes: past_limit takes no context
@@ -2010,5 +2077,7 @@ int main(int argc, char** argv)
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
+                                   {"number_options_cli", test_number_options_cli},
+                                   {"add_sketch_partless_cli", test_add_sketch_partless_cli},
                                    {0}});
 }
