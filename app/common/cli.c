@@ -1,6 +1,7 @@
 #include "cli.h"
 
-#include <ctype.h>
+#include "sp/sketch_io.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -132,16 +133,6 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
     return false;
 }
 
-// Case-insensitive suffix, without strcasecmp (not C11).
-static bool ends_with_ci(const char* s, const char* suffix)
-{
-    size_t n = strlen(s), k = strlen(suffix);
-    if (n < k) return false;
-    for (size_t i = 0; i < k; ++i)
-        if (tolower((unsigned char)s[n - k + i]) != tolower((unsigned char)suffix[i])) return false;
-    return true;
-}
-
 bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind)
 {
     if (!path) return true;
@@ -151,15 +142,15 @@ bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cl
     struct stat st;
     if (!strncmp(path, "/dev/", 5) || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)))) return true;
     if (kind == SP_CLI_OUT_GLTF) {
-        if (ends_with_ci(path, ".glb") || ends_with_ci(path, ".gltf")) return true;
+        if (sp_path_ext_is(path, "glb") || sp_path_ext_is(path, "gltf")) return true;
         fprintf(stderr, "%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'\n", cmd, name, path);
     } else if (kind == SP_CLI_OUT_PNG) {
-        if (ends_with_ci(path, ".png")) return true;
+        if (sp_path_ext_is(path, "png")) return true;
         fprintf(stderr, "%s: %s writes a PNG: the file name must end in .png, got '%s'\n", cmd, name, path);
     } else {
         // The drawing readers (classify, db add-sketch, labelled folders) tell
         // a stroke file from SVG, PNG and ndjson by this name.
-        if (ends_with_ci(path, ".json")) return true;
+        if (sp_path_ext_is(path, "json")) return true;
         fprintf(stderr, "%s: %s writes a stroke file (JSON): the file name must end in .json, got '%s'\n", cmd, name, path);
     }
     return false;
