@@ -184,8 +184,7 @@ int cmd_demo(int argc, char** argv)
         if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
             fprintf(stderr,
                     "note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's "
-                    "strokes "
-                    "(fewer visitors' drawings recognised)\n",
+                    "strokes (fewer visitors' drawings recognised)\n",
                     assets);
     }
     if (sp_db_open_or_create_default(path, assets, SP_DB_READONLY, &db, &err) != SP_OK) {
