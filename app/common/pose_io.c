@@ -58,29 +58,11 @@ done:
 
 sp_result sp_pose_read(const char* path, const sp_param* params, int count, double* p, int* clamped, sp_error* err)
 {
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 4096, n = 0;
-    char* text = malloc(cap);
-    size_t got;
-    while (text && (got = fread(text + n, 1, cap - n - 1, f)) > 0) {
-        n += got;
-        if (n + 1 == cap) {
-            char* grown = realloc(text, cap * 2);
-            if (!grown) free(text);
-            text = grown;
-            cap *= 2;
-        }
-    }
-    bool bad = ferror(f) != 0;
-    fclose(f);
-    if (!text) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    if (bad) {
-        free(text);
-        return sp_fail(err, SP_ERR_IO, "%s: read error", path);
-    }
-    text[n] = 0;
-    sp_result r = sp_pose_parse(text, path, params, count, p, clamped, err);
+    char* text;
+    size_t n;
+    sp_result r = sp_sketch_file_read(path, &text, &n, err); // a pose file is as small as a drawing
+    if (r != SP_OK) return r;
+    r = sp_pose_parse(text, path, params, count, p, clamped, err);
     free(text);
     return r;
 }

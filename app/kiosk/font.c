@@ -5,6 +5,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "sp/sketch_io.h"
 
 // Why static and the pragmas: as in image.c, our copy cannot clash with
 // another module's, and stb's own warnings must not break -Werror builds.
@@ -62,29 +65,15 @@ int sp_utf8_next(const char** s)
 
 static unsigned char* read_file(const char* path, size_t* size, sp_error* err)
 {
-    FILE* f = fopen(path, "rb");
-    if (!f) {
-        if (errno == ENOENT)
-            sp_fail(err, SP_ERR_IO, "%s: font missing (install the Debian package fonts-dejavu-core)", path);
-        else
-            sp_fail(err, SP_ERR_IO, "%s: cannot open font (%s)", path, strerror(errno));
-        return NULL;
+    void* data = NULL;
+    if (access(path, F_OK) != 0 && errno == ENOENT)
+        sp_fail(err, SP_ERR_IO, "%s: font missing (install the Debian package fonts-dejavu-core)", path);
+    else if (sp_file_read(path, (size_t)64 << 20, &data, size, err) == SP_OK && *size == 0) {
+        sp_fail(err, SP_ERR_IO, "%s: the font file is empty", path);
+        free(data);
+        data = NULL;
     }
-    unsigned char* buf = NULL;
-    long n = -1;
-    if (fseek(f, 0, SEEK_END) == 0) n = ftell(f);
-    if (n <= 0 || n > (64L << 20) || fseek(f, 0, SEEK_SET) != 0) {
-        sp_fail(err, SP_ERR_IO, "%s: cannot read font (empty or larger than 64 MB)", path);
-    } else if (!(buf = malloc((size_t)n))) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    } else if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        sp_fail(err, SP_ERR_IO, "%s: read error", path);
-        free(buf);
-        buf = NULL;
-    }
-    fclose(f);
-    *size = (size_t)n;
-    return buf;
+    return data;
 }
 
 sp_font* sp_font_load(const char* path, sp_error* err)

@@ -459,25 +459,6 @@ static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size,
     return SP_OK;
 }
 
-static sp_result read_bytes(const char* path, void** out, size_t* size, sp_error* err)
-{
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open", path);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    void* b = n >= 0 ? malloc((size_t)n + 1) : NULL;
-    bool ok = b && fread(b, 1, (size_t)n, f) == (size_t)n;
-    fclose(f);
-    if (!ok) {
-        free(b);
-        return sp_fail(err, SP_ERR_IO, "%s: read error", path);
-    }
-    *out = b;
-    *size = (size_t)n;
-    return SP_OK;
-}
-
 static sp_result add_file(sketch_set* s, const char* path, const char* category, sp_error* err)
 {
     int label = sp_dataset_add_category(&s->ds, category);
@@ -503,7 +484,7 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
     }
     void* png = NULL;
     size_t n = 0;
-    if (smp.raster.pixels && (r = read_bytes(path, &png, &n, err)) != SP_OK) {
+    if (smp.raster.pixels && (r = sp_file_read(path, (size_t)1 << 30, &png, &n, err)) != SP_OK) {
         sp_raster_free(&smp.raster);
         return r;
     }

@@ -1446,32 +1446,12 @@ oom:
 sp_result sp_clf_load(const char* path, sp_clf** out, sp_error* err)
 {
     *out = NULL;
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
-    // Read in growing blocks: a model's size is not known before its header,
-    // and a FIFO or a device has none.
-    unsigned char* data = NULL;
-    size_t n = 0, cap = 0;
-    bool oom = false;
-    for (;;) {
-        if (n == cap) {
-            if (cap > ((size_t)1 << 32) + 32) break; // more than any model holds: refused as corrupt below
-            unsigned char* g = realloc(data, cap = cap ? 2 * cap : 1 << 16);
-            if (!g) {
-                oom = true;
-                break;
-            }
-            data = g;
-        }
-        size_t got = fread(data + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) break;
-    }
-    bool failed = ferror(f) != 0;
-    fclose(f);
-    sp_result r = oom      ? sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path)
-                  : failed ? sp_fail(err, SP_ERR_IO, "%s: read error", path)
-                           : sp_clf_from_bytes(data, n, path, out, err);
+    void* data;
+    size_t size;
+    // At most the largest body the header can claim, and the header and checksum.
+    sp_result r = sp_file_read(path, ((size_t)1 << 32) + 32, &data, &size, err);
+    if (r != SP_OK) return r;
+    r = sp_clf_from_bytes(data, size, path, out, err);
     free(data);
     return r;
 }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "db_internal.h"
+#include "sp/sketch_io.h"
 
 void (*sp_db_test_hook)(const char* point) = NULL;
 
@@ -153,35 +154,7 @@ sp_result db_read_json(const char* path, cJSON** root, sp_error* err)
 
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err)
 {
-    *data = NULL;
-    *size = 0;
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
-    }
-    if ((unsigned long long)st.st_size > (1ull << 30)) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: larger than 1 GiB", path);
-    }
-    char* buf = malloc((size_t)st.st_size + 1);
-    if (!buf) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    }
-    size_t n = fread(buf, 1, (size_t)st.st_size, f);
-    bool bad = ferror(f);
-    fclose(f);
-    if (bad || n != (size_t)st.st_size) {
-        free(buf);
-        return sp_fail(err, SP_ERR_IO, "%s: read error", path);
-    }
-    buf[n] = 0;
-    *data = buf;
-    *size = n;
-    return SP_OK;
+    return sp_file_read(path, (size_t)1 << 30, data, size, err);
 }
 
 sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err)

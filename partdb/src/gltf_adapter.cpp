@@ -1275,21 +1275,18 @@ extern "C" sp_result sp_gltf_load(const char* path, sp_character* out, sp_error*
 {
     memset(out, 0, sizeof *out);
     return read_firewall(path, out, err, [&] {
-        FILE* f = fopen(path, "rb");
-        if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-        std::vector<unsigned char> bytes;
-        unsigned char buf[65536];
-        size_t got;
-        while ((got = fread(buf, 1, sizeof buf, f)) > 0)
-            bytes.insert(bytes.end(), buf, buf + got);
-        bool bad = ferror(f) != 0;
-        fclose(f);
-        if (bad) return sp_fail(err, SP_ERR_IO, "%s: read error", path);
+        // Whole and sized first (sp_file_read): a device such as /dev/zero is
+        // refused, not read until the memory runs out; at most 2 GiB, as a buffer.
+        void* data = nullptr;
+        size_t size = 0;
+        sp_result r = sp_file_read(path, (size_t)0x7fffffff, &data, &size, err);
+        if (r != SP_OK) return r;
+        std::unique_ptr<void, decltype(&free)> bytes(data, &free);
         std::string dir = path;
         size_t slash = dir.rfind('/');
         dir = slash == std::string::npos ? "." : dir.substr(0, slash == 0 ? 1 : slash);
         tinygltf::Model model;
-        parse_model(model, bytes.data(), bytes.size(), path, dir, true, out);
+        parse_model(model, static_cast<const unsigned char*>(bytes.get()), size, path, dir, true, out);
         import(model, path, out);
         return SP_OK;
     });

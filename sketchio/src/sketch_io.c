@@ -117,21 +117,23 @@ sp_result sp_file_write_printed(const char* path, FILE* f, char** text, size_t* 
     return r;
 }
 
-sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err)
+sp_result sp_file_read(const char* path, size_t max_bytes, void** data, size_t* size, sp_error* err)
 {
-    *out = NULL;
-    *len = 0;
+    *data = NULL;
+    *size = 0;
     FILE* f = fopen(path, "rb");
     if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    // Regular files only: a device (/dev/zero) or a pipe has no end to size a
+    // buffer by, and reading it "whole" would fill the memory.
     struct stat st;
     if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
         fclose(f);
         return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
     }
-    if ((unsigned long long)st.st_size > SP_SKETCH_MAX_FILE_BYTES) {
+    if ((unsigned long long)st.st_size > max_bytes) {
         fclose(f);
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: file too large (%lld bytes, at most %u)", path, (long long)st.st_size,
-                       SP_SKETCH_MAX_FILE_BYTES);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: file too large (%lld bytes, at most %zu)", path, (long long)st.st_size,
+                       max_bytes);
     }
     size_t n = (size_t)st.st_size;
     char* buf = malloc(n + 1);
@@ -140,15 +142,22 @@ sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_erro
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory reading %zu bytes", path, n);
     }
     size_t got = fread(buf, 1, n, f);
+    bool more = got == n && fgetc(f) != EOF; // grown since fstat: not the file that was sized
+    bool bad = ferror(f) != 0;
     fclose(f);
-    if (got != n) {
+    if (got != n || more || bad) {
         free(buf);
-        return sp_fail(err, SP_ERR_IO, "%s: short read", path);
+        return sp_fail(err, SP_ERR_IO, "%s: read error (%s)", path, bad ? "the system refused" : "the file changed while read");
     }
     buf[n] = '\0';
-    *out = buf;
-    *len = n;
+    *data = buf;
+    *size = n;
     return SP_OK;
+}
+
+sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err)
+{
+    return sp_file_read(path, SP_SKETCH_MAX_FILE_BYTES, (void**)out, len, err);
 }
 
 static const char* ext_of(const char* path)

@@ -552,6 +552,33 @@ static void test_pose_file_whole(void)
     unlink(path);
 }
 
+// A device or a pipe given where a file is read (a rig, a pose, a model, a
+// stroke file, a PNG to add) is refused in one line, not read without end:
+// /dev/zero used to fill the memory of `inspect --rig`.
+static void test_device_inputs(void)
+{
+    const char* cases[] = {"inspect --rig /dev/zero", "export --rig %s/assets/tail.glb --pose /dev/zero --out %s",
+                           "classify --model /dev/zero --strokes /dev/null",
+                           "pose --rig %s/assets/tail.glb --strokes /dev/zero --out %s",
+                           "pose --rig /dev/zero --strokes /dev/null"};
+    const char* out = sp_test_tmp_path("device_inputs.glb");
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char args[1200], cmd[3000];
+        snprintf(args, sizeof args, cases[i], SP_SOURCE_DIR, out);
+        const char* log = sp_test_tmp_path("device_inputs.txt");
+        // timeout: a reader that does not refuse would run until the memory is gone.
+        snprintf(cmd, sizeof cmd, "timeout 60 '%s' %s 2>'%s' >/dev/null", SP_SKETCHPOSE, args, log);
+        int rc = run(cmd);
+        char text[2048] = {0};
+        FILE* f = fopen(log, "rb");
+        size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+        if (f) fclose(f);
+        fprintf(stderr, "  %s: exit %d, %.*s", args, rc, (int)n, text);
+        ENSURE(rc == 1 && strstr(text, "not a regular file") && strchr(text, '\n') == text + n - 1);
+        ENSURE(access(out, F_OK) != 0);
+    }
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -565,5 +592,6 @@ int main(int argc, char** argv)
                                    {"cli_missing_value", test_cli_missing_value},
                                    {"pose_option_ranges", test_pose_option_ranges},
                                    {"pose_file_whole", test_pose_file_whole},
+                                   {"device_inputs", test_device_inputs},
                                    {0}});
 }

@@ -228,33 +228,9 @@ done:
 sp_result sp_kiosk_session_read(const char* path, sp_kiosk_session* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
-    char* buf = NULL;
-    size_t n = 0, cap = 0;
-    sp_result r = SP_OK;
-    for (;;) {
-        if (n == cap) {
-            if (cap >= (512u << 20)) {
-                r = sp_fail(err, SP_ERR_INVALID, "%s: larger than 512 MB", path);
-                break;
-            }
-            cap = cap ? 2 * cap : 1 << 16;
-            char* b = realloc(buf, cap);
-            if (!b) {
-                r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-                break;
-            }
-            buf = b;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) {
-            if (ferror(f)) r = sp_fail(err, SP_ERR_IO, "%s: read error", path);
-            break;
-        }
-    }
-    fclose(f);
+    void* buf;
+    size_t n;
+    sp_result r = sp_file_read(path, (size_t)512 << 20, &buf, &n, err);
     if (r == SP_OK) r = sp_kiosk_session_parse(buf, n, path, out, err);
     free(buf);
     return r;

@@ -95,8 +95,11 @@ void sp_dataset_free(sp_dataset* ds);
 /// leaves `smp` with the caller.
 sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 
-/// Reads a whole drawing file into *out (malloc'd, NUL-terminated, *len
-/// bytes without the NUL): regular files of at most SP_SKETCH_MAX_FILE_BYTES.
+/// Reads a whole file into *data (malloc'd, NUL-terminated, *size bytes
+/// without the NUL): regular files only (a device or a pipe is refused, never
+/// read without end) of at most max_bytes. One line in `err` names the path.
+sp_result sp_file_read(const char* path, size_t max_bytes, void** data, size_t* size, sp_error* err);
+/// sp_file_read of a drawing file: at most SP_SKETCH_MAX_FILE_BYTES.
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
 /// Syncs the folder that holds `path` (fsync(2) on the folder), so that a name
 /// just made there by rename(2), link(2) or mkdir(2) survives a power cut.
