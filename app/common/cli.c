@@ -90,7 +90,9 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             *(int*)o->out = (int)x;
         } else if (o->kind == SP_OPT_DOUBLE) {
             double x = strtod(v, &end);
-            if (errno || end == v || *end || !isfinite(x)) {
+            // ERANGE with a finite x is an underflow (1e-320): a number all the
+            // same, and the option's range check says whether it will do.
+            if ((errno && !(errno == ERANGE && isfinite(x) && fabs(x) < 1)) || end == v || *end || !isfinite(x)) {
                 fprintf(stderr, "%s: %s expects a finite number, got '%s'\n", cmd, o->name, v);
                 return 2;
             }

@@ -507,6 +507,10 @@ static void test_pose_option_ranges(void)
     snprintf(cmd, sizeof cmd, "'%s' pose --rig /nonexistent.glb --strokes s.json --max-iterations 5 --max-ms 10 2>/dev/null",
              SP_SKETCHPOSE);
     ENSURE(run(cmd) == 1);
+    // A number too small for a normal double is a number all the same.
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig /nonexistent.glb --strokes s.json --lambda-pose 1e-320 2>/dev/null",
+             SP_SKETCHPOSE);
+    ENSURE(run(cmd) == 1);
 }
 
 // A pose file is written whole (`synth --truth`): a write that fails part-way
