@@ -184,21 +184,8 @@ sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_so
     sp_bounds(m->rest, m->vertex_count, &lo, &hi);
     s->D = sp_v3_len(sp_v3_sub(hi, lo));
     if (!(s->D > 0)) s->D = 1.0;
-    const int* given = s->d.representative_vertices;
-    int ng = given ? s->d.representative_count : 0;
-    for (int i = 0; i < ng; ++i)
-        if (given[i] < 0 || given[i] >= m->vertex_count || (i > 0 && given[i] <= given[i - 1])) ng = -1;
-    if (given && (ng < 1 || ng > s->d.representatives)) {
-        int most = s->d.representatives;
-        sp_solver_destroy(s);
-        return sp_fail(err, SP_ERR_INVALID, "representative_vertices: not 1 to %d distinct vertices in increasing order", most);
-    }
-    s->d.representative_vertices = NULL; // not kept: the caller's buffer
     s->reps = malloc(sizeof(int) * (size_t)(s->d.representatives + 1));
-    if (s->reps && given)
-        memcpy(s->reps, given, sizeof(int) * (size_t)(s->k = ng));
-    else
-        s->k = s->reps && m->vertex_count > 0 ? coarsen(m->rest, m->vertex_count, s->d.representatives, s->reps) : 0;
+    s->k = s->reps && m->vertex_count > 0 ? coarsen(m->rest, m->vertex_count, s->d.representatives, s->reps) : 0;
     // Column lists.
     // Before deduplication a point lists every ancestor parameter of up to
     // 12 influences (an embedded point: 3 vertices x 4 joints).

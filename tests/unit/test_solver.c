@@ -158,51 +158,6 @@ static void test_order_independence_and_determinism(void)
     sp_rig_free(&st.rig);
 }
 
-// A coarsening handed over from another solver of the same rig gives the
-// same solves, bit for bit; one that is not increasing distinct vertices of
-// the mesh, or more than `representatives` of them, is refused.
-static void test_representatives_given(void)
-{
-    setup st;
-    make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .branching = true, .seed = 11});
-    sp_solver *a = NULL, *b = NULL;
-    sp_error err = {0};
-    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.representatives = 40}, &a, &err) == SP_OK);
-    int k = 0;
-    const int* reps = sp_solver_representatives(a, &k);
-    ENSURE(k > 1 && k <= 40 && k < st.rig.vertex_count);
-    int* copy = malloc(sizeof(int) * (size_t)k);
-    memcpy(copy, reps, sizeof(int) * (size_t)k);
-    sp_solve_desc given = {.representatives = 40, .representative_vertices = copy, .representative_count = k};
-    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &given, &b, &err) == SP_OK);
-    int kb = 0;
-    const int* rb = sp_solver_representatives(b, &kb);
-    ENSURE(kb == k && !memcmp(rb, reps, sizeof(int) * (size_t)k));
-    int P = st.rig.param_count;
-    double *truth = malloc(sizeof(double) * P), *pa = malloc(sizeof(double) * P), *pb = malloc(sizeof(double) * P);
-    sp_solve_report ra, rb_rep;
-    solve_random_pose(a, &st.rig, 5, truth, pa, &ra);
-    solve_random_pose(b, &st.rig, 5, truth, pb, &rb_rep);
-    ENSURE(hash_doubles(pa, P) == hash_doubles(pb, P) && ra.iterations == rb_rep.iterations);
-    sp_solver_destroy(b);
-    // Refused: out of the mesh, repeated, decreasing, too many, none.
-    int bad_count[] = {2, 2, 2, 41, 0};
-    int bad[][2] = {{0, st.rig.vertex_count}, {3, 3}, {5, 2}, {0, 1}, {0, 1}};
-    int* many = malloc(sizeof(int) * 41);
-    for (int i = 0; i < 41; ++i)
-        many[i] = i;
-    for (int c = 0; c < 5; ++c) {
-        sp_solve_desc d = {
-            .representatives = 40, .representative_vertices = c == 3 ? many : bad[c], .representative_count = bad_count[c]};
-        b = NULL;
-        ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &d, &b, &err) == SP_ERR_INVALID && !b && strstr(err.text, "representative"));
-    }
-    fprintf(stderr, "  %s\n", err.text);
-    free(many), free(copy), free(truth), free(pa), free(pb);
-    sp_solver_destroy(a);
-    sp_rig_free(&st.rig);
-}
-
 static void test_bad_strokes(void)
 {
     setup st;
@@ -621,17 +576,16 @@ static void test_creation_says_why(void)
 
 int main(int argc, char** argv)
 {
-    return sp_test_run(argc, argv,
-                       (sp_test[]){{"recovery_chain", test_recovery_chain},
-                                   {"bounds_exact", test_bounds_exact},
-                                   {"order_independence_and_determinism", test_order_independence_and_determinism},
-                                   {"bad_strokes", test_bad_strokes},
-                                   {"representatives_given", test_representatives_given},
-                                   {"regulariser_paths_agree", test_regulariser_paths_agree},
-                                   {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
-                                   {"gauss_newton_consistent", test_gauss_newton_consistent},
-                                   {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
-                                   {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
-                                   {"creation_says_why", test_creation_says_why},
-                                   {0}});
+    return sp_test_run(argc, argv, (sp_test[]){
+        {"recovery_chain", test_recovery_chain},
+        {"bounds_exact", test_bounds_exact},
+        {"order_independence_and_determinism", test_order_independence_and_determinism},
+        {"bad_strokes", test_bad_strokes},
+        {"regulariser_paths_agree", test_regulariser_paths_agree},
+        {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
+        {"gauss_newton_consistent", test_gauss_newton_consistent},
+        {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
+        {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
+        {"creation_says_why", test_creation_says_why},
+        {0}});
 }

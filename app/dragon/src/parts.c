@@ -197,9 +197,6 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
     t->solver_cam = t->base;
     sp_solve_desc sd = *solve;
     if (line_of) {
-        // The same mesh: the outline's coarsening, not a second k-means (the
-        // larger part of loading a part).
-        sd.representative_vertices = sp_solver_representatives(line_of->solver, &sd.representative_count);
         // A line says nothing of a part's thickness: its proportions stay
         // as modelled (the bone scales held at rest) and only the pose and
         // the root's size move, so a tail drawn as a line is not fattened.

@@ -54,10 +54,6 @@ typedef struct sp_solve_desc {
     double lambda_plane; ///< 0: 0.01; < 0: term off
     double lambda_dist;  ///< 0: 0.001; < 0: term off
     int representatives; ///< k for the coarsening (eq. 12); 0: 200
-    /// The coarsening of another solver of the same rig (sp_solver_representatives),
-    /// taken as it is instead of running the k-means again; NULL: computed.
-    const int* representative_vertices;
-    int representative_count; ///< how many representative_vertices
     int samples;         ///< samples per curve after resampling; 0: by length, 24..160
     int max_iterations;  ///< Gauss-Newton iterations in all; 0: 300
     int max_icp_rounds;  ///< correspondence updates; 0: 40
