@@ -2,13 +2,15 @@
 // the rest vertices), the column lists of the sparse Jacobian blocks, the
 // row groups of the normal equations, and the buffers a solve uses.
 #include <flann/flann.h>
+#include <pthread.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "solver_internal.h"
 
 // k-means of the rest vertices (FLANN), centres snapped to the nearest vertex.
-static int coarsen(const double* rest_in, int n, int k, int* reps)
+static int coarsen_kmeans(const double* rest_in, int n, int k, int* reps)
 {
     double* rest = (double*)rest_in; // FLANN's C API only reads it but is not const-correct
     if (n <= k) {
@@ -60,6 +62,57 @@ static int coarsen(const double* rest_in, int n, int k, int* reps)
     if (idx) flann_free_index_double(idx, &ip);
     free(dist);
     free(centers);
+    return m;
+}
+
+// The coarsening is a pure function of the mesh and k, and its k-means is
+// most of loading a part: the kiosk loads each part twice (its attract
+// screen's dragon and the visitor's), a part's line solver shares the mesh
+// of its outline solver, and a curator's change reloads every part. So the
+// last COARSEN_MEMO answers are remembered for the process, by a hash of
+// the vertices (FNV-1a 64 over their bytes, with n and k).
+#define COARSEN_MEMO 64
+typedef struct coarsen_memo {
+    uint64_t hash;
+    int n, k, m;
+    int* reps;
+} coarsen_memo;
+static struct {
+    pthread_mutex_t lock;
+    coarsen_memo e[COARSEN_MEMO];
+    int next;
+} g_memo = {PTHREAD_MUTEX_INITIALIZER, {{0}}, 0};
+
+static uint64_t rest_hash(const double* rest, int n)
+{
+    uint64_t h = 1469598103934665603ull;
+    const unsigned char* b = (const unsigned char*)rest;
+    for (size_t i = 0; i < sizeof(double) * 3 * (size_t)n; ++i)
+        h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+static int coarsen(const double* rest, int n, int k, int* reps)
+{
+    uint64_t h = rest_hash(rest, n);
+    int m = -1;
+    pthread_mutex_lock(&g_memo.lock);
+    for (int i = 0; i < COARSEN_MEMO && m < 0; ++i) {
+        const coarsen_memo* e = &g_memo.e[i];
+        if (e->reps && e->hash == h && e->n == n && e->k == k) memcpy(reps, e->reps, sizeof(int) * (size_t)(m = e->m));
+    }
+    pthread_mutex_unlock(&g_memo.lock);
+    if (m >= 0) return m;
+    m = coarsen_kmeans(rest, n, k, reps);
+    int* keep = m > 0 ? malloc(sizeof(int) * (size_t)m) : NULL;
+    if (!keep) return m; // not remembered: only the next load pays
+    memcpy(keep, reps, sizeof(int) * (size_t)m);
+    pthread_mutex_lock(&g_memo.lock);
+    coarsen_memo* e = &g_memo.e[g_memo.next];
+    g_memo.next = (g_memo.next + 1) % COARSEN_MEMO;
+    free(e->reps);
+    *e = (coarsen_memo){h, n, k, m, keep};
+    pthread_mutex_unlock(&g_memo.lock);
     return m;
 }
 

@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "../../solver/src/solver_internal.h" // the model's choice of regulariser path
+#include <flann/flann.h>
+
 #include "fixtures.h"
 #include "sp/blackbox.h"
 #include "sp/solver.h"
@@ -155,6 +157,52 @@ static void test_order_independence_and_determinism(void)
     sp_sketch_free(&sk), sp_sketch_free(&shuffled);
     free(truth), free(a), free(b), free(c);
     sp_solver_destroy(s);
+    sp_rig_free(&st.rig);
+}
+
+// The coarsening's k-means, counted through the linker's --wrap (solver.cmake).
+int __real_flann_compute_cluster_centers_double(double* dataset, int rows, int cols, int clusters, double* result,
+                                                struct FLANNParameters* flann_params);
+static int g_kmeans_runs;
+int __wrap_flann_compute_cluster_centers_double(double* dataset, int rows, int cols, int clusters, double* result,
+                                                struct FLANNParameters* flann_params)
+{
+    ++g_kmeans_runs;
+    return __real_flann_compute_cluster_centers_double(dataset, rows, cols, clusters, result, flann_params);
+}
+
+// The coarsening is remembered: a second solver of the same mesh and k runs
+// no k-means and solves bit for bit as the first; another k, or a mesh moved
+// by a hair, is coarsened afresh.
+static void test_coarsening_remembered(void)
+{
+    setup st;
+    make_setup(&st, &(sp_fixture_desc){.joint_count = 6, .branching = true, .seed = 11});
+    sp_solver *a = NULL, *b = NULL, *c = NULL;
+    sp_error err = {0};
+    int before = g_kmeans_runs;
+    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.representatives = 40}, &a, &err) == SP_OK);
+    ENSURE(g_kmeans_runs == before + 1);
+    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.representatives = 40}, &b, &err) == SP_OK);
+    ENSURE(g_kmeans_runs == before + 1);
+    int ka = 0, kb = 0;
+    const int* ra = sp_solver_representatives(a, &ka);
+    const int* rb = sp_solver_representatives(b, &kb);
+    ENSURE(ka > 1 && ka == kb && !memcmp(ra, rb, sizeof(int) * (size_t)ka));
+    int P = st.rig.param_count;
+    double *truth = malloc(sizeof(double) * P), *pa = malloc(sizeof(double) * P), *pb = malloc(sizeof(double) * P);
+    sp_solve_report rep_a, rep_b;
+    solve_random_pose(a, &st.rig, 5, truth, pa, &rep_a);
+    solve_random_pose(b, &st.rig, 5, truth, pb, &rep_b);
+    ENSURE(hash_doubles(pa, P) == hash_doubles(pb, P) && rep_a.iterations == rep_b.iterations);
+    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.representatives = 30}, &c, &err) == SP_OK);
+    ENSURE(g_kmeans_runs == before + 2);
+    sp_solver_destroy(c);
+    st.rig.rest[0] = nextafter(st.rig.rest[0], INFINITY);
+    ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.representatives = 40}, &c, &err) == SP_OK);
+    ENSURE(g_kmeans_runs == before + 3);
+    free(truth), free(pa), free(pb);
+    sp_solver_destroy(a), sp_solver_destroy(b), sp_solver_destroy(c);
     sp_rig_free(&st.rig);
 }
 
@@ -576,16 +624,17 @@ static void test_creation_says_why(void)
 
 int main(int argc, char** argv)
 {
-    return sp_test_run(argc, argv, (sp_test[]){
-        {"recovery_chain", test_recovery_chain},
-        {"bounds_exact", test_bounds_exact},
-        {"order_independence_and_determinism", test_order_independence_and_determinism},
-        {"bad_strokes", test_bad_strokes},
-        {"regulariser_paths_agree", test_regulariser_paths_agree},
-        {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
-        {"gauss_newton_consistent", test_gauss_newton_consistent},
-        {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
-        {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
-        {"creation_says_why", test_creation_says_why},
-        {0}});
+    return sp_test_run(argc, argv,
+                       (sp_test[]){{"recovery_chain", test_recovery_chain},
+                                   {"bounds_exact", test_bounds_exact},
+                                   {"order_independence_and_determinism", test_order_independence_and_determinism},
+                                   {"bad_strokes", test_bad_strokes},
+                                   {"coarsening_remembered", test_coarsening_remembered},
+                                   {"regulariser_paths_agree", test_regulariser_paths_agree},
+                                   {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
+                                   {"gauss_newton_consistent", test_gauss_newton_consistent},
+                                   {"stalled_when_no_step_lowers_w", test_stalled_when_no_step_lowers_w},
+                                   {"stop_reasons_of_closest_point_solves", test_stop_reasons_of_closest_point_solves},
+                                   {"creation_says_why", test_creation_says_why},
+                                   {0}});
 }
