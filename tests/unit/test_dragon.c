@@ -210,6 +210,15 @@ static sp_dragon* new_dragon(const char* db_path)
     return d;
 }
 
+// A pipeline on the database at `path`, and the database opened read-only
+// beside it (for the parts' names and strokes).
+static sp_dragon* dragon_and_db(const char* path, sp_db** db)
+{
+    sp_error err = {0};
+    ENSURE(sp_db_open(path, SP_DB_READONLY, db, &err) == SP_OK);
+    return new_dragon(path);
+}
+
 // Draws the test parts in layout order (torso first); returns how many were classified right.
 static int draw_layout(sp_dragon* d, sp_db* db, uint64_t seed, bool verbose)
 {
@@ -558,8 +567,7 @@ static void test_build_and_attach(void)
     const char* path = test_db();
     sp_db* db = NULL;
     sp_error err = {0};
-    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
-    sp_dragon* d = new_dragon(path);
+    sp_dragon* d = dragon_and_db(path, &db);
     int right = draw_layout(d, db, 100, true);
     fprintf(stderr, "  classified %d of %d right\n", right, TEST_PART_COUNT);
     ENSURE(right >= TEST_PART_COUNT - 1);
@@ -611,8 +619,7 @@ static void test_animation(void)
     const char* path = test_db();
     sp_db* db = NULL;
     sp_error err = {0};
-    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
-    sp_dragon* d = new_dragon(path);
+    sp_dragon* d = dragon_and_db(path, &db);
     draw_layout(d, db, 200, false);
     double T = sp_dragon_period(d);
     ENSURE_NEAR(T, 2.0, 1e-6); // the torso's clip is the longest
@@ -1019,8 +1026,7 @@ static void test_export(void)
     const char* path = test_db();
     sp_db* db = NULL;
     sp_error err = {0};
-    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
-    sp_dragon* d = new_dragon(path);
+    sp_dragon* d = dragon_and_db(path, &db);
     ENSURE(sp_dragon_export(d, sp_test_tmp_path("dragon_empty.glb"), &err) == SP_ERR_INVALID);
     draw_layout(d, db, 300, false);
     check_export(d, sp_test_tmp_path("dragon_test.glb"), TEST_PART_COUNT);
@@ -1124,8 +1130,7 @@ static void test_rejects_and_bad_strokes(void)
     const char* path = test_db();
     sp_db* db = NULL;
     sp_error err = {0};
-    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
-    sp_dragon* d = new_dragon(path);
+    sp_dragon* d = dragon_and_db(path, &db);
     sp_vec2* xy;
     int n = part_stroke(db, "torso_t", 5, 0.3, 640, 400, 400, &xy);
     sp_dragon_result res;
@@ -1288,8 +1293,7 @@ static void test_undo_clear_refit(void)
     const char* path = test_db();
     sp_db* db = NULL;
     sp_error err = {0};
-    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
-    sp_dragon* d = new_dragon(path);
+    sp_dragon* d = dragon_and_db(path, &db);
     sp_dragon_result res;
     ENSURE(sp_dragon_refit_last(d, "tail", &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_NOTHING_TO_REFIT);
     ENSURE(!sp_dragon_undo(d));
@@ -2113,15 +2117,6 @@ static bool guessed(const sp_dragon_result* res, const char* category)
     for (int g = 0; g < res->guess_count; ++g)
         if (!strcmp(res->guesses[g].category, category)) return true;
     return false;
-}
-
-// A pipeline on the database at `path`, and the database opened read-only
-// beside it (for the parts' names and strokes).
-static sp_dragon* dragon_and_db(const char* path, sp_db** db)
-{
-    sp_error err = {0};
-    ENSURE(sp_db_open(path, SP_DB_READONLY, db, &err) == SP_OK);
-    return new_dragon(path);
 }
 
 // Front and hind legs are one family (sp_part.family "legs"): legs drawn at
