@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
@@ -182,6 +183,16 @@ int sp_fixture_run(const char* cmd, char* out, size_t cap)
     out[n] = 0;
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+void sp_fixture_remove_db(const char* path)
+{
+    char side[1200];
+    unlink(path);
+    snprintf(side, sizeof side, "%.1100s-wal", path);
+    unlink(side);
+    snprintf(side, sizeof side, "%.1100s-shm", path);
+    unlink(side);
 }
 
 cJSON* sp_fixture_json_file(const char* path)

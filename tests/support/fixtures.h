@@ -51,6 +51,9 @@ char* sp_fixture_file_text(const char* path, size_t* n);
 /// Fails the running test when the command cannot be started.
 int sp_fixture_run(const char* cmd, char* out, size_t cap);
 
+/// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).
+void sp_fixture_remove_db(const char* path);
+
 /// A JSON file, parsed (fails the running test when it does
 /// not read or parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_json_file(const char* path);

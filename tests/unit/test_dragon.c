@@ -38,16 +38,6 @@
 
 // ---- test parts: tests/support/test_parts.h (the fixture library) -----------------
 
-static void remove_db(const char* path)
-{
-    char side[1100];
-    unlink(path);
-    snprintf(side, sizeof side, "%s-wal", path);
-    unlink(side);
-    snprintf(side, sizeof side, "%s-shm", path);
-    unlink(side);
-}
-
 // Writes the part (flat: see test_part_rig) and adds it to the database with `sketches` synthetic sketches (-1: none).
 static void add_spec_sketches(sp_db* db, const test_part_spec* s, bool flat, uint64_t seed, int sketches)
 {
@@ -87,7 +77,7 @@ static const char* test_db(void)
     static char path[1024];
     if (path[0]) return path;
     snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_test.db"));
-    remove_db(path);
+    sp_fixture_remove_db(path);
     sp_db* db = NULL;
     sp_error err = {0};
     ENSURE(sp_db_open(path, SP_DB_CREATE, &db, &err) == SP_OK);
@@ -101,7 +91,7 @@ static const char* test_db(void)
 static void copy_file(const char* from, const char* to)
 {
     char cmd[2300];
-    remove_db(to);
+    sp_fixture_remove_db(to);
     snprintf(cmd, sizeof cmd, "cp '%s' '%s'", from, to);
     ENSURE(system(cmd) == 0);
 }
@@ -1285,7 +1275,7 @@ static void test_corrupt_part(void)
            strstr(text, "no stroke became a part"));
     free(text);
     free(tail), free(torso);
-    remove_db(path);
+    sp_fixture_remove_db(path);
 }
 
 static void test_undo_clear_refit(void)
@@ -1433,7 +1423,7 @@ static void test_live_update(void)
             res.guess_count ? res.guesses[0].confidence : 0, sp_dragon_reject_name(res.reason));
     ENSURE(!res.rejected && !strcmp(sp_dragon_part_get(d, res.part)->category, "horns"));
     // The database deleted: the kiosk keeps drawing with what it has.
-    remove_db(path);
+    sp_fixture_remove_db(path);
     ENSURE(sp_dragon_add_stroke(d, s, &(sp_dragon_stroke_opts){.category = "horns"}, &res, &err) == SP_OK);
     ENSURE(sp_dragon_part_count(d) >= 2);
     sp_sketch_free(&sk);
@@ -1627,7 +1617,7 @@ static const char* real_db_ex(bool drawn)
     }
     if (glbs == 0) return NULL;
     snprintf(path, 1024, "%s", sp_test_tmp_path(drawn ? "dragon_default.db" : "dragon_undrawn.db"));
-    remove_db(path);
+    sp_fixture_remove_db(path);
     sp_error err = {0};
     sp_db_default_desc dd = {.synth_per_part = 40, .drawn_per_design = drawn ? 0 : -1, .train = quick_train()};
     sp_result r = sp_db_create_default(path, assets, &dd, &err);
@@ -1869,7 +1859,7 @@ static void test_robustness(void)
     // A body of zero-area triangles (its outline is fine: it can be drawn and fitted).
     char path[1024];
     snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_flat.db"));
-    remove_db(path);
+    sp_fixture_remove_db(path);
     sp_db* db = NULL;
     sp_error err = {0};
     ENSURE(sp_db_open(path, SP_DB_CREATE, &db, &err) == SP_OK);

@@ -83,7 +83,7 @@ static const char* e2e_db(void)
 static void e2e_db_copy(const char* name, char* path, size_t size)
 {
     snprintf(path, size, "%s", sp_test_tmp_path(name));
-    kp_remove_db(path);
+    sp_fixture_remove_db(path);
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), path);
     ENSURE(system(cmd) == 0);
@@ -659,7 +659,7 @@ static void test_db_replaced(void)
     char live[1100], spare[1100];
     snprintf(live, sizeof live, "%s", sp_test_tmp_path("kiosk_live.db"));
     snprintf(spare, sizeof spare, "%s", sp_test_tmp_path("kiosk_spare.db"));
-    kp_remove_db(live);
+    sp_fixture_remove_db(live);
     char cmd[16384];
     snprintf(cmd, sizeof cmd, "cp '%s' '%s' && cp '%s' '%s'", db, live, db, spare);
     ENSURE(system(cmd) == 0);
@@ -1393,7 +1393,7 @@ static void test_collect_replaced(void)
     e2e_db_copy("kiosk_repl.db", db, sizeof db);
     e2e_db_copy("kiosk_repl_next.db", next, sizeof next);
     snprintf(old_copy, sizeof old_copy, "%s", sp_test_tmp_path("kiosk_repl_old.db"));
-    kp_remove_db(old_copy);
+    sp_fixture_remove_db(old_copy);
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_repl_ex", &gl, &t);
