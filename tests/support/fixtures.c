@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -183,6 +184,22 @@ int sp_fixture_run(const char* cmd, char* out, size_t cap)
     out[n] = 0;
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+int sp_fixture_gltf_validate(const char* file)
+{
+    char tool[1100], cmd[3000];
+    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
+    struct stat st;
+    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
+    const char* rep = sp_test_tmp_path("gltf_validator.json");
+    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
+    int rc = system(cmd);
+    if (rc != 0) {
+        snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);
+        if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
+    }
+    return rc == 0;
 }
 
 void sp_fixture_remove_db(const char* path)

@@ -51,6 +51,11 @@ char* sp_fixture_file_text(const char* path, size_t* n);
 /// Fails the running test when the command cannot be started.
 int sp_fixture_run(const char* cmd, char* out, size_t cap);
 
+/// The Khronos glTF validator (tests/tools/validate.js) on a file: 1 when
+/// it passes, 0 when it fails (its report on stderr), -1 when node or the
+/// validator (tests/tools/node_modules) is not installed.
+int sp_fixture_gltf_validate(const char* file);
+
 /// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).
 void sp_fixture_remove_db(const char* path);
 

@@ -693,23 +693,6 @@ static void test_animation(void)
     sp_db_close(db);
 }
 
-// The Khronos validator on a file: 1 pass, 0 fail, -1 when it is not installed.
-static int validate(const char* file)
-{
-    char tool[1100], cmd[3000];
-    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
-    const char* rep = sp_test_tmp_path("dragon_validator.json");
-    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
-    int rc = system(cmd);
-    if (rc != 0) {
-        snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);
-        if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
-    }
-    return rc == 0;
-}
-
 // glTF Transform (tests/tools/inspect.js) on a file: 1 loads with skins and
 // animation intact, 0 not, -1 when it is not installed.
 static int gltf_transform_loads(const char* file)
@@ -1002,7 +985,7 @@ static void check_export(sp_dragon* d, const char* file, int parts)
             c.z, size, 2 * xmag, 2 * ymag);
     ENSURE(sp_v3_len(c) < 1e-4 * size);
     ENSURE(fmax(fabs(lo.x), hi.x) <= xmag && fmax(fabs(lo.y), hi.y) <= ymag);
-    int v = validate(file);
+    int v = sp_fixture_gltf_validate(file);
     if (v < 0)
         fprintf(stderr, "  note: gltf-validator not installed (cd tests/tools && npm ci): not validated\n");
     else
@@ -1025,7 +1008,7 @@ static void test_export(void)
     // .gltf with embedded buffers, by extension.
     const char* gltf = sp_test_tmp_path("dragon_test.gltf");
     ENSURE(sp_dragon_export(d, gltf, &err) == SP_OK);
-    int v = validate(gltf);
+    int v = sp_fixture_gltf_validate(gltf);
     if (v >= 0) ENSURE(v == 1);
     // The export changes nothing: posing afterwards gives the same as before.
     ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
@@ -1499,7 +1482,7 @@ static void test_command(void)
             cJSON_GetObjectItem(j, "mean_error_px")->valuedouble, cJSON_GetArraySize(parts),
             cJSON_GetObjectItem(j, "ms")->valuedouble);
     cJSON_Delete(j);
-    int v = validate(out);
+    int v = sp_fixture_gltf_validate(out);
     if (v >= 0) ENSURE(v == 1);
     // Bad input: exit 1 with one line; bad usage: exit 2.
     snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes /nonexistent.json --out '%s' 2>/dev/null", SP_SKETCHPOSE, path,
@@ -1593,7 +1576,7 @@ static void check_demo(const char* db_path)
     fprintf(stderr, "  demo: every part on the body, outline/stroke IoU >= %.2f\n", worst);
     ENSURE(worst >= 0.6);
     cJSON_Delete(j);
-    int v = validate(glb);
+    int v = sp_fixture_gltf_validate(glb);
     if (v >= 0) ENSURE(v == 1);
 }
 
@@ -2998,7 +2981,7 @@ static double ink_played_back(sp_dragon* d, const char* name, int count, const i
     }
     cJSON_Delete(g.j);
     free(g.bin);
-    int v = validate(glbf);
+    int v = sp_fixture_gltf_validate(glbf);
     if (v >= 0) ENSURE(v == 1);
     return worst;
 }

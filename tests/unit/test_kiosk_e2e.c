@@ -249,23 +249,6 @@ static double num(const cJSON* j, const char* key)
     return cJSON_IsNumber(v) ? v->valuedouble : NAN;
 }
 
-// The Khronos validator: 1 pass, 0 fail, -1 when it is not installed.
-static int validate(const char* file)
-{
-    char tool[1100], cmd[3000];
-    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
-    const char* rep = sp_test_tmp_path("kiosk_validator.json");
-    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
-    int rc = system(cmd);
-    if (rc != 0) {
-        snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);
-        if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
-    }
-    return rc == 0;
-}
-
 // ------------------------------------------------------------ picture checks
 
 static bool is_yellow(const uint8_t* p)
@@ -505,7 +488,7 @@ static void test_dragon_session(void)
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "skins")) == DRAGON_PART_COUNT);
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "animations")) == 1);
     cJSON_Delete(g);
-    int v = validate(glb);
+    int v = sp_fixture_gltf_validate(glb);
     if (v < 0) fprintf(stderr, "  note: gltf-validator not installed (tests/tools: npm ci); validation skipped\n");
     ENSURE(v != 0);
     // Save wrote <code>.glb and a postcard.
@@ -513,7 +496,7 @@ static void test_dragon_session(void)
     ENSURE(cJSON_IsString(code) && strlen(code->valuestring) == 4);
     snprintf(path, sizeof path, "%s/%s.glb", exports, code->valuestring);
     ENSURE(access(path, R_OK) == 0);
-    if (v > 0) ENSURE(validate(path) == 1);
+    if (v > 0) ENSURE(sp_fixture_gltf_validate(path) == 1);
     sp_image card = {0};
     snprintf(path, sizeof path, "%s/%s.png", exports, code->valuestring);
     load_png(path, &card);
