@@ -1220,12 +1220,13 @@ static void updates_until(sp_kiosk* k, double* t, double until)
         sp_kiosk_update(k, *t);
 }
 
-// A kiosk in-process on a headless context, past its attract screen; NULL
-// (and *gl NULL) without headless OpenGL.
+// A kiosk in-process on a headless context, past its attract screen; skips
+// the running test without headless OpenGL, fails it when the kiosk does
+// not start.
 static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headless** gl, double* t)
 {
     sp_error err = {0};
-    if (sp_headless_create(gl, &err) != SP_OK) return NULL;
+    if (sp_headless_create(gl, &err) != SP_OK) SKIP("no headless OpenGL");
     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
                                                    .canvas_w = 1280,
                                                    .canvas_h = 800,
@@ -1233,10 +1234,8 @@ static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headles
                                                    .no_attract_demo = true,
                                                    .fit_time_cap_ms = 60000},
                                   &err);
-    if (!k) {
-        fprintf(stderr, "  %s\n", err.text);
-        return NULL;
-    }
+    if (!k) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(k);
     *t = 0;
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, *t, 640, 400, 0}); // leaves the attract screen
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, *t + 60, 640, 400, 0});
@@ -1291,8 +1290,6 @@ static void test_collect_reload(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_reload_ex", &gl, &t);
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
     // The visitor draws a tail, then starts over: the stroke is collected.
     draw_then_start_over(k, &t, &g_strokes[3]);
@@ -1344,8 +1341,6 @@ static void test_collect_busy(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_busy_ex", &gl, &t);
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     sqlite3* curator = NULL;
     ENSURE(sqlite3_open(db, &curator) == SQLITE_OK);
     ENSURE(sqlite3_exec(curator, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK);
@@ -1380,8 +1375,6 @@ static void test_collect_replaced(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_repl_ex", &gl, &t);
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     draw_then_start_over(k, &t, &g_strokes[3]);
     int stored = 0, dropped = 0;
     wait_collected(k, 1, &stored, &dropped);
@@ -1556,8 +1549,6 @@ static void test_save_fails_whole(void)
         sp_headless* gl = NULL;
         double t = 0;
         sp_kiosk* k = inproc_kiosk(db, "kiosk_savefail_ex", &gl, &t);
-        if (!gl) SKIP("no headless OpenGL");
-        ENSURE(k);
         const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
         draw_part(k, &t, &g_strokes[0]);
         sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_SAVE});
@@ -1641,8 +1632,6 @@ static void test_parts_loaded_while_idle(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_idle_ex", &gl, &t); // 500 ms of frames
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     const sp_dragon* d = sp_kiosk_dragon(k);
     fprintf(stderr, "  after 30 idle frames: %d of %d parts loaded\n", sp_dragon_loaded_parts(d), want);
     ENSURE(sp_dragon_loaded_parts(d) == want);
