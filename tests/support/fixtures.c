@@ -10,6 +10,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "sp/gltf.h"
 #include "test.h"
 
 double sp_test_uniform(sp_test_rng* r)
@@ -141,6 +142,17 @@ void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplit
         if (sp_channel_is_rotation(q->channel)) lo = fmax(lo, q->def - amplitude), hi = fmin(hi, q->def + amplitude);
         p[i] = sp_test_range(rng, lo, hi);
     }
+}
+
+void sp_fixture_shared_gltf(const char* rel, sp_character* ch)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) SKIP("../shared/data absent");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf/%s", data, rel);
+    *ch = (sp_character){0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(path, ch, &err) == SP_OK);
 }
 
 cJSON* sp_fixture_glb_json(const char* path)

@@ -16,6 +16,8 @@
 
 #include "sp/rig.h"
 
+struct sp_character;
+
 /// Deterministic splitmix64 generator for tests.
 typedef struct sp_test_rng { uint64_t s; } sp_test_rng;
 double sp_test_uniform(sp_test_rng* r); ///< [0, 1)
@@ -37,6 +39,11 @@ typedef struct sp_fixture_desc {
 void sp_fixture_tree_rig(const sp_fixture_desc* desc, sp_rig* out);
 /// Random in-bounds parameters (rotations within +-amplitude of the default).
 void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p);
+
+/// ../shared/data/gltf/<rel> (e.g. "CesiumMan/CesiumMan.glb") loaded into
+/// ch; skips the running test when ../shared/data is absent, fails it when
+/// the file does not load. Free with sp_character_free.
+void sp_fixture_shared_gltf(const char* rel, struct sp_character* ch);
 
 /// A GLB file's JSON chunk, parsed (fails the running test when the file is
 /// no GLB or its JSON does not parse). Free with cJSON_Delete.

@@ -151,13 +151,9 @@ static void test_drawover_fixture(void)
 // bends the arm; the fitted curve matches and the legs barely move.
 static void test_drawover_cesiumman(void)
 {
-    const char* data = sp_test_data_dir();
-    if (!data) SKIP("../shared/data absent");
-    char path[1024];
-    snprintf(path, sizeof path, "%s/gltf/CesiumMan/CesiumMan.glb", data);
-    sp_character ch = {0};
+    sp_character ch;
+    sp_fixture_shared_gltf("CesiumMan/CesiumMan.glb", &ch);
     sp_error err = {0};
-    ENSURE(sp_gltf_load(path, &ch, &err) == SP_OK);
     sp_rig* rig = &ch.rig;
     int P = rig->param_count, arm = sp_rig_find_param(rig, "node17.rx");
     ENSURE(arm >= 0);
