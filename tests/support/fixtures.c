@@ -10,6 +10,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "sp/classifier.h"
 #include "sp/gltf.h"
 #include "test.h"
 
@@ -153,6 +154,23 @@ void sp_fixture_shared_gltf(const char* rel, sp_character* ch)
     *ch = (sp_character){0};
     sp_error err = {0};
     ENSURE(sp_gltf_load(path, ch, &err) == SP_OK);
+}
+
+bool sp_fixture_bench_quickdraw(const char* prog, sp_dataset* ds)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) {
+        fprintf(stderr, "%s: ../shared/data absent (needs quickdraw)\n", prog);
+        return false;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/quickdraw", data);
+    sp_error err = {0};
+    if (sp_dataset_load(path, ds, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", prog, err.text);
+        return false;
+    }
+    return true;
 }
 
 cJSON* sp_fixture_glb_json(const char* path)

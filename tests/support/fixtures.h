@@ -17,6 +17,7 @@
 #include "sp/rig.h"
 
 struct sp_character;
+struct sp_dataset;
 
 /// Deterministic splitmix64 generator for tests.
 typedef struct sp_test_rng { uint64_t s; } sp_test_rng;
@@ -44,6 +45,10 @@ void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplit
 /// ch; skips the running test when ../shared/data is absent, fails it when
 /// the file does not load. Free with sp_character_free.
 void sp_fixture_shared_gltf(const char* rel, struct sp_character* ch);
+
+/// ../shared/data/quickdraw as a data set, for a benchmark: false, having
+/// said why on stderr after "prog: ", when the data is absent or does not load.
+bool sp_fixture_bench_quickdraw(const char* prog, struct sp_dataset* ds);
 
 /// A GLB file's JSON chunk, parsed (fails the running test when the file is
 /// no GLB or its JSON does not parse). Free with cJSON_Delete.
