@@ -66,13 +66,7 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
     }
     // Mesh: rings along each bone (parent -> child), blended weights.
     int bones = nj - 1 > 0 ? nj - 1 : 1;
-    int nv = bones * rings * rv;
-    rig->vertex_count = nv;
-    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
-    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
-    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
-    rig->triangle_count = bones * (rings - 1) * rv * 2;
-    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
+    sp_fixture_tube_alloc(rig, bones, rings, rv);
     // Stick abstraction: 8 points per bone, one curve per bone.
     const int per = d->stick_points > 1 ? d->stick_points : 8;
     sp_abstraction ab = {0};
@@ -106,14 +100,7 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
                 ++v;
             }
         }
-        for (int r = 0; r + 1 < rings; ++r)
-            for (int k = 0; k < rv; ++k) {
-                uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
-                uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
-                uint32_t* tr = rig->triangles + 3 * t;
-                tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
-                t += 2;
-            }
+        sp_fixture_tube_triangles(rig, base, rings, rv, &t);
         snprintf(ab.curves[b].name, sizeof ab.curves[b].name, "bone%d", b);
         ab.curves[b].first_point = b * per;
         ab.curves[b].point_count = per;
@@ -133,6 +120,46 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
     sp_result r = sp_rig_finalize(rig, "fixture", NULL, &err);
     if (r != SP_OK) fprintf(stderr, "fixture: %s\n", err.text);
     assert(r == SP_OK);
+}
+
+void sp_fixture_tube_alloc(sp_rig* rig, int bones, int rings, int rv)
+{
+    int nv = bones * rings * rv;
+    rig->vertex_count = nv;
+    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
+    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
+    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
+    rig->triangle_count = bones * (rings - 1) * rv * 2;
+    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
+}
+
+void sp_fixture_tube_triangles(sp_rig* rig, int base, int rings, int rv, int* t)
+{
+    for (int r = 0; r + 1 < rings; ++r)
+        for (int k = 0; k < rv; ++k) {
+            uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
+            uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
+            uint32_t* tr = rig->triangles + 3 * *t;
+            tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
+            *t += 2;
+        }
+}
+
+sp_abstraction sp_fixture_outline(int n)
+{
+    sp_abstraction ab = {0};
+    snprintf(ab.name, sizeof ab.name, "outline");
+    ab.correspondence = SP_CORR_CLOSEST;
+    ab.curve_count = 1;
+    ab.curves = calloc(1, sizeof(sp_curve));
+    snprintf(ab.curves[0].name, sizeof ab.curves[0].name, "outline");
+    ab.curves[0].point_count = n;
+    ab.curves[0].closed = true;
+    ab.point_count = n;
+    ab.rest = calloc((size_t)n * 3, sizeof(double));
+    ab.joints = calloc((size_t)n * 4, sizeof(uint16_t));
+    ab.weights = calloc((size_t)n * 4, sizeof(float));
+    return ab;
 }
 
 void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p)

@@ -41,6 +41,19 @@ void sp_fixture_tree_rig(const sp_fixture_desc* desc, sp_rig* out);
 /// Random in-bounds parameters (rotations within +-amplitude of the default).
 void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p);
 
+// ---- pieces the fixture rigs are built from (fixtures.c, test_parts.c, dragon_parts.c)
+
+/// Room for a tube mesh of `bones` bones, each `rings` rings of
+/// `ring_vertices` vertices: vertex_count, rest (unset), joints4 and
+/// weights4 (zero), triangle_count and the triangles between the rings.
+void sp_fixture_tube_alloc(sp_rig* rig, int bones, int rings, int ring_vertices);
+/// The triangles between the rings of one bone whose first vertex is
+/// `base` (ring after ring), written from triangle *t on; *t advances.
+void sp_fixture_tube_triangles(sp_rig* rig, int base, int rings, int ring_vertices, int* t);
+/// An abstraction "outline" of n points (closest-point correspondences), one
+/// closed curve "outline"; rest, joints and weights zero, to fill.
+sp_abstraction sp_fixture_outline(int n);
+
 /// ../shared/data/gltf/<rel> (e.g. "CesiumMan/CesiumMan.glb") loaded into
 /// ch; skips the running test when ../shared/data is absent, fails it when
 /// the file does not load. Free with sp_character_free.
