@@ -1581,8 +1581,8 @@ static void check_demo(const char* db_path)
 }
 
 // A default database of the shipped parts (built once per run; quickly
-// trained), with the hand-placed designs (`drawn`) or without, or NULL when
-// assets/ has no parts yet.
+// trained), with the hand-placed designs (`drawn`) or without; skips the
+// running test when assets/ has no parts yet.
 static const char* real_db_ex(bool drawn)
 {
     static char paths[2][1024];
@@ -1598,7 +1598,7 @@ static const char* real_db_ex(bool drawn)
             glbs += strlen(e->d_name) > 4 && !strcmp(e->d_name + strlen(e->d_name) - 4, ".glb");
         closedir(dir);
     }
-    if (glbs == 0) return NULL;
+    if (glbs == 0) SKIP("assets/ has no parts yet");
     snprintf(path, 1024, "%s", sp_test_tmp_path(drawn ? "dragon_default.db" : "dragon_undrawn.db"));
     sp_fixture_remove_db(path);
     sp_error err = {0};
@@ -1618,7 +1618,6 @@ static const char* real_db(void)
 static void test_six_real_parts(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_result r;
     sp_db* db = NULL;
@@ -1974,7 +1973,6 @@ static bool check_rerank(sp_dragon* d, const sp_stroke* stroke, const sp_dragon_
 static void test_visitors_policy(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/tests/data/visitors/tune", SP_BINARY_DIR); // built from designs.json (tests/bench/visitors.cmake)
     sp_dataset ds;
@@ -2101,7 +2099,6 @@ static bool guessed(const sp_dragon_result* res, const char* category)
 static void test_family_by_place(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
@@ -2230,7 +2227,6 @@ static int readme_session(sp_vec2** xy, int* n, int cap)
 static void test_drawn_on_body(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
@@ -2346,7 +2342,6 @@ static sp_vec2* tail_out_of_body(sp_dragon* d, sp_db* db, const char* tail, bool
 static void test_root_at_the_body(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
@@ -2424,7 +2419,6 @@ static double fitted_reach(const sp_dragon* d, int i, const sp_vec2* xy, int n, 
 static void test_line_drawn(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_dragon* d = new_dragon(path);
     const char* lines[] = {"tail/tail-wavy-line.json", "tail/tail-wavy-line-rising.json"};
     int as_line = 0, total = 0;
@@ -2468,7 +2462,6 @@ static void test_line_drawn(void)
 static void test_facing_follows_dragon(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_dragon* d = new_dragon(path);
     const char* rel[] = {"torso/torso-humped.json", "head/head-open-jaw-teeth.json", "front_legs/front-legs-boots.json",
                          "hind_legs/hind-legs-boots.json", "wings/wing-2-scallops-drooping.json"};
@@ -2527,7 +2520,6 @@ static void test_facing_follows_dragon(void)
 static void test_head_first_faces_as_after(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
     char dir[1200];
@@ -2594,7 +2586,6 @@ static void test_mirror_refusal(void)
     // The tree is taken for a head by the recipe without the hand-placed
     // designs; with them, for legs (the mirror then has nothing to say).
     const char* path = real_db_ex(false);
-    if (!path) SKIP("assets/ has no parts yet");
     sp_dragon* d = new_dragon(path);
     sp_error err = {0};
     const char* doodles[] = {"not_a_part/tree.json", "not_a_part/sun.json"};
@@ -2643,7 +2634,6 @@ static void test_mirror_refusal(void)
 static void test_polygon_refusal(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_dragon* d = new_dragon(path);
     sp_error err = {0};
     sp_dragon_result res;
@@ -2697,7 +2687,6 @@ static void test_polygon_refusal(void)
 static void test_parts_before_body(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
@@ -3168,7 +3157,6 @@ static void details_ride_their_part(sp_dragon* d)
 static void test_details_on_parts(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_dragon_result res;
     sp_dragon* d = new_dragon(path);
@@ -3268,7 +3256,6 @@ static void wavy_line(sp_vec2 from, sp_vec2 dir, double turn, double length, sp_
 static void test_flourishes_off_parts(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_dragon_result res;
     sp_vec2* s6[8];
@@ -3456,7 +3443,6 @@ static int spikes_along(const sp_vec2* body, int nb, double x0, double x1, doubl
 static void test_spikes_on_the_back(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     sp_error err = {0};
     sp_dragon_result res;
     sp_vec2* s6[8];
@@ -3630,7 +3616,6 @@ static void storm_check(sp_dragon* d, double t)
 static void test_scene_storm(void)
 {
     const char* path = real_db();
-    if (!path) SKIP("assets/ has no parts yet");
     const char* env_ops = getenv("SP_STORM_OPS");
     const char* env_seed = getenv("SP_STORM_SEED");
     int ops = env_ops ? atoi(env_ops) : 240;
