@@ -2901,6 +2901,21 @@ static void small_loop(sp_vec2 c, double r, sp_vec2 xy[40])
     }
 }
 
+// Whether a dark pixel (every channel low, as ink, not a part's colour) lies
+// within r px of p (canvas pixels) in the picture.
+static bool dark_near(const sp_image* img, sp_vec2 p, int r)
+{
+    int x = (int)lround(p.x), y = (int)lround(p.y);
+    bool found = false;
+    for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx) {
+            if (x + dx < 0 || y + dy < 0 || x + dx >= img->width || y + dy >= img->height) continue;
+            const uint8_t* px = img->rgba + 4 * ((size_t)(y + dy) * (size_t)img->width + (size_t)(x + dx));
+            found |= px[0] < 70 && px[1] < 70 && px[2] < 70;
+        }
+    return found;
+}
+
 // Ink point k of detail i on the canvas at the last pose_at.
 static sp_vec2 ink_px(const sp_dragon* d, int i, int k)
 {
@@ -3104,14 +3119,7 @@ static void details_ride_their_part(sp_dragon* d)
         ENSURE(r == SP_OK);
         int dark = 0, total = 0;
         for (int k = 0; k < n6[2]; ++k) { // ink (every channel low: not the green body) within 4 px
-            int x = (int)lround(s6[2][k].x), y = (int)lround(s6[2][k].y), found = 0;
-            for (int dy = -4; dy <= 4; ++dy)
-                for (int dx = -4; dx <= 4; ++dx) {
-                    if (x + dx < 0 || y + dy < 0 || x + dx >= img.width || y + dy >= img.height) continue;
-                    const uint8_t* px = img.rgba + 4 * ((size_t)(y + dy) * (size_t)img.width + (size_t)(x + dx));
-                    found |= px[0] < 70 && px[1] < 70 && px[2] < 70;
-                }
-            dark += found, ++total;
+            dark += dark_near(&img, s6[2][k], 4), ++total;
         }
         fprintf(stderr, "  %d of %d points of the first spot dark in the picture\n", dark, total);
         ENSURE(total > 0 && dark >= total / 2);
@@ -3338,15 +3346,7 @@ static void test_flourishes_off_parts(void)
         ENSURE(r == SP_OK);
         int dark = 0;
         for (int k = 0; k < 40; ++k) {
-            sp_vec2 q = ink_px(d, 1, k);
-            int x = (int)lround(q.x), y = (int)lround(q.y), hit = 0;
-            for (int dy = -3; dy <= 3; ++dy)
-                for (int dx = -3; dx <= 3; ++dx) {
-                    if (x + dx < 0 || y + dy < 0 || x + dx >= img.width || y + dy >= img.height) continue;
-                    const uint8_t* px = img.rgba + 4 * ((size_t)(y + dy) * (size_t)img.width + (size_t)(x + dx));
-                    hit |= px[0] < 70 && px[1] < 70 && px[2] < 70;
-                }
-            dark += hit;
+            dark += dark_near(&img, ink_px(d, 1, k), 3);
         }
         fprintf(stderr, "  %d of 40 points of the middle line dark in the picture\n", dark);
         ENSURE(dark >= 36);
