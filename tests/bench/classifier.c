@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../../classifier/src/feat.h"
+#include "fixtures.h"
 #include "sp/classifier.h"
 #include "sp/clock.h"
 #include "sp/sketch_io.h"
@@ -39,19 +40,9 @@ int main(int argc, char** argv)
             return 2;
         }
     }
-    const char* data = sp_test_data_dir();
-    if (!data) {
-        fprintf(stderr, "bench_classifier: ../shared/data absent (needs quickdraw)\n");
-        return 1;
-    }
-    char path[1024];
-    snprintf(path, sizeof path, "%s/quickdraw", data);
     sp_dataset ds;
+    if (!sp_fixture_bench_quickdraw("bench_classifier", &ds)) return 1;
     sp_error err = {0};
-    if (sp_dataset_load(path, &ds, &err) != SP_OK) {
-        fprintf(stderr, "bench_classifier: %s\n", err.text);
-        return 1;
-    }
     row rows[4];
     int nr = 0;
     // Fold 0 of the 5-fold protocol (index mod 5): train on 2000, test on 500.

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fixtures.h"
 #include "sp/classifier.h"
 #include "sp/clock.h"
 #include "sp/handdraw.h"
@@ -56,19 +57,9 @@ int main(int argc, char** argv)
         fprintf(stderr, "bench_classifier_train: --threads >= 1, --copies 0..100\n");
         return 2;
     }
-    const char* data = sp_test_data_dir();
-    if (!data) {
-        fprintf(stderr, "bench_classifier_train: ../shared/data absent (needs quickdraw)\n");
-        return 1;
-    }
-    char path[1024];
-    snprintf(path, sizeof path, "%s/quickdraw", data);
     sp_dataset ds;
+    if (!sp_fixture_bench_quickdraw("bench_classifier_train", &ds)) return 1;
     sp_error err = {0};
-    if (sp_dataset_load(path, &ds, &err) != SP_OK) {
-        fprintf(stderr, "bench_classifier_train: %s\n", err.text);
-        return 1;
-    }
     // Hand-drawn variants of every drawing.
     int orig = ds.count;
     sp_sample* g = realloc(ds.samples, sizeof *g * (size_t)orig * (size_t)(1 + copies));

@@ -73,6 +73,20 @@ static double frame(sp_kiosk* k, double t)
 }
 
 // The CPU time of the frames since the last call, as an extra JSON member.
+// A kiosk at the canvas size, its first frame drawn; NULL (said on stderr) when it does not start.
+static sp_kiosk* start_kiosk(const sp_kiosk_desc* desc)
+{
+    sp_error err = {0};
+    sp_kiosk* k = sp_kiosk_create(desc, &err);
+    if (!k) {
+        fprintf(stderr, "bench kiosk: %s\n", err.text);
+        return NULL;
+    }
+    sp_kiosk_resize(k, W, H, 96 / 25.4);
+    frame(k, 0);
+    return k;
+}
+
 static void cpu_extra(sp_bench_row* r)
 {
     double med = 0, p90 = 0, umed = 0;
@@ -230,20 +244,14 @@ int main(int argc, char** argv)
     sp_bench_row rows[16];
     int nr = 0;
     if (soak > 0) {
-        sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
-                                                       .canvas_w = W,
-                                                       .canvas_h = H,
-                                                       .export_dir = dir,
-                                                       .lod_triangles = lod,
-                                                       .no_attract_demo = true,
-                                                       .no_collect = no_collect},
-                                      &err);
-        if (!k) {
-            fprintf(stderr, "bench kiosk: %s\n", err.text);
-            return 1;
-        }
-        sp_kiosk_resize(k, W, H, 96 / 25.4);
-        frame(k, 0);
+        sp_kiosk* k = start_kiosk(&(sp_kiosk_desc){.db_path = db,
+                                                   .canvas_w = W,
+                                                   .canvas_h = H,
+                                                   .export_dir = dir,
+                                                   .lod_triangles = lod,
+                                                   .no_attract_demo = true,
+                                                   .no_collect = no_collect});
+        if (!k) return 1;
         ev(k, SP_KEV_DOWN, 10, 640, 400);
         ev(k, SP_KEV_UP, 20, 640, 400);
         soak_run(k, strokes, soak, &rows[nr++]);
@@ -260,16 +268,9 @@ int main(int argc, char** argv)
 
     // Start to first frame (the database exists, as in a museum after install).
     double t0 = sp_now_ms();
-    sp_kiosk* k = sp_kiosk_create(
-        &(sp_kiosk_desc){
-            .db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod, .no_collect = no_collect},
-        &err);
-    if (!k) {
-        fprintf(stderr, "bench kiosk: %s\n", err.text);
-        return 1;
-    }
-    sp_kiosk_resize(k, W, H, 96 / 25.4);
-    frame(k, 0);
+    sp_kiosk* k = start_kiosk(&(sp_kiosk_desc){
+        .db_path = db, .canvas_w = W, .canvas_h = H, .export_dir = dir, .lod_triangles = lod, .no_collect = no_collect});
+    if (!k) return 1;
     double start = sp_now_ms() - t0;
     rows[nr++] = (sp_bench_row){"start to first frame", start, start, 1, -1, 2000, ""};
     snprintf(rows[nr - 1].extra, sizeof rows[nr - 1].extra, "\"database\": \"%s\"", real ? "assets" : "stand-ins");

@@ -51,6 +51,7 @@
 #include <unistd.h>
 
 #include "bench.h"
+#include "fixtures.h"
 #include "sp/clock.h"
 #include "sp/dragon.h"
 #include "sp/kiosk_ui.h"
@@ -352,12 +353,7 @@ static int find(char** names, int n, const char* s)
 static void remove_tmp_db(const char* dir, const char* db)
 {
     if (!db[0]) return;
-    char path[256];
-    snprintf(path, sizeof path, "%s-wal", db);
-    unlink(path);
-    snprintf(path, sizeof path, "%s-shm", db);
-    unlink(path);
-    unlink(db);
+    sp_fixture_remove_db(db);
     rmdir(dir);
 }
 

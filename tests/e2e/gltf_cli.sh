@@ -8,20 +8,7 @@ DATA="$2/tests/e2e/data"
 WORK="$3/gltf_cli.$$"
 mkdir -p "$WORK"
 fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-
-# expect CODE CMD... : runs CMD, keeps stdout/stderr in $WORK/out, $WORK/err.
-expect() {
-    want="$1"
-    shift
-    "$@" >"$WORK/out" 2>"$WORK/err"
-    got=$?
-    [ "$got" = "$want" ] || fail "exit $got (wanted $want): $* -- $(cat "$WORK/err")"
-}
-one_line_naming() { # one_line_naming NAME: stderr is one line that names NAME
-    [ "$(wc -l <"$WORK/err")" -eq 1 ] || fail "stderr is not one line: $(cat "$WORK/err")"
-    grep -q "$1" "$WORK/err" || fail "stderr does not name $1: $(cat "$WORK/err")"
-}
+. "$2/tests/e2e/checks.sh" # fail, expect, one_line_naming
 
 expect 0 "$SP" inspect --help
 grep -q -- "--rig" "$WORK/out" || fail "inspect --help does not mention --rig"

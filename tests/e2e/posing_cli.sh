@@ -12,18 +12,7 @@ SHARED="${4:-}"
 RIG="$SRC/tests/e2e/data/two_bone_extras.gltf"
 mkdir -p "$WORK"
 fails=0
-fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
-expect() { # expect CODE CMD...: stdout/stderr kept in $WORK/out, $WORK/err
-    want="$1"
-    shift
-    "$@" >"$WORK/out" 2>"$WORK/err"
-    got=$?
-    [ "$got" = "$want" ] || fail "exit $got (wanted $want): $* -- $(head -c 300 "$WORK/err")"
-}
-one_line_naming() {
-    [ "$(wc -l <"$WORK/err")" -eq 1 ] || fail "stderr is not one line: $(cat "$WORK/err")"
-    grep -q "$1" "$WORK/err" || fail "stderr does not name $1: $(cat "$WORK/err")"
-}
+. "$SRC/tests/e2e/checks.sh" # fail, expect, one_line_naming
 strokes() { # strokes FILE POINTS-JSON...: a stroke file with one stroke per argument
     f="$1"
     shift

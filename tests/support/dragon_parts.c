@@ -2,6 +2,8 @@
 // dragon-part evaluation sets; see dragon_parts.h.
 #include "dragon_parts.h"
 
+#include "fixtures.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -100,18 +102,7 @@ void dragon_standin(int i, dragon_part* out)
     rig.weights4 = calloc((size_t)(np + 1) * 4, sizeof(float));
     rig.triangle_count = np;
     rig.triangles = malloc(sizeof(uint32_t) * 3 * (size_t)np);
-    sp_abstraction ab = {0};
-    snprintf(ab.name, sizeof ab.name, "outline");
-    ab.correspondence = SP_CORR_CLOSEST;
-    ab.curve_count = 1;
-    ab.curves = calloc(1, sizeof(sp_curve));
-    snprintf(ab.curves[0].name, sizeof ab.curves[0].name, "outline");
-    ab.curves[0].point_count = np;
-    ab.curves[0].closed = true;
-    ab.point_count = np;
-    ab.rest = calloc((size_t)np * 3, sizeof(double));
-    ab.joints = calloc((size_t)np * 4, sizeof(uint16_t));
-    ab.weights = calloc((size_t)np * 4, sizeof(float));
+    sp_abstraction ab = sp_fixture_outline(np);
     double cx = 0, cy = 0;
     for (int k = 0; k < np; ++k) {
         int e = k / per;

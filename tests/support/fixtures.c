@@ -4,10 +4,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
+#include "sp/classifier.h"
+#include "sp/gltf.h"
 #include "test.h"
 
 double sp_test_uniform(sp_test_rng* r)
@@ -62,13 +66,7 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
     }
     // Mesh: rings along each bone (parent -> child), blended weights.
     int bones = nj - 1 > 0 ? nj - 1 : 1;
-    int nv = bones * rings * rv;
-    rig->vertex_count = nv;
-    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
-    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
-    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
-    rig->triangle_count = bones * (rings - 1) * rv * 2;
-    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
+    sp_fixture_tube_alloc(rig, bones, rings, rv);
     // Stick abstraction: 8 points per bone, one curve per bone.
     const int per = d->stick_points > 1 ? d->stick_points : 8;
     sp_abstraction ab = {0};
@@ -102,14 +100,7 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
                 ++v;
             }
         }
-        for (int r = 0; r + 1 < rings; ++r)
-            for (int k = 0; k < rv; ++k) {
-                uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
-                uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
-                uint32_t* tr = rig->triangles + 3 * t;
-                tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
-                t += 2;
-            }
+        sp_fixture_tube_triangles(rig, base, rings, rv, &t);
         snprintf(ab.curves[b].name, sizeof ab.curves[b].name, "bone%d", b);
         ab.curves[b].first_point = b * per;
         ab.curves[b].point_count = per;
@@ -131,6 +122,46 @@ void sp_fixture_tree_rig(const sp_fixture_desc* d, sp_rig* rig)
     assert(r == SP_OK);
 }
 
+void sp_fixture_tube_alloc(sp_rig* rig, int bones, int rings, int rv)
+{
+    int nv = bones * rings * rv;
+    rig->vertex_count = nv;
+    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
+    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
+    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
+    rig->triangle_count = bones * (rings - 1) * rv * 2;
+    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
+}
+
+void sp_fixture_tube_triangles(sp_rig* rig, int base, int rings, int rv, int* t)
+{
+    for (int r = 0; r + 1 < rings; ++r)
+        for (int k = 0; k < rv; ++k) {
+            uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
+            uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
+            uint32_t* tr = rig->triangles + 3 * *t;
+            tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
+            *t += 2;
+        }
+}
+
+sp_abstraction sp_fixture_outline(int n)
+{
+    sp_abstraction ab = {0};
+    snprintf(ab.name, sizeof ab.name, "outline");
+    ab.correspondence = SP_CORR_CLOSEST;
+    ab.curve_count = 1;
+    ab.curves = calloc(1, sizeof(sp_curve));
+    snprintf(ab.curves[0].name, sizeof ab.curves[0].name, "outline");
+    ab.curves[0].point_count = n;
+    ab.curves[0].closed = true;
+    ab.point_count = n;
+    ab.rest = calloc((size_t)n * 3, sizeof(double));
+    ab.joints = calloc((size_t)n * 4, sizeof(uint16_t));
+    ab.weights = calloc((size_t)n * 4, sizeof(float));
+    return ab;
+}
+
 void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p)
 {
     for (int i = 0; i < rig->param_count; ++i) {
@@ -139,6 +170,34 @@ void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplit
         if (sp_channel_is_rotation(q->channel)) lo = fmax(lo, q->def - amplitude), hi = fmin(hi, q->def + amplitude);
         p[i] = sp_test_range(rng, lo, hi);
     }
+}
+
+void sp_fixture_shared_gltf(const char* rel, sp_character* ch)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) SKIP("../shared/data absent");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf/%s", data, rel);
+    *ch = (sp_character){0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(path, ch, &err) == SP_OK);
+}
+
+bool sp_fixture_bench_quickdraw(const char* prog, sp_dataset* ds)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) {
+        fprintf(stderr, "%s: ../shared/data absent (needs quickdraw)\n", prog);
+        return false;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/quickdraw", data);
+    sp_error err = {0};
+    if (sp_dataset_load(path, ds, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", prog, err.text);
+        return false;
+    }
+    return true;
 }
 
 cJSON* sp_fixture_glb_json(const char* path)
@@ -182,6 +241,32 @@ int sp_fixture_run(const char* cmd, char* out, size_t cap)
     out[n] = 0;
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+int sp_fixture_gltf_validate(const char* file)
+{
+    char tool[1100], cmd[3000];
+    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
+    struct stat st;
+    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
+    const char* rep = sp_test_tmp_path("gltf_validator.json");
+    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
+    int rc = system(cmd);
+    if (rc != 0) {
+        snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);
+        if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
+    }
+    return rc == 0;
+}
+
+void sp_fixture_remove_db(const char* path)
+{
+    char side[1200];
+    unlink(path);
+    snprintf(side, sizeof side, "%.1100s-wal", path);
+    unlink(side);
+    snprintf(side, sizeof side, "%.1100s-shm", path);
+    unlink(side);
 }
 
 cJSON* sp_fixture_json_file(const char* path)

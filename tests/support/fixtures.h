@@ -16,6 +16,9 @@
 
 #include "sp/rig.h"
 
+struct sp_character;
+struct sp_dataset;
+
 /// Deterministic splitmix64 generator for tests.
 typedef struct sp_test_rng { uint64_t s; } sp_test_rng;
 double sp_test_uniform(sp_test_rng* r); ///< [0, 1)
@@ -38,6 +41,28 @@ void sp_fixture_tree_rig(const sp_fixture_desc* desc, sp_rig* out);
 /// Random in-bounds parameters (rotations within +-amplitude of the default).
 void sp_fixture_random_params(const sp_rig* rig, sp_test_rng* rng, double amplitude, double* p);
 
+// ---- pieces the fixture rigs are built from (fixtures.c, test_parts.c, dragon_parts.c)
+
+/// Room for a tube mesh of `bones` bones, each `rings` rings of
+/// `ring_vertices` vertices: vertex_count, rest (unset), joints4 and
+/// weights4 (zero), triangle_count and the triangles between the rings.
+void sp_fixture_tube_alloc(sp_rig* rig, int bones, int rings, int ring_vertices);
+/// The triangles between the rings of one bone whose first vertex is
+/// `base` (ring after ring), written from triangle *t on; *t advances.
+void sp_fixture_tube_triangles(sp_rig* rig, int base, int rings, int ring_vertices, int* t);
+/// An abstraction "outline" of n points (closest-point correspondences), one
+/// closed curve "outline"; rest, joints and weights zero, to fill.
+sp_abstraction sp_fixture_outline(int n);
+
+/// ../shared/data/gltf/<rel> (e.g. "CesiumMan/CesiumMan.glb") loaded into
+/// ch; skips the running test when ../shared/data is absent, fails it when
+/// the file does not load. Free with sp_character_free.
+void sp_fixture_shared_gltf(const char* rel, struct sp_character* ch);
+
+/// ../shared/data/quickdraw as a data set, for a benchmark: false, having
+/// said why on stderr after "prog: ", when the data is absent or does not load.
+bool sp_fixture_bench_quickdraw(const char* prog, struct sp_dataset* ds);
+
 /// A GLB file's JSON chunk, parsed (fails the running test when the file is
 /// no GLB or its JSON does not parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_glb_json(const char* path);
@@ -50,6 +75,14 @@ char* sp_fixture_file_text(const char* path, size_t* n);
 /// and NUL-terminated; returns its exit status (-1 when it did not exit).
 /// Fails the running test when the command cannot be started.
 int sp_fixture_run(const char* cmd, char* out, size_t cap);
+
+/// The Khronos glTF validator (tests/tools/validate.js) on a file: 1 when
+/// it passes, 0 when it fails (its report on stderr), -1 when node or the
+/// validator (tests/tools/node_modules) is not installed.
+int sp_fixture_gltf_validate(const char* file);
+
+/// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).
+void sp_fixture_remove_db(const char* path);
 
 /// A JSON file, parsed (fails the running test when it does
 /// not read or parse). Free with cJSON_Delete.

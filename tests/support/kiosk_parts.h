@@ -12,6 +12,7 @@
 #define SP_TEST_KIOSK_PARTS_H
 
 #include "dragon_parts.h"
+#include "fixtures.h"
 
 #include "sp/partdb.h"
 #include "sp/synth.h"
@@ -84,20 +85,10 @@ static inline bool kp_write_standin(int i, const char* path, sp_error* err)
     return r == SP_OK;
 }
 
-static inline void kp_remove_db(const char* path)
-{
-    char side[1200];
-    unlink(path);
-    snprintf(side, sizeof side, "%.1100s-wal", path);
-    unlink(side);
-    snprintf(side, sizeof side, "%.1100s-shm", path);
-    unlink(side);
-}
-
 /// Builds `path` (replacing it); glb_dir holds the stand-ins' files. *real tells whether assets/ was used.
 static inline bool kp_build_db(const char* path, const char* assets_dir, const char* glb_dir, bool* real, sp_error* err)
 {
-    kp_remove_db(path);
+    sp_fixture_remove_db(path);
     dragon_part parts[DRAGON_PART_COUNT];
     *real = dragon_parts_load(assets_dir, parts);
     dragon_parts_free(parts);
@@ -119,7 +110,7 @@ static inline bool kp_build_db(const char* path, const char* assets_dir, const c
         // The assets are checked by their own tests; the kiosk's go on with the stand-ins.
         fprintf(stderr, "  note: no database from assets/ (%s); using the stand-in parts\n", err->text);
         *real = false;
-        kp_remove_db(path);
+        sp_fixture_remove_db(path);
     }
     if (sp_db_open(path, SP_DB_CREATE, &db, err) != SP_OK) return false;
     bool ok = true;

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fixtures.h"
 #include "sp/gltf.h"
 #include "test.h"
 
@@ -98,27 +99,10 @@ void test_part_rig(const test_part_spec* s, bool flat, sp_rig* rig)
             sp_rig_add_param(rig, j, SP_CH_S, 0.7, 1.4, SP_GROUP_SHAPE);
         }
     }
-    int nv = bones * rings * rv;
-    rig->vertex_count = nv;
-    rig->rest = malloc(sizeof(double) * 3 * (size_t)nv);
-    rig->joints4 = calloc((size_t)nv * 4, sizeof(uint16_t));
-    rig->weights4 = calloc((size_t)nv * 4, sizeof(float));
-    rig->triangle_count = bones * (rings - 1) * rv * 2;
-    rig->triangles = malloc(sizeof(uint32_t) * 3 * (size_t)rig->triangle_count);
+    sp_fixture_tube_alloc(rig, bones, rings, rv);
     // Outline: one side root -> tip, the other tip -> root (a closed loop).
     int side = bones * (rings - 1) + 1, np = 2 * side;
-    sp_abstraction ab = {0};
-    snprintf(ab.name, sizeof ab.name, "outline");
-    ab.correspondence = SP_CORR_CLOSEST;
-    ab.curve_count = 1;
-    ab.curves = calloc(1, sizeof(sp_curve));
-    snprintf(ab.curves[0].name, sizeof ab.curves[0].name, "outline");
-    ab.curves[0].point_count = np;
-    ab.curves[0].closed = true;
-    ab.point_count = np;
-    ab.rest = malloc(sizeof(double) * 3 * (size_t)np);
-    ab.joints = calloc((size_t)np * 4, sizeof(uint16_t));
-    ab.weights = calloc((size_t)np * 4, sizeof(float));
+    sp_abstraction ab = sp_fixture_outline(np);
     int v = 0, t = 0;
     for (int b = 0; b < bones; ++b) {
         sp_vec3 a = sp_mat4_translation(&world[b]), c = sp_mat4_translation(&world[b + 1]);
@@ -150,14 +134,7 @@ void test_part_rig(const test_part_spec* s, bool flat, sp_rig* rig)
             ab.weights[4 * i] = ab.weights[4 * k2] = w0;
             ab.weights[4 * i + 1] = ab.weights[4 * k2 + 1] = w1;
         }
-        for (int r = 0; r + 1 < rings; ++r)
-            for (int k = 0; k < rv; ++k) {
-                uint32_t i0 = (uint32_t)(base + r * rv + k), i1 = (uint32_t)(base + r * rv + (k + 1) % rv);
-                uint32_t i2 = i0 + (uint32_t)rv, i3 = i1 + (uint32_t)rv;
-                uint32_t* tr = rig->triangles + 3 * t;
-                tr[0] = i0, tr[1] = i1, tr[2] = i3, tr[3] = i0, tr[4] = i3, tr[5] = i2;
-                t += 2;
-            }
+        sp_fixture_tube_triangles(rig, base, rings, rv, &t);
     }
     rig->abstraction_count = 1;
     rig->abstractions = malloc(sizeof(sp_abstraction));

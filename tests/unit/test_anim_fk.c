@@ -6,18 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fixtures.h"
 #include "sp/gltf.h"
 #include "test.h"
 
 static void check_model(const char* rel)
 {
-    const char* data = sp_test_data_dir();
-    if (!data) SKIP("../shared/data absent");
-    char path[1024];
-    snprintf(path, sizeof path, "%s/gltf/%s", data, rel);
-    sp_character ch = {0};
+    sp_character ch;
+    sp_fixture_shared_gltf(rel, &ch);
     sp_error err = {0};
-    ENSURE(sp_gltf_load(path, &ch, &err) == SP_OK);
     sp_rig* rig = &ch.rig;
     ENSURE(rig->animation_count >= 1);
     // Replace the derived DOFs by full ones: every rotation, translation and scale axis.
@@ -27,7 +24,7 @@ static void check_model(const char* rel)
         for (int c = SP_CH_TX; c <= SP_CH_TZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, -1e3, 1e3, SP_GROUP_POSE);
         for (int c = SP_CH_SX; c <= SP_CH_SZ; ++c) sp_rig_add_param(rig, j, (sp_channel)c, 1e-3, 1e3, SP_GROUP_SHAPE);
     }
-    ENSURE(sp_rig_finalize(rig, path, NULL, &err) == SP_OK);
+    ENSURE(sp_rig_finalize(rig, rel, NULL, &err) == SP_OK);
     int J = rig->joint_count, P = rig->param_count;
     sp_vec3* t = malloc(sizeof(sp_vec3) * J);
     sp_quat* r = malloc(sizeof(sp_quat) * J);

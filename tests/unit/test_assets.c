@@ -220,6 +220,19 @@ static void check_clip(const sp_rig* rig)
     }
 }
 
+// Every parameter's bounds are finite and ordered, a scale's above 0; adds
+// the pose and shape parameters to *pose and *shape.
+static void ensure_param_bounds(const sp_rig* rig, int* pose, int* shape)
+{
+    for (int q = 0; q < rig->param_count; ++q) {
+        const sp_param* p = &rig->params[q];
+        ENSURE(isfinite(p->min) && isfinite(p->max) && p->min < p->max);
+        if (sp_channel_is_scale(p->channel)) ENSURE(p->min > 0.0);
+        *shape += p->group == SP_GROUP_SHAPE;
+        *pose += p->group == SP_GROUP_POSE;
+    }
+}
+
 static void test_contents(void)
 {
     for (int i = 0; i < PART_COUNT; ++i) {
@@ -229,13 +242,7 @@ static void test_contents(void)
         for (int w = 0; w < ch.warning_count; ++w)
             fprintf(stderr, "  %s: warning: %s\n", k_parts[i], ch.warnings[w]);
         int shape = 0, pose = 0;
-        for (int q = 0; q < rig->param_count; ++q) {
-            const sp_param* p = &rig->params[q];
-            ENSURE(isfinite(p->min) && isfinite(p->max) && p->min < p->max);
-            if (sp_channel_is_scale(p->channel)) ENSURE(p->min > 0.0);
-            shape += p->group == SP_GROUP_SHAPE;
-            pose += p->group == SP_GROUP_POSE;
-        }
+        ensure_param_bounds(rig, &pose, &shape);
         int ab = sp_rig_find_abstraction(rig, "outline");
         fprintf(stderr, "  %-10s %5d vertices %5d triangles %2d parameters (%d pose, %d shape) %2d joints, outline %d points\n",
                 k_parts[i], rig->vertex_count, rig->triangle_count, rig->param_count, pose, shape, rig->joint_count,
@@ -358,6 +365,41 @@ static sp_vec3 tri_normal(const double* x, const uint32_t* t)
     return sp_v3_cross(sp_v3_sub(b, a), sp_v3_sub(c, a));
 }
 
+// The linear part of vertex v's blended skin matrix (M: the joints' skin
+// matrices), column-major 3x3.
+static void skin_linear(const sp_rig* rig, const sp_mat4* M, int v, double a[9])
+{
+    for (int k = 0; k < 9; ++k)
+        a[k] = 0;
+    for (int k = 0; k < 4; ++k) {
+        double w = rig->weights4[4 * (size_t)v + (size_t)k];
+        if (w == 0) continue;
+        const double* m = M[rig->joints4[4 * (size_t)v + (size_t)k]].m;
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r)
+                a[3 * c + r] += w * m[4 * c + r];
+    }
+}
+
+// Faces folded over at the posed points x: the posed normal against the rest
+// normal carried by the face's mean skin_linear (A: 9 per vertex). n0s: the
+// rest normals (3 per face), or NULL to compute them; degenerate rest faces
+// are skipped.
+static int folded_faces(const sp_rig* rig, const double* n0s, const double* x, const double* A)
+{
+    int inverted = 0;
+    for (int t = 0; t < rig->triangle_count; ++t) {
+        const uint32_t* tri = rig->triangles + 3 * (size_t)t;
+        sp_vec3 n0 = n0s ? (sp_vec3){n0s[3 * t], n0s[3 * t + 1], n0s[3 * t + 2]} : tri_normal(rig->rest, tri);
+        if (!(sp_v3_len(n0) > 1e-14)) continue;
+        double ac[9];
+        for (int k = 0; k < 9; ++k)
+            ac[k] = (A[9 * (size_t)tri[0] + k] + A[9 * (size_t)tri[1] + k] + A[9 * (size_t)tri[2] + k]) / 3.0;
+        inverted += sp_v3_dot(tri_normal(x, tri), cof_apply(ac, n0)) < 0;
+    }
+    return inverted;
+}
+
 static void test_random_poses(void)
 {
     for (int i = 0; i < ASSET_COUNT; ++i) {
@@ -394,28 +436,10 @@ static void test_random_poses(void)
             }
             for (int v = 0; v < nv; ++v) {
                 double* a = A + 9 * (size_t)v;
-                for (int k = 0; k < 9; ++k)
-                    a[k] = 0;
-                for (int k = 0; k < 4; ++k) {
-                    double w = rig->weights4[4 * (size_t)v + (size_t)k];
-                    if (w == 0) continue;
-                    const double* m = M[rig->joints4[4 * (size_t)v + (size_t)k]].m;
-                    for (int c = 0; c < 3; ++c)
-                        for (int r = 0; r < 3; ++r)
-                            a[3 * c + r] += w * m[4 * c + r];
-                }
+                skin_linear(rig, M, v, a);
                 negative += !(det3(a) > 0);
             }
-            int inverted = 0;
-            for (int t = 0; t < nt; ++t) {
-                const uint32_t* tri = rig->triangles + 3 * (size_t)t;
-                sp_vec3 n0 = {n0s[3 * t], n0s[3 * t + 1], n0s[3 * t + 2]};
-                if (!(sp_v3_len(n0) > 1e-14)) continue;
-                double ac[9];
-                for (int k = 0; k < 9; ++k)
-                    ac[k] = (A[9 * (size_t)tri[0] + k] + A[9 * (size_t)tri[1] + k] + A[9 * (size_t)tri[2] + k]) / 3.0;
-                inverted += sp_v3_dot(tri_normal(x, tri), cof_apply(ac, n0)) < 0;
-            }
+            int inverted = folded_faces(rig, n0s, x, A);
             total += inverted;
             if (inverted > worst) worst = inverted, worst_seed = seed;
         }
@@ -469,35 +493,17 @@ static int bend_check(const sp_rig* rig, sp_rig_eval* ev, const double* p, int j
     pivot0 = sp_mat4_translation(&bind);
     *min_ratio = INFINITY;
     for (int v = 0; v < nv; ++v) {
-        double* a = A + 9 * (size_t)v;
+        skin_linear(rig, M, v, A + 9 * (size_t)v);
         double wj = 0;
-        for (int k = 0; k < 9; ++k)
-            a[k] = 0;
-        for (int k = 0; k < 4; ++k) {
-            double w = rig->weights4[4 * (size_t)v + (size_t)k];
-            int j = rig->joints4[4 * (size_t)v + (size_t)k];
-            if (w == 0) continue;
-            if (j == joint) wj += w;
-            for (int c = 0; c < 3; ++c)
-                for (int r = 0; r < 3; ++r)
-                    a[3 * c + r] += w * M[j].m[4 * c + r];
-        }
+        for (int k = 0; k < 4; ++k)
+            if (rig->joints4[4 * (size_t)v + (size_t)k] == joint) wj += rig->weights4[4 * (size_t)v + (size_t)k];
         if (wj < 0.25 || wj > 0.75) continue;
         sp_vec3 x0 = {rig->rest[3 * v], rig->rest[3 * v + 1], rig->rest[3 * v + 2]};
         sp_vec3 x1 = {x[3 * v], x[3 * v + 1], x[3 * v + 2]};
         double r0 = sp_v3_len(sp_v3_sub(x0, pivot0));
         if (r0 > 0) *min_ratio = fmin(*min_ratio, sp_v3_len(sp_v3_sub(x1, pivot)) / r0);
     }
-    int inverted = 0;
-    for (int t = 0; t < rig->triangle_count; ++t) {
-        const uint32_t* tri = rig->triangles + 3 * (size_t)t;
-        sp_vec3 n0 = tri_normal(rig->rest, tri);
-        if (!(sp_v3_len(n0) > 1e-14)) continue;
-        double ac[9];
-        for (int k = 0; k < 9; ++k)
-            ac[k] = (A[9 * (size_t)tri[0] + k] + A[9 * (size_t)tri[1] + k] + A[9 * (size_t)tri[2] + k]) / 3.0;
-        inverted += sp_v3_dot(tri_normal(x, tri), cof_apply(ac, n0)) < 0;
-    }
+    int inverted = folded_faces(rig, NULL, x, A);
     free(x), free(A);
     return inverted;
 }
@@ -544,14 +550,9 @@ static void test_characters(void)
         for (int w = 0; w < ch.warning_count; ++w)
             fprintf(stderr, "  %s: warning: %s\n", cs->name, ch.warnings[w]);
         int shape = 0, pose = 0, placement = 0;
-        for (int q = 0; q < rig->param_count; ++q) {
-            const sp_param* p = &rig->params[q];
-            ENSURE(isfinite(p->min) && isfinite(p->max) && p->min < p->max);
-            if (sp_channel_is_scale(p->channel)) ENSURE(p->min > 0.0);
-            shape += p->group == SP_GROUP_SHAPE;
-            pose += p->group == SP_GROUP_POSE;
-            placement += p->joint == 0 && (p->channel == SP_CH_TX || p->channel == SP_CH_TY);
-        }
+        ensure_param_bounds(rig, &pose, &shape);
+        for (int q = 0; q < rig->param_count; ++q)
+            placement += rig->params[q].joint == 0 && (rig->params[q].channel == SP_CH_TX || rig->params[q].channel == SP_CH_TY);
         fprintf(stderr, "  %-11s %5d vertices (%d mesh coordinates) %3d parameters (%d pose, %d shape) %2d joints\n", cs->name,
                 rig->vertex_count, 3 * rig->vertex_count, rig->param_count, pose, shape, rig->joint_count);
         ENSURE(ch.warning_count == 0);

@@ -83,7 +83,7 @@ static const char* e2e_db(void)
 static void e2e_db_copy(const char* name, char* path, size_t size)
 {
     snprintf(path, size, "%s", sp_test_tmp_path(name));
-    kp_remove_db(path);
+    sp_fixture_remove_db(path);
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "cp '%s' '%s'", e2e_db(), path);
     ENSURE(system(cmd) == 0);
@@ -247,23 +247,6 @@ static double num(const cJSON* j, const char* key)
 {
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, key);
     return cJSON_IsNumber(v) ? v->valuedouble : NAN;
-}
-
-// The Khronos validator: 1 pass, 0 fail, -1 when it is not installed.
-static int validate(const char* file)
-{
-    char tool[1100], cmd[3000];
-    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
-    const char* rep = sp_test_tmp_path("kiosk_validator.json");
-    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
-    int rc = system(cmd);
-    if (rc != 0) {
-        snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);
-        if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
-    }
-    return rc == 0;
 }
 
 // ------------------------------------------------------------ picture checks
@@ -505,7 +488,7 @@ static void test_dragon_session(void)
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "skins")) == DRAGON_PART_COUNT);
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(g, "animations")) == 1);
     cJSON_Delete(g);
-    int v = validate(glb);
+    int v = sp_fixture_gltf_validate(glb);
     if (v < 0) fprintf(stderr, "  note: gltf-validator not installed (tests/tools: npm ci); validation skipped\n");
     ENSURE(v != 0);
     // Save wrote <code>.glb and a postcard.
@@ -513,7 +496,7 @@ static void test_dragon_session(void)
     ENSURE(cJSON_IsString(code) && strlen(code->valuestring) == 4);
     snprintf(path, sizeof path, "%s/%s.glb", exports, code->valuestring);
     ENSURE(access(path, R_OK) == 0);
-    if (v > 0) ENSURE(validate(path) == 1);
+    if (v > 0) ENSURE(sp_fixture_gltf_validate(path) == 1);
     sp_image card = {0};
     snprintf(path, sizeof path, "%s/%s.png", exports, code->valuestring);
     load_png(path, &card);
@@ -659,7 +642,7 @@ static void test_db_replaced(void)
     char live[1100], spare[1100];
     snprintf(live, sizeof live, "%s", sp_test_tmp_path("kiosk_live.db"));
     snprintf(spare, sizeof spare, "%s", sp_test_tmp_path("kiosk_spare.db"));
-    kp_remove_db(live);
+    sp_fixture_remove_db(live);
     char cmd[16384];
     snprintf(cmd, sizeof cmd, "cp '%s' '%s' && cp '%s' '%s'", db, live, db, spare);
     ENSURE(system(cmd) == 0);
@@ -1237,12 +1220,13 @@ static void updates_until(sp_kiosk* k, double* t, double until)
         sp_kiosk_update(k, *t);
 }
 
-// A kiosk in-process on a headless context, past its attract screen; NULL
-// (and *gl NULL) without headless OpenGL.
+// A kiosk in-process on a headless context, past its attract screen; skips
+// the running test without headless OpenGL, fails it when the kiosk does
+// not start.
 static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headless** gl, double* t)
 {
     sp_error err = {0};
-    if (sp_headless_create(gl, &err) != SP_OK) return NULL;
+    if (sp_headless_create(gl, &err) != SP_OK) SKIP("no headless OpenGL");
     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
                                                    .canvas_w = 1280,
                                                    .canvas_h = 800,
@@ -1250,10 +1234,8 @@ static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headles
                                                    .no_attract_demo = true,
                                                    .fit_time_cap_ms = 60000},
                                   &err);
-    if (!k) {
-        fprintf(stderr, "  %s\n", err.text);
-        return NULL;
-    }
+    if (!k) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(k);
     *t = 0;
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, *t, 640, 400, 0}); // leaves the attract screen
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, *t + 60, 640, 400, 0});
@@ -1308,8 +1290,6 @@ static void test_collect_reload(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_reload_ex", &gl, &t);
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
     // The visitor draws a tail, then starts over: the stroke is collected.
     draw_then_start_over(k, &t, &g_strokes[3]);
@@ -1361,8 +1341,6 @@ static void test_collect_busy(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_busy_ex", &gl, &t);
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     sqlite3* curator = NULL;
     ENSURE(sqlite3_open(db, &curator) == SQLITE_OK);
     ENSURE(sqlite3_exec(curator, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK);
@@ -1393,12 +1371,10 @@ static void test_collect_replaced(void)
     e2e_db_copy("kiosk_repl.db", db, sizeof db);
     e2e_db_copy("kiosk_repl_next.db", next, sizeof next);
     snprintf(old_copy, sizeof old_copy, "%s", sp_test_tmp_path("kiosk_repl_old.db"));
-    kp_remove_db(old_copy);
+    sp_fixture_remove_db(old_copy);
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_repl_ex", &gl, &t);
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     draw_then_start_over(k, &t, &g_strokes[3]);
     int stored = 0, dropped = 0;
     wait_collected(k, 1, &stored, &dropped);
@@ -1573,8 +1549,6 @@ static void test_save_fails_whole(void)
         sp_headless* gl = NULL;
         double t = 0;
         sp_kiosk* k = inproc_kiosk(db, "kiosk_savefail_ex", &gl, &t);
-        if (!gl) SKIP("no headless OpenGL");
-        ENSURE(k);
         const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
         draw_part(k, &t, &g_strokes[0]);
         sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_SAVE});
@@ -1658,8 +1632,6 @@ static void test_parts_loaded_while_idle(void)
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_idle_ex", &gl, &t); // 500 ms of frames
-    if (!gl) SKIP("no headless OpenGL");
-    ENSURE(k);
     const sp_dragon* d = sp_kiosk_dragon(k);
     fprintf(stderr, "  after 30 idle frames: %d of %d parts loaded\n", sp_dragon_loaded_parts(d), want);
     ENSURE(sp_dragon_loaded_parts(d) == want);

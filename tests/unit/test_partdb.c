@@ -80,16 +80,6 @@ static const char* part_file(int i)
     return paths[i];
 }
 
-static void remove_db(const char* path)
-{
-    char side[1100];
-    unlink(path);
-    snprintf(side, sizeof side, "%s-wal", path);
-    unlink(side);
-    snprintf(side, sizeof side, "%s-shm", path);
-    unlink(side);
-}
-
 static sp_db* open_ok(const char* path, unsigned flags)
 {
     sp_db* db = NULL;
@@ -180,7 +170,7 @@ static const char* base_db(const char* name)
     static char built[1024];
     if (!built[0]) {
         const char* b = sp_test_tmp_path("base_built.db");
-        remove_db(b);
+        sp_fixture_remove_db(b);
         sp_db* db = open_ok(b, SP_DB_CREATE);
         add_ok(db, 0, 30);
         add_ok(db, 1, 30);
@@ -192,7 +182,7 @@ static const char* base_db(const char* name)
         snprintf(built, sizeof built, "%s", b);
     }
     const char* path = sp_test_tmp_path(name);
-    remove_db(path);
+    sp_fixture_remove_db(path);
     copy_file(built, path);
     return path;
 }
@@ -223,7 +213,7 @@ static void test_round_trip(void)
     const char* path = sp_test_tmp_path("rt.db");
     char p[1024];
     snprintf(p, sizeof p, "%s", path);
-    remove_db(p);
+    sp_fixture_remove_db(p);
     sp_error err = {0};
     sp_db* db = NULL;
     ENSURE(sp_db_open(p, 0, &db, &err) == SP_ERR_IO && strstr(err.text, "no such database")); // no CREATE
@@ -294,7 +284,7 @@ static void test_round_trip(void)
     char cmd[2200];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     ENSURE(system(cmd) == 0);
-    remove_db(p2);
+    sp_fixture_remove_db(p2);
     ENSURE(sp_db_export(db, dir, &err) == SP_OK);
     sp_db_close(db);
     sp_db_train_desc td = quick_train(-1);
@@ -471,7 +461,7 @@ static void test_two_writers(void)
 {
     char p[1024];
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("busy.db"));
-    remove_db(p);
+    sp_fixture_remove_db(p);
     sp_db_close(open_ok(p, SP_DB_CREATE));
     // Another writer holds the lock: we wait our timeout, then fail with the message.
     sqlite3* other;
@@ -590,7 +580,7 @@ static void test_read_only_and_full(void)
     ENSURE(WEXITSTATUS(st) == 0);
     file_sha(ro, after);
     ENSURE(!strcmp(before, after));
-    remove_db(ro);
+    sp_fixture_remove_db(ro);
     ENSURE(rmdir(dir) == 0);
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
@@ -646,7 +636,7 @@ static void test_unreachable(void)
     ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
     ENSURE(chmod(dir, 0755) == 0);
     ENSURE(WEXITSTATUS(st) == 0);
-    remove_db(p);
+    sp_fixture_remove_db(p);
     ENSURE(rmdir(dir) == 0);
     // A file that is really missing still says so.
     sp_db* d = NULL;
@@ -686,7 +676,7 @@ static void test_read_only_folder(void)
     char side[1100];
     snprintf(side, sizeof side, "%s-shm", p);
     ENSURE(stat(side, &sb) != 0); // the reader left nothing beside it
-    remove_db(p);
+    sp_fixture_remove_db(p);
     ENSURE(rmdir(dir) == 0);
 }
 
@@ -740,7 +730,7 @@ static void test_foreign_wal(void)
     ENSURE(WEXITSTATUS(st) == 0);
     ENSURE(scalar(p, "SELECT count(*) FROM log WHERE by = 'crashed'") == 1);
     ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 0);
-    remove_db(p);
+    sp_fixture_remove_db(p);
     ENSURE(rmdir(dir) == 0);
 }
 
@@ -788,21 +778,21 @@ static void test_schema_versions(void)
            SP_OK);
     ENSURE(sp_db_open(q, 0, &db, &err) != SP_OK);
     fprintf(stderr, "  not a database: %s\n", err.text);
-    remove_db(q);
+    sp_fixture_remove_db(q);
     ENSURE(sqlite3_open(q, &h) == SQLITE_OK);
     ENSURE(sqlite3_exec(h, "CREATE TABLE foo(x)", NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(h);
     ENSURE(sp_db_open(q, 0, &db, &err) == SP_ERR_INVALID && strstr(err.text, "not a sketchpose database"));
     // An empty file (a typo'd path, a truncated copy) opened for writing is
     // refused and stays empty; only SP_DB_CREATE makes a database of it.
-    remove_db(q);
+    sp_fixture_remove_db(q);
     ENSURE(db_write_file(q, "", 0, &err) == SP_OK);
     ENSURE(sp_db_open(q, 0, &db, &err) == SP_ERR_INVALID && strstr(err.text, "empty file"));
     struct stat st;
     ENSURE(stat(q, &st) == 0 && st.st_size == 0);
     ENSURE(sp_db_open(q, SP_DB_CREATE, &db, &err) == SP_OK);
     sp_db_close(db);
-    remove_db(q);
+    sp_fixture_remove_db(q);
 }
 
 static void test_bad_input(void)
@@ -1235,7 +1225,7 @@ static void test_default_db(void)
     char dir[1100], p[1024];
     default_assets("default", dir, sizeof dir);
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("default.db"));
-    remove_db(p);
+    sp_fixture_remove_db(p);
     sp_db* db = NULL;
     sp_error err = {0};
     // Two hand-placed designs, a tail and a horn, drawn twice each (family 2, as the concepts).
@@ -1439,7 +1429,7 @@ static void test_kiosk_collect(void)
     char dir[1024], q[1024];
     snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("kiosk-export"));
     snprintf(q, sizeof q, "%s", sp_test_tmp_path("kiosk-rebuilt.db"));
-    remove_db(q);
+    sp_fixture_remove_db(q);
     ENSURE(sp_db_export(kiosk, dir, &err) == SP_OK);
     ENSURE(sp_db_create_from_export(q, dir, NULL, "test", &err) == SP_OK);
     ENSURE(scalar(q, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'approved'") == 2);
@@ -1456,7 +1446,7 @@ static void test_kiosk_migration(void)
 {
     char p[1024];
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("v2.db"));
-    remove_db(p);
+    sp_fixture_remove_db(p);
     sqlite3* h;
     ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
     sqlite3_close(h);
@@ -1518,7 +1508,7 @@ static void test_number_options_cli(void)
     if (!bin) SKIP("sketchpose not built");
     char p[1024], cmd[4096], out[65536];
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("numbers.db"));
-    remove_db(p);
+    sp_fixture_remove_db(p);
     snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --synth 0 --no-selftest", bin, p, part_file(0));
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     ENSURE(scalar(p, "SELECT count(*) FROM parts") == 1 && scalar(p, "SELECT count(*) FROM sketches") == 0);
@@ -1583,7 +1573,7 @@ static void test_default_db_cli(void)
     char root[1024], assets[1100], p[1024], cmd[8192], out[65536];
     snprintf(root, sizeof root, "%s", default_assets("defcli", assets, sizeof assets));
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("defcli.db"));
-    remove_db(p);
+    sp_fixture_remove_db(p);
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 --quickdraw '%s/nowhere' 2>&1",
              bin, p, assets, root);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere: no such folder") &&
@@ -1611,7 +1601,7 @@ static void test_default_db_cli(void)
     ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3") && strstr(out, "\"part_sketches\": 24") &&
            strstr(out, "\"concept_sketches\": 4") && strstr(out, "\"design_sketches\": 2"));
     // The data moved away: built without them, with a warning that names picks.json.
-    remove_db(p);
+    sp_fixture_remove_db(p);
     snprintf(cmd, sizeof cmd, "rm -rf '%s/qd' && '%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 2>&1 >/dev/null",
              root, bin, p, assets);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 &&

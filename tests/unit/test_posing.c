@@ -151,13 +151,9 @@ static void test_drawover_fixture(void)
 // bends the arm; the fitted curve matches and the legs barely move.
 static void test_drawover_cesiumman(void)
 {
-    const char* data = sp_test_data_dir();
-    if (!data) SKIP("../shared/data absent");
-    char path[1024];
-    snprintf(path, sizeof path, "%s/gltf/CesiumMan/CesiumMan.glb", data);
-    sp_character ch = {0};
+    sp_character ch;
+    sp_fixture_shared_gltf("CesiumMan/CesiumMan.glb", &ch);
     sp_error err = {0};
-    ENSURE(sp_gltf_load(path, &ch, &err) == SP_OK);
     sp_rig* rig = &ch.rig;
     int P = rig->param_count, arm = sp_rig_find_param(rig, "node17.rx");
     ENSURE(arm >= 0);
@@ -225,17 +221,6 @@ static int run(const char* cmd)
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
-static cJSON* read_json(const char* path)
-{
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[1 << 22];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = 0;
-    return cJSON_Parse(buf);
-}
-
 // `sketchpose animate` with 4 keys on CesiumMan: the .glb's animation,
 // sampled at each key time, reproduces each key's fitted pose.
 static void test_animate_cli_cesiumman(void)
@@ -261,7 +246,7 @@ static void test_animate_cli_cesiumman(void)
     for (int i = 0; i < ch.rig.animation_count; ++i)
         if (!strcmp(ch.rig.animations[i].name, "sketchpose")) an = i;
     ENSURE(an >= 0);
-    cJSON* reports = read_json(rep);
+    cJSON* reports = sp_fixture_json_file(rep);
     ENSURE(reports && cJSON_GetArraySize(reports) == 4);
     int P = ch.rig.param_count;
     double* keyp = malloc(sizeof(double) * P * 4);

@@ -47,13 +47,8 @@ static void test_chain(void)
 
 static void check_model(const char* rel)
 {
-    const char* data = sp_test_data_dir();
-    if (!data) SKIP("../shared/data absent");
-    char path[1024];
-    snprintf(path, sizeof path, "%s/gltf/%s", data, rel);
-    sp_character ch = {0};
-    sp_error err = {0};
-    ENSURE(sp_gltf_load(path, &ch, &err) == SP_OK);
+    sp_character ch;
+    sp_fixture_shared_gltf(rel, &ch);
     int ok = recovered(&ch.rig, &ch.camera, 100);
     fprintf(stderr, "  %s: %d of 100 within 1%%\n", rel, ok);
     ENSURE(ok >= 95);

@@ -137,6 +137,16 @@ static void ensure_boxes_match(const sp_image* img, const double pbox[4], double
         ENSURE_NEAR(box[k], floor(pbox[k] * px_per_cam), 2.0);
 }
 
+// An offscreen target of w x h pixels (fails the running test without one).
+static sp_render_target* new_target(int w, int h)
+{
+    sp_error err = {0};
+    sp_render_target* t;
+    sp_render_target_create(w, h, 0, &t, &err);
+    ENSURE(t != NULL);
+    return t;
+}
+
 static void render_scene(const scene* s, sp_render_mesh* m, const sp_camera* cam, sp_render_target* t, int vw, int vh,
                          bool with_stick, sp_image* img)
 {
@@ -165,10 +175,7 @@ static void check_mesh_alignment(sp_camera_kind kind, const char* png)
     scene s;
     scene_make(&s, 0.9);
     sp_camera cam = sp_camera_frame(kind, s.lo, s.hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
-    sp_error err = {0};
-    sp_render_target* t;
-    sp_render_target_create(W, H, 0, &t, &err);
-    ENSURE(t != NULL);
+    sp_render_target* t = new_target(W, H);
     sp_render_mesh* m = scene_mesh(&s);
     sp_image img = {0};
     render_scene(&s, m, &cam, t, W, H, false, &img);
@@ -232,10 +239,7 @@ static void test_viewport_scale(void)
     scene s;
     scene_make(&s, 0.6);
     sp_camera cam = sp_camera_frame(SP_CAMERA_PERSPECTIVE, s.lo, s.hi, sp_v3(0.3, -0.2, -1), sp_v3(0, 1, 0), W, H);
-    sp_error err = {0};
-    sp_render_target* t;
-    sp_render_target_create(2 * W, 2 * H, 0, &t, &err);
-    ENSURE(t != NULL);
+    sp_render_target* t = new_target(2 * W, 2 * H);
     sp_render_mesh* m = scene_mesh(&s);
     sp_image img = {0};
     render_scene(&s, m, &cam, t, 2 * W, 2 * H, false, &img);
@@ -258,9 +262,7 @@ static void test_depth_and_model(void)
     scene_make(&s, 0.7);
     sp_camera cam = sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, s.lo, s.hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
     sp_error err = {0};
-    sp_render_target* t;
-    sp_render_target_create(W, H, 0, &t, &err);
-    ENSURE(t != NULL);
+    sp_render_target* t = new_target(W, H);
     sp_mesh_desc d = {.vertex_count = s.rig.vertex_count,
                       .positions = s.xyz,
                       .base_color = {0.9f, 0.05f, 0.05f, 1},
@@ -344,10 +346,7 @@ static void test_abstraction_overlay(void)
     scene s;
     scene_make(&s, 0.9);
     sp_camera cam = sp_camera_frame(SP_CAMERA_PERSPECTIVE, s.lo, s.hi, sp_v3(0, 0, -1), sp_v3(0, 1, 0), W, H);
-    sp_error err = {0};
-    sp_render_target* t;
-    sp_render_target_create(W, H, 0, &t, &err);
-    ENSURE(t != NULL);
+    sp_render_target* t = new_target(W, H);
     sp_render_mesh* m = scene_mesh(&s);
     sp_image img = {0};
     render_scene(&s, m, &cam, t, W, H, true, &img);
@@ -372,9 +371,7 @@ static void test_polyline(void)
     need_gl();
     sp_camera cam = {.kind = SP_CAMERA_ORTHOGRAPHIC, .view = sp_mat4_identity(), .scale = 1, .width = W, .height = H};
     sp_error err = {0};
-    sp_render_target* t;
-    sp_render_target_create(W, H, 0, &t, &err);
-    ENSURE(t != NULL);
+    sp_render_target* t = new_target(W, H);
     const sp_vec2 pts[4] = {{40.5, 40.5}, {200.5, 60.5}, {120.5, 200.5}, {280.5, 210.5}};
     sp_render_target_bind(t);
     sp_renderer_begin(g_r, &cam, W, H);
@@ -457,9 +454,7 @@ static void test_ink_on_surface(void)
             q[0] = -0.9 + 1.8 * i / 40, q[1] = k ? -0.3 : 0.3, q[2] = 0;
             up[3 * i] = down[3 * i] = 0, up[3 * i + 1] = down[3 * i + 1] = 0, up[3 * i + 2] = 1, down[3 * i + 2] = -1;
         }
-    sp_render_target* t;
-    sp_render_target_create(W, H, 0, &t, &err);
-    ENSURE(t != NULL);
+    sp_render_target* t = new_target(W, H);
     sp_render_target_bind(t);
     sp_renderer_begin(g_r, &cam, W, H);
     sp_renderer_clear(g_r, k_bg, NULL);
