@@ -45,6 +45,13 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             return 2;
         }
         const sp_opt* o = &opts[k];
+        // A value given twice is a mistake, not an override: `--out a.glb ...
+        // --out b.glb` wrote only b.glb. A flag twice means the same, and a
+        // list's values gather.
+        if (k < 64 && seen[k] && o->kind != SP_OPT_FLAG && o->kind != SP_OPT_LIST) {
+            fprintf(stderr, "%s: %s given twice (once is enough; see --help)\n", cmd, o->name);
+            return 2;
+        }
         if (k < 64) seen[k] = true;
         if (o->kind == SP_OPT_FLAG) {
             *(bool*)o->out = true;

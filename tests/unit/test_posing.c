@@ -473,6 +473,14 @@ static void test_cli_missing_value(void)
     ENSURE(sp_cli_parse(4, a2, "t", "", opts, 4) == 2 && out == NULL);
     char* a3[] = {"t", "--n", "-1", "--out", "-"};
     ENSURE(sp_cli_parse(5, a3, "t", "", opts, 4) == -1 && n == -1 && out && !strcmp(out, "-"));
+    // A value given twice is bad usage (it silently took the last); a flag twice means the same.
+    char* a4[] = {"t", "--out", "a.png", "--flag", "--out", "b.png"};
+    ENSURE(sp_cli_parse(6, a4, "t", "", opts, 4) == 2);
+    char* a5[] = {"t", "--n", "1", "--n", "1"};
+    ENSURE(sp_cli_parse(5, a5, "t", "", opts, 4) == 2);
+    flag = false;
+    char* a6[] = {"t", "--flag", "--flag"};
+    ENSURE(sp_cli_parse(3, a6, "t", "", opts, 4) == -1 && flag);
 }
 
 // The solve's limits on the command line: out of range is bad usage (it
