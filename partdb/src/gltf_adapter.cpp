@@ -1233,12 +1233,6 @@ void import(tinygltf::Model& model, const char* what, sp_character* ch)
     im.run();
 }
 
-bool ends_with_ci(const char* s, const char* suffix)
-{
-    size_t a = strlen(s), b = strlen(suffix);
-    return a >= b && strcasecmp(s + a - b, suffix) == 0;
-}
-
 // The exception firewall of the readers (STYLE.md): nothing thrown leaves for C,
 // and a character half read is freed. A Failure's text names the file already.
 template <class Body> sp_result read_firewall(const char* what, sp_character* out, sp_error* err, Body body)
@@ -1938,7 +1932,7 @@ static sp_result write_file(const char* path, const std::string& bytes, sp_error
 extern "C" sp_result sp_gltf_save(const sp_character* ch, const double* params, const char* path, sp_error* err)
 {
     return write_firewall(path, err, [&] {
-        std::string bytes = serialize(ch, params, ends_with_ci(path, ".glb"));
+        std::string bytes = serialize(ch, params, sp_path_ext_is(path, "glb"));
         return write_file(path, bytes, err);
     });
 }
@@ -1964,7 +1958,7 @@ extern "C" sp_result sp_gltf_save_scene(const sp_gltf_scene_desc* desc, const ch
         tinygltf::Model m = build_scene(desc);
         tinygltf::TinyGLTF writer;
         std::ostringstream os;
-        bool binary = ends_with_ci(path, ".glb");
+        bool binary = sp_path_ext_is(path, "glb");
         if (!writer.WriteGltfSceneToStream(&m, os, !binary, binary))
             fail(SP_ERR_INTERNAL, "tinygltf could not serialise the scene");
         std::string bytes = os.str();
