@@ -350,6 +350,29 @@ static int open_immutable(const char* path, sqlite3** h)
     return rc;
 }
 
+// True when this user could write the database, its folder and any -wal or
+// -shm beside it. A reader then opens the file read-write (SQLite's
+// query_only keeps it from changing anything): SQLite removes the -wal and
+// -shm only when the last connection to close could write, so a read-only
+// reader would leave both behind in the user's folder.
+static bool reader_may_write(const char* path)
+{
+    if (faccessat(AT_FDCWD, path, W_OK, AT_EACCESS) != 0) return false;
+    size_t n = strlen(path) + 5;
+    char* buf = malloc(n);
+    if (!buf) return false;
+    snprintf(buf, n, "%s", path);
+    char* slash = strrchr(buf, '/');
+    const char* dir = slash ? (slash == buf ? "/" : (*slash = 0, buf)) : ".";
+    bool ok = faccessat(AT_FDCWD, dir, W_OK | X_OK, AT_EACCESS) == 0;
+    for (int k = 0; ok && k < 2; ++k) {
+        snprintf(buf, n, "%s-%s", path, k ? "shm" : "wal");
+        ok = faccessat(AT_FDCWD, buf, F_OK, AT_EACCESS) != 0 || faccessat(AT_FDCWD, buf, W_OK, AT_EACCESS) == 0;
+    }
+    free(buf);
+    return ok;
+}
+
 sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err)
 {
     return sp_db_open_wait(path, flags, -1, out, err);
@@ -377,7 +400,9 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     }
     db->readonly = ro;
     db->busy_ms = busy_ms >= 0 ? busy_ms : SP_DB_BUSY_MS_DEFAULT;
-    int oflags = ro ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | ((flags & SP_DB_CREATE) ? SQLITE_OPEN_CREATE : 0);
+    bool ro_file = ro && !reader_may_write(path);
+    int oflags =
+        ro_file ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | ((flags & SP_DB_CREATE) && !ro ? SQLITE_OPEN_CREATE : 0);
     int rc = sqlite3_open_v2(path, &db->h, oflags | SQLITE_OPEN_FULLMUTEX, NULL);
     sp_result r = SP_OK;
     if (rc != SQLITE_OK) {
@@ -436,6 +461,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
         // FULL: a committed change survives a power cut too, not only a crash.
         if ((r = db_exec(db, "PRAGMA synchronous = FULL", err)) != SP_OK) goto fail;
     }
+    if (ro && !ro_file && (r = db_exec(db, "PRAGMA query_only = ON", err)) != SP_OK) goto fail;
     if ((r = db_exec(db, "PRAGMA foreign_keys = ON", err)) != SP_OK) goto fail;
     if (v < SP_DB_SCHEMA_VERSION) {
         if (ro && exists && v > 0) {

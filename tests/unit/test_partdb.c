@@ -680,6 +680,53 @@ static void test_read_only_folder(void)
     ENSURE(rmdir(dir) == 0);
 }
 
+static bool beside(const char* db, const char* suffix)
+{
+    char side[1100];
+    snprintf(side, sizeof side, "%s-%s", db, suffix);
+    return access(side, F_OK) == 0;
+}
+
+// Readers leave no -wal or -shm beside a database they could write (SQLite
+// removes them only when the last connection to close may write): the demo's
+// and the kiosk's folder keeps the one file. A reader that closes while a
+// writer is open leaves the writer's WAL alone, and a reader still changes
+// nothing.
+static void test_readers_leave_one_file(void)
+{
+    const char* p = base_db("one_file.db");
+    for (int pass = 0; pass < 2; ++pass) {
+        sp_db* r1 = open_ok(p, SP_DB_READONLY);
+        sp_db* r2 = open_ok(p, SP_DB_READONLY);
+        char** cats = NULL;
+        int n = 0;
+        sp_error e = {0};
+        ENSURE(sp_db_categories(r2, &cats, &n, &e) == SP_OK && n == 2);
+        sp_db_free_strings(cats, n);
+        ENSURE(beside(p, "wal") && beside(p, "shm")); // open readers share them
+        sp_db_close(r1);
+        ENSURE(beside(p, "wal"));
+        sp_db_close(r2);
+        ENSURE(!beside(p, "wal") && !beside(p, "shm"));
+    }
+    sp_db* w = open_ok(p, 0);
+    sp_error e = {0};
+    ENSURE(sp_db_log(w, "writer", "note", "one_file", NULL, &e) == SP_OK);
+    sp_db* r = open_ok(p, SP_DB_READONLY);
+    sp_db_close(r);
+    ENSURE(beside(p, "wal")); // the writer's, still open
+    sp_dataset ds = one_sketch("tail");
+    r = open_ok(p, SP_DB_READONLY);
+    ENSURE(sp_db_add_sketches(r, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &e) == SP_ERR_IO && strstr(e.text, "read-only"));
+    sp_db_close(r);
+    sp_db_close(w);
+    sp_dataset_free(&ds);
+    ENSURE(!beside(p, "wal") && !beside(p, "shm"));
+    ENSURE(scalar(p, "SELECT count(*) FROM log WHERE by = 'writer'") == 1);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 0);
+    sp_fixture_remove_db(p);
+}
+
 // A WAL database whose -wal and -shm a writer that crashed left behind, owned
 // by another user (root) and not writable by this one, in a folder and beside
 // a database file everyone may write: readers still read it (the WAL's rows
@@ -2056,6 +2103,7 @@ int main(int argc, char** argv)
                                    {"unreachable", test_unreachable},
                                    {"read_only_folder", test_read_only_folder},
                                    {"foreign_wal", test_foreign_wal},
+                                   {"readers_leave_one_file", test_readers_leave_one_file},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
