@@ -4,7 +4,41 @@
 
 #include <limits.h>
 #include <stb/stb_image.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <string.h>
+#include <zlib.h>
+
+static uint32_t be32(const unsigned char* p)
+{
+    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
+
+// True when every whole chunk's CRC matches (zlib's crc32 over type and data).
+// stb_image checks no CRC at all, so a damaged chunk would decode to other
+// pixels without a word; libpng refused it. A chunk cut short is left to the
+// decoder, which says "truncated".
+static bool chunks_intact(const unsigned char* bytes, size_t len, const char** why)
+{
+    static _Thread_local char said[96]; // *why outlives the call
+    size_t at = 8;                      // after the signature
+    while (at + 12 <= len) {
+        uint32_t n = be32(bytes + at);
+        if (n > len - at - 12) return true;
+        uint32_t want = be32(bytes + at + 8 + n);
+        if ((uint32_t)crc32(0L, bytes + at + 4, n + 4) != want) {
+            char type[5] = {0};
+            for (int i = 0; i < 4; ++i)
+                type[i] = bytes[at + 4 + i] >= 0x20 && bytes[at + 4 + i] < 0x7f ? (char)bytes[at + 4 + i] : '?';
+            snprintf(said, sizeof said, "chunk '%s' at byte %zu fails its CRC", type, at);
+            *why = said;
+            return false;
+        }
+        if (!memcmp(bytes + at + 4, "IEND", 4)) return true;
+        at += 12 + (size_t)n;
+    }
+    return true;
+}
 
 bool sp_png_decode(const unsigned char* bytes, size_t len, sp_png_image* out, const char** why)
 {
@@ -13,6 +47,7 @@ bool sp_png_decode(const unsigned char* bytes, size_t len, sp_png_image* out, co
         *why = "file too large";
         return false;
     }
+    if (!chunks_intact(bytes, len, why)) return false;
     // Colour type 0 (grey) at byte 25, in IHDR: asking for one channel drops
     // the alpha stb would make of a tRNS key, as OpenCV's decoder did.
     int want = len > 25 && bytes[25] == 0 ? 1 : 0;

@@ -12,8 +12,8 @@ typedef struct sp_png_image {
     bool wide;     // 16 bits a sample (a 16-bit PNG), else 8
 } sp_png_image;
 
-/// Decodes the PNG in bytes; false with *why (static text) when it does not
-/// decode. Quiet: libpng, under OpenCV's decoder, printed its own
+/// Decodes the PNG in bytes; false with *why (static, per-thread text) when it
+/// does not decode or a chunk fails its CRC. Quiet: libpng, under OpenCV's decoder, printed its own
 /// "libpng error: ..." line to stderr for a broken file, stb prints nothing.
 /// The channels are those OpenCV's decoder gave, so the grey conversion after
 /// it is unchanged: a grey PNG's tRNS colour key is ignored, any other tRNS

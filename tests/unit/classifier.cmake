@@ -1,1 +1,1 @@
-sp_unit_test(classifier LIBS sp::classifier TIMEOUT 120)
+sp_unit_test(classifier LIBS sp::classifier ZLIB::ZLIB TIMEOUT 120)

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include "sp/classifier.h"
 #include "sp/sketch_io.h"
@@ -35,6 +36,13 @@ static void write_text(const char* path, const char* text)
     ENSURE(f != NULL);
     fputs(text, f);
     fclose(f);
+}
+
+static void write_bytes(const char* path, const void* bytes, size_t n)
+{
+    FILE* f = fopen(path, "wb");
+    ENSURE(f != NULL && fwrite(bytes, 1, n, f) == n);
+    ENSURE(fclose(f) == 0);
 }
 
 static uint64_t g_rng;
@@ -342,6 +350,37 @@ static void test_png(void)
     fclose(fp);
     ENSURE(sp_raster_read_png(huge, &r, &err) == SP_ERR_UNSUPPORTED);
     ENSURE(contains(err.text, "20000x20000") && contains(err.text, "huge.png"));
+
+    // A damaged chunk is refused, naming it: stb checks no CRC, and a flipped
+    // bit in the pixel data would decode to another drawing without a word.
+    // An ancillary chunk is checked too (a tRNS changes the pixels); a whole
+    // one (a tEXt note) reads.
+    fp = fopen(ok, "rb");
+    n = fread(buf, 1, sizeof buf, fp);
+    fclose(fp);
+    ENSURE(n > 60 && !memcmp(buf + 37, "IDAT", 4));
+    static const unsigned char note[] = {0, 0, 0, 5, 't', 'E', 'X', 't', 'a', 0, 'b', 'c', 'd'};
+    unsigned char noted[4096 + 32];
+    memcpy(noted, buf, 33); // the signature and IHDR
+    memcpy(noted + 33, note, sizeof note);
+    uLong c = crc32(0L, note + 4, sizeof note - 4);
+    unsigned char crc[4] = {(unsigned char)(c >> 24), (unsigned char)(c >> 16), (unsigned char)(c >> 8), (unsigned char)c};
+    memcpy(noted + 33 + sizeof note, crc, 4);
+    memcpy(noted + 33 + sizeof note + 4, buf + 33, n - 33);
+    size_t nn = n + sizeof note + 4;
+    const char* dam = sp_test_tmp_path("damaged.png");
+    write_bytes(dam, noted, nn);
+    ENSURE(sp_raster_read_png(dam, &r, &err) == SP_OK && r.w == 120);
+    sp_raster_free(&r);
+    noted[33 + sizeof note + 3] ^= 1;
+    write_bytes(dam, noted, nn);
+    ENSURE(sp_raster_read_png(dam, &r, &err) == SP_ERR_PARSE && contains(err.text, "damaged.png") &&
+           contains(err.text, "chunk 'tEXt' at byte 33 fails its CRC"));
+    buf[45] ^= 0x10;
+    write_bytes(dam, buf, n);
+    ENSURE(sp_raster_read_png(dam, &r, &err) == SP_ERR_PARSE && contains(err.text, "chunk 'IDAT' at byte 33 fails its CRC") &&
+           !strchr(err.text, '\n'));
+    buf[45] ^= 0x10;
 
     const char* fake = sp_test_tmp_path("fake.png");
     write_text(fake, "this is not a png at all");
