@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 static void print_help(const char* cmd, const char* summary, const sp_opt* opts, int nopts)
 {
@@ -142,14 +143,35 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
     return false;
 }
 
+bool sp_cli_out_is_stream(const char* path)
+{
+    // /dev/stdout redirected to a file is a regular file by stat, hence the prefix.
+    struct stat st;
+    return !strncmp(path, "/dev/", 5) || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)));
+}
+
+bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)
+{
+    if (!path || sp_cli_out_is_stream(path)) return true;
+    const char* slash = strrchr(path, '/');
+    char* dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
+    if (!dir) return true; // out of memory: the writer will say so
+    struct stat st;
+    const char* why = stat(dir, &st) != 0             ? strerror(errno)
+                      : !S_ISDIR(st.st_mode)          ? "not a folder"
+                      : access(dir, W_OK | X_OK) != 0 ? "this user may not write there"
+                                                      : NULL;
+    if (why) fprintf(stderr, "%s: %s %s: cannot write into folder '%s' (%s)\n", cmd, name, path, dir, why);
+    free(dir);
+    return why == NULL;
+}
+
 bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind)
 {
     if (!path) return true;
     // A pipe or a device has no file name to say a format, and the writers
-    // write into one (`render --out /dev/stdout | ...`); /dev/stdout redirected
-    // to a file is a regular file by stat, hence the prefix.
-    struct stat st;
-    if (!strncmp(path, "/dev/", 5) || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)))) return true;
+    // write into one (`render --out /dev/stdout | ...`).
+    if (sp_cli_out_is_stream(path)) return true;
     if (kind == SP_CLI_OUT_GLTF) {
         if (sp_path_ext_is(path, "glb") || sp_path_ext_is(path, "gltf")) return true;
         fprintf(stderr, "%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'\n", cmd, name, path);

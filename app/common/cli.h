@@ -63,6 +63,16 @@ typedef enum sp_cli_out_kind {
 /// is written into as it is (glTF as JSON unless it ends in .glb).
 bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cli_out_kind kind);
 
+/// True when an output path is written as a stream: under /dev/ or naming a
+/// FIFO or a device (no file name, no folder to write beside it).
+bool sp_cli_out_is_stream(const char* path);
+
+/// For outputs written at the end of long work (a kiosk session): NULL and
+/// streams pass; otherwise the file's folder must exist and be writable by
+/// this user, else "<cmd>: <name> <path>: cannot write into folder 'dir'
+/// (reason)" and false (exit 1), said before the work, not after it.
+bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path);
+
 /// The longest solve time cap a command takes (--max-ms), ms: one hour.
 #define SP_CLI_MAX_MS 3600000.0
 /// Its range as --help words it (beside SP_CLI_MAX_MS, so that they agree).

@@ -422,6 +422,20 @@ int main(int argc, char** argv)
         }
         if (!size && session.canvas_w > 0 && !session.unit_coords) win_w = session.canvas_w, win_h = session.canvas_h;
     }
+    // A mark's screenshot goes beside --screenshot (mark_path): a pipe or a
+    // device has no beside.
+    if (shot && session.mark_count > 0 && sp_cli_out_is_stream(shot)) {
+        fprintf(stderr, "%s: --screenshot %s: the script has marks, each written as <name>-<mark>.png beside it; name a file\n",
+                k_cmd, shot);
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_USAGE;
+    }
+    // Written when the session ends: a folder that cannot take them is said now.
+    if (!sp_cli_check_out_folder(k_cmd, "--screenshot", shot) || !sp_cli_check_out_folder(k_cmd, "--export", out_glb) ||
+        !sp_cli_check_out_folder(k_cmd, "--record", record)) {
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
+    }
     if (!has_parts(db ? db : sp_db_default_path())) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
