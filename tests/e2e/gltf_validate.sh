@@ -3,19 +3,15 @@
 # hand-made fixtures (and the Khronos samples when ../shared/data exists),
 # posed, and runs the Khronos glTF validator on each: 0 errors required.
 # Exits 77 (CTest SKIP_RETURN_CODE) when node or tests/tools/node_modules is
-# missing: run `npm ci` in tests/tools.
+# missing (run `npm ci` in tests/tools), 1 then under SP_TEST_REQUIRE_TOOLS=1.
 set -u
 SP="$1"
 SRC="$2"
 WORK="$3/gltf_validate.$$"
 SHARED="${4:-}"
-TOOLS="$SRC/tests/tools"
-if ! command -v node >/dev/null 2>&1; then
-    echo "SKIP: node is not installed"
-    exit 77
-fi
-if [ ! -d "$TOOLS/node_modules/gltf-validator" ]; then
-    echo "SKIP: $TOOLS/node_modules is missing (run: cd tests/tools && npm ci)"
+. "$SRC/tests/e2e/checks.sh" # node_tools
+if ! node_tools gltf-validator; then
+    echo "SKIP: node or $TOOLS/node_modules/gltf-validator is missing (run: cd tests/tools && npm ci)"
     exit 77
 fi
 mkdir -p "$WORK"

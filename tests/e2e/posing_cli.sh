@@ -12,7 +12,7 @@ SHARED="${4:-}"
 RIG="$SRC/tests/e2e/data/two_bone_extras.gltf"
 mkdir -p "$WORK"
 fails=0
-. "$SRC/tests/e2e/checks.sh" # fail, expect, one_line_naming
+. "$SRC/tests/e2e/checks.sh" # fail, expect, one_line_naming, node_tools
 strokes() { # strokes FILE POINTS-JSON...: a stroke file with one stroke per argument
     f="$1"
     shift
@@ -165,13 +165,13 @@ expect 0 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" "$WORK/k2.json" --t
 expect 0 "$SP" inspect --rig "$WORK/anim.glb"
 grep -q '"sketchpose"' "$WORK/out" || fail "animate: no 'sketchpose' animation in the export"
 expect 2 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" "$WORK/k2.json" --times 1,0.5 --out "$WORK/x.glb"
-if command -v node >/dev/null 2>&1 && [ -d "$SRC/tests/tools/node_modules/gltf-validator" ]; then
-    node "$SRC/tests/tools/validate.js" "$WORK/anim.glb" >"$WORK/val.json" || fail "animate export does not validate: $(cat "$WORK/val.json")"
+if node_tools gltf-validator; then
+    node "$TOOLS/validate.js" "$WORK/anim.glb" >"$WORK/val.json" || fail "animate export does not validate: $(cat "$WORK/val.json")"
     if [ -n "$SHARED" ] && [ -f "$SHARED/gltf/CesiumMan/CesiumMan.glb" ]; then
         C="$SHARED/gltf/CesiumMan/CesiumMan.glb"
         for k in 1 2 3 4; do "$SP" synth --rig "$C" --seed "$k" --amplitude 0.4 --out "$WORK/c$k.json" >/dev/null 2>&1; done
         expect 0 "$SP" animate --rig "$C" --strokes "$WORK/c1.json" "$WORK/c2.json" "$WORK/c3.json" "$WORK/c4.json" --out "$WORK/canim.glb"
-        node "$SRC/tests/tools/validate.js" "$WORK/canim.glb" >"$WORK/val.json" || fail "CesiumMan animate export does not validate: $(cat "$WORK/val.json")"
+        node "$TOOLS/validate.js" "$WORK/canim.glb" >"$WORK/val.json" || fail "CesiumMan animate export does not validate: $(cat "$WORK/val.json")"
     fi
 else
     echo "note: node or tests/tools/node_modules missing, the validator step was skipped"

@@ -244,14 +244,32 @@ int sp_fixture_run(const char* cmd, char* out, size_t cap)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+const char* sp_fixture_node_tools(const char* pkg)
+{
+    static char dir[1024];
+    const char* env = getenv("SP_TEST_TOOLS_DIR");
+    snprintf(dir, sizeof dir, "%s", env && *env ? env : SP_SOURCE_DIR "/tests/tools");
+    char probe[1200];
+    snprintf(probe, sizeof probe, "%s/node_modules/%s", dir, pkg);
+    struct stat st;
+    bool node = system("command -v node >/dev/null 2>&1") == 0;
+    if (node && stat(probe, &st) == 0) return dir;
+    const char* req = getenv("SP_TEST_REQUIRE_TOOLS");
+    if (req && !strcmp(req, "1")) {
+        fprintf(stderr, "  %s is not installed (%s), and SP_TEST_REQUIRE_TOOLS=1: failing, not skipping\n", node ? pkg : "node",
+                node ? probe : "not on PATH");
+        ENSURE(!"a required test tool is missing");
+    }
+    return NULL;
+}
+
 int sp_fixture_gltf_validate(const char* file)
 {
-    char tool[1100], cmd[3000];
-    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
+    const char* tools = sp_fixture_node_tools("gltf-validator");
+    if (!tools) return -1;
+    char cmd[3000];
     const char* rep = sp_test_tmp_path("gltf_validator.json");
-    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/validate.js' '%s' > '%s'", SP_SOURCE_DIR, file, rep);
+    snprintf(cmd, sizeof cmd, "node '%s/validate.js' '%s' > '%s'", tools, file, rep);
     int rc = system(cmd);
     if (rc != 0) {
         snprintf(cmd, sizeof cmd, "cat '%s' >&2", rep);

@@ -76,9 +76,16 @@ char* sp_fixture_file_text(const char* path, size_t* n);
 /// Fails the running test when the command cannot be started.
 int sp_fixture_run(const char* cmd, char* out, size_t cap);
 
+/// The npm test tools' folder (tests/tools, or $SP_TEST_TOOLS_DIR) when node
+/// and its package pkg ("gltf-validator", "@gltf-transform/core") are
+/// installed; NULL when not. With SP_TEST_REQUIRE_TOOLS=1 (tools/sp test sets
+/// it, having installed them) a missing tool fails the running test instead:
+/// a check that skips quietly there would hide a broken install.
+const char* sp_fixture_node_tools(const char* pkg);
+
 /// The Khronos glTF validator (tests/tools/validate.js) on a file: 1 when
 /// it passes, 0 when it fails (its report on stderr), -1 when node or the
-/// validator (tests/tools/node_modules) is not installed.
+/// validator is not installed (see sp_fixture_node_tools).
 int sp_fixture_gltf_validate(const char* file);
 
 /// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).

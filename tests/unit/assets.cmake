@@ -14,6 +14,16 @@ foreach(check regenerate_identical contents line characters random_poses validat
   add_test(NAME assets_${check} COMMAND test_assets ${check})
   set_tests_properties(assets_${check} PROPERTIES TIMEOUT 300 ENVIRONMENT "SP_BUILD_DIR=${PROJECT_BINARY_DIR}")
 endforeach()
+# sp_fixture_node_tools: a missing validator skips, and fails the test under
+# SP_TEST_REQUIRE_TOOLS=1 (what tools/sp test sets).
+foreach(req 0 1)
+  add_test(NAME assets_validator_missing_${req} COMMAND test_assets validator)
+  set_tests_properties(assets_validator_missing_${req} PROPERTIES ENVIRONMENT
+    "SP_BUILD_DIR=${PROJECT_BINARY_DIR};SP_TEST_TOOLS_DIR=${PROJECT_BINARY_DIR}/no_tools;SP_TEST_REQUIRE_TOOLS=${req}")
+endforeach()
+set_tests_properties(assets_validator_missing_0 PROPERTIES PASS_REGULAR_EXPRESSION "SKIP validator")
+set_tests_properties(assets_validator_missing_1 PROPERTIES PASS_REGULAR_EXPRESSION
+  "no_tools/node_modules/gltf-validator\\), and SP_TEST_REQUIRE_TOOLS=1: failing, not skipping")
 
 add_executable(test_assets_recovery unit/test_assets_recovery.c)
 target_link_libraries(test_assets_recovery PRIVATE sp_test_fixtures sp::partdb)

@@ -24,6 +24,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "fixtures.h"
 #include "sp/clock.h"
 #include "sp/gltf.h"
 #include "sp/synth.h"
@@ -604,13 +605,10 @@ static void test_validator(void)
     // Copies: sp_test_*_path return a small ring of buffers that the loop's
     // calls reuse (the report path once became a committed asset's that way).
     char tools[1024], report[1024];
-    snprintf(tools, sizeof tools, "%s", sp_test_src_path("tests/tools"));
+    const char* t = sp_fixture_node_tools("gltf-validator");
+    if (!t) SKIP("node or tests/tools/node_modules is missing (run: cd tests/tools && npm ci)");
+    snprintf(tools, sizeof tools, "%s", t);
     snprintf(report, sizeof report, "%s", sp_test_tmp_path("validator.json"));
-    char probe[1200];
-    snprintf(probe, sizeof probe, "%s/node_modules/gltf-validator", tools);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0) SKIP("node is not installed");
-    if (stat(probe, &st) != 0) SKIP("tests/tools/node_modules is missing (run: cd tests/tools && npm ci)");
     int failed = 0;
     for (int i = 0; i < ASSET_COUNT; ++i) {
         char rel[256], cmd[4096];
@@ -660,13 +658,11 @@ static cJSON* run_json(const char* cmd, const char* out, int* rc)
 // itself is not used: its npm package needs Node 20, Debian 12 has 18.
 static void test_gltf_client(void)
 {
-    char tools[1024], out[1024], probe[1200];
-    snprintf(tools, sizeof tools, "%s", sp_test_src_path("tests/tools"));
+    char tools[1024], out[1024];
+    const char* t = sp_fixture_node_tools("@gltf-transform/core");
+    if (!t) SKIP("node or tests/tools/node_modules/@gltf-transform is missing (run: cd tests/tools && npm ci)");
+    snprintf(tools, sizeof tools, "%s", t);
     snprintf(out, sizeof out, "%s", sp_test_tmp_path("client.json"));
-    snprintf(probe, sizeof probe, "%s/node_modules/@gltf-transform/core", tools);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0) SKIP("node is not installed");
-    if (stat(probe, &st) != 0) SKIP("tests/tools/node_modules has no @gltf-transform (run: cd tests/tools && npm ci)");
     int failed = 0;
     for (int i = 0; i < ASSET_COUNT; ++i) {
         char rel[256], path[1024], cmd[4096];

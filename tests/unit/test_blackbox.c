@@ -692,10 +692,9 @@ static void test_cli(void)
     ENSURE(stat(glb, &st) == 0 && st.st_size > 100000);
     // The posed result is a valid glTF (Khronos validator, when node and the
     // test tools are installed).
-    char val[2048];
-    snprintf(val, sizeof val, "%s/tests/tools/node_modules/gltf-validator", SP_SOURCE_DIR);
-    if (stat(val, &st) == 0 && system("command -v node > /dev/null 2>&1") == 0) {
-        snprintf(cmd, sizeof cmd, "node %s/tests/tools/validate.js %s > %s", SP_SOURCE_DIR, glb, vr);
+    const char* tools = sp_fixture_node_tools("gltf-validator");
+    if (tools) {
+        snprintf(cmd, sizeof cmd, "node '%s/validate.js' '%s' > '%s'", tools, glb, vr);
         ENSURE(system(cmd) == 0);
         char* v = slurp(vr);
         ENSURE(v && strstr(v, "\"numErrors\": 0"));

@@ -20,13 +20,14 @@
 
 #include <cjson/cJSON.h>
 
+#include "fixtures.h"
 #include "foreign_gltf.h"
-#include "sp/headless.h"
-#include "sp/image.h"
-#include "sp/render.h"
 #include "sp/derive.h"
 #include "sp/handdraw.h"
+#include "sp/headless.h"
+#include "sp/image.h"
 #include "sp/partdb.h"
+#include "sp/render.h"
 #include "sp/synth.h"
 #include "test.h"
 
@@ -803,9 +804,9 @@ static void test_validator(void)
 {
     const char* bin = sketchpose_bin();
     char tools[1024], cmd[8192];
-    snprintf(tools, sizeof tools, "%s", sp_test_src_path("tests/tools/node_modules/gltf-validator"));
-    if (!bin || access(tools, R_OK) != 0 || run("command -v node >/dev/null", NULL) != 0)
-        SKIP("node or tests/tools/node_modules is missing (cd tests/tools && npm ci)");
+    const char* t = bin ? sp_fixture_node_tools("gltf-validator") : NULL;
+    if (!t) SKIP("sketchpose, node or tests/tools/node_modules is missing (cd tests/tools && npm ci)");
+    snprintf(tools, sizeof tools, "%s", t);
     for (int i = -1; i < MODELS; ++i) {
         const char* path =
             i < 0 ? lizard("val_lizard.gltf", (sp_foreign_desc){.z_up = true, .missing_texture = true}) : model_path(i);
@@ -814,7 +815,7 @@ static void test_validator(void)
         snprintf(out, sizeof out, "%s", sp_test_tmp_path("val_sp.glb"));
         snprintf(cmd, sizeof cmd, "'%s' derive --rig '%s' --out '%s' --category x 2>/dev/null", bin, path, out);
         ENSURE(run(cmd, NULL) == 0);
-        snprintf(cmd, sizeof cmd, "node '%s' '%s'", sp_test_src_path("tests/tools/validate.js"), out);
+        snprintf(cmd, sizeof cmd, "node '%s/validate.js' '%s'", tools, out);
         char* report = NULL;
         int rc = run(cmd, &report);
         cJSON* j = report ? cJSON_Parse(report) : NULL;

@@ -697,12 +697,10 @@ static void test_animation(void)
 // animation intact, 0 not, -1 when it is not installed.
 static int gltf_transform_loads(const char* file)
 {
-    char tool[1100], cmd[3000];
-    snprintf(tool, sizeof tool, "%s/tests/tools/node_modules/@gltf-transform/core", SP_SOURCE_DIR);
-    struct stat st;
-    if (system("command -v node >/dev/null 2>&1") != 0 || stat(tool, &st) != 0) return -1;
-    snprintf(cmd, sizeof cmd, "node '%s/tests/tools/inspect.js' '%s' > '%s'", SP_SOURCE_DIR, file,
-             sp_test_tmp_path("dragon_inspect.json"));
+    const char* tools = sp_fixture_node_tools("@gltf-transform/core");
+    if (!tools) return -1;
+    char cmd[3000];
+    snprintf(cmd, sizeof cmd, "node '%s/inspect.js' '%s' > '%s'", tools, file, sp_test_tmp_path("dragon_inspect.json"));
     return system(cmd) == 0;
 }
 
