@@ -22,6 +22,14 @@
 #include "sp/math.h"
 #include "sp/sketch_io.h"
 
+// The memory describing one drawing takes (about 1.3 MB; feat.h). A classifier
+// keeps what its callers' threads used, for their next drawings.
+typedef struct clf_work {
+    sp_feat_scratch scratch;
+    sp_features f;
+} clf_work;
+enum { WORK_SLOTS = 8 };
+
 struct sp_clf {
     sp_clf_desc desc; // resolved, progress NULL
     int category_count;
@@ -51,7 +59,32 @@ struct sp_clf {
     float* pics;         // pic_count by SP_PICTURE_DIM
     int* pic_labels;     // pic_count
     float pic_bandwidth; // voting kernel width (picture distance)
+    // Idle work memory (work_take, work_give): a cache, so a const sp_clf
+    // may fill it; every sp_clf is allocated (calloc: all NULL), never const.
+    _Atomic(clf_work*) work[WORK_SLOTS];
 };
+
+// An idle clf_work of c's, or a new one (NULL: out of memory).
+static clf_work* work_take(const sp_clf* c)
+{
+    sp_clf* m = (sp_clf*)c;
+    for (int i = 0; i < WORK_SLOTS; ++i) {
+        clf_work* w = atomic_exchange(&m->work[i], NULL);
+        if (w) return w;
+    }
+    return malloc(sizeof(clf_work));
+}
+
+// Keeps w for the next drawing (freed when every slot is taken).
+static void work_give(const sp_clf* c, clf_work* w)
+{
+    sp_clf* m = (sp_clf*)c;
+    for (int i = 0; w && i < WORK_SLOTS; ++i) {
+        clf_work* none = NULL;
+        if (atomic_compare_exchange_strong(&m->work[i], &none, w)) return;
+    }
+    free(w);
+}
 
 sp_clf_desc sp_clf_desc_defaults(const sp_clf_desc* d)
 {
@@ -110,6 +143,8 @@ void sp_clf_destroy(sp_clf* clf)
     free(clf->shape_labels);
     free(clf->pics);
     free(clf->pic_labels);
+    for (int i = 0; i < WORK_SLOTS; ++i)
+        free(atomic_load(&clf->work[i]));
     free(clf);
 }
 
@@ -546,11 +581,12 @@ static sp_result classify_hist(const sp_clf* c, float* hist, const double* shape
 sp_result sp_clf_classify(const sp_clf* c, const sp_sketch* sketch, const sp_raster* raster, sp_clf_answer* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    sp_features* f = malloc(sizeof *f);
+    clf_work* w = work_take(c);
+    sp_features* f = w ? &w->f : NULL;
     float* raw = malloc(sizeof(float) * (size_t)c->hist_dim * 2);
     double* shape = malloc(sizeof(double) * (size_t)c->category_count * 2);
-    sp_result rc = (!f || !raw || !shape) ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : SP_OK;
-    if (rc == SP_OK) rc = sp_feat_extract(sketch, raster, f, err);
+    sp_result rc = (!w || !raw || !shape) ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : SP_OK;
+    if (rc == SP_OK) rc = sp_feat_extract(sketch, raster, &w->scratch, f, err);
     if (rc == SP_OK) rc = raw_hist(c, f, raw, err);
     if (rc == SP_OK) {
         finish_hist(c, raw, raw + c->hist_dim);
@@ -559,7 +595,7 @@ sp_result sp_clf_classify(const sp_clf* c, const sp_sketch* sketch, const sp_ras
         bool shaped = strokes && shape_shares(c, sketch, shape), pictured = strokes && picture_shares(c, sketch, pic);
         rc = classify_hist(c, raw + c->hist_dim, shaped ? shape : NULL, pictured ? pic : NULL, out, err);
     }
-    free(f);
+    work_give(c, w);
     free(raw);
     free(shape);
     return rc;
@@ -661,9 +697,10 @@ static int train_job(void* user, int k)
     sp_result rc = job_drawing(t, j, &sk, &r, &owned);
     if (rc != SP_OK) // an augmented copy that could not be made is skipped like a bad drawing
         rc = sp_fail(&t->errs[i], rc, "augmented copy %d: %s", j->variant - 1, sp_result_name(rc));
-    sp_features* f = rc == SP_OK ? malloc(sizeof *f) : NULL;
-    if (rc == SP_OK && !f) rc = sp_fail(&t->errs[i], SP_ERR_NO_MEMORY, "out of memory");
-    if (rc == SP_OK) rc = sp_feat_extract(&sk, &r, f, &t->errs[i]);
+    clf_work* w = rc == SP_OK ? work_take(t->clf) : NULL;
+    sp_features* f = w ? &w->f : NULL;
+    if (rc == SP_OK && !w) rc = sp_fail(&t->errs[i], SP_ERR_NO_MEMORY, "out of memory");
+    if (rc == SP_OK) rc = sp_feat_extract(&sk, &r, &w->scratch, f, &t->errs[i]);
     if (rc == SP_OK && t->pass == 1) {
         // A seeded partial shuffle picks this drawing's share of the vocabulary sample.
         uint64_t rng = t->clf->desc.seed ^ ((uint64_t)(i + 1) * 0xd1b54a32d192ed03ull);
@@ -683,7 +720,7 @@ static int train_job(void* user, int k)
     } else if (rc == SP_OK) {
         rc = raw_hist(t->clf, f, t->raw + (size_t)i * t->clf->hist_dim, &t->errs[i]);
     }
-    free(f);
+    work_give(t->clf, w);
     if (owned) {
         sp_sketch_free(&sk);
         sp_raster_free(&r);

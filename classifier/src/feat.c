@@ -74,30 +74,21 @@ static inline float bilinear(const float* m, int n, float x, float y)
     return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
 }
 
-enum { MAP_DOWN = 2, MAP_N = SP_FEAT_CANVAS / MAP_DOWN };
+enum { MAP_DOWN = SP_FEAT_MAP_DOWN, MAP_N = SP_FEAT_MAP_N };
 
-sp_result sp_feat_describe(const unsigned char* canvas, sp_features* out, sp_error* err)
+sp_result sp_feat_describe(const unsigned char* canvas, sp_feat_scratch* scratch, sp_features* out, sp_error* err)
 {
     const int C = SP_FEAT_CANVAS;
     // Patch side: 12.5% of the frame's area; 4x4 cells inside it.
     const float patch = (float)(SP_FEAT_FRAME * sqrt(0.125));
     const float cell = patch / 4.0f;
-    float* maps = malloc(sizeof(float) * 4 * MAP_N * MAP_N);
-    unsigned* integral = malloc(sizeof(unsigned) * (size_t)(C + 1) * (C + 1));
-    if (!maps || !integral) {
-        free(maps);
-        free(integral);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory describing");
-    }
+    float* maps = scratch->maps;
+    unsigned* integral = scratch->integral;
     // Why Gaussian-smoothed responses sampled at cell centres: this is the
     // paper's soft spatial binning, and costs 4 blurs instead of a loop over
     // every pixel of 784 overlapping patches.
     sp_result rc = sp_cv_orientation_maps(canvas, C, MAP_DOWN, 0.5 * cell / MAP_DOWN, maps, err);
-    if (rc != SP_OK) {
-        free(maps);
-        free(integral);
-        return rc;
-    }
+    if (rc != SP_OK) return rc;
     for (int x = 0; x <= C; ++x)
         integral[x] = 0;
     for (int y = 0; y < C; ++y) {
@@ -144,15 +135,14 @@ sp_result sp_feat_describe(const unsigned char* canvas, sp_features* out, sp_err
             out->pos[2 * out->count + 1] = (py - SP_FEAT_MARGIN) / SP_FEAT_FRAME;
             ++out->count;
         }
-    free(maps);
-    free(integral);
     return SP_OK;
 }
 
-sp_result sp_feat_extract(const sp_sketch* s, const sp_raster* r, sp_features* out, sp_error* err)
+sp_result sp_feat_extract(const sp_sketch* s, const sp_raster* r, sp_feat_scratch* scratch, sp_features* out, sp_error* err)
 {
-    unsigned char* canvas = malloc((size_t)SP_FEAT_CANVAS * SP_FEAT_CANVAS);
-    if (!canvas) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    sp_feat_scratch* own = scratch ? NULL : malloc(sizeof *own);
+    if (!scratch && !(scratch = own)) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    unsigned char* canvas = scratch->canvas;
     sp_result rc;
     if (s && s->stroke_count > 0)
         rc = sp_feat_rasterise(s, canvas, err);
@@ -160,8 +150,8 @@ sp_result sp_feat_extract(const sp_sketch* s, const sp_raster* r, sp_features* o
         rc = sp_feat_rasterise_raster(r, canvas, err);
     else
         rc = sp_fail(err, SP_ERR_INVALID, "empty drawing (no strokes)");
-    if (rc == SP_OK) rc = sp_feat_describe(canvas, out, err);
+    if (rc == SP_OK) rc = sp_feat_describe(canvas, scratch, out, err);
     if (rc == SP_OK && out->count == 0) rc = sp_fail(err, SP_ERR_INVALID, "drawing has no ink to describe");
-    free(canvas);
+    free(own);
     return rc;
 }

@@ -25,6 +25,20 @@
 /// Stroke thickness when rasterising, pixels of the 256 frame.
 #define SP_FEAT_THICKNESS 3
 
+/// The orientation maps are computed at half the canvas's resolution.
+#define SP_FEAT_MAP_DOWN 2
+#define SP_FEAT_MAP_N (SP_FEAT_CANVAS / SP_FEAT_MAP_DOWN)
+
+/// The memory describing one drawing works in (about 1.1 MB). A caller that
+/// describes many drawings keeps one per thread: memory that large, fresh
+/// from the system for each drawing, costs more in page faults than the
+/// description costs in work.
+typedef struct sp_feat_scratch {
+    unsigned char canvas[SP_FEAT_CANVAS * SP_FEAT_CANVAS];
+    float maps[4 * SP_FEAT_MAP_N * SP_FEAT_MAP_N];
+    unsigned integral[(SP_FEAT_CANVAS + 1) * (SP_FEAT_CANVAS + 1)];
+} sp_feat_scratch;
+
 typedef struct sp_features {
     int count;                             ///< descriptors kept (non-empty patches)
     float desc[SP_FEAT_MAX * SP_FEAT_DIM]; ///< count by 64, L2-normalised, non-negative
@@ -40,9 +54,10 @@ sp_result sp_feat_check_drawing(const sp_sketch* s, int* total, sp_vec2* lo, sp_
 sp_result sp_feat_rasterise(const sp_sketch* s, unsigned char* canvas, sp_error* err);
 /// Fits a grey raster (dark ink) into the canvas the same way.
 sp_result sp_feat_rasterise_raster(const sp_raster* r, unsigned char* canvas, sp_error* err);
-/// Descriptors of a rasterised canvas.
-sp_result sp_feat_describe(const unsigned char* canvas, sp_features* out, sp_error* err);
-/// Rasterise (sketch, or raster when sketch has no strokes and raster has pixels) and describe.
-sp_result sp_feat_extract(const sp_sketch* s, const sp_raster* r, sp_features* out, sp_error* err);
+/// Descriptors of a rasterised canvas (which may be scratch->canvas).
+sp_result sp_feat_describe(const unsigned char* canvas, sp_feat_scratch* scratch, sp_features* out, sp_error* err);
+/// Rasterise (sketch, or raster when sketch has no strokes and raster has
+/// pixels) and describe; scratch NULL: one is allocated for this call.
+sp_result sp_feat_extract(const sp_sketch* s, const sp_raster* r, sp_feat_scratch* scratch, sp_features* out, sp_error* err);
 
 #endif

@@ -333,7 +333,7 @@ static void test_png(void)
     ENSURE(r.w == 120 && r.h == 90 && r.pixels[0] == 0 && r.pixels[119] == 255);
     sp_features* f = malloc(sizeof *f);
     ENSURE(f != NULL);
-    ENSURE(sp_feat_extract(NULL, &r, f, &err) == SP_OK);
+    ENSURE(sp_feat_extract(NULL, &r, NULL, f, &err) == SP_OK);
     ENSURE(f->count > 50);
     sp_raster_free(&r);
 
@@ -420,7 +420,7 @@ static void test_png(void)
     const char* blank = sp_test_tmp_path("blank.png");
     ENSURE(stbi_write_png(blank, 64, 64, 1, white, 64) != 0);
     ENSURE(sp_raster_read_png(blank, &r, &err) == SP_OK);
-    ENSURE(sp_feat_extract(NULL, &r, f, &err) == SP_ERR_INVALID);
+    ENSURE(sp_feat_extract(NULL, &r, NULL, f, &err) == SP_ERR_INVALID);
     sp_raster_free(&r);
     free(f);
 }
@@ -496,7 +496,7 @@ static void test_descriptors(void)
     sp_features* f = malloc(sizeof *f);
     sp_error err = {0};
     ENSURE(f != NULL);
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_OK);
     ENSURE(f->count > 100 && f->count <= SP_FEAT_MAX);
     for (int i = 0; i < f->count; ++i) {
         double n2 = 0;
@@ -515,13 +515,13 @@ static void test_descriptors(void)
     sp_vec2 dot = {5, 5};
     s = (sp_sketch){0};
     ENSURE(sp_sketch_add_stroke(&s, &dot, NULL, 1) == SP_OK);
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_OK);
     ENSURE(f->count > 0 && f->count < 150); // empty patches skipped
     // A horizontal line: its descriptors see (almost) only the horizontal-edge bin (gradient along y = bin 2).
     sp_sketch_free(&s);
     sp_vec2 line[2] = {{0, 50}, {100, 50}};
     ENSURE(sp_sketch_add_stroke(&s, line, NULL, 2) == SP_OK);
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_OK);
     double bins[4] = {0};
     for (int i = 0; i < f->count; ++i)
         for (int d = 0; d < SP_FEAT_DIM; ++d)
@@ -537,10 +537,10 @@ static void test_bad_drawings(void)
     sp_error err = {0};
     ENSURE(f != NULL);
     sp_sketch s = {0};
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_ERR_INVALID && contains(err.text, "empty"));
     sp_vec2 nan_pt[2] = {{0, 0}, {NAN, 1}};
     ENSURE(sp_sketch_add_stroke(&s, nan_pt, NULL, 2) == SP_OK);
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_ERR_INVALID && contains(err.text, "finite"));
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_ERR_INVALID && contains(err.text, "finite"));
     sp_sketch_free(&s);
     int n = SP_SKETCH_MAX_POINTS + 1;
     sp_vec2* many = malloc(sizeof(sp_vec2) * (size_t)n);
@@ -548,10 +548,10 @@ static void test_bad_drawings(void)
     for (int i = 0; i < n; ++i)
         many[i] = (sp_vec2){i % 1000, i / 1000};
     ENSURE(sp_sketch_add_stroke(&s, many, NULL, n) == SP_OK);
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_ERR_UNSUPPORTED && contains(err.text, "1000000"));
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_ERR_UNSUPPORTED && contains(err.text, "1000000"));
     sp_sketch_free(&s);
     ENSURE(sp_sketch_add_stroke(&s, many, NULL, n - 1) == SP_OK); // exactly the cap is fine
-    ENSURE(sp_feat_extract(&s, NULL, f, &err) == SP_OK);
+    ENSURE(sp_feat_extract(&s, NULL, NULL, f, &err) == SP_OK);
     sp_sketch_free(&s);
     free(many);
     free(f);
