@@ -20,19 +20,16 @@
 sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    // Why read the header ourselves: a decoder would allocate the whole image
+    // Why read the header first: a decoder would allocate the whole image
     // before we could refuse a 20000x20000 file.
-    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     FILE* f = fopen(path, "rb");
     if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
     unsigned char hdr[24];
     size_t got = fread(hdr, 1, sizeof hdr, f);
     fclose(f);
-    if (got < 8 || memcmp(hdr, sig, 8) != 0) return sp_fail(err, SP_ERR_PARSE, "%s: not a PNG file", path);
-    if (got < 24 || memcmp(hdr + 12, "IHDR", 4) != 0) return sp_fail(err, SP_ERR_PARSE, "%s: PNG header truncated", path);
-    uint32_t w = (uint32_t)hdr[16] << 24 | (uint32_t)hdr[17] << 16 | (uint32_t)hdr[18] << 8 | hdr[19];
-    uint32_t h = (uint32_t)hdr[20] << 24 | (uint32_t)hdr[21] << 16 | (uint32_t)hdr[22] << 8 | hdr[23];
-    if (w == 0 || h == 0) return sp_fail(err, SP_ERR_PARSE, "%s: PNG has zero size", path);
+    uint32_t w, h;
+    const char* bad = sp_png_header(hdr, got, &w, &h);
+    if (bad) return sp_fail(err, SP_ERR_PARSE, "%s: %s", path, bad);
     if (w > SP_RASTER_MAX_SIDE || h > SP_RASTER_MAX_SIDE)
         return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: PNG is %ux%u, larger than %dx%d", path, w, h, SP_RASTER_MAX_SIDE,
                        SP_RASTER_MAX_SIDE);

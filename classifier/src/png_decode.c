@@ -40,6 +40,16 @@ static bool chunks_intact(const unsigned char* bytes, size_t len, const char** w
     return true;
 }
 
+const char* sp_png_header(const unsigned char* bytes, size_t len, uint32_t* w, uint32_t* h)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (len < 8 || memcmp(bytes, sig, 8) != 0) return "not a PNG file";
+    if (len < 24 || memcmp(bytes + 12, "IHDR", 4) != 0) return "PNG header truncated";
+    *w = be32(bytes + 16);
+    *h = be32(bytes + 20);
+    return *w == 0 || *h == 0 ? "PNG has zero size" : NULL;
+}
+
 bool sp_png_decode(const unsigned char* bytes, size_t len, sp_png_image* out, const char** why)
 {
     memset(out, 0, sizeof *out);

@@ -3,6 +3,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 /// A decoded PNG: rows top down, samples interleaved R, G, B, A.
 typedef struct sp_png_image {
@@ -11,6 +12,12 @@ typedef struct sp_png_image {
     int channels;  // 1 grey, 2 grey and alpha, 3 RGB, 4 RGBA
     bool wide;     // 16 bits a sample (a 16-bit PNG), else 8
 } sp_png_image;
+
+/// The size the PNG's header (its first 24 bytes will do) says: NULL with *w
+/// and *h, else why not (static text: "not a PNG file", "PNG header
+/// truncated", "PNG has zero size"). Read before decoding, so that a caller
+/// can refuse a size before the decoder allocates it.
+const char* sp_png_header(const unsigned char* bytes, size_t len, uint32_t* w, uint32_t* h);
 
 /// Decodes the PNG in bytes; false with *why (static, per-thread text) when it
 /// does not decode or a chunk fails its CRC. Quiet: libpng, under OpenCV's decoder, printed its own
