@@ -14,22 +14,27 @@ static uint32_t be32(const unsigned char* p)
     return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
 }
 
-// True when every whole chunk's CRC matches (zlib's crc32 over type and data).
-// stb_image checks no CRC at all, so a damaged chunk would decode to other
-// pixels without a word; libpng refused it. A chunk cut short is left to the
-// decoder, which says "truncated".
+// True when every chunk is whole and its CRC matches (zlib's crc32 over type
+// and data). stb_image checks no CRC at all, so a damaged chunk would decode
+// to other pixels without a word (libpng refused it); and it takes a chunk's
+// length on trust, so a 100-byte file whose IDAT claims 1.7 GB made it
+// allocate that much before finding the data missing.
 static bool chunks_intact(const unsigned char* bytes, size_t len, const char** why)
 {
-    static _Thread_local char said[96]; // *why outlives the call
-    size_t at = 8;                      // after the signature
+    static _Thread_local char said[128]; // *why outlives the call
+    size_t at = 8;                       // after the signature
     while (at + 12 <= len) {
         uint32_t n = be32(bytes + at);
-        if (n > len - at - 12) return true;
-        uint32_t want = be32(bytes + at + 8 + n);
-        if ((uint32_t)crc32(0L, bytes + at + 4, n + 4) != want) {
-            char type[5] = {0};
-            for (int i = 0; i < 4; ++i)
-                type[i] = bytes[at + 4 + i] >= 0x20 && bytes[at + 4 + i] < 0x7f ? (char)bytes[at + 4 + i] : '?';
+        char type[5] = {0};
+        for (int i = 0; i < 4; ++i)
+            type[i] = bytes[at + 4 + i] >= 0x20 && bytes[at + 4 + i] < 0x7f ? (char)bytes[at + 4 + i] : '?';
+        if (n > len - at - 12) {
+            snprintf(said, sizeof said, "chunk '%s' at byte %zu claims %u bytes, %zu are left", type, at, (unsigned)n,
+                     len - at - 12);
+            *why = said;
+            return false;
+        }
+        if ((uint32_t)crc32(0L, bytes + at + 4, n + 4) != be32(bytes + at + 8 + n)) {
             snprintf(said, sizeof said, "chunk '%s' at byte %zu fails its CRC", type, at);
             *why = said;
             return false;

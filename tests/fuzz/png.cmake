@@ -6,7 +6,8 @@ if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
   message(WARNING "SP_FUZZ needs clang; fuzz_png not built")
   return()
 endif()
-# The decoder's file compiled in, instrumented; stb_image is Debian's library.
+# The decoder's file compiled in, instrumented; stb_image is Debian's library
+# (not instrumented: the target also feeds it each input with its CRCs made right).
 add_executable(fuzz_png ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_png.c ${PROJECT_SOURCE_DIR}/classifier/src/png_decode.c)
 target_include_directories(fuzz_png PRIVATE ${PROJECT_SOURCE_DIR}/classifier/src)
 target_link_libraries(fuzz_png PRIVATE PkgConfig::STB ZLIB::ZLIB sp_flags)

@@ -381,6 +381,18 @@ static void test_png(void)
     ENSURE(sp_raster_read_png(dam, &r, &err) == SP_ERR_PARSE && contains(err.text, "chunk 'IDAT' at byte 33 fails its CRC") &&
            !strchr(err.text, '\n'));
     buf[45] ^= 0x10;
+    // A chunk longer than what is left of the file is refused before the
+    // decoder, which took the length on trust (an IDAT claiming 1.7 GB in a
+    // 100-byte file made it allocate 1.7 GB); so is a file cut inside a chunk.
+    unsigned char claim[4] = {buf[33], buf[34], buf[35], buf[36]};
+    buf[33] = 0x68, buf[34] = 0, buf[35] = 0, buf[36] = 0x2f;
+    write_bytes(dam, buf, n);
+    ENSURE(sp_raster_read_png(dam, &r, &err) == SP_ERR_PARSE &&
+           contains(err.text, "chunk 'IDAT' at byte 33 claims 1744830511 bytes"));
+    memcpy(buf + 33, claim, 4);
+    write_bytes(dam, buf, 60);
+    ENSURE(sp_raster_read_png(dam, &r, &err) == SP_ERR_PARSE && contains(err.text, "chunk 'IDAT' at byte 33 claims") &&
+           contains(err.text, "15 are left"));
 
     const char* fake = sp_test_tmp_path("fake.png");
     write_text(fake, "this is not a png at all");
