@@ -19,9 +19,10 @@ typedef struct sp_png_image {
 /// can refuse a size before the decoder allocates it.
 const char* sp_png_header(const unsigned char* bytes, size_t len, uint32_t* w, uint32_t* h);
 
-/// Decodes the PNG in bytes; false with *why (static, per-thread text) when it
-/// does not decode or a chunk fails its CRC. Quiet: libpng, under OpenCV's decoder, printed its own
-/// "libpng error: ..." line to stderr for a broken file, stb prints nothing.
+/// Decodes the PNG in bytes; false with *why (static, per-thread text) when
+/// it does not decode, or a chunk runs past the end or fails its CRC. Quiet:
+/// libpng, under OpenCV's decoder, printed its own "libpng error: ..." line
+/// to stderr for a broken file, stb prints nothing.
 /// The channels are those OpenCV's decoder gave, so the grey conversion after
 /// it is unchanged: a grey PNG's tRNS colour key is ignored, any other tRNS
 /// becomes alpha.
