@@ -1,8 +1,10 @@
 #include "fixtures.h"
 
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -276,6 +278,25 @@ int sp_fixture_gltf_validate(const char* file)
         if (system(cmd) != 0) fprintf(stderr, "  (no report)\n");
     }
     return rc == 0;
+}
+
+int sp_fixture_fork_file_limit(long bytes)
+{
+    fflush(NULL); // nothing buffered is written twice
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit rl = {.rlim_cur = (rlim_t)bytes, .rlim_max = RLIM_INFINITY};
+        if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(3);
+    }
+    return (int)pid;
+}
+
+bool sp_fixture_child_passed(int pid)
+{
+    int status = 0;
+    return waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
 void sp_fixture_remove_db(const char* path)

@@ -88,6 +88,16 @@ const char* sp_fixture_node_tools(const char* pkg);
 /// validator is not installed (see sp_fixture_node_tools).
 int sp_fixture_gltf_validate(const char* file);
 
+/// fork() for a write checked against a full disk: the child (0 returned)
+/// may grow files to at most `bytes` (SIGXFSZ ignored, so a write past it
+/// fails with EFBIG; it exits 3 when the limit cannot be set); the parent
+/// gets the child's pid, for sp_fixture_child_passed. Fails the running test
+/// when fork fails.
+int sp_fixture_fork_file_limit(long bytes);
+
+/// Waits for the child `pid`: true when it exited with status 0.
+bool sp_fixture_child_passed(int pid);
+
 /// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).
 void sp_fixture_remove_db(const char* path);
 

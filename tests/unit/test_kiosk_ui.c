@@ -3,11 +3,9 @@
 // and record -> replay. A small fake pipeline answers the UI's jobs.
 #include <dirent.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -1348,18 +1346,14 @@ static void recording_written_whole(const char* path, const sp_kiosk_session* re
 {
     size_t n0;
     char* before = sp_fixture_file_text(path, &n0);
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    int pid = sp_fixture_fork_file_limit((long)n0 / 2);
     if (pid == 0) {
-        signal(SIGXFSZ, SIG_IGN);
-        struct rlimit lim = {(rlim_t)n0 / 2, (rlim_t)n0 / 2};
         sp_error e = {0};
         sp_kiosk_session twice = *rec;
         twice.end_ms += 1; // other bytes: a write that got through would show
-        _exit(setrlimit(RLIMIT_FSIZE, &lim) == 0 && sp_kiosk_session_write(path, &twice, &e) == SP_ERR_IO ? 0 : 1);
+        _exit(sp_kiosk_session_write(path, &twice, &e) == SP_ERR_IO ? 0 : 1);
     }
-    int status = 0;
-    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(sp_fixture_child_passed(pid));
     size_t n1;
     char* after = sp_fixture_file_text(path, &n1);
     ENSURE(n1 == n0 && memcmp(before, after, n0) == 0);

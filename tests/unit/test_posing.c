@@ -4,10 +4,8 @@
 // rig handle on both kinds of rig.
 #include <cjson/cJSON.h>
 #include <math.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -528,19 +526,14 @@ static void test_pose_file_whole(void)
     size_t n = f ? fread(before, 1, sizeof before, f) : 0;
     if (f) fclose(f);
     ENSURE(n > 10 && n < 256);
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    int pid = sp_fixture_fork_file_limit(256);
     if (pid == 0) {
-        signal(SIGXFSZ, SIG_IGN);
-        struct rlimit rl = {.rlim_cur = 256, .rlim_max = RLIM_INFINITY};
-        if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(3);
         sp_error e = {0};
         sp_result r = sp_pose_write(path, params, 40, p, &e); // about 1 KB
         fprintf(stderr, "  under a 256-byte file limit: %s\n", r == SP_OK ? "written" : e.text);
         _exit(r == SP_ERR_IO && strstr(e.text, "whole_pose.json") ? 0 : 1);
     }
-    int status = 0;
-    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(sp_fixture_child_passed(pid));
     char after[4096];
     f = fopen(path, "rb");
     size_t m = f ? fread(after, 1, sizeof after, f) : 0;

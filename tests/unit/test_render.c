@@ -4,9 +4,7 @@
 // offscreen through EGL, read back and compared with the projection of its
 // vertices; overlays must show their colours where they were drawn. No GL
 // context is a failure, not a skip: EGL (Mesa) is present here and in CI.
-#include <signal.h>
 #include <stdint.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -555,19 +553,14 @@ static void test_png_write_whole(void)
     ENSURE(n0 > 65536);
     for (int i = 0; i < 256 * 256 * 4; ++i)
         img.rgba[i] ^= 0x5a;
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    int pid = sp_fixture_fork_file_limit(16384);
     if (pid == 0) {
-        signal(SIGXFSZ, SIG_IGN);
-        struct rlimit rl = {.rlim_cur = 16384, .rlim_max = RLIM_INFINITY};
-        if (setrlimit(RLIMIT_FSIZE, &rl) != 0) _exit(3);
         sp_error e = {0};
         sp_result r = sp_image_write_png(&img, path, &e);
         fprintf(stderr, "  under a 16 KB file limit: %s\n", r == SP_OK ? "written" : e.text);
         _exit(r == SP_ERR_IO && strstr(e.text, "whole.png") && strstr(e.text, "too large") ? 0 : 1);
     }
-    int status = 0;
-    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(sp_fixture_child_passed(pid));
     ENSURE(slurp(path, after, sizeof after) == n0 && !memcmp(before, after, (size_t)n0));
     ENSURE(leftovers(path) == 0);
     // Through a symbolic link: the target is written, the link stays.
@@ -589,7 +582,7 @@ static void test_png_write_whole(void)
         _exit(n == slurp(path, before, sizeof before) && !memcmp(before, after, (size_t)n) ? 0 : 1);
     }
     ENSURE(sp_image_write_png(&img, fifo, &err) == SP_OK);
-    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(sp_fixture_child_passed(pid));
     ENSURE(lstat(fifo, &st) == 0 && S_ISFIFO(st.st_mode));
     // A folder is not a file.
     const char* dir = sp_test_tmp_path("whole_dir");
