@@ -153,8 +153,7 @@ bool sp_cli_out_is_stream(const char* path)
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)
 {
     if (!path || sp_cli_out_is_stream(path)) return true;
-    const char* slash = strrchr(path, '/');
-    char* dir = slash ? strndup(path, slash == path ? 1 : (size_t)(slash - path)) : strdup(".");
+    char* dir = sp_path_folder(path);
     if (!dir) return true; // out of memory: the writer will say so
     struct stat st;
     const char* why = stat(dir, &st) != 0             ? strerror(errno)

@@ -358,13 +358,12 @@ static int open_immutable(const char* path, sqlite3** h)
 static bool reader_may_write(const char* path)
 {
     if (faccessat(AT_FDCWD, path, W_OK, AT_EACCESS) != 0) return false;
+    char* dir = sp_path_folder(path);
+    bool ok = dir && faccessat(AT_FDCWD, dir, W_OK | X_OK, AT_EACCESS) == 0;
+    free(dir);
     size_t n = strlen(path) + 5;
-    char* buf = malloc(n);
-    if (!buf) return false;
-    snprintf(buf, n, "%s", path);
-    char* slash = strrchr(buf, '/');
-    const char* dir = slash ? (slash == buf ? "/" : (*slash = 0, buf)) : ".";
-    bool ok = faccessat(AT_FDCWD, dir, W_OK | X_OK, AT_EACCESS) == 0;
+    char* buf = ok ? malloc(n) : NULL;
+    ok = ok && buf;
     for (int k = 0; ok && k < 2; ++k) {
         snprintf(buf, n, "%s-%s", path, k ? "shm" : "wal");
         ok = faccessat(AT_FDCWD, buf, F_OK, AT_EACCESS) != 0 || faccessat(AT_FDCWD, buf, W_OK, AT_EACCESS) == 0;

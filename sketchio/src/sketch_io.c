@@ -42,19 +42,26 @@ static sp_result write_into(const char* path, const void* data, size_t size, sp_
     return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write error (%s)", path, strerror(e));
 }
 
-bool sp_path_sync_folder(const char* path)
+char* sp_path_folder(const char* path)
 {
     size_t n = strlen(path);
     char* dir = malloc(n + 2);
-    if (!dir) return false;
+    if (!dir) return NULL;
     memcpy(dir, path, n + 1);
-    while (n > 1 && dir[n - 1] == '/') // "out/" is held by the folder out is in
+    while (n > 1 && dir[n - 1] == '/')
         dir[--n] = 0;
     char* slash = strrchr(dir, '/');
     if (!slash)
         strcpy(dir, ".");
     else
         slash[slash == dir] = 0; // "/x" is held by "/"
+    return dir;
+}
+
+bool sp_path_sync_folder(const char* path)
+{
+    char* dir = sp_path_folder(path);
+    if (!dir) return false;
     int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     free(dir);
     if (fd < 0) return false;

@@ -101,6 +101,11 @@ sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 sp_result sp_file_read(const char* path, size_t max_bytes, void** data, size_t* size, sp_error* err);
 /// sp_file_read of a drawing file: at most SP_SKETCH_MAX_FILE_BYTES.
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
+/// The folder that holds `path` (malloc'd; NULL when out of memory): "." for
+/// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
+/// held by the folder out is in).
+char* sp_path_folder(const char* path);
+
 /// Syncs the folder that holds `path` (fsync(2) on the folder), so that a name
 /// just made there by rename(2), link(2) or mkdir(2) survives a power cut.
 /// False when the folder cannot be opened or synced; a file system that
