@@ -73,6 +73,18 @@ static int get(const grid* g, int x, int y)
     return g->c[(size_t)y * (size_t)g->w + (size_t)x];
 }
 
+// fmin and fmax by comparison: libm's calls cost more than the rest of a
+// small triangle, and the corners are finite here (no NaN rule to keep).
+static inline double lo(double a, double b)
+{
+    return b < a ? b : a;
+}
+
+static inline double hi(double a, double b)
+{
+    return b > a ? b : a;
+}
+
 void sp_raster_triangle(unsigned char* cells, int w, int h, const double a[2], const double b[2], const double c[2])
 {
     if (!isfinite(a[0] + a[1] + b[0] + b[1] + c[0] + c[1])) return;
@@ -80,10 +92,10 @@ void sp_raster_triangle(unsigned char* cells, int w, int h, const double a[2], c
     if (area == 0.0) return;
     // The cells whose centres the box holds, clamped to the grid before the
     // cast (a far-flung corner would overflow an int).
-    double x0 = ceil(fmin(a[0], fmin(b[0], c[0])) - 0.5), x1 = floor(fmax(a[0], fmax(b[0], c[0])) - 0.5);
-    double y0 = ceil(fmin(a[1], fmin(b[1], c[1])) - 0.5), y1 = floor(fmax(a[1], fmax(b[1], c[1])) - 0.5);
+    double x0 = ceil(lo(a[0], lo(b[0], c[0])) - 0.5), x1 = floor(hi(a[0], hi(b[0], c[0])) - 0.5);
+    double y0 = ceil(lo(a[1], lo(b[1], c[1])) - 0.5), y1 = floor(hi(a[1], hi(b[1], c[1])) - 0.5);
     if (x1 < 0 || y1 < 0 || x0 > w - 1 || y0 > h - 1) return;
-    int cx0 = (int)fmax(x0, 0), cx1 = (int)fmin(x1, w - 1), cy0 = (int)fmax(y0, 0), cy1 = (int)fmin(y1, h - 1);
+    int cx0 = (int)hi(x0, 0), cx1 = (int)lo(x1, w - 1), cy0 = (int)hi(y0, 0), cy1 = (int)lo(y1, h - 1);
     double sgn = area > 0 ? 1.0 : -1.0;
     for (int y = cy0; y <= cy1; ++y)
         for (int x = cx0; x <= cx1; ++x) {
@@ -95,29 +107,37 @@ void sp_raster_triangle(unsigned char* cells, int w, int h, const double a[2], c
         }
 }
 
+// The row pass of morph: row y's cells or'd (and'ed) with their left and
+// right neighbours into r.
+static void morph_row(const grid* g, bool grow, size_t y, unsigned char* r)
+{
+    size_t w = (size_t)g->w;
+    const unsigned char* c = g->c + y * w;
+    for (size_t x = 0; x < w; ++x) {
+        unsigned char l = x > 0 ? c[x - 1] : 0, m = c[x], n = x + 1 < w ? c[x + 1] : 0;
+        r[x] = grow ? (unsigned char)(l | m | n) : (unsigned char)(l & m & n);
+    }
+}
+
 // 3x3 dilation (grow = true) or erosion of the inside, cells off the grid
-// empty. Separable (a row pass into `row`, then a column pass into `*spare`,
-// which then swaps with the grid's cells): the same cells as the 3x3 window,
-// in rows the compiler vectorises, because the training recipe traces a
-// silhouette for many of its sketches. The caller's buffers (w * h each)
-// serve every pass of a trace.
-static void morph(grid* g, bool grow, unsigned char* row, unsigned char** spare)
+// empty, in place. Separable (a row pass, then a column pass over three row
+// results): the same cells as the 3x3 window, in rows the compiler
+// vectorises, because the training recipe traces a silhouette for many of
+// its sketches. `ring` (3 * w, the caller's) holds the row results of rows
+// y-1..y+1; row y+1's is taken before row y is overwritten, so the grid
+// needs no copy.
+static void morph(grid* g, bool grow, unsigned char* ring)
 {
     size_t w = (size_t)g->w, h = (size_t)g->h;
-    unsigned char* out = *spare;
+    if (h == 0) return;
+    morph_row(g, grow, 0, ring);
+    if (h > 1) morph_row(g, grow, 1, ring + w);
     for (size_t y = 0; y < h; ++y) {
-        const unsigned char* c = g->c + y * w;
-        unsigned char* r = row + y * w;
-        for (size_t x = 0; x < w; ++x) {
-            unsigned char l = x > 0 ? c[x - 1] : 0, m = c[x], n = x + 1 < w ? c[x + 1] : 0;
-            r[x] = grow ? (unsigned char)(l | m | n) : (unsigned char)(l & m & n);
-        }
-    }
-    for (size_t y = 0; y < h; ++y) {
-        const unsigned char* u = y > 0 ? row + (y - 1) * w : NULL;
-        const unsigned char* m = row + y * w;
-        const unsigned char* d = y + 1 < h ? row + (y + 1) * w : NULL;
-        unsigned char* o = out + y * w;
+        if (y > 0 && y + 1 < h) morph_row(g, grow, y + 1, ring + ((y + 1) % 3) * w);
+        const unsigned char* u = y > 0 ? ring + ((y - 1) % 3) * w : NULL;
+        const unsigned char* m = ring + (y % 3) * w;
+        const unsigned char* d = y + 1 < h ? ring + ((y + 1) % 3) * w : NULL;
+        unsigned char* o = g->c + y * w;
         if (!u || !d) {
             for (size_t x = 0; x < w; ++x)
                 o[x] = grow ? (unsigned char)((u ? u[x] : 0) | m[x] | (d ? d[x] : 0)) : 0;
@@ -129,45 +149,49 @@ static void morph(grid* g, bool grow, unsigned char* row, unsigned char** spare)
                 o[x] = (unsigned char)(u[x] & m[x] & d[x]);
         }
     }
-    *spare = g->c;
-    g->c = out;
 }
 
-// Labels 4-connected regions of cells equal to `value` into lab (region ids
-// from 1); returns the count (-1: out of memory) and writes each region's
-// size into *sizes (malloc'd, indexed by id). `stack`: w * h ints of the
-// caller's.
-static int label(const grid* g, int value, int* lab, int* stack, int** sizes)
+// Flood-fills the 4-connected region of cells equal to `from` around cell
+// `seed`, setting them to `to` (!= from), a row span at a time (a division
+// per span, not per cell); returns its size, -1 when out of memory. Marking
+// the grid itself needs no label grid (4 bytes a cell, fresh pages for every
+// trace). `stack` (cell indices) grows as needed and is the caller's to free.
+static long long fill(grid* g, unsigned char from, unsigned char to, size_t seed, size_t** stack, size_t* cap)
 {
-    size_t n = (size_t)g->w * (size_t)g->h;
-    int count = 0;
-    *sizes = NULL;
-    for (size_t i = 0; i < n; ++i)
-        lab[i] = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (g->c[i] != value || lab[i]) continue;
-        ++count;
-        int* grown = realloc(*sizes, sizeof(int) * (size_t)(count + 1));
-        if (!grown) return -1;
-        *sizes = grown;
-        int size = 0, top = 0;
-        stack[top++] = (int)i;
-        lab[i] = count;
-        while (top) {
-            int k = stack[--top];
-            ++size;
-            int x = k % g->w, y = k / g->w;
-            const int nb[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-            for (int d = 0; d < 4; ++d) {
-                int nx = x + nb[d][0], ny = y + nb[d][1];
-                if (nx < 0 || ny < 0 || nx >= g->w || ny >= g->h) continue;
-                size_t q = (size_t)ny * (size_t)g->w + (size_t)nx;
-                if (g->c[q] == value && !lab[q]) lab[q] = count, stack[top++] = (int)q;
+    size_t w = (size_t)g->w, h = (size_t)g->h, top = 0;
+    long long size = 0;
+    (*stack)[top++] = seed;
+    while (top) {
+        size_t k = (*stack)[--top];
+        if (g->c[k] != from) continue;
+        size_t y = k / w, row = y * w, l = k - row, r = l;
+        unsigned char* c = g->c + row;
+        while (l > 0 && c[l - 1] == from)
+            --l;
+        while (r + 1 < w && c[r + 1] == from)
+            ++r;
+        memset(c + l, to, r - l + 1);
+        size += (long long)(r - l + 1);
+        // The first cell of every run of the span's neighbours above and below.
+        for (int side = 0; side < 2; ++side) {
+            if ((side == 0 && y == 0) || (side == 1 && y + 1 >= h)) continue;
+            const unsigned char* n = g->c + (side == 0 ? row - w : row + w);
+            bool run = false;
+            for (size_t x = l; x <= r; ++x) {
+                bool in = n[x] == from;
+                if (in && !run) {
+                    if (top == *cap) {
+                        size_t* grown = realloc(*stack, sizeof(size_t) * 2 * *cap);
+                        if (!grown) return -1;
+                        *stack = grown, *cap *= 2;
+                    }
+                    (*stack)[top++] = (size_t)(n + x - g->c);
+                }
+                run = in;
             }
         }
-        (*sizes)[count] = size;
     }
-    return count;
+    return size;
 }
 
 typedef struct pt {
@@ -362,11 +386,12 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     int points = d->points > 0 ? d->points : 150;
     int nv = d->vertex_count;
     sp_result res = SP_OK;
-    double *xy = NULL, *cell = NULL, *acc = NULL, *nrm = NULL, *zv = NULL;
+    double *xy = NULL, *cell = NULL, *acc = NULL, *nrm = NULL, *nlen = NULL, *zv = NULL;
     candidate* cands = NULL;
     int ncand = 0;
-    int *lab = NULL, *sizes = NULL, *stack = NULL;
-    unsigned char *rows = NULL, *spare = NULL;
+    int* sizes = NULL;
+    size_t *seeds = NULL, *stack = NULL;
+    unsigned char* ring = NULL;
     pt *poly = NULL, *tmp = NULL;
     sp_skin8 *bound = NULL, *tmp_skin = NULL;
     grid g = {0, 0, NULL};
@@ -407,23 +432,33 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     }
     // Closing (dilate, erode) removes hairline gaps between touching pieces.
     size_t ncell = (size_t)g.w * (size_t)g.h;
-    rows = malloc(ncell), spare = malloc(ncell);
-    if (!rows || !spare) goto oom;
-    morph(&g, true, rows, &spare), morph(&g, true, rows, &spare);
-    morph(&g, false, rows, &spare), morph(&g, false, rows, &spare);
-    free(rows), free(spare);
-    rows = spare = NULL;
+    if (!(ring = malloc(3 * (size_t)g.w))) goto oom;
+    morph(&g, true, ring), morph(&g, true, ring), morph(&g, false, ring), morph(&g, false, ring);
     // Fill holes: everything not reachable from the border is inside.
-    lab = malloc(sizeof(int) * ncell), stack = malloc(sizeof(int) * ncell);
-    if (!lab || !stack || label(&g, 0, lab, stack, &sizes) < 0) goto oom;
-    int border = lab[0]; // the corner cell is always empty (margin)
+    size_t stack_cap = 4096;
+    stack = malloc(sizeof(size_t) * stack_cap);
+    // The background (2) from the corner cell, which is always empty (margin).
+    if (!stack || fill(&g, 0, 2, 0, &stack, &stack_cap) < 0) goto oom;
     for (size_t i = 0; i < ncell; ++i)
-        g.c[i] = lab[i] != border;
-    free(sizes);
-    sizes = NULL;
-    // Keep the largest inside region; refuse a silhouette in several big pieces.
-    int regions = label(&g, 1, lab, stack, &sizes);
-    if (regions < 0) goto oom;
+        g.c[i] = g.c[i] != 2;
+    // The inside's regions (marked 2), numbered from 1 in the order of their
+    // first cell row by row; keep the largest, refuse a silhouette in several
+    // big pieces.
+    int regions = 0, room = 0;
+    for (size_t i = 0; i < ncell; ++i) {
+        if (g.c[i] != 1) continue;
+        if (regions + 2 > room) {
+            room = room ? 2 * room : 16;
+            int* grown = realloc(sizes, sizeof(int) * (size_t)room);
+            size_t* grown_seeds = realloc(seeds, sizeof(size_t) * (size_t)room);
+            if (grown) sizes = grown;
+            if (grown_seeds) seeds = grown_seeds;
+            if (!grown || !grown_seeds) goto oom;
+        }
+        long long size = fill(&g, 1, 2, i, &stack, &stack_cap);
+        if (size < 0) goto oom;
+        sizes[++regions] = (int)size, seeds[regions] = i;
+    }
     int best = 1, second = 0;
     long long total = 0;
     for (int r = 2; r <= regions; ++r)
@@ -443,10 +478,11 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
                       regions, second, regions ? sizes[best] : 0);
         goto done;
     }
+    if (fill(&g, 2, 3, seeds[best], &stack, &stack_cap) < 0) goto oom;
     for (size_t i = 0; i < ncell; ++i)
-        g.c[i] = lab[i] == best;
-    free(sizes), free(lab), free(stack);
-    sizes = NULL, lab = NULL, stack = NULL;
+        g.c[i] = g.c[i] == 3;
+    free(sizes), free(seeds), free(stack);
+    sizes = NULL, seeds = NULL, stack = NULL;
 
     int n = 0;
     poly = trace(&g, &n);
@@ -507,6 +543,13 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
         for (int j = 0; j < 3; ++j)
             nrm[2 * q[j]] += nv3.x, nrm[2 * q[j] + 1] -= nv3.y;
     }
+    // Their lengths once, not once a contour point (the nearest-vertex search
+    // below visits every vertex for each point).
+    if (!d->surface) {
+        if (!(nlen = malloc(sizeof(double) * (size_t)nv))) goto oom;
+        for (int v = 0; v < nv; ++v)
+            nlen[v] = hypot(nrm[2 * v], nrm[2 * v + 1]);
+    }
     int seg = 0;
     for (int i = 0; i < points; ++i) {
         double s = acc[n] * i / points;
@@ -537,7 +580,7 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
             if (skipped(d->skip_vertex, v)) continue;
             double ddx = xy[2 * v] - px, ddy = xy[2 * v + 1] - py, dd = ddx * ddx + ddy * ddy;
             if (dd < near_d) near_d = dd, near_v = v;
-            double nl = hypot(nrm[2 * v], nrm[2 * v + 1]);
+            double nl = nlen[v];
             bool outward = nl > 0 && (nrm[2 * v] * ox + nrm[2 * v + 1] * oy) > 0.5 * nl;
             if (outward && dd < best_d) best_d = dd, best_v = v;
         }
@@ -586,7 +629,7 @@ oom:
 done:
     if (res != SP_OK) sp_abstraction_free(out);
     free(cands), free(zv);
-    free(tmp_skin), free(bound), free(nrm), free(acc), free(tmp), free(poly), free(cell), free(xy), free(lab), free(sizes),
-        free(stack), free(rows), free(spare), free(g.c);
+    free(tmp_skin), free(bound), free(nrm), free(nlen), free(acc), free(tmp), free(poly), free(cell), free(xy), free(seeds),
+        free(sizes), free(stack), free(ring), free(g.c);
     return res;
 }

@@ -26,6 +26,7 @@
 #include "sp/handdraw.h"
 #include "sp/headless.h"
 #include "sp/image.h"
+#include "sp/outline.h"
 #include "sp/partdb.h"
 #include "sp/render.h"
 #include "sp/synth.h"
@@ -765,6 +766,102 @@ static void test_silhouette_khronos(void)
     }
 }
 
+// ---- the tracer's regions (sp/outline.h) -----------------------------------------
+
+// A flat mesh of unit squares, one for each '#' of `rows` (row 0 on top, at
+// world y 0 to -1), traced seen from the front.
+static sp_result trace_cells(const char* const* rows, int nrows, bool keep_largest, sp_abstraction* ab, sp_outline_info* info,
+                             sp_error* err)
+{
+    int cols = (int)strlen(rows[0]), cells = 0;
+    for (int r = 0; r < nrows; ++r)
+        for (int c = 0; c < cols; ++c)
+            cells += rows[r][c] == '#';
+    double* xyz = malloc(sizeof(double) * 12 * (size_t)cells);
+    uint32_t* tri = malloc(sizeof(uint32_t) * 6 * (size_t)cells);
+    uint16_t* joints = calloc(4 * (size_t)cells, sizeof(uint16_t));
+    double* weights = malloc(sizeof(double) * 4 * (size_t)cells);
+    ENSURE(xyz && tri && joints && weights);
+    int v = 0, t = 0;
+    for (int r = 0; r < nrows; ++r)
+        for (int c = 0; c < cols; ++c) {
+            if (rows[r][c] != '#') continue;
+            const double corner[4][2] = {{c, -r}, {c + 1, -r}, {c + 1, -r - 1}, {c, -r - 1}};
+            for (int k = 0; k < 4; ++k)
+                xyz[3 * (v + k)] = corner[k][0], xyz[3 * (v + k) + 1] = corner[k][1], xyz[3 * (v + k) + 2] = 0.0,
+                             weights[v + k] = 1.0;
+            const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+            for (int k = 0; k < 6; ++k)
+                tri[3 * t + k] = (uint32_t)v + q[k];
+            v += 4, t += 2;
+        }
+    sp_camera cam = sp_camera_frame(SP_CAMERA_ORTHOGRAPHIC, sp_v3(0, -nrows, 0), sp_v3(cols, 0, 0), sp_v3(0, 0, -1),
+                                    sp_v3(0, 1, 0), 800, 800);
+    sp_outline_desc d = {.vertex_count = v,
+                         .positions = xyz,
+                         .influences = 1,
+                         .joints = joints,
+                         .weights = weights,
+                         .triangle_count = t,
+                         .triangles = tri,
+                         .camera = &cam,
+                         .points = 400,
+                         .keep_largest = keep_largest};
+    sp_result res = sp_outline_trace(&d, ab, info, err);
+    free(xyz), free(tri), free(joints), free(weights);
+    return res;
+}
+
+// The curve's nearest approach to (x, y), world units.
+static double curve_distance(const sp_abstraction* ab, double x, double y)
+{
+    double best = INFINITY;
+    for (int i = 0; i < ab->point_count; ++i)
+        best = fmin(best, hypot(ab->rest[3 * i] - x, ab->rest[3 * i + 1] - y));
+    return best;
+}
+
+// Holes are filled, a channel that doubles back stays outside (the fill of
+// the background must reach it from below), a silhouette in two pieces is
+// refused or, when asked, loses its smaller piece.
+static void test_outline_regions(void)
+{
+    // A channel from the top down column 1, along row 5 and up column 7 to
+    // row 2; a closed hole at columns 4-5 of row 2.
+    static const char* const hook[] = {"#.#######", "#.#######", "#.##..#.#", "#.#####.#",
+                                       "#.#####.#", "#.......#", "#########", "#########"};
+    sp_abstraction ab;
+    sp_outline_info info;
+    sp_error err = {0};
+    sp_result r = trace_cells(hook, 8, false, &ab, &info, &err);
+    if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_OK);
+    ENSURE(info.regions == 1 && info.dropped_share == 0.0);
+    ENSURE(ab.point_count == 400 && ab.curve_count == 1 && ab.curves[0].closed);
+    // The channel's far end (the centre of column 7, row 2) is half a cell
+    // from the curve, 1.5 when filled; the hole's centre 2 when filled, 1 at
+    // most when not.
+    double far_end = curve_distance(&ab, 7.5, -2.5), hole = curve_distance(&ab, 5.0, -2.5);
+    fprintf(stderr, "  hook: channel's far end %.2f from the curve, hole %.2f (cells of 1)\n", far_end, hole);
+    ENSURE(far_end <= 0.6);
+    ENSURE(hole >= 1.5);
+    sp_abstraction_free(&ab);
+
+    // A 6 x 6 block and a 2 x 2 one three cells away.
+    static const char* const two[] = {"######.....", "######...##", "######...##", "######.....", "######.....", "######....."};
+    r = trace_cells(two, 6, false, &ab, &info, &err);
+    ENSURE(r == SP_ERR_INVALID && strstr(err.text, "falls apart"));
+    ENSURE(ab.point_count == 0 && ab.rest == NULL);
+    r = trace_cells(two, 6, true, &ab, &info, &err);
+    ENSURE(r == SP_OK);
+    fprintf(stderr, "  two pieces: %d regions, %.3f of the cells dropped\n", info.regions, info.dropped_share);
+    ENSURE(info.regions == 2);
+    ENSURE_NEAR(info.dropped_share, 4.0 / 40.0, 0.01);
+    for (int i = 0; i < ab.point_count; ++i)
+        ENSURE(ab.rest[3 * i] <= 6.05);
+    sp_abstraction_free(&ab);
+}
+
 // ---- the self-test, the validator -------------------------------------------------
 
 static double selftest(const sp_character* part, const char* name)
@@ -961,6 +1058,7 @@ int main(int argc, char** argv)
                                    {"cli", test_cli},
                                    {"silhouette_lizard", test_silhouette_lizard},
                                    {"silhouette_khronos", test_silhouette_khronos},
+                                   {"outline_regions", test_outline_regions},
                                    {"selftest", test_selftest},
                                    {"validator", test_validator},
                                    {"pipeline", test_pipeline},
