@@ -726,6 +726,26 @@ static void test_model_files(void)
     ENSURE(sp_clf_load(bad, &back, &err) == SP_ERR_PARSE && contains(err.text, "not a sketchpose classifier model"));
     ENSURE(sp_clf_load(sp_test_tmp_path("none.spclf"), &back, &err) == SP_ERR_IO);
     ENSURE(back == NULL);
+    // fuzz_model's seeds (tests/fuzz/corpus/model) load and classify: a
+    // format that refused them would leave the fuzzer at the header.
+    const char* seeds[] = {"default_small", "pyramid2_shapes", "plain"};
+    sp_sketch zigzag = {.canvas_w = 256, .canvas_h = 256};
+    sp_vec2 pts[10];
+    for (int i = 0; i < 10; ++i)
+        pts[i] = (sp_vec2){30.0 + 20.0 * i, i % 2 ? 145.0 : 100.0};
+    ENSURE(sp_sketch_add_stroke(&zigzag, pts, NULL, 10) == SP_OK);
+    for (int i = 0; i < 3; ++i) {
+        char rel[128];
+        snprintf(rel, sizeof rel, "tests/fuzz/corpus/model/%s.spclf", seeds[i]);
+        sp_result r = sp_clf_load(sp_test_src_path(rel), &back, &err);
+        if (r != SP_OK) fprintf(stderr, "  %s\n", err.text);
+        ENSURE(r == SP_OK);
+        sp_clf_answer a;
+        ENSURE(sp_clf_classify(back, &zigzag, NULL, &a, &err) == SP_OK);
+        ENSURE(a.count >= 1 && !strcmp(sp_clf_category(back, a.ranked[0].category), "zigzag"));
+        sp_clf_destroy(back);
+    }
+    sp_sketch_free(&zigzag);
 }
 
 // The model file's FNV-1a checksum (classifier.c), to write an older version's file.
