@@ -29,6 +29,7 @@ typedef struct mini_desc {
     bool byte_joints;  ///< JOINTS_0 as UNSIGNED_BYTE (in a separate view)
     const char* part;  ///< with extras: the scene's sp_part JSON (NULL: a tail attached by the short form)
     const float* ibm1; ///< 16 floats, column-major: the tip's inverse bind matrix (NULL: translate by -1 in y)
+    const float* ibm0; ///< the root's likewise (NULL: identity)
 } mini_desc;
 
 static void mini_base64(const unsigned char* d, size_t n, char* out)
@@ -63,6 +64,7 @@ static char* mini_gltf(const mini_desc* d)
     if (d->zero_weights) w[12] = 0;
     uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
     float ibm[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
+    if (d->ibm0) memcpy(ibm, d->ibm0, sizeof(float) * 16);
     if (d->ibm1) memcpy(ibm + 16, d->ibm1, sizeof(float) * 16);
     uint8_t jb[16];
     for (int i = 0; i < 16; ++i)
@@ -141,7 +143,7 @@ static char* mini_gltf(const mini_desc* d)
     return out;
 }
 
-static bool mini_write(const char* path, const char* text, size_t n)
+static inline bool mini_write(const char* path, const char* text, size_t n)
 {
     FILE* f = fopen(path, "wb");
     if (!f) return false;

@@ -22,6 +22,7 @@
 
 #include "fixtures.h"
 #include "foreign_gltf.h"
+#include "mini_gltf.h"
 #include "sp/derive.h"
 #include "sp/handdraw.h"
 #include "sp/headless.h"
@@ -468,6 +469,40 @@ static void test_refusals(void)
         snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' --category x '%s' 2>/dev/null", bin, db, cases[i][0]);
         ENSURE(run(cmd, NULL) == 1);
         ENSURE(access(db, F_OK) != 0);
+    }
+}
+
+// A skin that flattens the mesh at rest along an axis (an inverse bind
+// matrix scaled by 1e-7 or less there, or singular; glTF allows it) leaves
+// outline points with no reliable place in bind space: refused in one line.
+// Before, only an exactly singular blend was; fuzz_derive found a nearly
+// singular one whose outline points went past glTF's float range, so the
+// part failed only when saved, with a message naming the output file.
+static void test_collapsed_skin(void)
+{
+    // The root's inverse bind matrix (column-major) with its y column scaled.
+    const float ys[] = {1.0f, 1e-3f, 1e-7f, 1e-12f, 0.0f};
+    for (int i = 0; i < 5; ++i) {
+        const float ibm[16] = {1, 0, 0, 0, 0, ys[i], 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        char* text = mini_gltf(&(mini_desc){.ibm0 = ibm});
+        sp_character src = {0}, part = {0};
+        sp_error err = {0};
+        ENSURE(sp_gltf_load_memory(text, strlen(text), "mini.gltf", &src, &err) == SP_OK);
+        free(text);
+        sp_result r = sp_part_derive(&src, NULL, &part, NULL, &err);
+        fprintf(stderr, "  root's y scale %g: %s\n", ys[i], r == SP_OK ? "derived" : err.text);
+        if (i < 2) {
+            ENSURE(r == SP_OK);
+            void* glb = NULL;
+            size_t n = 0;
+            ENSURE(sp_gltf_save_memory(&part, NULL, &glb, &n, &err) == SP_OK);
+            free(glb);
+        } else {
+            ENSURE(r == SP_ERR_INVALID && strstr(err.text, "the skin collapses at outline point") && !strchr(err.text, '\n'));
+            ENSURE(part.rig.vertex_count == 0);
+        }
+        sp_character_free(&part);
+        sp_character_free(&src);
     }
 }
 
@@ -1055,6 +1090,7 @@ int main(int argc, char** argv)
                                    {"part_carried", test_part_carried},
                                    {"zup_and_facing", test_zup_and_facing},
                                    {"refusals", test_refusals},
+                                   {"collapsed_skin", test_collapsed_skin},
                                    {"cli", test_cli},
                                    {"silhouette_lizard", test_silhouette_lizard},
                                    {"silhouette_khronos", test_silhouette_khronos},
