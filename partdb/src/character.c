@@ -411,8 +411,13 @@ sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err)
     if (r != SP_OK) return r;
     if (renorm > 0) sp_character_warn(ch, "renormalised skin weights of %d vertices", renorm);
     if (rig->abstraction_count == 0) {
-        r = sp_gltf_derive_stick(rig, im->is_skin, err);
+        int flat = 0;
+        r = sp_gltf_derive_stick(rig, im->is_skin, &flat, err);
         if (r != SP_OK) return r;
+        if (flat > 0)
+            sp_character_warn(
+                ch, "the stick figure leaves out %d bone%s whose skin flattens the mesh (a singular inverse bind matrix)", flat,
+                flat == 1 ? "" : "s");
         if (rig->abstraction_count > 0) {
             ch->derived_abstraction = true;
             r = sp_rig_finalize(rig, what, NULL, err);

@@ -486,24 +486,6 @@ static sp_result build_rig(const work* w, sp_rig* R, sp_error* err)
     return r;
 }
 
-// The inverse of a rest or skin matrix, refused when the matrix flattens
-// space for any practical purpose: |det| against the cube of its linear
-// part's size (Frobenius), which a rotation with any uniform scale keeps at
-// 3^-1.5 and a scale of 1e-6 along one axis brings to 3.5e-7. The test of
-// sp_mat4_inverse is absolute (1e-300): a blend with an inverse bind matrix
-// that flattens the mesh (glTF allows it; the loader warns) passed it, and
-// moved outline points a million-fold or past glTF's float range.
-static bool usable_inverse(const sp_mat4* a, sp_mat4* inv)
-{
-    const double* m = a->m;
-    double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[4] * (m[1] * m[10] - m[2] * m[9]) + m[8] * (m[1] * m[6] - m[2] * m[5]);
-    double n2 = 0.0;
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r)
-            n2 += m[4 * c + r] * m[4 * c + r];
-    return fabs(det) > 1e-6 * n2 * sqrt(n2) && sp_mat4_inverse(a, inv);
-}
-
 // The traced outline (world points at rest) moved to bind space: x0 = A^-1 x
 // with A the point's blended skin matrix at rest, as the mesh's vertices are.
 static sp_result add_outline(sp_rig* R, const double* xyz, const sp_mat4* skin, const sp_camera* cam, int points,
@@ -546,7 +528,7 @@ static sp_result add_outline(sp_rig* R, const double* xyz, const sp_mat4* skin, 
                 A.m[e] += wk * skin[ab.joints[4 * i + k]].m[e];
         }
         sp_mat4 inv;
-        if (!usable_inverse(&A, &inv)) {
+        if (!sp_mat4_inverse_rel(&A, SP_MAT4_FLAT, &inv)) {
             sp_abstraction_free(&ab);
             return sp_fail(err, SP_ERR_INVALID, "the skin collapses at outline point %d (a singular blend of joint matrices)", i);
         }
@@ -642,7 +624,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         tr[j] = sr->joints[j].rest_t, rot[j] = sr->joints[j].rest_r, sc[j] = sr->joints[j].rest_s;
     fk(sr, tr, rot, sc, w.G);
     for (int j = 0; j < SJ; ++j) {
-        if (!usable_inverse(&w.G[j], &w.Ginv[j])) {
+        if (!sp_mat4_inverse_rel(&w.G[j], SP_MAT4_FLAT, &w.Ginv[j])) {
             r = sp_fail(err, SP_ERR_INVALID, "joint '%s' has a singular rest transform (a zero or vanishing scale)",
                         sr->joints[j].name);
             goto done;
@@ -713,10 +695,15 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     }
     for (int j = 0; j < R.joint_count; ++j)
         is_skin[j] = w.j[j].src >= 0;
-    if ((r = sp_gltf_derive_stick(&R, is_skin, err)) != SP_OK || (r = sp_rig_finalize(&R, what, NULL, err)) != SP_OK) {
+    int flat = 0;
+    if ((r = sp_gltf_derive_stick(&R, is_skin, &flat, err)) != SP_OK || (r = sp_rig_finalize(&R, what, NULL, err)) != SP_OK) {
         sp_character_free(&notes);
         goto done;
     }
+    if (flat > 0)
+        sp_character_warn(&notes,
+                          "the stick figure leaves out %d bone%s whose skin flattens the mesh (a singular inverse bind matrix)",
+                          flat, flat == 1 ? "" : "s");
     bool stick = sp_rig_find_abstraction(&R, "stick") >= 0;
     if (!strcmp(abstraction, "stick") && !stick) {
         sp_character_free(&notes);

@@ -57,8 +57,10 @@ sp_result sp_gltf_append_curve(sp_rig* rig, const char* abstraction, sp_correspo
 
 /// Derives the "stick" abstraction from the skeleton (finalized rig, default
 /// parameters): a curve per bone chain between skin joints. Returns SP_OK and
-/// appends nothing when there is no bone.
-sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err);
+/// appends nothing when there is no bone. A bone whose joint's skin matrix
+/// flattens space (sp_mat4_inverse_rel, SP_MAT4_FLAT) gets no points;
+/// `flat_bones` (may be NULL) counts them.
+sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones, sp_error* err);
 
 /// Everything after the adapter filled ch->rig (unfinalized), ch->colors and
 /// perhaps ch->camera: default DOFs, finalize, warnings, the derived stick

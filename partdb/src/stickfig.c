@@ -53,19 +53,21 @@ static void stick_free(stick_buf* b)
     free(b->rest), free(b->joints), free(b->weights);
 }
 
-sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
+sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones, sp_error* err)
 {
     int J = rig->joint_count;
+    if (flat_bones) *flat_bones = 0;
     int* nchild = calloc((size_t)J, sizeof(int));
     int* chain = malloc(sizeof(int) * (size_t)(J + 1));
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
     sp_mat4* inv = malloc(sizeof(sp_mat4) * (size_t)J);
+    bool* usable = malloc(sizeof(bool) * (size_t)J);
     sp_vec3* pos = malloc(sizeof(sp_vec3) * (size_t)J);
     sp_rig_eval* ev;
     sp_rig_eval_create(rig, &ev, NULL);
     stick_buf b = {0};
     sp_result r = SP_OK;
-    if (!nchild || !chain || !p || !inv || !pos || !ev) {
+    if (!nchild || !chain || !p || !inv || !usable || !pos || !ev) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "stick figure: out of memory");
         goto done;
     }
@@ -75,7 +77,9 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
     const sp_mat4* skin = sp_rig_eval_skin(ev);
     sp_vec3 lo = {0, 0, 0}, hi = {0, 0, 0};
     for (int j = 0; j < J; ++j) {
-        sp_mat4_inverse(&skin[j], &inv[j]);
+        // A joint whose skin matrix flattens space has no bind-space place
+        // for its bone's points (a singular inverse bind matrix): skipped.
+        usable[j] = sp_mat4_inverse_rel(&skin[j], SP_MAT4_FLAT, &inv[j]);
         pos[j] = sp_mat4_translation(&world[j]);
         if (j == 0) lo = hi = pos[j];
         lo = sp_v3(fmin(lo.x, pos[j].x), fmin(lo.y, pos[j].y), fmin(lo.z, pos[j].z));
@@ -111,6 +115,10 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
                 int u = chain[i], v = chain[i + 1];
                 sp_vec3 d = sp_v3_sub(pos[v], pos[u]);
                 if (!(sp_v3_len(d) > eps)) continue;
+                if (!usable[u]) {
+                    if (flat_bones) ++*flat_bones;
+                    continue;
+                }
                 for (int k = 0; k < SP_STICK_POINTS_PER_BONE; ++k)
                     if (!stick_push(&b, &inv[u], u, sp_v3_add(pos[u], sp_v3_scale(d, (double)k / SP_STICK_POINTS_PER_BONE)))) {
                         r = sp_fail(err, SP_ERR_NO_MEMORY, "stick figure: out of memory");
@@ -130,7 +138,7 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, sp_error* err)
     }
 done:
     sp_rig_eval_destroy(ev);
-    free(nchild), free(chain), free(p), free(inv), free(pos);
+    free(nchild), free(chain), free(p), free(inv), free(usable), free(pos);
     stick_free(&b);
     return r;
 }
@@ -269,7 +277,7 @@ sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err)
         sp_vec3 d = sp_v3_sub(at[i + 1], at[i]);
         int k = (int)ceil(LINE_POINTS * sp_v3_len(d) / total);
         sp_mat4 inv;
-        if (!sp_mat4_inverse(&skin[bone[i]], &inv)) {
+        if (!sp_mat4_inverse_rel(&skin[bone[i]], SP_MAT4_FLAT, &inv)) {
             r = sp_fail(err, SP_ERR_INVALID, "line: joint %s has a singular skin matrix", rig->joints[bone[i]].name);
             goto done;
         }

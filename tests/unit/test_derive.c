@@ -504,6 +504,41 @@ static void test_collapsed_skin(void)
         sp_character_free(&part);
         sp_character_free(&src);
     }
+    // The root's skin flattens only the stick figure's bone, not the
+    // outline (fuzz_derive's second finding): the stick figure leaves that
+    // bone out, where its points went past glTF's float range and the part
+    // did not save; the part is derived, with a warning, and saves.
+    sp_character src = {0}, part = {0};
+    load_ok(sp_test_src_path("tests/fuzz/corpus/derive/flat_stick.glb"), &src);
+    sp_error err = {0};
+    sp_result r = sp_part_derive(&src, NULL, &part, NULL, &err);
+    if (r != SP_OK) fprintf(stderr, "  flat_stick.glb: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    bool said = false;
+    for (int i = 0; i < part.warning_count; ++i)
+        said |= strstr(part.warnings[i], "the stick figure leaves out 1 bone whose skin flattens the mesh") != NULL;
+    ENSURE(said);
+    void* glb = NULL;
+    size_t n = 0;
+    r = sp_gltf_save_memory(&part, NULL, &glb, &n, &err);
+    if (r != SP_OK) fprintf(stderr, "  flat_stick.glb saved: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    free(glb);
+    sp_character_free(&part);
+    sp_character_free(&src);
+    // The loader's stick figure (a file without sketchpose extras) likewise.
+    const float flat[16] = {1, 0, 0, 0, 0, 1e-7f, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    char* text = mini_gltf(&(mini_desc){.ibm0 = flat});
+    ENSURE(sp_gltf_load_memory(text, strlen(text), "mini.gltf", &src, &err) == SP_OK);
+    free(text);
+    said = false;
+    for (int i = 0; i < src.warning_count; ++i)
+        said |= strstr(src.warnings[i], "the stick figure leaves out 1 bone") != NULL;
+    ENSURE(said);
+    for (int a = 0; a < src.rig.abstraction_count; ++a)
+        for (int i = 0; i < 3 * src.rig.abstractions[a].point_count; ++i)
+            ENSURE(fabs(src.rig.abstractions[a].rest[i]) < 10.0);
+    sp_character_free(&src);
 }
 
 // ---- the command line ----------------------------------------------------------------

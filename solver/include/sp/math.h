@@ -167,6 +167,29 @@ static inline bool sp_mat4_inverse(const sp_mat4* a, sp_mat4* out)
     for (int i = 0; i < 16; ++i) out->m[i] = inv[i] * det;
     return true;
 }
+/// sp_mat4_inverse_rel's `rel` for skin and rest matrices: below it a matrix
+/// flattens space for any practical purpose (a scale of 1e-7 along one axis),
+/// and its inverse would move points a million-fold or past float range.
+#define SP_MAT4_FLAT 1e-6
+/// The inverse, when the linear (upper 3x3) part is well away from singular
+/// whatever its scale: |det| over `rel` times its Frobenius norm cubed (a
+/// rotation with any uniform scale gives 3^-1.5); false and the identity
+/// otherwise. sp_mat4_inverse's test is absolute (1e-300), right only where
+/// the scale is known.
+static inline bool sp_mat4_inverse_rel(const sp_mat4* a, double rel, sp_mat4* out)
+{
+    const double* m = a->m;
+    double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[4] * (m[1] * m[10] - m[2] * m[9]) + m[8] * (m[1] * m[6] - m[2] * m[5]);
+    double n2 = 0.0;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+            n2 += m[4 * c + r] * m[4 * c + r];
+    if (!(fabs(det) > rel * n2 * sqrt(n2))) {
+        *out = sp_mat4_identity();
+        return false;
+    }
+    return sp_mat4_inverse(a, out);
+}
 static inline sp_vec3 sp_mat4_translation(const sp_mat4* a) { return (sp_vec3){a->m[12], a->m[13], a->m[14]}; }
 /// The translation by t.
 static inline sp_mat4 sp_mat4_translate(sp_vec3 t)
