@@ -17,6 +17,7 @@
 #include "cv_adapter.h"
 #include "feat.h"
 #include "kmeans.h"
+#include "model_checksum.h"
 #include "picture.h"
 #include "shape.h"
 #include "sp/math.h"
@@ -1198,14 +1199,6 @@ sp_result sp_clf_calibrate_reject(sp_clf* c, const sp_dataset* held_out, const u
 static const char k_magic[8] = {'S', 'P', 'C', 'L', 'F', 'M', 'D', 'L'};
 #define SP_CLF_BOM 0x01020304u
 
-static uint64_t fnv1a(const unsigned char* p, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
-
 typedef struct wbuf {
     unsigned char* p;
     size_t n, cap;
@@ -1289,7 +1282,7 @@ sp_result sp_clf_to_bytes(const sp_clf* c, void** bytes, size_t* size, sp_error*
     put(&b, c->pics, sizeof(float) * (size_t)c->pic_count * SP_PICTURE_DIM);
     put(&b, c->pic_labels, sizeof(int32_t) * (size_t)c->pic_count);
     uint32_t version = SP_CLF_FILE_VERSION, bom = SP_CLF_BOM;
-    uint64_t len = b.n - head, sum = b.oom ? 0 : fnv1a(b.p + head, len);
+    uint64_t len = b.n - head, sum = b.oom ? 0 : sp_clf_checksum(b.p + head, len);
     put(&b, &sum, 8);
     if (b.oom) {
         free(b.p);
@@ -1389,7 +1382,7 @@ sp_result sp_clf_from_bytes(const void* bytes, size_t size, const char* what, sp
     const unsigned char* p = hdr + 24;
     uint64_t sum;
     memcpy(&sum, p + len, 8);
-    if (size - 24 != len + 8 || sum != fnv1a(p, (size_t)len))
+    if (size - 24 != len + 8 || sum != sp_clf_checksum(p, (size_t)len))
         return sp_fail(err, SP_ERR_PARSE, "%s: model file corrupt (checksum mismatch)", what);
     rbuf b = {p, (size_t)len, 0, false};
     sp_clf* c = calloc(1, sizeof *c);

@@ -9,16 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_check.h"
 #include "sp/derive.h"
 #include "sp/gltf.h"
-
-static void one_line(const sp_error* err)
-{
-    if (!err->text[0] || memchr(err->text, '\n', sizeof err->text)) {
-        fprintf(stderr, "bad error message: \"%s\"\n", err->text);
-        abort(); // every refusal comes with a one-line message
-    }
-}
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
@@ -45,7 +38,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         free(glb);
         sp_character_free(&part);
     } else {
-        one_line(&err);
+        sp_fuzz_one_line(&err);
     }
     sp_character_free(&src);
     return 0;

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model_checksum.h"
 #include "sp/classifier.h"
 
 // A zigzag over a square canvas: ink in every pyramid cell.
@@ -33,15 +34,6 @@ static void load(const uint8_t* data, size_t size)
     sp_clf_destroy(clf);
 }
 
-// The model's 64-bit FNV-1a checksum (classifier.c).
-static uint64_t fnv1a(const uint8_t* p, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
     load(data, size);
@@ -51,7 +43,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     uint8_t* fixed = malloc(size);
     if (!fixed) return 0;
     memcpy(fixed, data, size);
-    uint64_t len = size - 32, sum = fnv1a(fixed + 24, (size_t)len);
+    uint64_t len = size - 32, sum = sp_clf_checksum(fixed + 24, (size_t)len);
     memcpy(fixed + 16, &len, 8);
     memcpy(fixed + 24 + len, &sum, 8);
     load(fixed, size);

@@ -7,3 +7,5 @@
 # test_classifier model_files checks that they still load. Run longer by hand, e.g.
 #   build-fuzz/tests/fuzz_model -max_total_time=300 /tmp/model-corpus tests/fuzz/corpus/model
 sp_fuzz_target(model LIBS sp::classifier INSTRUMENT sp_classifier RUNS 500 MAX_LEN 70000)
+# The model format's checksum (model_checksum.h), to make a mutated file's right.
+target_include_directories(fuzz_model PRIVATE ${PROJECT_SOURCE_DIR}/classifier/src)

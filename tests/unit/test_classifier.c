@@ -14,6 +14,7 @@
 
 // Internals (tests may reach into src/, STYLE.md).
 #include "../../classifier/src/feat.h"
+#include "../../classifier/src/model_checksum.h"
 #include "../../classifier/src/picture.h"
 #include "../../classifier/src/shape.h"
 
@@ -748,15 +749,6 @@ static void test_model_files(void)
     sp_sketch_free(&zigzag);
 }
 
-// The model file's FNV-1a checksum (classifier.c), to write an older version's file.
-static uint64_t model_checksum(const unsigned char* p, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
-
 static void test_shape_descriptor(void)
 {
     sp_error err = {0};
@@ -942,7 +934,7 @@ static void write_old_version(const char* from, const char* to, uint32_t version
     len -= cut;
     memcpy(buf + 8, &version, 4);
     memcpy(buf + 16, &len, 8);
-    uint64_t sum = model_checksum(buf + 24, (size_t)len);
+    uint64_t sum = sp_clf_checksum(buf + 24, (size_t)len);
     memcpy(buf + 24 + len, &sum, 8);
     f = fopen(to, "wb");
     ENSURE(f && fwrite(buf, 1, 24 + (size_t)len + 8, f) == 24 + (size_t)len + 8);
