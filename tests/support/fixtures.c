@@ -186,6 +186,13 @@ void sp_fixture_shared_gltf(const char* rel, sp_character* ch)
     ENSURE(sp_gltf_load(path, ch, &err) == SP_OK);
 }
 
+bool sp_fixture_has_warning(const sp_character* ch, const char* text)
+{
+    for (int i = 0; i < ch->warning_count; ++i)
+        if (strstr(ch->warnings[i], text)) return true;
+    return false;
+}
+
 bool sp_fixture_bench_quickdraw(const char* prog, sp_dataset* ds)
 {
     const char* data = sp_test_data_dir();

@@ -58,6 +58,8 @@ sp_abstraction sp_fixture_outline(int n);
 /// ch; skips the running test when ../shared/data is absent, fails it when
 /// the file does not load. Free with sp_character_free.
 void sp_fixture_shared_gltf(const char* rel, struct sp_character* ch);
+/// Whether one of ch's load or derive warnings contains `text`.
+bool sp_fixture_has_warning(const struct sp_character* ch, const char* text);
 
 /// ../shared/data/quickdraw as a data set, for a benchmark: false, having
 /// said why on stderr after "prog: ", when the data is absent or does not load.

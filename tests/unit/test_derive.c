@@ -63,13 +63,6 @@ static void derive_ok(const sp_character* src, const sp_derive_desc* d, sp_chara
     ENSURE(r == SP_OK);
 }
 
-static bool has_warning(const sp_character* ch, const char* part)
-{
-    for (int i = 0; i < ch->warning_count; ++i)
-        if (strstr(ch->warnings[i], part)) return true;
-    return false;
-}
-
 // The mesh of a rig at its rest TRS, or playing `an` at time t (NULL: rest):
 // world transforms from local TRS, linear blend skinning (xyz: vertices by 3).
 static void mesh_at(const sp_rig* rig, const sp_animation* an, double t, double* xyz)
@@ -262,11 +255,11 @@ static void test_what_is_derived(void)
 {
     sp_character src = {0}, part = {0};
     load_ok(lizard("lizard.glb", (sp_foreign_desc){.missing_texture = true}), &src);
-    ENSURE(has_warning(&src, "lizard_skin.png")); // a warning, not a failure
+    ENSURE(sp_fixture_has_warning(&src, "lizard_skin.png")); // a warning, not a failure
     ENSURE(sp_part_needs_derivation(&src) && src.mesh_skins == 1);
     sp_derive_info info;
     derive_ok(&src, &(sp_derive_desc){.category = "lizard"}, &part, &info);
-    ENSURE(has_warning(&part, "lizard_skin.png"));
+    ENSURE(sp_fixture_has_warning(&part, "lizard_skin.png"));
     ENSURE(info.derived == (SP_DERIVED_OUTLINE | SP_DERIVED_STICK | SP_DERIVED_PARAMETERS | SP_DERIVED_ATTACH | SP_DERIVED_CLIP |
                             SP_DERIVED_VIEW));
     // The Armature node is folded away; every joint moves vertices.
@@ -514,7 +507,7 @@ static void test_collapsed_skin(void)
     sp_result r = sp_part_derive(&src, NULL, &part, NULL, &err);
     if (r != SP_OK) fprintf(stderr, "  flat_stick.glb: %s\n", err.text);
     ENSURE(r == SP_OK);
-    ENSURE(has_warning(&part, "the stick figure leaves out 1 bone whose skin flattens the mesh"));
+    ENSURE(sp_fixture_has_warning(&part, "the stick figure leaves out 1 bone whose skin flattens the mesh"));
     void* glb = NULL;
     size_t n = 0;
     r = sp_gltf_save_memory(&part, NULL, &glb, &n, &err);
@@ -528,7 +521,7 @@ static void test_collapsed_skin(void)
     char* text = mini_gltf(&(mini_desc){.ibm0 = flat});
     ENSURE(sp_gltf_load_memory(text, strlen(text), "mini.gltf", &src, &err) == SP_OK);
     free(text);
-    ENSURE(has_warning(&src, "the stick figure leaves out 1 bone"));
+    ENSURE(sp_fixture_has_warning(&src, "the stick figure leaves out 1 bone"));
     for (int a = 0; a < src.rig.abstraction_count; ++a)
         for (int i = 0; i < 3 * src.rig.abstractions[a].point_count; ++i)
             ENSURE(fabs(src.rig.abstractions[a].rest[i]) < 10.0);

@@ -41,13 +41,6 @@ static sp_character load_ok(const char* path)
     return ch;
 }
 
-static bool has_warning(const sp_character* ch, const char* text)
-{
-    for (int i = 0; i < ch->warning_count; ++i)
-        if (strstr(ch->warnings[i], text)) return true;
-    return false;
-}
-
 // The writer's text of a part (sp_part_write_json), malloc'd.
 static char* part_text(const sp_part* part)
 {
@@ -262,8 +255,8 @@ static void test_cesium_gltf_vs_glb(void)
     ENSURE(!memcmp(a.rig.rest, b.rig.rest, sizeof(double) * 3 * (size_t)a.rig.vertex_count));
     ENSURE(!memcmp(a.rig.weights4, b.rig.weights4, sizeof(float) * 4 * (size_t)a.rig.vertex_count));
     ENSURE(!memcmp(a.rig.joints4, b.rig.joints4, sizeof(uint16_t) * 4 * (size_t)a.rig.vertex_count));
-    ENSURE(has_warning(&a, "renormalised skin weights of 210 vertices"));
-    ENSURE(has_warning(&b, "renormalised skin weights of 210 vertices"));
+    ENSURE(sp_fixture_has_warning(&a, "renormalised skin weights of 210 vertices"));
+    ENSURE(sp_fixture_has_warning(&b, "renormalised skin weights of 210 vertices"));
     ENSURE(a.derived_dofs && a.rig.param_count >= 3 * 19);
     ENSURE(a.rig.animation_count == 1 && a.rig.animations[0].duration_s > 0);
     ENSURE(!a.has_camera && a.camera.scale > 0);
@@ -279,7 +272,7 @@ static void test_rigged_figure(void)
     sp_character b = load_ok(data_path("RiggedFigure/RiggedFigure.glb"));
     ENSURE(a.rig.vertex_count == 370);
     ensure_same_rig(&a.rig, &b.rig, 1e-12);
-    ENSURE(has_warning(&a, "renormalised skin weights of 31 vertices"));
+    ENSURE(sp_fixture_has_warning(&a, "renormalised skin weights of 31 vertices"));
     ensure_stick(&a);
     sp_character_free(&a);
     sp_character_free(&b);
@@ -293,7 +286,7 @@ static void test_simple_skins(void)
     ENSURE(s.rig.param_count == 6);
     ENSURE(s.rig.animation_count == 1);
     // Its only bone has length 0 (the child joint sits on its parent): no stick figure.
-    ENSURE(s.rig.abstraction_count == 0 && has_warning(&s, "no bones"));
+    ENSURE(s.rig.abstraction_count == 0 && sp_fixture_has_warning(&s, "no bones"));
     sp_character_free(&s);
     sp_character a = load_ok(data_path("RiggedSimple/glTF/RiggedSimple.gltf"));
     sp_character b = load_ok(data_path("RiggedSimple/RiggedSimple.glb"));
@@ -328,7 +321,7 @@ static void test_mini_plain(void)
     ENSURE(ch.rig.param_count == 6 && ch.derived_dofs);
     ENSURE(sp_rig_find_param(&ch.rig, "tip.ry") >= 0);
     ENSURE_NEAR(ch.rig.params[0].max, 2.0943951023931957, 1e-12);
-    ENSURE(has_warning(&ch, "renormalised skin weights of 1 vertices"));
+    ENSURE(sp_fixture_has_warning(&ch, "renormalised skin weights of 1 vertices"));
     ENSURE(ch.rig.joints4[4 * 2] == 2 && ch.rig.joints4[4 * 2 + 1] == 1); // skin joint 1 -> rig joint 2
     ENSURE_NEAR(ch.colors[0], 0.9, 1e-6);
     ENSURE_NEAR(ch.colors[1], 0.3, 1e-6);
@@ -352,7 +345,7 @@ static void test_mini_plain(void)
     // A second set of joints and weights: ignored, with a word.
     ch = load_ok(write_edited("influences8.gltf", &(mini_desc){0}, "\"WEIGHTS_0\": 2}",
                               "\"WEIGHTS_0\": 2, \"JOINTS_1\": 1, \"WEIGHTS_1\": 2}"));
-    ENSURE(has_warning(&ch, "mesh 0 primitive 0: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)"));
+    ENSURE(sp_fixture_has_warning(&ch, "mesh 0 primitive 0: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)"));
     sp_character_free(&ch);
 }
 
@@ -670,7 +663,8 @@ static void test_inverse_bind(void)
     // Singular but legal: every vertex the tip moves lands on one point.
     static const float flat[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 1};
     ch = load_ok(write_mini("ibm_flat.gltf", &(mini_desc){.ibm1 = flat}));
-    ENSURE(ch.warning_count == 1 && has_warning(&ch, "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix is singular"));
+    ENSURE(ch.warning_count == 1 &&
+           sp_fixture_has_warning(&ch, "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix is singular"));
     sp_character_free(&ch);
     // Not singular: a file in millimetres, a shear with a non-uniform scale.
     static const float small[16] = {1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, -1e-3f, 0, 1};
@@ -686,7 +680,7 @@ static void test_inverse_bind(void)
     ch = load_ok(write_edited("matrix_and_trs.gltf", &(mini_desc){0}, "\"translation\": [0, 1, 0]",
                               "\"translation\": [0, 5, 0], \"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 1]"));
     ENSURE(ch.warning_count == 1 &&
-           has_warning(&ch, "node 1 'tip' has both a matrix and translation/rotation/scale: the matrix is used"));
+           sp_fixture_has_warning(&ch, "node 1 'tip' has both a matrix and translation/rotation/scale: the matrix is used"));
     sp_character_free(&ch);
 }
 
