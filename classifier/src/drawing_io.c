@@ -22,8 +22,9 @@ sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
     memset(out, 0, sizeof *out);
     // Why read the header first: a decoder would allocate the whole image
     // before we could refuse a 20000x20000 file.
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    FILE* f;
+    sp_result rc = sp_file_open_regular(path, &f, NULL, err);
+    if (rc != SP_OK) return rc;
     unsigned char hdr[24];
     size_t got = fread(hdr, 1, sizeof hdr, f);
     fclose(f);
@@ -35,7 +36,7 @@ sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
                        SP_RASTER_MAX_SIDE);
     char* bytes;
     size_t len;
-    sp_result rc = sp_sketch_file_read(path, &bytes, &len, err);
+    rc = sp_sketch_file_read(path, &bytes, &len, err);
     if (rc != SP_OK) return rc;
     // Why stb and not OpenCV's decoder: it is quiet (see png_decode.h), and
     // the pixels it gives go straight to the grey conversion: one decode.

@@ -124,25 +124,45 @@ sp_result sp_file_write_printed(const char* path, FILE* f, char** text, size_t* 
     return r;
 }
 
+sp_result sp_file_open_regular(const char* path, FILE** out, long long* size, sp_error* err)
+{
+    *out = NULL;
+    // O_NONBLOCK: opening a FIFO for reading waits for a writer, so a pipe
+    // given as a file would hang before fstat could refuse it.
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
+    // Regular files only: a device (/dev/zero) or a pipe has no end to size a
+    // buffer by, and reading it "whole" would fill the memory.
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
+    }
+    int fl = fcntl(fd, F_GETFL);
+    FILE* f = fl >= 0 && fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) == 0 ? fdopen(fd, "rb") : NULL;
+    if (!f) {
+        int e = errno;
+        close(fd);
+        return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(e));
+    }
+    *out = f;
+    if (size) *size = (long long)st.st_size;
+    return SP_OK;
+}
+
 sp_result sp_file_read(const char* path, size_t max_bytes, void** data, size_t* size, sp_error* err)
 {
     *data = NULL;
     *size = 0;
-    FILE* f = fopen(path, "rb");
-    if (!f) return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno));
-    // Regular files only: a device (/dev/zero) or a pipe has no end to size a
-    // buffer by, and reading it "whole" would fill the memory.
-    struct stat st;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+    FILE* f;
+    long long bytes;
+    sp_result r = sp_file_open_regular(path, &f, &bytes, err);
+    if (r != SP_OK) return r;
+    if ((unsigned long long)bytes > max_bytes) {
         fclose(f);
-        return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: file too large (%lld bytes, at most %zu)", path, bytes, max_bytes);
     }
-    if ((unsigned long long)st.st_size > max_bytes) {
-        fclose(f);
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: file too large (%lld bytes, at most %zu)", path, (long long)st.st_size,
-                       max_bytes);
-    }
-    size_t n = (size_t)st.st_size;
+    size_t n = (size_t)bytes;
     char* buf = malloc(n + 1);
     if (!buf) {
         fclose(f);

@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -399,6 +400,24 @@ static void test_png(void)
     write_text(fake, "this is not a png at all");
     ENSURE(sp_raster_read_png(fake, &r, &err) == SP_ERR_PARSE);
     ENSURE(contains(err.text, "not a PNG") && contains(err.text, "fake.png"));
+
+    // A pipe named as a PNG is refused at once: opening it to read the
+    // header used to wait for a writer forever. In a child, so that a reader
+    // that waits fails the test (SIGALRM) instead of hanging it.
+    const char* fifo = sp_test_tmp_path("pipe.png");
+    unlink(fifo);
+    ENSURE(mkfifo(fifo, 0600) == 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        alarm(20);
+        sp_error e = {0};
+        _exit(sp_raster_read_png(fifo, &r, &e) == SP_ERR_IO && contains(e.text, "pipe.png: not a regular file") ? 0 : 1);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    unlink(fifo);
 
     // Right signature, garbage after: the decoder fails cleanly.
     memcpy(buf + 30, "garbagegarbagegarbage", 21);

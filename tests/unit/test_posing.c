@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -551,7 +552,8 @@ static void test_device_inputs(void)
                            "classify --model /dev/zero --strokes /dev/null",
                            "pose --rig %s/assets/tail.glb --strokes /dev/zero --out %s",
                            "pose --rig /dev/zero --strokes /dev/null"};
-    const char* out = sp_test_tmp_path("device_inputs.glb");
+    char out[1024]; // a copy: sp_test_tmp_path's buffers are reused after eight calls
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("device_inputs.glb"));
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char args[1200], cmd[3000];
         snprintf(args, sizeof args, cases[i], SP_SOURCE_DIR, out);
@@ -567,6 +569,33 @@ static void test_device_inputs(void)
         ENSURE(rc == 1 && strstr(text, "not a regular file") && strchr(text, '\n') == text + n - 1);
         ENSURE(access(out, F_OK) != 0);
     }
+    // A named pipe with no writer: opening it to read used to wait forever.
+    char fifo[1024], strokes[1024], log[1024];
+    snprintf(fifo, sizeof fifo, "%s", sp_test_tmp_path("device_inputs.fifo"));
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("device_inputs.json"));
+    snprintf(log, sizeof log, "%s", sp_test_tmp_path("device_inputs.txt"));
+    unlink(fifo);
+    ENSURE(mkfifo(fifo, 0600) == 0);
+    char cmd[3000];
+    snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s/assets/tail.glb' --seed 1 --out '%s' > /dev/null", SP_SKETCHPOSE,
+             SP_SOURCE_DIR, strokes);
+    ENSURE(run(cmd) == 0);
+    const char* fifo_cases[] = {"inspect --rig %1$s", "export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s",
+                                "classify --model %1$s --strokes %3$s",
+                                "pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s"};
+    for (size_t i = 0; i < sizeof fifo_cases / sizeof fifo_cases[0]; ++i) {
+        char args[1200];
+        snprintf(args, sizeof args, fifo_cases[i], fifo, SP_SOURCE_DIR, strokes, out);
+        snprintf(cmd, sizeof cmd, "timeout 60 '%s' %s 2>'%s' >/dev/null", SP_SKETCHPOSE, args, log);
+        int rc = run(cmd);
+        size_t n = 0;
+        char* text = sp_fixture_file_text(log, &n);
+        fprintf(stderr, "  %s: exit %d, %s", args, rc, text);
+        ENSURE(rc == 1 && strstr(text, "device_inputs.fifo: not a regular file") && strchr(text, '\n') == text + n - 1);
+        ENSURE(access(out, F_OK) != 0);
+        free(text);
+    }
+    unlink(fifo);
 }
 
 int main(int argc, char** argv)
