@@ -221,11 +221,14 @@ int buffer_of_path(const LoadContext& cx, const std::string& path)
 // and of a missing one says only "File not found". A buffer's file is said to
 // exist beside the glTF, so that read_buffer_file tries exactly that one (a
 // relative uri is relative to the glTF, not to where we run) and says which
-// buffer is missing.
+// buffer is missing. Otherwise stat, not tinygltf::FileExists: that opens
+// the file, and opening a FIFO (an image's uri) waits for a writer forever;
+// read_buffer_file then refuses what is not a regular file.
 bool buffer_file_exists(const std::string& path, void* user)
 {
     const LoadContext& cx = *static_cast<const LoadContext*>(user);
-    return buffer_of_path(cx, path) >= 0 || tinygltf::FileExists(path, nullptr);
+    struct stat st;
+    return buffer_of_path(cx, path) >= 0 || stat(path.c_str(), &st) == 0;
 }
 
 // tinygltf's own reader sizes its vector by seeking to the end, which for a

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "fixtures.h"
@@ -568,6 +569,29 @@ static void test_says_what_is_wrong(void)
 {
     ensure_fails(write_edited("buf_dir.gltf", &(mini_desc){.uri = "NAME"}, "NAME", "."), "buf_dir.gltf", "buffer 0: ");
     ensure_fails(sp_test_tmp_path("buf_dir.gltf"), "buf_dir.gltf", "is a directory");
+    // An image whose uri names a pipe: the file loads, with a warning. Looking
+    // for the file used to open it, which waits for a writer forever; in a
+    // child, so that such a wait fails the test (SIGALRM) instead of hanging it.
+    char fifo[1024];
+    snprintf(fifo, sizeof fifo, "%s", sp_test_tmp_path("image.fifo"));
+    unlink(fifo);
+    ENSURE(mkfifo(fifo, 0600) == 0);
+    char images[1200];
+    snprintf(images, sizeof images, "{\"images\": [{\"uri\": \"%s\"}], \"asset\"", strrchr(fifo, '/') + 1);
+    const char* img = write_edited("image_fifo.gltf", &(mini_desc){0}, "{\"asset\"", images);
+    fflush(NULL);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) {
+        alarm(20);
+        sp_character c = {0};
+        sp_error e = {0};
+        bool ok = sp_gltf_load(img, &c, &e) == SP_OK && sp_fixture_has_warning(&c, "image.fifo is not a regular file");
+        _exit(ok ? 0 : 1);
+    }
+    int status = 0;
+    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    unlink(fifo);
     // An external file of the wrong size is refused before it is read.
     const char* bin = sp_test_tmp_path("short.bin");
     ENSURE(mini_write(bin, "0123456789", 10));
