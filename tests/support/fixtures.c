@@ -300,6 +300,15 @@ int sp_fixture_fork_file_limit(long bytes)
     return (int)pid;
 }
 
+int sp_fixture_fork_alarm(unsigned seconds)
+{
+    fflush(NULL);
+    pid_t pid = fork();
+    ENSURE(pid >= 0);
+    if (pid == 0) alarm(seconds);
+    return (int)pid;
+}
+
 bool sp_fixture_child_passed(int pid)
 {
     int status = 0;

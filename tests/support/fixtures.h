@@ -97,6 +97,11 @@ int sp_fixture_gltf_validate(const char* file);
 /// when fork fails.
 int sp_fixture_fork_file_limit(long bytes);
 
+/// fork() for a call that must not hang (a read of a pipe): the child (0
+/// returned) is killed by SIGALRM after `seconds`; the parent gets its pid,
+/// for sp_fixture_child_passed. Fails the running test when fork fails.
+int sp_fixture_fork_alarm(unsigned seconds);
+
 /// Waits for the child `pid`: true when it exited with status 0.
 bool sp_fixture_child_passed(int pid);
 

@@ -5,10 +5,10 @@
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
+#include "fixtures.h"
 #include "sp/classifier.h"
 #include "sp/sketch_io.h"
 #include "test.h"
@@ -407,16 +407,12 @@ static void test_png(void)
     const char* fifo = sp_test_tmp_path("pipe.png");
     unlink(fifo);
     ENSURE(mkfifo(fifo, 0600) == 0);
-    fflush(NULL);
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    int pid = sp_fixture_fork_alarm(20);
     if (pid == 0) {
-        alarm(20);
         sp_error e = {0};
         _exit(sp_raster_read_png(fifo, &r, &e) == SP_ERR_IO && contains(e.text, "pipe.png: not a regular file") ? 0 : 1);
     }
-    int status = 0;
-    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(sp_fixture_child_passed(pid));
     unlink(fifo);
 
     // Right signature, garbage after: the decoder fails cleanly.

@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "fixtures.h"
@@ -579,18 +578,13 @@ static void test_says_what_is_wrong(void)
     char images[1200];
     snprintf(images, sizeof images, "{\"images\": [{\"uri\": \"%s\"}], \"asset\"", strrchr(fifo, '/') + 1);
     const char* img = write_edited("image_fifo.gltf", &(mini_desc){0}, "{\"asset\"", images);
-    fflush(NULL);
-    pid_t pid = fork();
-    ENSURE(pid >= 0);
+    int pid = sp_fixture_fork_alarm(20);
     if (pid == 0) {
-        alarm(20);
         sp_character c = {0};
         sp_error e = {0};
-        bool ok = sp_gltf_load(img, &c, &e) == SP_OK && sp_fixture_has_warning(&c, "image.fifo is not a regular file");
-        _exit(ok ? 0 : 1);
+        _exit(sp_gltf_load(img, &c, &e) == SP_OK && sp_fixture_has_warning(&c, "image.fifo is not a regular file") ? 0 : 1);
     }
-    int status = 0;
-    ENSURE(waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ENSURE(sp_fixture_child_passed(pid));
     unlink(fifo);
     // An external file of the wrong size is refused before it is read.
     const char* bin = sp_test_tmp_path("short.bin");
