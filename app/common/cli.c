@@ -28,6 +28,57 @@ static void print_help(const char* cmd, const char* summary, const sp_opt* opts,
     printf("  %-12s %-12s %s\n", "--help", "", "show this help");
 }
 
+// One file: one inode when both exist; the same name in one folder when
+// neither does (two outputs yet to be written).
+static bool same_file(const char* a, const char* b)
+{
+    struct stat sa, sb;
+    bool ea = stat(a, &sa) == 0, eb = stat(b, &sb) == 0;
+    if (ea || eb) return ea && eb && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    char *da = sp_path_folder(a), *db = sp_path_folder(b);
+    const char *na = strrchr(a, '/'), *nb = strrchr(b, '/');
+    bool same = da && db && stat(da, &sa) == 0 && stat(db, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino &&
+                !strcmp(na ? na + 1 : a, nb ? nb + 1 : b);
+    free(da), free(db);
+    return same;
+}
+
+// An output that is also an input would be overwritten by the command's
+// own result (`pose --strokes s.json --report s.json` replaced the strokes
+// with the report); two outputs on one file keep only the last. Streams
+// (/dev/stdout, a pipe) are written as they go and left alone.
+static int check_files(const char* cmd, const sp_opt* opts, int nopts)
+{
+    for (int i = 0; i < nopts; ++i) {
+        const char* out = opts[i].kind == SP_OPT_OUT ? *(const char* const*)opts[i].out : NULL;
+        if (!out || !strcmp(out, "-") || sp_cli_out_is_stream(out)) continue;
+        for (int j = 0; j < nopts; ++j) {
+            bool list = opts[j].kind == SP_OPT_IN_LIST;
+            if (j == i || !(list || opts[j].kind == SP_OPT_IN || opts[j].kind == SP_OPT_OUT)) continue;
+            const char* const* vals = list ? ((const sp_str_list*)opts[j].out)->items : opts[j].out;
+            int n = list ? ((const sp_str_list*)opts[j].out)->count : 1;
+            for (int k = 0; k < n; ++k) {
+                if (!vals[k] || !same_file(out, vals[k])) continue;
+                if (opts[j].kind != SP_OPT_OUT)
+                    fprintf(stderr, "%s: %s %s is the same file as %s: it would be overwritten\n", cmd, opts[i].name, out,
+                            opts[j].name);
+                else if (j < i)
+                    fprintf(stderr, "%s: %s %s is the same file as %s: one would overwrite the other\n", cmd, opts[i].name, out,
+                            opts[j].name);
+                else
+                    continue; // said once, from the later option
+                return 2;
+            }
+        }
+    }
+    for (int i = 0; i < nopts; ++i)
+        if (opts[i].kind == SP_OPT_OUT) {
+            const char* out = *(const char* const*)opts[i].out;
+            if (out && strcmp(out, "-") && !sp_cli_check_out_folder(cmd, opts[i].name, out)) return 1;
+        }
+    return -1;
+}
+
 int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts)
 {
     bool seen[64] = {0};
@@ -49,7 +100,8 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
         // A value given twice is a mistake, not an override: `--out a.glb ...
         // --out b.glb` wrote only b.glb. A flag twice means the same, and a
         // list's values gather.
-        if (k < 64 && seen[k] && o->kind != SP_OPT_FLAG && o->kind != SP_OPT_LIST) {
+        bool list = o->kind == SP_OPT_LIST || o->kind == SP_OPT_IN_LIST;
+        if (k < 64 && seen[k] && o->kind != SP_OPT_FLAG && !list) {
             fprintf(stderr, "%s: %s given twice (once is enough; see --help)\n", cmd, o->name);
             return 2;
         }
@@ -58,7 +110,7 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             *(bool*)o->out = true;
             continue;
         }
-        if (o->kind == SP_OPT_LIST) {
+        if (list) {
             sp_str_list* l = o->out;
             while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) {
                 if (l->count >= 256) {
@@ -82,7 +134,7 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
         const char* v = argv[++i];
         char* end = NULL;
         errno = 0;
-        if (o->kind == SP_OPT_STRING) {
+        if (o->kind == SP_OPT_STRING || o->kind == SP_OPT_IN || o->kind == SP_OPT_OUT) {
             *(const char**)o->out = v;
         } else if (o->kind == SP_OPT_INT) {
             long x = strtol(v, &end, 10);
@@ -112,7 +164,7 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
             fprintf(stderr, "%s: missing %s %s (see --help)\n", cmd, opts[j].name, opts[j].arg);
             return 2;
         }
-    return -1;
+    return check_files(cmd, opts, nopts);
 }
 
 bool sp_cli_parse_size(const char* s, int* w, int* h)
@@ -162,6 +214,10 @@ bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path
                                                       : NULL;
     if (why) fprintf(stderr, "%s: %s %s: cannot write into folder '%s' (%s)\n", cmd, name, path, dir, why);
     free(dir);
+    if (!why && stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "%s: %s %s: is a folder, not a file\n", cmd, name, path);
+        return false;
+    }
     return why == NULL;
 }
 

@@ -13,11 +13,14 @@
 #include <stdbool.h>
 
 typedef enum sp_opt_kind {
-    SP_OPT_FLAG,   ///< bool*, no value
-    SP_OPT_STRING, ///< const char**
-    SP_OPT_INT,    ///< int*
-    SP_OPT_DOUBLE, ///< double*
-    SP_OPT_LIST,   ///< sp_str_list*: every value up to the next option
+    SP_OPT_FLAG,    ///< bool*, no value
+    SP_OPT_STRING,  ///< const char**
+    SP_OPT_INT,     ///< int*
+    SP_OPT_DOUBLE,  ///< double*
+    SP_OPT_LIST,    ///< sp_str_list*: every value up to the next option
+    SP_OPT_IN,      ///< const char**: a file the command reads
+    SP_OPT_OUT,     ///< const char**: a file the command writes
+    SP_OPT_IN_LIST, ///< sp_str_list*: files the command reads
 } sp_opt_kind;
 
 typedef struct sp_str_list {
@@ -36,6 +39,10 @@ typedef struct sp_opt {
 
 /// Parses argv[1..) against opts. Returns -1 when the command should run,
 /// 0 after printing --help, 2 after printing a usage error to stderr.
+/// Before any work, it also refuses (one line, exit 2) an output that names
+/// the same file as an input ("--report s.json is the same file as
+/// --strokes: it would be overwritten") or as another output, and (exit 1)
+/// an output sp_cli_check_out_folder refuses.
 int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts);
 
 /// Parses "WxH" into two ints of 16..8192; false if malformed or out of range.
@@ -67,10 +74,11 @@ bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cl
 /// FIFO or a device (no file name, no folder to write beside it).
 bool sp_cli_out_is_stream(const char* path);
 
-/// For outputs written at the end of long work (a kiosk session): NULL and
-/// streams pass; otherwise the file's folder must exist and be writable by
-/// this user, else "<cmd>: <name> <path>: cannot write into folder 'dir'
-/// (reason)" and false (exit 1), said before the work, not after it.
+/// For outputs written at the end of work (a solve, a kiosk session): NULL
+/// and streams pass; otherwise the file's folder must exist and be writable
+/// by this user, else "<cmd>: <name> <path>: cannot write into folder 'dir'
+/// (reason)", and the path must not be a folder ("<cmd>: <name> <path>: is a
+/// folder, not a file"); false (exit 1), said before the work, not after it.
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path);
 
 /// The longest solve time cap a command takes (--max-ms), ms: one hour.

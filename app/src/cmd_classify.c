@@ -13,9 +13,9 @@ int cmd_classify(int argc, char** argv)
     const char* strokes = NULL;
     int top = 5;
     sp_opt opts[] = {
-        {"--model", SP_OPT_STRING, &model, "M", "trained model (sketchpose train)", false},
-        {"--db", SP_OPT_STRING, &db_path, "DB", "use the part database's current model instead (sketchpose db train)", false},
-        {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the drawing: stroke JSON, SVG, PNG or ndjson (first drawing)", true},
+        {"--model", SP_OPT_IN, &model, "M", "trained model (sketchpose train)", false},
+        {"--db", SP_OPT_IN, &db_path, "DB", "use the part database's current model instead (sketchpose db train)", false},
+        {"--strokes", SP_OPT_IN, &strokes, "S.json", "the drawing: stroke JSON, SVG, PNG or ndjson (first drawing)", true},
         {"--top", SP_OPT_INT, &top, "N", "ranked categories to print (default 5, at most 10)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose classify", "classify one drawing; prints ranked categories as JSON", opts,

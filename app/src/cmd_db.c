@@ -27,7 +27,7 @@ typedef struct db_common {
 } db_common;
 
 #define DB_COMMON_OPTS(c)                                                                                                        \
-    {"--db", SP_OPT_STRING, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},                     \
+    {"--db", SP_OPT_IN, &(c).db, "PATH", "the database (default: $SP_DB, else ./sketchpose.db)", false},                         \
         {"--busy-timeout", SP_OPT_DOUBLE, &(c).busy_s, "S", "seconds to wait for another writer, 0..86400 (default 5)", false},  \
     {                                                                                                                            \
         "--by", SP_OPT_STRING, &(c).by, "WHO", "curator's name for the log (default $USER)", false                               \
@@ -62,8 +62,10 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
             continue;
         }
         kept[nk++] = argv[i];
-        if (o && o->kind != SP_OPT_FLAG && o->kind != SP_OPT_LIST && i + 1 < argc) kept[nk++] = argv[++i];
-        else if (o && o->kind == SP_OPT_LIST)
+        bool list = o && (o->kind == SP_OPT_LIST || o->kind == SP_OPT_IN_LIST);
+        if (o && o->kind != SP_OPT_FLAG && !list && i + 1 < argc)
+            kept[nk++] = argv[++i];
+        else if (list)
             while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0)
                 kept[nk++] = argv[++i];
     }
@@ -331,7 +333,8 @@ static int db_init(int argc, char** argv)
 }
 
 // Whether a file can be made at `path`: it is not a folder, and its folder
-// exists and may be written. One line and false when not.
+// exists and may be written. One line and false when not, ending "nothing
+// stored" (why add-part's --preview is an SP_OPT_STRING, not an SP_OPT_OUT).
 static bool preview_writable(const char* cmd, const char* path)
 {
     char dir[1024];
@@ -891,7 +894,7 @@ static int db_review(int argc, char** argv)
         {"--status", SP_OPT_STRING, &status, "S", "which to list: pending (default), approved, rejected or all", false},
         {"--limit", SP_OPT_INT, &limit, "N", "list at most N, oldest first (default 100; 0: all)", false},
         {"--after", SP_OPT_INT, &after, "ID", "list only ids above ID (the next page: the last id shown)", false},
-        {"--sheet", SP_OPT_STRING, &sheet, "out.png", "also draw the listed sketches as a labelled contact sheet", false},
+        {"--sheet", SP_OPT_OUT, &sheet, "out.png", "also draw the listed sketches as a labelled contact sheet", false},
         {"--approve", SP_OPT_LIST, &approve, "ID...", "approve these kiosk sketches (`db train` uses approved ones)", false},
         {"--reject", SP_OPT_LIST, &reject, "ID...", "reject these kiosk sketches (kept, never trained on)", false},
         {"--relabel", SP_OPT_LIST, &relabel, "ID CATEGORY", "give a kiosk sketch another part category", false}};

@@ -21,11 +21,11 @@ int cmd_derive(int argc, char** argv)
     const char *rig_path = NULL, *out_path = NULL, *preview = NULL, *view = NULL;
     sp_derive_desc d = {0};
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "a rigged, skinned glTF (.gltf or .glb), e.g. from Blender or a download",
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "a rigged, skinned glTF (.gltf or .glb), e.g. from Blender or a download",
          true},
-        {"--out", SP_OPT_STRING, &out_path, "R_sp.glb", "the part with the derived extras (.glb, or .gltf with embedded buffers)",
+        {"--out", SP_OPT_OUT, &out_path, "R_sp.glb", "the part with the derived extras (.glb, or .gltf with embedded buffers)",
          true},
-        {"--preview", SP_OPT_STRING, &preview, "out.png",
+        {"--preview", SP_OPT_OUT, &preview, "out.png",
          "also render the derived outline over the part at rest and in three random poses", false},
         {"--category", SP_OPT_STRING, &d.category, "C",
          "the part's category (sp_part.category; `db add-part --category` can give it later)", false},
@@ -70,12 +70,12 @@ int cmd_derive(int argc, char** argv)
         fprintf(stderr, "%s: preview: %s\n", k_cmd, err.text);
         goto done;
     }
-    if (sp_gltf_save(&part, NULL, out_path, &err) != SP_OK) {
-        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
-        goto done;
-    }
-    if (preview && sp_image_write_png(&sheet, preview, &err) != SP_OK) {
-        sp_outputs_undo(&(sp_outputs){.paths = {out_path}, .count = 1}); // a failed command leaves no part behind
+    sp_outputs staged = {0};
+    const char *out_to, *preview_to;
+    if (sp_outputs_stage(&staged, out_path, &out_to, &err) != SP_OK ||
+        sp_outputs_stage(&staged, preview, &preview_to, &err) != SP_OK || sp_gltf_save(&part, NULL, out_to, &err) != SP_OK ||
+        (preview_to && sp_image_write_png(&sheet, preview_to, &err) != SP_OK) || sp_outputs_commit(&staged, &err) != SP_OK) {
+        sp_outputs_undo(&staged, &err); // a failed command leaves the outputs as they were
         fprintf(stderr, "%s: %s\n", k_cmd, err.text);
         goto done;
     }

@@ -24,12 +24,12 @@ int cmd_dragon(int argc, char** argv)
     const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = SP_SOURCE_DIR "/assets";
     double max_ms = NAN, at = 0; // NAN: not given
     const sp_opt opts[] = {
-        {"--db", SP_OPT_STRING, &db_path, "DB", "the part database (created from --assets when missing)", true},
-        {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the strokes, one per part, in drawing order (sketchpose-strokes JSON)",
+        {"--db", SP_OPT_IN, &db_path, "DB", "the part database (created from --assets when missing)", true},
+        {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes, one per part, in drawing order (sketchpose-strokes JSON)",
          true},
-        {"--out", SP_OPT_STRING, &out, "dragon.glb", "write the animated dragon (.glb, or .gltf)", false},
-        {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: parts, strokes blue, fitted outlines yellow", false},
-        {"--report", SP_OPT_STRING, &report, "report.json", "write the report (also printed on stdout)", false},
+        {"--out", SP_OPT_OUT, &out, "dragon.glb", "write the animated dragon (.glb, or .gltf)", false},
+        {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: parts, strokes blue, fitted outlines yellow", false},
+        {"--report", SP_OPT_OUT, &report, "report.json", "write the report (also printed on stdout)", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
          "parts for a database that does not exist yet (default: the source tree's assets/)", false},
         {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve, " SP_CLI_MAX_MS_RANGE " (default 250)", false},
@@ -73,7 +73,7 @@ int cmd_dragon(int argc, char** argv)
     }
     int exit_code = SP_EXIT_INPUT;
     cJSON* j = NULL;
-    sp_outputs written = {.count = 0};
+    sp_outputs staged = {0};
     cJSON* list = cJSON_CreateArray();
     for (int i = 0; i < sk.stroke_count; ++i) {
         sp_dragon_result res;
@@ -126,19 +126,22 @@ int cmd_dragon(int argc, char** argv)
         fprintf(stderr, "sketchpose dragon: %s: no stroke became a part\n", strokes);
         goto done;
     }
-    if (report && sp_json_write_file(report, j, &err) != SP_OK) goto fail;
-    sp_outputs_add(&written, report);
-    sp_json_print(j);
-    if (out && sp_dragon_export(d, out, &err) != SP_OK) goto fail;
-    sp_outputs_add(&written, out);
-    if (render) {
+    const char *rep_to, *out_to, *render_to;
+    if (sp_outputs_stage(&staged, report, &rep_to, &err) != SP_OK || sp_outputs_stage(&staged, out, &out_to, &err) != SP_OK ||
+        sp_outputs_stage(&staged, render, &render_to, &err) != SP_OK)
+        goto fail;
+    if (rep_to && sp_json_write_file(rep_to, j, &err) != SP_OK) goto fail;
+    if (out_to && sp_dragon_export(d, out_to, &err) != SP_OK) goto fail;
+    if (render_to) {
         sp_dragon_snapshot_desc sd = {.t = at, .strokes = true, .outlines = true};
-        if (sp_dragon_snapshot_png(d, &sd, render, &err) != SP_OK) goto fail;
+        if (sp_dragon_snapshot_png(d, &sd, render_to, &err) != SP_OK) goto fail;
     }
+    if (sp_outputs_commit(&staged, &err) != SP_OK) goto fail;
+    sp_json_print(j);
     exit_code = SP_EXIT_OK;
     goto done;
 fail:
-    sp_outputs_undo(&written);
+    sp_outputs_undo(&staged, &err);
     fprintf(stderr, "sketchpose dragon: %s\n", err.text);
 done:
     cJSON_Delete(list);

@@ -58,12 +58,12 @@ int cmd_drawover(int argc, char** argv)
     sp_solve_desc desc = {0};
     double cap_ms = NAN, lambda_dist = NAN; // not given: the solver's defaults
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
-        {"--on", SP_OPT_STRING, &on_path, "S1.json", "strokes drawn over the character in its view", true},
-        {"--to", SP_OPT_STRING, &to_path, "S2.json", "the same strokes redrawn in their desired shape", true},
-        {"--out", SP_OPT_STRING, &out, "posed.glb", "write the posed character", false},
-        {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: --on grey, --to blue, the fitted curves yellow", false},
-        {"--report", SP_OPT_STRING, &report, "report.json", "write the solve report (also printed on stdout)", false},
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
+        {"--on", SP_OPT_IN, &on_path, "S1.json", "strokes drawn over the character in its view", true},
+        {"--to", SP_OPT_IN, &to_path, "S2.json", "the same strokes redrawn in their desired shape", true},
+        {"--out", SP_OPT_OUT, &out, "posed.glb", "write the posed character", false},
+        {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: --on grey, --to blue, the fitted curves yellow", false},
+        {"--report", SP_OPT_OUT, &report, "report.json", "write the solve report (also printed on stdout)", false},
         {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L", "weight of W_dist, locality (default 0.001; 0 or negative: off)",
          false},
         {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},

@@ -51,7 +51,7 @@ int cmd_eval(int argc, char** argv)
     int folds = 0;
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
-        {"--model", SP_OPT_STRING, &model, "M",
+        {"--model", SP_OPT_IN, &model, "M",
          "trained model (required unless --folds; with --folds, the folds train with its options)", false},
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder to evaluate on", true},
         {"--folds", SP_OPT_INT, &folds, "K", "K-fold cross-validation on DIR (fold = drawing index mod K)", false},

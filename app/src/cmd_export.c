@@ -17,11 +17,9 @@ int cmd_export(int argc, char** argv)
     const char* pose_path = NULL;
     const char* out_path = NULL;
     sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
-         true},
-        {"--pose", SP_OPT_STRING, &pose_path, "p.json", "pose file {\"parameters\": {...}}; default: the pose stored in R",
-         false},
-        {"--out", SP_OPT_STRING, &out_path, "X.glb", "output: .glb, or .gltf with embedded buffers", true},
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
+        {"--pose", SP_OPT_IN, &pose_path, "p.json", "pose file {\"parameters\": {...}}; default: the pose stored in R", false},
+        {"--out", SP_OPT_OUT, &out_path, "X.glb", "output: .glb, or .gltf with embedded buffers", true},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose export",
                           "Write a rig posed by a pose file as glTF (parameters baked into the joints).", opts,

@@ -87,7 +87,8 @@ static cJSON* inspect_json(sp_rig_handle* h)
 int cmd_inspect(int argc, char** argv)
 {
     const char* rig_path = NULL;
-    sp_opt opts[] = {{"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true}};
+    sp_opt opts[] = {
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true}};
     int rc = sp_cli_parse(argc, argv, "sketchpose inspect",
                           "Print a rig's joints, parameters, abstractions, animations and load warnings as JSON.", opts,
                           (int)(sizeof opts / sizeof opts[0]));

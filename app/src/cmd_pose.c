@@ -18,14 +18,13 @@ int cmd_pose(int argc, char** argv)
     int reps = SP_CLI_UNSET, iters = SP_CLI_UNSET;
     double cap_ms = NAN, lambda_pose = NAN, lambda_plane = NAN, lambda_dist = NAN;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
-         true},
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
-        {"--strokes", SP_OPT_STRING, &strokes, "S.json", "the strokes (sketchpose-strokes JSON)", true},
-        {"--start", SP_OPT_STRING, &start, "p.json", "start pose (default: the rig's stored pose)", false},
-        {"--out", SP_OPT_STRING, &out, "posed.glb", "write the posed character", false},
-        {"--render", SP_OPT_STRING, &render, "out.png", "write a picture: strokes blue, fitted abstraction yellow", false},
-        {"--report", SP_OPT_STRING, &report, "report.json", "write the solve report (also printed on stdout)", false},
+        {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes (sketchpose-strokes JSON)", true},
+        {"--start", SP_OPT_IN, &start, "p.json", "start pose (default: the rig's stored pose)", false},
+        {"--out", SP_OPT_OUT, &out, "posed.glb", "write the posed character", false},
+        {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: strokes blue, fitted abstraction yellow", false},
+        {"--report", SP_OPT_OUT, &report, "report.json", "write the solve report (also printed on stdout)", false},
         {"--lambda-pose", SP_OPT_DOUBLE, &lambda_pose, "L", "weight of W_pose (default 0.5; 0 or negative: off)", false},
         {"--lambda-plane", SP_OPT_DOUBLE, &lambda_plane, "L", "weight of W_plane (default 0.01; 0 or negative: off)", false},
         {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L", "weight of W_dist (default 0.001; 0 or negative: off)", false},

@@ -53,13 +53,11 @@ int cmd_render(int argc, char** argv)
     double line_width = NAN, yaw = 0, pitch = 0; // NAN: not given
     bool no_shadow = false;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)",
-         true},
-        {"--pose", SP_OPT_STRING, &pose_path, "p.json", "pose file {\"parameters\": {...}} (default: the rig's stored pose)",
-         false},
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
+        {"--pose", SP_OPT_IN, &pose_path, "p.json", "pose file {\"parameters\": {...}} (default: the rig's stored pose)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "abstraction to overlay (default: the first; 'none': no overlay)",
          false},
-        {"--out", SP_OPT_STRING, &out_path, "X.png", "the PNG to write", true},
+        {"--out", SP_OPT_OUT, &out_path, "X.png", "the PNG to write", true},
         {"--size", SP_OPT_STRING, &size, "WxH", "image size in pixels (default 640x480)", false},
         {"--line-width", SP_OPT_DOUBLE, &line_width, "PX",
          "overlay line width, pixels in (0, 256] (default: scales with the image)", false},

@@ -255,14 +255,14 @@ int cmd_synth(int argc, char** argv)
     double amplitude = 0.7853981633974483, noise = 0, spikes = 0;
     bool details = false, concepts = false, drawings = false;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_STRING, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
         {"--seed", SP_OPT_INT, &seed, "N", "random seed, not negative (required unless --pose)", false},
-        {"--pose", SP_OPT_STRING, &pose, "p.json", "draw this pose instead of a random one", false},
+        {"--pose", SP_OPT_IN, &pose, "p.json", "draw this pose instead of a random one", false},
         {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A",
          "largest change per rotation from rest, radians (default 0.785; with --parts 0.4)", false},
-        {"--out", SP_OPT_STRING, &out, "S.json", "stroke file to write (required unless --parts)", false},
-        {"--truth", SP_OPT_STRING, &truth, "p.json", "also write the pose's parameters", false},
+        {"--out", SP_OPT_OUT, &out, "S.json", "stroke file to write (required unless --parts)", false},
+        {"--truth", SP_OPT_OUT, &truth, "p.json", "also write the pose's parameters", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "canvas size (default: the rig's sketch view)", false},
         {"--noise", SP_OPT_DOUBLE, &noise, "PX", "Gaussian jitter of the stroke points, pixels in [0, 8192] (default 0)", false},
         {"--style", SP_OPT_STRING, &style_name, "S",
@@ -289,7 +289,7 @@ int cmd_synth(int argc, char** argv)
          "the default recipe's draws of the hand-placed designs of assets/sketches/drawings.json, --per-part draws of each "
          "(default 1), as --sheet",
          false},
-        {"--sheet", SP_OPT_STRING, &sheet, "S.png", "with --concepts or --drawings: a labelled contact sheet of them", false},
+        {"--sheet", SP_OPT_OUT, &sheet, "S.png", "with --concepts or --drawings: a labelled contact sheet of them", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose synth",
                           "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "

@@ -15,10 +15,12 @@ int cmd_train(int argc, char** argv)
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder: DIR/<category>/*.{json,svg,png}, DIR/<category>.ndjson", true},
-        {"--model", SP_OPT_STRING, &model, "M", "model file to write", true},
+        {"--model", SP_OPT_OUT, &model, "M", "model file to write", true},
         {"--calibrate", SP_OPT_STRING, &calibrate, "DIR",
-         "held-out labelled folder (e.g. `synth --parts P --style harsh --seed 3`): set the reject threshold from its distances", false},
-        {"--calibrate-quantile", SP_OPT_DOUBLE, &cal_q, "Q", "with --calibrate: share of its drawings accepted (default 0.96)", false},
+         "held-out labelled folder (e.g. `synth --parts P --style harsh --seed 3`): set the reject threshold from its distances",
+         false},
+        {"--calibrate-quantile", SP_OPT_DOUBLE, &cal_q, "Q", "with --calibrate: share of its drawings accepted (default 0.96)",
+         false},
         CLF_CLI_OPTS(o),
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose train", "train a sketch classifier on a labelled folder", opts,

@@ -367,17 +367,17 @@ int main(int argc, char** argv)
         {"--assets", SP_OPT_STRING, &assets, "DIR", "parts for a missing database (default: $SP_ASSETS or assets)", false},
         {"--fullscreen", SP_OPT_FLAG, &fullscreen, "", "full screen on the primary monitor", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "window size (default 1280x800, or the script's canvas)", false},
-        {"--script", SP_OPT_STRING, &script, "S.json", "replay a session (virtual clock), then exit", false},
-        {"--record", SP_OPT_STRING, &record, "R.json", "record the input events to a session file", false},
-        {"--screenshot", SP_OPT_STRING, &shot, "out.png", "PNG of the last frame (and of every script mark)", false},
-        {"--export", SP_OPT_STRING, &out_glb, "out.glb", "glTF of the dragon at the end", false},
+        {"--script", SP_OPT_IN, &script, "S.json", "replay a session (virtual clock), then exit", false},
+        {"--record", SP_OPT_OUT, &record, "R.json", "record the input events to a session file", false},
+        {"--screenshot", SP_OPT_OUT, &shot, "out.png", "PNG of the last frame (and of every script mark)", false},
+        {"--export", SP_OPT_OUT, &out_glb, "out.glb", "glTF of the dragon at the end", false},
         {"--export-dir", SP_OPT_STRING, &export_dir, "DIR", "where Save writes (default: dragon-exports)", false},
         {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen, > 0 (default 90; < 0: never)",
          false},
         {"--join-ms", SP_OPT_DOUBLE, &join_ms, "MS",
          "a stroke begun this soon after the last one's pen-up, where it ended, continues it (default 200; 0 or < 0: never)",
          false},
-        {"--font", SP_OPT_STRING, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
+        {"--font", SP_OPT_IN, &font, "F.ttf", "font (default: DejaVu Sans Bold)", false},
         {"--msaa", SP_OPT_INT, &msaa, "N", "window multisampling, samples 0..16 (default: 4 on a GPU, 0 on software GL)", false},
         {"--lod", SP_OPT_INT, &lod, "N",
          "display triangles per part, 1..10000000 or -1: all (default: 4000 on software GL, all on a GPU)", false},
@@ -429,12 +429,6 @@ int main(int argc, char** argv)
                 k_cmd, shot);
         sp_kiosk_session_free(&session);
         return SP_EXIT_USAGE;
-    }
-    // Written when the session ends: a folder that cannot take them is said now.
-    if (!sp_cli_check_out_folder(k_cmd, "--screenshot", shot) || !sp_cli_check_out_folder(k_cmd, "--export", out_glb) ||
-        !sp_cli_check_out_folder(k_cmd, "--record", record)) {
-        sp_kiosk_session_free(&session);
-        return SP_EXIT_INPUT;
     }
     if (!has_parts(db ? db : sp_db_default_path())) {
         sp_kiosk_session_free(&session);

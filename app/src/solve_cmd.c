@@ -29,20 +29,23 @@ bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
     return true;
 }
 
-// --out and --render of the rig at p.
-static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_solve_outputs* o, sp_outputs* done, sp_error* err)
+// --out and --render of the rig at p, to the names staged for them.
+static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_solve_outputs* o, const char* out,
+                             const char* render, sp_error* err)
 {
     sp_rig_posed v;
     sp_result r = sp_rig_handle_posed(s->rig, s->abstraction, p, &s->cam, &v, err);
-    if (r == SP_OK && o->out && (r = sp_rig_posed_save(&v, o->out, err)) == SP_OK) sp_outputs_add(done, o->out);
-    if (r == SP_OK && o->render) {
+    if (r == SP_OK && out) r = sp_rig_posed_save(&v, out, err);
+    if (r == SP_OK && render) {
         sp_snapshot_desc d = {.character = v.character,
                               .params = v.params,
                               .camera = &s->cam,
                               .abstraction = v.abstraction,
                               .strokes = o->strokes,
                               .ghost = o->ghost};
-        r = sp_snapshot_png(&d, o->render, err);
+        // The picture is the strokes' canvas, which can be too large for GL: say which output failed.
+        sp_error e = {0};
+        if ((r = sp_snapshot_png(&d, render, &e)) != SP_OK) sp_fail(err, r, "%s: %s", render, e.text);
     }
     sp_rig_posed_free(&v);
     return r;
@@ -51,16 +54,20 @@ static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_so
 bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double* p, const sp_solve_outputs* o)
 {
     sp_error err = {0};
-    sp_outputs done = {.count = 0};
-    sp_result r = o->report ? sp_json_write_file(o->report, report, &err) : SP_OK;
-    if (r == SP_OK) sp_outputs_add(&done, o->report);
-    sp_json_print(report);
-    if (r == SP_OK && (o->out || o->render)) r = write_posed(s, p, o, &done, &err);
+    sp_outputs staged = {0};
+    const char *rep = NULL, *out = NULL, *render = NULL;
+    sp_result r = sp_outputs_stage(&staged, o->report, &rep, &err);
+    if (r == SP_OK) r = sp_outputs_stage(&staged, o->out, &out, &err);
+    if (r == SP_OK) r = sp_outputs_stage(&staged, o->render, &render, &err);
+    if (r == SP_OK && rep) r = sp_json_write_file(rep, report, &err);
+    if (r == SP_OK && (out || render)) r = write_posed(s, p, o, out, render, &err);
+    if (r == SP_OK) r = sp_outputs_commit(&staged, &err);
     if (r != SP_OK) {
-        sp_outputs_undo(&done);
+        sp_outputs_undo(&staged, &err);
         fprintf(stderr, "%s: %s\n", s->cmd, err.text);
         return false;
     }
+    sp_json_print(report);
     if (o->note && o->note[0]) fprintf(stderr, "%s: %s\n", s->cmd, o->note);
     return true;
 }

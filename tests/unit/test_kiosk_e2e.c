@@ -1534,7 +1534,8 @@ static int kiosk_no_display(const char* args, char* out, size_t cap)
 // file) is exit 1 and one line naming it, before the database or a window
 // (it was one line at the end of the replay); a script with marks and a
 // screenshot to a stream, which has no "beside" for the marks' PNGs, is bad
-// usage (it wrote /dev/stdout-<mark>.png).
+// usage (it wrote /dev/stdout-<mark>.png), and so is a recording over the
+// script it replays (which it replaced).
 static void test_screenshot_unwritable(void)
 {
     char file_dir[1100], args[3000], out[1024];
@@ -1550,7 +1551,8 @@ static void test_screenshot_unwritable(void)
     } cases[] = {{"--screenshot", "/nonexistent-sp/out.png", 1, "cannot write into folder '/nonexistent-sp'"},
                  {"--export", "/nonexistent-sp/d.glb", 1, "cannot write into folder '/nonexistent-sp'"},
                  {"--record", NULL, 1, "(not a folder)"},
-                 {"--screenshot", "/dev/stdout", 2, "the script has marks"}};
+                 {"--screenshot", "/dev/stdout", 2, "the script has marks"},
+                 {"--record", script, 2, "is the same file as --script: it would be overwritten"}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char rec[1200];
         snprintf(rec, sizeof rec, "%s/r.json", file_dir);

@@ -598,6 +598,111 @@ static void test_device_inputs(void)
     unlink(fifo);
 }
 
+// The command's stderr (one line expected) after running `args` with exit rc.
+static char* run_said(const char* args, int* rc)
+{
+    char log[1024], cmd[4096];
+    snprintf(log, sizeof log, "%s", sp_test_tmp_path("outputs_said.txt"));
+    snprintf(cmd, sizeof cmd, "timeout 120 '%s' %s 2>'%s' >/dev/null", SP_SKETCHPOSE, args, log);
+    *rc = run(cmd);
+    char* text = sp_fixture_file_text(log, NULL);
+    fprintf(stderr, "  %s\n    -> exit %d, %s", args, *rc, text);
+    return text;
+}
+
+// Outputs are all or nothing and never an input: a command that fails
+// after its work (a picture too large for GL) leaves files it would have
+// replaced as they were (they used to be deleted), an output that is a folder or
+// in no folder is refused before the work, and an output that names an
+// input or another output is refused (`pose --report` onto `--strokes`
+// replaced the strokes with the report).
+static void test_outputs_kept(void)
+{
+    char dir[1024], strokes[1200], big[1200], out[1200], report[1200], args[6000];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("outputs"));
+    mkdir(dir, 0755);
+    snprintf(strokes, sizeof strokes, "%s/s.json", dir);
+    snprintf(big, sizeof big, "%s/big.json", dir);
+    snprintf(out, sizeof out, "%s/posed.glb", dir);
+    snprintf(report, sizeof report, "%s/report.json", dir);
+    const char* rig = SP_SOURCE_DIR "/assets/tail.glb";
+    snprintf(args, sizeof args, "synth --rig '%s' --seed 2 --out '%s'", rig, strokes);
+    int rc;
+    free(run_said(args, &rc));
+    ENSURE(rc == 0);
+    // The same strokes on a canvas too large to draw.
+    char* text = sp_fixture_file_text(strokes, NULL);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    ENSURE(j);
+    cJSON* canvas = cJSON_GetObjectItem(j, "canvas");
+    ENSURE(cJSON_IsArray(canvas));
+    cJSON_ReplaceItemInArray(canvas, 0, cJSON_CreateNumber(1e6));
+    cJSON_ReplaceItemInArray(canvas, 1, cJSON_CreateNumber(1e6));
+    text = cJSON_Print(j);
+    cJSON_Delete(j);
+    FILE* f = fopen(big, "wb");
+    ENSURE(f && fputs(text, f) >= 0 && fclose(f) == 0);
+    free(text);
+
+    FILE* o = fopen(out, "wb");
+    ENSURE(o && fputs("old glb", o) >= 0 && fclose(o) == 0);
+    FILE* r = fopen(report, "wb");
+    ENSURE(r && fputs("old report", r) >= 0 && fclose(r) == 0);
+    ENSURE(chmod(report, 0600) == 0);
+    snprintf(args, sizeof args, "pose --rig '%s' --strokes '%s' --out '%s' --report '%s' --render '%s/r.png'", rig, big, out,
+             report, dir);
+    text = run_said(args, &rc);
+    ENSURE(rc == 1 && strstr(text, "/r.png: render:") && !strstr(text, ".part") && strchr(text, '\n') == text + strlen(text) - 1);
+    free(text);
+    text = sp_fixture_file_text(out, NULL);
+    ENSURE(!strcmp(text, "old glb"));
+    free(text);
+    text = sp_fixture_file_text(report, NULL);
+    ENSURE(!strcmp(text, "old report"));
+    free(text);
+    // Nothing staged is left behind.
+    char ls[1400];
+    snprintf(ls, sizeof ls, "ls '%s' | grep -q part", dir);
+    ENSURE(run(ls) == 1); // grep found none
+    // The same command that succeeds replaces them, keeping the report's permissions.
+    snprintf(args, sizeof args, "pose --rig '%s' --strokes '%s' --out '%s' --report '%s'", rig, strokes, out, report);
+    free(run_said(args, &rc));
+    ENSURE(rc == 0);
+    struct stat st;
+    ENSURE(stat(out, &st) == 0 && st.st_size > 1000 && stat(report, &st) == 0 && (st.st_mode & 0777) == 0600);
+    cJSON_Delete(sp_fixture_glb_json(out));
+
+    // Refused before the work, naming the option and the path.
+    struct {
+        const char* fmt;
+        int rc;
+        const char* said;
+    } cases[] = {
+        {"pose --rig '%1$s' --strokes '%2$s' --render '%3$s'", 1, "--render %3$s: is a folder, not a file"},
+        {"pose --rig '%1$s' --strokes '%2$s' --out '%3$s/none/p.glb'", 1, "cannot write into folder '%3$s/none'"},
+        {"pose --rig '%1$s' --strokes '%2$s' --report '%2$s'", 2,
+         "--report %2$s is the same file as --strokes: it would be overwritten"},
+        {"synth --rig '%1$s' --seed 1 --out '%3$s/t.json' --truth '%3$s/./t.json'", 2,
+         "--truth %3$s/./t.json is the same file as --out: one would overwrite the other"},
+        {"export --rig '%3$s/posed.glb' --out '%3$s/posed.glb'", 2, "--out %3$s/posed.glb is the same file as --rig"},
+        {"animate --rig '%1$s' --strokes '%2$s' '%3$s/posed.glb' --out '%3$s/posed.glb'", 2,
+         "--out %3$s/posed.glb is the same file as --strokes"},
+    };
+    struct stat before;
+    ENSURE(stat(strokes, &before) == 0);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char said[2000];
+        snprintf(args, sizeof args, cases[i].fmt, rig, strokes, dir);
+        snprintf(said, sizeof said, cases[i].said, rig, strokes, dir);
+        text = run_said(args, &rc);
+        ENSURE(rc == cases[i].rc && strstr(text, said) && strchr(text, '\n') == text + strlen(text) - 1);
+        free(text);
+    }
+    ENSURE(stat(strokes, &st) == 0 && st.st_size == before.st_size && st.st_mtime == before.st_mtime);
+    ENSURE(access(strcat(dir, "/t.json"), F_OK) != 0);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -612,5 +717,6 @@ int main(int argc, char** argv)
                                    {"pose_option_ranges", test_pose_option_ranges},
                                    {"pose_file_whole", test_pose_file_whole},
                                    {"device_inputs", test_device_inputs},
+                                   {"outputs_kept", test_outputs_kept},
                                    {0}});
 }
