@@ -193,8 +193,9 @@ int cmd_demo(int argc, char** argv)
     }
     sp_dragon* d;
     sp_dragon_create(&(sp_dragon_desc){.db = db, .canvas_w = DEMO_W, .canvas_h = DEMO_H}, &d, &err);
-    if (!d) {
-        fprintf(stderr, "sketchpose demo: %s\n", err.text);
+    if (!d || !sp_dragon_model(d)) { // without a model no drawing becomes a part
+        fprintf(stderr, "sketchpose demo: %s\n", d ? sp_dragon_model_error(d) : err.text);
+        sp_dragon_destroy(d);
         sp_db_close(db);
         return SP_EXIT_INPUT;
     }
@@ -253,7 +254,7 @@ int cmd_demo(int argc, char** argv)
         if (!placed) fprintf(stderr, "  %-10s not recognised in %d tries: left out\n", k_layout[li].category, DEMO_TRIES);
     }
     if (sp_dragon_part_count(d) == 0) {
-        fprintf(stderr, "sketchpose demo: no part was recognised; is the model in %s trained?\n", path);
+        fprintf(stderr, "sketchpose demo: no part was recognised by the model in %s\n", path);
         goto done;
     }
     char* text = NULL;

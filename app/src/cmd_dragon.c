@@ -73,6 +73,12 @@ int cmd_dragon(int argc, char** argv)
     }
     int exit_code = SP_EXIT_INPUT;
     cJSON* j = NULL;
+    if (!sp_dragon_model(d)) { // every stroke would be refused, each blaming the stroke file
+        fprintf(stderr, "sketchpose dragon: %s\n", sp_dragon_model_error(d));
+        sp_dragon_destroy(d);
+        sp_sketch_free(&sk);
+        return SP_EXIT_INPUT;
+    }
     sp_outputs staged = {0};
     cJSON* list = cJSON_CreateArray();
     for (int i = 0; i < sk.stroke_count; ++i) {

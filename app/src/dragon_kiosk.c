@@ -520,10 +520,8 @@ int main(int argc, char** argv)
         return SP_EXIT_INPUT;
     }
     if (!sp_dragon_model(sp_kiosk_dragon(a.k)))
-        fprintf(stderr,
-                "%s: %s: no trained model: strokes are refused and the parts row alone makes parts (`sketchpose db train` "
-                "makes one)\n",
-                k_cmd, db ? db : sp_db_default_path());
+        fprintf(stderr, "%s: %s: strokes are refused and the parts row alone makes parts\n", k_cmd,
+                sp_dragon_model_error(sp_kiosk_dragon(a.k)));
     glfwSetWindowUserPointer(win, &a);
     relayout(&a);
     glfwSetMouseButtonCallback(win, cb_button);

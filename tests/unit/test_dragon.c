@@ -1080,7 +1080,7 @@ static void test_no_model(void)
     sp_dragon* d = NULL;
     ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .no_model = true}, &d, &err) ==
            SP_OK);
-    ENSURE(sp_dragon_model(d) == NULL);
+    ENSURE(sp_dragon_model(d) == NULL && !sp_dragon_model_error(d)[0]); // none asked for: no error
     sp_vec2* xy;
     int n = part_stroke(db, "torso_t", 5, 0.3, 640, 400, 400, &xy);
     sp_dragon_result res;
@@ -1255,6 +1255,23 @@ static void test_corrupt_part(void)
     ENSURE(strstr(text, "stroke 0 left out (no_part: ") && strstr(text, "does not match its checksum") &&
            strstr(text, "no stroke became a part"));
     free(text);
+    // A model that cannot be used is said once, naming the database, not
+    // as every stroke left out "no_model" blaming the stroke file.
+    const char* models[] = {"UPDATE models SET model = substr(model, 1, 1000)", "DELETE FROM models"};
+    const char* says[] = {": stored bytes do not match the checksum", ": no trained model (run `sketchpose db train`)"};
+    for (int i = 0; i < 2; ++i) {
+        db_sql(path, models[i]);
+        ENSURE(system(cmd) != 0);
+        text = sp_fixture_file_text(log, NULL);
+        fprintf(stderr, "%s", text);
+        char want[1400];
+        snprintf(want, sizeof want, "sketchpose dragon: %s: ", path);
+        ENSURE(!strncmp(text, want, strlen(want)) && strstr(text, says[i]) && strchr(text, '\n') == text + strlen(text) - 1);
+        free(text);
+        sp_dragon* m = new_dragon(path);
+        ENSURE(!sp_dragon_model(m) && strstr(sp_dragon_model_error(m), says[i]));
+        sp_dragon_destroy(m);
+    }
     free(tail), free(torso);
     sp_fixture_remove_db(path);
 }

@@ -95,8 +95,10 @@ sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error
     o->db = NULL, o->db_path = NULL, o->assets_dir = NULL; // not kept: the caller's strings
     d->gen = sp_db_generation(d->db);
     sp_error merr = {0};
-    if (o->no_model || sp_db_load_model(d->db, &d->clf, NULL, &merr) != SP_OK)
+    if (!o->no_model && sp_db_load_model(d->db, &d->clf, NULL, &merr) != SP_OK) {
         d->clf = NULL; // strokes then need a forced category
+        snprintf(d->model_error, sizeof d->model_error, "%s", merr.text);
+    }
     *out = d;
     return SP_OK;
 }
@@ -115,6 +117,11 @@ void sp_dragon_destroy(sp_dragon* d)
 const sp_clf* sp_dragon_model(const sp_dragon* d)
 {
     return d->clf;
+}
+
+const char* sp_dragon_model_error(const sp_dragon* d)
+{
+    return d->model_error;
 }
 
 int sp_dragon_part_count(const sp_dragon* d)

@@ -159,6 +159,7 @@ struct sp_dragon {
     struct dragon_failed* failed;
     int failed_n;
     char part_error[512]; // why a part the last stroke needed did not load; "" when none
+    char model_error[512]; // why there is no model (sp_dragon_model_error); "" when there is one or none was asked for
     part** parts;
     int part_n, part_cap;
     uint64_t next_id;

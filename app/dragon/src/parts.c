@@ -346,7 +346,9 @@ static void reload_model(sp_dragon* d)
         // SP_ERR_INVALID: no model stored (strokes then need a forced category).
         sp_clf_destroy(d->clf);
         d->clf = r == SP_OK ? clf : NULL;
-    }
+        snprintf(d->model_error, sizeof d->model_error, "%s", r == SP_OK ? "" : merr.text);
+    } else if (!d->clf)
+        snprintf(d->model_error, sizeof d->model_error, "%s", merr.text);
 }
 
 sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err)

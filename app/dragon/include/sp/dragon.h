@@ -328,6 +328,11 @@ int sp_dragon_loaded_parts(const sp_dragon* d);
 const char* sp_dragon_part_error(const sp_dragon* d);
 /// The categories the current model knows (for hints); NULL when there is no model.
 const sp_clf* sp_dragon_model(const sp_dragon* d);
+/// Why sp_dragon_model is NULL, one line naming the database ("DB: no
+/// trained model (run `sketchpose db train`)", "DB: model 3: stored bytes
+/// do not match the checksum"); "" when there is a model or `no_model` was
+/// asked for.
+const char* sp_dragon_model_error(const sp_dragon* d);
 
 /// The solve report of the whole dragon as JSON (DESIGN.md: the parts'
 /// solve reports combined, plus "parts": [{"category", "confidence", "name",
