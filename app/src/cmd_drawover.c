@@ -92,6 +92,13 @@ int cmd_drawover(int argc, char** argv)
     sp_character* ch = sp_rig_handle_character(rig);
     run.rig = rig;
     if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
+    // Both drawings are on one screen: --to's points are read in --on's
+    // canvas (its camera), so another canvas gave a wrong fit with exit 0.
+    if (to.canvas_w > 0 && on.canvas_w > 0 && (to.canvas_w != on.canvas_w || to.canvas_h != on.canvas_h)) {
+        sp_fail(&err, SP_ERR_INVALID, "%s: its canvas %gx%g is not --on's %gx%g (draw both over one view)", to_path, to.canvas_w,
+                to.canvas_h, on.canvas_w, on.canvas_h);
+        goto fail;
+    }
     sp_camera cam = sp_rig_handle_camera(rig, on.canvas_w, on.canvas_h);
     if (sp_rig_handle_read_pose(rig, NULL, &p, NULL, &err) != SP_OK) goto fail;
     xyz = malloc(sizeof(double) * 3 * (size_t)(ch->rig.vertex_count + 1));

@@ -18,6 +18,7 @@
 #include "sp/blackbox.h"
 #include "sp/embed.h"
 #include "sp/gltf.h"
+#include "sp/sketch_io.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
 #include "test.h"
@@ -703,6 +704,41 @@ static void test_outputs_kept(void)
     ENSURE(access(strcat(dir, "/t.json"), F_OK) != 0);
 }
 
+// drawover's two drawings are on one screen: --to on another canvas is
+// refused, naming it (its points were read in --on's canvas: a wrong fit,
+// exit 0); on the same canvas it fits.
+static void test_drawover_canvas(void)
+{
+    char on[1100], to[1100], args[4000];
+    snprintf(on, sizeof on, "%s", sp_test_tmp_path("drawover_on.json"));
+    snprintf(to, sizeof to, "%s", sp_test_tmp_path("drawover_to.json"));
+    const char* rig = SP_SOURCE_DIR "/assets/cartoon_man.glb";
+    sp_error err = {0};
+    // Down the body, then bent to the right.
+    const sp_vec2 down[] = {{300, 150}, {320, 200}, {330, 260}}, bent[] = {{300, 150}, {340, 200}, {370, 240}};
+    sp_sketch a = {.canvas_w = 640, .canvas_h = 480};
+    ENSURE(sp_sketch_add_stroke(&a, down, NULL, 3) == SP_OK && sp_sketch_write_json(on, &a, &err) == SP_OK);
+    sp_sketch_free(&a);
+    for (int twice = 0; twice < 2; ++twice) {
+        int k = 1 + twice;
+        sp_vec2 xy[3];
+        for (int i = 0; i < 3; ++i)
+            xy[i] = (sp_vec2){bent[i].x * k, bent[i].y * k};
+        sp_sketch b = {.canvas_w = 640 * k, .canvas_h = 480 * k};
+        ENSURE(sp_sketch_add_stroke(&b, xy, NULL, 3) == SP_OK && sp_sketch_write_json(to, &b, &err) == SP_OK);
+        sp_sketch_free(&b);
+        snprintf(args, sizeof args, "drawover --rig '%s' --on '%s' --to '%s'", rig, on, to);
+        int rc;
+        char* text = run_said(args, &rc);
+        if (twice)
+            ENSURE(rc == 1 && strstr(text, "drawover_to.json: its canvas 1280x960 is not --on's 640x480") &&
+                   strchr(text, '\n') == text + strlen(text) - 1);
+        else
+            ENSURE(rc == 0);
+        free(text);
+    }
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -718,5 +754,6 @@ int main(int argc, char** argv)
                                    {"pose_file_whole", test_pose_file_whole},
                                    {"device_inputs", test_device_inputs},
                                    {"outputs_kept", test_outputs_kept},
+                                   {"drawover_canvas", test_drawover_canvas},
                                    {0}});
 }
