@@ -752,7 +752,13 @@ static int db_check(int argc, char** argv)
         "matches the part categories; JSON; exit 1 on any problem",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    sp_db* db = open_db(cmd, &c, 0); // writable: an older schema gets migrated
+    // Writable, so that an older schema gets migrated; read-only where this
+    // user may not write it (another user's file, read-only media): a check
+    // only reads, and was refused there as "the database is read-only".
+    char* dir = sp_path_folder(db_path(&c));
+    bool ro = access(db_path(&c), W_OK) != 0 || (dir && access(dir, W_OK) != 0);
+    free(dir);
+    sp_db* db = open_db(cmd, &c, ro ? SP_DB_READONLY : 0);
     if (!db) return SP_EXIT_INPUT;
     sp_error err = {0};
     bool ok = false;
