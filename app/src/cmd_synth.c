@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "pose_io.h"
@@ -45,15 +46,18 @@ static bool takes_only(int argc, char** argv, const char* mode, const char* cons
     return true;
 }
 
-static void json_str(const char* s)
+static void json_str(FILE* f, const char* s)
 {
-    putchar('"');
+    fputc('"', f);
     for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
-        if (*p == '"' || *p == '\\') printf("\\%c", *p);
-        else if (*p < 0x20) printf("\\u%04x", *p);
-        else putchar(*p);
+        if (*p == '"' || *p == '\\')
+            fprintf(f, "\\%c", *p);
+        else if (*p < 0x20)
+            fprintf(f, "\\u%04x", *p);
+        else
+            fputc(*p, f);
     }
-    putchar('"');
+    fputc('"', f);
 }
 
 // --parts DIR: every .glb/.gltf part of DIR (category from extras.sp_part),
@@ -82,19 +86,26 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         free(names);
         return SP_EXIT_INPUT;
     }
-    if (sp_dir_make(out_dir, &err) != SP_OK) goto fail;
+    // The result is said once the sketches are all written; a failure
+    // takes back the folder it made (it printed a result and left the folder).
+    struct stat st;
+    bool made = stat(out_dir, &st) != 0;
+    char* text = NULL;
+    size_t len = 0;
+    FILE* js = open_memstream(&text, &len);
+    if (!js || sp_dir_make(out_dir, &err) != SP_OK) goto fail;
     sp_handdraw_desc desc = *base;
     int total = 0, written = 0;
-    printf("{\"out_dir\": ");
-    json_str(out_dir);
-    printf(", \"style\": \"%s\", \"seed\": %llu, \"parts\": [", sp_handdraw_style_name(style), (unsigned long long)family);
+    fprintf(js, "{\"out_dir\": ");
+    json_str(js, out_dir);
+    fprintf(js, ", \"style\": \"%s\", \"seed\": %llu, \"parts\": [", sp_handdraw_style_name(style), (unsigned long long)family);
     for (int k = 0; k < n; ++k) {
         char path[4096], stem[256], category[SP_NAME_MAX];
         snprintf(path, sizeof path, "%s/%s", dir, names[k]);
         snprintf(stem, sizeof stem, "%s", names[k]);
         *strrchr(stem, '.') = 0;
         sp_character ch = {0};
-        if (sp_gltf_load(path, &ch, &err) != SP_OK) goto fail_open;
+        if (sp_gltf_load(path, &ch, &err) != SP_OK) goto fail;
         if (!ch.part.category[0]) {
             // A character beside the parts (assets/ holds both): not a part, left out.
             fprintf(stderr, "sketchpose synth: %s: skipped (no extras.sp_part.category: not a part)\n", path);
@@ -111,7 +122,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         snprintf(cdir, sizeof cdir, "%s/%s", out_dir, category);
         if (a < 0 || sp_dir_make(cdir, &err) != SP_OK) {
             sp_character_free(&ch);
-            goto fail_open;
+            goto fail;
         }
         uint64_t pf = sp_handdraw_part_family(family, stem);
         int count = sp_handdraw_shape_available(&ch.rig, desc.shape) ? per_part : 0; // no single line through a head
@@ -119,7 +130,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
             sp_sketch sk = {0};
             if (sp_handdraw_part(&ch.rig, a, &ch.camera, &desc, sp_handdraw_seed(pf, i), &sk, NULL, &err) != SP_OK) {
                 sp_character_free(&ch);
-                goto fail_open;
+                goto fail;
             }
             char file[4400];
             snprintf(file, sizeof file, "%s/%s-%s-s%llu-%04d.json", cdir, stem, sp_handdraw_style_name(style), (unsigned long long)family, i);
@@ -127,31 +138,39 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
             sp_sketch_free(&sk);
             if (r != SP_OK) {
                 sp_character_free(&ch);
-                goto fail_open;
+                goto fail;
             }
         }
         total += count;
-        printf("%s{\"name\": ", written++ ? ", " : "");
-        json_str(stem);
-        printf(", \"category\": ");
-        json_str(category);
-        printf(", \"abstraction\": ");
-        json_str(ch.rig.abstractions[a].name);
-        printf(", \"sketches\": %d}", count);
+        fprintf(js, "%s{\"name\": ", written++ ? ", " : "");
+        json_str(js, stem);
+        fprintf(js, ", \"category\": ");
+        json_str(js, category);
+        fprintf(js, ", \"abstraction\": ");
+        json_str(js, ch.rig.abstractions[a].name);
+        fprintf(js, ", \"sketches\": %d}", count);
         sp_character_free(&ch);
     }
-    printf("], \"sketches\": %d}\n", total);
+    fprintf(js, "], \"sketches\": %d}\n", total);
     if (written == 0) {
         sp_fail(&err, SP_ERR_INVALID, "%s: no part (a .glb/.gltf with extras.sp_part.category) in the folder", dir);
         goto fail;
     }
+    if (fclose(js) != 0) {
+        js = NULL;
+        sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
+        goto fail;
+    }
+    js = NULL;
+    fputs(text, stdout);
     code = SP_EXIT_OK;
     goto done;
-fail_open:
-    printf("]}\n");
 fail:
     fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
+    if (made) sp_dir_remove_tree(out_dir);
 done:
+    if (js) fclose(js);
+    free(text);
     for (int k = 0; k < n; ++k)
         free(names[k]);
     free(names);

@@ -31,20 +31,6 @@ typedef struct export_dir {
     bool exists;
 } export_dir;
 
-static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
-{
-    (void)st, (void)flag, (void)ftw;
-    remove(path);
-    return 0; // on past what cannot be removed: the rest still goes
-}
-
-// Removes a folder the export made and everything in it, deepest first;
-// symbolic links are not followed (the export makes none).
-static void remove_tree(const char* path)
-{
-    nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-}
-
 static int sync_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
 {
     (void)st, (void)ftw;
@@ -147,7 +133,7 @@ static sp_result export_end(export_dir* ex, sp_result r, sp_error* err)
         else
             sp_fail(err, r, "%s; %s: no export was written", was, ex->final);
     }
-    remove_tree(ex->tmp);
+    sp_dir_remove_tree(ex->tmp);
     return r;
 }
 

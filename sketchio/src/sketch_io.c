@@ -1,6 +1,7 @@
 // sketch_io.c: readers for stroke JSON, Quick, Draw! ndjson and SVG, the
 // stroke JSON writer, and labelled sets of drawings as data. PNGs and
 // folders (which may hold PNGs) are the classifier's (drawing_io.c).
+#define _XOPEN_SOURCE 700 // nftw
 #include "sp/sketch_io.h"
 
 #include <cjson/cJSON.h>
@@ -8,6 +9,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <ftw.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -238,6 +240,18 @@ sp_result sp_dir_make(const char* path, sp_error* err)
         errno = ENOTDIR;
     }
     return sp_fail(err, SP_ERR_IO, "%s: cannot create the folder (%s)", path, strerror(errno));
+}
+
+static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    remove(path);
+    return 0; // on past what cannot be removed: the rest still goes
+}
+
+void sp_dir_remove_tree(const char* path)
+{
+    nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
 void sp_dir_list_free(char** names, int count)

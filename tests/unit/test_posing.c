@@ -739,6 +739,41 @@ static void test_drawover_canvas(void)
     }
 }
 
+// `synth --parts` that fails on a broken part after writing another's
+// sketches prints no result and takes back the folder it made (it printed
+// a result and left a partial folder); one it did not make stays.
+static void test_synth_parts_fails_whole(void)
+{
+    char parts[1100], out[1100], cmd[8000], args[4000];
+    snprintf(parts, sizeof parts, "%s", sp_test_tmp_path("synth_parts"));
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("synth_parts_out"));
+    snprintf(cmd, sizeof cmd,
+             "rm -rf '%s' '%s' && mkdir '%s' && cp '%s/assets/tail.glb' '%s/a_tail.glb' && head -c 1000 '%s/assets/head.glb' > "
+             "'%s/b_broken.glb'",
+             parts, out, parts, SP_SOURCE_DIR, parts, SP_SOURCE_DIR, parts);
+    ENSURE(run(cmd) == 0);
+    char said[1200];
+    snprintf(said, sizeof said, "%s", sp_test_tmp_path("synth_parts_stdout.txt"));
+    for (int existed = 0; existed < 2; ++existed) {
+        if (existed) ENSURE(mkdir(out, 0755) == 0);
+        snprintf(args, sizeof args, "'%s' synth --parts '%s' --per-part 2 --out-dir '%s' > '%s' 2>/dev/null", SP_SKETCHPOSE,
+                 parts, out, said);
+        ENSURE(run(args) == 1);
+        size_t n = 0;
+        free(sp_fixture_file_text(said, &n));
+        ENSURE(n == 0);
+        struct stat st;
+        if (existed) {
+            // Kept, with what it wrote: the folder was the caller's.
+            snprintf(cmd, sizeof cmd, "test -f '%s/tail/a_tail-normal-s1-0000.json'", out);
+            ENSURE(run(cmd) == 0);
+        } else
+            ENSURE(stat(out, &st) != 0);
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", parts, out);
+    ENSURE(run(cmd) == 0);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -755,5 +790,6 @@ int main(int argc, char** argv)
                                    {"device_inputs", test_device_inputs},
                                    {"outputs_kept", test_outputs_kept},
                                    {"drawover_canvas", test_drawover_canvas},
+                                   {"synth_parts_fails_whole", test_synth_parts_fails_whole},
                                    {0}});
 }

@@ -139,6 +139,10 @@ void sp_dir_list_free(char** names, int count);
 /// Creates folder `path` (its parent must exist); one that exists already is
 /// fine. SP_ERR_IO naming it and why otherwise (also when a file has its name).
 sp_result sp_dir_make(const char* path, sp_error* err);
+/// Removes a folder the caller made and everything in it, deepest first,
+/// going on past what cannot be removed; symbolic links are removed, not
+/// followed.
+void sp_dir_remove_tree(const char* path);
 
 #ifdef __cplusplus
 }
