@@ -193,6 +193,18 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
         const char* ext;
         if (sqlite3_column_type(st, 4) != SQLITE_NULL) {
             ext = "json";
+            // Strokes that do not parse would make an export `db init --from`
+            // refuses: the export fails now, naming the row, not at the restore.
+            char what[SP_NAME_MAX + 64];
+            snprintf(what, sizeof what, "sketch %lld (%s)", id, cat);
+            sp_sketch s = {0};
+            sp_error e = {0};
+            if (sp_sketch_parse_json((const char*)sqlite3_column_text(st, 4), (size_t)sqlite3_column_bytes(st, 4), what, &s,
+                                     &e) != SP_OK) {
+                r = sp_fail(err, SP_ERR_PARSE, "%s: %s (`db check` lists such sketches)", db->path, e.text);
+                break;
+            }
+            sp_sketch_free(&s);
             snprintf(path, sizeof path, "%s/sketches/%s/%s-%06lld.json", dir, cat, src, id);
             r = db_write_file(path, sqlite3_column_text(st, 4), (size_t)sqlite3_column_bytes(st, 4), err);
         } else if (sqlite3_column_type(st, 5) != SQLITE_NULL) {

@@ -1882,6 +1882,27 @@ static void test_export_whole(void)
     ENSURE(stat(dir, &st) == 0 && (st.st_mode & 0777) == 0750);
     snprintf(cmd, sizeof cmd, "diff -r '%s' '%s'", dir, full);
     ENSURE(system(cmd) == 0);
+    // A sketch whose strokes do not parse fails the export, naming the
+    // database and the row: `db init --from` would refuse the export (it
+    // was written whole, with exit 0).
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
+    ENSURE(sqlite3_exec(
+               h, "UPDATE sketches SET strokes = 'not json' WHERE id = (SELECT min(id) FROM sketches WHERE strokes IS NOT NULL)",
+               NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(h);
+    long long bad = scalar(p, "SELECT id FROM sketches WHERE strokes = 'not json'");
+    snprintf(cmd, sizeof cmd, "%s/bad", parent);
+    tree_listing(parent, before, sizeof before);
+    db = open_ok(p, SP_DB_READONLY);
+    ENSURE(sp_db_export(db, cmd, &err) == SP_ERR_PARSE && strstr(err.text, p) == err.text && !strchr(err.text, '\n'));
+    fprintf(stderr, "  a sketch that does not parse: %s\n", err.text);
+    char want[64];
+    snprintf(want, sizeof want, ": sketch %lld (", bad);
+    ENSURE(strstr(err.text, want) && strstr(err.text, "malformed JSON") && strstr(err.text, "no export was written"));
+    sp_db_close(db);
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after));
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", parent);
     ENSURE(system(cmd) == 0);
 }
