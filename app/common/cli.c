@@ -10,9 +10,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static void print_help(const char* cmd, const char* summary, const sp_opt* opts, int nopts)
+static void print_help(const char* cmd, const char* positional, const char* summary, const sp_opt* opts, int nopts)
 {
-    printf("usage: %s", cmd);
+    printf("usage: %s%s%s", cmd, positional ? " " : "", positional ? positional : "");
     for (int i = 0; i < nopts; ++i) {
         const char* a = opts[i].kind == SP_OPT_FLAG ? "" : " ";
         printf(opts[i].required ? " %s%s%s" : " [%s%s%s]", opts[i].name, a, opts[i].kind == SP_OPT_FLAG ? "" : opts[i].arg);
@@ -71,20 +71,31 @@ static int check_files(const char* cmd, const sp_opt* opts, int nopts)
             }
         }
     }
+    return -1;
+}
+
+bool sp_cli_check_out_folders(const char* cmd, const sp_opt* opts, int nopts)
+{
     for (int i = 0; i < nopts; ++i)
         if (opts[i].kind == SP_OPT_OUT) {
             const char* out = *(const char* const*)opts[i].out;
-            if (out && strcmp(out, "-") && !sp_cli_check_out_folder(cmd, opts[i].name, out)) return 1;
+            if (out && strcmp(out, "-") && !sp_cli_check_out_folder(cmd, opts[i].name, out)) return false;
         }
-    return -1;
+    return true;
 }
 
 int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts)
 {
+    return sp_cli_parse_pos(argc, argv, cmd, NULL, summary, opts, nopts);
+}
+
+int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positional, const char* summary, const sp_opt* opts,
+                     int nopts)
+{
     bool seen[64] = {0};
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            print_help(cmd, summary, opts, nopts);
+            print_help(cmd, positional, summary, opts, nopts);
             return 0;
         }
     }

@@ -39,11 +39,14 @@ typedef struct sp_opt {
 
 /// Parses argv[1..) against opts. Returns -1 when the command should run,
 /// 0 after printing --help, 2 after printing a usage error to stderr.
-/// Before any work, it also refuses (one line, exit 2) an output that names
-/// the same file as an input ("--report s.json is the same file as
-/// --strokes: it would be overwritten") or as another output, and (exit 1)
-/// an output sp_cli_check_out_folder refuses.
+/// It also refuses (one line, exit 2) an output that names the same file as
+/// an input ("--report s.json is the same file as --strokes: it would be
+/// overwritten") or as another output.
 int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, const sp_opt* opts, int nopts);
+/// sp_cli_parse for a command that also takes positional arguments, shown in
+/// --help's usage line after `cmd` ("FILES..."); messages start with `cmd` alone.
+int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positional, const char* summary, const sp_opt* opts,
+                     int nopts);
 
 /// Parses "WxH" into two ints of 16..8192; false if malformed or out of range.
 bool sp_cli_parse_size(const char* s, int* w, int* h);
@@ -80,6 +83,11 @@ bool sp_cli_out_is_stream(const char* path);
 /// (reason)", and the path must not be a folder ("<cmd>: <name> <path>: is a
 /// folder, not a file"); false (exit 1), said before the work, not after it.
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path);
+
+/// sp_cli_check_out_folder of every SP_OPT_OUT option given ("-" aside): a
+/// command calls it after its usage checks (bad usage is said first, exit
+/// 2) and before its work; false after saying why (exit 1).
+bool sp_cli_check_out_folders(const char* cmd, const sp_opt* opts, int nopts);
 
 /// The longest solve time cap a command takes (--max-ms), ms: one hour.
 #define SP_CLI_MAX_MS 3600000.0

@@ -89,9 +89,7 @@ static int parse(int argc, char** argv, const char* cmd, const db_common* c, con
             fprintf(stderr, "%s: unexpected argument '%s' (at most %d %s; see --help)\n", cmd, extra, maxpos, posname);
         return SP_EXIT_USAGE;
     }
-    char full[256];
-    snprintf(full, sizeof full, "%s%s%s", cmd, maxpos ? " " : "", maxpos ? posname : "");
-    int rc = sp_cli_parse(nk, kept, full, summary, opts, nopts);
+    int rc = sp_cli_parse_pos(nk, kept, cmd, maxpos ? posname : NULL, summary, opts, nopts);
     if (rc >= 0) return rc;
     // A day at most: beyond, the milliseconds overflow an int. 0 waits not at all.
     if (!isnan(c->busy_s) && !sp_cli_check_double(cmd, "--busy-timeout", c->busy_s, 0, false, 86400)) return SP_EXIT_USAGE;
@@ -923,12 +921,13 @@ static int db_review(int argc, char** argv)
     if (!status) status = "pending";
     if (limit == SP_CLI_UNSET) limit = 100;
     if (after == SP_CLI_UNSET) after = 0;
-    if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2) || limit < 0 || after < 0) {
-        fprintf(
-            stderr,
-            "%s: give one of --approve ID..., --reject ID..., --relabel ID CATEGORY (not with --sheet); --limit and --after are "
-            "not negative\n",
-            cmd);
+    if (limit < 0 || after < 0) {
+        fprintf(stderr, "%s: %s must not be negative, got %d\n", cmd, limit < 0 ? "--limit" : "--after",
+                limit < 0 ? limit : after);
+        return SP_EXIT_USAGE;
+    }
+    if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2)) {
+        fprintf(stderr, "%s: give one of --approve ID..., --reject ID..., --relabel ID CATEGORY (not with --sheet)\n", cmd);
         return SP_EXIT_USAGE;
     }
     unsigned mask = 0;

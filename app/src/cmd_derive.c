@@ -51,6 +51,11 @@ int cmd_derive(int argc, char** argv)
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", k_cmd, view);
         return SP_EXIT_USAGE;
     }
+    if (d.abstraction && strcmp(d.abstraction, "outline") != 0 && strcmp(d.abstraction, "stick") != 0) {
+        fprintf(stderr, "%s: --abstraction wants outline or stick, got '%s'\n", k_cmd, d.abstraction);
+        return SP_EXIT_USAGE;
+    }
+    if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT; // before the work
     sp_error err = {0};
     sp_character src = {0}, part = {0};
     sp_derive_info info;

@@ -24,7 +24,10 @@ int cmd_dragon(int argc, char** argv)
     const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = SP_SOURCE_DIR "/assets";
     double max_ms = NAN, at = 0; // NAN: not given
     const sp_opt opts[] = {
-        {"--db", SP_OPT_IN, &db_path, "DB", "the part database (created from --assets when missing)", true},
+        {"--db", SP_OPT_IN, &db_path, "DB",
+         "the part database (default: $SP_DB, else ./sketchpose.db, as for demo, db and the kiosk; created from --assets when "
+         "missing)",
+         false},
         {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes, one per part, in drawing order (sketchpose-strokes JSON)",
          true},
         {"--out", SP_OPT_OUT, &out, "dragon.glb", "write the animated dragon (.glb, or .gltf)", false},
@@ -46,6 +49,8 @@ int cmd_dragon(int argc, char** argv)
         !sp_cli_check_out("sketchpose dragon", "--out", out, SP_CLI_OUT_GLTF) ||
         !sp_cli_check_out("sketchpose dragon", "--render", render, SP_CLI_OUT_PNG))
         return SP_EXIT_USAGE;
+    if (!sp_cli_check_out_folders("sketchpose dragon", opts, (int)(sizeof opts / sizeof opts[0])))
+        return SP_EXIT_INPUT; // before the work
     sp_error err = {0};
     sp_sketch sk = {0};
     if (sp_sketch_read_json(strokes, &sk, &err) != SP_OK) {

@@ -75,6 +75,8 @@ int cmd_drawover(int argc, char** argv)
         !sp_cli_check_out("sketchpose drawover", "--out", out, SP_CLI_OUT_GLTF) ||
         !sp_cli_check_out("sketchpose drawover", "--render", render, SP_CLI_OUT_PNG))
         return SP_EXIT_USAGE;
+    if (!sp_cli_check_out_folders("sketchpose drawover", opts, (int)(sizeof opts / sizeof opts[0])))
+        return SP_EXIT_INPUT; // before the work
     if (!isnan(cap_ms)) desc.time_cap_ms = cap_ms;
     desc.lambda_dist = sp_solve_cmd_lambda(lambda_dist);
     sp_rig_handle* rig = NULL;

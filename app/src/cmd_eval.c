@@ -54,20 +54,22 @@ int cmd_eval(int argc, char** argv)
         {"--model", SP_OPT_IN, &model, "M",
          "trained model (required unless --folds; with --folds, the folds train with its options)", false},
         {"--data", SP_OPT_STRING, &data, "DIR", "labelled folder to evaluate on", true},
-        {"--folds", SP_OPT_INT, &folds, "K", "K-fold cross-validation on DIR (fold = drawing index mod K)", false},
+        {"--folds", SP_OPT_INT, &folds, "K",
+         "K-fold cross-validation on DIR (fold = drawing index mod K), 2..100 (-1 or 0: none, the default)", false},
         CLF_CLI_OPTS(o),
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose eval",
                           "accuracy of a classifier: top-1/top-3, per-class recall, confusion matrix, ms per drawing", opts,
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
+    if (folds == -1) folds = 0; // none, as for db init and db train
     if (!model && folds == 0) {
         fprintf(stderr, "sketchpose eval: give --model M, or --folds K to cross-validate (see --help)\n");
         return SP_EXIT_USAGE;
     }
     if (!clf_cli_check("sketchpose eval", &o)) return SP_EXIT_USAGE;
     if (folds != 0 && (folds < 2 || folds > 100)) {
-        fprintf(stderr, "sketchpose eval: --folds must be 2..100\n");
+        fprintf(stderr, "sketchpose eval: --folds must be 2..100 (-1 or 0: none), got %d\n", folds);
         return SP_EXIT_USAGE;
     }
     // A model keeps its training options, so with --model the training options

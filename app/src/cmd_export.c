@@ -26,6 +26,8 @@ int cmd_export(int argc, char** argv)
                           (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
     if (!sp_cli_check_out("sketchpose export", "--out", out_path, SP_CLI_OUT_GLTF)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_out_folders("sketchpose export", opts, (int)(sizeof opts / sizeof opts[0])))
+        return SP_EXIT_INPUT; // before the work
     sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_rig_posed posed = {0};

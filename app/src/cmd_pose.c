@@ -41,6 +41,7 @@ int cmd_pose(int argc, char** argv)
         !sp_cli_check_max_ms(cmd, cap_ms) || !sp_cli_check_out(cmd, "--out", out, SP_CLI_OUT_GLTF) ||
         !sp_cli_check_out(cmd, "--render", render, SP_CLI_OUT_PNG))
         return SP_EXIT_USAGE;
+    if (!sp_cli_check_out_folders(cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT; // before the work
     desc.lambda_pose = sp_solve_cmd_lambda(lambda_pose);
     desc.lambda_plane = sp_solve_cmd_lambda(lambda_plane);
     desc.lambda_dist = sp_solve_cmd_lambda(lambda_dist);

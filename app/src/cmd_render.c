@@ -80,6 +80,8 @@ int cmd_render(int argc, char** argv)
     if ((!isnan(line_width) && !sp_cli_check_double("sketchpose render", "--line-width", line_width, 0, true, 256)) ||
         !sp_cli_check_double("sketchpose render", "--pitch", pitch, -89, false, 89))
         return SP_EXIT_USAGE;
+    if (!sp_cli_check_out_folders("sketchpose render", opts, (int)(sizeof opts / sizeof opts[0])))
+        return SP_EXIT_INPUT; // before the work
 
     sp_error err = {0};
     sp_rig_handle* handle = NULL;

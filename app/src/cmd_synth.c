@@ -274,7 +274,8 @@ int cmd_synth(int argc, char** argv)
     double amplitude = 0.7853981633974483, noise = 0, spikes = 0;
     bool details = false, concepts = false, drawings = false;
     const sp_opt opts[] = {
-        {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb) (required unless --parts)", false},
+        {"--rig", SP_OPT_IN, &rig_path, "R.gltf",
+         "the rigged character (.gltf or .glb), or a black-box rig plugin (.so) (required unless --parts)", false},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
         {"--seed", SP_OPT_INT, &seed, "N", "random seed, not negative (required unless --pose)", false},
         {"--pose", SP_OPT_IN, &pose, "p.json", "draw this pose instead of a random one", false},
@@ -378,7 +379,7 @@ int cmd_synth(int argc, char** argv)
         if (!takes_only(argc, argv, "--parts", taken)) return SP_EXIT_USAGE;
         return synth_parts(parts, abs_name, per_part, (uint64_t)(seeded ? seed : 1), &hd, out_dir);
     }
-    if (!rig_path || !out || out_dir) {
+    if (!rig_path || !out) { // what else is given, e.g. --out-dir, takes_only names
         fprintf(stderr, "sketchpose synth: missing --rig R.gltf and --out S.json (or use --parts DIR --out-dir D; see --help)\n");
         return SP_EXIT_USAGE;
     }
@@ -409,6 +410,8 @@ int cmd_synth(int argc, char** argv)
         fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
         return SP_EXIT_USAGE;
     }
+    if (!sp_cli_check_out_folders("sketchpose synth", opts, (int)(sizeof opts / sizeof opts[0])))
+        return SP_EXIT_INPUT; // before the work
     sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_sketch sk = {0};

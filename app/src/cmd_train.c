@@ -34,6 +34,8 @@ int cmd_train(int argc, char** argv)
     }
     if (isnan(cal_q)) cal_q = 0.96;
     if (!sp_cli_check_double("sketchpose train", "--calibrate-quantile", cal_q, 0, true, 1)) return SP_EXIT_USAGE;
+    if (!sp_cli_check_out_folders("sketchpose train", opts, (int)(sizeof opts / sizeof opts[0])))
+        return SP_EXIT_INPUT; // before the work
     double t0 = sp_now_ms();
     sp_error err = {0};
     sp_dataset ds;

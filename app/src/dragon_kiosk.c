@@ -430,6 +430,11 @@ int main(int argc, char** argv)
         sp_kiosk_session_free(&session);
         return SP_EXIT_USAGE;
     }
+    // Written when the session ends: a folder that cannot take them is said now.
+    if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0]))) {
+        sp_kiosk_session_free(&session);
+        return SP_EXIT_INPUT;
+    }
     if (!has_parts(db ? db : sp_db_default_path())) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;

@@ -400,11 +400,15 @@ static bool is_part_file(const char* n)
 
 // Builds a database beside `path` with fill(), then links it into place, so
 // that an interrupted build never leaves a half database at `path`. link()
-// never replaces: a database someone else completed meanwhile wins.
+// never replaces: a database someone else completed meanwhile wins. An empty
+// file is no database (`mktemp` makes one): it is replaced, if still empty.
 static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, const void*, sp_error*), const void* ctx, sp_error* err)
 {
-    struct stat st;
-    if (stat(path, &st) == 0) return sp_fail(err, SP_ERR_INVALID, "%s: exists already (remove it, or use another --db)", path);
+    struct stat st = {0};
+    bool empty = stat(path, &st) == 0 && S_ISREG(st.st_mode) && st.st_size == 0;
+    if (!empty && stat(path, &st) == 0)
+        return sp_fail(err, SP_ERR_INVALID, "%s: exists already (remove it, or use another --db)", path);
+    ino_t was = st.st_ino;
     char tmp[1024];
     snprintf(tmp, sizeof tmp, "%s.building-%ld", path, (long)getpid());
     sp_db* db = NULL;
@@ -417,7 +421,11 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     }
     if (r == SP_OK) r = fill(db, ctx, err);
     sp_db_close(db);
-    if (r == SP_OK && link(tmp, path) != 0)
+    struct stat now;
+    bool replace = empty && stat(path, &now) == 0 && now.st_ino == was && now.st_size == 0;
+    if (r == SP_OK && empty && !replace)
+        r = sp_fail(err, SP_ERR_BUSY, "%s: written by another process meanwhile; nothing replaced", path);
+    else if (r == SP_OK && (replace ? rename(tmp, path) : link(tmp, path)) != 0)
         r = sp_fail(err, errno == EEXIST ? SP_ERR_BUSY : SP_ERR_IO, "%s: %s", path, strerror(errno));
     else if (r == SP_OK)
         sp_path_sync_folder(path); // SQLite synced the file; its new name too

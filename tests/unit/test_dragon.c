@@ -11,6 +11,7 @@
 // `six_real_parts` runs the same checks on the shipped parts once assets/
 // holds them (skipped before).
 #include <dirent.h>
+#include <errno.h>
 #include <math.h>
 #include <sqlite3.h>
 #include <stdio.h>
@@ -1462,8 +1463,9 @@ static void test_command(void)
     ENSURE(sp_sketch_write_json(strokes, &sk, &err) == SP_OK);
     sp_sketch_free(&sk);
     unlink(out), unlink(png), unlink(rep);
-    snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' --out '%s' --render '%s' --report '%s' > /dev/null",
-             SP_SKETCHPOSE, path, strokes, out, png, rep);
+    // The database from $SP_DB, as for demo, db and the kiosk (--db was required).
+    snprintf(cmd, sizeof cmd, "SP_DB='%s' '%s' dragon --strokes '%s' --out '%s' --render '%s' --report '%s' > /dev/null", path,
+             SP_SKETCHPOSE, strokes, out, png, rep);
     ENSURE(system(cmd) == 0);
     struct stat st;
     ENSURE(stat(png, &st) == 0 && st.st_size > 1000);
@@ -1503,8 +1505,18 @@ static void test_command(void)
     snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes /nonexistent.json --out '%s' 2>/dev/null", SP_SKETCHPOSE, path,
              out);
     ENSURE(WEXITSTATUS(system(cmd)) == 1);
-    snprintf(cmd, sizeof cmd, "'%s' dragon --strokes '%s' 2>/dev/null", SP_SKETCHPOSE, strokes);
-    ENSURE(WEXITSTATUS(system(cmd)) == 2);
+    // No --db and no $SP_DB: ./sketchpose.db, built from --assets when missing
+    // (here there are none: exit 1, nothing made).
+    char nodb[1100];
+    snprintf(nodb, sizeof nodb, "%s", sp_test_tmp_path("dragon_nodb"));
+    ENSURE(mkdir(nodb, 0755) == 0 || errno == EEXIST);
+    snprintf(cmd, sizeof cmd, "cd '%s' && env -u SP_DB '%s' dragon --strokes '%s' --assets /nonexistent 2>/dev/null", nodb,
+             SP_SKETCHPOSE, strokes);
+    ENSURE(WEXITSTATUS(system(cmd)) == 1);
+    snprintf(cmd, sizeof cmd, "%s/sketchpose.db", nodb);
+    ENSURE(access(cmd, F_OK) != 0 && rmdir(nodb) == 0);
+    snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' 2>/dev/null", SP_SKETCHPOSE, path);
+    ENSURE(WEXITSTATUS(system(cmd)) == 2); // --strokes is required
     // --max-ms out of (0, 3600000] is bad usage, as for pose (it was the default)
     for (int i = 0; i < 2; ++i) {
         snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' --max-ms %s 2>&1 >/dev/null | grep -q 'max-ms must be'",

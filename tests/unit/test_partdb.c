@@ -301,6 +301,17 @@ static void test_round_trip(void)
     sp_db_close(db);
     // Existing targets are never overwritten.
     ENSURE(sp_db_create_from_export(p2, dir, NULL, "test", &err) == SP_ERR_INVALID && strstr(err.text, "exists"));
+    // An empty file is no database (`mktemp` makes one): it takes the build
+    // (it was refused as existing, though the database opener treats it as new).
+    char empty[1100];
+    snprintf(empty, sizeof empty, "%s", sp_test_tmp_path("empty_target.db"));
+    sp_fixture_remove_db(empty);
+    FILE* f = fopen(empty, "wb");
+    ENSURE(f && fclose(f) == 0);
+    r = sp_db_create_from_export(empty, dir, NULL, "test", &err);
+    if (r != SP_OK) fprintf(stderr, "  into an empty file: %s\n", err.text);
+    ENSURE(r == SP_OK && scalar(empty, "SELECT count(*) FROM parts") == 2);
+    sp_fixture_remove_db(empty);
 }
 
 static void test_curator_category(void)
