@@ -315,6 +315,12 @@ std::string without_data_payloads(std::string line)
 std::string explain(LoadContext& cx, const unsigned char* data, size_t size, const std::string& line)
 {
     char msg[512];
+    // nlohmann's own words ("[json.exception.parse_error.101] parse error at
+    // line 1, column 92: ...") said as ours: what is wrong, and where.
+    const char* json_head = "[json.exception.parse_error.";
+    size_t at = line.find("] parse error at ");
+    if (line.compare(0, strlen(json_head), json_head) == 0 && at != std::string::npos)
+        return "not valid JSON at " + line.substr(at + strlen("] parse error at "));
     if (line.find("'uri' is missing from non binary glTF file buffer") != std::string::npos) {
         if (!cx.scanned) scan_buffers_of(cx, data, size);
         for (size_t i = 0; i < cx.buffers.size(); ++i)

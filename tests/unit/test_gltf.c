@@ -568,6 +568,12 @@ static void test_says_what_is_wrong(void)
 {
     ensure_fails(write_edited("buf_dir.gltf", &(mini_desc){.uri = "NAME"}, "NAME", "."), "buf_dir.gltf", "buffer 0: ");
     ensure_fails(sp_test_tmp_path("buf_dir.gltf"), "buf_dir.gltf", "is a directory");
+    // JSON that does not parse is said in our words, not nlohmann's
+    // ("[json.exception.parse_error.101] parse error at ...").
+    const char* nan_json = sp_test_tmp_path("nan.gltf");
+    static const char nan_text[] = "{\"asset\": {\"version\": \"2.0\"}, \"x\": [1, NaN]}";
+    ENSURE(mini_write(nan_json, nan_text, sizeof nan_text - 1));
+    ensure_fails(nan_json, "nan.gltf", "nan.gltf: not valid JSON at line 1, column 40: syntax error");
     // An image whose uri names a pipe: the file loads, with a warning. Looking
     // for the file used to open it, which waits for a writer forever; in a
     // child, so that such a wait fails the test (SIGALRM) instead of hanging it.
