@@ -152,11 +152,11 @@ void sp_outputs_undo(sp_outputs* o, sp_error* err)
     for (int i = 0; i < o->count; ++i) {
         if (!o->staged[i]) continue;
         unlink(o->staged[i]);
-        char* at = err ? strstr(err->text, o->staged[i]) : NULL;
-        if (at) {
+        for (char* at = err ? strstr(err->text, o->staged[i]) : NULL; at; at = strstr(at, o->staged[i])) {
             char rest[sizeof err->text];
             snprintf(rest, sizeof rest, "%s", at + strlen(o->staged[i]));
             snprintf(at, sizeof err->text - (size_t)(at - err->text), "%s%s", o->paths[i], rest);
+            at += strlen(o->paths[i]);
         }
         forget(o, i);
     }

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "report.h"
 #include "sp/snapshot.h"
@@ -45,7 +46,12 @@ static sp_result write_posed(const sp_solve_cmd* s, const double* p, const sp_so
                               .ghost = o->ghost};
         // The picture is the strokes' canvas, which can be too large for GL: say which output failed.
         sp_error e = {0};
-        if ((r = sp_snapshot_png(&d, render, &e)) != SP_OK) sp_fail(err, r, "%s: %s", render, e.text);
+        if ((r = sp_snapshot_png(&d, render, &e)) != SP_OK && err) {
+            if (strstr(e.text, render))
+                *err = e;
+            else
+                sp_fail(err, r, "%s: %s", render, e.text);
+        }
     }
     sp_rig_posed_free(&v);
     return r;
