@@ -200,6 +200,7 @@ int cmd_demo(int argc, char** argv)
         return SP_EXIT_INPUT;
     }
     int exit_code = SP_EXIT_INPUT;
+    sp_outputs staged = {0};
     sp_sketch drawn = {.canvas_w = DEMO_W, .canvas_h = DEMO_H};
     cJSON* j = NULL;
     char strokes[1200], png[1200], glb[1200], report[1200];
@@ -262,9 +263,14 @@ int cmd_demo(int argc, char** argv)
     j = cJSON_Parse(text);
     free(text);
     if (!j) goto oom;
-    if (sp_sketch_write_json(strokes, &drawn, &err) != SP_OK || sp_json_write_file(report, j, &err) != SP_OK ||
-        sp_dragon_export(d, glb, &err) != SP_OK ||
-        sp_dragon_snapshot_png(d, &(sp_dragon_snapshot_desc){.strokes = true, .outlines = true}, png, &err) != SP_OK)
+    // The four files together or none, over a folder of an earlier demo.
+    const char *strokes_to, *report_to, *glb_to, *png_to;
+    if (sp_outputs_stage(&staged, strokes, &strokes_to, &err) != SP_OK ||
+        sp_outputs_stage(&staged, report, &report_to, &err) != SP_OK || sp_outputs_stage(&staged, glb, &glb_to, &err) != SP_OK ||
+        sp_outputs_stage(&staged, png, &png_to, &err) != SP_OK || sp_sketch_write_json(strokes_to, &drawn, &err) != SP_OK ||
+        sp_json_write_file(report_to, j, &err) != SP_OK || sp_dragon_export(d, glb_to, &err) != SP_OK ||
+        sp_dragon_snapshot_png(d, &(sp_dragon_snapshot_desc){.strokes = true, .outlines = true}, png_to, &err) != SP_OK ||
+        sp_outputs_commit(&staged, &err) != SP_OK)
         goto fail;
     printf("a dragon of %d parts (animation %.1f s, looped)\n", sp_dragon_part_count(d), sp_dragon_period(d));
     printf("wrote %s (parts, strokes blue, fitted outlines yellow), %s (animated), %s, %s\n", png, glb, strokes, report);
@@ -276,6 +282,7 @@ int cmd_demo(int argc, char** argv)
 oom:
     sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
 fail:
+    sp_outputs_undo(&staged, &err);
     fprintf(stderr, "sketchpose demo: %s\n", err.text);
 done:
     free(b.px);

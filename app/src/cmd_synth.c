@@ -11,6 +11,7 @@
 #include "cli.h"
 #include "pose_io.h"
 #include "posing.h"
+#include "report.h"
 #include "rig_handle.h"
 #include "sp/concept.h"
 #include "sp/gltf.h"
@@ -415,6 +416,7 @@ int cmd_synth(int argc, char** argv)
     sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_sketch sk = {0};
+    sp_outputs staged = {0};
     double* p = NULL;
     int exit_code = SP_EXIT_INPUT;
     if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
@@ -432,11 +434,17 @@ int cmd_synth(int argc, char** argv)
         sk = drawn;
     }
     if (noise > 0) sp_synth_jitter(&sk, noise, (uint64_t)(unsigned)seed);
-    if (sp_sketch_write_json(out, &sk, &err) != SP_OK) goto fail;
-    if (truth && sp_pose_write(truth, sp_rig_handle_params(rig), sp_rig_handle_param_count(rig), p, &err) != SP_OK) goto fail;
+    // The strokes and their pose together or neither (sp_outputs).
+    const char *out_to, *truth_to;
+    if (sp_outputs_stage(&staged, out, &out_to, &err) != SP_OK || sp_outputs_stage(&staged, truth, &truth_to, &err) != SP_OK ||
+        sp_sketch_write_json(out_to, &sk, &err) != SP_OK ||
+        (truth_to && sp_pose_write(truth_to, sp_rig_handle_params(rig), sp_rig_handle_param_count(rig), p, &err) != SP_OK) ||
+        sp_outputs_commit(&staged, &err) != SP_OK)
+        goto fail;
     exit_code = SP_EXIT_OK;
     goto done;
 fail:
+    sp_outputs_undo(&staged, &err);
     fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
 done:
     free(p);
