@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
@@ -165,7 +166,11 @@ int cmd_demo(int argc, char** argv)
         fprintf(stderr, "sketchpose demo: --seed must not be negative\n");
         return SP_EXIT_USAGE;
     }
-    if (mkdir(out_dir, 0755) != 0) {
+    // Made first, so that a folder that cannot be made is said before the
+    // database is built; a demo that fails removes it again when it is
+    // still empty (rmdir removes nothing else).
+    bool made_out = mkdir(out_dir, 0755) == 0;
+    if (!made_out) {
         struct stat st;
         if (stat(out_dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
             fprintf(stderr, "sketchpose demo: %s: cannot create the folder\n", out_dir);
@@ -189,6 +194,7 @@ int cmd_demo(int argc, char** argv)
     }
     if (sp_db_open_or_create_default(path, assets, SP_DB_READONLY, &db, &err) != SP_OK) {
         fprintf(stderr, "sketchpose demo: %s\n", err.text);
+        if (made_out) rmdir(out_dir);
         return SP_EXIT_INPUT;
     }
     sp_dragon* d;
@@ -197,6 +203,7 @@ int cmd_demo(int argc, char** argv)
         fprintf(stderr, "sketchpose demo: %s\n", d ? sp_dragon_model_error(d) : err.text);
         sp_dragon_destroy(d);
         sp_db_close(db);
+        if (made_out) rmdir(out_dir);
         return SP_EXIT_INPUT;
     }
     int exit_code = SP_EXIT_INPUT;
@@ -285,6 +292,7 @@ fail:
     sp_outputs_undo(&staged, &err);
     fprintf(stderr, "sketchpose demo: %s\n", err.text);
 done:
+    if (exit_code != SP_EXIT_OK && made_out) rmdir(out_dir);
     free(b.px);
     cJSON_Delete(j);
     sp_sketch_free(&drawn);

@@ -465,7 +465,9 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     if (v < SP_DB_SCHEMA_VERSION) {
         if (ro && exists && v > 0) {
             r = sp_fail(err, SP_ERR_UNSUPPORTED,
-                        "%s: database schema version %d is older than %d; open it once for writing (e.g. `sketchpose db check`) to migrate",
+                        "%s: database schema version %d is older than %d; a user who may write it migrates it by opening it once "
+                        "for writing "
+                        "(e.g. `sketchpose db check`)",
                         path, v, SP_DB_SCHEMA_VERSION);
             goto fail;
         }

@@ -1273,6 +1273,15 @@ static void test_corrupt_part(void)
         ENSURE(!sp_dragon_model(m) && strstr(sp_dragon_model_error(m), says[i]));
         sp_dragon_destroy(m);
     }
+    // The demo says it the same way, and takes back the output folder it made.
+    char demo_out[1100];
+    snprintf(demo_out, sizeof demo_out, "%s", sp_test_tmp_path("corrupt_demo_out"));
+    snprintf(cmd, sizeof cmd, "'%s' demo --db '%s' --out '%s' > /dev/null 2> '%s'", SP_SKETCHPOSE, path, demo_out, log);
+    ENSURE(WEXITSTATUS(system(cmd)) == 1);
+    text = sp_fixture_file_text(log, NULL);
+    ENSURE(strstr(text, "sketchpose demo: ") && strstr(text, says[1]) && strchr(text, '\n') == text + strlen(text) - 1);
+    free(text);
+    ENSURE(access(demo_out, F_OK) != 0);
     free(tail), free(torso);
     sp_fixture_remove_db(path);
 }
