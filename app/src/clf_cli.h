@@ -1,6 +1,6 @@
 /// clf_cli.h: what the classifier commands (train, eval, classify) share:
 /// training options on the command line, a terminal progress bar, JSON strings.
-/// Header-only so that it needs no build changes; included by cmd_train.c and cmd_eval.c.
+/// Header-only so that it needs no build changes; included by the commands that train, evaluate or print JSON by hand.
 #ifndef SP_CLF_CLI_H
 #define SP_CLF_CLI_H
 

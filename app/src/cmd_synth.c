@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "clf_cli.h"
 #include "cli.h"
 #include "pose_io.h"
 #include "posing.h"
@@ -47,20 +48,6 @@ static bool takes_only(int argc, char** argv, const char* mode, const char* cons
     return true;
 }
 
-static void json_str(FILE* f, const char* s)
-{
-    fputc('"', f);
-    for (const unsigned char* p = (const unsigned char*)s; *p; ++p) {
-        if (*p == '"' || *p == '\\')
-            fprintf(f, "\\%c", *p);
-        else if (*p < 0x20)
-            fprintf(f, "\\u%04x", *p);
-        else
-            fputc(*p, f);
-    }
-    fputc('"', f);
-}
-
 // --parts DIR: every .glb/.gltf part of DIR (category from extras.sp_part),
 // `per_part` hand-drawn sketches each, into OUT/<category>/<part>-<style>-<family>-<i>.json.
 static int synth_parts(const char* dir, const char* abs_name, int per_part, uint64_t family, const sp_handdraw_desc* base,
@@ -98,7 +85,7 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     sp_handdraw_desc desc = *base;
     int total = 0, written = 0;
     fprintf(js, "{\"out_dir\": ");
-    json_str(js, out_dir);
+    clf_cli_json_str(js, out_dir);
     fprintf(js, ", \"style\": \"%s\", \"seed\": %llu, \"parts\": [", sp_handdraw_style_name(style), (unsigned long long)family);
     for (int k = 0; k < n; ++k) {
         char path[4096], stem[256], category[SP_NAME_MAX];
@@ -144,11 +131,11 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         }
         total += count;
         fprintf(js, "%s{\"name\": ", written++ ? ", " : "");
-        json_str(js, stem);
+        clf_cli_json_str(js, stem);
         fprintf(js, ", \"category\": ");
-        json_str(js, category);
+        clf_cli_json_str(js, category);
         fprintf(js, ", \"abstraction\": ");
-        json_str(js, ch.rig.abstractions[a].name);
+        clf_cli_json_str(js, ch.rig.abstractions[a].name);
         fprintf(js, ", \"sketches\": %d}", count);
         sp_character_free(&ch);
     }
