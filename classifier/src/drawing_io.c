@@ -20,24 +20,21 @@
 sp_result sp_raster_read_png(const char* path, sp_raster* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    // Why read the header first: a decoder would allocate the whole image
+    // One read (regular files only, at most a drawing file's size), then
+    // the header before the decoder: it would allocate the whole image
     // before we could refuse a 20000x20000 file.
-    FILE* f;
-    sp_result rc = sp_file_open_regular(path, &f, NULL, err);
-    if (rc != SP_OK) return rc;
-    unsigned char hdr[24];
-    size_t got = fread(hdr, 1, sizeof hdr, f);
-    fclose(f);
-    uint32_t w, h;
-    const char* bad = sp_png_header(hdr, got, &w, &h);
-    if (bad) return sp_fail(err, SP_ERR_PARSE, "%s: %s", path, bad);
-    if (w > SP_RASTER_MAX_SIDE || h > SP_RASTER_MAX_SIDE)
-        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: PNG is %ux%u, larger than %dx%d", path, w, h, SP_RASTER_MAX_SIDE,
-                       SP_RASTER_MAX_SIDE);
     char* bytes;
     size_t len;
-    rc = sp_sketch_file_read(path, &bytes, &len, err);
+    sp_result rc = sp_sketch_file_read(path, &bytes, &len, err);
     if (rc != SP_OK) return rc;
+    uint32_t w, h;
+    const char* bad = sp_png_header((const unsigned char*)bytes, len, &w, &h);
+    if (bad || w > SP_RASTER_MAX_SIDE || h > SP_RASTER_MAX_SIDE) {
+        free(bytes);
+        if (bad) return sp_fail(err, SP_ERR_PARSE, "%s: %s", path, bad);
+        return sp_fail(err, SP_ERR_UNSUPPORTED, "%s: PNG is %ux%u, larger than %dx%d", path, w, h, SP_RASTER_MAX_SIDE,
+                       SP_RASTER_MAX_SIDE);
+    }
     // Why stb and not OpenCV's decoder: it is quiet (see png_decode.h), and
     // the pixels it gives go straight to the grey conversion: one decode.
     const char* why = NULL;

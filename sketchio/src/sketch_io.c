@@ -126,7 +126,8 @@ sp_result sp_file_write_printed(const char* path, FILE* f, char** text, size_t* 
     return r;
 }
 
-sp_result sp_file_open_regular(const char* path, FILE** out, long long* size, sp_error* err)
+// `path` opened for reading, *size its bytes: regular files only.
+static sp_result open_regular(const char* path, FILE** out, long long* size, sp_error* err)
 {
     *out = NULL;
     // O_NONBLOCK: opening a FIFO for reading waits for a writer, so a pipe
@@ -148,7 +149,7 @@ sp_result sp_file_open_regular(const char* path, FILE** out, long long* size, sp
         return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(e));
     }
     *out = f;
-    if (size) *size = (long long)st.st_size;
+    *size = (long long)st.st_size;
     return SP_OK;
 }
 
@@ -157,8 +158,8 @@ sp_result sp_file_read(const char* path, size_t max_bytes, void** data, size_t* 
     *data = NULL;
     *size = 0;
     FILE* f;
-    long long bytes;
-    sp_result r = sp_file_open_regular(path, &f, &bytes, err);
+    long long bytes = 0;
+    sp_result r = open_regular(path, &f, &bytes, err);
     if (r != SP_OK) return r;
     if ((unsigned long long)bytes > max_bytes) {
         fclose(f);

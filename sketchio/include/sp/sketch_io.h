@@ -95,10 +95,6 @@ void sp_dataset_free(sp_dataset* ds);
 /// leaves `smp` with the caller.
 sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 
-/// Opens `path` for reading (*f, its *size in bytes when size is not NULL):
-/// regular files only, a device or a pipe refused in one line naming the
-/// path, without waiting for a pipe's writer.
-sp_result sp_file_open_regular(const char* path, FILE** f, long long* size, sp_error* err);
 /// Reads a whole file into *data (malloc'd, NUL-terminated, *size bytes
 /// without the NUL): regular files only (a device or a pipe is refused, never
 /// read without end) of at most max_bytes. One line in `err` names the path.
