@@ -550,50 +550,41 @@ static void test_pose_file_whole(void)
 // /dev/zero used to fill the memory of `inspect --rig`.
 static void test_device_inputs(void)
 {
-    const char* cases[] = {"inspect --rig /dev/zero", "export --rig %s/assets/tail.glb --pose /dev/zero --out %s",
-                           "classify --model /dev/zero --strokes /dev/null",
-                           "pose --rig %s/assets/tail.glb --strokes /dev/zero --out %s",
-                           "pose --rig /dev/zero --strokes /dev/null"};
-    char out[1024]; // a copy: sp_test_tmp_path's buffers are reused after eight calls
+    // %1$s the device or pipe, %2$s the source tree, %3$s a stroke file, %4$s an output.
+    const struct {
+        const char* fmt;
+        bool fifo; // a named pipe with no writer: opening it to read used to wait forever
+    } cases[] = {{"inspect --rig %1$s", false},
+                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", false},
+                 {"classify --model %1$s --strokes /dev/null", false},
+                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", false},
+                 {"pose --rig %1$s --strokes /dev/null", false},
+                 {"inspect --rig %1$s", true},
+                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", true},
+                 {"classify --model %1$s --strokes %3$s", true},
+                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", true}};
+    // Copies: sp_test_tmp_path's buffers are reused after eight calls.
+    char out[1024], fifo[1024], strokes[1024], log[1024], cmd[3000];
     snprintf(out, sizeof out, "%s", sp_test_tmp_path("device_inputs.glb"));
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        char args[1200], cmd[3000];
-        snprintf(args, sizeof args, cases[i], SP_SOURCE_DIR, out);
-        const char* log = sp_test_tmp_path("device_inputs.txt");
-        // timeout: a reader that does not refuse would run until the memory is gone.
-        snprintf(cmd, sizeof cmd, "timeout 60 '%s' %s 2>'%s' >/dev/null", SP_SKETCHPOSE, args, log);
-        int rc = run(cmd);
-        char text[2048] = {0};
-        FILE* f = fopen(log, "rb");
-        size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
-        if (f) fclose(f);
-        fprintf(stderr, "  %s: exit %d, %.*s", args, rc, (int)n, text);
-        ENSURE(rc == 1 && strstr(text, "not a regular file") && strchr(text, '\n') == text + n - 1);
-        ENSURE(access(out, F_OK) != 0);
-    }
-    // A named pipe with no writer: opening it to read used to wait forever.
-    char fifo[1024], strokes[1024], log[1024];
     snprintf(fifo, sizeof fifo, "%s", sp_test_tmp_path("device_inputs.fifo"));
     snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("device_inputs.json"));
     snprintf(log, sizeof log, "%s", sp_test_tmp_path("device_inputs.txt"));
     unlink(fifo);
     ENSURE(mkfifo(fifo, 0600) == 0);
-    char cmd[3000];
     snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s/assets/tail.glb' --seed 1 --out '%s' > /dev/null", SP_SKETCHPOSE,
              SP_SOURCE_DIR, strokes);
     ENSURE(run(cmd) == 0);
-    const char* fifo_cases[] = {"inspect --rig %1$s", "export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s",
-                                "classify --model %1$s --strokes %3$s",
-                                "pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s"};
-    for (size_t i = 0; i < sizeof fifo_cases / sizeof fifo_cases[0]; ++i) {
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char args[1200];
-        snprintf(args, sizeof args, fifo_cases[i], fifo, SP_SOURCE_DIR, strokes, out);
+        snprintf(args, sizeof args, cases[i].fmt, cases[i].fifo ? fifo : "/dev/zero", SP_SOURCE_DIR, strokes, out);
+        // timeout: a reader that does not refuse would run until the memory is gone, or wait for a writer.
         snprintf(cmd, sizeof cmd, "timeout 60 '%s' %s 2>'%s' >/dev/null", SP_SKETCHPOSE, args, log);
         int rc = run(cmd);
         size_t n = 0;
         char* text = sp_fixture_file_text(log, &n);
         fprintf(stderr, "  %s: exit %d, %s", args, rc, text);
-        ENSURE(rc == 1 && strstr(text, "device_inputs.fifo: not a regular file") && strchr(text, '\n') == text + n - 1);
+        ENSURE(rc == 1 && strstr(text, cases[i].fifo ? "device_inputs.fifo: not a regular file" : "not a regular file") &&
+               strchr(text, '\n') == text + n - 1);
         ENSURE(access(out, F_OK) != 0);
         free(text);
     }
