@@ -231,9 +231,23 @@ bool buffer_file_exists(const std::string& path, void* user)
     return buffer_of_path(cx, path) >= 0 || stat(path.c_str(), &st) == 0;
 }
 
+// A uri with a scheme ("http:", "file:") or an absolute path: tinygltf would
+// join it to the glTF's folder ("g//dev/zero") and then find nothing there.
+bool is_absolute_uri(const std::string& uri)
+{
+    if (!uri.empty() && uri[0] == '/') return true;
+    size_t i = 0;
+    while (i < uri.size() && (isalnum((unsigned char)uri[i]) || uri[i] == '+' || uri[i] == '-' || uri[i] == '.'))
+        ++i;
+    return i > 1 && i < uri.size() && uri[i] == ':' && isalpha((unsigned char)uri[0]);
+}
+
 // tinygltf's own reader sizes its vector by seeking to the end, which for a
 // directory gives 2^63 - 1 and an attempt to allocate that. Ours reads only a
 // regular file, and only as many bytes as the buffer that names it declares.
+// An image's file is looked at but never read: skip_image ignores its bytes,
+// so reading a texture of many megabytes (or one outside the glTF's folder)
+// would only cost time and memory.
 bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user)
 {
     LoadContext& cx = *static_cast<LoadContext*>(user);
@@ -244,7 +258,11 @@ bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const s
     struct stat st;
     FILE* f = nullptr;
     int stat_errno = stat(path.c_str(), &st) != 0 ? errno : 0;
-    if (index >= 0 && (stat_errno == ENOENT || stat_errno == ENOTDIR))
+    if (index >= 0 && is_absolute_uri(url_decode(cx.buffers[(size_t)index].uri)))
+        snprintf(msg, sizeof msg,
+                 "%s: buffer %d (uri '%s'): not a path relative to the glTF (only those and data: URIs are read)", cx.what, index,
+                 cx.buffers[(size_t)index].uri.c_str());
+    else if (index >= 0 && (stat_errno == ENOENT || stat_errno == ENOTDIR))
         snprintf(msg, sizeof msg, "%s: buffer %d (uri '%s'): file not found (%s)", cx.what, index,
                  cx.buffers[(size_t)index].uri.c_str(), path.c_str());
     else if (stat_errno)
@@ -256,12 +274,17 @@ bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const s
     else if (index >= 0 && (double)st.st_size != cx.buffers[(size_t)index].byte_length)
         snprintf(msg, sizeof msg, "%s: %s%s has %lld bytes, but the buffer's byteLength is %.17g", cx.what, who, path.c_str(),
                  (long long)st.st_size, cx.buffers[(size_t)index].byte_length);
-    else if (st.st_size > 0x7fffffff)
+    else if (index < 0) {
+        out->assign(st.st_size > 0 ? 1 : 0, 0); // tinygltf warns of an empty file
+        return true;
+    } else if (st.st_size > 0x7fffffff)
         snprintf(msg, sizeof msg, "%s: %s%s is over 2 GiB (not supported)", cx.what, who, path.c_str());
     else if (!(f = fopen(path.c_str(), "rb")))
         snprintf(msg, sizeof msg, "%s: %s%s: %s", cx.what, who, path.c_str(), strerror(errno));
     if (!f) {
-        if (cx.message.empty()) cx.message = msg;
+        // Only a buffer's: an image's is a warning, which must not become the
+        // reason of a load that fails on something else.
+        if (index >= 0 && cx.message.empty()) cx.message = msg;
         if (err) *err += msg;
         return false;
     }

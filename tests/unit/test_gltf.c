@@ -6,6 +6,7 @@
 // `test_gltf --write-corpus DIR` writes the hand-made seed files (fuzz corpus,
 // CLI fixture) instead of running tests.
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -592,6 +593,32 @@ static void test_says_what_is_wrong(void)
     }
     ENSURE(sp_fixture_child_passed(pid));
     unlink(fifo);
+    // An image's file is never read (its pixels are never used): a texture
+    // over the 2 GiB a buffer may have loads without a word, while an empty
+    // one is still said. The big one is sparse, so it costs no disk.
+    const char* huge = sp_test_tmp_path("huge.png");
+    int hfd = open(huge, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ENSURE(hfd >= 0 && ftruncate(hfd, (off_t)3 << 30) == 0);
+    close(hfd);
+    snprintf(images, sizeof images, "{\"images\": [{\"uri\": \"%s\"}], \"asset\"", strrchr(huge, '/') + 1);
+    {
+        sp_character c = {0};
+        sp_error e = {0};
+        ENSURE(sp_gltf_load(write_edited("image_huge.gltf", &(mini_desc){0}, "{\"asset\"", images), &c, &e) == SP_OK);
+        ENSURE(c.warning_count == 0);
+        sp_character_free(&c);
+        ENSURE(truncate(huge, 0) == 0);
+        ENSURE(sp_gltf_load(sp_test_tmp_path("image_huge.gltf"), &c, &e) == SP_OK);
+        ENSURE(sp_fixture_has_warning(&c, "File is empty"));
+        sp_character_free(&c);
+    }
+    unlink(huge);
+    // A buffer's uri that is absolute or has a scheme is said as such, not
+    // as a file missing at the glTF's folder joined to it.
+    ensure_fails(write_mini("buf_abs.gltf", &(mini_desc){.uri = "/dev/zero"}), "buf_abs.gltf",
+                 "buffer 0 (uri '/dev/zero'): not a path relative to the glTF");
+    ensure_fails(write_mini("buf_http.gltf", &(mini_desc){.uri = "http://example.com/a.bin"}), "buf_http.gltf",
+                 "buffer 0 (uri 'http://example.com/a.bin'): not a path relative to the glTF");
     // An external file of the wrong size is refused before it is read.
     const char* bin = sp_test_tmp_path("short.bin");
     ENSURE(mini_write(bin, "0123456789", 10));
