@@ -729,10 +729,12 @@ void check_inverse_bind(sp_mat4& a, int skin, size_t k, const tinygltf::Model& m
         fail(SP_ERR_INVALID, "%s: %s: its inverse bind matrix has the fourth row [%g, %g, %g, %g], not [0, 0, 0, 1]", what, who,
              a.m[3], a.m[7], a.m[11], a.m[15]);
     a.m[3] = a.m[7] = a.m[11] = 0, a.m[15] = 1;
-    sp_vec3 c0 = sp_v3(a.m[0], a.m[1], a.m[2]), c1 = sp_v3(a.m[4], a.m[5], a.m[6]), c2 = sp_v3(a.m[8], a.m[9], a.m[10]);
-    // Relative to the columns' lengths, so that a file's unit does not matter.
-    double det = sp_v3_dot(c0, sp_v3_cross(c1, c2));
-    if (!(std::fabs(det) > 1e-6 * sp_v3_len(c0) * sp_v3_len(c1) * sp_v3_len(c2)))
+    // The test the stick figure and the deriver skip such a joint by, so that
+    // the warning and what they leave out agree (a scale of 1e-8 along one
+    // axis flattens as surely as a zero column); relative, so that a file's
+    // unit does not matter.
+    sp_mat4 inv;
+    if (!sp_mat4_inverse_rel(&a, SP_MAT4_FLAT, &inv))
         sp_character_warn(ch, "%s: its inverse bind matrix is singular: the vertices it moves are flattened", who);
 }
 

@@ -717,6 +717,12 @@ static void test_inverse_bind(void)
     ENSURE(ch.warning_count == 1 &&
            sp_fixture_has_warning(&ch, "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix is singular"));
     sp_character_free(&ch);
+    // Nearly so, by a scale of 1e-8 along one axis: as flat for the stick
+    // figure and the deriver, which leave the joint out, so said as well.
+    static const float thin[16] = {1, 0, 0, 0, 0, 1e-8f, 0, 0, 0, 0, 1, 0, 0, -1e-8f, 0, 1};
+    ch = load_ok(write_mini("ibm_thin.gltf", &(mini_desc){.ibm1 = thin}));
+    ENSURE(sp_fixture_has_warning(&ch, "skin 0 joint 1 (node 1 'tip'): its inverse bind matrix is singular"));
+    sp_character_free(&ch);
     // Not singular: a file in millimetres, a shear with a non-uniform scale.
     static const float small[16] = {1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, 0, 0, 1e-3f, 0, 0, -1e-3f, 0, 1};
     static const float sheared[16] = {2, 0, 0, 0, 0.5f, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};
