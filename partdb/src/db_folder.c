@@ -409,8 +409,12 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     if (!empty && stat(path, &st) == 0)
         return sp_fail(err, SP_ERR_INVALID, "%s: exists already (remove it, or use another --db)", path);
     ino_t was = st.st_ino;
+    // The empty file itself is replaced: through a link, the file it names
+    // (the link stays), and built beside that one, on its file system.
+    char* real = empty ? realpath(path, NULL) : NULL;
+    const char* where = real ? real : path;
     char tmp[1024];
-    snprintf(tmp, sizeof tmp, "%s.building-%ld", path, (long)getpid());
+    snprintf(tmp, sizeof tmp, "%s.building-%ld", where, (long)getpid());
     sp_db* db = NULL;
     sp_result r = sp_db_open(tmp, SP_DB_CREATE, &db, err);
     size_t tl = strlen(tmp);
@@ -425,10 +429,14 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     bool replace = empty && stat(path, &now) == 0 && now.st_ino == was && now.st_size == 0;
     if (r == SP_OK && empty && !replace)
         r = sp_fail(err, SP_ERR_BUSY, "%s: written by another process meanwhile; nothing replaced", path);
-    else if (r == SP_OK && (replace ? rename(tmp, path) : link(tmp, path)) != 0)
+    // It keeps the empty file's permissions (mktemp makes it 0600: a
+    // database built into it is as private).
+    if (r == SP_OK && replace) chmod(tmp, st.st_mode & 07777);
+    if (r == SP_OK && (replace ? rename(tmp, where) : link(tmp, path)) != 0)
         r = sp_fail(err, errno == EEXIST ? SP_ERR_BUSY : SP_ERR_IO, "%s: %s", path, strerror(errno));
     else if (r == SP_OK)
-        sp_path_sync_folder(path); // SQLite synced the file; its new name too
+        sp_path_sync_folder(where); // SQLite synced the file; its new name too
+    free(real);
     unlink(tmp);
     char side[1100];
     snprintf(side, sizeof side, "%s-wal", tmp);

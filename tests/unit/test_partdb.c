@@ -312,6 +312,21 @@ static void test_round_trip(void)
     if (r != SP_OK) fprintf(stderr, "  into an empty file: %s\n", err.text);
     ENSURE(r == SP_OK && scalar(empty, "SELECT count(*) FROM parts") == 2);
     sp_fixture_remove_db(empty);
+    // It keeps the empty file's permissions (a 0600 file became a 0644
+    // database), and through a link the file it names takes the build (the
+    // link became a database and its target stayed empty).
+    char link[1100];
+    snprintf(link, sizeof link, "%s", sp_test_tmp_path("empty_link.db"));
+    unlink(link);
+    f = fopen(empty, "wb");
+    ENSURE(f && fclose(f) == 0 && chmod(empty, 0600) == 0 && symlink(empty, link) == 0);
+    r = sp_db_create_from_export(link, dir, NULL, "test", &err);
+    if (r != SP_OK) fprintf(stderr, "  into a link to an empty file: %s\n", err.text);
+    struct stat st;
+    ENSURE(r == SP_OK && lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
+    ENSURE(stat(empty, &st) == 0 && (st.st_mode & 0777) == 0600 && scalar(empty, "SELECT count(*) FROM parts") == 2);
+    unlink(link);
+    sp_fixture_remove_db(empty);
 }
 
 static void test_curator_category(void)
