@@ -99,6 +99,9 @@ sp_result sp_blackbox_load_plugin(const char* path, sp_blackbox** out, sp_error*
     struct stat st;
     if (stat(path, &st) != 0) return sp_fail(err, SP_ERR_IO, "%s: %s", path, strerror(errno));
     if (S_ISDIR(st.st_mode)) return sp_fail(err, SP_ERR_IO, "%s: is a directory, not a plugin", path);
+    // Opening a named pipe waits for a writer forever (as would dlopen), and
+    // a device has no end: a plugin is a regular file.
+    if (!S_ISREG(st.st_mode)) return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
     // A bare file name would make dlopen search the library path instead of
     // loading the file the user named.
     char local[4096];

@@ -551,44 +551,49 @@ static void test_pose_file_whole(void)
 static void test_device_inputs(void)
 {
     // %1$s the device or pipe, %2$s the source tree, %3$s a stroke file, %4$s an output.
+    enum { DEVICE, FIFO, FIFO_SO }; // a named pipe with no writer: opening it to read used to wait forever
     const struct {
         const char* fmt;
-        bool fifo; // a named pipe with no writer: opening it to read used to wait forever
-    } cases[] = {{"inspect --rig %1$s", false},
-                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", false},
-                 {"classify --model %1$s --strokes /dev/null", false},
-                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", false},
-                 {"pose --rig %1$s --strokes /dev/null", false},
-                 {"inspect --rig %1$s", true},
-                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", true},
-                 {"classify --model %1$s --strokes %3$s", true},
-                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", true}};
+        int kind;
+    } cases[] = {{"inspect --rig %1$s", DEVICE},
+                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", DEVICE},
+                 {"classify --model %1$s --strokes /dev/null", DEVICE},
+                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", DEVICE},
+                 {"pose --rig %1$s --strokes /dev/null", DEVICE},
+                 {"inspect --rig %1$s", FIFO},
+                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", FIFO},
+                 {"classify --model %1$s --strokes %3$s", FIFO},
+                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", FIFO},
+                 {"inspect --rig %1$s", FIFO_SO}}; // a black-box rig's plugin
     // Copies: sp_test_tmp_path's buffers are reused after eight calls.
-    char out[1024], fifo[1024], strokes[1024], log[1024], cmd[3000];
+    char out[1024], fifo[1024], fifo_so[1024], strokes[1024], log[1024], cmd[3000];
     snprintf(out, sizeof out, "%s", sp_test_tmp_path("device_inputs.glb"));
     snprintf(fifo, sizeof fifo, "%s", sp_test_tmp_path("device_inputs.fifo"));
+    snprintf(fifo_so, sizeof fifo_so, "%s", sp_test_tmp_path("device_inputs.so"));
     snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("device_inputs.json"));
     snprintf(log, sizeof log, "%s", sp_test_tmp_path("device_inputs.txt"));
-    unlink(fifo);
-    ENSURE(mkfifo(fifo, 0600) == 0);
+    unlink(fifo), unlink(fifo_so);
+    ENSURE(mkfifo(fifo, 0600) == 0 && mkfifo(fifo_so, 0600) == 0);
     snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s/assets/tail.glb' --seed 1 --out '%s' > /dev/null", SP_SKETCHPOSE,
              SP_SOURCE_DIR, strokes);
     ENSURE(run(cmd) == 0);
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char args[1200];
-        snprintf(args, sizeof args, cases[i].fmt, cases[i].fifo ? fifo : "/dev/zero", SP_SOURCE_DIR, strokes, out);
+        const char* input = cases[i].kind == FIFO ? fifo : cases[i].kind == FIFO_SO ? fifo_so : "/dev/zero";
+        snprintf(args, sizeof args, cases[i].fmt, input, SP_SOURCE_DIR, strokes, out);
         // timeout: a reader that does not refuse would run until the memory is gone, or wait for a writer.
         snprintf(cmd, sizeof cmd, "timeout 60 '%s' %s 2>'%s' >/dev/null", SP_SKETCHPOSE, args, log);
         int rc = run(cmd);
         size_t n = 0;
         char* text = sp_fixture_file_text(log, &n);
         fprintf(stderr, "  %s: exit %d, %s", args, rc, text);
-        ENSURE(rc == 1 && strstr(text, cases[i].fifo ? "device_inputs.fifo: not a regular file" : "not a regular file") &&
-               strchr(text, '\n') == text + n - 1);
+        char said[1100];
+        snprintf(said, sizeof said, "%s: not a regular file", cases[i].kind == DEVICE ? "" : strrchr(input, '/') + 1);
+        ENSURE(rc == 1 && strstr(text, said) && strchr(text, '\n') == text + n - 1);
         ENSURE(access(out, F_OK) != 0);
         free(text);
     }
-    unlink(fifo);
+    unlink(fifo), unlink(fifo_so);
 }
 
 // The command's stderr (one line expected) after running `args` with exit rc.
