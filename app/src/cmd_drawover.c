@@ -101,6 +101,8 @@ int cmd_drawover(int argc, char** argv)
                 to.canvas_h, on.canvas_w, on.canvas_h);
         goto fail;
     }
+    // A file without a canvas is on the other's (both missing: the rig's view).
+    if (on.canvas_w <= 0) on.canvas_w = to.canvas_w, on.canvas_h = to.canvas_h;
     sp_camera cam = sp_rig_handle_camera(rig, on.canvas_w, on.canvas_h);
     if (sp_rig_handle_read_pose(rig, NULL, &p, NULL, &err) != SP_OK) goto fail;
     xyz = malloc(sizeof(double) * 3 * (size_t)(ch->rig.vertex_count + 1));

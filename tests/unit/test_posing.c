@@ -733,34 +733,51 @@ static void test_outputs_kept(void)
 // exit 0); on the same canvas it fits.
 static void test_drawover_canvas(void)
 {
-    char on[1100], to[1100], args[4000];
+    char on[1100], to[1100], rep[1100], args[4000];
     snprintf(on, sizeof on, "%s", sp_test_tmp_path("drawover_on.json"));
     snprintf(to, sizeof to, "%s", sp_test_tmp_path("drawover_to.json"));
+    snprintf(rep, sizeof rep, "%s", sp_test_tmp_path("drawover_report.json"));
     const char* rig = SP_SOURCE_DIR "/assets/cartoon_man.glb";
     sp_error err = {0};
     // Down the body, then bent to the right.
     const sp_vec2 down[] = {{300, 150}, {320, 200}, {330, 260}}, bent[] = {{300, 150}, {340, 200}, {370, 240}};
-    sp_sketch a = {.canvas_w = 640, .canvas_h = 480};
-    ENSURE(sp_sketch_add_stroke(&a, down, NULL, 3) == SP_OK && sp_sketch_write_json(on, &a, &err) == SP_OK);
-    sp_sketch_free(&a);
-    for (int twice = 0; twice < 2; ++twice) {
-        int k = 1 + twice;
+    double mean_px[3] = {0};
+    // Both at 640x480; --to at twice the size (refused); --on at twice the
+    // size without a canvas, which takes --to's (it took the rig's view's,
+    // and fitted to a mean error of 278 px with exit 0).
+    for (int round = 0; round < 3; ++round) {
+        int k_on = round == 2 ? 2 : 1, k_to = round == 0 ? 1 : 2;
         sp_vec2 xy[3];
         for (int i = 0; i < 3; ++i)
-            xy[i] = (sp_vec2){bent[i].x * k, bent[i].y * k};
-        sp_sketch b = {.canvas_w = 640 * k, .canvas_h = 480 * k};
+            xy[i] = (sp_vec2){down[i].x * k_on, down[i].y * k_on};
+        sp_sketch a = {.canvas_w = round == 2 ? 0 : 640, .canvas_h = round == 2 ? 0 : 480};
+        ENSURE(sp_sketch_add_stroke(&a, xy, NULL, 3) == SP_OK && sp_sketch_write_json(on, &a, &err) == SP_OK);
+        sp_sketch_free(&a);
+        for (int i = 0; i < 3; ++i)
+            xy[i] = (sp_vec2){bent[i].x * k_to, bent[i].y * k_to};
+        sp_sketch b = {.canvas_w = 640 * k_to, .canvas_h = 480 * k_to};
         ENSURE(sp_sketch_add_stroke(&b, xy, NULL, 3) == SP_OK && sp_sketch_write_json(to, &b, &err) == SP_OK);
         sp_sketch_free(&b);
-        snprintf(args, sizeof args, "drawover --rig '%s' --on '%s' --to '%s'", rig, on, to);
+        unlink(rep);
+        snprintf(args, sizeof args, "drawover --rig '%s' --on '%s' --to '%s' --report '%s'", rig, on, to, rep);
         int rc;
         char* text = run_said(args, &rc);
-        if (twice)
+        if (round == 1) {
             ENSURE(rc == 1 && strstr(text, "drawover_to.json: its canvas 1280x960 is not --on's 640x480") &&
                    strchr(text, '\n') == text + strlen(text) - 1);
-        else
+        } else {
             ENSURE(rc == 0);
+            char* r = sp_fixture_file_text(rep, NULL);
+            cJSON* j = cJSON_Parse(r);
+            free(r);
+            mean_px[round] = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "mean_error_px"));
+            cJSON_Delete(j);
+            fprintf(stderr, "  mean error %.2f px\n", mean_px[round]);
+        }
         free(text);
     }
+    // The same fit at twice the size: twice the error, give or take.
+    ENSURE(mean_px[2] <= 2 * mean_px[0] + 2);
 }
 
 // `synth --parts` that fails on a broken part after writing another's
