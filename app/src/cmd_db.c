@@ -963,6 +963,7 @@ static int db_review(int argc, char** argv)
         }
         return SP_EXIT_OK;
     }
+    if (!sp_cli_check_out_folders(cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
     sp_db_kiosk_sketch* ks = NULL;

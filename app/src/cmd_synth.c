@@ -323,6 +323,7 @@ int cmd_synth(int argc, char** argv)
         }
         static const char* const taken[] = {"--drawings", "--per-part", "--seed", "--sheet", NULL};
         if (!takes_only(argc, argv, "--drawings", taken)) return SP_EXIT_USAGE;
+        if (!sp_cli_check_out_folders("sketchpose synth", opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT;
         return synth_drawings(per, (uint64_t)(seeded ? seed : 1), sheet);
     }
     if (concepts) {
@@ -338,6 +339,9 @@ int cmd_synth(int argc, char** argv)
         }
         static const char* const taken[] = {"--concepts", "--per-part", "--seed", "--style", "--out-dir", "--sheet", NULL};
         if (!takes_only(argc, argv, "--concepts", taken)) return SP_EXIT_USAGE;
+        // With --out-dir the sheet may go into the folder this command makes.
+        if (!out_dir && !sp_cli_check_out_folders("sketchpose synth", opts, (int)(sizeof opts / sizeof opts[0])))
+            return SP_EXIT_INPUT;
         return synth_concepts(per_part, (uint64_t)(seeded ? seed : 1), style == SP_HANDDRAW_CLEAN, out_dir, sheet);
     }
     if (parts) {

@@ -711,6 +711,10 @@ static void test_outputs_kept(void)
         {"export --rig '%3$s/posed.glb' --out '%3$s/posed.glb'", 2, "--out %3$s/posed.glb is the same file as --rig"},
         {"animate --rig '%1$s' --strokes '%2$s' '%3$s/posed.glb' --out '%3$s/posed.glb'", 2,
          "--out %3$s/posed.glb is the same file as --strokes"},
+        // A contact sheet too (said after the work, not naming the option).
+        {"synth --drawings --sheet '%3$s/none/s.png'", 1, "--sheet %3$s/none/s.png: cannot write into folder '%3$s/none'"},
+        {"synth --concepts --sheet '%3$s/none/s.png'", 1, "--sheet %3$s/none/s.png: cannot write into folder '%3$s/none'"},
+        {"db review --db '%3$s/no.db' --sheet '%3$s/none/s.png'", 1, "--sheet %3$s/none/s.png: cannot write into folder"},
     };
     struct stat before;
     ENSURE(stat(strokes, &before) == 0);
