@@ -216,8 +216,11 @@ bool sp_cli_out_is_stream(const char* path)
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)
 {
     if (!path || sp_cli_out_is_stream(path)) return true;
-    char* dir = sp_path_folder(path);
-    if (!dir) return true; // out of memory: the writer will say so
+    // Through a link, the file is written in the folder of the one it names.
+    char* real = sp_path_follow_links(path);
+    char* dir = real ? sp_path_folder(real) : NULL;
+    free(real);
+    if (!dir) return true; // out of memory or a loop of links: the writer will say so
     struct stat st;
     const char* why = stat(dir, &st) != 0             ? strerror(errno)
                       : !S_ISDIR(st.st_mode)          ? "not a folder"

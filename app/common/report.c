@@ -1,12 +1,9 @@
 #include "report.h"
 #include "sp/sketch_io.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "pose_io.h"
 
@@ -84,81 +81,4 @@ sp_result sp_json_write_file(const char* path, const cJSON* j, sp_error* err)
     sp_result r = sp_file_write(path, s, n + 1, err);
     free(s);
     return r;
-}
-
-sp_result sp_outputs_stage(sp_outputs* o, const char* path, const char** write_to, sp_error* err)
-{
-    static unsigned serial;
-    *write_to = path;
-    if (!path) return SP_OK;
-    if (o->count >= (int)(sizeof o->paths / sizeof o->paths[0]))
-        return sp_fail(err, SP_ERR_INTERNAL, "%s: too many outputs for one command", path);
-    struct stat st;
-    bool link = lstat(path, &st) == 0 && S_ISLNK(st.st_mode);
-    char* real = link ? realpath(path, NULL) : NULL;
-    const char* target = real ? real : path;
-    // Written in place: stdout, a stream, a dangling link (what it names is created).
-    if (!strcmp(path, "-") || (link && !real) || (stat(target, &st) == 0 && !S_ISREG(st.st_mode)) || !strncmp(path, "/dev/", 5)) {
-        free(real);
-        return SP_OK;
-    }
-    const char* base = strrchr(target, '/');
-    const char* dot = strrchr(base ? base + 1 : target, '.');
-    size_t n = strlen(target) + 64;
-    char* tmp = malloc(n);
-    if (!tmp) {
-        free(real);
-        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
-    }
-    snprintf(tmp, n, "%s.part%ld-%u%s", target, (long)getpid(), serial++, dot ? dot : "");
-    o->paths[o->count] = path;
-    o->staged[o->count] = tmp;
-    o->target[o->count] = real;
-    ++o->count;
-    *write_to = tmp;
-    return SP_OK;
-}
-
-static void forget(sp_outputs* o, int i)
-{
-    free(o->staged[i]);
-    free(o->target[i]);
-    o->staged[i] = o->target[i] = NULL;
-}
-
-sp_result sp_outputs_commit(sp_outputs* o, sp_error* err)
-{
-    sp_result r = SP_OK;
-    for (int i = 0; i < o->count; ++i) {
-        if (!o->staged[i]) continue;
-        const char* target = o->target[i] ? o->target[i] : o->paths[i];
-        struct stat st;
-        if (r == SP_OK) {
-            if (stat(target, &st) == 0 && S_ISREG(st.st_mode)) chmod(o->staged[i], st.st_mode & 07777);
-            if (rename(o->staged[i], target) == 0)
-                sp_path_sync_folder(target);
-            else
-                r = sp_fail(err, SP_ERR_IO, "%s: cannot write (%s)", o->paths[i], strerror(errno));
-        }
-        if (r != SP_OK) unlink(o->staged[i]);
-        forget(o, i);
-    }
-    o->count = 0;
-    return r;
-}
-
-void sp_outputs_undo(sp_outputs* o, sp_error* err)
-{
-    for (int i = 0; i < o->count; ++i) {
-        if (!o->staged[i]) continue;
-        unlink(o->staged[i]);
-        for (char* at = err ? strstr(err->text, o->staged[i]) : NULL; at; at = strstr(at, o->staged[i])) {
-            char rest[sizeof err->text];
-            snprintf(rest, sizeof rest, "%s", at + strlen(o->staged[i]));
-            snprintf(at, sizeof err->text - (size_t)(at - err->text), "%s%s", o->paths[i], rest);
-            at += strlen(o->paths[i]);
-        }
-        forget(o, i);
-    }
-    o->count = 0;
 }

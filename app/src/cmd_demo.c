@@ -15,6 +15,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "outputs.h"
 #include "report.h"
 #include "sp/dragon.h"
 #include "sp/dragon_snapshot.h"

@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "outputs.h"
 #include "report.h"
 #include "sp/derive.h"
 #include "sp/part_preview.h"

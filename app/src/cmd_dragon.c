@@ -10,6 +10,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "outputs.h"
 #include "posing.h"
 #include "report.h"
 #include "sp/dragon.h"

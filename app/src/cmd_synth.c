@@ -10,6 +10,7 @@
 
 #include "clf_cli.h"
 #include "cli.h"
+#include "outputs.h"
 #include "pose_io.h"
 #include "posing.h"
 #include "report.h"

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "outputs.h"
 #include "report.h"
 #include "sp/snapshot.h"
 

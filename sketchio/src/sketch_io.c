@@ -60,6 +60,33 @@ char* sp_path_folder(const char* path)
     return dir;
 }
 
+char* sp_path_follow_links(const char* path)
+{
+    char* p = strdup(path);
+    for (int hop = 0; p && hop < 40; ++hop) { // 40: the kernel's own limit (ELOOP)
+        struct stat st;
+        if (lstat(p, &st) != 0 || !S_ISLNK(st.st_mode)) return p;
+        char to[4096];
+        ssize_t n = readlink(p, to, sizeof to - 1);
+        if (n < 0) return p;
+        to[n] = 0;
+        char* next;
+        if (to[0] == '/') {
+            next = strdup(to);
+        } else {
+            char* dir = sp_path_folder(p);
+            size_t len = (dir ? strlen(dir) : 0) + strlen(to) + 2;
+            next = dir ? malloc(len) : NULL;
+            if (next) snprintf(next, len, "%s/%s", dir, to);
+            free(dir);
+        }
+        free(p);
+        p = next;
+    }
+    free(p);
+    return NULL;
+}
+
 bool sp_path_sync_folder(const char* path)
 {
     char* dir = sp_path_folder(path);
@@ -76,12 +103,11 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
 {
     static atomic_uint serial; // temporary names unique across threads too
     struct stat st;
-    char* real = NULL;
-    const char* target = path;
-    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
-        if (!(real = realpath(path, NULL))) return write_into(path, data, size, err); // a dangling link: create what it names
-        target = real;
-    }
+    // Through a link, the file it names is replaced (a dangling one's is
+    // created), so the link stays a link.
+    char* real = sp_path_follow_links(path);
+    if (!real) return sp_fail(err, SP_ERR_IO, "%s: cannot follow its links (a loop, or out of memory)", path);
+    const char* target = real;
     bool exists = stat(target, &st) == 0;
     if (exists && S_ISDIR(st.st_mode)) {
         free(real);

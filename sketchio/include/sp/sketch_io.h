@@ -105,6 +105,10 @@ sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_erro
 /// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
 /// held by the folder out is in).
 char* sp_path_folder(const char* path);
+/// `path` with every symbolic link followed, a dangling one's last hop too:
+/// the file a write through `path` makes or replaces (malloc'd; `path`
+/// itself when it is no link; NULL when out of memory or the links loop).
+char* sp_path_follow_links(const char* path);
 
 /// Syncs the folder that holds `path` (fsync(2) on the folder), so that a name
 /// just made there by rename(2), link(2) or mkdir(2) survives a power cut.
@@ -115,8 +119,9 @@ bool sp_path_sync_folder(const char* path);
 /// beside it (the old file's permissions, else 0666 less the umask), synced
 /// and renamed into place once every byte is written, so that a failed write
 /// (a full disk, a size limit) or a power cut leaves the old file as it was
-/// and no truncated one; the folder is synced after the rename. A symbolic link is followed (its target is
-/// replaced, the link stays); a path that is not a regular file (a FIFO, a
+/// and no truncated one; the folder is synced after the rename. A symbolic
+/// link is followed (its target is replaced, a dangling one's created, the
+/// link stays; sp_path_follow_links); a path that is not a regular file (a FIFO, a
 /// device such as /dev/stdout) is written into directly. One line in `err`
 /// names the path and the system's reason.
 sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err);

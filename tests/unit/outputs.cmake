@@ -1,0 +1,3 @@
+if(TARGET sp_app_common)
+  sp_unit_test(outputs LIBS sp_app_common)
+endif()
