@@ -3,7 +3,6 @@
 #include <errno.h>
 #include <pthread.h>
 #include <signal.h>
-#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,24 +11,6 @@
 #include <unistd.h>
 
 #include "sp/sketch_io.h"
-
-// Temporary names unique within the process, across threads too.
-static atomic_uint g_serial;
-
-// "<folder of target>/.sp-<pid>-<k><ext>": short, so that a name near the
-// file system's limit still has a temporary beside it, and hidden, so that a
-// folder reader (a category of drawings, a folder of parts) never takes one
-// left by a killed command for its own.
-static char* name_beside(const char* target, const char* ext)
-{
-    char* dir = sp_path_folder(target);
-    if (!dir) return NULL;
-    size_t n = strlen(dir) + strlen(ext) + 48;
-    char* s = malloc(n);
-    if (s) snprintf(s, n, "%s/.sp-%ld-%u%s", dir, (long)getpid(), atomic_fetch_add(&g_serial, 1u), ext);
-    free(dir);
-    return s;
-}
 
 sp_result sp_outputs_stage(sp_outputs* o, const char* path, const char** write_to, sp_error* err)
 {
@@ -50,7 +31,7 @@ sp_result sp_outputs_stage(sp_outputs* o, const char* path, const char** write_t
     base = base ? base + 1 : path;
     const char* dot = strrchr(base, '.');
     const char* ext = dot && dot != base && strlen(dot) <= 16 ? dot : "";
-    char* tmp = name_beside(target, ext);
+    char* tmp = sp_path_temp_beside(target, ext);
     if (!tmp) {
         free(target);
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
@@ -94,7 +75,7 @@ sp_result sp_outputs_commit(sp_outputs* o, sp_error* err)
             chmod(o->staged[done], st.st_mode & 07777); // a replaced file keeps its permissions
             // A hard link keeps the old file until every output is in place;
             // where the file system has none, that one cannot be put back.
-            backup[done] = name_beside(target, ".old");
+            backup[done] = sp_path_temp_beside(target, ".old");
             if (backup[done] && link(target, backup[done]) != 0) free(backup[done]), backup[done] = NULL;
         }
         if (rename(o->staged[done], target) != 0) {

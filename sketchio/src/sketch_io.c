@@ -99,9 +99,20 @@ bool sp_path_sync_folder(const char* path)
     return ok;
 }
 
+char* sp_path_temp_beside(const char* target, const char* ext)
+{
+    static atomic_uint serial; // unique across threads too
+    char* dir = sp_path_folder(target);
+    if (!dir) return NULL;
+    size_t n = strlen(dir) + strlen(ext) + 48;
+    char* s = malloc(n);
+    if (s) snprintf(s, n, "%s/.sp-%ld-%u%s", dir, (long)getpid(), atomic_fetch_add(&serial, 1u), ext);
+    free(dir);
+    return s;
+}
+
 sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err)
 {
-    static atomic_uint serial; // temporary names unique across threads too
     struct stat st;
     // Through a link, the file it names is replaced (a dangling one's is
     // created), so the link stays a link.
@@ -118,13 +129,11 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
         free(real);
         return r;
     }
-    size_t n = strlen(target) + 48;
-    char* tmp = malloc(n);
+    char* tmp = sp_path_temp_beside(target, ".tmp");
     if (!tmp) {
         free(real);
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     }
-    snprintf(tmp, n, "%s.tmp%ld-%u", target, (long)getpid(), atomic_fetch_add(&serial, 1u));
     int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
     int e = errno;
     bool ok = fd >= 0;

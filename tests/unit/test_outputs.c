@@ -140,7 +140,8 @@ static void test_links(void)
 }
 
 // A name near the file system's 255-byte limit still has a temporary beside
-// it (".part<pid>-<k>" added to it was too long, found after the work).
+// it (".part<pid>-<k>" or ".tmp<pid>-<k>" added to it was too long, found
+// after the work).
 static void test_long_name(void)
 {
     const char* dir = fresh_dir("outputs_long");
@@ -154,6 +155,9 @@ static void test_long_name(void)
     ENSURE(sp_outputs_stage(&o, path, &t, &e) == SP_OK);
     put(t, "long");
     ENSURE(sp_outputs_commit(&o, &e) == SP_OK && holds(path, "long"));
+    // The same for one file written alone (its ".tmp<pid>-<k>" was too long).
+    ENSURE(sp_file_write(path, "alone", 5, &e) == SP_OK && holds(path, "alone"));
+    ENSURE(entries(dir) == 1);
 }
 
 // A writer's message names the staged file: undo says the name the user

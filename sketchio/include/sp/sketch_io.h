@@ -109,6 +109,12 @@ char* sp_path_folder(const char* path);
 /// the file a write through `path` makes or replaces (malloc'd; `path`
 /// itself when it is no link; NULL when out of memory or the links loop).
 char* sp_path_follow_links(const char* path);
+/// A new name for a temporary file in the folder of `target`,
+/// "<folder>/.sp-<pid>-<k><ext>" (malloc'd; NULL when out of memory): short,
+/// so that a name near the file system's 255-byte limit still has one beside
+/// it, and hidden, so that a folder reader (a category of drawings, a folder
+/// of parts) never takes one that a killed process left for its own.
+char* sp_path_temp_beside(const char* target, const char* ext);
 
 /// Syncs the folder that holds `path` (fsync(2) on the folder), so that a name
 /// just made there by rename(2), link(2) or mkdir(2) survives a power cut.
@@ -116,7 +122,7 @@ char* sp_path_follow_links(const char* path);
 /// cannot sync folders counts as done.
 bool sp_path_sync_folder(const char* path);
 /// Writes `size` bytes to `path` whole or not at all: into a temporary file
-/// beside it (the old file's permissions, else 0666 less the umask), synced
+/// beside it (sp_path_temp_beside; the old file's permissions, else 0666 less the umask), synced
 /// and renamed into place once every byte is written, so that a failed write
 /// (a full disk, a size limit) or a power cut leaves the old file as it was
 /// and no truncated one; the folder is synced after the rename. A symbolic
