@@ -136,6 +136,7 @@ struct LoadContext {
     const char* what = "";
     std::vector<BufferDecl> buffers;
     std::vector<int> matrix_and_trs; // nodes with both (tinygltf keeps only the matrix)
+    std::vector<std::string> required; // extensionsRequired
     bool scanned = false;
     std::string message; // set by read_buffer_file: says better what went wrong
 };
@@ -156,6 +157,13 @@ void scan_buffers(LoadContext& cx, const unsigned char* json, size_t len)
         if (d.has_uri) d.uri = uri->valuestring;
         if (cJSON_IsNumber(bl)) d.byte_length = bl->valuedouble;
         cx.buffers.push_back(d);
+    }
+    const cJSON* req = cJSON_GetObjectItemCaseSensitive(root, "extensionsRequired");
+    if (!cJSON_IsArray(req)) req = nullptr;
+    const cJSON* r;
+    cJSON_ArrayForEach(r, req)
+    {
+        if (cJSON_IsString(r)) cx.required.push_back(r->valuestring);
     }
     const cJSON* nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
     if (!cJSON_IsArray(nodes)) nodes = nullptr;
@@ -370,6 +378,29 @@ std::string explain(LoadContext& cx, const unsigned char* data, size_t size, con
     return without_data_payloads(line);
 }
 
+// An extension the file requires changes what its data mean: the geometry
+// compressed (Draco, meshopt), quantized, or instanced. Read without it, the
+// bytes become garbage or a message about accessors that names nothing the
+// curator can act on, so one we do not read is refused by name. Those that
+// touch only images and materials are safe to leave aside: we never decode
+// images, and a part's colour comes from baseColorFactor.
+void check_required_extensions(const LoadContext& cx, const char* what)
+{
+    static const char* const ignorable_prefixes[] = {"KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", "KHR_xmp"};
+    for (const std::string& ext : cx.required) {
+        bool ok = false;
+        for (const char* pre : ignorable_prefixes)
+            ok = ok || ext.compare(0, strlen(pre), pre) == 0;
+        if (ok) continue;
+        const char* hint = ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression"
+                               ? ": export it without mesh compression"
+                           : ext == "KHR_mesh_quantization" ? ": dequantize it first (e.g. gltf-transform dequantize)"
+                                                            : "";
+        fail(SP_ERR_UNSUPPORTED, "%s: requires the glTF extension %.64s, which sketchpose does not read%s", what, ext.c_str(),
+             hint);
+    }
+}
+
 void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size, const char* what, const std::string& base_dir,
                  bool use_fs, sp_character* ch)
 {
@@ -389,6 +420,7 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
     if (size >= 4 && !memcmp(data, "glTF", 4)) {
         size_t total = check_glb(data, size, what);
         scan_buffers_of(cx, data, total);
+        check_required_extensions(cx, what);
         ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, data, (unsigned)total, base_dir);
     } else {
         size_t i = 0;
@@ -401,6 +433,7 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
             fail(SP_ERR_PARSE, "%s: neither glTF JSON nor a .glb", what);
         }
         scan_buffers_of(cx, data, size);
+        check_required_extensions(cx, what);
         ok = loader.LoadASCIIFromString(&model, &terr, &twarn, reinterpret_cast<const char*>(data), (unsigned)size, base_dir);
     }
     if (!ok) {
@@ -757,6 +790,27 @@ struct Importer {
         warned_influences = true;
     }
 
+    // Morph targets are not read: the base shape is the part's. Said, since
+    // default weights (the node's, else the mesh's) other than 0 give a
+    // shape in viewers that the part will not have.
+    std::vector<bool> warned_morph_mesh{};
+    void warn_morph_targets(const tinygltf::Mesh& mesh, const tinygltf::Node& nd)
+    {
+        bool has = false;
+        for (const tinygltf::Primitive& prim : mesh.primitives)
+            has = has || !prim.targets.empty();
+        warned_morph_mesh.resize(m.meshes.size());
+        if (!has || warned_morph_mesh[(size_t)nd.mesh]) return;
+        warned_morph_mesh[(size_t)nd.mesh] = true;
+        const std::vector<double>& w = nd.weights.empty() ? mesh.weights : nd.weights;
+        bool weighted = false;
+        for (double x : w)
+            weighted = weighted || x != 0;
+        sp_character_warn(ch, "mesh %d: morph targets ignored%s", nd.mesh,
+                          weighted ? ": its default weights are not applied (the shape without them is used; bake them first)"
+                                   : " (the shape without them is used)");
+    }
+
     void check_graph()
     {
         size_t N = m.nodes.size();
@@ -982,6 +1036,7 @@ struct Importer {
                 fail(SP_ERR_INVALID, "%s: node %d refers to skin %d, but there are %zu", what, n, nd.skin, m.skins.size());
             sp_curve_tag node_tag = tag_of(nd.extras_json_string);
             const tinygltf::Mesh& mesh = m.meshes[(size_t)nd.mesh];
+            warn_morph_targets(mesh, nd);
             for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
                 const tinygltf::Primitive& prim = mesh.primitives[pi];
                 // tinygltf takes any integer; an unknown mode would otherwise
@@ -1127,7 +1182,7 @@ struct Importer {
             if (an.channels.empty()) continue;
             out->channels = static_cast<sp_anim_channel*>(calloc(an.channels.size(), sizeof(sp_anim_channel)));
             if (!out->channels) throw std::bad_alloc();
-            bool warned = false;
+            bool warned = false, warned_morph_anim = false;
             for (size_t ci = 0; ci < an.channels.size(); ++ci) {
                 const tinygltf::AnimationChannel& c = an.channels[ci];
                 int node = c.target_node;
@@ -1138,8 +1193,13 @@ struct Importer {
                     path = SP_ANIM_ROTATION;
                 else if (c.target_path == "scale")
                     path = SP_ANIM_SCALE;
-                else
-                    continue; // morph weights: nothing to animate here
+                else { // morph weights: the shape has no targets here to animate
+                    if (!warned_morph_anim)
+                        sp_character_warn(ch, "animation '%s': morph-weight channels ignored (morph targets are not read)",
+                                          out->name);
+                    warned_morph_anim = true;
+                    continue;
+                }
                 if (node < 0 || (size_t)node >= m.nodes.size())
                     fail(SP_ERR_INVALID, "%s: animation %zu channel %zu targets node %d, but there are %zu", what, ai, ci, node,
                          m.nodes.size());

@@ -613,6 +613,26 @@ static void test_says_what_is_wrong(void)
         sp_character_free(&c);
     }
     unlink(huge);
+    // An extension the file requires and we do not read is said by name
+    // (meshopt's compressed bytes were read as inverse bind matrices, Draco's
+    // gave "accessor[0] invalid bufferView", a made-up one loaded silently);
+    // one that only touches images or materials is left aside.
+    ensure_fails(write_edited("req_meshopt.gltf", &(mini_desc){0}, "{\"asset\"",
+                              "{\"extensionsRequired\": [\"KHR_texture_transform\", \"EXT_meshopt_compression\"], \"asset\""),
+                 "req_meshopt.gltf",
+                 "requires the glTF extension EXT_meshopt_compression, which sketchpose does not read: export it without mesh "
+                 "compression");
+    ensure_fails(
+        write_edited("req_made_up.gltf", &(mini_desc){0}, "{\"asset\"", "{\"extensionsRequired\": [\"EXT_made_up\"], \"asset\""),
+        "req_made_up.gltf", "requires the glTF extension EXT_made_up, which sketchpose does not read");
+    {
+        sp_character c = {0};
+        sp_error e = {0};
+        ENSURE(sp_gltf_load(write_edited("req_webp.gltf", &(mini_desc){0}, "{\"asset\"",
+                                         "{\"extensionsRequired\": [\"EXT_texture_webp\", \"KHR_materials_unlit\"], \"asset\""),
+                            &c, &e) == SP_OK);
+        sp_character_free(&c);
+    }
     // A buffer's uri that is absolute or has a scheme is said as such, not
     // as a file missing at the glTF's folder joined to it.
     ensure_fails(write_mini("buf_abs.gltf", &(mini_desc){.uri = "/dev/zero"}), "buf_abs.gltf",
@@ -733,6 +753,13 @@ static void test_inverse_bind(void)
         ENSURE(ch.warning_count == 0);
         sp_character_free(&ch);
     }
+    // Morph targets are not read: said, and louder when default weights
+    // would give another shape in a viewer (they were dropped silently).
+    ch = load_ok(write_edited("morph.gltf", &(mini_desc){0}, "\"material\": 0}]}",
+                              "\"material\": 0, \"targets\": [{\"POSITION\": 0}]}], \"weights\": [0.5]}"));
+    ENSURE(ch.warning_count == 1 &&
+           sp_fixture_has_warning(&ch, "mesh 0: morph targets ignored: its default weights are not applied"));
+    sp_character_free(&ch);
     // A node with both a matrix and a TRS (glTF forbids it): the matrix is used, and said so.
     ch = load_ok(write_edited("matrix_and_trs.gltf", &(mini_desc){0}, "\"translation\": [0, 1, 0]",
                               "\"translation\": [0, 5, 0], \"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 1]"));
