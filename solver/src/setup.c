@@ -2,6 +2,7 @@
 // the rest vertices), the column lists of the sparse Jacobian blocks, the
 // row groups of the normal equations, and the buffers a solve uses.
 #include <flann/flann.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -90,6 +91,63 @@ static uint64_t rest_hash(const double* rest, int n)
     for (size_t i = 0; i < sizeof(double) * 3 * (size_t)n; ++i)
         h = (h ^ b[i]) * 1099511628211ull;
     return h;
+}
+
+static int cmp_double(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+// How much larger the mesh is in the world, at the default pose, than in
+// its rest (bind-space) coordinates: the median, over the representatives,
+// of the distance to the nearest other one there over here, which a bone's
+// rotation leaves alone (a spread about the centroid would not). The
+// reference size D must be in world units, where the strokes and the camera
+// are; an armature scaled 10x or 100x (a unit conversion in an FBX export)
+// keeps the vertices 10x or 100x smaller, and the regularisers, weighted by
+// 1/D^2, then held a fit 100x or 10^4x too hard. A default pose that is the
+// bind pose gives 1 up to a glTF's float rounding; within 5% is taken for 1,
+// so that only a change of units is corrected and other rigs solve exactly
+// as before.
+static double bind_to_world_scale(sp_solver* s, sp_model* m)
+{
+    int k = s->k;
+    if (k < 2) return 1.0;
+    double* x = malloc(sizeof(double) * 3 * (size_t)k);
+    double* p = malloc(sizeof(double) * (size_t)(m->P + 1));
+    double* ratio = malloc(sizeof(double) * (size_t)k);
+    if (!x || !p || !ratio) {
+        free(x), free(p), free(ratio);
+        return 1.0;
+    }
+    for (int i = 0; i < m->P; ++i)
+        p[i] = m->params[i].def;
+    m->ops->update(m, p, false);
+    m->ops->rows(m, s->reps, k, x);
+    int n = 0;
+    for (int i = 0; i < k; ++i) {
+        const double* ri = m->rest + 3 * s->reps[i];
+        double best = INFINITY;
+        int nearest = -1;
+        for (int j = 0; j < k; ++j) {
+            const double* rj = m->rest + 3 * s->reps[j];
+            double d = (ri[0] - rj[0]) * (ri[0] - rj[0]) + (ri[1] - rj[1]) * (ri[1] - rj[1]) + (ri[2] - rj[2]) * (ri[2] - rj[2]);
+            if (j != i && d > 0 && d < best) best = d, nearest = j;
+        }
+        if (nearest < 0) continue;
+        const double *xi = x + 3 * i, *xj = x + 3 * nearest;
+        double w = (xi[0] - xj[0]) * (xi[0] - xj[0]) + (xi[1] - xj[1]) * (xi[1] - xj[1]) + (xi[2] - xj[2]) * (xi[2] - xj[2]);
+        ratio[n++] = sqrt(w / best);
+    }
+    double f = 1.0;
+    if (n > 0) {
+        qsort(ratio, (size_t)n, sizeof *ratio, cmp_double);
+        f = ratio[n / 2];
+    }
+    free(x), free(p), free(ratio);
+    if (m->failed || !(isfinite(f) && f > 0)) return 1.0; // a black box that failed: the solve says why
+    return fabs(f - 1) < 0.05 ? 1.0 : f;
 }
 
 static int coarsen(const double* rest, int n, int k, int* reps)
@@ -297,6 +355,7 @@ sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_so
         !s->unit || !s->free_ || !s->Hl || !s->rows || !s->step_work || !s->step_iwork || !s->seg_mom || !s->seg_pairs ||
         !s->seg_list || !s->ab_used)
         goto fail;
+    s->D *= bind_to_world_scale(s, m);
     for (int i = 0; i < s->P; ++i)
         s->unit[i] = m->params[i].length ? s->D / SP_REF_SIZE : 1.0;
     *out = s;

@@ -83,6 +83,61 @@ static void test_recovery_chain(void)
     sp_rig_free(&st.rig);
 }
 
+// The reference size is in world units: a rig whose bind-space mesh is 16x
+// smaller than its world (an armature scaled up, as unit conversions
+// export) solves as the same rig in world units. Its regularisers were 100x
+// too strong: RiggedSimple under a 10x root fitted its own synthetic
+// sketches 20x worse, and db add-part refused it.
+
+static void test_bind_space_scale(void)
+{
+    setup a, b;
+    const sp_fixture_desc d = {.joint_count = 5, .seed = 3};
+    make_setup(&a, &d);
+    make_setup(&b, &d);
+    // b: the rest points / 16 and every inverse bind matrix * S(16), so that
+    // every pose puts every point where a does. A power of two, so that the
+    // two differ in no rounding: on these random 45-degree poses a change in
+    // the last bits alone (a scale of 0.9999999) moves some fits to another
+    // local minimum.
+    const double k_scale = 16;
+    for (int i = 0; i < 3 * b.rig.vertex_count; ++i)
+        b.rig.rest[i] /= k_scale;
+    for (int k = 0; k < b.rig.abstraction_count; ++k)
+        for (int i = 0; b.rig.abstractions[k].rest && i < 3 * b.rig.abstractions[k].point_count; ++i)
+            b.rig.abstractions[k].rest[i] /= k_scale;
+    sp_mat4 S = sp_mat4_identity();
+    S.m[0] = S.m[5] = S.m[10] = k_scale;
+    for (int j = 0; j < b.rig.joint_count; ++j)
+        b.rig.joints[j].inverse_bind = sp_mat4_mul(&b.rig.joints[j].inverse_bind, &S);
+    sp_solver *sa, *sb, *draw; // draw makes the strokes, so that sa and sb have the same history
+    sp_solver_create(&a.rig, 0, &a.cam, &(sp_solve_desc){0}, &sa, NULL);
+    sp_solver_create(&b.rig, 0, &a.cam, &(sp_solve_desc){0}, &sb, NULL);
+    sp_solver_create(&a.rig, 0, &a.cam, &(sp_solve_desc){0}, &draw, NULL);
+    ENSURE(sa && sb && draw);
+    int P = a.rig.param_count;
+    double *truth = malloc(sizeof(double) * P), *pa = malloc(sizeof(double) * P), *pb = malloc(sizeof(double) * P);
+    for (int c = 0; c < 5; ++c) {
+        sp_test_rng rng = {(uint64_t)(300 + c)};
+        sp_fixture_random_params(&a.rig, &rng, 0.785, truth);
+        sp_sketch sk;
+        strokes_at(draw, &a.rig, truth, &sk);
+        sp_solve_report ra, rb;
+        sp_error err = {0};
+        ENSURE(sp_solver_solve(sa, &sk, NULL, pa, &ra, &err) == SP_OK && sp_solver_solve(sb, &sk, NULL, pb, &rb, &err) == SP_OK);
+        sp_sketch_free(&sk);
+        double most = 0;
+        for (int i = 0; i < P; ++i)
+            most = fmax(most, fabs(pa[i] - pb[i]) / (a.rig.params[i].max - a.rig.params[i].min));
+        fprintf(stderr, "  case %d: mean error %.3f px and %.3f px, parameters apart by %.2g of their range\n", c,
+                ra.mean_error_px, rb.mean_error_px, most);
+        ENSURE(most < 1e-5 && fabs(ra.mean_error_px - rb.mean_error_px) < 1e-4);
+    }
+    free(truth), free(pa), free(pb);
+    sp_solver_destroy(sa), sp_solver_destroy(sb), sp_solver_destroy(draw);
+    sp_rig_free(&a.rig), sp_rig_free(&b.rig);
+}
+
 static void test_bounds_exact(void)
 {
     setup st;
@@ -626,6 +681,7 @@ int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
                        (sp_test[]){{"recovery_chain", test_recovery_chain},
+                                   {"bind_space_scale", test_bind_space_scale},
                                    {"bounds_exact", test_bounds_exact},
                                    {"order_independence_and_determinism", test_order_independence_and_determinism},
                                    {"bad_strokes", test_bad_strokes},
