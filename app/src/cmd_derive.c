@@ -86,7 +86,7 @@ int cmd_derive(int argc, char** argv)
         goto done;
     }
     for (int i = 0; i < part.warning_count; ++i)
-        fprintf(stderr, "%s: warning: %s\n", k_cmd, part.warnings[i]);
+        fprintf(stderr, "%s: warning: %s: %s\n", k_cmd, rig_path, part.warnings[i]);
 
     cJSON* root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "out", out_path);

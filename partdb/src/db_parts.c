@@ -380,6 +380,14 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
         char* dot = strrchr(name, '.');
         if (dot && dot != name) *dot = 0;
         d.name = name;
+        // The name comes from the file: say so, and how to give another.
+        if (!sp_part_name_is_plain(name)) {
+            free(bytes);
+            return sp_fail(err, SP_ERR_INVALID,
+                           "%s: the part would be named '%s' after the file, which is not a plain name ([A-Za-z0-9_.-], < 64 "
+                           "chars): rename the file, or give the part a name (db add-part --name)",
+                           path, name);
+        }
     }
     r = add_part(db, bytes, size, &d, derived, info, err);
     free(bytes);

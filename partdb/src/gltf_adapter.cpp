@@ -1126,6 +1126,8 @@ struct Importer {
                 }
             }
         }
+        if (rest.empty() && warned_lines)
+            fail(SP_ERR_INVALID, "%s: the skinned mesh is only lines (LINES, LINE_STRIP or LINE_LOOP): no surface to pose", what);
         if (rest.empty()) fail(SP_ERR_INVALID, "%s: the skinned mesh has no vertices", what);
         if (tris.size() / 3 > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many triangles", what);
         rig->rest = c_array(rest);

@@ -558,6 +558,12 @@ static void test_cli(void)
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItem(j, "derived")) == 6);
     ENSURE(cJSON_GetObjectItem(j, "clip") && cJSON_GetArraySize(cJSON_GetObjectItem(j, "warnings")) >= 1);
     cJSON_Delete(j);
+    // Each warning on stderr names the glTF it is about.
+    char* said = sp_fixture_file_text(errf, NULL);
+    char want[1200];
+    snprintf(want, sizeof want, "sketchpose derive: warning: %s: ", src);
+    ENSURE(strstr(said, want));
+    free(said);
     sp_image img = {0};
     sp_error err = {0};
     ENSURE(sp_image_read_png(png, &img, &err) == SP_OK && img.width == 2 * 560 + 3 * 6 && img.height == 2 * 420 + 3 * 6);

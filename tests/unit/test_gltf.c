@@ -669,6 +669,9 @@ static void test_says_what_is_wrong(void)
     ensure_fails(len, "buf_len.gltf", "buffer 0: its data URI holds 300 bytes, but its byteLength is 301");
     ensure_fails(write_edited("buf_b64.gltf", &(mini_desc){0}, "base64,", "base64,!"), "buf_b64.gltf",
                  "buffer 0: its data URI is not valid base64");
+    // A mesh of lines only: said as such (it was "has no vertices", though it has them).
+    ensure_fails(write_edited("lines_only.gltf", &(mini_desc){0}, "\"mode\": 4", "\"mode\": 1"), "lines_only.gltf",
+                 "the skinned mesh is only lines (LINES, LINE_STRIP or LINE_LOOP): no surface to pose");
     ensure_fails(write_edited("mode99.gltf", &(mini_desc){0}, "\"mode\": 4", "\"mode\": 99"), "mode99.gltf",
                  "mesh 0 primitive 0: mode 99 is not a glTF primitive mode");
     ensure_fails(write_edited("no_position.gltf", &(mini_desc){0}, "\"POSITION\": 0, ", ""), "no_position.gltf",

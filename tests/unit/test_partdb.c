@@ -225,6 +225,16 @@ static void test_round_trip(void)
     err = (sp_error){0};
     ENSURE(sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "tail_a", .synth_sketches = -1}, NULL, &err) == SP_ERR_INVALID);
     ENSURE(strstr(err.text, "exists"));
+    // A name taken from a file name that is no plain name says where it came
+    // from and what to do (it said only "part name 'my part' is not a plain name").
+    char spaced[1100], cp[2400];
+    snprintf(spaced, sizeof spaced, "%s", sp_test_tmp_path("my part.glb"));
+    snprintf(cp, sizeof cp, "cp '%s' '%s'", part_file(0), spaced);
+    ENSURE(system(cp) == 0);
+    ENSURE(sp_db_add_part_file(db, spaced, &(sp_db_part_desc){.synth_sketches = -1}, NULL, &err) == SP_ERR_INVALID);
+    ENSURE(strstr(err.text, "my part.glb: the part would be named '") && strstr(err.text, "my part' after the file") &&
+           strstr(err.text, "rename the file, or give the part a name"));
+    unlink(spaced);
     sp_db_part_info* parts;
     int n;
     ENSURE(sp_db_list_parts(db, &parts, &n, &err) == SP_OK && n == 2);
