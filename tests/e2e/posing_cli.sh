@@ -46,7 +46,20 @@ expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/left.glb"
 one_line_naming nowhere/x.png
 [ -e "$WORK/left.glb" ] && fail "pose left its .glb after --render failed"
 [ -e "$WORK/left.json" ] && fail "pose left its report after --render failed"
-ls "$WORK" | grep -q 'tmp' && fail "pose left a temporary file: $(ls "$WORK" | grep tmp)"
+ls -A "$WORK" | grep -q -e 'tmp' -e '^[.]sp-' && fail "pose left a temporary file: $(ls -A "$WORK" | grep -e tmp -e '^[.]sp-')"
+
+# Streams are not files: one stream named as two outputs overwrites nothing.
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out /dev/null --report /dev/null
+# The top of an integer range is in it.
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 1000000 --representatives 100000
+# A named pipe is written into, whatever its name (no .png needed): the
+# reader gets the PNG. timeout: a render that refused would leave cat
+# waiting for a writer.
+mkfifo "$WORK/pipe"
+timeout 60 cat "$WORK/pipe" >"$WORK/from_pipe" &
+expect 0 "$SP" render --rig "$RIG" --out "$WORK/pipe" --size 64x48
+wait
+head -c 8 "$WORK/from_pipe" | od -An -c | grep -q 'P   N   G' || fail "render into a named pipe: no PNG came out"
 
 # --max-ms: one range, worded alike by the commands that take it.
 expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-ms 0
@@ -112,6 +125,8 @@ one_line_naming "pitch must be in \[-89, 89\], got 90"
 # A picture size out of range says the range.
 expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 1x1
 one_line_naming "16..8192"
+expect 2 "$SP" render --rig "$RIG" --out "$WORK/tiny.png" --size 64x1
+one_line_naming "16..8192"
 
 # Bad strokes: one clear line naming the file, exit 1.
 strokes "$WORK/empty.json"
@@ -123,6 +138,12 @@ one_line_naming one.json
 printf '{"format": "sketchpose-strokes", "version": 1, "strokes": [{"points": [[1, NaN], [2, 3]]}]}\n' >"$WORK/nan.json"
 expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/nan.json"
 one_line_naming nan.json
+# Beyond 1e9 in x or in y is no drawing (a solve ran on x = 1e12).
+for far in '[[1e12, 3], [2, 3]]' '[[1, 3], [2, -1e12]]'; do
+    strokes "$WORK/huge_xy.json" "$far"
+    expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/huge_xy.json"
+    one_line_naming "huge_xy.json: stroke 0 point [01] is not finite (or beyond 1e9)"
+done
 expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/missing.json"
 one_line_naming missing.json
 expect 1 "$SP" pose --rig "$WORK/missing.glb" --strokes "$WORK/s.json"

@@ -2073,6 +2073,11 @@ static void test_visitors_policy(void)
     ENSURE(right >= parts / 2);
     ENSURE(top3 >= 9 * parts / 10);
     ENSURE(non_refused >= non / 4);
+    // With the default recipe's people's strokes, the policy holds near
+    // where the tune half put it (53 right, 3 refused, 65 in the top 3, 14 of
+    // 25 non-parts refused): a refusal limit moved from 1.23 to 1.33 refused
+    // 10 non-parts and passed the looser checks above.
+    if (people) ENSURE(right >= 3 * parts / 4 && refused <= parts / 10 && top3 >= 95 * parts / 100 && 2 * non_refused >= non);
     // A tap, a tiny stroke and a dense scribble are refused whatever the model.
     sp_vec2 tap[2] = {{640, 400}, {641, 400}}, tiny[3] = {{640, 400}, {646, 404}, {650, 406}}, scribble[200];
     for (int i = 0; i < 200; ++i)

@@ -467,6 +467,17 @@ static void test_refused_stroke(void)
     tap(ui, t + 300, SP_KT_CHIP_GUESS3);
     frame(ui, &f, t + 400);
     ENSURE(f.parts == 5 && f.cat[4] == 2 && !ui->redraw_armed && f.log[f.log_n - 1] == 'R');
+    // A refusal that comes back while a later stroke waits offers nothing:
+    // the chips would be for a stroke that is no longer the last.
+    t = refused_stroke(ui, t + 2000, 900, 150);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    t = stroke(ui, t + 300, 300, 500, 18, 5);
+    ENSURE(ui->pending_count == 1);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"head", "wings", "tail"}, .part_count = 5});
+    ENSURE(!sp_kiosk_ui_offering(ui) && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    // Nor does an Undo's label bring back the chips of the part now last.
+    sp_kiosk_ui_parts_changed(ui, 4, &(sp_kiosk_part_label){.category = "torso", .guesses = {"tail", "head"}});
+    ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL) && !sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
     sp_kiosk_ui_destroy(ui);
 }
 

@@ -1782,6 +1782,9 @@ static void test_kiosk_review_cli(void)
     double t0 = sp_now_ms();
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "more than 0.2 s"));
     ENSURE(sp_now_ms() - t0 < 3000);
+    // 0 means no wait (it was the default 5 s).
+    snprintf(cmd, sizeof cmd, "'%s' db list --db '%s' --busy-timeout 0 2>&1 >/dev/null", bin, p);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "more than 0 s"));
     sqlite3_exec(other, "COMMIT", NULL, NULL, NULL);
     sqlite3_close(other);
     ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'") == 2);
@@ -1793,6 +1796,29 @@ static void test_kiosk_review_cli(void)
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --status approved", bin, p);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"status\": \"approved\"") &&
            strstr(out, "\"category\": \"wings\""));
+    // --status all lists every status, the rejected one too.
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --status all", bin, p);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"status\": \"approved\"") &&
+           strstr(out, "\"status\": \"rejected\""));
+    // One action at a time, and --relabel takes one id and one category:
+    // anything else is bad usage (exit 2), and nothing changes.
+    file_sha(p, before);
+    const char* usage[] = {"--approve %1$lld --reject %2$lld", "--relabel %1$lld wings %2$lld"};
+    for (int u = 0; u < 2; ++u) {
+        char args[200];
+        snprintf(args, sizeof args, usage[u], (long long)id, (long long)first);
+        snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' %s 2>&1 >/dev/null", bin, p, args);
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "give one of --approve ID..., --reject ID..."));
+    }
+    // --relabel acts on kiosk sketches only: a curated or generated one is
+    // "no kiosk sketch", exit 1.
+    long long other_id = (long long)scalar(p, "SELECT min(id) FROM sketches WHERE source != 'kiosk'");
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --relabel %lld wings 2>&1 >/dev/null", bin, p, other_id);
+    char no_such[80];
+    snprintf(no_such, sizeof no_such, "no kiosk sketch %lld", other_id);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, no_such));
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
     snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --words 64 --folds -1", bin, p);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     fprintf(stderr, "  train: %.160s\n", out);
@@ -1811,6 +1837,23 @@ static void test_kiosk_review_cli(void)
     ENSURE(found);
     sp_dataset_free(&ds);
     sp_db_close(db);
+    // db check: a part whose bytes no longer match their checksum, or their
+    // recorded size, is a problem, said, with exit 1.
+    const char* tamper[] = {"UPDATE parts SET sha256 = 'x' || substr(sha256, 2) WHERE name = (SELECT min(name) FROM parts)",
+                            "UPDATE parts SET bytes = bytes + 1 WHERE name = (SELECT min(name) FROM parts)"};
+    const char* said[] = {"checksum mismatch", "size mismatch"};
+    for (int t = 0; t < 2; ++t) {
+        char copy[1100];
+        snprintf(copy, sizeof copy, "%s", sp_test_tmp_path("tampered.db"));
+        sp_fixture_remove_db(copy);
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s'", p, copy);
+        ENSURE(system(cmd) == 0);
+        ENSURE(sqlite3_open(copy, &other) == SQLITE_OK && sqlite3_exec(other, tamper[t], NULL, NULL, NULL) == SQLITE_OK);
+        sqlite3_close(other);
+        snprintf(cmd, sizeof cmd, "'%s' db check --db '%s' 2>/dev/null", bin, copy);
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "\"ok\": false") && strstr(out, said[t]));
+        sp_fixture_remove_db(copy);
+    }
     // The database's current model classifies (classify --db); a bad stroke file is one line and exit 1.
     snprintf(cmd, sizeof cmd, "'%s' classify --db '%s' --strokes '%s/tests/data/visitors/tune/tail/tail-wavy-line.json'", bin, p,
              SP_SOURCE_DIR);

@@ -850,6 +850,16 @@ static void test_usage_messages(void)
         free(text);
     }
     ENSURE(access(tmp, F_OK) != 0);
+    // A list option takes at most 256 values: the 257th is bad usage (one more
+    // would be written past the list's end).
+    char many[3000];
+    int n = snprintf(many, sizeof many, "db review --db '%s.db' --approve", tmp);
+    for (int v = 1; v <= 257; ++v)
+        n += snprintf(many + n, sizeof many - (size_t)n, " %d", v);
+    int rc;
+    char* text = run_said(many, &rc);
+    ENSURE(rc == 2 && strstr(text, "sketchpose db review: too many values for --approve (256 at most)"));
+    free(text);
 }
 
 int main(int argc, char** argv)
