@@ -464,14 +464,43 @@ struct View {
     int comp = 0, ncomp = 0;
     bool normalized = false;
     int index = -1;
+    std::shared_ptr<std::vector<unsigned char>> own; // a sparse accessor's elements, made dense
 };
 
-View view_accessor(const tinygltf::Model& m, int index, const char* what, const char* usage)
+// The bytes [offset, offset + size) of buffer view `bv_index`, checked.
+const unsigned char* view_bytes(const tinygltf::Model& m, int bv_index, size_t offset, size_t size, const char* what,
+                                const char* usage)
 {
-    if (index < 0 || (size_t)index >= m.accessors.size())
-        fail(SP_ERR_INVALID, "%s: %s refers to accessor %d, but there are %zu", what, usage, index, m.accessors.size());
+    if (bv_index < 0 || (size_t)bv_index >= m.bufferViews.size())
+        fail(SP_ERR_INVALID, "%s: %s refers to buffer view %d, but there are %zu", what, usage, bv_index, m.bufferViews.size());
+    const tinygltf::BufferView& bv = m.bufferViews[(size_t)bv_index];
+    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+        fail(SP_ERR_INVALID, "%s: buffer view %d refers to buffer %d, but there are %zu", what, bv_index, bv.buffer,
+             m.buffers.size());
+    const std::vector<unsigned char>& buf = m.buffers[(size_t)bv.buffer].data;
+    if (bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset || offset > bv.byteLength ||
+        size > bv.byteLength - offset)
+        fail(SP_ERR_INVALID, "%s: %s reads past the end of buffer view %d", what, usage, bv_index);
+    return buf.data() + bv.byteOffset + offset;
+}
+
+View make_view(const tinygltf::Accessor& a, int index, const unsigned char* base, size_t stride, int ncomp)
+{
+    View v;
+    v.base = base;
+    v.stride = stride;
+    v.count = a.count;
+    v.comp = a.componentType;
+    v.ncomp = ncomp;
+    v.normalized = a.normalized;
+    v.index = index;
+    return v;
+}
+
+// Accessor `index` read in place from its buffer view, every bound checked.
+View plain_view(const tinygltf::Model& m, int index, const char* what)
+{
     const tinygltf::Accessor& a = m.accessors[(size_t)index];
-    if (a.sparse.isSparse) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d is sparse (not supported)", what, index);
     if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
         fail(SP_ERR_INVALID, "%s: accessor %d refers to buffer view %d, but there are %zu", what, index, a.bufferView,
              m.bufferViews.size());
@@ -494,15 +523,70 @@ View view_accessor(const tinygltf::Model& m, int index, const char* what, const 
         if (a.byteOffset > bv.byteLength || need > bv.byteLength - a.byteOffset)
             fail(SP_ERR_INVALID, "%s: accessor %d reads past the end of buffer view %d", what, index, a.bufferView);
     }
-    View v;
-    v.base = buf.data() + bv.byteOffset + a.byteOffset;
-    v.stride = stride;
-    v.count = a.count;
-    v.comp = a.componentType;
-    v.ncomp = ncomp;
-    v.normalized = a.normalized;
-    v.index = index;
+    return make_view(a, index, buf.data() + bv.byteOffset + a.byteOffset, stride, ncomp);
+}
+
+// glTF's sparse accessors (and those without a buffer view, all zeros):
+// the base elements, then the listed ones replaced, copied into one dense
+// array the View owns.
+View dense_view(const tinygltf::Model& m, int index, const char* what)
+{
+    const tinygltf::Accessor& a = m.accessors[(size_t)index];
+    int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    int ncomp = tinygltf::GetNumComponentsInType((uint32_t)a.type);
+    if (csize <= 0 || ncomp <= 0) fail(SP_ERR_INVALID, "%s: accessor %d has an invalid type or component type", what, index);
+    if (a.count > (1u << 28)) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d has %zu elements (too many)", what, index, a.count);
+    size_t elem = (size_t)csize * (size_t)ncomp;
+    auto own = std::make_shared<std::vector<unsigned char>>(a.count * elem + 1, 0);
+    unsigned char* out = own->data();
+    if (a.bufferView >= 0) {
+        View base = plain_view(m, index, what);
+        for (size_t i = 0; i < a.count; ++i)
+            memcpy(out + i * elem, base.base + i * base.stride, elem);
+    }
+    if (a.sparse.isSparse) {
+        const auto& sp = a.sparse;
+        if (sp.count < 1 || (size_t)sp.count > a.count)
+            fail(SP_ERR_INVALID, "%s: accessor %d: sparse count %d is not 1..%zu", what, index, sp.count, a.count);
+        int isize = tinygltf::GetComponentSizeInBytes((uint32_t)sp.indices.componentType);
+        if (sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(SP_ERR_INVALID, "%s: accessor %d: sparse indices must be unsigned bytes, shorts or ints", what, index);
+        char usage[64];
+        snprintf(usage, sizeof usage, "accessor %d's sparse indices", index);
+        const unsigned char* idx =
+            view_bytes(m, sp.indices.bufferView, (size_t)sp.indices.byteOffset, (size_t)sp.count * (size_t)isize, what, usage);
+        snprintf(usage, sizeof usage, "accessor %d's sparse values", index);
+        const unsigned char* val =
+            view_bytes(m, sp.values.bufferView, (size_t)sp.values.byteOffset, (size_t)sp.count * elem, what, usage);
+        for (int k = 0; k < sp.count; ++k) {
+            uint32_t at = 0;
+            if (isize == 1) {
+                at = idx[k];
+            } else if (isize == 2) {
+                uint16_t u;
+                memcpy(&u, idx + 2 * (size_t)k, 2);
+                at = u;
+            } else {
+                memcpy(&at, idx + 4 * (size_t)k, 4);
+            }
+            if (at >= a.count)
+                fail(SP_ERR_INVALID, "%s: accessor %d: sparse index %u is past its %zu elements", what, index, at, a.count);
+            memcpy(out + (size_t)at * elem, val + (size_t)k * elem, elem);
+        }
+    }
+    View v = make_view(a, index, out, elem, ncomp);
+    v.own = own;
     return v;
+}
+
+View view_accessor(const tinygltf::Model& m, int index, const char* what, const char* usage)
+{
+    if (index < 0 || (size_t)index >= m.accessors.size())
+        fail(SP_ERR_INVALID, "%s: %s refers to accessor %d, but there are %zu", what, usage, index, m.accessors.size());
+    const tinygltf::Accessor& a = m.accessors[(size_t)index];
+    return a.sparse.isSparse || a.bufferView < 0 ? dense_view(m, index, what) : plain_view(m, index, what);
 }
 
 // One component as a double; normalized integers map to [0, 1] / [-1, 1].

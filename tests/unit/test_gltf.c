@@ -715,6 +715,36 @@ static void test_says_what_is_wrong(void)
 // Inverse bind matrices glTF forbids (not finite, a fourth row other than
 // [0, 0, 0, 1], e.g. all zeros) are refused naming the skin and the joint;
 // a singular one is legal, so it loads, with a warning.
+// glTF's sparse accessors are read (they were refused, "not supported"):
+// the base elements with the listed ones replaced. Here vertex i0 (the first
+// index) takes vertex 3's position, read from the positions' own view.
+static void test_sparse(void)
+{
+    sp_character plain = load_ok(write_mini("sparse_base.gltf", &(mini_desc){0}));
+    const char* sparse = "{\"bufferView\": 0, \"sparse\": {\"count\": 1, \"indices\": {\"bufferView\": 3, "
+                         "\"componentType\": 5123}, \"values\": {\"bufferView\": 0, \"byteOffset\": 36}}, ";
+    sp_character ch = load_ok(write_edited("sparse.gltf", &(mini_desc){0}, "{\"bufferView\": 0, ", sparse));
+    int i0 = (int)plain.rig.triangles[0];
+    ENSURE(i0 != 3);
+    ENSURE(ch.rig.vertex_count == plain.rig.vertex_count && ch.warning_count == 0);
+    for (int v = 0; v < ch.rig.vertex_count; ++v)
+        for (int c = 0; c < 3; ++c)
+            ENSURE(ch.rig.rest[3 * v + c] == plain.rig.rest[3 * (v == i0 ? 3 : v) + c]);
+    sp_character_free(&ch);
+    sp_character_free(&plain);
+    // Its indices are unsigned integers within the accessor's count.
+    char bad[400];
+    snprintf(bad, sizeof bad, "%s", sparse);
+    char* ct = strstr(bad, "5123");
+    memcpy(ct, "5126", 4);
+    ensure_fails(write_edited("sparse_float.gltf", &(mini_desc){0}, "{\"bufferView\": 0, ", bad), "sparse_float.gltf",
+                 "accessor 0: sparse indices must be unsigned bytes, shorts or ints");
+    ensure_fails(write_edited("sparse_count.gltf", &(mini_desc){0}, "{\"bufferView\": 0, ",
+                              "{\"bufferView\": 0, \"sparse\": {\"count\": 99, \"indices\": {\"bufferView\": 3, "
+                              "\"componentType\": 5123}, \"values\": {\"bufferView\": 0}}, "),
+                 "sparse_count.gltf", "accessor 0: sparse count 99 is not 1..4");
+}
+
 static void test_inverse_bind(void)
 {
     static const float zero[16] = {0};
@@ -833,6 +863,7 @@ int main(int argc, char** argv)
                                    {"bad_input", test_bad_input},
                                    {"says_what_is_wrong", test_says_what_is_wrong},
                                    {"inverse_bind", test_inverse_bind},
+                                   {"sparse", test_sparse},
                                    {"mutations", test_mutations},
                                    {0}});
 }
