@@ -712,9 +712,6 @@ static void test_says_what_is_wrong(void)
     free(text);
 }
 
-// Inverse bind matrices glTF forbids (not finite, a fourth row other than
-// [0, 0, 0, 1], e.g. all zeros) are refused naming the skin and the joint;
-// a singular one is legal, so it loads, with a warning.
 // glTF's sparse accessors are read (they were refused, "not supported"):
 // the base elements with the listed ones replaced. Here vertex i0 (the first
 // index) takes vertex 3's position, read from the positions' own view.
@@ -745,6 +742,9 @@ static void test_sparse(void)
                  "sparse_count.gltf", "accessor 0: sparse count 99 is not 1..4");
 }
 
+// Inverse bind matrices glTF forbids (not finite, a fourth row other than
+// [0, 0, 0, 1], e.g. all zeros) are refused naming the skin and the joint;
+// a singular one is legal, so it loads, with a warning.
 static void test_inverse_bind(void)
 {
     static const float zero[16] = {0};
