@@ -478,10 +478,22 @@ const unsigned char* view_bytes(const tinygltf::Model& m, int bv_index, size_t o
         fail(SP_ERR_INVALID, "%s: buffer view %d refers to buffer %d, but there are %zu", what, bv_index, bv.buffer,
              m.buffers.size());
     const std::vector<unsigned char>& buf = m.buffers[(size_t)bv.buffer].data;
-    if (bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset || offset > bv.byteLength ||
-        size > bv.byteLength - offset)
+    if (bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset)
+        fail(SP_ERR_INVALID, "%s: buffer view %d reads past the end of buffer %d", what, bv_index, bv.buffer);
+    if (offset > bv.byteLength || size > bv.byteLength - offset)
         fail(SP_ERR_INVALID, "%s: %s reads past the end of buffer view %d", what, usage, bv_index);
     return buf.data() + bv.byteOffset + offset;
+}
+
+// Bytes of one element of accessor `index` (*ncomp its components), checked,
+// as is its count.
+size_t element_bytes(const tinygltf::Accessor& a, int index, const char* what, int* ncomp)
+{
+    int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    *ncomp = tinygltf::GetNumComponentsInType((uint32_t)a.type);
+    if (csize <= 0 || *ncomp <= 0) fail(SP_ERR_INVALID, "%s: accessor %d has an invalid type or component type", what, index);
+    if (a.count > (1u << 28)) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d has %zu elements (too many)", what, index, a.count);
+    return (size_t)csize * (size_t)*ncomp;
 }
 
 View make_view(const tinygltf::Accessor& a, int index, const unsigned char* base, size_t stride, int ncomp)
@@ -501,29 +513,16 @@ View make_view(const tinygltf::Accessor& a, int index, const unsigned char* base
 View plain_view(const tinygltf::Model& m, int index, const char* what)
 {
     const tinygltf::Accessor& a = m.accessors[(size_t)index];
-    if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
-        fail(SP_ERR_INVALID, "%s: accessor %d refers to buffer view %d, but there are %zu", what, index, a.bufferView,
-             m.bufferViews.size());
+    char usage[32];
+    snprintf(usage, sizeof usage, "accessor %d", index);
+    const unsigned char* start = view_bytes(m, a.bufferView, 0, 0, what, usage); // the view and its buffer
+    int ncomp;
+    size_t elem = element_bytes(a, index, what, &ncomp);
     const tinygltf::BufferView& bv = m.bufferViews[(size_t)a.bufferView];
-    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
-        fail(SP_ERR_INVALID, "%s: buffer view %d refers to buffer %d, but there are %zu", what, a.bufferView, bv.buffer,
-             m.buffers.size());
-    const std::vector<unsigned char>& buf = m.buffers[(size_t)bv.buffer].data;
-    int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
-    int ncomp = tinygltf::GetNumComponentsInType((uint32_t)a.type);
-    if (csize <= 0 || ncomp <= 0) fail(SP_ERR_INVALID, "%s: accessor %d has an invalid type or component type", what, index);
-    if (bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset)
-        fail(SP_ERR_INVALID, "%s: buffer view %d reads past the end of buffer %d", what, a.bufferView, bv.buffer);
-    size_t elem = (size_t)csize * (size_t)ncomp;
     size_t stride = bv.byteStride ? bv.byteStride : elem;
     if (stride < elem) fail(SP_ERR_INVALID, "%s: accessor %d: byteStride %zu is smaller than an element", what, index, stride);
-    if (a.count > (1u << 28)) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d has %zu elements (too many)", what, index, a.count);
-    if (a.count > 0) {
-        size_t need = stride * (a.count - 1) + elem;
-        if (a.byteOffset > bv.byteLength || need > bv.byteLength - a.byteOffset)
-            fail(SP_ERR_INVALID, "%s: accessor %d reads past the end of buffer view %d", what, index, a.bufferView);
-    }
-    return make_view(a, index, buf.data() + bv.byteOffset + a.byteOffset, stride, ncomp);
+    if (a.count > 0) view_bytes(m, a.bufferView, a.byteOffset, stride * (a.count - 1) + elem, what, usage);
+    return make_view(a, index, start + a.byteOffset, stride, ncomp);
 }
 
 // glTF's sparse accessors (and those without a buffer view, all zeros):
@@ -532,11 +531,8 @@ View plain_view(const tinygltf::Model& m, int index, const char* what)
 View dense_view(const tinygltf::Model& m, int index, const char* what)
 {
     const tinygltf::Accessor& a = m.accessors[(size_t)index];
-    int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
-    int ncomp = tinygltf::GetNumComponentsInType((uint32_t)a.type);
-    if (csize <= 0 || ncomp <= 0) fail(SP_ERR_INVALID, "%s: accessor %d has an invalid type or component type", what, index);
-    if (a.count > (1u << 28)) fail(SP_ERR_UNSUPPORTED, "%s: accessor %d has %zu elements (too many)", what, index, a.count);
-    size_t elem = (size_t)csize * (size_t)ncomp;
+    int ncomp;
+    size_t elem = element_bytes(a, index, what, &ncomp);
     auto own = std::make_shared<std::vector<unsigned char>>(a.count * elem + 1, 0);
     unsigned char* out = own->data();
     if (a.bufferView >= 0) {
