@@ -562,6 +562,29 @@ static sp_result derived_part(const work* w, const sp_rig* R, const char* catego
     return SP_OK;
 }
 
+// Whether some triangle has an area above rounding, relative to the mesh's
+// size: a mesh of flattened triangles has no silhouette in any view.
+static bool has_area(const sp_rig* r)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < r->vertex_count; ++i)
+        for (int c = 0; c < 3; ++c)
+            lo[c] = fmin(lo[c], r->rest[3 * (size_t)i + c]), hi[c] = fmax(hi[c], r->rest[3 * (size_t)i + c]);
+    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    if (!(ext > 0) || !isfinite(ext)) return false;
+    double tiny = 1e-12 * ext * ext;
+    for (int t = 0; t < r->triangle_count; ++t) {
+        const uint32_t* q = r->triangles + 3 * (size_t)t;
+        if (q[0] >= (uint32_t)r->vertex_count || q[1] >= (uint32_t)r->vertex_count || q[2] >= (uint32_t)r->vertex_count)
+            return true; // the tracer names the bad index
+        const double *a = r->rest + 3 * (size_t)q[0], *b = r->rest + 3 * (size_t)q[1], *c = r->rest + 3 * (size_t)q[2];
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n0 = u[1] * v[2] - u[2] * v[1], n1 = u[2] * v[0] - u[0] * v[2], n2 = u[0] * v[1] - u[1] * v[0];
+        if (sqrt(n0 * n0 + n1 * n1 + n2 * n2) > tiny) return true;
+    }
+    return false;
+}
+
 sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp_character* out, sp_derive_info* info_out,
                          sp_error* err)
 {
@@ -579,6 +602,11 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         return sp_fail(err, SP_ERR_UNSUPPORTED, "the file has no skinned mesh");
     if (sr->triangle_count == 0)
         return sp_fail(err, SP_ERR_INVALID, "the skinned mesh has no triangles to trace an outline from");
+    if (!has_area(sr))
+        return sp_fail(err, SP_ERR_INVALID,
+                       "the skinned mesh's %d triangles all have no area (corners in one place or in a line): no surface "
+                       "to trace an outline from",
+                       sr->triangle_count);
     const char* abstraction = d.abstraction ? d.abstraction : "outline";
     if (strcmp(abstraction, "outline") != 0 && strcmp(abstraction, "stick") != 0)
         return sp_fail(err, SP_ERR_INVALID, "abstraction '%s': a derived part's sketches show its outline or its stick figure",

@@ -472,10 +472,16 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
         info->dropped_share = total > 0 ? (double)(total - (regions ? sizes[best] : 0)) / (double)total : 0.0;
         info->cell_px = 1.0 / k;
     }
-    bool ok = regions >= 1 && (second < sizes[best] / 200 || d->keep_largest);
+    if (regions == 0) {
+        res = sp_fail(err, SP_ERR_INVALID,
+                      "outline: the mesh covers no area in the sketch view (it is seen edge-on, or "
+                      "its triangles are flat)");
+        goto done;
+    }
+    bool ok = second < sizes[best] / 200 || d->keep_largest;
     if (!ok) {
         res = sp_fail(err, SP_ERR_INVALID, "outline: the side silhouette falls apart (%d regions, second largest %d of %d cells)",
-                      regions, second, regions ? sizes[best] : 0);
+                      regions, second, sizes[best]);
         goto done;
     }
     if (fill(&g, 2, 3, seeds[best], &stack, &stack_cap) < 0) goto oom;

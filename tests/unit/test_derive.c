@@ -427,6 +427,16 @@ static void test_refusals(void)
     ENSURE(sp_part_derive(&two, NULL, &part, NULL, &err) == SP_ERR_UNSUPPORTED && strstr(err.text, "2 skins") &&
            !strchr(err.text, '\n'));
     sp_character_free(&two);
+    // Every triangle without area (the mesh squashed onto a line, as a broken
+    // export gives): said so, not that the silhouette "falls apart".
+    sp_character flat = {0};
+    load_ok(lizard("lizard_flat.glb", (sp_foreign_desc){0}), &flat);
+    for (int i = 0; i < flat.rig.vertex_count; ++i)
+        flat.rig.rest[3 * i + 1] = flat.rig.rest[3 * i + 2] = 0.0;
+    ENSURE(sp_part_derive(&flat, NULL, &part, NULL, &err) == SP_ERR_INVALID);
+    fprintf(stderr, "  flat: %s\n", err.text);
+    ENSURE(strstr(err.text, "all have no area") && !strchr(err.text, '\n'));
+    sp_character_free(&flat);
     const char* bin = sketchpose_bin();
     if (!bin) return;
     const char* none = lizard("lizard_no_skin.glb", (sp_foreign_desc){.no_skin = true});
@@ -832,9 +842,10 @@ static void test_silhouette_khronos(void)
 // ---- the tracer's regions (sp/outline.h) -----------------------------------------
 
 // A flat mesh of unit squares, one for each '#' of `rows` (row 0 on top, at
-// world y 0 to -1), traced seen from the front.
-static sp_result trace_cells(const char* const* rows, int nrows, bool keep_largest, sp_abstraction* ab, sp_outline_info* info,
-                             sp_error* err)
+// world y 0 to -1, y scaled by `ys`: 0 flattens them to a line), traced seen
+// from the front.
+static sp_result trace_cells_scaled(const char* const* rows, int nrows, bool keep_largest, double ys, sp_abstraction* ab,
+                                    sp_outline_info* info, sp_error* err)
 {
     int cols = (int)strlen(rows[0]), cells = 0;
     for (int r = 0; r < nrows; ++r)
@@ -851,7 +862,7 @@ static sp_result trace_cells(const char* const* rows, int nrows, bool keep_large
             if (rows[r][c] != '#') continue;
             const double corner[4][2] = {{c, -r}, {c + 1, -r}, {c + 1, -r - 1}, {c, -r - 1}};
             for (int k = 0; k < 4; ++k)
-                xyz[3 * (v + k)] = corner[k][0], xyz[3 * (v + k) + 1] = corner[k][1], xyz[3 * (v + k) + 2] = 0.0,
+                xyz[3 * (v + k)] = corner[k][0], xyz[3 * (v + k) + 1] = ys * corner[k][1], xyz[3 * (v + k) + 2] = 0.0,
                              weights[v + k] = 1.0;
             const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
             for (int k = 0; k < 6; ++k)
@@ -873,6 +884,12 @@ static sp_result trace_cells(const char* const* rows, int nrows, bool keep_large
     sp_result res = sp_outline_trace(&d, ab, info, err);
     free(xyz), free(tri), free(joints), free(weights);
     return res;
+}
+
+static sp_result trace_cells(const char* const* rows, int nrows, bool keep_largest, sp_abstraction* ab, sp_outline_info* info,
+                             sp_error* err)
+{
+    return trace_cells_scaled(rows, nrows, keep_largest, 1.0, ab, info, err);
 }
 
 // The curve's nearest approach to (x, y), world units.
@@ -923,6 +940,11 @@ static void test_outline_regions(void)
     for (int i = 0; i < ab.point_count; ++i)
         ENSURE(ab.rest[3 * i] <= 6.05);
     sp_abstraction_free(&ab);
+
+    // Cells flattened to a line cover nothing: said so, not "falls apart".
+    r = trace_cells_scaled(two, 6, true, 0.0, &ab, &info, &err);
+    fprintf(stderr, "  flat: %s\n", err.text);
+    ENSURE(r == SP_ERR_INVALID && strstr(err.text, "covers no area") && ab.point_count == 0);
 }
 
 // ---- the self-test, the validator -------------------------------------------------
