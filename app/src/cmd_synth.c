@@ -77,8 +77,9 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     }
     // The result is said once the sketches are all written; a failure
     // takes back the folder it made (it printed a result and left the folder).
-    struct stat st;
-    bool made = stat(out_dir, &st) != 0;
+    // Made is mkdir's own answer: a folder another process made meanwhile is
+    // not this command's to remove.
+    bool made = mkdir(out_dir, 0777) == 0;
     char* text = NULL;
     size_t len = 0;
     FILE* js = open_memstream(&text, &len);
