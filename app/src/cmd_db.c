@@ -330,28 +330,6 @@ static int db_init(int argc, char** argv)
     return SP_EXIT_OK;
 }
 
-// Whether a file can be made at `path`: it is not a folder, and its folder
-// exists and may be written. One line and false when not, ending "nothing
-// stored" (why add-part's --preview is an SP_OPT_STRING, not an SP_OPT_OUT).
-static bool preview_writable(const char* cmd, const char* path)
-{
-    char dir[1024];
-    snprintf(dir, sizeof dir, "%s", path);
-    char* slash = strrchr(dir, '/');
-    if (slash) *slash = 0;
-    const char* d = !slash ? "." : dir[0] ? dir : "/";
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        fprintf(stderr, "%s: %s: is a folder, not a file; nothing stored\n", cmd, path);
-        return false;
-    }
-    if (stat(d, &st) != 0 || !S_ISDIR(st.st_mode) || access(d, W_OK) != 0) {
-        fprintf(stderr, "%s: %s: its folder %s is not there or not writable; nothing stored\n", cmd, path, d);
-        return false;
-    }
-    return true;
-}
-
 static int db_add_part(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-part";
@@ -371,7 +349,7 @@ static int db_add_part(int argc, char** argv)
          "a derived part attaches by this joint (default: its root's end)", false},
         {"--view", SP_OPT_STRING, &view, "V",
          "a derived part's sketch view: auto (default), -z, +z, -x, +x (see `sketchpose derive --help`)", false},
-        {"--preview", SP_OPT_STRING, &preview, "out.png",
+        {"--preview", SP_OPT_OUT, &preview, "out.png",
          "render the stored part at rest and in three random poses, its abstraction overlaid", false},
         {"--synth", SP_OPT_INT, &synth, "N", "synthetic sketches stored with it, -1 or 0 (none) to 10000 (default 60)", false},
         {"--no-selftest", SP_OPT_FLAG, &no_selftest, "", "skip the solver self-test", false}};
@@ -396,7 +374,7 @@ static int db_add_part(int argc, char** argv)
     sp_error err = {0};
     if (preview) {
         // A renderer and a place for the picture first: without them nothing is stored.
-        if (!preview_writable(cmd, preview)) return SP_EXIT_INPUT;
+        if (!sp_cli_check_out_folders(cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT;
         sp_headless* gl;
         sp_headless_create(&gl, &err);
         if (!gl) return fail(cmd, &err);
