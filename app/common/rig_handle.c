@@ -74,11 +74,6 @@ void sp_rig_handle_free(sp_rig_handle* h)
     free(h);
 }
 
-const char* sp_rig_handle_path(const sp_rig_handle* h)
-{
-    return h->path;
-}
-
 bool sp_rig_handle_is_black_box(const sp_rig_handle* h)
 {
     return h->bb != NULL;

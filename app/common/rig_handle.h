@@ -50,8 +50,6 @@ sp_result sp_rig_handle_load_character(const char* path, const char* command, sp
 /// Frees the rig (and unloads a plugin). NULL is fine.
 void sp_rig_handle_free(sp_rig_handle* h);
 
-/// The path it was loaded from (for messages).
-const char* sp_rig_handle_path(const sp_rig_handle* h);
 /// True for a plugin.
 bool sp_rig_handle_is_black_box(const sp_rig_handle* h);
 /// The glTF character (mutable: `drawover` adds its curves, `animate` its

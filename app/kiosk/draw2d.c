@@ -162,11 +162,6 @@ void sp_draw2d_destroy(sp_draw2d* d)
     free(d);
 }
 
-const sp_font* sp_draw2d_font(const sp_draw2d* d)
-{
-    return d->font;
-}
-
 void sp_draw2d_begin(sp_draw2d* d, int fb_w, int fb_h)
 {
     d->n = 0;

@@ -49,7 +49,5 @@ float sp_draw2d_text(sp_draw2d* d, const char* text, float x, float y, float px,
 /// Text shrunk (never grown) to fit max_w. Returns the em size used.
 float sp_draw2d_text_fit(sp_draw2d* d, const char* text, float x, float y, float px, float max_w, sp_align align,
                          const float rgba[4]);
-/// The font (for measuring).
-const sp_font* sp_draw2d_font(const sp_draw2d* d);
 
 #endif

@@ -475,7 +475,6 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
     return r;
 }
 
-// Sorted entries of a directory, no dot files (*names malloc'd).
 static bool is_dir(const char* p)
 {
     struct stat st;

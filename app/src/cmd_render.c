@@ -90,18 +90,9 @@ int cmd_render(int argc, char** argv)
         return SP_EXIT_INPUT;
     }
     int nabs = sp_rig_handle_abstraction_count(handle), ai = -1;
-    const sp_abstraction* abstractions = sp_rig_handle_abstractions(handle);
     if (abs_name && strcmp(abs_name, "none") != 0) {
-        for (int i = 0; i < nabs; ++i)
-            if (!strcmp(abstractions[i].name, abs_name)) ai = i;
-        if (ai < 0) {
-            char names[256] = "";
-            for (int i = 0; i < nabs; ++i) {
-                size_t n = strlen(names);
-                snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", abstractions[i].name);
-            }
-            fprintf(stderr, "sketchpose render: %s has no abstraction '%s' (it has: %s)\n", rig_path, abs_name,
-                    nabs ? names : "none");
+        if ((ai = sp_rig_handle_pick_abstraction(handle, abs_name, &err)) < 0) {
+            fprintf(stderr, "sketchpose render: %s\n", err.text);
             sp_rig_handle_free(handle);
             return SP_EXIT_INPUT;
         }

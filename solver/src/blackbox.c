@@ -245,13 +245,6 @@ const sp_blackbox_rig* sp_blackbox_desc(const sp_blackbox* bb)
     return bb->rig;
 }
 
-int sp_blackbox_find_abstraction(const sp_blackbox* bb, const char* name)
-{
-    for (int a = 0; a < bb->abstraction_count; ++a)
-        if (!strcmp(bb->abs[a].name, name)) return a;
-    return -1;
-}
-
 int sp_blackbox_abstraction_points(const sp_blackbox* bb, int a)
 {
     return bb->abs[a].point_count;

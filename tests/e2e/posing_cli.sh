@@ -52,6 +52,9 @@ ls -A "$WORK" | grep -q -e 'tmp' -e '^[.]sp-' && fail "pose left a temporary fil
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out /dev/null --report /dev/null
 # The top of an integer range is in it.
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --max-iterations 1000000 --representatives 100000
+# An abstraction the rig lacks: the rig's name and what it has, as pose says it.
+expect 1 "$SP" render --rig "$RIG" --abstraction nope --out "$WORK/nope.png" --size 64x48
+one_line_naming "sketchpose render: $RIG: no abstraction 'nope' (it has: "
 # A named pipe is written into, whatever its name (no .png needed): the
 # reader gets the PNG. timeout: a render that refused would leave cat
 # waiting for a writer.

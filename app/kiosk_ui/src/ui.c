@@ -1,4 +1,4 @@
-// ui.c: the kiosk's pure UI state machine (see ui.h). No GL, no clock, no
+// ui.c: the kiosk's pure UI state machine (see sp/kiosk_ui.h). No GL, no clock, no
 // allocation after create: a tap storm or 10^4 strokes a minute only ever
 // touch fixed buffers.
 #include "sp/kiosk_ui.h"

@@ -864,14 +864,6 @@ void sp_render_mesh_update(sp_render_mesh* m, const double* positions, const flo
     upload_dynamic(m);
 }
 
-void sp_render_mesh_set_colors(sp_render_mesh* m, const float* colors)
-{
-    assert(m && (colors || m->nv == 0));
-    glBindBuffer(GL_ARRAY_BUFFER, m->vbo_col);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 4 * (size_t)m->nv), colors, GL_STATIC_DRAW);
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
-}
-
 void sp_render_mesh_bounds(const sp_render_mesh* m, sp_vec3* lo, sp_vec3* hi)
 {
     *lo = m->lo;
@@ -998,12 +990,6 @@ void sp_render_target_bind(const sp_render_target* t)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo_ms);
     glViewport(0, 0, t->w, t->h);
-}
-
-void sp_render_target_size(const sp_render_target* t, int* width, int* height)
-{
-    if (width) *width = t->w;
-    if (height) *height = t->h;
 }
 
 sp_result sp_render_target_read(const sp_render_target* t, sp_image* img, sp_error* err)

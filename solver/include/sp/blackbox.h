@@ -136,8 +136,6 @@ void sp_blackbox_destroy(sp_blackbox* bb);
 
 /// The description (read-only; valid until sp_blackbox_destroy).
 const sp_blackbox_rig* sp_blackbox_desc(const sp_blackbox* bb);
-/// Index of an abstraction by name, -1 if none.
-int sp_blackbox_find_abstraction(const sp_blackbox* bb, const char* name);
 /// Points of abstraction a.
 int sp_blackbox_abstraction_points(const sp_blackbox* bb, int a);
 /// Points of all abstractions (the length of evaluate()'s abstraction_xyz / 3).

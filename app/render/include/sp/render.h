@@ -129,8 +129,6 @@ sp_result sp_render_mesh_create(sp_renderer* r, const sp_mesh_desc* desc, sp_ren
 /// New positions (vertex_count by 3, world) for the next draws, e.g. a new
 /// pose. normals NULL recomputes smooth normals from the triangles.
 void sp_render_mesh_update(sp_render_mesh* m, const double* positions, const float* normals);
-/// Replaces the per-vertex colours (vertex_count by 4, linear RGBA).
-void sp_render_mesh_set_colors(sp_render_mesh* m, const float* colors);
 /// World bounds of the current positions.
 void sp_render_mesh_bounds(const sp_render_mesh* m, sp_vec3* lo, sp_vec3* hi);
 /// Frees the mesh's GL objects and memory. NULL is fine.
@@ -179,8 +177,6 @@ void sp_render_target_bind(const sp_render_target* t);
 /// Resolves the samples and reads RGBA8 into *img (allocated or reused),
 /// top-down rows.
 sp_result sp_render_target_read(const sp_render_target* t, sp_image* img, sp_error* err);
-/// Its size in pixels.
-void sp_render_target_size(const sp_render_target* t, int* width, int* height);
 
 /// Compiles and links a GLSL program from a vertex and a fragment shader (a
 /// GL context must be current): 0 and a one-line error naming `what` and the
