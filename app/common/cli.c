@@ -29,17 +29,19 @@ static void print_help(const char* cmd, const char* positional, const char* summ
 }
 
 // One file: one inode when both exist; the same name in one folder when
-// neither does (two outputs yet to be written).
-static bool same_file(const char* a, const char* b)
+// neither does (two outputs yet to be written; a dangling link's target
+// counts as the name it would make).
+static bool same_file(const char* a_given, const char* b_given)
 {
     struct stat sa, sb;
-    bool ea = stat(a, &sa) == 0, eb = stat(b, &sb) == 0;
+    bool ea = stat(a_given, &sa) == 0, eb = stat(b_given, &sb) == 0;
     if (ea || eb) return ea && eb && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-    char *da = sp_path_folder(a), *db = sp_path_folder(b);
-    const char *na = strrchr(a, '/'), *nb = strrchr(b, '/');
+    char *a = sp_path_follow_links(a_given), *b = sp_path_follow_links(b_given);
+    char *da = a ? sp_path_folder(a) : NULL, *db = b ? sp_path_folder(b) : NULL;
+    const char *na = a ? strrchr(a, '/') : NULL, *nb = b ? strrchr(b, '/') : NULL;
     bool same = da && db && stat(da, &sa) == 0 && stat(db, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino &&
                 !strcmp(na ? na + 1 : a, nb ? nb + 1 : b);
-    free(da), free(db);
+    free(da), free(db), free(a), free(b);
     return same;
 }
 
@@ -218,6 +220,10 @@ bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path
     if (!path || sp_cli_out_is_stream(path)) return true;
     // Through a link, the file is written in the folder of the one it names.
     char* real = sp_path_follow_links(path);
+    if (real && sp_path_is_kernel(real)) { // a link to /dev/stdout: a stream
+        free(real);
+        return true;
+    }
     char* dir = real ? sp_path_folder(real) : NULL;
     free(real);
     if (!dir) return true; // out of memory or a loop of links: the writer will say so

@@ -21,7 +21,8 @@ sp_result sp_outputs_stage(sp_outputs* o, const char* path, const char** write_t
     char* target = sp_path_follow_links(path);
     if (!target) return sp_fail(err, SP_ERR_IO, "%s: cannot follow its links (a loop, or out of memory)", path);
     struct stat st;
-    if (stat(target, &st) == 0 && !S_ISREG(st.st_mode)) { // a stream, written as it goes (a folder: the writer says so)
+    if (sp_path_is_kernel(target) || (stat(target, &st) == 0 && !S_ISREG(st.st_mode))) {
+        // A stream, written as it goes (a folder: the writer says so).
         free(target);
         return SP_OK;
     }

@@ -60,12 +60,30 @@ char* sp_path_folder(const char* path)
     return dir;
 }
 
+bool sp_path_is_kernel(const char* path)
+{
+    return !strncmp(path, "/dev/", 5) || !strncmp(path, "/proc/", 6);
+}
+
+// The descriptor a kernel name stands for (/dev/stdout, /dev/stderr,
+// /dev/fd/N, /proc/self/fd/N), else -1.
+static int descriptor_of(const char* path)
+{
+    if (!strcmp(path, "/dev/stdout")) return 1;
+    if (!strcmp(path, "/dev/stderr")) return 2;
+    const char* n = !strncmp(path, "/dev/fd/", 8) ? path + 8 : !strncmp(path, "/proc/self/fd/", 14) ? path + 14 : NULL;
+    if (!n || !*n || strlen(n) > 6 || strspn(n, "0123456789") != strlen(n)) return -1;
+    return atoi(n);
+}
+
 char* sp_path_follow_links(const char* path)
 {
     char* p = strdup(path);
     for (int hop = 0; p && hop < 40; ++hop) { // 40: the kernel's own limit (ELOOP)
         struct stat st;
-        if (lstat(p, &st) != 0 || !S_ISLNK(st.st_mode)) return p;
+        // The kernel's links (/dev/stdout -> /proc/self/fd/1 -> "pipe:[N]")
+        // name open files, not paths: followed no further.
+        if (sp_path_is_kernel(p) || lstat(p, &st) != 0 || !S_ISLNK(st.st_mode)) return p;
         char to[4096];
         ssize_t n = readlink(p, to, sizeof to - 1);
         if (n < 0) return p;
@@ -119,12 +137,23 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
     char* real = sp_path_follow_links(path);
     if (!real) return sp_fail(err, SP_ERR_IO, "%s: cannot follow its links (a loop, or out of memory)", path);
     const char* target = real;
+    int fd_out = descriptor_of(target);
+    if (fd_out >= 0) {
+        // Through the descriptor itself, at its offset: reopening the name
+        // would start a redirected file at byte 0, or replace it by rename.
+        if (fd_out == 1) fflush(stdout);
+        if (fd_out == 2) fflush(stderr);
+        bool ok = write_all(fd_out, data, size);
+        int e = errno;
+        free(real);
+        return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write error (%s)", path, strerror(e));
+    }
     bool exists = stat(target, &st) == 0;
     if (exists && S_ISDIR(st.st_mode)) {
         free(real);
         return sp_fail(err, SP_ERR_IO, "%s: is a folder, not a file", path);
     }
-    if (exists && !S_ISREG(st.st_mode)) {
+    if ((exists && !S_ISREG(st.st_mode)) || sp_path_is_kernel(target)) {
         sp_result r = write_into(target, data, size, err);
         free(real);
         return r;

@@ -107,6 +107,25 @@ refused_out s.svg --out
 # A device or a pipe has no name to say a format; it is written into.
 "$SP" render --rig "$RIG" --out /dev/stdout --size 64x48 >"$WORK/piped" 2>"$WORK/err" || fail "render --out /dev/stdout: $(cat "$WORK/err")"
 [ "$(head -c 4 "$WORK/piped" | tail -c 3)" = PNG ] || fail "render --out /dev/stdout wrote no PNG"
+# Into a pipe (the name leads to /proc/self/fd/1 -> "pipe:[N]", which was
+# taken for a file name: "cannot write", nothing piped), /dev/fd/1 too.
+for dev in /dev/stdout /dev/fd/1; do
+    { "$SP" render --rig "$RIG" --out "$dev" --size 64x48 2>"$WORK/err" || echo "exit $?" >>"$WORK/err"; } | cat >"$WORK/piped"
+    [ "$(head -c 4 "$WORK/piped" | tail -c 3)" = PNG ] || fail "render --out $dev | cat: no PNG came through ($(cat "$WORK/err"))"
+done
+# Appended to (>>) through /dev/stdout: the file keeps what it held and the
+# report goes after it, beside the one pose prints (it was replaced whole).
+echo "before" >"$WORK/log"
+"$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --report /dev/stdout >>"$WORK/log" 2>"$WORK/err" || fail "pose --report /dev/stdout >>: $(cat "$WORK/err")"
+[ "$(head -n 1 "$WORK/log")" = before ] || fail "pose --report /dev/stdout >> log replaced the log"
+[ "$(grep -c '"stopped"' "$WORK/log")" -eq 2 ] || fail "pose --report /dev/stdout >> log: not both reports in the log"
+# Two outputs on one name through a dangling link are one file (the report
+# was silently lost, exit 0).
+rm -f "$WORK/same.glb"
+ln -sf same.glb "$WORK/l_same.glb"
+expect 2 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/l_same.glb" --report "$WORK/same.glb"
+one_line_naming "is the same file as --out"
+[ -e "$WORK/same.glb" ] && fail "pose wrote through a link that two outputs share"
 
 # Numbers: the parser refuses what is not one finite number; ranges name
 # themselves. A typed 0 weight turns its term off (it was the default weight).

@@ -105,10 +105,14 @@ sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_erro
 /// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
 /// held by the folder out is in).
 char* sp_path_folder(const char* path);
-/// `path` with every symbolic link followed, a dangling one's last hop too:
+/// `path` with every symbolic link followed, a dangling one's last hop too,
+/// up to a name under /dev/ or /proc/ (the kernel's, sp_path_is_kernel):
 /// the file a write through `path` makes or replaces (malloc'd; `path`
 /// itself when it is no link; NULL when out of memory or the links loop).
 char* sp_path_follow_links(const char* path);
+/// Whether `path` is under /dev/ or /proc/: a device or an open file's name
+/// (/dev/stdout), written into, never replaced by a temporary file.
+bool sp_path_is_kernel(const char* path);
 /// A new name for a temporary file in the folder of `target`,
 /// "<folder>/.sp-<pid>-<k><ext>" (malloc'd; NULL when out of memory): short,
 /// so that a name near the file system's 255-byte limit still has one beside
@@ -127,8 +131,10 @@ bool sp_path_sync_folder(const char* path);
 /// (a full disk, a size limit) or a power cut leaves the old file as it was
 /// and no truncated one; the folder is synced after the rename. A symbolic
 /// link is followed (its target is replaced, a dangling one's created, the
-/// link stays; sp_path_follow_links); a path that is not a regular file (a FIFO, a
-/// device such as /dev/stdout) is written into directly. One line in `err`
+/// link stays; sp_path_follow_links); a path that is not a regular file (a
+/// FIFO, a device) or is the kernel's is written into directly, and
+/// /dev/stdout, /dev/stderr, /dev/fd/N and /proc/self/fd/N through that
+/// descriptor at its offset (a pipe, or a file the shell redirected, `>>` too). One line in `err`
 /// names the path and the system's reason.
 sp_result sp_file_write(const char* path, const void* data, size_t size, sp_error* err);
 /// For writers that print their file: closes f, an open_memstream(3) over
