@@ -467,6 +467,17 @@ static void test_refused_stroke(void)
     tap(ui, t + 300, SP_KT_CHIP_GUESS3);
     frame(ui, &f, t + 400);
     ENSURE(f.parts == 5 && f.cat[4] == 2 && !ui->redraw_armed && f.log[f.log_n - 1] == 'R');
+    // Redraw, refused, left until its offer goes: the Redraw goes with it, and
+    // the next stroke is a new part, not the last one's replacement.
+    tap(ui, t + 1000, SP_KT_REDRAW);
+    t = refused_stroke(ui, t + 1200, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && ui->redraw_armed);
+    frame(ui, &f, t + ui->desc.offer_ms + 100);
+    ENSURE(!sp_kiosk_ui_offering(ui) && !ui->redraw_armed);
+    t = stroke(ui, t + ui->desc.offer_ms + 500, 300, 500, 18, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 6});
     // A refusal that comes back while a later stroke waits offers nothing:
     // the chips would be for a stroke that is no longer the last.
     t = refused_stroke(ui, t + 2000, 900, 150);

@@ -757,7 +757,13 @@ static void advance(sp_kiosk_ui* ui, double t)
         ui->yaw *= f, ui->pitch *= f;
         if (fabs(ui->yaw) < 1e-3 && fabs(ui->pitch) < 1e-3) ui->yaw = ui->pitch = 0;
     }
-    if (offering(ui) && t >= ui->held_until) end_offer(ui, true);
+    if (offering(ui) && t >= ui->held_until) {
+        // A Redraw whose stroke was refused and left unanswered lapses with
+        // it: the button went on glowing after the hint had gone, and a
+        // visitor's next, unrelated part replaced the last one.
+        end_offer(ui, true);
+        ui->redraw_armed = false;
+    }
     if (ui->mode != SP_KM_ATTRACT && ui->desc.idle_ms > 0 && t - ui->last_input >= ui->desc.idle_ms) reset_to_attract(ui);
 }
 
