@@ -571,8 +571,8 @@ static void test_storms(void)
     script_mark(&s, t, "after");
     // Still responsive: Start over, then the torso.
     script_press(&s, t, "start_over");
-    script_press(&s, t + 200, "start_over");
-    double up = script_stroke(&s, t + 600, g_strokes[0].xy, g_strokes[0].n, 4);
+    script_press(&s, t + 600, "start_over");
+    double up = script_stroke(&s, t + 1000, g_strokes[0].xy, g_strokes[0].n, 4);
     if (g_strokes[0].rank > 0) script_press(&s, up + 250, g_strokes[0].rank == 1 ? "guess1" : "guess2");
     script_end(&s, sc, up + 2000);
     const char* shot = sp_test_tmp_path("kiosk_storm.png");
@@ -1078,7 +1078,7 @@ static void test_collect(void)
     script_event(&s, 60, "up", 640, 400);
     up = part_stroke_at(&s, 500, &g_strokes[0], 0, 0);
     script_press(&s, up + 1500, "start_over");
-    script_press(&s, up + 1700, "start_over");
+    script_press(&s, up + 2100, "start_over");
     script_end(&s, sc, up + 2500);
     for (int off = 1; off >= 0; --off) {
         snprintf(args, sizeof args, "--script '%s'%s", sc, off ? " --no-collect" : "");
@@ -1113,7 +1113,7 @@ static void test_continued_stroke(void)
     double up = script_stroke(&s, 500, st->xy, k + 1, 4);
     up = script_stroke(&s, up + 120, st->xy + k, st->n - k, 4);
     script_press(&s, up + 1500, "start_over");
-    script_press(&s, up + 1700, "start_over");
+    script_press(&s, up + 2100, "start_over");
     up = script_stroke(&s, up + 2500, st->xy, k + 1, 4);
     up = script_stroke(&s, up + 700, st->xy + k, st->n - k, 4);
     script_end(&s, sc, up + 1500);
@@ -1262,7 +1262,7 @@ static void draw_then_start_over(sp_kiosk* k, double* t, const stroke* s)
     const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
     draw_part(k, t, s);
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, *t, 0, 0, SP_KT_START_OVER});
-    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, *t + 200, 0, 0, SP_KT_START_OVER});
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, *t + 600, 0, 0, SP_KT_START_OVER});
     updates_until(k, t, *t + 3000);
     ENSURE(st->parts == 0);
 }

@@ -367,7 +367,12 @@ static void test_flow(void)
     ENSURE(f.clears == 0 && sp_kiosk_ui_clear_armed(ui));
     frame(ui, &f, 17200); // too late: disarmed
     ENSURE(!sp_kiosk_ui_clear_armed(ui));
+    // A double tap is one touch: the question stands, the dragon stays
+    // (a 120 ms double click cleared it); a tap read and given clears.
     tap(ui, 17300, SP_KT_START_OVER);
+    tap(ui, 17420, SP_KT_START_OVER);
+    frame(ui, &f, 17600);
+    ENSURE(f.clears == 0 && ui->part_count == 1 && sp_kiosk_ui_clear_armed(ui));
     tap(ui, 18000, SP_KT_START_OVER);
     frame(ui, &f, 18100);
     ENSURE(f.clears == 1 && ui->part_count == 0 && ui->mode == SP_KM_DRAW);
@@ -666,10 +671,10 @@ static void test_start_over(void)
     frame(ui, &f, t + 3000);
     ENSURE(ui->playing && ui->anim_ms > 1000 && sp_kiosk_ui_banner_visible(ui));
     tap(ui, t + 3100, SP_KT_START_OVER);
-    tap(ui, t + 3400, SP_KT_START_OVER);
+    tap(ui, t + 3600, SP_KT_START_OVER);
     // At once: no part drawn, nothing playing, no old code, the prompt.
     ENSURE(!ui->playing && ui->anim_ms == 0 && !sp_kiosk_ui_banner_visible(ui) && ui->chip[0][0] == 0);
-    frame(ui, &f, t + 3500);
+    frame(ui, &f, t + 3700);
     ENSURE(f.clears == 1 && ui->part_count == 0 && ui->mode == SP_KM_DRAW);
     ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_PROMPT)));
     frame(ui, &f, t + 60000); // the prompt stays as long as the canvas is empty

@@ -856,13 +856,16 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             ui->hint_until = -1;
         break;
     case SP_KT_START_OVER:
-        if (sp_kiosk_ui_clear_armed(ui)) {
+        if (sp_kiosk_ui_clear_armed(ui) && ui->now - ui->clear_armed_at < SP_KIOSK_CONFIRM_MIN_MS) {
+            break; // the same touch again: the question stands
+        } else if (sp_kiosk_ui_clear_armed(ui)) {
             if (push_job(ui, SP_KJOB_CLEAR)) {
                 fresh_canvas(ui);
                 ui->mode = SP_KM_DRAW;
             }
         } else {
             ui->clear_armed_until = ui->now + ui->desc.confirm_ms;
+            ui->clear_armed_at = ui->now;
             set_hint(ui, sp_kiosk_text(SP_KTEXT_CONFIRM_CLEAR));
         }
         break;

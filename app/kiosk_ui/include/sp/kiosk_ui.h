@@ -51,7 +51,7 @@ typedef enum sp_kiosk_target {
     SP_KT_NONE = 0,
     SP_KT_UNDO,        ///< remove the last part
     SP_KT_REDRAW,      ///< the next stroke replaces the last part (toggles)
-    SP_KT_START_OVER,  ///< two taps within clear_confirm_ms: remove every part
+    SP_KT_START_OVER,  ///< two taps, the second SP_KIOSK_CONFIRM_MIN_MS to confirm_ms after the first: remove every part
     SP_KT_PLAY,        ///< play / pause the animation
     SP_KT_TURN,        ///< orbit mode (drag turns the dragon) / back to the drawing view
     SP_KT_SAVE,        ///< export .glb + postcard, show the code
@@ -85,6 +85,9 @@ enum {
     SP_KIOSK_JOBS_MAX = 32,      ///< queued jobs; more are dropped (tap storms)
     SP_KIOSK_LABEL_MAX = 48,
     SP_KIOSK_TEXT_MAX = 160,
+    /// Start over's second tap comes at least this long after the first: a
+    /// double tap (0.1-0.3 s) is one touch, not a confirmation read and given.
+    SP_KIOSK_CONFIRM_MIN_MS = 400,
 };
 
 /// Zero means the default.
@@ -254,6 +257,7 @@ typedef struct sp_kiosk_ui {
     uint64_t saved_revision;                        ///< revision at the last successful save (0: never)
     bool redraw_armed;
     double clear_armed_until;
+    double clear_armed_at; ///< when Start over was first tapped
     // Animation and view.
     bool playing;
     double anim_ms;    ///< animation clock, advances only while playing
