@@ -944,14 +944,22 @@ static void test_save_code(void)
     // change, so the next Save writes it again.
     tap(ui, t + 300, SP_KT_SAVE);
     frame(ui, &f, t + 400);
-    ENSURE(f.saves == 1);
+    ENSURE(f.saves == 1 && sp_kiosk_ui_banner_visible(ui));
+    // A new stroke ends the banner (it covered the stroke's chips and the
+    // refusal's row, whose hidden tiles still took taps), and the kept ink
+    // changes the dragon, so the code no longer names what is on screen.
     t = refused_stroke(ui, t + 1000, 800, 200);
+    ENSURE(!sp_kiosk_ui_banner_visible(ui));
     sp_kiosk_job j;
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_DETAIL, .kept = true, .part_count = 1});
     tap(ui, t + 200, SP_KT_SAVE);
     frame(ui, &f, t + 300);
-    ENSURE(f.saves == 2 && ui->part_count == 1);
+    ENSURE(f.saves == 2 && ui->part_count == 1 && sp_kiosk_ui_banner_visible(ui));
+    // Undo changes the dragon: the banner goes at once, not after 15 s.
+    tap(ui, t + 500, SP_KT_UNDO);
+    frame(ui, &f, t + 600);
+    ENSURE(f.undos == 1 && !sp_kiosk_ui_banner_visible(ui));
     sp_kiosk_ui_destroy(ui);
 }
 

@@ -459,7 +459,9 @@ const char* sp_kiosk_ui_message(const sp_kiosk_ui* ui)
 
 bool sp_kiosk_ui_banner_visible(const sp_kiosk_ui* ui)
 {
-    return ui->code[0] && ui->now < ui->banner_until;
+    // Only while the code names the dragon on screen: a changed dragon is
+    // not the one saved under it.
+    return ui->code[0] && ui->now < ui->banner_until && ui->revision == ui->saved_revision;
 }
 
 bool sp_kiosk_ui_clear_armed(const sp_kiosk_ui* ui)
@@ -579,6 +581,7 @@ static sp_kiosk_job* queue_fit(sp_kiosk_ui* ui, const sp_kiosk_line* stroke)
     }
     int slot = (ui->pending_head + ui->pending_count++) % SP_KIOSK_PENDING_MAX;
     line_copy(&ui->pending[slot], stroke);
+    ui->banner_until = -1; // drawing on: the banner would cover the stroke's chips and row
     j->replace = ui->redraw_armed;
     ui->redraw_armed = false;
     return j;
