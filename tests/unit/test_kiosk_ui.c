@@ -927,6 +927,26 @@ static void test_continued_stroke(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// A double tap on Undo (a bouncing finger, 120 ms apart) takes back one
+// part, not two: there is no Redo. Undo tapped again after it acts again.
+static void test_undo_double_tap(void)
+{
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t);
+    t = stroke(ui, t + 1000, 500, 300, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 2);
+    tap(ui, t + 500, SP_KT_UNDO);
+    tap(ui, t + 620, SP_KT_UNDO);
+    frame(ui, &f, t + 700);
+    ENSURE(f.undos == 1 && ui->part_count == 1);
+    tap(ui, t + 1100, SP_KT_UNDO);
+    frame(ui, &f, t + 1200);
+    ENSURE(f.undos == 2 && ui->part_count == 0);
+    sp_kiosk_ui_destroy(ui);
+}
+
 // Issue 16, item 7: the save banner says what the code is for (Save names
 // the .glb and the postcard by it, where staff find them).
 static void test_save_code(void)
@@ -1650,6 +1670,7 @@ int main(int argc, char** argv)
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},
+                                   {"undo_double_tap", test_undo_double_tap},
                                    {"waiting_part", test_waiting_part},
                                    {"tap_storm", test_tap_storm},
                                    {"stroke_flood", test_stroke_flood},

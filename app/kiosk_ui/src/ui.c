@@ -127,6 +127,7 @@ sp_result sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc, sp_kiosk_ui** out, sp
     ui->mode = SP_KM_ATTRACT;
     ui->playing = ui->desc.start_playing;
     ui->flash_until = ui->fade_until = ui->held_until = ui->hint_until = ui->banner_until = ui->clear_armed_until = -1;
+    ui->undo_at = -SP_KIOSK_REPEAT_MIN_MS;
     sp_kiosk_ui_resize(ui, 1280, 800, 0);
     *out = ui;
     return SP_OK;
@@ -843,6 +844,8 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     }
     switch (t) {
     case SP_KT_UNDO:
+        if (ui->now - ui->undo_at < SP_KIOSK_REPEAT_MIN_MS) break;
+        ui->undo_at = ui->now;
         // The refused stroke was the last thing drawn: it is what goes (kept as ink, the dragon gives it back too).
         if (offering(ui) && !ui->held_kept) {
             end_offer(ui, false);

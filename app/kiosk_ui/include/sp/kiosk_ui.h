@@ -88,6 +88,9 @@ enum {
     /// Start over's second tap comes at least this long after the first: a
     /// double tap (0.1-0.3 s) is one touch, not a confirmation read and given.
     SP_KIOSK_CONFIRM_MIN_MS = 400,
+    /// An Undo this soon after the last one is the same touch (a bouncing
+    /// finger, a double tap): without Redo, a second part lost for nothing.
+    SP_KIOSK_REPEAT_MIN_MS = 300,
 };
 
 /// Zero means the default.
@@ -258,6 +261,7 @@ typedef struct sp_kiosk_ui {
     bool redraw_armed;
     double clear_armed_until;
     double clear_armed_at; ///< when Start over was first tapped
+    double undo_at;        ///< when Undo last acted
     // Animation and view.
     bool playing;
     double anim_ms;    ///< animation clock, advances only while playing
