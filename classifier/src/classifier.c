@@ -666,11 +666,11 @@ static sp_result job_drawing(const train_ctx* t, const job* j, sp_sketch* sk, sp
     double m[4] = {-1, 0, 0, 1}; // mirror
     if (j->variant >= 2) {
         uint64_t rng = t->clf->desc.seed * 0x9e3779b97f4a7c15ull ^ ((uint64_t)j->sample << 20) ^ (uint64_t)j->variant;
-        sp_rng_next(&rng);
-        double ang = (sp_rng_uniform(&rng) * 2 - 1) * 12.0 * M_PI / 180.0;
-        double sx = 0.85 + 0.3 * sp_rng_uniform(&rng), sy = 0.85 + 0.3 * sp_rng_uniform(&rng);
-        double sh = (sp_rng_uniform(&rng) * 2 - 1) * 0.1;
-        double flip = (t->clf->desc.mirror > 0 && sp_rng_uniform(&rng) < 0.5) ? -1.0 : 1.0;
+        clf_rng_next(&rng);
+        double ang = (clf_rng_uniform(&rng) * 2 - 1) * 12.0 * M_PI / 180.0;
+        double sx = 0.85 + 0.3 * clf_rng_uniform(&rng), sy = 0.85 + 0.3 * clf_rng_uniform(&rng);
+        double sh = (clf_rng_uniform(&rng) * 2 - 1) * 0.1;
+        double flip = (t->clf->desc.mirror > 0 && clf_rng_uniform(&rng) < 0.5) ? -1.0 : 1.0;
         double cs = cos(ang), sn = sin(ang);
         // R * Shear * S * Flip
         double a = sx * flip, b = sh * sy, d = sy;
@@ -710,7 +710,7 @@ static int train_job(void* user, int k)
         for (int k = 0; k < f->count; ++k)
             order[k] = k;
         for (int k = 0; k < keep; ++k) {
-            int o = k + (int)(sp_rng_next(&rng) % (uint64_t)(f->count - k));
+            int o = k + (int)(clf_rng_next(&rng) % (uint64_t)(f->count - k));
             int tmp = order[k];
             order[k] = order[o];
             order[o] = tmp;
@@ -1081,7 +1081,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
             norms[i] = (float)s2;
             if (i > 0 && src[i] == src[i - 1]) continue; // one query per original drawing, not its variants
             uint64_t h = (uint64_t)src[i] ^ ((uint64_t)c->desc.seed << 32);
-            if (stride > 1 && sp_rng_next(&h) % (uint64_t)stride != 0) continue;
+            if (stride > 1 && clf_rng_next(&h) % (uint64_t)stride != 0) continue;
             queries[nq++] = i;
         }
         loo_ctx lc = {c, src, queries, nq, norms, loo};
@@ -1393,9 +1393,19 @@ sp_result sp_clf_from_bytes(const void* bytes, size_t size, const char* what, sp
     if (ni != 12) goto corrupt;
     for (int i = 0; i < 12; ++i)
         ints[i] = get_i32(&b);
-    sp_clf_desc d = {ints[0],  ints[1], ints[2], ints[3], ints[4], ints[5],
-                     ints[6],  ints[7], ints[8], ints[9], 0,       (uint32_t)ints[10],
-                     ints[11], NULL,    NULL};
+    // The order sp_clf_save writes them in.
+    sp_clf_desc d = {.words = ints[0],
+                     .vocab_samples = ints[1],
+                     .kmeans_iterations = ints[2],
+                     .soft_neighbours = ints[3],
+                     .knn = ints[4],
+                     .pyramid = ints[5],
+                     .tfidf = ints[6],
+                     .hellinger = ints[7],
+                     .mirror = ints[8],
+                     .augment = ints[9],
+                     .seed = (uint32_t)ints[10],
+                     .threads = ints[11]};
     get(&b, &d.reject_quantile, 8);
     c->desc = sp_clf_desc_defaults(&d);
     int32_t nc = get_i32(&b);

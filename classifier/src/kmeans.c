@@ -118,7 +118,7 @@ sp_result sp_kmeans(const float* data, int n, int dim, int k, uint64_t seed, int
     uint64_t rng = seed;
     int nchunks = (n + CHUNK - 1) / CHUNK;
     // k-means++ seeding: each new centre drawn with probability ~ squared distance.
-    int first = (int)(sp_rng_next(&rng) % (uint64_t)n);
+    int first = (int)(clf_rng_next(&rng) % (uint64_t)n);
     memcpy(centers, data + (size_t)first * dim, sizeof(float) * (size_t)dim);
     for (int i = 0; i < n; ++i)
         mind[i] = 3.4e38f;
@@ -131,7 +131,7 @@ sp_result sp_kmeans(const float* data, int n, int dim, int k, uint64_t seed, int
             total += mind[i];
         int pick = 0;
         if (total > 0.0) {
-            double r = sp_rng_uniform(&rng) * total, c = 0.0;
+            double r = clf_rng_uniform(&rng) * total, c = 0.0;
             pick = n - 1;
             for (int i = 0; i < n; ++i) {
                 c += mind[i];
@@ -141,7 +141,7 @@ sp_result sp_kmeans(const float* data, int n, int dim, int k, uint64_t seed, int
                 }
             }
         } else {
-            pick = (int)(sp_rng_next(&rng) % (uint64_t)n); // all points coincide with centres
+            pick = (int)(clf_rng_next(&rng) % (uint64_t)n); // all points coincide with centres
         }
         memcpy(centers + (size_t)j * dim, data + (size_t)pick * dim, sizeof(float) * (size_t)dim);
     }

@@ -7,7 +7,7 @@
 #include "sp/result.h"
 
 /// splitmix64: tiny, seedable, the same on every platform.
-static inline uint64_t sp_rng_next(uint64_t* s)
+static inline uint64_t clf_rng_next(uint64_t* s)
 {
     uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -15,9 +15,9 @@ static inline uint64_t sp_rng_next(uint64_t* s)
     return z ^ (z >> 31);
 }
 /// Uniform in [0, 1).
-static inline double sp_rng_uniform(uint64_t* s)
+static inline double clf_rng_uniform(uint64_t* s)
 {
-    return (double)(sp_rng_next(s) >> 11) * (1.0 / 9007199254740992.0);
+    return (double)(clf_rng_next(s) >> 11) * (1.0 / 9007199254740992.0);
 }
 
 /// Clusters `n` rows of `dim` (= 64) floats into `k` centres (k <= n). Deterministic for a
