@@ -11,6 +11,7 @@
 #include "pose_io.h"
 #include "posing.h"
 #include "sp/blackbox.h"
+#include "sp/plugin.h"
 #include "sp/synth.h"
 
 struct sp_rig_handle {

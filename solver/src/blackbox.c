@@ -230,12 +230,19 @@ oom:
     return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
 }
 
+void sp_blackbox_on_destroy(sp_blackbox* bb, void (*fn)(void* user), void* user)
+{
+    bb->on_destroy = fn;
+    bb->on_destroy_user = user;
+}
+
 void sp_blackbox_destroy(sp_blackbox* bb)
 {
     if (!bb) return;
-    void* dl = bb->dl;
+    void (*fn)(void*) = bb->on_destroy;
+    void* user = bb->on_destroy_user;
     blackbox_destroy(bb, true);
-    sp__blackbox_unload(dl);
+    if (fn) fn(user);
 }
 
 // ---------------------------------------------------------------- queries

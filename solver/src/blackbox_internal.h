@@ -1,5 +1,5 @@
 // blackbox_internal.h: the host's view of a black-box rig, shared by
-// blackbox.c and blackbox_plugin.c.
+// blackbox.c and the solver's model of it.
 #ifndef SP_BLACKBOX_INTERNAL_H
 #define SP_BLACKBOX_INTERNAL_H
 
@@ -10,7 +10,8 @@
 struct sp_blackbox {
     const sp_blackbox_rig* rig;
     char what[512]; // names the rig in messages (the plugin's path)
-    void* dl;       // dlopen handle, or NULL for a rig linked into the host
+    void (*on_destroy)(void* user); // after the rig's release (a plugin's dlclose), or NULL
+    void* on_destroy_user;
     int P, n;       // parameters, vertices
     int abstraction_count;
     sp_abstraction* abs; // the abstractions as the solver's types (curves only)
@@ -26,7 +27,5 @@ struct sp_blackbox {
 sp_result sp__blackbox_eval_raw(const sp_blackbox* bb, const double* p, double* x, double* z, int* rc, size_t* bad);
 // The one-line message for a failed sp__blackbox_eval_raw; `where` says when.
 sp_result sp__blackbox_eval_message(const sp_blackbox* bb, sp_result r, int rc, size_t bad, const char* where, sp_error* err);
-// dlclose()s a plugin handle (NULL is fine).
-void sp__blackbox_unload(void* dl);
 
 #endif

@@ -17,6 +17,7 @@
 #include "fixtures.h"
 #include "sp/blackbox.h"
 #include "sp/gltf.h"
+#include "sp/plugin.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
 #include "test.h"

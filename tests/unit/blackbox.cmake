@@ -2,7 +2,7 @@
 # analytic Jacobians, threads, the plugin loader's errors (small plugins
 # built from unit/blackbox_plugin.c, one defect each), recovery on the face
 # plugin, and `sketchpose synth/pose --rig face.so`.
-sp_unit_test(blackbox TIMEOUT 300)
+sp_unit_test(blackbox TIMEOUT 300 LIBS sp::plugin)
 set(SP_TEST_PLUGIN_DIR ${PROJECT_BINARY_DIR}/tests/plugins)
 foreach(variant good nosym null badversion badsize badtri badrest nan nanlater)
   add_library(sp_test_bb_${variant} MODULE unit/blackbox_plugin.c)

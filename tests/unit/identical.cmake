@@ -4,7 +4,7 @@
 # and energies to 1e-9). `build/tests/test_identical --repin` re-pins.
 # One CTest entry per group so that they run in parallel.
 add_executable(test_identical unit/test_identical.c)
-target_link_libraries(test_identical PRIVATE sp_test_fixtures sp::partdb)
+target_link_libraries(test_identical PRIVATE sp_test_fixtures sp::partdb sp::plugin)
 target_compile_definitions(test_identical PRIVATE SP_FACE_PLUGIN="$<TARGET_FILE:sp_face>")
 add_dependencies(test_identical sp_face)
 if(TARGET sp_dragon)

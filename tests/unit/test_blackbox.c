@@ -12,6 +12,7 @@
 
 #include "fixtures.h"
 #include "sp/blackbox.h"
+#include "sp/plugin.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
 #include "test.h"

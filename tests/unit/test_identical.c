@@ -27,6 +27,7 @@
 #include "sp/embed.h"
 #include "sp/gltf.h"
 #include "sp/partdb.h"
+#include "sp/plugin.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
 #include "test.h"

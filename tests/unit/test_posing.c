@@ -19,6 +19,7 @@
 #include "sp/blackbox.h"
 #include "sp/embed.h"
 #include "sp/gltf.h"
+#include "sp/plugin.h"
 #include "sp/sketch_io.h"
 #include "sp/solver.h"
 #include "sp/synth.h"

@@ -1,6 +1,6 @@
 /// sp/blackbox.h: rigs given only as an evaluation function ("black-box"
-/// rigs, paper section 3): the C ABI such a rig implements, loading one
-/// from a plugin shared object, and posing it with the same solver as
+/// rigs, paper section 3): the C ABI such a rig implements (a plugin shared
+/// object is loaded by sp/plugin.h, partdb/), and posing it with the same solver as
 /// skinned rigs (energy, regularisers, coarsening, bounds, report), its
 /// Jacobians estimated by central finite differences on a thread pool.
 ///
@@ -126,12 +126,10 @@ typedef struct sp_blackbox sp_blackbox;
 /// failure *out is NULL, and release is called if the version and struct
 /// size matched (only then is the layout known), so a bad rig is still freed.
 sp_result sp_blackbox_open(const sp_blackbox_rig* rig, const char* what, sp_blackbox** out, sp_error* err);
-/// dlopen()s a shared object, calls its SP_BLACKBOX_ENTRY and opens the
-/// result. One-line errors name the file: missing file, not a shared
-/// object, missing entry symbol, entry returned NULL, wrong ABI version or
-/// struct size, inconsistent counts, NaN or failing evaluation.
-sp_result sp_blackbox_load_plugin(const char* path, sp_blackbox** out, sp_error* err);
-/// Releases the rig and unloads its plugin. NULL is fine.
+/// `fn(user)` is called by sp_blackbox_destroy after the rig's own release,
+/// last: a plugin's loader unloads the code the rig lives in there.
+void sp_blackbox_on_destroy(sp_blackbox* bb, void (*fn)(void* user), void* user);
+/// Releases the rig, then calls what sp_blackbox_on_destroy gave. NULL is fine.
 void sp_blackbox_destroy(sp_blackbox* bb);
 
 /// The description (read-only; valid until sp_blackbox_destroy).

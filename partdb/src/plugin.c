@@ -1,5 +1,7 @@
-// blackbox_plugin.c: loading a black-box rig from a shared object with
-// dlopen/dlsym of its one entry symbol (SP_BLACKBOX_ENTRY).
+// plugin.c: loading a black-box rig from a shared object with dlopen/dlsym
+// of its one entry symbol (SP_BLACKBOX_ENTRY).
+#include "sp/plugin.h"
+
 #include <dlfcn.h>
 #include <elf.h>
 #include <errno.h>
@@ -9,11 +11,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "blackbox_internal.h"
-
-void sp__blackbox_unload(void* dl)
+static void unload(void* dl)
 {
-    if (dl) dlclose(dl);
+    dlclose(dl);
 }
 
 // ELF fields in either byte order, so a foreign object is still checked
@@ -138,6 +138,6 @@ sp_result sp_blackbox_load_plugin(const char* path, sp_blackbox** out, sp_error*
         dlclose(dl);
         return r;
     }
-    (*out)->dl = dl;
+    sp_blackbox_on_destroy(*out, unload, dl);
     return SP_OK;
 }
