@@ -432,6 +432,18 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
                     path);
         goto fail;
     }
+    // Another application's SQLite file is refused before anything here
+    // writes to it: the journal mode below stayed WAL on a file `db check`
+    // had refused (its schema version may be any number).
+    int ours = 0, tables = 0;
+    if (pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables) == SQLITE_OK && tables > 0 &&
+        pragma_int(db, "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name IN ('parts', 'sketches', 'models')",
+                   &ours) == SQLITE_OK &&
+        (v == 0 || ours < 3)) {
+        r = sp_fail(err, SP_ERR_INVALID, "%s: an SQLite file but not a sketchpose database (%s); nothing in it was changed", path,
+                    v == 0 ? "no schema version" : "no parts, sketches and models tables");
+        goto fail;
+    }
     if (v > SP_DB_SCHEMA_VERSION) {
         r = sp_fail(err, SP_ERR_UNSUPPORTED,
                     "%s: database schema version %d is newer than this sketchpose understands (%d); update sketchpose", path, v,
@@ -440,7 +452,6 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     }
     // Only SP_DB_CREATE makes a database: an existing empty file (a typo'd
     // path, a truncated copy) opened for writing is refused, not given a schema.
-    int tables = 0;
     if (!ro && exists && v == 0 && !(flags & SP_DB_CREATE) &&
         pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables) == SQLITE_OK && tables == 0) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: not a sketchpose database (an empty file; `sketchpose db init` makes one)", path);

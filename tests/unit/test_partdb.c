@@ -880,6 +880,28 @@ static void test_schema_versions(void)
     ENSURE(sqlite3_exec(h, "CREATE TABLE foo(x)", NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(h);
     ENSURE(sp_db_open(q, 0, &db, &err) == SP_ERR_INVALID && strstr(err.text, "not a sketchpose database"));
+    // With a schema version of its own (any application may set one): said
+    // so, not "no such table" or "newer than this sketchpose", and its
+    // journal mode is left as it was (it stayed WAL after the refusal).
+    for (int v = 1; v <= SP_DB_SCHEMA_VERSION + 1; v += SP_DB_SCHEMA_VERSION) {
+        sp_fixture_remove_db(q);
+        ENSURE(sqlite3_open(q, &h) == SQLITE_OK);
+        char sql[96];
+        snprintf(sql, sizeof sql, "CREATE TABLE foo(x); PRAGMA user_version = %d;", v);
+        ENSURE(sqlite3_exec(h, sql, NULL, NULL, NULL) == SQLITE_OK);
+        sqlite3_close(h);
+        for (int ro = 0; ro < 2; ++ro) {
+            sp_result r = sp_db_open(q, ro ? SP_DB_READONLY : 0, &db, &err);
+            fprintf(stderr, "  another application's (version %d): %s\n", v, err.text);
+            ENSURE(r == SP_ERR_INVALID && strstr(err.text, "not a sketchpose database"));
+        }
+        ENSURE(sqlite3_open(q, &h) == SQLITE_OK);
+        sqlite3_stmt* jm = NULL;
+        ENSURE(sqlite3_prepare_v2(h, "PRAGMA journal_mode", -1, &jm, NULL) == SQLITE_OK && sqlite3_step(jm) == SQLITE_ROW);
+        ENSURE(!strcmp((const char*)sqlite3_column_text(jm, 0), "delete"));
+        sqlite3_finalize(jm);
+        sqlite3_close(h);
+    }
     // An empty file (a typo'd path, a truncated copy) opened for writing is
     // refused and stays empty; only SP_DB_CREATE makes a database of it.
     sp_fixture_remove_db(q);
