@@ -353,6 +353,9 @@ static bool has_parts(const char* path)
 
 int main(int argc, char** argv)
 {
+    // Past a file-size limit a write fails (a sketch dropped, a save that
+    // says so) instead of the signal killing the kiosk.
+    signal(SIGXFSZ, SIG_IGN);
     double start = sp_now_ms();
     const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL,
                *size = NULL;

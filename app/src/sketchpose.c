@@ -1,5 +1,6 @@
 // sketchpose: the command line. Dispatches to cmd_<name>() (commands.h).
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -36,6 +37,10 @@ static int finish(int rc)
 
 int main(int argc, char** argv)
 {
+    // Past a file-size limit (ulimit -f) a write fails with EFBIG, said in
+    // one line, instead of the signal killing the command silently, even
+    // after a database change was committed.
+    signal(SIGXFSZ, SIG_IGN);
     if (argc < 2) {
         usage(stderr);
         return 2;

@@ -210,10 +210,24 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
     case SQLITE_NOMEM: return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while %s", p, doing);
     case SQLITE_CORRUPT:
     case SQLITE_NOTADB: return sp_fail(err, SP_ERR_PARSE, "%s: not a valid sketchpose database (%s) while %s", p, sqlite3_errstr(rc), doing);
-    case SQLITE_IOERR:
+    case SQLITE_IOERR: {
+        // The system's reason: a read also fails on a full disk or past a
+        // size limit, where SQLite cannot make the -shm beside the database.
+        int e = db->h ? sqlite3_system_errno(db->h) : 0;
+        if (e == ENOSPC || e == EDQUOT)
+            return sp_fail(err, SP_ERR_IO,
+                           "%s: disk full while %s (SQLite needs room for the -wal and -shm beside it, also to read it); nothing "
+                           "was changed",
+                           p, doing);
+        if (e == EFBIG)
+            return sp_fail(err, SP_ERR_IO, "%s: this process's file size limit (ulimit -f) reached while %s; nothing was changed",
+                           p, doing);
         if (rc == SQLITE_IOERR_WRITE || rc == SQLITE_IOERR_FSYNC || rc == SQLITE_IOERR_TRUNCATE)
-            return sp_fail(err, SP_ERR_IO, "%s: write failed (disk full or file too large?) while %s; nothing was changed", p, doing);
-        return sp_fail(err, SP_ERR_IO, "%s: I/O error (%s) while %s", p, sqlite3_errmsg(db->h), doing);
+            return sp_fail(err, SP_ERR_IO, "%s: write failed (%s) while %s; nothing was changed", p,
+                           e ? strerror(e) : "disk full or file too large?", doing);
+        return sp_fail(err, SP_ERR_IO, "%s: I/O error (%s%s%s) while %s", p, sqlite3_errmsg(db->h), e ? ": " : "",
+                       e ? strerror(e) : "", doing);
+    }
     default: return sp_fail(err, SP_ERR_INTERNAL, "%s: %s while %s", p, db->h ? sqlite3_errmsg(db->h) : sqlite3_errstr(rc), doing);
     }
 }

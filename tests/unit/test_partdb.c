@@ -1876,6 +1876,21 @@ static void test_kiosk_review_cli(void)
         ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "\"ok\": false") && strstr(out, said[t]));
         sp_fixture_remove_db(copy);
     }
+    // Past the file size limit (ulimit -f: 5 KB, less than the -shm SQLite
+    // makes to read a WAL database): one line that says so, exit 1, not
+    // "disk I/O error" (nor, before SIGXFSZ was ignored, a silent death).
+    {
+        char copy[1100];
+        snprintf(copy, sizeof copy, "%s", sp_test_tmp_path("limited.db"));
+        sp_fixture_remove_db(copy);
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s'", p, copy);
+        ENSURE(system(cmd) == 0);
+        snprintf(cmd, sizeof cmd, "ulimit -f 10; '%s' db check --db '%s' 2>&1 >/dev/null", bin, copy);
+        int rc = sp_fixture_run(cmd, out, sizeof out);
+        fprintf(stderr, "  ulimit -f 10: exit %d: %s", rc, out);
+        ENSURE(rc == 1 && strstr(out, "file size limit (ulimit -f)") && strchr(out, '\n') == out + strlen(out) - 1);
+        sp_fixture_remove_db(copy);
+    }
     // The database's current model classifies (classify --db); a bad stroke file is one line and exit 1.
     snprintf(cmd, sizeof cmd, "'%s' classify --db '%s' --strokes '%s/tests/data/visitors/tune/tail/tail-wavy-line.json'", bin, p,
              SP_SOURCE_DIR);
