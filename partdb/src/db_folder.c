@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <ftw.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -398,6 +399,45 @@ static bool is_part_file(const char* n)
     return n[0] != '.' && ((l > 4 && !strcmp(n + l - 4, ".glb")) || (l > 5 && !strcmp(n + l - 5, ".gltf")));
 }
 
+// A message that starts with the temporary name says the name the user gave.
+static void say_as_given(sp_error* err, const char* tmp, const char* path)
+{
+    size_t tl = strlen(tmp);
+    if (!err || strncmp(err->text, tmp, tl) != 0) return;
+    sp_error why = *err;
+    snprintf(err->text, sizeof err->text, "%s%s", path, why.text + tl);
+}
+
+// Removes what builds killed before they could clean up left beside `where`
+// (`<where>.building-<pid>` and its -wal and -shm): only those whose process
+// is gone, so that a build running now keeps its files.
+static void remove_stale_builds(const char* where)
+{
+    char* dir = sp_path_folder(where);
+    const char* base = strrchr(where, '/');
+    base = base ? base + 1 : where;
+    char prefix[300];
+    snprintf(prefix, sizeof prefix, "%s.building-", base);
+    size_t pl = strlen(prefix);
+    char** names = NULL;
+    int n = 0;
+    if (dir && sp_dir_list(dir, &names, &n, NULL) == SP_OK) {
+        for (int i = 0; i < n; ++i) {
+            const char* rest = names[i] + (strncmp(names[i], prefix, pl) ? strlen(names[i]) : pl);
+            size_t digits = strspn(rest, "0123456789");
+            if (digits == 0 || digits > 9 || (rest[digits] && strcmp(rest + digits, "-wal") && strcmp(rest + digits, "-shm")))
+                continue;
+            pid_t pid = (pid_t)atol(rest);
+            if (pid <= 0 || pid == getpid() || kill(pid, 0) == 0 || errno != ESRCH) continue;
+            char file[4200];
+            snprintf(file, sizeof file, "%s/%s", dir, names[i]);
+            unlink(file);
+        }
+        sp_dir_list_free(names, n);
+    }
+    free(dir);
+}
+
 // Builds a database beside `path` with fill(), then links it into place, so
 // that an interrupted build never leaves a half database at `path`. link()
 // never replaces: a database someone else completed meanwhile wins. An empty
@@ -415,16 +455,14 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     const char* where = real ? real : path;
     char tmp[1024];
     snprintf(tmp, sizeof tmp, "%s.building-%ld", where, (long)getpid());
+    remove_stale_builds(where);
     sp_db* db = NULL;
     sp_result r = sp_db_open(tmp, SP_DB_CREATE, &db, err);
-    size_t tl = strlen(tmp);
-    if (r != SP_OK && err && !strncmp(err->text, tmp, tl)) {
-        // The user named `path`; the temporary name beside it would only puzzle them.
-        sp_error why = *err;
-        sp_fail(err, r, "%s%s", path, why.text + tl);
-    }
     if (r == SP_OK) r = fill(db, ctx, err);
     sp_db_close(db);
+    // The user named `path`; the temporary name beside it would only puzzle
+    // them (a full disk while committing named it).
+    if (r != SP_OK) say_as_given(err, tmp, path);
     struct stat now;
     bool replace = empty && stat(path, &now) == 0 && now.st_ino == was && now.st_size == 0;
     if (r == SP_OK && empty && !replace)

@@ -1712,10 +1712,27 @@ static void test_default_db_cli(void)
     char f[1200];
     snprintf(f, sizeof f, "%s/sketches/drawings.json", assets);
     put_text(f, "{\"drawings\": [{\"name\": \"t\", \"label\": \"tail\", \"points\": [[0, 50], [50, 30], [100, 60]]}]}");
+    // What builds killed meanwhile left beside it (SIGKILL, SIGTERM, each
+    // under its own pid) goes with the next build; a live process's stays.
+    pid_t gone = fork();
+    if (gone == 0) _exit(0);
+    ENSURE(gone > 0 && waitpid(gone, NULL, 0) == gone);
+    char stale[3][1200], live[1200];
+    static const char* const sides[3] = {"", "-wal", "-shm"};
+    for (int i = 0; i < 3; ++i) {
+        snprintf(stale[i], sizeof stale[i], "%s.building-%ld%s", p, (long)gone, sides[i]);
+        put_text(stale[i], "left by a killed build");
+    }
+    snprintf(live, sizeof live, "%s.building-%ld", p, (long)getpid());
+    put_text(live, "a build that is still running");
     snprintf(cmd, sizeof cmd,
              "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --drawings 2 --folds -1 --words 32 2>/dev/null", bin, p,
              assets);
     int rc = sp_fixture_run(cmd, out, sizeof out);
+    for (int i = 0; i < 3; ++i)
+        ENSURE(stat(stale[i], &st) != 0);
+    ENSURE(stat(live, &st) == 0);
+    unlink(live);
     if (rc != 0) fprintf(stderr, "  db init: %d %s\n", rc, out);
     ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3") && strstr(out, "\"part_sketches\": 24") &&
            strstr(out, "\"concept_sketches\": 4") && strstr(out, "\"design_sketches\": 2"));
