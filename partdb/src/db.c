@@ -171,6 +171,25 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
 // (another user's, left by their process) read-only, and every write then
 // fails as SQLITE_READONLY, which reads as though the database file were.
 // True (err set, naming the file and its owner) when that is the cause.
+// A reader of a database it could not write (mode 444) leaves its -wal and
+// -shm with that mode: SQLite makes them like the database and removes them
+// only when a connection that may write closes. Once the owner may write the
+// database again, its own leftovers would refuse every write, so they get
+// the database's mode. Another user's are left as they are (and said).
+static void own_side_files_writable(const char* path, const struct stat* db_st)
+{
+    if (db_st->st_uid != geteuid() || !(db_st->st_mode & S_IWUSR)) return;
+    size_t n = strlen(path) + 5;
+    char* side = malloc(n);
+    for (int k = 0; side && k < 2; ++k) {
+        snprintf(side, n, "%s-%s", path, k ? "shm" : "wal");
+        struct stat st;
+        if (lstat(side, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == geteuid() && !(st.st_mode & S_IWUSR))
+            chmod(side, db_st->st_mode & 0777);
+    }
+    free(side);
+}
+
 static bool side_file_unwritable(const char* path, const char* doing, sp_error* err)
 {
     for (int k = 0; k < 2; ++k) {
@@ -413,6 +432,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     }
     db->readonly = ro;
     db->busy_ms = busy_ms >= 0 ? busy_ms : SP_DB_BUSY_MS_DEFAULT;
+    if (!ro && exists) own_side_files_writable(path, &st);
     bool ro_file = ro && !reader_may_write(path);
     int oflags =
         ro_file ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | ((flags & SP_DB_CREATE) && !ro ? SQLITE_OPEN_CREATE : 0);

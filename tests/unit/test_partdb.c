@@ -776,6 +776,52 @@ static void test_readers_leave_one_file(void)
     sp_fixture_remove_db(p);
 }
 
+// A reader of a database it owns but could not write (mode 444) leaves the
+// -wal and -shm at 444 (SQLite removes them only when a connection that may
+// write closes); once the owner may write the database again, those
+// leftovers of its own no longer refuse every write ("not writable by this
+// user ... run as its owner", to the owner). Needs root to be another user.
+static void test_own_readonly_leftovers(void)
+{
+    if (geteuid() != 0) SKIP("needs root (to run as a user that owns the database)");
+    char p[1024], side[1100];
+    const char* dir = base_db_in_folder("sp_partdb_ro", "mine.db", "own_ro.db", p);
+    ENSURE(chown(dir, 65534, 65534) == 0 && chown(p, 65534, 65534) == 0 && chmod(p, 0444) == 0);
+    for (int step = 0; step < 2; ++step) {
+        if (step == 1) ENSURE(chmod(p, 0644) == 0); // the owner may write it again
+        pid_t pid = fork_unprivileged();
+        if (pid == 0) {
+            sp_db* d = NULL;
+            sp_error e = {0};
+            sp_result r;
+            if (step == 0) { // read, leaving -wal and -shm behind
+                char* log = NULL;
+                r = sp_db_open(p, SP_DB_READONLY, &d, &e);
+                if (r == SP_OK) r = sp_db_log_json(d, "own_ro", &log, &e);
+                free(log);
+            } else {
+                sp_dataset ds = one_sketch("tail");
+                if ((r = sp_db_open(p, 0, &d, &e)) == SP_OK)
+                    r = sp_db_add_sketches(d, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &e);
+                sp_dataset_free(&ds);
+            }
+            fprintf(stderr, "  own read-only leftovers, step %d: %s\n", step, r == SP_OK ? "ok" : e.text);
+            sp_db_close(d);
+            _exit(r == SP_OK ? 0 : 6);
+        }
+        int st;
+        ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st) && WEXITSTATUS(st) == 0);
+        if (step == 0) {
+            snprintf(side, sizeof side, "%s-shm", p);
+            struct stat ss;
+            ENSURE(stat(side, &ss) == 0 && (ss.st_mode & 0777) == 0444); // the case this is about
+        }
+    }
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 1);
+    sp_fixture_remove_db(p);
+    ENSURE(rmdir(dir) == 0);
+}
+
 // A WAL database whose -wal and -shm a writer that crashed left behind, owned
 // by another user (root) and not writable by this one, in a folder and beside
 // a database file everyone may write: readers still read it (the WAL's rows
@@ -2271,6 +2317,7 @@ int main(int argc, char** argv)
                                    {"unreachable", test_unreachable},
                                    {"read_only_folder", test_read_only_folder},
                                    {"foreign_wal", test_foreign_wal},
+                                   {"own_readonly_leftovers", test_own_readonly_leftovers},
                                    {"readers_leave_one_file", test_readers_leave_one_file},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
