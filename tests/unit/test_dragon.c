@@ -1256,6 +1256,40 @@ static void test_corrupt_part(void)
     ENSURE(strstr(text, "stroke 0 left out (no_part: ") && strstr(text, "does not match its checksum") &&
            strstr(text, "no stroke became a part"));
     free(text);
+    // The parts table itself unreadable (its root page overwritten): the
+    // stroke left out names the database and why, not the stroke file alone.
+    {
+        char broken[1024];
+        snprintf(broken, sizeof broken, "%s", sp_test_tmp_path("dragon_parts_table.db"));
+        copy_file(good, broken);
+        sqlite3* h = NULL;
+        sqlite3_stmt* q = NULL;
+        ENSURE(sqlite3_open(broken, &h) == SQLITE_OK &&
+               sqlite3_exec(h, "PRAGMA journal_mode = DELETE", NULL, NULL, NULL) == SQLITE_OK);
+        ENSURE(sqlite3_prepare_v2(
+                   h, "SELECT rootpage, (SELECT page_size FROM pragma_page_size) FROM sqlite_master WHERE name = 'parts'", -1, &q,
+                   NULL) == SQLITE_OK &&
+               sqlite3_step(q) == SQLITE_ROW);
+        long page = sqlite3_column_int64(q, 0), size = sqlite3_column_int64(q, 1);
+        sqlite3_finalize(q);
+        sqlite3_close(h);
+        FILE* f = fopen(broken, "r+b");
+        ENSURE(f && page > 1 && fseek(f, (page - 1) * size, SEEK_SET) == 0);
+        for (long i = 0; i < size; ++i)
+            fputc((int)((i * 131 + 7) & 0xff), f);
+        fclose(f);
+        char run[4000];
+        snprintf(run, sizeof run, "'%s' dragon --db '%s' --strokes '%s' > /dev/null 2> '%s'", SP_SKETCHPOSE, broken, strokes,
+                 log);
+        ENSURE(system(run) != 0);
+        text = sp_fixture_file_text(log, NULL);
+        fprintf(stderr, "%s", text);
+        char want[1200];
+        snprintf(want, sizeof want, "stroke 0 left out (no_part: %s: ", broken);
+        ENSURE(strstr(text, want) && strstr(text, "malformed"));
+        free(text);
+        sp_fixture_remove_db(broken);
+    }
     // A model that cannot be used is said once, naming the database, not
     // as every stroke left out "no_model" blaming the stroke file.
     const char* models[] = {"UPDATE models SET model = substr(model, 1, 1000)", "DELETE FROM models"};

@@ -442,7 +442,11 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
             if (!strcmp(d->cache[k]->category, category)) out[got++] = d->cache[k];
         return got;
     }
-    if (sp_db_category_parts(d->db, category, &names, &n, err) != SP_OK) return 0;
+    if (sp_db_category_parts(d->db, category, &names, &n, err) != SP_OK) {
+        // Said with the stroke it leaves out (it blamed the stroke file alone).
+        if (err) snprintf(d->part_error, sizeof d->part_error, "%s", err->text);
+        return 0;
+    }
     for (int i = 0; i < n && got < cap; ++i) {
         tpl* t = cached(d, names[i]);
         const struct dragon_failed* f = t ? NULL : failed_before(d, names[i]);
