@@ -249,12 +249,19 @@ static void print_stats(const app* a, double start_ms)
     printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d,\n", st->collected, stored, dropped);
     printf(" \"others\": %d, \"others_chosen\": %d, \"joined\": %d, \"merged\": %d,\n", ui->others, ui->others_chosen, ui->joined,
            ui->merged);
-    // What a visitor reads on screen now (JSON-escaped).
-    cJSON* hint = cJSON_CreateString(sp_kiosk_ui_hint_visible(ui) ? ui->hint : "");
-    char* hint_text = hint ? cJSON_PrintUnformatted(hint) : NULL;
-    printf(" \"hint\": %s,\n", hint_text ? hint_text : "\"\"");
-    free(hint_text);
-    cJSON_Delete(hint);
+    // What a visitor reads on screen now (JSON-escaped): the message box
+    // (a hint, or the first-draw prompt) and the save banner.
+    char banner[2 * SP_KIOSK_TEXT_MAX + 2] = "";
+    if (sp_kiosk_ui_banner_visible(ui)) snprintf(banner, sizeof banner, "%s %s", ui->banner[0], ui->banner[1]);
+    const char* message = sp_kiosk_ui_message(ui);
+    cJSON* said = cJSON_CreateObject();
+    cJSON_AddStringToObject(said, "hint", message ? message : "");
+    cJSON_AddStringToObject(said, "banner", banner);
+    char* said_text = said ? cJSON_PrintUnformatted(said) : NULL;
+    // Printed without its braces, as two fields of the stats object.
+    if (said_text && strlen(said_text) > 2) printf(" %.*s,\n", (int)strlen(said_text) - 2, said_text + 1);
+    free(said_text);
+    cJSON_Delete(said);
     printf(" \"framebuffer\": [%d, %d], \"px_per_mm\": %.4f, \"gl_renderer\": \"%s\", \"start_ms\": %.1f, \"frames\": %d, "
            "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"fit_ms_median\": %.2f, \"fit_ms_p90\": %.2f, "
            "\"latency_ms_median\": %.2f, \"latency_ms_p90\": %.2f, \"latency_n\": %d, \"update_ms_median\": %.2f, "

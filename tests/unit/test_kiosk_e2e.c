@@ -856,6 +856,11 @@ static void test_visit(void)
     ENSURE(!strcmp(stat_category(st, 0), "torso") && !strcmp(stat_category(st, 2), "head"));
     ENSURE(!strcmp(stat_category(st, 3), "head") && !strcmp(stat_category(st, 4), g_strokes[5].category));
     ENSURE(num(st, "resets") == 0 && num(st, "saves") == 1 && num(st, "loose_parts") == 1 && num(st, "bodies") == 1);
+    // What the visitor reads at the end, 1 s after Save: the banner with the
+    // code ("hint" alone was "" while it showed).
+    const cJSON *banner = cJSON_GetObjectItemCaseSensitive(st, "banner"), *code = cJSON_GetObjectItemCaseSensitive(st, "code");
+    ENSURE(cJSON_IsString(banner) && cJSON_IsString(code) && code->valuestring[0] &&
+           strstr(banner->valuestring, code->valuestring));
     const cJSON* att = cJSON_GetObjectItemCaseSensitive(st, "attached_to");
     ENSURE(cJSON_GetArraySize(att) == 5 && cJSON_GetArrayItem(att, 1)->valuedouble == 0 &&
            cJSON_GetArrayItem(att, 2)->valuedouble == 0 && cJSON_GetArrayItem(att, 3)->valuedouble == -1);
