@@ -175,32 +175,17 @@ static void draw_button(sp_kiosk* k, sp_kiosk_target t)
     sp_draw2d_rect(k->d2, r->x, r->y, r->w, r->h, rad, fmaxf(1.5f, 0.025f * r->h),
                    (const float[4]){1, 1, 1, enabled ? 0.9f : 0.5f});
     bool alt = (t == SP_KT_PLAY && ui->playing) || (t == SP_KT_TURN && ui->mode == SP_KM_TURN);
-    const char* label = "";
-    switch (t) {
-    case SP_KT_UNDO:
-        label = "Undo";
-        break;
-    case SP_KT_REDRAW:
-        label = "Redraw";
-        break;
-    case SP_KT_START_OVER:
-        label = sp_kiosk_ui_clear_armed(ui) ? "Sure?" : "Start over";
-        break;
-    case SP_KT_PLAY:
-        label = alt ? "Pause" : "Play";
-        break;
-    case SP_KT_TURN:
-        label = alt ? "Draw" : "Turn";
-        break;
-    case SP_KT_SAVE:
-        label = "Save";
-        break;
-    default:
-        break;
-    }
+    sp_kiosk_text_id label = t == SP_KT_UNDO     ? SP_KTEXT_BUTTON_UNDO
+                             : t == SP_KT_REDRAW ? SP_KTEXT_BUTTON_REDRAW
+                             : t == SP_KT_START_OVER
+                                 ? (sp_kiosk_ui_clear_armed(ui) ? SP_KTEXT_BUTTON_SURE : SP_KTEXT_BUTTON_START_OVER)
+                             : t == SP_KT_PLAY ? (alt ? SP_KTEXT_BUTTON_PAUSE : SP_KTEXT_BUTTON_PLAY)
+                             : t == SP_KT_TURN ? (alt ? SP_KTEXT_BUTTON_DRAW : SP_KTEXT_BUTTON_TURN)
+                                               : SP_KTEXT_BUTTON_SAVE;
     float s = fminf(r->h * 0.46f, r->w * 0.5f);
     icon(k->d2, t, alt, r->x + 0.5f * r->w, r->y + 0.38f * r->h, s, fg);
-    sp_draw2d_text_fit(k->d2, label, r->x + 0.5f * r->w, r->y + 0.79f * r->h, 0.21f * r->h, 0.9f * r->w, SP_ALIGN_CENTER, fg);
+    sp_draw2d_text_fit(k->d2, sp_kiosk_text(label), r->x + 0.5f * r->w, r->y + 0.79f * r->h, 0.21f * r->h, 0.9f * r->w,
+                       SP_ALIGN_CENTER, fg);
 }
 
 static void draw_chips(sp_kiosk* k)

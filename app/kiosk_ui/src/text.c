@@ -49,6 +49,15 @@ static const char* const k_text[SP_KTEXT_COUNT] = {
     [SP_KTEXT_LOADING] = "Getting the dragon parts ready...",
     [SP_KTEXT_POSTCARD_TITLE] = "My dragon",
     [SP_KTEXT_POSTCARD_CODE] = "code",
+    [SP_KTEXT_BUTTON_UNDO] = "Undo",
+    [SP_KTEXT_BUTTON_REDRAW] = "Redraw",
+    [SP_KTEXT_BUTTON_START_OVER] = "Start over",
+    [SP_KTEXT_BUTTON_SURE] = "Sure?",
+    [SP_KTEXT_BUTTON_PLAY] = "Play",
+    [SP_KTEXT_BUTTON_PAUSE] = "Pause",
+    [SP_KTEXT_BUTTON_TURN] = "Turn",
+    [SP_KTEXT_BUTTON_DRAW] = "Draw",
+    [SP_KTEXT_BUTTON_SAVE] = "Save",
 };
 
 const char* sp_kiosk_text(sp_kiosk_text_id id)

@@ -61,6 +61,15 @@ typedef enum sp_kiosk_text_id {
     SP_KTEXT_LOADING,               ///< the first start, while the database is built
     SP_KTEXT_POSTCARD_TITLE,        ///< on the saved postcard
     SP_KTEXT_POSTCARD_CODE,         ///< on the saved postcard, before the code
+    SP_KTEXT_BUTTON_UNDO,           ///< the toolbar's buttons, under their icons
+    SP_KTEXT_BUTTON_REDRAW,
+    SP_KTEXT_BUTTON_START_OVER,
+    SP_KTEXT_BUTTON_SURE, ///< Start over asking for its second tap
+    SP_KTEXT_BUTTON_PLAY,
+    SP_KTEXT_BUTTON_PAUSE,
+    SP_KTEXT_BUTTON_TURN,
+    SP_KTEXT_BUTTON_DRAW, ///< Turn, while turning: back to drawing
+    SP_KTEXT_BUTTON_SAVE,
     SP_KTEXT_COUNT
 } sp_kiosk_text_id;
 
