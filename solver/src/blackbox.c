@@ -13,6 +13,7 @@
 #include "blackbox_internal.h"
 #include "model.h"
 #include "sp/synth.h"
+#include "synth_internal.h"
 
 // Limits that only catch garbage counts (a misread struct, an uninitialised
 // field) before they become huge allocations.
@@ -347,19 +348,10 @@ double sp_blackbox_fd_step(const sp_blackbox* bb, int k)
 
 void sp_blackbox_synth_params(const sp_blackbox* bb, uint64_t seed, double amplitude, double* p)
 {
-    // The same generator and rule as sp_synth_params (sp/synth.h).
-    sp_rng rng = {seed * 0x2545F4914F6CDD1Dull + 1};
-    double a = fabs(amplitude);
+    sp_rng rng = sp__synth_rng(seed);
     for (int i = 0; i < bb->P; ++i) {
         const sp_blackbox_param* q = &bb->rig->params[i];
-        double lo = q->min, hi = q->max;
-        if (q->unit == SP_BB_UNIT_ANGLE) {
-            lo = fmax(lo, q->def - a), hi = fmin(hi, q->def + a);
-        } else if (q->group == SP_GROUP_POSE) {
-            double f = fmin(1.0, a / 3.14159265358979323846);
-            lo = q->def - f * (q->def - q->min), hi = q->def + f * (q->max - q->def);
-        }
-        p[i] = sp_rng_range(&rng, lo, hi);
+        p[i] = sp__synth_param(&rng, q->def, q->min, q->max, q->unit == SP_BB_UNIT_ANGLE, q->group == SP_GROUP_POSE, amplitude);
     }
 }
 

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "synth_internal.h"
+
 double sp_rng_uniform(sp_rng* r)
 {
     uint64_t z = (r->state += 0x9E3779B97F4A7C15ull);
@@ -32,20 +34,30 @@ void sp_synth_jitter(sp_sketch* sk, double noise_px, uint64_t seed)
         }
 }
 
+sp_rng sp__synth_rng(uint64_t seed)
+{
+    return (sp_rng){seed * 0x2545F4914F6CDD1Dull + 1};
+}
+
+double sp__synth_param(sp_rng* rng, double def, double min, double max, bool angle, bool pose, double amplitude)
+{
+    double a = fabs(amplitude), lo = min, hi = max;
+    if (angle) {
+        lo = fmax(lo, def - a), hi = fmin(hi, def + a);
+    } else if (pose) {
+        double f = fmin(1.0, a / 3.14159265358979323846);
+        lo = def - f * (def - min), hi = def + f * (max - def);
+    }
+    return sp_rng_range(rng, lo, hi);
+}
+
 void sp_synth_params(const sp_rig* rig, uint64_t seed, double amplitude, double* p)
 {
-    sp_rng rng = {seed * 0x2545F4914F6CDD1Dull + 1};
-    double a = fabs(amplitude);
+    sp_rng rng = sp__synth_rng(seed);
     for (int i = 0; i < rig->param_count; ++i) {
         const sp_param* q = &rig->params[i];
-        double lo = q->min, hi = q->max;
-        if (sp_channel_is_rotation(q->channel)) {
-            lo = fmax(lo, q->def - a), hi = fmin(hi, q->def + a);
-        } else if (q->group == SP_GROUP_POSE) {
-            double f = fmin(1.0, a / 3.14159265358979323846);
-            lo = q->def - f * (q->def - q->min), hi = q->def + f * (q->max - q->def);
-        }
-        p[i] = sp_rng_range(&rng, lo, hi);
+        p[i] = sp__synth_param(&rng, q->def, q->min, q->max, sp_channel_is_rotation(q->channel), q->group == SP_GROUP_POSE,
+                               amplitude);
     }
 }
 
