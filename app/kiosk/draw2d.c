@@ -1,5 +1,5 @@
 // draw2d.c: one shader, one vertex buffer, signed-distance coverage per primitive.
-#include "draw2d.h"
+#include "sp/draw2d.h"
 
 #include <math.h>
 #include <stddef.h>

@@ -1,5 +1,5 @@
 // font.c: stb_truetype (Debian libstb-dev) signed distance fields, shelf-packed.
-#include "font.h"
+#include "sp/font.h"
 
 #include <errno.h>
 #include <stdio.h>

@@ -4,10 +4,10 @@
 #ifndef SP_KIOSK_INTERNAL_H
 #define SP_KIOSK_INTERNAL_H
 
-#include "draw2d.h"
-#include "font.h"
-#include "kiosk.h"
 #include "sp/dragon.h"
+#include "sp/draw2d.h"
+#include "sp/font.h"
+#include "sp/kiosk.h"
 #include "sp/kiosk_lod.h"
 #include "sp/render.h"
 

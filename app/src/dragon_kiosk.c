@@ -17,10 +17,10 @@
 #include <GL/glcorearb.h>
 
 #include "cli.h"
-#include "draw2d.h"
-#include "kiosk.h"
 #include "sp/clock.h"
 #include "sp/dragon.h"
+#include "sp/draw2d.h"
+#include "sp/kiosk.h"
 #include "sp/kiosk_session.h"
 #include "sp/kiosk_text.h"
 #include "sp/partdb.h"

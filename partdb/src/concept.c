@@ -12,6 +12,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "db_internal.h"
 #include "sp/handdraw.h"
 #include "sp/synth.h"
 

@@ -87,4 +87,11 @@ void db_str_printf(db_str* b, const char* fmt, ...)
     ;
 void db_str_json(db_str* b, const char* s); // a JSON string literal
 
+// A design's path (`p`, in drawing order, overwritten) placed as a concept
+// sketch (concept.c): mirrored about the upright axis (`mirror` -1) or not
+// (1), turned by `turn` radians, scaled to a bounding-box diagonal of 340 px
+// and centred on the canvas, as the one stroke of *out. SP_ERR_INVALID for a
+// path with no extent (fewer than 2 points, or all at one place).
+sp_result sp_concept_place(sp_vec2* p, int n, double mirror, double turn, sp_sketch* out, sp_error* err);
+
 #endif

@@ -82,6 +82,13 @@ void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s);
 /// unknown names and non-numbers become warnings on ch; values are clamped.
 void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, double* p);
 
+/// Appends a warning line to ch->warnings (printf style).
+void sp_character_warn(sp_character* ch, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
 #ifdef __cplusplus
 }
 #endif

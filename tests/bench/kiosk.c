@@ -25,11 +25,11 @@
 
 #include "bench.h"
 #include "fixtures.h"
-#include "kiosk.h"
 #include "kiosk_parts.h"
 #include "sp/clock.h"
 #include "sp/dragon.h"
 #include "sp/headless.h"
+#include "sp/kiosk.h"
 #include "sp/render.h"
 
 enum { W = 1280, H = 800 };

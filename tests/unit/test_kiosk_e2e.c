@@ -25,11 +25,11 @@
 #include <sqlite3.h>
 
 #include "fixtures.h"
-#include "kiosk.h"
 #include "kiosk_parts.h"
 #include "sp/dragon.h"
 #include "sp/headless.h"
 #include "sp/image.h"
+#include "sp/kiosk.h"
 #include "sp/kiosk_text.h"
 #include "test.h"
 

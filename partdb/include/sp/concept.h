@@ -53,15 +53,9 @@ uint64_t sp_concept_seed(sp_concept c, uint64_t family, int i);
 /// repeating its first point at the end, its bounding box 340 px across the
 /// diagonal, centred on the canvas. SP_ERR_INVALID for an unknown concept.
 sp_result sp_concept_clean(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
-/// A design's path (`p`, in drawing order, overwritten) placed as a concept
-/// sketch: mirrored about the upright axis (`mirror` -1) or not (1), turned
-/// by `turn` radians, scaled to a bounding-box diagonal of 340 px and
-/// centred on the canvas, as the one stroke of *out. SP_ERR_INVALID for a
-/// path with no extent (fewer than 2 points, or all at one place).
-sp_result sp_concept_place(sp_vec2* p, int n, double mirror, double turn, sp_sketch* out, sp_error* err);
 /// The same design through the hand-drawing model (normal style), with timestamps.
 sp_result sp_concept_sketch(sp_concept c, uint64_t seed, sp_sketch* out, sp_error* err);
-/// A placed sketch (sp_concept_clean's, sp_concept_place's) through the
+/// A placed sketch (sp_concept_clean's, or a design's placed as one) through the
 /// hand-drawing model (normal style), seeded by `seed`, as sp_concept_sketch
 /// draws its own: the recipe's designs are drawn by the same hand.
 sp_result sp_concept_draw(const sp_sketch* clean, uint64_t seed, sp_sketch* out, sp_error* err);

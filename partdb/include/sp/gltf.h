@@ -125,12 +125,6 @@ sp_result sp_character_from_rig(sp_rig* rig, sp_character* out, sp_error* err);
 sp_result sp_character_clone(const sp_character* src, sp_character* dst, sp_error* err);
 /// Frees everything the character owns and zeroes it.
 void sp_character_free(sp_character* ch);
-/// Appends a warning line (printf style).
-void sp_character_warn(sp_character* ch, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
 
 #ifdef __cplusplus
 }

@@ -1,4 +1,4 @@
-/// draw2d.h: the kiosk's flat 2D layer (buttons, chips, icons, text) in OpenGL 3.3.
+/// sp/draw2d.h: the kiosk's flat 2D layer (buttons, chips, icons, text) in OpenGL 3.3.
 ///
 ///     sp_draw2d* d = sp_draw2d_create(font, &err);      // a GL 3.3 core context is current
 ///     sp_draw2d_begin(d, fb_w, fb_h);
@@ -15,7 +15,7 @@
 
 #include <stdbool.h>
 
-#include "font.h"
+#include "sp/font.h"
 #include "sp/result.h"
 
 typedef struct sp_draw2d sp_draw2d;

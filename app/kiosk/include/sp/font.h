@@ -1,4 +1,4 @@
-/// font.h: one TrueType font baked into a signed-distance-field atlas (stb_truetype).
+/// sp/font.h: one TrueType font baked into a signed-distance-field atlas (stb_truetype).
 ///
 ///     sp_font* f = sp_font_load(NULL, &err);       // DejaVu Sans Bold from fonts-dejavu-core
 ///     float w = sp_font_width(f, "Undo", 24);      // pixels at a 24 px em

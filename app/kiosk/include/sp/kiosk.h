@@ -1,4 +1,4 @@
-/// kiosk.h: the dragon kiosk without its window: UI state machine + pipeline + drawing.
+/// sp/kiosk.h: the dragon kiosk without its window: UI state machine + pipeline + drawing.
 ///
 /// How to use (dragon_kiosk.c's main loop; a GL 3.3 core context is current):
 ///
