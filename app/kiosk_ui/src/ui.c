@@ -127,7 +127,7 @@ sp_result sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc, sp_kiosk_ui** out, sp
     ui->mode = SP_KM_ATTRACT;
     ui->playing = ui->desc.start_playing;
     ui->flash_until = ui->fade_until = ui->held_until = ui->hint_until = ui->banner_until = ui->clear_armed_until = -1;
-    ui->undo_at = -SP_KIOSK_REPEAT_MIN_MS;
+    ui->undo_at = ui->target_at = -SP_KIOSK_REPEAT_MIN_MS;
     sp_kiosk_ui_resize(ui, 1280, 800, 0);
     *out = ui;
     return SP_OK;
@@ -690,8 +690,10 @@ static void finish_stroke(sp_kiosk_ui* ui)
         if (cont) return; // a finger bouncing off the glass at the end: the last stroke stands
         ++ui->taps;
         ui->last_outcome = SP_KLAST_NONE;
-        // A touch that only stopped the countdown needs no lesson in drawing.
-        if (!ui->woke) set_hint(ui, sp_kiosk_text(SP_KTEXT_TAP));
+        // A touch that only stopped the countdown needs no lesson in drawing,
+        // nor the second tap of a double tap on a chip or button that moved
+        // from under the finger ("Other?" as the row opens).
+        if (!ui->woke && ui->now - ui->target_at >= SP_KIOSK_REPEAT_MIN_MS) set_hint(ui, sp_kiosk_text(SP_KTEXT_TAP));
         return;
     }
     ++ui->strokes_finished;
@@ -825,6 +827,7 @@ static void refit_last(sp_kiosk_ui* ui, const char* category)
 static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     ++ui->activations[t];
+    ui->target_at = ui->now;
     ui->last_outcome = SP_KLAST_NONE; // a button between two strokes: the next one is a stroke of its own
     if (!sp_kiosk_ui_target_enabled(ui, t)) {
         if (ui->part_count == 0 && t < SP_KT_CHIP_LABEL) set_hint(ui, sp_kiosk_text(SP_KTEXT_NEED_PART));

@@ -262,6 +262,7 @@ typedef struct sp_kiosk_ui {
     double clear_armed_until;
     double clear_armed_at; ///< when Start over was first tapped
     double undo_at;        ///< when Undo last acted
+    double target_at;      ///< when a chip or button was last tapped
     // Animation and view.
     bool playing;
     double anim_ms;    ///< animation clock, advances only while playing
