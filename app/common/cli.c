@@ -3,6 +3,7 @@
 #include "sp/sketch_io.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -210,17 +211,28 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
 
 bool sp_cli_out_is_stream(const char* path)
 {
-    // /dev/stdout redirected to a file is a regular file by stat, hence the prefix.
+    // /dev/stdout redirected to a file is a regular file by stat, hence its
+    // name; a regular file elsewhere under /dev (/dev/shm) is a file.
     struct stat st;
-    return !strncmp(path, "/dev/", 5) || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)));
+    return sp_path_descriptor(path) >= 0 ||
+           (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode) || S_ISSOCK(st.st_mode)));
 }
 
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)
 {
-    if (!path || sp_cli_out_is_stream(path)) return true;
+    if (!path) return true;
     // Through a link, the file is written in the folder of the one it names.
     char* real = sp_path_follow_links(path);
-    if (real && sp_path_is_kernel(real)) { // a link to /dev/stdout: a stream
+    int fd = sp_path_descriptor(real ? real : path);
+    if (fd >= 0) {
+        // Written through that descriptor: one this process did not get
+        // (`>&-`) would be whatever it opens next, a database, say.
+        free(real);
+        if (fcntl(fd, F_GETFD) != -1) return true;
+        fprintf(stderr, "%s: %s %s: descriptor %d is not open (nothing to write into)\n", cmd, name, path, fd);
+        return false;
+    }
+    if (sp_cli_out_is_stream(path)) {
         free(real);
         return true;
     }

@@ -17,11 +17,11 @@ sp_result sp_outputs_stage(sp_outputs* o, const char* path, const char** write_t
     *write_to = path;
     if (!path) return SP_OK;
     if (o->count >= SP_OUTPUTS_MAX) return sp_fail(err, SP_ERR_INTERNAL, "%s: too many outputs for one command", path);
-    if (!strcmp(path, "-") || !strncmp(path, "/dev/", 5)) return SP_OK;
+    if (!strcmp(path, "-")) return SP_OK;
     char* target = sp_path_follow_links(path);
     if (!target) return sp_fail(err, SP_ERR_IO, "%s: cannot follow its links (a loop, or out of memory)", path);
     struct stat st;
-    if (sp_path_is_kernel(target) || (stat(target, &st) == 0 && !S_ISREG(st.st_mode))) {
+    if (sp_path_descriptor(target) >= 0 || (stat(target, &st) == 0 && !S_ISREG(st.st_mode))) {
         // A stream, written as it goes (a folder: the writer says so).
         free(target);
         return SP_OK;

@@ -60,14 +60,7 @@ char* sp_path_folder(const char* path)
     return dir;
 }
 
-bool sp_path_is_kernel(const char* path)
-{
-    return !strncmp(path, "/dev/", 5) || !strncmp(path, "/proc/", 6);
-}
-
-// The descriptor a kernel name stands for (/dev/stdout, /dev/stderr,
-// /dev/fd/N, /proc/self/fd/N), else -1.
-static int descriptor_of(const char* path)
+int sp_path_descriptor(const char* path)
 {
     if (!strcmp(path, "/dev/stdout")) return 1;
     if (!strcmp(path, "/dev/stderr")) return 2;
@@ -83,7 +76,7 @@ char* sp_path_follow_links(const char* path)
         struct stat st;
         // The kernel's links (/dev/stdout -> /proc/self/fd/1 -> "pipe:[N]")
         // name open files, not paths: followed no further.
-        if (sp_path_is_kernel(p) || lstat(p, &st) != 0 || !S_ISLNK(st.st_mode)) return p;
+        if (sp_path_descriptor(p) >= 0 || !strncmp(p, "/proc/", 6) || lstat(p, &st) != 0 || !S_ISLNK(st.st_mode)) return p;
         char to[4096];
         ssize_t n = readlink(p, to, sizeof to - 1);
         if (n < 0) return p;
@@ -137,7 +130,7 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
     char* real = sp_path_follow_links(path);
     if (!real) return sp_fail(err, SP_ERR_IO, "%s: cannot follow its links (a loop, or out of memory)", path);
     const char* target = real;
-    int fd_out = descriptor_of(target);
+    int fd_out = sp_path_descriptor(target);
     if (fd_out >= 0) {
         // Through the descriptor itself, at its offset: reopening the name
         // would start a redirected file at byte 0, or replace it by rename.
@@ -153,7 +146,7 @@ sp_result sp_file_write(const char* path, const void* data, size_t size, sp_erro
         free(real);
         return sp_fail(err, SP_ERR_IO, "%s: is a folder, not a file", path);
     }
-    if ((exists && !S_ISREG(st.st_mode)) || sp_path_is_kernel(target)) {
+    if (exists && !S_ISREG(st.st_mode)) {
         sp_result r = write_into(target, data, size, err);
         free(real);
         return r;

@@ -119,6 +119,19 @@ echo "before" >"$WORK/log"
 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --report /dev/stdout >>"$WORK/log" 2>"$WORK/err" || fail "pose --report /dev/stdout >>: $(cat "$WORK/err")"
 [ "$(head -n 1 "$WORK/log")" = before ] || fail "pose --report /dev/stdout >> log replaced the log"
 [ "$(grep -c '"stopped"' "$WORK/log")" -eq 2 ] || fail "pose --report /dev/stdout >> log: not both reports in the log"
+# A descriptor this process did not get (closed, or never given) is refused
+# before any work: writing through it would hit whatever it opens next (a
+# database). A regular file under /dev (/dev/shm) is a file like any other,
+# replaced whole or not at all (it was truncated in place).
+expect 1 "$SP" render --rig "$RIG" --out /dev/fd/7 --size 64x48
+one_line_naming "descriptor 7 is not open"
+if [ -d /dev/shm ] && [ -w /dev/shm ]; then
+    shm="/dev/shm/sp-posing-cli-$$.png"
+    echo "the old picture" >"$shm"
+    (ulimit -f 1; exec "$SP" render --rig "$RIG" --out "$shm" --size 800x600) 2>"$WORK/err" && fail "render past ulimit -f 1 into $shm: exit 0"
+    [ "$(cat "$shm")" = "the old picture" ] || fail "render that failed left $shm changed"
+    rm -f "$shm"
+fi
 # Two outputs on one name through a dangling link are one file (the report
 # was silently lost, exit 0).
 rm -f "$WORK/same.glb"

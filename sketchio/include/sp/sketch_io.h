@@ -106,13 +106,15 @@ sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_erro
 /// held by the folder out is in).
 char* sp_path_folder(const char* path);
 /// `path` with every symbolic link followed, a dangling one's last hop too,
-/// up to a name under /dev/ or /proc/ (the kernel's, sp_path_is_kernel):
+/// up to an open file's name (sp_path_descriptor) or one under /proc/ (the
+/// kernel's links there name open files, not paths):
 /// the file a write through `path` makes or replaces (malloc'd; `path`
 /// itself when it is no link; NULL when out of memory or the links loop).
 char* sp_path_follow_links(const char* path);
-/// Whether `path` is under /dev/ or /proc/: a device or an open file's name
-/// (/dev/stdout), written into, never replaced by a temporary file.
-bool sp_path_is_kernel(const char* path);
+/// The descriptor an open file's name stands for (/dev/stdout 1, /dev/stderr
+/// 2, /dev/fd/N, /proc/self/fd/N), else -1: written through it, never
+/// replaced by a temporary file. Whether it is open is the caller's to check.
+int sp_path_descriptor(const char* path);
 /// A new name for a temporary file in the folder of `target`,
 /// "<folder>/.sp-<pid>-<k><ext>" (malloc'd; NULL when out of memory): short,
 /// so that a name near the file system's 255-byte limit still has one beside
@@ -132,7 +134,7 @@ bool sp_path_sync_folder(const char* path);
 /// and no truncated one; the folder is synced after the rename. A symbolic
 /// link is followed (its target is replaced, a dangling one's created, the
 /// link stays; sp_path_follow_links); a path that is not a regular file (a
-/// FIFO, a device) or is the kernel's is written into directly, and
+/// FIFO, a device) is written into directly, and
 /// /dev/stdout, /dev/stderr, /dev/fd/N and /proc/self/fd/N through that
 /// descriptor at its offset (a pipe, or a file the shell redirected, `>>` too). One line in `err`
 /// names the path and the system's reason.
