@@ -483,6 +483,17 @@ static void test_refused_stroke(void)
     t = stroke(ui, t + ui->desc.offer_ms + 500, 300, 500, 18, 5);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 6});
+    // A Redraw tapped during another refusal's offer is the visitor's own: it
+    // outlives that offer and the next stroke replaces the last part.
+    t = refused_stroke(ui, t + 1000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && !ui->redraw_armed);
+    tap(ui, t + 500, SP_KT_REDRAW);
+    frame(ui, &f, t + ui->desc.offer_ms + 100);
+    ENSURE(!sp_kiosk_ui_offering(ui) && ui->redraw_armed);
+    t = stroke(ui, t + ui->desc.offer_ms + 500, 300, 500, 18, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.replace);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 6});
     // A refusal that comes back while a later stroke waits offers nothing:
     // the chips would be for a stroke that is no longer the last.
     t = refused_stroke(ui, t + 2000, 900, 150);

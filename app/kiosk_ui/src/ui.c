@@ -584,7 +584,7 @@ static sp_kiosk_job* queue_fit(sp_kiosk_ui* ui, const sp_kiosk_line* stroke)
     line_copy(&ui->pending[slot], stroke);
     ui->banner_until = -1; // drawing on: the banner would cover the stroke's chips and row
     j->replace = ui->redraw_armed;
-    ui->redraw_armed = false;
+    ui->redraw_armed = ui->redraw_for_offer = false;
     return j;
 }
 
@@ -768,7 +768,7 @@ static void advance(sp_kiosk_ui* ui, double t)
         // it: the button went on glowing after the hint had gone, and a
         // visitor's next, unrelated part replaced the last one.
         end_offer(ui, true);
-        ui->redraw_armed = false;
+        if (ui->redraw_for_offer) ui->redraw_armed = ui->redraw_for_offer = false;
     }
     if (ui->mode != SP_KM_ATTRACT && ui->desc.idle_ms > 0 && t - ui->last_input >= ui->desc.idle_ms) reset_to_attract(ui);
 }
@@ -859,6 +859,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         break;
     case SP_KT_REDRAW:
         ui->redraw_armed = !ui->redraw_armed;
+        ui->redraw_for_offer = false; // the visitor's own Redraw: it waits for them
         if (ui->redraw_armed)
             set_hint(ui, sp_kiosk_text(SP_KTEXT_REDRAW));
         else
@@ -1140,7 +1141,7 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
             return;
         }
         // Still waiting for the replacement: a chip for this stroke, or the next stroke, replaces.
-        if (ui->inflight_replace) ui->redraw_armed = true;
+        if (ui->inflight_replace) ui->redraw_armed = ui->redraw_for_offer = true;
         // The dragon changed all the same: what the stroke's first piece made was
         // taken back, or the stroke stays on it as ink (a save must see either).
         if (ui->inflight_undo || r->kept) {

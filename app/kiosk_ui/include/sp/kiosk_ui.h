@@ -259,6 +259,7 @@ typedef struct sp_kiosk_ui {
     uint64_t revision;                              ///< grows with every change of the dragon
     uint64_t saved_revision;                        ///< revision at the last successful save (0: never)
     bool redraw_armed;
+    bool redraw_for_offer; ///< armed again by a refused Redraw: it lapses with the offer
     double clear_armed_until;
     double clear_armed_at; ///< when Start over was first tapped
     double undo_at;        ///< when Undo last acted
