@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -408,9 +409,31 @@ static void say_as_given(sp_error* err, const char* tmp, const char* path)
     snprintf(err->text, sizeof err->text, "%s%s", path, why.text + tl);
 }
 
+// A build holds `<where>.building-<pid>-lock` (flock) while it runs, made
+// before its database: a lock tells a live build from a killed one also
+// across PID namespaces (containers) and NFS clients, where a pid says nothing.
+static int hold_build_lock(const char* tmp)
+{
+    char lock[1100];
+    snprintf(lock, sizeof lock, "%s-lock", tmp);
+    int fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) != 0) close(fd), fd = -1;
+    return fd;
+}
+
+// Whether the build of that pid is gone: its lock can be taken, or, with no
+// lock file (a build of an older sketchpose), no process has its pid here.
+static bool build_gone(const char* lock, pid_t pid)
+{
+    int fd = open(lock, O_RDWR | O_CLOEXEC);
+    if (fd < 0) return errno == ENOENT && pid != getpid() && kill(pid, 0) != 0 && errno == ESRCH;
+    bool gone = flock(fd, LOCK_EX | LOCK_NB) == 0;
+    close(fd);
+    return gone;
+}
+
 // Removes what builds killed before they could clean up left beside `where`
-// (`<where>.building-<pid>` and its -wal and -shm): only those whose process
-// is gone, so that a build running now keeps its files.
+// (`<where>.building-<pid>` and its -wal, -shm and -lock), hidden names too.
 static void remove_stale_builds(const char* where)
 {
     char* dir = sp_path_folder(where);
@@ -419,22 +442,31 @@ static void remove_stale_builds(const char* where)
     char prefix[300];
     snprintf(prefix, sizeof prefix, "%s.building-", base);
     size_t pl = strlen(prefix);
-    char** names = NULL;
-    int n = 0;
-    if (dir && sp_dir_list(dir, &names, &n, NULL) == SP_OK) {
-        for (int i = 0; i < n; ++i) {
-            const char* rest = names[i] + (strncmp(names[i], prefix, pl) ? strlen(names[i]) : pl);
-            size_t digits = strspn(rest, "0123456789");
-            if (digits == 0 || digits > 9 || (rest[digits] && strcmp(rest + digits, "-wal") && strcmp(rest + digits, "-shm")))
-                continue;
-            pid_t pid = (pid_t)atol(rest);
-            if (pid <= 0 || pid == getpid() || kill(pid, 0) == 0 || errno != ESRCH) continue;
-            char file[4200];
-            snprintf(file, sizeof file, "%s/%s", dir, names[i]);
-            unlink(file);
+    // The lock files go last: each of a build's files asks its lock.
+    char* gone_locks[16];
+    int ngone = 0;
+    DIR* d = dir ? opendir(dir) : NULL;
+    for (struct dirent* e; d && (e = readdir(d));) {
+        if (strncmp(e->d_name, prefix, pl) != 0) continue;
+        const char* rest = e->d_name + pl;
+        size_t digits = strspn(rest, "0123456789");
+        const char* side = rest + digits;
+        if (digits == 0 || digits > 9 || (side[0] && strcmp(side, "-wal") && strcmp(side, "-shm") && strcmp(side, "-lock")))
+            continue;
+        char lock[4200];
+        snprintf(lock, sizeof lock, "%s/%s%.*s-lock", dir, prefix, (int)digits, rest);
+        if (!build_gone(lock, (pid_t)atol(rest))) continue;
+        if (!strcmp(side, "-lock")) {
+            if (ngone < 16 && (gone_locks[ngone] = strdup(lock))) ++ngone;
+            continue;
         }
-        sp_dir_list_free(names, n);
+        char file[4200];
+        snprintf(file, sizeof file, "%s/%s", dir, e->d_name);
+        unlink(file);
     }
+    if (d) closedir(d);
+    for (int i = 0; i < ngone; ++i)
+        unlink(gone_locks[i]), free(gone_locks[i]);
     free(dir);
 }
 
@@ -455,6 +487,7 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     const char* where = real ? real : path;
     char tmp[1024];
     snprintf(tmp, sizeof tmp, "%s.building-%ld", where, (long)getpid());
+    int lock = hold_build_lock(tmp);
     remove_stale_builds(where);
     sp_db* db = NULL;
     sp_result r = sp_db_open(tmp, SP_DB_CREATE, &db, err);
@@ -481,6 +514,11 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     unlink(side);
     snprintf(side, sizeof side, "%s-shm", tmp);
     unlink(side);
+    if (lock >= 0) {
+        snprintf(side, sizeof side, "%s-lock", tmp);
+        unlink(side);
+        close(lock);
+    }
     return r;
 }
 

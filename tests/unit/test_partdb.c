@@ -17,6 +17,7 @@
 #include <sqlite3.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -1759,26 +1760,49 @@ static void test_default_db_cli(void)
     snprintf(f, sizeof f, "%s/sketches/drawings.json", assets);
     put_text(f, "{\"drawings\": [{\"name\": \"t\", \"label\": \"tail\", \"points\": [[0, 50], [50, 30], [100, 60]]}]}");
     // What builds killed meanwhile left beside it (SIGKILL, SIGTERM, each
-    // under its own pid) goes with the next build; a live process's stays.
+    // under its own pid) goes with the next build: one of an older
+    // sketchpose (no lock file) whose pid is gone, one whose lock nobody
+    // holds. A build whose lock is held stays, whatever its pid says (in
+    // another PID namespace or on another NFS client it means nothing here),
+    // and so does one with no lock whose process is alive.
     pid_t gone = fork();
     if (gone == 0) _exit(0);
     ENSURE(gone > 0 && waitpid(gone, NULL, 0) == gone);
-    char stale[3][1200], live[1200];
-    static const char* const sides[3] = {"", "-wal", "-shm"};
-    for (int i = 0; i < 3; ++i) {
-        snprintf(stale[i], sizeof stale[i], "%s.building-%ld%s", p, (long)gone, sides[i]);
+    char stale[4][1200], live[1200], held[2][1200];
+    static const char* const sides[4] = {"", "-wal", "-shm", "-lock"};
+    for (int i = 0; i < 4; ++i) {
+        snprintf(stale[i], sizeof stale[i], "%s.building-%ld%s", p, (long)(i < 3 ? gone : gone + 1000000), i < 3 ? sides[i] : "");
         put_text(stale[i], "left by a killed build");
     }
+    char unheld_lock[1300];
+    snprintf(unheld_lock, sizeof unheld_lock, "%s-lock", stale[3]);
+    put_text(unheld_lock, "");
     snprintf(live, sizeof live, "%s.building-%ld", p, (long)getpid());
     put_text(live, "a build that is still running");
+    for (int i = 0; i < 2; ++i)
+        snprintf(held[i], sizeof held[i], "%s.building-%ld%s", p, (long)gone + 2000000, sides[3 * i]);
+    put_text(held[0], "a build in another namespace");
+    int held_fd = open(held[1], O_RDWR | O_CREAT, 0600);
+    ENSURE(held_fd >= 0 && flock(held_fd, LOCK_EX | LOCK_NB) == 0);
+    // A hidden database's leftovers too (the folder reader skipped them).
+    char hidden_db[1200], hidden[1300];
+    snprintf(hidden_db, sizeof hidden_db, "%s/.hidden_%ld.db", root, (long)getpid());
+    snprintf(hidden, sizeof hidden, "%s.building-%ld", hidden_db, (long)gone);
+    put_text(hidden, "left by a killed build of a hidden database");
     snprintf(cmd, sizeof cmd,
              "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --drawings 2 --folds -1 --words 32 2>/dev/null", bin, p,
              assets);
     int rc = sp_fixture_run(cmd, out, sizeof out);
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 4; ++i)
         ENSURE(stat(stale[i], &st) != 0);
-    ENSURE(stat(live, &st) == 0);
-    unlink(live);
+    ENSURE(stat(unheld_lock, &st) != 0);
+    ENSURE(stat(live, &st) == 0 && stat(held[0], &st) == 0 && stat(held[1], &st) == 0);
+    unlink(live), unlink(held[0]), unlink(held[1]);
+    close(held_fd);
+    snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 >/dev/null 2>&1",
+             bin, hidden_db, assets);
+    ENSURE(system(cmd) == 0 && stat(hidden, &st) != 0 && stat(hidden_db, &st) == 0);
+    sp_fixture_remove_db(hidden_db);
     if (rc != 0) fprintf(stderr, "  db init: %d %s\n", rc, out);
     ENSURE(rc == 0 && strstr(out, "\"people_strokes\": 3") && strstr(out, "\"part_sketches\": 24") &&
            strstr(out, "\"concept_sketches\": 4") && strstr(out, "\"design_sketches\": 2"));
