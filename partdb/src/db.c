@@ -216,12 +216,15 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
 {
     int prim = rc & 0xff;
     const char* p = db->path;
+    // A checkpoint runs after the commit: what was committed stays in the WAL.
+    const char* kept = strncmp(doing, "checkpoint", 10) ? "nothing was changed" : "what was committed stays, in the WAL";
     switch (prim) {
     case SQLITE_BUSY:
     case SQLITE_LOCKED:
         return sp_fail(err, SP_ERR_BUSY, "%s: database is busy (held by another writer for more than %g s) while %s", p,
                        db->busy_ms / 1000.0, doing);
-    case SQLITE_FULL: return sp_fail(err, SP_ERR_IO, "%s: disk full while %s; nothing was changed", p, doing);
+    case SQLITE_FULL:
+        return sp_fail(err, SP_ERR_IO, "%s: disk full while %s; %s", p, doing, kept);
     case SQLITE_READONLY:
         if (!db->readonly && side_file_unwritable(p, doing, err)) return SP_ERR_IO;
         return sp_fail(err, SP_ERR_IO, "%s: the database is read-only (file permissions or opened read-only) while %s; nothing was changed",
@@ -235,15 +238,13 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
         int e = db->h ? sqlite3_system_errno(db->h) : 0;
         if (e == ENOSPC || e == EDQUOT)
             return sp_fail(err, SP_ERR_IO,
-                           "%s: disk full while %s (SQLite needs room for the -wal and -shm beside it, also to read it); nothing "
-                           "was changed",
-                           p, doing);
+                           "%s: disk full while %s (SQLite needs room for the -wal and -shm beside it, also to read it); %s", p,
+                           doing, kept);
         if (e == EFBIG)
-            return sp_fail(err, SP_ERR_IO, "%s: this process's file size limit (ulimit -f) reached while %s; nothing was changed",
-                           p, doing);
+            return sp_fail(err, SP_ERR_IO, "%s: this process's file size limit (ulimit -f) reached while %s; %s", p, doing, kept);
         if (rc == SQLITE_IOERR_WRITE || rc == SQLITE_IOERR_FSYNC || rc == SQLITE_IOERR_TRUNCATE)
-            return sp_fail(err, SP_ERR_IO, "%s: write failed (%s) while %s; nothing was changed", p,
-                           e ? strerror(e) : "disk full or file too large?", doing);
+            return sp_fail(err, SP_ERR_IO, "%s: write failed (%s) while %s; %s", p,
+                           e ? strerror(e) : "disk full or file too large?", doing, kept);
         return sp_fail(err, SP_ERR_IO, "%s: I/O error (%s%s%s) while %s", p, sqlite3_errmsg(db->h), e ? ": " : "",
                        e ? strerror(e) : "", doing);
     }
