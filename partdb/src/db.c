@@ -190,6 +190,13 @@ static void own_side_files_writable(const char* path, const struct stat* db_st)
     free(side);
 }
 
+// How a failure leaves the data: a checkpoint runs after the commit, and
+// what was committed stays in the WAL.
+static const char* db_fail_kept(const char* doing)
+{
+    return strncmp(doing, "checkpoint", 10) ? "nothing was changed" : "what was committed stays, in the WAL";
+}
+
 static bool side_file_unwritable(const char* path, const char* doing, sp_error* err)
 {
     for (int k = 0; k < 2; ++k) {
@@ -203,9 +210,9 @@ static bool side_file_unwritable(const char* path, const char* doing, sp_error* 
         if (theirs)
             sp_fail(
                 err, SP_ERR_IO,
-                "%s: not writable by this user (owned by uid %ld, mode %03o) while %s; nothing was changed (run as its owner, or "
-                "have them make it writable)",
-                side, (long)st.st_uid, (unsigned)(st.st_mode & 0777), doing);
+                "%s: not writable by this user (owned by uid %ld, mode %03o) while %s; %s (run as its owner, or have them make "
+                "it writable)",
+                side, (long)st.st_uid, (unsigned)(st.st_mode & 0777), doing, db_fail_kept(doing));
         free(side);
         if (theirs) return true;
     }
@@ -216,8 +223,7 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
 {
     int prim = rc & 0xff;
     const char* p = db->path;
-    // A checkpoint runs after the commit: what was committed stays in the WAL.
-    const char* kept = strncmp(doing, "checkpoint", 10) ? "nothing was changed" : "what was committed stays, in the WAL";
+    const char* kept = db_fail_kept(doing);
     switch (prim) {
     case SQLITE_BUSY:
     case SQLITE_LOCKED:
@@ -227,8 +233,8 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
         return sp_fail(err, SP_ERR_IO, "%s: disk full while %s; %s", p, doing, kept);
     case SQLITE_READONLY:
         if (!db->readonly && side_file_unwritable(p, doing, err)) return SP_ERR_IO;
-        return sp_fail(err, SP_ERR_IO, "%s: the database is read-only (file permissions or opened read-only) while %s; nothing was changed",
-                       p, doing);
+        return sp_fail(err, SP_ERR_IO, "%s: the database is read-only (file permissions or opened read-only) while %s; %s", p,
+                       doing, kept);
     case SQLITE_NOMEM: return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while %s", p, doing);
     case SQLITE_CORRUPT:
     case SQLITE_NOTADB: return sp_fail(err, SP_ERR_PARSE, "%s: not a valid sketchpose database (%s) while %s", p, sqlite3_errstr(rc), doing);

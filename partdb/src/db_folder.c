@@ -409,31 +409,60 @@ static void say_as_given(sp_error* err, const char* tmp, const char* path)
     snprintf(err->text, sizeof err->text, "%s%s", path, why.text + tl);
 }
 
-// A build holds `<where>.building-<pid>-lock` (flock) while it runs, made
-// before its database: a lock tells a live build from a killed one also
-// across PID namespaces (containers) and NFS clients, where a pid says nothing.
-static int hold_build_lock(const char* tmp)
+// A build holds `<tmp>-lock` (flock) while it runs, taken before its
+// database is made: a lock tells a live build from a killed one also across
+// PID namespaces (containers) and NFS clients, where a pid says nothing.
+// Returns the held descriptor; -1 with *busy when another build holds that
+// name (a container's pid 1 and another's), -1 when the file system has no
+// flock (then the build goes on unlocked, its lock file removed).
+static int hold_build_lock(const char* tmp, bool* busy)
 {
     char lock[1100];
     snprintf(lock, sizeof lock, "%s-lock", tmp);
-    int fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
-    if (fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) != 0) close(fd), fd = -1;
-    return fd;
+    *busy = false;
+    for (int tries = 0; tries < 8; ++tries) {
+        int fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+        if (fd < 0) return -1;
+        if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            *busy = errno == EWOULDBLOCK;
+            if (!*busy) unlink(lock);
+            close(fd);
+            return -1;
+        }
+        // Still the file at that name: a cleaner may have removed it between
+        // the open and the lock (it unlinks only what it holds).
+        struct stat a, b;
+        if (fstat(fd, &a) == 0 && stat(lock, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) return fd;
+        close(fd);
+    }
+    return -1;
 }
 
-// Whether the build of that pid is gone: its lock can be taken, or, with no
-// lock file (a build of an older sketchpose), no process has its pid here.
+// Whether the build that owns `lock` is gone: its lock can be taken (then
+// the lock file is removed while held, so a build that opened it meanwhile
+// sees it gone and makes another), or, with no lock file or no flock on this
+// file system (a build of an older sketchpose), no process here has its pid.
 static bool build_gone(const char* lock, pid_t pid)
 {
     int fd = open(lock, O_RDWR | O_CLOEXEC);
-    if (fd < 0) return errno == ENOENT && pid != getpid() && kill(pid, 0) != 0 && errno == ESRCH;
-    bool gone = flock(fd, LOCK_EX | LOCK_NB) == 0;
+    bool no_lock_file = fd < 0 && errno == ENOENT;
+    bool no_pid = pid != getpid() && kill(pid, 0) != 0 && errno == ESRCH;
+    if (fd < 0) return no_lock_file && no_pid;
+    bool gone;
+    if (flock(fd, LOCK_EX | LOCK_NB) == 0) {
+        struct stat a, b;
+        gone = fstat(fd, &a) == 0 && stat(lock, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+        if (gone) unlink(lock);
+    } else {
+        gone = errno != EWOULDBLOCK && no_pid; // no flock here: the pid is all there is
+    }
     close(fd);
     return gone;
 }
 
 // Removes what builds killed before they could clean up left beside `where`
-// (`<where>.building-<pid>` and its -wal, -shm and -lock), hidden names too.
+// (`<where>.building-<n>` and its -wal, -shm and -lock), hidden names too:
+// each build's fate is asked once, then its files go.
 static void remove_stale_builds(const char* where)
 {
     char* dir = sp_path_folder(where);
@@ -442,31 +471,37 @@ static void remove_stale_builds(const char* where)
     char prefix[300];
     snprintf(prefix, sizeof prefix, "%s.building-", base);
     size_t pl = strlen(prefix);
-    // The lock files go last: each of a build's files asks its lock.
-    char* gone_locks[16];
-    int ngone = 0;
+    enum { BUILDS_MAX = 64 };
+    char ids[BUILDS_MAX][16];
+    int nid = 0;
     DIR* d = dir ? opendir(dir) : NULL;
-    for (struct dirent* e; d && (e = readdir(d));) {
+    for (struct dirent* e; d && (e = readdir(d)) && nid < BUILDS_MAX;) {
         if (strncmp(e->d_name, prefix, pl) != 0) continue;
         const char* rest = e->d_name + pl;
         size_t digits = strspn(rest, "0123456789");
         const char* side = rest + digits;
         if (digits == 0 || digits > 9 || (side[0] && strcmp(side, "-wal") && strcmp(side, "-shm") && strcmp(side, "-lock")))
             continue;
-        char lock[4200];
-        snprintf(lock, sizeof lock, "%s/%s%.*s-lock", dir, prefix, (int)digits, rest);
-        if (!build_gone(lock, (pid_t)atol(rest))) continue;
-        if (!strcmp(side, "-lock")) {
-            if (ngone < 16 && (gone_locks[ngone] = strdup(lock))) ++ngone;
-            continue;
-        }
-        char file[4200];
-        snprintf(file, sizeof file, "%s/%s", dir, e->d_name);
-        unlink(file);
+        char id[16];
+        snprintf(id, sizeof id, "%.*s", (int)digits, rest);
+        bool seen = false;
+        for (int k = 0; k < nid && !seen; ++k)
+            seen = !strcmp(ids[k], id);
+        if (!seen) snprintf(ids[nid++], sizeof ids[0], "%s", id);
     }
     if (d) closedir(d);
-    for (int i = 0; i < ngone; ++i)
-        unlink(gone_locks[i]), free(gone_locks[i]);
+    for (int k = 0; dir && k < nid; ++k) {
+        char file[4200];
+        snprintf(file, sizeof file, "%s/%s%s-lock", dir, prefix, ids[k]);
+        // A name with two more digits than a pid (a build that shared its pid
+        // with another) always has a working lock: its number is no pid then.
+        if (!build_gone(file, (pid_t)atol(ids[k]))) continue;
+        static const char* const sides[] = {"", "-wal", "-shm"};
+        for (int s = 0; s < 3; ++s) {
+            snprintf(file, sizeof file, "%s/%s%s%s", dir, prefix, ids[k], sides[s]);
+            unlink(file);
+        }
+    }
     free(dir);
 }
 
@@ -485,9 +520,18 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     // (the link stays), and built beside that one, on its file system.
     char* real = empty ? realpath(path, NULL) : NULL;
     const char* where = real ? real : path;
+    // `<where>.building-<pid>`, or with two more digits when another build
+    // holds that name (the first process of two containers is pid 1 in each).
     char tmp[1024];
-    snprintf(tmp, sizeof tmp, "%s.building-%ld", where, (long)getpid());
-    int lock = hold_build_lock(tmp);
+    int lock = -1;
+    bool busy = true;
+    for (int k = 0; busy && k < 100; ++k) {
+        if (k == 0)
+            snprintf(tmp, sizeof tmp, "%s.building-%ld", where, (long)getpid());
+        else
+            snprintf(tmp, sizeof tmp, "%s.building-%ld%02d", where, (long)getpid(), k);
+        lock = hold_build_lock(tmp, &busy);
+    }
     remove_stale_builds(where);
     sp_db* db = NULL;
     sp_result r = sp_db_open(tmp, SP_DB_CREATE, &db, err);

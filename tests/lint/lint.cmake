@@ -27,11 +27,11 @@ endforeach()
 add_test(NAME function_length_passes_120 COMMAND function_length 120 ${sp_lint_dir}/f120.c)
 # A check that must fail: exit 1 and the message (PASS_REGULAR_EXPRESSION
 # alone ignores the exit code, so a lint that printed and passed would pass).
-function(sp_lint_fails name msg)
+function(sp_lint_fails name msg exe)
   add_test(NAME ${name} COMMAND sh -c "out=\$(\"\$0\" \"\$@\"); rc=\$?; printf '%s\\n' \"\$out\"; [ \$rc -eq 1 ] && printf '%s\\n' \"\$out\" | grep -qF -- '${msg}'"
-           $<TARGET_FILE:function_length> ${ARGN})
+           $<TARGET_FILE:${exe}> ${ARGN})
 endfunction()
-sp_lint_fails(function_length_fails_121 "f121.c:205: f is 121 lines, limit 120" 120 ${sp_lint_dir}/f121.c)
+sp_lint_fails(function_length_fails_121 "f121.c:205: f is 121 lines, limit 120" function_length 120 ${sp_lint_dir}/f121.c)
 # The list: f listed at 121 passes; listed at 120 it fails; a listed function
 # now within the limit, or one that is not there, fails.
 foreach(entry "121:pass" "120:grew")
@@ -43,10 +43,10 @@ endforeach()
 file(WRITE ${sp_lint_dir}/allow_stale.txt "f120.c f 130\n")
 file(WRITE ${sp_lint_dir}/allow_missing.txt "f121.c f 121\nf121.c g 300\n")
 add_test(NAME function_length_allow_passes COMMAND function_length 120 --allow ${sp_lint_dir}/allow_pass.txt ${sp_lint_dir}/f121.c)
-sp_lint_fails(function_length_allow_grew "f is 121 lines, limit 120" 120 --allow ${sp_lint_dir}/allow_grew.txt ${sp_lint_dir}/f121.c)
-sp_lint_fails(function_length_allow_stale "within 120: take it off the list" 120 --allow ${sp_lint_dir}/allow_stale.txt
+sp_lint_fails(function_length_allow_grew "f is 121 lines, limit 120" function_length 120 --allow ${sp_lint_dir}/allow_grew.txt ${sp_lint_dir}/f121.c)
+sp_lint_fails(function_length_allow_stale "within 120: take it off the list" function_length 120 --allow ${sp_lint_dir}/allow_stale.txt
               ${sp_lint_dir}/f120.c)
-sp_lint_fails(function_length_allow_missing "no function g: take it off the list" 120 --allow ${sp_lint_dir}/allow_missing.txt
+sp_lint_fails(function_length_allow_missing "no function g: take it off the list" function_length 120 --allow ${sp_lint_dir}/allow_missing.txt
               ${sp_lint_dir}/f121.c)
 
 # The posing commands link neither OpenCV nor SQLite (the solver's own FLANN
@@ -77,9 +77,9 @@ file(WRITE ${sp_lint_dir}/clean.h
   "#include <stdint.h>\n#include \"sp/result.h\"\n/// Built on cJSON and GLFW (glfwPollEvents); FLANN's kd-tree.\n"
   "#define SP_X_NAME \"cJSON\"\nsp_result sp_x_json(char** json, sp_error* err); // free() it, no cJSON_Delete\n"
   "int sp_glyph_count(void);\n")
-add_test(NAME public_headers_fails_foreign COMMAND public_headers ${sp_lint_dir}/foreign.h)
-set_tests_properties(public_headers_fails_foreign PROPERTIES PASS_REGULAR_EXPRESSION
-  "foreign.h:2: includes <GLFW/glfw3.h>.*foreign.h:3: names cJSON .*foreign.h:4: names a C\\+\\+ scope")
+sp_lint_fails(public_headers_fails_foreign_include "foreign.h:2: includes <GLFW/glfw3.h>" public_headers ${sp_lint_dir}/foreign.h)
+sp_lint_fails(public_headers_fails_foreign_type "foreign.h:3: names cJSON" public_headers ${sp_lint_dir}/foreign.h)
+sp_lint_fails(public_headers_fails_foreign_scope "foreign.h:4: names a C++ scope" public_headers ${sp_lint_dir}/foreign.h)
 add_test(NAME public_headers_passes_comments COMMAND public_headers ${sp_lint_dir}/clean.h)
 
 # --max-ms has one range check (sp_cli_check_max_ms, app/common/cli.c) that

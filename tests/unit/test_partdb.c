@@ -1799,6 +1799,10 @@ static void test_default_db_cli(void)
     ENSURE(stat(live, &st) == 0 && stat(held[0], &st) == 0 && stat(held[1], &st) == 0);
     unlink(live), unlink(held[0]), unlink(held[1]);
     close(held_fd);
+    // The build itself left nothing beside the database: no file, no lock.
+    char listing[4096];
+    snprintf(cmd, sizeof cmd, "ls -a \"$(dirname '%s')\" | grep -F \"$(basename '%s').building-\"", p, p);
+    ENSURE(sp_fixture_run(cmd, listing, sizeof listing) == 1 && !listing[0]);
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --synth 8 --concepts 2 --folds -1 --words 32 >/dev/null 2>&1",
              bin, hidden_db, assets);
     ENSURE(system(cmd) == 0 && stat(hidden, &st) != 0 && stat(hidden_db, &st) == 0);
