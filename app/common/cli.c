@@ -214,8 +214,7 @@ bool sp_cli_out_is_stream(const char* path)
     // /dev/stdout redirected to a file is a regular file by stat, hence its
     // name; a regular file elsewhere under /dev (/dev/shm) is a file.
     struct stat st;
-    return sp_path_descriptor(path) >= 0 ||
-           (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode) || S_ISSOCK(st.st_mode)));
+    return sp_path_descriptor(path) >= 0 || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)));
 }
 
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)

@@ -60,8 +60,18 @@ char* sp_path_folder(const char* path)
     return dir;
 }
 
-int sp_path_descriptor(const char* path)
+int sp_path_descriptor(const char* given)
 {
+    // Spelled as the kernel reads it: "//" and "/./" are one "/" ("$dir/stdout" with dir=/dev/).
+    char path[64];
+    size_t n_out = 0;
+    for (const char* c = given; *c; ++c) {
+        if (n_out + 1 >= sizeof path) return -1; // longer than any such name
+        if (*c == '/' && n_out > 0 && path[n_out - 1] == '/') continue;
+        if (*c == '.' && n_out > 0 && path[n_out - 1] == '/' && (c[1] == '/' || !c[1])) continue;
+        path[n_out++] = *c;
+    }
+    path[n_out] = 0;
     if (!strcmp(path, "/dev/stdout")) return 1;
     if (!strcmp(path, "/dev/stderr")) return 2;
     const char* n = !strncmp(path, "/dev/fd/", 8) ? path + 8 : !strncmp(path, "/proc/self/fd/", 14) ? path + 14 : NULL;

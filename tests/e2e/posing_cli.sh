@@ -109,7 +109,7 @@ refused_out s.svg --out
 [ "$(head -c 4 "$WORK/piped" | tail -c 3)" = PNG ] || fail "render --out /dev/stdout wrote no PNG"
 # Into a pipe (the name leads to /proc/self/fd/1 -> "pipe:[N]", which was
 # taken for a file name: "cannot write", nothing piped), /dev/fd/1 too.
-for dev in /dev/stdout /dev/fd/1; do
+for dev in /dev/stdout /dev/fd/1 /dev//stdout /dev/./fd/1; do
     { "$SP" render --rig "$RIG" --out "$dev" --size 64x48 2>"$WORK/err" || echo "exit $?" >>"$WORK/err"; } | cat >"$WORK/piped"
     [ "$(head -c 4 "$WORK/piped" | tail -c 3)" = PNG ] || fail "render --out $dev | cat: no PNG came through ($(cat "$WORK/err"))"
 done
