@@ -167,10 +167,6 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
     return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (%s)", path, strerror(e));
 }
 
-// SQLite opens a WAL database's -wal or -shm that this user may not write
-// (another user's, left by their process) read-only, and every write then
-// fails as SQLITE_READONLY, which reads as though the database file were.
-// True (err set, naming the file and its owner) when that is the cause.
 // A reader of a database it could not write (mode 444) leaves its -wal and
 // -shm with that mode: SQLite makes them like the database and removes them
 // only when a connection that may write closes. Once the owner may write the
@@ -197,6 +193,10 @@ static const char* db_fail_kept(const char* doing)
     return strncmp(doing, "checkpoint", 10) ? "nothing was changed" : "what was committed stays, in the WAL";
 }
 
+// SQLite opens a WAL database's -wal or -shm that this user may not write
+// (another user's, left by their process) read-only, and every write then
+// fails as SQLITE_READONLY, which reads as though the database file were.
+// True (err set, naming the file and its owner) when that is the cause.
 static bool side_file_unwritable(const char* path, const char* doing, sp_error* err)
 {
     for (int k = 0; k < 2; ++k) {
