@@ -373,8 +373,11 @@ static void test_flow(void)
     tap(ui, 17420, SP_KT_START_OVER);
     frame(ui, &f, 17600);
     ENSURE(f.clears == 0 && ui->part_count == 1 && sp_kiosk_ui_clear_armed(ui));
-    tap(ui, 18000, SP_KT_START_OVER);
-    frame(ui, &f, 18100);
+    tap(ui, 17750, SP_KT_START_OVER); // a bouncing third tap, 0.45 s after the first: still the same touch
+    frame(ui, &f, 17850);
+    ENSURE(f.clears == 0 && ui->part_count == 1);
+    tap(ui, 18300, SP_KT_START_OVER); // read and given: 0.55 s after the last touch
+    frame(ui, &f, 18400);
     ENSURE(f.clears == 1 && ui->part_count == 0 && ui->mode == SP_KM_DRAW);
     sp_kiosk_ui_destroy(ui);
 }

@@ -867,7 +867,8 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         break;
     case SP_KT_START_OVER:
         if (sp_kiosk_ui_clear_armed(ui) && ui->now - ui->clear_armed_at < SP_KIOSK_CONFIRM_MIN_MS) {
-            break; // the same touch again: the question stands
+            ui->clear_armed_at = ui->now; // the same touch again, a bounce: the question stands, the wait starts over
+            break;
         } else if (sp_kiosk_ui_clear_armed(ui)) {
             if (push_job(ui, SP_KJOB_CLEAR)) {
                 fresh_canvas(ui);
