@@ -225,6 +225,16 @@ static double quantile(const double* v, int n, double q)
     return r;
 }
 
+// Prints ` "name": "value",` with value JSON-escaped.
+static void print_string_field(const char* name, const char* value)
+{
+    cJSON* v = cJSON_CreateString(value);
+    char* text = v ? cJSON_PrintUnformatted(v) : NULL;
+    printf(" \"%s\": %s,\n", name, text ? text : "\"\"");
+    free(text);
+    cJSON_Delete(v);
+}
+
 static void print_stats(const app* a, double start_ms)
 {
     const sp_kiosk_stats* st = sp_kiosk_stats_of(a->k);
@@ -254,14 +264,8 @@ static void print_stats(const app* a, double start_ms)
     char banner[2 * SP_KIOSK_TEXT_MAX + 2] = "";
     if (sp_kiosk_ui_banner_visible(ui)) snprintf(banner, sizeof banner, "%s %s", ui->banner[0], ui->banner[1]);
     const char* message = sp_kiosk_ui_message(ui);
-    cJSON* said = cJSON_CreateObject();
-    cJSON_AddStringToObject(said, "hint", message ? message : "");
-    cJSON_AddStringToObject(said, "banner", banner);
-    char* said_text = said ? cJSON_PrintUnformatted(said) : NULL;
-    // Printed without its braces, as two fields of the stats object.
-    if (said_text && strlen(said_text) > 2) printf(" %.*s,\n", (int)strlen(said_text) - 2, said_text + 1);
-    free(said_text);
-    cJSON_Delete(said);
+    print_string_field("hint", message ? message : "");
+    print_string_field("banner", banner);
     printf(" \"framebuffer\": [%d, %d], \"px_per_mm\": %.4f, \"gl_renderer\": \"%s\", \"start_ms\": %.1f, \"frames\": %d, "
            "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"fit_ms_median\": %.2f, \"fit_ms_p90\": %.2f, "
            "\"latency_ms_median\": %.2f, \"latency_ms_p90\": %.2f, \"latency_n\": %d, \"update_ms_median\": %.2f, "

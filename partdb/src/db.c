@@ -167,6 +167,16 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
     return ok ? SP_OK : sp_fail(err, SP_ERR_IO, "%s: write failed (%s)", path, strerror(e));
 }
 
+// The database's -wal (k 0) or -shm (k 1) beside `path` (malloc'd; NULL
+// when out of memory).
+static char* side_path(const char* path, int k)
+{
+    size_t n = strlen(path) + 5;
+    char* side = malloc(n);
+    if (side) snprintf(side, n, "%s-%s", path, k ? "shm" : "wal");
+    return side;
+}
+
 // A reader of a database it could not write (mode 444) leaves its -wal and
 // -shm with that mode: SQLite makes them like the database and removes them
 // only when a connection that may write closes. Once the owner may write the
@@ -175,15 +185,13 @@ sp_result db_write_file(const char* path, const void* data, size_t size, sp_erro
 static void own_side_files_writable(const char* path, const struct stat* db_st)
 {
     if (db_st->st_uid != geteuid() || !(db_st->st_mode & S_IWUSR)) return;
-    size_t n = strlen(path) + 5;
-    char* side = malloc(n);
-    for (int k = 0; side && k < 2; ++k) {
-        snprintf(side, n, "%s-%s", path, k ? "shm" : "wal");
+    for (int k = 0; k < 2; ++k) {
+        char* side = side_path(path, k);
         struct stat st;
-        if (lstat(side, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == geteuid() && !(st.st_mode & S_IWUSR))
+        if (side && lstat(side, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == geteuid() && !(st.st_mode & S_IWUSR))
             chmod(side, db_st->st_mode & 0777);
+        free(side);
     }
-    free(side);
 }
 
 // How a failure leaves the data: a checkpoint runs after the commit, and
@@ -200,10 +208,8 @@ static const char* db_fail_kept(const char* doing)
 static bool side_file_unwritable(const char* path, const char* doing, sp_error* err)
 {
     for (int k = 0; k < 2; ++k) {
-        size_t n = strlen(path) + 5;
-        char* side = malloc(n);
+        char* side = side_path(path, k);
         if (!side) return false;
-        snprintf(side, n, "%s-%s", path, k ? "shm" : "wal");
         struct stat st;
         bool theirs =
             stat(side, &st) == 0 && faccessat(AT_FDCWD, side, W_OK, AT_EACCESS) != 0 && (errno == EACCES || errno == EPERM);
@@ -401,14 +407,11 @@ static bool reader_may_write(const char* path)
     char* dir = sp_path_folder(path);
     bool ok = dir && faccessat(AT_FDCWD, dir, W_OK | X_OK, AT_EACCESS) == 0;
     free(dir);
-    size_t n = strlen(path) + 5;
-    char* buf = ok ? malloc(n) : NULL;
-    ok = ok && buf;
     for (int k = 0; ok && k < 2; ++k) {
-        snprintf(buf, n, "%s-%s", path, k ? "shm" : "wal");
-        ok = faccessat(AT_FDCWD, buf, F_OK, AT_EACCESS) != 0 || faccessat(AT_FDCWD, buf, W_OK, AT_EACCESS) == 0;
+        char* side = side_path(path, k);
+        ok = side && (faccessat(AT_FDCWD, side, F_OK, AT_EACCESS) != 0 || faccessat(AT_FDCWD, side, W_OK, AT_EACCESS) == 0);
+        free(side);
     }
-    free(buf);
     return ok;
 }
 
@@ -477,7 +480,8 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     // writes to it: the journal mode below stayed WAL on a file `db check`
     // had refused (its schema version may be any number).
     int ours = 0, tables = 0;
-    if (pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables) == SQLITE_OK && tables > 0 &&
+    bool counted = pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables) == SQLITE_OK;
+    if (counted && tables > 0 &&
         pragma_int(db, "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name IN ('parts', 'sketches', 'models')",
                    &ours) == SQLITE_OK &&
         (v == 0 || ours < 3)) {
@@ -493,8 +497,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     }
     // Only SP_DB_CREATE makes a database: an existing empty file (a typo'd
     // path, a truncated copy) opened for writing is refused, not given a schema.
-    if (!ro && exists && v == 0 && !(flags & SP_DB_CREATE) &&
-        pragma_int(db, "SELECT count(*) FROM sqlite_master", &tables) == SQLITE_OK && tables == 0) {
+    if (!ro && exists && v == 0 && !(flags & SP_DB_CREATE) && counted && tables == 0) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: not a sketchpose database (an empty file; `sketchpose db init` makes one)", path);
         goto fail;
     }

@@ -409,6 +409,13 @@ static void say_as_given(sp_error* err, const char* tmp, const char* path)
     snprintf(err->text, sizeof err->text, "%s%s", path, why.text + tl);
 }
 
+// Whether open `fd` is still the file at `path` (not unlinked or replaced).
+static bool fd_is_at(int fd, const char* path)
+{
+    struct stat a, b;
+    return fstat(fd, &a) == 0 && stat(path, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
+
 // A build holds `<tmp>-lock` (flock) while it runs, taken before its
 // database is made: a lock tells a live build from a killed one also across
 // PID namespaces (containers) and NFS clients, where a pid says nothing.
@@ -431,8 +438,7 @@ static int hold_build_lock(const char* tmp, bool* busy)
         }
         // Still the file at that name: a cleaner may have removed it between
         // the open and the lock (it unlinks only what it holds).
-        struct stat a, b;
-        if (fstat(fd, &a) == 0 && stat(lock, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) return fd;
+        if (fd_is_at(fd, lock)) return fd;
         close(fd);
     }
     return -1;
@@ -450,8 +456,7 @@ static bool build_gone(const char* lock, pid_t pid)
     if (fd < 0) return no_lock_file && no_pid;
     bool gone;
     if (flock(fd, LOCK_EX | LOCK_NB) == 0) {
-        struct stat a, b;
-        gone = fstat(fd, &a) == 0 && stat(lock, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+        gone = fd_is_at(fd, lock);
         if (gone) unlink(lock);
     } else {
         gone = errno != EWOULDBLOCK && no_pid; // no flock here: the pid is all there is

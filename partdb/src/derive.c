@@ -566,11 +566,9 @@ static sp_result derived_part(const work* w, const sp_rig* R, const char* catego
 // size: a mesh of flattened triangles has no silhouette in any view.
 static bool has_area(const sp_rig* r)
 {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < r->vertex_count; ++i)
-        for (int c = 0; c < 3; ++c)
-            lo[c] = fmin(lo[c], r->rest[3 * (size_t)i + c]), hi[c] = fmax(hi[c], r->rest[3 * (size_t)i + c]);
-    double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    sp_vec3 lo, hi;
+    sp_bounds(r->rest, r->vertex_count, &lo, &hi);
+    double ext = fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
     if (!(ext > 0) || !isfinite(ext)) return false;
     double tiny = 1e-12 * ext * ext;
     for (int t = 0; t < r->triangle_count; ++t) {
