@@ -1,5 +1,8 @@
+#define _XOPEN_SOURCE 700 // nftw
 #include "test.h"
 
+#include <dirent.h>
+#include <ftw.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,6 +73,31 @@ const char* sp_test_reachable_dir(const char* prefix)
     return NULL;
 }
 
+static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    remove(path);
+    return 0;
+}
+
+// A passing run takes its scratch files (sp_test_tmp_path's <pid>_ names)
+// with it: left behind, every run of the suite added some 100 MB to the
+// build folder. A failing run keeps them.
+static void remove_own_scratch(void)
+{
+    char prefix[32];
+    snprintf(prefix, sizeof prefix, "%d_", (int)getpid());
+    DIR* d = opendir(SP_BINARY_DIR "/tmp");
+    if (!d) return;
+    for (struct dirent* e; (e = readdir(d));) {
+        if (strncmp(e->d_name, prefix, strlen(prefix)) != 0) continue;
+        char path[1200];
+        snprintf(path, sizeof path, "%s/tmp/%s", SP_BINARY_DIR, e->d_name);
+        nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    }
+    closedir(d);
+}
+
 // 0 ok, 1 failed, 2 skipped. The setjmp lives here, apart from the loop's
 // locals, so that longjmp cannot clobber them.
 static int run_one(const sp_test* t)
@@ -102,5 +130,9 @@ int sp_test_run(int argc, char** argv, const sp_test* tests)
         fflush(stdout);
     }
     printf("%d passed, %d failed, %d skipped\n", ran - failed - skipped, failed, skipped);
+    if (failed)
+        printf("scratch files kept for a look: %s/tmp/%d_*\n", SP_BINARY_DIR, (int)getpid());
+    else
+        remove_own_scratch();
     return failed ? 1 : 0;
 }

@@ -185,7 +185,7 @@ static const char* xvfb_run_in(const char* dir)
 {
     static char cmd[1400];
     static int calls;
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -f '%s/xauth-%ld-%d' -s '-screen 0 1600x1000x24'", dir, (long)getpid(), ++calls);
+    snprintf(cmd, sizeof cmd, "xvfb-run -a -f '%s/%ld_xauth-%d' -s '-screen 0 1600x1000x24'", dir, (long)getpid(), ++calls);
     return cmd;
 }
 

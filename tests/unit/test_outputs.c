@@ -1,10 +1,13 @@
 // A command's outputs, all or none (app/common/outputs.h): what a failure at
 // any step leaves, links, long names, and the names in a writer's message.
 #include <dirent.h>
+#include <fcntl.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -217,6 +220,53 @@ static void test_folder_check(void)
     ENSURE(holds(b, "png") && lstat(into_dir, &st) == 0 && S_ISLNK(st.st_mode));
 }
 
+static void harness_passes(void) {}
+
+static void harness_fails(void)
+{
+    ENSURE(0);
+}
+
+// Runs a one-test table in a child that first makes a scratch file and a
+// scratch folder; true when the child's scratch is still there after it.
+static bool scratch_kept(void (*fn)(void))
+{
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE* f = fopen(sp_test_tmp_path("probe.txt"), "w");
+        if (!f || fputs("x", f) < 0 || fclose(f) != 0) _exit(3);
+        char sub[1100];
+        snprintf(sub, sizeof sub, "%s/inner", sp_test_tmp_path("probe_dir"));
+        if (mkdir(sp_test_tmp_path("probe_dir"), 0755) != 0 || mkdir(sub, 0755) != 0) _exit(3);
+        int devnull = open("/dev/null", O_WRONLY);
+        dup2(devnull, 1), dup2(devnull, 2);
+        char* argv[] = {"probe", NULL};
+        _exit(sp_test_run(1, argv, (sp_test[]){{"probe", fn}, {0}}));
+    }
+    int status = 0;
+    ENSURE(pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status));
+    ENSURE(WEXITSTATUS(status) == (fn == harness_passes ? 0 : 1));
+    char file[1100], dir[1100];
+    snprintf(file, sizeof file, "%s/tmp/%d_probe.txt", SP_BINARY_DIR, (int)pid);
+    snprintf(dir, sizeof dir, "%s/tmp/%d_probe_dir/inner", SP_BINARY_DIR, (int)pid);
+    struct stat st;
+    bool has_file = stat(file, &st) == 0, has_dir = stat(dir, &st) == 0;
+    remove(file), rmdir(dir);
+    *strrchr(dir, '/') = '\0';
+    rmdir(dir);
+    ENSURE(has_file == has_dir);
+    return has_file;
+}
+
+// A passing test run removes its scratch files; a failing one keeps them to
+// look at (the build folder grew by some 100 MB a run before).
+static void test_harness_scratch(void)
+{
+    ENSURE(!scratch_kept(harness_passes));
+    ENSURE(scratch_kept(harness_fails));
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -225,5 +275,6 @@ int main(int argc, char** argv)
                                    {"long_name", test_long_name},
                                    {"message", test_message},
                                    {"folder_check", test_folder_check},
+                                   {"harness_scratch", test_harness_scratch},
                                    {0}});
 }
