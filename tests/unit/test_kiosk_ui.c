@@ -1378,12 +1378,12 @@ static void test_long_stroke(void)
     for (int i = 1; i <= 100000; ++i)
         send(ui, SP_KEV_MOVE, 100 + 0.01 * i, 10.0f + (float)(i % 1000), 10.0f + (float)(i / 1000) * 5.0f);
     ENSURE(ui->stroke.count <= SP_KIOSK_STROKE_MAX && ui->stroke.count > SP_KIOSK_STROKE_MAX / 4);
-    send(ui, SP_KEV_MOVE, 2000, 5000, -300); // leaves the window: clamped to its edge
+    send(ui, SP_KEV_MOVE, 2000, 5000, -300); // leaves the window: clamped to the canvas's edge
     send(ui, SP_KEV_UP, 2001, 5000, -300);
     sp_kiosk_job j;
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
     ENSURE_NEAR(j.stroke->xy[0], 10, 1e-6);
-    ENSURE_NEAR(j.stroke->xy[2 * j.stroke->count - 2], 1279, 1e-6);
+    ENSURE_NEAR(j.stroke->xy[2 * j.stroke->count - 2], ui->canvas.x + ui->canvas.w - 1, 1e-6);
     ENSURE_NEAR(j.stroke->xy[2 * j.stroke->count - 1], 0, 1e-6);
     // One point, and a tiny wiggle, are taps: a hint, no job.
     int taps = ui->taps;
@@ -1393,6 +1393,17 @@ static void test_long_stroke(void)
     send(ui, SP_KEV_MOVE, 3110, 505, 502);
     send(ui, SP_KEV_UP, 3120, 505, 502);
     ENSURE(!sp_kiosk_ui_next_job(ui, &j) && ui->taps == taps + 2 && sp_kiosk_ui_hint_visible(ui));
+    // Nor does a stroke run into the toolbar: it stays on the canvas's edge.
+    float right = ui->canvas.x + ui->canvas.w - 1.0f; // the toolbar is on the right here
+    ENSURE(right < 1200.0f);
+    send(ui, SP_KEV_DOWN, 3500, right - 200, 300);
+    send(ui, SP_KEV_MOVE, 3510, right - 100, 320);
+    send(ui, SP_KEV_MOVE, 3520, 1250, 340);
+    send(ui, SP_KEV_UP, 3530, 1270, 360);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->count == 4);
+    for (int i = 0; i < j.stroke->count; ++i)
+        ENSURE(j.stroke->xy[2 * i] <= right);
+    ENSURE_NEAR(j.stroke->xy[6], right, 1e-6);
     // A focus loss in mid-stroke keeps the stroke.
     send(ui, SP_KEV_DOWN, 4000, 100, 100);
     send(ui, SP_KEV_MOVE, 4010, 300, 150);

@@ -776,9 +776,11 @@ static void advance(sp_kiosk_ui* ui, double t)
 static void add_point(sp_kiosk_ui* ui, float x, float y, bool last)
 {
     sp_kiosk_line* s = &ui->stroke;
-    // Strokes that leave the window stay on its edge.
-    x = fminf(fmaxf(x, 0.0f), (float)ui->width - 1.0f);
-    y = fminf(fmaxf(y, 0.0f), (float)ui->height - 1.0f);
+    // Strokes that leave the canvas stay on its edge: a part fitted to ink
+    // over the toolbar (or off the window) would sit hidden under it.
+    const sp_kiosk_rect* c = &ui->canvas;
+    x = fminf(fmaxf(x, c->x), fmaxf(c->x, c->x + c->w - 1.0f));
+    y = fminf(fmaxf(y, c->y), fmaxf(c->y, c->y + c->h - 1.0f));
     if (s->count > 0) {
         float dx = x - s->xy[2 * s->count - 2], dy = y - s->xy[2 * s->count - 1];
         double d = hypot(dx, dy);
