@@ -26,6 +26,43 @@ static uint64_t elf_get(const unsigned char* p, int n, int big)
     return v;
 }
 
+#if defined(__x86_64__)
+#define SP_HOST_MACHINE EM_X86_64
+#elif defined(__aarch64__)
+#define SP_HOST_MACHINE EM_AARCH64
+#elif defined(__i386__)
+#define SP_HOST_MACHINE EM_386
+#elif defined(__arm__)
+#define SP_HOST_MACHINE EM_ARM
+#elif defined(__riscv)
+#define SP_HOST_MACHINE EM_RISCV
+#elif defined(__powerpc64__)
+#define SP_HOST_MACHINE EM_PPC64
+#else
+#define SP_HOST_MACHINE EM_NONE // unknown here: left to dlopen
+#endif
+
+static const char* machine_name(unsigned m, char* buf, size_t size)
+{
+    switch (m) {
+    case EM_X86_64:
+        return "x86-64";
+    case EM_AARCH64:
+        return "AArch64";
+    case EM_386:
+        return "x86 (32-bit)";
+    case EM_ARM:
+        return "ARM (32-bit)";
+    case EM_RISCV:
+        return "RISC-V";
+    case EM_PPC64:
+        return "PowerPC 64";
+    default:
+        snprintf(buf, size, "ELF machine %u", m);
+        return buf;
+    }
+}
+
 // Does [off, off + len) lie within a file of `size` bytes (without overflow)?
 static int elf_within(uint64_t off, uint64_t len, uint64_t size)
 {
@@ -59,6 +96,14 @@ static sp_result check_elf_complete(const char* path, uint64_t size, sp_error* e
     }
     int w = cls == ELFCLASS64, big = data == ELFDATA2MSB;
     if (got < (w ? sizeof(Elf64_Ehdr) : sizeof(Elf32_Ehdr))) goto truncated;
+    // dlopen says "No such file or directory" for another machine's object.
+    unsigned machine = (unsigned)elf_get(h + offsetof(Elf64_Ehdr, e_machine), 2, big); // same offset in both classes
+    if (SP_HOST_MACHINE != EM_NONE && machine != SP_HOST_MACHINE) {
+        char a[32], b[32];
+        r = sp_fail(err, SP_ERR_PARSE, "%s: built for another processor (%s), this is %s", path,
+                    machine_name(machine, a, sizeof a), machine_name(SP_HOST_MACHINE, b, sizeof b));
+        goto done;
+    }
     // Offsets of the header fields, from <elf.h>'s layouts.
     uint64_t phoff = w ? elf_get(h + offsetof(Elf64_Ehdr, e_phoff), 8, big) : elf_get(h + offsetof(Elf32_Ehdr, e_phoff), 4, big);
     uint64_t shoff = w ? elf_get(h + offsetof(Elf64_Ehdr, e_shoff), 8, big) : elf_get(h + offsetof(Elf32_Ehdr, e_shoff), 4, big);
@@ -122,7 +167,10 @@ sp_result sp_blackbox_load_plugin(const char* path, sp_blackbox** out, sp_error*
     void* sym = dlsym(dl, SP_BLACKBOX_ENTRY);
     if (!sym) {
         dlclose(dl);
-        return sp_fail(err, SP_ERR_INVALID, "%s: no symbol %s (not a sketchpose black-box plugin)", path, SP_BLACKBOX_ENTRY);
+        return sp_fail(err, SP_ERR_INVALID,
+                       "%s: no symbol %s (not a sketchpose black-box plugin; the entry must be exported with C linkage, "
+                       "extern \"C\" in C++, and default visibility)",
+                       path, SP_BLACKBOX_ENTRY);
     }
     // ISO C has no cast from an object pointer to a function pointer; POSIX
     // guarantees the representation is the same.

@@ -15,16 +15,41 @@
 #include "sp/synth.h"
 #include "synth_internal.h"
 
-// Limits that only catch garbage counts (a misread struct, an uninitialised
-// field) before they become huge allocations.
-enum { BB_MAX_PARAMS = 100000, BB_MAX_VERTICES = 50000000, BB_MAX_POINTS = 10000000 };
+// Limits that catch garbage counts (a misread struct, an uninitialised
+// field) before they become huge allocations. Parameters: the solver's
+// normal equations are dense, two P x P matrices (4096: 256 MB); more could
+// be loaded but never solved.
+enum { BB_MAX_PARAMS = 4096, BB_MAX_VERTICES = 50000000, BB_MAX_POINTS = 10000000 };
 
 // The FD step as a fraction of a parameter's range (see sp_blackbox_fd_step).
 #define SP_BB_FD_FRACTION 1e-5
 
-static bool name_ok(const char* s, size_t max)
+// Well-formed UTF-8 (no overlong forms, surrogates or values past
+// U+10FFFF): names go into JSON reports and pose files as they are.
+static bool utf8_ok(const unsigned char* s)
 {
-    return s && s[0] && strlen(s) <= max;
+    while (*s) {
+        unsigned c = *s++;
+        if (c < 0x80) continue;
+        int more = c >= 0xF0 ? 3 : c >= 0xE0 ? 2 : c >= 0xC2 ? 1 : -1;
+        if (more < 0 || c > 0xF4) return false;
+        unsigned v = c & (0x3Fu >> more);
+        for (int i = 0; i < more; ++i, ++s) {
+            if ((*s & 0xC0) != 0x80) return false;
+            v = (v << 6) | (*s & 0x3Fu);
+        }
+        if ((more == 2 && (v < 0x800 || (v >= 0xD800 && v <= 0xDFFF))) || (more == 3 && (v < 0x10000 || v > 0x10FFFF)))
+            return false;
+    }
+    return true;
+}
+
+// What is wrong with a name, or NULL.
+static const char* name_problem(const char* s, size_t max)
+{
+    if (!s || !s[0]) return "has no name";
+    if (strlen(s) > max) return max > 100 ? "has a name longer than 127 bytes" : "has a name longer than 63 bytes";
+    return utf8_ok((const unsigned char*)s) ? NULL : "has a name that is not UTF-8";
 }
 
 static bool all_finite(const double* v, size_t n, size_t* bad)
@@ -52,12 +77,12 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
 {
     if (!r->evaluate) return sp_fail(err, SP_ERR_INVALID, "%s: the rig has no evaluate function", what);
     if (r->param_count < 1 || r->param_count > BB_MAX_PARAMS || !r->params)
-        return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %d parameters%s", what, (int)r->param_count,
-                       r->params ? "" : " (params is NULL)");
+        return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %d parameters (1..%d)%s", what, (int)r->param_count,
+                       BB_MAX_PARAMS, r->params ? "" : ", params is NULL");
     for (int i = 0; i < r->param_count; ++i) {
         const sp_blackbox_param* q = &r->params[i];
-        if (!name_ok(q->name, 2 * SP_NAME_MAX - 1))
-            return sp_fail(err, SP_ERR_INVALID, "%s: parameter %d has no name or one longer than 127 bytes", what, i);
+        const char* bad = name_problem(q->name, 2 * SP_NAME_MAX - 1);
+        if (bad) return sp_fail(err, SP_ERR_INVALID, "%s: parameter %d %s", what, i, bad);
         for (int j = 0; j < i; ++j)
             if (!strcmp(r->params[j].name, q->name))
                 return sp_fail(err, SP_ERR_INVALID, "%s: two parameters are called '%s'", what, q->name);
@@ -65,6 +90,11 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
             return sp_fail(err, SP_ERR_INVALID,
                            "%s: parameter '%s' needs finite bounds with min <= default <= max (has %g <= %g <= %g)", what,
                            q->name, q->min, q->def, q->max);
+        // The finite-difference step is a fraction of the range, which must
+        // itself be a number (-DBL_MAX..DBL_MAX is not).
+        if (!isfinite(q->max - q->min))
+            return sp_fail(err, SP_ERR_INVALID, "%s: parameter '%s' has a range max - min too large to be a number (%g..%g)",
+                           what, q->name, q->min, q->max);
         if (q->group != SP_GROUP_POSE && q->group != SP_GROUP_SHAPE)
             return sp_fail(err, SP_ERR_INVALID, "%s: parameter '%s' has group %d (0 pose, 1 shape)", what, q->name,
                            (int)q->group);
@@ -73,8 +103,8 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
                            q->name, (int)q->unit);
     }
     if (r->vertex_count < 1 || r->vertex_count > BB_MAX_VERTICES || !r->rest)
-        return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %d vertices%s", what, (int)r->vertex_count,
-                       r->rest ? "" : " (rest is NULL)");
+        return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %d vertices (1..%d)%s", what, (int)r->vertex_count,
+                       BB_MAX_VERTICES, r->rest ? "" : ", rest is NULL");
     size_t bad = 0;
     if (!all_finite(r->rest, 3 * (size_t)r->vertex_count, &bad))
         return sp_fail(err, SP_ERR_INVALID, "%s: rest vertex %zu is not finite", what, bad / 3);
@@ -85,14 +115,19 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
         if (r->triangles[i] >= (uint32_t)r->vertex_count)
             return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: triangle %zu uses vertex %u of %d", what, i / 3,
                            r->triangles[i], (int)r->vertex_count);
+    // Colours are drawn and written to glTF, whose COLOR_0 is 0..1.
+    for (size_t i = 0; r->colors && i < 4 * (size_t)r->vertex_count; ++i)
+        if (!(r->colors[i] >= 0.0f && r->colors[i] <= 1.0f))
+            return sp_fail(err, SP_ERR_INVALID, "%s: the colour of vertex %zu has a component %g, not in 0..1", what, i / 4,
+                           (double)r->colors[i]);
     if (r->abstraction_count < 1 || !r->abstractions)
-        return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %d abstractions (at least one is needed)", what,
-                       (int)r->abstraction_count);
+        return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %d abstractions (at least one is needed)%s", what,
+                       (int)r->abstraction_count, r->abstraction_count >= 1 ? ", abstractions is NULL" : "");
     long long total = 0;
     for (int a = 0; a < r->abstraction_count; ++a) {
         const sp_blackbox_abstraction* ab = &r->abstractions[a];
-        if (!name_ok(ab->name, SP_NAME_MAX - 1))
-            return sp_fail(err, SP_ERR_INVALID, "%s: abstraction %d has no name or one longer than 63 bytes", what, a);
+        const char* bad = name_problem(ab->name, SP_NAME_MAX - 1);
+        if (bad) return sp_fail(err, SP_ERR_INVALID, "%s: abstraction %d %s", what, a, bad);
         for (int b = 0; b < a; ++b)
             if (!strcmp(r->abstractions[b].name, ab->name))
                 return sp_fail(err, SP_ERR_INVALID, "%s: two abstractions are called '%s'", what, ab->name);
@@ -104,16 +139,19 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
                            (int)ab->curve_count, SP_REPORT_CURVES);
         for (int c = 0; c < ab->curve_count; ++c) {
             const sp_blackbox_curve* cv = &ab->curves[c];
-            if (!name_ok(cv->name, SP_NAME_MAX - 1))
-                return sp_fail(err, SP_ERR_INVALID, "%s: curve %d of '%s' has no name or one longer than 63 bytes", what, c,
-                               ab->name);
+            bad = name_problem(cv->name, SP_NAME_MAX - 1);
+            if (bad) return sp_fail(err, SP_ERR_INVALID, "%s: curve %d of '%s' %s", what, c, ab->name, bad);
+            for (int d = 0; d < c; ++d)
+                if (!strcmp(ab->curves[d].name, cv->name))
+                    return sp_fail(err, SP_ERR_INVALID, "%s: two curves of '%s' are called '%s'", what, ab->name, cv->name);
             if (cv->point_count < 2 || cv->point_count > BB_MAX_POINTS)
-                return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: curve '%s' of '%s' has %d points (at least 2)", what,
-                               cv->name, ab->name, (int)cv->point_count);
+                return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: curve '%s' of '%s' has %d points (2..%d)", what,
+                               cv->name, ab->name, (int)cv->point_count, BB_MAX_POINTS);
             total += cv->point_count;
         }
         if (total > BB_MAX_POINTS)
-            return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %lld abstraction points", what, total);
+            return sp_fail(err, SP_ERR_INVALID, "%s: inconsistent sizes: %lld abstraction points (at most %d)", what, total,
+                           BB_MAX_POINTS);
     }
     if (!all_finite(r->view_forward, 3, NULL) || !all_finite(r->view_up, 3, NULL))
         return sp_fail(err, SP_ERR_INVALID, "%s: the sketch view has a non-finite direction", what);
@@ -130,7 +168,7 @@ static void blackbox_destroy(sp_blackbox* bb, bool release)
     if (release && bb->rig->release) bb->rig->release(bb->rig->user);
     for (int a = 0; a < bb->abstraction_count; ++a)
         free(bb->abs[a].curves);
-    free(bb->abs), free(bb->first), free(bb->params);
+    free(bb->abs), free(bb->first), free(bb->params), free(bb->desc_params);
     free(bb);
 }
 
@@ -157,7 +195,8 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
         if (r->release) r->release(r->user);
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
     }
-    bb->rig = r;
+    bb->desc = *r;
+    bb->rig = &bb->desc;
     snprintf(bb->what, sizeof bb->what, "%s", what);
     bb->P = r->param_count;
     bb->n = r->vertex_count;
@@ -165,14 +204,18 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
     bb->abs = calloc((size_t)r->abstraction_count, sizeof(sp_abstraction));
     bb->first = calloc((size_t)r->abstraction_count + 1, sizeof(int));
     bb->params = calloc((size_t)bb->P, sizeof(sp_param));
-    if (!bb->abs || !bb->first || !bb->params) goto oom;
+    bb->desc_params = calloc((size_t)bb->P, sizeof(sp_blackbox_param));
+    if (!bb->abs || !bb->first || !bb->params || !bb->desc_params) goto oom;
     for (int i = 0; i < bb->P; ++i) {
         const sp_blackbox_param* q = &r->params[i];
         sp_param* d = &bb->params[i];
         *d = (sp_param){
             .joint = -1, .channel = SP_CH_COUNT, .min = q->min, .max = q->max, .def = q->def, .group = (sp_group)q->group};
         snprintf(d->name, sizeof d->name, "%s", q->name); // validated: at most 127 bytes
+        bb->desc_params[i] = *q;
+        bb->desc_params[i].name = d->name;
     }
+    bb->desc.params = bb->desc_params;
     for (int a = 0; a < r->abstraction_count; ++a) {
         const sp_blackbox_abstraction* src = &r->abstractions[a];
         sp_abstraction* dst = &bb->abs[a];
@@ -205,8 +248,14 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
             free(x), free(z), free(def);
             goto oom;
         }
+        // NaN where evaluate() must write: what it leaves out is then caught.
+        for (size_t i = 0; i < 3 * (size_t)bb->n; ++i)
+            x[i] = NAN;
         sp_blackbox_defaults(bb, def);
-        res = sp_blackbox_evaluate(bb, def, x, z, err);
+        int rc = 0;
+        size_t bad = 0;
+        res = sp__blackbox_eval_raw(bb, def, x, z, &rc, &bad);
+        if (res != SP_OK) res = sp__blackbox_eval_message(bb, res, rc, bad, "at the defaults", err);
         double tol = 1e-6 * (bb->diag > 0 ? bb->diag : 1.0), worst = 0;
         int wi = 0;
         for (int i = 0; res == SP_OK && i < bb->n; ++i) {
@@ -295,6 +344,10 @@ sp_camera sp_blackbox_camera(const sp_blackbox* bb, int width, int height)
 
 sp_result sp__blackbox_eval_raw(const sp_blackbox* bb, const double* p, double* x, double* z, int* rc_out, size_t* bad)
 {
+    // The abstraction points are few: NaN in them catches a rig that writes
+    // fewer than it declares on every call (its vertices, on open).
+    for (size_t i = 0; z && i < 3 * (size_t)bb->total; ++i)
+        z[i] = NAN;
     int rc = bb->rig->evaluate(bb->rig->user, p, x, z);
     if (rc_out) *rc_out = rc;
     if (rc != 0) return SP_ERR_INTERNAL;
@@ -311,10 +364,10 @@ sp_result sp__blackbox_eval_message(const sp_blackbox* bb, sp_result r, int rc, 
     if (r == SP_ERR_INTERNAL) return sp_fail(err, SP_ERR_INVALID, "%s: evaluate() failed (returned %d) %s", bb->what, rc, where);
     size_t nx = 3 * (size_t)bb->n;
     if (bad < nx)
-        return sp_fail(err, SP_ERR_INVALID, "%s: evaluate() gave a NaN or infinite coordinate (vertex %zu) %s", bb->what, bad / 3,
-                       where);
-    return sp_fail(err, SP_ERR_INVALID, "%s: evaluate() gave a NaN or infinite coordinate (abstraction point %zu) %s", bb->what,
-                   (bad - nx) / 3, where);
+        return sp_fail(err, SP_ERR_INVALID, "%s: evaluate() gave a NaN or infinite coordinate, or none (vertex %zu) %s", bb->what,
+                       bad / 3, where);
+    return sp_fail(err, SP_ERR_INVALID, "%s: evaluate() gave a NaN or infinite coordinate, or none (abstraction point %zu) %s",
+                   bb->what, (bad - nx) / 3, where);
 }
 
 sp_result sp_blackbox_evaluate(const sp_blackbox* bb, const double* p, double* vertices_xyz, double* abstraction_xyz,

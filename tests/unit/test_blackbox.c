@@ -30,6 +30,7 @@ typedef struct lbs_box {
     double* rest;
     atomic_int out_of_bounds; // evaluations asked for outside the bounds
     atomic_int calls;
+    bool short_write; // evaluate() leaves the last abstraction point unwritten
 } lbs_box;
 
 static int lbs_evaluate(void* user, const double* p, double* x, double* z)
@@ -44,7 +45,15 @@ static int lbs_evaluate(void* user, const double* p, double* x, double* z)
     if (!ev) return 1;
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(b->rig), x);
-    if (z) sp_rig_eval_abstraction(ev, &b->rig->abstractions[0], x, z);
+    const sp_abstraction* a = &b->rig->abstractions[0];
+    double* all = z && b->short_write ? malloc(sizeof(double) * 3 * (size_t)a->point_count) : NULL;
+    if (all) {
+        sp_rig_eval_abstraction(ev, a, x, all);
+        memcpy(z, all, sizeof(double) * 3 * (size_t)(a->point_count - 1));
+        free(all);
+    } else if (z) {
+        sp_rig_eval_abstraction(ev, a, x, z);
+    }
     sp_rig_eval_destroy(ev);
     return 0;
 }
@@ -489,7 +498,26 @@ static void test_plugin_errors(void)
     fputs("this is not an ELF file\n", f);
     fclose(f);
     expect_load_error(bogus, SP_ERR_PARSE, "cannot load it as a shared object", NULL);
-    expect_load_error(plugin("nosym"), SP_ERR_INVALID, "no symbol sp_blackbox_plugin_v1", NULL);
+    expect_load_error(plugin("nosym"), SP_ERR_INVALID, "no symbol sp_blackbox_plugin_v1", "extern \"C\"");
+    // Another processor's object: dlopen alone says "No such file or directory".
+    FILE* in = fopen(plugin("good"), "rb");
+    ENSURE(in);
+    static unsigned char so[1 << 20];
+    size_t n = fread(so, 1, sizeof so, in);
+    fclose(in);
+    ENSURE(n > 64 && n < sizeof so && so[5] == 1); // little-endian, as this host
+    bool x86 = so[18] == 62 && so[19] == 0;
+    so[18] = x86 ? 183 : 62, so[19] = 0; // e_machine: AArch64 on x86-64, else x86-64
+    const char* arch = sp_test_tmp_path("other_arch.so");
+    f = fopen(arch, "wb");
+    ENSURE(f && fwrite(so, 1, n, f) == n && fclose(f) == 0);
+    expect_load_error(arch, SP_ERR_PARSE, x86 ? "built for another processor (AArch64), this is x86-64" : "(x86-64), this is",
+                      NULL);
+    so[18] = 7; // e_machine 0x0707: no name here
+    so[19] = 7;
+    f = fopen(arch, "wb");
+    ENSURE(f && fwrite(so, 1, n, f) == n && fclose(f) == 0);
+    expect_load_error(arch, SP_ERR_PARSE, "built for another processor (ELF machine 1799)", NULL);
     expect_load_error(plugin("null"), SP_ERR_INVALID, "returned no rig", NULL);
     expect_load_error(plugin("badversion"), SP_ERR_UNSUPPORTED, "ABI version 99", "reads version 1");
     expect_load_error(plugin("badsize"), SP_ERR_UNSUPPORTED, "inconsistent sizes", "sp_blackbox_rig");
@@ -763,6 +791,129 @@ static void test_creation_says_why(void)
     sp_rig_free(&rig);
 }
 
+// docs/blackbox.md's example plugin, as a reader copies it out of the page
+// (blackbox.cmake builds it from there): it loads, and its seeded poses are
+// found again from their strokes, bend included.
+static void test_doc_example(void)
+{
+    sp_blackbox* bb = NULL;
+    sp_error err = {0};
+    ENSURE(sp_blackbox_load_plugin(plugin("doc"), &bb, &err) == SP_OK);
+    const sp_blackbox_rig* r = sp_blackbox_desc(bb);
+    ENSURE(r->param_count == 4 && !strcmp(r->params[3].name, "bend"));
+    sp_camera cam = sp_blackbox_camera(bb, 640, 480);
+    sp_solver* s = NULL;
+    ENSURE(sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){.time_cap_ms = 1e9}, &s, &err) == SP_OK);
+    double worst = 0;
+    for (int seed = 1; seed <= 6; ++seed) {
+        double truth[4], p[4];
+        sp_blackbox_synth_params(bb, (uint64_t)seed, 1.0, truth);
+        sp_sketch sk;
+        ENSURE(sp_blackbox_synth_sketch(bb, 0, &cam, truth, &sk, &err) == SP_OK);
+        sp_solve_report rep;
+        ENSURE(sp_solver_solve(s, &sk, NULL, p, &rep, &err) == SP_OK);
+        for (int k = 0; k < 4; ++k)
+            worst = fmax(worst, fabs(p[k] - truth[k]));
+        sp_sketch_free(&sk);
+    }
+    printf("  doc example: worst parameter error %.3f over 6 seeds\n", worst);
+    ENSURE(worst < 0.1);
+    sp_solver_destroy(s);
+    sp_blackbox_destroy(bb);
+}
+
+// Opens the box's description as it is now: NULL when it opened, else the message.
+static const char* open_error(lbs_box* box)
+{
+    static sp_error err;
+    sp_blackbox* bb = NULL;
+    memset(&err, 0, sizeof err);
+    if (sp_blackbox_open(&box->desc, "lbs box", &bb, &err) == SP_OK) {
+        sp_blackbox_destroy(bb);
+        return NULL;
+    }
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(!bb && strstr(err.text, "lbs box: ") == err.text && !strchr(err.text, '\n'));
+    return err.text;
+}
+
+// What a plugin author gets wrong is refused on open with what is wrong:
+// names that would break the JSON they go into, a range whose step is not a
+// number, two curves of one name, colours glTF cannot hold, too many
+// parameters to solve, points evaluate() leaves out.
+static void test_description_checks(void)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 3, .seed = 1}, &rig);
+    lbs_box box;
+    lbs_box_init(&box, &rig);
+    ENSURE(box.ab.curve_count >= 2);
+    ENSURE(open_error(&box) == NULL);
+    const char* name = box.params[0].name;
+    const char* bad_names[] = {"mov\xff\xfe_y", "a\xc0\xaf", "a\xed\xa0\x80", "a\xf4\x90\x80\x80", "a\xe2\x82"};
+    for (size_t i = 0; i < sizeof bad_names / sizeof bad_names[0]; ++i) {
+        box.params[0].name = bad_names[i];
+        const char* e = open_error(&box);
+        ENSURE(e && strstr(e, "parameter 0 has a name that is not UTF-8"));
+    }
+    box.params[0].name = "caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x90\x89"; // café € and a dragon
+    ENSURE(open_error(&box) == NULL);
+    box.params[0].name = name;
+    double lo = box.params[1].min, hi = box.params[1].max, def = box.params[1].def;
+    box.params[1].min = -1.7e308, box.params[1].max = 1.7e308, box.params[1].def = 0;
+    const char* e = open_error(&box);
+    ENSURE(e && strstr(e, box.params[1].name) && strstr(e, "too large to be a number"));
+    box.params[1].min = lo, box.params[1].max = hi, box.params[1].def = def;
+    const char* curve = box.curves[1].name;
+    box.curves[1].name = box.curves[0].name;
+    e = open_error(&box);
+    ENSURE(e && strstr(e, "two curves of") && strstr(e, box.curves[0].name));
+    box.curves[1].name = curve;
+    float* colors = malloc(sizeof(float) * 4 * (size_t)rig.vertex_count);
+    for (int i = 0; i < 4 * rig.vertex_count; ++i)
+        colors[i] = 0.5f;
+    box.desc.colors = colors;
+    ENSURE(open_error(&box) == NULL);
+    colors[4 * 7 + 1] = 255.0f; // 0..255 by mistake
+    e = open_error(&box);
+    ENSURE(e && strstr(e, "colour of vertex 7") && strstr(e, "not in 0..1"));
+    colors[4 * 7 + 1] = NAN;
+    ENSURE(open_error(&box) != NULL);
+    box.desc.colors = NULL;
+    free(colors);
+    int P = box.desc.param_count;
+    static sp_blackbox_param many[5000];
+    static char names[5000][16];
+    for (int i = 0; i < 5000; ++i) {
+        snprintf(names[i], sizeof names[i], "p%d", i);
+        many[i] = (sp_blackbox_param){names[i], 0, 1, 0, SP_GROUP_POSE, SP_BB_UNIT_WEIGHT};
+    }
+    box.desc.params = many, box.desc.param_count = 5000;
+    e = open_error(&box);
+    ENSURE(e && strstr(e, "5000 parameters (1..4096)"));
+    box.desc.params = box.params, box.desc.param_count = P;
+    box.short_write = true;
+    e = open_error(&box);
+    char want[96];
+    snprintf(want, sizeof want, "or none (abstraction point %d) at the defaults", rig.abstractions[0].point_count - 1);
+    ENSURE(e && strstr(e, want));
+    box.short_write = false;
+    // The description is the host's copy: a rig that changes its own after
+    // open (counts, functions) is not read past its arrays.
+    sp_blackbox* bb = NULL;
+    ENSURE(sp_blackbox_open(&box.desc, "lbs box", &bb, NULL) == SP_OK);
+    box.desc.param_count = 1000000, box.desc.params = NULL, box.desc.evaluate = NULL;
+    ENSURE(sp_blackbox_desc(bb)->param_count == P && !strcmp(sp_blackbox_desc(bb)->params[0].name, name));
+    double* p = malloc(sizeof(double) * (size_t)P);
+    double* x = malloc(sizeof(double) * 3 * (size_t)rig.vertex_count);
+    sp_blackbox_defaults(bb, p);
+    ENSURE(sp_blackbox_evaluate(bb, p, x, NULL, NULL) == SP_OK);
+    free(p), free(x);
+    sp_blackbox_destroy(bb);
+    free(box.rest);
+    sp_rig_free(&rig);
+}
+
 int main(int argc, char** argv)
 {
     return sp_test_run(argc, argv,
@@ -778,5 +929,7 @@ int main(int argc, char** argv)
                                    {"face_recovery", test_face_recovery},
                                    {"cli", test_cli},
                                    {"creation_says_why", test_creation_says_why},
+                                   {"description_checks", test_description_checks},
+                                   {"doc_example", test_doc_example},
                                    {0}});
 }
