@@ -11,6 +11,22 @@
 #include "solver_internal.h"
 
 // k-means of the rest vertices (FLANN), centres snapped to the nearest vertex.
+// FLANN's hierarchical k-means returns (b - 1) m + 1 <= k clusters for a
+// branching b: with b = 32, every k under 32 got one cluster (and the
+// regularisers one vertex), 32..62 got 32. From k = 64 up, 32 gives at least
+// k - 31 (the default 200: 187, the kiosk's 100: 94); below, the branching
+// that comes closest to k, the largest of equals (k itself up to 32).
+static int kmeans_branching(int k)
+{
+    if (k >= 64) return 32;
+    int best = 2, best_got = 0;
+    for (int b = 2; b <= 32; ++b) {
+        int got = (b - 1) * ((k - 1) / (b - 1)) + 1;
+        if (got >= best_got) best = b, best_got = got;
+    }
+    return best;
+}
+
 static int coarsen_kmeans(const double* rest_in, int n, int k, int* reps)
 {
     double* rest = (double*)rest_in; // FLANN's C API only reads it but is not const-correct
@@ -23,12 +39,11 @@ static int coarsen_kmeans(const double* rest_in, int n, int k, int* reps)
     if (!centers) return 0;
     struct FLANNParameters fp = DEFAULT_FLANN_PARAMETERS;
     fp.algorithm = FLANN_INDEX_KMEANS;
-    fp.branching = 32;
+    fp.branching = kmeans_branching(k);
     fp.iterations = 11;
     fp.centers_init = FLANN_CENTERS_KMEANSPP;
     fp.random_seed = 12345; // deterministic coarsening
     fp.log_level = FLANN_LOG_NONE;
-    // FLANN's hierarchical k-means returns (branching-1)*m+1 <= k clusters.
     int got = flann_compute_cluster_centers_double(rest, n, 3, k, centers, &fp);
     if (got <= 0) {
         // Fallback: evenly spaced vertices.

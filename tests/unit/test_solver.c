@@ -261,6 +261,33 @@ static void test_coarsening_remembered(void)
     sp_rig_free(&st.rig);
 }
 
+// --representatives K gives K representatives, or close below: FLANN's
+// hierarchical k-means gave one for every K under 32 (the regularisers then
+// held one vertex) and 32 for 32..62. From 64 up the branching, and so every
+// default solve, is as it was: 187 of 200, 94 of the kiosk's 100.
+static void test_coarsening_count(void)
+{
+    setup st;
+    make_setup(&st,
+               &(sp_fixture_desc){.joint_count = 8, .branching = true, .rings_per_bone = 8, .ring_vertices = 16, .seed = 11});
+    ENSURE(st.rig.vertex_count > 800);
+    const int ks[] = {1, 2, 3, 7, 20, 30, 32, 33, 40, 50, 63, 64, 100, 200};
+    const int want_min[] = {1, 2, 3, 7, 20, 30, 32, 33, 40, 50, 63, 63, 94, 187};
+    for (size_t i = 0; i < sizeof ks / sizeof ks[0]; ++i) {
+        sp_solver* s = NULL;
+        ENSURE(sp_solver_create(&st.rig, 0, &st.cam, &(sp_solve_desc){.representatives = ks[i]}, &s, NULL) == SP_OK);
+        int m = 0;
+        const int* reps = sp_solver_representatives(s, &m);
+        printf("  k %d: %d representatives\n", ks[i], m);
+        // Two centres may snap to one vertex (kept once): allow one fewer.
+        ENSURE(m <= ks[i] && m >= want_min[i] - 1);
+        for (int j = 1; j < m; ++j)
+            ENSURE(reps[j] > reps[j - 1] && reps[j] < st.rig.vertex_count);
+        sp_solver_destroy(s);
+    }
+    sp_rig_free(&st.rig);
+}
+
 static void test_bad_strokes(void)
 {
     setup st;
@@ -686,6 +713,7 @@ int main(int argc, char** argv)
                                    {"order_independence_and_determinism", test_order_independence_and_determinism},
                                    {"bad_strokes", test_bad_strokes},
                                    {"coarsening_remembered", test_coarsening_remembered},
+                                   {"coarsening_count", test_coarsening_count},
                                    {"regulariser_paths_agree", test_regulariser_paths_agree},
                                    {"bounded_step_matches_reduced_solves", test_bounded_step_matches_reduced_solves},
                                    {"gauss_newton_consistent", test_gauss_newton_consistent},
