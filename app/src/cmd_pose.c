@@ -20,7 +20,7 @@ int cmd_pose(int argc, char** argv)
     const sp_opt opts[] = {
         {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
-        {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes (sketchpose-strokes JSON)", true},
+        {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes (sketchpose-strokes JSON, or an SVG drawing: .svg)", true},
         {"--start", SP_OPT_IN, &start, "p.json", "start pose (default: the rig's stored pose)", false},
         {"--out", SP_OPT_OUT, &out, "posed.glb", "write the posed character", false},
         {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: strokes blue, fitted abstraction yellow", false},

@@ -38,6 +38,17 @@ for key in '"ms"' '"iterations"' '"icp_rounds"' '"stopped"' '"energy_before"' '"
     grep -q "$key" "$WORK/r.json" || fail "report lacks $key"
 done
 grep -q '"stopped":' "$WORK/out" || fail "pose prints no report on stdout"
+# The same strokes as an SVG drawing (its viewBox the canvas) pose the same;
+# one with no viewBox has no canvas and is refused.
+pts=$(sed -n 's/.*"points": \[\[\(.*\)\]\]}.*/\1/p' "$WORK/s.json" | sed 's/\], \[/ L /g; s/, / /g')
+[ -n "$pts" ] || fail "synth's stroke file changed its layout: $(head -c 200 "$WORK/s.json")"
+printf '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 640 480"><g><path d="M %s"/></g></svg>\n' "$pts" >"$WORK/drawn.svg"
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/drawn.svg" --report "$WORK/r_svg.json"
+[ "$(grep -m1 '"mean_error_px"' "$WORK/r.json")" = "$(grep -m1 '"mean_error_px"' "$WORK/r_svg.json")" ] ||
+    fail "pose of the SVG drawing differs: $(grep -m1 mean_error_px "$WORK/r.json" "$WORK/r_svg.json")"
+sed 's/ viewBox="[^"]*"//' "$WORK/drawn.svg" >"$WORK/nobox.SVG"
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/nobox.SVG"
+one_line_naming "no viewBox"
 
 # An output that cannot be written fails the command, and it leaves none of
 # its outputs (each written whole, the ones before taken back).
