@@ -1158,6 +1158,12 @@ struct Importer {
                 weights.insert(weights.end(), s.weights.begin(), s.weights.end());
                 float rgba[4];
                 material_color(m, prim.material, what, rgba);
+                if (prim.material >= 0 && m.materials[(size_t)prim.material].pbrMetallicRoughness.baseColorTexture.index >= 0 &&
+                    !ch->textured) {
+                    ch->textured = true;
+                    sp_character_warn(ch, "its base colour texture is not used: sketchpose reads no images, so pictures and "
+                                          "saved files show it grey");
+                }
                 size_t cbase = colors.size();
                 colors.resize(cbase + 4 * nv);
                 for (size_t i = 0; i < nv; ++i)

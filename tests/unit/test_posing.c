@@ -238,12 +238,22 @@ static void test_animate_cli_cesiumman(void)
     }
     const char* out = sp_test_tmp_path("anim.glb");
     const char* rep = sp_test_tmp_path("anim_report.json");
-    snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s %s %s %s --times 0,0.5,1.25,2 --out %s --report %s > /dev/null", SP_SKETCHPOSE,
-             rig, keys[0], keys[1], keys[2], keys[3], out, rep);
+    char errs[1024];
+    snprintf(errs, sizeof errs, "%s", sp_test_tmp_path("anim_err.txt"));
+    snprintf(cmd, sizeof cmd,
+             "%s animate --rig %s --strokes %s %s %s %s --times 0,0.5,1.25,2 --out %s --report %s > /dev/null 2> %s",
+             SP_SKETCHPOSE, rig, keys[0], keys[1], keys[2], keys[3], out, rep, errs);
     ENSURE(run(cmd) == 0);
+    // CesiumMan's texture is not in the file written: one line says so.
+    char* said = sp_fixture_file_text(errs, NULL);
+    char want[2048];
+    snprintf(want, sizeof want, "sketchpose animate: warning: %s has a texture, which %s does not keep", rig, out);
+    ENSURE(said && strstr(said, want) && strchr(said, '\n') == said + strlen(said) - 1);
+    free(said);
     sp_character ch = {0};
     sp_error err = {0};
     ENSURE(sp_gltf_load(out, &ch, &err) == SP_OK);
+    ENSURE(!ch.textured); // what was written has no texture, so a second save says nothing
     int an = -1;
     for (int i = 0; i < ch.rig.animation_count; ++i)
         if (!strcmp(ch.rig.animations[i].name, "sketchpose")) an = i;

@@ -47,6 +47,7 @@ typedef struct sp_character {
     bool derived_abstraction; ///< the stick figure was derived from the skeleton
     bool derived_dofs;        ///< default rotation DOFs were added
     int mesh_skins;           ///< distinct skins of the scene's skinned meshes (the rig is the first one's)
+    bool textured;            ///< a skinned mesh's material has a base colour texture (never read: grey)
     int warning_count;
     char (*warnings)[SP_WARNING_MAX]; ///< one line each
 } sp_character;
