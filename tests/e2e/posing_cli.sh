@@ -38,6 +38,18 @@ for key in '"ms"' '"iterations"' '"icp_rounds"' '"stopped"' '"energy_before"' '"
     grep -q "$key" "$WORK/r.json" || fail "report lacks $key"
 done
 grep -q '"stopped":' "$WORK/out" || fail "pose prints no report on stdout"
+# A stick figure of the cartoon man with an arm up, drawn by hand (an
+# outside tester's, tests/e2e/data): fitted with no note; the same with both
+# legs drawn as one stroke leaves a leg curve far from its stroke at a small
+# mean error, which the note names (it said nothing).
+MAN="$SRC/assets/cartoon_man.glb"
+expect 0 "$SP" pose --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up.json" --report "$WORK/man.json"
+grep -q '"note":	""' "$WORK/man.json" || fail "a clean stick figure got a note: $(grep '"note"' "$WORK/man.json")"
+[ -s "$WORK/err" ] && fail "a clean stick figure said: $(cat "$WORK/err")"
+expect 0 "$SP" pose --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --report "$WORK/man1.json"
+grep -q '"note":	"loose fit: curve .leg_' "$WORK/man1.json" || fail "legs drawn as one stroke: no note: $(grep '"note"' "$WORK/man1.json")"
+one_line_naming "loose fit: curve 'leg_"
+
 # The same strokes as an SVG drawing (its viewBox the canvas) pose the same;
 # one with no viewBox has no canvas and is refused.
 pts=$(sed -n 's/.*"points": \[\[\(.*\)\]\]}.*/\1/p' "$WORK/s.json" | sed 's/\], \[/ L /g; s/, / /g')
