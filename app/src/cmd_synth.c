@@ -255,6 +255,22 @@ static int synth_drawings(int per_design, uint64_t family, const char* sheet)
     return code;
 }
 
+// The view frames the rest pose, so a random pose can carry the strokes
+// off the canvas; posing from them then works on points no one could have
+// drawn there. Said, not refused: a test may want exactly that.
+static void warn_off_canvas(const sp_sketch* sk, const char* out)
+{
+    int outside = 0, total = 0;
+    for (int i = 0; i < sk->stroke_count; ++i)
+        for (int k = 0; k < sk->strokes[i].count; ++k, ++total) {
+            sp_vec2 q = sk->strokes[i].points[k];
+            outside += !(q.x >= 0 && q.x <= sk->canvas_w && q.y >= 0 && q.y <= sk->canvas_h);
+        }
+    if (outside)
+        fprintf(stderr, "sketchpose synth: warning: %s: %d of %d points lie outside the %gx%g canvas\n", out, outside, total,
+                sk->canvas_w, sk->canvas_h);
+}
+
 int cmd_synth(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *out = NULL, *truth = NULL, *size = NULL, *pose = NULL;
@@ -434,6 +450,7 @@ int cmd_synth(int argc, char** argv)
         (truth_to && sp_pose_write(truth_to, sp_rig_handle_params(rig), sp_rig_handle_param_count(rig), p, &err) != SP_OK) ||
         sp_outputs_commit(&staged, &err) != SP_OK)
         goto fail;
+    warn_off_canvas(&sk, out);
     exit_code = SP_EXIT_OK;
     goto done;
 fail:

@@ -33,6 +33,11 @@ done
 "$SP" pose --help | awk '/^  --/ && (substr($0, 28, 1) != " " || substr($0, 29, 1) == " ") { bad = 1; print } END { exit bad }' >"$WORK/cols" ||
     fail "pose --help: option help out of its column: $(cat "$WORK/cols")"
 expect 0 "$SP" synth --rig "$RIG" --seed 4 --out "$WORK/s.json" --truth "$WORK/t.json"
+[ -s "$WORK/err" ] && fail "synth of a pose inside the view said: $(cat "$WORK/err")"
+# A pose that carries the strokes off the canvas is written, and said.
+echo '{"parameters": {"root.tx": 0.25, "root.s": 2, "root.rz": 1}}' >"$WORK/big.json"
+expect 0 "$SP" synth --rig "$RIG" --pose "$WORK/big.json" --out "$WORK/off.json"
+one_line_naming "off.json: 1 of 5 points lie outside the 640x480 canvas"
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out "$WORK/posed.glb" --report "$WORK/r.json"
 for key in '"ms"' '"iterations"' '"icp_rounds"' '"stopped"' '"energy_before"' '"energy_after"' '"mean_error_px"' '"max_error_px"' '"bbox_diagonal_px"' '"curves"' '"parameters"'; do
     grep -q "$key" "$WORK/r.json" || fail "report lacks $key"
