@@ -3,7 +3,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "sp/sketch_io.h"
 
@@ -25,24 +24,18 @@ int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_pa
     return -1;
 }
 
-// A name ending in .svg, in any case.
-static bool is_svg_name(const char* path)
-{
-    size_t n = strlen(path);
-    return n >= 4 && !strcasecmp(path + n - 4, ".svg");
-}
-
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
 {
     // An animator's drawing from a vector editor: one stroke per subpath,
     // its viewBox the canvas.
-    bool svg = is_svg_name(path);
+    bool svg = sp_path_ext_is(path, "svg");
     sp_result r = svg ? sp_sketch_read_svg(path, sk, err) : sp_sketch_read_json(path, sk, err);
     if (r != SP_OK) return r;
     if (svg && !(sk->canvas_w > 0 && sk->canvas_h > 0)) {
         sp_sketch_free(sk);
-        return sp_fail(err, SP_ERR_INVALID, "%s: the SVG has no viewBox, so its canvas is unknown (add viewBox=\"0 0 W H\")",
-                       path);
+        return sp_fail(
+            err, SP_ERR_INVALID,
+            "%s: the SVG has no usable viewBox, so its canvas is unknown (viewBox=\"X Y W H\", W and H in (0, 1000000))", path);
     }
     if (sk->stroke_count == 0) {
         sp_sketch_free(sk);

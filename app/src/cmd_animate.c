@@ -66,6 +66,7 @@ int cmd_animate(int argc, char** argv)
     sp_error err = {0};
     sp_solve_cmd run = {.cmd = "sketchpose animate"};
     double *kp = NULL, *p0 = NULL;
+    char(*notes)[256] = NULL; // each key's report note (sp_solve_report.note)
     cJSON* all = cJSON_CreateArray();
     int exit_code = SP_EXIT_INPUT;
     // A glTF animation keys joints; a black box's deformers have none.
@@ -77,7 +78,8 @@ int cmd_animate(int argc, char** argv)
     const int P = sp_rig_handle_param_count(rig);
     if (sp_rig_handle_read_pose(rig, NULL, &p0, NULL, &err) != SP_OK) goto fail;
     kp = malloc(sizeof(double) * (size_t)(P + 1) * (size_t)n);
-    if (!kp) goto oom;
+    notes = calloc((size_t)n, sizeof *notes);
+    if (!kp || !notes) goto oom;
     for (int k = 0; k < n; ++k) {
         sp_sketch sk = {0};
         if (sp_read_strokes(keys.items[k], &sk, &err) != SP_OK) goto fail;
@@ -88,6 +90,7 @@ int cmd_animate(int argc, char** argv)
         bool solved = sp_solve_cmd_solve(&run, &cam, &sk, keys.items[k], start, kp + (size_t)k * P, &rep, &j);
         sp_sketch_free(&sk);
         if (!solved) goto done;
+        snprintf(notes[k], sizeof notes[k], "%s", rep.note);
         cJSON_AddStringToObject(j, "strokes", keys.items[k]);
         cJSON_AddNumberToObject(j, "time_s", times[k]);
         cJSON_AddItemToArray(all, j);
@@ -105,7 +108,12 @@ int cmd_animate(int argc, char** argv)
     ch->rig.animations = grown;
     ch->rig.animations[ch->rig.animation_count++] = anim;
     // The keys' reports, then the character with the animation, at the first key's pose.
-    if (sp_solve_cmd_write(&run, all, kp, &(sp_solve_outputs){.report = report, .out = out})) exit_code = SP_EXIT_OK;
+    if (sp_solve_cmd_write(&run, all, kp, &(sp_solve_outputs){.report = report, .out = out})) {
+        exit_code = SP_EXIT_OK;
+        // Each key's note, as pose says its one.
+        for (int k = 0; k < n; ++k)
+            if (notes[k][0]) fprintf(stderr, "sketchpose animate: %s: %s\n", keys.items[k], notes[k]);
+    }
     goto done;
 oom:
     sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
@@ -114,7 +122,7 @@ fail:
 done:
     cJSON_Delete(all);
     sp_solve_cmd_end(&run);
-    free(kp), free(p0), free(times);
+    free(kp), free(p0), free(times), free(notes);
     sp_rig_handle_free(rig);
     return exit_code;
 }

@@ -1063,9 +1063,13 @@ sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp
             if (out->canvas_w == 0 && svg_attr(s, gt, "viewBox", &vb, &ve)) {
                 double v[4];
                 const char* q = vb;
-                if (svg_numbers(&q, ve, v, 4) && v[2] > 0 && v[3] > 0 && v[2] < 1e6 && v[3] < 1e6) {
+                if (svg_numbers(&q, ve, v, 4) && isfinite(v[0]) && isfinite(v[1]) && fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9 &&
+                    v[2] > 0 && v[3] > 0 && v[2] < 1e6 && v[3] < 1e6) {
                     out->canvas_w = v[2];
                     out->canvas_h = v[3];
+                    // The canvas starts at the viewBox's corner: a drawing an
+                    // editor padded or cropped keeps its place on it.
+                    local = affine_mul((affine){1, 0, 0, 1, -v[0], -v[1]}, local);
                 }
             }
         }

@@ -54,6 +54,8 @@ grep -q '"note":	""' "$WORK/man.json" || fail "a clean stick figure got a note: 
 expect 0 "$SP" pose --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --report "$WORK/man1.json"
 grep -q '"note":	"loose fit: curve .leg_' "$WORK/man1.json" || fail "legs drawn as one stroke: no note: $(grep '"note"' "$WORK/man1.json")"
 one_line_naming "loose fit: curve 'leg_"
+expect 0 "$SP" animate --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up.json" "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --out "$WORK/man.glb"
+one_line_naming "man_arm_up_legs_one.json: loose fit: curve 'leg_"
 
 # The same strokes as an SVG drawing (its viewBox the canvas) pose the same;
 # one with no viewBox has no canvas and is refused.
@@ -63,9 +65,16 @@ printf '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 640 480"><g><path d
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/drawn.svg" --report "$WORK/r_svg.json"
 [ "$(grep -m1 '"mean_error_px"' "$WORK/r.json")" = "$(grep -m1 '"mean_error_px"' "$WORK/r_svg.json")" ] ||
     fail "pose of the SVG drawing differs: $(grep -m1 mean_error_px "$WORK/r.json" "$WORK/r_svg.json")"
+# A viewBox that starts elsewhere (an editor's padding) keeps the drawing's
+# place on the canvas: the same drawing moved by 40 px in both, the same fit.
+sed 's/viewBox="0 0 640 480"><g>/viewBox="-40 -40 640 480"><g transform="translate(-40 -40)">/' "$WORK/drawn.svg" >"$WORK/padded.svg"
+grep -q 'viewBox="-40' "$WORK/padded.svg" || fail "padded.svg not made: $(head -c 200 "$WORK/padded.svg")"
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/padded.svg" --report "$WORK/r_pad.json"
+[ "$(grep -m1 '"mean_error_px"' "$WORK/r.json")" = "$(grep -m1 '"mean_error_px"' "$WORK/r_pad.json")" ] ||
+    fail "pose of the padded SVG differs: $(grep -m1 mean_error_px "$WORK/r.json" "$WORK/r_pad.json")"
 sed 's/ viewBox="[^"]*"//' "$WORK/drawn.svg" >"$WORK/nobox.SVG"
 expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/nobox.SVG"
-one_line_naming "no viewBox"
+one_line_naming "no usable viewBox"
 
 # An output that cannot be written fails the command, and it leaves none of
 # its outputs (each written whole, the ones before taken back).
