@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "sp/clock.h"
@@ -33,6 +34,14 @@ const char* sp_test_src_path(const char* rel)
 {
     char* b = ring_next();
     snprintf(b, 1024, "%s/%s", SP_SOURCE_DIR, rel);
+    return b;
+}
+
+const char* sp_test_keep_path(const char* name)
+{
+    char* b = ring_next();
+    mkdir(SP_BINARY_DIR "/tmp", 0755);
+    snprintf(b, 1024, "%s/tmp/%s", SP_BINARY_DIR, name);
     return b;
 }
 
@@ -73,6 +82,8 @@ const char* sp_test_reachable_dir(const char* prefix)
     return NULL;
 }
 
+static time_t g_started; // when sp_test_run began: older <pid>_ files are another run's
+
 static int remove_entry(const char* path, const struct stat* st, int flag, struct FTW* ftw)
 {
     (void)st, (void)flag, (void)ftw;
@@ -93,6 +104,9 @@ static void remove_own_scratch(void)
         if (strncmp(e->d_name, prefix, strlen(prefix)) != 0) continue;
         char path[1200];
         snprintf(path, sizeof path, "%s/tmp/%s", SP_BINARY_DIR, e->d_name);
+        // A failed run long ago under the same pid kept its files to look at.
+        struct stat st;
+        if (lstat(path, &st) != 0 || st.st_mtime < g_started) continue;
         nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
     }
     closedir(d);
@@ -111,6 +125,7 @@ static int run_one(const sp_test* t)
 
 int sp_test_run(int argc, char** argv, const sp_test* tests)
 {
+    g_started = time(NULL) - 1; // mtimes have whole seconds on some file systems
     int ran = 0, failed = 0, skipped = 0;
     for (const sp_test* t = tests; t->name; ++t) {
         if (argc > 1 && !strstr(t->name, argv[1])) continue;

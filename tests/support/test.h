@@ -56,7 +56,11 @@ extern const char* sp_test_skip_reason;
 const char* sp_test_data_dir(void);
 /// Path inside the project source tree / the build tree (static buffer, rotates over 8).
 const char* sp_test_src_path(const char* rel);
+/// <build>/tmp/<pid>_<name>: scratch, removed when the run passes.
 const char* sp_test_tmp_path(const char* name);
+/// <build>/tmp/<name>: a file kept for a person to look at (a picture),
+/// overwritten by the next run.
+const char* sp_test_keep_path(const char* name);
 /// A fresh folder <prefix>_XXXXXX (mode 0755) that any user can reach, for
 /// cases run as another user (root ignores permissions, so a test drops
 /// them in a child): the build folder may lie under one only its owner may

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -236,6 +237,11 @@ static bool scratch_kept(void (*fn)(void))
     if (pid == 0) {
         FILE* f = fopen(sp_test_tmp_path("probe.txt"), "w");
         if (!f || fputs("x", f) < 0 || fclose(f) != 0) _exit(3);
+        // An older file under the same pid: a failed run's, long ago, kept.
+        f = fopen(sp_test_tmp_path("probe_old.txt"), "w");
+        if (!f || fclose(f) != 0) _exit(3);
+        struct timespec old[2] = {{time(NULL) - 86400, 0}, {time(NULL) - 86400, 0}};
+        if (utimensat(AT_FDCWD, sp_test_tmp_path("probe_old.txt"), old, 0) != 0) _exit(3);
         char sub[1100];
         snprintf(sub, sizeof sub, "%s/inner", sp_test_tmp_path("probe_dir"));
         if (mkdir(sp_test_tmp_path("probe_dir"), 0755) != 0 || mkdir(sub, 0755) != 0) _exit(3);
@@ -252,7 +258,10 @@ static bool scratch_kept(void (*fn)(void))
     snprintf(dir, sizeof dir, "%s/tmp/%d_probe_dir/inner", SP_BINARY_DIR, (int)pid);
     struct stat st;
     bool has_file = stat(file, &st) == 0, has_dir = stat(dir, &st) == 0;
-    remove(file), rmdir(dir);
+    char old[1100];
+    snprintf(old, sizeof old, "%s/tmp/%d_probe_old.txt", SP_BINARY_DIR, (int)pid);
+    ENSURE(stat(old, &st) == 0); // never another run's
+    remove(old), remove(file), rmdir(dir);
     *strrchr(dir, '/') = '\0';
     rmdir(dir);
     ENSURE(has_file == has_dir);

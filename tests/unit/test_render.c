@@ -163,7 +163,7 @@ static void render_scene(const scene* s, sp_render_mesh* m, const sp_camera* cam
 static void save_for_people(const sp_image* img, const char* name)
 {
     sp_error err = {0};
-    const char* path = sp_test_tmp_path(name);
+    const char* path = sp_test_keep_path(name);
     if (sp_image_write_png(img, path, &err) == SP_OK) printf("  wrote %s\n", path);
 }
 
