@@ -268,7 +268,7 @@ void sp_rig_posed_free(sp_rig_posed* v)
     memset(v, 0, sizeof *v);
 }
 
-void sp_warn_textures_dropped(const char* cmd, const sp_rig_handle* h, const char* out)
+void sp_rig_handle_warn_textures(const char* cmd, const sp_rig_handle* h, const char* out)
 {
     if (!h->bb && h->ch.textured)
         fprintf(stderr, "%s: warning: %s has a texture, which %s does not keep (sketchpose reads no images: it is grey)\n", cmd,

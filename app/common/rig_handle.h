@@ -57,7 +57,7 @@ bool sp_rig_handle_is_black_box(const sp_rig_handle* h);
 sp_character* sp_rig_handle_character(sp_rig_handle* h);
 /// After a glTF file `out` was written from a textured character: one
 /// warning line on stderr that the texture is not in it (nothing otherwise).
-void sp_warn_textures_dropped(const char* cmd, const sp_rig_handle* h, const char* out);
+void sp_rig_handle_warn_textures(const char* cmd, const sp_rig_handle* h, const char* out);
 /// Mesh vertices and triangles.
 int sp_rig_handle_vertex_count(const sp_rig_handle* h);
 int sp_rig_handle_triangle_count(const sp_rig_handle* h);

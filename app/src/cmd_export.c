@@ -46,7 +46,7 @@ int cmd_export(int argc, char** argv)
     if (text) puts(text);
     free(text);
     cJSON_Delete(root);
-    sp_warn_textures_dropped("sketchpose export", rig, out_path);
+    sp_rig_handle_warn_textures("sketchpose export", rig, out_path);
     exit_code = SP_EXIT_OK;
     goto done;
 fail:

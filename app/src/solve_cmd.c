@@ -100,7 +100,7 @@ bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double
     }
     sp_json_print(report);
     if (o->note && o->note[0]) fprintf(stderr, "%s: %s\n", s->cmd, o->note);
-    if (o->out) sp_warn_textures_dropped(s->cmd, s->rig, o->out);
+    if (o->out) sp_rig_handle_warn_textures(s->cmd, s->rig, o->out);
     return true;
 }
 

@@ -43,6 +43,7 @@ sp_result sp_character_clone(const sp_character* src, sp_character* dst, sp_erro
     dst->has_part = src->has_part;
     dst->derived_abstraction = src->derived_abstraction, dst->derived_dofs = src->derived_dofs;
     dst->mesh_skins = src->mesh_skins;
+    dst->textured = src->textured;
     return SP_OK;
 }
 

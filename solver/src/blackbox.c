@@ -44,11 +44,14 @@ static bool utf8_ok(const unsigned char* s)
     return true;
 }
 
-// What is wrong with a name, or NULL.
-static const char* name_problem(const char* s, size_t max)
+// What is wrong with a name, in `buf`, or NULL.
+static const char* name_problem(const char* s, size_t max, char* buf, size_t size)
 {
     if (!s || !s[0]) return "has no name";
-    if (strlen(s) > max) return max > 100 ? "has a name longer than 127 bytes" : "has a name longer than 63 bytes";
+    if (strlen(s) > max) {
+        snprintf(buf, size, "has a name longer than %zu bytes", max);
+        return buf;
+    }
     return utf8_ok((const unsigned char*)s) ? NULL : "has a name that is not UTF-8";
 }
 
@@ -81,7 +84,8 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
                        BB_MAX_PARAMS, r->params ? "" : ", params is NULL");
     for (int i = 0; i < r->param_count; ++i) {
         const sp_blackbox_param* q = &r->params[i];
-        const char* bad = name_problem(q->name, 2 * SP_NAME_MAX - 1);
+        char why[64];
+        const char* bad = name_problem(q->name, 2 * SP_NAME_MAX - 1, why, sizeof why);
         if (bad) return sp_fail(err, SP_ERR_INVALID, "%s: parameter %d %s", what, i, bad);
         for (int j = 0; j < i; ++j)
             if (!strcmp(r->params[j].name, q->name))
@@ -126,7 +130,8 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
     long long total = 0;
     for (int a = 0; a < r->abstraction_count; ++a) {
         const sp_blackbox_abstraction* ab = &r->abstractions[a];
-        const char* bad = name_problem(ab->name, SP_NAME_MAX - 1);
+        char why[64];
+        const char* bad = name_problem(ab->name, SP_NAME_MAX - 1, why, sizeof why);
         if (bad) return sp_fail(err, SP_ERR_INVALID, "%s: abstraction %d %s", what, a, bad);
         for (int b = 0; b < a; ++b)
             if (!strcmp(r->abstractions[b].name, ab->name))
@@ -139,7 +144,7 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
                            (int)ab->curve_count, SP_REPORT_CURVES);
         for (int c = 0; c < ab->curve_count; ++c) {
             const sp_blackbox_curve* cv = &ab->curves[c];
-            bad = name_problem(cv->name, SP_NAME_MAX - 1);
+            bad = name_problem(cv->name, SP_NAME_MAX - 1, why, sizeof why);
             if (bad) return sp_fail(err, SP_ERR_INVALID, "%s: curve %d of '%s' %s", what, c, ab->name, bad);
             for (int d = 0; d < c; ++d)
                 if (!strcmp(ab->curves[d].name, cv->name))

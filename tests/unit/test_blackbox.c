@@ -500,24 +500,31 @@ static void test_plugin_errors(void)
     expect_load_error(bogus, SP_ERR_PARSE, "cannot load it as a shared object", NULL);
     expect_load_error(plugin("nosym"), SP_ERR_INVALID, "no symbol sp_blackbox_plugin_v1", "extern \"C\"");
     // Another processor's object: dlopen alone says "No such file or directory".
+    // Checked where this host is little-endian x86-64 or AArch64 (the loader
+    // names the processors it knows; elsewhere dlopen speaks).
     FILE* in = fopen(plugin("good"), "rb");
     ENSURE(in);
     static unsigned char so[1 << 20];
     size_t n = fread(so, 1, sizeof so, in);
     fclose(in);
-    ENSURE(n > 64 && n < sizeof so && so[5] == 1); // little-endian, as this host
-    bool x86 = so[18] == 62 && so[19] == 0;
-    so[18] = x86 ? 183 : 62, so[19] = 0; // e_machine: AArch64 on x86-64, else x86-64
-    const char* arch = sp_test_tmp_path("other_arch.so");
-    f = fopen(arch, "wb");
-    ENSURE(f && fwrite(so, 1, n, f) == n && fclose(f) == 0);
-    expect_load_error(arch, SP_ERR_PARSE, x86 ? "built for another processor (AArch64), this is x86-64" : "(x86-64), this is",
-                      NULL);
-    so[18] = 7; // e_machine 0x0707: no name here
-    so[19] = 7;
-    f = fopen(arch, "wb");
-    ENSURE(f && fwrite(so, 1, n, f) == n && fclose(f) == 0);
-    expect_load_error(arch, SP_ERR_PARSE, "built for another processor (ELF machine 1799)", NULL);
+    ENSURE(n > 64 && n < sizeof so);
+    bool x86 = so[18] == 62 && so[19] == 0, arm64 = so[18] == 183 && so[19] == 0;
+    if (so[5] == 1 && (x86 || arm64)) {
+        so[18] = x86 ? 183 : 62; // e_machine: the other one
+        const char* arch = sp_test_tmp_path("other_arch.so");
+        f = fopen(arch, "wb");
+        ENSURE(f && fwrite(so, 1, n, f) == n && fclose(f) == 0);
+        expect_load_error(arch, SP_ERR_PARSE,
+                          x86 ? "built for another processor (AArch64), this is x86-64"
+                              : "built for another processor (x86-64), this is AArch64",
+                          NULL);
+        so[18] = 7, so[19] = 7; // e_machine 0x0707: no name here
+        f = fopen(arch, "wb");
+        ENSURE(f && fwrite(so, 1, n, f) == n && fclose(f) == 0);
+        expect_load_error(arch, SP_ERR_PARSE, "built for another processor (ELF machine 1799)", NULL);
+    } else {
+        printf("  the other-processor check is not run on this processor\n");
+    }
     expect_load_error(plugin("null"), SP_ERR_INVALID, "returned no rig", NULL);
     expect_load_error(plugin("badversion"), SP_ERR_UNSUPPORTED, "ABI version 99", "reads version 1");
     expect_load_error(plugin("badsize"), SP_ERR_UNSUPPORTED, "inconsistent sizes", "sp_blackbox_rig");

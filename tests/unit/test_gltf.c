@@ -258,6 +258,11 @@ static void test_cesium_gltf_vs_glb(void)
     ENSURE(!memcmp(a.rig.joints4, b.rig.joints4, sizeof(uint16_t) * 4 * (size_t)a.rig.vertex_count));
     ENSURE(sp_fixture_has_warning(&a, "renormalised skin weights of 210 vertices"));
     ENSURE(sp_fixture_has_warning(&b, "renormalised skin weights of 210 vertices"));
+    // Its texture is never read, and a warning says so; a copy knows it too.
+    ENSURE(a.textured && b.textured && sp_fixture_has_warning(&a, "base colour texture is not used"));
+    sp_character c;
+    ENSURE(sp_character_clone(&a, &c, NULL) == SP_OK && c.textured);
+    sp_character_free(&c);
     ENSURE(a.derived_dofs && a.rig.param_count >= 3 * 19);
     ENSURE(a.rig.animation_count == 1 && a.rig.animations[0].duration_s > 0);
     ENSURE(!a.has_camera && a.camera.scale > 0);
@@ -272,6 +277,7 @@ static void test_rigged_figure(void)
     sp_character a = load_ok(data_path("RiggedFigure/glTF/RiggedFigure.gltf"));
     sp_character b = load_ok(data_path("RiggedFigure/RiggedFigure.glb"));
     ENSURE(a.rig.vertex_count == 370);
+    ENSURE(!a.textured && !b.textured);
     ensure_same_rig(&a.rig, &b.rig, 1e-12);
     ENSURE(sp_fixture_has_warning(&a, "renormalised skin weights of 31 vertices"));
     ensure_stick(&a);
