@@ -105,8 +105,12 @@ int cmd_animate(int argc, char** argv)
         if (ar == SP_OK) goto oom;
         goto fail;
     }
+    // First in the file: viewers play a file's first animation, and the user
+    // asked for this one (the file's own clips follow, kept).
     ch->rig.animations = grown;
-    ch->rig.animations[ch->rig.animation_count++] = anim;
+    memmove(ch->rig.animations + 1, ch->rig.animations, sizeof(sp_animation) * (size_t)ch->rig.animation_count);
+    ch->rig.animations[0] = anim;
+    ++ch->rig.animation_count;
     // The keys' reports, then the character with the animation, at the first key's pose.
     if (sp_solve_cmd_write(&run, all, kp, &(sp_solve_outputs){.report = report, .out = out})) {
         exit_code = SP_EXIT_OK;
