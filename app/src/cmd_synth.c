@@ -300,8 +300,7 @@ int cmd_synth(int argc, char** argv)
          false},
         {"--shape", SP_OPT_STRING, &shape_name, "S",
          "with --parts: outline (default), top, underside, line (one line through the joints; parts whose skeleton is one or two "
-         "chains), "
-         "or piece (the silhouette of the part's far end: a head without its neck, one leg)",
+         "chains), or piece (the silhouette of the part's far end: a head without its neck, one leg)",
          false},
         {"--details", SP_OPT_FLAG, &details, "",
          "with --parts: the mesh's silhouette with its decorations instead of the abstraction", false},
