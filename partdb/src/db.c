@@ -270,6 +270,19 @@ sp_result db_exec(sp_db* db, const char* sql, sp_error* err)
     return rc == SQLITE_OK ? SP_OK : db_fail(db, rc, "writing", err);
 }
 
+sp_result db_bind_blob(sp_db* db, sqlite3_stmt* st, int i, const void* data, size_t size, const char* what, sp_error* err)
+{
+    int rc = sqlite3_bind_blob64(st, i, data, (sqlite3_uint64)size, SQLITE_STATIC);
+    if (rc == SQLITE_OK) return SP_OK;
+    // Unchecked, a refused bind left NULL to insert, and the row failed as
+    // "NOT NULL constraint failed" after minutes of training.
+    if (rc == SQLITE_TOOBIG)
+        return sp_fail(err, SP_ERR_UNSUPPORTED,
+                       "%s: %s is %zu bytes, more than SQLite stores in one value (%d bytes); nothing was stored", db->path, what,
+                       size, sqlite3_limit(db->h, SQLITE_LIMIT_LENGTH, -1));
+    return db_fail(db, rc, "storing it", err);
+}
+
 sp_result db_prepare(sp_db* db, const char* sql, sqlite3_stmt** st, sp_error* err)
 {
     int rc = sqlite3_prepare_v2(db->h, sql, -1, st, NULL);

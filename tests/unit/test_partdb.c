@@ -997,6 +997,16 @@ static void test_bad_input(void)
         err = (sp_error){0};
         ENSURE(sp_db_add_part(db, glb, cuts[i], &(sp_db_part_desc){.name = "cut"}, NULL, &err) != SP_OK && err.text[0]);
     }
+    // A glTF over SQLite's value limit (lowered here to 10 kB; 1 GB by
+    // default, which a 45,000-sketch model passed) is refused in words, not
+    // as a NOT NULL constraint.
+    int limit = sqlite3_limit(db->h, SQLITE_LIMIT_LENGTH, 10000);
+    ENSURE(n > 10000);
+    err = (sp_error){0};
+    ENSURE(sp_db_add_part(db, glb, n, &(sp_db_part_desc){.name = "big"}, NULL, &err) == SP_ERR_UNSUPPORTED);
+    printf("  %s\n", err.text);
+    ENSURE(strstr(err.text, "the part's glTF is") && strstr(err.text, "more than SQLite stores in one value"));
+    sqlite3_limit(db->h, SQLITE_LIMIT_LENGTH, limit);
     memset((char*)glb + 20, 'x', 40);
     ENSURE(sp_db_add_part(db, glb, n, &(sp_db_part_desc){.name = "garbled"}, NULL, &err) != SP_OK);
     free(glb);
