@@ -274,6 +274,7 @@ sp_result db_bind_blob(sp_db* db, sqlite3_stmt* st, int i, const void* data, siz
 {
     int rc = sqlite3_bind_blob64(st, i, data, (sqlite3_uint64)size, SQLITE_STATIC);
     if (rc == SQLITE_OK) return SP_OK;
+    sqlite3_finalize(st);
     // Unchecked, a refused bind left NULL to insert, and the row failed as
     // "NOT NULL constraint failed" after minutes of training.
     if (rc == SQLITE_TOOBIG)

@@ -41,7 +41,7 @@ void db_rollback(sp_db* db);
 /// Executes SQL without results.
 sp_result db_exec(sp_db* db, const char* sql, sp_error* err);
 /// Binds a blob, SQLITE_STATIC; one larger than SQLite's value limit fails
-/// saying so (`what` names it: "the model").
+/// saying so (`what` names it: "the model"), and finalizes `st`.
 sp_result db_bind_blob(sp_db* db, sqlite3_stmt* st, int i, const void* data, size_t size, const char* what, sp_error* err);
 /// Prepares or fails with a message.
 sp_result db_prepare(sp_db* db, const char* sql, sqlite3_stmt** st, sp_error* err);

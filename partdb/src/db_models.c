@@ -191,10 +191,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
         if ((r = db_prepare(db, "INSERT INTO models(model, sha256, categories, options, report, created_by) VALUES (?,?,?,?,?,?)", &st,
                             err)) != SP_OK)
             goto rollback;
-        if ((r = db_bind_blob(db, st, 1, bytes, size, "the model", err)) != SP_OK) {
-            sqlite3_finalize(st);
-            goto rollback;
-        }
+        if ((r = db_bind_blob(db, st, 1, bytes, size, "the model", err)) != SP_OK) goto rollback;
         sqlite3_bind_text(st, 2, sha, -1, SQLITE_STATIC);
         sqlite3_bind_text(st, 3, cats_s, -1, SQLITE_STATIC);
         sqlite3_bind_text(st, 4, opts, -1, SQLITE_STATIC);

@@ -289,10 +289,7 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
     sqlite3_bind_text(st, 1, info.name, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(st, 2, info.category, -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(st, 3, info.abstraction, -1, SQLITE_TRANSIENT);
-    if ((r = db_bind_blob(db, st, 4, glb, size, "the part's glTF", err)) != SP_OK) {
-        sqlite3_finalize(st);
-        goto rollback;
-    }
+    if ((r = db_bind_blob(db, st, 4, glb, size, "the part's glTF", err)) != SP_OK) goto rollback;
     sqlite3_bind_int64(st, 5, (sqlite3_int64)size);
     sqlite3_bind_text(st, 6, info.sha256, -1, SQLITE_TRANSIENT);
     sqlite3_bind_int(st, 7, info.vertices);
