@@ -93,8 +93,10 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
     if (smp->raster.pixels) {
         sqlite3_bind_int(st, 5, smp->raster.w);
         sqlite3_bind_int(st, 6, smp->raster.h);
-        sqlite3_bind_blob64(st, 7, smp->raster.pixels, (sqlite3_uint64)smp->raster.w * (sqlite3_uint64)smp->raster.h, SQLITE_STATIC);
-        if (png && png->bytes) sqlite3_bind_blob64(st, 8, png->bytes, png->size, SQLITE_STATIC);
+        size_t n = (size_t)smp->raster.w * (size_t)smp->raster.h;
+        if ((r = db_bind_blob(db, st, 7, smp->raster.pixels, n, "the drawing's picture", err)) != SP_OK) return r;
+        if (png && png->bytes && (r = db_bind_blob(db, st, 8, png->bytes, png->size, "the drawing's PNG", err)) != SP_OK)
+            return r;
     } else {
         if (!(json = db_sketch_json(&smp->sketch))) {
             sqlite3_finalize(st);

@@ -1006,6 +1006,18 @@ static void test_bad_input(void)
     ENSURE(sp_db_add_part(db, glb, n, &(sp_db_part_desc){.name = "big"}, NULL, &err) == SP_ERR_UNSUPPORTED);
     printf("  %s\n", err.text);
     ENSURE(strstr(err.text, "the part's glTF is") && strstr(err.text, "more than SQLite stores in one value"));
+    // So is a drawing's picture; the set is stored whole or not at all.
+    sp_dataset big = {0};
+    ENSURE(sp_dataset_add_category(&big, "tail") == 0);
+    sp_sample smp = {.label = 0, .raster = {200, 200, calloc(200 * 200, 1)}};
+    ENSURE(smp.raster.pixels && sp_dataset_add_sample(&big, &smp) == SP_OK);
+    int had = -1, has = -2, added = -1;
+    ENSURE(sp_db_sketch_count_by(db, SP_DB_SOURCE_CURATED, "test", &had, &err) == SP_OK);
+    ENSURE(sp_db_add_sketches(db, &big, NULL, SP_DB_SOURCE_CURATED, "test", &added, &err) == SP_ERR_UNSUPPORTED);
+    printf("  %s\n", err.text);
+    ENSURE(strstr(err.text, "the drawing's picture is 40000 bytes") && added == 0);
+    ENSURE(sp_db_sketch_count_by(db, SP_DB_SOURCE_CURATED, "test", &has, &err) == SP_OK && has == had);
+    sp_dataset_free(&big);
     sqlite3_limit(db->h, SQLITE_LIMIT_LENGTH, limit);
     memset((char*)glb + 20, 'x', 40);
     ENSURE(sp_db_add_part(db, glb, n, &(sp_db_part_desc){.name = "garbled"}, NULL, &err) != SP_OK);
