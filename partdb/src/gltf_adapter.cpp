@@ -805,11 +805,12 @@ std::vector<uint32_t> read_indices(const tinygltf::Model& m, const tinygltf::Pri
     return idx;
 }
 
-// Base colour of a primitive's material (linear RGBA).
-void material_color(const tinygltf::Model& m, int material, const char* what, float rgba[4])
+// Base colour of a primitive's material (linear RGBA); true when the
+// material has a base colour texture (never read: grey).
+bool material_color(const tinygltf::Model& m, int material, const char* what, float rgba[4])
 {
     rgba[0] = rgba[1] = rgba[2] = rgba[3] = 1.0f;
-    if (material < 0) return;
+    if (material < 0) return false;
     if ((size_t)material >= m.materials.size())
         fail(SP_ERR_INVALID, "%s: a primitive refers to material %d, but there are %zu", what, material, m.materials.size());
     const tinygltf::PbrMetallicRoughness& pbr = m.materials[(size_t)material].pbrMetallicRoughness;
@@ -818,9 +819,10 @@ void material_color(const tinygltf::Model& m, int material, const char* what, fl
             double x = pbr.baseColorFactor[(size_t)c];
             rgba[c] = std::isfinite(x) ? (float)std::min(1.0, std::max(0.0, x)) : 1.0f;
         }
-    if (pbr.baseColorTexture.index >= 0)
-        for (int c = 0; c < 3; ++c)
-            rgba[c] *= SP_GLTF_TEXTURE_GREY;
+    if (pbr.baseColorTexture.index < 0) return false;
+    for (int c = 0; c < 3; ++c)
+        rgba[c] *= SP_GLTF_TEXTURE_GREY;
+    return true;
 }
 
 // glTF requires an inverse bind matrix to be finite with a fourth row of
@@ -1157,9 +1159,7 @@ struct Importer {
                 joints.insert(joints.end(), s.joints.begin(), s.joints.end());
                 weights.insert(weights.end(), s.weights.begin(), s.weights.end());
                 float rgba[4];
-                material_color(m, prim.material, what, rgba);
-                if (prim.material >= 0 && m.materials[(size_t)prim.material].pbrMetallicRoughness.baseColorTexture.index >= 0 &&
-                    !ch->textured) {
+                if (material_color(m, prim.material, what, rgba) && !ch->textured) {
                     ch->textured = true;
                     sp_character_warn(ch, "its base colour texture is not used: sketchpose reads no images, so pictures and "
                                           "saved files show it grey");

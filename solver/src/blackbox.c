@@ -170,7 +170,7 @@ static sp_result validate(const sp_blackbox_rig* r, const char* what, sp_error* 
 static void blackbox_destroy(sp_blackbox* bb, bool release)
 {
     if (!bb) return;
-    if (release && bb->rig->release) bb->rig->release(bb->rig->user);
+    if (release && bb->rig.release) bb->rig.release(bb->rig.user);
     for (int a = 0; a < bb->abstraction_count; ++a)
         free(bb->abs[a].curves);
     free(bb->abs), free(bb->first), free(bb->params), free(bb->desc_params);
@@ -200,8 +200,7 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
         if (r->release) r->release(r->user);
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
     }
-    bb->desc = *r;
-    bb->rig = &bb->desc;
+    bb->rig = *r;
     snprintf(bb->what, sizeof bb->what, "%s", what);
     bb->P = r->param_count;
     bb->n = r->vertex_count;
@@ -220,7 +219,7 @@ sp_result sp_blackbox_open(const sp_blackbox_rig* r, const char* what, sp_blackb
         bb->desc_params[i] = *q;
         bb->desc_params[i].name = d->name;
     }
-    bb->desc.params = bb->desc_params;
+    bb->rig.params = bb->desc_params;
     for (int a = 0; a < r->abstraction_count; ++a) {
         const sp_blackbox_abstraction* src = &r->abstractions[a];
         sp_abstraction* dst = &bb->abs[a];
@@ -304,7 +303,7 @@ void sp_blackbox_destroy(sp_blackbox* bb)
 
 const sp_blackbox_rig* sp_blackbox_desc(const sp_blackbox* bb)
 {
-    return bb->rig;
+    return &bb->rig;
 }
 
 int sp_blackbox_abstraction_points(const sp_blackbox* bb, int a)
@@ -337,7 +336,7 @@ void sp_blackbox_defaults(const sp_blackbox* bb, double* p)
 
 sp_camera sp_blackbox_camera(const sp_blackbox* bb, int width, int height)
 {
-    const sp_blackbox_rig* r = bb->rig;
+    const sp_blackbox_rig* r = &bb->rig;
     sp_vec3 f = {r->view_forward[0], r->view_forward[1], r->view_forward[2]};
     if (!(sp_v3_len(f) > 0)) return sp_camera_default_view(r->rest, bb->n, width, height);
     sp_vec3 u = {r->view_up[0], r->view_up[1], r->view_up[2]};
@@ -353,7 +352,7 @@ sp_result sp__blackbox_eval_raw(const sp_blackbox* bb, const double* p, double* 
     // fewer than it declares on every call (its vertices, on open).
     for (size_t i = 0; z && i < 3 * (size_t)bb->total; ++i)
         z[i] = NAN;
-    int rc = bb->rig->evaluate(bb->rig->user, p, x, z);
+    int rc = bb->rig.evaluate(bb->rig.user, p, x, z);
     if (rc_out) *rc_out = rc;
     if (rc != 0) return SP_ERR_INTERNAL;
     if (!all_finite(x, 3 * (size_t)bb->n, bad)) return SP_ERR_INVALID;
@@ -398,7 +397,7 @@ sp_result sp_blackbox_evaluate(const sp_blackbox* bb, const double* p, double* v
 
 double sp_blackbox_fd_step(const sp_blackbox* bb, int k)
 {
-    const sp_blackbox_param* q = &bb->rig->params[k];
+    const sp_blackbox_param* q = &bb->rig.params[k];
     return SP_BB_FD_FRACTION * (q->max - q->min);
 }
 
@@ -408,7 +407,7 @@ void sp_blackbox_synth_params(const sp_blackbox* bb, uint64_t seed, double ampli
 {
     sp_rng rng = sp__synth_rng(seed);
     for (int i = 0; i < bb->P; ++i) {
-        const sp_blackbox_param* q = &bb->rig->params[i];
+        const sp_blackbox_param* q = &bb->rig.params[i];
         p[i] = sp__synth_param(&rng, q->def, q->min, q->max, q->unit == SP_BB_UNIT_ANGLE, q->group == SP_GROUP_POSE, amplitude);
     }
 }
@@ -479,7 +478,7 @@ struct sp_blackbox_fd {
 static void column(sp_blackbox_fd* fd, fd_lane* ln, int k)
 {
     const sp_blackbox* bb = fd->bb;
-    const sp_blackbox_param* q = &bb->rig->params[k];
+    const sp_blackbox_param* q = &bb->rig.params[k];
     double* out = fd->Jt + (size_t)k * (size_t)fd->M;
     double h = sp_blackbox_fd_step(bb, k);
     fd->status[k] = 0;
@@ -492,10 +491,10 @@ static void column(sp_blackbox_fd* fd, fd_lane* ln, int k)
     if (lo < q->min) lo = q->min, hi = q->min + 2 * h;
     memcpy(ln->q, fd->p, sizeof(double) * (size_t)bb->P);
     ln->q[k] = hi;
-    int rc = bb->rig->evaluate(bb->rig->user, ln->q, ln->xb, ln->zb);
+    int rc = bb->rig.evaluate(bb->rig.user, ln->q, ln->xb, ln->zb);
     if (rc == 0) {
         ln->q[k] = lo;
-        rc = bb->rig->evaluate(bb->rig->user, ln->q, ln->xa, ln->za);
+        rc = bb->rig.evaluate(bb->rig.user, ln->q, ln->xa, ln->za);
     }
     if (rc != 0) {
         fd->status[k] = SP_ERR_INTERNAL;
@@ -681,7 +680,7 @@ sp_result sp_blackbox_fd_jacobian(sp_blackbox_fd* fd, const double* p, double* J
     for (int k = 0; k < P; ++k)
         if (fd->status[k] != 0) {
             char where[200];
-            snprintf(where, sizeof where, "at a finite-difference step of parameter '%s'", bb->rig->params[k].name);
+            snprintf(where, sizeof where, "at a finite-difference step of parameter '%s'", bb->rig.params[k].name);
             return sp__blackbox_eval_message(bb, (sp_result)fd->status[k], fd->rc[k], fd->bad[k], where, err);
         }
     // Column-major to the row-major (3 * rows) x P layout of the callers.
@@ -841,14 +840,14 @@ sp_result sp_solver_create_blackbox(const sp_blackbox* bb, int abstraction, cons
         return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory making a solver", bb->what);
     }
     for (int i = 0; i < bb->P; ++i) {
-        const sp_blackbox_param* q = &bb->rig->params[i];
+        const sp_blackbox_param* q = &bb->rig.params[i];
         B->params[i] = (sp_model_param){q->min, q->max, q->def, q->unit == SP_BB_UNIT_LENGTH};
     }
     B->base = (sp_model){.ops = &bb_ops,
                          .P = bb->P,
                          .params = B->params,
                          .vertex_count = bb->n,
-                         .rest = bb->rig->rest,
+                         .rest = bb->rig.rest,
                          .ab = &bb->abs[abstraction],
                          .embedded = false,
                          .placement_count = 0};

@@ -8,11 +8,10 @@
 #include "sp/blackbox.h"
 
 struct sp_blackbox {
-    const sp_blackbox_rig* rig; // &desc
     // The rig's description and parameters as validated: a plugin that
     // changed its counts or functions afterwards would be read past its
     // arrays. What they point to (rest, triangles, curves) is the rig's.
-    sp_blackbox_rig desc;
+    sp_blackbox_rig rig;
     sp_blackbox_param* desc_params;
     char what[512]; // names the rig in messages (the plugin's path)
     void (*on_destroy)(void* user); // after the rig's release (a plugin's dlclose), or NULL
