@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -21,8 +22,11 @@
 #include <map>
 #include <memory>
 #include <new>
+#include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <unordered_map>
 #include <vector>
 
 // Why the pragma: sp/math.h is C11 and uses compound literals, which C++
@@ -1101,13 +1105,132 @@ struct Importer {
         if (r != SP_OK) fail(r, "%s", e.text);
     }
 
-    void read_meshes(int skin)
-    {
-        sp_rig* rig = &ch->rig;
+    // The surface being read: per vertex, then triangles of absolute indices.
+    struct Surface {
         std::vector<double> rest;
         std::vector<uint16_t> joints;
         std::vector<float> weights, colors;
         std::vector<uint32_t> tris;
+    };
+    using AttrKey = std::array<int, 3>;                              // POSITION, JOINTS_0, WEIGHTS_0 accessors
+    using ColorKey = std::tuple<AttrKey, int, std::array<float, 4>>; // + COLOR_0, material colour
+    // Where an attribute set's vertices went. Exporters that split a mesh by
+    // material give every primitive the one vertex array: copied per
+    // primitive, 2,000 of them ran a 2 MB file out of memory. The first
+    // colouring copies the array whole and in order (so files that share
+    // nothing load as they always did); another colouring copies only the
+    // vertices its triangles use.
+    struct Placement {
+        bool whole = false;
+        size_t base = 0;
+        std::unordered_map<uint32_t, uint32_t> at; // source vertex -> surface vertex
+    };
+    std::map<AttrKey, size_t> attr_base{};
+    std::map<ColorKey, Placement> placements{};
+
+    // COLOR_0 of a primitive with nv vertices, checked; count 0 when it has none.
+    View vertex_colors(const tinygltf::Primitive& prim, int mesh, size_t pi, size_t nv)
+    {
+        View cv;
+        auto cit = prim.attributes.find("COLOR_0");
+        if (cit == prim.attributes.end()) return cv;
+        char usage[64];
+        snprintf(usage, sizeof usage, "mesh %d primitive %zu COLOR_0", mesh, pi);
+        cv = view_accessor(m, cit->second, what, usage);
+        if ((cv.ncomp != 3 && cv.ncomp != 4) || cv.count != nv)
+            fail(SP_ERR_INVALID, "%s: %s has the wrong type or count", what, usage);
+        // Why: integers read as 0-255 would all clamp to white.
+        bool unorm = (cv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || cv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                     cv.normalized;
+        if (cv.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && !unorm)
+            fail(SP_ERR_INVALID, "%s: %s (accessor %d) must be float or normalized unsigned bytes or shorts", what, usage,
+                 cv.index);
+        return cv;
+    }
+
+    static void add_color(Surface& s, const View& cv, size_t i, const std::array<float, 4>& rgba)
+    {
+        for (int c = 0; c < 4; ++c) {
+            float x = rgba[(size_t)c];
+            if (c < cv.ncomp && cv.count) {
+                double k = read_comp(cv, i, c);
+                x *= (float)(std::isfinite(k) ? std::min(1.0, std::max(0.0, k)) : 1.0);
+            }
+            s.colors.push_back(x);
+        }
+    }
+
+    // The surface vertices of a triangle primitive's indices (appending the
+    // vertices it brings), or an empty list when an identical primitive was
+    // read before (a mesh on two nodes of one skin draws the same triangles).
+    std::vector<uint32_t> place_primitive(const tinygltf::Primitive& prim, int mesh, size_t pi, int skin, Surface& s,
+                                          std::set<std::tuple<ColorKey, int, int>>& seen)
+    {
+        auto attr = [&](const char* name) {
+            auto it = prim.attributes.find(name);
+            return it == prim.attributes.end() ? -1 : it->second;
+        };
+        AttrKey ak = {attr("POSITION"), attr("JOINTS_0"), attr("WEIGHTS_0")};
+        std::array<float, 4> rgba;
+        if (material_color(m, prim.material, what, rgba.data()) && !ch->textured) {
+            ch->textured = true;
+            sp_character_warn(ch, "its base colour texture is not used: sketchpose reads no images, so pictures and "
+                                  "saved files show it grey");
+        }
+        ColorKey ck{ak, attr("COLOR_0"), rgba};
+        auto found = attr_base.find(ak);
+        if (found == attr_base.end()) {
+            Skinned sk;
+            warn_extra_influences(prim, mesh, (int)pi);
+            read_skinned(m, prim, mesh, (int)pi, skin_map(skin), skin, what, sk);
+            size_t nv = sk.rest.size() / 3, base = s.rest.size() / 3;
+            if (base + nv > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
+            View cv = vertex_colors(prim, mesh, pi, nv);
+            s.rest.insert(s.rest.end(), sk.rest.begin(), sk.rest.end());
+            s.joints.insert(s.joints.end(), sk.joints.begin(), sk.joints.end());
+            s.weights.insert(s.weights.end(), sk.weights.begin(), sk.weights.end());
+            for (size_t i = 0; i < nv; ++i)
+                add_color(s, cv, i, rgba);
+            attr_base[ak] = base;
+            Placement& pl = placements[ck];
+            pl.whole = true, pl.base = base;
+        }
+        if (!seen.insert({ck, prim.indices, prim.mode}).second) return {};
+        size_t nv = m.accessors[(size_t)ak[0]].count, src = attr_base[ak];
+        std::vector<uint32_t> idx = read_indices(m, prim, mesh, (int)pi, nv, what);
+        Placement& pl = placements[ck];
+        if (pl.whole) {
+            for (uint32_t& i : idx)
+                i += (uint32_t)pl.base;
+            return idx;
+        }
+        View cv = vertex_colors(prim, mesh, pi, nv);
+        for (uint32_t& i : idx) {
+            auto at = pl.at.find(i);
+            if (at != pl.at.end()) {
+                i = at->second;
+                continue;
+            }
+            size_t from = src + i, to = s.rest.size() / 3;
+            if (to >= 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
+            for (int c = 0; c < 3; ++c)
+                s.rest.push_back(s.rest[3 * from + (size_t)c]);
+            for (int c = 0; c < 4; ++c) {
+                s.joints.push_back(s.joints[4 * from + (size_t)c]);
+                s.weights.push_back(s.weights[4 * from + (size_t)c]);
+            }
+            add_color(s, cv, i, rgba);
+            pl.at[i] = (uint32_t)to;
+            i = (uint32_t)to;
+        }
+        return idx;
+    }
+
+    void read_meshes(int skin)
+    {
+        sp_rig* rig = &ch->rig;
+        Surface s;
+        std::set<std::tuple<ColorKey, int, int>> seen;
         bool warned_unskinned = false, warned_lines = false;
         for (int n : order) {
             const tinygltf::Node& nd = m.nodes[(size_t)n];
@@ -1150,49 +1273,9 @@ struct Importer {
                     warned_unskinned = true;
                     continue;
                 }
-                Skinned s;
-                warn_extra_influences(prim, nd.mesh, (int)pi);
-                read_skinned(m, prim, nd.mesh, (int)pi, skin_map(skin), skin, what, s);
-                size_t nv = s.rest.size() / 3, base = rest.size() / 3;
-                if (base + nv > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
-                rest.insert(rest.end(), s.rest.begin(), s.rest.end());
-                joints.insert(joints.end(), s.joints.begin(), s.joints.end());
-                weights.insert(weights.end(), s.weights.begin(), s.weights.end());
-                float rgba[4];
-                if (material_color(m, prim.material, what, rgba) && !ch->textured) {
-                    ch->textured = true;
-                    sp_character_warn(ch, "its base colour texture is not used: sketchpose reads no images, so pictures and "
-                                          "saved files show it grey");
-                }
-                size_t cbase = colors.size();
-                colors.resize(cbase + 4 * nv);
-                for (size_t i = 0; i < nv; ++i)
-                    for (int c = 0; c < 4; ++c)
-                        colors[cbase + 4 * i + (size_t)c] = rgba[c];
-                auto cit = prim.attributes.find("COLOR_0");
-                if (cit != prim.attributes.end()) {
-                    char usage[64];
-                    snprintf(usage, sizeof usage, "mesh %d primitive %zu COLOR_0", nd.mesh, pi);
-                    View cv = view_accessor(m, cit->second, what, usage);
-                    if ((cv.ncomp != 3 && cv.ncomp != 4) || cv.count != nv)
-                        fail(SP_ERR_INVALID, "%s: %s has the wrong type or count", what, usage);
-                    // Why: integers read as 0-255 would all clamp to white.
-                    bool unorm =
-                        (cv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || cv.comp == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
-                        cv.normalized;
-                    if (cv.comp != TINYGLTF_COMPONENT_TYPE_FLOAT && !unorm)
-                        fail(SP_ERR_INVALID, "%s: %s (accessor %d) must be float or normalized unsigned bytes or shorts", what,
-                             usage, cv.index);
-                    for (size_t i = 0; i < nv; ++i)
-                        for (int c = 0; c < cv.ncomp; ++c) {
-                            double x = read_comp(cv, i, c);
-                            if (!std::isfinite(x)) x = 1.0;
-                            colors[cbase + 4 * i + (size_t)c] *= (float)std::min(1.0, std::max(0.0, x));
-                        }
-                }
-                std::vector<uint32_t> idx = read_indices(m, prim, nd.mesh, (int)pi, nv, what);
+                std::vector<uint32_t> idx = place_primitive(prim, nd.mesh, pi, skin, s, seen);
                 auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
-                    tris.push_back((uint32_t)base + a), tris.push_back((uint32_t)base + b), tris.push_back((uint32_t)base + c);
+                    s.tris.push_back(a), s.tris.push_back(b), s.tris.push_back(c);
                 };
                 if (mode == TINYGLTF_MODE_TRIANGLES) {
                     if (idx.size() % 3)
@@ -1212,17 +1295,17 @@ struct Importer {
                 }
             }
         }
-        if (rest.empty() && warned_lines)
+        if (s.rest.empty() && warned_lines)
             fail(SP_ERR_INVALID, "%s: the skinned mesh is only lines (LINES, LINE_STRIP or LINE_LOOP): no surface to pose", what);
-        if (rest.empty()) fail(SP_ERR_INVALID, "%s: the skinned mesh has no vertices", what);
-        if (tris.size() / 3 > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many triangles", what);
-        rig->rest = c_array(rest);
-        rig->joints4 = c_array(joints);
-        rig->weights4 = c_array(weights);
-        rig->vertex_count = (int)(rest.size() / 3);
-        rig->triangles = c_array(tris);
-        rig->triangle_count = (int)(tris.size() / 3);
-        ch->colors = c_array(colors);
+        if (s.rest.empty()) fail(SP_ERR_INVALID, "%s: the skinned mesh has no vertices", what);
+        if (s.tris.size() / 3 > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many triangles", what);
+        rig->rest = c_array(s.rest);
+        rig->joints4 = c_array(s.joints);
+        rig->weights4 = c_array(s.weights);
+        rig->vertex_count = (int)(s.rest.size() / 3);
+        rig->triangles = c_array(s.tris);
+        rig->triangle_count = (int)(s.tris.size() / 3);
+        ch->colors = c_array(s.colors);
     }
 
     void read_curve(const tinygltf::Node& nd, int n, const tinygltf::Primitive& prim, int mesh, int pi, int mode,

@@ -71,21 +71,31 @@ static const char* write_mini(const char* name, const mini_desc* d)
     return path;
 }
 
-// mini_gltf's text with the first `from` replaced by `to`, written to name.
-static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
+// mini_gltf's text with, in turn, the first from[k] replaced by to[k] for
+// each of the n edits, written to name.
+static const char* write_edits(const char* name, const mini_desc* d, int n, const char* const* from, const char* const* to)
 {
     char* text = mini_gltf(d);
-    char* at = strstr(text, from);
-    ENSURE(at);
-    size_t head = (size_t)(at - text), nf = strlen(from), nt = strlen(to), n = strlen(text) - nf + nt;
-    char* out = malloc(n + 1);
-    memcpy(out, text, head);
-    memcpy(out + head, to, nt);
-    strcpy(out + head + nt, at + nf);
+    for (int k = 0; k < n; ++k) {
+        char* at = strstr(text, from[k]);
+        ENSURE(at);
+        size_t head = (size_t)(at - text), nf = strlen(from[k]), nt = strlen(to[k]), len = strlen(text) - nf + nt;
+        char* out = malloc(len + 1);
+        memcpy(out, text, head);
+        memcpy(out + head, to[k], nt);
+        strcpy(out + head + nt, at + nf);
+        free(text);
+        text = out;
+    }
     const char* path = sp_test_tmp_path(name);
-    ENSURE(mini_write(path, out, n));
-    free(text), free(out);
+    ENSURE(mini_write(path, text, strlen(text)));
+    free(text);
     return path;
+}
+
+static const char* write_edited(const char* name, const mini_desc* d, const char* from, const char* to)
+{
+    return write_edits(name, d, 1, &from, &to);
 }
 
 // Skinned mesh vertices of ch at p (malloc'd, vertex_count by 3).
@@ -353,6 +363,51 @@ static void test_mini_plain(void)
     ch = load_ok(write_edited("influences8.gltf", &(mini_desc){0}, "\"WEIGHTS_0\": 2}",
                               "\"WEIGHTS_0\": 2, \"JOINTS_1\": 1, \"WEIGHTS_1\": 2}"));
     ENSURE(sp_fixture_has_warning(&ch, "mesh 0 primitive 0: JOINTS_1/WEIGHTS_1 ignored (at most 4 joints a vertex)"));
+    sp_character_free(&ch);
+}
+
+// Primitives that share one vertex array (exporters that split a mesh by
+// material write them) bring its vertices once; a second colouring brings
+// only the vertices its triangles use, and a repeated primitive nothing.
+static void test_shared_vertices(void)
+{
+    const char* prim = "{\"attributes\": {\"POSITION\": 0, \"JOINTS_0\": 1, \"WEIGHTS_0\": 2}, \"mode\": 4";
+    size_t cap = 2100 * 128;
+    char* prims = malloc(cap);
+    int at = snprintf(prims, cap, "\"material\": 0}");
+    // Then, over and over to 2,000 primitives: the same two triangles, the
+    // first triangle in a second material, and the first triangle again.
+    for (int k = 1; k < 2000; ++k)
+        at += snprintf(prims + at, cap - (size_t)at, ", %s, \"indices\": %d, \"material\": %d}", prim, k % 3 ? 6 : 3, k % 3 == 1);
+    snprintf(prims + at, cap - (size_t)at, "]},");
+    const char* from[] = {"\"material\": 0}]},", "\"count\": 4, \"type\": \"VEC4\"}\n ],",
+                          "{\"baseColorFactor\": [0.9, 0.3, 0.1, 1]}}"};
+    const char* to[] = {prims,
+                        "\"count\": 4, \"type\": \"VEC4\"},\n"
+                        "  {\"bufferView\": 3, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}\n ],",
+                        "{\"baseColorFactor\": [0.9, 0.3, 0.1, 1]}}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.2, 0.4, "
+                        "0.6, 1]}}"};
+    sp_character ch = load_ok(write_edits("shared_vertices.gltf", &(mini_desc){0}, 3, from, to));
+    free(prims);
+    // 4 of the first material's, and vertices 0-2 again in the second's.
+    ENSURE(ch.rig.vertex_count == 7);
+    // Both triangles, the first in the second material, the first again.
+    ENSURE(ch.rig.triangle_count == 4);
+    for (int v = 4; v < 7; ++v) {
+        for (int c = 0; c < 3; ++c)
+            ENSURE(ch.rig.rest[3 * v + c] == ch.rig.rest[3 * (v - 4) + c]);
+        for (int c = 0; c < 4; ++c)
+            ENSURE(ch.rig.joints4[4 * v + c] == ch.rig.joints4[4 * (v - 4) + c] &&
+                   ch.rig.weights4[4 * v + c] == ch.rig.weights4[4 * (v - 4) + c]);
+        ENSURE_NEAR(ch.colors[4 * v], 0.2, 1e-6);
+        ENSURE_NEAR(ch.colors[4 * v + 2], 0.6, 1e-6);
+    }
+    ENSURE_NEAR(ch.colors[4 * 3], 0.9, 1e-6);
+    // The second material's triangle is made of its own vertices.
+    int second = 0;
+    for (int t = 0; t < ch.rig.triangle_count; ++t)
+        second += ch.rig.triangles[3 * t] >= 4 && ch.rig.triangles[3 * t + 1] >= 4 && ch.rig.triangles[3 * t + 2] >= 4;
+    ENSURE(second == 1);
     sp_character_free(&ch);
 }
 
@@ -862,6 +917,7 @@ int main(int argc, char** argv)
                                    {"simple_skins", test_simple_skins},
                                    {"cesium_round_trip", test_cesium_round_trip},
                                    {"mini_plain", test_mini_plain},
+                                   {"shared_vertices", test_shared_vertices},
                                    {"mini_extras", test_mini_extras},
                                    {"fixture_round_trip", test_fixture_round_trip},
                                    {"part_round_trip", test_part_round_trip},
