@@ -4,6 +4,7 @@
 // of such a rig (model.h).
 #include "sp/blackbox.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +13,7 @@
 
 #include "blackbox_internal.h"
 #include "model.h"
+#include "sp/clock.h"
 #include "sp/synth.h"
 #include "synth_internal.h"
 
@@ -469,7 +471,8 @@ struct sp_blackbox_fd {
     pthread_cond_t wake, done;
     unsigned generation;
     int next_col, busy;
-    bool quit;
+    bool quit, timed_out;
+    double deadline_ms;
     const double* p;
 };
 
@@ -530,7 +533,11 @@ static void column(sp_blackbox_fd* fd, fd_lane* ln, int k)
 static void drain(sp_blackbox_fd* fd, fd_lane* ln)
 {
     for (;;) {
+        // A rig that takes a second an evaluation would otherwise overrun
+        // the solve's time cap by 2 P seconds.
+        const bool late = sp_now_ms() > fd->deadline_ms;
         pthread_mutex_lock(&fd->mu);
+        if (late) fd->timed_out = true, fd->next_col = fd->bb->P;
         int k = fd->next_col < fd->bb->P ? fd->next_col++ : -1;
         pthread_mutex_unlock(&fd->mu);
         if (k < 0) return;
@@ -591,6 +598,7 @@ sp_result sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, const in
     fd->npts = bb->abs[abstraction].point_count;
     fd->nrows = nrows;
     fd->M = 3 * (nrows + fd->npts);
+    fd->deadline_ms = INFINITY;
     fd->threads = threads > 0 ? threads : online_cores();
     if (fd->threads > bb->P) fd->threads = bb->P;
     fd->rows = malloc(sizeof(int) * (size_t)(nrows + 1));
@@ -660,6 +668,13 @@ int sp_blackbox_fd_threads(const sp_blackbox_fd* fd)
     return fd->threads;
 }
 
+void sp_blackbox_fd_set_deadline(sp_blackbox_fd* fd, double deadline_ms)
+{
+    pthread_mutex_lock(&fd->mu);
+    fd->deadline_ms = deadline_ms;
+    pthread_mutex_unlock(&fd->mu);
+}
+
 sp_result sp_blackbox_fd_jacobian(sp_blackbox_fd* fd, const double* p, double* J_rows, double* J_abs, sp_error* err)
 {
     const sp_blackbox* bb = fd->bb;
@@ -667,6 +682,7 @@ sp_result sp_blackbox_fd_jacobian(sp_blackbox_fd* fd, const double* p, double* J
     pthread_mutex_lock(&fd->mu);
     fd->p = p;
     fd->next_col = 0;
+    fd->timed_out = false;
     fd->busy = fd->threads - 1;
     ++fd->generation;
     pthread_cond_broadcast(&fd->wake);
@@ -675,7 +691,9 @@ sp_result sp_blackbox_fd_jacobian(sp_blackbox_fd* fd, const double* p, double* J
     pthread_mutex_lock(&fd->mu);
     while (fd->busy > 0)
         pthread_cond_wait(&fd->done, &fd->mu);
+    const bool timed_out = fd->timed_out;
     pthread_mutex_unlock(&fd->mu);
+    if (timed_out) return sp_fail(err, SP_ERR_TIMEOUT, "%s: the time cap ran out during a finite-difference Jacobian", bb->what);
     // The first failing column (in parameter order, whatever thread ran it) names the problem.
     for (int k = 0; k < P; ++k)
         if (fd->status[k] != 0) {
@@ -793,8 +811,13 @@ static void bbm_jacobians(sp_model* m, const int* reps, int k, const sparse_bloc
     }
     sp_error e = {0};
     B->J_valid = false;
-    if (sp_blackbox_fd_jacobian(B->fd, B->p, Jr, Jz, &e) != SP_OK) {
-        bbm_fail(B, &e);
+    sp_blackbox_fd_set_deadline(B->fd, m->deadline_ms);
+    sp_result r = sp_blackbox_fd_jacobian(B->fd, B->p, Jr, Jz, &e);
+    if (r != SP_OK) {
+        if (r == SP_ERR_TIMEOUT)
+            m->timed_out = true; // not the rig's fault: the solve stops with what it has
+        else
+            bbm_fail(B, &e);
         memset(Jr, 0, sizeof(double) * nr);
         memset(Jz, 0, sizeof(double) * nz);
         return;

@@ -204,6 +204,10 @@ static bool iterate_round(sp_solver* s, attempt_run* r, int its, const sp_weight
         }
         ++r->rep->iterations;
         sp_step_result got = sp__gauss_newton_iteration(s, &r->it, r->moves, w);
+        if (s->model->timed_out) {
+            r->time_up = true;
+            break;
+        }
         if (got != SP_STEP_TAKEN) return got == SP_STEP_FAILED;
     }
     return false;
@@ -356,7 +360,8 @@ static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_
     }
     sp__start_pose(s, p_start, r.it.p);
     memcpy(s->p0, r.it.p, sizeof(double) * (size_t)s->P);
-    s->model->failed = false;
+    s->model->failed = s->model->timed_out = false;
+    s->model->deadline_ms = r.t0 + time_cap_ms;
     const double iou = start_view(s, sk, r.it.p);
     rep->bbox_diagonal_px = s->L;
     plan_attempt(s, sk, at, iou, pl);
@@ -368,6 +373,7 @@ static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_
     if (res == SP_OK) res = run_plan(s, &r, p_out);
     rep->ms = sp_now_ms() - r.t0;
 done:
+    s->model->deadline_ms = INFINITY;
     free(r.it.p), free(r.it.trial), free(r.it.delta), free(r.moves);
     return res;
 }

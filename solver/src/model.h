@@ -72,6 +72,8 @@ struct sp_model {
     int placement_count;      // the first n parameters place the root (first solve stage); 0: no such stage
     bool closed_reg;          // prepare chose the reg_* calls for W_plane and W_dist (see sp_model_ops)
     bool failed;              // an evaluation failed (black-box rigs); `error` says why
+    double deadline_ms;       // sp_now_ms() by which the solve must end (INFINITY: none)
+    bool timed_out;           // the deadline passed inside a Jacobian (black-box rigs): no step from it
     sp_error error;
 };
 

@@ -24,6 +24,8 @@ const char* sp_result_name(sp_result r)
     case SP_ERR_NO_MEMORY: return "out of memory";
     case SP_ERR_BUSY: return "busy";
     case SP_ERR_INTERNAL: return "internal error";
+    case SP_ERR_TIMEOUT:
+        return "time cap reached";
     }
     return "unknown";
 }

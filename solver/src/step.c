@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "solver_internal.h"
+#include "sp/clock.h"
 
 // Solves (H_ff + mu diag) delta_f = -g_f over the free parameters, within
 // the bounds: a parameter whose step would leave its box is put on the bound
@@ -159,8 +160,14 @@ sp_step_result sp__gauss_newton_iteration(sp_solver* s, sp_iterate* it, const bo
 {
     const int P = s->P;
     sp__linearise(s, it->p, !it->z_at_p, w);
+    if (s->model->timed_out) return SP_STEP_NONE; // no Jacobian to step by
     choose_free(s, it->p, moves);
     for (int tries = 0; tries < 12; ++tries) {
+        // Each try evaluates the rig: a slow black box would overrun the cap.
+        if (tries > 0 && sp_now_ms() > s->model->deadline_ms) {
+            s->model->timed_out = true;
+            return SP_STEP_NONE;
+        }
         if (!lm_step(s, it->p, it->mu, it->delta)) {
             it->mu *= 10;
             continue;

@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 
 #include "fixtures.h"
 #include "sp/blackbox.h"
@@ -31,12 +32,14 @@ typedef struct lbs_box {
     atomic_int out_of_bounds; // evaluations asked for outside the bounds
     atomic_int calls;
     bool short_write; // evaluate() leaves the last abstraction point unwritten
+    int sleep_ms;     // each evaluate() takes at least this long
 } lbs_box;
 
 static int lbs_evaluate(void* user, const double* p, double* x, double* z)
 {
     lbs_box* b = user;
     atomic_fetch_add(&b->calls, 1);
+    if (b->sleep_ms > 0) nanosleep(&(struct timespec){0, b->sleep_ms * 1000000L}, NULL);
     for (int k = 0; k < b->rig->param_count; ++k)
         if (p[k] < b->rig->params[k].min || p[k] > b->rig->params[k].max) atomic_fetch_add(&b->out_of_bounds, 1);
     // An evaluator per call: the black-box contract allows concurrent calls.
@@ -207,6 +210,46 @@ static void test_lbs_as_blackbox_solves(void)
     sp_solver_destroy(sb);
     sp_blackbox_destroy(bb);
     free(truth), free(pa), free(pb), free(box.rest);
+    sp_rig_free(&rig);
+}
+
+// The time cap holds inside a finite-difference Jacobian and between the
+// damped tries: a rig slow to evaluate stops the solve near the cap, with
+// the best pose so far, not 2 P evaluations later.
+static void test_time_cap_slow_rig(void)
+{
+    sp_rig rig;
+    sp_fixture_tree_rig(&(sp_fixture_desc){.joint_count = 8, .seed = 3}, &rig);
+    lbs_box box;
+    lbs_box_init(&box, &rig);
+    sp_blackbox* bb = NULL;
+    ENSURE(sp_blackbox_open(&box.desc, "slow box", &bb, NULL) == SP_OK);
+    sp_camera cam = sp_camera_default_view(rig.rest, rig.vertex_count, 640, 480);
+    const int P = rig.param_count;
+    ENSURE(P >= 20);
+    double *truth = malloc(sizeof(double) * P), *p = malloc(sizeof(double) * P);
+    sp_synth_params(&rig, 5, 0.6, truth);
+    sp_sketch sk;
+    ENSURE(sp_synth_sketch(&rig, 0, &cam, truth, &sk) == SP_OK);
+    sp_solver* s = NULL;
+    ENSURE(sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){.threads = 1, .time_cap_ms = 100}, &s, NULL) == SP_OK);
+    // At least 10 ms an evaluation: at most 10 begin before the cap, where
+    // one Jacobian alone asks for 2 P.
+    box.sleep_ms = 10;
+    atomic_store(&box.calls, 0);
+    sp_solve_report rep;
+    sp_error err = {0};
+    ENSURE(sp_solver_solve(s, &sk, NULL, p, &rep, &err) == SP_OK);
+    int calls = atomic_load(&box.calls);
+    printf("  %d parameters, %d evaluations, %.0f ms, stopped: %s\n", P, calls, rep.ms, sp_stop_reason_name(rep.stopped));
+    ENSURE(rep.stopped == SP_STOP_TIME_CAP);
+    ENSURE(calls < P);
+    for (int k = 0; k < P; ++k)
+        ENSURE(isfinite(p[k]) && p[k] >= rig.params[k].min && p[k] <= rig.params[k].max);
+    sp_solver_destroy(s);
+    sp_sketch_free(&sk);
+    sp_blackbox_destroy(bb);
+    free(truth), free(p), free(box.rest);
     sp_rig_free(&rig);
 }
 
@@ -924,6 +967,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"fd_matches_analytic", test_fd_matches_analytic},
                                    {"lbs_as_blackbox_solves", test_lbs_as_blackbox_solves},
+                                   {"time_cap_slow_rig", test_time_cap_slow_rig},
                                    {"face_asset", test_face_asset},
                                    {"face_no_inversions", test_face_no_inversions},
                                    {"threads_bit_identical", test_threads_bit_identical},

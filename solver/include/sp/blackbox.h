@@ -184,11 +184,16 @@ sp_result sp_blackbox_fd_create(const sp_blackbox* bb, int abstraction, const in
 void sp_blackbox_fd_destroy(sp_blackbox_fd* fd);
 /// Threads the engine uses.
 int sp_blackbox_fd_threads(const sp_blackbox_fd* fd);
+/// Wall-clock time (sp_now_ms) after which sp_blackbox_fd_jacobian begins
+/// no more columns and returns SP_ERR_TIMEOUT; INFINITY (the default): none.
+/// A column already begun runs to its end.
+void sp_blackbox_fd_set_deadline(sp_blackbox_fd* fd, double deadline_ms);
 /// dx/dp at p for the rows (J_rows: (3 * nrows) by param_count, row-major)
 /// and dz/dp for the abstraction's points (J_abs: (3 * points) by
 /// param_count); either may be NULL. Each column is computed by one thread
 /// from its own evaluations, so the result is bit-identical for any thread
-/// count and timing. Fails (naming the parameter) if an evaluation fails.
+/// count and timing. Fails (naming the parameter) if an evaluation fails, and
+/// with SP_ERR_TIMEOUT when the deadline passes first.
 sp_result sp_blackbox_fd_jacobian(sp_blackbox_fd* fd, const double* p, double* J_rows, double* J_abs, sp_error* err);
 
 /// A solver for a black-box rig: the same energy, regularisers, coarsening,

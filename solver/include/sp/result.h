@@ -24,6 +24,7 @@ typedef enum sp_result {
     SP_ERR_NO_MEMORY,   ///< an allocation failed
     SP_ERR_BUSY,        ///< a resource (database) is held by someone else
     SP_ERR_INTERNAL,    ///< a bug or an exception from a library
+    SP_ERR_TIMEOUT,     ///< a time cap ran out before the work was done
 } sp_result;
 
 /// One-line error message. Zero-initialise before use.
