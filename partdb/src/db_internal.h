@@ -64,9 +64,18 @@ sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* er
 sp_result db_read_json(const char* path, cJSON** root, sp_error* err);
 /// Writes a whole file.
 sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err);
+/// What a training set holds and leaves out.
+typedef struct db_training_counts {
+    int unused;           ///< sketches of categories with no part
+    int kiosk;            ///< approved kiosk sketches in the set
+    int curated;          ///< curated sketches in the set
+    int curated_left_out; ///< curated sketches of the set's categories past the cap
+} db_training_counts;
 /// The training set: sp_db_load_dataset with at most `kiosk_cap` approved
-/// kiosk sketches per category (the newest); *kiosk (may be NULL) counts them.
-sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* unused, int* kiosk, sp_error* err);
+/// kiosk sketches per category (the newest) and `curated_max` curated ones
+/// (-1: all; spread over those stored); `counts` may be NULL.
+sp_result db_load_training_set(sp_db* db, int kiosk_cap, int curated_max, sp_dataset* out, db_training_counts* counts,
+                               sp_error* err);
 /// A dataset of one category and n zeroed samples (count 0: the caller fills them in and counts).
 sp_result db_dataset_one(sp_dataset* out, const char* category, int n, sp_error* err);
 /// A dataset with no samples whose categories are the distinct string values

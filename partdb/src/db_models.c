@@ -75,6 +75,16 @@ static sp_result calibration_set(sp_db* db, const sp_dataset* like, int per_part
     return r;
 }
 
+// The training report's first fields: what the set holds.
+static void report_head(db_str* rep, const char* cats, int drawings, const db_training_counts* n, int folds)
+{
+    db_str_printf(
+        rep,
+        "{\"categories\": %s, \"drawings\": %d, \"kiosk_sketches\": %d, \"curated_sketches\": %d, \"curated_left_out\": %d,"
+        " \"unused_drawings\": %d, \"folds\": %d",
+        cats ? cats : "[]", drawings, n->kiosk, n->curated, n->curated_left_out, n->unused, folds);
+}
+
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err)
 {
     if (report_json) *report_json = NULL;
@@ -83,8 +93,9 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     int folds = d.folds == 0 ? 3 : d.folds < 0 ? 0 : d.folds;
     double t0 = now_s();
     sp_dataset ds;
-    int unused = 0, kiosk = 0;
-    sp_result r = db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, &ds, &unused, &kiosk, err);
+    db_training_counts n;
+    sp_result r =
+        db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, d.curated_max ? d.curated_max : SP_DB_CURATED_TRAIN_MAX, &ds, &n, err);
     if (r != SP_OK) return r;
     sp_clf* clf = NULL;
     void* bytes = NULL;
@@ -148,8 +159,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     db_str cb = {0};
     cats_json(&cb, ds.categories, ds.category_count);
     cats_s = cb.s;
-    db_str_printf(&rep, "{\"categories\": %s, \"drawings\": %d, \"kiosk_sketches\": %d, \"unused_drawings\": %d, \"folds\": %d",
-                  cats_s ? cats_s : "[]", ds.count, kiosk, unused, folds);
+    report_head(&rep, cats_s, ds.count, &n, folds);
     if (folds > 0) {
         db_str_printf(&rep, ", \"top1\": %.4f, \"per_class\": {", cv_n ? (double)cv_ok / cv_n : 0.0);
         for (int c = 0; c < ds.category_count; ++c) {

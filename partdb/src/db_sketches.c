@@ -221,14 +221,39 @@ static int find_cat(char** cats, int n, const char* c)
 
 sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err)
 {
-    return db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, out, unused, NULL, err);
+    db_training_counts n;
+    sp_result r = db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, SP_DB_CURATED_TRAIN_MAX, out, &n, err);
+    if (unused) *unused = n.unused;
+    return r;
 }
 
-sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* unused, int* kiosk, sp_error* err)
+// Curated sketches past the cap: of the set's categories (cats, sorted) in
+// n->curated_left_out, of others in n->unused (the rows never read).
+static sp_result curated_past_cap(sp_db* db, char** cats, int ncat, int cap, db_training_counts* n, sp_error* err)
+{
+    if (cap < 0) return SP_OK;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT category, count(*) FROM sketches WHERE source = 'curated' GROUP BY category", &st, err);
+    if (r != SP_OK) return r;
+    int rc;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        int past = sqlite3_column_int(st, 1) - cap;
+        if (past <= 0) continue;
+        if (find_cat(cats, ncat, (const char*)sqlite3_column_text(st, 0)) >= 0)
+            n->curated_left_out += past;
+        else
+            n->unused += past;
+    }
+    if (rc != SQLITE_DONE) r = db_fail(db, rc, "counting curated sketches", err);
+    sqlite3_finalize(st);
+    return r;
+}
+
+sp_result db_load_training_set(sp_db* db, int kiosk_cap, int curated_max, sp_dataset* out, db_training_counts* counts,
+                               sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    if (unused) *unused = 0;
-    if (kiosk) *kiosk = 0;
+    db_training_counts n = {0};
     // One read transaction: categories and sketches are one consistent snapshot.
     sp_result r = db_exec(db, "BEGIN", err);
     if (r != SP_OK) return r;
@@ -240,29 +265,36 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* u
     }
     out->categories = cats;
     out->category_count = ncat;
-    sqlite3_stmt* st;
-    // Every synthetic and curated sketch, and of the approved kiosk sketches
-    // the newest `kiosk_cap` per category (a year of visitors would otherwise
-    // swamp the parts' own sketches and the training time).
-    if ((r = db_prepare(
+    sqlite3_stmt* st = NULL;
+    // Every synthetic sketch; of the approved kiosk sketches the newest
+    // `kiosk_cap` per category (a year of visitors would otherwise
+    // swamp the parts' own sketches and the training time); of the curated
+    // ones `curated_max` per category, ordered by a fixed hash of the id so
+    // that they spread over all that were added, early and late (a curator's
+    // 30,000 made an 18-minute training and a 2.3 GB kiosk).
+    if ((r = curated_past_cap(db, cats, ncat, curated_max, &n, err)) != SP_OK ||
+        (r = db_prepare(
              db,
-             "SELECT id, category, strokes, raster_w, raster_h, raster, source = 'kiosk' FROM sketches"
-             " WHERE source <> 'kiosk' OR id IN (SELECT id FROM (SELECT id, row_number() OVER"
+             "SELECT id, category, strokes, raster_w, raster_h, raster, source FROM sketches"
+             " WHERE source = 'synthetic' OR id IN (SELECT id FROM (SELECT id, row_number() OVER"
              " (PARTITION BY category ORDER BY id DESC) AS k FROM sketches WHERE source = 'kiosk' AND status = 'approved')"
-             " WHERE k <= ?1) ORDER BY category, id",
+             " WHERE k <= ?1) OR id IN (SELECT id FROM (SELECT id, row_number() OVER"
+             " (PARTITION BY category ORDER BY (id * 2654435761) % 4294967311, id) AS k FROM sketches WHERE source = 'curated')"
+             " WHERE ?2 < 0 OR k <= ?2) ORDER BY category, id",
              &st, err)) != SP_OK) {
         db_rollback(db);
         sp_dataset_free(out);
         return r;
     }
     sqlite3_bind_int(st, 1, kiosk_cap);
+    sqlite3_bind_int(st, 2, curated_max);
     int rc, cap = 0;
     int* per_cat = calloc((size_t)(ncat > 0 ? ncat : 1), sizeof(int));
     if (!per_cat) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         int label = find_cat(cats, ncat, (const char*)sqlite3_column_text(st, 1));
         if (label < 0) {
-            if (unused) ++*unused;
+            ++n.unused;
             continue;
         }
         if (out->count == cap) {
@@ -297,7 +329,9 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* u
         }
         if (r == SP_OK) {
             ++out->count;
-            if (kiosk) *kiosk += sqlite3_column_int(st, 6);
+            const char* source = (const char*)sqlite3_column_text(st, 6);
+            n.kiosk += source && !strcmp(source, "kiosk");
+            n.curated += source && !strcmp(source, "curated");
         } else {
             sp_sketch_free(&s->sketch);
             sp_raster_free(&s->raster);
@@ -308,5 +342,6 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, sp_dataset* out, int* u
     db_rollback(db);
     free(per_cat);
     if (r != SP_OK) sp_dataset_free(out);
+    if (counts) *counts = n;
     return r;
 }

@@ -198,8 +198,9 @@ sp_result sp_db_sketch_count_by(sp_db* db, sp_db_source source, const char* by, 
 #define SP_DB_BY_DRAWINGS "drawings"
 /// The training set: the stored sketches of the current part categories as a
 /// dataset (categories = sp_db_categories), kiosk sketches only when approved
-/// (the newest SP_DB_KIOSK_TRAIN_MAX per category); `unused` (may be NULL)
-/// counts sketches of other categories.
+/// (the newest SP_DB_KIOSK_TRAIN_MAX per category), curated ones at most
+/// SP_DB_CURATED_TRAIN_MAX per category; `unused` (may be NULL) counts
+/// sketches of other categories.
 sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err);
 
 // ---- visitors' strokes (kiosk sketches) -------------------------------------------
@@ -212,6 +213,11 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
 /// `db train` within 2 minutes on 2 cores with a year of visitors stored
 /// (BENCHMARKS.md, "Kiosk sketches").
 #define SP_DB_KIOSK_TRAIN_MAX 200
+/// Curated sketches per category in a training set (sp_db_train_desc.curated_max
+/// by default), spread over those stored: without a cap a curator's 30,000
+/// made an 18-minute `db train` and a 2.3 GB kiosk (BENCHMARKS.md, "Curated
+/// sketches").
+#define SP_DB_CURATED_TRAIN_MAX 400
 
 /// Review status of a kiosk sketch.
 typedef enum sp_db_status { SP_DB_PENDING, SP_DB_APPROVED, SP_DB_REJECTED, SP_DB_STATUS_COUNT } sp_db_status;
@@ -283,13 +289,15 @@ typedef struct sp_db_train_desc {
     /// the training set's leave-one-out threshold.
     int calibrate;
     double calibrate_quantile; ///< share of the calibration sketches accepted; 0: 0.96
+    int curated_max;           ///< curated sketches per category trained on; 0: SP_DB_CURATED_TRAIN_MAX; -1: all
 } sp_db_train_desc;
 /// Rebuilds the classifier from the stored sketches of the current part
-/// categories (synthetic, curated, and approved kiosk sketches: the newest
+/// categories (synthetic, curated: `curated_max` per category, and approved kiosk sketches: the newest
 /// SP_DB_KIOSK_TRAIN_MAX per category), cross-validates it for the report, calibrates its reject
 /// threshold on fresh hand-drawn sketches of the parts, and stores the model with
 /// its options and report in one transaction. `report_json` (may be NULL) gets
-/// the report: {"categories", "drawings", "kiosk_sketches" (approved kiosk sketches among the drawings), "folds", "top1",
+/// the report: {"categories", "drawings", "kiosk_sketches" (approved kiosk sketches among the drawings), "curated_sketches"
+/// (likewise), "curated_left_out" (stored past the cap), "unused_drawings" (other categories'), "folds", "top1",
 /// "per_class": {"<cat>": {"recall", "n"}}, "seconds_train", "seconds_cv", "reject_distance", "calibration": {"sketches",
 /// "quantile"} (absent without calibration)} (malloc'd, free()). Fails when a part category has no sketches.
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err);
