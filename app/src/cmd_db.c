@@ -1,5 +1,6 @@
 // cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -870,19 +871,37 @@ static void print_kiosk_sketch(const sp_db_kiosk_sketch* k)
     printf("}");
 }
 
-// Reads the ids of --approve/--reject/--relabel: positive integers, else one line and false.
-static bool parse_ids(const char* cmd, const sp_str_list* l, int first, int count, int64_t* ids)
+// One positive id at *s, up to `stop` ('\0' or '-'); *s moves past it.
+static bool parse_id(const char** s, char stop, int64_t* id)
 {
+    char* end = NULL;
+    errno = 0;
+    long long x = isdigit((unsigned char)**s) ? strtoll(*s, &end, 10) : 0;
+    if (!end || *end != stop || x <= 0 || errno == ERANGE) return false;
+    *id = x;
+    *s = end + (stop != 0);
+    return true;
+}
+
+// Reads the values of --approve/--reject/--relabel: ids (positive integers)
+// and, unless ranges is NULL, FIRST-LAST ranges; else one line and false.
+static bool parse_ids(const char* cmd, const sp_str_list* l, int count, int64_t* ids, int* n, sp_db_kiosk_range* ranges, int* nr)
+{
+    *n = 0;
+    if (nr) *nr = 0;
     for (int i = 0; i < count; ++i) {
-        const char* v = l->items[first + i];
-        char* end = NULL;
-        errno = 0;
-        long long x = strtoll(v, &end, 10);
-        if (end == v || *end || x <= 0 || errno == ERANGE) {
-            fprintf(stderr, "%s: '%s' is not a kiosk sketch id (a positive number); nothing was changed\n", cmd, v);
+        const char* v = l->items[i];
+        const char* s = v;
+        sp_db_kiosk_range g;
+        if (parse_id(&s, 0, &ids[*n])) {
+            ++*n;
+        } else if (ranges && parse_id(&s, '-', &g.first) && parse_id(&s, 0, &g.last) && g.first <= g.last) {
+            ranges[(*nr)++] = g;
+        } else {
+            fprintf(stderr, "%s: '%s' is not a kiosk sketch id (a positive number)%s; nothing was changed\n", cmd, v,
+                    ranges ? " or a range of them (FIRST-LAST, FIRST <= LAST)" : "");
             return false;
         }
-        ids[i] = x;
     }
     return true;
 }
@@ -900,8 +919,10 @@ static int db_review(int argc, char** argv)
         {"--limit", SP_OPT_INT, &limit, "N", "list at most N, oldest first (default 100; 0: all)", false},
         {"--after", SP_OPT_INT, &after, "ID", "list only ids above ID (the next page: the last id shown)", false},
         {"--sheet", SP_OPT_OUT, &sheet, "out.png", "also draw the listed sketches as a labelled contact sheet", false},
-        {"--approve", SP_OPT_LIST, &approve, "ID...", "approve these kiosk sketches (`db train` uses approved ones)", false},
-        {"--reject", SP_OPT_LIST, &reject, "ID...", "reject these kiosk sketches (kept, never trained on)", false},
+        {"--approve", SP_OPT_LIST, &approve, "ID...",
+         "approve these kiosk sketches (`db train` uses approved ones); FIRST-LAST: the pending ones from FIRST to LAST", false},
+        {"--reject", SP_OPT_LIST, &reject, "ID...",
+         "reject these kiosk sketches (kept, never trained on); FIRST-LAST: the pending ones from FIRST to LAST", false},
         {"--relabel", SP_OPT_LIST, &relabel, "ID CATEGORY", "give a kiosk sketch another part category", false}};
     const char* pos[1];
     int npos;
@@ -942,14 +963,15 @@ static int db_review(int argc, char** argv)
     sp_error err = {0};
     if (actions) {
         const sp_str_list* l = approve.count ? &approve : reject.count ? &reject : &relabel;
-        int n = relabel.count ? 1 : l->count;
-        int64_t ids[256];
-        if (!parse_ids(cmd, l, 0, n, ids)) return SP_EXIT_INPUT;
+        int64_t ids[256], *changed = NULL;
+        sp_db_kiosk_range ranges[256];
+        int n, nr = 0, m = 0;
+        if (!parse_ids(cmd, l, relabel.count ? 1 : l->count, ids, &n, relabel.count ? NULL : ranges, &nr)) return SP_EXIT_INPUT;
         sp_db* db = open_db(cmd, &c, 0);
         if (!db) return SP_EXIT_INPUT;
-        sp_result r = relabel.count
-                          ? sp_db_kiosk_relabel(db, ids[0], relabel.items[1], c.by, &err)
-                          : sp_db_kiosk_set_status(db, ids, n, approve.count ? SP_DB_APPROVED : SP_DB_REJECTED, c.by, &err);
+        sp_result r = relabel.count ? sp_db_kiosk_relabel(db, ids[0], relabel.items[1], c.by, &err)
+                                    : sp_db_kiosk_review(db, ids, n, ranges, nr, approve.count ? SP_DB_APPROVED : SP_DB_REJECTED,
+                                                         c.by, &changed, &m, &err);
         sp_db_close(db);
         if (r != SP_OK) return fail(cmd, &err);
         if (relabel.count) {
@@ -958,10 +980,11 @@ static int db_review(int argc, char** argv)
             printf("}\n");
         } else {
             printf("{\"%s\": [", approve.count ? "approved" : "rejected");
-            for (int i = 0; i < n; ++i)
-                printf("%s%lld", i ? ", " : "", (long long)ids[i]);
+            for (int i = 0; i < m; ++i)
+                printf("%s%lld", i ? ", " : "", (long long)changed[i]);
             printf("]}\n");
         }
+        free(changed);
         return SP_EXIT_OK;
     }
     if (!sp_cli_check_out_folders(cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT;

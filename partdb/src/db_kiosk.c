@@ -173,27 +173,109 @@ static sp_result update_one(sp_db* db, const char* sql, const char* value, int64
     return SP_OK;
 }
 
+typedef struct id_list {
+    int64_t* v;
+    int n, cap;
+} id_list;
+
+static bool id_push(id_list* l, int64_t id)
+{
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 64;
+        int64_t* g = realloc(l->v, sizeof(int64_t) * (size_t)cap);
+        if (!g) return false;
+        l->v = g, l->cap = cap;
+    }
+    l->v[l->n++] = id;
+    return true;
+}
+
+static int cmp_id(const void* a, const void* b)
+{
+    int64_t x = *(const int64_t*)a, y = *(const int64_t*)b;
+    return (x > y) - (x < y);
+}
+
+// The pending kiosk sketches of one range to `status`, inside the caller's
+// transaction, their ids appended to `set`; SP_ERR_INVALID when it has none.
+static sp_result update_range(sp_db* db, const sp_db_kiosk_range* g, const char* status, id_list* set, sp_error* err)
+{
+    sqlite3_stmt* st;
+    sp_result r =
+        db_prepare(db,
+                   "UPDATE sketches SET status = ?1 WHERE source = 'kiosk' AND status = 'pending' AND id BETWEEN ?2 AND ?3"
+                   " RETURNING id",
+                   &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_text(st, 1, status, -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 2, g->first);
+    sqlite3_bind_int64(st, 3, g->last);
+    int rc, found = 0;
+    while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        ++found;
+        if (!id_push(set, sqlite3_column_int64(st, 0))) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reviewing kiosk sketches", err);
+    sqlite3_finalize(st);
+    if (r == SP_OK && found == 0)
+        r = sp_fail(err, SP_ERR_INVALID, "%s: no pending kiosk sketch in %lld-%lld; nothing was changed", db->path,
+                    (long long)g->first, (long long)g->last);
+    return r;
+}
+
 sp_result sp_db_kiosk_set_status(sp_db* db, const int64_t* ids, int n, sp_db_status status, const char* by, sp_error* err)
 {
-    if (status < 0 || status >= SP_DB_STATUS_COUNT) return sp_fail(err, SP_ERR_INVALID, "unknown review status");
     if (n <= 0) return sp_fail(err, SP_ERR_INVALID, "%s: no kiosk sketch ids given", db->path);
+    return sp_db_kiosk_review(db, ids, n, NULL, 0, status, by, NULL, NULL, err);
+}
+
+sp_result sp_db_kiosk_review(sp_db* db, const int64_t* ids, int n, const sp_db_kiosk_range* ranges, int nr, sp_db_status status,
+                             const char* by, int64_t** changed, int* n_changed, sp_error* err)
+{
+    if (changed) *changed = NULL;
+    if (n_changed) *n_changed = 0;
+    if (status < 0 || status >= SP_DB_STATUS_COUNT) return sp_fail(err, SP_ERR_INVALID, "unknown review status");
+    if (n <= 0 && nr <= 0) return sp_fail(err, SP_ERR_INVALID, "%s: no kiosk sketch ids given", db->path);
+    for (int i = 0; i < nr; ++i)
+        if (ranges[i].first > ranges[i].last)
+            return sp_fail(err, SP_ERR_INVALID, "%s: the range %lld-%lld is empty", db->path, (long long)ranges[i].first,
+                           (long long)ranges[i].last);
     sp_result r = db_begin(db, err);
     if (r != SP_OK) return r;
-    db_str b = {0};
-    db_str_printf(&b, "{\"status\": \"%s\", \"ids\": [", k_status[status]);
+    id_list set = {0};
+    // Ranges first: an id also named alone is then set again, not missed
+    // by its range as no longer pending.
+    for (int i = 0; r == SP_OK && i < nr; ++i)
+        r = update_range(db, &ranges[i], k_status[status], &set, err);
     for (int i = 0; r == SP_OK && i < n; ++i) {
         r = update_one(db, "UPDATE sketches SET status = ?1 WHERE id = ?2 AND source = 'kiosk'", k_status[status], ids[i], err);
-        db_str_printf(&b, "%s%lld", i ? ", " : "", (long long)ids[i]);
+        if (r == SP_OK && !id_push(&set, ids[i])) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     }
+    int m = 0;
+    if (r == SP_OK && set.n > 0) {
+        qsort(set.v, (size_t)set.n, sizeof(int64_t), cmp_id);
+        for (int i = 0; i < set.n; ++i)
+            if (i == 0 || set.v[i] != set.v[m - 1]) set.v[m++] = set.v[i];
+    }
+    db_str b = {0};
+    db_str_printf(&b, "{\"status\": \"%s\", \"ids\": [", k_status[status]);
+    for (int i = 0; r == SP_OK && i < m; ++i)
+        db_str_printf(&b, "%s%lld", i ? ", " : "", (long long)set.v[i]);
     db_str_printf(&b, "]}");
     if (r == SP_OK)
         r = b.oom ? sp_fail(err, SP_ERR_NO_MEMORY, "out of memory") : db_log_row(db, by, "review", "kiosk sketches", b.s, err);
     free(b.s);
-    if (r != SP_OK) {
+    if (r == SP_OK)
+        r = db_commit(db, err);
+    else
         db_rollback(db);
-        return r;
+    if (r == SP_OK && changed) {
+        *changed = set.v;
+        set.v = NULL;
     }
-    return db_commit(db, err);
+    if (r == SP_OK && n_changed) *n_changed = m;
+    free(set.v);
+    return r;
 }
 
 sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const char* by, sp_error* err)

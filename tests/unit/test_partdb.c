@@ -1913,6 +1913,68 @@ static void test_default_db_cli(void)
 
 // The review through the command line, end to end: a stroke the visitor
 // corrected is collected with the corrected label, listed, approved, trained on.
+// A page of kiosk sketches approved but the few rejected: FIRST-LAST sets
+// the pending ones in it, in one transaction with the ids given alone.
+static void test_kiosk_review_ranges(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("ranges.db"));
+    sp_db* db = open_ok(p, 0);
+    int64_t id[8];
+    for (int i = 0; i < 8; ++i)
+        id[i] = collect_ok(db, i % 2 ? "tail" : "wings", i);
+    sp_error err = {0};
+    ENSURE(sp_db_kiosk_set_status(db, &id[2], 1, SP_DB_REJECTED, "curator", &err) == SP_OK);
+    // The library: an id also in a range is listed once; a range with
+    // nothing pending fails and changes nothing.
+    int64_t* changed = NULL;
+    int m = 0;
+    sp_db_kiosk_range g = {id[6], id[7]};
+    ENSURE(sp_db_kiosk_review(db, &id[7], 1, &g, 1, SP_DB_REJECTED, "curator", &changed, &m, &err) == SP_OK);
+    ENSURE(m == 2 && changed[0] == id[6] && changed[1] == id[7]);
+    free(changed);
+    int counts[SP_DB_STATUS_COUNT];
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 5 && counts[SP_DB_REJECTED] == 3);
+    ENSURE(sp_db_kiosk_review(db, &id[0], 1, &g, 1, SP_DB_APPROVED, "curator", NULL, NULL, &err) == SP_ERR_INVALID &&
+           strstr(err.text, "no pending kiosk sketch in"));
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 5 && counts[SP_DB_APPROVED] == 0);
+    // A good range and an unknown id: the range's changes are rolled back.
+    int64_t bogus = 424242;
+    g = (sp_db_kiosk_range){id[0], id[1]};
+    ENSURE(sp_db_kiosk_review(db, &bogus, 1, &g, 1, SP_DB_APPROVED, "curator", NULL, NULL, &err) == SP_ERR_INVALID &&
+           strstr(err.text, "no kiosk sketch 424242"));
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 5 && counts[SP_DB_APPROVED] == 0);
+    sp_db_close(db);
+    // The command: the range approves the pending ones, the rejected stay so.
+    char cmd[4096], out[65536], want[256];
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld-%lld", bin, p, (long long)id[0], (long long)id[7]);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    snprintf(want, sizeof want, "{\"approved\": [%lld, %lld, %lld, %lld, %lld]}", (long long)id[0], (long long)id[1],
+             (long long)id[3], (long long)id[4], (long long)id[5]);
+    fprintf(stderr, "  %s", out);
+    ENSURE(strstr(out, want));
+    db = open_ok(p, SP_DB_READONLY);
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 0 && counts[SP_DB_APPROVED] == 5 &&
+           counts[SP_DB_REJECTED] == 3);
+    sp_db_close(db);
+    // Nothing pending left in it, a range backwards, a half range: one line, exit 1, nothing changed.
+    char before[65], after[65];
+    file_sha(p, before);
+    const char* bad[][2] = {{"", "no pending kiosk sketch in"}, {"9-3", "'9-3' is not a kiosk sketch id"}, {"4-", "'4-' is not"}};
+    for (int i = 0; i < 3; ++i) {
+        if (i == 0)
+            snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %lld-%lld 2>&1 >/dev/null", bin, p, (long long)id[0],
+                     (long long)id[7]);
+        else
+            snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %s 2>&1 >/dev/null", bin, p, bad[i][0]);
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, bad[i][1]) && strchr(out, '\n') == out + strlen(out) - 1);
+    }
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+}
+
 static void test_kiosk_review_cli(void)
 {
     const char* bin = sketchpose_bin();
@@ -2451,6 +2513,7 @@ int main(int argc, char** argv)
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
+                                   {"kiosk_review_ranges", test_kiosk_review_ranges},
                                    {"number_options_cli", test_number_options_cli},
                                    {"add_sketch_partless_cli", test_add_sketch_partless_cli},
                                    {0}});

@@ -266,6 +266,18 @@ void sp_db_kiosk_free(sp_db_kiosk_sketch* s, int count);
 /// that is not a kiosk sketch changes nothing and fails with SP_ERR_INVALID
 /// naming it. Logged for the curator log.
 sp_result sp_db_kiosk_set_status(sp_db* db, const int64_t* ids, int n, sp_db_status status, const char* by, sp_error* err);
+/// Ids first..last, both included.
+typedef struct sp_db_kiosk_range {
+    int64_t first, last;
+} sp_db_kiosk_range;
+/// sp_db_kiosk_set_status of the ids (any status) and of every kiosk sketch
+/// still pending in each range (a curator approves a page but the few they
+/// rejected), all in one transaction: an id that is not a kiosk sketch, or a
+/// range with none pending, fails with SP_ERR_INVALID naming it and changes
+/// nothing. *changed (may be NULL; malloc'd, free()) gets the ids set,
+/// ascending, each once, and *n_changed (may be NULL) their count.
+sp_result sp_db_kiosk_review(sp_db* db, const int64_t* ids, int n, const sp_db_kiosk_range* ranges, int nr, sp_db_status status,
+                             const char* by, int64_t** changed, int* n_changed, sp_error* err);
 /// Gives a kiosk sketch another category (one of the current part
 /// categories; anything else fails with SP_ERR_INVALID and changes nothing).
 sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const char* by, sp_error* err);
