@@ -194,22 +194,8 @@ int main(int argc, char** argv)
     sp_error err = {0};
     char db_path[1100], dir[1024];
     bool real = false;
-    if (!db) {
-        snprintf(dir, sizeof dir, "%s/tmp", SP_BINARY_DIR);
-        mkdir(dir, 0755);
-        snprintf(db_path, sizeof db_path, "%.1024s/bench_kiosk.db", dir);
-        if (!kp_build_db(db_path, SP_SOURCE_DIR "/assets", dir, &real, &err)) {
-            fprintf(stderr, "bench kiosk: %s\n", err.text);
-            return 1;
-        }
-        db = db_path;
-    }
     kp_stroke strokes[DRAGON_PART_COUNT];
-    memset(strokes, 0, sizeof strokes);
-    if (!kp_six_strokes(db, strokes, &err)) {
-        fprintf(stderr, "bench kiosk: %s\n", err.text);
-        return 1;
-    }
+    if (!kp_bench_setup("kiosk", &db, "bench_kiosk.db", dir, db_path, &real, strokes)) return 1;
     sp_headless* gl;
     sp_headless_create(&gl, &err);
     if (!gl) {

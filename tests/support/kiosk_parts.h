@@ -11,6 +11,8 @@
 #ifndef SP_TEST_KIOSK_PARTS_H
 #define SP_TEST_KIOSK_PARTS_H
 
+#include <sys/stat.h>
+
 #include "dragon_parts.h"
 #include "fixtures.h"
 
@@ -214,6 +216,31 @@ static inline bool kp_six_strokes(const char* db_path, kp_stroke* out, sp_error*
     sp_clf_destroy(clf);
     sp_db_close(db);
     return ok;
+}
+
+/// A benchmark's database and strokes: `db` when given, else `name` built by
+/// kp_build_db in dir (SP_BINARY_DIR/tmp; path gets it); the six strokes in
+/// out. False with a line on stderr naming `who`.
+static inline bool kp_bench_setup(const char* who, const char** db, const char* name, char dir[1024], char path[1100], bool* real,
+                                  kp_stroke out[DRAGON_PART_COUNT])
+{
+    sp_error err = {0};
+    snprintf(dir, 1024, "%s/tmp", SP_BINARY_DIR);
+    mkdir(dir, 0755);
+    if (!*db) {
+        snprintf(path, 1100, "%.1024s/%s", dir, name);
+        if (!kp_build_db(path, SP_SOURCE_DIR "/assets", dir, real, &err)) {
+            fprintf(stderr, "bench %s: %s\n", who, err.text);
+            return false;
+        }
+        *db = path;
+    }
+    memset(out, 0, sizeof(kp_stroke) * DRAGON_PART_COUNT);
+    if (!kp_six_strokes(*db, out, &err)) {
+        fprintf(stderr, "bench %s: %s\n", who, err.text);
+        return false;
+    }
+    return true;
 }
 
 #endif

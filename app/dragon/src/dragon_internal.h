@@ -104,6 +104,8 @@ typedef struct part {
     // Bodies: vertices at the fit, world and canvas (for attaching; NULL until needed).
     double* body_xyz;
     sp_vec2* body_px;
+    double* body_tri_box;     // per triangle its canvas box: lo.x, lo.y, hi.x, hi.y
+    sp_vec2 body_lo, body_hi; // canvas box of its vertices
     bool body_has_surface;
     // Its fit before a part drawn later changed it (a body that decided it
     // again or turned it, a body, head or tail that made legs the other

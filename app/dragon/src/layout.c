@@ -96,6 +96,8 @@ static void mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, 
         px[v] = sp_camera_project(&d->world, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
 }
 
+static bool px_box(const sp_vec2* px, int n, sp_vec2* lo, sp_vec2* hi);
+
 // A body's vertices at its fit, in the world and on the canvas, and the
 // area of its surface (kept: a body's fit never changes).
 static bool body_prepare(const sp_dragon* d, part* q)
@@ -105,12 +107,23 @@ static bool body_prepare(const sp_dragon* d, part* q)
     size_t n = (size_t)rig->vertex_count;
     q->body_xyz = malloc(sizeof(double) * 3 * (n + 1));
     q->body_px = malloc(sizeof(sp_vec2) * (n + 1));
-    if (!q->body_xyz || !q->body_px) {
-        free(q->body_xyz), free(q->body_px);
-        q->body_xyz = NULL, q->body_px = NULL;
+    q->body_tri_box = malloc(sizeof(double) * 4 * ((size_t)rig->triangle_count + 1));
+    if (!q->body_xyz || !q->body_px || !q->body_tri_box) {
+        free(q->body_xyz), free(q->body_px), free(q->body_tri_box);
+        q->body_xyz = NULL, q->body_px = NULL, q->body_tri_box = NULL;
         return false;
     }
     mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px);
+    // Boxes kept for nearest_surface, which every part laid out asks of
+    // every body near it (a new body lays out them all again).
+    for (int f = 0; f < rig->triangle_count; ++f) {
+        const uint32_t* tr = rig->triangles + 3 * f;
+        sp_vec2 a = q->body_px[tr[0]], b = q->body_px[tr[1]], c = q->body_px[tr[2]];
+        double* box = q->body_tri_box + 4 * (size_t)f;
+        box[0] = fmin(a.x, fmin(b.x, c.x)), box[1] = fmin(a.y, fmin(b.y, c.y));
+        box[2] = fmax(a.x, fmax(b.x, c.x)), box[3] = fmax(a.y, fmax(b.y, c.y));
+    }
+    if (!px_box(q->body_px, (int)n, &q->body_lo, &q->body_hi)) q->body_lo = q->body_hi = (sp_vec2){NAN, NAN};
     // Its surface: the triangles' area in the world. None (every triangle of
     // zero area, or nothing finite) means there is nothing to hold a part.
     double area = 0;
@@ -203,15 +216,16 @@ static double box_distance(sp_vec2 p, sp_vec2 lo, sp_vec2 hi)
 // Two passes over the body's triangles: the nearest distance, then among
 // the points that near (a point inside the silhouette is covered by a front
 // and a back triangle; a silhouette edge by the triangles meeting there) the
-// nearest to the viewer and the farthest.
-static bool nearest_surface(const part* q, sp_vec2 p, surface_hit* h)
+// nearest to the viewer and the farthest. False when no point of the body
+// lies within `within` pixels (INFINITY: anywhere).
+static bool nearest_surface(const part* q, sp_vec2 p, double within, surface_hit* h)
 {
     const sp_rig* rig = &q->t->ch.rig;
     const sp_vec2* px = q->body_px;
     double best = INFINITY;
     for (int pass = 0; pass < 2; ++pass) {
         if (pass == 1) {
-            if (!isfinite(best)) return false;
+            if (!isfinite(best) || !(best <= within)) return false;
             h->dist = best;
             h->tri[0] = h->tri[1] = -1;
             h->z[0] = -INFINITY, h->z[1] = INFINITY;
@@ -219,11 +233,11 @@ static bool nearest_surface(const part* q, sp_vec2 p, surface_hit* h)
         double limit = pass == 0 ? INFINITY : best + SAME_DISTANCE_PX;
         for (int f = 0; f < rig->triangle_count; ++f) {
             const uint32_t* tr = rig->triangles + 3 * f;
+            const double* box = q->body_tri_box + 4 * (size_t)f;
+            double bx = fmax(fmax(box[0] - p.x, p.x - box[2]), 0.0), by = fmax(fmax(box[1] - p.y, p.y - box[3]), 0.0);
+            double cut = pass == 0 ? fmin(best, within) : limit;
+            if (!(bx * bx + by * by <= cut * cut)) continue; // also skips non-finite corners
             sp_vec2 a = px[tr[0]], b = px[tr[1]], c = px[tr[2]];
-            sp_vec2 lo = {fmin(a.x, fmin(b.x, c.x)), fmin(a.y, fmin(b.y, c.y))};
-            sp_vec2 hi = {fmax(a.x, fmax(b.x, c.x)), fmax(a.y, fmax(b.y, c.y))};
-            double bound = box_distance(p, lo, hi);
-            if (!(bound <= (pass == 0 ? best : limit))) continue; // also skips non-finite corners
             double bary[3];
             sp_vec2 cp = closest_on_triangle(p, a, b, c, bary);
             double dist = sp_v2_len(sp_v2_sub(p, cp));
@@ -847,8 +861,12 @@ static void layout_part(sp_dragon* d, int i)
     for (int k = 0; k < d->part_n; ++k) {
         part* q = d->parts[k];
         if (k == i || !q->t->is_torso || !body_prepare(d, q)) continue;
+        // Only a body nearer than the snap distance and than the nearest
+        // so far can hold the part: the others' triangles need no look.
+        double within = fmin(snap, best.dist);
+        if (box_distance(a2, q->body_lo, q->body_hi) > within) continue;
         surface_hit h;
-        if (nearest_surface(q, a2, &h) && h.dist < best.dist) best = h, bk = k;
+        if (nearest_surface(q, a2, within, &h) && h.dist < best.dist) best = h, bk = k;
     }
     if (bk < 0 || !(best.dist <= snap)) return; // far from every body: free, where it was drawn
     if (!d->parts[bk]->body_has_surface) {

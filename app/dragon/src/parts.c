@@ -247,6 +247,7 @@ void dragon_part_free(part* p)
     free(p->outline);
     free(p->body_xyz);
     free(p->body_px);
+    free(p->body_tri_box);
     sp_rig_eval_destroy(p->ev);
     free(p);
 }
