@@ -63,8 +63,15 @@ int cmd_dragon(int argc, char** argv)
         sp_sketch_free(&sk);
         return SP_EXIT_INPUT;
     }
-    int w = sk.canvas_w >= 1 && sk.canvas_w <= 16384 ? (int)sk.canvas_w : 0,
-        h = sk.canvas_h >= 1 && sk.canvas_h <= 16384 ? (int)sk.canvas_h : 0;
+    // The kiosk's canvas is at most 16384 px a side (a render target's);
+    // a larger one was replaced by 1280 x 800 with no word, its strokes off it.
+    if (sk.canvas_w > 16384 || sk.canvas_h > 16384) {
+        fprintf(stderr, "sketchpose dragon: %s: canvas %g x %g is larger than the kiosk pipeline's 16384 px a side\n", strokes,
+                sk.canvas_w, sk.canvas_h);
+        sp_sketch_free(&sk);
+        return SP_EXIT_INPUT;
+    }
+    int w = sk.canvas_w >= 1 ? (int)sk.canvas_w : 0, h = sk.canvas_h >= 1 ? (int)sk.canvas_h : 0;
     sp_dragon* d;
     sp_dragon_create(&(sp_dragon_desc){.db_path = db_path,
                                        .assets_dir = assets,

@@ -1548,6 +1548,17 @@ static void test_command(void)
     snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes /nonexistent.json --out '%s' 2>/dev/null", SP_SKETCHPOSE, path,
              out);
     ENSURE(WEXITSTATUS(system(cmd)) == 1);
+    // A canvas larger than the kiosk's (it became 1280 x 800, the strokes off it).
+    char big[1024], line[2048];
+    snprintf(big, sizeof big, "%s", sp_test_tmp_path("dragon_big_canvas.json"));
+    sp_sketch bigsk = {.canvas_w = 20000, .canvas_h = 12000};
+    sp_vec2 two[2] = {{100, 100}, {15000, 9000}};
+    ENSURE(sp_sketch_add_stroke(&bigsk, two, NULL, 2) == SP_OK && sp_sketch_write_json(big, &bigsk, &err) == SP_OK);
+    sp_sketch_free(&bigsk);
+    snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' 2>&1 >/dev/null", SP_SKETCHPOSE, path, big);
+    ENSURE(sp_fixture_run(cmd, line, sizeof line) == 1 &&
+           strstr(line, "dragon_big_canvas.json: canvas 20000 x 12000 is larger") &&
+           strchr(line, '\n') == line + strlen(line) - 1);
     // No --db and no $SP_DB: ./sketchpose.db, built from --assets when missing
     // (here there are none: exit 1, nothing made).
     char nodb[1100];
