@@ -49,3 +49,14 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
         }
     return SP_OK;
 }
+
+bool* sp_drawover_active(const sp_rig* rig)
+{
+    bool* on = malloc(sizeof(bool) * (size_t)(rig->param_count + 1));
+    if (!on) return NULL;
+    for (int q = 0; q < rig->param_count; ++q) {
+        const sp_param* k = &rig->params[q];
+        on[q] = !(k->joint == rig->params[0].joint && k->channel >= SP_CH_TX && k->channel <= SP_CH_TZ);
+    }
+    return on;
+}

@@ -15,5 +15,11 @@ int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_pa
 /// viewBox the canvas) and checks that it has at least one stroke of two
 /// or more points; err names the file.
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
+/// The parameters a draw-over solve may move (sp_solve_desc.active;
+/// malloc'd, param_count of them; NULL when out of memory): all but the
+/// first joint's translations. Draw-over bends the character where it
+/// stands: a curve over one arm moved the whole of CesiumMan (the loader's
+/// derived placement) to fit it.
+bool* sp_drawover_active(const sp_rig* rig);
 
 #endif

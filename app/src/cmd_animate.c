@@ -31,6 +31,30 @@ static bool parse_times(const char* s, double* t, int n)
     return *at == 0 && sp_animation_check_times(t, n, &ignored) == SP_OK;
 }
 
+// A key drawn where the previous key's pose cannot reach (the character
+// moved between keys, and the solve from that pose stays in its local
+// minimum: "best effort", over 5% of the size) is solved again from the rest
+// pose, and the better fit kept in p, *rep and *j. False when out of memory.
+static bool retry_from_rest(sp_solve_cmd* run, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* rest,
+                            double* p, int P, sp_solve_report* rep, cJSON** j)
+{
+    if (!(rep->mean_error_px > 0.05 * rep->bbox_diagonal_px)) return true;
+    double* alt = malloc(sizeof(double) * (size_t)(P + 1));
+    if (!alt) return false;
+    sp_solve_report r2;
+    cJSON* j2 = NULL;
+    if (sp_solve_cmd_solve(run, cam, sk, strokes, rest, alt, &r2, &j2) && r2.mean_error_px < rep->mean_error_px) {
+        memcpy(p, alt, sizeof(double) * (size_t)P);
+        *rep = r2;
+        cJSON_Delete(*j);
+        *j = j2;
+    } else {
+        cJSON_Delete(j2);
+    }
+    free(alt);
+    return true;
+}
+
 int cmd_animate(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *times_s = NULL, *out = NULL, *report = NULL;
@@ -88,6 +112,10 @@ int cmd_animate(int argc, char** argv)
         sp_solve_report rep;
         cJSON* j = NULL;
         bool solved = sp_solve_cmd_solve(&run, &cam, &sk, keys.items[k], start, kp + (size_t)k * P, &rep, &j);
+        if (solved && k > 0 && !retry_from_rest(&run, &cam, &sk, keys.items[k], p0, kp + (size_t)k * P, P, &rep, &j)) {
+            sp_sketch_free(&sk);
+            goto oom;
+        }
         sp_sketch_free(&sk);
         if (!solved) goto done;
         snprintf(notes[k], sizeof notes[k], "%s", rep.note);

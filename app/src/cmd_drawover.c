@@ -86,6 +86,7 @@ int cmd_drawover(int argc, char** argv)
     sp_abstraction emb = {0};
     cJSON* rep_json = NULL;
     double *p = NULL, *xyz = NULL;
+    bool* active = NULL;
     sp_rig_eval* ev = NULL;
     int exit_code = SP_EXIT_INPUT;
     // Its curves are embedded in the mesh surface, and a black box evaluates
@@ -93,6 +94,8 @@ int cmd_drawover(int argc, char** argv)
     if (sp_rig_handle_load_character(rig_path, "draw-over", &rig, &err) != SP_OK) goto fail;
     sp_character* ch = sp_rig_handle_character(rig);
     run.rig = rig;
+    if (!(active = sp_drawover_active(&ch->rig))) goto oom;
+    run.desc.active = active;
     if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
     // Both drawings are on one screen: --to's points are read in --on's
     // canvas (its camera), so another canvas gave a wrong fit with exit 0.
@@ -132,7 +135,7 @@ done:
     sp_solve_cmd_end(&run);
     sp_rig_eval_destroy(ev);
     sp_abstraction_free(&emb);
-    free(p), free(xyz);
+    free(p), free(xyz), free(active);
     sp_sketch_free(&on), sp_sketch_free(&to);
     sp_rig_handle_free(rig);
     return exit_code;

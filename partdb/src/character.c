@@ -389,6 +389,18 @@ static sp_result scene_extras(sp_character* ch, const char* json, const char* wh
 
 // ---- finishing ----------------------------------------------------------
 
+// How many world units one unit of joint j's parent space is at rest (the
+// ancestors' rest scales, each its geometric mean).
+static double parent_scale(const sp_rig* rig, int j)
+{
+    double s = 1;
+    for (int a = rig->joints[j].parent; a >= 0; a = rig->joints[a].parent) {
+        sp_vec3 k = rig->joints[a].rest_s;
+        s *= cbrt(fabs(k.x * k.y * k.z));
+    }
+    return s;
+}
+
 sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err)
 {
     sp_rig* rig = &ch->rig;
@@ -396,8 +408,25 @@ sp_result sp_gltf_finish(sp_character* ch, const sp_import* im, sp_error* err)
     // Why only when no joint declares sp_dofs: a file that declares some has
     // chosen its parameters; an explicit empty list means "this joint is fixed".
     if (!im->any_dofs) {
-        int added = 0;
+        // The skin's top joint also translates, by up to the mesh's size: a
+        // drawing seldom lands where the default view puts the character,
+        // and without a placement the solve bent limbs to reach it (a stick
+        // figure drawn 40 px off, a tenth of its size, fitted at 15 px). On
+        // the node above it when there is one, so that the solve's placement
+        // stage (the first joint's parameters) moves it without turning it.
+        sp_vec3 lo, hi;
+        sp_bounds(rig->rest, rig->vertex_count, &lo, &hi);
+        double size = sp_v3_len(sp_v3_sub(hi, lo));
+        int added = 0, carrier = -1;
+        for (int j = 0; j < rig->joint_count && carrier < 0; ++j)
+            if (im->is_skin[j])
+                carrier = rig->joints[j].parent >= 0 && !im->is_skin[rig->joints[j].parent] ? rig->joints[j].parent : j;
+        double reach = carrier >= 0 ? size / parent_scale(rig, carrier) : 0;
         for (int j = 0; j < rig->joint_count; ++j) {
+            if (j == carrier && isfinite(reach) && reach > 0)
+                for (int c = SP_CH_TX; c <= SP_CH_TZ; ++c)
+                    if (sp_rig_add_param(rig, j, (sp_channel)c, -reach, reach, SP_GROUP_POSE) < 0)
+                        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
             if (!im->is_skin[j]) continue;
             for (int c = SP_CH_RX; c <= SP_CH_RZ; ++c)
                 if (sp_rig_add_param(rig, j, (sp_channel)c, -SP_GLTF_DEFAULT_ROT_LIMIT, SP_GLTF_DEFAULT_ROT_LIMIT,

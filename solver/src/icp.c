@@ -115,6 +115,7 @@ typedef struct attempt {
 } attempt;
 
 // The stages of attempt `at`. The placement stage is skipped when the
+// caller holds every placement parameter still, and when the
 // strokes' box already overlaps the abstraction's at the start pose by an
 // IoU over 0.5 (a character redrawn where it stands: closest points would
 // only misplace a posed figure). A loop drawn away from the part is placed
@@ -128,7 +129,11 @@ typedef struct attempt {
 static void plan_attempt(const sp_solver* s, const sp_sketch* sk, const attempt* at, double start_iou, plan* pl)
 {
     const sp_model* m = s->model;
-    const bool placing = !s->d.no_root_alignment && m->placement_count > 0 && start_iou <= 0.5;
+    // A placement held still (sp_solve_desc.active: draw-over's) is none.
+    bool can_place = false;
+    for (int q = 0; q < m->placement_count; ++q)
+        can_place |= !s->d.active || s->d.active[q];
+    const bool placing = !s->d.no_root_alignment && can_place && start_iou <= 0.5;
     const bool loop = s->ab->correspondence == SP_CORR_CLOSEST && s->ab->curve_count == 1 && s->ab->curves[0].closed &&
                       sk->stroke_count == 1 && sp_stroke_is_loop(&sk->strokes[0]) && at->allow_loop;
     *pl = (plan){.loop = loop, .placed_free = placing && loop && at->place_free, .graduate_vertex = m->embedded};

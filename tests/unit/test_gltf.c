@@ -300,7 +300,8 @@ static void test_simple_skins(void)
     if (!sp_test_data_dir()) SKIP("../shared/data absent");
     sp_character s = load_ok(data_path("SimpleSkin/SimpleSkin.gltf"));
     ENSURE(s.rig.vertex_count == 10);
-    ENSURE(s.rig.param_count == 6);
+    // Two joints' rotations, and the top one's translation (no node above it).
+    ENSURE(s.rig.param_count == 9 && sp_rig_find_param(&s.rig, "node1.tz") == 5);
     ENSURE(s.rig.animation_count == 1);
     // Its only bone has length 0 (the child joint sits on its parent): no stick figure.
     ENSURE(s.rig.abstraction_count == 0 && sp_fixture_has_warning(&s, "no bones"));
@@ -334,10 +335,13 @@ static void test_mini_plain(void)
     ENSURE(!strcmp(ch.rig.joints[0].name, "Armature") && ch.rig.joints[0].parent == -1);
     ENSURE(!strcmp(ch.rig.joints[1].name, "root") && ch.rig.joints[1].parent == 0);
     ENSURE(!strcmp(ch.rig.joints[2].name, "tip") && ch.rig.joints[2].parent == 1);
-    ENSURE(ch.rig.joints[0].param_count == 0); // not a skin joint
-    ENSURE(ch.rig.param_count == 6 && ch.derived_dofs);
+    // Not a skin joint, so no rotations; the node above the skin carries the
+    // placement: a translation by up to the mesh's diagonal (sqrt 5).
+    ENSURE(ch.rig.joints[0].param_count == 3 && !strcmp(ch.rig.params[0].name, "Armature.tx"));
+    ENSURE_NEAR(ch.rig.params[0].max, sqrt(5.0), 1e-6);
+    ENSURE(ch.rig.param_count == 9 && ch.derived_dofs);
     ENSURE(sp_rig_find_param(&ch.rig, "tip.ry") >= 0);
-    ENSURE_NEAR(ch.rig.params[0].max, 2.0943951023931957, 1e-12);
+    ENSURE_NEAR(ch.rig.params[sp_rig_find_param(&ch.rig, "root.rx")].max, 2.0943951023931957, 1e-12);
     ENSURE(sp_fixture_has_warning(&ch, "renormalised skin weights of 1 vertices"));
     ENSURE(ch.rig.joints4[4 * 2] == 2 && ch.rig.joints4[4 * 2 + 1] == 1); // skin joint 1 -> rig joint 2
     ENSURE_NEAR(ch.colors[0], 0.9, 1e-6);
