@@ -56,20 +56,28 @@ static void count_result(kiosk_collector* c, bool stored)
 
 // The database file at c->path is still the one the handle has open; a file
 // replaced by a rename (a curator's new database) is opened anew, so that
-// no stroke goes into the old, unlinked one.
-static void follow_file(kiosk_collector* c)
+// no stroke goes into the old, unlinked one. False, with one line, when no
+// file is at the path (deleted, or moved away: the handle would write into
+// the unlinked file or the one under its new name, and the stroke be lost
+// without a word); the stroke is then dropped, until a file is there again.
+static bool follow_file(kiosk_collector* c)
 {
     struct stat st;
-    if (stat(c->path, &st) != 0 || (st.st_dev == c->dev && st.st_ino == c->ino)) return;
+    if (stat(c->path, &st) != 0) {
+        fprintf(stderr, "dragon-kiosk: %s: the database is gone (deleted or moved away): sketch dropped\n", c->path);
+        return false;
+    }
+    if (st.st_dev == c->dev && st.st_ino == c->ino) return true;
     sp_db* db = NULL;
     sp_error err = {0};
     if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
         fprintf(stderr, "dragon-kiosk: the database was replaced and cannot be written: %s\n", err.text);
-        return; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
+        return true; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
     }
     sp_db_close(c->db);
     sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
     c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
+    return true;
 }
 
 // The writer: one sketch a transaction, each waiting at most
@@ -87,11 +95,13 @@ static void* collector_main(void* arg)
         memset(&c->q[c->head], 0, sizeof s);
         c->head = (c->head + 1) % QUEUE_MAX, --c->count;
         pthread_mutex_unlock(&c->lock);
-        follow_file(c);
         sp_error err = {0};
         sp_stroke st = {.count = s.n, .points = s.xy, .t = s.t};
-        sp_result r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
-        if (r != SP_OK) fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+        sp_result r = SP_ERR_IO;
+        if (follow_file(c)) {
+            r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
+            if (r != SP_OK) fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+        }
         queued_free(&s);
         count_result(c, r == SP_OK);
         pthread_mutex_lock(&c->lock);

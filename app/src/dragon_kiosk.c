@@ -57,6 +57,24 @@ static void on_signal(int sig)
     g_quit = 1;
 }
 
+// Past a file-size limit a write fails (a sketch dropped, a save that says
+// so) instead of the signal killing the kiosk; so does a write to a log pipe
+// whose reader is gone (SIGPIPE killed it, the visit lost).
+static void ignore_write_signals(void)
+{
+    signal(SIGXFSZ, SIG_IGN);
+    signal(SIGPIPE, SIG_IGN);
+}
+
+// Ctrl-C, a stop and a hang-up (the terminal or session gone) end the kiosk
+// cleanly: the visit on the canvas is kept (a hang-up lost it, exit 129).
+static void catch_quit_signals(void)
+{
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    signal(SIGHUP, on_signal);
+}
+
 // Pixels per millimetre of the framebuffer: the monitor's physical size
 // when it reports a plausible one, else 96 dpi times the content scale.
 static double measure_ppm(GLFWwindow* win, int fb_w)
@@ -364,9 +382,7 @@ static bool has_parts(const char* path)
 
 int main(int argc, char** argv)
 {
-    // Past a file-size limit a write fails (a sketch dropped, a save that
-    // says so) instead of the signal killing the kiosk.
-    signal(SIGXFSZ, SIG_IGN);
+    ignore_write_signals();
     double start = sp_now_ms();
     const char *db = NULL, *assets = NULL, *script = NULL, *record = NULL, *shot = NULL, *out_glb = NULL, *export_dir = NULL,
                *size = NULL;
@@ -549,8 +565,7 @@ int main(int argc, char** argv)
     glfwSetFramebufferSizeCallback(win, cb_resize);
     glfwSetWindowContentScaleCallback(win, cb_scale);
     glfwSetKeyCallback(win, cb_key);
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    catch_quit_signals();
     if (record) {
         a.recording = true;
         a.rec.canvas_w = a.fb_w, a.rec.canvas_h = a.fb_h, a.rec.px_per_mm = a.ppm;

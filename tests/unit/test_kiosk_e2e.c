@@ -1397,6 +1397,67 @@ static void test_collect_replaced(void)
     ENSURE(stored == 2 && dropped == 0 && in_new == 1 && in_old == 1);
 }
 
+// A hang-up ends the kiosk as SIGTERM does (it killed it: exit 129, no
+// stats, the visit lost), and a log pipe whose reader is gone does not kill
+// it (SIGPIPE: exit 141).
+static void test_hangup(void)
+{
+    char db[1100], sh[1200], out[1200], cmd[8192], said[4096];
+    e2e_db_copy("kiosk_hup.db", db, sizeof db);
+    snprintf(sh, sizeof sh, "%s", sp_test_tmp_path("kiosk_hup.sh"));
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("kiosk_hup.txt"));
+    FILE* f = fopen(sh, "w");
+    ENSURE(f);
+    // A session that ends by itself, its --stats into a pipe whose reader
+    // is gone; then a kiosk waiting for a visitor, hung up on.
+    // (env --default-signal: the test's own parents may ignore SIGPIPE, and
+    // an ignored signal is inherited.)
+    fprintf(f, "env --default-signal=PIPE \"$1\" --db \"$2\" --no-collect --stats --script \"$4\" 2>/dev/null | true; "
+               "echo \"pipe=${PIPESTATUS[0]}\"\n"
+               "\"$1\" --db \"$2\" --stats > \"$3\" & pid=$!; sleep 6; kill -HUP $pid; wait $pid; echo \"rc=$?\"\n");
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "%s bash '%s' '%s' '%s' '%s' '%s/docs/img/kiosk_refused.json' 2>/dev/null", xvfb_run(), sh,
+             SP_DRAGON_KIOSK, db, out, SP_SOURCE_DIR);
+    int rc = sp_fixture_run(cmd, said, sizeof said);
+    fprintf(stderr, "  %s", said);
+    ENSURE(rc == 0 && strstr(said, "rc=0") && strstr(said, "pipe=") && !strstr(said, "pipe=141"));
+    cJSON* stats = read_stats(out);
+    ENSURE(stats); // printed at a clean end
+    cJSON_Delete(stats);
+}
+
+// The database deleted (or moved away) under a running kiosk: its strokes
+// were written into the unlinked file, counted as stored, with no word. Now
+// each is dropped with one line until a database is at the path again.
+static void test_collect_deleted(void)
+{
+    six_strokes();
+    char db[1100], back[1100], cmd[3600];
+    e2e_db_copy("kiosk_gone.db", db, sizeof db);
+    e2e_db_copy("kiosk_gone_back.db", back, sizeof back);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_gone_ex", &gl, &t);
+    draw_then_start_over(k, &t, &g_strokes[3]);
+    int stored = 0, dropped = 0;
+    wait_collected(k, 1, &stored, &dropped);
+    ENSURE(stored == 1);
+    snprintf(cmd, sizeof cmd, "rm -f '%s' '%s-wal' '%s-shm'", db, db, db);
+    ENSURE(system(cmd) == 0);
+    draw_then_start_over(k, &t, &g_strokes[0]);
+    wait_collected(k, 2, &stored, &dropped);
+    ENSURE(stored == 1 && dropped == 1);
+    // A database back at the path: collecting goes on into it.
+    ENSURE(rename(back, db) == 0);
+    draw_then_start_over(k, &t, &g_strokes[1]);
+    wait_collected(k, 3, &stored, &dropped);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+    int in_db = pending_count(db);
+    fprintf(stderr, "  stored %d, dropped %d; pending in the file put back %d\n", stored, dropped, in_db);
+    ENSURE(stored == 2 && dropped == 1 && in_db == 1);
+}
+
 // A part drawn before the body (a visitor who starts with the tail): a
 // small body-shaped stroke, which alone is a body, then the body around it.
 // When the body comes the small one is a part of that dragon, on screen as
@@ -1755,6 +1816,8 @@ int main(int argc, char** argv)
                                    {"parts_loaded_while_idle", test_parts_loaded_while_idle},
                                    {"collect_busy", test_collect_busy},
                                    {"collect_replaced", test_collect_replaced},
+                                   {"collect_deleted", test_collect_deleted},
+                                   {"hangup", test_hangup},
                                    {"body_after_parts", test_body_after_parts},
                                    {"detail_ink", test_detail_ink},
                                    {"screenshot_unwritable", test_screenshot_unwritable},
