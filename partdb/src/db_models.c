@@ -268,6 +268,25 @@ sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err)
     return r;
 }
 
+sp_result sp_db_model_head(sp_db* db, int64_t* id, char sha256[65], sp_error* err)
+{
+    *id = 0;
+    sha256[0] = 0;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT id, sha256 FROM models ORDER BY id DESC LIMIT 1", &st, err);
+    if (r != SP_OK) return r;
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) {
+        const char* s = (const char*)sqlite3_column_text(st, 1);
+        *id = sqlite3_column_int64(st, 0);
+        snprintf(sha256, 65, "%s", s ? s : "");
+    } else if (rc != SQLITE_DONE) {
+        r = db_fail(db, rc, "reading the model", err);
+    }
+    sqlite3_finalize(st);
+    return r;
+}
+
 // ---- check -------------------------------------------------------------------
 
 static void problem(db_str* b, int* n, const char* fmt, ...)

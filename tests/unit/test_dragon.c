@@ -1391,6 +1391,53 @@ static void test_undo_clear_refit(void)
     sp_db_close(db);
 }
 
+// A curator's sketch or review bumps the database's generation but leaves
+// its model: the pipeline keeps the model it has (parsing it again held the
+// kiosk's frames for 0.5-1 s). A new model row is read.
+static void test_reload_keeps_model(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_keep.db"));
+    copy_file(test_db(), path);
+    sp_dragon* d = new_dragon(path);
+    const sp_clf* first = sp_dragon_model(d);
+    ENSURE(first);
+    sp_db* writer = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(path, 0, &writer, &err) == SP_OK);
+    sp_sketch one = {0};
+    sp_vec2 line[3] = {{10, 10}, {60, 40}, {120, 30}};
+    ENSURE(sp_sketch_add_stroke(&one, line, NULL, 3) == SP_OK);
+    sp_dataset ds = {0};
+    ds.categories = (char*[]){"tail"};
+    ds.category_count = 1;
+    ds.samples = &(sp_sample){.sketch = one, .label = 0};
+    ds.count = 1;
+    ENSURE(sp_db_add_sketches(writer, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err) == SP_OK);
+    sp_sketch_free(&one);
+    bool reloaded = false;
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded);
+    ENSURE(sp_dragon_model(d) == first);
+    // The same model stored again, as a new row: read.
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(path, &h) == SQLITE_OK);
+    char* msg = NULL;
+    int rc =
+        sqlite3_exec(h,
+                     "INSERT INTO models (created_at, created_by, model, sha256, categories, options, report)"
+                     " SELECT created_at, created_by, model, sha256, categories, options, report FROM models ORDER BY id DESC"
+                     " LIMIT 1",
+                     NULL, NULL, &msg);
+    if (rc != SQLITE_OK) fprintf(stderr, "  sqlite: %s\n", msg ? msg : "?");
+    sqlite3_free(msg);
+    sqlite3_close(h);
+    ENSURE(rc == SQLITE_OK);
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded);
+    ENSURE(sp_dragon_model(d) && sp_dragon_model(d) != first);
+    sp_db_close(writer);
+    sp_dragon_destroy(d);
+}
+
 static void test_live_update(void)
 {
     char path[1024], other[1024];
@@ -3774,6 +3821,7 @@ int main(int argc, char** argv)
                                    {"no_model", test_no_model},
                                    {"undo_clear_refit", test_undo_clear_refit},
                                    {"live_update", test_live_update},
+                                   {"reload_keeps_model", test_reload_keeps_model},
                                    {"command", test_command},
                                    {"six_real_parts", test_six_real_parts},
                                    {"many_parts", test_many_parts},

@@ -94,11 +94,7 @@ sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error
     }
     o->db = NULL, o->db_path = NULL, o->assets_dir = NULL; // not kept: the caller's strings
     d->gen = sp_db_generation(d->db);
-    sp_error merr = {0};
-    if (!o->no_model && sp_db_load_model(d->db, &d->clf, NULL, &merr) != SP_OK) {
-        d->clf = NULL; // strokes then need a forced category
-        snprintf(d->model_error, sizeof d->model_error, "%s", merr.text);
-    }
+    dragon_reload_model(d); // without one, strokes need a forced category
     *out = d;
     return SP_OK;
 }

@@ -75,6 +75,9 @@ tpl* dragon_category_first(sp_dragon* d, const char* category);
 /// Releases every cached template.
 void dragon_cache_clear(sp_dragon* d);
 /// The file's device and inode (a database replaced on disk is a new inode); false when it does not exist.
+// Takes the newest model of d->db (d->desc.no_model: none); keeps the one
+// loaded when it cannot be read or is that model already.
+void dragon_reload_model(sp_dragon* d);
 bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
 
 // ---- the dragon --------------------------------------------------------------------
@@ -152,6 +155,8 @@ struct sp_dragon {
     ino_t ino;
     uint64_t gen;
     sp_clf* clf;
+    int64_t model_id;   // the row clf was read from (0: none)
+    char model_sha[65]; // its SHA-256 ("" when not known)
     tpl** cache;
     int cache_n;
     int preload_next; // sp_dragon_preload_step's cursor over the database's parts

@@ -336,17 +336,27 @@ static sp_result open_own(sp_dragon* d, sp_error* err)
     return SP_OK;
 }
 
-// Takes the newest model of the (re)opened database; keeps the old one when it cannot be read.
-static void reload_model(sp_dragon* d)
+// Takes the newest model of the (re)opened database; keeps the old one when
+// it cannot be read, and when it is the one already loaded: a curator's
+// sketch or review bumps the generation too, and parsing a 30 MB model
+// again held the kiosk's frames for half a second or more.
+void dragon_reload_model(sp_dragon* d)
 {
     if (d->desc.no_model) return;
-    sp_clf* clf = NULL;
+    int64_t head = 0, id = 0;
+    char sha[65] = "";
     sp_error merr = {0};
-    sp_result r = sp_db_load_model(d->db, &clf, NULL, &merr);
+    bool known = sp_db_model_head(d->db, &head, sha, &merr) == SP_OK;
+    if (known && d->clf && head > 0 && head == d->model_id && d->model_sha[0] && !strcmp(sha, d->model_sha)) return;
+    sp_clf* clf = NULL;
+    sp_result r = sp_db_load_model(d->db, &clf, &id, &merr);
     if (r == SP_OK || r == SP_ERR_INVALID) {
         // SP_ERR_INVALID: no model stored (strokes then need a forced category).
         sp_clf_destroy(d->clf);
         d->clf = r == SP_OK ? clf : NULL;
+        d->model_id = r == SP_OK ? id : 0;
+        // The checksum read before the model is its own only when the rows agree.
+        snprintf(d->model_sha, sizeof d->model_sha, "%s", r == SP_OK && known && id == head ? sha : "");
         snprintf(d->model_error, sizeof d->model_error, "%s", r == SP_OK ? "" : merr.text);
     } else if (!d->clf)
         snprintf(d->model_error, sizeof d->model_error, "%s", merr.text);
@@ -367,7 +377,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
             if (replaced) drop_stale_sidecars(d->db_path);
             d->db = NULL;
             if (open_own(d, err) != SP_OK) return SP_ERR_IO; // parts already loaded and the model stay usable
-            reload_model(d);
+            dragon_reload_model(d);
             d->gen = sp_db_generation(d->db);
             cache_prune(d);
             if (reloaded) *reloaded = true;
@@ -377,7 +387,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
     uint64_t g = sp_db_generation(d->db);
     if (g == 0) return sp_fail(err, SP_ERR_IO, "%s: the database cannot be read", d->db_path);
     if (g == d->gen) return SP_OK;
-    reload_model(d);
+    dragon_reload_model(d);
     d->gen = g;
     cache_prune(d);
     if (reloaded) *reloaded = true;
