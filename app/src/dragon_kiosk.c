@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -360,8 +361,18 @@ static void mark_path(const char* shot, const char* name, char* out, size_t cap)
 // A database that is there must have parts to draw: checked before any
 // window opens, one line when not. One not there is built by the default
 // recipe (sp_kiosk_create).
-static bool has_parts(const char* path)
+static bool has_parts(const char* path, const char* assets)
 {
+    struct stat st;
+    // Missing, it is built from the assets: without them the kiosk said
+    // only "assets: cannot open the folder", after opening its window.
+    if (access(path, F_OK) != 0 && (stat(assets, &st) != 0 || !S_ISDIR(st.st_mode))) {
+        fprintf(stderr,
+                "%s: no part database at %s, and no folder '%s' of parts to build one from (give --db DB, or --assets DIR: "
+                "the source tree's assets/)\n",
+                k_cmd, path, assets);
+        return false;
+    }
     if (access(path, F_OK) != 0) return true;
     sp_error err = {0};
     sp_db* db = NULL;
@@ -465,7 +476,7 @@ int main(int argc, char** argv)
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
-    if (!has_parts(db ? db : sp_db_default_path())) {
+    if (!has_parts(db ? db : sp_db_default_path(), assets ? assets : sp_dragon_default_assets())) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }

@@ -11,6 +11,7 @@
 // when it is not first the script taps its chip, as a visitor would.
 //
 // Skipped when xvfb-run is missing.
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -1397,6 +1398,23 @@ static void test_collect_replaced(void)
     ENSURE(stored == 2 && dropped == 0 && in_new == 1 && in_old == 1);
 }
 
+// Started where there is neither a database nor parts to build one from
+// (a technician's wrong folder): one line saying so, before any window
+// (it said only "assets: cannot open the folder"), and nothing made.
+static void test_no_database_here(void)
+{
+    char dir[1100], cmd[4096], said[2048];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("kiosk_empty_dir"));
+    ENSURE(mkdir(dir, 0755) == 0 || errno == EEXIST);
+    snprintf(cmd, sizeof cmd, "cd '%s' && env -u SP_DB -u SP_ASSETS -u DISPLAY -u WAYLAND_DISPLAY '%s' 2>&1", dir,
+             SP_DRAGON_KIOSK);
+    int rc = sp_fixture_run(cmd, said, sizeof said);
+    fprintf(stderr, "  %s", said);
+    ENSURE(rc == 1 && strstr(said, "no part database at sketchpose.db, and no folder 'assets' of parts to build one from") &&
+           strchr(said, '\n') == said + strlen(said) - 1);
+    ENSURE(rmdir(dir) == 0); // empty: nothing was made
+}
+
 // A hang-up ends the kiosk as SIGTERM does (it killed it: exit 129, no
 // stats, the visit lost), and a log pipe whose reader is gone does not kill
 // it (SIGPIPE: exit 141).
@@ -1818,6 +1836,7 @@ int main(int argc, char** argv)
                                    {"collect_replaced", test_collect_replaced},
                                    {"collect_deleted", test_collect_deleted},
                                    {"hangup", test_hangup},
+                                   {"no_database_here", test_no_database_here},
                                    {"body_after_parts", test_body_after_parts},
                                    {"detail_ink", test_detail_ink},
                                    {"screenshot_unwritable", test_screenshot_unwritable},
