@@ -93,7 +93,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     int folds = d.folds == 0 ? 3 : d.folds < 0 ? 0 : d.folds;
     double t0 = now_s();
     sp_dataset ds;
-    db_training_counts n;
+    db_training_counts n = {0};
     sp_result r =
         db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, d.curated_max ? d.curated_max : SP_DB_CURATED_TRAIN_MAX, &ds, &n, err);
     if (r != SP_OK) return r;

@@ -221,7 +221,7 @@ static int find_cat(char** cats, int n, const char* c)
 
 sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* err)
 {
-    db_training_counts n;
+    db_training_counts n = {0};
     sp_result r = db_load_training_set(db, SP_DB_KIOSK_TRAIN_MAX, SP_DB_CURATED_TRAIN_MAX, out, &n, err);
     if (unused) *unused = n.unused;
     return r;
@@ -254,6 +254,7 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, int curated_max, sp_dat
 {
     memset(out, 0, sizeof *out);
     db_training_counts n = {0};
+    if (counts) *counts = n; // also when it fails early
     // One read transaction: categories and sketches are one consistent snapshot.
     sp_result r = db_exec(db, "BEGIN", err);
     if (r != SP_OK) return r;

@@ -1213,11 +1213,16 @@ struct Importer {
             }
             size_t from = src + i, to = s.rest.size() / 3;
             if (to >= 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many vertices", what);
-            for (int c = 0; c < 3; ++c)
-                s.rest.push_back(s.rest[3 * from + (size_t)c]);
+            // Copied out first: the vectors may grow while their own elements are read.
+            for (int c = 0; c < 3; ++c) {
+                double x = s.rest[3 * from + (size_t)c];
+                s.rest.push_back(x);
+            }
             for (int c = 0; c < 4; ++c) {
-                s.joints.push_back(s.joints[4 * from + (size_t)c]);
-                s.weights.push_back(s.weights[4 * from + (size_t)c]);
+                uint16_t j = s.joints[4 * from + (size_t)c];
+                float w = s.weights[4 * from + (size_t)c];
+                s.joints.push_back(j);
+                s.weights.push_back(w);
             }
             add_color(s, cv, i, rgba);
             pl.at[i] = (uint32_t)to;
