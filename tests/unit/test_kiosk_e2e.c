@@ -1648,9 +1648,12 @@ static void test_screenshot_unwritable(void)
         ENSURE(rc == cases[i].code && one_line && strstr(out, cases[i].says) && strstr(out, cases[i].opt));
     }
     // Without marks a stream takes the last frame, as before: past these
-    // checks (a missing database is built later, by the kiosk), the missing
-    // display stops it.
-    snprintf(args, sizeof args, "--script '%s' --screenshot /dev/stdout", sp_test_src_path("docs/img/kiosk_fire.json"));
+    // checks (a missing database is built later, by the kiosk, from the
+    // assets given), the missing display stops it.
+    char assets[1100];
+    snprintf(assets, sizeof assets, "%s", sp_test_src_path("assets"));
+    snprintf(args, sizeof args, "--script '%s' --screenshot /dev/stdout --assets '%s'",
+             sp_test_src_path("docs/img/kiosk_fire.json"), assets);
     ENSURE(kiosk_no_display(args, out, sizeof out) == 1 && strstr(out, "cannot open a window"));
     unlink(file_dir);
 }
