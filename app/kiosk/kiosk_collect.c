@@ -138,7 +138,8 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     struct stat st;
     if (stat(db_path, &st) == 0) c->dev = st.st_dev, c->ino = st.st_ino;
     if (sp_db_open(db_path, 0, &c->db, &err) != SP_OK) {
-        fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected: %s\n", err.text);
+        // Said: a technician who then fixes the file expected collecting to resume.
+        fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected until the kiosk is restarted: %s\n", err.text);
         c->db = NULL;
     }
     // Every wait of the writer's (a store, a checkpoint) is short: closing the

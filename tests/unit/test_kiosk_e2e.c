@@ -1213,7 +1213,7 @@ static void test_collect_read_only(void)
     ENSURE(num(st, "collected") == 2 && num(st, "collect_stored") == 0 && num(st, "collect_dropped") == 2);
     cJSON_Delete(st);
     // One line says why at start, one line a sketch.
-    ENSURE(lines_with(errf, "cannot be collected") == 1 && lines_with(errf, "sketch dropped") == 2);
+    ENSURE(lines_with(errf, "cannot be collected until the kiosk is restarted") == 1 && lines_with(errf, "sketch dropped") == 2);
     ENSURE(pending_count(db) == 0);
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     ENSURE(system(cmd) == 0);
