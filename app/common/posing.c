@@ -54,9 +54,7 @@ bool* sp_drawover_active(const sp_rig* rig)
 {
     bool* on = malloc(sizeof(bool) * (size_t)(rig->param_count + 1));
     if (!on) return NULL;
-    for (int q = 0; q < rig->param_count; ++q) {
-        const sp_param* k = &rig->params[q];
-        on[q] = !(k->joint == rig->params[0].joint && k->channel >= SP_CH_TX && k->channel <= SP_CH_TZ);
-    }
+    for (int q = 0; q < rig->param_count; ++q)
+        on[q] = !sp_rig_param_shifts(rig, q);
     return on;
 }

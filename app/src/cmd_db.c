@@ -1,5 +1,6 @@
 // cmd_db.c: sketchpose db init|add-part|add-sketch|list|show|remove|check|train|export|log|review
 // The curators' commands over the part database (sp/partdb.h).
+#include <cjson/cJSON.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -791,8 +792,10 @@ static int db_train(int argc, char** argv)
     sp_result r = sp_db_train(db, &td, &report, &err);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);
-    const char* left = strstr(report, "\"curated_left_out\": ");
-    long n_left = left ? strtol(left + strlen("\"curated_left_out\": "), NULL, 10) : 0;
+    cJSON* rj = cJSON_Parse(report);
+    const cJSON* left = cJSON_GetObjectItemCaseSensitive(rj, "curated_left_out");
+    long n_left = cJSON_IsNumber(left) ? (long)left->valuedouble : 0;
+    cJSON_Delete(rj);
     if (n_left > 0)
         fprintf(
             stderr,

@@ -68,8 +68,8 @@ static void run_solves_ab(const sp_rig* rig, int ab, const sp_camera* cam, int f
     o->n = n;
     for (int i = 0; i < n; ++i) {
         sp_synth_params(rig, (uint64_t)(first_seed + i), 0.7853981633974483, truth);
-        for (int q = 0; g_hold_placement && q < P && rig->params[q].joint == rig->params[0].joint; ++q)
-            if (rig->params[q].channel >= SP_CH_TX && rig->params[q].channel <= SP_CH_TZ) truth[q] = rig->params[q].def;
+        for (int q = 0; g_hold_placement && q < P; ++q)
+            if (sp_rig_param_shifts(rig, q)) truth[q] = rig->params[q].def;
         sp_sketch sk;
         sp_synth_sketch(rig, ab, cam, truth, &sk);
         sp_solve_report rep;

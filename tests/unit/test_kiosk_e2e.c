@@ -1370,6 +1370,17 @@ static void test_collect_busy(void)
 // A curator replaces the database file (a rename over it) while the kiosk
 // runs: strokes collected afterwards go into the new file, none into the
 // old, unlinked one.
+// An in-process kiosk on db that has stored one visit's stroke.
+static sp_kiosk* kiosk_after_one_visit(const char* db, const char* export_dir, sp_headless** gl, double* t)
+{
+    sp_kiosk* k = inproc_kiosk(db, export_dir, gl, t);
+    draw_then_start_over(k, t, &g_strokes[3]);
+    int stored = 0, dropped = 0;
+    wait_collected(k, 1, &stored, &dropped);
+    ENSURE(stored == 1);
+    return k;
+}
+
 static void test_collect_replaced(void)
 {
     six_strokes();
@@ -1380,11 +1391,8 @@ static void test_collect_replaced(void)
     sp_fixture_remove_db(old_copy);
     sp_headless* gl = NULL;
     double t = 0;
-    sp_kiosk* k = inproc_kiosk(db, "kiosk_repl_ex", &gl, &t);
-    draw_then_start_over(k, &t, &g_strokes[3]);
+    sp_kiosk* k = kiosk_after_one_visit(db, "kiosk_repl_ex", &gl, &t);
     int stored = 0, dropped = 0;
-    wait_collected(k, 1, &stored, &dropped);
-    ENSURE(stored == 1);
     // The old file stays reachable under a second name, so the test can
     // show that nothing more went into it.
     ENSURE(link(db, old_copy) == 0);
@@ -1455,11 +1463,8 @@ static void test_collect_deleted(void)
     e2e_db_copy("kiosk_gone_back.db", back, sizeof back);
     sp_headless* gl = NULL;
     double t = 0;
-    sp_kiosk* k = inproc_kiosk(db, "kiosk_gone_ex", &gl, &t);
-    draw_then_start_over(k, &t, &g_strokes[3]);
+    sp_kiosk* k = kiosk_after_one_visit(db, "kiosk_gone_ex", &gl, &t);
     int stored = 0, dropped = 0;
-    wait_collected(k, 1, &stored, &dropped);
-    ENSURE(stored == 1);
     snprintf(cmd, sizeof cmd, "rm -f '%s' '%s-wal' '%s-shm'", db, db, db);
     ENSURE(system(cmd) == 0);
     draw_then_start_over(k, &t, &g_strokes[0]);

@@ -29,8 +29,8 @@ static int recovered(const sp_rig* rig, const sp_camera* cam, int cases, double 
     sp_solver_create(rig, 0, cam, &(sp_solve_desc){0}, &s, NULL);
     for (int i = 1; i <= cases; ++i) {
         sp_synth_params(rig, (uint64_t)i, 0.7853981633974483, truth);
-        for (int q = 0; shift >= 0 && q < P && rig->params[q].joint == rig->params[0].joint; ++q)
-            if (rig->params[q].channel >= SP_CH_TX && rig->params[q].channel <= SP_CH_TZ) truth[q] = rig->params[q].def;
+        for (int q = 0; shift >= 0 && q < P; ++q)
+            if (sp_rig_param_shifts(rig, q)) truth[q] = rig->params[q].def;
         sp_sketch sk;
         ENSURE(sp_synth_sketch(rig, 0, cam, truth, &sk) == SP_OK);
         sp_vec2 lo, hi;

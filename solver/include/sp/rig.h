@@ -167,6 +167,14 @@ int sp_rig_find_param(const sp_rig* rig, const char* name);
 int sp_rig_find_abstraction(const sp_rig* rig, const char* name);
 /// Writes every parameter's default into p (param_count).
 void sp_rig_defaults(const sp_rig* rig, double* p);
+/// Whether parameter k moves the whole character: a translation of the
+/// first joint with parameters (the solver's placement joint; for a file
+/// without sp_dofs, the placement the loader derives).
+static inline bool sp_rig_param_shifts(const sp_rig* rig, int k)
+{
+    const sp_param* q = &rig->params[k];
+    return q->joint == rig->params[0].joint && q->channel >= SP_CH_TX && q->channel <= SP_CH_TZ;
+}
 /// The one clamp of a parameter value, for every rig kind and the solve: a
 /// value that is not finite becomes `def`, then it is put inside [min, max].
 static inline double sp_param_clamp(double v, double min, double max, double def)
