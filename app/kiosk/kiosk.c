@@ -250,7 +250,8 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
                                            .canvas_w = k->canvas_w,
                                            .canvas_h = k->canvas_h,
                                            .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
-                                           .max_parts = k->desc.max_parts},
+                                           .max_parts = k->desc.max_parts,
+                                           .background_model = true},
                          &k->dragon, err) != SP_OK)
         goto fail;
     if (!k->desc.no_collect && !k->collector) k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
@@ -757,15 +758,19 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         run_job(k, &j);
         k->heavy_done = j.heavy;
     }
+    // A model read in the background since is used from the next stroke on.
+    if (sp_dragon_model_update(k->dragon)) ++k->stats.models_loaded;
     // A curator's change (or a replaced database file) is picked up between
     // strokes; add_stroke polls too, this only keeps idle kiosks current.
+    // The parts row is read again in a frame of its own.
     if (!k->heavy_done && k->ui->capture == SP_KCAP_NONE && t_ms - k->last_reload_check >= 2000) {
         k->last_reload_check = t_ms;
         bool reloaded = false;
         sp_error err = {0};
         if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK)
             fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
-        if (reloaded) ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false; // a curator may have changed the parts
+        if (reloaded) // a curator may have changed the parts
+            ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false, k->heavy_done = true;
     }
     // The parts row, once the first frame is on screen (starting fast matters more).
     if (!k->heavy_done && !k->icons_loaded && k->updates >= 2) {

@@ -99,6 +99,7 @@ struct sp_kiosk {
     part_icon icons[SP_KIOSK_ROW_MAX];
     int icon_count;
     bool icons_loaded;
+    char* row_source;  // what the icons were drawn from (kiosk_row.c); NULL: read them again
     bool parts_loaded; // every part of the database is loaded (sp_dragon_preload_step said so)
     // Bookkeeping.
     sp_kiosk_stats stats;

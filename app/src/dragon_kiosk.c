@@ -275,7 +275,8 @@ static void print_stats(const app* a, double start_ms)
         ui->code, sp_kiosk_last_save(a->k));
     int stored = 0, dropped = 0;
     sp_kiosk_collect_counts(a->k, &stored, &dropped);
-    printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d,\n", st->collected, stored, dropped);
+    printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d, \"models_loaded\": %d,\n", st->collected, stored,
+           dropped, st->models_loaded);
     printf(" \"others\": %d, \"others_chosen\": %d, \"joined\": %d, \"merged\": %d,\n", ui->others, ui->others_chosen, ui->joined,
            ui->merged);
     // What a visitor reads on screen now (JSON-escaped): the message box
@@ -286,13 +287,14 @@ static void print_stats(const app* a, double start_ms)
     print_string_field("hint", message ? message : "");
     print_string_field("banner", banner);
     printf(" \"framebuffer\": [%d, %d], \"px_per_mm\": %.4f, \"gl_renderer\": \"%s\", \"start_ms\": %.1f, \"frames\": %d, "
-           "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"fit_ms_median\": %.2f, \"fit_ms_p90\": %.2f, "
+           "\"frame_ms_median\": %.2f, \"frame_ms_p90\": %.2f, \"frame_ms_max\": %.2f, \"fit_ms_median\": %.2f, "
+           "\"fit_ms_p90\": %.2f, "
            "\"latency_ms_median\": %.2f, \"latency_ms_p90\": %.2f, \"latency_n\": %d, \"update_ms_median\": %.2f, "
            "\"draw_ms_median\": %.2f, \"swap_ms_median\": %.2f,\n \"rss_kb\": [",
            a->fb_w, a->fb_h, a->ppm, (const char*)glGetString(GL_RENDERER), start_ms, a->frames, quantile(a->frame_ms, nf, 0.5),
-           quantile(a->frame_ms, nf, 0.9), quantile(st->fit_ms, nfit, 0.5), quantile(st->fit_ms, nfit, 0.9),
-           quantile(a->latency, a->latency_n, 0.5), quantile(a->latency, a->latency_n, 0.9), a->latency_n,
-           quantile(a->update_ms, nf, 0.5), quantile(a->draw_ms, nf, 0.5), quantile(a->swap_ms, nf, 0.5));
+           quantile(a->frame_ms, nf, 0.9), quantile(a->frame_ms, nf, 1), quantile(st->fit_ms, nfit, 0.5),
+           quantile(st->fit_ms, nfit, 0.9), quantile(a->latency, a->latency_n, 0.5), quantile(a->latency, a->latency_n, 0.9),
+           a->latency_n, quantile(a->update_ms, nf, 0.5), quantile(a->draw_ms, nf, 0.5), quantile(a->swap_ms, nf, 0.5));
     for (int i = 0; i < a->rss_n; ++i)
         printf("%s%ld", i ? ", " : "", a->rss_kb[i]);
     printf("],\n \"categories\": [");

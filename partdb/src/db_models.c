@@ -271,15 +271,16 @@ sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err)
 sp_result sp_db_model_head(sp_db* db, int64_t* id, char sha256[65], sp_error* err)
 {
     *id = 0;
-    sha256[0] = 0;
+    if (sha256) sha256[0] = 0;
     sqlite3_stmt* st;
-    sp_result r = db_prepare(db, "SELECT id, sha256 FROM models ORDER BY id DESC LIMIT 1", &st, err);
+    sp_result r = db_prepare(db, sha256 ? "SELECT id, sha256 FROM models ORDER BY id DESC LIMIT 1" : "SELECT max(id) FROM models",
+                             &st, err);
     if (r != SP_OK) return r;
     int rc = sqlite3_step(st);
     if (rc == SQLITE_ROW) {
-        const char* s = (const char*)sqlite3_column_text(st, 1);
-        *id = sqlite3_column_int64(st, 0);
-        snprintf(sha256, 65, "%s", s ? s : "");
+        *id = sqlite3_column_int64(st, 0); // max() of no rows is NULL: 0
+        const char* s = sha256 ? (const char*)sqlite3_column_text(st, 1) : NULL;
+        if (sha256) snprintf(sha256, 65, "%s", s ? s : "");
     } else if (rc != SQLITE_DONE) {
         r = db_fail(db, rc, "reading the model", err);
     }

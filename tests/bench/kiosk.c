@@ -6,6 +6,10 @@
 //   build/tests/bench/kiosk --soak N [--json]   N strokes in one session (undo, start over and
 //   save now and then); resident memory right after each Start over (every 40
 //   strokes): the first one after 200 strokes (warm-up) against the largest later one.
+//   build/tests/bench/kiosk --model-swap [--db DB] [--runs N] [--json]   a copy of the database;
+//   N times its newest model stored again (what `db train` commits), while the
+//   kiosk draws frames at 60 per second of wall time: the longest frame until
+//   the kiosk uses the new model, and how long that took.
 // Cases: start to first frame, pen-up to the fitted part on screen (the
 // first stroke of each part after start, and all of them; the paper's solve
 // alone took 100 ms; target 50 ms), frames of the attract
@@ -22,6 +26,8 @@
 
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
+
+#include <sqlite3.h>
 
 #include "bench.h"
 #include "fixtures.h"
@@ -168,6 +174,65 @@ static void soak_run(sp_kiosk* k, const kp_stroke* strokes, int n, sp_bench_row*
              warm > 0 ? 100.0 * (double)(peak - warm) / (double)warm : 0.0, sp_kiosk_stats_of(k)->saves);
 }
 
+// --model-swap: frames go on while a new model is read (a kiosk on the
+// copy `path`, idle on an empty canvas, the clock the wall's).
+static bool model_swap_run(const char* path, const char* dir, int runs, sp_bench_row* rows, int* nr)
+{
+    sp_kiosk* k = start_kiosk(&(sp_kiosk_desc){
+        .db_path = path, .canvas_w = W, .canvas_h = H, .export_dir = dir, .no_attract_demo = true, .no_collect = true});
+    if (!k) return false;
+    double t0 = sp_now_ms();
+    ev(k, SP_KEV_DOWN, 10, 640, 400);
+    ev(k, SP_KEV_UP, 20, 640, 400);
+    for (int f = 0; f < 120; ++f) // the parts row and the parts load
+        frame(k, 30 + sp_now_ms() - t0);
+    double* longest = malloc(sizeof(double) * (size_t)runs * 2);
+    double* took = longest + runs;
+    int n = 0;
+    for (int i = 0; i < runs; ++i) {
+        const sp_clf* before = sp_dragon_model(sp_kiosk_dragon(k));
+        if (!sp_fixture_store_model_again(path)) break;
+        double s0 = sp_now_ms(), worst = 0;
+        // The kiosk polls every 2 s of its clock; 30 s is far past any read.
+        while (sp_dragon_model(sp_kiosk_dragon(k)) == before && sp_now_ms() - s0 < 30000) {
+            double f0 = sp_now_ms();
+            worst = fmax(worst, frame(k, 30 + f0 - t0));
+            double rest = 1000.0 / 60.0 - (sp_now_ms() - f0);
+            if (rest > 0) usleep((useconds_t)(rest * 1000));
+        }
+        if (sp_dragon_model(sp_kiosk_dragon(k)) == before) {
+            fprintf(stderr, "bench kiosk: the new model was not in use after 30 s\n");
+            break;
+        }
+        longest[n] = worst, took[n++] = sp_now_ms() - s0;
+    }
+    bool ok = n == runs;
+    if (ok) {
+        sp_bench_row r = {"new model stored: the longest frame until it is used", 0, 0, n, -1, 33, ""};
+        sp_bench_stats(longest, n, &r.ms_median, &r.ms_p90);
+        snprintf(r.extra, sizeof r.extra, "\"models_loaded\": %d, \"reloads\": %d", sp_kiosk_stats_of(k)->models_loaded,
+                 sp_kiosk_stats_of(k)->reloads);
+        rows[(*nr)++] = r;
+        r = (sp_bench_row){"new model stored: until it is used (the poll every 2 s included)", 0, 0, n, -1, -1, ""};
+        sp_bench_stats(took, n, &r.ms_median, &r.ms_p90);
+        rows[(*nr)++] = r;
+    }
+    free(longest);
+    sp_kiosk_destroy(k);
+    return ok;
+}
+
+// The strokes and the GL objects main made, and the context.
+static void teardown(kp_stroke* strokes, sp_render_target* target, GLuint fbo, GLuint rb[2], sp_headless* gl)
+{
+    for (int i = 0; i < DRAGON_PART_COUNT; ++i)
+        free(strokes[i].xy);
+    sp_render_target_destroy(target);
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (rb[0]) glDeleteRenderbuffers(2, rb);
+    sp_headless_destroy(gl);
+}
+
 int main(int argc, char** argv)
 {
     bool json = sp_bench_json_flag(argc, argv);
@@ -175,7 +240,7 @@ int main(int argc, char** argv)
     const char* db = NULL;
     const char* png = NULL;
     int lod = 0, soak = 0;
-    bool no_collect = false;
+    bool no_collect = false, model_swap = false;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--runs") && i + 1 < argc)
             runs = atoi(argv[++i]);
@@ -189,7 +254,10 @@ int main(int argc, char** argv)
             db = argv[++i];
         else if (!strcmp(argv[i], "--no-collect"))
             no_collect = true;
+        else if (!strcmp(argv[i], "--model-swap"))
+            model_swap = true;
     }
+    if (model_swap && runs == 60) runs = 5; // each waits for a poll (2 s) and a read
     if (runs < 3) runs = 3;
     sp_error err = {0};
     char db_path[1100], dir[1024];
@@ -229,6 +297,24 @@ int main(int argc, char** argv)
     }
     sp_bench_row rows[16];
     int nr = 0;
+    if (model_swap) {
+        // On a copy: the bench stores models into it.
+        char copy[1100];
+        snprintf(copy, sizeof copy, "%.1024s/bench_swap.db", dir);
+        remove(copy);
+        sqlite3* h = NULL;
+        char sql[1200];
+        snprintf(sql, sizeof sql, "VACUUM INTO '%s'", copy);
+        bool copied = strchr(copy, '\'') == NULL && sqlite3_open_v2(db, &h, SQLITE_OPEN_READONLY, NULL) == SQLITE_OK &&
+                      sqlite3_exec(h, sql, NULL, NULL, NULL) == SQLITE_OK;
+        if (!copied) fprintf(stderr, "bench kiosk: %s: cannot copy to %s: %s\n", db, copy, h ? sqlite3_errmsg(h) : "?");
+        sqlite3_close(h);
+        bool ok = copied && model_swap_run(copy, dir, runs, rows, &nr);
+        if (ok) sp_bench_print("kiosk: a new model (headless, 1280x800)", rows, nr, json);
+        remove(copy);
+        teardown(strokes, target, fbo, rb, gl);
+        return ok ? 0 : 1;
+    }
     if (soak > 0) {
         sp_kiosk* k = start_kiosk(&(sp_kiosk_desc){.db_path = db,
                                                    .canvas_w = W,
@@ -243,12 +329,7 @@ int main(int argc, char** argv)
         soak_run(k, strokes, soak, &rows[nr++]);
         sp_bench_print("kiosk soak (headless, 1280x800)", rows, nr, json);
         sp_kiosk_destroy(k);
-        for (int i = 0; i < DRAGON_PART_COUNT; ++i)
-            free(strokes[i].xy);
-        sp_render_target_destroy(target);
-        if (fbo) glDeleteFramebuffers(1, &fbo);
-        if (rb[0]) glDeleteRenderbuffers(2, rb);
-        sp_headless_destroy(gl);
+        teardown(strokes, target, fbo, rb, gl);
         return 0;
     }
 
@@ -420,12 +501,7 @@ int main(int argc, char** argv)
     sp_bench_print("kiosk (headless, 1280x800)", rows, nr, json);
     free(ms);
     free(lat);
-    for (int i = 0; i < DRAGON_PART_COUNT; ++i)
-        free(strokes[i].xy);
     sp_kiosk_destroy(k);
-    sp_render_target_destroy(target);
-    if (fbo) glDeleteFramebuffers(1, &fbo);
-    if (rb[0]) glDeleteRenderbuffers(2, rb);
-    sp_headless_destroy(gl);
+    teardown(strokes, target, fbo, rb, gl);
     return 0;
 }

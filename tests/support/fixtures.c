@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
+#include <sqlite3.h>
 
 #include "sp/classifier.h"
 #include "sp/gltf.h"
@@ -357,4 +358,21 @@ int sp_fixture_session_strokes(const char* path, sp_vec2** xy, int* n, int cap)
     }
     cJSON_Delete(session);
     return strokes;
+}
+
+bool sp_fixture_store_model_again(const char* path)
+{
+    sqlite3* h = NULL;
+    int rc = sqlite3_open(path, &h);
+    if (rc == SQLITE_OK) {
+        sqlite3_busy_timeout(h, 5000);
+        rc = sqlite3_exec(h,
+                          "INSERT INTO models (created_at, created_by, model, sha256, categories, options, report)"
+                          " SELECT created_at, created_by, model, sha256, categories, options, report FROM models"
+                          " ORDER BY id DESC LIMIT 1",
+                          NULL, NULL, NULL);
+    }
+    if (rc != SQLITE_OK) fprintf(stderr, "  %s: %s\n", path, sqlite3_errmsg(h));
+    sqlite3_close(h);
+    return rc == SQLITE_OK;
 }

@@ -108,6 +108,11 @@ bool sp_fixture_child_passed(int pid);
 /// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).
 void sp_fixture_remove_db(const char* path);
 
+/// Stores the newest model of the database at `path` again, as a new row:
+/// what `db train` commits, without its minute (the real model's bytes, so a
+/// reader reads them as it would). False, said on stderr, when it cannot.
+bool sp_fixture_store_model_again(const char* path);
+
 /// A JSON file, parsed (fails the running test when it does
 /// not read or parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_json_file(const char* path);

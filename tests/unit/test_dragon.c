@@ -1391,6 +1391,58 @@ static void test_undo_clear_refit(void)
     sp_db_close(db);
 }
 
+// Waits (at most a minute) until the model read in the background is taken.
+static bool model_taken(sp_dragon* d)
+{
+    for (int i = 0; i < 6000; ++i) {
+        if (sp_dragon_model_update(d)) return true;
+        usleep(10000);
+    }
+    return false;
+}
+
+// desc.background_model: a new model is read on a thread of its own while
+// the pipeline goes on with the one it has; a model stored during that read
+// is read after it; a pipeline destroyed mid-read waits for the thread.
+static void test_background_model(void)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_background.db"));
+    copy_file(test_db(), path);
+    sp_error err = {0};
+    sp_dragon* d = NULL;
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
+                            &err) == SP_OK);
+    const sp_clf* first = sp_dragon_model(d);
+    ENSURE(first && !sp_dragon_model_loading(d) && !sp_dragon_model_update(d));
+    ENSURE(sp_fixture_store_model_again(path));
+    bool reloaded = false;
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded);
+    ENSURE(sp_dragon_model(d) == first && sp_dragon_model_loading(d));
+    // A stroke meanwhile has a model (the old one, or the new one if its read has ended).
+    sp_dragon_result res = {0};
+    sp_vec2 tail[4] = {{300, 300}, {420, 330}, {540, 300}, {660, 340}};
+    ENSURE(sp_dragon_add_points(d, tail, 4, NULL, &res, &err) == SP_OK && res.reason != SP_DRAGON_NO_MODEL &&
+           res.guess_count > 0);
+    ENSURE(sp_dragon_model(d) && (sp_dragon_model(d) == first || !sp_dragon_model_loading(d)));
+    if (sp_dragon_model_loading(d)) ENSURE(model_taken(d));
+    const sp_clf* second = sp_dragon_model(d);
+    ENSURE(second != first && !sp_dragon_model_loading(d));
+    // Nothing new stored: nothing read.
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && !sp_dragon_model_loading(d));
+    // A model stored during a read is read once that one is taken.
+    ENSURE(sp_fixture_store_model_again(path));
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded && sp_dragon_model_loading(d));
+    ENSURE(sp_fixture_store_model_again(path));
+    ENSURE(model_taken(d) && sp_dragon_model_loading(d));
+    ENSURE(model_taken(d) && !sp_dragon_model_loading(d));
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && !sp_dragon_model_loading(d));
+    // Destroyed mid-read.
+    ENSURE(sp_fixture_store_model_again(path));
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && sp_dragon_model_loading(d));
+    sp_dragon_destroy(d);
+}
+
 // A curator's sketch or review bumps the database's generation but leaves
 // its model: the pipeline keeps the model it has (parsing it again held the
 // kiosk's frames for 0.5-1 s). A new model row is read.
@@ -1419,19 +1471,7 @@ static void test_reload_keeps_model(void)
     ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded);
     ENSURE(sp_dragon_model(d) == first);
     // The same model stored again, as a new row: read.
-    sqlite3* h = NULL;
-    ENSURE(sqlite3_open(path, &h) == SQLITE_OK);
-    char* msg = NULL;
-    int rc =
-        sqlite3_exec(h,
-                     "INSERT INTO models (created_at, created_by, model, sha256, categories, options, report)"
-                     " SELECT created_at, created_by, model, sha256, categories, options, report FROM models ORDER BY id DESC"
-                     " LIMIT 1",
-                     NULL, NULL, &msg);
-    if (rc != SQLITE_OK) fprintf(stderr, "  sqlite: %s\n", msg ? msg : "?");
-    sqlite3_free(msg);
-    sqlite3_close(h);
-    ENSURE(rc == SQLITE_OK);
+    ENSURE(sp_fixture_store_model_again(path));
     ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded);
     ENSURE(sp_dragon_model(d) && sp_dragon_model(d) != first);
     sp_db_close(writer);
@@ -3822,6 +3862,7 @@ int main(int argc, char** argv)
                                    {"undo_clear_refit", test_undo_clear_refit},
                                    {"live_update", test_live_update},
                                    {"reload_keeps_model", test_reload_keeps_model},
+                                   {"background_model", test_background_model},
                                    {"command", test_command},
                                    {"six_real_parts", test_six_real_parts},
                                    {"many_parts", test_many_parts},

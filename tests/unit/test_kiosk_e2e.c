@@ -1326,12 +1326,54 @@ static void test_collect_reload(void)
     sp_clf* fresh = NULL;
     ENSURE(sp_db_load_model(w, &fresh, NULL, &err) == SP_OK);
     sp_db_close(w);
+    // The poll (every 2 s of its clock) starts reading the model on a thread;
+    // the kiosk's frames go on with the old one until the read ends.
     updates_until(k, &t, t + 2500);
+    ENSURE(st->reloads == 1);
+    const sp_clf* old = sp_dragon_model(sp_kiosk_dragon(k));
+    for (int i = 0; i < 6000 && sp_dragon_model_loading(sp_kiosk_dragon(k)); ++i) {
+        ENSURE(sp_dragon_model(sp_kiosk_dragon(k)) == old);
+        usleep(10000);
+        updates_until(k, &t, t + 1);
+    }
     double after = sp_clf_reject_distance(sp_dragon_model(sp_kiosk_dragon(k))), want = sp_clf_reject_distance(fresh);
-    fprintf(stderr, "  reloads %d; the kiosk's model: reject distance %.4f before, %.4f after (the new model's: %.4f)\n",
-            st->reloads, before, after, want);
-    ENSURE(st->reloads == 1 && after == want && before != want);
+    fprintf(
+        stderr,
+        "  reloads %d, models loaded %d; the kiosk's model: reject distance %.4f before, %.4f after (the new model's: %.4f)\n",
+        st->reloads, st->models_loaded, before, after, want);
+    ENSURE(st->reloads == 1 && st->models_loaded == 1 && after == want && before != want);
     sp_clf_destroy(fresh);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
+// The refusal's parts row follows the curators' parts: a new model alone
+// keeps it (reading six parts again held a frame), a part removed leaves it.
+static void test_parts_row_follows(void)
+{
+    char db[1100];
+    e2e_db_copy("kiosk_row.db", db, sizeof db);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_row_ex", &gl, &t);
+    const sp_kiosk_ui* ui = sp_kiosk_ui_of(k);
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    ENSURE(ui->row_count == 6);
+    sp_db* w = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK);
+    ENSURE(sp_fixture_store_model_again(db));
+    updates_until(k, &t, t + 2500);
+    ENSURE(st->reloads == 1 && ui->row_count == 6);
+    ENSURE(sp_db_remove_part(w, "hind_legs", "test", &err) == SP_OK);
+    sp_db_close(w);
+    updates_until(k, &t, t + 2500);
+    fprintf(stderr, "  reloads %d, row %d parts\n", st->reloads, ui->row_count);
+    ENSURE(st->reloads == 2 && ui->row_count == 5);
+    for (int i = 0; i < ui->row_count; ++i)
+        ENSURE(strcmp(ui->row[i], "hind_legs") != 0);
+    while (sp_dragon_model_loading(sp_kiosk_dragon(k)))
+        usleep(10000), updates_until(k, &t, t + 1);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
 }
@@ -1839,6 +1881,7 @@ int main(int argc, char** argv)
                                    {"collect", test_collect},
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
+                                   {"parts_row_follows", test_parts_row_follows},
                                    {"parts_loaded_while_idle", test_parts_loaded_while_idle},
                                    {"collect_busy", test_collect_busy},
                                    {"collect_replaced", test_collect_replaced},

@@ -1133,6 +1133,11 @@ static void test_generation(void)
     ENSURE(sp_db_generation(writer) == g1);
     ENSURE(sp_db_load_model(reader, &clf, &id1, &err) == SP_OK && id1 > id0);
     sp_clf_destroy(clf);
+    // The newest model's head, with its checksum and without (the id alone).
+    int64_t head = 0, bare = 0;
+    char sha[65] = "";
+    ENSURE(sp_db_model_head(reader, &head, sha, &err) == SP_OK && head == id1 && strlen(sha) == 64);
+    ENSURE(sp_db_model_head(reader, &bare, NULL, &err) == SP_OK && bare == id1);
     ENSURE(sp_db_remove_part(writer, "wings_a", "t", &err) == SP_OK);
     ENSURE(sp_db_generation(reader) > g1);
     sp_db_close(writer);

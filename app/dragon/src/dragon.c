@@ -94,7 +94,7 @@ sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error
     }
     o->db = NULL, o->db_path = NULL, o->assets_dir = NULL; // not kept: the caller's strings
     d->gen = sp_db_generation(d->db);
-    dragon_reload_model(d); // without one, strokes need a forced category
+    dragon_reload_model(d, false); // without one, strokes need a forced category
     *out = d;
     return SP_OK;
 }
@@ -102,6 +102,7 @@ sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error
 void sp_dragon_destroy(sp_dragon* d)
 {
     if (!d) return;
+    (void)dragon_model_load_take(d, true); // a read in the background ends first
     sp_dragon_clear(d);
     free(d->parts);
     dragon_cache_clear(d);

@@ -76,8 +76,17 @@ tpl* dragon_category_first(sp_dragon* d, const char* category);
 void dragon_cache_clear(sp_dragon* d);
 /// The file's device and inode (a database replaced on disk is a new inode); false when it does not exist.
 // Takes the newest model of d->db (d->desc.no_model: none); keeps the one
-// loaded when it cannot be read or is that model already.
-void dragon_reload_model(sp_dragon* d);
+// loaded when it cannot be read or is that model already (same_file: d->db
+// is the file it was read from; else another file, a replaced one).
+void dragon_reload_model(sp_dragon* d, bool same_file);
+// model_load.c: the background read of a model (desc.background_model).
+typedef struct dragon_loader dragon_loader;
+// Starts reading the newest model of d->db_path on a thread (one at a
+// time: false only when no thread could be started).
+bool dragon_model_load_start(sp_dragon* d);
+// Takes the model read, when the read has ended (wait: waits for it);
+// true when the pipeline's model changed.
+bool dragon_model_load_take(sp_dragon* d, bool wait);
 bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
 
 // ---- the dragon --------------------------------------------------------------------
@@ -157,6 +166,7 @@ struct sp_dragon {
     sp_clf* clf;
     int64_t model_id;   // the row clf was read from (0: none)
     char model_sha[65]; // its SHA-256 ("" when not known)
+    dragon_loader* loader; // a model being read in the background (NULL: none)
     tpl** cache;
     int cache_n;
     int preload_next; // sp_dragon_preload_step's cursor over the database's parts

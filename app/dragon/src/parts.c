@@ -339,15 +339,23 @@ static sp_result open_own(sp_dragon* d, sp_error* err)
 // Takes the newest model of the (re)opened database; keeps the old one when
 // it cannot be read, and when it is the one already loaded: a curator's
 // sketch or review bumps the generation too, and parsing a 30 MB model
-// again held the kiosk's frames for half a second or more.
-void dragon_reload_model(sp_dragon* d)
+// again held the kiosk's frames for half a second or more. Within one file
+// models are only ever added (no command deletes one), so the newest row's
+// id tells; another file may have a model of the same id, so there its
+// checksum tells (read past the model's bytes: 15-35 ms, so not every poll).
+void dragon_reload_model(sp_dragon* d, bool same_file)
 {
     if (d->desc.no_model) return;
     int64_t head = 0, id = 0;
     char sha[65] = "";
     sp_error merr = {0};
-    bool known = sp_db_model_head(d->db, &head, sha, &merr) == SP_OK;
-    if (known && d->clf && head > 0 && head == d->model_id && d->model_sha[0] && !strcmp(sha, d->model_sha)) return;
+    bool known = sp_db_model_head(d->db, &head, same_file ? NULL : sha, &merr) == SP_OK;
+    bool loaded = known && d->clf && head > 0 && head == d->model_id;
+    if (loaded && (same_file || (d->model_sha[0] && !strcmp(sha, d->model_sha)))) return;
+    // With a model to go on with, a kiosk reads the new one on a thread of
+    // its own (model_load.c); with none there is nothing better to show meanwhile.
+    if (d->desc.background_model && d->own_db && d->clf && dragon_model_load_start(d)) return;
+    if (same_file) known = sp_db_model_head(d->db, &head, sha, &merr) == SP_OK;
     sp_clf* clf = NULL;
     sp_result r = sp_db_load_model(d->db, &clf, &id, &merr);
     if (r == SP_OK || r == SP_ERR_INVALID) {
@@ -365,6 +373,7 @@ void dragon_reload_model(sp_dragon* d)
 sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err)
 {
     if (reloaded) *reloaded = false;
+    sp_dragon_model_update(d);
     if (d->own_db) {
         // A database replaced on disk (a new file renamed over it) is a new
         // inode: the open connection still reads the old one. A deleted file
@@ -377,7 +386,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
             if (replaced) drop_stale_sidecars(d->db_path);
             d->db = NULL;
             if (open_own(d, err) != SP_OK) return SP_ERR_IO; // parts already loaded and the model stay usable
-            dragon_reload_model(d);
+            dragon_reload_model(d, false);
             d->gen = sp_db_generation(d->db);
             cache_prune(d);
             if (reloaded) *reloaded = true;
@@ -387,7 +396,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
     uint64_t g = sp_db_generation(d->db);
     if (g == 0) return sp_fail(err, SP_ERR_IO, "%s: the database cannot be read", d->db_path);
     if (g == d->gen) return SP_OK;
-    dragon_reload_model(d);
+    dragon_reload_model(d, true);
     d->gen = g;
     cache_prune(d);
     if (reloaded) *reloaded = true;

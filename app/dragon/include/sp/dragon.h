@@ -80,7 +80,8 @@
 ///
 /// Live update: before each stroke (and on sp_dragon_reload_if_changed) the
 /// database generation is polled; a new model or part is used for the next
-/// stroke. A database file replaced on disk (a new inode) is reopened. Parts
+/// stroke (desc.background_model: the first stroke after it has been read).
+/// A database file replaced on disk (a new inode) is reopened. Parts
 /// already on the canvas keep the rig they were fitted with. A failed reload
 /// keeps the previous model and parts (the kiosk keeps running).
 ///
@@ -120,6 +121,11 @@ typedef struct sp_dragon_desc {
     double fps;            ///< key rate of the exported animation, per second; 0: 30
     int max_parts;         ///< a stroke beyond this many parts is rejected (a kiosk runs all day); 0: 48
     bool no_model;         ///< every stroke names its category (the attract screen's demo): the model is never loaded
+    /// A new model (once one is in use, and the database is the pipeline's
+    /// own: db_path) is read on a thread of its own, and the pipeline goes on
+    /// with the one it has until sp_dragon_model_update takes it (a kiosk's
+    /// frames go on); false: read at the poll that finds it.
+    bool background_model;
 } sp_dragon_desc;
 
 /// Why a stroke left the dragon unchanged.
@@ -308,6 +314,13 @@ sp_result sp_dragon_export(const sp_dragon* d, const char* path, sp_error* err);
 /// (may be NULL) tells whether anything was reloaded. On failure the previous
 /// state is kept and err says why.
 sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err);
+/// With desc.background_model: takes the model read in the background when
+/// its read has ended (and starts reading a newer one stored meanwhile); true
+/// when the pipeline's model changed. Cheap when there is nothing to take:
+/// call it every frame. Polls and strokes take it too.
+bool sp_dragon_model_update(sp_dragon* d);
+/// Whether a model is being read in the background, or read and not yet taken.
+bool sp_dragon_model_loading(const sp_dragon* d);
 /// Loads every part of the database now (parsing, checksum, the solver's
 /// coarsening), so that the first stroke of each category costs no more than
 /// the others; otherwise each part is loaded by the first stroke that needs it.

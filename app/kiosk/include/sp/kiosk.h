@@ -52,6 +52,7 @@ typedef struct sp_kiosk_stats {
     int waiting;           ///< parts drawn while no body was on the canvas (told to draw one)
     int kept, kept_chosen; ///< parts on the canvas at a Start over or timeout; of them, labelled by the visitor
     int collected;         ///< strokes handed to the collector (sp_kiosk_collect_counts: stored, dropped)
+    int models_loaded;     ///< new models read in the background and put to use (reloads: database changes seen)
     double last_fit_ms;    ///< wall time of the last classify+fit (the pipeline's)
     int fit_count;
     double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
