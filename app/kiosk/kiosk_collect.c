@@ -22,7 +22,7 @@ typedef struct queued {
 } queued;
 
 struct kiosk_collector {
-    sp_db* db; // the writer's own handle; NULL: it could not be opened, every sketch is dropped
+    sp_db* db; // the writer's own handle; NULL: it could not be opened (tried again for each sketch)
     char path[1024];
     dev_t dev; // the file the handle has open
     ino_t ino;
@@ -80,6 +80,30 @@ static bool follow_file(kiosk_collector* c)
     return true;
 }
 
+// A database that could not be written (read-only, damaged, not there) is
+// tried again for each sketch, in this thread: a technician who mends the
+// file expects collecting to resume without a restart. False, with one line
+// naming the file and why, while it still cannot.
+static bool open_writer(kiosk_collector* c)
+{
+    if (c->db) return true;
+    sp_db* db = NULL;
+    sp_error err = {0};
+    struct stat st;
+    if (stat(c->path, &st) != 0) {
+        fprintf(stderr, "dragon-kiosk: %s: no database there: sketch dropped\n", c->path);
+        return false;
+    }
+    if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
+        fprintf(stderr, "dragon-kiosk: %s; sketch dropped\n", err.text);
+        return false;
+    }
+    sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
+    c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
+    fprintf(stderr, "dragon-kiosk: %s: the database can be written now: visitors' strokes are collected again\n", c->path);
+    return true;
+}
+
 // The writer: one sketch a transaction, each waiting at most
 // SP_DB_COLLECT_BUSY_MS for another writer (partdb.h); whatever fails is
 // dropped with one line (the error says "sketch dropped").
@@ -98,14 +122,14 @@ static void* collector_main(void* arg)
         sp_error err = {0};
         sp_stroke st = {.count = s.n, .points = s.xy, .t = s.t};
         sp_result r = SP_ERR_IO;
-        if (follow_file(c)) {
+        if (open_writer(c) && follow_file(c)) {
             r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
             if (r != SP_OK) fprintf(stderr, "dragon-kiosk: %s\n", err.text);
         }
         queued_free(&s);
         count_result(c, r == SP_OK);
         pthread_mutex_lock(&c->lock);
-        if (r == SP_OK && c->count == 0) {
+        if (r == SP_OK && c->count == 0 && c->db) {
             // Once the queue is empty, the visit's sketches go from the WAL
             // into the file itself: a curator's copy of the file has them,
             // and a file renamed over it (follow_file) never meets this
@@ -133,20 +157,20 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     // A writable handle of its own (the pipeline reads through a read-only
     // one); opening migrates an older schema. It runs at start, before the
     // first frame. A database that cannot be written keeps the kiosk running:
-    // each sketch is then dropped with one line.
+    // each sketch is then dropped with one line, until the writer's handle
+    // opens (open_writer).
     sp_error err = {0};
     struct stat st;
     if (stat(db_path, &st) == 0) c->dev = st.st_dev, c->ino = st.st_ino;
     if (sp_db_open(db_path, 0, &c->db, &err) != SP_OK) {
-        // Said: a technician who then fixes the file expected collecting to resume.
-        fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected until the kiosk is restarted: %s\n", err.text);
+        fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected for now (tried again for each): %s\n", err.text);
         c->db = NULL;
     }
     // Every wait of the writer's (a store, a checkpoint) is short: closing the
     // kiosk waits for the writer.
     if (c->db) sp_db_set_busy_timeout(c->db, SP_DB_COLLECT_BUSY_MS);
-    c->threaded = c->db && pthread_create(&c->thread, NULL, collector_main, c) == 0;
-    if (c->db && !c->threaded) {
+    c->threaded = pthread_create(&c->thread, NULL, collector_main, c) == 0;
+    if (!c->threaded) {
         fprintf(stderr, "dragon-kiosk: %s: visitors' strokes cannot be collected: no thread to write them\n", db_path);
         sp_db_close(c->db);
         c->db = NULL;
@@ -158,7 +182,7 @@ void kiosk_collector_push(kiosk_collector* c, const char* category, const sp_vec
 {
     if (!c) return;
     if (!c->threaded) {
-        fprintf(stderr, "dragon-kiosk: a %s stroke not collected (the database cannot be written); sketch dropped\n", category);
+        fprintf(stderr, "dragon-kiosk: a %s stroke not collected (no thread to write it); sketch dropped\n", category);
         count_result(c, false);
         return;
     }

@@ -5,5 +5,6 @@
 if(TARGET dragon-kiosk)
   sp_unit_test(kiosk_e2e LIBS sp_kiosk sp_render sp::partdb SQLite::SQLite3 TIMEOUT 900)
   target_compile_definitions(test_kiosk_e2e PRIVATE SP_DRAGON_KIOSK="$<TARGET_FILE:dragon-kiosk>")
+  target_include_directories(test_kiosk_e2e PRIVATE ${PROJECT_SOURCE_DIR}/app/kiosk) # the collector alone (collect_mended)
   add_dependencies(test_kiosk_e2e dragon-kiosk sketchpose)
 endif()

@@ -26,6 +26,7 @@
 #include <sqlite3.h>
 
 #include "fixtures.h"
+#include "kiosk_internal.h" // the collector alone: kiosk_collector_*
 #include "kiosk_parts.h"
 #include "sp/dragon.h"
 #include "sp/headless.h"
@@ -1213,7 +1214,8 @@ static void test_collect_read_only(void)
     ENSURE(num(st, "collected") == 2 && num(st, "collect_stored") == 0 && num(st, "collect_dropped") == 2);
     cJSON_Delete(st);
     // One line says why at start, one line a sketch.
-    ENSURE(lines_with(errf, "cannot be collected until the kiosk is restarted") == 1 && lines_with(errf, "sketch dropped") == 2);
+    ENSURE(lines_with(errf, "cannot be collected for now (tried again for each)") == 1 &&
+           lines_with(errf, "sketch dropped") == 2);
     ENSURE(pending_count(db) == 0);
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     ENSURE(system(cmd) == 0);
@@ -1281,6 +1283,47 @@ static void wait_collected(sp_kiosk* k, int want, int* stored, int* dropped)
         if (*stored + *dropped >= want) return;
         usleep(10000);
     }
+}
+
+// The collector's counts once `want` sketches were stored or dropped (at most 2 s).
+static void collector_wait(kiosk_collector* c, int want, int* stored, int* dropped)
+{
+    for (int i = 0; i < 200; ++i) {
+        kiosk_collector_counts(c, stored, dropped);
+        if (*stored + *dropped >= want) return;
+        usleep(10000);
+    }
+}
+
+// A database the collector cannot write at start (here a file that is not a
+// database: root may write any file) is tried again for each sketch: once a
+// good one is renamed over it, collecting resumes without a restart.
+static void test_collect_mended(void)
+{
+    six_strokes();
+    char db[1100], good[1100];
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_mended.db"));
+    sp_fixture_remove_db(db);
+    FILE* f = fopen(db, "wb");
+    ENSURE(f);
+    for (int i = 0; i < 256; ++i)
+        fputs("not a database, ", f);
+    ENSURE(fclose(f) == 0);
+    kiosk_collector* c = kiosk_collector_open(db, 1280, 800);
+    ENSURE(c);
+    const stroke* s = &g_strokes[3];
+    int stored = 0, dropped = 0;
+    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
+    collector_wait(c, 1, &stored, &dropped);
+    ENSURE(stored == 0 && dropped == 1);
+    e2e_db_copy("kiosk_mended_good.db", good, sizeof good);
+    ENSURE(rename(good, db) == 0);
+    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
+    collector_wait(c, 2, &stored, &dropped);
+    kiosk_collector_close(c, &stored, &dropped);
+    fprintf(stderr, "  stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 1 && dropped == 1);
+    ENSURE(pending_count(db) == 1);
 }
 
 // A running kiosk picks up the model `db train` stores, trained on a stroke
@@ -1881,6 +1924,7 @@ int main(int argc, char** argv)
                                    {"collect", test_collect},
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
+                                   {"collect_mended", test_collect_mended},
                                    {"parts_row_follows", test_parts_row_follows},
                                    {"parts_loaded_while_idle", test_parts_loaded_while_idle},
                                    {"collect_busy", test_collect_busy},
