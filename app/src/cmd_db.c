@@ -223,6 +223,20 @@ static bool curated_max_opt(const char* cmd, int* v)
     return false;
 }
 
+_Static_assert(SP_DB_KEEP_MODELS == 3, "db train's help gives the default");
+
+// --keep-models: -1 or 1..1,000,000; not given 0 (the library's SP_DB_KEEP_MODELS).
+static bool keep_models_opt(const char* cmd, int* v)
+{
+    if (*v == SP_CLI_UNSET) {
+        *v = 0;
+        return true;
+    }
+    if (*v == -1 || (*v >= 1 && *v <= 1000000)) return true;
+    fprintf(stderr, "%s: --keep-models must be -1 (all) or 1..1000000, got %d\n", cmd, *v);
+    return false;
+}
+
 // ---- subcommands ---------------------------------------------------------------
 
 static int db_init(int argc, char** argv)
@@ -768,13 +782,15 @@ static int db_train(int argc, char** argv)
     const char* cmd = "sketchpose db train";
     db_common c = db_common_unset();
     int folds = SP_CLI_UNSET; // not given: the library's 3 (folds_opt)
-    int curated_max = SP_CLI_UNSET;
+    int curated_max = SP_CLI_UNSET, keep_models = SP_CLI_UNSET;
     clf_cli_opts o = clf_cli_opts_unset();
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
         {"--folds", SP_OPT_INT, &folds, "K", "cross-validation folds for the report, 2..100 (default 3; -1 or 0: none)", false},
         {"--curated-max", SP_OPT_INT, &curated_max, "N",
          "curated sketches per category to train on, spread over those stored, 1..1000000 (default 400; -1: all)", false},
+        {"--keep-models", SP_OPT_INT, &keep_models, "N",
+         "models kept, the new one and the newest before it; older ones are removed, 1..1000000 (default 3; -1: all)", false},
         CLF_CLI_OPTS(o)};
     const char* pos[1];
     int npos;
@@ -782,10 +798,13 @@ static int db_train(int argc, char** argv)
                    "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    if (!clf_cli_check(cmd, &o) || !folds_opt(cmd, &folds) || !curated_max_opt(cmd, &curated_max)) return SP_EXIT_USAGE;
+    if (!clf_cli_check(cmd, &o) || !folds_opt(cmd, &folds) || !curated_max_opt(cmd, &curated_max) ||
+        !keep_models_opt(cmd, &keep_models))
+        return SP_EXIT_USAGE;
     sp_db* db = open_db(cmd, &c, 0);
     if (!db) return SP_EXIT_INPUT;
-    sp_db_train_desc td = {.clf = clf_cli_desc(&o), .folds = folds, .by = c.by, .curated_max = curated_max};
+    sp_db_train_desc td = {
+        .clf = clf_cli_desc(&o), .folds = folds, .by = c.by, .curated_max = curated_max, .keep_models = keep_models};
     if (clf_cli_tty()) td.clf.progress = clf_cli_progress;
     sp_error err = {0};
     char* report = NULL;

@@ -85,6 +85,93 @@ static void report_head(db_str* rep, const char* cats, int drawings, const db_tr
         cats ? cats : "[]", drawings, n->kiosk, n->curated, n->curated_left_out, n->unused, folds);
 }
 
+// Rows of `table`; -1 when it cannot be read.
+static int count_rows(sp_db* db, const char* table)
+{
+    char sql[64];
+    snprintf(sql, sizeof sql, "SELECT count(*) FROM %s", table);
+    sqlite3_stmt* st = NULL;
+    int n = -1;
+    if (sqlite3_prepare_v2(db->h, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
+        n = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    return n;
+}
+
+// What sp_db_train stores.
+typedef struct stored_model {
+    const void* bytes;
+    size_t size;
+    const char *sha, *categories, *options, *by;
+    const sp_dataset* ds; // what it was trained on
+    int keep_models;      // sp_db_train_desc's
+} stored_model;
+
+// Stores the model with its report (closed here, with "models_removed") in
+// one transaction, unless the parts changed while it trained (it would not
+// match them), and removes the models past the newest keep_models.
+static sp_result store_model(sp_db* db, const stored_model* m, db_str* rep, sp_error* err)
+{
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    char** now;
+    int nnow;
+    if ((r = sp_db_categories(db, &now, &nnow, err)) != SP_OK) goto rollback;
+    bool same = nnow == m->ds->category_count;
+    for (int c = 0; same && c < nnow; ++c)
+        same = !strcmp(now[c], m->ds->categories[c]);
+    sp_db_free_strings(now, nnow);
+    if (!same) {
+        r = sp_fail(err, SP_ERR_BUSY, "%s: the part categories changed while training; train again", db->path);
+        goto rollback;
+    }
+    int keep = m->keep_models ? m->keep_models : SP_DB_KEEP_MODELS;
+    int stored = keep > 0 ? count_rows(db, "models") : 0;
+    if (stored < 0) {
+        r = sp_fail(err, SP_ERR_IO, "%s: the models cannot be counted", db->path);
+        goto rollback;
+    }
+    int removed = keep > 0 && stored + 1 > keep ? stored + 1 - keep : 0;
+    db_str_printf(rep, ", \"models_removed\": %d}", removed);
+    if (rep->oom) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        goto rollback;
+    }
+    sqlite3_stmt* st;
+    if ((r = db_prepare(db, "INSERT INTO models(model, sha256, categories, options, report, created_by) VALUES (?,?,?,?,?,?)",
+                        &st, err)) != SP_OK)
+        goto rollback;
+    if ((r = db_bind_blob(db, st, 1, m->bytes, m->size, "the model", err)) != SP_OK) goto rollback;
+    sqlite3_bind_text(st, 2, m->sha, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 3, m->categories, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 4, m->options, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 5, rep->s, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 6, db_who(m->by), -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        r = db_fail(db, rc, "storing the model", err);
+        goto rollback;
+    }
+    DB_HOOK("model");
+    char subject[32];
+    snprintf(subject, sizeof subject, "model %lld", (long long)sqlite3_last_insert_rowid(db->h));
+    if (removed > 0) {
+        // The newest is never among them, so row ids only grow (a reader compares them: sp_db_model_head).
+        char sql[128];
+        snprintf(sql, sizeof sql, "DELETE FROM models WHERE id NOT IN (SELECT id FROM models ORDER BY id DESC LIMIT %d)", keep);
+        if ((rc = sqlite3_exec(db->h, sql, NULL, NULL, NULL)) != SQLITE_OK) {
+            r = db_fail(db, rc, "removing older models", err);
+            goto rollback;
+        }
+    }
+    if ((r = db_log_row(db, m->by, "train", subject, rep->s, err)) != SP_OK) goto rollback;
+    return db_commit(db, err);
+rollback:
+    db_rollback(db);
+    return r;
+}
+
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err)
 {
     if (report_json) *report_json = NULL;
@@ -173,7 +260,6 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
     db_str_printf(&rep, ", \"seconds_train\": %.3f, \"seconds_cv\": %.3f, \"reject_distance\": %.4f", t_train, t_cv,
                   isfinite(reject) ? reject : -1.0);
     if (n_cal > 0) db_str_printf(&rep, ", \"calibration\": {\"sketches\": %d, \"quantile\": %.4g}", n_cal, q_cal);
-    db_str_printf(&rep, "}");
     if (!opts || !cats_s || cb.oom || rep.oom) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         goto done;
@@ -183,45 +269,7 @@ sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_jso
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         goto done;
     }
-    // Store, unless the parts changed while we trained (the model would not match them).
-    if ((r = db_begin(db, err)) != SP_OK) goto done;
-    {
-        char** now;
-        int nnow;
-        if ((r = sp_db_categories(db, &now, &nnow, err)) != SP_OK) goto rollback;
-        bool same = nnow == ds.category_count;
-        for (int c = 0; same && c < nnow; ++c)
-            same = !strcmp(now[c], ds.categories[c]);
-        sp_db_free_strings(now, nnow);
-        if (!same) {
-            r = sp_fail(err, SP_ERR_BUSY, "%s: the part categories changed while training; train again", db->path);
-            goto rollback;
-        }
-        sqlite3_stmt* st;
-        if ((r = db_prepare(db, "INSERT INTO models(model, sha256, categories, options, report, created_by) VALUES (?,?,?,?,?,?)", &st,
-                            err)) != SP_OK)
-            goto rollback;
-        if ((r = db_bind_blob(db, st, 1, bytes, size, "the model", err)) != SP_OK) goto rollback;
-        sqlite3_bind_text(st, 2, sha, -1, SQLITE_STATIC);
-        sqlite3_bind_text(st, 3, cats_s, -1, SQLITE_STATIC);
-        sqlite3_bind_text(st, 4, opts, -1, SQLITE_STATIC);
-        sqlite3_bind_text(st, 5, rep.s, -1, SQLITE_STATIC);
-        sqlite3_bind_text(st, 6, db_who(d.by), -1, SQLITE_TRANSIENT);
-        int rc = sqlite3_step(st);
-        sqlite3_finalize(st);
-        if (rc != SQLITE_DONE) {
-            r = db_fail(db, rc, "storing the model", err);
-            goto rollback;
-        }
-        DB_HOOK("model");
-        char subject[32];
-        snprintf(subject, sizeof subject, "model %lld", (long long)sqlite3_last_insert_rowid(db->h));
-        if ((r = db_log_row(db, d.by, "train", subject, rep.s, err)) != SP_OK) goto rollback;
-        r = db_commit(db, err);
-        goto done;
-    }
-rollback:
-    db_rollback(db);
+    r = store_model(db, &(stored_model){bytes, size, sha, cats_s, opts, d.by, &ds, d.keep_models}, &rep, err);
 done:
     (void)t0;
     if (r == SP_OK && report_json) {
@@ -304,17 +352,6 @@ static void problem(db_str* b, int* n, const char* fmt, ...)
     va_end(ap);
     db_str_printf(b, "%s", (*n)++ ? ", " : "");
     db_str_json(b, line);
-}
-
-static int count_rows(sp_db* db, const char* table)
-{
-    char sql[64];
-    snprintf(sql, sizeof sql, "SELECT count(*) FROM %s", table);
-    sqlite3_stmt* st = NULL;
-    int n = -1;
-    if (sqlite3_prepare_v2(db->h, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW) n = sqlite3_column_int(st, 0);
-    sqlite3_finalize(st);
-    return n;
 }
 
 sp_result sp_db_check(sp_db* db, bool* ok, char** json, sp_error* err)

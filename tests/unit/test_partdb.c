@@ -430,7 +430,7 @@ static void crash_loop(crash_op op, int runs, uint64_t seed)
     sp_test_rng rng = {seed};
     int olds = 0, news = 0;
     for (int k = 0; k < runs; ++k) {
-        int models = scalar(p, "SELECT count(*) FROM models");
+        int newest = scalar(p, "SELECT max(id) FROM models");
         double at = sp_test_range(&rng, 0.0, 1.1 * span);
         pid = fork();
         ENSURE(pid >= 0);
@@ -458,11 +458,13 @@ static void crash_loop(crash_op op, int runs, uint64_t seed)
                 sp_db_close(db);
             }
         } else {
-            int m = scalar(p, "SELECT count(*) FROM models");
-            ENSURE(m == models || m == models + 1);
-            ENSURE(scalar(p, "SELECT count(*) FROM log WHERE action = 'train'") == m); // model and its log row together
-            olds += m == models;
-            news += m == models + 1;
+            int m = scalar(p, "SELECT max(id) FROM models");
+            ENSURE(m == newest || m == newest + 1);
+            // Each model stored has its log row, and only those (ids from 1; older models removed by train).
+            ENSURE(scalar(p, "SELECT count(*) FROM log WHERE action = 'train'") == m);
+            ENSURE(scalar(p, "SELECT count(*) FROM models") == (m < SP_DB_KEEP_MODELS ? m : SP_DB_KEEP_MODELS));
+            olds += m == newest;
+            news += m == newest + 1;
         }
     }
     fprintf(stderr, "  %s: %d kills over %.0f ms: %d old, %d new, never mixed\n", op == OP_ADD_PART ? "add-part" : "train", runs, span,
@@ -1144,6 +1146,57 @@ static void test_generation(void)
     sp_db_close(reader);
 }
 
+// Trains with keep_models `keep`; the report's "models_removed".
+static int train_keeping(sp_db* db, int keep)
+{
+    sp_db_train_desc td = quick_train(-1);
+    td.keep_models = keep;
+    char* report = NULL;
+    sp_error err = {0};
+    sp_result r = sp_db_train(db, &td, &report, &err);
+    if (r != SP_OK) fprintf(stderr, "  train: %s\n", err.text);
+    ENSURE(r == SP_OK);
+    cJSON* j = cJSON_Parse(report);
+    free(report);
+    const cJSON* removed = cJSON_GetObjectItemCaseSensitive(j, "models_removed");
+    ENSURE(cJSON_IsNumber(removed));
+    int n = (int)removed->valuedouble;
+    cJSON_Delete(j);
+    return n;
+}
+
+// db train keeps the newest models (SP_DB_KEEP_MODELS by default) and
+// removes the older ones in its transaction; the newest is the one read.
+static void test_keep_models(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("keep_models.db"));
+    sp_db* db = open_ok(p, 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM models") == 1);
+    ENSURE(train_keeping(db, -1) == 0 && train_keeping(db, -1) == 0 && train_keeping(db, -1) == 0);
+    ENSURE(scalar(p, "SELECT count(*) FROM models") == 4);
+    int newest = scalar(p, "SELECT max(id) FROM models");
+    ENSURE(train_keeping(db, 0) == 2); // the default keeps 3
+    ENSURE(scalar(p, "SELECT count(*) FROM models") == SP_DB_KEEP_MODELS);
+    ENSURE(scalar(p, "SELECT min(id) FROM models") == newest - 1 && scalar(p, "SELECT max(id) FROM models") == newest + 1);
+    ENSURE(train_keeping(db, 1) == 3);
+    ENSURE(scalar(p, "SELECT count(*) FROM models") == 1 && scalar(p, "SELECT max(id) FROM models") == newest + 2);
+    int64_t id = 0;
+    sp_clf* clf = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_load_model(db, &clf, &id, &err) == SP_OK && id == newest + 2);
+    sp_clf_destroy(clf);
+    check_ok(db);
+    sp_db_close(db);
+    // The command: --keep-models, and the same line in the help.
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char cmd[4096], out[65536];
+    snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --folds -1 --words 64 --keep-models 1 2>/dev/null", bin, p);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"models_removed\": 1"));
+    ENSURE(scalar(p, "SELECT count(*) FROM models") == 1 && scalar(p, "SELECT max(id) FROM models") == newest + 3);
+}
+
 static void put_text(const char* path, const char* text)
 {
     FILE* f = fopen(path, "wb");
@@ -1782,6 +1835,7 @@ static void test_number_options_cli(void)
                             {"init --folds 1", "--folds must be -1 or 0 (none), or 2..100, got 1"},
                             {"train --folds 101", "--folds must be -1 or 0 (none), or 2..100, got 101"},
                             {"train --curated-max 0", "--curated-max must be -1 (all) or 1..1000000, got 0"},
+                            {"train --keep-models 0", "--keep-models must be -1 (all) or 1..1000000, got 0"},
                             {"init --from x --synth 5", "--synth does not apply with --from DIR"},
                             {"init --from x --assets y", "--assets does not apply with --from DIR"},
                             {"init --no-train", "--no-train does not apply without --from DIR"},
@@ -2509,6 +2563,7 @@ int main(int argc, char** argv)
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
                                    {"generation", test_generation},
+                                   {"keep_models", test_keep_models},
                                    {"people_strokes", test_people_strokes},
                                    {"drawn_sketches", test_drawn_sketches},
                                    {"curated_cap", test_curated_cap},

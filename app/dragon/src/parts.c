@@ -340,8 +340,8 @@ static sp_result open_own(sp_dragon* d, sp_error* err)
 // it cannot be read, and when it is the one already loaded: a curator's
 // sketch or review bumps the generation too, and parsing a 30 MB model
 // again held the kiosk's frames for half a second or more. Within one file
-// models are only ever added (no command deletes one), so the newest row's
-// id tells; another file may have a model of the same id, so there its
+// model ids only grow (db train removes old models, never the newest), so the
+// newest row's id tells; another file may have a model of the same id, so there its
 // checksum tells (read past the model's bytes: 15-35 ms, so not every poll).
 void dragon_reload_model(sp_dragon* d, bool same_file)
 {

@@ -218,6 +218,10 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
 /// made an 18-minute `db train` and a 2.3 GB kiosk (BENCHMARKS.md, "Curated
 /// sketches").
 #define SP_DB_CURATED_TRAIN_MAX 400
+/// Models a database keeps after `db train` stores one (sp_db_train_desc.keep_models
+/// by default): the newest, and the two before it to compare reports with. Each
+/// is tens of MB and only the newest is used: a weekly retrain kept 1.6 GB a year.
+#define SP_DB_KEEP_MODELS 3
 
 /// Review status of a kiosk sketch.
 typedef enum sp_db_status { SP_DB_PENDING, SP_DB_APPROVED, SP_DB_REJECTED, SP_DB_STATUS_COUNT } sp_db_status;
@@ -302,16 +306,19 @@ typedef struct sp_db_train_desc {
     int calibrate;
     double calibrate_quantile; ///< share of the calibration sketches accepted; 0: 0.96
     int curated_max;           ///< curated sketches per category trained on; 0: SP_DB_CURATED_TRAIN_MAX; -1: all
+    int keep_models;           ///< models kept once this one is stored, the newest (it among them); 0: SP_DB_KEEP_MODELS; -1: all
 } sp_db_train_desc;
 /// Rebuilds the classifier from the stored sketches of the current part
 /// categories (synthetic, curated: `curated_max` per category, and approved kiosk sketches: the newest
 /// SP_DB_KIOSK_TRAIN_MAX per category), cross-validates it for the report, calibrates its reject
 /// threshold on fresh hand-drawn sketches of the parts, and stores the model with
-/// its options and report in one transaction. `report_json` (may be NULL) gets
+/// its options and report in one transaction, removing the models older than
+/// the newest `keep_models` in it (their space is reused by later writes; the
+/// file does not shrink). `report_json` (may be NULL) gets
 /// the report: {"categories", "drawings", "kiosk_sketches" (approved kiosk sketches among the drawings), "curated_sketches"
 /// (likewise), "curated_left_out" (stored past the cap), "unused_drawings" (other categories'), "folds", "top1",
 /// "per_class": {"<cat>": {"recall", "n"}}, "seconds_train", "seconds_cv", "reject_distance", "calibration": {"sketches",
-/// "quantile"} (absent without calibration)} (malloc'd, free()). Fails when a part category has no sketches.
+/// "quantile"} (absent without calibration), "models_removed"} (malloc'd, free()). Fails when a part category has no sketches.
 sp_result sp_db_train(sp_db* db, const sp_db_train_desc* desc, char** report_json, sp_error* err);
 /// The newest model; *id (may be NULL) its row id. SP_ERR_INVALID when none is stored.
 sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err);
