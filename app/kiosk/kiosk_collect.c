@@ -6,19 +6,26 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 #include "kiosk_internal.h"
+#include "sp/clock.h"
 #include "sp/partdb.h"
 
 // Sketches waiting for the writer: more than a whole dragon's (48 parts),
 // so only a database that keeps refusing drops what it cannot take.
 enum { QUEUE_MAX = 256 };
+// Another writer (a curator's `db train` committing its model, an import)
+// holds the database longer than a store waits: the sketch is tried again
+// this often, for at most this long, in this thread, before it is dropped.
+enum { BUSY_RETRY_MS = 200, BUSY_GIVE_UP_MS = 30000 };
 
 typedef struct queued {
     char category[SP_NAME_MAX];
     sp_vec2* xy;
     double* t;
     int n;
+    double busy_since; // sp_now_ms of its first try that found the database busy (0: none)
 } queued;
 
 struct kiosk_collector {
@@ -104,9 +111,33 @@ static bool open_writer(kiosk_collector* c)
     return true;
 }
 
+// After a store found the database busy: puts the sketch back at the head of
+// the queue and waits BUSY_RETRY_MS (or until woken), returning with the lock
+// held; false (nothing done, the lock not held) when it is to be dropped:
+// waited long enough, the kiosk closing, or no room.
+static bool wait_busy(kiosk_collector* c, queued* s)
+{
+    double now = sp_now_ms();
+    if (s->busy_since == 0) s->busy_since = now;
+    pthread_mutex_lock(&c->lock);
+    if (c->stop || now - s->busy_since >= BUSY_GIVE_UP_MS || c->count >= QUEUE_MAX) {
+        pthread_mutex_unlock(&c->lock);
+        return false;
+    }
+    c->head = (c->head + QUEUE_MAX - 1) % QUEUE_MAX;
+    c->q[c->head] = *s, ++c->count;
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_nsec += (long)BUSY_RETRY_MS * 1000000L;
+    until.tv_sec += until.tv_nsec / 1000000000L, until.tv_nsec %= 1000000000L;
+    if (!c->stop) pthread_cond_timedwait(&c->wake, &c->lock, &until);
+    return true;
+}
+
 // The writer: one sketch a transaction, each waiting at most
-// SP_DB_COLLECT_BUSY_MS for another writer (partdb.h); whatever fails is
-// dropped with one line (the error says "sketch dropped").
+// SP_DB_COLLECT_BUSY_MS for another writer (partdb.h) and tried again while
+// one holds the database (wait_busy); whatever fails is dropped with one
+// line (the error says "sketch dropped").
 static void* collector_main(void* arg)
 {
     kiosk_collector* c = arg;
@@ -124,7 +155,12 @@ static void* collector_main(void* arg)
         sp_result r = SP_ERR_IO;
         if (open_writer(c) && follow_file(c)) {
             r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
-            if (r != SP_OK) fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+            if (r == SP_ERR_BUSY && wait_busy(c, &s)) continue; // the lock is held again
+            if (r == SP_ERR_BUSY && s.busy_since > 0)
+                fprintf(stderr, "dragon-kiosk: %s: another writer held the database for %.1f s%s; sketch dropped\n", c->path,
+                        (sp_now_ms() - s.busy_since) / 1000.0, c->stop ? " when the kiosk closed" : "");
+            else if (r != SP_OK)
+                fprintf(stderr, "dragon-kiosk: %s\n", err.text);
         }
         queued_free(&s);
         count_result(c, r == SP_OK);

@@ -1421,9 +1421,10 @@ static void test_parts_row_follows(void)
     sp_headless_destroy(gl);
 }
 
-// A curator's tool holds the database's write lock while a visitor leaves:
-// the writer waits its short while, drops that sketch and the kiosk goes
-// on; once the lock is gone the next visitor's stroke is stored.
+// A curator's tool holds the database's write lock while a visitor leaves
+// (a `db train` committing its model): the kiosk goes on, its writer tries
+// the sketch again until the lock is gone, and stores it; a sketch still
+// waiting when the kiosk closes is dropped, and closing does not wait.
 static void test_collect_busy(void)
 {
     six_strokes();
@@ -1437,19 +1438,34 @@ static void test_collect_busy(void)
     ENSURE(sqlite3_exec(curator, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK);
     draw_then_start_over(k, &t, &g_strokes[3]);
     int stored = 0, dropped = 0;
-    wait_collected(k, 1, &stored, &dropped);
-    fprintf(stderr, "  write lock held: stored %d, dropped %d\n", stored, dropped);
-    ENSURE(stored == 0 && dropped == 1);
+    // The kiosk goes on drawing; its writer waits for the database.
+    for (int i = 0; i < 30; ++i)
+        usleep(20000), updates_until(k, &t, t + 20);
+    sp_kiosk_collect_counts(k, &stored, &dropped);
+    fprintf(stderr, "  write lock held 0.6 s: stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 0 && dropped == 0);
     ENSURE(sqlite3_exec(curator, "COMMIT", NULL, NULL, NULL) == SQLITE_OK);
-    sqlite3_close(curator);
-    // The kiosk never stopped: the next visitor's part is made and kept.
+    // Released: that visitor's stroke is stored, and the next one's.
+    wait_collected(k, 1, &stored, &dropped);
+    ENSURE(stored == 1 && dropped == 0);
     draw_then_start_over(k, &t, &g_strokes[0]);
     wait_collected(k, 2, &stored, &dropped);
     fprintf(stderr, "  lock released: stored %d, dropped %d\n", stored, dropped);
-    ENSURE(stored == 1 && dropped == 1);
+    ENSURE(stored == 2 && dropped == 0);
+    // Held again while the kiosk closes: the stroke waiting is dropped, and
+    // closing does not wait for the lock.
+    ENSURE(sqlite3_exec(curator, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK);
+    draw_then_start_over(k, &t, &g_strokes[1]);
+    usleep(100000);
+    sp_kiosk_close_collection(k);
+    sp_kiosk_collect_counts(k, &stored, &dropped);
+    fprintf(stderr, "  held while closing: stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 2 && dropped == 1);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
-    ENSURE(pending_count(db) == 1);
+    ENSURE(sqlite3_exec(curator, "COMMIT", NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(curator);
+    ENSURE(pending_count(db) == 2);
 }
 
 // A curator replaces the database file (a rename over it) while the kiosk

@@ -1188,7 +1188,7 @@ static void test_keep_models(void)
     sp_clf_destroy(clf);
     check_ok(db);
     sp_db_close(db);
-    // The command: --keep-models, and the same line in the help.
+    // The command: --keep-models, and the count in its report.
     const char* bin = sketchpose_bin();
     if (!bin) SKIP("sketchpose not built");
     char cmd[4096], out[65536];
