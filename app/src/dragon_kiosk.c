@@ -125,6 +125,18 @@ static double live_t(const app* a)
     return (glfwGetTime() - a->t0) * 1000.0;
 }
 
+// Live frames come at most 60 a second: where the swap does not wait for the
+// display (software GL, Xvfb) the loop drew 90 and more a second of an idle
+// screen. Input is handled while waiting (each event keeps its own time), and
+// a stroke's pen-up (a job) starts the next frame at once.
+static void wait_for_frame(const app* a, double until)
+{
+    for (double now = glfwGetTime(); now < until && !g_quit; now = glfwGetTime()) {
+        glfwWaitEventsTimeout(until - now);
+        if (sp_kiosk_ui_peek_job(sp_kiosk_ui_of(a->k)) != SP_KJOB_NONE) return;
+    }
+}
+
 static void cb_button(GLFWwindow* w, int button, int action, int mods)
 {
     (void)mods;
@@ -625,9 +637,11 @@ int main(int argc, char** argv)
         a.t0 = glfwGetTime();
         long n = 0;
         while (!glfwWindowShouldClose(win) && !g_quit) {
+            double slot = glfwGetTime();
             glfwPollEvents();
             frame(&a, live_t(&a), true);
             if (n++ == 0) first_frame_ms = sp_now_ms() - start;
+            wait_for_frame(&a, slot + 1.0 / 60.0);
         }
     }
     if (shot && exit_code == SP_EXIT_OK && sp_kiosk_screenshot(a.k, shot, &err) != SP_OK) {
