@@ -178,7 +178,7 @@ void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool upd
         }
         sp_render_mesh_create(r, &md, &it.mesh, &err);
         if (!it.mesh) {
-            fprintf(stderr, "dragon-kiosk: part %s: %s\n", p->name, err.text);
+            sp_kiosk_log("part %s: %s", p->name, err.text);
             sp_lod_free(&it.lod);
             continue;
         }
@@ -464,7 +464,7 @@ static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* re
 {
     ++k->stats.rejected;
     if (rc == SP_OK && res->reason == SP_DRAGON_NO_PART && sp_dragon_part_error(k->dragon)[0])
-        fprintf(stderr, "dragon-kiosk: no part to make of that stroke: %s\n", sp_dragon_part_error(k->dragon));
+        sp_kiosk_log("no part to make of that stroke: %s", sp_dragon_part_error(k->dragon));
     sp_kiosk_fit_result r = {.ok = false,
                              .refusal = rc == SP_OK ? refusal_of(res->reason) : SP_KREF_UNRECOGNISED,
                              .part_count = sp_dragon_part_count(k->dragon)};
@@ -493,7 +493,7 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
     if (rc != SP_OK || res->rejected || res->part < 0 || res->part >= sp_dragon_part_count(k->dragon)) {
         if (rc != SP_OK) {
             ++k->stats.pipeline_errors;
-            fprintf(stderr, "dragon-kiosk: %s\n", err->text);
+            sp_kiosk_log("%s", err->text);
         }
         answer_refusal(k, rc, res, forced);
         return;
@@ -667,7 +667,7 @@ static void run_save(sp_kiosk* k)
         sp_kiosk_ui_saved(k->ui, true, code);
     } else {
         ++k->stats.save_failures;
-        fprintf(stderr, "dragon-kiosk: save: %s\n", err.text);
+        sp_kiosk_log("save: %s", err.text);
         sp_kiosk_ui_saved(k->ui, false, NULL);
     }
 }
@@ -767,8 +767,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         k->last_reload_check = t_ms;
         bool reloaded = false;
         sp_error err = {0};
-        if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK)
-            fprintf(stderr, "dragon-kiosk: database: %s\n", err.text);
+        if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK) sp_kiosk_log("database: %s", err.text);
         if (reloaded) // a curator may have changed the parts
             ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false, k->heavy_done = true;
     }
@@ -783,7 +782,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         (k->demo_prepared || k->ui->mode != SP_KM_ATTRACT)) { // the attract screen's demo first: it is what shows
         sp_error err = {0};
         sp_dragon_preload_step(k->dragon, &k->parts_loaded, &err);
-        if (err.text[0]) fprintf(stderr, "dragon-kiosk: %s\n", err.text); // a part that does not load is skipped
+        if (err.text[0]) sp_kiosk_log("%s", err.text); // a part that does not load is skipped
         k->heavy_done = !k->parts_loaded;
     }
     if (k->ui->mode == SP_KM_ATTRACT) kiosk_attract_update(k);
@@ -796,7 +795,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
             mesh_cache_sync(&k->meshes, k->r, k->dragon, true);
             k->posed = true, k->posed_rev = k->rev, k->posed_t = t;
         } else {
-            fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+            sp_kiosk_log("%s", err.text);
         }
         k->stats.pose_ms = sp_now_ms() - t0;
         k->stats.triangles = mesh_cache_triangles(&k->meshes);

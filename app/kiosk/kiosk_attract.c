@@ -68,7 +68,7 @@ static void prepare(sp_kiosk* k)
     sp_db* db = NULL;
     sp_error err = {0};
     if (sp_db_open(k->db_path, SP_DB_READONLY, &db, &err) != SP_OK) {
-        fprintf(stderr, "dragon-kiosk: attract screen without its demo: %s\n", err.text);
+        sp_kiosk_log("attract screen without its demo: %s", err.text);
         return;
     }
     for (int li = 0; li < LAYOUT_N && k->demo_count < DEMO_MAX; ++li)
@@ -81,7 +81,7 @@ static void prepare(sp_kiosk* k)
                                            .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
                                            .no_model = true}, // its strokes name their parts: loading the model took 290 ms
                          &k->demo, &err) != SP_OK)
-        fprintf(stderr, "dragon-kiosk: attract screen without its demo: %s\n", err.text);
+        sp_kiosk_log("attract screen without its demo: %s", err.text);
 }
 
 // Where the demo is: the part being drawn (or -1 once all are), the time

@@ -71,14 +71,14 @@ static bool follow_file(kiosk_collector* c)
 {
     struct stat st;
     if (stat(c->path, &st) != 0) {
-        fprintf(stderr, "dragon-kiosk: %s: the database is gone (deleted or moved away): sketch dropped\n", c->path);
+        sp_kiosk_log("%s: the database is gone (deleted or moved away): sketch dropped", c->path);
         return false;
     }
     if (st.st_dev == c->dev && st.st_ino == c->ino) return true;
     sp_db* db = NULL;
     sp_error err = {0};
     if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
-        fprintf(stderr, "dragon-kiosk: the database was replaced and cannot be written: %s\n", err.text);
+        sp_kiosk_log("the database was replaced and cannot be written: %s", err.text);
         return true; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
     }
     sp_db_close(c->db);
@@ -98,16 +98,16 @@ static bool open_writer(kiosk_collector* c)
     sp_error err = {0};
     struct stat st;
     if (stat(c->path, &st) != 0) {
-        fprintf(stderr, "dragon-kiosk: %s: no database there: sketch dropped\n", c->path);
+        sp_kiosk_log("%s: no database there: sketch dropped", c->path);
         return false;
     }
     if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
-        fprintf(stderr, "dragon-kiosk: %s; sketch dropped\n", err.text);
+        sp_kiosk_log("%s; sketch dropped", err.text);
         return false;
     }
     sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
     c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
-    fprintf(stderr, "dragon-kiosk: %s: the database can be written now: visitors' strokes are collected again\n", c->path);
+    sp_kiosk_log("%s: the database can be written now: visitors' strokes are collected again", c->path);
     return true;
 }
 
@@ -157,10 +157,10 @@ static void* collector_main(void* arg)
             r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
             if (r == SP_ERR_BUSY && wait_busy(c, &s)) continue; // the lock is held again
             if (r == SP_ERR_BUSY && s.busy_since > 0)
-                fprintf(stderr, "dragon-kiosk: %s: another writer held the database for %.1f s%s; sketch dropped\n", c->path,
-                        (sp_now_ms() - s.busy_since) / 1000.0, c->stop ? " when the kiosk closed" : "");
+                sp_kiosk_log("%s: another writer held the database for %.1f s%s; sketch dropped", c->path,
+                             (sp_now_ms() - s.busy_since) / 1000.0, c->stop ? " when the kiosk closed" : "");
             else if (r != SP_OK)
-                fprintf(stderr, "dragon-kiosk: %s\n", err.text);
+                sp_kiosk_log("%s", err.text);
         }
         queued_free(&s);
         count_result(c, r == SP_OK);
@@ -183,7 +183,7 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
 {
     kiosk_collector* c = calloc(1, sizeof *c);
     if (!c) {
-        fprintf(stderr, "dragon-kiosk: out of memory: visitors' strokes are not collected\n");
+        sp_kiosk_log("out of memory: visitors' strokes are not collected");
         return NULL;
     }
     c->canvas_w = canvas_w, c->canvas_h = canvas_h;
@@ -199,7 +199,7 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     struct stat st;
     if (stat(db_path, &st) == 0) c->dev = st.st_dev, c->ino = st.st_ino;
     if (sp_db_open(db_path, 0, &c->db, &err) != SP_OK) {
-        fprintf(stderr, "dragon-kiosk: visitors' strokes cannot be collected for now (tried again for each): %s\n", err.text);
+        sp_kiosk_log("visitors' strokes cannot be collected for now (tried again for each): %s", err.text);
         c->db = NULL;
     }
     // Every wait of the writer's (a store, a checkpoint) is short: closing the
@@ -207,7 +207,7 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     if (c->db) sp_db_set_busy_timeout(c->db, SP_DB_COLLECT_BUSY_MS);
     c->threaded = pthread_create(&c->thread, NULL, collector_main, c) == 0;
     if (!c->threaded) {
-        fprintf(stderr, "dragon-kiosk: %s: visitors' strokes cannot be collected: no thread to write them\n", db_path);
+        sp_kiosk_log("%s: visitors' strokes cannot be collected: no thread to write them", db_path);
         sp_db_close(c->db);
         c->db = NULL;
     }
@@ -218,7 +218,7 @@ void kiosk_collector_push(kiosk_collector* c, const char* category, const sp_vec
 {
     if (!c) return;
     if (!c->threaded) {
-        fprintf(stderr, "dragon-kiosk: a %s stroke not collected (no thread to write it); sketch dropped\n", category);
+        sp_kiosk_log("a %s stroke not collected (no thread to write it); sketch dropped", category);
         count_result(c, false);
         return;
     }
@@ -240,7 +240,7 @@ void kiosk_collector_push(kiosk_collector* c, const char* category, const sp_vec
     }
     pthread_mutex_unlock(&c->lock);
     if (!ok) {
-        fprintf(stderr, "dragon-kiosk: a %s stroke not collected (%s); sketch dropped\n", category, why);
+        sp_kiosk_log("a %s stroke not collected (%s); sketch dropped", category, why);
         queued_free(&s);
     }
 }

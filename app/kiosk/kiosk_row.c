@@ -95,7 +95,7 @@ void kiosk_row_load(sp_kiosk* k)
     char** cats = NULL;
     int n = 0;
     if (sp_db_open(k->db_path, SP_DB_READONLY, &db, &err) != SP_OK || sp_db_categories(db, &cats, &n, &err) != SP_OK) {
-        fprintf(stderr, "dragon-kiosk: refused strokes get no parts row: %s\n", err.text);
+        sp_kiosk_log("refused strokes get no parts row: %s", err.text);
         sp_db_close(db);
         kiosk_row_free(k);
         return;
@@ -118,7 +118,7 @@ void kiosk_row_load(sp_kiosk* k)
         sp_character ch = {0};
         int a = 0;
         if (kiosk_load_category_part(db, cats[c], &ch, &a, &err) != SP_OK) {
-            fprintf(stderr, "dragon-kiosk: parts row: %s\n", err.text);
+            sp_kiosk_log("parts row: %s", err.text);
             continue;
         }
         int cap = 0;

@@ -105,7 +105,7 @@ static void push_event(app* a, const sp_kiosk_event* ev)
     int before = ui->strokes_finished, merged = ui->merged;
     sp_kiosk_input(a->k, ev);
     if (a->recording && ev->type != SP_KEV_FRAME && sp_kiosk_session_append(&a->rec, ev) != SP_OK) {
-        fprintf(stderr, "%s: recording full or out of memory; recording stops here\n", k_cmd);
+        sp_kiosk_log("recording full or out of memory; recording stops here");
         a->recording = false;
     }
     if (ui->merged > merged && a->up_count > 0) {
@@ -199,7 +199,7 @@ static void cb_key(GLFWwindow* w, int key, int scancode, int action, int mods)
 
 static void cb_error(int code, const char* text)
 {
-    fprintf(stderr, "%s: GLFW error 0x%x: %s\n", k_cmd, code, text);
+    sp_kiosk_log("GLFW error 0x%x: %s", code, text);
 }
 
 // One frame: update at t, draw, swap; the pen-up latency of strokes whose fit just landed.

@@ -1163,6 +1163,24 @@ static int lines_with(const char* path, const char* what)
     return n;
 }
 
+// Lines of the kiosk's log at `path` holding `what` that begin with the UTC
+// time and the program's name ("2026-12-06T07:30:12Z dragon-kiosk: ").
+static int stamped_lines_with(const char* path, const char* what)
+{
+    FILE* f = fopen(path, "r");
+    if (!f) return -1;
+    char line[4096];
+    int n = 0;
+    while (fgets(line, sizeof line, f)) {
+        int y, mo, d, h, mi, sec, end = 0;
+        bool stamped =
+            sscanf(line, "%4d-%2d-%2dT%2d:%2d:%2dZ dragon-kiosk: %n", &y, &mo, &d, &h, &mi, &sec, &end) == 6 && end == 35;
+        n += stamped && strstr(line, what) != NULL;
+    }
+    fclose(f);
+    return n;
+}
+
 // A database the kiosk may not write (mode 0444; as root, the kiosk runs in
 // an unprivileged child, since root ignores permissions): the visit goes on
 // as ever, and each stroke left is dropped with one line on stderr.
@@ -1216,6 +1234,7 @@ static void test_collect_read_only(void)
     // One line says why at start, one line a sketch.
     ENSURE(lines_with(errf, "cannot be collected for now (tried again for each)") == 1 &&
            lines_with(errf, "sketch dropped") == 2);
+    ENSURE(stamped_lines_with(errf, "sketch dropped") == 2); // the running kiosk's log says when
     ENSURE(pending_count(db) == 0);
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     ENSURE(system(cmd) == 0);

@@ -92,6 +92,15 @@ void sp_kiosk_collect_counts(const sp_kiosk* k, int* stored, int* dropped);
 const sp_dragon* sp_kiosk_dragon(const sp_kiosk* k);
 /// The path of the last save (without extension), "" before any.
 const char* sp_kiosk_last_save(const sp_kiosk* k);
+/// One line of the running kiosk's log on stderr: the UTC time, "dragon-kiosk: "
+/// and the message (printf format, no newline), e.g. "2026-12-06T07:30:12Z
+/// dragon-kiosk: ...; sketch dropped". Why the time: a kiosk runs for weeks and
+/// its log is read after the fact. Safe from any thread.
+void sp_kiosk_log(const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
 /// Parts that are not bodies and do not touch one (their boxes in the
 /// drawing view, at the current animation time, 2% apart or more), and in
 /// *bodies the bodies: what a visitor sees floating free.
