@@ -234,6 +234,7 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
     k->canvas_h = k->desc.canvas_h > 0 ? k->desc.canvas_h : 800;
     k->fb_w = k->canvas_w, k->fb_h = k->canvas_h;
     k->code_state = k->desc.code_seed ? k->desc.code_seed : 1;
+    kiosk_prune_saves(k);
     for (int i = 0; i < DEMO_MAX; ++i)
         k->demo_parts[i].part = -1;
     if (!(k->font = sp_font_load(k->desc.font_path, err))) goto fail;
@@ -605,73 +606,6 @@ static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
         free(kept.xy), free(kept.t);
 }
 
-// A four-character code that reads aloud unambiguously (no 0/O, 1/I, 2/Z, 5/S, 8/B).
-static void next_code(sp_kiosk* k, char code[8])
-{
-    static const char alphabet[] = "ACEFHJKLMNPRTUVWXY3479";
-    for (int attempt = 0; attempt < 1000; ++attempt) {
-        uint64_t z = (k->code_state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        z ^= z >> 31;
-        for (int i = 0; i < 4; ++i, z /= (sizeof alphabet - 1))
-            code[i] = alphabet[z % (sizeof alphabet - 1)];
-        code[4] = 0;
-        char path[1200];
-        snprintf(path, sizeof path, "%s/%s.glb", k->export_dir, code);
-        if (access(path, F_OK) != 0) return;
-    }
-}
-
-static sp_result make_dirs(const char* dir, sp_error* err)
-{
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", dir);
-    if (!buf[0]) return sp_fail(err, SP_ERR_INVALID, "the export folder is not named");
-    for (char* p = buf + 1;; ++p) { // each folder on the way, then dir itself
-        if (*p && *p != '/') continue;
-        char c = *p;
-        *p = 0;
-        if (mkdir(buf, 0755) == 0)
-            sp_path_sync_folder(buf); // a folder made for the saves survives a power cut with them
-        else if (errno != EEXIST)
-            return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
-        if (!(*p = c)) return SP_OK;
-    }
-}
-
-static void run_save(sp_kiosk* k)
-{
-    sp_error err = {0};
-    char code[8];
-    next_code(k, code);
-    char glb[1200], png[1200];
-    snprintf(glb, sizeof glb, "%s/%s.glb", k->export_dir, code);
-    snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
-    sp_image img = {0};
-    // Each file is written whole (sp_file_write): a visitor's code never names half a file.
-    sp_result r = make_dirs(k->export_dir, &err);
-    if (r == SP_OK) r = sp_dragon_export(k->dragon, glb, &err);
-    if (r == SP_OK) {
-        // The export evaluates poses of its own: pose the dragon again for the picture.
-        r = sp_dragon_pose_at(k->dragon, k->ui->anim_ms / 1000.0, &err);
-        k->posed = false;
-        if (r == SP_OK) r = kiosk_postcard(k, code, &img, &err);
-        if (r == SP_OK) r = sp_image_write_png(&img, png, &err);
-        if (r != SP_OK) unlink(glb); // the visitor gets no code, so no file may carry it
-    }
-    sp_image_free(&img);
-    if (r == SP_OK) {
-        ++k->stats.saves;
-        snprintf(k->last_save, sizeof k->last_save, "%s/%s", k->export_dir, code);
-        sp_kiosk_ui_saved(k->ui, true, code);
-    } else {
-        ++k->stats.save_failures;
-        sp_kiosk_log("save: %s", err.text);
-        sp_kiosk_ui_saved(k->ui, false, NULL);
-    }
-}
-
 // The parts on the canvas leave it (Start over, the idle timeout, the kiosk
 // closing) with the labels the visitor left them with. This is where a
 // part's label is final: Undo and Redraw took back the parts they removed
@@ -733,7 +667,7 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         sp_kiosk_ui_parts_changed(k->ui, 0, NULL);
         break;
     case SP_KJOB_SAVE:
-        run_save(k);
+        kiosk_run_save(k);
         break;
     default:
         break;

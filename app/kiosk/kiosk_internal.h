@@ -155,6 +155,11 @@ sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id);
 void kiosk_draw_frame(sp_kiosk* k, int w, int h);
 /// Renders the postcard (the dragon framed, a title and the code) into img.
 sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error* err);
+/// kiosk_save.c: Save now (the export, the postcard, the banner; refused when
+/// the export folder's disk is under its reserve).
+void kiosk_run_save(sp_kiosk* k);
+/// Removes the saves older than desc.keep_saves_days (0: none), with one line.
+void kiosk_prune_saves(sp_kiosk* k);
 
 // kiosk_row.c
 /// Loads every category's outline from the database and gives the UI its row of parts.

@@ -405,6 +405,30 @@ static bool has_parts(const char* path, const char* assets)
     return ok && n > 0;
 }
 
+// The number options in their ranges (one line and false otherwise); those
+// not given become the kiosk's defaults (0; --msaa -1: chosen by the renderer).
+static bool numbers_ok(int* lod, int* msaa, int* max_parts, int* keep_days, double idle_s)
+{
+    if (*lod != SP_CLI_UNSET && *lod != -1 && (*lod < 1 || *lod > 10000000)) {
+        fprintf(stderr, "%s: --lod must be -1 (all) or 1..10000000, got %d\n", k_cmd, *lod);
+        return false;
+    }
+    if ((*msaa != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--msaa", *msaa, 0, 16)) ||
+        (*max_parts != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--max-parts", *max_parts, 1, 1000)) ||
+        (*keep_days != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--keep-saves-days", *keep_days, 1, 36500)))
+        return false;
+    // A typed 0 was the default (90 s): no timeout is asked for by a negative value.
+    if (idle_s == 0) {
+        fprintf(stderr, "%s: --idle must be more than 0 seconds, or negative: never\n", k_cmd);
+        return false;
+    }
+    if (*lod == SP_CLI_UNSET) *lod = 0;
+    if (*msaa == SP_CLI_UNSET) *msaa = -1; // 4, or 1 on a software rasteriser (below)
+    if (*max_parts == SP_CLI_UNSET) *max_parts = 0;
+    if (*keep_days == SP_CLI_UNSET) *keep_days = 0;
+    return true;
+}
+
 int main(int argc, char** argv)
 {
     ignore_write_signals();
@@ -415,7 +439,7 @@ int main(int argc, char** argv)
     bool fullscreen = false, stats = false, no_collect = false;
     double idle_s = NAN, join_ms = NAN; // not given: the kiosk's defaults
     // SP_CLI_UNSET: not given (the kiosk's defaults); given, a value in range.
-    int lod = SP_CLI_UNSET, msaa = SP_CLI_UNSET, max_parts = SP_CLI_UNSET;
+    int lod = SP_CLI_UNSET, msaa = SP_CLI_UNSET, max_parts = SP_CLI_UNSET, keep_days = SP_CLI_UNSET;
     sp_opt opts[] = {
         {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)",
          false},
@@ -427,6 +451,8 @@ int main(int argc, char** argv)
         {"--screenshot", SP_OPT_OUT, &shot, "out.png", "PNG of the last frame (and of every script mark)", false},
         {"--export", SP_OPT_OUT, &out_glb, "out.glb", "glTF of the dragon at the end", false},
         {"--export-dir", SP_OPT_STRING, &export_dir, "DIR", "where Save writes (default: dragon-exports)", false},
+        {"--keep-saves-days", SP_OPT_INT, &keep_days, "N", "remove saves older than N days, 1..36500 (default: keep them)",
+         false},
         {"--idle", SP_OPT_DOUBLE, &idle_s, "S", "seconds without input before the attract screen, > 0 (default 90; < 0: never)",
          false},
         {"--join-ms", SP_OPT_DOUBLE, &join_ms, "MS",
@@ -448,21 +474,7 @@ int main(int argc, char** argv)
     if (!sp_cli_check_out(k_cmd, "--screenshot", shot, SP_CLI_OUT_PNG) ||
         !sp_cli_check_out(k_cmd, "--export", out_glb, SP_CLI_OUT_GLTF))
         return SP_EXIT_USAGE;
-    if (lod != SP_CLI_UNSET && lod != -1 && (lod < 1 || lod > 10000000)) {
-        fprintf(stderr, "%s: --lod must be -1 (all) or 1..10000000, got %d\n", k_cmd, lod);
-        return SP_EXIT_USAGE;
-    }
-    if ((msaa != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--msaa", msaa, 0, 16)) ||
-        (max_parts != SP_CLI_UNSET && !sp_cli_check_int(k_cmd, "--max-parts", max_parts, 1, 1000)))
-        return SP_EXIT_USAGE;
-    // A typed 0 was the default (90 s): no timeout is asked for by a negative value.
-    if (idle_s == 0) {
-        fprintf(stderr, "%s: --idle must be more than 0 seconds, or negative: never\n", k_cmd);
-        return SP_EXIT_USAGE;
-    }
-    if (lod == SP_CLI_UNSET) lod = 0;
-    if (msaa == SP_CLI_UNSET) msaa = -1; // 4, or 1 on a software rasteriser (below)
-    if (max_parts == SP_CLI_UNSET) max_parts = 0;
+    if (!numbers_ok(&lod, &msaa, &max_parts, &keep_days, idle_s)) return SP_EXIT_USAGE;
     int win_w = 1280, win_h = 800;
     if (size && !sp_cli_parse_size(size, &win_w, &win_h)) {
         fprintf(stderr, "%s: --size expects WxH with sides 16..8192, got '%s'\n", k_cmd, size);
@@ -556,6 +568,7 @@ int main(int argc, char** argv)
                         .code_seed = script ? 1 : (uint64_t)time(NULL),
                         .lod_triangles = lod,
                         .max_parts = max_parts,
+                        .keep_saves_days = keep_days,
                         .no_collect = no_collect,
                         // A replay must not depend on the machine's speed: the solver's
                         // wall-clock cap (a visitor's safety net) is lifted; its

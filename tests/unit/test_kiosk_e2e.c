@@ -12,6 +12,7 @@
 //
 // Skipped when xvfb-run is missing.
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -1250,17 +1251,12 @@ static void updates_until(sp_kiosk* k, double* t, double until)
 // A kiosk in-process on a headless context, past its attract screen; skips
 // the running test without headless OpenGL, fails it when the kiosk does
 // not start.
-static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headless** gl, double* t)
+static sp_kiosk* inproc_kiosk_desc(sp_kiosk_desc desc, sp_headless** gl, double* t)
 {
     sp_error err = {0};
     if (sp_headless_create(gl, &err) != SP_OK) SKIP("no headless OpenGL");
-    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
-                                                   .canvas_w = 1280,
-                                                   .canvas_h = 800,
-                                                   .export_dir = sp_test_tmp_path(export_dir),
-                                                   .no_attract_demo = true,
-                                                   .fit_time_cap_ms = 60000},
-                                  &err);
+    desc.canvas_w = 1280, desc.canvas_h = 800, desc.no_attract_demo = true, desc.fit_time_cap_ms = 60000;
+    sp_kiosk* k = sp_kiosk_create(&desc, &err);
     if (!k) fprintf(stderr, "  %s\n", err.text);
     ENSURE(k);
     *t = 0;
@@ -1268,6 +1264,11 @@ static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headles
     sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, *t + 60, 640, 400, 0});
     updates_until(k, t, 500);
     return k;
+}
+
+static sp_kiosk* inproc_kiosk(const char* db, const char* export_dir, sp_headless** gl, double* t)
+{
+    return inproc_kiosk_desc((sp_kiosk_desc){.db_path = db, .export_dir = sp_test_tmp_path(export_dir)}, gl, t);
 }
 
 // The visitor draws one part, which is added.
@@ -1436,6 +1437,60 @@ static void test_parts_row_follows(void)
         ENSURE(strcmp(ui->row[i], "hind_legs") != 0);
     while (sp_dragon_model_loading(sp_kiosk_dragon(k)))
         usleep(10000), updates_until(k, &t, t + 1);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
+// Draws a part and taps Save: true when it was saved.
+static bool draw_and_save(sp_kiosk* k, double* t)
+{
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    int before = st->saves;
+    draw_part(k, t, &g_strokes[0]);
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, *t, 0, 0, SP_KT_SAVE});
+    updates_until(k, t, *t + 100);
+    return st->saves == before + 1;
+}
+
+// The export folder's disk: Save is refused under the space kept for the
+// database (nothing written); saves older than keep_saves_days are removed
+// at start and after each save, and files that are not saves stay.
+static void test_saves_disk(void)
+{
+    six_strokes();
+    char db[1100], cmd[2400], path[1300];
+    e2e_db_copy("kiosk_saves.db", db, sizeof db);
+    const char* ex = sp_test_tmp_path("kiosk_saves_ex");
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir '%s'", ex, ex);
+    ENSURE(system(cmd) == 0);
+    const char* names[5] = {"ACEF.glb", "ACEF.png", "HJKL.glb", "notes.txt", "ABCD.glb"};
+    const bool old[5] = {true, true, false, true, true}, kept[5] = {false, false, true, true, true};
+    for (int i = 0; i < 5; ++i) {
+        snprintf(path, sizeof path, "%s/%s", ex, names[i]);
+        FILE* f = fopen(path, "wb");
+        ENSURE(f && fputs("x", f) >= 0 && fclose(f) == 0);
+        struct timespec when[2] = {{time(NULL) - 40 * 86400, 0}, {time(NULL) - 40 * 86400, 0}};
+        if (old[i]) ENSURE(utimensat(AT_FDCWD, path, when, 0) == 0);
+    }
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk_desc(
+        (sp_kiosk_desc){.db_path = db, .export_dir = ex, .keep_saves_days = 30, .save_reserve_mb = 1e12, .no_collect = true}, &gl,
+        &t);
+    for (int i = 0; i < 5; ++i) {
+        snprintf(path, sizeof path, "%s/%s", ex, names[i]);
+        ENSURE((access(path, F_OK) == 0) == kept[i]);
+    }
+    ENSURE(!draw_and_save(k, &t) && sp_kiosk_stats_of(k)->save_failures == 1);
+    snprintf(cmd, sizeof cmd, "test $(ls -A '%s' | wc -l) -eq 3", ex);
+    ENSURE(system(cmd) == 0); // nothing written
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+    // With room: saved.
+    k = inproc_kiosk_desc((sp_kiosk_desc){.db_path = db, .export_dir = ex, .keep_saves_days = 30, .no_collect = true}, &gl, &t);
+    ENSURE(draw_and_save(k, &t));
+    snprintf(path, sizeof path, "%s.glb", sp_kiosk_last_save(k));
+    ENSURE(access(path, F_OK) == 0);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
 }
@@ -1964,6 +2019,7 @@ int main(int argc, char** argv)
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
                                    {"collect_mended", test_collect_mended},
+                                   {"saves_disk", test_saves_disk},
                                    {"parts_row_follows", test_parts_row_follows},
                                    {"parts_loaded_while_idle", test_parts_loaded_while_idle},
                                    {"collect_busy", test_collect_busy},

@@ -26,6 +26,11 @@
 typedef struct sp_kiosk sp_kiosk;
 typedef struct sp_dragon sp_dragon; // dragon.h
 
+/// Free space (MB) on the export folder's disk under which Save is refused:
+/// the rest is the database's (visitors' strokes, a curator's `db train`),
+/// where saves of 6-12 MB each filled a busy museum's disk in weeks.
+#define SP_KIOSK_SAVE_RESERVE_MB 256.0
+
 /// Zero means the default.
 typedef struct sp_kiosk_desc {
     const char* db_path;    ///< NULL: sp_db_default_path(); created from assets_dir when missing
@@ -41,6 +46,9 @@ typedef struct sp_kiosk_desc {
     int lod_triangles; ///< display mesh budget per part (lod.h); 0: 4000 on software renderers, full meshes on GPUs; < 0: full
                        ///< meshes
     int max_parts;     ///< parts a dragon may have (sp_dragon_desc.max_parts); 0: the pipeline's (48)
+    int keep_saves_days; ///< saves older than this many days are removed, at start and after each save; 0: kept
+    double
+        save_reserve_mb; ///< Save is refused while the export folder's disk has less free; 0: SP_KIOSK_SAVE_RESERVE_MB; < 0: none
     bool no_collect;   ///< keep no visitors' strokes (default: each part left on the canvas is stored as a pending kiosk
                        ///< sketch; docs/DESIGN.md "Collecting visitors' strokes")
 } sp_kiosk_desc;

@@ -1,0 +1,138 @@
+// kiosk_save.c: Save (a visitor's dragon as <code>.glb and <code>.png in the
+// export folder), the disk it fills, and the old saves a museum lets go.
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "kiosk_internal.h"
+#include "sp/sketch_io.h"
+
+// Save codes: four characters that read aloud unambiguously (no 0/O, 1/I, 2/Z, 5/S, 8/B).
+static const char k_code_alphabet[] = "ACEFHJKLMNPRTUVWXY3479";
+
+// Free space under a save this large (MB) is worth a line in the log: about
+// 300 saves of a six-part dragon (6 MB each) before saves stop.
+enum { SAVE_WARN_MB = 2048 };
+
+static void next_code(sp_kiosk* k, char code[8])
+{
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+        uint64_t z = (k->code_state += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        for (int i = 0; i < 4; ++i, z /= (sizeof k_code_alphabet - 1))
+            code[i] = k_code_alphabet[z % (sizeof k_code_alphabet - 1)];
+        code[4] = 0;
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s.glb", k->export_dir, code);
+        if (access(path, F_OK) != 0) return;
+    }
+}
+
+static sp_result make_dirs(const char* dir, sp_error* err)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", dir);
+    if (!buf[0]) return sp_fail(err, SP_ERR_INVALID, "the export folder is not named");
+    for (char* p = buf + 1;; ++p) { // each folder on the way, then dir itself
+        if (*p && *p != '/') continue;
+        char c = *p;
+        *p = 0;
+        if (mkdir(buf, 0755) == 0)
+            sp_path_sync_folder(buf); // a folder made for the saves survives a power cut with them
+        else if (errno != EEXIST)
+            return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", buf, strerror(errno));
+        if (!(*p = c)) return SP_OK;
+    }
+}
+
+// MB free to this user on the disk holding the export folder; < 0 when unknown.
+static double free_mb(const char* dir)
+{
+    struct statvfs v;
+    if (statvfs(dir, &v) != 0) return -1;
+    return (double)v.f_bavail * (double)v.f_frsize / (1024.0 * 1024.0);
+}
+
+// A save's name: a code of the alphabet and .glb or .png.
+static bool is_save_name(const char* name)
+{
+    size_t n = strlen(name);
+    if (n != 8 || (strcmp(name + 4, ".glb") && strcmp(name + 4, ".png"))) return false;
+    for (int i = 0; i < 4; ++i)
+        if (!name[i] || !strchr(k_code_alphabet, name[i])) return false;
+    return true;
+}
+
+void kiosk_prune_saves(sp_kiosk* k)
+{
+    if (k->desc.keep_saves_days <= 0) return;
+    char** names = NULL;
+    int count = 0;
+    sp_error err = {0};
+    if (sp_dir_list(k->export_dir, &names, &count, &err) != SP_OK) return; // no folder yet: nothing saved
+    time_t before = time(NULL) - (time_t)k->desc.keep_saves_days * 86400;
+    int removed = 0;
+    for (int i = 0; i < count; ++i) {
+        if (!is_save_name(names[i])) continue; // anything else in the folder is staff's
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s", k->export_dir, names[i]);
+        struct stat st;
+        if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && st.st_mtime < before && unlink(path) == 0) ++removed;
+    }
+    sp_dir_list_free(names, count);
+    if (removed > 0)
+        sp_kiosk_log("%s: %d files of saves older than %d days removed (--keep-saves-days)", k->export_dir, removed,
+                     k->desc.keep_saves_days);
+}
+
+void kiosk_run_save(sp_kiosk* k)
+{
+    sp_error err = {0};
+    char code[8];
+    next_code(k, code);
+    char glb[1200], png[1200];
+    snprintf(glb, sizeof glb, "%s/%s.glb", k->export_dir, code);
+    snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
+    sp_image img = {0};
+    // Each file is written whole (sp_file_write): a visitor's code never names half a file.
+    sp_result r = make_dirs(k->export_dir, &err);
+    // The last of the disk is the database's: a visitor's strokes, a curator's training.
+    double reserve = k->desc.save_reserve_mb == 0 ? SP_KIOSK_SAVE_RESERVE_MB : k->desc.save_reserve_mb, left = -1;
+    if (r == SP_OK && reserve > 0 && (left = free_mb(k->export_dir)) >= 0 && left < reserve)
+        r = sp_fail(&err, SP_ERR_IO,
+                    "%s: %.0f MB free on its disk, under the %.0f MB kept for the database: not saved (move old saves away, or "
+                    "--keep-saves-days)",
+                    k->export_dir, left, reserve);
+    if (r == SP_OK) r = sp_dragon_export(k->dragon, glb, &err);
+    if (r == SP_OK) {
+        // The export evaluates poses of its own: pose the dragon again for the picture.
+        r = sp_dragon_pose_at(k->dragon, k->ui->anim_ms / 1000.0, &err);
+        k->posed = false;
+        if (r == SP_OK) r = kiosk_postcard(k, code, &img, &err);
+        if (r == SP_OK) r = sp_image_write_png(&img, png, &err);
+        if (r != SP_OK) unlink(glb); // the visitor gets no code, so no file may carry it
+    }
+    sp_image_free(&img);
+    if (r == SP_OK) {
+        ++k->stats.saves;
+        snprintf(k->last_save, sizeof k->last_save, "%s/%s", k->export_dir, code);
+        sp_kiosk_ui_saved(k->ui, true, code);
+        kiosk_prune_saves(k);
+        struct stat a, b;
+        double mb = stat(glb, &a) == 0 && stat(png, &b) == 0 ? (double)(a.st_size + b.st_size) / (1024.0 * 1024.0) : 0;
+        if ((left = free_mb(k->export_dir)) >= 0 && left < SAVE_WARN_MB)
+            sp_kiosk_log("%s: %.0f MB free on its disk; this save took %.1f MB, and saves stop under %.0f MB", k->export_dir,
+                         left, mb, reserve > 0 ? reserve : 0.0);
+    } else {
+        ++k->stats.save_failures;
+        sp_kiosk_log("save: %s", err.text);
+        sp_kiosk_ui_saved(k->ui, false, NULL);
+    }
+}
