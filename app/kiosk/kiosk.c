@@ -696,15 +696,17 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     if (sp_dragon_model_update(k->dragon)) ++k->stats.models_loaded;
     // A curator's change (or a replaced database file) is picked up between
     // strokes; add_stroke polls too, this only keeps idle kiosks current.
-    // The parts row is read again in a frame of its own.
     if (!k->heavy_done && k->ui->capture == SP_KCAP_NONE && t_ms - k->last_reload_check >= 2000) {
         k->last_reload_check = t_ms;
-        bool reloaded = false;
         sp_error err = {0};
-        if (sp_dragon_reload_if_changed(k->dragon, &reloaded, &err) != SP_OK) sp_kiosk_log("database: %s", err.text);
-        if (reloaded) // a curator may have changed the parts
-            ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false, k->heavy_done = true;
+        if (sp_dragon_reload_if_changed(k->dragon, NULL, &err) != SP_OK) sp_kiosk_log("database: %s", err.text);
     }
+    // A change either poll took in (a stroke's came first when it was drawn
+    // right after the change): a curator may have changed the parts, so the
+    // parts row is read again, in a frame of its own, and the parts loaded.
+    uint64_t reloads = sp_dragon_reload_count(k->dragon);
+    if (reloads != k->reloads_seen)
+        k->reloads_seen = reloads, ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false, k->heavy_done = true;
     // The parts row, once the first frame is on screen (starting fast matters more).
     if (!k->heavy_done && !k->icons_loaded && k->updates >= 2) {
         kiosk_row_load(k);

@@ -1411,9 +1411,11 @@ static void test_collect_reload(void)
 }
 
 // The refusal's parts row follows the curators' parts: a new model alone
-// keeps it (reading six parts again held a frame), a part removed leaves it.
+// keeps it (reading six parts again held a frame), a part removed leaves it,
+// whichever poll (the kiosk's or a stroke's) takes the change in.
 static void test_parts_row_follows(void)
 {
+    six_strokes();
     char db[1100];
     e2e_db_copy("kiosk_row.db", db, sizeof db);
     sp_headless* gl = NULL;
@@ -1435,6 +1437,22 @@ static void test_parts_row_follows(void)
     ENSURE(st->reloads == 2 && ui->row_count == 5);
     for (int i = 0; i < ui->row_count; ++i)
         ENSURE(strcmp(ui->row[i], "hind_legs") != 0);
+    // A part removed while a finger draws: the stroke's own poll takes the
+    // change in first (the kiosk's waits while a finger is down), and the row follows.
+    const stroke* s = &g_strokes[0];
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_DOWN, t, (float)s->xy[0].x, (float)s->xy[0].y, 0});
+    updates_until(k, &t, t + 50);
+    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK && sp_db_remove_part(w, "wings", "test", &err) == SP_OK);
+    sp_db_close(w);
+    for (int i = 1; i < s->n; ++i)
+        sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_MOVE, t + 4 * i, (float)s->xy[i].x, (float)s->xy[i].y, 0});
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_UP, t + 4 * s->n, (float)s->xy[s->n - 1].x, (float)s->xy[s->n - 1].y, 0});
+    updates_until(k, &t, t + 4 * s->n + 100);
+    fprintf(stderr, "  after a stroke's poll: reloads %d, row %d parts, %d on the canvas\n", st->reloads, ui->row_count,
+            st->parts);
+    ENSURE(st->parts == 1 && st->reloads == 3 && ui->row_count == 4);
+    for (int i = 0; i < ui->row_count; ++i)
+        ENSURE(strcmp(ui->row[i], "wings") != 0);
     while (sp_dragon_model_loading(sp_kiosk_dragon(k)))
         usleep(10000), updates_until(k, &t, t + 1);
     sp_kiosk_destroy(k);

@@ -163,6 +163,7 @@ struct sp_dragon {
     dev_t dev;
     ino_t ino;
     uint64_t gen;
+    uint64_t reloads; // sp_dragon_reload_count
     sp_clf* clf;
     int64_t model_id;   // the row clf was read from (0: none)
     char model_sha[65]; // its SHA-256 ("" when not known)

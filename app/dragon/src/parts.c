@@ -370,6 +370,11 @@ void dragon_reload_model(sp_dragon* d, bool same_file)
         snprintf(d->model_error, sizeof d->model_error, "%s", merr.text);
 }
 
+uint64_t sp_dragon_reload_count(const sp_dragon* d)
+{
+    return d->reloads;
+}
+
 sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err)
 {
     if (reloaded) *reloaded = false;
@@ -389,6 +394,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
             dragon_reload_model(d, false);
             d->gen = sp_db_generation(d->db);
             cache_prune(d);
+            ++d->reloads;
             if (reloaded) *reloaded = true;
             return SP_OK;
         }
@@ -399,6 +405,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
     dragon_reload_model(d, true);
     d->gen = g;
     cache_prune(d);
+    ++d->reloads;
     if (reloaded) *reloaded = true;
     return SP_OK;
 }

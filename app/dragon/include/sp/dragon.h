@@ -314,6 +314,10 @@ sp_result sp_dragon_export(const sp_dragon* d, const char* path, sp_error* err);
 /// (may be NULL) tells whether anything was reloaded. On failure the previous
 /// state is kept and err says why.
 sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* err);
+/// How many changes of the database the pipeline has taken in so far, by
+/// sp_dragon_reload_if_changed or by a stroke's own poll: a caller that keeps
+/// something drawn from the parts (the kiosk's parts row) compares it.
+uint64_t sp_dragon_reload_count(const sp_dragon* d);
 /// With desc.background_model: takes the model read in the background when
 /// its read has ended (and starts reading a newer one stored meanwhile); true
 /// when the pipeline's model changed. Cheap when there is nothing to take:
