@@ -77,7 +77,7 @@ static bool follow_file(kiosk_collector* c)
     if (st.st_dev == c->dev && st.st_ino == c->ino) return true;
     sp_db* db = NULL;
     sp_error err = {0};
-    if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
+    if (sp_db_open_wait(c->path, 0, SP_DB_COLLECT_BUSY_MS, &db, &err) != SP_OK) {
         sp_kiosk_log("the database was replaced and cannot be written: %s", err.text);
         return true; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
     }
@@ -101,7 +101,8 @@ static bool open_writer(kiosk_collector* c)
         sp_kiosk_log("%s: no database there: sketch dropped", c->path);
         return false;
     }
-    if (sp_db_open(c->path, 0, &db, &err) != SP_OK) {
+    // Waiting no longer than a store does: closing the kiosk waits for this thread.
+    if (sp_db_open_wait(c->path, 0, SP_DB_COLLECT_BUSY_MS, &db, &err) != SP_OK) {
         sp_kiosk_log("%s; sketch dropped", err.text);
         return false;
     }
@@ -114,20 +115,21 @@ static bool open_writer(kiosk_collector* c)
 // After a store found the database busy: puts the sketch back at the head of
 // the queue and waits BUSY_RETRY_MS (or until woken), returning with the lock
 // held; false (nothing done, the lock not held) when it is to be dropped:
-// waited long enough, the kiosk closing, or no room.
-static bool wait_busy(kiosk_collector* c, queued* s)
+// waited long enough, the kiosk closing (*closing), or no room.
+static bool wait_busy(kiosk_collector* c, queued* s, bool* closing)
 {
     double now = sp_now_ms();
     if (s->busy_since == 0) s->busy_since = now;
     pthread_mutex_lock(&c->lock);
+    *closing = c->stop;
     if (c->stop || now - s->busy_since >= BUSY_GIVE_UP_MS || c->count >= QUEUE_MAX) {
         pthread_mutex_unlock(&c->lock);
         return false;
     }
     c->head = (c->head + QUEUE_MAX - 1) % QUEUE_MAX;
     c->q[c->head] = *s, ++c->count;
-    struct timespec until;
-    clock_gettime(CLOCK_REALTIME, &until);
+    struct timespec until; // on the monotonic clock (the condition's): a clock set back does not stretch the wait
+    clock_gettime(CLOCK_MONOTONIC, &until);
     until.tv_nsec += (long)BUSY_RETRY_MS * 1000000L;
     until.tv_sec += until.tv_nsec / 1000000000L, until.tv_nsec %= 1000000000L;
     if (!c->stop) pthread_cond_timedwait(&c->wake, &c->lock, &until);
@@ -155,10 +157,11 @@ static void* collector_main(void* arg)
         sp_result r = SP_ERR_IO;
         if (open_writer(c) && follow_file(c)) {
             r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
-            if (r == SP_ERR_BUSY && wait_busy(c, &s)) continue; // the lock is held again
+            bool closing = false;
+            if (r == SP_ERR_BUSY && wait_busy(c, &s, &closing)) continue; // the lock is held again
             if (r == SP_ERR_BUSY && s.busy_since > 0)
                 sp_kiosk_log("%s: another writer held the database for %.1f s%s; sketch dropped", c->path,
-                             (sp_now_ms() - s.busy_since) / 1000.0, c->stop ? " when the kiosk closed" : "");
+                             (sp_now_ms() - s.busy_since) / 1000.0, closing ? " when the kiosk closed" : "");
             else if (r != SP_OK)
                 sp_kiosk_log("%s", err.text);
         }
@@ -189,7 +192,11 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     c->canvas_w = canvas_w, c->canvas_h = canvas_h;
     snprintf(c->path, sizeof c->path, "%s", db_path);
     pthread_mutex_init(&c->lock, NULL);
-    pthread_cond_init(&c->wake, NULL);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&c->wake, &ca);
+    pthread_condattr_destroy(&ca);
     // A writable handle of its own (the pipeline reads through a read-only
     // one); opening migrates an older schema. It runs at start, before the
     // first frame. A database that cannot be written keeps the kiosk running:

@@ -75,7 +75,12 @@ static char* row_source(sp_db* db, char** cats, int n)
     int np = 0;
     sp_error err = {0};
     if (sp_db_list_parts(db, &parts, &np, &err) != SP_OK) return NULL;
-    size_t cap = 1 + (size_t)n * (SP_NAME_MAX + 1) + (size_t)np * (3 * SP_NAME_MAX + 70);
+    // Sized exactly: a category's name has no length limit in the database.
+    size_t cap = 1;
+    for (int c = 0; c < n; ++c)
+        cap += strlen(cats[c]) + 1;
+    for (int i = 0; i < np; ++i)
+        cap += strlen(parts[i].name) + strlen(parts[i].category) + strlen(parts[i].abstraction) + strlen(parts[i].sha256) + 4;
     char* s = malloc(cap);
     size_t at = 0;
     for (int c = 0; s && c < n; ++c)
@@ -119,6 +124,8 @@ void kiosk_row_load(sp_kiosk* k)
         int a = 0;
         if (kiosk_load_category_part(db, cats[c], &ch, &a, &err) != SP_OK) {
             sp_kiosk_log("parts row: %s", err.text);
+            free(k->row_source); // read again at the next change: the failure may pass (busy, memory)
+            k->row_source = NULL;
             continue;
         }
         int cap = 0;

@@ -1478,6 +1478,114 @@ static void test_reload_keeps_model(void)
     sp_dragon_destroy(d);
 }
 
+// The newest model's row id in the database at `path`.
+static int64_t newest_model(const char* path)
+{
+    sp_db* db = NULL;
+    sp_error err = {0};
+    int64_t head = 0;
+    ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK && sp_db_model_head(db, &head, NULL, &err) == SP_OK);
+    sp_db_close(db);
+    return head;
+}
+
+// Polls (at most a minute) until no model is being read in the background.
+static void settle(sp_dragon* d)
+{
+    bool reloaded = false;
+    sp_error err = {0};
+    for (int i = 0; i < 6000 && sp_dragon_model_loading(d); ++i)
+        sp_dragon_model_update(d), usleep(10000);
+    ENSURE(!sp_dragon_model_loading(d));
+    (void)sp_dragon_reload_if_changed(d, &reloaded, &err);
+}
+
+// A background read that fails for a reason that may pass (the file moved
+// away while it read) keeps the model in use and is tried again later (here
+// "later" is brought forward); a stored model that does not parse keeps the
+// one in use without a retry.
+static void test_background_read_fails(void)
+{
+    char path[1024], away[1100];
+    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_bg_fail.db"));
+    snprintf(away, sizeof away, "%s.away", path);
+    copy_file(test_db(), path);
+    sp_error err = {0};
+    sp_dragon* d = NULL;
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
+                            &err) == SP_OK);
+    const sp_clf* first = sp_dragon_model(d);
+    ENSURE(sp_fixture_store_model_again(path));
+    ENSURE(rename(path, away) == 0);
+    bool reloaded = false;
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded && sp_dragon_model_loading(d));
+    settle(d);
+    ENSURE(sp_dragon_model(d) == first && d->model_retry_at > 0);
+    ENSURE(rename(away, path) == 0);
+    d->model_retry_at = 1; // its time has come
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && sp_dragon_model_loading(d));
+    settle(d);
+    fprintf(stderr, "  in use: model %lld of %lld\n", (long long)d->model_id, (long long)newest_model(path));
+    ENSURE(sp_dragon_model(d) != first && d->model_id == newest_model(path) && d->model_retry_at == 0);
+    // A newest model whose stored bytes are damaged: the one in use stays, no retry.
+    const sp_clf* second = sp_dragon_model(d);
+    ENSURE(sp_fixture_store_model_again(path));
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(path, &h) == SQLITE_OK);
+    ENSURE(sqlite3_exec(h, "UPDATE models SET sha256 = 'x' WHERE id = (SELECT max(id) FROM models)", NULL, NULL, NULL) ==
+           SQLITE_OK);
+    sqlite3_close(h);
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && sp_dragon_model_loading(d));
+    settle(d);
+    ENSURE(sp_dragon_model(d) == second && d->model_retry_at == 0);
+    sp_dragon_destroy(d);
+}
+
+// The database file replaced (a rename) while a model is read, the new
+// file's newest model of the same row id as the one read: the new file's is
+// the one used.
+static void test_background_replaced(void)
+{
+    char p[1024], b[1024];
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("dragon_bg_p.db"));
+    snprintf(b, sizeof b, "%s", sp_test_tmp_path("dragon_bg_b.db"));
+    copy_file(test_db(), p);
+    copy_file(test_db(), b);
+    sp_error err = {0};
+    sp_db* w = NULL;
+    // B: another model of the next id (a copy trained elsewhere, other options).
+    sp_db_train_desc td = quick_train();
+    td.clf.words = 64;
+    ENSURE(sp_db_open(b, 0, &w, &err) == SP_OK && sp_db_train(w, &td, NULL, &err) == SP_OK);
+    sp_db_close(w);
+    sp_dragon* d = NULL;
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = p, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
+                            &err) == SP_OK);
+    // P's next model, of the same id as B's; large, so that its read lasts.
+    td.clf.words = 3000;
+    ENSURE(sp_db_open(p, 0, &w, &err) == SP_OK && sp_db_train(w, &td, NULL, &err) == SP_OK);
+    sp_db_close(w);
+    ENSURE(newest_model(p) == newest_model(b));
+    bool reloaded = false;
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK && reloaded && sp_dragon_model_loading(d));
+    ENSURE(rename(b, p) == 0);
+    sp_result polled = sp_dragon_reload_if_changed(d, &reloaded, &err); // a stroke's poll: the file is reopened
+    if (polled != SP_OK) fprintf(stderr, "  poll: %s\n", err.text);
+    ENSURE(polled == SP_OK);
+    bool mid_read = sp_dragon_model_loading(d);
+    for (int i = 0; i < 3; ++i)
+        settle(d);
+    sp_db* r = NULL;
+    sp_clf* want = NULL;
+    ENSURE(sp_db_open(p, SP_DB_READONLY, &r, &err) == SP_OK && sp_db_load_model(r, &want, NULL, &err) == SP_OK);
+    sp_db_close(r);
+    fprintf(stderr, "  replaced %s; words in use %d, the file's model %d\n", mid_read ? "mid-read" : "after the read",
+            sp_clf_get_desc(sp_dragon_model(d)).words, sp_clf_get_desc(want).words);
+    ENSURE(sp_clf_get_desc(sp_dragon_model(d)).words == 64 && sp_clf_get_desc(want).words == 64);
+    sp_clf_destroy(want);
+    sp_dragon_destroy(d);
+}
+
 static void test_live_update(void)
 {
     char path[1024], other[1024];
@@ -3863,6 +3971,8 @@ int main(int argc, char** argv)
                                    {"live_update", test_live_update},
                                    {"reload_keeps_model", test_reload_keeps_model},
                                    {"background_model", test_background_model},
+                                   {"background_read_fails", test_background_read_fails},
+                                   {"background_replaced", test_background_replaced},
                                    {"command", test_command},
                                    {"six_real_parts", test_six_real_parts},
                                    {"many_parts", test_many_parts},

@@ -87,6 +87,9 @@ bool dragon_model_load_start(sp_dragon* d);
 // Takes the model read, when the read has ended (wait: waits for it);
 // true when the pipeline's model changed.
 bool dragon_model_load_take(sp_dragon* d, bool wait);
+// At a poll: reads again a model whose background read failed for a reason
+// that may pass, once its time has come.
+void dragon_model_retry(sp_dragon* d);
 bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
 
 // ---- the dragon --------------------------------------------------------------------
@@ -168,6 +171,7 @@ struct sp_dragon {
     int64_t model_id;   // the row clf was read from (0: none)
     char model_sha[65]; // its SHA-256 ("" when not known)
     dragon_loader* loader; // a model being read in the background (NULL: none)
+    double model_retry_at; // sp_now_ms when a background read that failed is tried again (0: none)
     tpl** cache;
     int cache_n;
     int preload_next; // sp_dragon_preload_step's cursor over the database's parts
