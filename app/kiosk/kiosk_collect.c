@@ -61,37 +61,11 @@ static void count_result(kiosk_collector* c, bool stored)
     pthread_mutex_unlock(&c->lock);
 }
 
-// The database file at c->path is still the one the handle has open; a file
-// replaced by a rename (a curator's new database) is opened anew, so that
-// no stroke goes into the old, unlinked one. False, with one line, when no
-// file is at the path (deleted, or moved away: the handle would write into
-// the unlinked file or the one under its new name, and the stroke be lost
-// without a word); the stroke is then dropped, until a file is there again.
-static bool follow_file(kiosk_collector* c)
-{
-    struct stat st;
-    if (stat(c->path, &st) != 0) {
-        sp_kiosk_log("%s: the database is gone (deleted or moved away): sketch dropped", c->path);
-        return false;
-    }
-    if (st.st_dev == c->dev && st.st_ino == c->ino) return true;
-    sp_db* db = NULL;
-    sp_error err = {0};
-    if (sp_db_open_wait(c->path, 0, SP_DB_COLLECT_BUSY_MS, &db, &err) != SP_OK) {
-        sp_kiosk_log("the database was replaced and cannot be written: %s", err.text);
-        return true; // keeps the old handle: its sketches are dropped or kept in the old file, the kiosk runs
-    }
-    sp_db_close(c->db);
-    sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
-    c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
-    return true;
-}
-
 // A database that could not be written (read-only, damaged, not there) is
 // tried again for each sketch, in this thread: a technician who mends the
 // file expects collecting to resume without a restart. False, with one line
-// naming the file and why, while it still cannot.
-static bool open_writer(kiosk_collector* c)
+// naming the file and why, while it still cannot; once open, it says `said`.
+static bool open_writer(kiosk_collector* c, const char* said)
 {
     if (c->db) return true;
     sp_db* db = NULL;
@@ -108,8 +82,32 @@ static bool open_writer(kiosk_collector* c)
     }
     sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
     c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
-    sp_kiosk_log("%s: the database can be written now: visitors' strokes are collected again", c->path);
+    sp_kiosk_log("%s: %s", c->path, said);
     return true;
+}
+
+// The database file at c->path is still the one the handle has open; a file
+// replaced by a rename (a curator's new database) is opened anew, so that
+// no stroke goes into the old, unlinked one: the old handle closes first,
+// then the old file's WAL and -shm beside the path go (a connection opened
+// by path would apply that WAL to the new file, and a checkpoint write it
+// into it). False, with one line, when no file is at the path (deleted, or
+// moved away: the handle would write into the unlinked file or the one under
+// its new name, and the stroke be lost without a word), or the new file
+// cannot be written (open_writer tries again at the next sketch); the
+// stroke is then dropped.
+static bool follow_file(kiosk_collector* c)
+{
+    struct stat st;
+    if (stat(c->path, &st) != 0) {
+        sp_kiosk_log("%s: the database is gone (deleted or moved away): sketch dropped", c->path);
+        return false;
+    }
+    if (st.st_dev == c->dev && st.st_ino == c->ino) return true;
+    sp_db_close(c->db);
+    c->db = NULL;
+    sp_db_drop_stale_sidecars(c->path);
+    return open_writer(c, "a new database file there: visitors' strokes go into it");
 }
 
 // After a store found the database busy: puts the sketch back at the head of
@@ -155,7 +153,7 @@ static void* collector_main(void* arg)
         sp_error err = {0};
         sp_stroke st = {.count = s.n, .points = s.xy, .t = s.t};
         sp_result r = SP_ERR_IO;
-        if (open_writer(c) && follow_file(c)) {
+        if (open_writer(c, "the database can be written now: visitors' strokes are collected again") && follow_file(c)) {
             r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
             bool closing = false;
             if (r == SP_ERR_BUSY && wait_busy(c, &s, &closing)) continue; // the lock is held again

@@ -570,6 +570,37 @@ void sp_db_set_busy_timeout(sp_db* db, int ms)
     sqlite3_busy_timeout(db->h, db->busy_ms);
 }
 
+// Whether the WAL w was made or written after the database file db arrived
+// (its mtime against the file's ctime, which rename sets; to the nanosecond:
+// a connection opened in the second of a rename makes its WAL within it. Not
+// the WAL's ctime: SQLite running as root gives the WAL its owner at every open).
+static bool written_after(const struct stat* w, const struct stat* db)
+{
+    return w->st_mtim.tv_sec != db->st_ctim.tv_sec ? w->st_mtim.tv_sec > db->st_ctim.tv_sec
+                                                   : w->st_mtim.tv_nsec > db->st_ctim.tv_nsec;
+}
+
+// The -shm's times say nothing (readers write it), so only the WAL's are compared.
+void sp_db_drop_stale_sidecars(const char* path)
+{
+    char wal[1100], shm[1100];
+    snprintf(wal, sizeof wal, "%s-wal", path);
+    snprintf(shm, sizeof shm, "%s-shm", path);
+    struct stat db, w;
+    if (stat(path, &db) != 0) return;
+    if (stat(wal, &w) == 0 && written_after(&w, &db)) return;
+    int fd = open(shm, O_RDWR);
+    if (fd >= 0) {
+        // SQLite's unix VFS locks bytes 120..128 of the -shm (the lock slots and the dead man switch).
+        struct flock fl = {.l_type = F_WRLCK, .l_whence = SEEK_SET, .l_start = 120, .l_len = 9};
+        bool used = fcntl(fd, F_GETLK, &fl) != 0 || fl.l_type != F_UNLCK;
+        close(fd);
+        if (used) return;
+    }
+    unlink(wal);
+    unlink(shm);
+}
+
 sp_result sp_db_checkpoint(sp_db* db, sp_error* err)
 {
     int log = 0, done = 0;

@@ -1315,6 +1315,16 @@ static void collector_wait(kiosk_collector* c, int want, int* stored, int* dropp
     }
 }
 
+// The collector alone on db, a tail's stroke handed to it and settled.
+static kiosk_collector* collector_after_one(const char* db, int* stored, int* dropped)
+{
+    kiosk_collector* c = kiosk_collector_open(db, 1280, 800);
+    ENSURE(c);
+    kiosk_collector_push(c, "tail", g_strokes[3].xy, NULL, g_strokes[3].n);
+    collector_wait(c, 1, stored, dropped);
+    return c;
+}
+
 // A database the collector cannot write at start (here a file that is not a
 // database: root may write any file) is tried again for each sketch: once a
 // good one is renamed over it, collecting resumes without a restart.
@@ -1329,12 +1339,9 @@ static void test_collect_mended(void)
     for (int i = 0; i < 256; ++i)
         fputs("not a database, ", f);
     ENSURE(fclose(f) == 0);
-    kiosk_collector* c = kiosk_collector_open(db, 1280, 800);
-    ENSURE(c);
-    const stroke* s = &g_strokes[3];
     int stored = 0, dropped = 0;
-    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
-    collector_wait(c, 1, &stored, &dropped);
+    kiosk_collector* c = collector_after_one(db, &stored, &dropped);
+    const stroke* s = &g_strokes[3];
     ENSURE(stored == 0 && dropped == 1);
     e2e_db_copy("kiosk_mended_good.db", good, sizeof good);
     ENSURE(rename(good, db) == 0);
@@ -1343,6 +1350,60 @@ static void test_collect_mended(void)
     kiosk_collector_close(c, &stored, &dropped);
     fprintf(stderr, "  stored %d, dropped %d\n", stored, dropped);
     ENSURE(stored == 1 && dropped == 1);
+    ENSURE(pending_count(db) == 1);
+}
+
+// A database file renamed over the live one while the old file's WAL still
+// holds commits (a curator's write a moment before, kept out of the file by
+// the kiosk's open connections): the collector's next sketch goes into the
+// new file, which gets none of the old file's pages (a connection opened by
+// path applied the old WAL to it, and a checkpoint wrote it in).
+static void test_collect_stale_wal(void)
+{
+    six_strokes();
+    char db[1100], next[1100], wal[1200];
+    e2e_db_copy("kiosk_stale.db", db, sizeof db);
+    e2e_db_copy("kiosk_stale_next.db", next, sizeof next);
+    snprintf(wal, sizeof wal, "%s-wal", db);
+    int stored = 0, dropped = 0;
+    kiosk_collector* c = collector_after_one(db, &stored, &dropped);
+    const stroke* s = &g_strokes[3];
+    ENSURE(stored == 1);
+    // The curator's write stays in the old file's WAL.
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+    ENSURE(sqlite3_db_config(h, SQLITE_DBCONFIG_NO_CKPT_ON_CLOSE, 1, NULL) == SQLITE_OK);
+    sqlite3_busy_timeout(h, 5000); // the collector's checkpoint after its store
+    char* msg = NULL;
+    int rc = sqlite3_exec(h, "PRAGMA wal_autocheckpoint = 0; CREATE TABLE old_file_only(x); INSERT INTO old_file_only VALUES (1)",
+                          NULL, NULL, &msg);
+    if (rc != SQLITE_OK) fprintf(stderr, "  sqlite: %s\n", msg ? msg : "?");
+    sqlite3_free(msg);
+    sqlite3_close(h);
+    ENSURE(rc == SQLITE_OK);
+    struct stat st;
+    ENSURE(stat(wal, &st) == 0 && st.st_size > 0);
+    ENSURE(rename(next, db) == 0);
+    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
+    collector_wait(c, 2, &stored, &dropped);
+    kiosk_collector_close(c, &stored, &dropped);
+    fprintf(stderr, "  stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 2 && dropped == 0);
+    // The new file: its own tables, whole, and the sketch.
+    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+    sqlite3_stmt* q = NULL;
+    ENSURE(sqlite3_prepare_v2(h,
+                              "SELECT (SELECT count(*) FROM sqlite_master WHERE name = 'old_file_only'), "
+                              "(SELECT integrity_check FROM pragma_integrity_check)",
+                              -1, &q, NULL) == SQLITE_OK);
+    ENSURE(sqlite3_step(q) == SQLITE_ROW);
+    int leaked = sqlite3_column_int(q, 0);
+    char check[64];
+    snprintf(check, sizeof check, "%s", (const char*)sqlite3_column_text(q, 1));
+    sqlite3_finalize(q);
+    sqlite3_close(h);
+    fprintf(stderr, "  the old file's table in the new file: %d; integrity: %s\n", leaked, check);
+    ENSURE(leaked == 0 && !strcmp(check, "ok"));
     ENSURE(pending_count(db) == 1);
 }
 
@@ -2060,6 +2121,7 @@ int main(int argc, char** argv)
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
                                    {"collect_mended", test_collect_mended},
+                                   {"collect_stale_wal", test_collect_stale_wal},
                                    {"saves_disk", test_saves_disk},
                                    {"parts_row_follows", test_parts_row_follows},
                                    {"long_category", test_long_category},

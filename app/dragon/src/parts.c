@@ -299,42 +299,6 @@ bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino)
     return true;
 }
 
-// Whether the WAL w was made or written after the database file db arrived
-// (its mtime against the file's ctime, which rename sets; to the nanosecond:
-// a connection opened in the second of a rename makes its WAL within it. Not
-// the WAL's ctime: SQLite running as root gives the WAL its owner at every open).
-static bool written_after(const struct stat* w, const struct stat* db)
-{
-    return w->st_mtim.tv_sec != db->st_ctim.tv_sec ? w->st_mtim.tv_sec > db->st_ctim.tv_sec
-                                                   : w->st_mtim.tv_nsec > db->st_ctim.tv_nsec;
-}
-
-// After the database file was replaced by a rename, its -wal/-shm beside it
-// still belong to the old file (SQLite does not remove them when the file it
-// had open has moved), and a new connection would read the new file through
-// the old file's WAL. They are removed when no process holds a lock on the
-// -shm (nobody uses them) and the WAL was not made or written since the new
-// file arrived (the -shm's times say nothing: readers write it).
-static void drop_stale_sidecars(const char* path)
-{
-    char wal[1100], shm[1100];
-    snprintf(wal, sizeof wal, "%s-wal", path);
-    snprintf(shm, sizeof shm, "%s-shm", path);
-    struct stat db, w;
-    if (stat(path, &db) != 0) return;
-    if (stat(wal, &w) == 0 && written_after(&w, &db)) return;
-    int fd = open(shm, O_RDWR);
-    if (fd >= 0) {
-        // SQLite's unix VFS locks bytes 120..128 of the -shm (the lock slots and the dead man switch).
-        struct flock fl = {.l_type = F_WRLCK, .l_whence = SEEK_SET, .l_start = 120, .l_len = 9};
-        bool used = fcntl(fd, F_GETLK, &fl) != 0 || fl.l_type != F_UNLCK;
-        close(fd);
-        if (used) return;
-    }
-    unlink(wal);
-    unlink(shm);
-}
-
 // Opens our own connection, read-only: the kiosk never writes.
 static sp_result open_own(sp_dragon* d, sp_error* err)
 {
@@ -402,7 +366,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
             // model being read ends, and what it read is not taken).
             (void)dragon_model_load_take(d, true);
             if (d->db) sp_db_close(d->db);
-            if (replaced) drop_stale_sidecars(d->db_path);
+            if (replaced) sp_db_drop_stale_sidecars(d->db_path);
             d->db = NULL;
             if (open_own(d, err) != SP_OK) return SP_ERR_IO; // parts already loaded and the model stay usable
             dragon_reload_model(d, false);

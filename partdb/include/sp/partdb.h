@@ -91,6 +91,16 @@ void sp_db_set_busy_timeout(sp_db* db, int ms);
 /// or writer kept it from finishing (nothing is lost: the commits stay in
 /// the WAL until the next checkpoint).
 sp_result sp_db_checkpoint(sp_db* db, sp_error* err);
+/// After the database file at `path` was replaced by a rename (another inode
+/// there), the -wal and -shm beside it still belong to the old file: SQLite
+/// does not remove them when the file it had open has moved, and a
+/// connection opened by path would read the new file through the old file's
+/// WAL, and a writer's checkpoint would write the old pages into it. Removes
+/// them when no other process uses them (a lock on the -shm) and the WAL was
+/// not made or written since the new file arrived (rename sets its ctime).
+/// Call it only once the file is known to be replaced, with this process's
+/// own connections to the old file closed (its own locks do not show).
+void sp_db_drop_stale_sidecars(const char* path);
 /// The file's path as opened.
 const char* sp_db_path(const sp_db* db);
 /// The schema version of the open database (== SP_DB_SCHEMA_VERSION once open).
