@@ -2,6 +2,7 @@
 // the busy message, the generation counter and the curator log.
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -434,6 +435,69 @@ sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* er
     return sp_db_open_wait(path, flags, -1, out, err);
 }
 
+// The database files this process has open, with how many handles each:
+// sp_db_drop_stale_sidecars must not take another handle's -wal and -shm
+// for an old file's, and a process's own fcntl locks do not show to it.
+static pthread_mutex_t g_open_lock = PTHREAD_MUTEX_INITIALIZER;
+static struct open_file {
+    dev_t dev;
+    ino_t ino;
+    int handles;
+} * g_open;
+static int g_open_n, g_open_cap, g_open_unlisted;
+
+static void list_open(sp_db* db)
+{
+    struct stat st;
+    pthread_mutex_lock(&g_open_lock);
+    if (stat(db->path, &st) != 0) {
+        ++g_open_unlisted; // not known: every drop waits until it closes
+    } else {
+        db->dev = st.st_dev, db->ino = st.st_ino, db->listed = true;
+        int i = 0;
+        while (i < g_open_n && (g_open[i].dev != db->dev || g_open[i].ino != db->ino))
+            ++i;
+        if (i == g_open_n && g_open_n == g_open_cap) {
+            int cap = g_open_cap ? 2 * g_open_cap : 8;
+            struct open_file* grown = realloc(g_open, sizeof *grown * (size_t)cap);
+            if (grown) g_open = grown, g_open_cap = cap;
+        }
+        if (i < g_open_n)
+            ++g_open[i].handles;
+        else if (g_open_n < g_open_cap)
+            g_open[g_open_n++] = (struct open_file){db->dev, db->ino, 1};
+        else
+            db->listed = false, ++g_open_unlisted;
+    }
+    pthread_mutex_unlock(&g_open_lock);
+}
+
+static void unlist_open(const sp_db* db)
+{
+    pthread_mutex_lock(&g_open_lock);
+    if (!db->listed) {
+        --g_open_unlisted;
+    } else {
+        for (int i = 0; i < g_open_n; ++i)
+            if (g_open[i].dev == db->dev && g_open[i].ino == db->ino && --g_open[i].handles == 0) {
+                g_open[i] = g_open[--g_open_n];
+                break;
+            }
+    }
+    pthread_mutex_unlock(&g_open_lock);
+}
+
+// Whether this process has a handle on the file (or one it could not list).
+static bool open_here(const struct stat* st)
+{
+    pthread_mutex_lock(&g_open_lock);
+    bool here = g_open_unlisted > 0;
+    for (int i = 0; !here && i < g_open_n; ++i)
+        here = g_open[i].dev == st->st_dev && g_open[i].ino == st->st_ino;
+    pthread_mutex_unlock(&g_open_lock);
+    return here;
+}
+
 sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db** out, sp_error* err)
 {
     *out = NULL;
@@ -546,6 +610,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
         }
         if ((r = db_migrate(db, SP_DB_SCHEMA_VERSION, err)) != SP_OK) goto fail;
     }
+    list_open(db);
     *out = db;
     return SP_OK;
 fail:
@@ -560,6 +625,7 @@ void sp_db_close(sp_db* db)
     if (!db) return;
     db_rollback(db);
     sqlite3_close(db->h);
+    unlist_open(db);
     free(db->path);
     free(db);
 }
@@ -588,6 +654,9 @@ void sp_db_drop_stale_sidecars(const char* path)
     snprintf(shm, sizeof shm, "%s-shm", path);
     struct stat db, w;
     if (stat(path, &db) != 0) return;
+    // Another handle of ours on the new file made those, or uses them (the
+    // kiosk's collector follows a replaced file before its pipeline does).
+    if (open_here(&db)) return;
     if (stat(wal, &w) == 0 && written_after(&w, &db)) return;
     int fd = open(shm, O_RDWR);
     if (fd >= 0) {

@@ -7,12 +7,16 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <sys/types.h>
 
 #include "sp/partdb.h"
 
 struct sp_db {
     sqlite3* h;
     char* path;
+    dev_t dev; // the file opened (db.c's list of this process's open files)
+    ino_t ino;
+    bool listed;
     int busy_ms;
     bool readonly;
     bool gen_valid;   // gen is current as of data_version dv

@@ -40,7 +40,9 @@ static void* load_main(void* arg)
     l->same_file = dragon_file_id(l->path, &dev, &ino) && dev == l->dev && ino == l->ino;
     // A file renamed over the path is the poll's to open: it removes the old
     // file's WAL first, which a connection opened here would apply to the new file.
-    l->r = l->same_file ? sp_db_open(l->path, SP_DB_READONLY, &db, &err)
+    // Waiting little for a lock: the poll that reopens a replaced file waits
+    // for this read, and a read that fails is tried again later.
+    l->r = l->same_file ? sp_db_open_wait(l->path, SP_DB_READONLY, 100, &db, &err)
                         : sp_fail(&err, SP_ERR_IO, "%s: the database file was replaced", l->path);
     l->opened = l->r == SP_OK;
     if (l->opened) {

@@ -353,7 +353,6 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
 {
     if (reloaded) *reloaded = false;
     sp_dragon_model_update(d);
-    dragon_model_retry(d);
     if (d->own_db) {
         // A database replaced on disk (a new file renamed over it) is a new
         // inode: the open connection still reads the old one. A deleted file
@@ -377,6 +376,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
             return SP_OK;
         }
     }
+    dragon_model_retry(d); // after a reopen, which reads anew anyway
     uint64_t g = sp_db_generation(d->db);
     if (g == 0) return sp_fail(err, SP_ERR_IO, "%s: the database cannot be read", d->db_path);
     if (g == d->gen) return SP_OK;

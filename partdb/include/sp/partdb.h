@@ -96,10 +96,11 @@ sp_result sp_db_checkpoint(sp_db* db, sp_error* err);
 /// does not remove them when the file it had open has moved, and a
 /// connection opened by path would read the new file through the old file's
 /// WAL, and a writer's checkpoint would write the old pages into it. Removes
-/// them when no other process uses them (a lock on the -shm) and the WAL was
-/// not made or written since the new file arrived (rename sets its ctime).
-/// Call it only once the file is known to be replaced, with this process's
-/// own connections to the old file closed (its own locks do not show).
+/// them when no handle of this process has the new file open (one that
+/// follows first makes its own), no other process uses them (a lock on the
+/// -shm) and the WAL was not made or written since the new file arrived
+/// (rename sets its ctime). Call it only once the file is known to be
+/// replaced, with the caller's own handle on the old file closed.
 void sp_db_drop_stale_sidecars(const char* path);
 /// The file's path as opened.
 const char* sp_db_path(const sp_db* db);
