@@ -63,27 +63,25 @@ static void count_result(kiosk_collector* c, bool stored)
 
 // A database that could not be written (read-only, damaged, not there) is
 // tried again for each sketch, in this thread: a technician who mends the
-// file expects collecting to resume without a restart. False, with one line
-// naming the file and why, while it still cannot; once open, it says `said`.
-static bool open_writer(kiosk_collector* c, const char* said)
+// file expects collecting to resume without a restart. Once open, it says
+// `said`; otherwise err says why (SP_ERR_BUSY: another writer holds it).
+static sp_result open_writer(kiosk_collector* c, const char* said, sp_error* err)
 {
-    if (c->db) return true;
-    sp_db* db = NULL;
-    sp_error err = {0};
+    if (c->db) return SP_OK;
     struct stat st;
-    if (stat(c->path, &st) != 0) {
-        sp_kiosk_log("%s: no database there: sketch dropped", c->path);
-        return false;
-    }
+    if (stat(c->path, &st) != 0) return sp_fail(err, SP_ERR_IO, "%s: no database there; sketch dropped", c->path);
     // Waiting no longer than a store does: closing the kiosk waits for this thread.
-    if (sp_db_open_wait(c->path, 0, SP_DB_COLLECT_BUSY_MS, &db, &err) != SP_OK) {
-        sp_kiosk_log("%s; sketch dropped", err.text);
-        return false;
+    sp_db* db = NULL;
+    sp_result r = sp_db_open_wait(c->path, 0, SP_DB_COLLECT_BUSY_MS, &db, err);
+    if (r != SP_OK) {
+        char why[sizeof err->text];
+        snprintf(why, sizeof why, "%s", err->text);
+        return sp_fail(err, r, "%s; sketch dropped", why);
     }
     sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
     c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
     sp_kiosk_log("%s: %s", c->path, said);
-    return true;
+    return SP_OK;
 }
 
 // The database file at c->path is still the one the handle has open; a file
@@ -91,23 +89,20 @@ static bool open_writer(kiosk_collector* c, const char* said)
 // no stroke goes into the old, unlinked one: the old handle closes first,
 // then the old file's WAL and -shm beside the path go (a connection opened
 // by path would apply that WAL to the new file, and a checkpoint write it
-// into it). False, with one line, when no file is at the path (deleted, or
+// into it). Fails (err says why) when no file is at the path (deleted, or
 // moved away: the handle would write into the unlinked file or the one under
 // its new name, and the stroke be lost without a word), or the new file
-// cannot be written (open_writer tries again at the next sketch); the
-// stroke is then dropped.
-static bool follow_file(kiosk_collector* c)
+// cannot be written (open_writer tries again at the next sketch).
+static sp_result follow_file(kiosk_collector* c, sp_error* err)
 {
     struct stat st;
-    if (stat(c->path, &st) != 0) {
-        sp_kiosk_log("%s: the database is gone (deleted or moved away): sketch dropped", c->path);
-        return false;
-    }
-    if (st.st_dev == c->dev && st.st_ino == c->ino) return true;
+    if (stat(c->path, &st) != 0)
+        return sp_fail(err, SP_ERR_IO, "%s: the database is gone (deleted or moved away); sketch dropped", c->path);
+    if (st.st_dev == c->dev && st.st_ino == c->ino) return SP_OK;
     sp_db_close(c->db);
     c->db = NULL;
     sp_db_drop_stale_sidecars(c->path);
-    return open_writer(c, "a new database file there: visitors' strokes go into it");
+    return open_writer(c, "a new database file there: visitors' strokes go into it", err);
 }
 
 // After a store found the database busy: puts the sketch back at the head of
@@ -152,17 +147,18 @@ static void* collector_main(void* arg)
         pthread_mutex_unlock(&c->lock);
         sp_error err = {0};
         sp_stroke st = {.count = s.n, .points = s.xy, .t = s.t};
-        sp_result r = SP_ERR_IO;
-        if (open_writer(c, "the database can be written now: visitors' strokes are collected again") && follow_file(c)) {
-            r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
-            bool closing = false;
-            if (r == SP_ERR_BUSY && wait_busy(c, &s, &closing)) continue; // the lock is held again
-            if (r == SP_ERR_BUSY && s.busy_since > 0)
-                sp_kiosk_log("%s: another writer held the database for %.1f s%s; sketch dropped", c->path,
-                             (sp_now_ms() - s.busy_since) / 1000.0, closing ? " when the kiosk closed" : "");
-            else if (r != SP_OK)
-                sp_kiosk_log("%s", err.text);
-        }
+        // A database another writer holds is waited for, whether it was
+        // found so at the open or at the store.
+        sp_result r = open_writer(c, "the database can be written now: visitors' strokes are collected again", &err);
+        if (r == SP_OK) r = follow_file(c, &err);
+        if (r == SP_OK) r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
+        bool closing = false;
+        if (r == SP_ERR_BUSY && wait_busy(c, &s, &closing)) continue; // the lock is held again
+        if (r == SP_ERR_BUSY && s.busy_since > 0)
+            sp_kiosk_log("%s: another writer held the database for %.1f s%s; sketch dropped", c->path,
+                         (sp_now_ms() - s.busy_since) / 1000.0, closing ? " when the kiosk closed" : "");
+        else if (r != SP_OK)
+            sp_kiosk_log("%s", err.text);
         queued_free(&s);
         count_result(c, r == SP_OK);
         pthread_mutex_lock(&c->lock);

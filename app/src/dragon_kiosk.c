@@ -126,7 +126,7 @@ static double live_t(const app* a)
 }
 
 // Live frames come at most 60 a second: where the swap does not wait for the
-// display (software GL, Xvfb) the loop drew 90 and more a second of an idle
+// display (software GL, Xvfb) the loop drew 200 a second of an idle
 // screen. Input is handled while waiting (each event keeps its own time), and
 // a stroke's pen-up (a job) starts the next frame at once.
 static void wait_for_frame(const app* a, double until)
