@@ -209,31 +209,18 @@ static bool folds_opt(const char* cmd, int* v)
     return false;
 }
 
-_Static_assert(SP_DB_CURATED_TRAIN_MAX == 400, "db train's help gives the default");
+_Static_assert(SP_DB_CURATED_TRAIN_MAX == 400 && SP_DB_KEEP_MODELS == 3, "db train's help gives the defaults");
 
-// --curated-max: -1 or 1..1,000,000; not given 0 (the library's SP_DB_CURATED_TRAIN_MAX).
-static bool curated_max_opt(const char* cmd, int* v)
+// A count option that takes -1 for all or 1..1,000,000 (--curated-max,
+// --keep-models); not given, 0: the library's default.
+static bool all_or_count_opt(const char* cmd, const char* name, int* v)
 {
     if (*v == SP_CLI_UNSET) {
         *v = 0;
         return true;
     }
     if (*v == -1 || (*v >= 1 && *v <= 1000000)) return true;
-    fprintf(stderr, "%s: --curated-max must be -1 (all) or 1..1000000, got %d\n", cmd, *v);
-    return false;
-}
-
-_Static_assert(SP_DB_KEEP_MODELS == 3, "db train's help gives the default");
-
-// --keep-models: -1 or 1..1,000,000; not given 0 (the library's SP_DB_KEEP_MODELS).
-static bool keep_models_opt(const char* cmd, int* v)
-{
-    if (*v == SP_CLI_UNSET) {
-        *v = 0;
-        return true;
-    }
-    if (*v == -1 || (*v >= 1 && *v <= 1000000)) return true;
-    fprintf(stderr, "%s: --keep-models must be -1 (all) or 1..1000000, got %d\n", cmd, *v);
+    fprintf(stderr, "%s: %s must be -1 (all) or 1..1000000, got %d\n", cmd, name, *v);
     return false;
 }
 
@@ -798,8 +785,8 @@ static int db_train(int argc, char** argv)
                    "rebuild the classifier from the stored sketches of the current part categories; store it with its report",
                    opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
-    if (!clf_cli_check(cmd, &o) || !folds_opt(cmd, &folds) || !curated_max_opt(cmd, &curated_max) ||
-        !keep_models_opt(cmd, &keep_models))
+    if (!clf_cli_check(cmd, &o) || !folds_opt(cmd, &folds) || !all_or_count_opt(cmd, "--curated-max", &curated_max) ||
+        !all_or_count_opt(cmd, "--keep-models", &keep_models))
         return SP_EXIT_USAGE;
     sp_db* db = open_db(cmd, &c, 0);
     if (!db) return SP_EXIT_INPUT;

@@ -201,6 +201,25 @@ static sp_dragon* new_dragon(const char* db_path)
     return d;
 }
 
+// A pipeline that reads new models in the background (desc.background_model).
+static sp_dragon* new_background_dragon(const char* db_path)
+{
+    sp_error err = {0};
+    sp_dragon* d = NULL;
+    sp_dragon_create(&(sp_dragon_desc){.db_path = db_path, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
+                     &err);
+    if (!d) fprintf(stderr, "  create: %s\n", err.text);
+    ENSURE(d);
+    return d;
+}
+
+// A copy of the test database in the scratch folder, its path in `path`.
+static void test_db_copy(const char* name, char path[1024])
+{
+    snprintf(path, 1024, "%s", sp_test_tmp_path(name));
+    copy_file(test_db(), path);
+}
+
 // A pipeline on the database at `path`, and the database opened read-only
 // beside it (for the parts' names and strokes).
 static sp_dragon* dragon_and_db(const char* path, sp_db** db)
@@ -1407,12 +1426,9 @@ static bool model_taken(sp_dragon* d)
 static void test_background_model(void)
 {
     char path[1024];
-    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_background.db"));
-    copy_file(test_db(), path);
+    test_db_copy("dragon_background.db", path);
     sp_error err = {0};
-    sp_dragon* d = NULL;
-    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
-                            &err) == SP_OK);
+    sp_dragon* d = new_background_dragon(path);
     const sp_clf* first = sp_dragon_model(d);
     ENSURE(first && !sp_dragon_model_loading(d) && !sp_dragon_model_update(d));
     ENSURE(sp_fixture_store_model_again(path));
@@ -1449,8 +1465,7 @@ static void test_background_model(void)
 static void test_reload_keeps_model(void)
 {
     char path[1024];
-    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_keep.db"));
-    copy_file(test_db(), path);
+    test_db_copy("dragon_keep.db", path);
     sp_dragon* d = new_dragon(path);
     const sp_clf* first = sp_dragon_model(d);
     ENSURE(first);
@@ -1507,13 +1522,10 @@ static void settle(sp_dragon* d)
 static void test_background_read_fails(void)
 {
     char path[1024], away[1100];
-    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_bg_fail.db"));
+    test_db_copy("dragon_bg_fail.db", path);
     snprintf(away, sizeof away, "%s.away", path);
-    copy_file(test_db(), path);
     sp_error err = {0};
-    sp_dragon* d = NULL;
-    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = path, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
-                            &err) == SP_OK);
+    sp_dragon* d = new_background_dragon(path);
     const sp_clf* first = sp_dragon_model(d);
     ENSURE(sp_fixture_store_model_again(path));
     ENSURE(rename(path, away) == 0);
@@ -1547,10 +1559,8 @@ static void test_background_read_fails(void)
 static void test_background_replaced(void)
 {
     char p[1024], b[1024];
-    snprintf(p, sizeof p, "%s", sp_test_tmp_path("dragon_bg_p.db"));
-    snprintf(b, sizeof b, "%s", sp_test_tmp_path("dragon_bg_b.db"));
-    copy_file(test_db(), p);
-    copy_file(test_db(), b);
+    test_db_copy("dragon_bg_p.db", p);
+    test_db_copy("dragon_bg_b.db", b);
     sp_error err = {0};
     sp_db* w = NULL;
     // B: another model of the next id (a copy trained elsewhere, other options).
@@ -1558,9 +1568,7 @@ static void test_background_replaced(void)
     td.clf.words = 64;
     ENSURE(sp_db_open(b, 0, &w, &err) == SP_OK && sp_db_train(w, &td, NULL, &err) == SP_OK);
     sp_db_close(w);
-    sp_dragon* d = NULL;
-    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = p, .canvas_w = 1280, .canvas_h = 800, .background_model = true}, &d,
-                            &err) == SP_OK);
+    sp_dragon* d = new_background_dragon(p);
     // P's next model, of the same id as B's; large, so that its read lasts.
     td.clf.words = 3000;
     ENSURE(sp_db_open(p, 0, &w, &err) == SP_OK && sp_db_train(w, &td, NULL, &err) == SP_OK);
@@ -1589,9 +1597,8 @@ static void test_background_replaced(void)
 static void test_live_update(void)
 {
     char path[1024], other[1024];
-    snprintf(path, sizeof path, "%s", sp_test_tmp_path("dragon_live.db"));
+    test_db_copy("dragon_live.db", path);
     snprintf(other, sizeof other, "%s", sp_test_tmp_path("dragon_live_new.db"));
-    copy_file(test_db(), path);
     sp_dragon* d = new_dragon(path);
     sp_db* writer = NULL;
     sp_error err = {0};

@@ -1353,6 +1353,18 @@ static void test_collect_mended(void)
     ENSURE(pending_count(db) == 1);
 }
 
+// A live database `<name>.db` and the one a curator renames over it,
+// `<name>_next.db` (both copies of the test database), and the live one's WAL.
+static void live_and_next(const char* name, char db[1100], char next[1100], char wal[1200])
+{
+    char file[256];
+    snprintf(file, sizeof file, "%s.db", name);
+    e2e_db_copy(file, db, 1100);
+    snprintf(file, sizeof file, "%s_next.db", name);
+    e2e_db_copy(file, next, 1100);
+    snprintf(wal, 1200, "%s-wal", db);
+}
+
 // A database file renamed over the live one while the old file's WAL still
 // holds commits (a curator's write a moment before, kept out of the file by
 // the kiosk's open connections): the collector's next sketch goes into the
@@ -1362,9 +1374,7 @@ static void test_collect_stale_wal(void)
 {
     six_strokes();
     char db[1100], next[1100], wal[1200];
-    e2e_db_copy("kiosk_stale.db", db, sizeof db);
-    e2e_db_copy("kiosk_stale_next.db", next, sizeof next);
-    snprintf(wal, sizeof wal, "%s-wal", db);
+    live_and_next("kiosk_stale", db, next, wal);
     int stored = 0, dropped = 0;
     kiosk_collector* c = collector_after_one(db, &stored, &dropped);
     const stroke* s = &g_strokes[3];
@@ -1416,9 +1426,7 @@ static void test_collect_before_pipeline(void)
 {
     six_strokes();
     char db[1100], next[1100], wal[1200];
-    e2e_db_copy("kiosk_order.db", db, sizeof db);
-    e2e_db_copy("kiosk_order_next.db", next, sizeof next);
-    snprintf(wal, sizeof wal, "%s-wal", db);
+    live_and_next("kiosk_order", db, next, wal);
     sp_error err = {0};
     sp_dragon* d = NULL;
     ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = db, .canvas_w = 1280, .canvas_h = 800}, &d, &err) == SP_OK);
