@@ -915,6 +915,42 @@ static bool parse_ids(const char* cmd, const sp_str_list* l, int count, int64_t*
     return true;
 }
 
+// db review's actions: --approve, --reject (ids and ranges), --relabel ID
+// CATEGORY, --delete-rejected; all or nothing, the result as JSON.
+static int review_act(const char* cmd, const db_common* c, const sp_str_list* approve, const sp_str_list* reject,
+                      const sp_str_list* relabel, bool delete_rejected)
+{
+    sp_error err = {0};
+    const sp_str_list* l = approve->count ? approve : reject->count ? reject : relabel;
+    int64_t ids[256], *changed = NULL;
+    sp_db_kiosk_range ranges[256];
+    int n = 0, nr = 0, m = 0;
+    if (!delete_rejected && !parse_ids(cmd, l, relabel->count ? 1 : l->count, ids, &n, relabel->count ? NULL : ranges, &nr))
+        return SP_EXIT_INPUT;
+    sp_db* db = open_db(cmd, c, 0);
+    if (!db) return SP_EXIT_INPUT;
+    sp_result r = delete_rejected  ? sp_db_kiosk_delete_rejected(db, c->by, &m, &err)
+                  : relabel->count ? sp_db_kiosk_relabel(db, ids[0], relabel->items[1], c->by, &err)
+                                   : sp_db_kiosk_review(db, ids, n, ranges, nr, approve->count ? SP_DB_APPROVED : SP_DB_REJECTED,
+                                                        c->by, &changed, &m, &err);
+    sp_db_close(db);
+    if (r != SP_OK) return fail(cmd, &err);
+    if (delete_rejected) {
+        printf("{\"deleted\": %d}\n", m);
+    } else if (relabel->count) {
+        printf("{\"relabelled\": %lld, \"category\": ", (long long)ids[0]);
+        clf_cli_json_str(stdout, relabel->items[1]);
+        printf("}\n");
+    } else {
+        printf("{\"%s\": [", approve->count ? "approved" : "rejected");
+        for (int i = 0; i < m; ++i)
+            printf("%s%lld", i ? ", " : "", (long long)changed[i]);
+        printf("]}\n");
+    }
+    free(changed);
+    return SP_EXIT_OK;
+}
+
 static int db_review(int argc, char** argv)
 {
     const char* cmd = "sketchpose db review";
@@ -922,6 +958,7 @@ static int db_review(int argc, char** argv)
     const char *status = NULL, *sheet = NULL;       // status NULL: pending
     int limit = SP_CLI_UNSET, after = SP_CLI_UNSET; // not given: 100, 0
     sp_str_list approve = {0}, reject = {0}, relabel = {0};
+    bool delete_rejected = false;
     sp_opt opts[] = {
         DB_COMMON_OPTS(c),
         {"--status", SP_OPT_STRING, &status, "S", "which to list: pending (default), approved, rejected or all", false},
@@ -932,21 +969,25 @@ static int db_review(int argc, char** argv)
          "approve these kiosk sketches (`db train` uses approved ones); FIRST-LAST: the pending ones from FIRST to LAST", false},
         {"--reject", SP_OPT_LIST, &reject, "ID...",
          "reject these kiosk sketches (kept, never trained on); FIRST-LAST: the pending ones from FIRST to LAST", false},
-        {"--relabel", SP_OPT_LIST, &relabel, "ID CATEGORY", "give a kiosk sketch another part category", false}};
+        {"--relabel", SP_OPT_LIST, &relabel, "ID CATEGORY", "give a kiosk sketch another part category", false},
+        {"--delete-rejected", SP_OPT_FLAG, &delete_rejected, NULL,
+         "delete every rejected kiosk sketch (their room is reused: the database stops growing with them)", false}};
     const char* pos[1];
     int npos;
     int rc =
         parse(argc, argv, cmd, &c,
               "the visitors' strokes the kiosk collected: list them as JSON (pending ones by default, oldest first), draw them, "
-              "approve, reject or relabel them; an unknown id changes nothing",
+              "approve, reject, relabel or delete them; an unknown id changes nothing",
               opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 0, 0, "");
     if (rc >= 0) return rc;
     if (!sp_cli_check_out(cmd, "--sheet", sheet, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
-    int actions = (approve.count > 0) + (reject.count > 0) + (relabel.count > 0);
+    int actions = (approve.count > 0) + (reject.count > 0) + (relabel.count > 0) + delete_rejected;
     // The listing's options were ignored by an action.
     const char* listing = status ? "--status" : limit != SP_CLI_UNSET ? "--limit" : after != SP_CLI_UNSET ? "--after" : NULL;
     if (actions && listing) {
-        fprintf(stderr, "%s: %s chooses what is listed; it does not apply to --approve, --reject or --relabel\n", cmd, listing);
+        fprintf(stderr,
+                "%s: %s chooses what is listed; it does not apply to --approve, --reject, --relabel or --delete-rejected\n", cmd,
+                listing);
         return SP_EXIT_USAGE;
     }
     if (!status) status = "pending";
@@ -958,7 +999,9 @@ static int db_review(int argc, char** argv)
         return SP_EXIT_USAGE;
     }
     if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2)) {
-        fprintf(stderr, "%s: give one of --approve ID..., --reject ID..., --relabel ID CATEGORY (not with --sheet)\n", cmd);
+        fprintf(stderr,
+                "%s: give one of --approve ID..., --reject ID..., --relabel ID CATEGORY, --delete-rejected (not with --sheet)\n",
+                cmd);
         return SP_EXIT_USAGE;
     }
     unsigned mask = 0;
@@ -969,33 +1012,8 @@ static int db_review(int argc, char** argv)
         fprintf(stderr, "%s: --status must be pending, approved, rejected or all, got '%s'\n", cmd, status);
         return SP_EXIT_USAGE;
     }
+    if (actions) return review_act(cmd, &c, &approve, &reject, &relabel, delete_rejected);
     sp_error err = {0};
-    if (actions) {
-        const sp_str_list* l = approve.count ? &approve : reject.count ? &reject : &relabel;
-        int64_t ids[256], *changed = NULL;
-        sp_db_kiosk_range ranges[256];
-        int n, nr = 0, m = 0;
-        if (!parse_ids(cmd, l, relabel.count ? 1 : l->count, ids, &n, relabel.count ? NULL : ranges, &nr)) return SP_EXIT_INPUT;
-        sp_db* db = open_db(cmd, &c, 0);
-        if (!db) return SP_EXIT_INPUT;
-        sp_result r = relabel.count ? sp_db_kiosk_relabel(db, ids[0], relabel.items[1], c.by, &err)
-                                    : sp_db_kiosk_review(db, ids, n, ranges, nr, approve.count ? SP_DB_APPROVED : SP_DB_REJECTED,
-                                                         c.by, &changed, &m, &err);
-        sp_db_close(db);
-        if (r != SP_OK) return fail(cmd, &err);
-        if (relabel.count) {
-            printf("{\"relabelled\": %lld, \"category\": ", (long long)ids[0]);
-            clf_cli_json_str(stdout, relabel.items[1]);
-            printf("}\n");
-        } else {
-            printf("{\"%s\": [", approve.count ? "approved" : "rejected");
-            for (int i = 0; i < m; ++i)
-                printf("%s%lld", i ? ", " : "", (long long)changed[i]);
-            printf("]}\n");
-        }
-        free(changed);
-        return SP_EXIT_OK;
-    }
     if (!sp_cli_check_out_folders(cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT;
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;

@@ -18,6 +18,7 @@ struct sp_db {
     ino_t ino;
     bool listed;
     int busy_ms;
+    int kiosk_pending_max; // 0: SP_DB_KIOSK_PENDING_MAX
     bool readonly;
     bool gen_valid;   // gen is current as of data_version dv
     int dv;

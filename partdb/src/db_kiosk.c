@@ -22,6 +22,31 @@ static sp_db_status status_of(const char* s)
     return SP_DB_PENDING;
 }
 
+void sp_db_set_kiosk_pending_max(sp_db* db, int max)
+{
+    db->kiosk_pending_max = max > 0 ? max : 0;
+}
+
+// SP_ERR_UNSUPPORTED when the pending kiosk sketches are at the handle's cap:
+// counted inside the store's transaction (the index on (source, status, id)
+// walks them; a few ms at the cap, on the collector's thread).
+static sp_result pending_room(sp_db* db, sp_error* err)
+{
+    int max = db->kiosk_pending_max > 0 ? db->kiosk_pending_max : SP_DB_KIOSK_PENDING_MAX;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'", &st, err);
+    if (r != SP_OK) return r;
+    int rc = sqlite3_step(st);
+    bool full = rc == SQLITE_ROW && sqlite3_column_int64(st, 0) >= max;
+    sqlite3_finalize(st);
+    if (rc != SQLITE_ROW) return db_fail(db, rc, "counting pending kiosk sketches", err);
+    if (full)
+        return sp_fail(err, SP_ERR_UNSUPPORTED,
+                       "%s: %d kiosk sketches await review (`sketchpose db review`); none more is kept until some are reviewed",
+                       db->path, max);
+    return SP_OK;
+}
+
 sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_stroke* stroke, double canvas_w, double canvas_h,
                                      int64_t* id, sp_error* err)
 {
@@ -47,6 +72,7 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
     sqlite3_exec(db->h, "PRAGMA synchronous = NORMAL", NULL, NULL, NULL);
     sqlite3_stmt* st = NULL;
     sp_result r = db_begin(db, err);
+    if (r == SP_OK && (r = pending_room(db, err)) != SP_OK) db_rollback(db);
     if (r == SP_OK &&
         (r = db_prepare(
              db, "INSERT INTO sketches(category, source, strokes, added_by, status) VALUES (?, 'kiosk', ?, 'kiosk', 'pending')",
@@ -304,4 +330,23 @@ sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const
         return r;
     }
     return db_commit(db, err);
+}
+
+sp_result sp_db_kiosk_delete_rejected(sp_db* db, const char* by, int* deleted, sp_error* err)
+{
+    if (deleted) *deleted = 0;
+    sp_result r = db_begin(db, err);
+    if (r != SP_OK) return r;
+    int rc = sqlite3_exec(db->h, "DELETE FROM sketches WHERE source = 'kiosk' AND status = 'rejected'", NULL, NULL, NULL);
+    int n = rc == SQLITE_OK ? sqlite3_changes(db->h) : 0;
+    if (rc != SQLITE_OK) r = db_fail(db, rc, "deleting rejected kiosk sketches", err);
+    char details[64];
+    snprintf(details, sizeof details, "{\"deleted\": %d}", n);
+    if (r == SP_OK) r = db_log_row(db, by, "delete", "rejected kiosk sketches", details, err);
+    if (r != SP_OK) {
+        db_rollback(db);
+        return r;
+    }
+    if ((r = db_commit(db, err)) == SP_OK && deleted) *deleted = n;
+    return r;
 }

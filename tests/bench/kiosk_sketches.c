@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bench.h"
@@ -108,6 +109,8 @@ int main(int argc, char** argv)
     }
     // A year of them: in bulk (as the kiosk's call stores them: pending, points
     // and times), then the last 1,000 through the kiosk's call, timed.
+    struct stat fs0, fs1;
+    if (sp_db_checkpoint(db, &err) != SP_OK || stat(path, &fs0) != 0) fail(&err);
     double t0 = sp_now_ms();
     int timed = count < 1000 ? count : 1000;
     char* text[DISTINCT];
@@ -140,6 +143,9 @@ int main(int argc, char** argv)
         if (sp_db_collect_kiosk_sketch(db, cats[labels[i % nd]], s, 1280, 800, NULL, &err) != SP_OK) fail(&err);
         ms_collect[i - (count - timed)] = sp_now_ms() - t;
     }
+    // What a year of them takes on the kiosk's disk (the pending ones' cap, SP_DB_KIOSK_PENDING_MAX).
+    if (sp_db_checkpoint(db, &err) != SP_OK || stat(path, &fs1) != 0) fail(&err);
+    double bytes_each = (double)(fs1.st_size - fs0.st_size) / count;
     // Approve a share (the worst case for training: all of them), in batches of 256 ids.
     int64_t first = 0;
     sp_db_kiosk_sketch* page;
@@ -202,6 +208,7 @@ int main(int argc, char** argv)
     rows[0].runs = timed;
     rows[0].paper_ms = -1;
     rows[0].target_ms = 16;
+    snprintf(rows[0].extra, sizeof rows[0].extra, "\"bytes_per_sketch\": %.0f", bytes_each);
 
     sp_bench_stats(ms_page, 20, &rows[1].ms_median, &rows[1].ms_p90);
     snprintf(rows[1].name, sizeof rows[1].name, "review: counts and the oldest 100");

@@ -1693,6 +1693,45 @@ static void test_collect_busy(void)
     ENSURE(pending_count(db) == 2);
 }
 
+// A kiosk nobody reviews: with SP_DB_KIOSK_PENDING_MAX sketches pending, the
+// collector drops the next stroke with its one line and goes on; once a
+// curator has reviewed one, it stores again.
+static void test_collect_full(void)
+{
+    six_strokes();
+    char db[1100];
+    e2e_db_copy("kiosk_full.db", db, sizeof db);
+    int stored = 0, dropped = 0;
+    kiosk_collector* c = collector_after_one(db, &stored, &dropped);
+    ENSURE(stored == 1);
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+    sqlite3_busy_timeout(h, 5000); // the collector's checkpoint after its store
+    char sql[512];
+    snprintf(sql, sizeof sql,
+             "WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n WHERE i < %d) "
+             "INSERT INTO sketches(category, source, strokes, added_by, status) SELECT 'tail', 'kiosk', "
+             "'{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [1280, 800], \"strokes\": [{\"points\": "
+             "[[1, 2], [3, 4]]}]}', 'kiosk', 'pending' FROM n",
+             SP_DB_KIOSK_PENDING_MAX - 1);
+    ENSURE(sqlite3_exec(h, sql, NULL, NULL, NULL) == SQLITE_OK);
+    const stroke* s = &g_strokes[3];
+    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
+    collector_wait(c, 2, &stored, &dropped);
+    fprintf(stderr, "  %d pending: stored %d, dropped %d\n", SP_DB_KIOSK_PENDING_MAX, stored, dropped);
+    ENSURE(stored == 1 && dropped == 1);
+    ENSURE(sqlite3_exec(h,
+                        "UPDATE sketches SET status = 'rejected' WHERE id = (SELECT max(id) FROM sketches WHERE source = "
+                        "'kiosk')",
+                        NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(h);
+    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
+    collector_wait(c, 3, &stored, &dropped);
+    kiosk_collector_close(c, &stored, &dropped);
+    fprintf(stderr, "  one reviewed: stored %d, dropped %d\n", stored, dropped);
+    ENSURE(stored == 2 && dropped == 1);
+}
+
 // A curator replaces the database file (a rename over it) while the kiosk
 // runs: strokes collected afterwards go into the new file, none into the
 // old, unlinked one.
@@ -2179,6 +2218,7 @@ int main(int argc, char** argv)
                                    {"collect_busy", test_collect_busy},
                                    {"collect_replaced", test_collect_replaced},
                                    {"collect_deleted", test_collect_deleted},
+                                   {"collect_full", test_collect_full},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},
                                    {"body_after_parts", test_body_after_parts},

@@ -2032,6 +2032,99 @@ static void test_kiosk_review_ranges(void)
     }
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
+    // --delete-rejected: the three rejected go, the approved stay; with a
+    // listing option it is bad usage and changes nothing.
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --delete-rejected --status all 2>&1 >/dev/null", bin, p);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "--status chooses what is listed"));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --delete-rejected --approve %lld 2>&1 >/dev/null", bin, p,
+             (long long)id[0]);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "give one of"));
+    file_sha(p, after);
+    ENSURE(!strcmp(before, after));
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --delete-rejected", bin, p);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "{\"deleted\": 3}"));
+    db = open_ok(p, SP_DB_READONLY);
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 0 && counts[SP_DB_APPROVED] == 5 &&
+           counts[SP_DB_REJECTED] == 0);
+    sp_db_close(db);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "{\"deleted\": 0}"));
+}
+
+// A kiosk nobody reviews stops at the cap of pending sketches instead of
+// filling its disk (its saves and `db train` need room too): a stroke past
+// it is dropped with one line saying why, and a reviewed one makes room. The
+// default cap is SP_DB_KIOSK_PENDING_MAX, filled here by SQL with copies of
+// one small stroke. Deleting the rejected ones leaves the rest.
+static void test_kiosk_pending_cap(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("pending_cap.db"));
+    sp_db* db = open_ok(p, 0);
+    sp_db_set_kiosk_pending_max(db, 3);
+    int64_t id[3];
+    for (int i = 0; i < 3; ++i)
+        id[i] = collect_ok(db, "tail", i);
+    sp_vec2 pts[40];
+    double t[40];
+    sp_stroke st = visitor_stroke(7, pts, t);
+    sp_error err = {0};
+    int64_t got = -1;
+    ENSURE(sp_db_collect_kiosk_sketch(db, "tail", &st, 1280, 800, &got, &err) == SP_ERR_UNSUPPORTED);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(got == 0 && strstr(err.text, ": 3 kiosk sketches await review") && strstr(err.text, "sketch dropped") &&
+           !strchr(err.text, '\n'));
+    int counts[SP_DB_STATUS_COUNT];
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 3);
+    // Rejected and approved ones are not waiting: each makes room for one.
+    ENSURE(sp_db_kiosk_set_status(db, &id[0], 1, SP_DB_REJECTED, "curator", &err) == SP_OK);
+    collect_ok(db, "tail", 8);
+    ENSURE(sp_db_collect_kiosk_sketch(db, "tail", &st, 1280, 800, NULL, &err) == SP_ERR_UNSUPPORTED);
+    ENSURE(sp_db_kiosk_set_status(db, &id[1], 1, SP_DB_APPROVED, "curator", &err) == SP_OK);
+    collect_ok(db, "wings", 9);
+    // The default cap.
+    sp_db_set_kiosk_pending_max(db, 0);
+    sp_stroke small = visitor_stroke(0, pts, t);
+    small.count = 2;
+    int64_t seed = 0;
+    ENSURE(sp_db_collect_kiosk_sketch(db, "tail", &small, 1280, 800, &seed, &err) == SP_OK);
+    sqlite3* h;
+    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
+    sqlite3_busy_timeout(h, 5000);
+    char sql[512];
+    snprintf(sql, sizeof sql,
+             "WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n WHERE i < %d) "
+             "INSERT INTO sketches(category, source, strokes, added_by, status) "
+             "SELECT category, source, strokes, added_by, status FROM sketches, n WHERE sketches.id = %lld",
+             SP_DB_KIOSK_PENDING_MAX - 5, (long long)seed);
+    ENSURE(sqlite3_exec(h, sql, NULL, NULL, NULL) == SQLITE_OK);
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == SP_DB_KIOSK_PENDING_MAX - 1);
+    collect_ok(db, "tail", 10);
+    double t0 = sp_now_ms();
+    sp_result r = sp_db_collect_kiosk_sketch(db, "tail", &st, 1280, 800, NULL, &err);
+    fprintf(stderr, "  at the default cap, %.1f ms: %s\n", sp_now_ms() - t0, err.text);
+    char want[64];
+    snprintf(want, sizeof want, ": %d kiosk sketches await review", SP_DB_KIOSK_PENDING_MAX);
+    ENSURE(r == SP_ERR_UNSUPPORTED && strstr(err.text, want));
+    // Deleting the rejected: only they go, logged; the pending, approved and
+    // the part's own sketches stay.
+    int all = scalar(p, "SELECT count(*) FROM sketches");
+    int deleted = -1;
+    ENSURE(sp_db_kiosk_delete_rejected(db, "curator", &deleted, &err) == SP_OK && deleted == 1);
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_REJECTED] == 0 && counts[SP_DB_APPROVED] == 1 &&
+           counts[SP_DB_PENDING] == SP_DB_KIOSK_PENDING_MAX);
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches") == all - 1);
+    ENSURE(scalar(p, "SELECT count(*) FROM log WHERE action = 'delete' AND subject = 'rejected kiosk sketches'") == 1);
+    ENSURE(sp_db_kiosk_delete_rejected(db, "curator", &deleted, &err) == SP_OK && deleted == 0);
+    // A database in use: nothing deleted, one line.
+    ENSURE(sp_db_kiosk_set_status(db, &id[2], 1, SP_DB_REJECTED, "curator", &err) == SP_OK);
+    ENSURE(sqlite3_exec(h, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK);
+    sp_db_set_busy_timeout(db, 50);
+    deleted = -1;
+    ENSURE(sp_db_kiosk_delete_rejected(db, "curator", &deleted, &err) == SP_ERR_BUSY && deleted == 0 && strstr(err.text, p));
+    sqlite3_exec(h, "ROLLBACK", NULL, NULL, NULL);
+    sqlite3_close(h);
+    ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_REJECTED] == 1);
+    sp_db_close(db);
 }
 
 static void test_kiosk_review_cli(void)
@@ -2574,6 +2667,7 @@ int main(int argc, char** argv)
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
                                    {"kiosk_review_ranges", test_kiosk_review_ranges},
+                                   {"kiosk_pending_cap", test_kiosk_pending_cap},
                                    {"number_options_cli", test_number_options_cli},
                                    {"add_sketch_partless_cli", test_add_sketch_partless_cli},
                                    {0}});

@@ -233,6 +233,11 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
 /// by default): the newest, and the two before it to compare reports with. Each
 /// is tens of MB and only the newest is used: a weekly retrain kept 1.6 GB a year.
 #define SP_DB_KEEP_MODELS 3
+/// Pending kiosk sketches a database takes (sp_db_collect_kiosk_sketch): a
+/// year of a busy museum's, the most measured (BENCHMARKS.md, "Kiosk
+/// sketches"). A kiosk nobody reviews stops there instead of filling its
+/// disk, which its saves and the curators' `db train` also need.
+#define SP_DB_KIOSK_PENDING_MAX 100000
 
 /// Review status of a kiosk sketch.
 typedef enum sp_db_status { SP_DB_PENDING, SP_DB_APPROVED, SP_DB_REJECTED, SP_DB_STATUS_COUNT } sp_db_status;
@@ -250,9 +255,15 @@ const char* sp_db_status_name(sp_db_status s);
 /// stroke with fewer than 2 points, more than 65536, non-finite ones or ones
 /// beyond SP_SKETCH_COORD_MAX (or a canvas beyond SP_SKETCH_CANVAS_MAX), which
 /// no reader would take back (SP_ERR_INVALID). *id (may be NULL) gets the new
-/// sketch's id.
+/// sketch's id. With SP_DB_KIOSK_PENDING_MAX (sp_db_set_kiosk_pending_max)
+/// pending already, it keeps nothing and returns SP_ERR_UNSUPPORTED, its line
+/// saying that they await review.
 sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_stroke* stroke, double canvas_w, double canvas_h,
                                      int64_t* id, sp_error* err);
+
+/// Sets how many pending kiosk sketches the handle's sp_db_collect_kiosk_sketch
+/// takes (>= 1; 0: SP_DB_KIOSK_PENDING_MAX).
+void sp_db_set_kiosk_pending_max(sp_db* db, int max);
 
 /// One kiosk sketch as stored (sp_db_kiosk_list).
 typedef struct sp_db_kiosk_sketch {
@@ -296,6 +307,11 @@ sp_result sp_db_kiosk_review(sp_db* db, const int64_t* ids, int n, const sp_db_k
 /// Gives a kiosk sketch another category (one of the current part
 /// categories; anything else fails with SP_ERR_INVALID and changes nothing).
 sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const char* by, sp_error* err);
+/// Deletes every rejected kiosk sketch in one transaction, logged as `by`;
+/// *deleted (may be NULL) gets how many. Their space is reused by later
+/// writes (the file does not shrink), so a kiosk's database stops growing
+/// with the strokes its curators turned down.
+sp_result sp_db_kiosk_delete_rejected(sp_db* db, const char* by, int* deleted, sp_error* err);
 
 /// The classifier's shape evidence weight (sp_clf_desc.shape_weight) a part
 /// database trains with unless told otherwise; tuned on the visitors' tune half
