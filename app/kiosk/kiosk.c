@@ -705,13 +705,20 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     // right after the change): a curator may have changed the parts, so the
     // parts row is read again, in a frame of its own, and the parts loaded.
     uint64_t reloads = sp_dragon_reload_count(k->dragon);
-    if (reloads != k->reloads_seen)
+    if (reloads != k->reloads_seen) {
         k->reloads_seen = reloads, ++k->stats.reloads, k->icons_loaded = k->parts_loaded = false, k->heavy_done = true;
+        // The attract screen's demo follows a database file replaced by
+        // another (its pipeline held the old one open); the row, changed parts.
+        struct stat st;
+        if (k->demo_prepared && stat(k->db_path, &st) == 0 && (st.st_dev != k->demo_dev || st.st_ino != k->demo_ino))
+            k->demo_stale = true;
+    }
     // The parts row, once the first frame is on screen (starting fast matters more).
     if (!k->heavy_done && !k->icons_loaded && k->updates >= 2) {
         kiosk_row_load(k);
         k->heavy_done = true;
     }
+    if (k->demo_stale) kiosk_attract_rebuild(k);
     // Then the parts, one a frame while no finger draws, so that a visit's
     // first strokes do not wait for loading theirs.
     if (!k->heavy_done && !k->parts_loaded && k->icons_loaded && k->ui->capture == SP_KCAP_NONE &&

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "sp/synth.h"
 
@@ -64,7 +65,10 @@ done:
 static void prepare(sp_kiosk* k)
 {
     k->demo_prepared = true;
+    ++k->stats.attract_builds;
     if (k->desc.no_attract_demo) return;
+    struct stat st;
+    if (stat(k->db_path, &st) == 0) k->demo_dev = st.st_dev, k->demo_ino = st.st_ino;
     sp_db* db = NULL;
     sp_error err = {0};
     if (sp_db_open(k->db_path, SP_DB_READONLY, &db, &err) != SP_OK) {
@@ -107,7 +111,16 @@ void kiosk_attract_update(sp_kiosk* k)
 {
     // Not before the first frame is on screen: starting fast matters more.
     if (k->updates < 2) return;
-    if (!k->demo_prepared) prepare(k);
+    if (!k->demo_prepared) {
+        // A rebuild reads parts like the first build: in a frame of its own.
+        bool rebuild = k->stats.attract_builds > 0;
+        if (rebuild && k->heavy_done) return;
+        prepare(k);
+        if (rebuild) {
+            k->heavy_done = true;
+            return;
+        }
+    }
     if (!k->demo) return;
     // Fit the next demo part (one a frame, and only when the visitor's jobs left room).
     if (!k->heavy_done) {
@@ -122,6 +135,7 @@ void kiosk_attract_update(sp_kiosk* k)
                 sp_dragon_add_points(k->demo, d->xy, d->n, &(sp_dragon_stroke_opts){.category = d->category}, &res, &err);
             if (rc == SP_OK && !res.rejected && res.part >= 0) {
                 d->part = res.part;
+                ++k->stats.attract_parts;
                 d->outline_n = kiosk_fitted_outline(sp_dragon_part_get(k->demo, res.part), &d->outline, &d->outline_cap,
                                                     d->breaks, 16, &d->break_n);
             }
@@ -213,4 +227,14 @@ void kiosk_attract_free(sp_kiosk* k)
         memset(&k->demo_parts[i], 0, sizeof k->demo_parts[i]);
     }
     k->demo_count = 0;
+}
+
+void kiosk_attract_rebuild(sp_kiosk* k)
+{
+    int lod = k->demo_meshes.lod_triangles;
+    kiosk_attract_free(k);
+    k->demo_meshes.lod_triangles = lod;
+    k->demo_prepared = k->demo_stale = false;
+    k->demo_posed_parts = -1;
+    k->stats.attract_parts = 0;
 }

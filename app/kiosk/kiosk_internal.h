@@ -4,6 +4,8 @@
 #ifndef SP_KIOSK_INTERNAL_H
 #define SP_KIOSK_INTERNAL_H
 
+#include <sys/types.h>
+
 #include "sp/dragon.h"
 #include "sp/draw2d.h"
 #include "sp/font.h"
@@ -91,6 +93,9 @@ struct sp_kiosk {
     demo_part demo_parts[DEMO_MAX];
     int demo_count;
     bool demo_prepared;
+    bool demo_stale; // the parts or the database file changed since it was built
+    dev_t demo_dev;  // the database file it was built from
+    ino_t demo_ino;
     int updates;   // sp_kiosk_update calls (the demo waits for the first frame)
     bool software; // a software rasteriser (llvmpipe): cheaper background, coarser meshes
     double demo_posed_t;
@@ -178,5 +183,9 @@ sp_camera kiosk_attract_camera(sp_kiosk* k);
 /// Draws the attract screen's demo: strokes being drawn, outlines, parts coming alive.
 void kiosk_attract_draw_scene(sp_kiosk* k);
 void kiosk_attract_free(sp_kiosk* k);
+/// After a curator's change (k->demo_stale): drops the demo, which is built
+/// again, in a frame with room, from the database as it is now; its pipeline
+/// no longer holds a replaced file open.
+void kiosk_attract_rebuild(sp_kiosk* k);
 
 #endif

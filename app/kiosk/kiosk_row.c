@@ -114,6 +114,8 @@ void kiosk_row_load(sp_kiosk* k)
         sp_db_close(db);
         return;
     }
+    // Parts changed since the last row: the attract screen's demo shows them too.
+    if (k->row_source) k->demo_stale = k->demo_prepared;
     kiosk_row_free(k);
     k->row_source = source;
     qsort(cats, (size_t)n, sizeof *cats, by_row_order);

@@ -1566,6 +1566,62 @@ static void test_parts_row_follows(void)
     sp_headless_destroy(gl);
 }
 
+// File descriptors of this process open on the file `was` (dev, ino).
+static int fds_on(const struct stat* was)
+{
+    int n = 0;
+    for (int fd = 0; fd < 4096; ++fd) {
+        struct stat st;
+        if (fstat(fd, &st) == 0 && st.st_dev == was->st_dev && st.st_ino == was->st_ino) ++n;
+    }
+    return n;
+}
+
+// The attract screen's demo dragon follows the curators: a part they remove
+// leaves it, and a database file renamed over the live one is read anew (the
+// demo's pipeline held the old file open, and the demo showed its parts,
+// until the kiosk restarted).
+static void test_attract_follows(void)
+{
+    char db[1100], next[1100], wal[1200];
+    live_and_next("kiosk_attract", db, next, wal);
+    sp_headless* gl = NULL;
+    sp_error err = {0};
+    if (sp_headless_create(&gl, &err) != SP_OK) SKIP("no headless OpenGL");
+    sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
+                                                   .export_dir = sp_test_tmp_path("kiosk_attract_ex"),
+                                                   .canvas_w = 1280,
+                                                   .canvas_h = 800,
+                                                   .no_collect = true,
+                                                   .fit_time_cap_ms = 60000},
+                                  &err);
+    if (!k) fprintf(stderr, "  %s\n", err.text);
+    ENSURE(k);
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    const sp_kiosk_ui* ui = sp_kiosk_ui_of(k);
+    double t = 0;
+    updates_until(k, &t, 3000);
+    fprintf(stderr, "  demo: built %d, %d parts\n", st->attract_builds, st->attract_parts);
+    ENSURE(ui->mode == SP_KM_ATTRACT && st->attract_builds == 1 && st->attract_parts == 6);
+    sp_db* w = NULL;
+    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK && sp_db_remove_part(w, "wings", "test", &err) == SP_OK);
+    sp_db_close(w);
+    updates_until(k, &t, t + 4000);
+    fprintf(stderr, "  wings removed: built %d, %d parts\n", st->attract_builds, st->attract_parts);
+    ENSURE(ui->mode == SP_KM_ATTRACT && st->attract_builds == 2 && st->attract_parts == 5);
+    struct stat old;
+    ENSURE(stat(db, &old) == 0 && fds_on(&old) > 0);
+    ENSURE(rename(next, db) == 0);
+    updates_until(k, &t, t + 4000);
+    fprintf(stderr, "  a file renamed over it: built %d, %d parts, %d descriptors on the old file\n", st->attract_builds,
+            st->attract_parts, fds_on(&old));
+    ENSURE(st->attract_builds == 3 && st->attract_parts == 6 && fds_on(&old) == 0);
+    while (sp_dragon_model_loading(sp_kiosk_dragon(k)))
+        usleep(10000), updates_until(k, &t, t + 1);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 // A category name of any length (a hand-edited or foreign database; the
 // row's record of what it was drawn from overran its buffer on one of 5,000
 // characters): the kiosk starts and offers every part.
@@ -2219,6 +2275,7 @@ int main(int argc, char** argv)
                                    {"collect_replaced", test_collect_replaced},
                                    {"collect_deleted", test_collect_deleted},
                                    {"collect_full", test_collect_full},
+                                   {"attract_follows", test_attract_follows},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},
                                    {"body_after_parts", test_body_after_parts},

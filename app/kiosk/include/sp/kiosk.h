@@ -61,6 +61,8 @@ typedef struct sp_kiosk_stats {
     int kept, kept_chosen; ///< parts on the canvas at a Start over or timeout; of them, labelled by the visitor
     int collected;         ///< strokes handed to the collector (sp_kiosk_collect_counts: stored, dropped)
     int models_loaded;     ///< new models read in the background and put to use (reloads: database changes seen)
+    int attract_parts;     ///< parts of the attract screen's demo dragon fitted so far
+    int attract_builds;    ///< times the demo was built: once, then again after a curator changed the parts or the file
     double last_fit_ms;    ///< wall time of the last classify+fit (the pipeline's)
     int fit_count;
     double fit_ms[4096]; ///< the last 4096 classify+fit wall times (ring)
