@@ -242,8 +242,9 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
     // The collector's writable handle first: opening it migrates an older
     // schema, which the pipeline's read-only handle could not read. A
     // database that does not exist yet is built by the pipeline.
+    double collect_reserve = k->desc.collect_reserve_mb == 0 ? SP_KIOSK_COLLECT_RESERVE_MB : k->desc.collect_reserve_mb;
     if (!k->desc.no_collect && access(k->db_path, F_OK) == 0)
-        k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
+        k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h, collect_reserve);
     // The pipeline's own attachment (docs/DESIGN.md, "Which strokes join a
     // dragon"): a part drawn far from every body stays where it was drawn.
     if (sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,
@@ -255,7 +256,8 @@ sp_kiosk* sp_kiosk_create(const sp_kiosk_desc* desc, sp_error* err)
                                            .background_model = true},
                          &k->dragon, err) != SP_OK)
         goto fail;
-    if (!k->desc.no_collect && !k->collector) k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h);
+    if (!k->desc.no_collect && !k->collector)
+        k->collector = kiosk_collector_open(k->db_path, k->canvas_w, k->canvas_h, collect_reserve);
     k->canvas_cam = sp_dragon_camera(k->dragon);
     if (sp_renderer_create(&(sp_renderer_desc){0}, &k->r, err) != SP_OK) goto fail;
     // Software rasterisers pay per triangle: coarser display meshes there.

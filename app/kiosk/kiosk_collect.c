@@ -34,6 +34,7 @@ struct kiosk_collector {
     dev_t dev; // the file the handle has open
     ino_t ino;
     double canvas_w, canvas_h;
+    double reserve_mb; // free space on the database's disk kept for saves and training (<= 0: none)
     bool threaded;
     pthread_t thread;
     pthread_mutex_t lock;
@@ -105,6 +106,18 @@ static sp_result follow_file(kiosk_collector* c, sp_error* err)
     return open_writer(c, "a new database file there: visitors' strokes go into it", err);
 }
 
+// SP_ERR_IO when the database's disk has less than the reserve free: the
+// room left is for the visitors' saves and a curator's `db train`.
+static sp_result room_left(const kiosk_collector* c, sp_error* err)
+{
+    double left = c->reserve_mb > 0 ? kiosk_free_mb(c->path) : -1;
+    if (left < 0 || left >= c->reserve_mb) return SP_OK;
+    return sp_fail(err, SP_ERR_IO,
+                   "%s: %.0f MB free on its disk, under the %.0f MB kept for saves and the curators' `db train`; sketch "
+                   "dropped (free some room, or `sketchpose db review --delete-rejected`)",
+                   c->path, left, c->reserve_mb);
+}
+
 // After a store found the database busy: puts the sketch back at the head of
 // the queue and waits BUSY_RETRY_MS (or until woken), returning with the lock
 // held; false (nothing done, the lock not held) when it is to be dropped:
@@ -151,6 +164,7 @@ static void* collector_main(void* arg)
         // found so at the open or at the store.
         sp_result r = open_writer(c, "the database can be written now: visitors' strokes are collected again", &err);
         if (r == SP_OK) r = follow_file(c, &err);
+        if (r == SP_OK) r = room_left(c, &err);
         if (r == SP_OK) r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
         bool closing = false;
         if (r == SP_ERR_BUSY && wait_busy(c, &s, &closing)) continue; // the lock is held again
@@ -176,14 +190,14 @@ static void* collector_main(void* arg)
     return NULL;
 }
 
-kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, double canvas_h)
+kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, double canvas_h, double reserve_mb)
 {
     kiosk_collector* c = calloc(1, sizeof *c);
     if (!c) {
         sp_kiosk_log("out of memory: visitors' strokes are not collected");
         return NULL;
     }
-    c->canvas_w = canvas_w, c->canvas_h = canvas_h;
+    c->canvas_w = canvas_w, c->canvas_h = canvas_h, c->reserve_mb = reserve_mb;
     snprintf(c->path, sizeof c->path, "%s", db_path);
     pthread_mutex_init(&c->lock, NULL);
     pthread_condattr_t ca;

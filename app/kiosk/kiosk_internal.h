@@ -137,11 +137,15 @@ int kiosk_outline(const sp_rig* rig, int abstraction, const double* params, cons
                   int* breaks, int max_breaks, int* nbreaks);
 /// Loads the first part of a category from db (*abstraction: the one its sketches are drawn of). SP_ERR_INVALID: none.
 sp_result kiosk_load_category_part(sp_db* db, const char* category, sp_character* ch, int* abstraction, sp_error* err);
+/// MB free to this user on the disk holding path; < 0 when unknown (kiosk_save.c).
+double kiosk_free_mb(const char* path);
+
 // kiosk_collect.c
 /// Opens db_path for writing (migrating an older schema) and starts the
 /// writer. A database that cannot be written gives one line on stderr and a
 /// collector that drops every sketch with one line each. NULL: out of memory.
-kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, double canvas_h);
+/// A stroke is dropped while the database's disk has under reserve_mb free (<= 0: never).
+kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, double canvas_h, double reserve_mb);
 /// Queues one stroke (copied; t may be NULL) as a pending kiosk sketch of
 /// category. Never waits for the database; what cannot be stored is dropped
 /// with one line on stderr.

@@ -52,11 +52,10 @@ static sp_result make_dirs(const char* dir, sp_error* err)
     }
 }
 
-// MB free to this user on the disk holding the export folder; < 0 when unknown.
-static double free_mb(const char* dir)
+double kiosk_free_mb(const char* path)
 {
     struct statvfs v;
-    if (statvfs(dir, &v) != 0) return -1;
+    if (statvfs(path, &v) != 0) return -1;
     return (double)v.f_bavail * (double)v.f_frsize / (1024.0 * 1024.0);
 }
 
@@ -105,7 +104,7 @@ void kiosk_run_save(sp_kiosk* k)
     sp_result r = make_dirs(k->export_dir, &err);
     // The last of the disk is the database's: a visitor's strokes, a curator's training.
     double reserve = k->desc.save_reserve_mb == 0 ? SP_KIOSK_SAVE_RESERVE_MB : k->desc.save_reserve_mb, left = -1;
-    if (r == SP_OK && reserve > 0 && (left = free_mb(k->export_dir)) >= 0 && left < reserve)
+    if (r == SP_OK && reserve > 0 && (left = kiosk_free_mb(k->export_dir)) >= 0 && left < reserve)
         r = sp_fail(&err, SP_ERR_IO,
                     "%s: %.0f MB free on its disk, under the %.0f MB kept for the database: not saved (move old saves away, or "
                     "--keep-saves-days)",
@@ -127,7 +126,7 @@ void kiosk_run_save(sp_kiosk* k)
         kiosk_prune_saves(k);
         struct stat a, b;
         double mb = stat(glb, &a) == 0 && stat(png, &b) == 0 ? (double)(a.st_size + b.st_size) / (1024.0 * 1024.0) : 0;
-        if ((left = free_mb(k->export_dir)) >= 0 && left < SAVE_WARN_MB)
+        if ((left = kiosk_free_mb(k->export_dir)) >= 0 && left < SAVE_WARN_MB)
             sp_kiosk_log("%s: %.0f MB free on its disk; this save took %.1f MB, and saves stop under %.0f MB", k->export_dir,
                          left, mb, reserve > 0 ? reserve : 0.0);
     } else {

@@ -1318,7 +1318,7 @@ static void collector_wait(kiosk_collector* c, int want, int* stored, int* dropp
 // The collector alone on db, a tail's stroke handed to it and settled.
 static kiosk_collector* collector_after_one(const char* db, int* stored, int* dropped)
 {
-    kiosk_collector* c = kiosk_collector_open(db, 1280, 800);
+    kiosk_collector* c = kiosk_collector_open(db, 1280, 800, 0);
     ENSURE(c);
     kiosk_collector_push(c, "tail", g_strokes[3].xy, NULL, g_strokes[3].n);
     collector_wait(c, 1, stored, dropped);
@@ -1786,6 +1786,32 @@ static void test_collect_full(void)
     kiosk_collector_close(c, &stored, &dropped);
     fprintf(stderr, "  one reviewed: stored %d, dropped %d\n", stored, dropped);
     ENSURE(stored == 2 && dropped == 1);
+}
+
+// A disk nearly full: a visitor's stroke is not collected while the
+// database's disk has less free than the kiosk keeps for saves and a
+// curator's `db train` (here a reserve no disk has); the visit goes on.
+static void test_collect_disk_reserve(void)
+{
+    six_strokes();
+    char db[1100];
+    e2e_db_copy("kiosk_reserve.db", db, sizeof db);
+    for (int pass = 0; pass < 2; ++pass) {
+        sp_headless* gl = NULL;
+        double t = 0;
+        sp_kiosk* k = inproc_kiosk_desc((sp_kiosk_desc){.db_path = db,
+                                                        .export_dir = sp_test_tmp_path("kiosk_reserve_ex"),
+                                                        .collect_reserve_mb = pass == 0 ? 1e12 : -1},
+                                        &gl, &t);
+        draw_then_start_over(k, &t, &g_strokes[3]);
+        int stored = 0, dropped = 0;
+        wait_collected(k, 1, &stored, &dropped);
+        fprintf(stderr, "  reserve %s: stored %d, dropped %d\n", pass == 0 ? "1e12 MB" : "none", stored, dropped);
+        ENSURE(pass == 0 ? stored == 0 && dropped == 1 : stored == 1 && dropped == 0);
+        sp_kiosk_destroy(k);
+        sp_headless_destroy(gl);
+        ENSURE(pending_count(db) == pass);
+    }
 }
 
 // A curator replaces the database file (a rename over it) while the kiosk
@@ -2275,6 +2301,7 @@ int main(int argc, char** argv)
                                    {"collect_replaced", test_collect_replaced},
                                    {"collect_deleted", test_collect_deleted},
                                    {"collect_full", test_collect_full},
+                                   {"collect_disk_reserve", test_collect_disk_reserve},
                                    {"attract_follows", test_attract_follows},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},

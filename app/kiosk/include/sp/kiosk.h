@@ -30,6 +30,11 @@ typedef struct sp_dragon sp_dragon; // dragon.h
 /// the rest is the database's (visitors' strokes, a curator's `db train`),
 /// where saves of 6-12 MB each filled a busy museum's disk in weeks.
 #define SP_KIOSK_SAVE_RESERVE_MB 256.0
+/// Free space (MB) on the database's disk under which a visitor's stroke is
+/// not collected: more than saves keep, so that the room left after both
+/// stop is a curator's `db train` (a model of tens of MB, written twice
+/// through the WAL).
+#define SP_KIOSK_COLLECT_RESERVE_MB 512.0
 
 /// Zero means the default.
 typedef struct sp_kiosk_desc {
@@ -49,6 +54,8 @@ typedef struct sp_kiosk_desc {
     int keep_saves_days; ///< saves older than this many days are removed, at start and after each save; 0: kept
     double
         save_reserve_mb; ///< Save is refused while the export folder's disk has less free; 0: SP_KIOSK_SAVE_RESERVE_MB; < 0: none
+    double collect_reserve_mb; ///< strokes are not collected while the database's disk has less free; 0:
+                               ///< SP_KIOSK_COLLECT_RESERVE_MB; < 0: none
     bool no_collect;   ///< keep no visitors' strokes (default: each part left on the canvas is stored as a pending kiosk
                        ///< sketch; docs/DESIGN.md "Collecting visitors' strokes")
 } sp_kiosk_desc;
