@@ -92,6 +92,18 @@ static char* row_source(sp_db* db, char** cats, int n)
     return s;
 }
 
+// One line for a curator: the categories past the row's room, which a
+// visitor reaches only as a guess.
+static void left_out(const sp_kiosk* k, char* const* cats, int from, int n)
+{
+    char names[512] = "";
+    size_t at = 0;
+    for (int i = from; i < n && at < sizeof names; ++i)
+        at += (size_t)snprintf(names + at, sizeof names - at, "%s%s", i > from ? ", " : "", cats[i]);
+    sp_kiosk_log("%s: %d part categories, more than the parts row's %d: not offered in it (only as guesses): %s%s", k->db_path, n,
+                 SP_KIOSK_ROW_MAX, names, at >= sizeof names ? "..." : "");
+}
+
 void kiosk_row_load(sp_kiosk* k)
 {
     k->icons_loaded = true;
@@ -120,7 +132,8 @@ void kiosk_row_load(sp_kiosk* k)
     k->row_source = source;
     qsort(cats, (size_t)n, sizeof *cats, by_row_order);
     const char* row[SP_KIOSK_ROW_MAX];
-    for (int c = 0; c < n && k->icon_count < SP_KIOSK_ROW_MAX; ++c) {
+    int c = 0;
+    for (; c < n && k->icon_count < SP_KIOSK_ROW_MAX; ++c) {
         part_icon* ic = &k->icons[k->icon_count];
         sp_character ch = {0};
         int a = 0;
@@ -137,6 +150,7 @@ void kiosk_row_load(sp_kiosk* k)
         snprintf(ic->category, sizeof ic->category, "%s", cats[c]);
         row[k->icon_count++] = ic->category;
     }
+    if (c < n) left_out(k, cats, c, n);
     sp_db_free_strings(cats, n);
     sp_db_close(db);
     sp_kiosk_ui_set_parts(k->ui, row, k->icon_count);

@@ -1622,6 +1622,37 @@ static void test_attract_follows(void)
     sp_headless_destroy(gl);
 }
 
+// A database with thirteen part categories (seven a curator added): the
+// refusal's row offers the first twelve, the shipped six first.
+static void test_row_twelve(void)
+{
+    char db[1100];
+    e2e_db_copy("kiosk_row12.db", db, sizeof db);
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+    int rc =
+        sqlite3_exec(h,
+                     "WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n WHERE i < 7) "
+                     "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, "
+                     "parameters, abstractions, animations, selftest_error, summary, added_by) "
+                     "SELECT 'extra_tail' || i, 'extra' || i, abstraction, gltf, bytes, sha256, vertices, triangles, joints, "
+                     "parameters, abstractions, animations, selftest_error, summary, 'test' FROM parts, n WHERE name = 'tail'",
+                     NULL, NULL, NULL);
+    sqlite3_close(h);
+    ENSURE(rc == SQLITE_OK);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk_desc(
+        (sp_kiosk_desc){.db_path = db, .export_dir = sp_test_tmp_path("kiosk_row12_ex"), .no_collect = true}, &gl, &t);
+    const sp_kiosk_ui* ui = sp_kiosk_ui_of(k);
+    fprintf(stderr, "  row %d parts: %s ... %s\n", ui->row_count, ui->row[0], ui->row[ui->row_count - 1]);
+    ENSURE(ui->row_count == 12 && !strcmp(ui->row[0], "torso") && !strcmp(ui->row[5], "hind_legs"));
+    for (int i = 6; i < 12; ++i)
+        ENSURE(!strncmp(ui->row[i], "extra", 5));
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 // A category name of any length (a hand-edited or foreign database; the
 // row's record of what it was drawn from overran its buffer on one of 5,000
 // characters): the kiosk starts and offers every part.
@@ -2303,6 +2334,7 @@ int main(int argc, char** argv)
                                    {"collect_full", test_collect_full},
                                    {"collect_disk_reserve", test_collect_disk_reserve},
                                    {"attract_follows", test_attract_follows},
+                                   {"row_twelve", test_row_twelve},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},
                                    {"body_after_parts", test_body_after_parts},

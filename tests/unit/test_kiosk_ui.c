@@ -571,6 +571,41 @@ static void test_parts_row(void)
     sp_kiosk_session_free(&s);
 }
 
+// A curator's twelve categories (the six shipped and six more): the
+// refusal's row offers every one, each a 15 mm target at least, none over
+// another, on the kiosk's canvas and on a small one; the twelfth tile fits
+// the stroke as the twelfth category. (It offered eight.)
+static void test_parts_row_twelve(void)
+{
+    static const char* const cats[13] = {"torso",  "head", "wings", "tail",  "front_legs", "hind_legs", "horns",
+                                         "spikes", "fire", "crown", "beard", "claws",      "thirteenth"};
+    const int sizes[2][2] = {{1280, 800}, {800, 600}};
+    for (int s = 0; s < 2; ++s) {
+        fake f;
+        sp_kiosk_ui* ui = started(&f);
+        sp_kiosk_ui_resize(ui, sizes[s][0], sizes[s][1], 96.0 / 25.4);
+        sp_kiosk_ui_set_parts(ui, cats, 13);
+        ENSURE(ui->row_count == SP_KIOSK_ROW_MAX && SP_KIOSK_ROW_MAX == 12);
+        double t = refused_stroke(ui, 1000, 0.45f * ui->canvas.w, ui->canvas.y + 0.1f * ui->canvas.h);
+        frame(ui, &f, t + 10);
+        ENSURE(sp_kiosk_ui_offering(ui));
+        for (int k = 0; k < SP_KIOSK_ROW_MAX; ++k)
+            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)(SP_KT_PART1 + k)));
+        check_targets(ui);
+        const sp_kiosk_rect* last = &ui->target[SP_KT_PART_LAST];
+        fprintf(stderr, "  %d x %d: the twelfth tile at (%.0f, %.0f), %.0f x %.0f px\n", sizes[s][0], sizes[s][1], last->x,
+                last->y, last->w, last->h);
+        ENSURE(last->y + last->h <= ui->canvas.y + ui->canvas.h);
+        ENSURE(!strcmp(sp_kiosk_ui_target_category(ui, SP_KT_PART_LAST), "claws"));
+        ENSURE(sp_kiosk_target_parse("part12") == SP_KT_PART_LAST && !strcmp(sp_kiosk_target_name(SP_KT_PART_LAST), "part12"));
+        tap(ui, t + 500, SP_KT_PART_LAST);
+        send(ui, SP_KEV_FRAME, t + 600, 0, 0);
+        sp_kiosk_job j;
+        ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !strcmp(j.category, "claws"));
+        sp_kiosk_ui_destroy(ui);
+    }
+}
+
 // A part the classifier got wrong, whose part is not among the two other
 // guesses, is still one choice away: "Other?" opens the row of parts for the
 // last part, in place of the two guesses; a tap re-fits it as that part. The
@@ -1712,6 +1747,7 @@ int main(int argc, char** argv)
                                    {"detail_refused", test_detail_refused},
                                    {"continued_stroke", test_continued_stroke},
                                    {"parts_row", test_parts_row},
+                                   {"parts_row_twelve", test_parts_row_twelve},
                                    {"other_chip", test_other_chip},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},

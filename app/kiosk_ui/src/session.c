@@ -135,7 +135,7 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
         if (k == SP_KT_NONE)
             return sp_fail(err, SP_ERR_INVALID,
                            "%s: events[%d]: \"press\" needs \"target\": one of undo, redraw, start_over, play, turn, save, "
-                           "label, guess1, guess2, guess3, more, part1..part8",
+                           "label, guess1, guess2, guess3, more, part1..part12",
                            name, i);
         ev.button = k;
         break;

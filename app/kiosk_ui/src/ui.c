@@ -11,10 +11,10 @@
 #include "sp/kiosk_text.h"
 
 static const char* const k_target_names[SP_KT_COUNT] = {
-    NULL,     "undo", "redraw", "start_over", "play",  "turn",  "save",  "label", "guess1", "guess2",
-    "guess3", "more", "part1",  "part2",      "part3", "part4", "part5", "part6", "part7",  "part8",
+    NULL,    "undo",  "redraw", "start_over", "play",  "turn",  "save",  "label", "guess1", "guess2", "guess3", "more",
+    "part1", "part2", "part3",  "part4",      "part5", "part6", "part7", "part8", "part9",  "part10", "part11", "part12",
 };
-_Static_assert(SP_KIOSK_ROW_MAX == 8, "k_target_names lists part1..part8");
+_Static_assert(SP_KIOSK_ROW_MAX == 12, "k_target_names lists part1..part12");
 
 static const char* const k_event_names[SP_KEV_TYPE_COUNT] = {NULL, "down", "move", "up", "cancel", "press", "frame"};
 

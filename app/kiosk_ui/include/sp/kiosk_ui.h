@@ -43,7 +43,7 @@
 #include "sp/result.h"
 
 enum {
-    SP_KIOSK_ROW_MAX = 8, ///< parts in the refusal's row (sp_kiosk_ui_set_parts)
+    SP_KIOSK_ROW_MAX = 12, ///< parts in the refusal's row (sp_kiosk_ui_set_parts): the six shipped and six more a curator adds
 };
 
 /// Touch targets (the order of the toolbar).
@@ -66,7 +66,7 @@ typedef enum sp_kiosk_target {
 } sp_kiosk_target;
 
 /// "undo", "redraw", "start_over", "play", "turn", "save", "label", "guess1", "guess2", "guess3",
-/// "more", "part1".."part8"; NULL otherwise.
+/// "more", "part1".."part12"; NULL otherwise.
 const char* sp_kiosk_target_name(sp_kiosk_target t);
 /// Parses a target name; SP_KT_NONE when unknown.
 sp_kiosk_target sp_kiosk_target_parse(const char* s);
