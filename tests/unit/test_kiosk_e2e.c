@@ -1622,24 +1622,28 @@ static void test_attract_follows(void)
     sp_headless_destroy(gl);
 }
 
+// A copy of the e2e database (db: 1100 bytes) changed by one SQL statement.
+static void e2e_db_copy_edited(const char* name, char* db, const char* sql)
+{
+    e2e_db_copy(name, db, 1100);
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+    int rc = sqlite3_exec(h, sql, NULL, NULL, NULL);
+    sqlite3_close(h);
+    ENSURE(rc == SQLITE_OK);
+}
+
 // A database with thirteen part categories (seven a curator added): the
 // refusal's row offers the first twelve, the shipped six first.
 static void test_row_twelve(void)
 {
     char db[1100];
-    e2e_db_copy("kiosk_row12.db", db, sizeof db);
-    sqlite3* h = NULL;
-    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
-    int rc =
-        sqlite3_exec(h,
-                     "WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n WHERE i < 7) "
-                     "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, "
-                     "parameters, abstractions, animations, selftest_error, summary, added_by) "
-                     "SELECT 'extra_tail' || i, 'extra' || i, abstraction, gltf, bytes, sha256, vertices, triangles, joints, "
-                     "parameters, abstractions, animations, selftest_error, summary, 'test' FROM parts, n WHERE name = 'tail'",
-                     NULL, NULL, NULL);
-    sqlite3_close(h);
-    ENSURE(rc == SQLITE_OK);
+    e2e_db_copy_edited("kiosk_row12.db", db,
+                       "WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM n WHERE i < 7) "
+                       "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, "
+                       "parameters, abstractions, animations, selftest_error, summary, added_by) "
+                       "SELECT 'extra_tail' || i, 'extra' || i, abstraction, gltf, bytes, sha256, vertices, triangles, joints, "
+                       "parameters, abstractions, animations, selftest_error, summary, 'test' FROM parts, n WHERE name = 'tail'");
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk_desc(
@@ -1659,14 +1663,8 @@ static void test_row_twelve(void)
 static void test_long_category(void)
 {
     char db[1100];
-    e2e_db_copy("kiosk_long_cat.db", db, sizeof db);
-    sqlite3* h = NULL;
-    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
-    int rc =
-        sqlite3_exec(h, "UPDATE parts SET category = 'tail' || replace(hex(zeroblob(2500)), '0', 'a') WHERE category = 'tail'",
-                     NULL, NULL, NULL);
-    sqlite3_close(h);
-    ENSURE(rc == SQLITE_OK);
+    e2e_db_copy_edited("kiosk_long_cat.db", db,
+                       "UPDATE parts SET category = 'tail' || replace(hex(zeroblob(2500)), '0', 'a') WHERE category = 'tail'");
     sp_headless* gl = NULL;
     double t = 0;
     sp_kiosk* k = inproc_kiosk(db, "kiosk_long_cat_ex", &gl, &t);
