@@ -712,7 +712,8 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
         // The attract screen's demo follows a database file replaced by
         // another (its pipeline held the old one open); the row, changed parts.
         struct stat st;
-        if (k->demo_prepared && stat(k->db_path, &st) == 0 && (st.st_dev != k->demo_dev || st.st_ino != k->demo_ino))
+        if (k->demo_prepared && !k->desc.no_attract_demo && stat(k->db_path, &st) == 0 &&
+            (st.st_dev != k->demo_dev || st.st_ino != k->demo_ino))
             k->demo_stale = true;
     }
     // The parts row, once the first frame is on screen (starting fast matters more).

@@ -75,6 +75,10 @@ static void prepare(sp_kiosk* k)
         sp_kiosk_log("attract screen without its demo: %s", err.text);
         return;
     }
+    char** cats = NULL;
+    int n = 0;
+    if (sp_db_categories(db, &cats, &n, &err) == SP_OK) k->demo_source = kiosk_row_source(db, cats, n);
+    sp_db_free_strings(cats, n);
     for (int li = 0; li < LAYOUT_N && k->demo_count < DEMO_MAX; ++li)
         demo_stroke(k, db, li);
     sp_db_close(db);
@@ -227,6 +231,8 @@ void kiosk_attract_free(sp_kiosk* k)
         memset(&k->demo_parts[i], 0, sizeof k->demo_parts[i]);
     }
     k->demo_count = 0;
+    free(k->demo_source);
+    k->demo_source = NULL;
 }
 
 void kiosk_attract_rebuild(sp_kiosk* k)

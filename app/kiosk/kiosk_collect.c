@@ -114,7 +114,7 @@ static sp_result room_left(const kiosk_collector* c, sp_error* err)
     if (left < 0 || left >= c->reserve_mb) return SP_OK;
     return sp_fail(err, SP_ERR_IO,
                    "%s: %.0f MB free on its disk, under the %.0f MB kept for saves and the curators' `db train`; sketch "
-                   "dropped (free some room, or `sketchpose db review --delete-rejected`)",
+                   "dropped (free some room on that disk)",
                    c->path, left, c->reserve_mb);
 }
 

@@ -93,7 +93,8 @@ struct sp_kiosk {
     demo_part demo_parts[DEMO_MAX];
     int demo_count;
     bool demo_prepared;
-    bool demo_stale; // the parts or the database file changed since it was built
+    bool demo_stale;   // the parts or the database file changed since it was built
+    char* demo_source; // kiosk_row_source of the parts it was built from (NULL: not read)
     dev_t demo_dev;  // the database file it was built from
     ino_t demo_ino;
     int updates;   // sp_kiosk_update calls (the demo waits for the first frame)
@@ -178,6 +179,10 @@ void kiosk_row_load(sp_kiosk* k);
 /// own category green while the row is open for it.
 void kiosk_row_draw(sp_kiosk* k, const float navy[4], const float yellow[4], const float ink[4], const float green[4]);
 void kiosk_row_free(sp_kiosk* k);
+/// What the row (and the attract screen's demo) is drawn from: the categories
+/// and every part's name, category, abstraction and checksum, one line each
+/// (malloc'd; NULL when they cannot be read, or no memory).
+char* kiosk_row_source(sp_db* db, char* const* cats, int n);
 
 // kiosk_attract.c
 /// Builds the demo strokes (once) and fits at most one demo part (when no heavy job ran).

@@ -66,10 +66,7 @@ void kiosk_row_free(sp_kiosk* k)
     k->row_source = NULL;
 }
 
-// What the row is drawn from: the categories and every part's name,
-// category, abstraction and checksum, one line each (malloc'd; NULL when
-// they cannot be read, or no memory).
-static char* row_source(sp_db* db, char** cats, int n)
+char* kiosk_row_source(sp_db* db, char* const* cats, int n)
 {
     sp_db_part_info* parts = NULL;
     int np = 0;
@@ -119,15 +116,16 @@ void kiosk_row_load(sp_kiosk* k)
     }
     // A database change that left the parts as they were (a model, a
     // curator's sketch) keeps the row: reading six parts again held a frame 45 ms.
-    char* source = row_source(db, cats, n);
+    char* source = kiosk_row_source(db, cats, n);
+    // The attract screen's demo shows the parts too: built from others, it is built again.
+    if (source && k->demo_prepared && !k->desc.no_attract_demo && (!k->demo_source || strcmp(source, k->demo_source) != 0))
+        k->demo_stale = true;
     if (source && k->row_source && !strcmp(source, k->row_source)) {
         free(source);
         sp_db_free_strings(cats, n);
         sp_db_close(db);
         return;
     }
-    // Parts changed since the last row: the attract screen's demo shows them too.
-    if (k->row_source) k->demo_stale = k->demo_prepared;
     kiosk_row_free(k);
     k->row_source = source;
     qsort(cats, (size_t)n, sizeof *cats, by_row_order);

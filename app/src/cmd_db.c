@@ -971,7 +971,7 @@ static int db_review(int argc, char** argv)
          "reject these kiosk sketches (kept, never trained on); FIRST-LAST: the pending ones from FIRST to LAST", false},
         {"--relabel", SP_OPT_LIST, &relabel, "ID CATEGORY", "give a kiosk sketch another part category", false},
         {"--delete-rejected", SP_OPT_FLAG, &delete_rejected, NULL,
-         "delete every rejected kiosk sketch (their room is reused: the database stops growing with them)", false}};
+         "delete every rejected kiosk sketch (later strokes reuse their room in the file, which does not shrink)", false}};
     const char* pos[1];
     int npos;
     int rc =

@@ -37,13 +37,14 @@ static sp_result pending_room(sp_db* db, sp_error* err)
     sp_result r = db_prepare(db, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'pending'", &st, err);
     if (r != SP_OK) return r;
     int rc = sqlite3_step(st);
-    bool full = rc == SQLITE_ROW && sqlite3_column_int64(st, 0) >= max;
+    long long pending = rc == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
     sqlite3_finalize(st);
     if (rc != SQLITE_ROW) return db_fail(db, rc, "counting pending kiosk sketches", err);
-    if (full)
+    if (pending >= max)
         return sp_fail(err, SP_ERR_UNSUPPORTED,
-                       "%s: %d kiosk sketches await review (`sketchpose db review`); none more is kept until some are reviewed",
-                       db->path, max);
+                       "%s: %lld kiosk sketches await review (`sketchpose db review`), the most kept is %d; none more is kept "
+                       "until some are reviewed",
+                       db->path, pending, max);
     return SP_OK;
 }
 

@@ -1256,6 +1256,8 @@ static sp_kiosk* inproc_kiosk_desc(sp_kiosk_desc desc, sp_headless** gl, double*
     sp_error err = {0};
     if (sp_headless_create(gl, &err) != SP_OK) SKIP("no headless OpenGL");
     desc.canvas_w = 1280, desc.canvas_h = 800, desc.no_attract_demo = true, desc.fit_time_cap_ms = 60000;
+    // The collect tests do not depend on the test disk's free space (collect_disk_reserve sets its own).
+    if (desc.collect_reserve_mb == 0) desc.collect_reserve_mb = -1;
     sp_kiosk* k = sp_kiosk_create(&desc, &err);
     if (!k) fprintf(stderr, "  %s\n", err.text);
     ENSURE(k);
@@ -1566,6 +1568,17 @@ static void test_parts_row_follows(void)
     sp_headless_destroy(gl);
 }
 
+// A copy of the e2e database (db: 1100 bytes) changed by one SQL statement.
+static void e2e_db_copy_edited(const char* name, char* db, const char* sql)
+{
+    e2e_db_copy(name, db, 1100);
+    sqlite3* h = NULL;
+    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+    int rc = sqlite3_exec(h, sql, NULL, NULL, NULL);
+    sqlite3_close(h);
+    ENSURE(rc == SQLITE_OK);
+}
+
 // File descriptors of this process open on the file `was` (dev, ino).
 static int fds_on(const struct stat* was)
 {
@@ -1577,60 +1590,97 @@ static int fds_on(const struct stat* was)
     return n;
 }
 
-// The attract screen's demo dragon follows the curators: a part they remove
-// leaves it, and a database file renamed over the live one is read anew (the
-// demo's pipeline held the old file open, and the demo showed its parts,
-// until the kiosk restarted).
-static void test_attract_follows(void)
+// An in-process kiosk on db that stays on the attract screen (its demo
+// dragon built, unless no_demo), collecting nothing.
+static sp_kiosk* attract_kiosk(const char* db, bool no_demo, sp_headless** gl, double* t)
 {
-    char db[1100], next[1100], wal[1200];
-    live_and_next("kiosk_attract", db, next, wal);
-    sp_headless* gl = NULL;
     sp_error err = {0};
-    if (sp_headless_create(&gl, &err) != SP_OK) SKIP("no headless OpenGL");
+    if (sp_headless_create(gl, &err) != SP_OK) SKIP("no headless OpenGL");
     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
                                                    .export_dir = sp_test_tmp_path("kiosk_attract_ex"),
                                                    .canvas_w = 1280,
                                                    .canvas_h = 800,
                                                    .no_collect = true,
+                                                   .no_attract_demo = no_demo,
                                                    .fit_time_cap_ms = 60000},
                                   &err);
     if (!k) fprintf(stderr, "  %s\n", err.text);
     ENSURE(k);
-    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
-    const sp_kiosk_ui* ui = sp_kiosk_ui_of(k);
-    double t = 0;
-    updates_until(k, &t, 3000);
-    fprintf(stderr, "  demo: built %d, %d parts\n", st->attract_builds, st->attract_parts);
-    ENSURE(ui->mode == SP_KM_ATTRACT && st->attract_builds == 1 && st->attract_parts == 6);
-    sp_db* w = NULL;
-    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK && sp_db_remove_part(w, "wings", "test", &err) == SP_OK);
-    sp_db_close(w);
-    updates_until(k, &t, t + 4000);
-    fprintf(stderr, "  wings removed: built %d, %d parts\n", st->attract_builds, st->attract_parts);
-    ENSURE(ui->mode == SP_KM_ATTRACT && st->attract_builds == 2 && st->attract_parts == 5);
-    struct stat old;
-    ENSURE(stat(db, &old) == 0 && fds_on(&old) > 0);
-    ENSURE(rename(next, db) == 0);
-    updates_until(k, &t, t + 4000);
-    fprintf(stderr, "  a file renamed over it: built %d, %d parts, %d descriptors on the old file\n", st->attract_builds,
-            st->attract_parts, fds_on(&old));
-    ENSURE(st->attract_builds == 3 && st->attract_parts == 6 && fds_on(&old) == 0);
+    *t = 0;
+    updates_until(k, t, 3000);
+    return k;
+}
+
+static void attract_kiosk_end(sp_kiosk* k, sp_headless* gl, double* t)
+{
     while (sp_dragon_model_loading(sp_kiosk_dragon(k)))
-        usleep(10000), updates_until(k, &t, t + 1);
+        usleep(10000), updates_until(k, t, *t + 1);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
 }
 
-// A copy of the e2e database (db: 1100 bytes) changed by one SQL statement.
-static void e2e_db_copy_edited(const char* name, char* db, const char* sql)
+static void remove_part(const char* db, const char* name)
 {
-    e2e_db_copy(name, db, 1100);
-    sqlite3* h = NULL;
-    ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
-    int rc = sqlite3_exec(h, sql, NULL, NULL, NULL);
-    sqlite3_close(h);
-    ENSURE(rc == SQLITE_OK);
+    sp_db* w = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK && sp_db_remove_part(w, name, "test", &err) == SP_OK);
+    sp_db_close(w);
+}
+
+// The attract screen's demo dragon follows the curators: a part they remove
+// leaves it, and a database file renamed over the live one is read anew (the
+// demo's pipeline held the old file open, and the demo showed its parts,
+// until the kiosk restarted). With no demo (no_attract_demo) nothing is built.
+static void test_attract_follows(void)
+{
+    for (int no_demo = 0; no_demo < 2; ++no_demo) {
+        char db[1100], next[1100], wal[1200];
+        live_and_next(no_demo ? "kiosk_attract_none" : "kiosk_attract", db, next, wal);
+        sp_headless* gl = NULL;
+        double t = 0;
+        sp_kiosk* k = attract_kiosk(db, no_demo, &gl, &t);
+        const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+        const sp_kiosk_ui* ui = sp_kiosk_ui_of(k);
+        fprintf(stderr, "  %s: built %d, %d parts\n", no_demo ? "no demo" : "demo", st->attract_builds, st->attract_parts);
+        ENSURE(ui->mode == SP_KM_ATTRACT && st->attract_builds == 1 && st->attract_parts == (no_demo ? 0 : 6));
+        remove_part(db, "wings");
+        updates_until(k, &t, t + 4000);
+        fprintf(stderr, "  wings removed: built %d, %d parts\n", st->attract_builds, st->attract_parts);
+        ENSURE(ui->mode == SP_KM_ATTRACT && st->attract_builds == (no_demo ? 1 : 2) && st->attract_parts == (no_demo ? 0 : 5));
+        // The old file stays under a second name, so that its inode is not
+        // freed and given to a new file while the test counts descriptors on it.
+        char kept[1200];
+        snprintf(kept, sizeof kept, "%s.old", db);
+        unlink(kept);
+        struct stat old;
+        ENSURE(stat(db, &old) == 0 && fds_on(&old) > 0 && link(db, kept) == 0);
+        ENSURE(rename(next, db) == 0);
+        updates_until(k, &t, t + 4000);
+        fprintf(stderr, "  a file renamed over it: built %d, %d parts, %d descriptors on the old file, %d reloads\n",
+                st->attract_builds, st->attract_parts, fds_on(&old), st->reloads);
+        ENSURE(st->reloads == 2 && fds_on(&old) == 0);
+        ENSURE(no_demo ? st->attract_builds == 1 && st->attract_parts == 0 : st->attract_builds == 3 && st->attract_parts == 6);
+        attract_kiosk_end(k, gl, &t);
+    }
+}
+
+// The same with a part that does not load (its glTF damaged): the row keeps
+// reading the parts again, and the demo still follows a removal (it kept the
+// parts of its start when the row's own record was away).
+static void test_attract_follows_damaged(void)
+{
+    char db[1100];
+    e2e_db_copy_edited("kiosk_attract_dmg.db", db, "UPDATE parts SET gltf = zeroblob(64) WHERE category = 'tail'");
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = attract_kiosk(db, false, &gl, &t);
+    const sp_kiosk_stats* st = sp_kiosk_stats_of(k);
+    ENSURE(st->attract_builds == 1 && st->attract_parts == 5);
+    remove_part(db, "wings");
+    updates_until(k, &t, t + 4000);
+    fprintf(stderr, "  tail damaged, wings removed: built %d, %d parts\n", st->attract_builds, st->attract_parts);
+    ENSURE(st->attract_builds == 2 && st->attract_parts == 4);
+    attract_kiosk_end(k, gl, &t);
 }
 
 // A database with thirteen part categories (seven a curator added): the
@@ -2332,6 +2382,7 @@ int main(int argc, char** argv)
                                    {"collect_full", test_collect_full},
                                    {"collect_disk_reserve", test_collect_disk_reserve},
                                    {"attract_follows", test_attract_follows},
+                                   {"attract_follows_damaged", test_attract_follows_damaged},
                                    {"row_twelve", test_row_twelve},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},
