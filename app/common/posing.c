@@ -1,5 +1,6 @@
 #include "posing.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,4 +58,28 @@ bool* sp_drawover_active(const sp_rig* rig)
     for (int q = 0; q < rig->param_count; ++q)
         on[q] = !sp_rig_param_shifts(rig, q);
     return on;
+}
+
+// A weight as the solver takes it (0: its default; < 0: off) times f.
+static double scaled(double typed, double def, double f)
+{
+    return typed < 0 ? typed : (typed == 0 ? def : typed) * f;
+}
+
+double sp_drawover_scale_weights(sp_solve_desc* d, const sp_rig* rig, const double* xyz, const sp_camera* cam,
+                                 const sp_sketch* on)
+{
+    double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
+    for (int v = 0; v < rig->vertex_count; ++v) {
+        sp_vec2 q = sp_camera_project(cam, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
+        lx = fmin(lx, q.x), hx = fmax(hx, q.x), ly = fmin(ly, q.y), hy = fmax(hy, q.y);
+    }
+    sp_vec2 lo, hi;
+    double mesh = hypot(hx - lx, hy - ly), drawn = sp_sketch_bounds(on, &lo, &hi) ? sp_v2_len(sp_v2_sub(hi, lo)) : 0;
+    double f = drawn > 0 && isfinite(mesh) ? (mesh / drawn) * (mesh / drawn) : 1;
+    f = fmin(fmax(f, 1), 1e4);
+    d->lambda_pose = scaled(d->lambda_pose, SP_LAMBDA_POSE, f);
+    d->lambda_plane = scaled(d->lambda_plane, SP_LAMBDA_PLANE, f);
+    d->lambda_dist = scaled(d->lambda_dist, SP_LAMBDA_DIST, f);
+    return f;
 }

@@ -6,6 +6,7 @@
 
 #include "sp/gltf.h"
 #include "sp/sketch.h"
+#include "sp/solver.h"
 
 /// Index of the abstraction called `name` (NULL: the first one) among
 /// abs[0..count). -1 and a message naming the rig and the abstractions it
@@ -21,5 +22,15 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// stands: a curve over one arm moved the whole of CesiumMan (the loader's
 /// derived placement) to fit it.
 bool* sp_drawover_active(const sp_rig* rig);
+/// Scales a draw-over solve's regulariser weights (0: the defaults; < 0:
+/// off, kept) by (the character's size on the canvas / the drawn curves'
+/// size)^2, clamped to [1, 10000], and returns that factor. Why: the solver
+/// measures the match term over the abstraction's own size, so a curve
+/// drawn over the neck, a seventh of the character, weighed 50 times more
+/// against the paper's regularisers than a whole figure's stick, and a
+/// redrawn neck swung the arms (xyz: the mesh at the start pose; on: the
+/// curves as drawn over it).
+double sp_drawover_scale_weights(sp_solve_desc* d, const sp_rig* rig, const double* xyz, const sp_camera* cam,
+                                 const sp_sketch* on);
 
 #endif

@@ -64,7 +64,9 @@ int cmd_drawover(int argc, char** argv)
         {"--out", SP_OPT_OUT, &out, "posed.glb", "write the posed character", false},
         {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: --on grey, --to blue, the fitted curves yellow", false},
         {"--report", SP_OPT_OUT, &report, "report.json", "write the solve report (also printed on stdout)", false},
-        {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L", "weight of W_dist, locality (default 0.001; 0 or negative: off)",
+        {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L",
+         "weight of W_dist, locality, for curves the character's size (default 0.001; scaled like the other weights by "
+         "(the character's size / the curves' size)^2; 0 or negative: off)",
          false},
         {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
@@ -121,6 +123,7 @@ int cmd_drawover(int argc, char** argv)
     // writes the file's own abstractions (sp_rig_posed.saved_abstractions).
     run.abstraction = sp_rig_add_abstraction(&ch->rig, &emb);
     if (run.abstraction < 0) goto oom;
+    sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &on);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
     sp_solve_outputs o = {.report = report, .out = out, .render = render, .strokes = &to, .ghost = &on, .note = rep.note};

@@ -295,9 +295,9 @@ sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_so
     s->ab = m->ab;
     s->cam = cam;
     s->d = desc ? *desc : (sp_solve_desc){0};
-    if (s->d.lambda_pose == 0) s->d.lambda_pose = 0.5;
-    if (s->d.lambda_plane == 0) s->d.lambda_plane = 0.01;
-    if (s->d.lambda_dist == 0) s->d.lambda_dist = 0.001;
+    if (s->d.lambda_pose == 0) s->d.lambda_pose = SP_LAMBDA_POSE;
+    if (s->d.lambda_plane == 0) s->d.lambda_plane = SP_LAMBDA_PLANE;
+    if (s->d.lambda_dist == 0) s->d.lambda_dist = SP_LAMBDA_DIST;
     if (s->d.lambda_pose < 0) s->d.lambda_pose = 0;
     if (s->d.lambda_plane < 0) s->d.lambda_plane = 0;
     if (s->d.lambda_dist < 0) s->d.lambda_dist = 0;

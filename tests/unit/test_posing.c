@@ -149,6 +149,28 @@ static void test_drawover_fixture(void)
     sp_rig_free(&rig);
 }
 
+// Solves a draw-over as `sketchpose drawover` does (the placement held, the
+// weights scaled to the drawn curves unless !scale) from `start`, and poses
+// the mesh at the result into x1 (ev: the rig's evaluator).
+static void drawover_solve(const sp_rig* rig, int a, const sp_camera* cam, const double* xyz, const sp_sketch* drawn, bool scale,
+                           const sp_sketch* to, const double* start, sp_rig_eval* ev, double* x1, sp_solve_report* rep,
+                           double* factor)
+{
+    bool* active = sp_drawover_active(rig);
+    double* p = malloc(sizeof(double) * rig->param_count);
+    ENSURE(active && p);
+    sp_solve_desc desc = {.active = active};
+    *factor = scale ? sp_drawover_scale_weights(&desc, rig, xyz, cam, drawn) : 1;
+    sp_solver* s;
+    sp_error err = {0};
+    sp_solver_create(rig, a, cam, &desc, &s, NULL);
+    ENSURE(sp_solver_solve(s, to, start, p, rep, &err) == SP_OK);
+    sp_rig_eval_update(ev, p, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), x1);
+    sp_solver_destroy(s);
+    free(active), free(p);
+}
+
 // Draw-over on CesiumMan: a curve drawn along the arm at rest, redrawn bent,
 // bends the arm; the fitted curve matches and the legs barely move.
 static void test_drawover_cesiumman(void)
@@ -160,7 +182,6 @@ static void test_drawover_cesiumman(void)
     int P = rig->param_count, arm = sp_rig_find_param(rig, "node17.rx");
     ENSURE(arm >= 0);
     double* bent = malloc(sizeof(double) * P);
-    double* p = malloc(sizeof(double) * P);
     memcpy(bent, ch.pose, sizeof(double) * P);
     bent[arm] = 1.0;
     bent[sp_rig_find_param(rig, "node17.rz")] = 0.6;
@@ -187,14 +208,13 @@ static void test_drawover_cesiumman(void)
     sp_sketch to = {0};
     ENSURE(sp_synth_sketch(rig, a, &ch.camera, bent, &to) == SP_OK);
     // As `sketchpose drawover` solves: the character stays where it stands.
-    bool* active = sp_drawover_active(rig);
-    ENSURE(active);
-    sp_solver* s;
-    sp_solver_create(rig, a, &ch.camera, &(sp_solve_desc){.active = active}, &s, NULL);
+    sp_sketch drawn = {.canvas_w = s_rest.canvas_w,
+                       .canvas_h = s_rest.canvas_h,
+                       .stroke_count = 1,
+                       .strokes = &(sp_stroke){.count = n - from, .points = s_rest.strokes[c].points + from}};
     sp_solve_report rep;
-    ENSURE(sp_solver_solve(s, &to, ch.pose, p, &rep, &err) == SP_OK);
-    sp_rig_eval_update(ev, p, false);
-    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), x1);
+    double f;
+    drawover_solve(rig, a, &ch.camera, xyz, &drawn, true, &to, ch.pose, ev, x1, &rep, &f);
     // Far from the arm: the vertices below the hips (lowest 40% of the body).
     sp_vec3 lo, hi;
     sp_bounds(xyz, rig->vertex_count, &lo, &hi);
@@ -206,18 +226,81 @@ static void test_drawover_cesiumman(void)
         if (h < lo.y + 0.4 * (hi.y - lo.y)) far = fmax(far, d);
         arm_moved = fmax(arm_moved, d);
     }
-    fprintf(stderr, "  drawover CesiumMan: mean error %.2f%% of %.0f px, legs moved %.3f%%, the arm %.1f%% of the size\n",
-            100 * rep.mean_error_px / rep.bbox_diagonal_px, rep.bbox_diagonal_px, 100 * far / D, 100 * arm_moved / D);
+    fprintf(stderr,
+            "  drawover CesiumMan: mean error %.2f%% of %.0f px, legs moved %.3f%%, the arm %.1f%% of the size (weights x%.1f)\n",
+            100 * rep.mean_error_px / rep.bbox_diagonal_px, rep.bbox_diagonal_px, 100 * far / D, 100 * arm_moved / D, f);
     ENSURE(rep.mean_error_px <= 0.02 * rep.bbox_diagonal_px);
     ENSURE(arm_moved > 0.05 * D); // the arm did bend
     ENSURE(far <= 0.01 * D);
-    sp_solver_destroy(s);
-    free(active);
     sp_rig_eval_destroy(ev);
     sp_abstraction_free(&emb);
     sp_sketch_free(&s_rest), sp_sketch_free(&s_bent), sp_sketch_free(&to);
-    free(bent), free(p), free(xyz), free(x1);
+    free(bent), free(xyz), free(x1);
     sp_character_free(&ch);
+}
+
+// Draw-over is local for a short curve too: a line drawn up CesiumMan's
+// neck and redrawn tilted tilts the head, and the hands and feet stay put.
+// The match term is measured over the curve's own size, so before the
+// weights were scaled to the character's (sp_drawover_scale_weights) the
+// redrawn neck swung an arm. Returns the largest move of a vertex drawn far
+// from the curve, over the mesh's size; *err: the fit's mean error in px.
+static double neck_far_move(bool scale, double* err_px, double* factor)
+{
+    sp_character ch;
+    sp_fixture_shared_gltf("CesiumMan/CesiumMan.glb", &ch);
+    sp_rig* rig = &ch.rig;
+    int V = rig->vertex_count;
+    sp_vec2 on_pts[14], to_pts[14];
+    for (int i = 0; i < 14; ++i) {
+        on_pts[i] = (sp_vec2){321, 165 - 5 * i};
+        to_pts[i] = (sp_vec2){321 + (i < 3 ? 0 : (i - 3) * 2.2), 165 - 5 * i + (i < 3 ? 0 : (i - 3) * 0.6)};
+    }
+    sp_sketch on = {.canvas_w = 640, .canvas_h = 480, .stroke_count = 1, .strokes = &(sp_stroke){.count = 14, .points = on_pts}};
+    sp_sketch to = {.canvas_w = 640, .canvas_h = 480, .stroke_count = 1, .strokes = &(sp_stroke){.count = 14, .points = to_pts}};
+    double* xyz = malloc(sizeof(double) * 3 * V);
+    double* x1 = malloc(sizeof(double) * 3 * V);
+    sp_rig_eval* ev;
+    sp_rig_eval_create(rig, &ev, NULL);
+    sp_rig_eval_update(ev, ch.pose, false);
+    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
+    sp_error err = {0};
+    sp_abstraction emb;
+    ENSURE(sp_embed_curve(rig, xyz, &ch.camera, on_pts, 14, 48, "drawover", &emb, &err) == SP_OK);
+    int a = sp_rig_add_abstraction(rig, &emb);
+    sp_solve_report rep;
+    drawover_solve(rig, a, &ch.camera, xyz, &on, scale, &to, ch.pose, ev, x1, &rep, factor);
+    *err_px = rep.mean_error_px;
+    sp_vec3 lo, hi;
+    sp_bounds(xyz, V, &lo, &hi);
+    double D = sp_v3_len(sp_v3_sub(hi, lo)), far = 0;
+    // Far: drawn more than 150 px (a third of the figure) from every point of the curve.
+    for (int v = 0; v < V; ++v) {
+        sp_vec2 q = sp_camera_project(&ch.camera, sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]));
+        double near = INFINITY;
+        for (int i = 0; i < 14; ++i)
+            near = fmin(near, sp_v2_len(sp_v2_sub(q, on_pts[i])));
+        if (near > 150)
+            far = fmax(far, sp_v3_len(sp_v3_sub(sp_v3(x1[3 * v], x1[3 * v + 1], x1[3 * v + 2]),
+                                                sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]))));
+    }
+    sp_rig_eval_destroy(ev);
+    sp_abstraction_free(&emb);
+    free(xyz), free(x1);
+    sp_character_free(&ch);
+    return far / D;
+}
+
+static void test_drawover_neck_local(void)
+{
+    double e0, e1, f0, f1;
+    double before = neck_far_move(false, &e0, &f0), after = neck_far_move(true, &e1, &f1);
+    fprintf(stderr,
+            "  a redrawn neck: far vertices moved %.2f%% of the size (error %.2f px) at the paper's weights, %.2f%% (%.2f px) "
+            "at %.0f times them\n",
+            100 * before, e0, 100 * after, e1, f1);
+    ENSURE(f1 > 10 && e1 < 0.5);
+    ENSURE(after < 0.5 * before);
 }
 
 // Runs a shell command; returns its exit status.
@@ -884,6 +967,7 @@ int main(int argc, char** argv)
                                    {"animate_cli_cesiumman", test_animate_cli_cesiumman},
                                    {"animate_cli_times", test_animate_cli_times},
                                    {"drawover_cesiumman", test_drawover_cesiumman},
+                                   {"drawover_neck_local", test_drawover_neck_local},
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
                                    {"cli_missing_value", test_cli_missing_value},

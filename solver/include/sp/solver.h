@@ -49,10 +49,16 @@ extern "C" {
 enum { SP_REPORT_CURVES = 64 };
 
 /// Options; zero means the default.
+/// The paper's regulariser weights (eq. 7), for the energies in the
+/// reference units above: the match term over the abstraction's own size.
+#define SP_LAMBDA_POSE 0.5
+#define SP_LAMBDA_PLANE 0.01
+#define SP_LAMBDA_DIST 0.001
+
 typedef struct sp_solve_desc {
-    double lambda_pose;  ///< 0: 0.5; < 0: term off
-    double lambda_plane; ///< 0: 0.01; < 0: term off
-    double lambda_dist;  ///< 0: 0.001; < 0: term off
+    double lambda_pose;  ///< 0: SP_LAMBDA_POSE; < 0: term off
+    double lambda_plane; ///< 0: SP_LAMBDA_PLANE; < 0: term off
+    double lambda_dist;  ///< 0: SP_LAMBDA_DIST; < 0: term off
     int representatives; ///< k for the coarsening (eq. 12); 0: 200
     int samples;         ///< samples per curve after resampling; 0: by length, 24..160
     int max_iterations;  ///< Gauss-Newton iterations in all; 0: 300
