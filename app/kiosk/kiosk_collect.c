@@ -31,8 +31,6 @@ typedef struct queued {
 struct kiosk_collector {
     sp_db* db; // the writer's own handle; NULL: it could not be opened (tried again for each sketch)
     char path[1024];
-    dev_t dev; // the file the handle has open
-    ino_t ino;
     double canvas_w, canvas_h;
     double reserve_mb; // free space on the database's disk kept for saves and training (<= 0: none)
     bool threaded;
@@ -80,7 +78,7 @@ static sp_result open_writer(kiosk_collector* c, const char* said, sp_error* err
         return sp_fail(err, r, "%s; sketch dropped", why);
     }
     sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
-    c->db = db, c->dev = st.st_dev, c->ino = st.st_ino;
+    c->db = db;
     sp_kiosk_log("%s: %s", c->path, said);
     return SP_OK;
 }
@@ -96,10 +94,10 @@ static sp_result open_writer(kiosk_collector* c, const char* said, sp_error* err
 // cannot be written (open_writer tries again at the next sketch).
 static sp_result follow_file(kiosk_collector* c, sp_error* err)
 {
-    struct stat st;
-    if (stat(c->path, &st) != 0)
+    sp_db_file_state at = sp_db_file_check(c->db);
+    if (at == SP_DB_FILE_GONE)
         return sp_fail(err, SP_ERR_IO, "%s: the database is gone (deleted or moved away); sketch dropped", c->path);
-    if (st.st_dev == c->dev && st.st_ino == c->ino) return SP_OK;
+    if (at == SP_DB_FILE_SAME) return SP_OK;
     sp_db_close(c->db);
     c->db = NULL;
     sp_db_drop_stale_sidecars(c->path);
@@ -211,8 +209,6 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
     // each sketch is then dropped with one line, until the writer's handle
     // opens (open_writer).
     sp_error err = {0};
-    struct stat st;
-    if (stat(db_path, &st) == 0) c->dev = st.st_dev, c->ino = st.st_ino;
     if (sp_db_open(db_path, 0, &c->db, &err) != SP_OK) {
         sp_kiosk_log("visitors' strokes cannot be collected for now (tried again for each): %s", err.text);
         c->db = NULL;

@@ -524,7 +524,12 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     bool ro_file = ro && !reader_may_write(path);
     int oflags =
         ro_file ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | ((flags & SP_DB_CREATE) && !ro ? SQLITE_OPEN_CREATE : 0);
+    // The file at the path just before SQLite opens it: one renamed over the
+    // path during the open then reads as replaced (noted after the open, the
+    // new file could be taken for the one the handle has, and never followed).
+    if (exists) db->at_dev = st.st_dev, db->at_ino = st.st_ino, db->at_known = true;
     int rc = sqlite3_open_v2(path, &db->h, oflags | SQLITE_OPEN_FULLMUTEX, NULL);
+    DB_HOOK("opened");
     sp_result r = SP_OK;
     if (rc != SQLITE_OK) {
         r = (rc & 0xff) == SQLITE_CANTOPEN ? sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno ? errno : EACCES))
@@ -611,6 +616,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
         if ((r = db_migrate(db, SP_DB_SCHEMA_VERSION, err)) != SP_OK) goto fail;
     }
     list_open(db);
+    if (!db->at_known && db->listed) db->at_dev = db->dev, db->at_ino = db->ino, db->at_known = true; // made by this open
     *out = db;
     return SP_OK;
 fail:
@@ -634,6 +640,20 @@ void sp_db_set_busy_timeout(sp_db* db, int ms)
 {
     db->busy_ms = ms < 0 ? 0 : ms;
     sqlite3_busy_timeout(db->h, db->busy_ms);
+}
+
+sp_db_file_state sp_db_file_check(const sp_db* db)
+{
+    struct stat st;
+    if (stat(db->path, &st) != 0) return errno == ENOENT || errno == ENOTDIR ? SP_DB_FILE_GONE : SP_DB_FILE_SAME;
+    return db->at_known && (st.st_dev != db->at_dev || st.st_ino != db->at_ino) ? SP_DB_FILE_REPLACED : SP_DB_FILE_SAME;
+}
+
+bool sp_db_file_id(const sp_db* db, uint64_t* dev, uint64_t* ino)
+{
+    *dev = db->at_known ? (uint64_t)db->at_dev : 0;
+    *ino = db->at_known ? (uint64_t)db->at_ino : 0;
+    return db->at_known;
 }
 
 // Whether the WAL w was made or written after the database file db arrived

@@ -17,6 +17,9 @@ struct sp_db {
     dev_t dev; // the file opened (db.c's list of this process's open files)
     ino_t ino;
     bool listed;
+    dev_t at_dev; // the file at the path just before the open (sp_db_file_check)
+    ino_t at_ino;
+    bool at_known;
     int busy_ms;
     int kiosk_pending_max; // 0: SP_DB_KIOSK_PENDING_MAX
     bool readonly;

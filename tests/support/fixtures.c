@@ -326,6 +326,33 @@ void sp_fixture_remove_db(const char* path)
     unlink(side);
 }
 
+// partdb's test hook (db_internal.h): called at named points; "opened":
+// SQLite has just opened the database file.
+extern void (*sp_db_test_hook)(const char* point);
+static char g_rename_from[1024], g_rename_to[1024];
+
+static void rename_at_open(const char* point)
+{
+    if (strcmp(point, "opened") != 0 || !g_rename_from[0]) return;
+    ENSURE(rename(g_rename_from, g_rename_to) == 0);
+    g_rename_from[0] = 0;
+}
+
+void sp_fixture_rename_when_opened(const char* from, const char* to)
+{
+    snprintf(g_rename_from, sizeof g_rename_from, "%s", from);
+    snprintf(g_rename_to, sizeof g_rename_to, "%s", to);
+    sp_db_test_hook = rename_at_open;
+}
+
+bool sp_fixture_rename_done(void)
+{
+    sp_db_test_hook = NULL;
+    bool done = !g_rename_from[0];
+    g_rename_from[0] = 0;
+    return done;
+}
+
 cJSON* sp_fixture_json_file(const char* path)
 {
     size_t got = 0;

@@ -108,6 +108,12 @@ bool sp_fixture_child_passed(int pid);
 /// Removes a SQLite database and the -wal and -shm files beside it (each may be absent).
 void sp_fixture_remove_db(const char* path);
 
+/// Arms partdb's test hook: the next database open renames `from` over `to`
+/// just after SQLite opened the file (a curator's new file arriving during
+/// the open). sp_fixture_rename_done says whether it ran, and disarms.
+void sp_fixture_rename_when_opened(const char* from, const char* to);
+bool sp_fixture_rename_done(void);
+
 /// Stores the newest model of the database at `path` again, as a new row:
 /// what `db train` commits, without its minute (the real model's bytes, so a
 /// reader reads them as it would). False, said on stderr, when it cannot.

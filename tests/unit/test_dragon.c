@@ -1594,6 +1594,35 @@ static void test_background_replaced(void)
     sp_dragon_destroy(d);
 }
 
+// A database file renamed over the path while the pipeline opens it (SQLite
+// has the old file, the pipeline has not yet noted which): the next poll
+// reopens the new one. Noted after the open, the new file was taken for the
+// one the handle had, and the pipeline read the old file for good.
+static void test_open_race(void)
+{
+    char path[1024], other[1024];
+    test_db_copy("dragon_race.db", path);
+    test_db_copy("dragon_race_new.db", other);
+    sp_db* w = NULL;
+    sp_error err = {0};
+    ENSURE(sp_db_open(other, 0, &w, &err) == SP_OK && sp_db_remove_part(w, "tail_t", "test", &err) == SP_OK);
+    sp_db_close(w);
+    sp_fixture_rename_when_opened(other, path);
+    sp_dragon* d = new_dragon(path);
+    ENSURE(sp_fixture_rename_done()); // renamed during the pipeline's open
+    bool reloaded = false;
+    ENSURE(sp_dragon_reload_if_changed(d, &reloaded, &err) == SP_OK);
+    sp_vec2 tail[40];
+    for (int i = 0; i < 40; ++i)
+        tail[i] = (sp_vec2){200 + 8 * i, 500 - 60 * sin(0.1 * i)};
+    sp_dragon_result res;
+    ENSURE(sp_dragon_add_points(d, tail, 40, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK);
+    fprintf(stderr, "  first poll: %s; a tail: %s\n", reloaded ? "reopened" : "nothing new",
+            res.rejected ? sp_dragon_reject_name(res.reason) : "a part");
+    ENSURE(reloaded && res.rejected && res.reason == SP_DRAGON_NO_PART); // the new file has no tail
+    sp_dragon_destroy(d);
+}
+
 static void test_live_update(void)
 {
     char path[1024], other[1024];
@@ -3980,6 +4009,7 @@ int main(int argc, char** argv)
                                    {"background_model", test_background_model},
                                    {"background_read_fails", test_background_read_fails},
                                    {"background_replaced", test_background_replaced},
+                                   {"open_race", test_open_race},
                                    {"command", test_command},
                                    {"six_real_parts", test_six_real_parts},
                                    {"many_parts", test_many_parts},

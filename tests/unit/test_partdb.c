@@ -1645,6 +1645,44 @@ static sp_result collect_many(sp_db* db, sp_error* err)
     return r == SP_OK || strstr(err->text, "dropped") ? r : SP_ERR_INTERNAL;
 }
 
+// A follower (the kiosk's pipeline and collector) asks partdb whether the
+// path still names the file its handle opened: the same, another renamed
+// over it, or none. A file renamed over the path while the handle was being
+// opened (after SQLite opened the old one) reads as replaced: noted after
+// the open, the new file was taken for the handle's and never followed.
+static void test_file_check(void)
+{
+    char p[1024], q[1024];
+    snprintf(p, sizeof p, "%s", base_db("check_p.db"));
+    snprintf(q, sizeof q, "%s", base_db("check_q.db"));
+    struct stat st;
+    ENSURE(stat(p, &st) == 0);
+    sp_db* db = open_ok(p, SP_DB_READONLY);
+    uint64_t dev = 0, ino = 0;
+    ENSURE(sp_db_file_id(db, &dev, &ino) && dev == (uint64_t)st.st_dev && ino == (uint64_t)st.st_ino);
+    ENSURE(sp_db_file_check(db) == SP_DB_FILE_SAME);
+    ENSURE(rename(q, p) == 0);
+    ENSURE(sp_db_file_check(db) == SP_DB_FILE_REPLACED);
+    sp_db_close(db);
+    sp_fixture_remove_db(p);
+    db = open_ok(base_db("check_p.db"), SP_DB_READONLY);
+    ENSURE(unlink(p) == 0 && sp_db_file_check(db) == SP_DB_FILE_GONE);
+    sp_db_close(db);
+    // Renamed over it during the open.
+    snprintf(p, sizeof p, "%s", base_db("check_p.db"));
+    snprintf(q, sizeof q, "%s", base_db("check_q.db"));
+    sp_fixture_rename_when_opened(q, p);
+    db = open_ok(p, SP_DB_READONLY);
+    ENSURE(sp_fixture_rename_done());
+    ENSURE(sp_db_file_check(db) == SP_DB_FILE_REPLACED);
+    sp_db_close(db);
+    // A database this open makes: its own file.
+    sp_fixture_remove_db(q);
+    db = open_ok(q, SP_DB_CREATE);
+    ENSURE(sp_db_file_check(db) == SP_DB_FILE_SAME && sp_db_file_id(db, &dev, &ino) && ino != 0);
+    sp_db_close(db);
+}
+
 static void test_kiosk_collect(void)
 {
     char p[1024];
@@ -2668,6 +2706,7 @@ int main(int argc, char** argv)
                                    {"kiosk_review_cli", test_kiosk_review_cli},
                                    {"kiosk_review_ranges", test_kiosk_review_ranges},
                                    {"kiosk_pending_cap", test_kiosk_pending_cap},
+                                   {"file_check", test_file_check},
                                    {"number_options_cli", test_number_options_cli},
                                    {"add_sketch_partless_cli", test_add_sketch_partless_cli},
                                    {0}});

@@ -89,7 +89,7 @@ sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error
             free(d);
             return r;
         }
-        dragon_file_id(d->db_path, &d->dev, &d->ino);
+        dragon_db_file_id(d);
         d->own_db = true;
     }
     o->db = NULL, o->db_path = NULL, o->assets_dir = NULL; // not kept: the caller's strings

@@ -90,7 +90,10 @@ bool dragon_model_load_take(sp_dragon* d, bool wait);
 // At a poll: reads again a model whose background read failed for a reason
 // that may pass, once its time has come.
 void dragon_model_retry(sp_dragon* d);
+// The device and inode of the file at path now (false: none there).
 bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino);
+// d->dev, d->ino: the file its handle opened, as partdb noted it before the open.
+void dragon_db_file_id(sp_dragon* d);
 
 // ---- the dragon --------------------------------------------------------------------
 

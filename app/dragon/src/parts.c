@@ -291,6 +291,13 @@ static void cache_prune(sp_dragon* d)
     d->cache_n = kept;
 }
 
+void dragon_db_file_id(sp_dragon* d)
+{
+    uint64_t dev = 0, ino = 0;
+    sp_db_file_id(d->db, &dev, &ino);
+    d->dev = (dev_t)dev, d->ino = (ino_t)ino;
+}
+
 bool dragon_file_id(const char* path, dev_t* dev, ino_t* ino)
 {
     struct stat st;
@@ -306,7 +313,7 @@ static sp_result open_own(sp_dragon* d, sp_error* err)
     sp_result r = sp_db_open(d->db_path, SP_DB_READONLY, &db, err);
     if (r != SP_OK) return r;
     d->db = db;
-    dragon_file_id(d->db_path, &d->dev, &d->ino);
+    dragon_db_file_id(d);
     return SP_OK;
 }
 
@@ -357,9 +364,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
         // A database replaced on disk (a new file renamed over it) is a new
         // inode: the open connection still reads the old one. A deleted file
         // keeps being read through the open connection until a new one appears.
-        dev_t dev;
-        ino_t ino;
-        bool replaced = d->db && dragon_file_id(d->db_path, &dev, &ino) && (dev != d->dev || ino != d->ino);
+        bool replaced = d->db && sp_db_file_check(d->db) == SP_DB_FILE_REPLACED;
         if (replaced || !d->db) {
             // First: then nothing of ours holds the old file's sidecars (a
             // model being read ends, and what it read is not taken).

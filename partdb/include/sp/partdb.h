@@ -104,6 +104,21 @@ sp_result sp_db_checkpoint(sp_db* db, sp_error* err);
 void sp_db_drop_stale_sidecars(const char* path);
 /// The file's path as opened.
 const char* sp_db_path(const sp_db* db);
+/// Whether the path still names the file the handle opened.
+typedef enum sp_db_file_state {
+    SP_DB_FILE_SAME,
+    /// Another file is there (a curator's renamed over it), also when it
+    /// arrived while the handle was being opened: open the path again.
+    SP_DB_FILE_REPLACED,
+    SP_DB_FILE_GONE, ///< nothing is there (deleted, or moved away)
+} sp_db_file_state;
+/// A stat of the path against the file there when the handle was opened
+/// (taken before the open: a rename during it reads as replaced, at worst
+/// once too often). A path that cannot be checked (permissions) reads as the same.
+sp_db_file_state sp_db_file_check(const sp_db* db);
+/// The device and inode of that file (false and zeros when unknown), for a
+/// reader that opens the path again and must know it is the same file.
+bool sp_db_file_id(const sp_db* db, uint64_t* dev, uint64_t* ino);
 /// The schema version of the open database (== SP_DB_SCHEMA_VERSION once open).
 int sp_db_schema_version(sp_db* db);
 /// A counter that grows with every committed change of parts, sketches or
