@@ -1027,6 +1027,11 @@ static int db_review(int argc, char** argv)
         return fail(cmd, &err);
     }
     sp_db_close(db);
+    if (counts[SP_DB_PENDING] >= SP_DB_KIOSK_PENDING_MAX)
+        fprintf(stderr,
+                "%s: note: %d kiosk sketches await review, the most a kiosk keeps: it keeps no new strokes until some are "
+                "approved or rejected\n",
+                cmd, counts[SP_DB_PENDING]);
     bool more = limit > 0 && listed > limit;
     int n = more ? limit : listed;
     int code = SP_EXIT_OK;

@@ -2143,6 +2143,14 @@ static void test_kiosk_pending_cap(void)
     char want[64];
     snprintf(want, sizeof want, ": %d kiosk sketches await review", SP_DB_KIOSK_PENDING_MAX);
     ENSURE(r == SP_ERR_UNSUPPORTED && strstr(err.text, want));
+    // The curator's review says so, on stderr (its JSON on stdout as always).
+    const char* bin = sketchpose_bin();
+    if (bin) {
+        char cmd[4096], out[4096];
+        snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --limit 1 2>&1 >/dev/null", bin, p);
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "kiosk sketches await review, the most a kiosk keeps") &&
+               strchr(out, '\n') == out + strlen(out) - 1);
+    }
     // Deleting the rejected: only they go, logged; the pending, approved and
     // the part's own sketches stay.
     int all = scalar(p, "SELECT count(*) FROM sketches");
