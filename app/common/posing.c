@@ -66,18 +66,37 @@ static double scaled(double typed, double def, double f)
     return typed < 0 ? typed : (typed == 0 ? def : typed) * f;
 }
 
-double sp_drawover_scale_weights(sp_solve_desc* d, const sp_rig* rig, const double* xyz, const sp_camera* cam,
-                                 const sp_sketch* on)
+// The canvas box's diagonal of n points (world, by 3).
+static double projected_diagonal(const double* xyz, int n, const sp_camera* cam)
 {
     double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
-    for (int v = 0; v < rig->vertex_count; ++v) {
+    for (int v = 0; v < n; ++v) {
         sp_vec2 q = sp_camera_project(cam, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
         lx = fmin(lx, q.x), hx = fmax(hx, q.x), ly = fmin(ly, q.y), hy = fmax(hy, q.y);
     }
-    sp_vec2 lo, hi;
-    double mesh = hypot(hx - lx, hy - ly), drawn = sp_sketch_bounds(on, &lo, &hi) ? sp_v2_len(sp_v2_sub(hi, lo)) : 0;
-    double f = drawn > 0 && isfinite(mesh) ? (mesh / drawn) * (mesh / drawn) : 1;
-    f = fmin(fmax(f, 1), 1e4);
+    return n > 0 ? hypot(hx - lx, hy - ly) : 0;
+}
+
+double sp_drawover_scale_weights(sp_solve_desc* d, const sp_rig* rig, const double* xyz, const sp_camera* cam,
+                                 const sp_abstraction* emb)
+{
+    enum { MAX_FACTOR = 10000 };
+    double mesh = projected_diagonal(xyz, rig->vertex_count, cam), f = MAX_FACTOR;
+    double* pts = emb->tri_vertices && emb->bary ? malloc(sizeof(double) * 3 * (size_t)(emb->point_count + 1)) : NULL;
+    if (pts) {
+        for (int i = 0; i < emb->point_count; ++i)
+            for (int c = 0; c < 3; ++c) {
+                const uint32_t* t = &emb->tri_vertices[3 * i];
+                const double* b = &emb->bary[3 * i];
+                pts[3 * i + c] = b[0] * xyz[3 * t[0] + c] + b[1] * xyz[3 * t[1] + c] + b[2] * xyz[3 * t[2] + c];
+            }
+        double drawn = projected_diagonal(pts, emb->point_count, cam);
+        if (drawn > 1e-9 && isfinite(mesh)) f = (mesh / drawn) * (mesh / drawn);
+        free(pts);
+    } else if (!emb->tri_vertices) {
+        f = 1; // not a curve on the mesh: its size is the character's own
+    }
+    f = fmin(fmax(f, 1), MAX_FACTOR);
     d->lambda_pose = scaled(d->lambda_pose, SP_LAMBDA_POSE, f);
     d->lambda_plane = scaled(d->lambda_plane, SP_LAMBDA_PLANE, f);
     d->lambda_dist = scaled(d->lambda_dist, SP_LAMBDA_DIST, f);

@@ -23,14 +23,16 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// derived placement) to fit it.
 bool* sp_drawover_active(const sp_rig* rig);
 /// Scales a draw-over solve's regulariser weights (0: the defaults; < 0:
-/// off, kept) by (the character's size on the canvas / the drawn curves'
-/// size)^2, clamped to [1, 10000], and returns that factor. Why: the solver
-/// measures the match term over the abstraction's own size, so a curve
-/// drawn over the neck, a seventh of the character, weighed 50 times more
-/// against the paper's regularisers than a whole figure's stick, and a
-/// redrawn neck swung the arms (xyz: the mesh at the start pose; on: the
-/// curves as drawn over it).
+/// off, kept) by (the character's size on the canvas / the embedded curves'
+/// size there)^2, clamped to [1, 10000] (curves of no size: 10000), and
+/// returns that factor. Why: the solver measures the match term over the
+/// abstraction's own size, so a curve drawn over the neck, a seventh of the
+/// character, weighed 50 times more against the paper's regularisers than a
+/// whole figure's stick, and a redrawn neck swung the arms (xyz: the mesh
+/// at the start pose; emb: the curves embedded in it, sp_embed_curve: their
+/// size is the one the solver measures, where the strokes as drawn may run
+/// off the mesh).
 double sp_drawover_scale_weights(sp_solve_desc* d, const sp_rig* rig, const double* xyz, const sp_camera* cam,
-                                 const sp_sketch* on);
+                                 const sp_abstraction* emb);
 
 #endif

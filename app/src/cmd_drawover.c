@@ -66,7 +66,7 @@ int cmd_drawover(int argc, char** argv)
         {"--report", SP_OPT_OUT, &report, "report.json", "write the solve report (also printed on stdout)", false},
         {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L",
          "weight of W_dist, locality, for curves the character's size (default 0.001; scaled like the other weights by "
-         "(the character's size / the curves' size)^2; 0 or negative: off)",
+         "(the character's size / the curves' size)^2, at most 10000; 0 or negative: off)",
          false},
         {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
@@ -123,7 +123,7 @@ int cmd_drawover(int argc, char** argv)
     // writes the file's own abstractions (sp_rig_posed.saved_abstractions).
     run.abstraction = sp_rig_add_abstraction(&ch->rig, &emb);
     if (run.abstraction < 0) goto oom;
-    sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &on);
+    sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
     sp_solve_outputs o = {.report = report, .out = out, .render = render, .strokes = &to, .ghost = &on, .note = rep.note};

@@ -152,15 +152,14 @@ static void test_drawover_fixture(void)
 // Solves a draw-over as `sketchpose drawover` does (the placement held, the
 // weights scaled to the drawn curves unless !scale) from `start`, and poses
 // the mesh at the result into x1 (ev: the rig's evaluator).
-static void drawover_solve(const sp_rig* rig, int a, const sp_camera* cam, const double* xyz, const sp_sketch* drawn, bool scale,
-                           const sp_sketch* to, const double* start, sp_rig_eval* ev, double* x1, sp_solve_report* rep,
-                           double* factor)
+static void drawover_solve(const sp_rig* rig, int a, const sp_camera* cam, const double* xyz, bool scale, const sp_sketch* to,
+                           const double* start, sp_rig_eval* ev, double* x1, sp_solve_report* rep, double* factor)
 {
     bool* active = sp_drawover_active(rig);
     double* p = malloc(sizeof(double) * rig->param_count);
     ENSURE(active && p);
     sp_solve_desc desc = {.active = active};
-    *factor = scale ? sp_drawover_scale_weights(&desc, rig, xyz, cam, drawn) : 1;
+    *factor = scale ? sp_drawover_scale_weights(&desc, rig, xyz, cam, &rig->abstractions[a]) : 1;
     sp_solver* s;
     sp_error err = {0};
     sp_solver_create(rig, a, cam, &desc, &s, NULL);
@@ -208,13 +207,9 @@ static void test_drawover_cesiumman(void)
     sp_sketch to = {0};
     ENSURE(sp_synth_sketch(rig, a, &ch.camera, bent, &to) == SP_OK);
     // As `sketchpose drawover` solves: the character stays where it stands.
-    sp_sketch drawn = {.canvas_w = s_rest.canvas_w,
-                       .canvas_h = s_rest.canvas_h,
-                       .stroke_count = 1,
-                       .strokes = &(sp_stroke){.count = n - from, .points = s_rest.strokes[c].points + from}};
     sp_solve_report rep;
     double f;
-    drawover_solve(rig, a, &ch.camera, xyz, &drawn, true, &to, ch.pose, ev, x1, &rep, &f);
+    drawover_solve(rig, a, &ch.camera, xyz, true, &to, ch.pose, ev, x1, &rep, &f);
     // Far from the arm: the vertices below the hips (lowest 40% of the body).
     sp_vec3 lo, hi;
     sp_bounds(xyz, rig->vertex_count, &lo, &hi);
@@ -239,6 +234,32 @@ static void test_drawover_cesiumman(void)
     sp_character_free(&ch);
 }
 
+// CesiumMan at its stored pose: the mesh there (xyz), room for another
+// pose's (x1) and the evaluator.
+typedef struct posed_man {
+    sp_character ch;
+    double *xyz, *x1;
+    sp_rig_eval* ev;
+} posed_man;
+
+static void posed_man_load(posed_man* m)
+{
+    sp_fixture_shared_gltf("CesiumMan/CesiumMan.glb", &m->ch);
+    int V = m->ch.rig.vertex_count;
+    m->xyz = malloc(sizeof(double) * 3 * V);
+    m->x1 = malloc(sizeof(double) * 3 * V);
+    ENSURE(m->xyz && m->x1 && sp_rig_eval_create(&m->ch.rig, &m->ev, NULL) == SP_OK);
+    sp_rig_eval_update(m->ev, m->ch.pose, false);
+    sp_rig_eval_points(m->ev, sp_rig_mesh_points(&m->ch.rig), m->xyz);
+}
+
+static void posed_man_free(posed_man* m)
+{
+    sp_rig_eval_destroy(m->ev);
+    free(m->xyz), free(m->x1);
+    sp_character_free(&m->ch);
+}
+
 // Draw-over is local for a short curve too: a line drawn up CesiumMan's
 // neck and redrawn tilted tilts the head, and the hands and feet stay put.
 // The match term is measured over the curve's own size, so before the
@@ -247,36 +268,30 @@ static void test_drawover_cesiumman(void)
 // from the curve, over the mesh's size; *err: the fit's mean error in px.
 static double neck_far_move(bool scale, double* err_px, double* factor)
 {
-    sp_character ch;
-    sp_fixture_shared_gltf("CesiumMan/CesiumMan.glb", &ch);
-    sp_rig* rig = &ch.rig;
+    posed_man m;
+    posed_man_load(&m);
+    sp_rig* rig = &m.ch.rig;
     int V = rig->vertex_count;
+    const double *xyz = m.xyz, *x1 = m.x1;
     sp_vec2 on_pts[14], to_pts[14];
     for (int i = 0; i < 14; ++i) {
         on_pts[i] = (sp_vec2){321, 165 - 5 * i};
         to_pts[i] = (sp_vec2){321 + (i < 3 ? 0 : (i - 3) * 2.2), 165 - 5 * i + (i < 3 ? 0 : (i - 3) * 0.6)};
     }
-    sp_sketch on = {.canvas_w = 640, .canvas_h = 480, .stroke_count = 1, .strokes = &(sp_stroke){.count = 14, .points = on_pts}};
     sp_sketch to = {.canvas_w = 640, .canvas_h = 480, .stroke_count = 1, .strokes = &(sp_stroke){.count = 14, .points = to_pts}};
-    double* xyz = malloc(sizeof(double) * 3 * V);
-    double* x1 = malloc(sizeof(double) * 3 * V);
-    sp_rig_eval* ev;
-    sp_rig_eval_create(rig, &ev, NULL);
-    sp_rig_eval_update(ev, ch.pose, false);
-    sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
     sp_error err = {0};
     sp_abstraction emb;
-    ENSURE(sp_embed_curve(rig, xyz, &ch.camera, on_pts, 14, 48, "drawover", &emb, &err) == SP_OK);
+    ENSURE(sp_embed_curve(rig, xyz, &m.ch.camera, on_pts, 14, 48, "drawover", &emb, &err) == SP_OK);
     int a = sp_rig_add_abstraction(rig, &emb);
     sp_solve_report rep;
-    drawover_solve(rig, a, &ch.camera, xyz, &on, scale, &to, ch.pose, ev, x1, &rep, factor);
+    drawover_solve(rig, a, &m.ch.camera, xyz, scale, &to, m.ch.pose, m.ev, m.x1, &rep, factor);
     *err_px = rep.mean_error_px;
     sp_vec3 lo, hi;
     sp_bounds(xyz, V, &lo, &hi);
     double D = sp_v3_len(sp_v3_sub(hi, lo)), far = 0;
     // Far: drawn more than 150 px (a third of the figure) from every point of the curve.
     for (int v = 0; v < V; ++v) {
-        sp_vec2 q = sp_camera_project(&ch.camera, sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]));
+        sp_vec2 q = sp_camera_project(&m.ch.camera, sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]));
         double near = INFINITY;
         for (int i = 0; i < 14; ++i)
             near = fmin(near, sp_v2_len(sp_v2_sub(q, on_pts[i])));
@@ -284,11 +299,48 @@ static double neck_far_move(bool scale, double* err_px, double* factor)
             far = fmax(far, sp_v3_len(sp_v3_sub(sp_v3(x1[3 * v], x1[3 * v + 1], x1[3 * v + 2]),
                                                 sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]))));
     }
-    sp_rig_eval_destroy(ev);
     sp_abstraction_free(&emb);
-    free(xyz), free(x1);
-    sp_character_free(&ch);
+    posed_man_free(&m);
     return far / D;
+}
+
+// The factor is the solver's own scale: the character's size over the
+// curve as embedded (the report's bbox_diagonal_px), also for a stroke that
+// runs off the mesh, which embedding pulls onto it (the stroke as drawn
+// gave a factor 3.6 times too small for an arm line run past the hand).
+static void test_drawover_scale_is_solvers(void)
+{
+    posed_man m;
+    posed_man_load(&m);
+    sp_rig* rig = &m.ch.rig;
+    int V = rig->vertex_count;
+    const double* xyz = m.xyz;
+    // Along the right arm and 120 px past the hand (CesiumMan's hand ends near x 470).
+    sp_vec2 on_pts[16], to_pts[16];
+    for (int i = 0; i < 16; ++i) {
+        on_pts[i] = (sp_vec2){360 + 15 * i, 160 + 3.9 * i};
+        to_pts[i] = (sp_vec2){360 + 15 * i, 160 + 3.9 * i - 0.08 * i * i};
+    }
+    sp_error err = {0};
+    sp_abstraction emb;
+    ENSURE(sp_embed_curve(rig, xyz, &m.ch.camera, on_pts, 16, 48, "drawover", &emb, &err) == SP_OK);
+    int a = sp_rig_add_abstraction(rig, &emb);
+    sp_sketch to = {.canvas_w = 640, .canvas_h = 480, .stroke_count = 1, .strokes = &(sp_stroke){.count = 16, .points = to_pts}};
+    sp_solve_report rep;
+    double f;
+    drawover_solve(rig, a, &m.ch.camera, xyz, true, &to, m.ch.pose, m.ev, m.x1, &rep, &f);
+    double lx = INFINITY, ly = INFINITY, hx = -INFINITY, hy = -INFINITY;
+    for (int v = 0; v < V; ++v) {
+        sp_vec2 q = sp_camera_project(&m.ch.camera, sp_v3(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]));
+        lx = fmin(lx, q.x), hx = fmax(hx, q.x), ly = fmin(ly, q.y), hy = fmax(hy, q.y);
+    }
+    double mesh = hypot(hx - lx, hy - ly), want = (mesh / rep.bbox_diagonal_px) * (mesh / rep.bbox_diagonal_px);
+    fprintf(stderr,
+            "  a stroke run off the hand: drawn %.0f px, embedded %.0f px; weights x%.2f, the solver's scale gives x%.2f\n",
+            hypot(on_pts[15].x - on_pts[0].x, on_pts[15].y - on_pts[0].y), rep.bbox_diagonal_px, f, want);
+    ENSURE(fabs(f - want) <= 0.02 * want);
+    sp_abstraction_free(&emb);
+    posed_man_free(&m);
 }
 
 static void test_drawover_neck_local(void)
@@ -968,6 +1020,7 @@ int main(int argc, char** argv)
                                    {"animate_cli_times", test_animate_cli_times},
                                    {"drawover_cesiumman", test_drawover_cesiumman},
                                    {"drawover_neck_local", test_drawover_neck_local},
+                                   {"drawover_scale_is_solvers", test_drawover_scale_is_solvers},
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
                                    {"cli_missing_value", test_cli_missing_value},
