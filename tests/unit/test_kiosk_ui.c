@@ -1126,60 +1126,91 @@ static void check_targets(const sp_kiosk_ui* ui)
     }
 }
 
+// Every part tile shown lies on the canvas (past it, tiles lay over the
+// toolbar and took its taps), and the first `want` of the row are shown.
+static void check_row_on_canvas(const sp_kiosk_ui* ui, int want)
+{
+    for (int i = 0; i < ui->row_fit; ++i) {
+        const sp_kiosk_rect* r = &ui->target[SP_KT_PART1 + i];
+        ENSURE(r->y >= ui->canvas.y && r->y + r->h <= ui->canvas.y + ui->canvas.h && r->x + r->w <= ui->canvas.x + ui->canvas.w);
+    }
+    ENSURE(ui->row_fit >= want && ui->row_fit <= ui->row_count);
+}
+
 static void test_layout(void)
 {
     // Screens: desktop, the e2e window, a 10" tablet, HiDPI laptop (content
-    // scale 2), 4K on 27", portrait tablet, a small window on a dense screen.
+    // scale 2), 4K on 27", portrait tablet, a small window on a dense
+    // screen; then phones, upright and sideways (the last three).
     const struct {
         int w, h;
         double ppm;
     } screens[] = {
-        {1280, 800, 96 / 25.4},      {1920, 1080, 3.6},        {1280, 800, 149 / 25.4},
-        {2560, 1600, 2 * 96 / 25.4}, {3840, 2160, 163 / 25.4}, {800, 1280, 216 / 25.4},
-        {640, 480, 96 / 25.4},       {1024, 600, 150 / 25.4},  {480, 800, 96 / 25.4},
+        {1280, 800, 96 / 25.4},   {1920, 1080, 3.6},        {1280, 800, 149 / 25.4},  {2560, 1600, 2 * 96 / 25.4},
+        {3840, 2160, 163 / 25.4}, {800, 1280, 216 / 25.4},  {640, 480, 96 / 25.4},    {1024, 600, 150 / 25.4},
+        {480, 800, 96 / 25.4},    {1080, 2340, 400 / 25.4}, {1170, 2532, 460 / 25.4}, {2340, 1080, 400 / 25.4},
     };
+    const int phones = 3, n_screens = (int)(sizeof screens / sizeof screens[0]);
+    static const char* const twelve[12] = {"torso", "head", "wings", "tail",  "front_legs", "hind_legs",
+                                           "horns", "fire", "crown", "beard", "claws",      "spikes"};
     fake f;
-    for (size_t s = 0; s < sizeof screens / sizeof screens[0]; ++s) {
-        sp_kiosk_ui* ui = started(&f);
-        sp_kiosk_ui_set_parts(ui, k_row, 6);
-        sp_kiosk_ui_resize(ui, screens[s].w, screens[s].h, screens[s].ppm);
-        // A part: its label and two guesses show, with long names.
-        stroke(ui, 1000, 0.2f * (float)screens[s].w, 0.3f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
-        sp_kiosk_job j;
-        ENSURE(sp_kiosk_ui_next_job(ui, &j));
-        sp_kiosk_ui_fit_done(
-            ui, &(sp_kiosk_fit_result){.ok = true, .category = "front_legs", .guesses = {"hind_legs", "wings"}, .part_count = 1});
-        for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
-            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) == (t <= SP_KT_CHIP_GUESS2 || t == SP_KT_CHIP_MORE));
-        check_targets(ui);
-        // The canvas keeps most of the screen.
-        ENSURE(ui->canvas.w * ui->canvas.h >= 0.45 * screens[s].w * screens[s].h);
-        // Far from every target: nothing.
-        ENSURE(sp_kiosk_ui_hit(ui, ui->canvas.x + 0.5f * ui->canvas.w, ui->canvas.y + 0.6f * ui->canvas.h) == SP_KT_NONE);
-        ENSURE(sp_kiosk_ui_hit(ui, NAN, 3) == SP_KT_NONE);
-        // "Other?" opens the row of parts in place of the two guesses, all of them targets.
-        sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 1500, 0, 0, SP_KT_CHIP_MORE});
-        for (int t = SP_KT_CHIP_LABEL; t < SP_KT_COUNT; ++t)
-            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
-                   (t == SP_KT_CHIP_LABEL || t == SP_KT_CHIP_MORE || (t >= SP_KT_PART1 && t < SP_KT_PART1 + 6)));
-        check_targets(ui);
-        ENSURE(ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
-        sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 1600, 0, 0, SP_KT_CHIP_MORE}); // closed again
-        ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS2));
-        // A refused stroke: three guesses and the six parts, no label.
-        stroke(ui, 3000, 0.2f * (float)screens[s].w, 0.5f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
-        ENSURE(sp_kiosk_ui_next_job(ui, &j));
-        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"hind_legs", "front_legs", "torso"}});
-        for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
-            ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
-                   (t <= SP_KT_SAVE || (t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3) ||
-                    (t >= SP_KT_PART1 && t < SP_KT_PART1 + 6)));
-        check_targets(ui);
-        // The hint fits under them (none on a canvas too small: only the portrait phone-sized one).
-        ENSURE(ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
-        ENSURE(ui->hint_box.h > 0 || ui->canvas.w * ui->canvas.h < 120 * 120 * ui->px_per_mm * ui->px_per_mm);
-        sp_kiosk_ui_destroy(ui);
-    }
+    for (int parts = 6; parts <= 12; parts += 6)
+        for (int s = 0; s < n_screens; ++s) {
+            sp_kiosk_ui* ui = started(&f);
+            sp_kiosk_ui_set_parts(ui, twelve, parts);
+            sp_kiosk_ui_resize(ui, screens[s].w, screens[s].h, screens[s].ppm);
+            // The six shipped parts always fit but on phones; a curator's
+            // twelve fit where they can, the rest not offered there.
+            int want = s >= n_screens - phones ? 0 : 6;
+            // A part: its label and two guesses show, with long names.
+            stroke(ui, 1000, 0.2f * (float)screens[s].w, 0.3f * (float)screens[s].h, 20, 0.02f * (float)screens[s].w);
+            sp_kiosk_job j;
+            ENSURE(sp_kiosk_ui_next_job(ui, &j));
+            sp_kiosk_ui_fit_done(
+                ui,
+                &(sp_kiosk_fit_result){.ok = true, .category = "front_legs", .guesses = {"hind_legs", "wings"}, .part_count = 1});
+            for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
+                ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) == (t <= SP_KT_CHIP_GUESS2 || t == SP_KT_CHIP_MORE));
+            check_targets(ui);
+            // The canvas keeps most of the screen.
+            ENSURE(ui->canvas.w * ui->canvas.h >= 0.45 * screens[s].w * screens[s].h);
+            // Far from every target: nothing (a phone's chips reach down its canvas).
+            ENSURE(sp_kiosk_ui_hit(ui, ui->canvas.x + 0.5f * ui->canvas.w, ui->canvas.y + 0.6f * ui->canvas.h) == SP_KT_NONE ||
+                   s >= n_screens - phones);
+            ENSURE(sp_kiosk_ui_hit(ui, NAN, 3) == SP_KT_NONE);
+            // "Other?" opens the row of parts in place of the two guesses, all of them targets.
+            sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 1500, 0, 0, SP_KT_CHIP_MORE});
+            int other_fit = ui->row_fit;
+            for (int t = SP_KT_CHIP_LABEL; t < SP_KT_COUNT; ++t)
+                ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
+                       (t == SP_KT_CHIP_LABEL || t == SP_KT_CHIP_MORE || (t >= SP_KT_PART1 && t < SP_KT_PART1 + ui->row_fit)));
+            check_targets(ui);
+            check_row_on_canvas(ui, want);
+            ENSURE(ui->hint_box.h == 0 || ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
+            sp_kiosk_ui_event(ui, &(sp_kiosk_event){SP_KEV_PRESS, 1600, 0, 0, SP_KT_CHIP_MORE}); // closed again
+            ENSURE(!sp_kiosk_ui_target_visible(ui, SP_KT_PART1) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS2));
+            // A refused stroke: three guesses and the parts, no label (on a
+            // phone drawn low, below the chips' lines).
+            float sy = 0.5f * (float)screens[s].h;
+            for (float k = 0.9f; s >= n_screens - phones && k > 0.2f; k -= 0.05f)
+                if (sp_kiosk_ui_hit(ui, 0.2f * (float)screens[s].w, sy = ui->canvas.y + k * ui->canvas.h) == SP_KT_NONE) break;
+            stroke(ui, 3000, 0.2f * (float)screens[s].w, sy, 20, 0.02f * (float)screens[s].w);
+            ENSURE(sp_kiosk_ui_next_job(ui, &j));
+            sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {"hind_legs", "front_legs", "torso"}});
+            for (int t = SP_KT_UNDO; t < SP_KT_COUNT; ++t)
+                ENSURE(sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) ==
+                       (t <= SP_KT_SAVE || (t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3) ||
+                        (t >= SP_KT_PART1 && t < SP_KT_PART1 + ui->row_fit)));
+            check_targets(ui);
+            check_row_on_canvas(ui, want);
+            fprintf(stderr, "  %d parts, %dx%d at %.0f dpi: %d tiles after Other?, %d with a refusal\n", parts, screens[s].w,
+                    screens[s].h, screens[s].ppm * 25.4, other_fit, ui->row_fit);
+            // The hint fits under them (none on a canvas too small: the portrait phone-sized ones).
+            ENSURE(ui->hint_box.h == 0 || ui->hint_box.y + ui->hint_box.h <= ui->canvas.y + ui->canvas.h);
+            ENSURE(ui->hint_box.h > 0 || ui->canvas.w * ui->canvas.h < 120 * 120 * ui->px_per_mm * ui->px_per_mm ||
+                   s >= n_screens - phones);
+            sp_kiosk_ui_destroy(ui);
+        }
     // Degenerate sizes and densities never crash and fall back to 96 dpi.
     sp_kiosk_ui* ui;
     sp_kiosk_ui_create(NULL, &ui, NULL);

@@ -205,7 +205,7 @@ static void keep_stroke_in_sight(sp_kiosk_ui* ui, float top, float end, float ma
     float bottom = ui->canvas.y + ui->canvas.h - margin, start = bottom - (end - top);
     if (start <= top || points_within(l, top, end) <= points_within(l, start, bottom)) return;
     float row_end = end - ui->hint_box.h - gap, dy = bottom - row_end;
-    for (int i = 0; i < ui->row_count; ++i)
+    for (int i = 0; i < ui->row_fit; ++i)
         ui->target[SP_KT_PART1 + i].y += dy;
     ui->hint_box.y = start;
 }
@@ -266,7 +266,19 @@ static void layout_chips(sp_kiosk_ui* ui)
             break;
         }
     }
-    for (int i = row ? ui->row_count : 0; i < SP_KIOSK_ROW_MAX; ++i)
+    // Tiles that do not fit even at the smallest target size (a phone, a
+    // portrait tablet with the guesses on a line each) are not offered:
+    // past the canvas they lay over the toolbar and took its taps.
+    ui->row_fit = 0;
+    float canvas_end = ui->canvas.y + ui->canvas.h - margin;
+    while (row && ui->row_fit < ui->row_count &&
+           ui->target[SP_KT_PART1 + ui->row_fit].y + ui->target[SP_KT_PART1 + ui->row_fit].h <= canvas_end)
+        ++ui->row_fit;
+    if (row && ui->row_fit < ui->row_count && ui->row_fit > 0) {
+        const sp_kiosk_rect* last = &ui->target[SP_KT_PART1 + ui->row_fit - 1];
+        below = last->y + last->h + gap;
+    }
+    for (int i = ui->row_fit; i < SP_KIOSK_ROW_MAX; ++i)
         ui->target[SP_KT_PART1 + i] = (sp_kiosk_rect){0};
     float hw = ui->canvas.w - 2 * margin, hh = 2.2f * ui->text_px;
     if (hw > (float)mm(ui, 220)) hw = (float)mm(ui, 220);
@@ -342,7 +354,7 @@ static bool visible(const sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     if (t <= SP_KT_NONE || t >= SP_KT_COUNT || ui->target[t].w <= 0) return false;
     if (ui->mode == SP_KM_ATTRACT) return false;
-    if (t >= SP_KT_PART1) return ui->mode == SP_KM_DRAW && row_shown(ui) && (int)t - SP_KT_PART1 < ui->row_count;
+    if (t >= SP_KT_PART1) return ui->mode == SP_KM_DRAW && row_shown(ui) && (int)t - SP_KT_PART1 < ui->row_fit;
     if (t == SP_KT_CHIP_MORE) return ui->mode == SP_KM_DRAW && ui->part_count > 0 && more_shown(ui);
     if (t >= SP_KT_CHIP_LABEL)
         return ui->mode == SP_KM_DRAW && (ui->part_count > 0 || ui->chips_offer) && ui->chip[t - SP_KT_CHIP_LABEL][0] &&

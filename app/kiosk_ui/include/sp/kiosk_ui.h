@@ -254,6 +254,7 @@ typedef struct sp_kiosk_ui {
     char chip[4][SP_KIOSK_LABEL_MAX];               ///< categories of the label and guesses 1-3 ("" = hidden)
     bool chips_offer;                               ///< the guesses are the held stroke's (no label)
     int row_count;                                  ///< parts in the row (a refusal's, or opened by "Other?")
+    int row_fit; ///< of them, those whose tiles fit on the canvas now (in order; the others are not offered on this screen)
     bool row_open;                                  ///< the row is open for the last part ("Other?")
     char row[SP_KIOSK_ROW_MAX][SP_KIOSK_LABEL_MAX]; ///< their categories
     uint64_t revision;                              ///< grows with every change of the dragon
