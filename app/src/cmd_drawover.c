@@ -123,9 +123,17 @@ int cmd_drawover(int argc, char** argv)
     // writes the file's own abstractions (sp_rig_posed.saved_abstractions).
     run.abstraction = sp_rig_add_abstraction(&ch->rig, &emb);
     if (run.abstraction < 0) goto oom;
-    sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
+    double scale = sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
+    // The weights the solve used (off: 0), so that it can be repeated with `pose`.
+    cJSON* w = cJSON_AddObjectToObject(rep_json, "weights");
+    if (w) {
+        cJSON_AddNumberToObject(w, "pose", fmax(run.desc.lambda_pose, 0));
+        cJSON_AddNumberToObject(w, "plane", fmax(run.desc.lambda_plane, 0));
+        cJSON_AddNumberToObject(w, "dist", fmax(run.desc.lambda_dist, 0));
+        cJSON_AddNumberToObject(w, "scaled_by", scale);
+    }
     sp_solve_outputs o = {.report = report, .out = out, .render = render, .strokes = &to, .ghost = &on, .note = rep.note};
     if (sp_solve_cmd_write(&run, rep_json, p, &o)) exit_code = SP_EXIT_OK;
     goto done;

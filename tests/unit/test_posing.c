@@ -924,6 +924,12 @@ static void test_drawover_canvas(void)
             cJSON* j = cJSON_Parse(r);
             free(r);
             mean_px[round] = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "mean_error_px"));
+            // The weights used: the paper's, scaled to the curve (sp_drawover_scale_weights).
+            const cJSON* w = cJSON_GetObjectItem(j, "weights");
+            double by = cJSON_GetNumberValue(cJSON_GetObjectItem(w, "scaled_by"));
+            ENSURE(w && by >= 1 && by <= 10000);
+            ENSURE_NEAR(cJSON_GetNumberValue(cJSON_GetObjectItem(w, "dist")), SP_LAMBDA_DIST * by, 1e-12 * by);
+            ENSURE_NEAR(cJSON_GetNumberValue(cJSON_GetObjectItem(w, "pose")), SP_LAMBDA_POSE * by, 1e-12 * by);
             cJSON_Delete(j);
             fprintf(stderr, "  mean error %.2f px\n", mean_px[round]);
         }
