@@ -55,8 +55,13 @@ bool* sp_drawover_active(const sp_rig* rig)
 {
     bool* on = malloc(sizeof(bool) * (size_t)(rig->param_count + 1));
     if (!on) return NULL;
+    // The placement joint: the first with parameters, when it translates the
+    // whole character (its rotation and scale then turn and grow it all).
+    bool placement = false;
     for (int q = 0; q < rig->param_count; ++q)
-        on[q] = !sp_rig_param_shifts(rig, q);
+        placement |= sp_rig_param_shifts(rig, q);
+    for (int q = 0; q < rig->param_count; ++q)
+        on[q] = !(placement && rig->params[q].joint == rig->params[0].joint);
     return on;
 }
 

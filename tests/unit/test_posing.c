@@ -930,6 +930,11 @@ static void test_drawover_canvas(void)
             ENSURE(w && by >= 1 && by <= 10000);
             ENSURE_NEAR(cJSON_GetNumberValue(cJSON_GetObjectItem(w, "dist")), SP_LAMBDA_DIST * by, 1e-12 * by);
             ENSURE_NEAR(cJSON_GetNumberValue(cJSON_GetObjectItem(w, "pose")), SP_LAMBDA_POSE * by, 1e-12 * by);
+            // The character stands where it was: the placement joint neither turns nor grows it
+            // (a line down the body redrawn bent grew the cartoon man by a quarter).
+            const cJSON* params = cJSON_GetObjectItem(j, "parameters");
+            ENSURE(cJSON_GetNumberValue(cJSON_GetObjectItem(params, "root.rz")) == 0 &&
+                   cJSON_GetNumberValue(cJSON_GetObjectItem(params, "root.s")) == 1);
             cJSON_Delete(j);
             fprintf(stderr, "  mean error %.2f px\n", mean_px[round]);
         }
