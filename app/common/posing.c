@@ -51,17 +51,35 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
     return SP_OK;
 }
 
+// The nearest joint that is an ancestor of both (or one of them); -1: none.
+// Parents come before children, so the larger index walks up.
+static int common_ancestor(const sp_rig* rig, int a, int b)
+{
+    while (a != b && a >= 0 && b >= 0)
+        if (a > b)
+            a = rig->joints[a].parent;
+        else
+            b = rig->joints[b].parent;
+    return a == b ? a : -1;
+}
+
 bool* sp_drawover_active(const sp_rig* rig)
 {
     bool* on = malloc(sizeof(bool) * (size_t)(rig->param_count + 1));
     if (!on) return NULL;
     // The placement joint: the first with parameters, when it translates the
-    // whole character (its rotation and scale then turn and grow it all).
+    // whole character (its rotation and scale then turn and grow it all);
+    // and the body's root under it, the nearest common ancestor of every
+    // other joint with parameters (hips, pelvis: a loader's derived
+    // placement only translates, and the hips' turn is the whole figure's).
     bool placement = false;
     for (int q = 0; q < rig->param_count; ++q)
         placement |= sp_rig_param_shifts(rig, q);
+    int place = rig->param_count > 0 ? rig->params[0].joint : -1, body = -2;
+    for (int j = 0; placement && j < rig->joint_count; ++j)
+        if (j != place && rig->joints[j].param_count > 0) body = body == -2 ? j : common_ancestor(rig, body, j);
     for (int q = 0; q < rig->param_count; ++q)
-        on[q] = !(placement && rig->params[q].joint == rig->params[0].joint);
+        on[q] = !(placement && (rig->params[q].joint == place || rig->params[q].joint == body));
     return on;
 }
 

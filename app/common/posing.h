@@ -19,10 +19,11 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// The parameters a draw-over solve may move (sp_solve_desc.active;
 /// malloc'd, param_count of them; NULL when out of memory): all but the
 /// placement joint's (the first joint with parameters, when it translates
-/// the whole character: its translations, rotation and scale). Draw-over
-/// bends the character where it stands: a curve over one arm moved the
-/// whole of CesiumMan (the loader's derived placement) to fit it, and
-/// turned and shrank the whole cartoon man.
+/// the whole character: its translations, rotation and scale) and those of
+/// the body's root (the nearest common ancestor of the other joints with
+/// parameters: hips, pelvis). Draw-over bends the character where it
+/// stands: a curve over one arm moved the whole of CesiumMan (the loader's
+/// derived placement) to fit it, and turned and grew the whole cartoon man.
 bool* sp_drawover_active(const sp_rig* rig);
 /// Scales a draw-over solve's regulariser weights (0: the defaults; < 0:
 /// off, kept) by (the character's size on the canvas / the embedded curves'
