@@ -146,6 +146,15 @@ static void look(const sp_kiosk_ui* ui)
         const char* s = sp_kiosk_ui_target_text(ui, k, text, sizeof text);
         CHECK(!s || strlen(s) < sizeof text || s != text);
     }
+    // The parts row's tiles shown lie on the canvas (past it they lay over the toolbar).
+    CHECK(ui->row_fit >= 0 && ui->row_fit <= ui->row_count && ui->row_count <= SP_KIOSK_ROW_MAX);
+    for (int i = 0; i < SP_KIOSK_ROW_MAX; ++i) {
+        sp_kiosk_target k = (sp_kiosk_target)(SP_KT_PART1 + i);
+        if (!sp_kiosk_ui_target_visible(ui, k)) continue;
+        const sp_kiosk_rect* r = &ui->target[k];
+        CHECK(i < ui->row_fit && r->y + r->h <= ui->canvas.y + ui->canvas.h + 1e-3f &&
+              r->x + r->w <= ui->canvas.x + ui->canvas.w + 1e-3f);
+    }
     const char* m = sp_kiosk_ui_message(ui);
     CHECK(!m || strlen(m) < 4096);
     double c = sp_kiosk_ui_countdown_s(ui), f = sp_kiosk_ui_fade(ui);

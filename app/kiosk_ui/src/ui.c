@@ -270,13 +270,15 @@ static void layout_chips(sp_kiosk_ui* ui)
     // portrait tablet with the guesses on a line each) are not offered:
     // past the canvas they lay over the toolbar and took its taps.
     ui->row_fit = 0;
-    float canvas_end = ui->canvas.y + ui->canvas.h - margin;
-    while (row && ui->row_fit < ui->row_count &&
-           ui->target[SP_KT_PART1 + ui->row_fit].y + ui->target[SP_KT_PART1 + ui->row_fit].h <= canvas_end)
-        ++ui->row_fit;
-    if (row && ui->row_fit < ui->row_count && ui->row_fit > 0) {
-        const sp_kiosk_rect* last = &ui->target[SP_KT_PART1 + ui->row_fit - 1];
-        below = last->y + last->h + gap;
+    float canvas_end = ui->canvas.y + ui->canvas.h - margin, canvas_right = ui->canvas.x + ui->canvas.w;
+    for (; row && ui->row_fit < ui->row_count; ++ui->row_fit) {
+        const sp_kiosk_rect* r = &ui->target[SP_KT_PART1 + ui->row_fit];
+        if (r->y + r->h > canvas_end || r->x + r->w > canvas_right) break;
+    }
+    if (row && ui->row_fit < ui->row_count) {
+        // The hint goes under the tiles shown (under the chips when none is).
+        below = ui->row_fit > 0 ? ui->target[SP_KT_PART1 + ui->row_fit - 1].y + ui->target[SP_KT_PART1 + ui->row_fit - 1].h + gap
+                                : chips_end;
     }
     for (int i = ui->row_fit; i < SP_KIOSK_ROW_MAX; ++i)
         ui->target[SP_KT_PART1 + i] = (sp_kiosk_rect){0};
