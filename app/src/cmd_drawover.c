@@ -126,7 +126,7 @@ int cmd_drawover(int argc, char** argv)
     double scale = sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
-    // The weights the solve used (off: 0), so that it can be repeated with `pose`.
+    // The weights the solve used (off: 0): they are scaled to the drawn curves.
     cJSON* w = cJSON_AddObjectToObject(rep_json, "weights");
     if (w) {
         cJSON_AddNumberToObject(w, "pose", fmax(run.desc.lambda_pose, 0));
