@@ -1317,6 +1317,15 @@ static void collector_wait(kiosk_collector* c, int want, int* stored, int* dropp
     }
 }
 
+// Hands the collector the tail's stroke, waits until `want` sketches in all
+// were stored or dropped, and closes it: the final counts.
+static void last_sketch_and_close(kiosk_collector* c, int want, int* stored, int* dropped)
+{
+    kiosk_collector_push(c, "tail", g_strokes[3].xy, NULL, g_strokes[3].n);
+    collector_wait(c, want, stored, dropped);
+    kiosk_collector_close(c, stored, dropped);
+}
+
 // The collector alone on db, a tail's stroke handed to it and settled.
 static kiosk_collector* collector_after_one(const char* db, int* stored, int* dropped)
 {
@@ -1343,13 +1352,10 @@ static void test_collect_mended(void)
     ENSURE(fclose(f) == 0);
     int stored = 0, dropped = 0;
     kiosk_collector* c = collector_after_one(db, &stored, &dropped);
-    const stroke* s = &g_strokes[3];
     ENSURE(stored == 0 && dropped == 1);
     e2e_db_copy("kiosk_mended_good.db", good, sizeof good);
     ENSURE(rename(good, db) == 0);
-    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
-    collector_wait(c, 2, &stored, &dropped);
-    kiosk_collector_close(c, &stored, &dropped);
+    last_sketch_and_close(c, 2, &stored, &dropped);
     fprintf(stderr, "  stored %d, dropped %d\n", stored, dropped);
     ENSURE(stored == 1 && dropped == 1);
     ENSURE(pending_count(db) == 1);
@@ -1379,7 +1385,6 @@ static void test_collect_stale_wal(void)
     live_and_next("kiosk_stale", db, next, wal);
     int stored = 0, dropped = 0;
     kiosk_collector* c = collector_after_one(db, &stored, &dropped);
-    const stroke* s = &g_strokes[3];
     ENSURE(stored == 1);
     // The curator's write stays in the old file's WAL.
     sqlite3* h = NULL;
@@ -1396,9 +1401,7 @@ static void test_collect_stale_wal(void)
     struct stat st;
     ENSURE(stat(wal, &st) == 0 && st.st_size > 0);
     ENSURE(rename(next, db) == 0);
-    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
-    collector_wait(c, 2, &stored, &dropped);
-    kiosk_collector_close(c, &stored, &dropped);
+    last_sketch_and_close(c, 2, &stored, &dropped);
     fprintf(stderr, "  stored %d, dropped %d\n", stored, dropped);
     ENSURE(stored == 2 && dropped == 0);
     // The new file: its own tables, whole, and the sketch.
@@ -1860,9 +1863,7 @@ static void test_collect_full(void)
                         "'kiosk')",
                         NULL, NULL, NULL) == SQLITE_OK);
     sqlite3_close(h);
-    kiosk_collector_push(c, "tail", s->xy, NULL, s->n);
-    collector_wait(c, 3, &stored, &dropped);
-    kiosk_collector_close(c, &stored, &dropped);
+    last_sketch_and_close(c, 3, &stored, &dropped);
     fprintf(stderr, "  one reviewed: stored %d, dropped %d\n", stored, dropped);
     ENSURE(stored == 2 && dropped == 1);
 }

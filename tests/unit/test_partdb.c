@@ -195,6 +195,18 @@ static const char* sketchpose_bin(void)
     return access(b, X_OK) == 0 ? b : NULL;
 }
 
+// `sketchpose db train` on the database at p, quickly (no folds, 64 words),
+// with `more` (options, redirections) appended; its exit status, what it
+// printed in out. Skips the test when the command is not built.
+static int quick_train_cli(const char* p, const char* more, char* out, size_t size)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --folds -1 --words 64 %s", bin, p, more);
+    return sp_fixture_run(cmd, out, size);
+}
+
 // ---- tests ---------------------------------------------------------------------------
 
 static void test_sha256(void)
@@ -1189,11 +1201,8 @@ static void test_keep_models(void)
     check_ok(db);
     sp_db_close(db);
     // The command: --keep-models, and the count in its report.
-    const char* bin = sketchpose_bin();
-    if (!bin) SKIP("sketchpose not built");
-    char cmd[4096], out[65536];
-    snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --folds -1 --words 64 --keep-models 1 2>/dev/null", bin, p);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"models_removed\": 1"));
+    char out[65536];
+    ENSURE(quick_train_cli(p, "--keep-models 1 2>/dev/null", out, sizeof out) == 0 && strstr(out, "\"models_removed\": 1"));
     ENSURE(scalar(p, "SELECT count(*) FROM models") == 1 && scalar(p, "SELECT max(id) FROM models") == newest + 3);
 }
 
@@ -1524,11 +1533,8 @@ static void test_curated_cap(void)
     free(report);
     sp_db_close(db);
     // The command says what it left out, in one line.
-    const char* bin = sketchpose_bin();
-    if (!bin) SKIP("sketchpose not built");
-    char cmd[2400], out[65536];
-    snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --folds -1 --words 64 --curated-max 25 2>&1 >/dev/null", bin, p);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    char out[65536];
+    ENSURE(quick_train_cli(p, "--curated-max 25 2>&1 >/dev/null", out, sizeof out) == 0);
     fprintf(stderr, "  %s", out);
     ENSURE(strstr(out, "5 curated sketches left out of training: at most 25 a category") &&
            strchr(out, '\n') == out + strlen(out) - 1);
