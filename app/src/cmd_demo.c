@@ -146,6 +146,21 @@ static sp_result part_stroke(sp_db* db, int li, uint64_t seed, sp_vec2 at, sp_ve
     return r;
 }
 
+// The database at path is about to be built from assets by the default
+// recipe: said, with a note when the people's strokes are not there to go in.
+static void announce_build(const char* path, const char* assets)
+{
+    fprintf(stderr, "creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
+    int picks;
+    bool missing = false;
+    sp_error err = {0};
+    if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
+        fprintf(stderr,
+                "note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's "
+                "strokes (fewer visitors' drawings recognised)\n",
+                assets);
+}
+
 int cmd_demo(int argc, char** argv)
 {
     const char *out_dir = "demo-out", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets";
@@ -183,16 +198,7 @@ int cmd_demo(int argc, char** argv)
     const char* path = db_path ? db_path : sp_db_default_path();
     struct stat st;
     bool created = stat(path, &st) != 0;
-    if (created) {
-        fprintf(stderr, "creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
-        int picks;
-        bool missing = false;
-        if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
-            fprintf(stderr,
-                    "note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's "
-                    "strokes (fewer visitors' drawings recognised)\n",
-                    assets);
-    }
+    if (created) announce_build(path, assets);
     if (sp_db_open_or_create_default(path, assets, SP_DB_READONLY, &db, &err) != SP_OK) {
         fprintf(stderr, "sketchpose demo: %s\n", err.text);
         if (made_out) rmdir(out_dir);

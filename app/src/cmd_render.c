@@ -47,6 +47,27 @@ static void orbit_camera(sp_camera* cam, sp_vec3 c, double yaw, double pitch)
     cam->view = sp_mat4_mul(&cam_m, &view);
 }
 
+// The abstraction in yellow, its open curves' ends as dots; a dark halo
+// first so that yellow reads on light skin and background. ends: room for
+// two a curve.
+static void draw_overlay(sp_renderer* r, const sp_camera* cam, const sp_abstraction* ab, const double* zxyz, sp_vec2* ends,
+                         float lw)
+{
+    int n_ends = 0;
+    for (int c = 0; c < ab->curve_count; ++c) {
+        const sp_curve* cv = &ab->curves[c];
+        if (cv->point_count < 1 || cv->closed) continue;
+        const double* a = zxyz + 3 * (size_t)cv->first_point;
+        const double* b = zxyz + 3 * (size_t)(cv->first_point + cv->point_count - 1);
+        ends[n_ends++] = sp_camera_project(cam, sp_v3(a[0], a[1], a[2]));
+        ends[n_ends++] = sp_camera_project(cam, sp_v3(b[0], b[1], b[2]));
+    }
+    sp_renderer_draw_abstraction(r, ab, zxyz, lw + 2.0f * fmaxf(1.0f, 0.35f * lw), SP_COLOR_OUTLINE);
+    sp_renderer_draw_dots(r, ends, n_ends, 0.5f * lw * 1.6f + fmaxf(1.0f, 0.35f * lw), SP_COLOR_OUTLINE);
+    sp_renderer_draw_abstraction(r, ab, zxyz, lw, SP_COLOR_ABSTRACTION);
+    sp_renderer_draw_dots(r, ends, n_ends, 0.5f * lw * 1.6f, SP_COLOR_ABSTRACTION);
+}
+
 int cmd_render(int argc, char** argv)
 {
     const char *rig_path = NULL, *pose_path = NULL, *abs_name = NULL, *out_path = NULL, *size = NULL;
@@ -165,22 +186,7 @@ int cmd_render(int argc, char** argv)
     sp_renderer_clear(r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
     if (!no_shadow) sp_renderer_draw_ground_shadow(r, lo, hi, 0.0f);
     sp_renderer_draw_mesh(r, mesh, NULL);
-    if (ab) {
-        // A dark halo first so that yellow reads on light skin and background.
-        int n_ends = 0;
-        for (int c = 0; c < ab->curve_count; ++c) {
-            const sp_curve* cv = &ab->curves[c];
-            if (cv->point_count < 1 || cv->closed) continue;
-            const double* a = zxyz + 3 * (size_t)cv->first_point;
-            const double* b = zxyz + 3 * (size_t)(cv->first_point + cv->point_count - 1);
-            ends[n_ends++] = sp_camera_project(&cam, sp_v3(a[0], a[1], a[2]));
-            ends[n_ends++] = sp_camera_project(&cam, sp_v3(b[0], b[1], b[2]));
-        }
-        sp_renderer_draw_abstraction(r, ab, zxyz, lw + 2.0f * fmaxf(1.0f, 0.35f * lw), SP_COLOR_OUTLINE);
-        sp_renderer_draw_dots(r, ends, n_ends, 0.5f * lw * 1.6f + fmaxf(1.0f, 0.35f * lw), SP_COLOR_OUTLINE);
-        sp_renderer_draw_abstraction(r, ab, zxyz, lw, SP_COLOR_ABSTRACTION);
-        sp_renderer_draw_dots(r, ends, n_ends, 0.5f * lw * 1.6f, SP_COLOR_ABSTRACTION);
-    }
+    if (ab) draw_overlay(r, &cam, ab, zxyz, ends, lw);
     sp_renderer_end(r);
     if (sp_render_target_read(target, &img, &err) != SP_OK || sp_image_write_png(&img, out_path, &err) != SP_OK) {
         fprintf(stderr, "sketchpose render: %s\n", err.text);

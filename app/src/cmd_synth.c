@@ -65,8 +65,10 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     // Only the .glb and .gltf files, in the listing's sorted order.
     int kept = 0;
     for (int k = 0; k < n; ++k) {
-        if (sp_path_ext_is(names[k], "glb") || sp_path_ext_is(names[k], "gltf")) names[kept++] = names[k];
-        else free(names[k]);
+        if (sp_path_ext_is(names[k], "glb") || sp_path_ext_is(names[k], "gltf"))
+            names[kept++] = names[k];
+        else
+            free(names[k]);
     }
     n = kept;
     int code = SP_EXIT_INPUT;
@@ -123,7 +125,8 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
                 goto fail;
             }
             char file[4400];
-            snprintf(file, sizeof file, "%s/%s-%s-s%llu-%04d.json", cdir, stem, sp_handdraw_style_name(style), (unsigned long long)family, i);
+            snprintf(file, sizeof file, "%s/%s-%s-s%llu-%04d.json", cdir, stem, sp_handdraw_style_name(style),
+                     (unsigned long long)family, i);
             sp_result r = sp_sketch_write_json(file, &sk, &err);
             sp_sketch_free(&sk);
             if (r != SP_OK) {
@@ -188,7 +191,8 @@ static int synth_concepts(int per_part, uint64_t family, bool clean, const char*
         if (out_dir && sp_dir_make(cdir, &err) != SP_OK) goto fail;
         for (int i = 0; i < per_part; ++i, ++made) {
             uint64_t sd = sp_concept_seed((sp_concept)c, family, i);
-            sp_result r = clean ? sp_concept_clean((sp_concept)c, sd, &sk[made], &err) : sp_concept_sketch((sp_concept)c, sd, &sk[made], &err);
+            sp_result r = clean ? sp_concept_clean((sp_concept)c, sd, &sk[made], &err)
+                                : sp_concept_sketch((sp_concept)c, sd, &sk[made], &err);
             if (r != SP_OK) goto fail;
             snprintf(labels[made], sizeof labels[made], "%s %d", sp_concept_name((sp_concept)c), i);
             items[made] = (sp_sheet_item){.sketch = &sk[made], .label = labels[made]};
@@ -199,7 +203,8 @@ static int synth_concepts(int per_part, uint64_t family, bool clean, const char*
     }
     char title[96];
     snprintf(title, sizeof title, "concept sketches, seed family %llu", (unsigned long long)family);
-    if (sheet && sp_sheet_write_png(items, n, &(sp_sheet_desc){.cols = per_part < 12 ? per_part : 12, .title = title}, sheet, &err) != SP_OK)
+    if (sheet && sp_sheet_write_png(items, n, &(sp_sheet_desc){.cols = per_part < 12 ? per_part : 12, .title = title}, sheet,
+                                    &err) != SP_OK)
         goto fail;
     printf("{\"concepts\": %d, \"per_part\": %d, \"seed\": %llu}\n", made, per_part, (unsigned long long)family);
     code = SP_EXIT_OK;
@@ -271,6 +276,93 @@ static void warn_off_canvas(const sp_sketch* sk, const char* out)
                 sk->canvas_w, sk->canvas_h);
 }
 
+// --shape's value (NULL: outline), SP_HANDDRAW_SHAPE_COUNT when unknown.
+static int shape_index(const char* name)
+{
+    static const char* const shapes[SP_HANDDRAW_SHAPE_COUNT] = {"outline", "top", "underside", "line", "piece"};
+    int k = 0;
+    while (name && k < SP_HANDDRAW_SHAPE_COUNT && strcmp(shapes[k], name) != 0)
+        ++k;
+    return k;
+}
+
+// The rig mode's options, checked.
+typedef struct rig_job {
+    const char *rig_path, *abs_name, *pose;
+    int seed;
+    double amplitude;
+    int w, h;                // 0: the rig's sketch view
+    sp_handdraw_style style; // SP_HANDDRAW_STYLE_COUNT: not hand-drawn
+    double noise;
+    const char *out, *truth;
+} rig_job;
+
+// The rig mode's numbers and --size (into j->w, j->h): one line and false
+// when one is out of range.
+static bool rig_job_ok(rig_job* j, const char* size)
+{
+    if (size && !sp_cli_parse_size(size, &j->w, &j->h)) {
+        fprintf(stderr, "sketchpose synth: --size expects WxH with sides 16..8192, got '%s'\n", size);
+        return false;
+    }
+    if (j->amplitude < 0) {
+        fprintf(stderr, "sketchpose synth: --amplitude must not be negative\n");
+        return false;
+    }
+    // At most the largest canvas side (--size): jitter beyond the canvas is
+    // no drawing, and 1e300 px wrote strokes that readers refuse.
+    if (!sp_cli_check_double("sketchpose synth", "--noise", j->noise, 0, false, 8192)) return false;
+    if (j->style != SP_HANDDRAW_STYLE_COUNT && sp_rig_path_is_plugin(j->rig_path)) {
+        fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
+        return false;
+    }
+    return true;
+}
+
+// Writes the strokes of a pose (random, or j->pose) of the rig's abstraction.
+static int synth_rig(const rig_job* j)
+{
+    sp_rig_handle* rig = NULL;
+    sp_error err = {0};
+    sp_sketch sk = {0};
+    sp_outputs staged = {0};
+    double* p = NULL;
+    int exit_code = SP_EXIT_INPUT;
+    if (sp_rig_handle_load(j->rig_path, &rig, &err) != SP_OK) goto fail;
+    int a = sp_rig_handle_pick_abstraction(rig, j->abs_name, &err);
+    if (a < 0) goto fail;
+    sp_camera cam = sp_rig_handle_camera(rig, j->w, j->h);
+    if (sp_rig_handle_read_pose(rig, j->pose, &p, NULL, &err) != SP_OK) goto fail;
+    if (!j->pose) sp_rig_handle_synth_params(rig, (uint64_t)(unsigned)j->seed, j->amplitude, p);
+    if (sp_rig_handle_synth_sketch(rig, a, &cam, p, &sk, &err) != SP_OK) goto fail;
+    if (j->style != SP_HANDDRAW_STYLE_COUNT) {
+        sp_handdraw_params hp = sp_handdraw_preset(j->style);
+        sp_sketch drawn;
+        if (sp_handdraw_apply(&sk, &hp, sp_handdraw_seed((uint64_t)(unsigned)j->seed, 0), &drawn, NULL, &err) != SP_OK) goto fail;
+        sp_sketch_free(&sk);
+        sk = drawn;
+    }
+    if (j->noise > 0) sp_synth_jitter(&sk, j->noise, (uint64_t)(unsigned)j->seed);
+    // The strokes and their pose together or neither (sp_outputs).
+    const char *out_to, *truth_to;
+    if (sp_outputs_stage(&staged, j->out, &out_to, &err) != SP_OK ||
+        sp_outputs_stage(&staged, j->truth, &truth_to, &err) != SP_OK || sp_sketch_write_json(out_to, &sk, &err) != SP_OK ||
+        (truth_to && sp_pose_write(truth_to, sp_rig_handle_params(rig), sp_rig_handle_param_count(rig), p, &err) != SP_OK) ||
+        sp_outputs_commit(&staged, &err) != SP_OK)
+        goto fail;
+    warn_off_canvas(&sk, j->out);
+    exit_code = SP_EXIT_OK;
+    goto done;
+fail:
+    sp_outputs_undo(&staged, &err);
+    fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
+done:
+    free(p);
+    sp_sketch_free(&sk);
+    sp_rig_handle_free(rig);
+    return exit_code;
+}
+
 int cmd_synth(int argc, char** argv)
 {
     const char *rig_path = NULL, *abs_name = NULL, *out = NULL, *truth = NULL, *size = NULL, *pose = NULL;
@@ -316,10 +408,11 @@ int cmd_synth(int argc, char** argv)
          false},
         {"--sheet", SP_OPT_OUT, &sheet, "S.png", "with --concepts or --drawings: a labelled contact sheet of them", false},
     };
-    int rc = sp_cli_parse(argc, argv, "sketchpose synth",
-                          "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "
-                          "with --parts DIR --out-dir D, a labelled folder of hand-drawn sketches of every part (seed family --seed).",
-                          opts, (int)(sizeof opts / sizeof opts[0]));
+    int rc =
+        sp_cli_parse(argc, argv, "sketchpose synth",
+                     "Writes the strokes of a random pose of the rig's abstraction (--style: as drawn by hand); "
+                     "with --parts DIR --out-dir D, a labelled folder of hand-drawn sketches of every part (seed family --seed).",
+                     opts, (int)(sizeof opts / sizeof opts[0]));
     if (rc >= 0) return rc;
     if (!sp_cli_check_out("sketchpose synth", "--sheet", sheet, SP_CLI_OUT_PNG) ||
         !sp_cli_check_out("sketchpose synth", "--out", out, SP_CLI_OUT_STROKES))
@@ -345,13 +438,16 @@ int cmd_synth(int argc, char** argv)
     }
     if (concepts) {
         if (parts || rig_path || out || pose || truth || size || (!out_dir && !sheet)) {
-            fprintf(stderr, "sketchpose synth: --concepts needs --out-dir D or --sheet S.png and takes none of --parts, --rig, --out, "
-                            "--pose, --truth, --size\n");
+            fprintf(stderr,
+                    "sketchpose synth: --concepts needs --out-dir D or --sheet S.png and takes none of --parts, --rig, --out, "
+                    "--pose, --truth, --size\n");
             return SP_EXIT_USAGE;
         }
-        if (per_part < 1 || per_part > 10000 || seed < 0 || (style != SP_HANDDRAW_STYLE_COUNT && style != SP_HANDDRAW_NORMAL &&
-                                                             style != SP_HANDDRAW_CLEAN)) {
-            fprintf(stderr, "sketchpose synth: --per-part must be 1..10000 with --concepts, --seed not negative, --style normal or clean\n");
+        if (per_part < 1 || per_part > 10000 || seed < 0 ||
+            (style != SP_HANDDRAW_STYLE_COUNT && style != SP_HANDDRAW_NORMAL && style != SP_HANDDRAW_CLEAN)) {
+            fprintf(
+                stderr,
+                "sketchpose synth: --per-part must be 1..10000 with --concepts, --seed not negative, --style normal or clean\n");
             return SP_EXIT_USAGE;
         }
         static const char* const taken[] = {"--concepts", "--per-part", "--seed", "--style", "--out-dir", "--sheet", NULL};
@@ -363,21 +459,20 @@ int cmd_synth(int argc, char** argv)
     }
     if (parts) {
         if (!out_dir || rig_path || out || pose || truth || size) {
-            fprintf(stderr, "sketchpose synth: --parts DIR needs --out-dir D and takes none of --rig, --out, --pose, --truth, --size\n");
+            fprintf(stderr,
+                    "sketchpose synth: --parts DIR needs --out-dir D and takes none of --rig, --out, --pose, --truth, --size\n");
             return SP_EXIT_USAGE;
         }
         if (per_part < 1 || per_part > 100000 || seed < 0 || amplitude < 0 || noise != 0) {
-            fprintf(stderr, "sketchpose synth: --per-part must be 1..100000, --seed and --amplitude not negative; --noise does not apply to --parts\n");
+            fprintf(stderr, "sketchpose synth: --per-part must be 1..100000, --seed and --amplitude not negative; --noise does "
+                            "not apply to --parts\n");
             return SP_EXIT_USAGE;
         }
         sp_handdraw_desc hd = {.style = style == SP_HANDDRAW_STYLE_COUNT ? SP_HANDDRAW_NORMAL : style,
                                .amplitude = has_opt(argc, argv, "--amplitude") ? amplitude : 0.0,
                                .details = details,
                                .spikes = spikes};
-        static const char* const shapes[SP_HANDDRAW_SHAPE_COUNT] = {"outline", "top", "underside", "line", "piece"};
-        int k = 0;
-        while (shape_name && k < SP_HANDDRAW_SHAPE_COUNT && strcmp(shapes[k], shape_name) != 0)
-            ++k;
+        int k = shape_index(shape_name);
         if (k == SP_HANDDRAW_SHAPE_COUNT || !(spikes >= 0 && spikes <= 1)) {
             fprintf(stderr, "sketchpose synth: --shape must be outline, top, underside, line or piece, and --spikes 0..1\n");
             return SP_EXIT_USAGE;
@@ -403,61 +498,9 @@ int cmd_synth(int argc, char** argv)
         fprintf(stderr, "sketchpose synth: --seed must not be negative, got %d\n", seed);
         return SP_EXIT_USAGE;
     }
-    int w = 0, h = 0;
-    if (size && !sp_cli_parse_size(size, &w, &h)) {
-        fprintf(stderr, "sketchpose synth: --size expects WxH with sides 16..8192, got '%s'\n", size);
-        return SP_EXIT_USAGE;
-    }
-    if (amplitude < 0) {
-        fprintf(stderr, "sketchpose synth: --amplitude must not be negative\n");
-        return SP_EXIT_USAGE;
-    }
-    // At most the largest canvas side (--size): jitter beyond the canvas is
-    // no drawing, and 1e300 px wrote strokes that readers refuse.
-    if (!sp_cli_check_double("sketchpose synth", "--noise", noise, 0, false, 8192)) return SP_EXIT_USAGE;
-    if (style != SP_HANDDRAW_STYLE_COUNT && sp_rig_path_is_plugin(rig_path)) {
-        fprintf(stderr, "sketchpose synth: --style is not available for black-box rig plugins (.so)\n");
-        return SP_EXIT_USAGE;
-    }
+    rig_job job = {rig_path, abs_name, pose, seed, amplitude, 0, 0, style, noise, out, truth};
+    if (!rig_job_ok(&job, size)) return SP_EXIT_USAGE;
     if (!sp_cli_check_out_folders("sketchpose synth", opts, (int)(sizeof opts / sizeof opts[0])))
         return SP_EXIT_INPUT; // before the work
-    sp_rig_handle* rig = NULL;
-    sp_error err = {0};
-    sp_sketch sk = {0};
-    sp_outputs staged = {0};
-    double* p = NULL;
-    int exit_code = SP_EXIT_INPUT;
-    if (sp_rig_handle_load(rig_path, &rig, &err) != SP_OK) goto fail;
-    int a = sp_rig_handle_pick_abstraction(rig, abs_name, &err);
-    if (a < 0) goto fail;
-    sp_camera cam = sp_rig_handle_camera(rig, w, h);
-    if (sp_rig_handle_read_pose(rig, pose, &p, NULL, &err) != SP_OK) goto fail;
-    if (!pose) sp_rig_handle_synth_params(rig, (uint64_t)(unsigned)seed, amplitude, p);
-    if (sp_rig_handle_synth_sketch(rig, a, &cam, p, &sk, &err) != SP_OK) goto fail;
-    if (style != SP_HANDDRAW_STYLE_COUNT) {
-        sp_handdraw_params hp = sp_handdraw_preset(style);
-        sp_sketch drawn;
-        if (sp_handdraw_apply(&sk, &hp, sp_handdraw_seed((uint64_t)(unsigned)seed, 0), &drawn, NULL, &err) != SP_OK) goto fail;
-        sp_sketch_free(&sk);
-        sk = drawn;
-    }
-    if (noise > 0) sp_synth_jitter(&sk, noise, (uint64_t)(unsigned)seed);
-    // The strokes and their pose together or neither (sp_outputs).
-    const char *out_to, *truth_to;
-    if (sp_outputs_stage(&staged, out, &out_to, &err) != SP_OK || sp_outputs_stage(&staged, truth, &truth_to, &err) != SP_OK ||
-        sp_sketch_write_json(out_to, &sk, &err) != SP_OK ||
-        (truth_to && sp_pose_write(truth_to, sp_rig_handle_params(rig), sp_rig_handle_param_count(rig), p, &err) != SP_OK) ||
-        sp_outputs_commit(&staged, &err) != SP_OK)
-        goto fail;
-    warn_off_canvas(&sk, out);
-    exit_code = SP_EXIT_OK;
-    goto done;
-fail:
-    sp_outputs_undo(&staged, &err);
-    fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
-done:
-    free(p);
-    sp_sketch_free(&sk);
-    sp_rig_handle_free(rig);
-    return exit_code;
+    return synth_rig(&job);
 }

@@ -363,6 +363,21 @@ static void terminate_glfw(void)
 #endif
 }
 
+// The database is about to be built by the default recipe: a line when the
+// people's strokes are not there to go in, and the loading screen.
+static void announce_build(GLFWwindow* win, const char* assets, const char* font)
+{
+    int picks;
+    bool missing = false;
+    sp_error err = {0};
+    if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
+        fprintf(stderr,
+                "%s: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building the database without the "
+                "people's strokes (fewer visitors' drawings recognised)\n",
+                k_cmd, assets);
+    loading_screen(win, font);
+}
+
 // Writes <screenshot stem>-<mark>.png.
 static void mark_path(const char* shot, const char* name, char* out, size_t cap)
 {
@@ -427,6 +442,132 @@ static bool numbers_ok(int* lod, int* msaa, int* max_parts, int* keep_days, doub
     if (*max_parts == SP_CLI_UNSET) *max_parts = 0;
     if (*keep_days == SP_CLI_UNSET) *keep_days = 0;
     return true;
+}
+
+// The kiosk's window, its context current (NULL, one line said, when none
+// opens). Full screen takes the monitor's size into *win_w, *win_h.
+static GLFWwindow* open_window(bool fullscreen, bool scripted, int msaa, int* win_w, int* win_h)
+{
+    glfwSetErrorCallback(cb_error);
+    if (!glfwInit()) {
+        fprintf(stderr,
+                "%s: cannot open a window (no display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n",
+                k_cmd);
+        return NULL;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_SAMPLES, msaa >= 0 ? msaa : 4);
+    glfwWindowHint(GLFW_STENCIL_BITS, 8);
+    glfwWindowHint(GLFW_SCALE_TO_MONITOR, scripted ? GLFW_FALSE : GLFW_TRUE);
+    GLFWmonitor* mon = fullscreen ? glfwGetPrimaryMonitor() : NULL;
+    if (mon) {
+        const GLFWvidmode* mode = glfwGetVideoMode(mon);
+        if (mode) *win_w = mode->width, *win_h = mode->height;
+    }
+    GLFWwindow* win = glfwCreateWindow(*win_w, *win_h, "Dragon kiosk", mon, NULL);
+    if (win) glfwMakeContextCurrent(win);
+    // A software rasteriser clears and shades every sample: without --msaa,
+    // its window gets one sample a pixel (the 2D layers are anti-aliased
+    // analytically anyway; screenshots still render with 4 samples).
+    const char* gl_name = win ? (const char*)glGetString(GL_RENDERER) : NULL;
+    if (msaa < 0 && gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast"))) {
+        glfwMakeContextCurrent(NULL);
+        glfwDestroyWindow(win);
+        glfwWindowHint(GLFW_SAMPLES, 0);
+        win = glfwCreateWindow(*win_w, *win_h, "Dragon kiosk", mon, NULL);
+        if (win) glfwMakeContextCurrent(win);
+    }
+    if (!win) {
+        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
+        glfwTerminate();
+    } else if (mon)
+        glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
+    return win;
+}
+
+// Replays a session on a virtual clock; screenshots at its marks. The exit
+// code: a failed mark screenshot is the input's.
+static int replay(app* a, const sp_kiosk_session* session, const char* shot, double start, double* first_frame_ms)
+{
+    int exit_code = SP_EXIT_OK;
+    sp_error err = {0};
+    // Virtual clock: events at their own times, 60 frames a second of
+    // session time, marks and the end hit exactly.
+    const double step = 1000.0 / 60.0;
+    double t = 0;
+    int ei = 0, mi = 0;
+    long n = 0;
+    for (;;) {
+        double target = fmin(t + step, session->end_ms);
+        if (mi < session->mark_count && session->marks[mi].t_ms < target) target = session->marks[mi].t_ms;
+        if (target < t) target = t;
+        for (; ei < session->count && session->events[ei].t_ms <= target; ++ei) {
+            sp_kiosk_event ev = sp_kiosk_session_map(session, &session->events[ei], a->fb_w, a->fb_h);
+            push_event(a, &ev);
+        }
+        bool at_end = target >= session->end_ms && ei >= session->count;
+        // On screen at 6 frames a second of session time: what a replay
+        // decides depends only on the clock, and marks and the end render
+        // their own screenshots offscreen.
+        frame(a, target, n % 10 == 0 || at_end);
+        if (n++ == 0) *first_frame_ms = sp_now_ms() - start;
+        glfwPollEvents();
+        for (; mi < session->mark_count && session->marks[mi].t_ms <= target; ++mi) {
+            // After the first failed screenshot no more are tried: one line
+            // says why, not one a mark (the replay still ends, --export and --record too).
+            if (!shot || exit_code != SP_EXIT_OK) continue;
+            char path[2048];
+            mark_path(shot, session->marks[mi].name, path, sizeof path);
+            if (sp_kiosk_screenshot(a->k, path, &err) != SP_OK) {
+                fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+                exit_code = SP_EXIT_INPUT;
+            }
+        }
+        t = target;
+        if (at_end || g_quit) break;
+    }
+    return exit_code;
+}
+
+static int run_live(app* a, double start, double* first_frame_ms)
+{
+    a->t0 = glfwGetTime();
+    long n = 0;
+    while (!glfwWindowShouldClose(a->win) && !g_quit) {
+        double slot = glfwGetTime();
+        glfwPollEvents();
+        frame(a, live_t(a), true);
+        if (n++ == 0) *first_frame_ms = sp_now_ms() - start;
+        wait_for_frame(a, slot + 1.0 / 60.0);
+    }
+    return SP_EXIT_OK;
+}
+
+// What the session ends with: the last frame's screenshot, the dragon's
+// glTF, the recorded events (each tried; false after any one line said).
+static bool write_outputs(app* a, const char* shot, const char* out_glb, const char* record, double end_ms)
+{
+    sp_error err = {0};
+    bool ok = true;
+    if (shot && sp_kiosk_screenshot(a->k, shot, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+        ok = false;
+    }
+    if (out_glb && sp_kiosk_export(a->k, out_glb, &err) != SP_OK) {
+        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+        ok = false;
+    }
+    if (record) {
+        a->rec.end_ms = end_ms;
+        if (sp_kiosk_session_write(record, &a->rec, &err) != SP_OK) {
+            fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+            ok = false;
+        }
+    }
+    return ok;
 }
 
 int main(int argc, char** argv)
@@ -506,48 +647,13 @@ int main(int argc, char** argv)
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
-    glfwSetErrorCallback(cb_error);
-    if (!glfwInit()) {
-        fprintf(stderr,
-                "%s: cannot open a window (no display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n",
-                k_cmd);
-        sp_kiosk_session_free(&session);
-        return SP_EXIT_INPUT;
-    }
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
-    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-    glfwWindowHint(GLFW_SAMPLES, msaa >= 0 ? msaa : 4);
-    glfwWindowHint(GLFW_STENCIL_BITS, 8);
-    glfwWindowHint(GLFW_SCALE_TO_MONITOR, script ? GLFW_FALSE : GLFW_TRUE);
-    GLFWmonitor* mon = fullscreen ? glfwGetPrimaryMonitor() : NULL;
-    if (mon) {
-        const GLFWvidmode* mode = glfwGetVideoMode(mon);
-        if (mode) win_w = mode->width, win_h = mode->height;
-    }
-    GLFWwindow* win = glfwCreateWindow(win_w, win_h, "Dragon kiosk", mon, NULL);
-    if (win) glfwMakeContextCurrent(win);
-    // A software rasteriser clears and shades every sample: without --msaa,
-    // its window gets one sample a pixel (the 2D layers are anti-aliased
-    // analytically anyway; screenshots still render with 4 samples).
-    const char* gl_name = win ? (const char*)glGetString(GL_RENDERER) : NULL;
-    if (msaa < 0 && gl_name && (strstr(gl_name, "llvmpipe") || strstr(gl_name, "softpipe") || strstr(gl_name, "swrast"))) {
-        glfwMakeContextCurrent(NULL);
-        glfwDestroyWindow(win);
-        glfwWindowHint(GLFW_SAMPLES, 0);
-        win = glfwCreateWindow(win_w, win_h, "Dragon kiosk", mon, NULL);
-        if (win) glfwMakeContextCurrent(win);
-    }
+    GLFWwindow* win = open_window(fullscreen, script != NULL, msaa, &win_w, &win_h);
     if (!win) {
-        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
-        glfwTerminate();
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
     glfwSwapInterval(script ? 0 : 1);
-    if (mon) glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
-    static app a;                                                    // large (frame ring): not on the stack
+    static app a; // large (frame ring): not on the stack
     a.win = win;
     a.scripted = script != NULL;
     a.ppm_override = script ? session.px_per_mm : 0;
@@ -574,16 +680,8 @@ int main(int argc, char** argv)
                         // wall-clock cap (a visitor's safety net) is lifted; its
                         // iteration caps still bound every fit.
                         .fit_time_cap_ms = script ? 60000 : 0};
-    if (access(db ? db : sp_db_default_path(), F_OK) != 0) {
-        const char* from = assets ? assets : sp_dragon_default_assets();
-        int picks;
-        bool missing = false;
-        sp_error perr = {0};
-        if (sp_db_people_source(from, NULL, &picks, &missing, &perr) == SP_OK && missing)
-            fprintf(stderr, "%s: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building the database without the "
-                            "people's strokes (fewer visitors' drawings recognised)\n", k_cmd, from);
-        loading_screen(win, font);
-    }
+    if (access(db ? db : sp_db_default_path(), F_OK) != 0)
+        announce_build(win, assets ? assets : sp_dragon_default_assets(), font);
     a.k = sp_kiosk_create(&kd, &err);
     if (!a.k) {
         fprintf(stderr, "%s: %s\n", k_cmd, err.text);
@@ -609,69 +707,9 @@ int main(int argc, char** argv)
         a.rec.canvas_w = a.fb_w, a.rec.canvas_h = a.fb_h, a.rec.px_per_mm = a.ppm;
     }
     double first_frame_ms = 0;
-    int exit_code = SP_EXIT_OK;
-    if (script) {
-        // Virtual clock: events at their own times, 60 frames a second of
-        // session time, marks and the end hit exactly.
-        const double step = 1000.0 / 60.0;
-        double t = 0;
-        int ei = 0, mi = 0;
-        long n = 0;
-        for (;;) {
-            double target = fmin(t + step, session.end_ms);
-            if (mi < session.mark_count && session.marks[mi].t_ms < target) target = session.marks[mi].t_ms;
-            if (target < t) target = t;
-            for (; ei < session.count && session.events[ei].t_ms <= target; ++ei) {
-                sp_kiosk_event ev = sp_kiosk_session_map(&session, &session.events[ei], a.fb_w, a.fb_h);
-                push_event(&a, &ev);
-            }
-            bool at_end = target >= session.end_ms && ei >= session.count;
-            // On screen at 6 frames a second of session time: what a replay
-            // decides depends only on the clock, and marks and the end render
-            // their own screenshots offscreen.
-            frame(&a, target, n % 10 == 0 || at_end);
-            if (n++ == 0) first_frame_ms = sp_now_ms() - start;
-            glfwPollEvents();
-            for (; mi < session.mark_count && session.marks[mi].t_ms <= target; ++mi) {
-                // After the first failed screenshot no more are tried: one line
-                // says why, not one a mark (the replay still ends, --export and --record too).
-                if (!shot || exit_code != SP_EXIT_OK) continue;
-                char path[2048];
-                mark_path(shot, session.marks[mi].name, path, sizeof path);
-                if (sp_kiosk_screenshot(a.k, path, &err) != SP_OK) {
-                    fprintf(stderr, "%s: %s\n", k_cmd, err.text);
-                    exit_code = SP_EXIT_INPUT;
-                }
-            }
-            t = target;
-            if (at_end || g_quit) break;
-        }
-    } else {
-        a.t0 = glfwGetTime();
-        long n = 0;
-        while (!glfwWindowShouldClose(win) && !g_quit) {
-            double slot = glfwGetTime();
-            glfwPollEvents();
-            frame(&a, live_t(&a), true);
-            if (n++ == 0) first_frame_ms = sp_now_ms() - start;
-            wait_for_frame(&a, slot + 1.0 / 60.0);
-        }
-    }
-    if (shot && exit_code == SP_EXIT_OK && sp_kiosk_screenshot(a.k, shot, &err) != SP_OK) {
-        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
+    int exit_code = script ? replay(&a, &session, shot, start, &first_frame_ms) : run_live(&a, start, &first_frame_ms);
+    if (!write_outputs(&a, exit_code == SP_EXIT_OK ? shot : NULL, out_glb, record, script ? session.end_ms : live_t(&a)))
         exit_code = SP_EXIT_INPUT;
-    }
-    if (out_glb && sp_kiosk_export(a.k, out_glb, &err) != SP_OK) {
-        fprintf(stderr, "%s: %s\n", k_cmd, err.text);
-        exit_code = SP_EXIT_INPUT;
-    }
-    if (record) {
-        a.rec.end_ms = script ? session.end_ms : live_t(&a);
-        if (sp_kiosk_session_write(record, &a.rec, &err) != SP_OK) {
-            fprintf(stderr, "%s: %s\n", k_cmd, err.text);
-            exit_code = SP_EXIT_INPUT;
-        }
-    }
     sp_kiosk_close_collection(a.k); // the last visitor's parts, before the counts are printed
     if (stats) print_stats(&a, first_frame_ms);
     sp_kiosk_destroy(a.k);

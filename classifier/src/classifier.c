@@ -384,7 +384,8 @@ static bool picture_shares(const sp_clf* c, const sp_sketch* sk, double* p)
 // is its vote share (plus the floor) times its shape share raised to
 // shape_weight times its picture share (plus its floor) raised to
 // picture_weight, renormalised.
-static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, const double* shape, const double* pic, sp_clf_answer* a)
+static void vote(const sp_clf* c, const int* idx, const float* d2, int nn, const double* shape, const double* pic,
+                 sp_clf_answer* a)
 {
     memset(a, 0, sizeof *a);
     float* score = calloc((size_t)c->category_count, sizeof(float));
@@ -714,8 +715,8 @@ static int train_job(void* user, int k)
             int tmp = order[k];
             order[k] = order[o];
             order[o] = tmp;
-            memcpy(t->sample + ((size_t)i / (size_t)t->stride * t->per_job + k) * SP_FEAT_DIM, f->desc + (size_t)order[k] * SP_FEAT_DIM,
-                   sizeof(float) * SP_FEAT_DIM);
+            memcpy(t->sample + ((size_t)i / (size_t)t->stride * t->per_job + k) * SP_FEAT_DIM,
+                   f->desc + (size_t)order[k] * SP_FEAT_DIM, sizeof(float) * SP_FEAT_DIM);
         }
         t->sample_n[i] = keep;
     } else if (rc == SP_OK) {
@@ -917,6 +918,83 @@ static sp_result train_pictures(sp_clf* c, const sp_dataset* data, const unsigne
     return SP_OK;
 }
 
+// Soft-assignment width: the median distance of a descriptor to its nearest word.
+static sp_result soft_width(sp_clf* c, const float* sample, int total)
+{
+    int* idx = malloc(sizeof(int) * (size_t)total);
+    float* d2 = malloc(sizeof(float) * (size_t)total);
+    if (!idx || !d2) {
+        free(idx);
+        free(d2);
+        return SP_ERR_NO_MEMORY;
+    }
+    sp_nearest_words(c->vocab, c->vnorm, c->words, sample, total, 1, idx, d2);
+    qsort(d2, (size_t)total, sizeof(float), sp_cmp_float);
+    c->sigma = sqrtf(fmaxf(d2[total / 2], 0.0f));
+    if (!(c->sigma > 1e-3f)) c->sigma = 1e-3f;
+    free(idx);
+    free(d2);
+    return SP_OK;
+}
+
+// Leave-one-out nearest distances (another drawing, not a variant of the same one)
+// give the voting bandwidth (median) and the reject threshold (quantile).
+static sp_result calibrate_distances(sp_clf* c, const int* src, int n, sp_error* err)
+{
+    float* loo = malloc(sizeof(float) * (size_t)n);
+    int* queries = malloc(sizeof(int) * (size_t)n);
+    float* norms = malloc(sizeof(float) * (size_t)n);
+    if (!loo || !queries || !norms) {
+        free(loo);
+        free(queries);
+        free(norms);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory while training");
+    }
+    // Why a sample: exact leave-one-out over n drawings costs n^2 histogram
+    // distances (20000 drawings: minutes); a few thousand queries give the
+    // median and the reject quantile just as well (a quickdraw 5-fold
+    // training set, 2000 drawings, is still done exactly).
+    int originals = 0;
+    for (int i = 0; i < n; ++i)
+        originals += i == 0 || src[i] != src[i - 1];
+    int stride = (originals + LOO_MAX_QUERIES - 1) / LOO_MAX_QUERIES, nq = 0;
+    for (int i = 0; i < n; ++i) {
+        loo[i] = -1.0f;
+        double s2 = 0.0;
+        for (int d = 0; d < c->hist_dim; ++d)
+            s2 += (double)c->hists[(size_t)i * c->hist_dim + d] * c->hists[(size_t)i * c->hist_dim + d];
+        norms[i] = (float)s2;
+        if (i > 0 && src[i] == src[i - 1]) continue; // one query per original drawing, not its variants
+        uint64_t h = (uint64_t)src[i] ^ ((uint64_t)c->desc.seed << 32);
+        if (stride > 1 && clf_rng_next(&h) % (uint64_t)stride != 0) continue;
+        queries[nq++] = i;
+    }
+    loo_ctx lc = {c, src, queries, nq, norms, loo};
+    int bad = sp_parallel_for((nq + LOO_BLOCK - 1) / LOO_BLOCK, c->desc.threads, loo_block, &lc);
+    free(queries);
+    free(norms);
+    if (bad) {
+        free(loo);
+        return sp_fail(err, (sp_result)bad, "leave-one-out distances: %s", sp_result_name((sp_result)bad));
+    }
+    int m = 0;
+    for (int i = 0; i < n; ++i)
+        if (loo[i] >= 0.0f) loo[m++] = loo[i];
+    if (m > 0) {
+        qsort(loo, (size_t)m, sizeof(float), sp_cmp_float);
+        c->bandwidth = fmaxf(loo[m / 2], 1e-4f);
+        int qi = (int)ceil(c->desc.reject_quantile * m) - 1;
+        if (qi < 0) qi = 0;
+        if (qi >= m) qi = m - 1;
+        c->reject = c->desc.reject_quantile >= 1.0 ? INFINITY : loo[qi];
+    } else {
+        c->bandwidth = 1.0f;
+        c->reject = INFINITY;
+    }
+    free(loo);
+    return SP_OK;
+}
+
 sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const sp_clf_desc* desc, sp_clf** out, sp_error* err)
 {
     *out = NULL;
@@ -927,7 +1005,6 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     sp_result rc = SP_OK;
     float* sample = NULL;
     int* src = NULL;
-    float* loo = NULL;
     if (!c) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     c->desc = sp_clf_desc_defaults(desc);
     pthread_mutex_init(&t.lock, NULL);
@@ -998,22 +1075,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     rc = sp_kmeans(sample, total, SP_FEAT_DIM, c->words, c->desc.seed, c->desc.kmeans_iterations, c->desc.threads, c->vocab, err);
     if (rc != SP_OK) goto fail;
     if ((rc = build_vocab_index(c, err)) != SP_OK) goto fail;
-    {
-        // Soft-assignment width: the median distance of a descriptor to its nearest word.
-        int* idx = malloc(sizeof(int) * (size_t)total);
-        float* d2 = malloc(sizeof(float) * (size_t)total);
-        if (!idx || !d2) {
-            free(idx);
-            free(d2);
-            goto oom;
-        }
-        sp_nearest_words(c->vocab, c->vnorm, c->words, sample, total, 1, idx, d2);
-        qsort(d2, (size_t)total, sizeof(float), sp_cmp_float);
-        c->sigma = sqrtf(fmaxf(d2[total / 2], 0.0f));
-        if (!(c->sigma > 1e-3f)) c->sigma = 1e-3f;
-        free(idx);
-        free(d2);
-    }
+    if ((rc = soft_width(c, sample, total)) != SP_OK) goto oom;
     if (c->desc.progress) c->desc.progress(c->desc.progress_user, "vocabulary", 1, 1);
     free(sample);
     sample = NULL;
@@ -1054,59 +1116,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     if ((rc = train_shapes(c, data, use, err)) != SP_OK) goto fail;
     if ((rc = train_pictures(c, data, use, err)) != SP_OK) goto fail;
 
-    // Leave-one-out nearest distances (another drawing, not a variant of the same one)
-    // give the voting bandwidth (median) and the reject threshold (quantile).
-    {
-        loo = malloc(sizeof(float) * (size_t)n);
-        int* queries = malloc(sizeof(int) * (size_t)n);
-        float* norms = malloc(sizeof(float) * (size_t)n);
-        if (!loo || !queries || !norms) {
-            free(queries);
-            free(norms);
-            goto oom;
-        }
-        // Why a sample: exact leave-one-out over n drawings costs n^2 histogram
-        // distances (20000 drawings: minutes); a few thousand queries give the
-        // median and the reject quantile just as well (a quickdraw 5-fold
-        // training set, 2000 drawings, is still done exactly).
-        int originals = 0;
-        for (int i = 0; i < n; ++i)
-            originals += i == 0 || src[i] != src[i - 1];
-        int stride = (originals + LOO_MAX_QUERIES - 1) / LOO_MAX_QUERIES, nq = 0;
-        for (int i = 0; i < n; ++i) {
-            loo[i] = -1.0f;
-            double s2 = 0.0;
-            for (int d = 0; d < c->hist_dim; ++d)
-                s2 += (double)c->hists[(size_t)i * c->hist_dim + d] * c->hists[(size_t)i * c->hist_dim + d];
-            norms[i] = (float)s2;
-            if (i > 0 && src[i] == src[i - 1]) continue; // one query per original drawing, not its variants
-            uint64_t h = (uint64_t)src[i] ^ ((uint64_t)c->desc.seed << 32);
-            if (stride > 1 && clf_rng_next(&h) % (uint64_t)stride != 0) continue;
-            queries[nq++] = i;
-        }
-        loo_ctx lc = {c, src, queries, nq, norms, loo};
-        int bad = sp_parallel_for((nq + LOO_BLOCK - 1) / LOO_BLOCK, c->desc.threads, loo_block, &lc);
-        free(queries);
-        free(norms);
-        if (bad) {
-            rc = sp_fail(err, (sp_result)bad, "leave-one-out distances: %s", sp_result_name((sp_result)bad));
-            goto fail;
-        }
-        int m = 0;
-        for (int i = 0; i < n; ++i)
-            if (loo[i] >= 0.0f) loo[m++] = loo[i];
-        if (m > 0) {
-            qsort(loo, (size_t)m, sizeof(float), sp_cmp_float);
-            c->bandwidth = fmaxf(loo[m / 2], 1e-4f);
-            int qi = (int)ceil(c->desc.reject_quantile * m) - 1;
-            if (qi < 0) qi = 0;
-            if (qi >= m) qi = m - 1;
-            c->reject = c->desc.reject_quantile >= 1.0 ? INFINITY : loo[qi];
-        } else {
-            c->bandwidth = 1.0f;
-            c->reject = INFINITY;
-        }
-    }
+    if ((rc = calibrate_distances(c, src, n, err)) != SP_OK) goto fail;
     c->desc.progress = NULL;
     c->desc.progress_user = NULL;
     c->desc.augment_fn = NULL;
@@ -1126,7 +1136,6 @@ fail:
     free(t.raw);
     free(sample);
     free(src);
-    free(loo);
     sp_clf_destroy(c);
     return rc;
 }
@@ -1163,7 +1172,8 @@ sp_result sp_clf_calibrate_reject(sp_clf* c, const sp_dataset* held_out, const u
                                   float* distances, int* count, sp_error* err)
 {
     if (count) *count = 0;
-    if (!(quantile > 0.0 && quantile <= 1.0)) return sp_fail(err, SP_ERR_INVALID, "calibration quantile %g is not in (0, 1]", quantile);
+    if (!(quantile > 0.0 && quantile <= 1.0))
+        return sp_fail(err, SP_ERR_INVALID, "calibration quantile %g is not in (0, 1]", quantile);
     if (margin == 0.0) margin = 1.0;
     if (!(margin >= 1.0 && isfinite(margin))) return sp_fail(err, SP_ERR_INVALID, "calibration margin %g is not >= 1", margin);
     float* d = malloc(sizeof(float) * (size_t)(held_out->count > 0 ? held_out->count : 1));

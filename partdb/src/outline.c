@@ -372,6 +372,167 @@ static sp_skin8 surface_bind(const sp_outline_desc* d, const double* xy, const d
     return s;
 }
 
+// Closes the filled cells' hairline gaps, fills their holes and keeps the
+// largest inside region (1 in g, all else 0); a silhouette in several big
+// pieces is refused unless d->keep_largest.
+static sp_result keep_silhouette(const sp_outline_desc* d, grid* g, double k, sp_outline_info* info, sp_error* err)
+{
+    sp_result res = SP_OK;
+    int* sizes = NULL;
+    size_t *seeds = NULL, *stack = NULL;
+    size_t stack_cap = 4096;
+    // Closing (dilate, erode) removes hairline gaps between touching pieces.
+    size_t ncell = (size_t)g->w * (size_t)g->h;
+    unsigned char* ring = malloc(3 * (size_t)g->w);
+    if (!ring) goto oom;
+    morph(g, true, ring), morph(g, true, ring), morph(g, false, ring), morph(g, false, ring);
+    // Fill holes: everything not reachable from the border is inside.
+    stack = malloc(sizeof(size_t) * stack_cap);
+    // The background (2) from the corner cell, which is always empty (margin).
+    if (!stack || fill(g, 0, 2, 0, &stack, &stack_cap) < 0) goto oom;
+    for (size_t i = 0; i < ncell; ++i)
+        g->c[i] = g->c[i] != 2;
+    // The inside's regions (marked 2), numbered from 1 in the order of their
+    // first cell row by row; keep the largest, refuse a silhouette in several
+    // big pieces.
+    int regions = 0, room = 0;
+    for (size_t i = 0; i < ncell; ++i) {
+        if (g->c[i] != 1) continue;
+        if (regions + 2 > room) {
+            room = room ? 2 * room : 16;
+            int* grown = realloc(sizes, sizeof(int) * (size_t)room);
+            size_t* grown_seeds = realloc(seeds, sizeof(size_t) * (size_t)room);
+            if (grown) sizes = grown;
+            if (grown_seeds) seeds = grown_seeds;
+            if (!grown || !grown_seeds) goto oom;
+        }
+        long long size = fill(g, 1, 2, i, &stack, &stack_cap);
+        if (size < 0) goto oom;
+        sizes[++regions] = (int)size, seeds[regions] = i;
+    }
+    int best = 1, second = 0;
+    long long total = 0;
+    for (int r = 2; r <= regions; ++r)
+        if (sizes[r] > sizes[best]) best = r;
+    for (int r = 1; r <= regions; ++r) {
+        total += sizes[r];
+        if (r != best && sizes[r] > second) second = sizes[r];
+    }
+    if (info) {
+        info->regions = regions;
+        info->dropped_share = total > 0 ? (double)(total - (regions ? sizes[best] : 0)) / (double)total : 0.0;
+        info->cell_px = 1.0 / k;
+    }
+    if (regions == 0) {
+        res = sp_fail(err, SP_ERR_INVALID,
+                      "outline: the mesh covers no area in the sketch view (it is seen edge-on, or "
+                      "its triangles are flat)");
+        goto done;
+    }
+    bool ok = second < sizes[best] / 200 || d->keep_largest;
+    if (!ok) {
+        res = sp_fail(err, SP_ERR_INVALID, "outline: the side silhouette falls apart (%d regions, second largest %d of %d cells)",
+                      regions, second, sizes[best]);
+        goto done;
+    }
+    if (fill(g, 2, 3, seeds[best], &stack, &stack_cap) < 0) goto oom;
+    for (size_t i = 0; i < ncell; ++i)
+        g->c[i] = g->c[i] == 3;
+    goto done;
+oom:
+    res = sp_fail(err, SP_ERR_NO_MEMORY, "outline: out of memory");
+done:
+    free(sizes), free(seeds), free(stack), free(ring);
+    return res;
+}
+
+// Smooths the traced staircase: a few passes of (1/4, 1/2, 1/4) averaging.
+static void smooth_polygon(pt* poly, pt* tmp, int n)
+{
+    for (int pass = 0; pass < 6; ++pass) {
+        for (int i = 0; i < n; ++i) {
+            pt a = poly[(i + n - 1) % n], b = poly[i], c = poly[(i + 1) % n];
+            tmp[i] = (pt){0.25 * a.x + 0.5 * b.x + 0.25 * c.x, 0.25 * a.y + 0.5 * b.y + 0.25 * c.y};
+        }
+        memcpy(poly, tmp, sizeof(pt) * (size_t)n);
+    }
+}
+
+// Smooth the skins along the curve: where the contour passes from one
+// bone's surface to another's (girdle to leg, leg to leg at the crotch)
+// the curve then stretches evenly instead of kinking at one point.
+static void smooth_skins(sp_skin8* bound, sp_skin8* tmp_skin, int points)
+{
+    for (int pass = 0; pass < 3; ++pass) {
+        for (int i = 0; i < points; ++i) {
+            const sp_skin8 *a = &bound[(i + points - 1) % points], *b = &bound[i], *c = &bound[(i + 1) % points];
+            sp_skin8 r = {0};
+            for (int q = 0; q < a->n; ++q)
+                sp_skin8_add(&r, a->joint[q], 0.25 * a->w[q]);
+            for (int q = 0; q < b->n; ++q)
+                sp_skin8_add(&r, b->joint[q], 0.5 * b->w[q]);
+            for (int q = 0; q < c->n; ++q)
+                sp_skin8_add(&r, c->joint[q], 0.25 * c->w[q]);
+            tmp_skin[i] = r;
+        }
+        memcpy(bound, tmp_skin, sizeof(sp_skin8) * (size_t)points);
+    }
+}
+
+// The vertex nearest the contour point (px, py) whose normal faces out
+// along (ox, oy), within a few cells of the nearest of all, which is the
+// fallback.
+static int nearest_outward(const sp_outline_desc* d, const double* xy, const double* nrm, const double* nlen, double px,
+                           double py, double ox, double oy, double cell_px)
+{
+    int nv = d->vertex_count;
+    int best_v = 0, near_v = 0;
+    double best_d = INFINITY, near_d = INFINITY;
+    for (int v = 0; v < nv; ++v) {
+        if (skipped(d->skip_vertex, v)) continue;
+        double ddx = xy[2 * v] - px, ddy = xy[2 * v + 1] - py, dd = ddx * ddx + ddy * ddy;
+        if (dd < near_d) near_d = dd, near_v = v;
+        double nl = nlen[v];
+        bool outward = nl > 0 && (nrm[2 * v] * ox + nrm[2 * v + 1] * oy) > 0.5 * nl;
+        if (outward && dd < best_d) best_d = dd, best_v = v;
+    }
+    if (!(sqrt(best_d) <= sqrt(near_d) + 4.0 * cell_px)) best_v = near_v;
+    return best_v;
+}
+
+// Depths along the curve: world z, the depth of a view along -Z (false:
+// out of memory).
+static bool smooth_depths(sp_abstraction* out, int points, int passes)
+{
+    double* z = passes > 0 ? malloc(sizeof(double) * (size_t)points) : NULL;
+    if (passes > 0 && !z) return false;
+    for (int pass = 0; pass < passes; ++pass) {
+        for (int i = 0; i < points; ++i)
+            z[i] = 0.25 * out->rest[3 * ((i + points - 1) % points) + 2] + 0.5 * out->rest[3 * i + 2] +
+                   0.25 * out->rest[3 * ((i + 1) % points) + 2];
+        for (int i = 0; i < points; ++i)
+            out->rest[3 * i + 2] = z[i];
+    }
+    free(z);
+    return true;
+}
+
+// Adds each triangle's area-weighted normal, in the view's pixel frame, to
+// its vertices' (nrm: 2 a vertex, zeroed).
+static void view_normals(const sp_outline_desc* d, double* nrm)
+{
+    for (int t = 0; t < d->triangle_count; ++t) {
+        if (skipped(d->skip_triangle, t)) continue;
+        const uint32_t* q = d->triangles + 3 * (size_t)t;
+        const double *pa = d->positions + 3 * (size_t)q[0], *pb = d->positions + 3 * (size_t)q[1],
+                     *pc = d->positions + 3 * (size_t)q[2];
+        sp_vec3 a = {pa[0], pa[1], pa[2]}, b = {pb[0], pb[1], pb[2]}, c = {pc[0], pc[1], pc[2]};
+        sp_vec3 nv3 = sp_mat4_dir(&d->camera->view, sp_v3_cross(sp_v3_sub(b, a), sp_v3_sub(c, a)));
+        for (int j = 0; j < 3; ++j)
+            nrm[2 * q[j]] += nv3.x, nrm[2 * q[j] + 1] -= nv3.y;
+    }
+}
+
 sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_outline_info* info, sp_error* err)
 {
     memset(out, 0, sizeof *out);
@@ -389,9 +550,6 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     double *xy = NULL, *cell = NULL, *acc = NULL, *nrm = NULL, *nlen = NULL, *zv = NULL;
     candidate* cands = NULL;
     int ncand = 0;
-    int* sizes = NULL;
-    size_t *seeds = NULL, *stack = NULL;
-    unsigned char* ring = NULL;
     pt *poly = NULL, *tmp = NULL;
     sp_skin8 *bound = NULL, *tmp_skin = NULL;
     grid g = {0, 0, NULL};
@@ -430,81 +588,16 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
         }
         sp_raster_triangle(g.c, g.w, g.h, cell + 2 * q[0], cell + 2 * q[1], cell + 2 * q[2]);
     }
-    // Closing (dilate, erode) removes hairline gaps between touching pieces.
-    size_t ncell = (size_t)g.w * (size_t)g.h;
-    if (!(ring = malloc(3 * (size_t)g.w))) goto oom;
-    morph(&g, true, ring), morph(&g, true, ring), morph(&g, false, ring), morph(&g, false, ring);
-    // Fill holes: everything not reachable from the border is inside.
-    size_t stack_cap = 4096;
-    stack = malloc(sizeof(size_t) * stack_cap);
-    // The background (2) from the corner cell, which is always empty (margin).
-    if (!stack || fill(&g, 0, 2, 0, &stack, &stack_cap) < 0) goto oom;
-    for (size_t i = 0; i < ncell; ++i)
-        g.c[i] = g.c[i] != 2;
-    // The inside's regions (marked 2), numbered from 1 in the order of their
-    // first cell row by row; keep the largest, refuse a silhouette in several
-    // big pieces.
-    int regions = 0, room = 0;
-    for (size_t i = 0; i < ncell; ++i) {
-        if (g.c[i] != 1) continue;
-        if (regions + 2 > room) {
-            room = room ? 2 * room : 16;
-            int* grown = realloc(sizes, sizeof(int) * (size_t)room);
-            size_t* grown_seeds = realloc(seeds, sizeof(size_t) * (size_t)room);
-            if (grown) sizes = grown;
-            if (grown_seeds) seeds = grown_seeds;
-            if (!grown || !grown_seeds) goto oom;
-        }
-        long long size = fill(&g, 1, 2, i, &stack, &stack_cap);
-        if (size < 0) goto oom;
-        sizes[++regions] = (int)size, seeds[regions] = i;
-    }
-    int best = 1, second = 0;
-    long long total = 0;
-    for (int r = 2; r <= regions; ++r)
-        if (sizes[r] > sizes[best]) best = r;
-    for (int r = 1; r <= regions; ++r) {
-        total += sizes[r];
-        if (r != best && sizes[r] > second) second = sizes[r];
-    }
-    if (info) {
-        info->regions = regions;
-        info->dropped_share = total > 0 ? (double)(total - (regions ? sizes[best] : 0)) / (double)total : 0.0;
-        info->cell_px = 1.0 / k;
-    }
-    if (regions == 0) {
-        res = sp_fail(err, SP_ERR_INVALID,
-                      "outline: the mesh covers no area in the sketch view (it is seen edge-on, or "
-                      "its triangles are flat)");
-        goto done;
-    }
-    bool ok = second < sizes[best] / 200 || d->keep_largest;
-    if (!ok) {
-        res = sp_fail(err, SP_ERR_INVALID, "outline: the side silhouette falls apart (%d regions, second largest %d of %d cells)",
-                      regions, second, sizes[best]);
-        goto done;
-    }
-    if (fill(&g, 2, 3, seeds[best], &stack, &stack_cap) < 0) goto oom;
-    for (size_t i = 0; i < ncell; ++i)
-        g.c[i] = g.c[i] == 3;
-    free(sizes), free(seeds), free(stack);
-    sizes = NULL, seeds = NULL, stack = NULL;
+    if ((res = keep_silhouette(d, &g, k, info, err)) != SP_OK) goto done;
 
     int n = 0;
     poly = trace(&g, &n);
     free(g.c);
     g.c = NULL;
     if (!poly) goto oom;
-    // Smooth the staircase: a few passes of (1/4, 1/2, 1/4) averaging.
     tmp = malloc(sizeof(pt) * (size_t)n);
     if (!tmp) goto oom;
-    for (int pass = 0; pass < 6; ++pass) {
-        for (int i = 0; i < n; ++i) {
-            pt a = poly[(i + n - 1) % n], b = poly[i], c = poly[(i + 1) % n];
-            tmp[i] = (pt){0.25 * a.x + 0.5 * b.x + 0.25 * c.x, 0.25 * a.y + 0.5 * b.y + 0.25 * c.y};
-        }
-        memcpy(poly, tmp, sizeof(pt) * (size_t)n);
-    }
+    smooth_polygon(poly, tmp, n);
     // Resample by arc length to `points` points.
     acc = malloc(sizeof(double) * (size_t)(n + 1));
     out->rest = malloc(sizeof(double) * 3 * (size_t)points);
@@ -539,16 +632,7 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
     out->correspondence = SP_CORR_CLOSEST;
     sp_mat4 inv_view;
     sp_mat4_inverse(&cam->view, &inv_view);
-    for (int t = 0; t < d->triangle_count; ++t) {
-        if (skipped(d->skip_triangle, t)) continue;
-        const uint32_t* q = d->triangles + 3 * (size_t)t;
-        const double *pa = d->positions + 3 * (size_t)q[0], *pb = d->positions + 3 * (size_t)q[1],
-                     *pc = d->positions + 3 * (size_t)q[2];
-        sp_vec3 a = {pa[0], pa[1], pa[2]}, b = {pb[0], pb[1], pb[2]}, c = {pc[0], pc[1], pc[2]};
-        sp_vec3 nv3 = sp_mat4_dir(&cam->view, sp_v3_cross(sp_v3_sub(b, a), sp_v3_sub(c, a)));
-        for (int j = 0; j < 3; ++j)
-            nrm[2 * q[j]] += nv3.x, nrm[2 * q[j] + 1] -= nv3.y;
-    }
+    view_normals(d, nrm);
     // Their lengths once, not once a contour point (the nearest-vertex search
     // below visits every vertex for each point).
     if (!d->surface) {
@@ -578,19 +662,7 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
                 surface_bind(d, xy, nrm, zv, px, py, ox, oy, 4.0 * cell_px, 2.0 * cell_px, &cands, &ncand, &out->rest[3 * i]);
             continue;
         }
-        // The nearest vertex facing outwards (within a few cells of the
-        // nearest of all, which is the fallback).
-        int best_v = 0, near_v = 0;
-        double best_d = INFINITY, near_d = INFINITY;
-        for (int v = 0; v < nv; ++v) {
-            if (skipped(d->skip_vertex, v)) continue;
-            double ddx = xy[2 * v] - px, ddy = xy[2 * v + 1] - py, dd = ddx * ddx + ddy * ddy;
-            if (dd < near_d) near_d = dd, near_v = v;
-            double nl = nlen[v];
-            bool outward = nl > 0 && (nrm[2 * v] * ox + nrm[2 * v + 1] * oy) > 0.5 * nl;
-            if (outward && dd < best_d) best_d = dd, best_v = v;
-        }
-        if (!(sqrt(best_d) <= sqrt(near_d) + 4.0 * cell_px)) best_v = near_v;
+        int best_v = nearest_outward(d, xy, nrm, nlen, px, py, ox, oy, cell_px);
         // Depth of the nearest vertex, position of the contour (orthographic view).
         const double* bp = d->positions + 3 * (size_t)best_v;
         sp_vec3 vc = sp_mat4_point(&cam->view, sp_v3(bp[0], bp[1], bp[2]));
@@ -599,43 +671,16 @@ sp_result sp_outline_trace(const sp_outline_desc* d, sp_abstraction* out, sp_out
         out->rest[3 * i] = w.x, out->rest[3 * i + 1] = w.y, out->rest[3 * i + 2] = w.z;
         bound[i] = vertex_skin(d, best_v);
     }
-    // Smooth the skins along the curve: where the contour passes from one
-    // bone's surface to another's (girdle to leg, leg to leg at the crotch)
-    // the curve then stretches evenly instead of kinking at one point.
-    for (int pass = 0; pass < 3; ++pass) {
-        for (int i = 0; i < points; ++i) {
-            const sp_skin8 *a = &bound[(i + points - 1) % points], *b = &bound[i], *c = &bound[(i + 1) % points];
-            sp_skin8 r = {0};
-            for (int q = 0; q < a->n; ++q)
-                sp_skin8_add(&r, a->joint[q], 0.25 * a->w[q]);
-            for (int q = 0; q < b->n; ++q)
-                sp_skin8_add(&r, b->joint[q], 0.5 * b->w[q]);
-            for (int q = 0; q < c->n; ++q)
-                sp_skin8_add(&r, c->joint[q], 0.25 * c->w[q]);
-            tmp_skin[i] = r;
-        }
-        memcpy(bound, tmp_skin, sizeof(sp_skin8) * (size_t)points);
-    }
+    smooth_skins(bound, tmp_skin, points);
     for (int i = 0; i < points; ++i)
         sp_skin8_pack(&bound[i], out->joints + 4 * i, out->weights + 4 * i);
-    // Depths along the curve: world z, the depth of a view along -Z.
-    double* z = d->depth_passes > 0 ? malloc(sizeof(double) * (size_t)points) : NULL;
-    if (d->depth_passes > 0 && !z) goto oom;
-    for (int pass = 0; pass < d->depth_passes; ++pass) {
-        for (int i = 0; i < points; ++i)
-            z[i] = 0.25 * out->rest[3 * ((i + points - 1) % points) + 2] + 0.5 * out->rest[3 * i + 2] +
-                   0.25 * out->rest[3 * ((i + 1) % points) + 2];
-        for (int i = 0; i < points; ++i)
-            out->rest[3 * i + 2] = z[i];
-    }
-    free(z);
+    if (!smooth_depths(out, points, d->depth_passes)) goto oom;
     goto done;
 oom:
     res = sp_fail(err, SP_ERR_NO_MEMORY, "outline: out of memory");
 done:
     if (res != SP_OK) sp_abstraction_free(out);
     free(cands), free(zv);
-    free(tmp_skin), free(bound), free(nrm), free(nlen), free(acc), free(tmp), free(poly), free(cell), free(xy), free(seeds),
-        free(sizes), free(stack), free(ring), free(g.c);
+    free(tmp_skin), free(bound), free(nrm), free(nlen), free(acc), free(tmp), free(poly), free(cell), free(xy), free(g.c);
     return res;
 }

@@ -77,6 +77,29 @@ static sp_camera framing_camera(const sp_dragon* d, sp_vec3 lo, sp_vec3 hi)
     return c;
 }
 
+// The details as ink lines on their parts' skins, grouped by part (each
+// part's lines one run of `lines`), in drawing order within it; the points
+// in one block (rest, joints, weights), sized for all the details.
+static void group_ink(const sp_dragon* d, sp_gltf_scene_part* parts, sp_gltf_scene_line* lines, double* ink_rest,
+                      uint16_t* ink_joints, float* ink_weights)
+{
+    int n = d->part_n, nd = d->detail_n;
+    sp_dragon_detail e;
+    for (int i = 0, used = 0, at = 0; i < n; ++i) {
+        parts[i].lines = lines + used;
+        for (int k = 0; k < nd; ++k) {
+            double* r = ink_rest + 3 * (size_t)at;
+            uint16_t* j = ink_joints + 4 * (size_t)at;
+            float* w = ink_weights + 4 * (size_t)at;
+            if (!sp_dragon_detail_get(d, k, &e) || e.part != i || dragon_detail_skinned(d, k, r, j, w) != i) continue;
+            lines[used++] = (sp_gltf_scene_line){
+                .point_count = e.point_count, .rest = r, .joints = j, .weights = w, .color = {0.01f, 0.006f, 0.006f, 1}};
+            at += e.point_count;
+            ++parts[i].line_count;
+        }
+    }
+}
+
 sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
 {
     // Why the cast: posing at the key times reuses the parts' evaluation
@@ -132,20 +155,7 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
             }
         }
     }
-    // Grouped by part (each part's lines one run of the array), in drawing order within it.
-    for (int i = 0, used = 0, at = 0; i < n; ++i) {
-        parts[i].lines = lines + used;
-        for (int k = 0; k < nd; ++k) {
-            double* r = ink_rest + 3 * (size_t)at;
-            uint16_t* j = ink_joints + 4 * (size_t)at;
-            float* w = ink_weights + 4 * (size_t)at;
-            if (!sp_dragon_detail_get(d, k, &e) || e.part != i || dragon_detail_skinned(d, k, r, j, w) != i) continue;
-            lines[used++] = (sp_gltf_scene_line){
-                .point_count = e.point_count, .rest = r, .joints = j, .weights = w, .color = {0.01f, 0.006f, 0.006f, 1}};
-            at += e.point_count;
-            ++parts[i].line_count;
-        }
-    }
+    group_ink(d, parts, lines, ink_rest, ink_joints, ink_weights);
     if (animated) {
         for (int k = 0; k <= K; ++k) {
             ftimes[k] = (float)times[k];

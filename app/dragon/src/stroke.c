@@ -829,6 +829,30 @@ static bool kept_as_flourish(sp_dragon* d, const sp_dragon_stroke_opts* o, const
     return true;
 }
 
+// The new part q in the last one's place (replace_last) or after it; q is
+// freed when there is no room.
+static sp_result put_part(sp_dragon* d, part* q, bool replace_last, sp_error* err)
+{
+    if (replace_last && d->part_n > 0) {
+        give_back_fits(d, d->parts[d->part_n - 1]->pub.id);
+        dragon_part_free(d->parts[d->part_n - 1]);
+        d->parts[d->part_n - 1] = q;
+        dragon_details_prune(d); // the replaced part's ink goes with it
+        return SP_OK;
+    }
+    if (d->part_n == d->part_cap) {
+        int cap2 = d->part_cap ? 2 * d->part_cap : 8;
+        part** np = realloc(d->parts, sizeof(part*) * (size_t)cap2);
+        if (!np) {
+            dragon_part_free(q);
+            return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        }
+        d->parts = np, d->part_cap = cap2;
+    }
+    d->parts[d->part_n++] = q;
+    return SP_OK;
+}
+
 sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
                                sp_dragon_result* out, sp_error* err)
 {
@@ -927,23 +951,9 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         return r;
     }
     q->chosen = o.category != NULL;
-    if (o.replace_last && d->part_n > 0) {
-        give_back_fits(d, d->parts[d->part_n - 1]->pub.id);
-        dragon_part_free(d->parts[d->part_n - 1]);
-        d->parts[d->part_n - 1] = q;
-        dragon_details_prune(d); // the replaced part's ink goes with it
-    } else {
-        if (d->part_n == d->part_cap) {
-            int cap2 = d->part_cap ? 2 * d->part_cap : 8;
-            part** np = realloc(d->parts, sizeof(part*) * (size_t)cap2);
-            if (!np) {
-                dragon_part_free(q);
-                free(pts);
-                return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-            }
-            d->parts = np, d->part_cap = cap2;
-        }
-        d->parts[d->part_n++] = q;
+    if ((r = put_part(d, q, o.replace_last, err)) != SP_OK) {
+        free(pts);
+        return r;
     }
     dragon_relayout(d);
     // A part that would float free, drawn out of a part of the dragon away
