@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include "sp/gltf.h"
 #include "sp/sketch_io.h"
 
 #include <errno.h>
@@ -46,10 +47,38 @@ static bool same_file(const char* a_given, const char* b_given)
     return same;
 }
 
+// A file that the glTF input `in` reads (an external buffer or image)
+// named as the output `out` (--report over a .gltf's .bin destroyed the rig).
+static bool out_on_gltf_file(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in)
+{
+    if (!sp_path_ext_is(in, "gltf") && !sp_path_ext_is(in, "glb")) return false;
+    char** files = NULL;
+    int n = 0;
+    sp_error err = {0};
+    bool hit = false;
+    if (sp_gltf_external_files(in, &files, &n, &err) != SP_OK) return false; // the loader will say
+    for (int k = 0; k < n && !hit; ++k)
+        if ((hit = same_file(out, files[k])))
+            fprintf(stderr, "%s: %s %s is a file that %s %s reads (%s): it would be overwritten\n", cmd, out_name, out, in_name,
+                    in, files[k]);
+    sp_gltf_files_free(files, n);
+    return hit;
+}
+
+bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in)
+{
+    if (!out || !in || !strcmp(out, "-") || sp_cli_out_is_stream(out)) return false;
+    if (out_on_gltf_file(cmd, out_name, out, in_name, in)) return true;
+    if (!same_file(out, in)) return false;
+    fprintf(stderr, "%s: %s %s is the same file as %s: it would be overwritten\n", cmd, out_name, out, in_name);
+    return true;
+}
+
 // An output that is also an input would be overwritten by the command's
 // own result (`pose --strokes s.json --report s.json` replaced the strokes
-// with the report); two outputs on one file keep only the last. Streams
-// (/dev/stdout, a pipe) are written as they go and left alone.
+// with the report), and so would a file a glTF input reads; two outputs on
+// one file keep only the last. Streams (/dev/stdout, a pipe) are written as
+// they go and left alone.
 static int check_files(const char* cmd, const sp_opt* opts, int nopts)
 {
     for (int i = 0; i < nopts; ++i) {
@@ -61,11 +90,13 @@ static int check_files(const char* cmd, const sp_opt* opts, int nopts)
             const char* const* vals = list ? ((const sp_str_list*)opts[j].out)->items : opts[j].out;
             int n = list ? ((const sp_str_list*)opts[j].out)->count : 1;
             for (int k = 0; k < n; ++k) {
-                if (!vals[k] || !same_file(out, vals[k])) continue;
-                if (opts[j].kind != SP_OPT_OUT)
-                    fprintf(stderr, "%s: %s %s is the same file as %s: it would be overwritten\n", cmd, opts[i].name, out,
-                            opts[j].name);
-                else if (j < i)
+                if (!vals[k]) continue;
+                if (opts[j].kind != SP_OPT_OUT) {
+                    if (sp_cli_out_is_input(cmd, opts[i].name, out, opts[j].name, vals[k])) return 2;
+                    continue;
+                }
+                if (!same_file(out, vals[k])) continue;
+                if (j < i)
                     fprintf(stderr, "%s: %s %s is the same file as %s: one would overwrite the other\n", cmd, opts[i].name, out,
                             opts[j].name);
                 else
@@ -215,6 +246,14 @@ bool sp_cli_out_is_stream(const char* path)
     // name; a regular file elsewhere under /dev (/dev/shm) is a file.
     struct stat st;
     return sp_path_descriptor(path) >= 0 || (stat(path, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode)));
+}
+
+bool sp_cli_out_is_stdout(const char* path)
+{
+    if (!path) return false;
+    if (!strcmp(path, "-") || sp_path_descriptor(path) == 1) return true;
+    struct stat sp, so;
+    return stat(path, &sp) == 0 && fstat(1, &so) == 0 && sp.st_dev == so.st_dev && sp.st_ino == so.st_ino;
 }
 
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)

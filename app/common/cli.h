@@ -76,6 +76,14 @@ bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cl
 /// True when an output path is written as a stream: under /dev/ or naming a
 /// FIFO or a device (no file name, no folder to write beside it).
 bool sp_cli_out_is_stream(const char* path);
+/// True when an output named `path` is this process's stdout: "-",
+/// /dev/stdout and its spellings, or the file stdout is redirected to. A
+/// command that prints its report on stdout does not print it twice there.
+bool sp_cli_out_is_stdout(const char* path);
+/// True, after one line naming both, when the output `out` would overwrite
+/// the input `in` or a file the input reads (a glTF's external buffers and
+/// images): for inputs that are not options (sp_cli_parse checks those).
+bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in);
 
 /// For outputs written at the end of work (a solve, a kiosk session): NULL
 /// and streams pass; otherwise the file's folder must exist and be writable

@@ -379,7 +379,8 @@ static int db_add_part(int argc, char** argv)
         "writes nothing",
         opts, (int)(sizeof opts / sizeof opts[0]), pos, &npos, 1, 1, "PART.glb");
     if (rc >= 0) return rc;
-    if (!sp_cli_check_out(cmd, "--preview", preview, SP_CLI_OUT_PNG) || !count_opt(cmd, "--synth", &synth, 10000))
+    if (!sp_cli_check_out(cmd, "--preview", preview, SP_CLI_OUT_PNG) || !count_opt(cmd, "--synth", &synth, 10000) ||
+        sp_cli_out_is_input(cmd, "--preview", preview, "the part", pos[0]))
         return SP_EXIT_USAGE;
     d.synth_sketches = synth;
     if (view && !sp_derive_view_parse(view, &d.view)) {

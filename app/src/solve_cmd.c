@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cli.h"
 #include "outputs.h"
 #include "report.h"
 #include "sp/snapshot.h"
@@ -98,7 +99,7 @@ bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double
         fprintf(stderr, "%s: %s\n", s->cmd, err.text);
         return false;
     }
-    sp_json_print(report);
+    if (!sp_cli_out_is_stdout(o->report)) sp_json_print(report);
     if (o->note && o->note[0]) fprintf(stderr, "%s: %s\n", s->cmd, o->note);
     if (o->out) sp_rig_handle_warn_textures(s->cmd, s->rig, o->out);
     return true;

@@ -1556,6 +1556,79 @@ extern "C" sp_result sp_gltf_load(const char* path, sp_character* out, sp_error*
     });
 }
 
+namespace
+{
+
+// The JSON text of a .gltf, or of a .glb's first chunk: the header and that
+// chunk only, not the binary one (a glb of 2 GiB is not read twice).
+std::string gltf_json_text(const char* path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > 0x7fffffff) return std::string();
+    std::unique_ptr<FILE, decltype(&fclose)> f(fopen(path, "rb"), &fclose);
+    if (!f) return std::string();
+    unsigned char head[20];
+    size_t got = fread(head, 1, sizeof head, f.get());
+    size_t len = (size_t)st.st_size;
+    if (got == sizeof head && !memcmp(head, "glTF", 4))
+        len = std::min((size_t)le32(head + 12), len - got);
+    else if (fseek(f.get(), 0, SEEK_SET) != 0)
+        return std::string();
+    std::string text(len, '\0');
+    text.resize(fread(&text[0], 1, len, f.get()));
+    return text;
+}
+
+} // namespace
+
+extern "C" sp_result sp_gltf_external_files(const char* path, char*** files, int* count, sp_error* err)
+{
+    *files = nullptr;
+    *count = 0;
+    try {
+        std::string text = gltf_json_text(path);
+        std::unique_ptr<cJSON, decltype(&cJSON_Delete)> root(cJSON_ParseWithLength(text.data(), text.size()), &cJSON_Delete);
+        std::string dir = path;
+        size_t slash = dir.rfind('/');
+        dir = slash == std::string::npos ? "." : dir.substr(0, slash == 0 ? 1 : slash);
+        std::vector<std::string> names;
+        for (const char* key : {"buffers", "images"}) {
+            const cJSON* list = cJSON_GetObjectItemCaseSensitive(root.get(), key);
+            if (!cJSON_IsArray(list)) continue;
+            const cJSON* it;
+            cJSON_ArrayForEach(it, list)
+            {
+                const cJSON* uri = cJSON_GetObjectItemCaseSensitive(it, "uri");
+                if (!cJSON_IsString(uri) || !uri->valuestring[0] || is_data_uri(uri->valuestring)) continue;
+                std::string name = url_decode(uri->valuestring);
+                names.push_back(name[0] == '/' ? name : dir + "/" + name);
+            }
+        }
+        if (names.empty()) return SP_OK;
+        char** out = static_cast<char**>(calloc(names.size(), sizeof(char*)));
+        if (!out) throw std::bad_alloc();
+        for (size_t i = 0; i < names.size(); ++i)
+            if (!(out[i] = strdup(names[i].c_str()))) {
+                sp_gltf_files_free(out, (int)i);
+                throw std::bad_alloc();
+            }
+        *files = out;
+        *count = (int)names.size();
+        return SP_OK;
+    } catch (const std::bad_alloc&) {
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    } catch (...) {
+        return sp_fail(err, SP_ERR_INTERNAL, "%s: internal error in the glTF reader", path);
+    }
+}
+
+extern "C" void sp_gltf_files_free(char** files, int count)
+{
+    for (int i = 0; i < count; ++i)
+        free(files[i]);
+    free(files);
+}
+
 // ---- export ---------------------------------------------------------------
 
 namespace

@@ -881,6 +881,95 @@ static void test_outputs_kept(void)
     ENSURE(access(strcat(dir, "/t.json"), F_OK) != 0);
 }
 
+// A file that a glTF input reads is an input too: `pose --report` onto a
+// .gltf's external buffer replaced the rig's vertices with the report, and
+// `--render` onto its texture the picture. Refused before the work, for a
+// .gltf and a .glb's JSON chunk alike, the files left as they were.
+static void test_outputs_off_gltf_files(void)
+{
+    char dir[1024], gltf[1200], glb[1200], bin[1200], png[1200], args[6000];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("gltf_files"));
+    mkdir(dir, 0755);
+    snprintf(gltf, sizeof gltf, "%s/ext.gltf", dir);
+    snprintf(glb, sizeof glb, "%s/ext.glb", dir);
+    snprintf(bin, sizeof bin, "%s/ext data.bin", dir);
+    snprintf(png, sizeof png, "%s/skin.png", dir);
+    // Read as far as its file names only: the check runs before any loading.
+    const char* json = "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"ext%20data.bin\", \"byteLength\": 4}, "
+                       "{\"uri\": \"data:application/octet-stream;base64,AAAA\", \"byteLength\": 3}], "
+                       "\"images\": [{\"uri\": \"skin.png\"}]}  ";
+    FILE* f = fopen(gltf, "wb");
+    ENSURE(f && fputs(json, f) >= 0 && fclose(f) == 0);
+    uint32_t len = (uint32_t)strlen(json), head[5] = {0x46546C67u, 2, 20 + len, len, 0x4E4F534Au}; // "glTF", "JSON"
+    f = fopen(glb, "wb");
+    ENSURE(f && fwrite(head, sizeof head, 1, f) == 1 && fputs(json, f) >= 0 && fclose(f) == 0);
+    f = fopen(bin, "wb");
+    ENSURE(f && fputs("abcd", f) >= 0 && fclose(f) == 0);
+    f = fopen(png, "wb");
+    ENSURE(f && fputs("not a png", f) >= 0 && fclose(f) == 0);
+    char strokes[1200]; // never read: the check comes first
+    snprintf(strokes, sizeof strokes, "%s/s.json", dir);
+    f = fopen(strokes, "wb");
+    ENSURE(f && fputs("{}", f) >= 0 && fclose(f) == 0);
+    const char* cases[][2] = {
+        {"pose --rig '%1$s/ext.gltf' --strokes '%2$s' --report '%1$s/ext data.bin'",
+         "--report %1$s/ext data.bin is a file that --rig %1$s/ext.gltf reads (%1$s/ext data.bin): it would be overwritten"},
+        {"render --rig '%1$s/ext.glb' --out '%1$s/./skin.png'", "--out %1$s/./skin.png is a file that --rig %1$s/ext.glb reads"},
+        {"pose --rig '%1$s/ext.gltf' --strokes '%2$s' --render '%1$s/skin.png'", "--render %1$s/skin.png is a file that --rig"},
+        {"db add-part --db '%1$s/p.db' '%1$s/ext.gltf' --preview '%1$s/skin.png'",
+         "--preview %1$s/skin.png is a file that the part %1$s/ext.gltf reads"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char said[2000];
+        int rc;
+        snprintf(args, sizeof args, cases[i][0], dir, strokes);
+        snprintf(said, sizeof said, cases[i][1], dir, strokes);
+        char* text = run_said(args, &rc);
+        ENSURE(rc == 2 && strstr(text, said) && strchr(text, '\n') == text + strlen(text) - 1);
+        free(text);
+    }
+    char* text = sp_fixture_file_text(bin, NULL);
+    ENSURE(!strcmp(text, "abcd"));
+    free(text);
+    text = sp_fixture_file_text(png, NULL);
+    ENSURE(!strcmp(text, "not a png"));
+    free(text);
+    snprintf(args, sizeof args, "%s/p.db", dir);
+    ENSURE(access(args, F_OK) != 0); // refused before a database was made
+}
+
+// The report printed on stdout once, also when --report names stdout
+// (DESIGN's `--report /dev/stdout >> log` appended it twice: two JSON
+// documents, which no reader takes).
+static void test_report_on_stdout_once(void)
+{
+    char strokes[1100], log[1100], args[4000];
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("stdout_once.json"));
+    snprintf(log, sizeof log, "%s", sp_test_tmp_path("stdout_once.log"));
+    const char* rig = SP_SOURCE_DIR "/assets/tail.glb";
+    snprintf(args, sizeof args, "'%s' synth --rig '%s' --seed 2 --out '%s' 2>/dev/null", SP_SKETCHPOSE, rig, strokes);
+    ENSURE(run(args) == 0);
+    const char* reports[] = {"/dev/stdout", "-", "/dev/fd/1", "'%s'"};
+    for (size_t i = 0; i < sizeof reports / sizeof reports[0]; ++i) {
+        char report[1200];
+        snprintf(report, sizeof report, reports[i], log);
+        FILE* f = fopen(log, "wb");
+        ENSURE(f && fputs("[1]\n", f) >= 0 && fclose(f) == 0);
+        snprintf(args, sizeof args, "'%s' pose --rig '%s' --strokes '%s' --report %s >> '%s' 2>/dev/null", SP_SKETCHPOSE, rig,
+                 strokes, report, log);
+        int rc = run(args);
+        char* text = sp_fixture_file_text(log, NULL);
+        // A file named as itself (the last) is replaced whole, the rest appended to.
+        const char* doc = i + 1 < sizeof reports / sizeof reports[0] ? strstr(text, "]\n") + 2 : text;
+        const char* end = NULL;
+        cJSON* j = cJSON_ParseWithOpts(doc, &end, false);
+        fprintf(stderr, "  --report %s: exit %d, %zu bytes\n", report, rc, strlen(text));
+        ENSURE(rc == 0 && j && cJSON_GetObjectItem(j, "parameters") && strspn(end, " \n") == strlen(end));
+        cJSON_Delete(j);
+        free(text);
+    }
+}
+
 // drawover's two drawings are on one screen: --to on another canvas is
 // refused, naming it (its points were read in --on's canvas: a wrong fit,
 // exit 0); on the same canvas it fits.
@@ -1041,6 +1130,8 @@ int main(int argc, char** argv)
                                    {"pose_file_whole", test_pose_file_whole},
                                    {"device_inputs", test_device_inputs},
                                    {"outputs_kept", test_outputs_kept},
+                                   {"outputs_off_gltf_files", test_outputs_off_gltf_files},
+                                   {"report_on_stdout_once", test_report_on_stdout_once},
                                    {"drawover_canvas", test_drawover_canvas},
                                    {"synth_parts_fails_whole", test_synth_parts_fails_whole},
                                    {"usage_messages", test_usage_messages},

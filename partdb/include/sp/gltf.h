@@ -55,6 +55,13 @@ typedef struct sp_character {
 /// Loads a .gltf or .glb. On failure err names the file and the problem and
 /// *out is left zeroed.
 sp_result sp_gltf_load(const char* path, sp_character* out, sp_error* err);
+/// The files the .gltf or .glb at `path` names besides itself (external
+/// buffers and images, resolved as the loader does: beside it), so that a
+/// command keeps its outputs off its inputs: *files holds *count paths, free
+/// them with sp_gltf_files_free. None (SP_OK) for a file that is not regular
+/// or has no JSON to read: the loader says what is wrong with it.
+sp_result sp_gltf_external_files(const char* path, char*** files, int* count, sp_error* err);
+void sp_gltf_files_free(char** files, int count);
 /// Loads from memory (used by the fuzzer and the database); `what` names it in messages.
 sp_result sp_gltf_load_memory(const void* data, size_t size, const char* what, sp_character* out, sp_error* err);
 /// Writes the character posed at `params` (rig.param_count, NULL = ch->pose).
