@@ -33,13 +33,16 @@ const char* sp_stop_reason_name(sp_stop_reason r)
 typedef struct stage {
     sp_correspondence pairing; // how its rounds pair samples
     bool placement_only;       // only the root's placement parameters move (else every active one)
+    // Pairs are kept after the first round at the configured weights (always
+    // with ordered pairs; closest ones only when this is set: the start's).
+    bool hold_pairs;
     // The weights' schedule: round r boosts W_pose (and, for draw-over
     // curves, W_plane and W_dist) by max(1, 1e7 / relax^r); 0: the
     // configured weights throughout.
     double relax;
     // Gauss-Newton iterations a round: one while the weights are boosted,
-    // its_frozen once ordered pairs are kept (at the configured weights,
-    // after the first such round), its_fresh otherwise.
+    // its_frozen once pairs are kept (at the configured weights, after the
+    // first such round), its_fresh otherwise.
     int its_fresh, its_frozen;
     // Stopping: converged when a round at the configured weights lowers W by
     // less than tol (relative); with final_rounds > 0 the stage ends after
@@ -56,12 +59,12 @@ typedef struct stage {
 // to the stroke before anything bends. Closest points need no stroke
 // assignment; 1% a round is close enough for a start.
 static const stage k_place = {.pairing = SP_CORR_CLOSEST, .placement_only = true, .its_fresh = 3, .tol = 1e-2};
-// A loop is placed in order too: the best cyclic shift and direction of a
-// closed curve do not depend on where the stroke is or how big (both only
-// add a term common to every shift), and fixed pairs place the root in a
-// few iterations where closest points crawl.
-static const stage k_place_in_order = {
-    .pairing = SP_CORR_ORDERED, .placement_only = true, .its_fresh = 3, .its_frozen = 2, .tol = 1e-2};
+// A loop's placement holds the closest points made at the start pose: held
+// pairs place the root in a few iterations where fresh closest points crawl,
+// and did as well as ordered pairs (BENCHMARKS.md, "Measurements behind the
+// solver's constants and stages").
+static const stage k_place_held = {
+    .pairing = SP_CORR_CLOSEST, .placement_only = true, .hold_pairs = true, .its_fresh = 3, .its_frozen = 2, .tol = 1e-2};
 // Everything moves, with the abstraction's own pairing. Graduated
 // regularisation: strongly damped early rounds follow the correspondences
 // in small steps instead of jumping into a folded local minimum, one
@@ -140,7 +143,7 @@ static void plan_attempt(const sp_solver* s, const sp_sketch* sk, const attempt*
     pl->boost_from = pl->placed_free ? m->placement_count : 0;
     const bool place_stage = placing && !pl->placed_free;
     pl->start_pairing = place_stage ? SP_CORR_CLOSEST : s->ab->correspondence;
-    if (place_stage) pl->stages[pl->count++] = loop ? k_place_in_order : k_place;
+    if (place_stage) pl->stages[pl->count++] = loop ? k_place_held : k_place;
     if (loop) {
         pl->stages[pl->count++] = k_loop_in_order;
         pl->stages[pl->count++] = k_loop_closest;
@@ -228,7 +231,7 @@ static stage_end run_stage(sp_solver* s, attempt_run* r, const stage* st, bool f
     double best_end = INFINITY;                // the lowest W at the end of a round with fresh pairs at the configured weights
     int stall_rounds = 0, final_rounds = 0;
     for (int round = 0; round < s->d.max_icp_rounds && !r->time_up && !s->model->failed; ++round) {
-        const bool frozen = st->pairing == SP_CORR_ORDERED && final_rounds > 0; // ordered pairs kept
+        const bool frozen = (st->pairing == SP_CORR_ORDERED || st->hold_pairs) && final_rounds > 0; // pairs kept
         if (st->final_rounds > 0 && final_rounds >= st->final_rounds) break;
         if ((round > 0 || !first) && !frozen) {
             sp__model_update(s, r->it.p, false);
@@ -320,6 +323,13 @@ static sp_result run_plan(sp_solver* s, attempt_run* r, double* p_out)
     for (int i = 0; i < r->pl->count && !r->time_up && !s->model->failed; ++i) {
         end = run_stage(s, r, &r->pl->stages[i], i == 0);
         if (end == STAGE_ERROR) return r->res;
+        // Out of iterations with stages to go: the solve is, whatever the
+        // stage said (a next stage with no iteration left would end at
+        // once, "converged").
+        if (rep->iterations >= s->d.max_iterations && (end == STAGE_OVER || i + 1 < r->pl->count)) {
+            end = STAGE_OVER;
+            break;
+        }
     }
     if (s->model->failed) {
         // A black-box rig that cannot evaluate inside its bounds is broken:

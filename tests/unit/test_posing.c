@@ -970,6 +970,41 @@ static void test_report_on_stdout_once(void)
     }
 }
 
+// A solve out of iterations is reported so, also when the cap falls between
+// two stages of its plan: the next stage ended at once, "converged", with
+// no iteration left (the cartoon man's outline drawn as one loop: its
+// ordered stage ends after 10 iterations here, the closest-point stage
+// that follows had none).
+static void test_max_iterations_between_stages(void)
+{
+    char strokes[1100], report[1100], args[4000];
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("cap_strokes.json"));
+    snprintf(report, sizeof report, "%s", sp_test_tmp_path("cap_report.json"));
+    const char* rig = SP_SOURCE_DIR "/assets/cartoon_man.glb";
+    snprintf(args, sizeof args, "'%s' synth --rig '%s' --abstraction outline --seed 1 --amplitude 0.1 --out '%s' 2>/dev/null",
+             SP_SKETCHPOSE, rig, strokes);
+    ENSURE(run(args) == 0);
+    const int caps[] = {10, 1000};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(args, sizeof args,
+                 "'%s' pose --rig '%s' --abstraction outline --strokes '%s' --max-iterations %d --report '%s' >/dev/null "
+                 "2>&1",
+                 SP_SKETCHPOSE, rig, strokes, caps[i], report);
+        ENSURE(run(args) == 0);
+        char* text = sp_fixture_file_text(report, NULL);
+        cJSON* j = cJSON_Parse(text);
+        free(text);
+        ENSURE(j);
+        const char* stopped = cJSON_GetStringValue(cJSON_GetObjectItem(j, "stopped"));
+        int its = (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "iterations"));
+        fprintf(stderr, "  --max-iterations %d: %s after %d iterations, %d rounds\n", caps[i], stopped, its,
+                (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "icp_rounds")));
+        // Uncapped, it settles (stalled or converged) well within 1000.
+        ENSURE(stopped && (!strcmp(stopped, "max_iterations") == (i == 0)) && (i == 1 || its == caps[i]) && its < 1000);
+        cJSON_Delete(j);
+    }
+}
+
 // drawover's two drawings are on one screen: --to on another canvas is
 // refused, naming it (its points were read in --on's canvas: a wrong fit,
 // exit 0); on the same canvas it fits.
@@ -1132,6 +1167,7 @@ int main(int argc, char** argv)
                                    {"outputs_kept", test_outputs_kept},
                                    {"outputs_off_gltf_files", test_outputs_off_gltf_files},
                                    {"report_on_stdout_once", test_report_on_stdout_once},
+                                   {"max_iterations_between_stages", test_max_iterations_between_stages},
                                    {"drawover_canvas", test_drawover_canvas},
                                    {"synth_parts_fails_whole", test_synth_parts_fails_whole},
                                    {"usage_messages", test_usage_messages},

@@ -25,8 +25,10 @@
 ///   - W_pose = sum_k ((p_k - p0_k) / u_k)^2: radians for angles, factors for
 ///     scales, reference units (D / 200) for translations.
 /// The reference is the paper's setting (Maya scenes in centimetres, a
-/// character a few hundred pixels tall); fixing the counts keeps the balance
-/// independent of sample and vertex counts, as the paper's n/k factor does.
+/// character a few hundred pixels tall). The fixed counts depart from the
+/// paper on purpose: its n/k factor makes the k representatives stand in for
+/// all n vertices, so its W_plane and W_dist grow with how finely a mesh is
+/// made; here the balance is the same for any vertex or sample count.
 ///
 /// The solve alternates correspondence updates (ICP rounds) with damped
 /// Gauss-Newton steps (Levenberg-Marquardt) on the linearised rig. Bounds
@@ -60,7 +62,7 @@ typedef struct sp_solve_desc {
     double lambda_plane; ///< 0: SP_LAMBDA_PLANE; < 0: term off
     double lambda_dist;  ///< 0: SP_LAMBDA_DIST; < 0: term off
     int representatives; ///< k for the coarsening (eq. 12); 0: 200
-    int samples;         ///< samples per curve after resampling; 0: by length, 24..160
+    int samples;         ///< samples per curve after resampling; 0: by length, 16..160
     int max_iterations;  ///< Gauss-Newton iterations in all; 0: 300
     int max_icp_rounds;  ///< correspondence updates; 0: 40
     double time_cap_ms;  ///< wall-clock cap; 0: 3000
@@ -112,6 +114,10 @@ typedef struct sp_solve_report {
     int iterations, icp_rounds;
     sp_stop_reason stopped;
     double ms;
+    /// W at the start pose, with the attempt's start pairs (closest points
+    /// when a placement stage comes first, else the abstraction's own), and
+    /// at the result, with the abstraction's own pairs made there: their
+    /// totals compare only when the two pairings are the same.
     sp_energy_terms before, after;
     double mean_error_px, max_error_px; ///< over all matched samples, both directions for closest
     double bbox_diagonal_px;            ///< L, the abstraction's 2D diagonal at the start pose
