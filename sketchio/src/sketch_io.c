@@ -812,6 +812,57 @@ static bool svg_numbers(const char** p, const char* end, double* v, int n)
 // Flattening: fixed segments per curve, enough for sketches drawn at <= 1000 px.
 enum { SVG_CURVE_SEGMENTS = 12 };
 
+// An arc flag is one character, '0' or '1' (SVG 1.1 path grammar): "011 1" is two flags and a number.
+static bool svg_flag(const char** p, const char* end, bool* f)
+{
+    const char* s = *p;
+    while (s < end && (isspace((unsigned char)*s) || *s == ','))
+        ++s;
+    if (s >= end || (*s != '0' && *s != '1')) return false;
+    *f = *s == '1';
+    *p = s + 1;
+    return true;
+}
+
+// Elliptical arc from (x1,y1); a = rx, ry, x-axis rotation (degrees), x2, y2. SVG 1.1
+// implementation notes F.6.5-F.6.6, worked in units of the radii so that a huge radius
+// cannot overflow the squares. Sampled at the curves' density: a circle drawn as arcs
+// gets as many points as one drawn as four Béziers.
+static sp_result svg_arc(svg_ctx* c, double x1, double y1, const double a[5], bool large, bool sweep)
+{
+    double rx = fabs(a[0]), ry = fabs(a[1]), x2 = a[3], y2 = a[4];
+    if (x1 == x2 && y1 == y2) return SP_OK;              // F.6.2: no arc at all
+    if (rx == 0 || ry == 0) return svg_point(c, x2, y2); // F.6.2: a straight line
+    double phi = a[2] * M_PI / 180.0, cs = cos(phi), sn = sin(phi);
+    double hx = (x1 - x2) / 2, hy = (y1 - y2) / 2;
+    double X = (cs * hx + sn * hy) / rx, Y = (-sn * hx + cs * hy) / ry; // x1', y1' over the radii
+    double l = X * X + Y * Y, k = 0;
+    if (!(l > 0) || !isfinite(l)) return svg_point(c, x2, y2);
+    if (l > 1) { // radii too small for the endpoints: scaled up until they just fit (F.6.6)
+        double s = sqrt(l);
+        rx *= s, ry *= s, X /= s, Y /= s;
+    } else
+        k = (large != sweep ? 1 : -1) * sqrt((1 - l) / l);
+    // Centre (k Y, -k X) in radius units; u and v run from it to the two endpoints.
+    double ux = X - k * Y, uy = Y + k * X, vx = -X - k * Y, vy = -Y + k * X;
+    double t0 = atan2(uy, ux), dt = atan2(ux * vy - uy * vx, ux * vx + uy * vy);
+    if (!sweep && dt > 0)
+        dt -= 2 * M_PI;
+    else if (sweep && dt < 0)
+        dt += 2 * M_PI;
+    if (!isfinite(k) || !isfinite(dt)) return svg_point(c, x2, y2);
+    double ccx = cs * k * rx * Y + sn * k * ry * X + (x1 + x2) / 2;
+    double ccy = sn * k * rx * Y - cs * k * ry * X + (y1 + y2) / 2;
+    int n = (int)ceil(fabs(dt) / (M_PI / 2) * SVG_CURVE_SEGMENTS);
+    if (n < 1) n = 1;
+    for (int i = 1; i < n; ++i) {
+        double t = t0 + dt * i / n, ex = rx * cos(t), ey = ry * sin(t);
+        sp_result rc = svg_point(c, cs * ex - sn * ey + ccx, sn * ex + cs * ey + ccy);
+        if (rc != SP_OK) return rc;
+    }
+    return svg_point(c, x2, y2); // exactly the endpoint, which the next command starts from
+}
+
 static sp_result svg_path(svg_ctx* c, const char* d, const char* end)
 {
     const char* p = d;
@@ -900,12 +951,17 @@ static sp_result svg_path(svg_ctx* c, const char* d, const char* end)
             lcx = x1, lcy = y1, cx = x, cy = y;
             break;
         }
-        case 'A': // elliptical arcs are rare in line drawings: approximated by their chord
-            if (!svg_numbers(&p, end, v, 7)) goto bad;
-            cx = ox + v[5];
-            cy = oy + v[6];
-            if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+        case 'A': {
+            bool large, sweep;
+            if (!svg_numbers(&p, end, v, 3) || !svg_flag(&p, end, &large) || !svg_flag(&p, end, &sweep) ||
+                !svg_numbers(&p, end, v + 3, 2))
+                goto bad;
+            v[3] += ox, v[4] += oy;
+            if (c->n == 0 && (rc = svg_point(c, cx, cy)) != SP_OK) return rc;
+            if ((rc = svg_arc(c, cx, cy, v, large, sweep)) != SP_OK) return rc;
+            cx = v[3], cy = v[4];
             break;
+        }
         case 'Z':
             if (c->n > 0 && (rc = svg_point(c, sx, sy)) != SP_OK) return rc;
             cx = sx, cy = sy;
@@ -1009,6 +1065,129 @@ static bool tag_is(const char* s, const char* e, const char* nm)
     return (size_t)(e - s) >= n && !strncmp(s, nm, n) && (s + n == e || isspace((unsigned char)s[n]) || s[n] == '/');
 }
 
+// The element name after '<' or '</', without an "svg:" prefix: some exporters write
+// the SVG namespace as a prefix (<svg:svg>, <svg:path>), which means no prefix here.
+static const char* svg_name(const char* s, const char* e)
+{
+    return e - s > 4 && !strncmp(s, "svg:", 4) ? s + 4 : s;
+}
+
+static size_t svg_name_len(const char* s, const char* e)
+{
+    const char* q = s;
+    while (q < e && !isspace((unsigned char)*q) && *q != '/')
+        ++q;
+    return (size_t)(q - s);
+}
+
+// True when [b, e), leading spaces aside, starts with CSS keyword kw (any case) and nothing
+// but "!important" or spaces follows.
+static bool svg_keyword(const char* b, const char* e, const char* kw)
+{
+    while (b < e && isspace((unsigned char)*b))
+        ++b;
+    size_t n = strlen(kw);
+    if ((size_t)(e - b) < n) return false;
+    for (size_t i = 0; i < n; ++i)
+        if (tolower((unsigned char)b[i]) != kw[i]) return false;
+    return b + n == e || isspace((unsigned char)b[n]) || b[n] == '!';
+}
+
+// Whether property [prop, prop + pl) (CSS names are in any case) with value [vb, ve) hides.
+static bool svg_hides(const char* prop, size_t pl, const char* vb, const char* ve)
+{
+    if (pl == 7 && svg_keyword(prop, prop + pl, "display")) return svg_keyword(vb, ve, "none");
+    if (pl == 10 && svg_keyword(prop, prop + pl, "visibility"))
+        return svg_keyword(vb, ve, "hidden") || svg_keyword(vb, ve, "collapse");
+    return false;
+}
+
+// An element that draws nothing, nor lets its content draw: display none or visibility
+// hidden, as attributes or in its style. (A child's visibility="visible" inside a hidden
+// group, which SVG would draw, is not looked for: editors hide whole layers.)
+static bool svg_hidden(const char* s, const char* e)
+{
+    const char *vb, *ve;
+    if (svg_attr(s, e, "display", &vb, &ve) && svg_hides("display", 7, vb, ve)) return true;
+    if (svg_attr(s, e, "visibility", &vb, &ve) && svg_hides("visibility", 10, vb, ve)) return true;
+    if (!svg_attr(s, e, "style", &vb, &ve)) return false;
+    for (const char* d = vb; d < ve;) { // "name: value; ..."
+        const char* semi = memchr(d, ';', (size_t)(ve - d));
+        if (!semi) semi = ve;
+        const char* colon = memchr(d, ':', (size_t)(semi - d));
+        while (d < semi && isspace((unsigned char)*d))
+            ++d;
+        if (colon) {
+            const char* pe = colon;
+            while (pe > d && isspace((unsigned char)pe[-1]))
+                --pe;
+            if (svg_hides(d, (size_t)(pe - d), colon + 1, semi)) return true;
+        }
+        d = semi < ve ? semi + 1 : ve;
+    }
+    return false;
+}
+
+// Containers whose content is drawn only where something else refers to it, if at all.
+static bool svg_unrendered(const char* s, const char* e)
+{
+    static const char* const names[] = {"defs", "symbol", "marker", "clipPath", "mask", "pattern"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (tag_is(s, e, names[i])) return true;
+    return false;
+}
+
+// One drawing element (its tag at lt in text, name at nm, ending at gt): its strokes, through c->m.
+static sp_result svg_shape(svg_ctx* c, const char* text, size_t len, const char* lt, const char* nm, const char* gt)
+{
+    const char* s = lt + 1;
+    const char *vb, *ve;
+    sp_result rc = SP_OK;
+    if (tag_is(nm, gt, "path")) {
+        if (svg_attr(s, gt, "d", &vb, &ve)) rc = svg_path(c, vb, ve);
+    } else if (tag_is(nm, gt, "line")) {
+        double v[4];
+        const char* keys[4] = {"x1", "y1", "x2", "y2"};
+        for (int i = 0; i < 4; ++i) {
+            const char* q;
+            v[i] = 0;
+            if (svg_attr(s, gt, keys[i], &vb, &ve) && (q = vb, !svg_number(&q, ve, &v[i])))
+                return sp_fail(c->err, SP_ERR_PARSE, "%s: bad <line> near line %d", c->name, line_of(text, len, lt));
+        }
+        if ((rc = svg_point(c, v[0], v[1])) == SP_OK && (rc = svg_point(c, v[2], v[3])) == SP_OK) rc = svg_flush(c);
+    } else if (tag_is(nm, gt, "polyline") || tag_is(nm, gt, "polygon")) {
+        if (svg_attr(s, gt, "points", &vb, &ve)) {
+            const char* q = vb;
+            double xy[2], x0 = 0, y0 = 0;
+            int k = 0;
+            while (rc == SP_OK && svg_numbers(&q, ve, xy, 2)) {
+                if (k++ == 0) x0 = xy[0], y0 = xy[1];
+                rc = svg_point(c, xy[0], xy[1]);
+            }
+            if (rc == SP_OK && k > 0 && tag_is(nm, gt, "polygon")) rc = svg_point(c, x0, y0);
+            if (rc == SP_OK) rc = svg_flush(c);
+        }
+    }
+    return rc;
+}
+
+// The translation that puts the first <svg>'s viewBox corner at the canvas origin, and its
+// size as the canvas: a drawing an editor padded or cropped keeps its place on it.
+static affine svg_viewbox(const char* s, const char* gt, sp_sketch* out)
+{
+    const char *vb, *ve;
+    double v[4];
+    const char* q;
+    if (out->canvas_w != 0 || !svg_attr(s, gt, "viewBox", &vb, &ve)) return k_identity;
+    q = vb;
+    if (!svg_numbers(&q, ve, v, 4) || fabs(v[0]) >= 1e9 || fabs(v[1]) >= 1e9 || !(v[2] > 0 && v[3] > 0) || v[2] >= 1e6 ||
+        v[3] >= 1e6)
+        return k_identity;
+    out->canvas_w = v[2];
+    out->canvas_h = v[3];
+    return (affine){1, 0, 0, 1, -v[0], -v[1]};
+}
+
 enum { SVG_MAX_DEPTH = 64 };
 
 sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
@@ -1016,7 +1195,12 @@ sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp
     memset(out, 0, sizeof *out);
     svg_ctx c = {.name = name, .err = err, .out = out, .m = k_identity};
     affine stack[SVG_MAX_DEPTH];
+    const char* open[SVG_MAX_DEPTH]; // the group names, for a file cut short
     int depth = 0;
+    // Inside a hidden or unrendered element: its name, and how many of that name are open.
+    const char* skip = NULL;
+    size_t skip_len = 0;
+    int skip_depth = 0;
     bool saw_svg = false;
     sp_result rc = SP_OK;
     const char* p = text;
@@ -1029,7 +1213,7 @@ sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp
             const char* q = s + 3;
             while (q + 2 < end && strncmp(q, "-->", 3))
                 ++q;
-            p = q + 3;
+            p = q + 2 < end ? q + 3 : end;
             continue;
         }
         const char* gt = memchr(s, '>', (size_t)(end - s));
@@ -1041,8 +1225,15 @@ sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp
         if (*s == '?' || *s == '!') continue;
         bool closing = *s == '/';
         bool self_closing = gt[-1] == '/';
+        const char* nm = svg_name(closing ? s + 1 : s, gt);
+        size_t nl = svg_name_len(nm, gt);
+        if (skip) {
+            if (nl == skip_len && !strncmp(nm, skip, nl) && !self_closing && (closing ? --skip_depth : ++skip_depth) == 0)
+                skip = NULL;
+            continue;
+        }
         if (closing) {
-            if (tag_is(s + 1, gt, "g") || tag_is(s + 1, gt, "svg") || tag_is(s + 1, gt, "a")) {
+            if (tag_is(nm, gt, "g") || tag_is(nm, gt, "svg") || tag_is(nm, gt, "a")) {
                 if (depth == 0) {
                     rc = sp_fail(err, SP_ERR_PARSE, "%s: unbalanced </g> near line %d", name, line_of(text, len, lt));
                     goto fail;
@@ -1051,70 +1242,40 @@ sp_result sp_sketch_parse_svg(const char* text, size_t len, const char* name, sp
             }
             continue;
         }
+        bool is_svg = tag_is(nm, gt, "svg");
+        saw_svg = saw_svg || is_svg;
+        if (svg_unrendered(nm, gt) || svg_hidden(s, gt)) {
+            if (!self_closing && nl > 0) skip = nm, skip_len = nl, skip_depth = 1;
+            continue;
+        }
         const char *vb, *ve;
         affine local = k_identity;
         if (svg_attr(s, gt, "transform", &vb, &ve) && !svg_transform(vb, ve, &local)) {
             rc = sp_fail(err, SP_ERR_PARSE, "%s: bad transform near line %d", name, line_of(text, len, lt));
             goto fail;
         }
-        bool group = tag_is(s, gt, "g") || tag_is(s, gt, "svg") || tag_is(s, gt, "a");
-        if (tag_is(s, gt, "svg")) {
-            saw_svg = true;
-            if (out->canvas_w == 0 && svg_attr(s, gt, "viewBox", &vb, &ve)) {
-                double v[4];
-                const char* q = vb;
-                if (svg_numbers(&q, ve, v, 4) && isfinite(v[0]) && isfinite(v[1]) && fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9 &&
-                    v[2] > 0 && v[3] > 0 && v[2] < 1e6 && v[3] < 1e6) {
-                    out->canvas_w = v[2];
-                    out->canvas_h = v[3];
-                    // The canvas starts at the viewBox's corner: a drawing an
-                    // editor padded or cropped keeps its place on it.
-                    local = affine_mul((affine){1, 0, 0, 1, -v[0], -v[1]}, local);
-                }
-            }
-        }
-        if (group) {
+        if (is_svg) local = affine_mul(svg_viewbox(s, gt, out), local);
+        if (is_svg || tag_is(nm, gt, "g") || tag_is(nm, gt, "a")) {
             if (self_closing) continue;
             if (depth == SVG_MAX_DEPTH) {
                 rc = sp_fail(err, SP_ERR_UNSUPPORTED, "%s: groups nested deeper than %d", name, SVG_MAX_DEPTH);
                 goto fail;
             }
+            open[depth] = is_svg ? "svg" : tag_is(nm, gt, "g") ? "g" : "a";
             stack[depth++] = c.m;
             c.m = affine_mul(c.m, local);
             continue;
         }
         affine saved = c.m;
         c.m = affine_mul(c.m, local);
-        if (tag_is(s, gt, "path")) {
-            if (svg_attr(s, gt, "d", &vb, &ve)) rc = svg_path(&c, vb, ve);
-        } else if (tag_is(s, gt, "line")) {
-            double v[4];
-            const char* keys[4] = {"x1", "y1", "x2", "y2"};
-            for (int i = 0; i < 4; ++i) {
-                const char* q;
-                v[i] = 0;
-                if (svg_attr(s, gt, keys[i], &vb, &ve) && (q = vb, !svg_number(&q, ve, &v[i]))) {
-                    rc = sp_fail(err, SP_ERR_PARSE, "%s: bad <line> near line %d", name, line_of(text, len, lt));
-                    break;
-                }
-            }
-            if (rc == SP_OK && (rc = svg_point(&c, v[0], v[1])) == SP_OK && (rc = svg_point(&c, v[2], v[3])) == SP_OK)
-                rc = svg_flush(&c);
-        } else if (tag_is(s, gt, "polyline") || tag_is(s, gt, "polygon")) {
-            if (svg_attr(s, gt, "points", &vb, &ve)) {
-                const char* q = vb;
-                double xy[2], x0 = 0, y0 = 0;
-                int k = 0;
-                while (rc == SP_OK && svg_numbers(&q, ve, xy, 2)) {
-                    if (k++ == 0) x0 = xy[0], y0 = xy[1];
-                    rc = svg_point(&c, xy[0], xy[1]);
-                }
-                if (rc == SP_OK && k > 0 && tag_is(s, gt, "polygon")) rc = svg_point(&c, x0, y0);
-                if (rc == SP_OK) rc = svg_flush(&c);
-            }
-        }
+        rc = svg_shape(&c, text, len, lt, nm, gt);
         c.m = saved;
         if (rc != SP_OK) goto fail;
+    }
+    if (skip || depth > 0) { // a file cut between two elements would otherwise pass for a whole drawing
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: the file ends inside <%.*s> (cut short?)", name,
+                     skip ? (int)(skip_len < 40 ? skip_len : 40) : (int)strlen(open[depth - 1]), skip ? skip : open[depth - 1]);
+        goto fail;
     }
     if (!saw_svg) {
         rc = sp_fail(err, SP_ERR_PARSE, "%s: no <svg> element", name);

@@ -284,6 +284,152 @@ static void test_svg(void)
     }
 }
 
+// Parses an SVG text that must be accepted; the caller frees s.
+static void parse_svg_ok(const char* text, sp_sketch* s)
+{
+    sp_error err = {0};
+    sp_result rc = sp_sketch_parse_svg(text, strlen(text), "t.svg", s, &err);
+    if (rc != SP_OK) fprintf(stderr, "  refused: %s\n", err.text);
+    ENSURE(rc == SP_OK);
+}
+
+// A file cut between two elements used to give the strokes read so far.
+static void test_svg_truncated(void)
+{
+    const char* path = sp_test_tmp_path("cut.svg");
+    write_text(path, "<svg viewBox=\"0 0 10 10\"><path d=\"M0 0 L1 1\"/><path d=\"M2 2 L3 3\"/>");
+    sp_sketch s;
+    sp_error err = {0};
+    ENSURE(sp_sketch_read_svg(path, &s, &err) == SP_ERR_PARSE);
+    ENSURE(contains(err.text, path) && contains(err.text, "ends inside <svg> (cut short?)"));
+    ENSURE(s.stroke_count == 0);
+    const char* cut[][2] = {{"<svg><g transform=\"scale(2)\"><path d=\"M0 0 L1 1\"/>", "<g>"},
+                            {"<svg><g></g><a href=\"x\"><line x1=\"0\" y1=\"0\" x2=\"1\" y2=\"1\"/>", "<a>"},
+                            {"<svg:svg><svg:g>", "<g>"},
+                            {"<svg><defs><path d=\"M0 0 L1 1\"/>", "<defs>"},
+                            {"<svg><g display=\"none\"><g></g>", "<g>"},
+                            {"<svg><g><!-- </g> </svg> -->", "<g>"},
+                            {"<svg><path d=\"M0 0 L1 1\"/></svg><svg>", "<svg>"}};
+    for (size_t i = 0; i < sizeof cut / sizeof cut[0]; ++i) {
+        sp_error e = {0};
+        ENSURE(sp_sketch_parse_svg(cut[i][0], strlen(cut[i][0]), "b.svg", &s, &e) == SP_ERR_PARSE);
+        if (!contains(e.text, cut[i][1])) fprintf(stderr, "  %s: %s\n", cut[i][0], e.text);
+        ENSURE(contains(e.text, "b.svg: the file ends inside ") && contains(e.text, cut[i][1]));
+        ENSURE(s.stroke_count == 0);
+    }
+    // Whole files with self-closing groups and trailing text still pass.
+    parse_svg_ok("<svg><g/><a/><path d=\"M0 0 L1 1\"/></svg>\n<!-- end -->\n", &s);
+    ENSURE(s.stroke_count == 1);
+    sp_sketch_free(&s);
+}
+
+// <defs>, <symbol>, <marker>, <clipPath>, <mask>, <pattern> and hidden elements draw
+// nothing: their paths used to be read as strokes.
+static void test_svg_unrendered(void)
+{
+    const char* text = "<svg viewBox=\"0 0 100 100\">\n"
+                       "<defs><g><path d=\"M9 9 L9 9\"/></g><defs><path d=\"M9 9 L9 9\"/></defs><path d=\"M9 9 L9 9\"/></defs>\n"
+                       "<defs/><path d=\"M0 0 L1 0\"/>\n"
+                       "<symbol id=\"s\"><line x1=\"9\" y1=\"9\" x2=\"9\" y2=\"9\"/></symbol>\n"
+                       "<marker><path d=\"M9 9 L9 9\"/></marker><clipPath><polygon points=\"9,9 9,9\"/></clipPath>\n"
+                       "<svg:mask><path d=\"M9 9 L9 9\"/></svg:mask><pattern><polyline points=\"9,9 9,9\"/></pattern>\n"
+                       "<path display=\"none\" d=\"M9 9 L9 9\"/><path d=\"M9 9 L9 9\" visibility='hidden'/>\n"
+                       "<path style=\"fill:none; Display : NONE !important\" d=\"M9 9 L9 9\"/>\n"
+                       "<g style=\"stroke:#000;visibility:hidden\"><g><path d=\"M9 9 L9 9\"/></g><path d=\"M9 9 L9 9\"/></g>\n"
+                       "<g display=\"none\" transform=\"bad(\"><g display=\"inline\"><path d=\"M9 9 L9 9\"/></g></g>\n"
+                       "<g style=\"display:inline\" transform=\"translate(0,2)\"><path d=\"M0 0 L1 0\"/></g>\n"
+                       "<path data-display=\"none\" style=\"opacity:0.5\" d=\"M0 3 L1 3\"/>\n"
+                       "</svg>\n";
+    sp_sketch s;
+    parse_svg_ok(text, &s);
+    ENSURE(s.stroke_count == 3 && s.canvas_w == 100);
+    for (int i = 0; i < s.stroke_count; ++i) {
+        ENSURE(s.strokes[i].count == 2);
+        ENSURE_NEAR(s.strokes[i].points[0].y, i == 0 ? 0 : i == 1 ? 2 : 3, 1e-12);
+    }
+    sp_sketch_free(&s);
+    // A hidden root draws nothing but is still an SVG drawing.
+    parse_svg_ok("<svg display=\"none\"><path d=\"M0 0 L1 1\"/></svg>", &s);
+    ENSURE(s.stroke_count == 0);
+    sp_sketch_free(&s);
+}
+
+// The "svg:" namespace prefix some exporters write means no prefix: those drawings were empty.
+static void test_svg_prefixed(void)
+{
+    const char* text = "<?xml version=\"1.0\"?>\n"
+                       "<svg:svg xmlns:svg=\"http://www.w3.org/2000/svg\" viewBox=\"10 0 50 40\">\n"
+                       "<svg:g transform=\"translate(20,0)\"><svg:path d=\"M10 1 L11 2\"/>"
+                       "<svg:line x1=\"10\" y1=\"0\" x2=\"12\" y2=\"0\"/></svg:g>\n"
+                       "<svg:polyline points=\"10,5 11,6 12,5\"/>\n</svg:svg>\n";
+    sp_sketch s;
+    parse_svg_ok(text, &s);
+    ENSURE(s.canvas_w == 50 && s.canvas_h == 40 && s.stroke_count == 3);
+    ENSURE_NEAR(s.strokes[0].points[0].x, 20, 1e-12); // translate(20) after the viewBox's -10
+    ENSURE_NEAR(s.strokes[1].points[1].x, 22, 1e-12);
+    ENSURE(s.strokes[2].count == 3);
+    ENSURE_NEAR(s.strokes[2].points[0].x, 0, 1e-12); // outside the closed <svg:g>
+    sp_sketch_free(&s);
+}
+
+// Largest distance of stroke points [from, to) from the ellipse with centre (cx, cy),
+// axis-aligned radii rx, ry, in units of the radius.
+static double ellipse_error(const sp_stroke* st, int from, int to, double cx, double cy, double rx, double ry)
+{
+    double worst = 0;
+    for (int i = from; i < to; ++i) {
+        double u = (st->points[i].x - cx) / rx, v = (st->points[i].y - cy) / ry;
+        worst = fmax(worst, fabs(sqrt(u * u + v * v) - 1));
+    }
+    return worst;
+}
+
+// Elliptical arcs were drawn as their chord.
+static void test_svg_arc(void)
+{
+    enum { SEGS = 12 }; // sketch_io.c's SVG_CURVE_SEGMENTS, per quarter turn
+    sp_sketch s;
+    // 0: a half circle over the top (sweep 1 is the positive angle: y down, clockwise on screen);
+    // 1: radii too small are scaled up to fit (r 5), sweep 0 goes under;
+    // 2: a zero radius is a straight line; 3: a large and a small arc on one circle,
+    // compact flags ("011" is two flags and a number), relative, implicitly repeated;
+    // 4: rotated 90 degrees, rx along y.
+    parse_svg_ok("<svg><path d=\"M0 0 A5 5 0 0 1 10 0\"/><path d=\"M0 0 A1 1 0 0 0 10 0\"/>"
+                 "<path d=\"M0 0 A0 5 0 0 1 10 0\"/><path d=\"M0 0a5 5 0 105 5 5,5,0,0,0-5-5\"/>"
+                 "<path d=\"M0,0 A10,5,90,0,1,0,20\"/></svg>",
+                 &s);
+    ENSURE(s.stroke_count == 5);
+    const sp_stroke* a = &s.strokes[0];
+    ENSURE(a->count == 1 + 2 * SEGS); // half a turn: as two quarter-circle Béziers
+    ENSURE(ellipse_error(a, 0, a->count, 5, 0, 5, 5) < 1e-9);
+    ENSURE_NEAR(a->points[SEGS].x, 5, 1e-9);
+    ENSURE_NEAR(a->points[SEGS].y, -5, 1e-9);
+    ENSURE(a->points[a->count - 1].x == 10 && a->points[a->count - 1].y == 0);
+    const sp_stroke* b = &s.strokes[1];
+    ENSURE(b->count == 1 + 2 * SEGS && ellipse_error(b, 0, b->count, 5, 0, 5, 5) < 1e-9);
+    ENSURE_NEAR(b->points[SEGS].y, 5, 1e-9);
+    ENSURE(s.strokes[2].count == 2 && s.strokes[2].points[1].x == 10);
+    // Through (0,0) and (5,5) with r 5, both about (0,5): the large arc (3/4 turn, sweep 0)
+    // there, the small one (1/4 turn) back: the whole circle.
+    const sp_stroke* c = &s.strokes[3];
+    ENSURE(c->count == 1 + 4 * SEGS && ellipse_error(c, 0, c->count, 0, 5, 5, 5) < 1e-9);
+    ENSURE_NEAR(c->points[3 * SEGS].x, 5, 1e-12);
+    ENSURE_NEAR(c->points[3 * SEGS].y, 5, 1e-12);
+    ENSURE_NEAR(c->points[SEGS].x, -5, 1e-9);
+    ENSURE_NEAR(c->points[2 * SEGS].y, 10, 1e-9);
+    ENSURE_NEAR(c->points[c->count - 1].x, 0, 1e-12);
+    const sp_stroke* d = &s.strokes[4];
+    ENSURE(d->count == 1 + 2 * SEGS && ellipse_error(d, 0, d->count, 0, 10, 5, 10) < 1e-9);
+    ENSURE_NEAR(d->points[SEGS].x, 5, 1e-9);
+    sp_sketch_free(&s);
+    const char* bad[] = {"<svg><path d=\"M0 0 A5 5 0 2 1 10 0\"/></svg>", "<svg><path d=\"M0 0 A5 5 0 0 1 10\"/></svg>"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        sp_error e = {0};
+        ENSURE(sp_sketch_parse_svg(bad[i], strlen(bad[i]), "b.svg", &s, &e) == SP_ERR_PARSE);
+        ENSURE(contains(e.text, "b.svg: bad numbers after path command 'A'"));
+    }
+}
+
 static void test_tuberlin_real(void)
 {
     const char* dir = sp_test_data_dir();
@@ -492,7 +638,8 @@ static void test_folder(void)
     char** names;
     int n;
     ENSURE(sp_dir_list(sub, &names, &n, &err) == SP_OK && n == 4);
-    ENSURE(!strcmp(names[0], "a.svg") && !strcmp(names[1], "b.json") && !strcmp(names[2], "c.png") && !strcmp(names[3], "notes.txt"));
+    ENSURE(!strcmp(names[0], "a.svg") && !strcmp(names[1], "b.json") && !strcmp(names[2], "c.png") &&
+           !strcmp(names[3], "notes.txt"));
     sp_dir_list_free(names, n);
     snprintf(p, sizeof p, "%s/none", dir);
     ENSURE(sp_dir_list(p, &names, &n, &err) == SP_ERR_IO && strstr(err.text, p) && names == NULL && n == 0);
@@ -1186,6 +1333,10 @@ int main(int argc, char** argv)
                                    {"ndjson", test_ndjson},
                                    {"quickdraw_real", test_quickdraw_real},
                                    {"svg", test_svg},
+                                   {"svg_truncated", test_svg_truncated},
+                                   {"svg_unrendered", test_svg_unrendered},
+                                   {"svg_prefixed", test_svg_prefixed},
+                                   {"svg_arc", test_svg_arc},
                                    {"tuberlin_real", test_tuberlin_real},
                                    {"png", test_png},
                                    {"folder", test_folder},
