@@ -1,5 +1,6 @@
 #include "sp/snapshot.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 #include "sp/headless.h"
@@ -11,6 +12,15 @@ static void draw_sketch(sp_renderer* r, const sp_sketch* s, float width, const f
     if (!s) return;
     for (int i = 0; i < s->stroke_count; ++i)
         if (s->strokes[i].count > 0) sp_renderer_draw_polyline(r, s->strokes[i].points, s->strokes[i].count, false, width, rgba);
+}
+
+void sp_snapshot_size(const sp_camera* cam, int* w, int* h)
+{
+    double cw = cam->width > 0 ? cam->width : 1, ch = cam->height > 0 ? cam->height : 1;
+    double k = fmin(1.0, SP_SNAPSHOT_MAX_SIDE / fmax(cw, ch));
+    k = fmin(fmax(k, SP_SNAPSHOT_MIN_SIDE / fmin(cw, ch)), SP_SNAPSHOT_MAX_SIDE / fmax(cw, ch));
+    *w = (int)fmax(1.0, lround(cw * k));
+    *h = (int)fmax(1.0, lround(ch * k));
 }
 
 sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error* err)
@@ -25,7 +35,9 @@ sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error*
     sp_renderer* r;
     sp_render_target* t = NULL;
     res = sp_renderer_create(&(sp_renderer_desc){0}, &r, err);
-    if (res == SP_OK) res = sp_render_target_create(cam->width, cam->height, 0, &t, err);
+    int w, h;
+    sp_snapshot_size(cam, &w, &h);
+    if (res == SP_OK) res = sp_render_target_create(w, h, 0, &t, err);
     sp_rig_eval* ev;
     sp_rig_eval_create(rig, &ev, NULL);
     double* xyz = malloc(sizeof(double) * 3 * (size_t)(rig->vertex_count + 1));
@@ -48,7 +60,7 @@ sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error*
         if ((res = sp_render_mesh_create(r, &md, &m, err)) != SP_OK) goto done;
     }
     sp_render_target_bind(t);
-    sp_renderer_begin(r, cam, cam->width, cam->height);
+    sp_renderer_begin(r, cam, w, h); // the overlays' pixels stay the canvas's
     sp_renderer_clear(r, SP_COLOR_BACKGROUND_TOP, SP_COLOR_BACKGROUND_BOTTOM);
     if (m) {
         sp_vec3 lo, hi;

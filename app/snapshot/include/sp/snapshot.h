@@ -24,6 +24,13 @@ typedef struct sp_snapshot_desc {
     const sp_sketch* ghost;      ///< grey overlay (e.g. the draw-over source stroke), may be NULL
 } sp_snapshot_desc;
 
+/// The picture is the canvas scaled to at most SP_SNAPSHOT_MAX_SIDE pixels on
+/// its longer side and, where that allows, SP_SNAPSHOT_MIN_SIDE on its
+/// shorter: a stroke file's canvas (up to 1e6 px, an A4 drawing's viewBox of
+/// 21000 x 29700) is a drawing's units, not a picture size. Its size here.
+enum { SP_SNAPSHOT_MAX_SIDE = 4096, SP_SNAPSHOT_MIN_SIDE = 16 };
+void sp_snapshot_size(const sp_camera* cam, int* w, int* h);
+
 /// Renders to RGBA (img allocated by the call; sp_image_free it).
 sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error* err);
 /// Renders and writes a PNG.
