@@ -33,6 +33,31 @@ static void note_loose_curve(sp_solve_report* rep, const sp_abstraction* ab)
              ab->curves[c->curve].name, c->mean_px, 100.0 * share, c->stroke);
 }
 
+// Fewer strokes than curves: each stroke goes to the curve it matches best,
+// which need not be the one meant (one raised arm drawn alone was taken by
+// the spine and folded the figure, 0.25 px, "converged", nothing said). The
+// curves left without a stroke, and where the strokes went, are named
+// (after a best-effort note: they often explain it).
+static void note_unmatched_curves(sp_solve_report* rep, const sp_abstraction* ab)
+{
+    char left[160] = "", took[96] = "";
+    int n_left = 0;
+    for (int i = 0; i < rep->curve_count; ++i) {
+        const sp_curve_report* c = &rep->curves[i];
+        if (c->curve < 0 || c->curve >= ab->curve_count) continue;
+        size_t at = c->stroke < 0 ? strlen(left) : strlen(took);
+        if (c->stroke < 0 && ++n_left <= 4)
+            snprintf(left + at, sizeof left - at, "%s'%s'", at ? ", " : "", ab->curves[c->curve].name);
+        else if (c->stroke >= 0)
+            snprintf(took + at, sizeof took - at, "%sstroke %d '%s'", at ? ", " : "", c->stroke, ab->curves[c->curve].name);
+    }
+    if (n_left == 0) return;
+    size_t at = strlen(rep->note);
+    snprintf(rep->note + at, sizeof rep->note - at,
+             "%s%d curve%s without a stroke (%s%s); each stroke took the curve it fits best: %s", at ? "; " : "", n_left,
+             n_left == 1 ? "" : "s", left, n_left > 4 ? ", ..." : "", took);
+}
+
 bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
                         double* p, sp_solve_report* rep, cJSON** report)
 {
@@ -51,6 +76,7 @@ bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
         return false;
     }
     note_loose_curve(rep, &sp_rig_handle_abstractions(s->rig)[s->abstraction]);
+    note_unmatched_curves(rep, &sp_rig_handle_abstractions(s->rig)[s->abstraction]);
     *report = sp_report_json(rep, &sp_rig_handle_abstractions(s->rig)[s->abstraction], sp_rig_handle_params(s->rig),
                              sp_rig_handle_param_count(s->rig), p);
     return true;

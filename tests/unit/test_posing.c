@@ -1055,6 +1055,37 @@ static void test_render_size(void)
     sp_sketch_free(&sk);
 }
 
+// One stroke for a five-curve stick figure: the note names the curves left
+// without a stroke and the curve the stroke took (a raised arm drawn alone
+// went to the spine and folded the figure with an empty note); every curve
+// drawn, no such note.
+static void test_note_unmatched_curves(void)
+{
+    char strokes[1100], report[1100], args[4000];
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("one_stroke.json"));
+    snprintf(report, sizeof report, "%s", sp_test_tmp_path("one_stroke_report.json"));
+    const char* rig = SP_SOURCE_DIR "/assets/cartoon_man.glb";
+    sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
+    const sp_vec2 arm[] = {{355, 205}, {380, 170}, {400, 130}, {410, 100}};
+    sp_error err = {0};
+    ENSURE(sp_sketch_add_stroke(&sk, arm, NULL, 4) == SP_OK && sp_sketch_write_json(strokes, &sk, &err) == SP_OK);
+    sp_sketch_free(&sk);
+    for (int all = 0; all < 2; ++all) {
+        if (all) synth_strokes(rig, 3, strokes);
+        snprintf(args, sizeof args, "'%s' pose --rig '%s' --strokes '%s' --report '%s' >/dev/null 2>&1", SP_SKETCHPOSE, rig,
+                 strokes, report);
+        ENSURE(run(args) == 0);
+        char* text = sp_fixture_file_text(report, NULL);
+        cJSON* j = cJSON_Parse(text);
+        free(text);
+        const char* note = cJSON_GetStringValue(cJSON_GetObjectItem(j, "note"));
+        fprintf(stderr, "  %s: note \"%s\"\n", all ? "every curve drawn" : "one stroke", note ? note : "(none)");
+        ENSURE(note && (strstr(note, "4 curves without a stroke") != NULL) == !all &&
+               (strstr(note, "stroke 0 '") != NULL) == !all);
+        cJSON_Delete(j);
+    }
+}
+
 // drawover's two drawings are on one screen: --to on another canvas is
 // refused, naming it (its points were read in --on's canvas: a wrong fit,
 // exit 0); on the same canvas it fits.
@@ -1218,6 +1249,7 @@ int main(int argc, char** argv)
                                    {"outputs_off_gltf_files", test_outputs_off_gltf_files},
                                    {"report_on_stdout_once", test_report_on_stdout_once},
                                    {"render_size", test_render_size},
+                                   {"note_unmatched_curves", test_note_unmatched_curves},
                                    {"max_iterations_between_stages", test_max_iterations_between_stages},
                                    {"drawover_canvas", test_drawover_canvas},
                                    {"synth_parts_fails_whole", test_synth_parts_fails_whole},
