@@ -180,6 +180,12 @@ int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positio
         char* end = NULL;
         errno = 0;
         if (o->kind == SP_OPT_STRING || o->kind == SP_OPT_IN || o->kind == SP_OPT_OUT) {
+            // An empty file name is a slip (an unset shell variable), not a
+            // file that cannot be opened (`--rig ""`: "cannot open", exit 1).
+            if (!v[0] && o->kind != SP_OPT_STRING) {
+                fprintf(stderr, "%s: %s needs a file name, got an empty value\n", cmd, o->name);
+                return 2;
+            }
             *(const char**)o->out = v;
         } else if (o->kind == SP_OPT_INT) {
             long x = strtol(v, &end, 10);

@@ -1207,6 +1207,9 @@ static void test_usage_messages(void)
         {"db review --db '%2$s.db' --limit -1", "sketchpose db review: --limit must not be negative, got -1"},
         {"db add-sketch '%2$s.json' --category head --category tail --db '%2$s.db'",
          "sketchpose db add-sketch: --category given twice"},
+        // An unset variable's empty name: "cannot open", exit 1, before.
+        {"pose --rig '' --strokes '%2$s.json'", "sketchpose pose: --rig needs a file name, got an empty value"},
+        {"render --rig '%1$s/assets/tail.glb' --out ''", "sketchpose render: --out needs a file name, got an empty value"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char args[3000];
