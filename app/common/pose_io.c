@@ -20,9 +20,19 @@ sp_result sp_pose_parse(const char* text, const char* what, const sp_param* para
                         sp_error* err)
 {
     if (clamped) *clamped = 0;
-    cJSON* root = cJSON_Parse(text);
-    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: not valid JSON", what);
+    const char* end = NULL;
+    cJSON* root = cJSON_ParseWithLengthOpts(text, strlen(text), &end, false);
+    if (sp_json_document_end(text, strlen(text), root != NULL, end, what, err) != SP_OK) {
+        cJSON_Delete(root);
+        return SP_ERR_PARSE;
+    }
     sp_result r = SP_OK;
+    // A parameter named twice is a mistake (the last silently won), as in a stroke file.
+    bool* seen = calloc((size_t)count + 1, sizeof(bool));
+    if (!seen) {
+        cJSON_Delete(root);
+        return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
+    }
     const cJSON* values = cJSON_GetObjectItemCaseSensitive(root, "parameters");
     if (!cJSON_IsObject(values)) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: expected {\"parameters\": {\"<joint>.<channel>\": value, ...}}", what);
@@ -36,6 +46,11 @@ sp_result sp_pose_parse(const char* text, const char* what, const sp_param* para
             r = sp_fail(err, SP_ERR_INVALID, "%s: unknown parameter '%s' (see `sketchpose inspect`)", what, it->string);
             goto done;
         }
+        if (seen[k]) {
+            r = sp_fail(err, SP_ERR_INVALID, "%s: parameter '%s' given twice", what, it->string);
+            goto done;
+        }
+        seen[k] = true;
         if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble)) {
             r = sp_fail(err, SP_ERR_INVALID, "%s: parameter '%s' is not a finite number", what, it->string);
             goto done;
@@ -44,14 +59,15 @@ sp_result sp_pose_parse(const char* text, const char* what, const sp_param* para
         const sp_param* q = &params[k];
         double c = sp_param_clamp(v, q->min, q->max, q->def);
         if (c != v) {
-            fprintf(stderr, "warning: %s: parameter '%s' = %g is outside [%g, %g], clamped to %g\n", what, it->string, v, q->min,
-                    q->max, c);
+            fprintf(stderr, "sketchpose: warning: %s: parameter '%s' = %g is outside [%g, %g], clamped to %g\n", what, it->string,
+                    v, q->min, q->max, c);
             v = c;
             if (clamped) ++*clamped;
         }
         p[k] = v;
     }
 done:
+    free(seen);
     cJSON_Delete(root);
     return r;
 }

@@ -385,21 +385,27 @@ static sp_result add_stroke(sp_sketch* s, const sp_vec2* pts, const double* ts, 
     return SP_OK;
 }
 
+sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const char* end, const char* name, sp_error* err)
+{
+    if (!parsed) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d", name, line_of(text, len, end));
+    // Anything but white space after the document means the file is not what it seems (two files joined, a bad edit).
+    while (end && end < text + len && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r' || *end == 0))
+        ++end;
+    if (end && end < text + len)
+        return sp_fail(err, SP_ERR_PARSE, "%s: text after the JSON document, line %d", name, line_of(text, len, end));
+    return SP_OK;
+}
+
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
     const char* end = NULL;
     cJSON* root = cJSON_ParseWithLengthOpts(text, len, &end, false);
-    if (!root) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d", name, line_of(text, len, end));
-    // Anything but white space after the document means the file is not what it seems (two files joined, a bad edit).
-    while (end && end < text + len && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r' || *end == 0))
-        ++end;
-    if (end && end < text + len) {
-        int line = line_of(text, len, end);
+    sp_result rc = sp_json_document_end(text, len, root != NULL, end, name, err);
+    if (rc != SP_OK) {
         cJSON_Delete(root);
-        return sp_fail(err, SP_ERR_PARSE, "%s: text after the JSON document, line %d", name, line);
+        return rc;
     }
-    sp_result rc = SP_OK;
     sp_sketch s = {0};
     stroke_scratch b = {0};
     const cJSON* fmt = cJSON_GetObjectItemCaseSensitive(root, "format");

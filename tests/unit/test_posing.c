@@ -694,6 +694,30 @@ static void test_pose_file_whole(void)
     unlink(path);
 }
 
+// A pose file is one JSON document naming each parameter once, as a stroke
+// file is: text after it and a parameter given twice were taken (the last
+// value silently won).
+static void test_pose_file_strict(void)
+{
+    sp_param params[2] = {{.name = "head.rx", .min = -1, .max = 1}, {.name = "head.ry", .min = -1, .max = 1}};
+    const struct {
+        const char* text;
+        const char* said;
+    } cases[] = {
+        {"{\"parameters\": {\"head.rx\": 0.1}}\n", NULL},
+        {"{\"parameters\": {\"head.rx\": 0.1}} x\n", "pose.json: text after the JSON document, line 1"},
+        {"{\"parameters\": {\"head.rx\": 0.1, \"head.rx\": 0.2}}", "pose.json: parameter 'head.rx' given twice"},
+        {"{\"parameters\": {\"head.rx\": 0.1", "pose.json: malformed JSON near line 1"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        double p[2] = {0};
+        sp_error err = {0};
+        sp_result r = sp_pose_parse(cases[i].text, "pose.json", params, 2, p, NULL, &err);
+        fprintf(stderr, "  %s -> %s\n", cases[i].text, r == SP_OK ? "read" : err.text);
+        ENSURE(cases[i].said ? r != SP_OK && !strcmp(err.text, cases[i].said) : r == SP_OK && p[0] == 0.1);
+    }
+}
+
 // A device or a pipe given where a file is read (a rig, a pose, a model, a
 // stroke file, a PNG to add) is refused in one line, not read without end:
 // /dev/zero used to fill the memory of `inspect --rig`.
@@ -1252,6 +1276,7 @@ int main(int argc, char** argv)
                                    {"outputs_off_gltf_files", test_outputs_off_gltf_files},
                                    {"report_on_stdout_once", test_report_on_stdout_once},
                                    {"render_size", test_render_size},
+                                   {"pose_file_strict", test_pose_file_strict},
                                    {"note_unmatched_curves", test_note_unmatched_curves},
                                    {"max_iterations_between_stages", test_max_iterations_between_stages},
                                    {"drawover_canvas", test_drawover_canvas},

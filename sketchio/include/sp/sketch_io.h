@@ -101,6 +101,11 @@ sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
 sp_result sp_file_read(const char* path, size_t max_bytes, void** data, size_t* size, sp_error* err);
 /// sp_file_read of a drawing file: at most SP_SKETCH_MAX_FILE_BYTES.
 sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_error* err);
+/// Whether text holds one JSON document, after a parser read it and stopped
+/// at `end` (`parsed`: it succeeded): SP_OK when only white space follows,
+/// else SP_ERR_PARSE with err naming `name` and the line ("malformed JSON
+/// near line 3", "text after the JSON document, line 9").
+sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const char* end, const char* name, sp_error* err);
 /// The folder that holds `path` (malloc'd; NULL when out of memory): "." for
 /// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
 /// held by the folder out is in).
