@@ -2469,6 +2469,30 @@ static void test_export_whole(void)
     sp_db_close(db);
     tree_listing(parent, after, sizeof after);
     ENSURE(!strcmp(before, after));
+    // So does a part whose stored bytes no longer match their checksum (it
+    // was copied without a word, and `db init --from` refused the export).
+    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
+    ENSURE(sqlite3_exec(h, "UPDATE parts SET gltf = substr(gltf, 1, 1000) WHERE name = 'tail_a'", NULL, NULL, NULL) == SQLITE_OK);
+    sqlite3_close(h);
+    db = open_ok(p, SP_DB_READONLY);
+    ENSURE(sp_db_export(db, cmd, &err) == SP_ERR_PARSE && strstr(err.text, p) == err.text && !strchr(err.text, '\n'));
+    fprintf(stderr, "  a damaged part: %s\n", err.text);
+    ENSURE(strstr(err.text, ": part tail_a (tail): stored bytes do not match the checksum (`db check` lists such parts)") &&
+           strstr(err.text, "no export was written"));
+    sp_db_close(db);
+    tree_listing(parent, after, sizeof after);
+    ENSURE(!strcmp(before, after));
+    // The command: that one line, exit 1.
+    const char* bin = sketchpose_bin();
+    if (bin) {
+        char line[8192], out[65536];
+        snprintf(line, sizeof line, "'%s' db export '%s' --db '%s' 2>&1 >/dev/null", bin, cmd, p);
+        int rc = sp_fixture_run(line, out, sizeof out);
+        ENSURE(rc == 1 && strstr(out, "sketchpose db export: ") == out && strstr(out, "part tail_a (tail): stored bytes") &&
+               strchr(out, '\n') == out + strlen(out) - 1);
+        tree_listing(parent, after, sizeof after);
+        ENSURE(!strcmp(before, after));
+    }
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", parent);
     ENSURE(system(cmd) == 0);
 }
