@@ -142,14 +142,45 @@ static void drop_if_unused(const db_common* c, bool existed)
     remove(side);
 }
 
+// Said once a command that may create its database has stored something in a
+// new one: a mistyped --db or a wrong folder is noticed at once, not when the
+// kiosk shows none of it.
+static void note_created(const char* cmd, const db_common* c, bool existed)
+{
+    if (!existed)
+        fprintf(stderr,
+                "%s: created a new database %s (no file was there; the kiosk's default database is built by `sketchpose db "
+                "init`)\n",
+                cmd, db_path(c));
+}
+
 static int fail(const char* cmd, const sp_error* err)
 {
     fprintf(stderr, "%s: %s\n", cmd, err->text);
     return SP_EXIT_INPUT;
 }
 
-// One part as JSON; `derived` adds what add-part derived.
-static void print_part(const sp_db_part_info* p, bool derived)
+// The warnings of the part being added (sp_db_part_desc.warn), one line each.
+typedef struct part_warnings {
+    int count;
+    char (*lines)[SP_WARNING_MAX];
+    int dropped; // not kept: out of memory
+} part_warnings;
+
+static void collect_warning(void* user, const char* line)
+{
+    part_warnings* w = user;
+    char(*grown)[SP_WARNING_MAX] = realloc(w->lines, sizeof *w->lines * (size_t)(w->count + 1));
+    if (!grown) {
+        ++w->dropped;
+        return;
+    }
+    w->lines = grown;
+    snprintf(w->lines[w->count++], SP_WARNING_MAX, "%s", line);
+}
+
+// One part as JSON; `derived` adds what add-part derived, `warns` (may be NULL) its warnings.
+static void print_part(const sp_db_part_info* p, bool derived, const part_warnings* warns)
 {
     printf("{\"name\": ");
     clf_cli_json_str(stdout, p->name);
@@ -170,6 +201,14 @@ static void print_part(const sp_db_part_info* p, bool derived)
         printf(", \"derived\": [");
         for (int b = 0, n = 0; b < SP_DERIVED_COUNT; ++b)
             if (p->derived & (1u << b)) printf("%s\"%s\"", n++ ? ", " : "", sp_derived_name(b));
+        printf("]");
+    }
+    if (warns) {
+        printf(", \"warnings\": [");
+        for (int i = 0; i < warns->count; ++i) {
+            printf("%s", i ? ", " : "");
+            clf_cli_json_str(stdout, warns->lines[i]);
+        }
         printf("]");
     }
     printf("}");
@@ -347,6 +386,23 @@ static int db_init(int argc, char** argv)
     return SP_EXIT_OK;
 }
 
+// --attach-joint and --view choose how a plain rigged glTF is derived; a part
+// with sketchpose extras of its own is stored as it is, so either is bad usage
+// there (it was ignored, even a joint the part does not have). A file that does
+// not load is left to the add, which says so.
+static bool derive_options_apply(const char* cmd, const char* file, const char* attach_joint, const char* view)
+{
+    if (!attach_joint && !view) return true;
+    sp_character ch = {0};
+    sp_error err = {0};
+    bool plain = sp_gltf_load(file, &ch, &err) != SP_OK || sp_part_needs_derivation(&ch);
+    sp_character_free(&ch);
+    if (!plain)
+        fprintf(stderr, "%s: %s applies to a part derived from a plain rigged glTF; %s already has sketchpose extras\n", cmd,
+                attach_joint ? "--attach-joint" : "--view", file);
+    return plain;
+}
+
 static int db_add_part(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-part";
@@ -387,6 +443,10 @@ static int db_add_part(int argc, char** argv)
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
     }
+    if (!derive_options_apply(cmd, pos[0], d.attach_joint, view)) return SP_EXIT_USAGE;
+    part_warnings warns = {0};
+    d.warn = collect_warning;
+    d.warn_user = &warns;
     d.added_by = c.by;
     if (no_selftest) d.selftest_seeds = -1;
     sp_error err = {0};
@@ -418,11 +478,18 @@ static int db_add_part(int argc, char** argv)
     sp_character_free(&part);
     sp_db_close(db);
     if (r != SP_OK) {
+        free(warns.lines);
         drop_if_unused(&c, existed);
         return fail(cmd, &err);
     }
-    print_part(&info, true);
+    note_created(cmd, &c, existed);
+    // As `sketchpose derive` prints them for the same file: stderr for the curator, JSON for a script.
+    for (int i = 0; i < warns.count; ++i)
+        fprintf(stderr, "%s: %s: warning: %s\n", cmd, pos[0], warns.lines[i]);
+    if (warns.dropped) fprintf(stderr, "%s: %s: warning: %d more warnings (out of memory)\n", cmd, pos[0], warns.dropped);
+    print_part(&info, true, &warns);
     printf("\n");
+    free(warns.lines);
     return SP_EXIT_OK;
 }
 
@@ -609,6 +676,7 @@ static int db_add_sketch(int argc, char** argv)
     int exit_code = SP_EXIT_OK;
     if (r != SP_OK) exit_code = db || err.text[0] ? fail(cmd, &err) : SP_EXIT_INPUT;
     else {
+        note_created(cmd, &c, existed);
         int* per = calloc((size_t)(s.ds.category_count + 1), sizeof(int));
         for (int i = 0; per && i < s.ds.count; ++i)
             per[s.ds.samples[i].label]++;
@@ -663,7 +731,7 @@ static int db_list(int argc, char** argv)
     printf(", \"schema\": %d, \"generation\": %llu, \"parts\": [", sp_db_schema_version(db), (unsigned long long)sp_db_generation(db));
     for (int i = 0; i < n; ++i) {
         printf("%s", i ? ", " : "");
-        print_part(&parts[i], false);
+        print_part(&parts[i], false, NULL);
     }
     printf("], \"sketches\": {");
     for (int i = 0; i < ncat; ++i) {
@@ -702,7 +770,7 @@ static int db_show(int argc, char** argv)
         return fail(cmd, &err);
     }
     printf("{\"part\": ");
-    print_part(&info, false);
+    print_part(&info, false, NULL);
     printf(", \"summary\": %s, \"log\": %s}\n", summary, log);
     free(summary);
     free(log);

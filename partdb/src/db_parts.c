@@ -208,6 +208,12 @@ static char* summary_json(const sp_rig* rig)
     return b.s;
 }
 
+static void report_warnings(const sp_character* ch, const sp_db_part_desc* d)
+{
+    for (int i = 0; d->warn && i < ch->warning_count; ++i)
+        d->warn(d->warn_user, ch->warnings[i]);
+}
+
 // A part without sketch abstractions of its own, derived (sp/derive.h) and
 // encoded as GLB (*glb malloc'd); *glb stays NULL when ch has its own.
 static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, const char* what, void** glb, size_t* size,
@@ -215,7 +221,15 @@ static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, c
 {
     *glb = NULL;
     *derived = 0;
-    if (!sp_part_needs_derivation(ch)) return SP_OK;
+    if (!sp_part_needs_derivation(ch)) {
+        // Its own extras are kept as they are: a derivation option would be silently ignored.
+        if (d->attach_joint || d->view != SP_DERIVE_VIEW_AUTO)
+            return sp_fail(err, SP_ERR_INVALID,
+                           "%s: %s applies to a part derived from a plain rigged glTF; this one already has sketchpose extras",
+                           what, d->attach_joint ? "attach_joint" : "view");
+        report_warnings(ch, d);
+        return SP_OK;
+    }
     sp_character part = {0};
     sp_derive_info info;
     sp_error e = {0};
@@ -223,6 +237,7 @@ static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, c
         .category = d->category, .abstraction = d->abstraction, .attach_joint = d->attach_joint, .view = d->view};
     sp_result r = sp_part_derive(ch, &dd, &part, &info, &e);
     if (r != SP_OK) return sp_fail(err, r, "%s: refused: %s", what, e.text);
+    report_warnings(&part, d); // the source's, and the derivation's own
     r = sp_gltf_save_memory(&part, NULL, glb, size, err);
     sp_character_free(&part);
     if (r == SP_OK) *derived = info.derived;

@@ -672,6 +672,82 @@ static void test_cli(void)
     unlink(dangling);
 }
 
+// db add-part says what `derive` says of the same file: each warning on
+// stderr, one line naming the file, and "warnings" in its JSON (it hid them).
+// --attach-joint and --view, for a part with sketchpose extras of its own,
+// are bad usage naming the option (they were ignored, even an unknown joint);
+// for a part it derives, an unknown joint is refused naming it.
+static void test_add_part_cli_notes(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("the sketchpose binary is not built");
+    const char* src = lizard("notes_lizard.gltf", (sp_foreign_desc){.missing_texture = true});
+    char out[1024], db[1024], errf[1024], cmd[8192];
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("notes_lizard_sp.glb"));
+    snprintf(db, sizeof db, "%s", sp_test_tmp_path("notes.db"));
+    snprintf(errf, sizeof errf, "%s", sp_test_tmp_path("notes.err"));
+    unlink(db);
+    char* text = NULL;
+    snprintf(cmd, sizeof cmd, "'%s' derive --rig '%s' --out '%s' --category tail 2>/dev/null", bin, src, out);
+    ENSURE(run(cmd, &text) == 0);
+    cJSON* derived = cJSON_Parse(text);
+    free(text);
+    const cJSON* want = cJSON_GetObjectItem(derived, "warnings");
+    ENSURE(cJSON_GetArraySize(want) >= 2); // the missing texture: not found, and never read
+    snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --category tail --name lz --synth 4 --no-selftest 2>'%s'", bin, db,
+             src, errf);
+    ENSURE(run(cmd, &text) == 0);
+    cJSON* added = cJSON_Parse(text);
+    free(text);
+    const cJSON* got = cJSON_GetObjectItem(added, "warnings");
+    ENSURE(cJSON_IsArray(got) && cJSON_Compare(got, want, true));
+    char* said = sp_fixture_file_text(errf, NULL);
+    fprintf(stderr, "%s", said);
+    const cJSON* w;
+    cJSON_ArrayForEach(w, want)
+    {
+        char line[1400];
+        snprintf(line, sizeof line, "sketchpose db add-part: %s: warning: %s\n", src, w->valuestring);
+        ENSURE(strstr(said, line));
+    }
+    free(said);
+    cJSON_Delete(added);
+    cJSON_Delete(derived);
+    // A part with its own extras: no warnings, an empty list.
+    snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --name lz_own --synth 4 --no-selftest 2>/dev/null", bin, db, out);
+    ENSURE(run(cmd, &text) == 0);
+    added = cJSON_Parse(text);
+    free(text);
+    ENSURE(cJSON_IsArray(cJSON_GetObjectItem(added, "warnings")) &&
+           cJSON_GetArraySize(cJSON_GetObjectItem(added, "warnings")) == 0);
+    cJSON_Delete(added);
+    // Derivation options for that part: bad usage, one line, nothing stored.
+    const char* opts[2][2] = {{"--attach-joint no_such_joint", "--attach-joint"}, {"--view -z", "--view"}};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(cmd, sizeof cmd, "( '%s' db add-part --db '%s' '%s' --name lz_opt %s 2>&1 )", bin, db, out, opts[i][0]);
+        int rc = run(cmd, &text);
+        fprintf(stderr, "  %s -> %d: %s", opts[i][0], rc, text ? text : "");
+        char line[1400];
+        snprintf(
+            line, sizeof line,
+            "sketchpose db add-part: %s applies to a part derived from a plain rigged glTF; %s already has sketchpose extras\n",
+            opts[i][1], out);
+        ENSURE(rc == 2 && text && !strcmp(text, line));
+        free(text);
+    }
+    // A joint the derived part does not have: refused naming it.
+    snprintf(cmd, sizeof cmd,
+             "( '%s' db add-part --db '%s' '%s' --category tail --name lz_joint --attach-joint no_such_joint 2>&1 )", bin, db,
+             src);
+    int rc = run(cmd, &text);
+    fprintf(stderr, "  unknown joint -> %d: %s", rc, text ? text : "");
+    ENSURE(rc == 1 && text && strstr(text, "no joint named 'no_such_joint'") && strchr(text, '\n') == text + strlen(text) - 1);
+    free(text);
+    snprintf(cmd, sizeof cmd, "'%s' db list --db '%s'", bin, db);
+    ENSURE(run(cmd, &text) == 0 && strstr(text, "\"lz_own\"") && !strstr(text, "lz_opt") && !strstr(text, "lz_joint"));
+    free(text);
+}
+
 // ---- the outline on the rendered silhouette ---------------------------------------
 
 typedef struct silhouette {
@@ -1146,6 +1222,7 @@ int main(int argc, char** argv)
                                    {"refusals", test_refusals},
                                    {"collapsed_skin", test_collapsed_skin},
                                    {"cli", test_cli},
+                                   {"add_part_cli_notes", test_add_part_cli_notes},
                                    {"silhouette_lizard", test_silhouette_lizard},
                                    {"silhouette_khronos", test_silhouette_khronos},
                                    {"outline_regions", test_outline_regions},

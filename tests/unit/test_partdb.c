@@ -1898,6 +1898,62 @@ static void test_number_options_cli(void)
     ENSURE(!strcmp(before, after));
 }
 
+// The derivation options, given for a part with abstractions of its own
+// (stored as it is), are refused by the library too, naming the option and
+// the part: they were ignored, even a joint the part does not have.
+static void test_add_part_derive_options(void)
+{
+    const char* p = sp_test_tmp_path("derive_options.db");
+    sp_fixture_remove_db(p);
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    sp_error err = {0};
+    const sp_db_part_desc bad[2] = {{.name = "a", .attach_joint = "no_such_joint", .synth_sketches = -1, .selftest_seeds = -1},
+                                    {.name = "a", .view = SP_DERIVE_VIEW_NEG_Z, .synth_sketches = -1, .selftest_seeds = -1}};
+    for (int i = 0; i < 2; ++i) {
+        ENSURE(sp_db_add_part_file(db, part_file(0), &bad[i], NULL, &err) == SP_ERR_INVALID);
+        fprintf(stderr, "  %s\n", err.text);
+        ENSURE(strstr(err.text, part_file(0)) == err.text && strstr(err.text, i ? "view applies" : "attach_joint applies") &&
+               strstr(err.text, "already has sketchpose extras"));
+    }
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 0);
+    sp_db_close(db);
+}
+
+// add-part and add-sketch create the database at a --db path where no file
+// is (documented), and now say so on stderr, one line naming it, so that a
+// mistyped path or a wrong folder is noticed; into an existing one, not a word.
+static void test_new_db_said_cli(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024], cmd[4096], out[65536];
+    const char* sketch = sp_test_tmp_path("said_one.json");
+    const char* text = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [9, 9], \"strokes\": [{\"points\": "
+                       "[[1, 2], [2, 3]]}]}";
+    sp_error err = {0};
+    ENSURE(db_write_file(sketch, text, strlen(text), &err) == SP_OK);
+    const char* adds[2][2] = {{"add-part", "--synth 0 --no-selftest --name"}, {"add-sketch", "--category tail --source"}};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(p, sizeof p, "%s", sp_test_tmp_path(i ? "said_sketch.db" : "said_part.db"));
+        sp_fixture_remove_db(p);
+        for (int again = 0; again < 2; ++again) {
+            // The second part needs a name of its own; the sketches take either source.
+            const char* last = i ? (again ? "kiosk" : "curated") : (again ? "p1" : "p0");
+            snprintf(cmd, sizeof cmd, "'%s' db %s --db '%s' '%s' %s %s 2>&1 >/dev/null", bin, adds[i][0], p,
+                     i ? sketch : part_file(0), adds[i][1], last);
+            int rc = sp_fixture_run(cmd, out, sizeof out);
+            fprintf(stderr, "  db %s (%s): exit %d: %s", adds[i][0], again ? "again" : "new", rc, out);
+            char want[1400];
+            snprintf(want, sizeof want,
+                     "sketchpose db %s: created a new database %s (no file was there; the kiosk's default database is built by "
+                     "`sketchpose db init`)\n",
+                     adds[i][0], p);
+            ENSURE(rc == 0 && (again ? !strstr(out, "created a new database") : strstr(out, want) == out));
+        }
+        ENSURE(scalar(p, i ? "SELECT count(*) FROM sketches" : "SELECT count(*) FROM parts") == 2);
+    }
+}
+
 // A sketch of a category no part has is stored (a curator may add the
 // sketch before the part) with one warning line naming the category and the
 // database's part categories; it was stored silently, and training later
@@ -2747,5 +2803,7 @@ int main(int argc, char** argv)
                                    {"file_check", test_file_check},
                                    {"number_options_cli", test_number_options_cli},
                                    {"add_sketch_partless_cli", test_add_sketch_partless_cli},
+                                   {"new_db_said_cli", test_new_db_said_cli},
+                                   {"add_part_derive_options", test_add_part_derive_options},
                                    {0}});
 }

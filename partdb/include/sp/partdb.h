@@ -155,6 +155,12 @@ typedef struct sp_db_part_desc {
     double synth_amplitude;  ///< largest rotation from rest in the synthetic sketches, radians (0: the recipe's, 0.4 and the whole bounds by turns; see sp/synth.h)
     int selftest_seeds;      ///< solver self-test seeds; 0: 3; -1: skip the self-test
     double selftest_tolerance; ///< largest mean error over the seeds, fraction of the 2D diagonal; 0: 0.02
+    /// Called with each warning of the part as loaded, or as derived when it
+    /// is (sp_character.warnings: an ignored mesh, a missing texture,
+    /// renormalised weights, replaced sp_dofs), one line each, before it is
+    /// validated (a refused part may have warned); NULL: not reported.
+    void (*warn)(void* user, const char* line);
+    void* warn_user; ///< passed to warn
 } sp_db_part_desc;
 
 /// Validates a part without writing anything: the glTF loads, it has a skin
@@ -169,7 +175,9 @@ sp_result sp_db_validate_part(const void* glb, size_t size, const char* what, co
 /// A part without sketch abstractions of its own (a rigged glTF made
 /// elsewhere) is first given what the kiosk needs by sp_part_derive
 /// (sp/derive.h: outline, stick, parameters, attachment, clip) and stored
-/// derived; info->derived says what was derived.
+/// derived; info->derived says what was derived. attach_joint and view apply
+/// only to such a part: given for a part with abstractions of its own they
+/// are refused (SP_ERR_INVALID), not ignored.
 /// A name that exists is refused (remove it first). Nothing is written on failure.
 sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err);
 /// Same from a .gltf/.glb file: the part is re-encoded as one self-contained GLB
