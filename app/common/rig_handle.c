@@ -12,6 +12,7 @@
 #include "posing.h"
 #include "sp/blackbox.h"
 #include "sp/plugin.h"
+#include "sp/sketch_io.h"
 #include "sp/synth.h"
 
 struct sp_rig_handle {
@@ -28,6 +29,8 @@ bool sp_rig_path_is_plugin(const char* path)
     const char* base = strrchr(path, '/');
     base = base ? base + 1 : path;
     size_t n = strlen(base);
+    // A glTF's own extension wins: `cm.so.backup.glb` was dlopen'ed.
+    if (sp_path_ext_is(base, "glb") || sp_path_ext_is(base, "gltf")) return false;
     return (n > 3 && !strcmp(base + n - 3, ".so")) || strstr(base, ".so.") != NULL;
 }
 

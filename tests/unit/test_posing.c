@@ -496,6 +496,8 @@ static void test_rig_handle(void)
 {
     ENSURE(sp_rig_path_is_plugin("dir/libface.so") && sp_rig_path_is_plugin("libface.so.1"));
     ENSURE(!sp_rig_path_is_plugin("face.glb") && !sp_rig_path_is_plugin("lib.so/face.gltf") && !sp_rig_path_is_plugin(NULL));
+    // A glTF's extension wins over ".so." in the name (it was dlopen'ed).
+    ENSURE(!sp_rig_path_is_plugin("cm.so.backup.glb") && !sp_rig_path_is_plugin("rig.so.2.GLTF"));
     sp_error err = {0};
     sp_rig_handle *g = NULL, *f = NULL;
     ENSURE(sp_rig_handle_load(sp_test_src_path("tests/e2e/data/two_bone_extras.gltf"), &g, &err) == SP_OK);

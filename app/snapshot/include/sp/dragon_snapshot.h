@@ -11,7 +11,7 @@
 #include "sp/image.h"
 
 typedef struct sp_dragon_snapshot_desc {
-    double t;                ///< animation time, seconds (0: as fitted)
+    double t;                ///< animation time, seconds (0: the loop's start; as fitted where a clip starts at rest)
     bool strokes;            ///< overlay each part's stroke in blue
     bool outlines;           ///< overlay each part's fitted abstraction in yellow
     const sp_camera* camera; ///< NULL: sp_dragon_camera (the canvas)
