@@ -1919,6 +1919,30 @@ static void test_add_part_derive_options(void)
     sp_db_close(db);
 }
 
+// A part whose category differs from one the database has only in case is
+// refused naming both (the kiosk showed two "Front legs" tiles); the same
+// category, and another one, are stored.
+static void test_category_case(void)
+{
+    const char* p = sp_test_tmp_path("category_case.db");
+    sp_fixture_remove_db(p);
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    add_ok(db, 0, -1); // tail_a: tail
+    sp_error err = {0};
+    const sp_db_part_desc quick = {.synth_sketches = -1, .selftest_seeds = -1};
+    sp_db_part_desc d = quick;
+    d.name = "tail_x", d.category = "Tail";
+    ENSURE(sp_db_add_part_file(db, part_file(3), &d, NULL, &err) == SP_ERR_INVALID);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "category 'Tail' differs from its 'tail' only in case"));
+    d.category = "tail";
+    ENSURE(sp_db_add_part_file(db, part_file(3), &d, NULL, &err) == SP_OK);
+    d.name = "tail_y", d.category = "tails";
+    ENSURE(sp_db_add_part_file(db, part_file(3), &d, NULL, &err) == SP_OK);
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 3);
+    sp_db_close(db);
+}
+
 // add-part and add-sketch create the database at a --db path where no file
 // is (documented), and now say so on stderr, one line naming it, so that a
 // mistyped path or a wrong folder is noticed; into an existing one, not a word.
@@ -2805,5 +2829,6 @@ int main(int argc, char** argv)
                                    {"add_sketch_partless_cli", test_add_sketch_partless_cli},
                                    {"new_db_said_cli", test_new_db_said_cli},
                                    {"add_part_derive_options", test_add_part_derive_options},
+                                   {"category_case", test_category_case},
                                    {0}});
 }

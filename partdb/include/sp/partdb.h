@@ -178,7 +178,8 @@ sp_result sp_db_validate_part(const void* glb, size_t size, const char* what, co
 /// derived; info->derived says what was derived. attach_joint and view apply
 /// only to such a part: given for a part with abstractions of its own they
 /// are refused (SP_ERR_INVALID), not ignored.
-/// A name that exists is refused (remove it first). Nothing is written on failure.
+/// A name that exists is refused (remove it first), and a category that differs
+/// from one the database has only in case. Nothing is written on failure.
 sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info, sp_error* err);
 /// Same from a .gltf/.glb file: the part is re-encoded as one self-contained GLB
 /// (derived, as above, when it has no sketch abstraction of its own).
