@@ -74,6 +74,16 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
     return nk;
 }
 
+// A curator's name as the log keeps it: newlines and escape codes in --by
+// reached `db log` and a terminal, and a 100 KB name every row.
+static bool name_ok(const char* by)
+{
+    size_t n = strlen(by);
+    for (size_t i = 0; i < n; ++i)
+        if ((unsigned char)by[i] < 0x20 || by[i] == 0x7f) return false;
+    return n >= 1 && n <= 128;
+}
+
 static int parse(int argc, char** argv, const char* cmd, const db_common* c, const char* summary, const sp_opt* opts, int nopts,
                  const char** pos, int* npos, int minpos, int maxpos, const char* posname)
 {
@@ -95,6 +105,10 @@ static int parse(int argc, char** argv, const char* cmd, const db_common* c, con
     if (rc >= 0) return rc;
     // A day at most: beyond, the milliseconds overflow an int. 0 waits not at all.
     if (!isnan(c->busy_s) && !sp_cli_check_double(cmd, "--busy-timeout", c->busy_s, 0, false, 86400)) return SP_EXIT_USAGE;
+    if (c->by && !name_ok(c->by)) {
+        fprintf(stderr, "%s: --by wants a name of 1 to 128 bytes without control characters (it goes into the log)\n", cmd);
+        return SP_EXIT_USAGE;
+    }
     if (*npos < minpos) {
         fprintf(stderr, "%s: missing %s (see --help)\n", cmd, posname);
         return SP_EXIT_USAGE;

@@ -1235,6 +1235,7 @@ static void test_usage_messages(void)
          "sketchpose db add-sketch: --category given twice"},
         // An unset variable's empty name: "cannot open", exit 1, before.
         {"pose --rig '' --strokes '%2$s.json'", "sketchpose pose: --rig needs a file name, got an empty value"},
+        {"db log --db '%2$s.db' --by \"$(printf 'a\\033[2Jb')\"", "sketchpose db log: --by wants a name of 1 to 128 bytes"},
         {"render --rig '%1$s/assets/tail.glb' --out ''", "sketchpose render: --out needs a file name, got an empty value"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
