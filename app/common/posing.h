@@ -24,7 +24,13 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// parameters: hips, pelvis). Draw-over bends the character where it
 /// stands: a curve over one arm moved the whole of CesiumMan (the loader's
 /// derived placement) to fit it, and turned and grew the whole cartoon man.
-bool* sp_drawover_active(const sp_rig* rig);
+/// With emb (the curves embedded in the mesh, sp_embed_curve), only the
+/// joints that carry them move, those with at least SP_DRAWOVER_CARRIER_SHARE
+/// of the skin at some curve point, and the joints below them. An arm redrawn
+/// raised past its bounds twisted the cartoon man's spine, chest, neck and
+/// head to their bounds, for 1.0 px where the arm alone fits to 2.1.
+#define SP_DRAWOVER_CARRIER_SHARE 0.15
+bool* sp_drawover_active(const sp_rig* rig, const sp_abstraction* emb);
 /// Scales a draw-over solve's regulariser weights (0: the defaults; < 0:
 /// off, kept) by (the character's size on the canvas / the embedded curves'
 /// size there)^2, clamped to [1, 10000] (curves of no size: 10000), and

@@ -96,8 +96,6 @@ int cmd_drawover(int argc, char** argv)
     if (sp_rig_handle_load_character(rig_path, "draw-over", &rig, &err) != SP_OK) goto fail;
     sp_character* ch = sp_rig_handle_character(rig);
     run.rig = rig;
-    if (!(active = sp_drawover_active(&ch->rig))) goto oom;
-    run.desc.active = active;
     if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
     // Both drawings are on one screen: --to's points are read in --on's
     // canvas (its camera), so another canvas gave a wrong fit with exit 0.
@@ -123,6 +121,8 @@ int cmd_drawover(int argc, char** argv)
     // writes the file's own abstractions (sp_rig_posed.saved_abstractions).
     run.abstraction = sp_rig_add_abstraction(&ch->rig, &emb);
     if (run.abstraction < 0) goto oom;
+    if (!(active = sp_drawover_active(&ch->rig, &emb))) goto oom;
+    run.desc.active = active;
     double scale = sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
