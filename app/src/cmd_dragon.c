@@ -38,9 +38,7 @@ int cmd_dragon(int argc, char** argv)
          "parts for a database that does not exist yet (default: the source tree's assets/)", false},
         {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve, " SP_CLI_MAX_MS_RANGE " (default 250)", false},
         {"--time", SP_OPT_DOUBLE, &at, "S",
-         "animation time of the render, seconds in [0, 3600] (default 0: the loop's start, where the shipped parts' clips are at "
-         "rest: as fitted)",
-         false},
+         "animation time, s in [0, 3600] (default 0: the loop's start; shipped parts as fitted)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose dragon",
                           "The kiosk pipeline without a window: one part per stroke, one animated dragon.", opts,
