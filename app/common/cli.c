@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include "rig_handle.h"
 #include "sp/gltf.h"
 #include "sp/sketch_io.h"
 
@@ -47,30 +48,59 @@ static bool same_file(const char* a_given, const char* b_given)
     return same;
 }
 
-// A file that the glTF input `in` reads (an external buffer or image)
-// named as the output `out` (--report over a .gltf's .bin destroyed the rig).
-static bool out_on_gltf_file(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in)
+// The files that an input reads besides itself (a glTF's external buffers
+// and images), read from it once a command. Any input but a drawing, a pose
+// or a picture by its name, and a plugin, may be a glTF: the loader goes by
+// the content (a link named `rig` to a .gltf).
+typedef struct in_files {
+    bool read;
+    char** files;
+    int count;
+} in_files;
+
+static const in_files* files_of(in_files* f, const char* in)
 {
-    if (!sp_path_ext_is(in, "gltf") && !sp_path_ext_is(in, "glb")) return false;
-    char** files = NULL;
-    int n = 0;
+    static const char* const not_gltf[] = {"json", "svg", "png", "ndjson"};
+    if (f->read) return f;
+    f->read = true;
+    bool maybe = !sp_rig_path_is_plugin(in);
+    for (size_t e = 0; maybe && e < sizeof not_gltf / sizeof not_gltf[0]; ++e)
+        maybe = !sp_path_ext_is(in, not_gltf[e]);
     sp_error err = {0};
-    bool hit = false;
-    if (sp_gltf_external_files(in, &files, &n, &err) != SP_OK) return false; // the loader will say
-    for (int k = 0; k < n && !hit; ++k)
-        if ((hit = same_file(out, files[k])))
+    if (maybe && sp_gltf_external_files(in, &f->files, &f->count, &err) != SP_OK) f->count = 0; // the loader will say
+    return f;
+}
+
+// One line and true when `out` would overwrite the input `in` or a file it
+// reads (--report over a .gltf's .bin replaced the rig's vertices).
+static bool out_overwrites(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in,
+                           const in_files* f)
+{
+    for (int k = 0; k < f->count; ++k)
+        if (same_file(out, f->files[k])) {
             fprintf(stderr, "%s: %s %s is a file that %s %s reads (%s): it would be overwritten\n", cmd, out_name, out, in_name,
-                    in, files[k]);
-    sp_gltf_files_free(files, n);
-    return hit;
+                    in, f->files[k]);
+            return true;
+        }
+    if (!same_file(out, in)) return false;
+    fprintf(stderr, "%s: %s %s is the same file as %s: it would be overwritten\n", cmd, out_name, out, in_name);
+    return true;
 }
 
 bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in)
 {
     if (!out || !in || !strcmp(out, "-") || sp_cli_out_is_stream(out)) return false;
-    if (out_on_gltf_file(cmd, out_name, out, in_name, in)) return true;
-    if (!same_file(out, in)) return false;
-    fprintf(stderr, "%s: %s %s is the same file as %s: it would be overwritten\n", cmd, out_name, out, in_name);
+    in_files f = {0};
+    bool hit = out_overwrites(cmd, out_name, out, in_name, in, files_of(&f, in));
+    sp_gltf_files_free(f.files, f.count);
+    return hit;
+}
+
+// Two outputs on one file keep only the last: said once, from the later.
+static bool outs_clash(const char* cmd, const sp_opt* opts, int i, int j, const char* out, const char* other)
+{
+    if (j > i || !same_file(out, other)) return false;
+    fprintf(stderr, "%s: %s %s is the same file as %s: one would overwrite the other\n", cmd, opts[i].name, out, opts[j].name);
     return true;
 }
 
@@ -81,31 +111,30 @@ bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out,
 // they go and left alone.
 static int check_files(const char* cmd, const sp_opt* opts, int nopts)
 {
-    for (int i = 0; i < nopts; ++i) {
+    in_files cache[64 * 4] = {{0}}; // an input's files, read once: the first 4 values of the first 64 options
+    int rc = -1;
+    for (int i = 0; i < nopts && rc < 0; ++i) {
         const char* out = opts[i].kind == SP_OPT_OUT ? *(const char* const*)opts[i].out : NULL;
         if (!out || !strcmp(out, "-") || sp_cli_out_is_stream(out)) continue;
-        for (int j = 0; j < nopts; ++j) {
+        for (int j = 0; j < nopts && rc < 0; ++j) {
             bool list = opts[j].kind == SP_OPT_IN_LIST;
             if (j == i || !(list || opts[j].kind == SP_OPT_IN || opts[j].kind == SP_OPT_OUT)) continue;
             const char* const* vals = list ? ((const sp_str_list*)opts[j].out)->items : opts[j].out;
             int n = list ? ((const sp_str_list*)opts[j].out)->count : 1;
-            for (int k = 0; k < n; ++k) {
+            for (int k = 0; k < n && rc < 0; ++k) {
                 if (!vals[k]) continue;
-                if (opts[j].kind != SP_OPT_OUT) {
-                    if (sp_cli_out_is_input(cmd, opts[i].name, out, opts[j].name, vals[k])) return 2;
-                    continue;
-                }
-                if (!same_file(out, vals[k])) continue;
-                if (j < i)
-                    fprintf(stderr, "%s: %s %s is the same file as %s: one would overwrite the other\n", cmd, opts[i].name, out,
-                            opts[j].name);
-                else
-                    continue; // said once, from the later option
-                return 2;
+                in_files once = {0}, *f = j < 64 && k < 4 ? &cache[4 * j + k] : &once;
+                bool hit = opts[j].kind == SP_OPT_OUT
+                               ? outs_clash(cmd, opts, i, j, out, vals[k])
+                               : out_overwrites(cmd, opts[i].name, out, opts[j].name, vals[k], files_of(f, vals[k]));
+                if (f == &once) sp_gltf_files_free(once.files, once.count);
+                if (hit) rc = 2;
             }
         }
     }
-    return -1;
+    for (int c = 0; c < 64 * 4; ++c)
+        sp_gltf_files_free(cache[c].files, cache[c].count);
+    return rc;
 }
 
 bool sp_cli_check_out_folders(const char* cmd, const sp_opt* opts, int nopts)
@@ -163,6 +192,10 @@ int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positio
                     return 2;
                 }
                 l->items[l->count++] = argv[++i];
+                if (o->kind == SP_OPT_IN_LIST && !argv[i][0]) {
+                    fprintf(stderr, "%s: %s needs file names, got an empty value\n", cmd, o->name);
+                    return 2;
+                }
             }
             if (l->count == 0) {
                 fprintf(stderr, "%s: %s needs at least one value\n", cmd, o->name);

@@ -90,7 +90,7 @@ int cmd_animate(int argc, char** argv)
     sp_error err = {0};
     sp_solve_cmd run = {.cmd = "sketchpose animate"};
     double *kp = NULL, *p0 = NULL;
-    char(*notes)[256] = NULL; // each key's report note (sp_solve_report.note)
+    char(*notes)[sizeof((sp_solve_report){0}.note)] = NULL; // each key's report note
     cJSON* all = cJSON_CreateArray();
     int exit_code = SP_EXIT_INPUT;
     // A glTF animation keys joints; a black box's deformers have none.

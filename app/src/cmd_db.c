@@ -113,6 +113,11 @@ static int parse(int argc, char** argv, const char* cmd, const db_common* c, con
         fprintf(stderr, "%s: missing %s (see --help)\n", cmd, posname);
         return SP_EXIT_USAGE;
     }
+    for (int i = 0; i < *npos; ++i)
+        if (!pos[i][0]) {
+            fprintf(stderr, "%s: %s: got an empty file name\n", cmd, posname);
+            return SP_EXIT_USAGE;
+        }
     return -1;
 }
 
@@ -457,7 +462,8 @@ static int db_add_part(int argc, char** argv)
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
     }
-    if (!derive_options_apply(cmd, pos[0], d.attach_joint, view)) return SP_EXIT_USAGE;
+    // --view auto is the default, which every part takes (sp_db_add_part agrees).
+    if (!derive_options_apply(cmd, pos[0], d.attach_joint, view && strcmp(view, "auto") != 0 ? view : NULL)) return SP_EXIT_USAGE;
     part_warnings warns = {0};
     d.warn = collect_warning;
     d.warn_user = &warns;

@@ -40,22 +40,24 @@ static void note_loose_curve(sp_solve_report* rep, const sp_abstraction* ab)
 // (after a best-effort note: they often explain it).
 static void note_unmatched_curves(sp_solve_report* rep, const sp_abstraction* ab)
 {
-    char left[160] = "", took[96] = "";
-    int n_left = 0;
+    // Three names of each at most (a curve's name is up to 63 bytes), after
+    // the best-effort or loose-fit note that may come first.
+    char left[220] = "", took[260] = "";
+    int n_left = 0, n_took = 0;
     for (int i = 0; i < rep->curve_count; ++i) {
         const sp_curve_report* c = &rep->curves[i];
         if (c->curve < 0 || c->curve >= ab->curve_count) continue;
         size_t at = c->stroke < 0 ? strlen(left) : strlen(took);
-        if (c->stroke < 0 && ++n_left <= 4)
+        if (c->stroke < 0 && ++n_left <= 3)
             snprintf(left + at, sizeof left - at, "%s'%s'", at ? ", " : "", ab->curves[c->curve].name);
-        else if (c->stroke >= 0)
+        else if (c->stroke >= 0 && ++n_took <= 3)
             snprintf(took + at, sizeof took - at, "%sstroke %d '%s'", at ? ", " : "", c->stroke, ab->curves[c->curve].name);
     }
     if (n_left == 0) return;
     size_t at = strlen(rep->note);
     snprintf(rep->note + at, sizeof rep->note - at,
-             "%s%d curve%s without a stroke (%s%s); each stroke took the curve it fits best: %s", at ? "; " : "", n_left,
-             n_left == 1 ? "" : "s", left, n_left > 4 ? ", ..." : "", took);
+             "%s%d curve%s without a stroke (%s%s); each stroke took the curve it fits best: %s%s", at ? "; " : "", n_left,
+             n_left == 1 ? "" : "s", left, n_left > 3 ? ", ..." : "", took, n_took > 3 ? ", ..." : "");
 }
 
 bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,

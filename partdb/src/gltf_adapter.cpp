@@ -1599,9 +1599,11 @@ extern "C" sp_result sp_gltf_external_files(const char* path, char*** files, int
             cJSON_ArrayForEach(it, list)
             {
                 const cJSON* uri = cJSON_GetObjectItemCaseSensitive(it, "uri");
+                // Only paths relative to the file are read (read_buffer_file): an
+                // absolute or scheme uri names nothing the loader opens.
                 if (!cJSON_IsString(uri) || !uri->valuestring[0] || is_data_uri(uri->valuestring)) continue;
                 std::string name = url_decode(uri->valuestring);
-                names.push_back(name[0] == '/' ? name : dir + "/" + name);
+                if (!is_absolute_uri(name)) names.push_back(dir + "/" + name);
             }
         }
         if (names.empty()) return SP_OK;

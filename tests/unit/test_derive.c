@@ -735,6 +735,11 @@ static void test_add_part_cli_notes(void)
         ENSURE(rc == 2 && text && !strcmp(text, line));
         free(text);
     }
+    // --view auto is the default, for any part.
+    snprintf(cmd, sizeof cmd,
+             "( '%s' db add-part --db '%s' '%s' --name lz_auto --view auto --synth 0 --no-selftest 2>/dev/null )", bin, db, out);
+    ENSURE(run(cmd, &text) == 0);
+    free(text);
     // A joint the derived part does not have: refused naming it.
     snprintf(cmd, sizeof cmd,
              "( '%s' db add-part --db '%s' '%s' --category tail --name lz_joint --attach-joint no_such_joint 2>&1 )", bin, db,

@@ -921,7 +921,7 @@ static void test_outputs_off_gltf_files(void)
     // Read as far as its file names only: the check runs before any loading.
     const char* json = "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"ext%20data.bin\", \"byteLength\": 4}, "
                        "{\"uri\": \"data:application/octet-stream;base64,AAAA\", \"byteLength\": 3}], "
-                       "\"images\": [{\"uri\": \"skin.png\"}]}  ";
+                       "\"images\": [{\"uri\": \"skin.png\"}, {\"uri\": \"/tmp/abs.png\"}]}  ";
     FILE* f = fopen(gltf, "wb");
     ENSURE(f && fputs(json, f) >= 0 && fclose(f) == 0);
     uint32_t len = (uint32_t)strlen(json), head[5] = {0x46546C67u, 2, 20 + len, len, 0x4E4F534Au}; // "glTF", "JSON"
@@ -931,6 +931,9 @@ static void test_outputs_off_gltf_files(void)
     ENSURE(f && fputs("abcd", f) >= 0 && fclose(f) == 0);
     f = fopen(png, "wb");
     ENSURE(f && fputs("not a png", f) >= 0 && fclose(f) == 0);
+    snprintf(args, sizeof args, "%s/rig", dir);
+    unlink(args);
+    ENSURE(symlink("ext.gltf", args) == 0);
     char strokes[1200]; // never read: the check comes first
     snprintf(strokes, sizeof strokes, "%s/s.json", dir);
     f = fopen(strokes, "wb");
@@ -942,6 +945,9 @@ static void test_outputs_off_gltf_files(void)
         {"pose --rig '%1$s/ext.gltf' --strokes '%2$s' --render '%1$s/skin.png'", "--render %1$s/skin.png is a file that --rig"},
         {"db add-part --db '%1$s/p.db' '%1$s/ext.gltf' --preview '%1$s/skin.png'",
          "--preview %1$s/skin.png is a file that the part %1$s/ext.gltf reads"},
+        // The loader goes by the content: a link without the extension is a glTF too.
+        {"pose --rig '%1$s/rig' --strokes '%2$s' --report '%1$s/ext data.bin'",
+         "--report %1$s/ext data.bin is a file that --rig"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char said[2000];
@@ -1283,6 +1289,8 @@ static void test_usage_messages(void)
         {"pose --rig '' --strokes '%2$s.json'", "sketchpose pose: --rig needs a file name, got an empty value"},
         {"db log --db '%2$s.db' --by \"$(printf 'a\\033[2Jb')\"", "sketchpose db log: --by wants a name of 1 to 128 bytes"},
         {"render --rig '%1$s/assets/tail.glb' --out ''", "sketchpose render: --out needs a file name, got an empty value"},
+        {"animate --rig '%1$s/assets/tail.glb' --strokes '' --out '%2$s.glb'", "sketchpose animate: --strokes needs file names"},
+        {"db add-part '' --db '%2$s.db'", "sketchpose db add-part: PART.glb: got an empty file name"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char args[3000];

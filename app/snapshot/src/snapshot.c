@@ -68,7 +68,9 @@ sp_result sp_snapshot_render(const sp_snapshot_desc* d, sp_image* img, sp_error*
         sp_renderer_draw_ground_shadow(r, lo, hi, 0);
         sp_renderer_draw_mesh(r, m, NULL);
     }
-    float line = (float)fmax(2.0, cam->height / 160.0);
+    // In canvas pixels, at least 2 of the picture's (a 21 x 16 picture of an
+    // 8 x 6 canvas drew its lines 5 px wide).
+    float line = (float)fmax(2.0 * cam->height / h, cam->height / 160.0);
     draw_sketch(r, d->ghost, line, (const float[4]){0.45f, 0.45f, 0.5f, 0.9f});
     draw_sketch(r, d->strokes, SP_STROKE_UNDER_FIT * line, SP_COLOR_STROKE);
     const sp_abstraction* abs[2] = {d->abstraction >= 0 && d->abstraction < rig->abstraction_count ? &rig->abstractions[d->abstraction] : NULL,

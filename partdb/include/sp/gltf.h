@@ -56,7 +56,8 @@ typedef struct sp_character {
 /// *out is left zeroed.
 sp_result sp_gltf_load(const char* path, sp_character* out, sp_error* err);
 /// The files the .gltf or .glb at `path` names besides itself (external
-/// buffers and images, resolved as the loader does: beside it), so that a
+/// buffers and images whose uri is a path relative to it: the only ones the
+/// loader reads, beside it), so that a
 /// command keeps its outputs off its inputs: *files holds *count paths, free
 /// them with sp_gltf_files_free. None (SP_OK) for a file that is not regular
 /// or has no JSON to read: the loader says what is wrong with it.

@@ -124,7 +124,7 @@ typedef struct sp_solve_report {
     int curve_count;                    ///< entries used in curves
     sp_curve_report curves[SP_REPORT_CURVES];
     int unused_strokes;                 ///< strokes left without a curve (more strokes than curves)
-    char note[256];                     ///< why a best-effort result is only that, or empty
+    char note[512];                     ///< why a best-effort result is only that, or empty (a few lines at most)
 } sp_solve_report;
 
 typedef struct sp_solver sp_solver;
