@@ -63,29 +63,53 @@ static int common_ancestor(const sp_rig* rig, int a, int b)
     return a == b ? a : -1;
 }
 
-// Marks the joints that carry the curves embedded in the mesh (at some curve
-// point, a joint's share of the skin there, the triangle's vertices' weights
-// blended by the point's barycentric coordinates, is at least `share`) and
-// the joints below them, which can then hold their own part still (W_dist):
-// a redrawn neck otherwise swung the head it carries, 6.2% of the size.
-static bool curve_carriers(const sp_rig* rig, const sp_abstraction* emb, double share, bool* carrier)
+// The joints a draw-over may move (`free`, by joint): those that carry the
+// curves embedded in the mesh, the limb above them and everything below.
+// - Carriers: a joint with at least SP_DRAWOVER_CARRIER_SHARE of the skin
+//   (the triangle's vertices' weights blended by the point's barycentric
+//   coordinates) at a tenth of the curve's points or more: one point on the
+//   chest where a stroke starts did not make the chest twist for an arm.
+// - The limb above: each carrier's ancestors up to, not including, the
+//   first that moves more than SP_DRAWOVER_LIMB_SHARE of the mesh (its skin
+//   and its descendants': a chest carries the head and both arms): a hand,
+//   a finger or a tail's tip redrawn moves its arm or its tail.
+// - Below: the joints under a carrier hold their own part still (W_dist):
+//   without them a redrawn neck swung the head, 6.2% of the size.
+static bool curve_carriers(const sp_rig* rig, const sp_abstraction* emb, double share, bool* free_j)
 {
-    double* w = calloc((size_t)rig->joint_count + 1, sizeof(double));
-    if (!w) return false;
+    int J = rig->joint_count;
+    double* w = calloc((size_t)J + 1, sizeof(double));
+    int* hits = calloc((size_t)J + 1, sizeof(int));
+    double* moves = calloc((size_t)J + 1, sizeof(double)); // share of the mesh's skin at or under the joint
+    if (!w || !hits || !moves) {
+        free(w), free(hits), free(moves);
+        return false;
+    }
     for (int i = 0; i < emb->point_count; ++i) {
         for (int c = 0; c < 3; ++c) {
             uint32_t v = emb->tri_vertices[3 * i + c];
             for (int k = 0; k < 4 && v < (uint32_t)rig->vertex_count; ++k)
                 w[rig->joints4[4 * (size_t)v + k]] += emb->bary[3 * i + c] * rig->weights4[4 * (size_t)v + k];
         }
-        for (int j = 0; j < rig->joint_count; ++j) {
-            carrier[j] |= w[j] >= share;
+        for (int j = 0; j < J; ++j) {
+            hits[j] += w[j] >= share;
             w[j] = 0;
         }
     }
-    for (int j = 0; j < rig->joint_count; ++j) // parents come first (sp_rig_finalize)
-        carrier[j] |= rig->joints[j].parent >= 0 && carrier[rig->joints[j].parent];
-    free(w);
+    for (size_t v = 0; v < (size_t)rig->vertex_count; ++v)
+        for (int k = 0; k < 4; ++k)
+            moves[rig->joints4[4 * v + k]] += rig->weights4[4 * v + k] / rig->vertex_count;
+    for (int j = J - 1; j > 0; --j) // children come after their parents (sp_rig_finalize)
+        if (rig->joints[j].parent >= 0) moves[rig->joints[j].parent] += moves[j];
+    for (int j = 0; j < J; ++j) {
+        if (10 * hits[j] < emb->point_count || hits[j] == 0) continue;
+        free_j[j] = true;
+        for (int a = rig->joints[j].parent; a >= 0 && moves[a] <= SP_DRAWOVER_LIMB_SHARE; a = rig->joints[a].parent)
+            free_j[a] = true;
+    }
+    for (int j = 0; j < J; ++j)
+        free_j[j] |= rig->joints[j].parent >= 0 && free_j[rig->joints[j].parent];
+    free(w), free(hits), free(moves);
     return true;
 }
 

@@ -25,11 +25,14 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// stands: a curve over one arm moved the whole of CesiumMan (the loader's
 /// derived placement) to fit it, and turned and grew the whole cartoon man.
 /// With emb (the curves embedded in the mesh, sp_embed_curve), only the
-/// joints that carry them move, those with at least SP_DRAWOVER_CARRIER_SHARE
-/// of the skin at some curve point, and the joints below them. An arm redrawn
+/// joints that carry them (SP_DRAWOVER_CARRIER_SHARE of the skin at a tenth
+/// of the curve's points), the limb above them (ancestors moving at most
+/// SP_DRAWOVER_LIMB_SHARE of the mesh), and
+/// the joints below them move (posing.c, curve_carriers). An arm redrawn
 /// raised past its bounds twisted the cartoon man's spine, chest, neck and
 /// head to their bounds, for 1.0 px where the arm alone fits to 2.1.
 #define SP_DRAWOVER_CARRIER_SHARE 0.15
+#define SP_DRAWOVER_LIMB_SHARE 0.25
 bool* sp_drawover_active(const sp_rig* rig, const sp_abstraction* emb);
 /// Scales a draw-over solve's regulariser weights (0: the defaults; < 0:
 /// off, kept) by (the character's size on the canvas / the embedded curves'
