@@ -583,14 +583,12 @@ static bool has_area(const sp_rig* r)
     return false;
 }
 
-sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp_character* out, sp_derive_info* info_out,
-                         sp_error* err)
+// What a derived part is refused for before any work: several skins, no
+// skinned mesh or no surface, an abstraction other than outline or stick,
+// a category the part database would refuse (after the work).
+static sp_result check_source(const sp_character* src, const sp_derive_desc* d, const char** abstraction, const char** category,
+                              sp_error* err)
 {
-    memset(out, 0, sizeof *out);
-    sp_derive_desc d = desc ? *desc : (sp_derive_desc){0};
-    sp_derive_info info_tmp;
-    sp_derive_info* info = info_out ? info_out : &info_tmp;
-    memset(info, 0, sizeof *info);
     const sp_rig* sr = &src->rig;
     if (src->mesh_skins > 1)
         return sp_fail(err, SP_ERR_UNSUPPORTED,
@@ -605,17 +603,77 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
                        "the skinned mesh's %d triangles all have no area (corners in one place or in a line): no surface "
                        "to trace an outline from",
                        sr->triangle_count);
-    const char* abstraction = d.abstraction ? d.abstraction : "outline";
-    if (strcmp(abstraction, "outline") != 0 && strcmp(abstraction, "stick") != 0)
+    *abstraction = d->abstraction ? d->abstraction : "outline";
+    if (strcmp(*abstraction, "outline") != 0 && strcmp(*abstraction, "stick") != 0)
         return sp_fail(err, SP_ERR_INVALID, "abstraction '%s': a derived part's sketches show its outline or its stick figure",
-                       abstraction);
-    const char* category = d.category ? d.category : src->part.category[0] ? src->part.category : NULL;
+                       *abstraction);
+    const char* c = d->category ? d->category : src->part.category[0] ? src->part.category : NULL;
+    *category = c;
     // Refused here, as the part database would refuse it later (after the work).
-    if (category && !sp_part_name_is_plain(category))
+    if (c && !sp_part_name_is_plain(c))
         return sp_fail(err, SP_ERR_INVALID,
                        "category '%s': not a plain name ([A-Za-z0-9_.-], 1 to %d characters, not starting with '.'), as the "
                        "part database takes it",
-                       category, SP_NAME_MAX - 1);
+                       c, SP_NAME_MAX - 1);
+    return SP_OK;
+}
+
+// The source at rest (node TRS; tr, rot, sc: scratch of a joint each): its
+// joints' world and skin matrices, its mesh in the part's space and extent.
+static sp_result source_at_rest(work* w, sp_vec3* tr, sp_quat* rot, sp_vec3* sc, sp_error* err)
+{
+    const sp_rig* sr = w->sr;
+    int SJ = sr->joint_count;
+    size_t nv = (size_t)sr->vertex_count;
+    for (int j = 0; j < SJ; ++j)
+        tr[j] = sr->joints[j].rest_t, rot[j] = sr->joints[j].rest_r, sc[j] = sr->joints[j].rest_s;
+    fk(sr, tr, rot, sc, w->G);
+    for (int j = 0; j < SJ; ++j) {
+        if (!sp_mat4_inverse_rel(&w->G[j], SP_MAT4_FLAT, &w->Ginv[j]))
+            return sp_fail(err, SP_ERR_INVALID, "joint '%s' has a singular rest transform (a zero or vanishing scale)",
+                           sr->joints[j].name);
+        w->S[j] = sp_mat4_mul(&w->G[j], &sr->joints[j].inverse_bind);
+    }
+    sp_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < nv; ++i) {
+        sp_vec3 x0 = sp_v3(sr->rest[3 * i], sr->rest[3 * i + 1], sr->rest[3 * i + 2]), x = {0, 0, 0};
+        for (int k = 0; k < 4; ++k) {
+            double wk = sr->weights4[4 * i + (size_t)k];
+            if (wk > 0) x = sp_v3_add(x, sp_v3_scale(sp_mat4_point(&w->S[sr->joints4[4 * i + (size_t)k]], x0), wk));
+        }
+        x = sp_mat4_point(&w->W, x);
+        w->xyz[3 * i] = x.x, w->xyz[3 * i + 1] = x.y, w->xyz[3 * i + 2] = x.z;
+        lo = sp_v3(fmin(lo.x, x.x), fmin(lo.y, x.y), fmin(lo.z, x.z));
+        hi = sp_v3(fmax(hi.x, x.x), fmax(hi.y, x.y), fmax(hi.z, x.z));
+    }
+    w->extent = sp_v3_len(sp_v3_sub(hi, lo));
+    if (!(w->extent > 0) || !isfinite(w->extent)) return sp_fail(err, SP_ERR_INVALID, "the mesh at rest has no extent");
+    return SP_OK;
+}
+
+// The derived joint a part attaches by, named by its source joint.
+static sp_result attach_joint_of(const work* w, const char* name, int* attach, sp_error* err)
+{
+    int sj = sp_rig_find_joint(w->sr, name);
+    if (sj < 0) return sp_fail(err, SP_ERR_INVALID, "--attach-joint: no joint named '%s'", name);
+    if (w->to_derived[sj] < 0)
+        return sp_fail(err, SP_ERR_INVALID, "--attach-joint: joint '%s' is above the skin (it moves no vertex)", name);
+    *attach = w->to_derived[sj];
+    return SP_OK;
+}
+
+sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp_character* out, sp_derive_info* info_out,
+                         sp_error* err)
+{
+    memset(out, 0, sizeof *out);
+    sp_derive_desc d = desc ? *desc : (sp_derive_desc){0};
+    sp_derive_info info_tmp;
+    sp_derive_info* info = info_out ? info_out : &info_tmp;
+    memset(info, 0, sizeof *info);
+    const sp_rig* sr = &src->rig;
+    const char *abstraction = NULL, *category = NULL;
+    sp_result r = check_source(src, &d, &abstraction, &category, err);
+    if (r != SP_OK) return r;
 
     work w = {0};
     w.src = src;
@@ -640,56 +698,16 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     double* p = NULL;
     bool* is_skin = NULL;
     sp_part part = {0};
-    sp_result r = SP_OK;
     if (!w.G || !w.Ginv || !w.S || !w.influences || !w.to_derived || !w.xyz || !tr || !rot || !sc) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         goto done;
     }
-    // The source at rest (node TRS), its mesh in the part's space.
-    for (int j = 0; j < SJ; ++j)
-        tr[j] = sr->joints[j].rest_t, rot[j] = sr->joints[j].rest_r, sc[j] = sr->joints[j].rest_s;
-    fk(sr, tr, rot, sc, w.G);
-    for (int j = 0; j < SJ; ++j) {
-        if (!sp_mat4_inverse_rel(&w.G[j], SP_MAT4_FLAT, &w.Ginv[j])) {
-            r = sp_fail(err, SP_ERR_INVALID, "joint '%s' has a singular rest transform (a zero or vanishing scale)",
-                        sr->joints[j].name);
-            goto done;
-        }
-        w.S[j] = sp_mat4_mul(&w.G[j], &sr->joints[j].inverse_bind);
-    }
-    sp_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < nv; ++i) {
-        sp_vec3 x0 = sp_v3(sr->rest[3 * i], sr->rest[3 * i + 1], sr->rest[3 * i + 2]), x = {0, 0, 0};
-        for (int k = 0; k < 4; ++k) {
-            double wk = sr->weights4[4 * i + (size_t)k];
-            if (wk > 0) x = sp_v3_add(x, sp_v3_scale(sp_mat4_point(&w.S[sr->joints4[4 * i + (size_t)k]], x0), wk));
-        }
-        x = sp_mat4_point(&w.W, x);
-        w.xyz[3 * i] = x.x, w.xyz[3 * i + 1] = x.y, w.xyz[3 * i + 2] = x.z;
-        lo = sp_v3(fmin(lo.x, x.x), fmin(lo.y, x.y), fmin(lo.z, x.z));
-        hi = sp_v3(fmax(hi.x, x.x), fmax(hi.y, x.y), fmax(hi.z, x.z));
-    }
-    w.extent = sp_v3_len(sp_v3_sub(hi, lo));
-    if (!(w.extent > 0) || !isfinite(w.extent)) {
-        r = sp_fail(err, SP_ERR_INVALID, "the mesh at rest has no extent");
-        goto done;
-    }
+    if ((r = source_at_rest(&w, tr, rot, sc, err)) != SP_OK) goto done;
     if ((r = build_joints(&w, info, err)) != SP_OK || (r = convert_clip(&w, err)) != SP_OK ||
         (r = build_rig(&w, &R, err)) != SP_OK)
         goto done;
     int attach = 0;
-    if (d.attach_joint) {
-        int sj = sp_rig_find_joint(sr, d.attach_joint);
-        if (sj < 0) {
-            r = sp_fail(err, SP_ERR_INVALID, "--attach-joint: no joint named '%s'", d.attach_joint);
-            goto done;
-        }
-        if (w.to_derived[sj] < 0) {
-            r = sp_fail(err, SP_ERR_INVALID, "--attach-joint: joint '%s' is above the skin (it moves no vertex)", d.attach_joint);
-            goto done;
-        }
-        attach = w.to_derived[sj];
-    }
+    if (d.attach_joint && (r = attach_joint_of(&w, d.attach_joint, &attach, err)) != SP_OK) goto done;
     if (w.clip && (r = add_clip(&w, &R, info, err)) != SP_OK) goto done;
     const char* what = "the derived part";
     if ((r = sp_rig_finalize(&R, what, NULL, err)) != SP_OK) goto done;
@@ -705,6 +723,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     sp_rig_defaults(&R, p);
     sp_rig_eval_update(ev, p, false);
     sp_rig_eval_points(ev, sp_rig_mesh_points(&R), w.xyz);
+    sp_vec3 lo, hi;
     sp_bounds(w.xyz, R.vertex_count, &lo, &hi);
     sp_camera cam = sp_part_side_camera(lo, hi, FRAME_MARGIN);
     double reach = 0.5 * fmax(cam.width, cam.height) / cam.scale;

@@ -235,6 +235,104 @@ typedef struct draw_ctx {
 } draw_ctx;
 
 // Traces one curve (pts, n >= 2, closed without the repeated point) into one or more strokes.
+// Where the pen goes along a curve of length L: its direction (1 or -1),
+// where it starts, how far it traces (a closed curve's gap, overshoot or
+// part; an open one's part), counted in c->info.
+static void pen_course(draw_ctx* c, double L, bool closed, int* dir, double* s0, double* total)
+{
+    const sp_handdraw_params* hp = c->hp;
+    sp_rng* rng = c->rng;
+    *dir = sp_rng_uniform(rng) < hp->reverse_probability ? -1 : 1;
+    double covered = 1.0;
+    bool partial = sp_rng_uniform(rng) < hp->partial_probability && hp->partial > 0;
+    double q = partial ? sp_rng_range(rng, 0.35, 1.0) * hp->partial : 0.0;
+    if (closed) {
+        *s0 = hp->random_start ? sp_rng_range(rng, 0, L) : 0.0;
+        double closure;
+        if (partial)
+            closure = -q;
+        else if (sp_rng_uniform(rng) < hp->gap_probability)
+            closure = -sp_rng_uniform(rng) * hp->gap;
+        else
+            closure = sp_rng_uniform(rng) * hp->overshoot;
+        *total = L * (1 + closure);
+        covered = fmin(1.0, 1 + closure);
+        c->info->closed_curves++;
+        if (closure < 0)
+            c->info->gaps++;
+        else if (closure > 0)
+            c->info->overshoots++;
+        c->info->closure_min = fmin(c->info->closure_min, closure);
+        c->info->closure_max = fmax(c->info->closure_max, closure);
+    } else {
+        double a = q * sp_rng_uniform(rng); // left out at the abstraction's start; q - a at its end
+        *total = L * (1 - q);
+        *s0 = *dir > 0 ? a * L : L - (q - a) * L;
+        covered = 1 - q;
+    }
+    c->info->partial += partial;
+    c->info->reversed += *dir < 0;
+    c->info->covered_min = fmin(c->info->covered_min, covered);
+    c->info->curves++;
+}
+
+// The pen slows in corners: turning angle over about 1% of D either side.
+static void corner_slowness(const sp_vec2* fine, int K, double* slow)
+{
+    int w = (int)ceil(0.01 / FINE);
+    for (int k = 0; k < K; ++k) {
+        int a = k - w < 0 ? 0 : k - w, b = k + w >= K ? K - 1 : k + w;
+        sp_vec2 u = sp_v2_sub(fine[k], fine[a]), v = sp_v2_sub(fine[b], fine[k]);
+        double lu = sp_v2_len(u), lv = sp_v2_len(v);
+        double ang = lu > 0 && lv > 0 ? acos(fmax(-1.0, fmin(1.0, sp_v2_dot(u, v) / (lu * lv)))) : 0.0;
+        slow[k] = 1.0 / (1.0 + 2.0 * ang);
+    }
+}
+
+// The pen's points as one to three strokes: the hand lifts and restarts a
+// little off, overlapping or leaving a gap; then it moves to the next curve.
+static sp_result add_pieces(draw_ctx* c, pen_buf* pen)
+{
+    const sp_handdraw_params* hp = c->hp;
+    const double D = c->D;
+    sp_rng* rng = c->rng;
+    int pieces = 1, cut[3] = {0, pen->n, pen->n};
+    if (pen->n >= 12 && sp_rng_uniform(rng) < hp->split_probability) {
+        pieces = sp_rng_uniform(rng) < 0.7 ? 2 : 3;
+        if (pieces == 2)
+            cut[1] = (int)(pen->n * sp_rng_range(rng, 0.3, 0.7));
+        else {
+            cut[1] = (int)(pen->n * sp_rng_range(rng, 0.2, 0.4));
+            cut[2] = (int)(pen->n * sp_rng_range(rng, 0.6, 0.8));
+        }
+        c->info->split++;
+    }
+    double last_t = pen->t[0];
+    for (int pc = 0; pc < pieces; ++pc) {
+        int b = cut[pc], e = pc + 1 < pieces ? cut[pc + 1] : pen->n;
+        sp_vec2 off = {0, 0};
+        double shift_t = 0;
+        if (pc > 0) {
+            b += (int)lround(sp_rng_range(rng, -0.04, 0.02) * pen->n); // < 0: overlap, > 0: gap
+            if (b < 0) b = 0;
+            if (b > e - 2) b = e - 2;
+            double ol = sp_rng_range(rng, 0, 0.008) * D, oa = sp_rng_range(rng, 0, 2 * PI);
+            off = (sp_vec2){ol * cos(oa), ol * sin(oa)};
+            shift_t = last_t + sp_rng_range(rng, 150, 400) - pen->t[b]; // a pause, then on from the restart
+        }
+        // In place: points before b that were already copied into the previous stroke are not read again.
+        for (int i = b; i < e; ++i) {
+            pen->p[i] = sp_v2_add(pen->p[i], off);
+            pen->t[i] += shift_t;
+        }
+        sp_result r = sp_sketch_add_stroke(c->out, pen->p + b, pen->t + b, e - b);
+        if (r != SP_OK) return r;
+        last_t = pen->t[e - 1];
+    }
+    c->t = last_t + sp_rng_range(rng, 150, 600); // the hand moves to the next curve
+    return SP_OK;
+}
+
 static sp_result draw_curve(draw_ctx* c, const sp_vec2* pts, int n, bool closed)
 {
     const sp_handdraw_params* hp = c->hp;
@@ -260,38 +358,9 @@ static sp_result draw_curve(draw_ctx* c, const sp_vec2* pts, int n, bool closed)
     smooth(dense, m, closed, hp->corner * D * sp_rng_range(rng, 0.5, 1.0) / step, sm);
 
     // Where the pen goes: start, direction, traced length.
-    int dir = sp_rng_uniform(rng) < hp->reverse_probability ? -1 : 1;
-    double s0, total, covered = 1.0;
-    bool partial = sp_rng_uniform(rng) < hp->partial_probability && hp->partial > 0;
-    double q = partial ? sp_rng_range(rng, 0.35, 1.0) * hp->partial : 0.0;
-    if (closed) {
-        s0 = hp->random_start ? sp_rng_range(rng, 0, L) : 0.0;
-        double closure;
-        if (partial)
-            closure = -q;
-        else if (sp_rng_uniform(rng) < hp->gap_probability)
-            closure = -sp_rng_uniform(rng) * hp->gap;
-        else
-            closure = sp_rng_uniform(rng) * hp->overshoot;
-        total = L * (1 + closure);
-        covered = fmin(1.0, 1 + closure);
-        c->info->closed_curves++;
-        if (closure < 0)
-            c->info->gaps++;
-        else if (closure > 0)
-            c->info->overshoots++;
-        c->info->closure_min = fmin(c->info->closure_min, closure);
-        c->info->closure_max = fmax(c->info->closure_max, closure);
-    } else {
-        double a = q * sp_rng_uniform(rng); // left out at the abstraction's start; q - a at its end
-        total = L * (1 - q);
-        s0 = dir > 0 ? a * L : L - (q - a) * L;
-        covered = 1 - q;
-    }
-    c->info->partial += partial;
-    c->info->reversed += dir < 0;
-    c->info->covered_min = fmin(c->info->covered_min, covered);
-    c->info->curves++;
+    int dir;
+    double s0, total;
+    pen_course(c, L, closed, &dir, &s0, &total);
 
     // The pen path, finely sampled, displaced by wobble and (closed curves) the miss at closure.
     int K = (int)ceil(total / (FINE * D)) + 1;
@@ -322,15 +391,7 @@ static sp_result draw_curve(draw_ctx* c, const sp_vec2* pts, int n, bool closed)
         fine[k] = p;
         cum[k] = k ? cum[k - 1] + sp_v2_len(sp_v2_sub(p, fine[k - 1])) : 0.0;
     }
-    // The pen slows in corners: turning angle over about 1% of D either side.
-    int w = (int)ceil(0.01 / FINE);
-    for (int k = 0; k < K; ++k) {
-        int a = k - w < 0 ? 0 : k - w, b = k + w >= K ? K - 1 : k + w;
-        sp_vec2 u = sp_v2_sub(fine[k], fine[a]), v = sp_v2_sub(fine[b], fine[k]);
-        double lu = sp_v2_len(u), lv = sp_v2_len(v);
-        double ang = lu > 0 && lv > 0 ? acos(fmax(-1.0, fmin(1.0, sp_v2_dot(u, v) / (lu * lv)))) : 0.0;
-        slow[k] = 1.0 / (1.0 + 2.0 * ang);
-    }
+    corner_slowness(fine, K, slow);
 
     // Sampling at a fixed interval while the speed varies: uneven spacing.
     double len = cum[K - 1];
@@ -365,40 +426,7 @@ static sp_result draw_curve(draw_ctx* c, const sp_vec2* pts, int n, bool closed)
         pen.p[i].y += hp->tremor * D * sp_rng_normal(rng);
     }
 
-    // Several strokes: the hand lifts and restarts a little off, overlapping or leaving a gap.
-    int pieces = 1, cut[3] = {0, pen.n, pen.n};
-    if (pen.n >= 12 && sp_rng_uniform(rng) < hp->split_probability) {
-        pieces = sp_rng_uniform(rng) < 0.7 ? 2 : 3;
-        if (pieces == 2)
-            cut[1] = (int)(pen.n * sp_rng_range(rng, 0.3, 0.7));
-        else {
-            cut[1] = (int)(pen.n * sp_rng_range(rng, 0.2, 0.4));
-            cut[2] = (int)(pen.n * sp_rng_range(rng, 0.6, 0.8));
-        }
-        c->info->split++;
-    }
-    double last_t = pen.t[0];
-    for (int pc = 0; pc < pieces; ++pc) {
-        int b = cut[pc], e = pc + 1 < pieces ? cut[pc + 1] : pen.n;
-        sp_vec2 off = {0, 0};
-        double shift_t = 0;
-        if (pc > 0) {
-            b += (int)lround(sp_rng_range(rng, -0.04, 0.02) * pen.n); // < 0: overlap, > 0: gap
-            if (b < 0) b = 0;
-            if (b > e - 2) b = e - 2;
-            double ol = sp_rng_range(rng, 0, 0.008) * D, oa = sp_rng_range(rng, 0, 2 * PI);
-            off = (sp_vec2){ol * cos(oa), ol * sin(oa)};
-            shift_t = last_t + sp_rng_range(rng, 150, 400) - pen.t[b]; // a pause, then on from the restart
-        }
-        // In place: points before b that were already copied into the previous stroke are not read again.
-        for (int i = b; i < e; ++i) {
-            pen.p[i] = sp_v2_add(pen.p[i], off);
-            pen.t[i] += shift_t;
-        }
-        if ((r = sp_sketch_add_stroke(c->out, pen.p + b, pen.t + b, e - b)) != SP_OK) goto done;
-        last_t = pen.t[e - 1];
-    }
-    c->t = last_t + sp_rng_range(rng, 150, 600); // the hand moves to the next curve
+    if ((r = add_pieces(c, &pen)) != SP_OK) goto done;
     goto done;
 oom:
     r = SP_ERR_NO_MEMORY;
