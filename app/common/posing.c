@@ -46,7 +46,8 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
         if (sk->strokes[i].count < 2) {
             int n = sk->strokes[i].count;
             sp_sketch_free(sk);
-            return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d has %d point%s (at least 2 are needed)", path, i, n, n == 1 ? "" : "s");
+            return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d has %d point%s (at least 2 are needed)", path, i, n,
+                           n == 1 ? "" : "s");
         }
     return SP_OK;
 }
@@ -137,6 +138,34 @@ bool* sp_drawover_active(const sp_rig* rig, const sp_abstraction* emb)
                 (!emb || !emb->tri_vertices || carrier[rig->params[q].joint]);
     free(carrier);
     return on;
+}
+
+void sp_drawover_note_held(const sp_rig* rig, const bool* active, char* note, size_t cap)
+{
+    if (!strstr(note, "best effort") && !strstr(note, "loose fit")) return;
+    bool* moves = calloc((size_t)rig->joint_count + 1, sizeof(bool));
+    if (!moves) return;
+    for (int q = 0; q < rig->param_count; ++q)
+        moves[rig->params[q].joint] |= active[q];
+    // The joints that move whose parents do not: where each moving limb starts.
+    char from[160] = "";
+    int n = 0;
+    for (int j = 0; j < rig->joint_count; ++j) {
+        int pa = rig->joints[j].parent;
+        if (!moves[j] || (pa >= 0 && moves[pa]) || ++n > 3) continue;
+        size_t at = strlen(from);
+        snprintf(from + at, sizeof from - at, "%s'%s'", at ? ", " : "", rig->joints[j].name);
+    }
+    free(moves);
+    size_t at = strlen(note);
+    if (n == 0)
+        snprintf(note + at, cap - at,
+                 "; no joint under the drawn curves may move (draw-over holds the placement and the body's root)");
+    else
+        snprintf(note + at, cap - at,
+                 "; draw-over moves only the joints under the drawn curves, from %s%s down, never the placement or the body's "
+                 "root (draw over more to move more)",
+                 from, n > 3 ? ", ..." : "");
 }
 
 // A weight as the solver takes it (0: its default; < 0: off) times f.

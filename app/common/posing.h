@@ -34,6 +34,10 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 #define SP_DRAWOVER_CARRIER_SHARE 0.15
 #define SP_DRAWOVER_LIMB_SHARE 0.25
 bool* sp_drawover_active(const sp_rig* rig, const sp_abstraction* emb);
+/// Appends to a best-effort or loose-fit note (cap bytes in all) which
+/// joints the draw-over could move (where each moving limb starts), or that
+/// none could: a redraw out of their reach said only "cannot reach".
+void sp_drawover_note_held(const sp_rig* rig, const bool* active, char* note, size_t cap);
 /// Scales a draw-over solve's regulariser weights (0: the defaults; < 0:
 /// off, kept) by (the character's size on the canvas / the embedded curves'
 /// size there)^2, clamped to [1, 10000] (curves of no size: 10000), and

@@ -126,6 +126,8 @@ int cmd_drawover(int argc, char** argv)
     double scale = sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;
+    sp_drawover_note_held(&ch->rig, active, rep.note, sizeof rep.note);
+    if (rep.note[0]) cJSON_ReplaceItemInObject(rep_json, "note", cJSON_CreateString(rep.note));
     // The weights the solve used (off: 0): they are scaled to the drawn curves.
     cJSON* w = cJSON_AddObjectToObject(rep_json, "weights");
     if (w) {

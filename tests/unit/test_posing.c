@@ -1176,6 +1176,35 @@ static void test_drawover_only_carriers(void)
     }
 }
 
+// A draw-over that cannot reach its redraw says which joints it could
+// move: "cannot reach" alone left a user guessing why the arm stayed down.
+static void test_drawover_note_held(void)
+{
+    char on[1100], to[1100], rep[1100], args[4000];
+    snprintf(on, sizeof on, "%s", sp_test_tmp_path("held_on.json"));
+    snprintf(to, sizeof to, "%s", sp_test_tmp_path("held_to.json"));
+    snprintf(rep, sizeof rep, "%s", sp_test_tmp_path("held_report.json"));
+    const sp_vec2 forearm[2][3] = {{{390, 245}, {400, 265}, {410, 285}}, {{390, 245}, {405, 230}, {420, 215}}};
+    sp_error err = {0};
+    for (int k = 0; k < 2; ++k) {
+        sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
+        ENSURE(sp_sketch_add_stroke(&sk, forearm[k], NULL, 3) == SP_OK && sp_sketch_write_json(k ? to : on, &sk, &err) == SP_OK);
+        sp_sketch_free(&sk);
+    }
+    snprintf(args, sizeof args,
+             "'%s' drawover --rig '%s/assets/cartoon_man.glb' --on '%s' --to '%s' --report '%s' >/dev/null 2>&1", SP_SKETCHPOSE,
+             SP_SOURCE_DIR, on, to, rep);
+    ENSURE(run(args) == 0);
+    char* text = sp_fixture_file_text(rep, NULL);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    const char* note = cJSON_GetStringValue(cJSON_GetObjectItem(j, "note"));
+    fprintf(stderr, "  the forearm redrawn out of reach: \"%s\"\n", note ? note : "(none)");
+    ENSURE(note && strstr(note, "best effort") &&
+           strstr(note, "draw-over moves only the joints under the drawn curves, from 'clavicle_l' down"));
+    cJSON_Delete(j);
+}
+
 // drawover's two drawings are on one screen: --to on another canvas is
 // refused, naming it (its points were read in --on's canvas: a wrong fit,
 // exit 0); on the same canvas it fits.
@@ -1348,6 +1377,7 @@ int main(int argc, char** argv)
                                    {"pose_file_strict", test_pose_file_strict},
                                    {"note_unmatched_curves", test_note_unmatched_curves},
                                    {"drawover_only_carriers", test_drawover_only_carriers},
+                                   {"drawover_note_held", test_drawover_note_held},
                                    {"max_iterations_between_stages", test_max_iterations_between_stages},
                                    {"drawover_canvas", test_drawover_canvas},
                                    {"synth_parts_fails_whole", test_synth_parts_fails_whole},
