@@ -151,14 +151,8 @@ static sp_result part_stroke(sp_db* db, int li, uint64_t seed, sp_vec2 at, sp_ve
 static void announce_build(const char* path, const char* assets)
 {
     fprintf(stderr, "creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
-    int picks;
-    bool missing = false;
-    sp_error err = {0};
-    if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
-        fprintf(stderr,
-                "note: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building without the people's "
-                "strokes (fewer visitors' drawings recognised)\n",
-                assets);
+    char note[1200];
+    if (sp_db_people_note(assets, note, sizeof note)) fprintf(stderr, "note: %s\n", note);
 }
 
 int cmd_demo(int argc, char** argv)

@@ -367,14 +367,8 @@ static void terminate_glfw(void)
 // people's strokes are not there to go in, and the loading screen.
 static void announce_build(GLFWwindow* win, const char* assets, const char* font)
 {
-    int picks;
-    bool missing = false;
-    sp_error err = {0};
-    if (sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && missing)
-        fprintf(stderr,
-                "%s: %s/sketches/picks.json: the Quick, Draw! data it names is not there; building the database without the "
-                "people's strokes (fewer visitors' drawings recognised)\n",
-                k_cmd, assets);
+    char note[1200];
+    if (sp_db_people_note(assets, note, sizeof note)) fprintf(stderr, "%s: %s\n", k_cmd, note);
     loading_screen(win, font);
 }
 

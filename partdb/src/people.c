@@ -167,3 +167,16 @@ sp_result sp_db_people_strokes(const char* assets_dir, const char* quickdraw_dir
     else *out = ds;
     return r;
 }
+
+bool sp_db_people_note(const char* assets_dir, char* note, size_t cap)
+{
+    int picks;
+    bool missing = false;
+    sp_error err = {0};
+    if (sp_db_people_source(assets_dir, NULL, &picks, &missing, &err) != SP_OK || !missing) return false;
+    snprintf(note, cap,
+             "%s/sketches/picks.json: the Quick, Draw! data it names is not there; building the database without the people's "
+             "strokes (fewer visitors' drawings recognised)",
+             assets_dir);
+    return true;
+}

@@ -1270,6 +1270,8 @@ static void test_people_strokes(void)
     ENSURE(sp_db_people_strokes(assets, qd, &ds, &missing, &err) == SP_ERR_IO && strstr(err.text, qd));
     ENSURE(sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && picks == 3 && missing);
     ENSURE(sp_db_people_source(assets, qd, &picks, &missing, &err) == SP_ERR_IO && strstr(err.text, qd));
+    char note[1200]; // what a first start says, the kiosk's and the demo's
+    ENSURE(sp_db_people_note(assets, note, sizeof note) && strstr(note, "/sketches/picks.json: the Quick, Draw! data it names"));
     // Picks the data does not have: one line naming the file and line.
     struct {
         const char* pick;
@@ -1298,6 +1300,7 @@ static void test_people_strokes(void)
     remove(f);
     ENSURE(sp_db_people_strokes(assets, NULL, &ds, &missing, &err) == SP_OK && ds.count == 0 && !missing);
     ENSURE(sp_db_people_source(assets, NULL, &picks, &missing, &err) == SP_OK && picks == 0 && !missing);
+    ENSURE(!sp_db_people_note(assets, note, sizeof note));
 
     // The project's own picks, read from ../shared/data.
     char qdreal[1100];

@@ -976,6 +976,41 @@ static void synth_strokes(const char* rig, int seed, const char* path)
     ENSURE(run(args) == 0);
 }
 
+// One stroke on a 640 x 480 canvas, into path.
+static void write_one_stroke(const char* path, const sp_vec2* pts, int n)
+{
+    sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
+    sp_error err = {0};
+    ENSURE(sp_sketch_add_stroke(&sk, pts, NULL, n) == SP_OK && sp_sketch_write_json(path, &sk, &err) == SP_OK);
+    sp_sketch_free(&sk);
+}
+
+// `sketchpose ARGS --report REPORT`, quiet, exit 0; the report read back.
+static cJSON* report_of(const char* args, const char* report)
+{
+    char cmd[6000];
+    snprintf(cmd, sizeof cmd, "'%s' %s --report '%s' >/dev/null 2>&1", SP_SKETCHPOSE, args, report);
+    ENSURE(run(cmd) == 0);
+    char* text = sp_fixture_file_text(report, NULL);
+    cJSON* j = cJSON_Parse(text);
+    free(text);
+    ENSURE(j);
+    return j;
+}
+
+// The cartoon man's draw-over from one stroke (n points) to another; its report.
+static cJSON* drawover_man(const sp_vec2* on_pts, const sp_vec2* to_pts, int n, const char* tag)
+{
+    char on[1100], to[1100], rep[1100], args[4000];
+    snprintf(on, sizeof on, "%s_on.json", sp_test_tmp_path(tag));
+    snprintf(to, sizeof to, "%s_to.json", sp_test_tmp_path(tag));
+    snprintf(rep, sizeof rep, "%s_report.json", sp_test_tmp_path(tag));
+    write_one_stroke(on, on_pts, n);
+    write_one_stroke(to, to_pts, n);
+    snprintf(args, sizeof args, "drawover --rig '%s/assets/cartoon_man.glb' --on '%s' --to '%s'", SP_SOURCE_DIR, on, to);
+    return report_of(args, rep);
+}
+
 // The report printed on stdout once, also when --report names stdout
 // (DESIGN's `--report /dev/stdout >> log` appended it twice: two JSON
 // documents, which no reader takes).
@@ -1023,15 +1058,9 @@ static void test_max_iterations_between_stages(void)
     ENSURE(run(args) == 0);
     const int caps[] = {10, 1000};
     for (int i = 0; i < 2; ++i) {
-        snprintf(args, sizeof args,
-                 "'%s' pose --rig '%s' --abstraction outline --strokes '%s' --max-iterations %d --report '%s' >/dev/null "
-                 "2>&1",
-                 SP_SKETCHPOSE, rig, strokes, caps[i], report);
-        ENSURE(run(args) == 0);
-        char* text = sp_fixture_file_text(report, NULL);
-        cJSON* j = cJSON_Parse(text);
-        free(text);
-        ENSURE(j);
+        snprintf(args, sizeof args, "pose --rig '%s' --abstraction outline --strokes '%s' --max-iterations %d", rig, strokes,
+                 caps[i]);
+        cJSON* j = report_of(args, report);
         const char* stopped = cJSON_GetStringValue(cJSON_GetObjectItem(j, "stopped"));
         int its = (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "iterations"));
         fprintf(stderr, "  --max-iterations %d: %s after %d iterations, %d rounds\n", caps[i], stopped, its,
@@ -1097,19 +1126,12 @@ static void test_note_unmatched_curves(void)
     snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("one_stroke.json"));
     snprintf(report, sizeof report, "%s", sp_test_tmp_path("one_stroke_report.json"));
     const char* rig = SP_SOURCE_DIR "/assets/cartoon_man.glb";
-    sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
     const sp_vec2 arm[] = {{355, 205}, {380, 170}, {400, 130}, {410, 100}};
-    sp_error err = {0};
-    ENSURE(sp_sketch_add_stroke(&sk, arm, NULL, 4) == SP_OK && sp_sketch_write_json(strokes, &sk, &err) == SP_OK);
-    sp_sketch_free(&sk);
+    write_one_stroke(strokes, arm, 4);
     for (int all = 0; all < 2; ++all) {
         if (all) synth_strokes(rig, 3, strokes);
-        snprintf(args, sizeof args, "'%s' pose --rig '%s' --strokes '%s' --report '%s' >/dev/null 2>&1", SP_SKETCHPOSE, rig,
-                 strokes, report);
-        ENSURE(run(args) == 0);
-        char* text = sp_fixture_file_text(report, NULL);
-        cJSON* j = cJSON_Parse(text);
-        free(text);
+        snprintf(args, sizeof args, "pose --rig '%s' --strokes '%s'", rig, strokes);
+        cJSON* j = report_of(args, report);
         const char* note = cJSON_GetStringValue(cJSON_GetObjectItem(j, "note"));
         fprintf(stderr, "  %s: note \"%s\"\n", all ? "every curve drawn" : "one stroke", note ? note : "(none)");
         ENSURE(note && (strstr(note, "4 curves without a stroke") != NULL) == !all &&
@@ -1127,10 +1149,6 @@ static void test_note_unmatched_curves(void)
 // hanging, 35.7 px), still not the body.
 static void test_drawover_only_carriers(void)
 {
-    char on[1100], to[1100], rep[1100], args[4000];
-    snprintf(on, sizeof on, "%s", sp_test_tmp_path("carriers_on.json"));
-    snprintf(to, sizeof to, "%s", sp_test_tmp_path("carriers_to.json"));
-    snprintf(rep, sizeof rep, "%s", sp_test_tmp_path("carriers_report.json"));
     const sp_vec2 strokes[2][2][5] = {
         {{{355, 205}, {372, 226}, {388, 245}, {404, 278}, {420, 310}},
          {{355, 205}, {378, 192}, {400, 180}, {420, 150}, {440, 120}}},
@@ -1139,21 +1157,8 @@ static void test_drawover_only_carriers(void)
     };
     const char* what[2] = {"the left arm", "the left hand"};
     const double max_px[2] = {3.0, 1.0};
-    sp_error err = {0};
     for (int c = 0; c < 2; ++c) {
-        for (int k = 0; k < 2; ++k) {
-            sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
-            ENSURE(sp_sketch_add_stroke(&sk, strokes[c][k], NULL, 4 + (c == 0)) == SP_OK &&
-                   sp_sketch_write_json(k ? to : on, &sk, &err) == SP_OK);
-            sp_sketch_free(&sk);
-        }
-        snprintf(args, sizeof args,
-                 "'%s' drawover --rig '%s/assets/cartoon_man.glb' --on '%s' --to '%s' --report '%s' >/dev/null 2>&1",
-                 SP_SKETCHPOSE, SP_SOURCE_DIR, on, to, rep);
-        ENSURE(run(args) == 0);
-        char* text = sp_fixture_file_text(rep, NULL);
-        cJSON* j = cJSON_Parse(text);
-        free(text);
+        cJSON* j = drawover_man(strokes[c][0], strokes[c][1], 4 + (c == 0), "carriers");
         double err_px = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "mean_error_px")), body = 0, arm = 0, upper = 0;
         const cJSON* it;
         cJSON_ArrayForEach(it, cJSON_GetObjectItem(j, "parameters"))
@@ -1180,24 +1185,8 @@ static void test_drawover_only_carriers(void)
 // move: "cannot reach" alone left a user guessing why the arm stayed down.
 static void test_drawover_note_held(void)
 {
-    char on[1100], to[1100], rep[1100], args[4000];
-    snprintf(on, sizeof on, "%s", sp_test_tmp_path("held_on.json"));
-    snprintf(to, sizeof to, "%s", sp_test_tmp_path("held_to.json"));
-    snprintf(rep, sizeof rep, "%s", sp_test_tmp_path("held_report.json"));
     const sp_vec2 forearm[2][3] = {{{390, 245}, {400, 265}, {410, 285}}, {{390, 245}, {405, 230}, {420, 215}}};
-    sp_error err = {0};
-    for (int k = 0; k < 2; ++k) {
-        sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
-        ENSURE(sp_sketch_add_stroke(&sk, forearm[k], NULL, 3) == SP_OK && sp_sketch_write_json(k ? to : on, &sk, &err) == SP_OK);
-        sp_sketch_free(&sk);
-    }
-    snprintf(args, sizeof args,
-             "'%s' drawover --rig '%s/assets/cartoon_man.glb' --on '%s' --to '%s' --report '%s' >/dev/null 2>&1", SP_SKETCHPOSE,
-             SP_SOURCE_DIR, on, to, rep);
-    ENSURE(run(args) == 0);
-    char* text = sp_fixture_file_text(rep, NULL);
-    cJSON* j = cJSON_Parse(text);
-    free(text);
+    cJSON* j = drawover_man(forearm[0], forearm[1], 3, "held");
     const char* note = cJSON_GetStringValue(cJSON_GetObjectItem(j, "note"));
     fprintf(stderr, "  the forearm redrawn out of reach: \"%s\"\n", note ? note : "(none)");
     ENSURE(note && strstr(note, "best effort") &&

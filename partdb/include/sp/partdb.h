@@ -459,6 +459,11 @@ sp_result sp_db_drawn_sketches(const char* assets_dir, int per_design, uint64_t 
 /// folder is not there (SP_ERR_IO when `quickdraw_dir` names one that is not).
 /// A database the default recipe builds holds all *picks of them, or none.
 sp_result sp_db_people_source(const char* assets_dir, const char* quickdraw_dir, int* picks, bool* missing, sp_error* err);
+/// The line a first start (the kiosk's, the demo's) says before it builds the
+/// default database when the people's strokes picks.json names are not
+/// there (from the default Quick, Draw! folder): true and `note` filled, else
+/// false.
+bool sp_db_people_note(const char* assets_dir, char* note, size_t cap);
 /// Creates `path` from an export folder (sp_db_import), then trains when
 /// `train` is not NULL. Built beside `path` and moved into place when complete.
 sp_result sp_db_create_from_export(const char* path, const char* dir, const sp_db_train_desc* train, const char* by, sp_error* err);
