@@ -368,6 +368,89 @@ static void build_params(elephant* e)
 
 // ---- mesh ------------------------------------------------------------------
 
+// Side s's ear (a thin flap behind the eye, flapping about its front
+// edge), tusk and eye.
+static void build_ear_side(elephant* e, int s)
+{
+    sp_gen_mesh* m = &e->m;
+    ear_ctx ec = ear_frame(s);
+    int ef = sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = ec.center,
+                                                          .ax = ec.ax,
+                                                          .ay = ec.ay,
+                                                          .az = ec.az,
+                                                          .rings = 8,
+                                                          .segments = 14,
+                                                          .color = ear_color,
+                                                          .user = &ec,
+                                                          .skin = sp_gen_skin_one(e->ear1[s])});
+    sp_gen_skin outer = sp_gen_skin_one(e->ear2[s]);
+    sp_vec3 back_dir = sp_v3_norm(ec.ay);
+    for (int v = ef; v < m->vertex_count; ++v) {
+        // The lower half droops backwards into a lobe.
+        sp_vec3 p = {m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]};
+        double up = sp_v3_dot(sp_v3_sub(p, ec.center), ec.ax) / sp_v3_dot(ec.ax, ec.ax);
+        p = sp_v3_add(p, sp_v3_scale(back_dir, 0.12 * fmax(0.0, -up) * fmax(0.0, -up)));
+        m->pos[3 * v] = p.x, m->pos[3 * v + 1] = p.y, m->pos[3 * v + 2] = p.z;
+        // How far back from the front edge (where ear_1 holds it).
+        sp_vec3 d = sp_v3_sub(sp_v3(m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]), ec.center);
+        double back = 1.0 + sp_v3_dot(d, ec.ay) / sp_v3_dot(ec.ay, ec.ay); // 0 at the front edge, 2 at the back
+        m->skin[v] = sp_gen_skin_lerp(&m->skin[v], &outer, sp_gen_smoothstep(0.4, 1.2, back));
+    }
+    // Tusks and eyes.
+    sp_vec3 base = side_z(sp_v3(1.26, 1.2, 0.14), s);
+    sp_gen_cone(m, &(sp_gen_cone_desc){.base = base,
+                                       .bend = side_z(sp_v3(1.5, 1.0, 0.17), s),
+                                       .tip = side_z(sp_v3(1.68, 1.12, 0.2), s),
+                                       .base_radius = 0.05,
+                                       .tip_radius = 0.012,
+                                       .taper = 0.8,
+                                       .flat = 1.0,
+                                       .rings = 6,
+                                       .segments = 8,
+                                       .base_color = k_ivory,
+                                       .tip_color = k_ivory_tip,
+                                       .skin = sp_gen_skin_one(e->tusk[s])});
+    double ex = 1.24, ey = 1.64;
+    double ez = k_head_r.z * sqrt(1.0 - pow((ex - k_head_c.x) / k_head_r.x, 2) - pow((ey - k_head_c.y) / k_head_r.y, 2)) - 0.008;
+    sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = side_z(sp_v3(ex, ey, ez), s),
+                                                 .ax = {0.035, 0, 0},
+                                                 .ay = {0, 0.026, 0},
+                                                 .az = {0, 0, 0.02},
+                                                 .rings = 4,
+                                                 .segments = 6,
+                                                 .color = flat_color,
+                                                 .user = (void*)&k_eye,
+                                                 .skin = sp_gen_skin_one(e->head)});
+}
+
+// The tail with a dark tuft.
+static void build_tail(elephant* e)
+{
+    sp_gen_mesh* m = &e->m;
+    sp_gen_chain lch = {0};
+    for (int k = 0; k < TAIL; ++k)
+        sp_gen_chain_add(&lch, e->tail[k], e->tail_path.length * k / TAIL, k == 0 ? 0.0 : 0.03);
+    sp_gen_tube(m, &(sp_gen_tube_desc){.path = &e->tail_path,
+                                       .rings = 12,
+                                       .segments = 6,
+                                       .profile = tail_profile,
+                                       .color = plain_hide,
+                                       .chain = &lch,
+                                       .cap0_rings = 1,
+                                       .cap0_len = 0.5});
+    sp_vec3 tt = e->tail_at[TAIL], tdir;
+    sp_gen_path_at(&e->tail_path, e->tail_path.length, &tdir);
+    sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = sp_v3_add(tt, sp_v3_scale(tdir, 0.02)),
+                                                 .ax = sp_v3_scale(tdir, 0.08),
+                                                 .ay = sp_v3_scale(sp_v3(-tdir.y, tdir.x, 0), 0.04),
+                                                 .az = {0, 0, 0.04},
+                                                 .rings = 5,
+                                                 .segments = 6,
+                                                 .color = flat_color,
+                                                 .user = (void*)&k_tuft,
+                                                 .skin = sp_gen_skin_one(e->tail[TAIL - 1])});
+}
+
 static void build_body(elephant* e)
 {
     sp_gen_mesh* m = &e->m;
@@ -445,81 +528,9 @@ static void build_body(elephant* e)
                                        .cap1_rings = 2,
                                        .cap1_len = 0.4});
     sp_gen_path_free(&tp);
-    // Ears: thin flaps behind the eyes, flapping about their front edge.
-    for (int s = 0; s < 2; ++s) {
-        ear_ctx ec = ear_frame(s);
-        int ef = sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = ec.center,
-                                                              .ax = ec.ax,
-                                                              .ay = ec.ay,
-                                                              .az = ec.az,
-                                                              .rings = 8,
-                                                              .segments = 14,
-                                                              .color = ear_color,
-                                                              .user = &ec,
-                                                              .skin = sp_gen_skin_one(e->ear1[s])});
-        sp_gen_skin outer = sp_gen_skin_one(e->ear2[s]);
-        sp_vec3 back_dir = sp_v3_norm(ec.ay);
-        for (int v = ef; v < m->vertex_count; ++v) {
-            // The lower half droops backwards into a lobe.
-            sp_vec3 p = {m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]};
-            double up = sp_v3_dot(sp_v3_sub(p, ec.center), ec.ax) / sp_v3_dot(ec.ax, ec.ax);
-            p = sp_v3_add(p, sp_v3_scale(back_dir, 0.12 * fmax(0.0, -up) * fmax(0.0, -up)));
-            m->pos[3 * v] = p.x, m->pos[3 * v + 1] = p.y, m->pos[3 * v + 2] = p.z;
-            // How far back from the front edge (where ear_1 holds it).
-            sp_vec3 d = sp_v3_sub(sp_v3(m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]), ec.center);
-            double back = 1.0 + sp_v3_dot(d, ec.ay) / sp_v3_dot(ec.ay, ec.ay); // 0 at the front edge, 2 at the back
-            m->skin[v] = sp_gen_skin_lerp(&m->skin[v], &outer, sp_gen_smoothstep(0.4, 1.2, back));
-        }
-        // Tusks and eyes.
-        sp_vec3 base = side_z(sp_v3(1.26, 1.2, 0.14), s);
-        sp_gen_cone(m, &(sp_gen_cone_desc){.base = base,
-                                           .bend = side_z(sp_v3(1.5, 1.0, 0.17), s),
-                                           .tip = side_z(sp_v3(1.68, 1.12, 0.2), s),
-                                           .base_radius = 0.05,
-                                           .tip_radius = 0.012,
-                                           .taper = 0.8,
-                                           .flat = 1.0,
-                                           .rings = 6,
-                                           .segments = 8,
-                                           .base_color = k_ivory,
-                                           .tip_color = k_ivory_tip,
-                                           .skin = sp_gen_skin_one(e->tusk[s])});
-        double ex = 1.24, ey = 1.64;
-        double ez =
-            k_head_r.z * sqrt(1.0 - pow((ex - k_head_c.x) / k_head_r.x, 2) - pow((ey - k_head_c.y) / k_head_r.y, 2)) - 0.008;
-        sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = side_z(sp_v3(ex, ey, ez), s),
-                                                     .ax = {0.035, 0, 0},
-                                                     .ay = {0, 0.026, 0},
-                                                     .az = {0, 0, 0.02},
-                                                     .rings = 4,
-                                                     .segments = 6,
-                                                     .color = flat_color,
-                                                     .user = (void*)&k_eye,
-                                                     .skin = sp_gen_skin_one(e->head)});
-    }
-    // The tail with a dark tuft.
-    sp_gen_chain lch = {0};
-    for (int k = 0; k < TAIL; ++k)
-        sp_gen_chain_add(&lch, e->tail[k], e->tail_path.length * k / TAIL, k == 0 ? 0.0 : 0.03);
-    sp_gen_tube(m, &(sp_gen_tube_desc){.path = &e->tail_path,
-                                       .rings = 12,
-                                       .segments = 6,
-                                       .profile = tail_profile,
-                                       .color = plain_hide,
-                                       .chain = &lch,
-                                       .cap0_rings = 1,
-                                       .cap0_len = 0.5});
-    sp_vec3 tt = e->tail_at[TAIL], tdir;
-    sp_gen_path_at(&e->tail_path, e->tail_path.length, &tdir);
-    sp_gen_ellipsoid(m, &(sp_gen_ellipsoid_desc){.center = sp_v3_add(tt, sp_v3_scale(tdir, 0.02)),
-                                                 .ax = sp_v3_scale(tdir, 0.08),
-                                                 .ay = sp_v3_scale(sp_v3(-tdir.y, tdir.x, 0), 0.04),
-                                                 .az = {0, 0, 0.04},
-                                                 .rings = 5,
-                                                 .segments = 6,
-                                                 .color = flat_color,
-                                                 .user = (void*)&k_tuft,
-                                                 .skin = sp_gen_skin_one(e->tail[TAIL - 1])});
+    for (int s = 0; s < 2; ++s)
+        build_ear_side(e, s);
+    build_tail(e);
 }
 
 static void build_leg(elephant* e, int pair, int s)
