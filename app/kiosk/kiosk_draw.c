@@ -228,20 +228,18 @@ static void draw_message(sp_kiosk* k, const sp_kiosk_rect* box, const char* text
     sp_draw2d_text_fit(k->d2, text, x + 0.5f * w, box->y + 0.5f * box->h, px, w - 1.2f * px, SP_ALIGN_CENTER, fg);
 }
 
-// The save code, big, and what it is for under it.
+// The save code, big, and what it is for under it, in the box the UI laid
+// out (where its taps go).
 static void draw_banner(sp_kiosk* k)
 {
     const sp_kiosk_ui* ui = k->ui;
     float big = 0.75f * ui->big_text_px, small = ui->text_px;
-    float w = fmaxf(sp_font_width(k->font, ui->banner[0], big), sp_font_width(k->font, ui->banner[1], small)) + 2.0f * big;
-    w = fminf(w, 0.92f * ui->canvas.w);
-    float h = 1.7f * big + 1.6f * small + 0.4f * big;
-    float x = ui->canvas.x + 0.5f * (ui->canvas.w - w), y = ui->canvas.y + ui->canvas.h - h - (float)(3 * ui->px_per_mm);
-    sp_draw2d_rect(k->d2, x, y, w, h, 0.25f * h, 0, k_green);
-    sp_draw2d_text_fit(k->d2, ui->banner[0], x + 0.5f * w, y + 0.2f * big + 0.85f * big, big, w - 1.2f * big, SP_ALIGN_CENTER,
-                       k_white);
-    sp_draw2d_text_fit(k->d2, ui->banner[1], x + 0.5f * w, y + h - 0.2f * big - 0.8f * small, small, w - 1.2f * big,
+    const sp_kiosk_rect* b = &ui->banner_box;
+    sp_draw2d_rect(k->d2, b->x, b->y, b->w, b->h, 0.25f * b->h, 0, k_green);
+    sp_draw2d_text_fit(k->d2, ui->banner[0], b->x + 0.5f * b->w, b->y + 0.2f * big + 0.85f * big, big, b->w - 1.2f * big,
                        SP_ALIGN_CENTER, k_white);
+    sp_draw2d_text_fit(k->d2, ui->banner[1], b->x + 0.5f * b->w, b->y + b->h - 0.2f * big - 0.8f * small, small,
+                       b->w - 1.2f * big, SP_ALIGN_CENTER, k_white);
 }
 
 static void draw_countdown(sp_kiosk* k, double left_s)

@@ -1053,6 +1053,144 @@ static void test_save_code(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+static bool in_rect(const sp_kiosk_rect* r, float x, float y)
+{
+    return x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
+}
+
+// A line from (x, y) by (dx, dy) a step, n points 8 ms apart; returns the end time.
+static double line_from(sp_kiosk_ui* ui, double t, float x, float y, float dx, float dy, int n)
+{
+    send(ui, SP_KEV_DOWN, t, x, y);
+    for (int i = 1; i < n; ++i)
+        send(ui, SP_KEV_MOVE, t + 8 * i, x + dx * (float)i, y + dy * (float)i);
+    send(ui, SP_KEV_UP, t + 8 * n, x + dx * (float)(n - 1), y + dy * (float)(n - 1));
+    return t + 8 * n;
+}
+
+// A kiosk review: children start lines anywhere. A line begun on a chip or
+// a tile of the parts row was a tap, and the drawing was lost (on "Other?"
+// it opened the row; on a tile it made the refused stroke that part); a
+// first line begun beside the canvas was lost too.
+static void test_line_from_overlay(void)
+{
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t);
+    // From the middle of a guess chip, down and right across the canvas: a
+    // stroke from the touch, no re-fit of the last part.
+    const sp_kiosk_rect* g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1) && in_rect(&ui->canvas, g1->x, g1->y));
+    float cx = g1->x + 0.5f * g1->w, cy = g1->y + 0.5f * g1->h;
+    int taps = ui->taps;
+    line_from(ui, t + 1000, cx, cy, 12, 9, 30);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.category[0]);
+    ENSURE(j.stroke->xy[0] == cx && j.stroke->xy[1] == cy && j.stroke->t[0] == t + 1000 && j.stroke->count > 20);
+    ENSURE(ui->activations[SP_KT_CHIP_GUESS1] == 0 && ui->taps == taps && !sp_kiosk_ui_next_job(ui, &j));
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "tail", .guesses = {"head"}, .part_count = 2});
+    f.parts = 2, f.cat[1] = 2;
+    // A tap that slides a little on its chip is still a tap.
+    g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    cx = g1->x + 0.5f * g1->w, cy = g1->y + 0.5f * g1->h;
+    line_from(ui, t + 3000, cx, cy, 1.5f, 1, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT && !strcmp(j.category, "head"));
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"tail"}, .part_count = 2});
+    // From a tile of a refusal's parts row: a new stroke (the refused one
+    // fades as for any new stroke), not the refused stroke made that part.
+    t = refused_stroke(ui, t + 5000, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    const sp_kiosk_rect* p1 = &ui->target[SP_KT_PART1];
+    float px = p1->x + 0.5f * p1->w, py = p1->y + 0.5f * p1->h;
+    int forced = f.forced, fits = f.fits;
+    line_from(ui, t + 500, px, py, 10, 6, 30);
+    ENSURE(!sp_kiosk_ui_offering(ui) && ui->chosen == 0 && sp_kiosk_ui_fade(ui) > 0.9);
+    frame(ui, &f, t + 900);
+    ENSURE(f.forced == forced && f.fits == fits + 1 && f.parts == 3);
+    // A toolbar button pressed and dragged away does nothing at all.
+    const sp_kiosk_rect* u = &ui->target[SP_KT_UNDO];
+    ENSURE(!in_rect(&ui->canvas, u->x, u->y));
+    line_from(ui, t + 2000, u->x + 0.5f * u->w, u->y + 0.5f * u->h, -15, 0, 30);
+    frame(ui, &f, t + 2500);
+    ENSURE(f.parts == 3 && f.undos == 0 && ui->pending_count == 0 && ui->job_count == 0);
+    // From the toolbar's strip (no button there) into the canvas: the line starts where it enters.
+    float sx = ui->canvas.x + ui->canvas.w + 4, sy = 3;
+    ENSURE(sx < ui->width && sp_kiosk_ui_hit(ui, sx, sy) == SP_KT_NONE);
+    line_from(ui, t + 3000, sx, sy + 200, -20, 5, 30);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->xy[0] < ui->canvas.x + ui->canvas.w &&
+           j.stroke->xy[0] > ui->canvas.x + ui->canvas.w - 25);
+    sp_kiosk_ui_destroy(ui);
+    // The attract screen: a first line begun where the toolbar will be is the visit's first stroke.
+    sp_kiosk_ui_create(NULL, &ui, NULL);
+    sp_kiosk_ui_resize(ui, 1280, 800, 96.0 / 25.4);
+    ENSURE(ui->mode == SP_KM_ATTRACT);
+    line_from(ui, 100, ui->canvas.x + ui->canvas.w + 20, 300, -20, 3, 30);
+    ENSURE(ui->mode == SP_KM_DRAW && sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->count > 20);
+    sp_kiosk_ui_destroy(ui);
+}
+
+// A kiosk review: the save banner covered the refusal's parts row, and a
+// child's tap on the banner made the refused stroke a part (and took the
+// code off the screen). Redraw then Undo left "it replaces the last one" up.
+static void test_banner_over_row(void)
+{
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t);
+    // Drawn near the top, the refused stroke sends the row to the canvas's bottom.
+    t = refused_stroke(ui, t + 1000, 150, 90);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && ui->target[SP_KT_PART1].y > 0.6f * ui->canvas.h);
+    // Save: the refused stroke fades (it is not on the saved dragon) and the row goes.
+    tap(ui, t + 200, SP_KT_SAVE);
+    ENSURE(!sp_kiosk_ui_offering(ui) && sp_kiosk_ui_fade(ui) > 0.9 && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    frame(ui, &f, t + 300);
+    ENSURE(sp_kiosk_ui_banner_visible(ui) && f.saves == 1);
+    const sp_kiosk_rect* b = &ui->banner_box;
+    ENSURE(b->w > 0 && b->h > 0 && in_rect(&ui->canvas, b->x, b->y) && in_rect(&ui->canvas, b->x + b->w - 1, b->y + b->h - 1));
+    for (int tg = SP_KT_UNDO; tg < SP_KT_COUNT; ++tg) {
+        const sp_kiosk_rect* r = &ui->target[tg];
+        ENSURE(!sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)tg) || !in_rect(b, r->x + 0.5f * r->w, r->y + 0.5f * r->h));
+    }
+    // A tap on the banner: nothing changes, no lesson in drawing.
+    float x = b->x + 0.3f * b->w, y = b->y + 0.5f * b->h;
+    send(ui, SP_KEV_DOWN, t + 1000, x, y);
+    send(ui, SP_KEV_UP, t + 1060, x, y);
+    frame(ui, &f, t + 1100);
+    ENSURE(sp_kiosk_ui_banner_visible(ui) && ui->chosen == 0 && f.forced == 0 && f.parts == 1 && !sp_kiosk_ui_hint_visible(ui));
+    // The same tap elsewhere on the canvas says how to draw.
+    send(ui, SP_KEV_DOWN, t + 2000, x, 300);
+    send(ui, SP_KEV_UP, t + 2060, x, 300);
+    ENSURE(sp_kiosk_ui_hint_visible(ui) && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_TAP)));
+    // A part, saved: "Other?" opens the row where the banner is, and the banner goes.
+    double e = stroke(ui, t + 2500, 300, 400, 30, 10);
+    frame(ui, &f, e + 10);
+    tap(ui, e + 100, SP_KT_SAVE);
+    frame(ui, &f, e + 200);
+    ENSURE(f.parts == 2 && f.saves == 2 && sp_kiosk_ui_banner_visible(ui) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_MORE));
+    tap(ui, t + 3000, SP_KT_CHIP_MORE);
+    ENSURE(ui->row_open && !sp_kiosk_ui_banner_visible(ui) && sp_kiosk_ui_target_visible(ui, SP_KT_PART1));
+    // Save with the row open closes it; a row opened while the save runs closes when the banner comes.
+    tap(ui, t + 4000, SP_KT_SAVE);
+    ENSURE(!ui->row_open && ui->code[0] && sp_kiosk_ui_banner_visible(ui) && f.saves == 2); // the same dragon: the same code
+    // Redraw, then Undo: the Redraw's hint goes with it.
+    tap(ui, t + 5000, SP_KT_REDRAW);
+    ENSURE(ui->redraw_armed && sp_kiosk_ui_hint_visible(ui) && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_REDRAW)));
+    tap(ui, t + 6000, SP_KT_UNDO);
+    frame(ui, &f, t + 6100);
+    ENSURE(!ui->redraw_armed && !sp_kiosk_ui_hint_visible(ui) && f.undos == 1 && f.parts == 1);
+    // The row opened while the save runs closes when the banner comes.
+    e = stroke(ui, t + 7000, 300, 400, 30, 10);
+    frame(ui, &f, e + 10);
+    tap(ui, e + 100, SP_KT_SAVE);
+    tap(ui, e + 600, SP_KT_CHIP_MORE);
+    ENSURE(ui->row_open && f.saves == 2);
+    frame(ui, &f, e + 700);
+    ENSURE(f.saves == 3 && !ui->row_open && sp_kiosk_ui_banner_visible(ui));
+    sp_kiosk_ui_destroy(ui);
+}
+
 // Issue 16, item 7: a part drawn while no body is on the canvas waits where it
 // was drawn (it joins the body drawn next); the visitor is told so.
 static void test_waiting_part(void)
@@ -1783,6 +1921,8 @@ int main(int argc, char** argv)
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},
+                                   {"line_from_overlay", test_line_from_overlay},
+                                   {"banner_over_row", test_banner_over_row},
                                    {"undo_double_tap", test_undo_double_tap},
                                    {"double_tap_chip", test_double_tap_chip},
                                    {"waiting_part", test_waiting_part},

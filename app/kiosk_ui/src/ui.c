@@ -291,6 +291,24 @@ static void layout_chips(sp_kiosk_ui* ui)
     if (row) keep_stroke_in_sight(ui, chips_end, below + hh, margin, gap);
 }
 
+static bool inside(const sp_kiosk_rect* r, float x, float y)
+{
+    return x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
+}
+
+// The save banner: the code big, what it is for under it, centred at the
+// canvas's bottom. Its width follows the text (DejaVu Sans averages ~0.6 of
+// the text height a character); the renderer shrinks text that would not fit.
+static void layout_banner(sp_kiosk_ui* ui)
+{
+    float big = 0.75f * ui->big_text_px, small = ui->text_px;
+    float w = fmaxf(0.6f * big * (float)strlen(ui->banner[0]), 0.6f * small * (float)strlen(ui->banner[1])) + 2.0f * big;
+    w = fminf(w, 0.92f * ui->canvas.w);
+    float h = 1.7f * big + 1.6f * small + 0.4f * big;
+    ui->banner_box =
+        (sp_kiosk_rect){ui->canvas.x + 0.5f * (ui->canvas.w - w), ui->canvas.y + ui->canvas.h - h - (float)mm(ui, 3.0), w, h};
+}
+
 void sp_kiosk_ui_resize(sp_kiosk_ui* ui, int width, int height, double px_per_mm)
 {
     if (width < 1) width = 1;
@@ -348,6 +366,7 @@ void sp_kiosk_ui_resize(sp_kiosk_ui* ui, int width, int height, double px_per_mm
     else
         ui->canvas = (sp_kiosk_rect){0, 0, (float)fmax(0.0, W - strip_b), (float)H};
     layout_chips(ui);
+    layout_banner(ui);
 }
 
 // ------------------------------------------------------------------ queries
@@ -707,7 +726,9 @@ static void finish_stroke(sp_kiosk_ui* ui)
         // A touch that only stopped the countdown needs no lesson in drawing,
         // nor the second tap of a double tap on a chip or button that moved
         // from under the finger ("Other?" as the row opens).
-        if (!ui->woke && ui->now - ui->target_at >= SP_KIOSK_REPEAT_MIN_MS) set_hint(ui, sp_kiosk_text(SP_KTEXT_TAP));
+        // Nor a tap on the save banner, which only shows the code.
+        if (!ui->woke && !ui->down_on_banner && ui->now - ui->target_at >= SP_KIOSK_REPEAT_MIN_MS)
+            set_hint(ui, sp_kiosk_text(SP_KTEXT_TAP));
         return;
     }
     ++ui->strokes_finished;
@@ -817,11 +838,6 @@ static void add_point(sp_kiosk_ui* ui, float x, float y, bool last)
     ++s->count;
 }
 
-static bool inside(const sp_kiosk_rect* r, float x, float y)
-{
-    return x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
-}
-
 // The row opened for the last part closes, and its hint with it.
 static void close_row(sp_kiosk_ui* ui)
 {
@@ -870,6 +886,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             end_offer(ui, false);
         } else if (push_job(ui, SP_KJOB_UNDO)) {
             clear_overlays(ui);
+            if (ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_REDRAW))) ui->hint_until = -1; // no longer true
             ui->redraw_armed = false;
         }
         break;
@@ -910,6 +927,11 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             ui->hint_until = -1;
         break;
     case SP_KT_SAVE:
+        // Saving says "this is my dragon": a refused stroke still offered
+        // is not on it, and the banner takes the canvas's bottom, where the
+        // parts row may be (its hidden tiles took a child's tap on the banner).
+        end_offer(ui, true);
+        if (ui->row_open) close_row(ui);
         if (ui->code[0] && ui->saved_revision == ui->revision) {
             ui->banner_until = ui->now + ui->desc.banner_ms; // same dragon: same code, no new files
         } else if (push_job(ui, SP_KJOB_SAVE)) {
@@ -936,6 +958,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             close_row(ui);
         } else {
             ui->row_open = true;
+            ui->banner_until = -1; // the row goes where the banner is
             ++ui->others;
             layout_chips(ui);
             set_hint(ui, sp_kiosk_text(SP_KTEXT_PICK_PART));
@@ -964,6 +987,27 @@ static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
     ui->pressed = SP_KT_NONE;
 }
 
+// A stroke begins at (x, y), touched at time t.
+static void start_stroke(sp_kiosk_ui* ui, float x, float y, double t)
+{
+    // A new stroke ends the flash at once: the visitor is already drawing on.
+    if (sp_kiosk_ui_flashing(ui)) ui->flash_until = ui->now;
+    ui->capture = SP_KCAP_STROKE;
+    ui->pressed = SP_KT_NONE;
+    ui->stroke.count = 0;
+    ui->stroke_spacing = fmax(0.5, mm(ui, 0.3));
+    // Drawn on from where the last stroke ended: one line, shown as one while it is drawn.
+    ui->continuing = continues_last(ui, x, y);
+    ui->continued_from = 0;
+    if (ui->continuing) {
+        line_copy(&ui->stroke, &ui->last_stroke);
+        ui->continued_from = ui->stroke.count;
+    }
+    int before = ui->stroke.count;
+    add_point(ui, x, y, false);
+    if (ui->stroke.count > before) ui->stroke.t[ui->stroke.count - 1] = t;
+}
+
 static void on_down(sp_kiosk_ui* ui, float x, float y)
 {
     if (ui->capture != SP_KCAP_NONE) end_capture(ui, ui->last_x, ui->last_y, false);
@@ -972,6 +1016,8 @@ static void on_down(sp_kiosk_ui* ui, float x, float y)
     ui->woke = sp_kiosk_ui_countdown_s(ui) > 0;
     ui->last_input = ui->now;
     ui->last_x = x, ui->last_y = y;
+    ui->down_x = x, ui->down_y = y, ui->down_t = ui->now;
+    ui->down_on_banner = sp_kiosk_ui_banner_visible(ui) && inside(&ui->banner_box, x, y);
     // The attract screen invites drawing, so a child often starts with a
     // stroke: it leaves the screen and is already the visit's first stroke.
     // A tap only starts (no lesson in drawing); the empty canvas then shows
@@ -1000,19 +1046,7 @@ static void on_down(sp_kiosk_ui* ui, float x, float y)
         ui->capture = SP_KCAP_SWALLOW;
         return;
     }
-    // A new stroke ends the flash at once: the visitor is already drawing on.
-    if (sp_kiosk_ui_flashing(ui)) ui->flash_until = ui->now;
-    ui->capture = SP_KCAP_STROKE;
-    ui->stroke.count = 0;
-    ui->stroke_spacing = fmax(0.5, mm(ui, 0.3));
-    // Drawn on from where the last stroke ended: one line, shown as one while it is drawn.
-    ui->continuing = continues_last(ui, x, y);
-    ui->continued_from = 0;
-    if (ui->continuing) {
-        line_copy(&ui->stroke, &ui->last_stroke);
-        ui->continued_from = ui->stroke.count;
-    }
-    add_point(ui, x, y, false);
+    start_stroke(ui, x, y, ui->now);
 }
 
 static void on_move(sp_kiosk_ui* ui, float x, float y)
@@ -1022,6 +1056,22 @@ static void on_move(sp_kiosk_ui* ui, float x, float y)
     switch (ui->capture) {
     case SP_KCAP_STROKE:
         add_point(ui, x, y, false);
+        break;
+    case SP_KCAP_TARGET:
+        // A finger that leaves the chip or tile it touched (drawn over the
+        // canvas) is drawing a line that happened to start there, as
+        // children start lines anywhere: the line is kept from its touch.
+        if (ui->mode == SP_KM_DRAW && ui->pressed >= SP_KT_CHIP_LABEL && inside(&ui->canvas, ui->down_x, ui->down_y) &&
+            sp_kiosk_ui_hit(ui, x, y) != ui->pressed) {
+            start_stroke(ui, ui->down_x, ui->down_y, ui->down_t);
+            add_point(ui, x, y, false);
+        }
+        break;
+    case SP_KCAP_SWALLOW:
+        // Touched beside the canvas (the toolbar's strip, or where its
+        // buttons will be on the attract screen): a line drawn from there
+        // into the canvas starts where it enters.
+        if (ui->mode == SP_KM_DRAW && inside(&ui->canvas, x, y)) start_stroke(ui, x, y, ui->now);
         break;
     case SP_KCAP_ORBIT: {
         // Half the shorter side of the screen turns the dragon by 180 degrees.
@@ -1234,6 +1284,8 @@ void sp_kiosk_ui_saved(sp_kiosk_ui* ui, bool ok, const char* code)
         ui->banner_until = ui->now + ui->desc.banner_ms;
         snprintf(ui->banner[0], sizeof ui->banner[0], "%s %s", sp_kiosk_text(SP_KTEXT_SAVED), ui->code);
         snprintf(ui->banner[1], sizeof ui->banner[1], "%s", sp_kiosk_text(SP_KTEXT_CODE_USE));
+        layout_banner(ui);
+        if (ui->row_open) close_row(ui); // opened while the save ran: the banner would hide it
         if (!strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_SAVING))) ui->hint_until = -1; // the banner says it now
     } else {
         set_hint(ui, sp_kiosk_text(SP_KTEXT_SAVE_FAILED));

@@ -188,7 +188,8 @@ typedef struct sp_kiosk_ui {
     double px_per_mm;
     sp_kiosk_rect canvas;              ///< where strokes start (the window minus the toolbar)
     sp_kiosk_rect target[SP_KT_COUNT]; ///< drawn rectangles (w = 0: not shown)
-    sp_kiosk_rect hint_box;            ///< where hints and the save code go
+    sp_kiosk_rect hint_box;            ///< where hints go
+    sp_kiosk_rect banner_box;          ///< where the save banner goes (over the canvas's bottom)
     float text_px;                     ///< body text height
     float big_text_px;                 ///< titles, the countdown
     float line_px;                     ///< stroke width
@@ -201,6 +202,9 @@ typedef struct sp_kiosk_ui {
     enum { SP_KCAP_NONE, SP_KCAP_STROKE, SP_KCAP_TARGET, SP_KCAP_ORBIT, SP_KCAP_SWALLOW } capture;
     sp_kiosk_target pressed; ///< the target under the finger (drawn pressed)
     float last_x, last_y;
+    float down_x, down_y; ///< where the finger now down touched, and when
+    double down_t;
+    bool down_on_banner;   ///< it touched the save banner
     sp_kiosk_line stroke;  ///< the stroke being drawn (blue)
     double stroke_spacing; ///< current thinning distance, pixels
     bool continuing;       ///< the stroke being drawn continues the last one (it starts with the last one's points)
