@@ -183,12 +183,41 @@ void scan_buffers(LoadContext& cx, const unsigned char* json, size_t len)
 }
 
 // The JSON text of a .gltf, or of a .glb's first chunk (check_glb has run).
+// tinygltf's JSON parser recurses once a level: a 40 KB file nested 20,000
+// deep overflowed the stack (every command, and the kiosk at start). No
+// glTF needs more than a few dozen levels; cJSON (scan_buffers) stops at
+// the same limit.
+enum { JSON_DEPTH_MAX = CJSON_NESTING_LIMIT };
+
+void check_json_depth(const LoadContext& cx, const unsigned char* json, size_t len)
+{
+    int depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < len; ++i) {
+        unsigned char c = json[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > JSON_DEPTH_MAX)
+                fail(SP_ERR_PARSE, "%s: the JSON is nested more than %d levels deep", cx.what, JSON_DEPTH_MAX);
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+}
+
 void scan_buffers_of(LoadContext& cx, const unsigned char* data, size_t size)
 {
-    if (size >= 20 && !memcmp(data, "glTF", 4))
-        scan_buffers(cx, data + 20, std::min((size_t)le32(data + 12), size - 20));
-    else
-        scan_buffers(cx, data, size);
+    const unsigned char* json = data;
+    size_t len = size;
+    if (size >= 20 && !memcmp(data, "glTF", 4)) json = data + 20, len = std::min((size_t)le32(data + 12), size - 20);
+    check_json_depth(cx, json, len);
+    scan_buffers(cx, json, len);
 }
 
 bool is_data_uri(const std::string& uri)

@@ -17,6 +17,7 @@
 #include "gltf_internal.h"
 #include "mini_gltf.h"
 #include "sp/gltf.h"
+#include "sp/sketch_io.h"
 #include "test.h"
 
 // ---- helpers --------------------------------------------------------------
@@ -750,6 +751,35 @@ static void test_says_what_is_wrong(void)
     ensure_fails(write_edited("color_ints.gltf", &(mini_desc){0}, "\"WEIGHTS_0\": 2}", "\"WEIGHTS_0\": 2, \"COLOR_0\": 1}"),
                  "color_ints.gltf",
                  "mesh 0 primitive 0 COLOR_0 (accessor 1) must be float or normalized unsigned bytes or shorts");
+    // JSON nested 20,000 deep (a 40 KB file) overflowed tinygltf's parser's
+    // stack; refused at 1000 levels, in a .gltf and in a .glb's JSON chunk
+    // (db check reads parts from memory); 100 levels of extras still load.
+    for (int deep = 100; deep <= 20000; deep += 19900) {
+        char* nest = malloc(2 * (size_t)deep + 64);
+        ENSURE(nest);
+        int k = sprintf(nest, "{\"asset\": {\"extras\": \"[{\\\"\", \"deep\": ");
+        for (int i = 0; i < deep; ++i)
+            nest[k++] = '[';
+        for (int i = 0; i < deep; ++i)
+            nest[k++] = ']';
+        sprintf(nest + k, ", ");
+        const char* deep_gltf = write_edited("deep.gltf", &(mini_desc){0}, "{\"asset\": {", nest);
+        free(nest);
+        if (deep == 100) {
+            sp_character ok = load_ok(deep_gltf);
+            sp_character_free(&ok);
+            continue;
+        }
+        ensure_fails(deep_gltf, "deep.gltf", "the JSON is nested more than 1000 levels deep");
+        void* bytes = NULL;
+        size_t size = 0;
+        sp_error e = {0};
+        ENSURE(sp_file_read(deep_gltf, (size_t)1 << 30, &bytes, &size, &e) == SP_OK);
+        sp_character dc;
+        ENSURE(sp_gltf_load_memory(bytes, size, "part deep", &dc, &e) == SP_ERR_PARSE &&
+               strstr(e.text, "part deep: the JSON is nested more than 1000 levels deep"));
+        free(bytes);
+    }
     const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         const char* p = sp_test_tmp_path("top.gltf");
