@@ -519,6 +519,7 @@ typedef struct sketch_set {
     sp_dataset ds;
     sp_db_png* png; // parallel to ds.samples
     int cap;
+    bool kiosk; // added as kiosk sketches: each one stroke (sp_db_add_sketches)
 } sketch_set;
 
 static bool has_ext(const char* p, const char* ext)
@@ -527,8 +528,16 @@ static bool has_ext(const char* p, const char* ext)
     return n > e && !strcasecmp(p + n - e, ext);
 }
 
-static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size, sp_error* err)
+// Adds a drawing read from `what` (a file, or a drawing of one).
+static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size, const char* what, sp_error* err)
 {
+    const sp_sketch* k = &smp->sketch;
+    if (s->kiosk && (smp->raster.pixels || k->stroke_count != 1 || k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX))
+        return sp_fail(err, SP_ERR_INVALID, "%s: a kiosk sketch is one stroke of 2..%d points; this is %s (add it as curated)",
+                       what, SP_DB_KIOSK_POINTS_MAX,
+                       smp->raster.pixels     ? "a picture"
+                       : k->stroke_count != 1 ? "several strokes"
+                                              : "one stroke of too many points");
     if (s->ds.count == s->cap) {
         int cap = s->cap ? 2 * s->cap : 64;
         sp_sample* g = realloc(s->ds.samples, sizeof *g * (size_t)cap);
@@ -554,7 +563,9 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
         for (int i = 0; r == SP_OK && i < tmp.count; ++i) {
             sp_sample smp = tmp.samples[i];
             smp.label = label;
-            if ((r = push(s, &smp, NULL, 0, err)) == SP_OK) memset(&tmp.samples[i], 0, sizeof tmp.samples[i]);
+            char what[2100];
+            snprintf(what, sizeof what, "%s: drawing %d", path, i + 1);
+            if ((r = push(s, &smp, NULL, 0, what, err)) == SP_OK) memset(&tmp.samples[i], 0, sizeof tmp.samples[i]);
         }
         sp_dataset_free(&tmp);
         return r;
@@ -572,7 +583,7 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
         sp_raster_free(&smp.raster);
         return r;
     }
-    if ((r = push(s, &smp, png, n, err)) != SP_OK) {
+    if ((r = push(s, &smp, png, n, path, err)) != SP_OK) {
         sp_sketch_free(&smp.sketch);
         sp_raster_free(&smp.raster);
         free(png);
@@ -680,7 +691,7 @@ static int db_add_sketch(int argc, char** argv)
             fprintf(stderr, "%s: %s: give --category for drawings outside a labelled folder\n", cmd, pos[i]);
             return SP_EXIT_USAGE;
         }
-    sketch_set s = {0};
+    sketch_set s = {.kiosk = src == SP_DB_SOURCE_KIOSK};
     sp_error err = {0};
     sp_result r = SP_OK;
     for (int i = 0; r == SP_OK && i < npos; ++i)

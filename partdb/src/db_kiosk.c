@@ -55,9 +55,9 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
     if (!sp_part_name_is_plain(category))
         return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: category '%s' is not a plain name; sketch dropped", db->path,
                        category ? category : "");
-    if (!stroke || stroke->count < 2 || stroke->count > 65536)
-        return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: %d points (2..65536); sketch dropped", db->path,
-                       stroke ? stroke->count : 0);
+    if (!stroke || stroke->count < 2 || stroke->count > SP_DB_KIOSK_POINTS_MAX)
+        return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: %d points (2..%d); sketch dropped", db->path,
+                       stroke ? stroke->count : 0, SP_DB_KIOSK_POINTS_MAX);
     sp_sample smp = {.sketch = {.canvas_w = canvas_w, .canvas_h = canvas_h, .stroke_count = 1, .strokes = (sp_stroke*)stroke}};
     sp_error why = {0};
     char what[sizeof why.text];

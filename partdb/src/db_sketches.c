@@ -125,6 +125,15 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
             return sp_fail(err, SP_ERR_INVALID, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", data->categories[s->label]);
         sp_result r = db_sample_ok(s, what, err);
         if (r != SP_OK) return r;
+        // Review shows and trains on a kiosk sketch's one stroke: 200,000
+        // strokes were listed as one, a million points took a minute a sheet.
+        const sp_sketch* k = &s->sketch;
+        if (source == SP_DB_SOURCE_KIOSK &&
+            (k->stroke_count != 1 || k->strokes[0].count < 2 || k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX))
+            return sp_fail(err, SP_ERR_INVALID,
+                           "%s: a kiosk sketch is one stroke of 2..%d points; this has %d stroke%s%s (add it as curated)", what,
+                           SP_DB_KIOSK_POINTS_MAX, k->stroke_count, k->stroke_count == 1 ? "" : "s",
+                           k->stroke_count == 1 && k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX ? ", too many points" : "");
     }
     if (data->count == 0) return sp_fail(err, SP_ERR_INVALID, "no drawings to add");
     sp_result r = db_begin(db, err);

@@ -1088,6 +1088,50 @@ static void test_bad_input(void)
         ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && strstr(line, "sketchpose db add-sketch: "));
         ENSURE(!strstr(sk[i].name, "trailing") || strstr(line, "text after the JSON document, line 2"));
     }
+    // As kiosk sketches, one stroke of at most SP_DB_KIOSK_POINTS_MAX points
+    // (a review listed 200,000 strokes as one, and a million points took a
+    // minute a sheet): refused naming the file, the database unchanged.
+    {
+        size_t cap = 64 + 24 * (size_t)(SP_DB_KIOSK_POINTS_MAX + 1);
+        char* big = malloc(cap);
+        ENSURE(big);
+        int k = sprintf(big, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [");
+        for (int i = 0; i <= SP_DB_KIOSK_POINTS_MAX; ++i)
+            k += sprintf(big + k, "%s[%d, %d]", i ? ", " : "", i % 300, i / 300);
+        sprintf(big + k, "]}]}");
+        const char* kinds[2][3] = {
+            {"k_two.json",
+             "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], [30, 40]]}, "
+             "{\"points\": [[5, 5], [50, 9]]}]}",
+             "this is several strokes"},
+            {"k_many.json", big, "this is one stroke of too many points"}};
+        for (int i = 0; i < 2; ++i) {
+            const char* f = sp_test_tmp_path(kinds[i][0]);
+            ENSURE(db_write_file(f, kinds[i][1], strlen(kinds[i][1]), &err) == SP_OK);
+            char cmd[4096], line[600] = "";
+            snprintf(cmd, sizeof cmd, "'%s' db add-sketch --db '%s' --category tail --source kiosk '%s' 2>&1 >/dev/null", bin, p,
+                     f);
+            FILE* pp = popen(cmd, "r");
+            if (!fgets(line, sizeof line, pp)) line[0] = 0;
+            int st = pclose(pp);
+            fprintf(stderr, "  %-15s -> exit %d: %s", kinds[i][0], WEXITSTATUS(st), line);
+            ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && strstr(line, f) && strstr(line, "a kiosk sketch is one stroke") &&
+                   strstr(line, kinds[i][2]));
+        }
+        // The library refuses them too, whoever calls it.
+        sp_db* kdb;
+        ENSURE(sp_db_open(p, 0, &kdb, &err) == SP_OK);
+        sp_stroke two[2] = {{.count = 2, .points = (sp_vec2[]){{1, 2}, {30, 40}}},
+                            {.count = 2, .points = (sp_vec2[]){{5, 5}, {50, 9}}}};
+        sp_sample smp = {.sketch = {.canvas_w = 100, .canvas_h = 100, .stroke_count = 2, .strokes = two}};
+        char* cats[1] = {"tail"};
+        sp_dataset ds = {.count = 1, .samples = &smp, .category_count = 1, .categories = cats};
+        int added = -1;
+        ENSURE(sp_db_add_sketches(kdb, &ds, NULL, SP_DB_SOURCE_KIOSK, "t", &added, &err) == SP_ERR_INVALID && added == 0 &&
+               strstr(err.text, "a kiosk sketch is one stroke"));
+        sp_db_close(kdb);
+        free(big);
+    }
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' 2>/dev/null >/dev/null", bin, p, sp_test_tmp_path("b_cycle.gltf"));
     int st = system(cmd);

@@ -211,7 +211,8 @@ const char* sp_db_source_name(sp_db_source s);
 /// Stores drawings of a dataset in one transaction; sample i goes under
 /// `data->categories[label]` (every sample needs strokes or a raster; empty or
 /// non-finite drawings, and ones beyond the stroke files' limits, refuse the
-/// whole set). `png` (may be NULL) gives the original PNG bytes of raster
+/// whole set; as `SP_DB_SOURCE_KIOSK`, each must be a kiosk sketch: one
+/// stroke of 2..SP_DB_KIOSK_POINTS_MAX points). `png` (may be NULL) gives the original PNG bytes of raster
 /// samples, kept for export.
 typedef struct sp_db_png {
     const void* bytes;
@@ -262,6 +263,9 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
 /// sketches"). A kiosk nobody reviews stops there instead of filling its
 /// disk, which its saves and the curators' `db train` also need.
 #define SP_DB_KIOSK_PENDING_MAX 100000
+/// A kiosk sketch is one stroke of 2 to this many points (the kiosk's own
+/// stroke holds fewer), collected or added (`db add-sketch --source kiosk`).
+#define SP_DB_KIOSK_POINTS_MAX 65536
 
 /// Review status of a kiosk sketch.
 typedef enum sp_db_status { SP_DB_PENDING, SP_DB_APPROVED, SP_DB_REJECTED, SP_DB_STATUS_COUNT } sp_db_status;
