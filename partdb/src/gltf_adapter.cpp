@@ -1332,6 +1332,14 @@ struct Importer {
         if (s.rest.empty() && warned_lines)
             fail(SP_ERR_INVALID, "%s: the skinned mesh is only lines (LINES, LINE_STRIP or LINE_LOOP): no surface to pose", what);
         if (s.rest.empty()) fail(SP_ERR_INVALID, "%s: the skinned mesh has no vertices", what);
+        // All at one point (zeroed positions, an accessor without data) frames
+        // a view of no size: strokes synthesised from it were 1e9 pixels long.
+        bool one_point = true;
+        for (size_t i = 3; one_point && i < s.rest.size(); ++i)
+            one_point = s.rest[i] == s.rest[i % 3];
+        if (one_point)
+            fail(SP_ERR_INVALID, "%s: the skinned mesh's %zu vertices are all at one point: no surface to pose", what,
+                 s.rest.size() / 3);
         if (s.tris.size() / 3 > 0x7fffffff) fail(SP_ERR_UNSUPPORTED, "%s: too many triangles", what);
         rig->rest = c_array(s.rest);
         rig->joints4 = c_array(s.joints);

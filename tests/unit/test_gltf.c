@@ -780,6 +780,10 @@ static void test_says_what_is_wrong(void)
                strstr(e.text, "part deep: the JSON is nested more than 1000 levels deep"));
         free(bytes);
     }
+    // Positions without data are zeros (glTF): a mesh at one point framed a
+    // view of no size, and synth wrote strokes 1e9 pixels long.
+    ensure_fails(write_edited("no_extent.gltf", &(mini_desc){0}, "{\"bufferView\": 0, ", "{"), "no_extent.gltf",
+                 "the skinned mesh's 4 vertices are all at one point: no surface to pose");
     const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         const char* p = sp_test_tmp_path("top.gltf");
