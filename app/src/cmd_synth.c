@@ -77,6 +77,26 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         free(names);
         return SP_EXIT_INPUT;
     }
+    // Every part is read and checked before anything is written: a bad part
+    // in the folder left the sketches of the ones before it in an existing D.
+    for (int k = 0; k < n; ++k) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        sp_character ch = {0};
+        bool ok = sp_gltf_load(path, &ch, &err) == SP_OK;
+        const char* an = abs_name ? abs_name : ch.part.abstraction[0] ? ch.part.abstraction : NULL;
+        if (ok && !an && sp_rig_find_abstraction(&ch.rig, "outline") >= 0) an = "outline";
+        if (ok && ch.part.category[0])
+            ok = sp_pick_abstraction(ch.rig.abstractions, ch.rig.abstraction_count, path, an, &err) >= 0;
+        sp_character_free(&ch);
+        if (!ok) {
+            fprintf(stderr, "sketchpose synth: %s\n", err.text);
+            for (int j = 0; j < n; ++j)
+                free(names[j]);
+            free(names);
+            return SP_EXIT_INPUT;
+        }
+    }
     // The result is said once the sketches are all written; a failure
     // takes back the folder it made (it printed a result and left the folder).
     // Made is mkdir's own answer: a folder another process made meanwhile is
