@@ -4,6 +4,7 @@
 #include "sp/gltf.h"
 #include "sp/sketch_io.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -354,4 +355,23 @@ bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cl
 bool sp_cli_check_max_ms(const char* cmd, double ms)
 {
     return isnan(ms) || sp_cli_check_double(cmd, "--max-ms", ms, 0, true, SP_CLI_MAX_MS);
+}
+
+void sp_cli_print_shell_word(FILE* f, const char* s)
+{
+    bool plain = s[0] != 0;
+    for (const char* c = s; plain && *c; ++c)
+        plain = isalnum((unsigned char)*c) || strchr("_./=:,+-", *c);
+    if (plain) {
+        fputs(s, f);
+        return;
+    }
+    fputc('\'', f);
+    for (const char* c = s; *c; ++c) {
+        if (*c == '\'')
+            fputs("'\\''", f);
+        else
+            fputc(*c, f);
+    }
+    fputc('\'', f);
 }

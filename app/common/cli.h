@@ -11,6 +11,7 @@
 
 #include <limits.h>
 #include <stdbool.h>
+#include <stdio.h>
 
 typedef enum sp_opt_kind {
     SP_OPT_FLAG,    ///< bool*, no value
@@ -105,6 +106,11 @@ bool sp_cli_check_out_folders(const char* cmd, const sp_opt* opts, int nopts);
 /// (0, SP_CLI_MAX_MS]; false after the usage line. One check, so that the
 /// three commands say the same range.
 bool sp_cli_check_max_ms(const char* cmd, double ms);
+
+/// Prints `s` as one word a POSIX shell reads back as `s`: as it is when it
+/// holds only [A-Za-z0-9_./=:,+-], else in single quotes (a quote as '\'').
+/// For command lines printed to be pasted.
+void sp_cli_print_shell_word(FILE* f, const char* s);
 
 /// Initial value of an int option whose "not given" must differ from every
 /// value a user can type (sp_cli_parse refuses INT_MIN).

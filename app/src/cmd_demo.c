@@ -15,6 +15,7 @@
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "commands.h"
 #include "outputs.h"
 #include "report.h"
 #include "sp/dragon.h"
@@ -146,9 +147,32 @@ static sp_result part_stroke(sp_db* db, int li, uint64_t seed, sp_vec2 at, sp_ve
     return r;
 }
 
-// The database at path is about to be built from assets by the default
-// recipe: said, with a note when the people's strokes are not there to go in.
-static void announce_build(const char* path, const char* assets)
+// The demo's last line: the database, and the command that makes the same
+// dragon again, to paste: this very program, every path quoted for the shell.
+static void print_again(const char* db_path, const char* strokes)
+{
+    char self[4096];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    self[n > 0 ? n : 0] = 0;
+    printf("database: %s; again from these strokes: ", db_path);
+    const char* words[] = {n > 0 ? self : "sketchpose",
+                           "dragon",
+                           "--db",
+                           db_path,
+                           "--strokes",
+                           strokes,
+                           "--out",
+                           "dragon.glb",
+                           "--render",
+                           "dragon.png"};
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {
+        if (i) putchar(' ');
+        sp_cli_print_shell_word(stdout, words[i]);
+    }
+    putchar('\n');
+}
+
+void announce_db_build(const char* path, const char* assets)
 {
     fprintf(stderr, "creating the part database %s from %s (parts, hand-drawn sketches, a trained model)...\n", path, assets);
     char note[1200];
@@ -157,7 +181,7 @@ static void announce_build(const char* path, const char* assets)
 
 int cmd_demo(int argc, char** argv)
 {
-    const char *out_dir = "demo-out", *db_path = NULL, *assets = SP_SOURCE_DIR "/assets";
+    const char *out_dir = "demo-out", *db_path = NULL, *assets = NULL;
     int seed = 1;
     const sp_opt opts[] = {
         {"--out", SP_OPT_STRING, &out_dir, "DIR", "where to write the strokes, render, .glb and report (default demo-out)",
@@ -165,7 +189,7 @@ int cmd_demo(int argc, char** argv)
         {"--db", SP_OPT_STRING, &db_path, "DB",
          "part database (default: $SP_DB or sketchpose.db; created from --assets when missing)", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
-         "parts for a database that does not exist yet (default: the source tree's assets/)", false},
+         "parts for a database that does not exist yet (default: $SP_ASSETS, else the source tree's assets/)", false},
         {"--seed", SP_OPT_INT, &seed, "N", "first seed of the hand-drawn strokes (default 1)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose demo",
@@ -189,10 +213,11 @@ int cmd_demo(int argc, char** argv)
     }
     sp_error err = {0};
     sp_db* db = NULL;
+    if (!assets) assets = sp_dragon_default_assets();
     const char* path = db_path ? db_path : sp_db_default_path();
     struct stat st;
     bool created = stat(path, &st) != 0;
-    if (created) announce_build(path, assets);
+    if (created) announce_db_build(path, assets);
     if (sp_db_open_or_create_default(path, assets, SP_DB_READONLY, &db, &err) != SP_OK) {
         fprintf(stderr, "sketchpose demo: %s\n", err.text);
         if (made_out) rmdir(out_dir);
@@ -282,9 +307,7 @@ int cmd_demo(int argc, char** argv)
         goto fail;
     printf("a dragon of %d parts (animation %.1f s, looped)\n", sp_dragon_part_count(d), sp_dragon_period(d));
     printf("wrote %s (parts, strokes blue, fitted outlines yellow), %s (animated), %s, %s\n", png, glb, strokes, report);
-    printf(
-        "database: %s; again from these strokes: sketchpose dragon --db %s --strokes %s --out dragon.glb --render dragon.png\n",
-        path, path, strokes);
+    print_again(path, strokes);
     exit_code = SP_EXIT_OK;
     goto done;
 oom:

@@ -6,10 +6,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
 #include "cli.h"
+#include "commands.h"
 #include "outputs.h"
 #include "posing.h"
 #include "report.h"
@@ -20,9 +22,33 @@
 #define SP_SOURCE_DIR "."
 #endif
 
+// The stroke file, as the pipeline takes it; false after one line on stderr.
+static bool read_strokes(const char* strokes, sp_sketch* sk)
+{
+    sp_error err = {0};
+    if (sp_sketch_read_json(strokes, sk, &err) != SP_OK) {
+        fprintf(stderr, "sketchpose dragon: %s\n", err.text);
+        return false;
+    }
+    if (sk->stroke_count == 0) {
+        fprintf(stderr, "sketchpose dragon: %s: the file has no strokes\n", strokes);
+        sp_sketch_free(sk);
+        return false;
+    }
+    // The kiosk's canvas is at most 16384 px a side (a render target's);
+    // a larger one was replaced by 1280 x 800 with no word, its strokes off it.
+    if (sk->canvas_w > 16384 || sk->canvas_h > 16384) {
+        fprintf(stderr, "sketchpose dragon: %s: canvas %g x %g is larger than the kiosk pipeline's 16384 px a side\n", strokes,
+                sk->canvas_w, sk->canvas_h);
+        sp_sketch_free(sk);
+        return false;
+    }
+    return true;
+}
+
 int cmd_dragon(int argc, char** argv)
 {
-    const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = SP_SOURCE_DIR "/assets";
+    const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = NULL;
     double max_ms = NAN, at = 0; // NAN: not given
     const sp_opt opts[] = {
         {"--db", SP_OPT_IN, &db_path, "DB",
@@ -35,7 +61,7 @@ int cmd_dragon(int argc, char** argv)
         {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: parts, strokes blue, fitted outlines yellow", false},
         {"--report", SP_OPT_OUT, &report, "report.json", "write the report (also printed on stdout)", false},
         {"--assets", SP_OPT_STRING, &assets, "DIR",
-         "parts for a database that does not exist yet (default: the source tree's assets/)", false},
+         "parts for a database that does not exist yet (default: $SP_ASSETS, else the source tree's assets/)", false},
         {"--max-ms", SP_OPT_DOUBLE, &max_ms, "MS", "time cap of each part's solve, " SP_CLI_MAX_MS_RANGE " (default 250)", false},
         {"--time", SP_OPT_DOUBLE, &at, "S",
          "animation time, s in [0, 3600] (default 0: the loop's start; shipped parts as fitted)", false},
@@ -55,24 +81,10 @@ int cmd_dragon(int argc, char** argv)
         return SP_EXIT_INPUT; // before the work
     sp_error err = {0};
     sp_sketch sk = {0};
-    if (sp_sketch_read_json(strokes, &sk, &err) != SP_OK) {
-        fprintf(stderr, "sketchpose dragon: %s\n", err.text);
-        return SP_EXIT_INPUT;
-    }
-    if (sk.stroke_count == 0) {
-        fprintf(stderr, "sketchpose dragon: %s: the file has no strokes\n", strokes);
-        sp_sketch_free(&sk);
-        return SP_EXIT_INPUT;
-    }
-    // The kiosk's canvas is at most 16384 px a side (a render target's);
-    // a larger one was replaced by 1280 x 800 with no word, its strokes off it.
-    if (sk.canvas_w > 16384 || sk.canvas_h > 16384) {
-        fprintf(stderr, "sketchpose dragon: %s: canvas %g x %g is larger than the kiosk pipeline's 16384 px a side\n", strokes,
-                sk.canvas_w, sk.canvas_h);
-        sp_sketch_free(&sk);
-        return SP_EXIT_INPUT;
-    }
+    if (!read_strokes(strokes, &sk)) return SP_EXIT_INPUT;
     int w = sk.canvas_w >= 1 ? (int)sk.canvas_w : 0, h = sk.canvas_h >= 1 ? (int)sk.canvas_h : 0;
+    const char* path = db_path ? db_path : sp_db_default_path();
+    if (access(path, F_OK) != 0) announce_db_build(path, assets ? assets : sp_dragon_default_assets()); // it waited silently
     sp_dragon* d;
     sp_dragon_create(&(sp_dragon_desc){.db_path = db_path,
                                        .assets_dir = assets,

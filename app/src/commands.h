@@ -25,4 +25,9 @@
 SP_COMMANDS(SP_DECLARE_CMD)
 #undef SP_DECLARE_CMD
 
+/// The part database at `path` is about to be built from `assets` by the
+/// default recipe (`demo` and `dragon` on a first run, a minute or so): one
+/// line on stderr, and a note when the people's strokes are not there to go in.
+void announce_db_build(const char* path, const char* assets);
+
 #endif

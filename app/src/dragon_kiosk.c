@@ -578,7 +578,8 @@ int main(int argc, char** argv)
     sp_opt opts[] = {
         {"--db", SP_OPT_STRING, &db, "DB", "part database (default: $SP_DB or sketchpose.db; created from assets/ when missing)",
          false},
-        {"--assets", SP_OPT_STRING, &assets, "DIR", "parts for a missing database (default: $SP_ASSETS or assets)", false},
+        {"--assets", SP_OPT_STRING, &assets, "DIR",
+         "parts for a missing database (default: $SP_ASSETS, else the source tree's assets/)", false},
         {"--fullscreen", SP_OPT_FLAG, &fullscreen, "", "full screen on the primary monitor", false},
         {"--size", SP_OPT_STRING, &size, "WxH", "window size (default 1280x800, or the script's canvas)", false},
         {"--script", SP_OPT_IN, &script, "S.json", "replay a session (virtual clock), then exit", false},

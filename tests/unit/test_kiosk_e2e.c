@@ -1934,20 +1934,28 @@ static void test_collect_replaced(void)
 }
 
 // Started where there is neither a database nor parts to build one from
-// (a technician's wrong folder): one line saying so, before any window
-// (it said only "assets: cannot open the folder"), and nothing made.
+// (a technician's wrong $SP_ASSETS): one line saying so, before any window
+// (it said only "assets: cannot open the folder"), and nothing made. Without
+// $SP_ASSETS the parts are the source tree's, from any folder, as for
+// `sketchpose dragon` and `demo` (the kiosk looked for ./assets).
 static void test_no_database_here(void)
 {
     char dir[1100], cmd[4096], said[2048];
     snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("kiosk_empty_dir"));
     ENSURE(mkdir(dir, 0755) == 0 || errno == EEXIST);
-    snprintf(cmd, sizeof cmd, "cd '%s' && env -u SP_DB -u SP_ASSETS -u DISPLAY -u WAYLAND_DISPLAY '%s' 2>&1", dir,
+    snprintf(cmd, sizeof cmd, "cd '%s' && env -u SP_DB -u DISPLAY -u WAYLAND_DISPLAY SP_ASSETS=no_parts_here '%s' 2>&1", dir,
              SP_DRAGON_KIOSK);
     int rc = sp_fixture_run(cmd, said, sizeof said);
     fprintf(stderr, "  %s", said);
-    ENSURE(rc == 1 && strstr(said, "no part database at sketchpose.db, and no folder 'assets' of parts to build one from") &&
+    ENSURE(rc == 1 &&
+           strstr(said, "no part database at sketchpose.db, and no folder 'no_parts_here' of parts to build one from") &&
            strchr(said, '\n') == said + strlen(said) - 1);
     ENSURE(rmdir(dir) == 0); // empty: nothing was made
+    unsetenv("SP_ASSETS");
+    ENSURE(!strcmp(sp_dragon_default_assets(), SP_SOURCE_DIR "/assets"));
+    setenv("SP_ASSETS", "elsewhere", 1);
+    ENSURE(!strcmp(sp_dragon_default_assets(), "elsewhere"));
+    unsetenv("SP_ASSETS");
 }
 
 // A hang-up ends the kiosk as SIGTERM does (it killed it: exit 129, no

@@ -270,6 +270,32 @@ static bool scratch_kept(void (*fn)(void))
 
 // A passing test run removes its scratch files; a failing one keeps them to
 // look at (the build folder grew by some 100 MB a run before).
+// The command lines commands print to be pasted (demo's "again from these
+// strokes"): every word reads back as itself in sh (the demo printed a
+// folder with a space bare, and the pasted line failed).
+static void test_shell_words(void)
+{
+    const char* words[] = {"build/app/sketchpose", "my db.db", "it's", "", "a;b", "$HOME", "x=1,y:2+3-4_5.json"};
+    char* text = NULL;
+    size_t len = 0;
+    FILE* f = open_memstream(&text, &len);
+    ENSURE(f);
+    fputs("printf '[%s]' ", f);
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {
+        sp_cli_print_shell_word(f, words[i]);
+        fputc(' ', f);
+    }
+    fclose(f);
+    FILE* p = popen(text, "r");
+    char got[512] = "";
+    size_t n = fread(got, 1, sizeof got - 1, p);
+    got[n] = 0;
+    ENSURE(pclose(p) == 0);
+    ENSURE(!strcmp(got, "[build/app/sketchpose][my db.db][it's][][a;b][$HOME][x=1,y:2+3-4_5.json]"));
+    ENSURE(strstr(text, " build/app/sketchpose ") && strstr(text, " x=1,y:2+3-4_5.json ")); // plain words stay plain
+    free(text);
+}
+
 static void test_harness_scratch(void)
 {
     ENSURE(!scratch_kept(harness_passes));
@@ -285,5 +311,6 @@ int main(int argc, char** argv)
                                    {"message", test_message},
                                    {"folder_check", test_folder_check},
                                    {"harness_scratch", test_harness_scratch},
+                                   {"shell_words", test_shell_words},
                                    {0}});
 }

@@ -46,7 +46,7 @@ const char* sp_dragon_note_name(sp_dragon_note n)
 const char* sp_dragon_default_assets(void)
 {
     const char* env = getenv("SP_ASSETS");
-    return env && *env ? env : "assets";
+    return env && *env ? env : SP_SOURCE_ASSETS;
 }
 
 sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error* err)

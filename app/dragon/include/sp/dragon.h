@@ -216,7 +216,7 @@ typedef struct sp_dragon_stroke_opts {
 /// newest model. On failure *out is NULL and err has one line. A database
 /// without a model still opens (strokes then need a forced category).
 sp_result sp_dragon_create(const sp_dragon_desc* desc, sp_dragon** out, sp_error* err);
-/// The parts' folder for a missing default database when the desc names none: $SP_ASSETS, else "assets".
+/// The parts' folder for a missing default database when the desc names none: $SP_ASSETS, else the source tree's assets/.
 const char* sp_dragon_default_assets(void);
 /// Frees everything (NULL is fine). Does not close a caller's database.
 void sp_dragon_destroy(sp_dragon* d);
