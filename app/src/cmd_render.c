@@ -79,7 +79,7 @@ int cmd_render(int argc, char** argv)
         {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "abstraction to overlay (default: the first; 'none': no overlay)",
          false},
         {"--out", SP_OPT_OUT, &out_path, "X.png", "the PNG to write", true},
-        {"--size", SP_OPT_STRING, &size, "WxH", "image size in pixels (default 640x480)", false},
+        {"--size", SP_OPT_STRING, &size, "WxH", "image size in pixels, sides 16..8192 (default 640x480)", false},
         {"--line-width", SP_OPT_DOUBLE, &line_width, "PX",
          "overlay line width, pixels in (0, 256] (default: scales with the image)", false},
         {"--yaw", SP_OPT_DOUBLE, &yaw, "DEG", "orbit the sketch camera about the vertical axis (default 0)", false},
