@@ -1130,6 +1130,30 @@ static void test_line_from_overlay(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// A kiosk review: a child trying to draw in Turn mode only spun the
+// dragon, and nothing said how to draw again once the first hint went. Each
+// turn says it again.
+static void test_turn_reminds_draw(void)
+{
+    fake f;
+    double t;
+    sp_kiosk_ui* ui = with_part(&f, NULL, &t);
+    tap(ui, t + 100, SP_KT_TURN);
+    ENSURE(ui->mode == SP_KM_TURN && sp_kiosk_ui_hint_visible(ui) && strstr(ui->hint, "Tap Draw"));
+    double td = t + 200 + ui->desc.hint_ms;
+    frame(ui, &f, td);
+    ENSURE(!sp_kiosk_ui_hint_visible(ui));
+    send(ui, SP_KEV_DOWN, td + 10, 600, 300);
+    send(ui, SP_KEV_MOVE, td + 30, 700, 320);
+    ENSURE(!sp_kiosk_ui_hint_visible(ui));
+    send(ui, SP_KEV_UP, td + 50, 700, 320);
+    ENSURE(ui->yaw > 0 && sp_kiosk_ui_hint_visible(ui) && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_TURN)));
+    ENSURE(ui->pending_count == 0 && f.parts == 1);
+    tap(ui, td + 200, SP_KT_TURN);
+    ENSURE(ui->mode == SP_KM_DRAW && !sp_kiosk_ui_hint_visible(ui));
+    sp_kiosk_ui_destroy(ui);
+}
+
 // A kiosk review: the save banner covered the refusal's parts row, and a
 // child's tap on the banner made the refused stroke a part (and took the
 // code off the screen). Redraw then Undo left "it replaces the last one" up.
@@ -1923,6 +1947,7 @@ int main(int argc, char** argv)
                                    {"save_code", test_save_code},
                                    {"line_from_overlay", test_line_from_overlay},
                                    {"banner_over_row", test_banner_over_row},
+                                   {"turn_reminds_draw", test_turn_reminds_draw},
                                    {"undo_double_tap", test_undo_double_tap},
                                    {"double_tap_chip", test_double_tap_chip},
                                    {"waiting_part", test_waiting_part},

@@ -980,6 +980,11 @@ static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
     case SP_KCAP_TARGET:
         if (up && ui->pressed != SP_KT_NONE && sp_kiosk_ui_hit(ui, x, y) == ui->pressed) activate(ui, ui->pressed);
         break;
+    case SP_KCAP_ORBIT:
+        // A child who tries to draw while turning only spins the dragon: each
+        // turn says again how to get back to drawing.
+        if (up && ui->mode == SP_KM_TURN) set_hint(ui, sp_kiosk_text(SP_KTEXT_TURN));
+        break;
     default:
         break;
     }
