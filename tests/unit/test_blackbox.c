@@ -667,7 +667,7 @@ static int run_cli(const char* cmd, char** out, char** err)
     char full[8192], o[1024], e[1024];
     snprintf(o, sizeof o, "%s", sp_test_tmp_path("cli_out.txt"));
     snprintf(e, sizeof e, "%s", sp_test_tmp_path("cli_err.txt"));
-    snprintf(full, sizeof full, "%s > %s 2> %s", cmd, o, e);
+    snprintf(full, sizeof full, "%s > '%s' 2> '%s'", cmd, o, e);
     int rc = system(full);
     static char ob[1 << 16];
     char* t = slurp(o);
@@ -697,14 +697,16 @@ static void cli_plugin_pose_files(const char* bin, const char* strokes, const ch
     ENSURE(f && fputs("{\"parameters\": {\"jaw_opn\": 0.5}}", f) >= 0 && fclose(f) == 0);
     f = fopen(far, "wb");
     ENSURE(f && fputs("{\"parameters\": {\"jaw_open\": 7}}", f) >= 0 && fclose(f) == 0);
-    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s --start %s", bin, SP_FACE_PLUGIN, strokes, bad);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig '%s' --strokes '%s' --start '%s'", bin, SP_FACE_PLUGIN, strokes, bad);
     ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, bad, "'jaw_opn'"));
-    snprintf(cmd, sizeof cmd, "%s synth --rig %s --pose %s --out %s", bin, SP_FACE_PLUGIN, bad, sp_test_tmp_path("x.json"));
+    snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --pose '%s' --out '%s'", bin, SP_FACE_PLUGIN, bad,
+             sp_test_tmp_path("x.json"));
     ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, bad, "'jaw_opn'"));
-    snprintf(cmd, sizeof cmd, "%s export --rig %s --pose %s --out %s", bin, SP_FACE_PLUGIN, far, sp_test_tmp_path("x.glb"));
+    snprintf(cmd, sizeof cmd, "'%s' export --rig '%s' --pose '%s' --out '%s'", bin, SP_FACE_PLUGIN, far,
+             sp_test_tmp_path("x.glb"));
     ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(err, "clamped to 1") && strstr(out, "\"clamped\":1"));
     // The truth pose file synth wrote starts a solve where it ends.
-    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s --start %s", bin, SP_FACE_PLUGIN, strokes, truth);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig '%s' --strokes '%s' --start '%s'", bin, SP_FACE_PLUGIN, strokes, truth);
     ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(out, "\"iterations\":\t"));
 }
 
@@ -717,19 +719,19 @@ static void cli_plugin_other_commands(const char* bin, const char* strokes, cons
     char *out, *err;
     snprintf(glb, sizeof glb, "%s", sp_test_tmp_path("face_export.glb"));
     remove(glb);
-    snprintf(cmd, sizeof cmd, "%s export --rig %s --pose %s --out %s", bin, SP_FACE_PLUGIN, truth, glb);
+    snprintf(cmd, sizeof cmd, "'%s' export --rig '%s' --pose '%s' --out '%s'", bin, SP_FACE_PLUGIN, truth, glb);
     ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(out, "\"parameters\":44") && strstr(out, "\"clamped\":0"));
-    snprintf(cmd, sizeof cmd, "%s inspect --rig %s", bin, glb);
+    snprintf(cmd, sizeof cmd, "'%s' inspect --rig '%s'", bin, glb);
     ENSURE(run_cli(cmd, &out, &err) == 0 && strstr(out, "\"vertices\":\t6537,") && strstr(out, "\"parameters\":\t[],"));
     ENSURE(strstr(out, "\"name\":\t\"root\"") && strstr(out, "\"name\":\t\"face\"") && !strstr(out, "black_box"));
-    snprintf(cmd, sizeof cmd, "%s drawover --rig %s --on %s --to %s", bin, SP_FACE_PLUGIN, strokes, strokes);
+    snprintf(cmd, sizeof cmd, "'%s' drawover --rig '%s' --on '%s' --to '%s'", bin, SP_FACE_PLUGIN, strokes, strokes);
     ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, SP_FACE_PLUGIN, "needs a glTF character"));
-    snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s --out %s", bin, SP_FACE_PLUGIN, strokes, glb);
+    snprintf(cmd, sizeof cmd, "'%s' animate --rig '%s' --strokes '%s' --out '%s'", bin, SP_FACE_PLUGIN, strokes, glb);
     ENSURE(run_cli(cmd, &out, &err) == 1 && one_line_naming(err, SP_FACE_PLUGIN, "needs a glTF character"));
-    snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed 1 --style normal --out %s", bin, SP_FACE_PLUGIN,
+    snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --seed 1 --style normal --out '%s'", bin, SP_FACE_PLUGIN,
              sp_test_tmp_path("x.json"));
     ENSURE(run_cli(cmd, &out, &err) == 2 && one_line_naming(err, "--style", NULL));
-    snprintf(cmd, sizeof cmd, "%s inspect --rig %s", bin, SP_FACE_PLUGIN);
+    snprintf(cmd, sizeof cmd, "'%s' inspect --rig '%s'", bin, SP_FACE_PLUGIN);
     ENSURE(run_cli(cmd, &out, &err) == 0 && !strncmp(out, "{\n\t\"black_box\":\ttrue,", 19) && strstr(out, "\"joints\":\t[]"));
     ENSURE(!strstr(out, "derived_dofs"));
 }
@@ -751,10 +753,11 @@ static void test_cli(void)
     snprintf(ins, sizeof ins, "%s", sp_test_tmp_path("face_inspect.json"));
     snprintf(rpng, sizeof rpng, "%s", sp_test_tmp_path("face_render.png"));
     remove(png), remove(rep), remove(glb);
-    snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed 7 --amplitude 3.1416 --out %s --truth %s", bin, SP_FACE_PLUGIN, s, t);
+    snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --seed 7 --amplitude 3.1416 --out '%s' --truth '%s'", bin, SP_FACE_PLUGIN, s,
+             t);
     ENSURE(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s --render %s --report %s --out %s > /dev/null", bin, SP_FACE_PLUGIN,
-             s, png, rep, glb);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig '%s' --strokes '%s' --render '%s' --report '%s' --out '%s' > /dev/null", bin,
+             SP_FACE_PLUGIN, s, png, rep, glb);
     ENSURE(system(cmd) == 0);
     char* j = slurp(rep);
     ENSURE(j && strstr(j, "\"parameters\"") && strstr(j, "\"jaw_open\"") && strstr(j, "\"mouth\""));
@@ -777,7 +780,7 @@ static void test_cli(void)
         ENSURE(v && strstr(v, "\"numErrors\": 0"));
     }
     // inspect reports the plugin's counts.
-    snprintf(cmd, sizeof cmd, "%s inspect --rig %s > %s", bin, SP_FACE_PLUGIN, ins);
+    snprintf(cmd, sizeof cmd, "'%s' inspect --rig '%s' > '%s'", bin, SP_FACE_PLUGIN, ins);
     ENSURE(system(cmd) == 0);
     char* ij = slurp(ins);
     int units = 0;
@@ -786,19 +789,19 @@ static void test_cli(void)
     ENSURE(ij && strstr(ij, "\"black_box\":\ttrue") && units == 44);
     // render shows the plugin at a pose file's pose.
     remove(rpng);
-    snprintf(cmd, sizeof cmd, "%s render --rig %s --pose %s --out %s --size 320x320", bin, SP_FACE_PLUGIN, t, rpng);
+    snprintf(cmd, sizeof cmd, "'%s' render --rig '%s' --pose '%s' --out '%s' --size 320x320", bin, SP_FACE_PLUGIN, t, rpng);
     ENSURE(system(cmd) == 0);
     ENSURE(stat(rpng, &st) == 0 && st.st_size > 5000);
     // Starting from the truth converges at once.
-    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s --start %s > /dev/null", bin, SP_FACE_PLUGIN, s, t);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig '%s' --strokes '%s' --start '%s' > /dev/null", bin, SP_FACE_PLUGIN, s, t);
     ENSURE(system(cmd) == 0);
     // A missing plugin: exit 1, one line naming it.
-    snprintf(cmd, sizeof cmd, "%s pose --rig /nonexistent/face.so --strokes %s 2> %s", bin, s, log);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig /nonexistent/face.so --strokes '%s' 2> '%s'", bin, s, log);
     int rc = system(cmd);
     ENSURE(WIFEXITED(rc) && WEXITSTATUS(rc) == 1);
     char* e = slurp(log);
     ENSURE(e && strstr(e, "/nonexistent/face.so") && strchr(e, '\n') == e + strlen(e) - 1);
-    snprintf(cmd, sizeof cmd, "%s pose --rig %s --strokes %s 2> %s", bin, plugin("badversion"), s, log);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig '%s' --strokes '%s' 2> '%s'", bin, plugin("badversion"), s, log);
     rc = system(cmd);
     ENSURE(WIFEXITED(rc) && WEXITSTATUS(rc) == 1);
     e = slurp(log);

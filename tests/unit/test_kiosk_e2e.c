@@ -181,14 +181,44 @@ static bool have_xvfb(void)
     return system("command -v xvfb-run >/dev/null 2>&1") == 0;
 }
 
-// The xvfb-run command line, with its X authority file in `dir`: left to
-// itself xvfb-run makes a temporary folder for it, and now and then fails
-// to remove it afterwards and exits 5 in place of the kiosk's status.
+static char g_xauth_dir[64]; // made by xauth_dir, when the test's own folder will not do
+static pid_t g_xauth_owner;
+
+static void remove_xauth_dir(void)
+{
+    if (!g_xauth_dir[0] || getpid() != g_xauth_owner) return; // a forked child leaves it to the parent
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_xauth_dir);
+    if (system(cmd) != 0) fprintf(stderr, "  could not remove %s\n", g_xauth_dir);
+}
+
+// A folder for xvfb-run's X authority file: `dir` itself when its path is
+// plain, else a fresh one under /tmp (removed at exit). Debian's xvfb-run
+// passes the file to Xvfb unquoted (-auth $AUTHFILE), so a clone whose path
+// has a space never got its Xvfb started.
+static const char* xauth_dir(const char* dir)
+{
+    if (strspn(dir, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789/._-+,=") == strlen(dir)) return dir;
+    if (!g_xauth_dir[0]) {
+        snprintf(g_xauth_dir, sizeof g_xauth_dir, "%s/sp_xauth_XXXXXX", P_tmpdir);
+        // 0777: a case that drops root runs xvfb-run as nobody.
+        ENSURE(mkdtemp(g_xauth_dir) && chmod(g_xauth_dir, 0777) == 0);
+        g_xauth_owner = getpid();
+        atexit(remove_xauth_dir);
+    }
+    return g_xauth_dir;
+}
+
+// The xvfb-run command line, with its X authority file in `dir` (or see
+// xauth_dir): left to itself xvfb-run makes a temporary folder for it, and
+// now and then fails to remove it afterwards and exits 5 in place of the
+// kiosk's status.
 static const char* xvfb_run_in(const char* dir)
 {
     static char cmd[1400];
     static int calls;
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -f '%s/%ld_xauth-%d' -s '-screen 0 1600x1000x24'", dir, (long)getpid(), ++calls);
+    snprintf(cmd, sizeof cmd, "xvfb-run -a -f '%s/%ld_xauth-%d' -s '-screen 0 1600x1000x24'", xauth_dir(dir), (long)getpid(),
+             ++calls);
     return cmd;
 }
 

@@ -372,16 +372,18 @@ static void test_animate_cli_cesiumman(void)
     snprintf(rig, sizeof rig, "%s/gltf/CesiumMan/CesiumMan.glb", data);
     const char* keys[4] = {sp_test_tmp_path("k0.json"), sp_test_tmp_path("k1.json"), sp_test_tmp_path("k2.json"), sp_test_tmp_path("k3.json")};
     for (int k = 0; k < 4; ++k) {
-        snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed %d --amplitude 0.4 --out %s", SP_SKETCHPOSE, rig, 10 + k, keys[k]);
+        snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --seed %d --amplitude 0.4 --out '%s'", SP_SKETCHPOSE, rig, 10 + k,
+                 keys[k]);
         ENSURE(run(cmd) == 0);
     }
     const char* out = sp_test_tmp_path("anim.glb");
     const char* rep = sp_test_tmp_path("anim_report.json");
     char errs[1024];
     snprintf(errs, sizeof errs, "%s", sp_test_tmp_path("anim_err.txt"));
-    snprintf(cmd, sizeof cmd,
-             "%s animate --rig %s --strokes %s %s %s %s --times 0,0.5,1.25,2 --out %s --report %s > /dev/null 2> %s",
-             SP_SKETCHPOSE, rig, keys[0], keys[1], keys[2], keys[3], out, rep, errs);
+    snprintf(
+        cmd, sizeof cmd,
+        "'%s' animate --rig '%s' --strokes '%s' '%s' '%s' '%s' --times 0,0.5,1.25,2 --out '%s' --report '%s' > /dev/null 2> '%s'",
+        SP_SKETCHPOSE, rig, keys[0], keys[1], keys[2], keys[3], out, rep, errs);
     ENSURE(run(cmd) == 0);
     // CesiumMan's texture is not in the file written: one line says so.
     char* said = sp_fixture_file_text(errs, NULL);
@@ -429,14 +431,14 @@ static void test_animate_cli_times(void)
     snprintf(out, sizeof out, "%s", sp_test_tmp_path("times.glb"));
     snprintf(log, sizeof log, "%s", sp_test_tmp_path("times_err.txt"));
     for (int k = 0; k < 2; ++k) {
-        snprintf(cmd, sizeof cmd, "%s synth --rig %s --seed %d --out %s > /dev/null", SP_SKETCHPOSE, rig, 1 + k, k ? b : a);
+        snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --seed %d --out '%s' > /dev/null", SP_SKETCHPOSE, rig, 1 + k, k ? b : a);
         ENSURE(run(cmd) == 0);
     }
     const char* bad[] = {"0,1e300", "0,1e-300", "1e39,1e40", "0,inf"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         remove(out);
-        snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s %s --times %s --out %s > /dev/null 2> %s", SP_SKETCHPOSE, rig,
-                 a, b, bad[i], out, log);
+        snprintf(cmd, sizeof cmd, "'%s' animate --rig '%s' --strokes '%s' '%s' --times '%s' --out '%s' > /dev/null 2> '%s'",
+                 SP_SKETCHPOSE, rig, a, b, bad[i], out, log);
         ENSURE(run(cmd) == 2);
         char text[1024] = {0};
         FILE* f = fopen(log, "rb");
@@ -446,8 +448,8 @@ static void test_animate_cli_times(void)
         ENSURE(strstr(text, "--times") && strstr(text, bad[i]));
         ENSURE(fopen(out, "rb") == NULL);
     }
-    snprintf(cmd, sizeof cmd, "%s animate --rig %s --strokes %s %s --times 0,3e38 --out %s > /dev/null", SP_SKETCHPOSE, rig, a, b,
-             out);
+    snprintf(cmd, sizeof cmd, "'%s' animate --rig '%s' --strokes '%s' '%s' --times 0,3e38 --out '%s' > /dev/null", SP_SKETCHPOSE,
+             rig, a, b, out);
     ENSURE(run(cmd) == 0);
     sp_character ch = {0};
     sp_error err = {0};
@@ -730,16 +732,16 @@ static void test_device_inputs(void)
     const struct {
         const char* fmt;
         int kind;
-    } cases[] = {{"inspect --rig %1$s", DEVICE},
-                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", DEVICE},
-                 {"classify --model %1$s --strokes /dev/null", DEVICE},
-                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", DEVICE},
-                 {"pose --rig %1$s --strokes /dev/null", DEVICE},
-                 {"inspect --rig %1$s", FIFO},
-                 {"export --rig %2$s/assets/tail.glb --pose %1$s --out %4$s", FIFO},
-                 {"classify --model %1$s --strokes %3$s", FIFO},
-                 {"pose --rig %2$s/assets/tail.glb --strokes %1$s --out %4$s", FIFO},
-                 {"inspect --rig %1$s", FIFO_SO}}; // a black-box rig's plugin
+    } cases[] = {{"inspect --rig '%1$s'", DEVICE},
+                 {"export --rig '%2$s/assets/tail.glb' --pose '%1$s' --out '%4$s'", DEVICE},
+                 {"classify --model '%1$s' --strokes /dev/null", DEVICE},
+                 {"pose --rig '%2$s/assets/tail.glb' --strokes '%1$s' --out '%4$s'", DEVICE},
+                 {"pose --rig '%1$s' --strokes /dev/null", DEVICE},
+                 {"inspect --rig '%1$s'", FIFO},
+                 {"export --rig '%2$s/assets/tail.glb' --pose '%1$s' --out '%4$s'", FIFO},
+                 {"classify --model '%1$s' --strokes '%3$s'", FIFO},
+                 {"pose --rig '%2$s/assets/tail.glb' --strokes '%1$s' --out '%4$s'", FIFO},
+                 {"inspect --rig '%1$s'", FIFO_SO}}; // a black-box rig's plugin
     // Copies: sp_test_tmp_path's buffers are reused after eight calls.
     char out[1024], fifo[1024], fifo_so[1024], strokes[1024], log[1024], cmd[3000];
     snprintf(out, sizeof out, "%s", sp_test_tmp_path("device_inputs.glb"));
