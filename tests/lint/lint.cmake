@@ -87,5 +87,16 @@ add_test(NAME public_headers_passes_comments COMMAND public_headers ${sp_lint_di
 # --max-ms has one range check (sp_cli_check_max_ms, app/common/cli.c) that
 # pose, drawover and dragon call; a command's own copy of the range would
 # drift from the others' (it was written three times).
-add_test(NAME cli_max_ms_checked_once
-         COMMAND sh -c "! grep -n 'sp_cli_check_double([^;]*--max-ms' ${PROJECT_SOURCE_DIR}/app/src/*.c")
+# grep's exit 1 (no copy found) passes; 0 (a copy) and 2 (a file it could
+# not read: a `!` alone would pass that) fail. The folder comes in as $0.
+set(sp_max_ms_check "grep -n 'sp_cli_check_double([^;]*--max-ms' \"\$0\"/*.c; [ \$? -eq 1 ]")
+add_test(NAME cli_max_ms_checked_once COMMAND sh -c "${sp_max_ms_check}" ${PROJECT_SOURCE_DIR}/app/src)
+# The check is checked: a folder with a copy fails, one with no .c files
+# (grep cannot read the unexpanded glob) fails, a clean one passes.
+file(WRITE ${sp_lint_dir}/max_ms_copy/cmd.c "sp_cli_check_double(argv[i], \"--max-ms\", 0, 1e9);\n")
+file(WRITE ${sp_lint_dir}/max_ms_clean/cmd.c "sp_cli_check_max_ms(argv[i]);\n")
+file(MAKE_DIRECTORY ${sp_lint_dir}/max_ms_none)
+add_test(NAME cli_max_ms_check_passes_clean COMMAND sh -c "${sp_max_ms_check}" ${sp_lint_dir}/max_ms_clean)
+add_test(NAME cli_max_ms_check_fails_copy COMMAND sh -c "${sp_max_ms_check}" ${sp_lint_dir}/max_ms_copy)
+add_test(NAME cli_max_ms_check_fails_unreadable COMMAND sh -c "${sp_max_ms_check}" ${sp_lint_dir}/max_ms_none)
+set_tests_properties(cli_max_ms_check_fails_copy cli_max_ms_check_fails_unreadable PROPERTIES WILL_FAIL TRUE)
