@@ -1,7 +1,7 @@
 # ctest visitors_set: the repository's copies are what sp-visitors-make makes
 # from designs.json: the hand-placed drawings and contact sheets of
 # tests/data/visitors and, with the Quick, Draw! data, assets/sketches/picks.json.
-# -D TOOL=... SRC=<source> OUT=<scratch folder> [QD=<quickdraw folder>]
+# -D TOOL=... SRC=<source> OUT=<scratch folder> [QD=<quickdraw folder, when it is there>]
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT}/train)
 execute_process(COMMAND ${TOOL} --designs ${SRC}/tests/data/visitors/designs.json --out ${OUT}/hand RESULT_VARIABLE rc OUTPUT_QUIET)
@@ -23,7 +23,7 @@ foreach(f ${made})
   endif()
 endforeach()
 list(LENGTH made n)
-if(NOT QD)
+if(NOT QD OR NOT EXISTS ${QD})
   message(STATUS "${n} files as made; no Quick, Draw! data here, so assets/sketches/picks.json is not checked")
   return()
 endif()
