@@ -396,9 +396,35 @@ sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const 
     return SP_OK;
 }
 
+sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+{
+    // Every value but the root follows a comma or opens its container, so
+    // commas + containers + 1 bounds the count (object keys live in their values).
+    size_t values = 1;
+    bool in_string = false;
+    for (size_t i = 0; i < len; ++i) {
+        char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == ',' || c == '[' || c == '{') {
+            if (++values > max_values)
+                return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values (a stroke file holds at most %d points)", name,
+                               max_values, SP_SKETCH_MAX_POINTS);
+        }
+    }
+    return SP_OK;
+}
+
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
+    sp_result vr = sp_json_values_within(text, len, SP_SKETCH_MAX_JSON_VALUES, name, err);
+    if (vr != SP_OK) return vr;
     const char* end = NULL;
     cJSON* root = cJSON_ParseWithLengthOpts(text, len, &end, false);
     sp_result rc = sp_json_document_end(text, len, root != NULL, end, name, err);

@@ -167,6 +167,28 @@ static void test_json_bad(void)
     sp_result rc = sp_sketch_parse_json(big, strlen(big), "big.json", &s, &err);
     free(big);
     ENSURE(rc == SP_ERR_UNSUPPORTED && contains(err.text, "1000000"));
+    // More JSON values than a stroke file of 10^6 points has (an unknown key
+    // of 6 M zeros: 12 MB that parsed took ~400 MB; under the 256 MiB file
+    // limit, 10 GB): refused before parsing. Commas and brackets inside
+    // strings are not values.
+    size_t nz = 6000000;
+    char* many = malloc(2 * nz + 400);
+    ENSURE(many != NULL);
+    at = (size_t)sprintf(many, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], "
+                               "[3, 4]]}], \"junk\": [");
+    for (size_t i = 0; i < nz; ++i)
+        many[at++] = '0', many[at++] = ',';
+    strcpy(many + at - 1, "]}");
+    ENSURE(sp_sketch_parse_json(many, strlen(many), "many.json", &s, &err) == SP_ERR_INVALID &&
+           contains(err.text, "many.json: more than 5000000 JSON values"));
+    at = (size_t)sprintf(many, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2], "
+                               "[3, 4]]}], \"note\": \"\\\"");
+    for (size_t i = 0; i < nz; ++i)
+        many[at++] = i & 1 ? ',' : '[';
+    strcpy(many + at, "\"}");
+    ENSURE(sp_sketch_parse_json(many, strlen(many), "many.json", &s, &err) == SP_OK && s.stroke_count == 1);
+    sp_sketch_free(&s);
+    free(many);
     // Missing file.
     ENSURE(sp_sketch_read_json(sp_test_tmp_path("does-not-exist.json"), &s, &err) == SP_ERR_IO);
     ENSURE(contains(err.text, "does-not-exist.json"));

@@ -106,6 +106,14 @@ sp_result sp_sketch_file_read(const char* path, char** out, size_t* len, sp_erro
 /// else SP_ERR_PARSE with err naming `name` and the line ("malformed JSON
 /// near line 3", "text after the JSON document, line 9").
 sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const char* end, const char* name, sp_error* err);
+/// Most JSON values a stroke file may hold: its SP_SKETCH_MAX_POINTS points
+/// with their times, and room for the rest. A parsed value takes ~64 bytes,
+/// so a file of small values under SP_SKETCH_MAX_FILE_BYTES could take 10 GB.
+#define SP_SKETCH_MAX_JSON_VALUES (5u * SP_SKETCH_MAX_POINTS)
+/// Whether text (a JSON document, before it is parsed) holds at most
+/// max_values values, counted from its commas and brackets in one pass:
+/// SP_OK, else SP_ERR_INVALID with err naming `name`.
+sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err);
 /// The folder that holds `path` (malloc'd; NULL when out of memory): "." for
 /// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
 /// held by the folder out is in).
