@@ -191,24 +191,8 @@ enum { JSON_DEPTH_MAX = CJSON_NESTING_LIMIT };
 
 void check_json_depth(const LoadContext& cx, const unsigned char* json, size_t len)
 {
-    int depth = 0;
-    bool in_string = false;
-    for (size_t i = 0; i < len; ++i) {
-        unsigned char c = json[i];
-        if (in_string) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                in_string = false;
-        } else if (c == '"') {
-            in_string = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > JSON_DEPTH_MAX)
-                fail(SP_ERR_PARSE, "%s: the JSON is nested more than %d levels deep", cx.what, JSON_DEPTH_MAX);
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
+    if (sp_json_measure(reinterpret_cast<const char*>(json), len).depth > JSON_DEPTH_MAX)
+        fail(SP_ERR_PARSE, "%s: the JSON is nested more than %d levels deep", cx.what, JSON_DEPTH_MAX);
 }
 
 void scan_buffers_of(LoadContext& cx, const unsigned char* data, size_t size)

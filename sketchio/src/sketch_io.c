@@ -396,11 +396,10 @@ sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const 
     return SP_OK;
 }
 
-sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+sp_json_shape sp_json_measure(const char* text, size_t len)
 {
-    // Every value but the root follows a comma or opens its container, so
-    // commas + containers + 1 bounds the count (object keys live in their values).
-    size_t values = 1;
+    sp_json_shape m = {0, 1};
+    size_t depth = 0;
     bool in_string = false;
     for (size_t i = 0; i < len; ++i) {
         char c = text[i];
@@ -411,12 +410,23 @@ sp_result sp_json_values_within(const char* text, size_t len, size_t max_values,
                 in_string = false;
         } else if (c == '"') {
             in_string = true;
-        } else if (c == ',' || c == '[' || c == '{') {
-            if (++values > max_values)
-                return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values (a stroke file holds at most %d points)", name,
-                               max_values, SP_SKETCH_MAX_POINTS);
+        } else if (c == ',') {
+            ++m.values;
+        } else if (c == '[' || c == '{') {
+            ++m.values;
+            if (++depth > m.depth) m.depth = depth;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
         }
     }
+    return m;
+}
+
+sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+{
+    if (sp_json_measure(text, len).values > max_values)
+        return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values (a stroke file holds at most %d points)", name,
+                       max_values, SP_SKETCH_MAX_POINTS);
     return SP_OK;
 }
 

@@ -110,9 +110,16 @@ sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const 
 /// with their times, and room for the rest. A parsed value takes ~64 bytes,
 /// so a file of small values under SP_SKETCH_MAX_FILE_BYTES could take 10 GB.
 #define SP_SKETCH_MAX_JSON_VALUES (5u * SP_SKETCH_MAX_POINTS)
-/// Whether text (a JSON document, before it is parsed) holds at most
-/// max_values values, counted from its commas and brackets in one pass:
-/// SP_OK, else SP_ERR_INVALID with err naming `name`.
+/// A JSON text measured in one pass before it is parsed (parsers recurse a
+/// level a frame and take ~64 bytes a value): how deep its arrays and objects
+/// nest, and a bound on its values (commas + containers + 1: every value but
+/// the root follows a comma or opens its container). Strings are skipped.
+typedef struct sp_json_shape {
+    size_t depth, values;
+} sp_json_shape;
+sp_json_shape sp_json_measure(const char* text, size_t len);
+/// Whether text holds at most max_values values (sp_json_measure): SP_OK,
+/// else SP_ERR_INVALID with err naming `name`.
 sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err);
 /// The folder that holds `path` (malloc'd; NULL when out of memory): "." for
 /// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
