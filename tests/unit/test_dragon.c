@@ -1164,6 +1164,21 @@ static void test_rejects_and_bad_strokes(void)
     ENSURE(sp_dragon_add_points(d, inf, 2, NULL, &res, &err) == SP_ERR_INVALID);
     sp_vec2 off[3] = {{-500, -500}, {-900, -20}, {-40, -800}}; // all off the canvas: clamped into a corner
     ENSURE(sp_dragon_add_points(d, off, 3, NULL, &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_TOO_SHORT);
+    // A part too small to see, away from the body (a review: a 20 px head
+    // became a body the size of a pea): "a bit bigger please". Chosen by a
+    // chip, it stands.
+    double speck = 0.9 * SP_DRAGON_PART_MIN * hypot(1280, 800);
+    for (int k = 0; k < 2; ++k) {
+        n = part_stroke(db, k ? "head_t" : "tail_t", 9, 0.3, 150, 120, speck, &xy);
+        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK && res.rejected && res.reason == SP_DRAGON_TOO_SHORT);
+        free(xy);
+    }
+    dragon_signature(d, after, sizeof after);
+    ENSURE(!strcmp(before, after));
+    n = part_stroke(db, "tail_t", 9, 0.3, 150, 120, speck, &xy);
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "tail"}, &res, &err) == SP_OK && !res.rejected);
+    free(xy);
+    ENSURE(sp_dragon_undo(d));
     dragon_signature(d, after, sizeof after);
     ENSURE(!strcmp(before, after));
     // Huge coordinates and a stroke that leaves the window: clamped onto the edges; whatever it becomes, it is valid.

@@ -908,6 +908,14 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         offer_kin(d, &a, out);
         return reject(out, why, t0);
     }
+    // A part this small on the canvas is a speck nobody meant (a review: a
+    // 20 px head became a body the size of a pea, wings of 25-45 px barely
+    // showed): "a bit bigger please". Details on a part were taken above,
+    // and a part chosen by a chip stands.
+    if (!o.category && sp_v2_len(sp_v2_sub(hi, lo)) < SP_DRAGON_PART_MIN * hypot(d->desc.canvas_w, d->desc.canvas_h)) {
+        free(pts);
+        return reject(out, SP_DRAGON_TOO_SHORT, t0);
+    }
     // Fit every variant of the category (and facing); keep the one that
     // matches best. A classified stroke is fitted with each of the
     // classifier's best guesses (rerank_by_fit).

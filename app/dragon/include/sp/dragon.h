@@ -131,11 +131,13 @@ typedef struct sp_dragon_desc {
 /// Why a stroke left the dragon unchanged.
 typedef enum sp_dragon_reject {
     SP_DRAGON_ACCEPTED = 0,
-    SP_DRAGON_TOO_SHORT,        ///< fewer than 2 points, or smaller than 1% of the canvas (a tap)
-    SP_DRAGON_UNRECOGNISED,     ///< refused by the kiosk's policy (a scribble, or far from every part: docs/DESIGN.md), or the top score < min_confidence
-    SP_DRAGON_NO_PART,          ///< the category has no part in the database (or none loads)
-    SP_DRAGON_NO_MODEL,         ///< the database has no trained model and no category was forced
-    SP_DRAGON_FIT_FAILED,       ///< every part of the category refused the stroke
+    SP_DRAGON_TOO_SHORT,    ///< fewer than 2 points, smaller than 1% of the canvas (a tap), or a part smaller than
+                            ///< SP_DRAGON_PART_MIN
+    SP_DRAGON_UNRECOGNISED, ///< refused by the kiosk's policy (a scribble, or far from every part: docs/DESIGN.md), or the top
+                            ///< score < min_confidence
+    SP_DRAGON_NO_PART,      ///< the category has no part in the database (or none loads)
+    SP_DRAGON_NO_MODEL,     ///< the database has no trained model and no category was forced
+    SP_DRAGON_FIT_FAILED,   ///< every part of the category refused the stroke
     SP_DRAGON_NOTHING_TO_REFIT, ///< sp_dragon_refit_last with no stroke kept
     SP_DRAGON_FULL,             ///< max_parts parts already (Redraw, refit, undo and clear still work)
     SP_DRAGON_DETAIL,           ///< a small stroke drawn on a part (an eye): a detail, kept as ink on it (guesses filled)
@@ -204,6 +206,10 @@ typedef struct sp_dragon_result {
 
 /// The refusal policy's limit on sp_dragon_result.far_score.
 #define SP_DRAGON_FAR_LIMIT 1.23
+/// The smallest part a stroke makes, its box's diagonal over the canvas's
+/// (3.5%: 49 px, 13 mm, on the kiosk's 1280 x 800): smaller, and not a
+/// detail on a part nor chosen by a chip, it is SP_DRAGON_TOO_SHORT.
+#define SP_DRAGON_PART_MIN 0.035
 
 /// How to treat one stroke. Zero (or a NULL pointer) means: classify, append.
 typedef struct sp_dragon_stroke_opts {
