@@ -430,6 +430,88 @@ sp_result sp_json_values_within(const char* text, size_t len, size_t max_values,
     return SP_OK;
 }
 
+bool sp_text_has_control(const char* s)
+{
+    for (const unsigned char* p = (const unsigned char*)(s ? s : ""); *p; ++p)
+        if (*p < 0x20 || *p == 0x7f) return true;
+    return false;
+}
+
+const char* sp_text_printable(const char* s, char* buf, size_t cap)
+{
+    size_t at = 0;
+    const unsigned char* p = (const unsigned char*)(s ? s : "");
+    for (; *p; ++p) {
+        char one[8];
+        int n = *p == '\n'                  ? snprintf(one, sizeof one, "\\n")
+                : *p == '\r'                ? snprintf(one, sizeof one, "\\r")
+                : *p == '\t'                ? snprintf(one, sizeof one, "\\t")
+                : *p == '\\'                ? snprintf(one, sizeof one, "\\\\")
+                : (*p < 0x20 || *p == 0x7f) ? snprintf(one, sizeof one, "\\x%02x", *p)
+                                            : snprintf(one, sizeof one, "%c", *p);
+        if (at + (size_t)n + 4 > cap) break; // room for "..." and the NUL
+        memcpy(buf + at, one, (size_t)n);
+        at += (size_t)n;
+    }
+    if (*p && cap >= 4) {
+        memcpy(buf + at, "...", 3);
+        at += 3;
+    }
+    buf[at < cap ? at : cap - 1] = 0;
+    return buf;
+}
+
+static int key_order(const void* a, const void* b)
+{
+    return strcmp(*(const char* const*)a, *(const char* const*)b);
+}
+
+// The first key that obj holds twice, else NULL (also for anything but an
+// object); *no_memory tells a failed allocation from no key twice.
+static const char* json_key_twice(const cJSON* obj, bool* no_memory)
+{
+    if (no_memory) *no_memory = false;
+    if (!cJSON_IsObject(obj)) return NULL;
+    int n = cJSON_GetArraySize(obj);
+    if (n < 2) return NULL;
+    // Sorted, so that an object of a million keys is checked in n log n, not n^2.
+    const char** keys = malloc(sizeof *keys * (size_t)n);
+    if (!keys) {
+        if (no_memory) *no_memory = true;
+        return NULL;
+    }
+    int k = 0;
+    for (const cJSON* it = obj->child; it && k < n; it = it->next)
+        keys[k++] = it->string ? it->string : "";
+    qsort(keys, (size_t)k, sizeof *keys, key_order);
+    const char* twice = NULL;
+    for (int i = 1; i < k && !twice; ++i)
+        if (!strcmp(keys[i - 1], keys[i])) twice = keys[i];
+    free(keys);
+    return twice;
+}
+
+// A key given twice in the stroke file's object or in one of its strokes: one
+// line naming it (cJSON keeps both and lookups find the first, so the second
+// was silently dropped: `"strokes": [], "strokes": [...]` read as no strokes).
+static sp_result keys_once(const cJSON* root, const char* name, sp_error* err)
+{
+    bool oom = false;
+    const char* twice = json_key_twice(root, &oom);
+    if (twice) return sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", name, twice);
+    const cJSON* strokes = cJSON_GetObjectItemCaseSensitive(root, "strokes");
+    int si = 0;
+    const cJSON* st;
+    if (cJSON_IsArray(strokes)) cJSON_ArrayForEach(st, strokes)
+        {
+            if (!oom && (twice = json_key_twice(st, &oom)) != NULL)
+                return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d: key \"%s\" given twice", name, si, twice);
+            ++si;
+        }
+    if (oom) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+    return SP_OK;
+}
+
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
@@ -452,6 +534,14 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
         rc = sp_fail(err, SP_ERR_PARSE, "%s: a stroke file is a JSON object", name);
         goto done;
     }
+    // A NUL byte is no JSON text; inside a key ("ca\0nvas") cJSON cut the key short and the canvas was dropped silently.
+    const char* nul = memchr(text, 0, (size_t)(end - text));
+    if (nul) {
+        rc = sp_fail(err, SP_ERR_PARSE, "%s: a NUL byte in the JSON document, line %d (not a text file?)", name,
+                     line_of(text, len, nul));
+        goto done;
+    }
+    if ((rc = keys_once(root, name, err)) != SP_OK) goto done;
     if (!cJSON_IsString(fmt) || strcmp(fmt->valuestring, "sketchpose-strokes") != 0) {
         rc = sp_fail(err, SP_ERR_PARSE, "%s: \"format\" must be \"sketchpose-strokes\"", name);
         goto done;

@@ -152,6 +152,24 @@ static void test_json_bad(void)
         SP_ERR_INVALID, "\"t\"");
     expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [-1, 5], \"strokes\": []}",
                       SP_ERR_INVALID, "canvas");
+    // A key given twice: the first won silently ("strokes": [] then the strokes read as none).
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [], \"strokes\": [{\"points\": "
+                      "[[1, 2]]}]}",
+                      SP_ERR_INVALID, "key \"strokes\" given twice");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [640, 480], \"canvas\": [10, 10], "
+                      "\"strokes\": []}",
+                      SP_ERR_INVALID, "key \"canvas\" given twice");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2]], \"points\": "
+                      "[[3, 4]]}]}",
+                      SP_ERR_INVALID, "stroke 0: key \"points\" given twice");
+    {
+        // A NUL byte in a key ("ca\0nvas") cut the key short, and the canvas was dropped silently.
+        const char nul[] = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"ca\0nvas\": [640, 480], \"strokes\": []}";
+        sp_sketch s;
+        sp_error err = {0};
+        ENSURE(sp_sketch_parse_json(nul, sizeof nul - 1, "x.json", &s, &err) == SP_ERR_PARSE);
+        ENSURE(contains(err.text, "x.json: a NUL byte"));
+    }
     // 10^6 + 1 points: refused with a clear message, not a crash or a huge allocation spree.
     size_t n = 1000001, cap = n * 6 + 200;
     char* big = malloc(cap);

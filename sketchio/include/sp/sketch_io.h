@@ -121,6 +121,13 @@ sp_json_shape sp_json_measure(const char* text, size_t len);
 /// Whether text holds at most max_values values (sp_json_measure): SP_OK,
 /// else SP_ERR_INVALID with err naming `name`.
 sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err);
+/// Whether s holds a control character (a byte below 0x20, or DEL 0x7f).
+bool sp_text_has_control(const char* s);
+/// `s` for a one-line message (returns buf, cap > 0): a control character
+/// is written as \n, \r, \t or \xNN and a backslash as \\, so that a name
+/// someone typed cannot break the line or drive a terminal (an escape
+/// code); text past cap ends in "...". NULL reads as "".
+const char* sp_text_printable(const char* s, char* buf, size_t cap);
 /// The folder that holds `path` (malloc'd; NULL when out of memory): "." for
 /// a bare name, "/" for "/x"; trailing slashes are not a level ("out/" is
 /// held by the folder out is in).
