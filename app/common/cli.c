@@ -2,6 +2,7 @@
 
 #include "rig_handle.h"
 #include "sp/gltf.h"
+#include "sp/part.h"
 #include "sp/sketch_io.h"
 
 #include <ctype.h>
@@ -277,6 +278,15 @@ bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo,
 {
     if ((lo_open ? v > lo : v >= lo) && v <= hi) return true;
     fprintf(stderr, "%s: %s must be in %s%.10g, %.10g], got %g\n", cmd, name, lo_open ? "(" : "[", lo, hi, v);
+    return false;
+}
+
+bool sp_cli_check_name(const char* cmd, const char* name, const char* value)
+{
+    if (!value || sp_part_name_is_plain(value)) return true;
+    char shown[160];
+    fprintf(stderr, "%s: %s wants a plain name ([A-Za-z0-9_.-], 1 to %d characters, not starting with '.'), got '%s'\n", cmd,
+            name, SP_NAME_MAX - 1, sp_text_printable(value, shown, sizeof shown));
     return false;
 }
 

@@ -58,6 +58,13 @@ bool sp_cli_check_int(const char* cmd, const char* name, int v, int lo, int hi);
 /// The same for a number in [lo, hi], or (lo, hi] when lo_open.
 bool sp_cli_check_double(const char* cmd, const char* name, double v, double lo, bool lo_open, double hi);
 
+/// A name option's value (a category, a part name; NULL: not given): true
+/// when it is a plain name as the part database takes it
+/// (sp_part_name_is_plain), else prints "<cmd>: <name> wants a plain name
+/// ..., got 'VALUE'" with the value escaped (sp_text_printable: a newline
+/// or an escape code never reaches the terminal raw) and returns false (exit 2).
+bool sp_cli_check_name(const char* cmd, const char* name, const char* value);
+
 /// What an output file holds. The file name's extension says which, so a
 /// command checks it before any work (sp_cli_check_out).
 typedef enum sp_cli_out_kind {

@@ -458,6 +458,7 @@ static int db_add_part(int argc, char** argv)
         sp_cli_out_is_input(cmd, "--preview", preview, "the part", pos[0]))
         return SP_EXIT_USAGE;
     d.synth_sketches = synth;
+    if (!sp_cli_check_name(cmd, "--category", d.category) || !sp_cli_check_name(cmd, "--name", d.name)) return SP_EXIT_USAGE;
     if (view && !sp_derive_view_parse(view, &d.view)) {
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
         return SP_EXIT_USAGE;
@@ -686,6 +687,7 @@ static int db_add_sketch(int argc, char** argv)
         fprintf(stderr, "%s: --source must be curated or kiosk, got '%s'\n", cmd, source);
         return SP_EXIT_USAGE;
     }
+    if (!sp_cli_check_name(cmd, "--category", category)) return SP_EXIT_USAGE;
     for (int i = 0; i < npos; ++i)
         if (!category && !is_dir(pos[i])) {
             fprintf(stderr, "%s: %s: give --category for drawings outside a labelled folder\n", cmd, pos[i]);
@@ -1007,8 +1009,9 @@ static bool parse_ids(const char* cmd, const sp_str_list* l, int count, int64_t*
         } else if (ranges && parse_id(&s, '-', &g.first) && parse_id(&s, 0, &g.last) && g.first <= g.last) {
             ranges[(*nr)++] = g;
         } else {
-            fprintf(stderr, "%s: '%s' is not a kiosk sketch id (a positive number)%s; nothing was changed\n", cmd, v,
-                    ranges ? " or a range of them (FIRST-LAST, FIRST <= LAST)" : "");
+            char shown[128];
+            fprintf(stderr, "%s: '%s' is not a kiosk sketch id (a positive number)%s; nothing was changed\n", cmd,
+                    sp_text_printable(v, shown, sizeof shown), ranges ? " or a range of them (FIRST-LAST, FIRST <= LAST)" : "");
             return false;
         }
     }
@@ -1025,8 +1028,9 @@ static int review_act(const char* cmd, const db_common* c, const sp_str_list* ap
     int64_t ids[256], *changed = NULL;
     sp_db_kiosk_range ranges[256];
     int n = 0, nr = 0, m = 0;
+    // A malformed id is a malformed option value: bad usage, as a number out of its range (an unknown id is bad input).
     if (!delete_rejected && !parse_ids(cmd, l, relabel->count ? 1 : l->count, ids, &n, relabel->count ? NULL : ranges, &nr))
-        return SP_EXIT_INPUT;
+        return SP_EXIT_USAGE;
     sp_db* db = open_db(cmd, c, 0);
     if (!db) return SP_EXIT_INPUT;
     sp_result r = delete_rejected  ? sp_db_kiosk_delete_rejected(db, c->by, &m, &err)
@@ -1112,6 +1116,7 @@ static int db_review(int argc, char** argv)
         fprintf(stderr, "%s: --status must be pending, approved, rejected or all, got '%s'\n", cmd, status);
         return SP_EXIT_USAGE;
     }
+    if (relabel.count == 2 && !sp_cli_check_name(cmd, "--relabel's CATEGORY", relabel.items[1])) return SP_EXIT_USAGE;
     if (actions) return review_act(cmd, &c, &approve, &reject, &relabel, delete_rejected);
     sp_error err = {0};
     if (!sp_cli_check_out_folders(cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT;

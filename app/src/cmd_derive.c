@@ -48,6 +48,7 @@ int cmd_derive(int argc, char** argv)
     if (!sp_cli_check_out(k_cmd, "--out", out_path, SP_CLI_OUT_GLTF) ||
         !sp_cli_check_out(k_cmd, "--preview", preview, SP_CLI_OUT_PNG))
         return SP_EXIT_USAGE;
+    if (!sp_cli_check_name(k_cmd, "--category", d.category)) return SP_EXIT_USAGE;
     if (view && !sp_derive_view_parse(view, &d.view)) {
         fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", k_cmd, view);
         return SP_EXIT_USAGE;

@@ -314,6 +314,38 @@ static int64_t part_id(sp_db* db, const char* name)
     return id;
 }
 
+// What a manifest's entries must be before anything is stored: a part's file
+// inside the export folder (said as such: "../outside.glb" was "a part entry
+// without name or file"), and an added_by without control characters, as
+// --by takes it (a newline and an escape code were stored and reached
+// `db log` and a terminal). The value is shown escaped.
+static sp_result manifest_entries_ok(const cJSON* parts, const cJSON* sketches, const char* path, sp_error* err)
+{
+    char shown[160];
+    int i = 0;
+    const cJSON* it;
+    cJSON_ArrayForEach(it, parts)
+    {
+        const char* file = jstr(it, "file");
+        if (file && (strstr(file, "..") || file[0] == '/'))
+            return sp_fail(err, SP_ERR_INVALID, "%s: part %d: file '%s' must be inside the export folder (no '..', not absolute)",
+                           path, i, sp_text_printable(file, shown, sizeof shown));
+        if (sp_text_has_control(jstr(it, "added_by")))
+            return sp_fail(err, SP_ERR_INVALID, "%s: part %d: added_by '%s' holds control characters", path, i,
+                           sp_text_printable(jstr(it, "added_by"), shown, sizeof shown));
+        ++i;
+    }
+    i = 0;
+    cJSON_ArrayForEach(it, sketches)
+    {
+        if (sp_text_has_control(jstr(it, "added_by")))
+            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: added_by '%s' holds control characters", path, i,
+                           sp_text_printable(jstr(it, "added_by"), shown, sizeof shown));
+        ++i;
+    }
+    return SP_OK;
+}
+
 sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err)
 {
     char path[1024];
@@ -327,6 +359,10 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
         strcmp(jstr(man, "format"), "sketchpose-db-export") != 0) {
         cJSON_Delete(man);
         return sp_fail(err, SP_ERR_PARSE, "%s: not a sketchpose-db-export manifest", path);
+    }
+    if ((r = manifest_entries_ok(parts, sketches, path, err)) != SP_OK) {
+        cJSON_Delete(man);
+        return r;
     }
     const cJSON* it;
     cJSON_ArrayForEach(it, parts)

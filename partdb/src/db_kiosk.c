@@ -7,6 +7,7 @@
 
 #include "db_internal.h"
 #include "sp/part.h"
+#include "sp/sketch_io.h"
 
 static const char* const k_status[SP_DB_STATUS_COUNT] = {"pending", "approved", "rejected"};
 
@@ -52,9 +53,10 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
                                      int64_t* id, sp_error* err)
 {
     if (id) *id = 0;
+    char shown[128];
     if (!sp_part_name_is_plain(category))
         return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: category '%s' is not a plain name; sketch dropped", db->path,
-                       category ? category : "");
+                       sp_text_printable(category, shown, sizeof shown));
     if (!stroke || stroke->count < 2 || stroke->count > SP_DB_KIOSK_POINTS_MAX)
         return sp_fail(err, SP_ERR_INVALID, "%s: kiosk sketch: %d points (2..%d); sketch dropped", db->path,
                        stroke ? stroke->count : 0, SP_DB_KIOSK_POINTS_MAX);
@@ -315,9 +317,10 @@ sp_result sp_db_kiosk_relabel(sp_db* db, int64_t id, const char* category, const
     for (int i = 0; category && i < ncat; ++i)
         known |= !strcmp(cats[i], category);
     sp_db_free_strings(cats, ncat);
+    char shown[128];
     if (!known)
         return sp_fail(err, SP_ERR_INVALID, "%s: '%s' is not a part category (see `sketchpose db list`); nothing was changed",
-                       db->path, category ? category : "");
+                       db->path, sp_text_printable(category, shown, sizeof shown));
     if ((r = db_begin(db, err)) != SP_OK) return r;
     r = update_one(db, "UPDATE sketches SET category = ?1 WHERE id = ?2 AND source = 'kiosk'", category, id, err);
     if (r == SP_OK) {

@@ -7,6 +7,7 @@
 #include "db_internal.h"
 #include "sp/handdraw.h"
 #include "sp/part.h"
+#include "sp/sketch_io.h"
 #include "sp/solver.h"
 #include "sp/synth.h"
 
@@ -105,8 +106,11 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
     if (rig->vertex_count == 0 || rig->triangle_count == 0) add_reason(reasons, sizeof reasons, "no triangle mesh");
     const char* category = d && d->category ? d->category : part_name(ch.part.category);
     if (!category) add_reason(reasons, sizeof reasons, "no category (give --category or the scene's extras.sp_part.category)");
-    else if (!sp_part_name_is_plain(category))
-        add_reason(reasons, sizeof reasons, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", category);
+    else if (!sp_part_name_is_plain(category)) {
+        char shown[128]; // escaped: a category from a file may hold newlines and escape codes
+        add_reason(reasons, sizeof reasons, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)",
+                   sp_text_printable(category, shown, sizeof shown));
+    }
     int a = pick_abstraction(&ch, d);
     if (a < 0) add_reason(reasons, sizeof reasons, "no sketch abstraction%s%s", d && d->abstraction ? " named " : "",
                           d && d->abstraction ? d->abstraction : "");
@@ -289,8 +293,10 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
                           sp_db_part_info* info_out, sp_error* err)
 {
     sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
+    char shown[128];
     if (!d.name || !sp_part_name_is_plain(d.name))
-        return sp_fail(err, SP_ERR_INVALID, "part name '%s' is not a plain name ([A-Za-z0-9_.-], < 64 chars)", d.name ? d.name : "");
+        return sp_fail(err, SP_ERR_INVALID, "part name '%s' is not a plain name ([A-Za-z0-9_.-], < 64 chars)",
+                       sp_text_printable(d.name, shown, sizeof shown));
     sp_db_part_info info;
     sp_character ch = {0};
     int a = -1;
@@ -416,12 +422,13 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
         if (dot && dot != name) *dot = 0;
         d.name = name;
         // The name comes from the file: say so, and how to give another.
+        char shown[128];
         if (!sp_part_name_is_plain(name)) {
             free(bytes);
             return sp_fail(err, SP_ERR_INVALID,
                            "%s: the part would be named '%s' after the file, which is not a plain name ([A-Za-z0-9_.-], < 64 "
                            "chars): rename the file, or give the part a name (db add-part --name)",
-                           path, name);
+                           path, sp_text_printable(name, shown, sizeof shown));
         }
     }
     r = add_part(db, bytes, size, &d, derived, info, err);

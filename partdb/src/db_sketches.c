@@ -121,8 +121,10 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
         char what[96];
         snprintf(what, sizeof what, "drawing %d", i);
         if (s->label < 0 || s->label >= data->category_count) return sp_fail(err, SP_ERR_INVALID, "%s: no category", what);
+        char shown[128];
         if (!sp_part_name_is_plain(data->categories[s->label]))
-            return sp_fail(err, SP_ERR_INVALID, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)", data->categories[s->label]);
+            return sp_fail(err, SP_ERR_INVALID, "category '%s' is not a plain name ([A-Za-z0-9_.-], < 64)",
+                           sp_text_printable(data->categories[s->label], shown, sizeof shown));
         sp_result r = db_sample_ok(s, what, err);
         if (r != SP_OK) return r;
         // Review shows and trains on a kiosk sketch's one stroke: 200,000

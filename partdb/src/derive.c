@@ -3,6 +3,7 @@
 // visitor's parameters, the outline and stick abstractions, the attachment
 // point and the clip re-keyed on the new frames.
 #include "sp/derive.h"
+#include "sp/sketch_io.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -610,11 +611,12 @@ static sp_result check_source(const sp_character* src, const sp_derive_desc* d, 
     const char* c = d->category ? d->category : src->part.category[0] ? src->part.category : NULL;
     *category = c;
     // Refused here, as the part database would refuse it later (after the work).
+    char shown[128]; // escaped: a category from the file may hold newlines and escape codes
     if (c && !sp_part_name_is_plain(c))
         return sp_fail(err, SP_ERR_INVALID,
                        "category '%s': not a plain name ([A-Za-z0-9_.-], 1 to %d characters, not starting with '.'), as the "
                        "part database takes it",
-                       c, SP_NAME_MAX - 1);
+                       sp_text_printable(c, shown, sizeof shown), SP_NAME_MAX - 1);
     return SP_OK;
 }
 

@@ -975,6 +975,56 @@ static void test_schema_versions(void)
     sp_fixture_remove_db(q);
 }
 
+// Names from files and from users reach one-line messages escaped, and an
+// export's entries are checked before anything is stored: a part file
+// outside the folder is said as such ("a part entry without name or file"
+// before), an added_by with a newline and an escape code is refused (it was
+// stored and reached `db log`).
+static void test_names_escaped(void)
+{
+    char dir[1024], target[1100], cmd[4400];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("esc_export"));
+    snprintf(target, sizeof target, "%s", sp_test_tmp_path("esc.db"));
+    const char* manifests[][2] = {
+        {"\"parts\": [{\"name\": \"tail_a\", \"file\": \"../outside.glb\"}], \"sketches\": []",
+         "part 0: file '../outside.glb' must be inside the export folder"},
+        {"\"parts\": [{\"name\": \"tail_a\", \"file\": \"parts/tail_a.glb\", \"added_by\": \"a\\nb\\u001b[31m\"}], "
+         "\"sketches\": []",
+         "part 0: added_by 'a\\nb\\x1b[31m' holds control characters"},
+        {"\"parts\": [], \"sketches\": [{\"file\": \"s.json\", \"category\": \"tail\", \"added_by\": \"x\\ry\"}]",
+         "sketch 0: added_by 'x\\ry' holds control characters"},
+    };
+    for (size_t i = 0; i < sizeof manifests / sizeof manifests[0]; ++i) {
+        snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s/parts' && cp '%s' '%s/parts/tail_a.glb'", dir, dir, part_file(0),
+                 dir);
+        ENSURE(system(cmd) == 0);
+        char man[1200];
+        snprintf(man, sizeof man, "%s/manifest.json", dir);
+        FILE* f = fopen(man, "w");
+        ENSURE(f);
+        fprintf(f, "{\"format\": \"sketchpose-db-export\", \"version\": 1, \"schema\": 3, %s}", manifests[i][0]);
+        ENSURE(fclose(f) == 0);
+        sp_fixture_remove_db(target);
+        sp_error err = {0};
+        sp_result r = sp_db_create_from_export(target, dir, NULL, "test", &err);
+        fprintf(stderr, "  %s\n", err.text);
+        ENSURE(r == SP_ERR_INVALID && strstr(err.text, manifests[i][1]) && !strchr(err.text, '\n') && !strchr(err.text, 27));
+        ENSURE(access(target, F_OK) != 0);
+    }
+    // A category with a newline and an escape code, given or from the file: shown escaped.
+    snprintf(target, sizeof target, "%s", sp_test_tmp_path("esc2.db"));
+    sp_fixture_remove_db(target);
+    sp_db* db = open_ok(target, SP_DB_CREATE);
+    sp_error err = {0};
+    sp_result r =
+        sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "t", .category = "to\nrso\x1b[31m"}, NULL, &err);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r != SP_OK && strstr(err.text, "'to\\nrso\\x1b[31m'") && !strchr(err.text, '\n') && !strchr(err.text, 27));
+    r = sp_db_add_part_file(db, part_file(0), &(sp_db_part_desc){.name = "t\nx"}, NULL, &err);
+    ENSURE(r != SP_OK && strstr(err.text, "part name 't\\nx'") && !strchr(err.text, '\n'));
+    sp_db_close(db);
+}
+
 static void test_bad_input(void)
 {
     char p[1024];
@@ -1139,7 +1189,8 @@ static void test_bad_input(void)
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     // A failed add into a database the command would create leaves none behind
-    // (a part that does not load; a sketch whose category the database refuses).
+    // (a part that does not load, exit 1; a sketch whose category is no plain
+    // name, bad usage since names are checked as options, exit 2).
     char fresh[1100];
     snprintf(fresh, sizeof fresh, "%s", sp_test_tmp_path("never_made.db"));
     unlink(fresh);
@@ -1152,7 +1203,7 @@ static void test_bad_input(void)
         snprintf(cmd, sizeof cmd, "'%s' db %s --db '%s' '%s' 2>/dev/null >/dev/null", bin, tries[i][0], fresh, tries[i][1]);
         st = system(cmd);
         struct stat fs;
-        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 1 && stat(fresh, &fs) != 0 && errno == ENOENT);
+        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == (i == 0 ? 1 : 2) && stat(fresh, &fs) != 0 && errno == ENOENT);
     }
     // A value a subcommand does not take is bad usage naming it (it printed "too many  (at most 0)").
     const char* sub[2] = {"list", "show head"};
@@ -2189,7 +2240,7 @@ static void test_kiosk_review_ranges(void)
     ENSURE(sp_db_kiosk_counts(db, counts, &err) == SP_OK && counts[SP_DB_PENDING] == 0 && counts[SP_DB_APPROVED] == 5 &&
            counts[SP_DB_REJECTED] == 3);
     sp_db_close(db);
-    // Nothing pending left in it, a range backwards, a half range: one line, exit 1, nothing changed.
+    // Nothing pending left in it (exit 1), a range backwards, a half range (exit 2): one line, nothing changed.
     char before[65], after[65];
     file_sha(p, before);
     const char* bad[][2] = {{"", "no pending kiosk sketch in"}, {"9-3", "'9-3' is not a kiosk sketch id"}, {"4-", "'4-' is not"}};
@@ -2199,7 +2250,9 @@ static void test_kiosk_review_ranges(void)
                      (long long)id[7]);
         else
             snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %s 2>&1 >/dev/null", bin, p, bad[i][0]);
-        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, bad[i][1]) && strchr(out, '\n') == out + strlen(out) - 1);
+        // A malformed value (backwards, half a range) is bad usage, exit 2, as a number out of its range; none pending is exit 1.
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == (i == 0 ? 1 : 2) && strstr(out, bad[i][1]) &&
+               strchr(out, '\n') == out + strlen(out) - 1);
     }
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
@@ -2350,9 +2403,9 @@ static void test_kiosk_review_cli(void)
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "no kiosk sketch 424242") &&
            !strchr(strchr(out, '\n') + 1, '\n'));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject nine 2>&1 >/dev/null", bin, p);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "'nine' is not a kiosk sketch id"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "'nine' is not a kiosk sketch id"));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve 99999999999999999999 2>&1 >/dev/null", bin, p);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "'99999999999999999999' is not a kiosk sketch id"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "'99999999999999999999' is not a kiosk sketch id"));
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     // A database in use: one clear line, exit 1, nothing lost.
@@ -2858,6 +2911,7 @@ int main(int argc, char** argv)
                                    {"readers_leave_one_file", test_readers_leave_one_file},
                                    {"schema_versions", test_schema_versions},
                                    {"bad_input", test_bad_input},
+                                   {"names_escaped", test_names_escaped},
                                    {"generation", test_generation},
                                    {"keep_models", test_keep_models},
                                    {"people_strokes", test_people_strokes},

@@ -1324,6 +1324,21 @@ static void test_usage_messages(void)
         {"render --rig '%1$s/assets/tail.glb' --out ''", "sketchpose render: --out needs a file name, got an empty value"},
         {"animate --rig '%1$s/assets/tail.glb' --strokes '' --out '%2$s.glb'", "sketchpose animate: --strokes needs file names"},
         {"db add-part '' --db '%2$s.db'", "sketchpose db add-part: PART.glb: got an empty file name"},
+        // A name with a newline or an escape code: bad usage, the value shown escaped (it was echoed raw, exit 1).
+        {"db add-sketch '%2$s.json' --category \"$(printf 'he\\nad')\" --db '%2$s.db'",
+         "sketchpose db add-sketch: --category wants a plain name ([A-Za-z0-9_.-], 1 to 63 characters, not starting with "
+         "'.'), got 'he\\nad'"},
+        {"db add-part '%1$s/assets/tail.glb' --name \"$(printf 'h\\033[2Jx')\" --db '%2$s.db'",
+         "sketchpose db add-part: --name wants a plain name ([A-Za-z0-9_.-], 1 to 63 characters, not starting with '.'), "
+         "got 'h\\x1b[2Jx'"},
+        {"db review --db '%2$s.db' --relabel 1 \"$(printf 'to\\nrso')\"",
+         "sketchpose db review: --relabel's CATEGORY wants a plain name"},
+        {"derive --rig '%1$s/assets/tail.glb' --out '%2$s.glb' --category \"$(printf 'a\\nb')\"",
+         "sketchpose derive: --category wants a plain name ([A-Za-z0-9_.-], 1 to 63 characters, not starting with '.'), "
+         "got 'a\\nb'"},
+        // A malformed id or range is a malformed value, as a number out of its range (exit 1 before).
+        {"db review --db '%2$s.db' --approve 1179-1172",
+         "sketchpose db review: '1179-1172' is not a kiosk sketch id (a positive number) or a range of them"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char args[3000];
