@@ -25,7 +25,7 @@ int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_pa
     return -1;
 }
 
-sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
+sp_result sp_read_drawing(const char* path, sp_sketch* sk, sp_error* err)
 {
     // An animator's drawing from a vector editor: one stroke per subpath,
     // its viewBox the canvas.
@@ -38,6 +38,13 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
             err, SP_ERR_INVALID,
             "%s: the SVG has no usable viewBox, so its canvas is unknown (viewBox=\"X Y W H\", W and H in (0, 1000000))", path);
     }
+    return SP_OK;
+}
+
+sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
+{
+    sp_result r = sp_read_drawing(path, sk, err);
+    if (r != SP_OK) return r;
     if (sk->stroke_count == 0) {
         sp_sketch_free(sk);
         return sp_fail(err, SP_ERR_INVALID, "%s: the file has no strokes", path);

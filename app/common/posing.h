@@ -12,8 +12,11 @@
 /// abs[0..count). -1 and a message naming the rig and the abstractions it
 /// has if there is none.
 int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_path, const char* name, sp_error* err);
-/// Reads a stroke file (JSON, or an SVG drawing: a name ending in .svg, its
-/// viewBox the canvas) and checks that it has at least one stroke of two
+/// Reads a stroke file as it is: JSON, or an SVG drawing (a name ending in
+/// .svg, in any case), whose viewBox is the canvas (one without is
+/// refused: its canvas is unknown); err names the file.
+sp_result sp_read_drawing(const char* path, sp_sketch* sk, sp_error* err);
+/// Reads a stroke file (sp_read_drawing) and checks that it has at least one stroke of two
 /// or more points; err names the file.
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// The parameters a draw-over solve may move (sp_solve_desc.active;

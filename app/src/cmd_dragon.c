@@ -3,6 +3,7 @@
 // drawn, attached where it touches a body; the dragon is written as one
 // animated .glb, a PNG and the report (DESIGN.md "dragon --report").
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +27,8 @@
 static bool read_strokes(const char* strokes, sp_sketch* sk)
 {
     sp_error err = {0};
-    if (sp_sketch_read_json(strokes, sk, &err) != SP_OK) {
+    // Through the posing commands' reader: an SVG drawing was "malformed JSON near line 1".
+    if (sp_read_drawing(strokes, sk, &err) != SP_OK) {
         fprintf(stderr, "sketchpose dragon: %s\n", err.text);
         return false;
     }
@@ -46,6 +48,66 @@ static bool read_strokes(const char* strokes, sp_sketch* sk)
     return true;
 }
 
+// The per-stroke lines on stderr: the first STROKE_LINES_MAX, then one
+// line for the rest (the report keeps every stroke). 500 dots said 500 lines.
+enum { STROKE_LINES_MAX = 10 };
+typedef struct stroke_lines {
+    double canvas_w, canvas_h; // the pipeline's canvas
+    int said;
+    int unsaid[SP_DRAGON_DETAIL + 1]; // left out past the cap, by reason (SP_DRAGON_DETAIL: kept as details)
+} stroke_lines;
+
+// Whether every point of the stroke lies off the canvas (the pipeline calls
+// it too_short: what is left of it on the canvas is nothing).
+static bool off_canvas(const stroke_lines* l, const sp_stroke* st)
+{
+    double w = l->canvas_w, h = l->canvas_h;
+    for (int k = 0; k < st->count; ++k)
+        if (st->points[k].x >= 0 && st->points[k].x <= w && st->points[k].y >= 0 && st->points[k].y <= h) return false;
+    return st->count > 0;
+}
+
+static void say_stroke(stroke_lines* l, const sp_dragon* d, const sp_dragon_result* res, const sp_stroke* st, const char* file,
+                       int i)
+{
+    sp_dragon_detail e;
+    bool detail = res->detail >= 0 && sp_dragon_detail_get(d, res->detail, &e);
+    if (!detail && !res->rejected) return;
+    if (l->said >= STROKE_LINES_MAX) {
+        ++l->unsaid[detail ? SP_DRAGON_DETAIL : res->reason];
+        return;
+    }
+    ++l->said;
+    if (detail)
+        fprintf(stderr, "sketchpose dragon: %s: stroke %d kept as a detail on part %d\n", file, i, e.part);
+    else if (res->reason == SP_DRAGON_NO_PART && sp_dragon_part_error(d)[0])
+        fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (no_part: %s)\n", file, i, sp_dragon_part_error(d));
+    else if (res->reason == SP_DRAGON_TOO_SHORT && off_canvas(l, st))
+        fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (too_short: it lies off the canvas)\n", file, i);
+    else
+        fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (%s)\n", file, i, sp_dragon_reject_name(res->reason));
+}
+
+// "... and 490 more strokes left out (too_short 480, full 10)", one line.
+static void say_strokes_unsaid(const stroke_lines* l, const char* file)
+{
+    int n = 0, details = l->unsaid[SP_DRAGON_DETAIL];
+    char why[256] = "";
+    for (int r = 0; r < SP_DRAGON_DETAIL; ++r)
+        if (l->unsaid[r]) {
+            size_t at = strlen(why);
+            snprintf(why + at, sizeof why - at, "%s%s %d", n ? ", " : "", sp_dragon_reject_name((sp_dragon_reject)r),
+                     l->unsaid[r]);
+            n += l->unsaid[r];
+        }
+    if (n)
+        fprintf(stderr, "sketchpose dragon: %s: ... and %d more stroke%s left out (%s)%s\n", file, n, n == 1 ? "" : "s", why,
+                details ? ", more kept as details" : "");
+    else if (details)
+        fprintf(stderr, "sketchpose dragon: %s: ... and %d more stroke%s kept as details\n", file, details,
+                details == 1 ? "" : "s");
+}
+
 int cmd_dragon(int argc, char** argv)
 {
     const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = NULL;
@@ -55,8 +117,8 @@ int cmd_dragon(int argc, char** argv)
          "the part database (default: $SP_DB, else ./sketchpose.db, as for demo, db and the kiosk; created from --assets when "
          "missing)",
          false},
-        {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes, one per part, in drawing order (sketchpose-strokes JSON)",
-         true},
+        {"--strokes", SP_OPT_IN, &strokes, "S.json",
+         "the strokes, one per part, in drawing order (sketchpose-strokes JSON, or an SVG drawing as for pose)", true},
         {"--out", SP_OPT_OUT, &out, "dragon.glb", "write the animated dragon (.glb, or .gltf)", false},
         {"--render", SP_OPT_OUT, &render, "out.png", "write a picture: parts, strokes blue, fitted outlines yellow", false},
         {"--report", SP_OPT_OUT, &report, "report.json", "write the report (also printed on stdout)", false},
@@ -106,6 +168,7 @@ int cmd_dragon(int argc, char** argv)
         return SP_EXIT_INPUT;
     }
     sp_outputs staged = {0};
+    stroke_lines said = {.canvas_w = w ? w : 1280, .canvas_h = h ? h : 800}; // sp_dragon_desc's default canvas
     cJSON* list = cJSON_CreateArray();
     for (int i = 0; i < sk.stroke_count; ++i) {
         sp_dragon_result res;
@@ -135,14 +198,9 @@ int cmd_dragon(int argc, char** argv)
             cJSON_AddItemToArray(g, o);
         }
         cJSON_AddNumberToObject(s, "ms", res.ms_total);
-        sp_dragon_detail e;
-        if (res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e))
-            fprintf(stderr, "sketchpose dragon: %s: stroke %d kept as a detail on part %d\n", strokes, i, e.part);
-        else if (res.rejected && res.reason == SP_DRAGON_NO_PART && sp_dragon_part_error(d)[0])
-            fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (no_part: %s)\n", strokes, i, sp_dragon_part_error(d));
-        else if (res.rejected)
-            fprintf(stderr, "sketchpose dragon: %s: stroke %d left out (%s)\n", strokes, i, sp_dragon_reject_name(res.reason));
+        say_stroke(&said, d, &res, &sk.strokes[i], strokes, i);
     }
+    say_strokes_unsaid(&said, strokes);
     char* text = NULL;
     if (sp_dragon_report_json(d, &text, &err) != SP_OK) goto fail;
     j = cJSON_Parse(text);

@@ -1729,6 +1729,54 @@ static void dragon_usage_error(const char* args, const char* want)
     ENSURE(rc == 2 && strstr(err, want) && strchr(err, '\n') == err + strlen(err) - 1);
 }
 
+// `sketchpose dragon`'s lines on stderr: at most 10 per-stroke lines and one
+// for the rest (500 dots said 500 lines), a stroke off the canvas said so
+// (it was "too_short"), and an SVG drawing read as pose reads it (it was
+// "malformed JSON near line 1").
+static void test_command_stroke_lines(void)
+{
+    const char* path = test_db();
+    char strokes[1024], svg[1024], cmd[4000], said[16384];
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("dragon_dots.json"));
+    snprintf(svg, sizeof svg, "%s", sp_test_tmp_path("dragon_line.svg"));
+    sp_sketch sk = {.canvas_w = 1280, .canvas_h = 800};
+    sp_vec2 off[2] = {{-500, -500}, {-300, -400}};
+    ENSURE(sp_sketch_add_stroke(&sk, off, NULL, 2) == SP_OK);
+    for (int i = 0; i < 30; ++i) {
+        sp_vec2 dot[2] = {{100 + 10.0 * i, 100}, {100 + 10.0 * i, 100}};
+        ENSURE(sp_sketch_add_stroke(&sk, dot, NULL, 2) == SP_OK);
+    }
+    sp_error err = {0};
+    ENSURE(sp_sketch_write_json(strokes, &sk, &err) == SP_OK);
+    sp_sketch_free(&sk);
+    snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' 2>&1 >/dev/null", SP_SKETCHPOSE, path, strokes);
+    ENSURE(sp_fixture_run(cmd, said, sizeof said) == 1);
+    fprintf(stderr, "%s", said);
+    int lines = 0;
+    for (const char* c = said; *c; ++c)
+        lines += *c == '\n';
+    ENSURE(lines == 12); // 10 strokes, the rest, "no stroke became a part"
+    ENSURE(strstr(said, "dragon_dots.json: stroke 0 left out (too_short: it lies off the canvas)\n"));
+    ENSURE(strstr(said, "dragon_dots.json: stroke 9 left out (too_short)\n") && !strstr(said, "stroke 10 left out"));
+    ENSURE(strstr(said, "dragon_dots.json: ... and 21 more strokes left out (too_short 21)\n"));
+    // The report keeps every stroke.
+    char rep[1024];
+    snprintf(rep, sizeof rep, "%s", sp_test_tmp_path("dragon_dots_report.json"));
+    snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' > '%s' 2>/dev/null", SP_SKETCHPOSE, path, strokes, rep);
+    ENSURE(WEXITSTATUS(system(cmd)) == 1);
+    cJSON* j = sp_fixture_json_file(rep);
+    ENSURE(j && cJSON_GetArraySize(cJSON_GetObjectItem(j, "strokes")) == 31);
+    cJSON_Delete(j);
+    FILE* f = fopen(svg, "w");
+    ENSURE(f);
+    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 1280 800\"><path d=\"M 5 5 L 6 5\"/></svg>\n");
+    ENSURE(fclose(f) == 0);
+    snprintf(cmd, sizeof cmd, "'%s' dragon --db '%s' --strokes '%s' 2>&1 >/dev/null", SP_SKETCHPOSE, path, svg);
+    ENSURE(sp_fixture_run(cmd, said, sizeof said) == 1);
+    fprintf(stderr, "%s", said);
+    ENSURE(strstr(said, "dragon_line.svg: stroke 0 left out (too_short)") && !strstr(said, "malformed JSON"));
+}
+
 // `sketchpose dragon`: a stroke file in, a .glb, a PNG and the report out.
 static void test_command(void)
 {
@@ -4061,6 +4109,7 @@ int main(int argc, char** argv)
                                    {"background_replaced", test_background_replaced},
                                    {"open_race", test_open_race},
                                    {"command", test_command},
+                                   {"command_stroke_lines", test_command_stroke_lines},
                                    {"six_real_parts", test_six_real_parts},
                                    {"many_parts", test_many_parts},
                                    {"body_last_and_undo", test_body_last_and_undo},
