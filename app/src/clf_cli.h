@@ -137,6 +137,22 @@ static inline void clf_cli_progress(void* user, const char* stage, int done, int
     fflush(stderr);
 }
 
+/// A labelled folder's drawings with no extent (a dot, all points at one
+/// place, an ndjson "drawing": []) are left out of training and evaluation
+/// with one warning line counting them, where they were trained on as
+/// blank pictures; false (err filled) when none is left.
+static inline bool clf_cli_drop_no_extent(const char* cmd, const char* dir, sp_dataset* ds, sp_error* err)
+{
+    int n = sp_dataset_drop_no_extent(ds);
+    if (n > 0)
+        fprintf(stderr, "%s: warning: %s: %d drawing%s left out: no extent (no points, or all at one place)\n", cmd, dir, n,
+                n == 1 ? "" : "s");
+    if (ds->count > 0) return true;
+    sp_dataset_free(ds);
+    sp_fail(err, SP_ERR_INVALID, "%s: no drawing with an extent (all points at one place, or none)", dir);
+    return false;
+}
+
 static inline bool clf_cli_tty(void) { return isatty(fileno(stderr)) != 0; }
 
 /// Writes s as a JSON string.

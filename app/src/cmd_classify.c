@@ -51,6 +51,14 @@ int cmd_classify(int argc, char** argv)
         sp_clf_destroy(clf);
         return SP_EXIT_INPUT;
     }
+    // A dot has nothing to classify (pose refuses it too): it was ranked, exit 0.
+    const char* why = r.pixels ? NULL : sp_sketch_extent_problem(&s);
+    if (why) {
+        fprintf(stderr, "sketchpose classify: %s: %s\n", strokes, why);
+        sp_sketch_free(&s);
+        sp_clf_destroy(clf);
+        return SP_EXIT_INPUT;
+    }
     sp_clf_answer a;
     sp_result res = sp_clf_classify(clf, &s, &r, &a, &err);
     sp_sketch_free(&s);

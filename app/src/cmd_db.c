@@ -553,6 +553,14 @@ static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size,
     return SP_OK;
 }
 
+// A drawing of strokes with no extent (a dot; an ndjson "drawing": []) is
+// nothing to train on or show: refused, as classify and pose refuse it.
+static sp_result extent_ok(const sp_sample* smp, const char* what, sp_error* err)
+{
+    const char* why = smp->raster.pixels ? NULL : sp_sketch_extent_problem(&smp->sketch);
+    return why ? sp_fail(err, SP_ERR_INVALID, "%s: %s", what, why) : SP_OK;
+}
+
 static sp_result add_file(sketch_set* s, const char* path, const char* category, sp_error* err)
 {
     int label = sp_dataset_add_category(&s->ds, category);
@@ -566,7 +574,8 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
             smp.label = label;
             char what[2100];
             snprintf(what, sizeof what, "%s: drawing %d", path, i + 1);
-            if ((r = push(s, &smp, NULL, 0, what, err)) == SP_OK) memset(&tmp.samples[i], 0, sizeof tmp.samples[i]);
+            if ((r = extent_ok(&smp, what, err)) == SP_OK && (r = push(s, &smp, NULL, 0, what, err)) == SP_OK)
+                memset(&tmp.samples[i], 0, sizeof tmp.samples[i]);
         }
         sp_dataset_free(&tmp);
         return r;
@@ -577,6 +586,10 @@ static sp_result add_file(sketch_set* s, const char* path, const char* category,
     if (!smp.raster.pixels && sp_sketch_point_count(&smp.sketch) == 0) {
         sp_sketch_free(&smp.sketch);
         return sp_fail(err, SP_ERR_INVALID, "%s: empty drawing (no strokes)", path);
+    }
+    if ((r = extent_ok(&smp, path, err)) != SP_OK) {
+        sp_sketch_free(&smp.sketch);
+        return r;
     }
     void* png = NULL;
     size_t n = 0;

@@ -84,7 +84,7 @@ int cmd_eval(int argc, char** argv)
             }
     sp_error err = {0};
     sp_dataset ds;
-    if (sp_dataset_load(data, &ds, &err) != SP_OK) {
+    if (sp_dataset_load(data, &ds, &err) != SP_OK || !clf_cli_drop_no_extent("sketchpose eval", data, &ds, &err)) {
         fprintf(stderr, "sketchpose eval: %s\n", err.text);
         return SP_EXIT_INPUT;
     }

@@ -39,7 +39,7 @@ int cmd_train(int argc, char** argv)
     double t0 = sp_now_ms();
     sp_error err = {0};
     sp_dataset ds;
-    if (sp_dataset_load(data, &ds, &err) != SP_OK) {
+    if (sp_dataset_load(data, &ds, &err) != SP_OK || !clf_cli_drop_no_extent("sketchpose train", data, &ds, &err)) {
         fprintf(stderr, "sketchpose train: %s\n", err.text);
         return SP_EXIT_INPUT;
     }

@@ -715,6 +715,42 @@ void sp_raster_free(sp_raster* r)
     memset(r, 0, sizeof *r);
 }
 
+const char* sp_sketch_extent_problem(const sp_sketch* s)
+{
+    bool any = false;
+    sp_vec2 first = {0, 0};
+    for (int i = 0; i < s->stroke_count; ++i)
+        for (int k = 0; k < s->strokes[i].count; ++k) {
+            sp_vec2 p = s->strokes[i].points[k];
+            if (!any) first = p, any = true;
+            if (p.x != first.x || p.y != first.y) return NULL;
+        }
+    return any ? "the drawing has no extent: all its points are at one place" : "the drawing has no points";
+}
+
+int sp_dataset_drop_no_extent(sp_dataset* ds)
+{
+    int kept = 0, dropped = 0;
+    for (int i = 0; i < ds->count; ++i) {
+        sp_sample* smp = &ds->samples[i];
+        if (!smp->raster.pixels && sp_sketch_extent_problem(&smp->sketch)) {
+            sp_sketch_free(&smp->sketch);
+            ++dropped;
+            continue;
+        }
+        ds->samples[kept++] = *smp;
+    }
+    ds->count = kept;
+    // Folds take a drawing's index within its category: renumbered, as the set was read.
+    int* next = dropped ? calloc((size_t)ds->category_count + 1, sizeof *next) : NULL;
+    for (int i = 0; next && i < kept; ++i) {
+        int l = ds->samples[i].label;
+        if (l >= 0 && l < ds->category_count) ds->samples[i].index = next[l]++;
+    }
+    free(next); // out of memory: the indices keep their gaps, which folds take as they come
+    return dropped;
+}
+
 void sp_dataset_free(sp_dataset* ds)
 {
     if (!ds) return;

@@ -245,6 +245,24 @@ static void test_ndjson(void)
     sp_dataset_free(&ds);
 }
 
+// Drawings with no extent (an ndjson "drawing": [], a dot) leave a set, the
+// others keep their order and are renumbered within their category (folds).
+static void test_drop_no_extent(void)
+{
+    const char* text = "{\"drawing\": [[[0, 10], [0, 5]]]}\n{\"drawing\": []}\n{\"drawing\": [[[3, 3, 3], [4, 4, 4]]]}\n"
+                       "{\"drawing\": [[[1, 2], [1, 1]]]}\n";
+    sp_dataset ds = {0};
+    sp_error err = {0};
+    int l = sp_dataset_add_category(&ds, "a");
+    ENSURE(sp_dataset_parse_ndjson(&ds, text, strlen(text), "a.ndjson", l, &err) == SP_OK && ds.count == 4);
+    ENSURE(!strcmp(sp_sketch_extent_problem(&ds.samples[1].sketch), "the drawing has no points"));
+    ENSURE(strstr(sp_sketch_extent_problem(&ds.samples[2].sketch), "all its points are at one place"));
+    ENSURE(sp_sketch_extent_problem(&ds.samples[3].sketch) == NULL);
+    ENSURE(sp_dataset_drop_no_extent(&ds) == 2 && ds.count == 2);
+    ENSURE(ds.samples[0].index == 0 && ds.samples[1].index == 1 && ds.samples[1].sketch.strokes[0].points[1].x == 2);
+    sp_dataset_free(&ds);
+}
+
 static void test_quickdraw_real(void)
 {
     const char* dir = sp_test_data_dir();
@@ -1371,6 +1389,7 @@ int main(int argc, char** argv)
                        (sp_test[]){{"json_roundtrip", test_json_roundtrip},
                                    {"json_bad", test_json_bad},
                                    {"ndjson", test_ndjson},
+                                   {"drop_no_extent", test_drop_no_extent},
                                    {"quickdraw_real", test_quickdraw_real},
                                    {"svg", test_svg},
                                    {"svg_truncated", test_svg_truncated},

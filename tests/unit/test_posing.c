@@ -1297,6 +1297,62 @@ static void test_synth_parts_fails_whole(void)
     ENSURE(run(cmd) == 0);
 }
 
+// Writes a one-stroke file of n points from (x0, y0) by (dx, dy) each.
+static void write_line(const char* path, double x0, double y0, double dx, double dy, int n)
+{
+    sp_sketch sk = {.canvas_w = 640, .canvas_h = 480};
+    sp_vec2 pts[64];
+    for (int i = 0; i < n && i < 64; ++i)
+        pts[i] = (sp_vec2){x0 + dx * i, y0 + dy * (i % 2 ? i : -i)};
+    sp_error err = {0};
+    ENSURE(sp_sketch_add_stroke(&sk, pts, NULL, n) == SP_OK && sp_sketch_write_json(path, &sk, &err) == SP_OK);
+    sp_sketch_free(&sk);
+}
+
+// A drawing with no extent (all its points at one place: a dot) is refused by
+// classify and db add-sketch (both took it, exit 0) and left out of a
+// labelled folder's training and evaluation with one warning line (it was
+// trained on as a blank picture).
+static void test_no_extent_cli(void)
+{
+    char dir[1024], cmd[6000], dot[1100], model[1100];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("extent_set"));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s/a' '%s/b'", dir, dir, dir);
+    ENSURE(run(cmd) == 0);
+    for (int i = 0; i < 3; ++i) {
+        char f[1200];
+        snprintf(f, sizeof f, "%s/a/%d.json", dir, i);
+        write_line(f, 100 + 5 * i, 200, 10, 0, 30);
+        snprintf(f, sizeof f, "%s/b/%d.json", dir, i);
+        write_line(f, 300, 50 + 5 * i, 1, 8, 30);
+    }
+    snprintf(dot, sizeof dot, "%s/b/dot.json", dir);
+    write_line(dot, 320, 240, 0, 0, 5);
+    snprintf(model, sizeof model, "%s", sp_test_tmp_path("extent.spclf"));
+    char args[4000];
+    int rc;
+    snprintf(args, sizeof args, "train --data '%s' --model '%s' --words 20", dir, model);
+    char* text = run_said(args, &rc);
+    ENSURE(rc == 0 && strstr(text, "sketchpose train: warning: ") && strstr(text, "1 drawing left out: no extent"));
+    free(text);
+    snprintf(args, sizeof args, "eval --data '%s' --model '%s'", dir, model);
+    text = run_said(args, &rc);
+    ENSURE(rc == 0 && strstr(text, "1 drawing left out: no extent"));
+    free(text);
+    const char* want = "dot.json: the drawing has no extent: all its points are at one place\n";
+    snprintf(args, sizeof args, "classify --model '%s' --strokes '%s'", model, dot);
+    text = run_said(args, &rc);
+    ENSURE(rc == 1 && strstr(text, "sketchpose classify: ") && strstr(text, want) &&
+           strchr(text, '\n') == text + strlen(text) - 1);
+    free(text);
+    snprintf(args, sizeof args, "db add-sketch --db '%s/x.db' --category a '%s'", dir, dot);
+    text = run_said(args, &rc);
+    ENSURE(rc == 1 && strstr(text, "sketchpose db add-sketch: ") && strstr(text, want));
+    free(text);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", dir, model);
+    ENSURE(run(cmd) == 0);
+}
+
 // Usage mistakes are exit 2 and one line that names the option and what it
 // takes (an audit of the commands against DESIGN.md found these said
 // otherwise: exit 1, or the wrong option, or a usage placeholder as the
@@ -1374,6 +1430,7 @@ int main(int argc, char** argv)
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
                                    {"cli_missing_value", test_cli_missing_value},
+                                   {"no_extent_cli", test_no_extent_cli},
                                    {"pose_option_ranges", test_pose_option_ranges},
                                    {"pose_file_whole", test_pose_file_whole},
                                    {"device_inputs", test_device_inputs},

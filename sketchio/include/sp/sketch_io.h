@@ -87,6 +87,14 @@ sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, 
 sp_result sp_dataset_read_ndjson(sp_dataset* ds, const char* path, int label, sp_error* err);
 /// Adds a category name (copied) and returns its index, or -1 when out of memory.
 int sp_dataset_add_category(sp_dataset* ds, const char* name);
+/// Why a drawing of strokes cannot be drawn or classified, else NULL: "the
+/// drawing has no points", or "the drawing has no extent: all its points
+/// are at one place" (a dot, or strokes scaled to nothing).
+const char* sp_sketch_extent_problem(const sp_sketch* s);
+/// Takes out of `ds` the stroke drawings that sp_sketch_extent_problem
+/// refuses (a raster sample stays), renumbering `index` within each
+/// category; returns how many were taken out.
+int sp_dataset_drop_no_extent(sp_dataset* ds);
 /// Frees everything and zeroes the set.
 void sp_dataset_free(sp_dataset* ds);
 
