@@ -563,6 +563,15 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
             rc = sp_fail(err, SP_ERR_INVALID, "%s: \"canvas\" must be [width, height] with 0 <= sizes <= 1e6", name);
             goto done;
         }
+        // [0, 0] is the writer's "no canvas" (as a file without one); a side
+        // under a pixel otherwise is no canvas either, and the commands put
+        // their default 640 x 480 in its place without a word.
+        if (!(w == 0 && h == 0) && (w < 1 || h < 1)) {
+            rc = sp_fail(err, SP_ERR_INVALID,
+                         "%s: \"canvas\" [%g, %g] has a side under 1 px (give [width, height] of 1 to 1e6 px, or no canvas)",
+                         name, w, h);
+            goto done;
+        }
         s.canvas_w = w;
         s.canvas_h = h;
     }

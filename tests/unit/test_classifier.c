@@ -152,6 +152,18 @@ static void test_json_bad(void)
         SP_ERR_INVALID, "\"t\"");
     expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [-1, 5], \"strokes\": []}",
                       SP_ERR_INVALID, "canvas");
+    // A canvas side under a pixel ([0, 480], [0.001, 0.001]) became the commands' 640 x 480 silently; [0, 0] is "none".
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [0, 480], \"strokes\": []}",
+                      SP_ERR_INVALID, "\"canvas\" [0, 480] has a side under 1 px");
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [0.001, 0.001], \"strokes\": []}",
+                      SP_ERR_INVALID, "\"canvas\" [0.001, 0.001] has a side under 1 px");
+    {
+        const char* none = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [0, 0], \"strokes\": []}";
+        sp_sketch s;
+        sp_error err = {0};
+        ENSURE(sp_sketch_parse_json(none, strlen(none), "x.json", &s, &err) == SP_OK && s.canvas_w == 0 && s.canvas_h == 0);
+        sp_sketch_free(&s);
+    }
     // A key given twice: the first won silently ("strokes": [] then the strokes read as none).
     expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [], \"strokes\": [{\"points\": "
                       "[[1, 2]]}]}",
