@@ -1040,6 +1040,18 @@ static sp_result svg_arc(svg_ctx* c, double x1, double y1, const double a[5], bo
     return svg_point(c, x2, y2); // exactly the endpoint, which the next command starts from
 }
 
+// The end of a path's subpath: a stroke, unless it is a lone moveto ("M 5 5
+// M 100 100 L ..."), which SVG does not draw (it was a stroke of 1 point,
+// and the file was refused as one).
+static sp_result svg_subpath_end(svg_ctx* c)
+{
+    if (c->n == 1) {
+        c->n = 0;
+        --c->total;
+    }
+    return svg_flush(c);
+}
+
 static sp_result svg_path(svg_ctx* c, const char* d, const char* end)
 {
     const char* p = d;
@@ -1063,7 +1075,7 @@ static sp_result svg_path(svg_ctx* c, const char* d, const char* end)
         switch (toupper((unsigned char)cmd)) {
         case 'M':
             if (!svg_numbers(&p, end, v, 2)) goto bad;
-            if ((rc = svg_flush(c)) != SP_OK) return rc;
+            if ((rc = svg_subpath_end(c)) != SP_OK) return rc;
             cx = sx = ox + v[0];
             cy = sy = oy + v[1];
             if ((rc = svg_point(c, cx, cy)) != SP_OK) return rc;
@@ -1151,7 +1163,7 @@ static sp_result svg_path(svg_ctx* c, const char* d, const char* end)
         }
         prev = cmd;
     }
-    return svg_flush(c);
+    return svg_subpath_end(c);
 bad:
     return sp_fail(c->err, SP_ERR_PARSE, "%s: bad numbers after path command '%c'", c->name, cmd);
 }
@@ -1337,9 +1349,19 @@ static sp_result svg_shape(svg_ctx* c, const char* text, size_t len, const char*
             const char* q = vb;
             double xy[2], x0 = 0, y0 = 0;
             int k = 0;
-            while (rc == SP_OK && svg_numbers(&q, ve, xy, 2)) {
+            for (const char* r = q; rc == SP_OK && svg_numbers(&r, ve, xy, 2); q = r) { // q: after the last whole pair
                 if (k++ == 0) x0 = xy[0], y0 = xy[1];
                 rc = svg_point(c, xy[0], xy[1]);
+            }
+            // What is left is no number pair ("3 nan 5 6", an odd count): named, where the points so far were read.
+            while (rc == SP_OK && q < ve && (isspace((unsigned char)*q) || *q == ','))
+                ++q;
+            if (rc == SP_OK && q < ve) {
+                char bad[40], shown[128];
+                snprintf(bad, sizeof bad, "%.*s", (int)(ve - q < 24 ? ve - q : 24), q);
+                return sp_fail(c->err, SP_ERR_PARSE, "%s: bad <%s> points near line %d: '%s%s' is not a number pair", c->name,
+                               tag_is(nm, gt, "polygon") ? "polygon" : "polyline", line_of(text, len, lt),
+                               sp_text_printable(bad, shown, sizeof shown), ve - q > 24 ? "..." : "");
             }
             if (rc == SP_OK && k > 0 && tag_is(nm, gt, "polygon")) rc = svg_point(c, x0, y0);
             if (rc == SP_OK) rc = svg_flush(c);

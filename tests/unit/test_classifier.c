@@ -363,6 +363,27 @@ static void parse_svg_ok(const char* text, sp_sketch* s)
     ENSURE(rc == SP_OK);
 }
 
+// A lone moveto draws nothing in SVG: "M 5 5 M 100 100 L 400 400" is one
+// stroke (it was a stroke of 1 point first, and the file was refused as one).
+// A <polyline>'s points that are no number pair are named (a "nan" or an odd
+// count ended the points there: "stroke 0 has 1 point").
+static void test_svg_moveto_points(void)
+{
+    sp_sketch s;
+    parse_svg_ok("<svg viewBox=\"0 0 800 800\"><path d=\"M 5 5 M 100 100 L 400 400 m 1 1\"/></svg>", &s);
+    ENSURE(s.stroke_count == 1 && s.strokes[0].count == 2 && s.strokes[0].points[0].x == 100);
+    sp_sketch_free(&s);
+    const char* bad[][2] = {
+        {"<svg>\n<polyline points=\"1 2 3 nan 5 6\"/></svg>", "b.svg: bad <polyline> points near line 2: '3 nan 5 6'"},
+        {"<svg><polygon points=\"1,2 3,4 5\"/></svg>", "b.svg: bad <polygon> points near line 1: '5' is not a number pair"}};
+    for (int i = 0; i < 2; ++i) {
+        sp_error e = {0};
+        sp_result rc = sp_sketch_parse_svg(bad[i][0], strlen(bad[i][0]), "b.svg", &s, &e);
+        if (rc == SP_OK || !contains(e.text, bad[i][1])) fprintf(stderr, "  %d: %s\n", rc, e.text);
+        ENSURE(rc == SP_ERR_PARSE && contains(e.text, bad[i][1]) && s.stroke_count == 0);
+    }
+}
+
 // A file cut between two elements used to give the strokes read so far.
 static void test_svg_truncated(void)
 {
@@ -1405,6 +1426,7 @@ int main(int argc, char** argv)
                                    {"quickdraw_real", test_quickdraw_real},
                                    {"svg", test_svg},
                                    {"svg_truncated", test_svg_truncated},
+                                   {"svg_moveto_points", test_svg_moveto_points},
                                    {"svg_unrendered", test_svg_unrendered},
                                    {"svg_prefixed", test_svg_prefixed},
                                    {"svg_arc", test_svg_arc},
