@@ -74,7 +74,8 @@ static void say_stroke(stroke_lines* l, const sp_dragon* d, const sp_dragon_resu
     bool detail = res->detail >= 0 && sp_dragon_detail_get(d, res->detail, &e);
     if (!detail && !res->rejected) return;
     if (l->said >= STROKE_LINES_MAX) {
-        ++l->unsaid[detail ? SP_DRAGON_DETAIL : res->reason];
+        int r = detail ? SP_DRAGON_DETAIL : (int)res->reason;
+        ++l->unsaid[r >= 0 && r <= SP_DRAGON_DETAIL ? r : SP_DRAGON_UNRECOGNISED]; // a reason added after DETAIL stays counted
         return;
     }
     ++l->said;

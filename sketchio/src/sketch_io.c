@@ -498,14 +498,17 @@ static sp_result keys_once(const cJSON* root, const char* name, sp_error* err)
 {
     bool oom = false;
     const char* twice = json_key_twice(root, &oom);
-    if (twice) return sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", name, twice);
+    char shown[96]; // a key is the file's text: \n in it is a newline by now
+    if (twice)
+        return sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", name, sp_text_printable(twice, shown, sizeof shown));
     const cJSON* strokes = cJSON_GetObjectItemCaseSensitive(root, "strokes");
     int si = 0;
     const cJSON* st;
     if (cJSON_IsArray(strokes)) cJSON_ArrayForEach(st, strokes)
         {
             if (!oom && (twice = json_key_twice(st, &oom)) != NULL)
-                return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d: key \"%s\" given twice", name, si, twice);
+                return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d: key \"%s\" given twice", name, si,
+                               sp_text_printable(twice, shown, sizeof shown));
             ++si;
         }
     if (oom) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);

@@ -174,6 +174,9 @@ static void test_json_bad(void)
     expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"strokes\": [{\"points\": [[1, 2]], \"points\": "
                       "[[3, 4]]}]}",
                       SP_ERR_INVALID, "stroke 0: key \"points\" given twice");
+    // The key is said escaped: "a\nb" in the file is a newline once read, and one line stays one line.
+    expect_json_error("{\"format\": \"sketchpose-strokes\", \"version\": 1, \"a\\nb\": 1, \"a\\nb\": 2, \"strokes\": []}",
+                      SP_ERR_INVALID, "key \"a\\nb\" given twice");
     {
         // A NUL byte in a key ("ca\0nvas") cut the key short, and the canvas was dropped silently.
         const char nul[] = "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"ca\0nvas\": [640, 480], \"strokes\": []}";
