@@ -169,7 +169,7 @@ int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positio
         for (int j = 0; j < nopts; ++j)
             if (!strcmp(argv[i], opts[j].name)) k = j;
         if (k < 0) {
-            fprintf(stderr, "%s: unknown option '%s' (see --help)\n", cmd, argv[i]);
+            fprintf(stderr, "%s: unknown option '%s' (see --help)\n", cmd, sp_text_printable(argv[i], (char[160]){0}, 160));
             return 2;
         }
         const sp_opt* o = &opts[k];
@@ -225,12 +225,13 @@ int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positio
         } else if (o->kind == SP_OPT_INT) {
             long x = strtol(v, &end, 10);
             if (end == v || *end) {
-                fprintf(stderr, "%s: %s expects an integer, got '%s'\n", cmd, o->name, v);
+                fprintf(stderr, "%s: %s expects an integer, got '%s'\n", cmd, o->name, sp_text_printable(v, (char[160]){0}, 160));
                 return 2;
             }
             // An integer all the same: say so, not that it is none.
             if (errno || x < -2147483647L || x > 2147483647L) {
-                fprintf(stderr, "%s: %s is out of range (see --help), got '%s'\n", cmd, o->name, v);
+                fprintf(stderr, "%s: %s is out of range (see --help), got '%s'\n", cmd, o->name,
+                        sp_text_printable(v, (char[160]){0}, 160));
                 return 2;
             }
             *(int*)o->out = (int)x;
@@ -239,7 +240,8 @@ int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positio
             // ERANGE with a finite x is an underflow (1e-320): a number all the
             // same, and the option's range check says whether it will do.
             if ((errno && !(errno == ERANGE && isfinite(x) && fabs(x) < 1)) || end == v || *end || !isfinite(x)) {
-                fprintf(stderr, "%s: %s expects a finite number, got '%s'\n", cmd, o->name, v);
+                fprintf(stderr, "%s: %s expects a finite number, got '%s'\n", cmd, o->name,
+                        sp_text_printable(v, (char[160]){0}, 160));
                 return 2;
             }
             *(double*)o->out = x;

@@ -96,9 +96,11 @@ static int parse(int argc, char** argv, const char* cmd, const db_common* c, con
     int nk = split_args(argc, argv, opts, nopts, kept, pos, npos, maxpos, &extra);
     if (nk < 0) {
         if (maxpos == 0)
-            fprintf(stderr, "%s: unexpected argument '%s' (it takes none; see --help)\n", cmd, extra);
+            fprintf(stderr, "%s: unexpected argument '%s' (it takes none; see --help)\n", cmd,
+                    sp_text_printable(extra, (char[160]){0}, 160));
         else
-            fprintf(stderr, "%s: unexpected argument '%s' (at most %d %s; see --help)\n", cmd, extra, maxpos, posname);
+            fprintf(stderr, "%s: unexpected argument '%s' (at most %d %s; see --help)\n", cmd,
+                    sp_text_printable(extra, (char[160]){0}, 160), maxpos, posname);
         return SP_EXIT_USAGE;
     }
     int rc = sp_cli_parse_pos(nk, kept, cmd, maxpos ? posname : NULL, summary, opts, nopts);
@@ -460,7 +462,7 @@ static int db_add_part(int argc, char** argv)
     d.synth_sketches = synth;
     if (!sp_cli_check_name(cmd, "--category", d.category) || !sp_cli_check_name(cmd, "--name", d.name)) return SP_EXIT_USAGE;
     if (view && !sp_derive_view_parse(view, &d.view)) {
-        fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, view);
+        fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", cmd, sp_text_printable(view, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     // --view auto is the default, which every part takes (sp_db_add_part agrees).
@@ -697,7 +699,7 @@ static int db_add_sketch(int argc, char** argv)
     sp_db_source src = SP_DB_SOURCE_CURATED;
     if (source && !strcmp(source, "kiosk")) src = SP_DB_SOURCE_KIOSK;
     else if (source && strcmp(source, "curated") != 0) {
-        fprintf(stderr, "%s: --source must be curated or kiosk, got '%s'\n", cmd, source);
+        fprintf(stderr, "%s: --source must be curated or kiosk, got '%s'\n", cmd, sp_text_printable(source, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     if (!sp_cli_check_name(cmd, "--category", category)) return SP_EXIT_USAGE;
@@ -1126,7 +1128,8 @@ static int db_review(int argc, char** argv)
         if (!strcmp(status, sp_db_status_name((sp_db_status)i))) mask = 1u << i;
     if (!strcmp(status, "all")) mask = (1u << SP_DB_STATUS_COUNT) - 1;
     if (!mask) {
-        fprintf(stderr, "%s: --status must be pending, approved, rejected or all, got '%s'\n", cmd, status);
+        fprintf(stderr, "%s: --status must be pending, approved, rejected or all, got '%s'\n", cmd,
+                sp_text_printable(status, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     if (relabel.count == 2 && !sp_cli_check_name(cmd, "--relabel's CATEGORY", relabel.items[1])) return SP_EXIT_USAGE;

@@ -14,6 +14,7 @@
 #include "report.h"
 #include "sp/derive.h"
 #include "sp/part_preview.h"
+#include "sp/sketch_io.h"
 
 static const char* k_cmd = "sketchpose derive";
 
@@ -50,11 +51,13 @@ int cmd_derive(int argc, char** argv)
         return SP_EXIT_USAGE;
     if (!sp_cli_check_name(k_cmd, "--category", d.category)) return SP_EXIT_USAGE;
     if (view && !sp_derive_view_parse(view, &d.view)) {
-        fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", k_cmd, view);
+        fprintf(stderr, "%s: --view wants auto, -z, +z, -x or +x, got '%s'\n", k_cmd,
+                sp_text_printable(view, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     if (d.abstraction && strcmp(d.abstraction, "outline") != 0 && strcmp(d.abstraction, "stick") != 0) {
-        fprintf(stderr, "%s: --abstraction wants outline or stick, got '%s'\n", k_cmd, d.abstraction);
+        fprintf(stderr, "%s: --abstraction wants outline or stick, got '%s'\n", k_cmd,
+                sp_text_printable(d.abstraction, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0]))) return SP_EXIT_INPUT; // before the work

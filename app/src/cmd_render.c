@@ -10,6 +10,7 @@
 #include "sp/headless.h"
 #include "sp/image.h"
 #include "sp/render.h"
+#include "sp/sketch_io.h"
 
 // The sketch camera maps the character onto its own canvas; fit that canvas
 // into the output keeping its aspect, centred (letterboxed), so that a
@@ -94,7 +95,8 @@ int cmd_render(int argc, char** argv)
     if (!sp_cli_check_out("sketchpose render", "--out", out_path, SP_CLI_OUT_PNG)) return SP_EXIT_USAGE;
     int w = 640, h = 480;
     if (size && !sp_cli_parse_size(size, &w, &h)) {
-        fprintf(stderr, "sketchpose render: --size wants WxH with sides 16..8192, e.g. 640x480, got '%s'\n", size);
+        fprintf(stderr, "sketchpose render: --size wants WxH with sides 16..8192, e.g. 640x480, got '%s'\n",
+                sp_text_printable(size, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     // A typed 0 was the default width; the parser already refuses what is not finite.

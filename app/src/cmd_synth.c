@@ -322,7 +322,8 @@ typedef struct rig_job {
 static bool rig_job_ok(rig_job* j, const char* size)
 {
     if (size && !sp_cli_parse_size(size, &j->w, &j->h)) {
-        fprintf(stderr, "sketchpose synth: --size expects WxH with sides 16..8192, got '%s'\n", size);
+        fprintf(stderr, "sketchpose synth: --size expects WxH with sides 16..8192, got '%s'\n",
+                sp_text_printable(size, (char[160]){0}, 160));
         return false;
     }
     if (j->amplitude < 0) {
@@ -440,7 +441,8 @@ int cmd_synth(int argc, char** argv)
     bool seeded = has_opt(argc, argv, "--seed");
     sp_handdraw_style style = SP_HANDDRAW_STYLE_COUNT;
     if (style_name && (style = sp_handdraw_style_parse(style_name)) == SP_HANDDRAW_STYLE_COUNT) {
-        fprintf(stderr, "sketchpose synth: --style must be normal, harsh or clean, got '%s'\n", style_name);
+        fprintf(stderr, "sketchpose synth: --style must be normal, harsh or clean, got '%s'\n",
+                sp_text_printable(style_name, (char[160]){0}, 160));
         return SP_EXIT_USAGE;
     }
     if (drawings) {

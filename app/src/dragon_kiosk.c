@@ -25,6 +25,7 @@
 #include "sp/kiosk_session.h"
 #include "sp/kiosk_text.h"
 #include "sp/partdb.h"
+#include "sp/sketch_io.h"
 
 static const char* const k_cmd = "dragon-kiosk";
 
@@ -564,6 +565,15 @@ static bool write_outputs(app* a, const char* shot, const char* out_glb, const c
     return ok;
 }
 
+// --size WxH (NULL: the default stays); false after the usage line.
+static bool window_size(const char* size, int* w, int* h)
+{
+    if (!size || sp_cli_parse_size(size, w, h)) return true;
+    fprintf(stderr, "%s: --size expects WxH with sides 16..8192, got '%s'\n", k_cmd,
+            sp_text_printable(size, (char[160]){0}, 160));
+    return false;
+}
+
 int main(int argc, char** argv)
 {
     ignore_write_signals();
@@ -612,10 +622,7 @@ int main(int argc, char** argv)
         return SP_EXIT_USAGE;
     if (!numbers_ok(&lod, &msaa, &max_parts, &keep_days, idle_s)) return SP_EXIT_USAGE;
     int win_w = 1280, win_h = 800;
-    if (size && !sp_cli_parse_size(size, &win_w, &win_h)) {
-        fprintf(stderr, "%s: --size expects WxH with sides 16..8192, got '%s'\n", k_cmd, size);
-        return SP_EXIT_USAGE;
-    }
+    if (!window_size(size, &win_w, &win_h)) return SP_EXIT_USAGE;
     sp_kiosk_session session = {0};
     sp_error err = {0};
     if (script) {

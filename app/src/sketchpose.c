@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "sp/sketch_io.h"
 
 typedef struct command {
     const char* name;
@@ -51,6 +52,7 @@ int main(int argc, char** argv)
     }
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; ++i)
         if (!strcmp(argv[1], k_commands[i].name)) return finish(k_commands[i].run(argc - 1, argv + 1));
-    fprintf(stderr, "sketchpose: unknown command '%s' (try sketchpose --help)\n", argv[1]);
+    fprintf(stderr, "sketchpose: unknown command '%s' (try sketchpose --help)\n",
+            sp_text_printable(argv[1], (char[160]){0}, 160));
     return 2;
 }

@@ -1392,6 +1392,15 @@ static void test_usage_messages(void)
         {"derive --rig '%1$s/assets/tail.glb' --out '%2$s.glb' --category \"$(printf 'a\\nb')\"",
          "sketchpose derive: --category wants a plain name ([A-Za-z0-9_.-], 1 to 63 characters, not starting with '.'), "
          "got 'a\\nb'"},
+        // Every value a usage message repeats is shown escaped: a newline or an escape code typed in an option or
+        // its value reached the terminal raw (two lines; a cleared screen).
+        {"pose --rig x \"$(printf -- '--str\\033[2Jokes')\"", "sketchpose pose: unknown option '--str\\x1b[2Jokes' (see --help)"},
+        {"db review --db '%2$s.db' --status \"$(printf 'al\\nl')\"",
+         "sketchpose db review: --status must be pending, approved, rejected or all, got 'al\\nl'"},
+        {"render --rig '%1$s/assets/tail.glb' --out '%2$s.png' --size \"$(printf '6\\n4x48')\"",
+         "sketchpose render: --size wants WxH with sides 16..8192, e.g. 640x480, got '6\\n4x48'"},
+        {"synth --rig '%1$s/assets/tail.glb' --seed \"$(printf '1\\n2')\" --out '%2$s.json'",
+         "sketchpose synth: --seed expects an integer, got '1\\n2'"},
         // A malformed id or range is a malformed value, as a number out of its range (exit 1 before).
         {"db review --db '%2$s.db' --approve 1179-1172",
          "sketchpose db review: '1179-1172' is not a kiosk sketch id (a positive number) or a range of them"},
