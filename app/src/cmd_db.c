@@ -534,13 +534,10 @@ static bool has_ext(const char* p, const char* ext)
 // Adds a drawing read from `what` (a file, or a drawing of one).
 static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size, const char* what, sp_error* err)
 {
-    const sp_sketch* k = &smp->sketch;
-    if (s->kiosk && (smp->raster.pixels || k->stroke_count != 1 || k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX))
+    const char* why = s->kiosk ? sp_db_kiosk_sketch_problem(smp) : NULL;
+    if (why)
         return sp_fail(err, SP_ERR_INVALID, "%s: a kiosk sketch is one stroke of 2..%d points; this is %s (add it as curated)",
-                       what, SP_DB_KIOSK_POINTS_MAX,
-                       smp->raster.pixels     ? "a picture"
-                       : k->stroke_count != 1 ? "several strokes"
-                                              : "one stroke of too many points");
+                       what, SP_DB_KIOSK_POINTS_MAX, why);
     if (s->ds.count == s->cap) {
         int cap = s->cap ? 2 * s->cap : 64;
         sp_sample* g = realloc(s->ds.samples, sizeof *g * (size_t)cap);

@@ -49,6 +49,26 @@ static bool takes_only(int argc, char** argv, const char* mode, const char* cons
     return true;
 }
 
+// Loads the parts `names` of `dir` into chs[] with the abstraction each
+// draws in abs_of[] (-1: not a part, no category); false on the first that
+// does not load or lacks its abstraction. The abstraction: --abstraction,
+// else the part's own choice, else its outline, else the first.
+static bool load_parts(const char* dir, char** names, int n, const char* abs_name, sp_character* chs, int* abs_of, sp_error* err)
+{
+    for (int k = 0; k < n; ++k) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        sp_character* ch = &chs[k];
+        if (sp_gltf_load(path, ch, err) != SP_OK) return false;
+        abs_of[k] = -1;
+        if (!ch->part.category[0]) continue;
+        const char* an = abs_name ? abs_name : ch->part.abstraction[0] ? ch->part.abstraction : NULL;
+        if (!an && sp_rig_find_abstraction(&ch->rig, "outline") >= 0) an = "outline";
+        if ((abs_of[k] = sp_pick_abstraction(ch->rig.abstractions, ch->rig.abstraction_count, path, an, err)) < 0) return false;
+    }
+    return true;
+}
+
 // --parts DIR: every .glb/.gltf part of DIR (category from extras.sp_part),
 // `per_part` hand-drawn sketches each, into OUT/<category>/<part>-<style>-<family>-<i>.json.
 static int synth_parts(const char* dir, const char* abs_name, int per_part, uint64_t family, const sp_handdraw_desc* base,
@@ -79,23 +99,16 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
     }
     // Every part is read and checked before anything is written: a bad part
     // in the folder left the sketches of the ones before it in an existing D.
-    for (int k = 0; k < n; ++k) {
-        char path[4096];
-        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        sp_character ch = {0};
-        bool ok = sp_gltf_load(path, &ch, &err) == SP_OK;
-        const char* an = abs_name ? abs_name : ch.part.abstraction[0] ? ch.part.abstraction : NULL;
-        if (ok && !an && sp_rig_find_abstraction(&ch.rig, "outline") >= 0) an = "outline";
-        if (ok && ch.part.category[0])
-            ok = sp_pick_abstraction(ch.rig.abstractions, ch.rig.abstraction_count, path, an, &err) >= 0;
-        sp_character_free(&ch);
-        if (!ok) {
-            fprintf(stderr, "sketchpose synth: %s\n", err.text);
-            for (int j = 0; j < n; ++j)
-                free(names[j]);
-            free(names);
-            return SP_EXIT_INPUT;
+    sp_character* chs = calloc((size_t)n, sizeof *chs);
+    int* abs_of = calloc((size_t)n, sizeof *abs_of);
+    if (!chs || !abs_of || !load_parts(dir, names, n, abs_name, chs, abs_of, &err)) {
+        fprintf(stderr, "sketchpose synth: %s\n", err.text[0] ? err.text : "out of memory");
+        for (int j = 0; j < n; ++j) {
+            free(names[j]);
+            if (chs) sp_character_free(&chs[j]);
         }
+        free(names), free(chs), free(abs_of);
+        return SP_EXIT_INPUT;
     }
     // The result is said once the sketches are all written; a failure
     // takes back the folder it made (it printed a result and left the folder).
@@ -116,43 +129,28 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         snprintf(path, sizeof path, "%s/%s", dir, names[k]);
         snprintf(stem, sizeof stem, "%s", names[k]);
         *strrchr(stem, '.') = 0;
-        sp_character ch = {0};
-        if (sp_gltf_load(path, &ch, &err) != SP_OK) goto fail;
-        if (!ch.part.category[0]) {
+        const sp_character* ch = &chs[k];
+        int a = abs_of[k];
+        if (a < 0) {
             // A character beside the parts (assets/ holds both): not a part, left out.
             fprintf(stderr, "sketchpose synth: %s: skipped (no extras.sp_part.category: not a part)\n", path);
-            sp_character_free(&ch);
             continue;
         }
-        snprintf(category, sizeof category, "%s", ch.part.category);
-        // The abstraction: --abstraction, else the part's own choice, else its outline, else the first.
-        const char* an = abs_name;
-        if (!an && ch.part.abstraction[0]) an = ch.part.abstraction;
-        if (!an && sp_rig_find_abstraction(&ch.rig, "outline") >= 0) an = "outline";
-        int a = sp_pick_abstraction(ch.rig.abstractions, ch.rig.abstraction_count, path, an, &err);
+        snprintf(category, sizeof category, "%s", ch->part.category);
         char cdir[4096];
         snprintf(cdir, sizeof cdir, "%s/%s", out_dir, category);
-        if (a < 0 || sp_dir_make(cdir, &err) != SP_OK) {
-            sp_character_free(&ch);
-            goto fail;
-        }
+        if (sp_dir_make(cdir, &err) != SP_OK) goto fail;
         uint64_t pf = sp_handdraw_part_family(family, stem);
-        int count = sp_handdraw_shape_available(&ch.rig, desc.shape) ? per_part : 0; // no single line through a head
+        int count = sp_handdraw_shape_available(&ch->rig, desc.shape) ? per_part : 0; // no single line through a head
         for (int i = 0; i < count; ++i) {
             sp_sketch sk = {0};
-            if (sp_handdraw_part(&ch.rig, a, &ch.camera, &desc, sp_handdraw_seed(pf, i), &sk, NULL, &err) != SP_OK) {
-                sp_character_free(&ch);
-                goto fail;
-            }
+            if (sp_handdraw_part(&ch->rig, a, &ch->camera, &desc, sp_handdraw_seed(pf, i), &sk, NULL, &err) != SP_OK) goto fail;
             char file[4400];
             snprintf(file, sizeof file, "%s/%s-%s-s%llu-%04d.json", cdir, stem, sp_handdraw_style_name(style),
                      (unsigned long long)family, i);
             sp_result r = sp_sketch_write_json(file, &sk, &err);
             sp_sketch_free(&sk);
-            if (r != SP_OK) {
-                sp_character_free(&ch);
-                goto fail;
-            }
+            if (r != SP_OK) goto fail;
         }
         total += count;
         fprintf(js, "%s{\"name\": ", written++ ? ", " : "");
@@ -160,9 +158,8 @@ static int synth_parts(const char* dir, const char* abs_name, int per_part, uint
         fprintf(js, ", \"category\": ");
         clf_cli_json_str(js, category);
         fprintf(js, ", \"abstraction\": ");
-        clf_cli_json_str(js, ch.rig.abstractions[a].name);
+        clf_cli_json_str(js, ch->rig.abstractions[a].name);
         fprintf(js, ", \"sketches\": %d}", count);
-        sp_character_free(&ch);
     }
     fprintf(js, "], \"sketches\": %d}\n", total);
     if (written == 0) {
@@ -185,8 +182,8 @@ done:
     if (js) fclose(js);
     free(text);
     for (int k = 0; k < n; ++k)
-        free(names[k]);
-    free(names);
+        free(names[k]), sp_character_free(&chs[k]);
+    free(names), free(chs), free(abs_of);
     return code;
 }
 

@@ -111,6 +111,16 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
     return rc == SQLITE_DONE ? SP_OK : db_fail(db, rc, "storing a sketch", err);
 }
 
+const char* sp_db_kiosk_sketch_problem(const sp_sample* smp)
+{
+    const sp_sketch* k = &smp->sketch;
+    if (smp->raster.pixels) return "a picture";
+    if (k->stroke_count != 1) return "several strokes";
+    if (k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX) return "one stroke of too many points";
+    if (k->strokes[0].count < 2) return "one stroke of fewer than 2 points";
+    return NULL;
+}
+
 sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png* png, sp_db_source source, const char* by, int* added,
                              sp_error* err)
 {
@@ -129,13 +139,11 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
         if (r != SP_OK) return r;
         // Review shows and trains on a kiosk sketch's one stroke: 200,000
         // strokes were listed as one, a million points took a minute a sheet.
-        const sp_sketch* k = &s->sketch;
-        if (source == SP_DB_SOURCE_KIOSK &&
-            (k->stroke_count != 1 || k->strokes[0].count < 2 || k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX))
+        const char* why = source == SP_DB_SOURCE_KIOSK ? sp_db_kiosk_sketch_problem(s) : NULL;
+        if (why)
             return sp_fail(err, SP_ERR_INVALID,
-                           "%s: a kiosk sketch is one stroke of 2..%d points; this has %d stroke%s%s (add it as curated)", what,
-                           SP_DB_KIOSK_POINTS_MAX, k->stroke_count, k->stroke_count == 1 ? "" : "s",
-                           k->stroke_count == 1 && k->strokes[0].count > SP_DB_KIOSK_POINTS_MAX ? ", too many points" : "");
+                           "%s: a kiosk sketch is one stroke of 2..%d points; this is %s (add it as curated)", what,
+                           SP_DB_KIOSK_POINTS_MAX, why);
     }
     if (data->count == 0) return sp_fail(err, SP_ERR_INVALID, "no drawings to add");
     sp_result r = db_begin(db, err);

@@ -266,6 +266,11 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
 /// A kiosk sketch is one stroke of 2 to this many points (the kiosk's own
 /// stroke holds fewer), collected or added (`db add-sketch --source kiosk`).
 #define SP_DB_KIOSK_POINTS_MAX 65536
+/// Why `smp` cannot be stored as a kiosk sketch ("a picture", "several
+/// strokes", "one stroke of too many points", "one stroke of fewer than 2
+/// points"), or NULL when it can: one check for the library and the command
+/// that names the file.
+const char* sp_db_kiosk_sketch_problem(const sp_sample* smp);
 
 /// Review status of a kiosk sketch.
 typedef enum sp_db_status { SP_DB_PENDING, SP_DB_APPROVED, SP_DB_REJECTED, SP_DB_STATUS_COUNT } sp_db_status;
