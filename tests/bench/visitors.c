@@ -28,7 +28,8 @@
 // It then draws every head, tail and wing drawing touching a dragon's body
 // (parts_on_body): printed per kind, those that became their own kind (and
 // attached to the body; facing the way the dragon does), a body, another
-// part, or were refused; with
+// part, or were refused, and the farthest an attached part's fitted
+// attachment end moved to meet the body's surface; with
 // --gap PX drawn that far apart instead (their box PX beyond the body's).
 // --part-scale F draws the legs, heads, tails and wings F times their size
 // (a visitor's small parts on a large body; the body stays 500 px).
@@ -249,6 +250,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     scene_set scenes;
     if (!scene_drawings(ds, &scenes)) return;
     int n[3] = {0}, own[3] = {0}, attached[3] = {0}, body[3] = {0}, other[3] = {0}, refused[3] = {0}, faced[3] = {0};
+    double moved[3] = {0}; // the farthest an attached part moved to meet its body, px
     int m = 0;
     for (int i = 0; i < ds->count; ++i) {
         const char* label = ds->categories[ds->samples[i].label];
@@ -282,10 +284,11 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
                 refused[kind]++;
             } else {
                 const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
-                if (!strcmp(p->category, label))
-                    own[kind]++, attached[kind] += p->attached_to >= 0 && sp_dragon_part_get(d, p->attached_to)->is_torso,
-                        faced[kind] += p->mirrored == (facing != 0);
-                else if (p->is_torso)
+                bool on = p->attached_to >= 0 && sp_dragon_part_get(d, p->attached_to)->is_torso;
+                if (!strcmp(p->category, label)) {
+                    own[kind]++, attached[kind] += on, faced[kind] += p->mirrored == (facing != 0);
+                    if (on) moved[kind] = fmax(moved[kind], sp_v2_len(sp_v2_sub(p->anchor, p->attach_end)));
+                } else if (p->is_torso)
                     body[kind]++;
                 else
                     other[kind]++;
@@ -297,9 +300,9 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     if (json) {
         for (int k = 0; k < 3; ++k)
             printf("  {\"case\": \"%s %s on a body%s\", \"gap_px\": %g, \"n\": %d, \"own\": %d, \"own_attached\": %d, "
-                   "\"body\": %d, \"other\": %d, \"refused\": %d, \"own_facing_the_dragon\": %d},\n",
+                   "\"body\": %d, \"other\": %d, \"refused\": %d, \"own_facing_the_dragon\": %d, \"moved_px_max\": %.0f},\n",
                    half, kinds[k], parts_first ? ", drawn first" : "", gap, n[k], own[k], attached[k], body[k], other[k],
-                   refused[k], faced[k]);
+                   refused[k], faced[k], moved[k]);
         return;
     }
     if (gap > 0)
@@ -308,11 +311,11 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
     else
         printf("Heads, tails and wings drawn touching a dragon's body%s (facing right, then left)\n",
                parts_first ? ", each drawn first, then the head and the body" : "");
-    printf("%-12s %6s %12s %12s %12s %12s %12s %14s\n", "part", "drawn", "own kind", "attached", "a body", "other part",
-           "refused", "facing dragon");
+    printf("%-12s %6s %12s %12s %12s %12s %12s %14s %12s\n", "part", "drawn", "own kind", "attached", "a body", "other part",
+           "refused", "facing dragon", "moved <= px");
     for (int k = 0; k < 3; ++k)
-        printf("%-12s %6d %12d %12d %12d %12d %12d %14d\n", kinds[k], n[k], own[k], attached[k], body[k], other[k], refused[k],
-               faced[k]);
+        printf("%-12s %6d %12d %12d %12d %12d %12d %14d %12.0f\n", kinds[k], n[k], own[k], attached[k], body[k], other[k],
+               refused[k], faced[k], moved[k]);
 }
 
 static int json_file(const struct dirent* e)

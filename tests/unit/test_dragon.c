@@ -3094,6 +3094,89 @@ static void test_polygon_refusal(void)
     sp_dragon_destroy(d);
 }
 
+// The distance from canvas point p to the nearest of part i's mesh vertices at its fit.
+static double to_fitted_mesh(const sp_dragon* d, int i, sp_vec2 p)
+{
+    sp_vec2* px = fitted_px(d, i);
+    double best = INFINITY;
+    for (int v = 0; v < sp_dragon_part_get(d, i)->character->rig.vertex_count; ++v)
+        best = fmin(best, sp_v2_len(sp_v2_sub(px[v], p)));
+    free(px);
+    return best;
+}
+
+// A part drawn a little apart from a body (its stroke within the snap
+// distance of the body's surface), whose fit puts its attachment end
+// farther (a round head's neck fitted inside the drawing, on the side away
+// from the body), is fitted again with that end where the stroke comes
+// nearest the body: it attaches, its neck meeting the body's surface, its
+// head still where it was drawn. Drawn farther apart it stays free, and a
+// chip's choice reaches too (the README's tree taken for a head).
+static void test_reaches_the_body(void)
+{
+    const char* path = real_db();
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    double snap = 0.06 * hypot(1280, 800);
+    for (int mirrored = 0; mirrored < 2; ++mirrored) {
+        for (int apart = 0; apart < 3; ++apart) {
+            sp_dragon_clear(d);
+            sp_dragon_result body = draw_part(d, db, "torso", 640, 440, 420, false, true), res;
+            sp_vec2 blo, bhi, slo, shi;
+            int n;
+            fitted_box(d, body.part, &blo, &bhi);
+            // 20 or 45 px beyond the body's front top corner (the visitors
+            // bench's --gap), or 200 px: apart.
+            double gap = apart == 0 ? 20 : apart == 1 ? 45 : 200;
+            sp_vec2* xy = at_box_end("head/head-blunt-round-ear.json", 230, blo.y - 40, mirrored, blo, bhi, !mirrored, -gap, &n);
+            points_box(xy, n, &slo, &shi);
+            ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
+                   !res.rejected);
+            const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+            double near = INFINITY; // how near the stroke comes to the body's mesh
+            for (int k = 0; k < n; ++k)
+                near = fmin(near, to_fitted_mesh(d, body.part, xy[k]));
+            free(xy);
+            sp_vec2 olo, ohi;
+            fitted_box(d, res.part, &olo, &ohi);
+            double diag = hypot(shi.x - slo.x, shi.y - slo.y),
+                   off = sp_v2_len(sp_v2_sub(sp_v2_scale(sp_v2_add(olo, ohi), 0.5), sp_v2_scale(sp_v2_add(slo, shi), 0.5)));
+            fprintf(stderr,
+                    "  round head %.0f px beyond the body (facing %s): stroke %.0f px from the body, attached to %d, "
+                    "its end %.0f px from the anchor, its fit's centre %.0f px from the stroke's, error %.1f px, pen-up to part "
+                    "%.1f ms\n",
+                    gap, mirrored ? "left" : "right", near, p->attached_to, sp_v2_len(sp_v2_sub(p->attach_end, p->anchor)), off,
+                    p->report.mean_error_px, res.ms_total);
+            if (near > snap) { // drawn apart: free where drawn
+                ENSURE(p->attached_to < 0);
+                continue;
+            }
+            ENSURE(p->attached_to == body.part);
+            ENSURE(sp_v2_len(sp_v2_sub(p->attach_end, p->anchor)) < 0.25 * snap); // its end fitted at the body
+            ENSURE(off < 0.25 * diag);                                            // the part fits its stroke where it was drawn
+        }
+        ENSURE(sp_dragon_undo(d));
+    }
+    // The README's refused stroke (docs/img/kiosk_refused.json): a tree
+    // drawn over the body's front, made a head with a chip (the kiosk adds
+    // the refused stroke again with the chip's category).
+    sp_dragon_clear(d);
+    sp_dragon_result body = draw_part(d, db, "torso", 640, 440, 420, false, true), res;
+    sp_vec2 blo, bhi;
+    int n;
+    fitted_box(d, body.part, &blo, &bhi);
+    sp_vec2* xy = visitor_stroke("not_a_part/tree.json", 260, (sp_vec2){bhi.x - 60, blo.y - 110}, false, &n);
+    ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK && !res.rejected);
+    free(xy);
+    const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+    fprintf(stderr, "  the README's tree as a head: attached to %d, its end %.0f px from the anchor\n", p->attached_to,
+            sp_v2_len(sp_v2_sub(p->attach_end, p->anchor)));
+    ENSURE(p->attached_to == body.part && sp_v2_len(sp_v2_sub(p->attach_end, p->anchor)) < 0.25 * snap);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // Parts drawn before the body end as if drawn after it, keeping their ids:
 // the same tails turn to face away from the body and attach; a round head
 // that alone is a body becomes the head; legs become the legs of their end
@@ -4123,6 +4206,7 @@ int main(int argc, char** argv)
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},
+                                   {"reaches_the_body", test_reaches_the_body},
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},

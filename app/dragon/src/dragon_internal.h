@@ -6,6 +6,7 @@
 //              the parts list (add, redraw, refit, undo, clear);
 //   layout.c   where a part goes: its view on the canvas, its placement in
 //              the world, attachment to a body;
+//   reach.c    a part drawn near a body fitted again to reach it;
 //   detail.c   details kept as ink bound to their part's mesh;
 //   animate.c  the clips as offsets, posing the dragon at a time;
 //   report.c   the report JSON;  export.c  the glTF export;
@@ -63,6 +64,10 @@ typedef struct tpl {
     // other parts and for the line template itself.
     struct tpl* line;
     bool* active; // the line template's solver moves these (param_count; NULL: all)
+    // The same fit with the attachment end held in place (reach.c; made on
+    // first use): every parameter of `active` but the root's translation.
+    sp_solver* pinned;
+    bool* pinned_active;
 } tpl;
 
 /// Drops one reference (the last frees it). NULL is fine.
@@ -295,6 +300,17 @@ int dragon_edge_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 
 void dragon_detail_hit_free(detail_hit* hit);
 /// Recomputes every attachment and the loop period (after any change of the parts).
 void dragon_relayout(sp_dragon* d);
+
+// ---- reach.c -----------------------------------------------------------------------
+
+/// Fits part p again with its attachment end held at canvas point `target`
+/// (a body's surface where the part's stroke comes nearest it): the root's
+/// translation set so that the end lies there and held, the rest of the
+/// pose fitted to the part's own stroke as before. Keeps the new fit
+/// (p->p_fit, p->pub.report) and returns true when the end got there and
+/// the fit is not clearly worse than the one it had; else leaves the part
+/// as it was.
+bool dragon_fit_reaching(sp_dragon* d, part* p, sp_vec2 target);
 
 // ---- detail.c ----------------------------------------------------------------------
 

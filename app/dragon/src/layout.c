@@ -838,6 +838,61 @@ static uint64_t bodies_key(const sp_dragon* d)
     return h;
 }
 
+// The body nearest canvas point a2 whose surface lies within `snap` of it,
+// and that surface point in *best; -1 for none.
+static int nearest_body_surface(sp_dragon* d, int i, sp_vec2 a2, double snap, surface_hit* best)
+{
+    int bk = -1;
+    best->dist = INFINITY;
+    for (int k = 0; k < d->part_n; ++k) {
+        part* q = d->parts[k];
+        if (k == i || !q->t->is_torso || !body_prepare(d, q)) continue;
+        // Only a body nearer than the snap distance and than the nearest
+        // so far can hold the part: the others' triangles need no look.
+        double within = fmin(snap, best->dist);
+        if (box_distance(a2, q->body_lo, q->body_hi) > within) continue;
+        surface_hit h;
+        if (nearest_surface(q, a2, within, &h) && h.dist < best->dist) *best = h, bk = k;
+    }
+    return bk;
+}
+
+// The stroke's points tried for where it comes nearest a body (evenly by index).
+#define REACH_SAMPLES 48
+
+// Where part i's stroke comes nearest a body it is drawn on or near
+// (dragon_on_body), within the snap distance: that body's surface point.
+// Of the stroke's points about that near (a stroke that overlaps the body
+// has many), the one nearest the fitted attachment end a2. -1: none.
+static int reach_target(sp_dragon* d, int i, sp_vec2 a2, sp_vec2* target)
+{
+    const part* p = d->parts[i];
+    sp_vec2 lo = {p->stroke_box[0], p->stroke_box[1]}, hi = {p->stroke_box[2], p->stroke_box[3]};
+    double snap = snap_px(d), dist[REACH_SAMPLES];
+    sp_vec2 at[REACH_SAMPLES], from[REACH_SAMPLES];
+    int body[REACH_SAMPLES], m = 0;
+    double bd = INFINITY;
+    for (int k = 0; k < d->part_n; ++k) {
+        part* q = d->parts[k];
+        if (k == i || !dragon_on_body(d, lo, hi, k) || !q->body_has_surface) continue;
+        for (int s = 0; s < REACH_SAMPLES && m < REACH_SAMPLES; ++s) {
+            sp_vec2 pt = p->stroke[(int)((long)s * (p->stroke_n - 1) / (REACH_SAMPLES - 1))];
+            surface_hit h;
+            if (box_distance(pt, q->body_lo, q->body_hi) > snap || !nearest_surface(q, pt, snap, &h)) continue;
+            dist[m] = h.dist, at[m] = h.px, from[m] = pt, body[m++] = k;
+            bd = fmin(bd, h.dist);
+        }
+    }
+    int best = -1;
+    for (int j = 0; j < m; ++j)
+        if (dist[j] <= bd + SAME_DISTANCE_PX + 0.02 * snap &&
+            (best < 0 || sp_v2_len(sp_v2_sub(from[j], a2)) < sp_v2_len(sp_v2_sub(from[best], a2))))
+            best = j;
+    if (best < 0) return -1;
+    *target = at[best];
+    return body[best];
+}
+
 // Lays part i out against the bodies: attached at the nearest body's
 // surface when its attachment end is within the snap distance of one, else
 // free where it was drawn.
@@ -856,19 +911,20 @@ static void layout_part(sp_dragon* d, int i)
     p->pub.attach_end = a2;
     if (p->t->is_torso) return;
     double snap = snap_px(d);
-    int bk = -1;
-    surface_hit best = {.dist = INFINITY};
-    for (int k = 0; k < d->part_n; ++k) {
-        part* q = d->parts[k];
-        if (k == i || !q->t->is_torso || !body_prepare(d, q)) continue;
-        // Only a body nearer than the snap distance and than the nearest
-        // so far can hold the part: the others' triangles need no look.
-        double within = fmin(snap, best.dist);
-        if (box_distance(a2, q->body_lo, q->body_hi) > within) continue;
-        surface_hit h;
-        if (nearest_surface(q, a2, within, &h) && h.dist < best.dist) best = h, bk = k;
+    surface_hit best;
+    int bk = nearest_body_surface(d, i, a2, snap, &best);
+    // The part just drawn near a body, its attachment end fitted farther
+    // from it: fitted again with that end held where the stroke comes
+    // nearest the body (reach.c). Only the newest part, at its first layout:
+    // an earlier part's fit stays what its own stroke made it.
+    sp_vec2 target;
+    if (bk < 0 && p->layout_key == 0 && i == d->part_n - 1 && reach_target(d, i, a2, &target) >= 0 &&
+        dragon_fit_reaching(d, p, target)) {
+        a = fitted_point(p, &p->pub.placement, p->t->attach_joint, p->t->attach_local);
+        p->pub.attach_end = a2 = sp_camera_project(&d->world, a);
+        bk = nearest_body_surface(d, i, a2, snap, &best);
     }
-    if (bk < 0 || !(best.dist <= snap)) return; // far from every body: free, where it was drawn
+    if (bk < 0) return; // far from every body: free, where it was drawn
     if (!d->parts[bk]->body_has_surface) {
         p->note = SP_DRAGON_NOTE_NO_SURFACE; // drawn at a body that cannot hold it: free
         return;

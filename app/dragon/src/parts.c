@@ -17,6 +17,8 @@ void dragon_tpl_release(tpl* t)
     dragon_tpl_release(t->line);
     sp_solver_destroy(t->solver);
     free(t->active);
+    sp_solver_destroy(t->pinned);
+    free(t->pinned_active);
     sp_rig_eval_destroy(t->ev);
     free(t->sockets);
     free(t->clip0);
