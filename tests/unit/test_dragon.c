@@ -3934,7 +3934,8 @@ static int spikes_along(const sp_vec2* body, int nb, double x0, double x1, doubl
 
 // Spikes drawn along a body's back are a detail of the body, kept as ink
 // whose points off the mesh are each carried by the vertex nearest them.
-// Before, the zigzag became a thin tail lying on the back. The README's
+// Before, the zigzag became a thin tail lying on the back, and low teeth
+// a pair of legs standing on it. The README's
 // dragon (docs/img/kiosk_detail.json: its body and head). The same zigzag
 // under the belly, far above the back, only a few teeth long or closed
 // into a loop is not.
@@ -3988,6 +3989,15 @@ static void test_spikes_on_the_back(void)
     fprintf(stderr, "  the exported spikes played back vs pose_at: %.2g world units\n", worst);
     ENSURE(worst < 0.5 * 2.0 / 800);
     ENSURE(sp_dragon_undo(d) && sp_dragon_detail_count(d) == 0);
+    // Low teeth (a review: 15-20 px high) lie on the body's own spikes in
+    // its mesh, few of their points off it: still ink along the back.
+    for (double tall = 12; tall <= 16; tall += 4) {
+        n = spikes_along(s6[0], n6[0], 430, 720, tall, false, sp, 128);
+        ENSURE(sp_dragon_add_points(d, sp, n, NULL, &res, &err) == SP_OK);
+        fprintf(stderr, "  spikes %.0f px high along the back: %s\n", tall, sp_dragon_reject_name(res.reason));
+        ENSURE(res.reason == SP_DRAGON_DETAIL && sp_dragon_detail_count(d) == 1);
+        ENSURE(sp_dragon_undo(d) && sp_dragon_detail_count(d) == 0);
+    }
     // Not along the back: under the belly (legs drawn short reach down there), 60 px above it, three teeth.
     const struct {
         const char* what;

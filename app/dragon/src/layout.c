@@ -703,6 +703,11 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
 // apart); mostly on it, it is drawn on the body (a detail or a part).
 #define EDGE_OUT 0.3
 #define EDGE_OFF 0.01
+// Or it lies wholly above the body's middle, its box's height at most this
+// fraction of its width: low teeth drawn on a body whose own spikes are in
+// its mesh lie on that mesh (a review: teeth 15-20 px high along the back
+// became a pair of legs standing on it).
+#define EDGE_FLAT 0.5
 // It runs along the body for at least this fraction of the body's size
 // (box diagonals): a small part drawn flat on the back is compact (the
 // on-body bench's wings at 0.3 of their size, 78 px against a body of 500).
@@ -733,7 +738,8 @@ int dragon_edge_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 
             along = dist <= band && (!off || x.y < 0.5 * (a.y + b.y));
             out += off;
         }
-        if (!along || out < EDGE_OUT * m) continue;
+        bool flat_top = hi.y - lo.y <= EDGE_FLAT * (hi.x - lo.x) && hi.y < 0.5 * (a.y + b.y);
+        if (!along || (out < EDGE_OUT * m && !flat_top)) continue;
         if (hit) { // the body's mesh at its fit (a body is shown where it was fitted), the hit's own copy
             double* xyz = malloc(sizeof(double) * 3 * (size_t)nv);
             sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)nv);
