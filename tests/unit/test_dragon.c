@@ -3724,6 +3724,45 @@ static void test_details_on_parts(void)
     ENSURE(sp_dragon_add_points(d, shade, 200, NULL, &res, &err) == SP_OK && res.reason == SP_DRAGON_DETAIL);
     sp_dragon_detail e; // kept, resampled along its length to at most SP_DRAGON_DETAIL_POINTS
     ENSURE(res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e) && e.point_count == SP_DRAGON_DETAIL_POINTS);
+    // A spot drawn half over a thin tail's edge (a review: "A bit bigger
+    // please" took it away): too small for a part, half on the tail, ink on
+    // it, whole. Drawn 40 px above the tail it is still too small.
+    xy = at_box_end("tail/tail-wavy-line.json", 260, 0.5 * (blo.y + bhi.y), false, blo, bhi, false, 30, &n);
+    int tail = add_as(d, xy, n, "tail");
+    free(xy);
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
+    sp_vec2 tlo, thi, edge = {0, INFINITY};
+    fitted_box(d, tail, &tlo, &thi);
+    sp_camera cam = sp_dragon_camera(d);
+    const double* txyz = sp_dragon_part_xyz(d, tail);
+    for (int v = 0; v < sp_dragon_part_get(d, tail)->character->rig.vertex_count; ++v) { // the top edge at the tail's middle
+        sp_vec2 x = sp_camera_project(&cam, (sp_vec3){txyz[3 * v], txyz[3 * v + 1], txyz[3 * v + 2]});
+        if (fabs(x.x - 0.5 * (tlo.x + thi.x)) < 8 && x.y < edge.y) edge = x;
+    }
+    ENSURE(isfinite(edge.y));
+    for (int above = 0; above < 2; ++above) {
+        small_loop((sp_vec2){edge.x, edge.y - (above ? 40 : 0)}, 8, loop);
+        ENSURE(sp_dragon_add_points(d, loop, 40, NULL, &res, &err) == SP_OK);
+        fprintf(stderr, "  a spot %s the tail's edge: %s\n", above ? "40 px above" : "over", sp_dragon_reject_name(res.reason));
+        if (above) {
+            ENSURE(res.reason == SP_DRAGON_TOO_SHORT);
+            continue;
+        }
+        ENSURE(res.reason == SP_DRAGON_DETAIL && res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e) && e.part == tail);
+        ENSURE(e.point_count >= 36); // its points off the tail are kept too
+        // Posed at t = 0 (the tail off its fit by its clip's first offsets): the spot, whole, where it was drawn.
+        ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
+        sp_vec2 ilo = {INFINITY, INFINITY}, ihi = {-INFINITY, -INFINITY}, slo, shi;
+        for (int k = 0; k < e.point_count; ++k) {
+            sp_vec2 q = ink_px(d, res.detail, k);
+            ilo.x = fmin(ilo.x, q.x), ilo.y = fmin(ilo.y, q.y), ihi.x = fmax(ihi.x, q.x), ihi.y = fmax(ihi.y, q.y);
+        }
+        points_box(loop, 40, &slo, &shi);
+        double size = hypot(ihi.x - ilo.x, ihi.y - ilo.y) / hypot(shi.x - slo.x, shi.y - slo.y),
+               moved = sp_v2_len(sp_v2_sub(sp_v2_add(ilo, ihi), sp_v2_add(slo, shi))) / 2;
+        fprintf(stderr, "  its ink %.2f its size, its centre %.1f px from the spot's\n", size, moved);
+        ENSURE(size > 0.85 && size < 1.2 && moved < 12);
+    }
     details_ride_their_part(d);
     sp_dragon_destroy(d);
 }

@@ -579,7 +579,14 @@ static int part_near_stroke(sp_dragon* d, int k, sp_vec2 lo, sp_vec2 hi, double*
     return 1;
 }
 
-int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+// A speck (a stroke too small to become a part) needs only this share of
+// its points on a part: a spot drawn at a thin tail's edge lies half off it.
+#define SPECK_ON 0.5
+
+// dragon_detail_of with `on`, the share of points that must lie on the
+// part, and what becomes of the points off it.
+static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, double on, detail_air air,
+                       detail_hit* hit)
 {
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
@@ -607,17 +614,28 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
         for (int s = 0; detail && s < m; ++s) { // stops once too many points are off
             // Half a cell's diagonal more: a point in a covered cell is on the mesh.
             off += !covered_near(cells, w, h, o, pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)], near + 0.71);
-            detail = off <= (1 - DETAIL_ON) * m;
+            detail = off <= (1 - on) * m;
         }
         free(cells);
         if (detail && hit) {
-            *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = near + 0.71};
+            *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = near + 0.71, .air = air};
             return k;
         }
         free(xyz), free(px);
         if (detail) return k;
     }
     return -1;
+}
+
+int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+{
+    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, DETAIL_AIR_NONE, hit);
+}
+
+int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+{
+    if (!(hypot(hi.x - lo.x, hi.y - lo.y) < SP_DRAGON_PART_MIN * hypot(d->desc.canvas_w, d->desc.canvas_h))) return -1;
+    return detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_AIR_EACH, hit);
 }
 
 // A flourish (fire from a mouth, a spade at a tail's tip, a crown on a

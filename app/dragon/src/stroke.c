@@ -891,13 +891,15 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     sp_clf_answer a;
     sp_dragon_reject why = classify_and_decide(d, &sk, o.category, out, category, &confidence, &near, &a);
     // A small stroke drawn on a part is a detail of it (an eye, spots,
-    // shading), and one drawn along a body's edge too (spikes on its back):
-    // a tiny or thin part there is not what was meant. It is kept as ink on
+    // shading), one drawn along a body's edge too (spikes on its back), and
+    // a speck half on a part (a spot at a thin tail's edge): a tiny or thin
+    // part there is not what was meant. It is kept as ink on
     // the part; its guesses stay, so a chip still makes it a part.
     detail_hit hit = {0};
     int skip = o.replace_last ? d->part_n - 1 : -1;
     if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
-        (dragon_detail_of(d, pts, n, lo, hi, skip, &hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, &hit) >= 0))
+        (dragon_detail_of(d, pts, n, lo, hi, skip, &hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, &hit) >= 0 ||
+         dragon_speck_of(d, pts, n, lo, hi, skip, &hit) >= 0))
         why = SP_DRAGON_DETAIL;
     bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
     if (flourish) why = SP_DRAGON_DETAIL;
