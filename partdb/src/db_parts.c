@@ -59,10 +59,15 @@ static double self_test(const sp_character* ch, int abstraction, int seeds, char
     double* p = malloc(sizeof(double) * (size_t)rig->param_count);
     double* q = malloc(sizeof(double) * (size_t)rig->param_count);
     sp_solver* s;
-    sp_solver_create(rig, abstraction, &ch->camera, &(sp_solve_desc){.time_cap_ms = 2000}, &s, NULL);
+    sp_error serr = {0};
+    sp_solver_create(rig, abstraction, &ch->camera, &(sp_solve_desc){.time_cap_ms = 2000}, &s, &serr);
     double sum = 0;
     int done = 0;
-    if (!p || !q || !s) {
+    if (!s) {
+        add_reason(reasons, cap, "self-test: %s", serr.text);
+        goto out;
+    }
+    if (!p || !q) {
         add_reason(reasons, cap, "self-test: out of memory");
         goto out;
     }

@@ -741,18 +741,21 @@ static int bbm_columns(const sp_model* m, bool abstraction, int v, int* out)
     return m->P;
 }
 
-static bool bbm_prepare(sp_model* m, const int* reps, int k)
+static sp_result bbm_prepare(sp_model* m, const int* reps, int k, sp_error* err)
 {
     bb_model* B = (bb_model*)m;
     sp_blackbox_fd_destroy(B->fd);
-    sp_blackbox_fd_create(B->bb, B->a, reps, k, B->threads, &B->fd, NULL);
     size_t P = (size_t)m->P;
     free(B->pJ), free(B->Jr), free(B->Jz);
+    B->pJ = B->Jr = B->Jz = NULL;
     B->J_valid = false;
+    sp_result r = sp_blackbox_fd_create(B->bb, B->a, reps, k, B->threads, &B->fd, err);
+    if (r != SP_OK) return r;
     B->pJ = malloc(sizeof(double) * P);
     B->Jr = malloc(sizeof(double) * (3 * (size_t)k * P + 1));
     B->Jz = malloc(sizeof(double) * (3 * (size_t)m->ab->point_count * P + 1));
-    return B->fd && B->pJ && B->Jr && B->Jz;
+    if (!B->pJ || !B->Jr || !B->Jz) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory making a solver", B->bb->what);
+    return SP_OK;
 }
 
 static void bbm_fail(bb_model* B, const sp_error* e)

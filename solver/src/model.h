@@ -31,8 +31,10 @@ typedef struct sp_model_ops {
     // vertex v (abstraction false) or abstraction point v (true): the
     // parameters that can move it. Writes at most 12 * P entries.
     int (*columns)(const sp_model* m, bool abstraction, int v, int* out);
-    // Called once after the coarsening with the representatives' vertex indices.
-    bool (*prepare)(sp_model* m, const int* reps, int k);
+    // Called once after the coarsening with the representatives' vertex
+    // indices. On failure err says why (out of memory, a thread that cannot
+    // start): the solver's creation fails with that result and text.
+    sp_result (*prepare)(sp_model* m, const int* reps, int k, sp_error* err);
     // Sets the state to p (param_count values, inside the bounds). With
     // `derivatives`, the next jacobians() call is at p.
     void (*update)(sp_model* m, const double* p, bool derivatives);

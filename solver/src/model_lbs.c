@@ -142,7 +142,7 @@ static int union_columns(const reg_lbs* R, const int* joints, int n, int* out, i
 }
 
 // The pair structure of the representatives (fixed by the coarsening).
-static bool lbs_prepare(sp_model* m, const int* reps, int k)
+static sp_result lbs_prepare(sp_model* m, const int* reps, int k, sp_error* err)
 {
     lbs_model* L = (lbs_model*)m;
     const sp_rig* rig = L->rig;
@@ -242,7 +242,7 @@ static bool lbs_prepare(sp_model* m, const int* reps, int k)
     free(cols);
 done:
     free(pairs), free(mark);
-    return ok;
+    return ok ? SP_OK : sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making a solver (%d joints, %d representatives)", nj, k);
 }
 
 // Fills the moments for a solve starting at the current state.

@@ -320,7 +320,13 @@ sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_so
     s->ab_sb = malloc(sizeof(sparse_block) * (size_t)(l > 0 ? l : 1));
     s->rep_sb = malloc(sizeof(sparse_block) * (size_t)(s->k > 0 ? s->k : 1));
     size_t ab_total = 0, rep_total = 0;
-    if (!tmp || !s->ab_sb || !s->rep_sb || !s->reps || !m->ops->prepare(m, s->reps, s->k)) goto fail;
+    if (!tmp || !s->ab_sb || !s->rep_sb || !s->reps) goto fail;
+    sp_result prepared = m->ops->prepare(m, s->reps, s->k, err);
+    if (prepared != SP_OK) {
+        free(tmp);
+        sp_solver_destroy(s);
+        return prepared;
+    }
     for (int pass = 0; pass < 2; ++pass) {
         ab_total = rep_total = 0;
         for (int i = 0; i < l; ++i) {

@@ -3,6 +3,8 @@
 # built from unit/blackbox_plugin.c, one defect each), recovery on the face
 # plugin, and `sketchpose synth/pose --rig face.so`.
 sp_unit_test(blackbox TIMEOUT 300 LIBS sp::plugin)
+# test_creation_says_why stands in for pthread_create.
+target_link_options(test_blackbox PRIVATE -Wl,--wrap=pthread_create)
 set(SP_TEST_PLUGIN_DIR ${PROJECT_BINARY_DIR}/tests/plugins)
 foreach(variant good nosym null badversion badsize badtri badrest nan nanlater)
   add_library(sp_test_bb_${variant} MODULE unit/blackbox_plugin.c)

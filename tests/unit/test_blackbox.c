@@ -5,6 +5,8 @@
 // honoured, and the commands on a plugin (`sketchpose synth/pose/inspect/
 // render/export --rig face.so`; drawover and animate refuse one).
 #include <elf.h>
+#include <errno.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
@@ -810,8 +812,19 @@ static void test_cli(void)
     cli_plugin_other_commands(bin, s, t);
 }
 
+// blackbox.cmake links with --wrap=pthread_create: while refuse_threads is
+// set, no thread starts, as when a process has reached its thread limit.
+static atomic_bool refuse_threads;
+int __real_pthread_create(pthread_t* t, const pthread_attr_t* a, void* (*fn)(void*), void* arg);
+int __wrap_pthread_create(pthread_t* t, const pthread_attr_t* a, void* (*fn)(void*), void* arg);
+int __wrap_pthread_create(pthread_t* t, const pthread_attr_t* a, void* (*fn)(void*), void* arg)
+{
+    return refuse_threads ? EAGAIN : __real_pthread_create(t, a, fn, arg);
+}
+
 // The creators say why they refuse (docs/DESIGN.md, "API conventions"):
-// *out NULL, SP_ERR_INVALID and a line naming the rig; err may be NULL.
+// *out NULL, SP_ERR_INVALID and a line naming the rig (SP_ERR_INTERNAL for
+// threads that cannot start); err may be NULL.
 static void test_creation_says_why(void)
 {
     sp_rig rig;
@@ -835,6 +848,13 @@ static void test_creation_says_why(void)
     snprintf(want, sizeof want, "lbs box: row 0 is vertex %d, out of range", row);
     ENSURE(strstr(err.text, want));
     ENSURE(sp_blackbox_fd_create(bb, -1, NULL, 0, 1, &fd, NULL) == SP_ERR_INVALID && !fd);
+    // Threads that cannot start: said so, not that memory ran out.
+    refuse_threads = true;
+    sp_result r = sp_solver_create_blackbox(bb, 0, &cam, &(sp_solve_desc){.threads = 2}, &s, &err);
+    refuse_threads = false;
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(r == SP_ERR_INTERNAL && !s);
+    ENSURE(strstr(err.text, "lbs box: cannot start finite-difference thread 1"));
     ENSURE(sp_solver_create_blackbox(bb, 0, &cam, NULL, &s, NULL) == SP_OK && s);
     sp_solver_destroy(s);
     sp_blackbox_destroy(bb);

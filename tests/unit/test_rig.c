@@ -338,7 +338,7 @@ static void check_regularisers(bool one_view)
     int* reps = malloc(sizeof(int) * k);
     for (int i = 0; i < k; ++i) reps[i] = 3 * i;
     sp_model* m = sp__model_lbs_create(&rig, 0);
-    ENSURE(m && m->ops->reg_normal && m->ops->prepare(m, reps, k));
+    ENSURE(m && m->ops->reg_normal && m->ops->prepare(m, reps, k, NULL) == SP_OK);
     double* p0 = malloc(sizeof(double) * P);
     double* p1 = malloc(sizeof(double) * P);
     double* d = malloc(sizeof(double) * k);

@@ -82,24 +82,43 @@ static void read_part_extras(tpl* t)
     }
 }
 
+// The template's clip: the first animation of its rig with channels.
+static void find_clip(tpl* t)
+{
+    const sp_rig* rig = &t->ch.rig;
+    for (int a = 0; a < rig->animation_count && !t->clip; ++a) {
+        const sp_animation* an = &rig->animations[a];
+        double start = INFINITY, end = -INFINITY;
+        for (int k = 0; k < an->channel_count; ++k)
+            if (an->channels[k].key_count > 0) {
+                start = fmin(start, an->channels[k].times[0]);
+                end = fmax(end, an->channels[k].times[an->channels[k].key_count - 1]);
+            }
+        if (end - start > 1e-3 && isfinite(end - start)) {
+            t->clip = an;
+            t->clip_start = start;
+            t->clip_len = end - start;
+        }
+    }
+}
+
 // Loads part `name` from the database as a template fitted with its
 // abstraction (`outline`); or, with line_of, makes line_of's part fitted
-// with a `line` added to it, from a copy of its character (NULL, and
-// nothing in err, when its skeleton has no line).
-static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve,
-                     sp_error* err)
+// with a `line` added to it, from a copy of its character (SP_OK, *out
+// NULL and nothing in err when its skeleton has no line).
+static sp_result tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve,
+                          tpl** out, sp_error* err)
 {
+    *out = NULL;
     tpl* t = calloc(1, sizeof *t);
-    if (!t) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-        return NULL;
-    }
+    if (!t) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     t->refs = 1;
     sp_db_part_info info;
-    if (line_of ? sp_character_clone(&line_of->ch, &t->ch, err) != SP_OK
-                : sp_db_part(db, name, &info, err) != SP_OK || sp_db_load_part(db, name, &t->ch, err) != SP_OK) {
+    sp_result r = line_of ? sp_character_clone(&line_of->ch, &t->ch, err) : sp_db_part(db, name, &info, err);
+    if (r == SP_OK && !line_of) r = sp_db_load_part(db, name, &t->ch, err);
+    if (r != SP_OK) {
         free(t);
-        return NULL;
+        return r;
     }
     dragon_copy_name(t->name, sizeof t->name, name);
     dragon_copy_name(t->category, sizeof t->category, line_of ? line_of->category : info.category);
@@ -107,9 +126,9 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
     const sp_rig* rig = &t->ch.rig;
     if (line_of) {
         bool added = false;
-        if (sp_rig_add_line(&t->ch.rig, &added, err) != SP_OK || !added) {
+        if ((r = sp_rig_add_line(&t->ch.rig, &added, err)) != SP_OK || !added) {
             dragon_tpl_release(t);
-            return NULL;
+            return r;
         }
         t->abstraction = sp_rig_find_abstraction(rig, "line");
     } else {
@@ -126,11 +145,11 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
     double* xy =
         t->abstraction >= 0 ? malloc(sizeof(double) * 2 * ((size_t)rig->abstractions[t->abstraction].point_count + 1)) : NULL;
     if (!t->ev || !t->scratch_p || !t->tr || !t->sc || !t->rot || !xyz || (t->abstraction >= 0 && !xy)) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
         goto fail;
     }
     if (t->abstraction < 0 || rig->abstractions[t->abstraction].point_count < 2) {
-        sp_fail(err, SP_ERR_INVALID, "part %s: no sketch abstraction to fit", name);
+        r = sp_fail(err, SP_ERR_INVALID, "part %s: no sketch abstraction to fit", name);
         goto fail;
     }
     // The rest pose: where sockets and attach points are given, and the depth reference.
@@ -160,7 +179,7 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
     }
     double diag = sp_v2_len(sp_v2_sub(t->rest_hi, t->rest_lo));
     if (!(diag > 1e-6) || !isfinite(diag)) {
-        sp_fail(err, SP_ERR_INVALID, "part %s: its abstraction is invisible in its sketch view", name);
+        r = sp_fail(err, SP_ERR_INVALID, "part %s: its abstraction is invisible in its sketch view", name);
         goto fail;
     }
     // Which way it reaches from its attachment end, as modelled: sideways
@@ -169,25 +188,11 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
     sp_vec2 reach = sp_v2_sub(sp_v2_scale(sp_v2_add(t->rest_lo, t->rest_hi), 0.5), at);
     t->lengthwise = !t->is_torso && fabs(reach.x) > fabs(reach.y);
     t->outward = reach.x >= 0 ? 1 : -1;
-    // The clip: the first animation with channels.
-    for (int a = 0; a < rig->animation_count && !t->clip; ++a) {
-        const sp_animation* an = &rig->animations[a];
-        double start = INFINITY, end = -INFINITY;
-        for (int k = 0; k < an->channel_count; ++k)
-            if (an->channels[k].key_count > 0) {
-                start = fmin(start, an->channels[k].times[0]);
-                end = fmax(end, an->channels[k].times[an->channels[k].key_count - 1]);
-            }
-        if (end - start > 1e-3 && isfinite(end - start)) {
-            t->clip = an;
-            t->clip_start = start;
-            t->clip_len = end - start;
-        }
-    }
+    find_clip(t);
     if (t->clip) {
         t->clip0 = malloc(sizeof(double) * P);
         if (!t->clip0) {
-            sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
             goto fail;
         }
         // Offsets relative to rest (docs/DESIGN.md, "Animation clips as
@@ -204,7 +209,7 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
         // the root's size move, so a tail drawn as a line is not fattened.
         t->active = malloc(sizeof(bool) * P);
         if (!t->active) {
-            sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "part %s: out of memory", name);
             goto fail;
         }
         for (int k = 0; k < rig->param_count; ++k)
@@ -212,9 +217,9 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
                            (rig->joints[rig->params[k].joint].parent < 0 && rig->params[k].channel == SP_CH_S);
         sd.active = t->active;
     }
-    sp_solver_create(rig, t->abstraction, &t->solver_cam, &sd, &t->solver, NULL);
-    if (!t->solver) {
-        sp_fail(err, SP_ERR_NO_MEMORY, "part %s: cannot prepare the solver (out of memory)", name);
+    sp_error serr = {0};
+    if ((r = sp_solver_create(rig, t->abstraction, &t->solver_cam, &sd, &t->solver, &serr)) != SP_OK) {
+        sp_fail(err, r, "part %s: cannot prepare the solver: %s", name, serr.text);
         goto fail;
     }
     free(xyz);
@@ -222,19 +227,20 @@ static tpl* tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas
     int ends[2];
     if (!line_of && !t->is_torso && sp_rig_line_joints(rig, ends, 2) > 0) {
         sp_error lerr = {0}; // a part whose line cannot be made is still fitted with its outline
-        t->line = tpl_load(db, t, name, canvas_w, canvas_h, solve, &lerr);
+        tpl_load(db, t, name, canvas_w, canvas_h, solve, &t->line, &lerr);
         if (t->line) {
             // Which way the part reaches is the part's, whichever curve is fitted.
             t->line->lengthwise = t->lengthwise;
             t->line->outward = t->outward;
         }
     }
-    return t;
+    *out = t;
+    return SP_OK;
 fail:
     free(xyz);
     free(xy);
     dragon_tpl_release(t);
-    return NULL;
+    return r;
 }
 
 void dragon_part_free(part* p)
@@ -256,6 +262,7 @@ void dragon_part_free(part* p)
 
 struct dragon_failed {
     char name[SP_NAME_MAX];
+    sp_result code;
     char why[512];
 };
 
@@ -411,7 +418,7 @@ static const struct dragon_failed* failed_before(const sp_dragon* d, const char*
 
 // Remembers that part `name` did not load, and why (with no memory to
 // remember it, it is simply tried again).
-static void fail_part(sp_dragon* d, const char* name, const char* why)
+static void fail_part(sp_dragon* d, const char* name, sp_result code, const char* why)
 {
     snprintf(d->part_error, sizeof d->part_error, "%s", why);
     struct dragon_failed* f = realloc(d->failed, sizeof *f * (size_t)(d->failed_n + 1));
@@ -419,6 +426,7 @@ static void fail_part(sp_dragon* d, const char* name, const char* why)
     d->failed = f;
     f += d->failed_n++;
     snprintf(f->name, sizeof f->name, "%s", name);
+    f->code = code;
     snprintf(f->why, sizeof f->why, "%s", why);
 }
 
@@ -426,10 +434,11 @@ static void fail_part(sp_dragon* d, const char* name, const char* why)
 static tpl* cache_load(sp_dragon* d, const char* name, sp_error* err)
 {
     sp_error lerr = {0};
-    tpl* t = tpl_load(d->db, NULL, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, &lerr);
-    if (!t) {
-        fail_part(d, name, lerr.text);
-        sp_fail(err, SP_ERR_PARSE, "%s", lerr.text);
+    tpl* t = NULL;
+    sp_result r = tpl_load(d->db, NULL, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, &t, &lerr);
+    if (r != SP_OK) {
+        fail_part(d, name, r, lerr.text);
+        sp_fail(err, r, "%s", lerr.text);
         return NULL;
     }
     tpl** c = realloc(d->cache, sizeof(tpl*) * (size_t)(d->cache_n + 1));
@@ -464,7 +473,7 @@ int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int
         const struct dragon_failed* f = t ? NULL : failed_before(d, names[i]);
         if (f) { // skipped, as it was when it failed
             snprintf(d->part_error, sizeof d->part_error, "%s", f->why);
-            sp_fail(err, SP_ERR_PARSE, "%s", f->why);
+            sp_fail(err, f->code, "%s", f->why);
             continue;
         }
         if (!t && !(t = cache_load(d, names[i], err))) continue; // a part that does not load is skipped; err keeps why
