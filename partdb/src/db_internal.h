@@ -61,10 +61,13 @@ const char* db_who(const char* by);
 /// Inserts one sketch (strokes or raster) inside the caller's transaction.
 sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source, int64_t part_id, const sp_sample* smp,
                            const sp_db_png* png, const char* by, sp_error* err);
+/// Significant digits of a stored sketch's numbers. Not SP_SKETCH_JSON_EXACT:
+/// the default database's model is trained from the stored text, and 17
+/// digits change it (and the visitors' answers); a change of this is a
+/// change of every database's training data.
+#define DB_SKETCH_DIGITS 9
 /// Checks a sample is storable (strokes with finite points, or a raster).
 sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err);
-/// Serialises strokes as a sketchpose-strokes JSON document (malloc'd).
-char* db_sketch_json(const sp_sketch* s);
 /// Reads a whole file (malloc'd, NUL-terminated beyond size).
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err);
 /// Reads and parses a JSON file: *root NULL when its bytes are not JSON (the

@@ -65,7 +65,7 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
     char what[sizeof why.text];
     snprintf(what, sizeof what, "%s: kiosk sketch", db->path);
     if (db_sample_ok(&smp, what, &why) != SP_OK) return sp_fail(err, SP_ERR_INVALID, "%s; sketch dropped", why.text);
-    char* json = db_sketch_json(&smp.sketch);
+    char* json = sp_sketch_to_json(&smp.sketch, DB_SKETCH_DIGITS);
     if (!json) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: kiosk sketch: out of memory; sketch dropped", db->path);
     // The UI thread must not wait: a short busy timeout, and a commit that
     // does not wait for the disk (WAL with synchronous NORMAL stays consistent

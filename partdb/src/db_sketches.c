@@ -19,36 +19,6 @@ const char* sp_db_source_name(sp_db_source s)
     return "curated";
 }
 
-char* db_sketch_json(const sp_sketch* s)
-{
-    db_str b = {0};
-    db_str_printf(&b, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [%.9g, %.9g], \"strokes\": [", s->canvas_w,
-                  s->canvas_h);
-    bool times = s->stroke_count > 0;
-    for (int i = 0; i < s->stroke_count; ++i)
-        if (!s->strokes[i].t) times = false;
-    for (int i = 0; i < s->stroke_count; ++i) {
-        const sp_stroke* k = &s->strokes[i];
-        db_str_printf(&b, "%s{\"points\": [", i ? ", " : "");
-        for (int j = 0; j < k->count; ++j)
-            db_str_printf(&b, "%s[%.9g, %.9g]", j ? ", " : "", k->points[j].x, k->points[j].y);
-        db_str_printf(&b, "]");
-        if (times) {
-            db_str_printf(&b, ", \"t\": [");
-            for (int j = 0; j < k->count; ++j)
-                db_str_printf(&b, "%s%.9g", j ? ", " : "", k->t[j]);
-            db_str_printf(&b, "]");
-        }
-        db_str_printf(&b, "}");
-    }
-    db_str_printf(&b, "]}");
-    if (b.oom) {
-        free(b.s);
-        return NULL;
-    }
-    return b.s;
-}
-
 sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err)
 {
     if (smp->raster.pixels) {
@@ -98,7 +68,7 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
         if (png && png->bytes && (r = db_bind_blob(db, st, 8, png->bytes, png->size, "the drawing's PNG", err)) != SP_OK)
             return r;
     } else {
-        if (!(json = db_sketch_json(&smp->sketch))) {
+        if (!(json = sp_sketch_to_json(&smp->sketch, DB_SKETCH_DIGITS))) {
             sqlite3_finalize(st);
             return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         }

@@ -655,35 +655,51 @@ sp_result sp_sketch_read_json(const char* path, sp_sketch* out, sp_error* err)
     return rc;
 }
 
-sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* err)
+char* sp_sketch_to_json(const sp_sketch* s, int digits)
 {
-    if (!sp_sketch_is_valid(s)) return sp_fail(err, SP_ERR_INVALID, "%s: sketch has non-finite values", path);
-    // Made in memory and written whole (sp_file_write): a failed write leaves no half a file.
     char* text = NULL;
     size_t len = 0;
     FILE* f = open_memstream(&text, &len);
-    if (!f) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    if (!f) return NULL;
     bool all_t = s->stroke_count > 0;
     for (int i = 0; i < s->stroke_count; ++i)
         if (!s->strokes[i].t) all_t = false;
-    fprintf(f, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [%.17g, %.17g], \"strokes\": [", s->canvas_w,
+    const int d = digits;
+    fprintf(f, "{\"format\": \"sketchpose-strokes\", \"version\": 1, \"canvas\": [%.*g, %.*g], \"strokes\": [", d, s->canvas_w, d,
             s->canvas_h);
     for (int i = 0; i < s->stroke_count; ++i) {
         const sp_stroke* st = &s->strokes[i];
         fprintf(f, "%s\n  {\"points\": [", i ? "," : "");
         for (int j = 0; j < st->count; ++j)
-            fprintf(f, "%s[%.17g, %.17g]", j ? ", " : "", st->points[j].x, st->points[j].y);
+            fprintf(f, "%s[%.*g, %.*g]", j ? ", " : "", d, st->points[j].x, d, st->points[j].y);
         fprintf(f, "]");
         if (all_t) {
             fprintf(f, ", \"t\": [");
             for (int j = 0; j < st->count; ++j)
-                fprintf(f, "%s%.17g", j ? ", " : "", st->t[j]);
+                fprintf(f, "%s%.*g", j ? ", " : "", d, st->t[j]);
             fprintf(f, "]");
         }
         fprintf(f, "}");
     }
     fprintf(f, "%s]}\n", s->stroke_count ? "\n" : "");
-    return sp_file_write_printed(path, f, &text, &len, err);
+    bool bad = ferror(f) != 0;
+    bad = fclose(f) != 0 || bad; // fclose sets text and len
+    if (bad) {
+        free(text);
+        return NULL;
+    }
+    return text;
+}
+
+sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* err)
+{
+    if (!sp_sketch_is_valid(s)) return sp_fail(err, SP_ERR_INVALID, "%s: sketch has non-finite values", path);
+    // Made in memory and written whole (sp_file_write): a failed write leaves no half a file.
+    char* text = sp_sketch_to_json(s, SP_SKETCH_JSON_EXACT);
+    if (!text) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    sp_result r = sp_file_write(path, text, strlen(text), err);
+    free(text);
+    return r;
 }
 
 // ---------------------------------------------------------------------------

@@ -115,7 +115,8 @@ int main(int argc, char** argv)
     int timed = count < 1000 ? count : 1000;
     char* text[DISTINCT];
     for (int i = 0; i < nd; ++i)
-        text[i] = db_sketch_json(&(sp_sketch){.canvas_w = 1280, .canvas_h = 800, .stroke_count = 1, .strokes = &strokes[i]});
+        text[i] = sp_sketch_to_json(&(sp_sketch){.canvas_w = 1280, .canvas_h = 800, .stroke_count = 1, .strokes = &strokes[i]},
+                                    DB_SKETCH_DIGITS);
     sqlite3_stmt* st;
     if (db_begin(db, &err) != SP_OK ||
         db_prepare(db,

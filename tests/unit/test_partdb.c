@@ -352,6 +352,82 @@ static void test_round_trip(void)
     sp_fixture_remove_db(empty);
 }
 
+// A stored sketch's doubles survive export and rebuild exactly, and the
+// stroke text's writer at SP_SKETCH_JSON_EXACT digits loses none (the
+// database stores DB_SKETCH_DIGITS: db_internal.h says why).
+static void same_bits(const sp_sketch* a, const sp_sketch* b)
+{
+    ENSURE(a->stroke_count == 1 && b->stroke_count == 1 && a->strokes[0].count == b->strokes[0].count);
+    ENSURE(!memcmp(&a->canvas_w, &b->canvas_w, sizeof a->canvas_w) && !memcmp(&a->canvas_h, &b->canvas_h, sizeof a->canvas_h));
+    ENSURE(!memcmp(a->strokes[0].points, b->strokes[0].points, sizeof(sp_vec2) * (size_t)a->strokes[0].count));
+    ENSURE(b->strokes[0].t && !memcmp(a->strokes[0].t, b->strokes[0].t, sizeof(double) * (size_t)a->strokes[0].count));
+}
+
+// The stored sketch of 7 timed points in the database at `path` (ds keeps it).
+static const sp_sketch* stored_sketch_of(const char* path, sp_dataset* ds)
+{
+    sp_db* db = open_ok(path, 0);
+    sp_error err = {0};
+    ENSURE(sp_db_load_dataset(db, ds, NULL, &err) == SP_OK);
+    sp_db_close(db);
+    const sp_sketch* found = NULL;
+    for (int i = 0; i < ds->count; ++i) {
+        const sp_sketch* k = &ds->samples[i].sketch;
+        if (k->stroke_count == 1 && k->strokes[0].count == 7 && k->strokes[0].t) {
+            ENSURE(!found);
+            found = k;
+        }
+    }
+    ENSURE(found);
+    return found;
+}
+
+static void test_sketch_doubles_exact(void)
+{
+    sp_vec2 pts[7] = {{0.1 + 0.2, 1.0 / 3.0},
+                      {100.0 / 7.0, 2.0 / 3.0},
+                      {1e-17, 123.456789012345678},
+                      {640.0000000000001, 1.1},
+                      {3.14159265358979, 2.718281828459045},
+                      {0.7, 0.1 * 3},
+                      {799.99999999999989, 5e-324}};
+    double t[7] = {0, 16.666666666666668, 33.333333333333336, 50.00000000000001, 66.7, 83.3, 1.0 / 7.0 + 100};
+    sp_stroke k = {.points = pts, .t = t, .count = 7};
+    sp_sketch sk = {.canvas_w = 1280.0000000000002, .canvas_h = 800.0 / 3.0, .stroke_count = 1, .strokes = &k};
+    sp_error err = {0};
+    char* text = sp_sketch_to_json(&sk, SP_SKETCH_JSON_EXACT);
+    sp_sketch back = {0};
+    ENSURE(text && sp_sketch_parse_json(text, strlen(text), "exact", &back, &err) == SP_OK);
+    same_bits(&sk, &back);
+    sp_sketch_free(&back);
+    free(text);
+    char p[1024], p2[1024], dir[1024], cmd[1100];
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("exact.db"));
+    snprintf(p2, sizeof p2, "%s", sp_test_tmp_path("exact_rebuilt.db"));
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("exact_export"));
+    sp_fixture_remove_db(p);
+    sp_fixture_remove_db(p2);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ENSURE(system(cmd) == 0);
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    add_ok(db, 0, 0);
+    char* cat = strdup(k_parts[0].category);
+    sp_sample smp = {.sketch = sk, .label = 0};
+    sp_dataset in = {.categories = &cat, .category_count = 1, .samples = &smp, .count = 1};
+    int n = 0;
+    ENSURE(sp_db_add_sketches(db, &in, NULL, SP_DB_SOURCE_CURATED, "test", &n, &err) == SP_OK && n == 1);
+    free(cat);
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
+    sp_db_close(db);
+    ENSURE(sp_db_create_from_export(p2, dir, NULL, "test", &err) == SP_OK);
+    sp_dataset d1 = {0}, d2 = {0};
+    const sp_sketch* s1 = stored_sketch_of(p, &d1);
+    same_bits(s1, stored_sketch_of(p2, &d2));
+    ENSURE(fabs(s1->strokes[0].points[0].x - pts[0].x) < 1e-12);
+    sp_dataset_free(&d1);
+    sp_dataset_free(&d2);
+}
+
 static void test_curator_category(void)
 {
     char p[1024];
@@ -2896,6 +2972,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"sha256", test_sha256},
                                    {"round_trip", test_round_trip},
+                                   {"sketch_doubles_exact", test_sketch_doubles_exact},
                                    {"export_whole", test_export_whole},
                                    {"durable", test_durable},
                                    {"model_in_memory", test_model_in_memory},

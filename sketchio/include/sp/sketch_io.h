@@ -71,6 +71,12 @@ sp_result sp_sketch_read_json(const char* path, sp_sketch* out, sp_error* err);
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err);
 /// Writes a sketch as a JSON stroke file (version 1). Times are written when every stroke has them.
 sp_result sp_sketch_write_json(const char* path, const sp_sketch* s, sp_error* err);
+/// Significant digits with which every double reads back exactly.
+#define SP_SKETCH_JSON_EXACT 17
+/// A sketch as JSON stroke text (NUL-terminated, malloc'd: the caller frees
+/// it), each number with `digits` significant digits (sp_sketch_write_json:
+/// SP_SKETCH_JSON_EXACT). NULL when out of memory.
+char* sp_sketch_to_json(const sp_sketch* s, int digits);
 
 /// Reads an SVG drawing: one stroke per subpath (and per <line>/<polyline>/<polygon>).
 sp_result sp_sketch_read_svg(const char* path, sp_sketch* out, sp_error* err);
