@@ -158,6 +158,9 @@ sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* er
     return sp_file_read(path, (size_t)1 << 30, data, size, err);
 }
 
+// Not sp_file_write: export writes its files into a fresh temporary folder,
+// synced as a tree and renamed into place whole (db_folder.c), so a file's
+// own temporary copy, fsync and folder sync would only cost a sync a file.
 sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err)
 {
     FILE* f = fopen(path, "wb");
@@ -669,25 +672,23 @@ static bool written_after(const struct stat* w, const struct stat* db)
 // The -shm's times say nothing (readers write it), so only the WAL's are compared.
 void sp_db_drop_stale_sidecars(const char* path)
 {
-    char wal[1100], shm[1100];
-    snprintf(wal, sizeof wal, "%s-wal", path);
-    snprintf(shm, sizeof shm, "%s-shm", path);
     struct stat db, w;
     if (stat(path, &db) != 0) return;
     // Another handle of ours on the new file made those, or uses them (the
     // kiosk's collector follows a replaced file before its pipeline does).
     if (open_here(&db)) return;
-    if (stat(wal, &w) == 0 && written_after(&w, &db)) return;
-    int fd = open(shm, O_RDWR);
+    // Whole names or none: a name cut short could be the database's own.
+    char *wal = side_path(path, 0), *shm = side_path(path, 1);
+    bool drop = wal && shm && !(stat(wal, &w) == 0 && written_after(&w, &db));
+    int fd = drop ? open(shm, O_RDWR) : -1;
     if (fd >= 0) {
         // SQLite's unix VFS locks bytes 120..128 of the -shm (the lock slots and the dead man switch).
         struct flock fl = {.l_type = F_WRLCK, .l_whence = SEEK_SET, .l_start = 120, .l_len = 9};
-        bool used = fcntl(fd, F_GETLK, &fl) != 0 || fl.l_type != F_UNLCK;
+        drop = fcntl(fd, F_GETLK, &fl) == 0 && fl.l_type == F_UNLCK;
         close(fd);
-        if (used) return;
     }
-    unlink(wal);
-    unlink(shm);
+    if (drop) unlink(wal), unlink(shm);
+    free(wal), free(shm);
 }
 
 sp_result sp_db_checkpoint(sp_db* db, sp_error* err)

@@ -73,7 +73,7 @@ sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* er
 /// Reads and parses a JSON file: *root NULL when its bytes are not JSON (the
 /// caller names what it wanted); errors are the reading's.
 sp_result db_read_json(const char* path, cJSON** root, sp_error* err);
-/// Writes a whole file.
+/// Writes a whole file in place (for files in a folder put in place whole; else sp_file_write).
 sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err);
 /// What a training set holds and leaves out.
 typedef struct db_training_counts {

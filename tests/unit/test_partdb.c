@@ -913,6 +913,34 @@ static void test_own_readonly_leftovers(void)
     ENSURE(rmdir(dir) == 0);
 }
 
+// A database whose path fills the 1,100 bytes the -wal and -shm names were
+// built in: the cut name was the database's own, and it was removed as a
+// stale sidecar.
+static void test_drop_sidecars_long_path(void)
+{
+    char dir[2048], path[2048];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("long"));
+    mkdir(dir, 0777);
+    while (strlen(dir) < 1099 - 200) {
+        size_t n = strlen(dir);
+        dir[n] = '/';
+        memset(dir + n + 1, 'd', 150);
+        dir[n + 151] = 0;
+        ENSURE(mkdir(dir, 0777) == 0 || errno == EEXIST);
+    }
+    size_t n = strlen(dir);
+    memcpy(path, dir, n);
+    path[n] = '/';
+    memset(path + n + 1, 'f', 1099 - n - 1);
+    path[1099] = 0;
+    FILE* f = fopen(path, "wb");
+    ENSURE(f && fputs("a database", f) >= 0 && fclose(f) == 0);
+    sp_db_drop_stale_sidecars(path);
+    struct stat st;
+    ENSURE(stat(path, &st) == 0);
+    unlink(path);
+}
+
 // A WAL database whose -wal and -shm a writer that crashed left behind, owned
 // by another user (root) and not writable by this one, in a folder and beside
 // a database file everyone may write: readers still read it (the WAL's rows
@@ -2984,6 +3012,7 @@ int main(int argc, char** argv)
                                    {"unreachable", test_unreachable},
                                    {"read_only_folder", test_read_only_folder},
                                    {"foreign_wal", test_foreign_wal},
+                                   {"drop_sidecars_long_path", test_drop_sidecars_long_path},
                                    {"own_readonly_leftovers", test_own_readonly_leftovers},
                                    {"readers_leave_one_file", test_readers_leave_one_file},
                                    {"schema_versions", test_schema_versions},
