@@ -52,6 +52,7 @@ extern "C" sp_result sp_cv_draw_polylines(const float* xy, const int* counts, in
                                           unsigned char* out, sp_error* err)
 {
     try {
+        single_threaded();
         cv::Mat img(size, size, CV_8UC1, out);
         img.setTo(0);
         // Why fixed point with 4 fractional bits: sub-pixel placement keeps the
@@ -83,6 +84,7 @@ extern "C" sp_result sp_cv_grey(const void* samples, int w, int h, int channels,
 {
     *pixels = nullptr;
     try {
+        single_threaded();
         if (channels < 1 || channels > 4) return sp_fail(err, SP_ERR_INVALID, "%s: %d channels", name, channels);
         cv::Mat img(h, w, CV_MAKETYPE(wide ? CV_16U : CV_8U, channels), const_cast<void*>(samples));
         if (wide) {
@@ -255,6 +257,7 @@ extern "C" sp_result sp_cv_convexity(const int* xy, int n, double* area, double*
     *count = 0;
     *area = *hull_area = 0.0;
     try {
+        single_threaded();
         if (n < 4) return sp_fail(err, SP_ERR_INVALID, "convexity: %d points (4 needed)", n);
         std::vector<cv::Point> pts((size_t)n);
         for (int i = 0; i < n; ++i)

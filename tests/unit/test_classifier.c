@@ -5,6 +5,7 @@
 #include <stdatomic.h>
 #include <stdint.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -14,6 +15,7 @@
 #include "test.h"
 
 // Internals (tests may reach into src/, STYLE.md).
+#include "../../classifier/src/cv_adapter.h"
 #include "../../classifier/src/feat.h"
 #include "../../classifier/src/model_checksum.h"
 #include "../../classifier/src/picture.h"
@@ -1419,10 +1421,61 @@ static void test_cleanup(void)
     g_model = NULL;
 }
 
+// In a fresh process (main, SP_CV_FIRST_CALL=k): BLAS at 2 threads, then
+// OpenCV entry point k as the first call; 0 when that left BLAS at one thread.
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+extern int openblas_get_num_threads(void) __attribute__((weak));
+static int cv_first_call(int k)
+{
+    if (!openblas_set_num_threads || !openblas_get_num_threads) return 77;
+    openblas_set_num_threads(2);
+    if (openblas_get_num_threads() != 2) return 77; // one core: nothing to see
+    sp_error err = {0};
+    if (k == 0) {
+        float xy[4] = {1, 1, 6, 6};
+        unsigned char img[64];
+        sp_cv_draw_polylines(xy, (int[]){2}, 1, 8, 1, img, &err);
+    } else if (k == 1) {
+        unsigned char px[4] = {0, 255, 255, 0}, *grey = NULL;
+        sp_cv_grey(px, 2, 2, 1, false, "px", &grey, &err);
+        free(grey);
+    } else {
+        int xy[8] = {0, 0, 4, 0, 4, 4, 0, 4};
+        double area, hull;
+        sp_cv_defect d[4];
+        int n;
+        sp_cv_convexity(xy, 4, &area, &hull, d, 4, &n, &err);
+    }
+    return openblas_get_num_threads() == 1 ? 0 : 3;
+}
+
+// Every OpenCV entry point sets the one-thread policy (cv_adapter.cpp,
+// single_threaded), whichever a process calls first.
+static void test_cv_entry_single_threaded(void)
+{
+    for (int k = 0; k < 3; ++k) {
+        char v[8];
+        snprintf(v, sizeof v, "%d", k);
+        pid_t pid = fork();
+        if (pid == 0) {
+            setenv("SP_CV_FIRST_CALL", v, 1);
+            execl("/proc/self/exe", "test_classifier", (char*)NULL);
+            _exit(2);
+        }
+        int st = 0;
+        ENSURE(pid > 0 && waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+        if (WEXITSTATUS(st) == 77) SKIP("no OpenBLAS, or one core");
+        fprintf(stderr, "  entry point %d first: exit %d\n", k, WEXITSTATUS(st));
+        ENSURE(WEXITSTATUS(st) == 0);
+    }
+}
+
 int main(int argc, char** argv)
 {
+    if (getenv("SP_CV_FIRST_CALL")) return cv_first_call(atoi(getenv("SP_CV_FIRST_CALL")));
     return sp_test_run(argc, argv,
                        (sp_test[]){{"json_roundtrip", test_json_roundtrip},
+                                   {"cv_entry_single_threaded", test_cv_entry_single_threaded},
                                    {"json_bad", test_json_bad},
                                    {"ndjson", test_ndjson},
                                    {"drop_no_extent", test_drop_no_extent},
