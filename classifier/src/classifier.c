@@ -46,9 +46,7 @@ struct sp_clf {
     int* labels;     // train_count
     float bandwidth; // voting kernel width (histogram distance)
     float reject;    // reject beyond this nearest distance
-    flann_index_t vocab_index;
-    flann_index_t hist_index;
-    struct FLANNParameters vocab_params;
+    flann_index_t hist_index; // beyond HIST_KDTREE_MIN training drawings; else NULL (knn_shortlist)
     struct FLANNParameters hist_params;
     int16_t* coarse;   // train_count by coarse_stride: the whole-drawing level quantised (knn_shortlist)
     int coarse_stride; // words rounded up to 8
@@ -129,7 +127,6 @@ sp_clf_desc sp_clf_get_desc(const sp_clf* clf)
 void sp_clf_destroy(sp_clf* clf)
 {
     if (!clf) return;
-    if (clf->vocab_index) flann_free_index_float(clf->vocab_index, &clf->vocab_params);
     if (clf->hist_index) flann_free_index_float(clf->hist_index, &clf->hist_params);
     for (int i = 0; i < clf->category_count; ++i)
         free(clf->categories[i]);
@@ -152,7 +149,8 @@ void sp_clf_destroy(sp_clf* clf)
 // ---------------------------------------------------------------------------
 // Indices
 
-static sp_result build_vocab_index(sp_clf* c, sp_error* err)
+// The words' squared norms, for the nearest words by dot products (sp_nearest_words).
+static sp_result vocab_norms(sp_clf* c, sp_error* err)
 {
     free(c->vnorm);
     if (!(c->vnorm = malloc(sizeof(float) * (size_t)c->words))) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
@@ -162,19 +160,6 @@ static sp_result build_vocab_index(sp_clf* c, sp_error* err)
             s += c->vocab[(size_t)w * SP_FEAT_DIM + d] * c->vocab[(size_t)w * SP_FEAT_DIM + d];
         c->vnorm[w] = s;
     }
-    struct FLANNParameters p = DEFAULT_FLANN_PARAMETERS;
-    // Why the single kd-tree: FLANN 1.9's randomised trees shuffle with
-    // std::random_device, so their (approximate) answers differ from run to run.
-    p.algorithm = FLANN_INDEX_KDTREE_SINGLE;
-    p.leaf_max_size = 8;
-    p.checks = 64;
-    p.cores = 1;
-    p.log_level = FLANN_LOG_NONE;
-    p.random_seed = (long)(c->desc.seed & 0x7fffffff) + 7;
-    c->vocab_params = p;
-    float speedup;
-    c->vocab_index = flann_build_index_float(c->vocab, c->words, SP_FEAT_DIM, &speedup, &c->vocab_params);
-    if (!c->vocab_index) return sp_fail(err, SP_ERR_INTERNAL, "FLANN: vocabulary index build failed");
     return SP_OK;
 }
 
@@ -193,24 +178,29 @@ static void quantise_coarse(const sp_clf* c, const float* hist, int16_t* out)
         out[w] = 0;
 }
 
+// Training sets of more histograms than this are searched with FLANN's kd-tree.
+#define HIST_KDTREE_MIN 20000
+
 static sp_result build_hist_index(sp_clf* c, sp_error* err)
 {
-    struct FLANNParameters p = DEFAULT_FLANN_PARAMETERS;
-    // Why exact search: a few thousand histograms are searched in about a
-    // millisecond, and approximate neighbours would make votes (and tests) flaky.
-    p.algorithm = c->train_count > 20000 ? FLANN_INDEX_KDTREE_SINGLE : FLANN_INDEX_LINEAR;
-    p.leaf_max_size = 8;
-    p.checks = 512;
-    p.cores = 1;
-    p.log_level = FLANN_LOG_NONE;
-    p.random_seed = (long)(c->desc.seed & 0x7fffffff) + 11;
-    c->hist_params = p;
-    float speedup;
-    c->hist_index = flann_build_index_float(c->hists, c->train_count, c->hist_dim, &speedup, &c->hist_params);
-    if (!c->hist_index) return sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram index build failed");
     free(c->coarse);
     c->coarse = NULL;
-    if (p.algorithm != FLANN_INDEX_LINEAR) return SP_OK; // the kd-tree searches those
+    if (c->train_count > HIST_KDTREE_MIN) {
+        struct FLANNParameters p = DEFAULT_FLANN_PARAMETERS;
+        // Why the single kd-tree: FLANN 1.9's randomised trees shuffle with
+        // std::random_device, so their (approximate) answers differ from run to run.
+        p.algorithm = FLANN_INDEX_KDTREE_SINGLE;
+        p.leaf_max_size = 8;
+        p.checks = 512;
+        p.cores = 1;
+        p.log_level = FLANN_LOG_NONE;
+        p.random_seed = (long)(c->desc.seed & 0x7fffffff) + 11;
+        c->hist_params = p;
+        float speedup;
+        c->hist_index = flann_build_index_float(c->hists, c->train_count, c->hist_dim, &speedup, &c->hist_params);
+        return c->hist_index ? SP_OK : sp_fail(err, SP_ERR_INTERNAL, "FLANN: histogram index build failed");
+    }
+    // Smaller sets: exact neighbours from the shortlist (knn_shortlist).
     c->coarse_stride = (c->words + 7) / 8 * 8;
     c->coarse = calloc((size_t)c->train_count * c->coarse_stride, sizeof(int16_t));
     if (!c->coarse) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
@@ -522,7 +512,7 @@ static int64_t coarse_dist2(const int16_t* a, const int16_t* b, int n)
 // the first 256. So candidates are shortlisted on that level (quantised, 4 MB:
 // cache-resident) and only the SHORTLIST_MIN (or 32 per neighbour) nearest get
 // full distances, each giving up once past the k-th best. Ties: the lower
-// index. Large sets (> 20000) use FLANN's kd-tree instead.
+// index. Large sets (> HIST_KDTREE_MIN) use FLANN's kd-tree instead.
 static sp_result knn_shortlist(const sp_clf* c, const float* q, int nn, int* idx, float* d2, sp_error* err)
 {
     const int n = c->train_count, dim = c->hist_dim, cs = c->coarse_stride;
@@ -568,7 +558,7 @@ static sp_result classify_hist(const sp_clf* c, float* hist, const double* shape
     int nn = c->desc.knn < c->train_count ? c->desc.knn : c->train_count;
     int idx[64];
     float d2[64];
-    if (c->hist_params.algorithm == FLANN_INDEX_LINEAR) {
+    if (!c->hist_index) {
         sp_result rc = knn_shortlist(c, hist, nn, idx, d2, err);
         if (rc != SP_OK) return rc;
     } else {
@@ -1074,7 +1064,7 @@ sp_result sp_clf_train(const sp_dataset* data, const unsigned char* use, const s
     if (c->desc.progress) c->desc.progress(c->desc.progress_user, "vocabulary", 0, 1);
     rc = sp_kmeans(sample, total, SP_FEAT_DIM, c->words, c->desc.seed, c->desc.kmeans_iterations, c->desc.threads, c->vocab, err);
     if (rc != SP_OK) goto fail;
-    if ((rc = build_vocab_index(c, err)) != SP_OK) goto fail;
+    if ((rc = vocab_norms(c, err)) != SP_OK) goto fail;
     if ((rc = soft_width(c, sample, total)) != SP_OK) goto oom;
     if (c->desc.progress) c->desc.progress(c->desc.progress_user, "vocabulary", 1, 1);
     free(sample);
@@ -1477,7 +1467,7 @@ sp_result sp_clf_from_bytes(const void* bytes, size_t size, const char* what, sp
     }
     if (b.bad || b.at != b.n || !(c->bandwidth > 0) || isnan(c->reject)) goto corrupt;
     if (!all_finite(c->vocab, (size_t)c->words * SP_FEAT_DIM) || (c->idf && !all_finite(c->idf, (size_t)c->words))) goto corrupt;
-    if ((rc = build_vocab_index(c, err)) != SP_OK || (rc = build_hist_index(c, err)) != SP_OK) {
+    if ((rc = vocab_norms(c, err)) != SP_OK || (rc = build_hist_index(c, err)) != SP_OK) {
         sp_clf_destroy(c);
         return rc;
     }
