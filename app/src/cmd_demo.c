@@ -204,14 +204,11 @@ int cmd_demo(int argc, char** argv)
     // database is built; a demo that fails removes it again when it is
     // still empty (rmdir removes nothing else).
     bool made_out = mkdir(out_dir, 0755) == 0;
-    if (!made_out) {
-        struct stat st;
-        if (stat(out_dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
-            fprintf(stderr, "sketchpose demo: %s: cannot create the folder\n", out_dir);
-            return SP_EXIT_INPUT;
-        }
-    }
     sp_error err = {0};
+    if (!made_out && sp_dir_make(out_dir, &err) != SP_OK) { // one there already is fine; else it says why
+        fprintf(stderr, "sketchpose demo: %s\n", err.text);
+        return SP_EXIT_INPUT;
+    }
     sp_db* db = NULL;
     if (!assets) assets = sp_dragon_default_assets();
     const char* path = db_path ? db_path : sp_db_default_path();

@@ -1350,6 +1350,12 @@ static void test_corrupt_part(void)
     ENSURE(strstr(text, "sketchpose demo: ") && strstr(text, says[1]) && strchr(text, '\n') == text + strlen(text) - 1);
     free(text);
     ENSURE(access(demo_out, F_OK) != 0);
+    // An output folder that cannot be made: said with the system's reason.
+    snprintf(cmd, sizeof cmd, "'%s' demo --db '%s' --out '%s/no/such' > /dev/null 2> '%s'", SP_SKETCHPOSE, path, demo_out, log);
+    ENSURE(WEXITSTATUS(system(cmd)) == 1);
+    text = sp_fixture_file_text(log, NULL);
+    ENSURE(strstr(text, "sketchpose demo: ") && strstr(text, "/no/such: cannot create the folder (No such file or directory)"));
+    free(text);
     free(tail), free(torso);
     sp_fixture_remove_db(path);
 }
