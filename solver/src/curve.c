@@ -213,9 +213,10 @@ typedef struct x_index {
 static inline bool x_less(x_index a, x_index b) { return a.x < b.x || (a.x == b.x && a.i < b.i); }
 
 // Sorts by (x, i), a total order, so the result is the one qsort gives; an
-// inlined quicksort with insertion sort below 16 entries takes a third of
-// qsort's time on the few hundred samples of a closest-point round, where
-// sorting was half of the matching's cost.
+// inlined quicksort with insertion sort below 16 entries is much faster than
+// qsort on the few hundred samples of a closest-point round, where sorting
+// weighs in the matching's cost (BENCHMARKS.md, "Measurements behind the
+// solver's constants and stages").
 static void sort_x_index(x_index* a, int n)
 {
     while (n > 16) {
@@ -256,12 +257,13 @@ static void sort_x_index(x_index* a, int n)
 // ties). The data sorted along their longer extent (x or y), each query
 // searches outwards from its own coordinate and stops where that gap alone
 // exceeds the best distance: exact, and a fraction of the all-pairs scan on
-// curves of a few hundred samples (the scan was a tenth of a dragon part's
-// solve). Each search starts from the previous query's answer and sorted
-// position: consecutive queries are neighbours along a curve, so the bound is
-// tight from the start and no binary search is needed (the cost had been
-// unpredictable branches). Still exact: a point that beats or ties the start
-// lies within the start's distance, so inside the swept band.
+// curves of a few hundred samples (BENCHMARKS.md, "Measurements behind the
+// solver's constants and stages", "Closest points' sweep"). Each search
+// starts from the previous query's answer and sorted position: consecutive
+// queries are neighbours along a curve, so the bound is tight from the start
+// and no binary search is needed (the cost had been unpredictable branches).
+// Still exact: a point that beats or ties the start lies within the start's
+// distance, so inside the swept band.
 static void closest_brute(const sp_vec2* q, int nq, const sp_vec2* d, int nd, int* idx)
 {
     x_index* xs = malloc(sizeof(x_index) * (size_t)nd);

@@ -15,8 +15,10 @@
 // its stroke), (0, 0) where the stroke has no length there.
 // Segment length of the projected abstraction: its coordinates are the
 // camera's pixels (at most ~1e13 after the perspective clamp), so squares
-// cannot overflow, and libm's hypot, which guards against that, was 4% of a
-// dragon part's solve. (User strokes keep hypot: they may hold anything finite.)
+// cannot overflow, and libm's hypot, which guards against that, is a visible
+// share of a dragon part's solve (BENCHMARKS.md, "Measurements behind the
+// solver's constants and stages"). (User strokes keep hypot: they may hold
+// anything finite.)
 static inline double seg_length(const double* a, const double* b)
 {
     double dx = b[0] - a[0], dy = b[1] - a[1];

@@ -22,7 +22,7 @@
 // moment without d_i).
 // Built once a solve, they make an energy or a Gauss-Newton H cost per pair
 // of joints instead of per representative: the representatives' Jacobian
-// rows were half of a dragon part's iteration.
+// rows dominated a dragon part's iteration.
 typedef struct reg_lbs {
     int nj;                         // rig joints
     int* anc_first;                 // nj + 1: CSR of the parameters at or above each joint
@@ -223,10 +223,10 @@ static sp_result lbs_prepare(sp_model* m, const int* reps, int k, sp_error* err)
     // 200 with a perspective camera, which this does not know) and 12 per
     // entry of the joints' E u^T blocks, against 4 c (c + 1) + 60 c per
     // representative of c columns (its 4 rows, Jacobian and residuals). The
-    // closed form's small products run slower than BLAS, hence the 1.5:
-    // dragon parts have 2.2-8.7x fewer (closed form: a fifth to a third fewer
-    // instructions a solve), the cartoon man 1.75x (closed: even), the
-    // elephant 1.02x (rows: the closed form took 6% more).
+    // closed form's small products run slower than BLAS, hence the 1.5: the
+    // measured break-even lies between the elephant's ratio and the cartoon
+    // man's (BENCHMARKS.md, "Measurements behind the solver's constants and
+    // stages").
     double closed_ops = 0, rows_ops = 0;
     for (int j = 0; ok && j < nj; ++j) {
         for (int i = R->adj_first[j]; i < R->adj_first[j + 1]; ++i) closed_ops += 100.0 * (R->anc_first[R->adj_joint[i] + 1] - R->anc_first[R->adj_joint[i]] + 1);
@@ -434,7 +434,8 @@ static void lbs_reg_normal(sp_model* m, double wp, double wd, double* H, double*
         // Only the upper triangle is needed, 12 products a dot: written out
         // as three four-lane products. (One dgemm E_j u^T for the whole block
         // computed both triangles, and its per-call setup and zeroing were
-        // most of its cost at these sizes: ~11k instructions a call.)
+        // most of its cost at these sizes; BENCHMARKS.md, "Solver: the
+        // paper's Table 1".)
         const double* Ej = R->E + 12 * (size_t)R->anc_first[j];
         int s0 = 0;
         for (int t = 0; t < na; ++t) {

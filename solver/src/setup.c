@@ -56,8 +56,8 @@ static int coarsen_kmeans(const double* rest_in, int n, int k, int* reps)
     ip.algorithm = FLANN_INDEX_KDTREE_SINGLE;
     ip.checks = -1; // exact search
     // One thread: FLANN's default searches with OpenMP on every core, whose
-    // idle threads then spin (a third of `sketchpose dragon`'s CPU, taken
-    // from the kiosk's UI thread) for a search of a few hundred centres.
+    // idle threads then spin (CPU taken from the kiosk's UI thread;
+    // BENCHMARKS.md, "The dragon kiosk") for a search of a few hundred centres.
     ip.cores = 1;
     ip.log_level = FLANN_LOG_NONE;
     ip.random_seed = 12345;
