@@ -741,8 +741,9 @@ typedef struct loo_ctx {
 #define LOO_BLOCK 128
 
 // One block of leave-one-out queries: exact distances to every training
-// histogram from dot products (OpenCV's gemm; FLANN's linear search took
-// minutes on 20000 histograms), the nearest that is another drawing.
+// histogram from dot products (OpenCV's gemm; FLANN's linear search is far
+// slower on tens of thousands of histograms: BENCHMARKS.md, "Classifier
+// training"), the nearest that is another drawing.
 static int loo_block(void* user, int b)
 {
     loo_ctx* l = user;

@@ -33,9 +33,10 @@
 // Why one thread for OpenCV and for the BLAS under it: the classifier already
 // runs one job per drawing on each of its own threads, and a single drawing's
 // work is small; OpenCV's pool and OpenBLAS's threads on top of that only
-// oversubscribed the cores (a third of training time went to the kernel, and
-// on a loaded machine OpenBLAS's spinning threads made the nearest-word
-// products of one classification 2.2 -> 14 ms). OpenBLAS is looked up at run
+// oversubscribed the cores (training time went to the kernel, and on a loaded
+// machine OpenBLAS's spinning threads slowed one classification's nearest-word
+// products several-fold; BENCHMARKS.md, "Classifier training" and
+// "Quick, Draw! 100 categories"). OpenBLAS is looked up at run
 // time so that any other BLAS under OpenCV works unchanged. Process-wide: the
 // solver's LAPACK calls are on matrices too small to gain from threads.
 static void single_threaded()
@@ -169,7 +170,8 @@ extern "C" sp_result sp_cv_orientation_maps(const unsigned char* img, int size, 
         // resizes: the same 3x3 Sobel gradient, split into the bins and averaged
         // over down x down blocks (what INTER_AREA does for an integer factor)
         // straight into the small planes; rows without ink nearby are skipped.
-        // Half the time of a classification's descriptors went to the planes.
+        // The planes were a large share of a classification's descriptors
+        // (BENCHMARKS.md, "Quick, Draw! 100 categories").
         const int osz = size / down;
         const float w = 1.0f / (255.0f * (float)(down * down));
         thread_local std::vector<float> small;

@@ -33,8 +33,8 @@ int sp_parallel_for(int n, int threads, int (*fn)(void* user, int i), void* user
 
 /// Exact `nn` nearest rows of `words` (K by 64, squared norms in `wnorm`) for each of `n`
 /// 64-D rows of `x`; idx/d2: n by nn, nearest first, squared distances.
-/// Why not FLANN here: for 784 queries against 500 words FLANN 1.9 takes ~10 ms
-/// (linear or kd-tree) on this machine; exact distances from dot products
-/// (OpenCV's gemm, ~1.5 ms; a vectorised scan when that fails, ~9 ms) are
-/// faster and deterministic.
+/// Why not FLANN here: exact distances from dot products (OpenCV's gemm; a
+/// vectorised scan when that fails) are faster than FLANN 1.9's linear or
+/// kd-tree search for a drawing's descriptors against the vocabulary, and
+/// deterministic (BENCHMARKS.md, "Quick, Draw! 100 categories").
 void sp_nearest_words(const float* words, const float* wnorm, int K, const float* x, int n, int nn, int* idx, float* d2);

@@ -58,7 +58,7 @@ typedef struct sp_clf_desc {
     int soft_neighbours;    ///< words each descriptor is soft-assigned to (default 4; 1 = hard assignment)
     int knn;                ///< neighbours voting at classification (default 8)
     int pyramid;            ///< spatial pyramid: 1 = 1x1 + 2x2 cells (default), 2 = also 4x4; -1 = whole drawing only
-    int tfidf;              ///< tf-idf word weighting (default on: +0.8 pt top-1 on quickdraw 5-fold)
+    int tfidf;              ///< tf-idf word weighting (default on: more top-1; BENCHMARKS.md, "Quick, Draw! 100 categories")
     int hellinger;          ///< square-root (Hellinger) map of the histograms before k-NN (default on)
     int mirror;             ///< also train on left-right mirrored drawings (default on)
     int augment;            ///< extra randomly jittered copies of each stroke drawing (default 0; -1 = none)
