@@ -685,7 +685,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     sp_kiosk_job_kind next;
     if (sp_kiosk_ui_peek_job(k->ui) != SP_KJOB_SAVE) k->save_shown = false; // a save dropped meanwhile (Start over)
     while (!k->heavy_done && (next = sp_kiosk_ui_peek_job(k->ui)) != SP_KJOB_NONE) {
-        // A save stops the window for about a third of a second (BENCHMARKS.md):
+        // A save stops the window for many frames (BENCHMARKS.md, "The dragon kiosk"):
         // one frame first, so that the tap shows ("Saving your dragon...").
         bool shown = k->save_shown;
         k->save_shown = next == SP_KJOB_SAVE && !shown;

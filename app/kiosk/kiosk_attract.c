@@ -87,7 +87,7 @@ static void prepare(sp_kiosk* k)
                                            .canvas_w = k->canvas_w,
                                            .canvas_h = k->canvas_h,
                                            .solve = {.time_cap_ms = k->desc.fit_time_cap_ms},
-                                           .no_model = true}, // its strokes name their parts: loading the model took 290 ms
+                                           .no_model = true}, // its strokes name their parts: no model to wait for
                          &k->demo, &err) != SP_OK)
         sp_kiosk_log("attract screen without its demo: %s", err.text);
 }

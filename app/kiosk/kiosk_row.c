@@ -115,7 +115,8 @@ void kiosk_row_load(sp_kiosk* k)
         return;
     }
     // A database change that left the parts as they were (a model, a
-    // curator's sketch) keeps the row: reading six parts again held a frame 45 ms.
+    // curator's sketch) keeps the row: reading six parts again held a frame
+    // (BENCHMARKS.md, "A new model while the kiosk runs").
     char* source = kiosk_row_source(db, cats, n);
     // The attract screen's demo shows the parts too: built from others, it is built again.
     if (source && k->demo_prepared && !k->desc.no_attract_demo && (!k->demo_source || strcmp(source, k->demo_source) != 0))

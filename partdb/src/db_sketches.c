@@ -108,7 +108,7 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
         sp_result r = db_sample_ok(s, what, err);
         if (r != SP_OK) return r;
         // Review shows and trains on a kiosk sketch's one stroke: 200,000
-        // strokes were listed as one, a million points took a minute a sheet.
+        // strokes were listed as one, and a million points stalled a sheet.
         const char* why = source == SP_DB_SOURCE_KIOSK ? sp_db_kiosk_sketch_problem(s) : NULL;
         if (why)
             return sp_fail(err, SP_ERR_INVALID,

@@ -1,8 +1,8 @@
 // model_load.c: reading a new model on a thread of its own (desc.background_model).
 // A model is tens of megabytes: its checksum and parse held a kiosk's frame
-// for 0.15-0.4 s on the default database. The thread reads through a
-// read-only connection of its own; the pipeline goes on with the model it
-// has and takes the new one at a poll.
+// far past its budget (BENCHMARKS.md, "A new model while the kiosk runs").
+// The thread reads through a read-only connection of its own; the pipeline
+// goes on with the model it has and takes the new one at a poll.
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>

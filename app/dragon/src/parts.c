@@ -329,10 +329,11 @@ static sp_result open_own(sp_dragon* d, sp_error* err)
 // Takes the newest model of the (re)opened database; keeps the old one when
 // it cannot be read, and when it is the one already loaded: a curator's
 // sketch or review bumps the generation too, and parsing a 30 MB model
-// again held the kiosk's frames for half a second or more. Within one file
-// model ids only grow (db train removes old models, never the newest), so the
-// newest row's id tells; another file may have a model of the same id, so there its
-// checksum tells (read past the model's bytes: 15-35 ms, so not every poll).
+// again held the kiosk's frames (BENCHMARKS.md, "A new model while the
+// kiosk runs"). Within one file model ids only grow (db train removes old
+// models, never the newest), so the newest row's id tells; another file may
+// have a model of the same id, so there its checksum tells (read past the
+// model's bytes: too slow for every poll).
 void dragon_reload_model(sp_dragon* d, bool same_file)
 {
     if (d->desc.no_model) return;

@@ -386,7 +386,7 @@ sp_result sp_db_load_model(sp_db* db, sp_clf** out, int64_t* id, sp_error* err);
 /// reader that has it loaded need not parse tens of MB again); *id 0 and
 /// sha "" when none is stored. sha256 may be NULL: then only the id is read,
 /// which is cheaper still (the checksum is stored past the model's bytes,
-/// and reaching it walks them: 15-35 ms for a 30 MB model).
+/// and reaching it walks them; BENCHMARKS.md, "A new model while the kiosk runs").
 sp_result sp_db_model_head(sp_db* db, int64_t* id, char sha256[65], sp_error* err);
 
 /// Stored models, newest first, as a JSON array [{"id", "created_at", "created_by",

@@ -7,8 +7,9 @@
 ///     }
 ///     sp_lod_free(&lod);
 ///
-/// Why: Mesa's llvmpipe spends ~1 us of CPU per triangle before shading a
-/// single pixel, so six 15k-vertex parts cost over 100 ms a frame. A part
+/// Why: Mesa's llvmpipe spends CPU on every triangle before shading a single
+/// pixel, so six full-detail parts cost more than a frame (BENCHMARKS.md,
+/// "The dragon kiosk"). A part
 /// drawn a few hundred pixels wide loses little when its vertices are merged
 /// on a grid (Rossignac-Borrel clustering) down to a few thousand triangles.
 /// The clustering is computed once (on the pose given) and kept: every frame
