@@ -260,8 +260,9 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, int curated_max, sp_dat
     // `kiosk_cap` per category (a year of visitors would otherwise
     // swamp the parts' own sketches and the training time); of the curated
     // ones `curated_max` per category, ordered by a fixed hash of the id so
-    // that they spread over all that were added, early and late (a curator's
-    // 30,000 made an 18-minute training and a 2.3 GB kiosk).
+    // that they spread over all that were added, early and late (without a
+    // cap a curator's tens of thousands made training slow and the kiosk
+    // huge: BENCHMARKS.md, "Curated sketches in training").
     if ((r = curated_past_cap(db, cats, ncat, curated_max, &n, err)) != SP_OK ||
         (r = db_prepare(
              db,

@@ -52,8 +52,9 @@ extern "C" {
 /// Synthetic sketches stored with a part by default (per part: random shape and
 /// pose, the shapes of the default recipe, drawn by the hand-drawing model of
 /// sp/handdraw.h; docs/DESIGN.md "Part database training data"). Why not 300:
-/// see docs/DESIGN.md (cost 4.5x, no bar gained in full; 120 and 200 gained
-/// nothing on the visitors' drawings either).
+/// several times the cost and no bar gained in full; 120 and 200 gained
+/// nothing on the visitors' drawings either (docs/DESIGN.md; BENCHMARKS.md,
+/// "Dragon-part classifier" and "Visitors' drawings", first pass).
 #define SP_DB_SYNTH_DEFAULT 60
 /// Concept sketches per part category of the default database (sp/concept.h:
 /// the parts as visitors imagine them, designs of their own).
@@ -250,9 +251,9 @@ sp_result sp_db_load_dataset(sp_db* db, sp_dataset* out, int* unused, sp_error* 
 /// (BENCHMARKS.md, "Kiosk sketches").
 #define SP_DB_KIOSK_TRAIN_MAX 200
 /// Curated sketches per category in a training set (sp_db_train_desc.curated_max
-/// by default), spread over those stored: without a cap a curator's 30,000
-/// made an 18-minute `db train` and a 2.3 GB kiosk (BENCHMARKS.md, "Curated
-/// sketches").
+/// by default), spread over those stored: without a cap a curator's tens of
+/// thousands made `db train` slow and the kiosk huge (BENCHMARKS.md,
+/// "Curated sketches in training").
 #define SP_DB_CURATED_TRAIN_MAX 400
 /// Models a database keeps after `db train` stores one (sp_db_train_desc.keep_models
 /// by default): the newest, and the two before it to compare reports with. Each
