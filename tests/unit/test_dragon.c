@@ -3958,6 +3958,23 @@ static void test_flourishes_off_parts(void)
     ENSURE(res.reason != SP_DRAGON_DETAIL && sp_dragon_detail_count(d) == 0);
     for (int k = 0; k < count; ++k)
         free(s6[k]);
+    // A crown drawn on the head as the visitor drew it, where the fit does
+    // not reach (an outside review's session: the fitted head sits 40-60 px
+    // under the drawn outline's top): ink on the head, not a tiny tail.
+    sp_dragon_clear(d);
+    char file[1200];
+    snprintf(file, sizeof file, "%s/tests/e2e/data/kiosk_crown_gap.json", SP_SOURCE_DIR);
+    sp_vec2* cg[8];
+    int ncg[8];
+    ENSURE(sp_fixture_session_strokes(file, cg, ncg, 8) == 4);
+    const char* kinds[3] = {"torso", "head", "tail"};
+    for (int k = 0; k < 3; ++k)
+        add_as(d, cg[k], ncg[k], kinds[k]);
+    ENSURE(sp_dragon_add_points(d, cg[3], ncg[3], NULL, &res, &err) == SP_OK);
+    fprintf(stderr, "  a crown on the head as drawn: %s\n", sp_dragon_reject_name(res.reason));
+    ENSURE(res.reason == SP_DRAGON_DETAIL && res.detail >= 0 && sp_dragon_detail_get(d, res.detail, &e) && e.part == 1);
+    for (int k = 0; k < 4; ++k)
+        free(cg[k]);
     sp_dragon_destroy(d);
 }
 

@@ -693,7 +693,9 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
                 if (j != skip && o->t->is_torso && o->body_px)
                     flourish = !(dragon_vertex_nearest(o->body_px, o->t->ch.rig.vertex_count, x, dp) < dp);
             }
-            nearest = fmin(nearest, dp);
+            // Touching counts for the part as drawn too: a visitor draws a
+            // crown on the head they drew, where the fit may not reach.
+            nearest = fmin(nearest, fmin(dp, dragon_vertex_nearest(q->stroke, q->stroke_n, x, dp)));
             out += dm > touch;
         }
         if (flourish && nearest <= touch && out >= FLOURISH_OUT * m) {
