@@ -3978,6 +3978,54 @@ static void test_flourishes_off_parts(void)
     sp_dragon_destroy(d);
 }
 
+// A flame drawn out of the tip of a tail drawn as one line (fitted with its
+// `line`) is ink on the tail, and at t = 0 it lies where it was drawn: it is
+// bound to the tail as shown, posed at the dragon's clock. Before, it was
+// bound to the tail at its fit, which the tail's sway (off rest at t = 0)
+// moves, and the flame showed well above where it was drawn.
+static void test_flourish_on_line_tail(void)
+{
+    const char* path = real_db();
+    sp_error err = {0};
+    sp_dragon_result res;
+    sp_vec2* s6[8];
+    int n6[8], body, head, n;
+    sp_dragon* d = readme_dragon(path, s6, n6, &body, &head);
+    sp_vec2 blo, bhi, hlo, hhi;
+    points_box(s6[0], n6[0], &blo, &bhi);
+    points_box(s6[1], n6[1], &hlo, &hhi);
+    bool right = hlo.x + hhi.x < blo.x + bhi.x; // the tail at the end away from the head
+    sp_vec2* xy = at_box_end("tail/tail-wavy-line.json", 300, 0.5 * (blo.y + bhi.y), !right, blo, bhi, right, 20, &n);
+    int tail = add_as(d, xy, n, "tail");
+    fprintf(stderr, "  the tail: fitted with its %s, attached to %d\n", fitted_curve(d, tail),
+            sp_dragon_part_get(d, tail)->attached_to);
+    ENSURE(!strcmp(fitted_curve(d, tail), "line") && sp_dragon_part_get(d, tail)->attached_to == body);
+    // The flame: a zigzag outline out of the stroke's end farthest from the body.
+    sp_vec2 tip = xy[0];
+    for (int k = 0; k < n; ++k)
+        if (right ? xy[k].x > tip.x : xy[k].x < tip.x) tip = xy[k];
+    double out = right ? 1 : -1;
+    sp_vec2 flame[60];
+    for (int k = 0; k < 60; ++k) {
+        double u = k < 30 ? k / 29.0 : (59 - k) / 29.0, zig = 12 * fabs(fmod(4 * u, 1.0) - 0.5);
+        flame[k] = (sp_vec2){tip.x + out * (4 + 110 * u), tip.y + (k < 30 ? -1 : 1) * (8 + 22 * sin(M_PI * u) + zig)};
+    }
+    ENSURE(sp_dragon_add_points(d, flame, 60, NULL, &res, &err) == SP_OK);
+    fprintf(stderr, "  the flame: %s, detail %d\n", sp_dragon_reject_name(res.reason), res.detail);
+    ENSURE(res.reason == SP_DRAGON_DETAIL && res.detail == 0);
+    sp_dragon_detail e;
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK && sp_dragon_detail_get(d, 0, &e) && e.part == tail && e.point_count == 60);
+    double worst = 0;
+    for (int k = 0; k < e.point_count; ++k)
+        worst = fmax(worst, sp_v2_len(sp_v2_sub(ink_px(d, 0, k), flame[k])));
+    fprintf(stderr, "  at t = 0 the flame's ink lies within %.2f px of its stroke\n", worst);
+    ENSURE(worst < 0.5);
+    free(xy);
+    for (int k = 0; k < 6; ++k)
+        free(s6[k]);
+    sp_dragon_destroy(d);
+}
+
 // A zigzag of spikes (n points) over the top (or, below, under the bottom)
 // of a body's stroke (body: nb points) from x0 to x1, its teeth `tall` px.
 static int spikes_along(const sp_vec2* body, int nb, double x0, double x1, double tall, bool below, sp_vec2* out, int cap)
@@ -4282,6 +4330,7 @@ int main(int argc, char** argv)
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},
+                                   {"flourish_on_line_tail", test_flourish_on_line_tail},
                                    {"scene_storm", test_scene_storm},
                                    {"spikes_on_the_back", test_spikes_on_the_back},
                                    {0}});

@@ -67,9 +67,8 @@ static sp_mat4 part_world_at(const sp_dragon* d, const part* p)
     return sp_mat4_mul(&f, &p->world_fit);
 }
 
-sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err)
+void dragon_pose_parts(sp_dragon* d, double t)
 {
-    (void)err;
     if (!isfinite(t)) t = 0;
     // Pass 0: parts that carry others (torsos) and free parts; pass 1: attached parts.
     for (int pass = 0; pass < 2; ++pass)
@@ -88,8 +87,20 @@ sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err)
         sp_mat4_points(&p->world_t, p->xyz, p->t->ch.rig.vertex_count);
         sp_mat4_points(&p->world_t, p->outline, p->t->ch.rig.abstractions[p->t->abstraction].point_count);
     }
+}
+
+void dragon_pose(sp_dragon* d, double t)
+{
+    dragon_pose_parts(d, t);
     dragon_details_pose(d);
     d->posed = true;
+}
+
+sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err)
+{
+    (void)err;
+    d->shown_t = isfinite(t) ? t : 0;
+    dragon_pose(d, d->shown_t);
     return SP_OK;
 }
 

@@ -157,16 +157,15 @@ static int vertex_at(const sp_vec2* px, const double* xyz, int n, sp_vec2 p)
 }
 
 // Canvas point p in the rig's rest space (*rest), carried from world point
-// A of part q's mesh at its fit, which the c joints (with weights w) skin:
-// placed in the world at A's depth, then taken back by the inverse of
-// their blended skin at the fit (q->t->ev evaluated there). False when
-// nothing carries it.
+// A of part q's mesh as posed (q->ev, q->world_t), which the c joints (with
+// weights w) skin: placed in the world at A's depth, then taken back by the
+// inverse of their blended skin there. False when nothing carries it.
 static bool carry(const sp_dragon* d, const part* q, sp_vec3 A, const int* joints, const double* w, int c, sp_vec2 p,
                   sp_vec3* rest)
 {
-    sp_mat4 fit = dragon_blended_skin(joints, w, c, sp_rig_eval_skin(q->t->ev), &q->world_fit), inv;
+    sp_mat4 skin = dragon_blended_skin(joints, w, c, sp_rig_eval_skin(q->ev), &q->world_t), inv;
     sp_vec3 W;
-    if (c <= 0 || !sp_mat4_inverse(&fit, &inv) || !canvas_to_world(&d->world, A, p, &W)) return false;
+    if (c <= 0 || !sp_mat4_inverse(&skin, &inv) || !canvas_to_world(&d->world, A, p, &W)) return false;
     *rest = sp_mat4_point(&inv, W);
     return true;
 }
@@ -232,7 +231,6 @@ static int bind_points(const sp_dragon* d, const part* q, const detail_hit* hit,
             A = sp_v3_add(A, sp_v3_scale(vertex(xyz, tr[j]), aw[j]));
         cn = tr ? blend_influences(rig, tr, aw, cj, cw) : 0;
     }
-    if (hit->air && air > 0) sp_rig_eval_update(q->t->ev, q->p_fit, false); // the skin at the fit, for carry()
     int k = 0;
     for (int i = 0; i < m; ++i) {
         if (face[i] < 0) { // off the mesh and not near it: in the air, or left out of the ink
@@ -293,9 +291,19 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
     e->drawn = (sp_vec2*)(void*)(e->normal + 3 * mm);
     e->weight = (double*)(void*)(e->drawn + mm);
-    // On the mesh the detail test found it on, within the same tolerance.
-    e->n = bind_points(d, q, hit, rs ? rs : pts, m, e);
-    free(rs);
+    // Bound to the part as the visitor saw it while drawing (posed at the
+    // dragon's clock), not at its fit, which a clip's pose moves (a tail's
+    // sway starts off rest). The parts only: what the caller posed and
+    // reads stays as it was.
+    dragon_pose_parts(d, d->shown_t);
+    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
+    for (int v = 0; px && v < rig->vertex_count; ++v)
+        px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
+    detail_hit shown = *hit;
+    shown.xyz = q->xyz, shown.px = px;
+    // Within the tolerance the detail test used.
+    e->n = px ? bind_points(d, q, &shown, rs ? rs : pts, m, e) : 0;
+    free(rs), free(px);
     if (e->n < 2) {
         detail_free(e);
         return -1;

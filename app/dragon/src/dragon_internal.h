@@ -198,6 +198,9 @@ struct sp_dragon {
     sp_camera world;
     double period;
     bool posed;
+    // The time of the last sp_dragon_pose_at (0 before one): the dragon as
+    // the visitor sees it while drawing, which a detail is bound to.
+    double shown_t;
     // Fault injection for tests (NULL in use): called on every fit's
     // parameters before they are checked, e.g. to put a NaN there.
     void (*fit_hook)(double* p, int n);
@@ -330,6 +333,12 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
 double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p);
 /// Poses every detail on its part's vertices at the last pose_at (after them).
 void dragon_details_pose(sp_dragon* d);
+/// Poses the dragon at time t as sp_dragon_pose_at does, without taking t as
+/// the time shown (for the export's and report's own poses).
+void dragon_pose(sp_dragon* d, double t);
+/// Poses only the parts (their p_t, ev, xyz, outline, world_t), not the
+/// details, and leaves d->posed as it was.
+void dragon_pose_parts(sp_dragon* d, double t);
 /// Detail i's points in its part's bind space with their skin (for the
 /// export; rest: n by 3, joints and weights: n by 4 for the detail's n
 /// points): each point's corners and their four influences blended by its

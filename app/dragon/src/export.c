@@ -137,7 +137,7 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
     // default camera looks there); the camera in the file frames the box of
     // the whole loop.
     sp_vec3 lo, hi, alo, ahi;
-    sp_dragon_pose_at(d, 0, err);
+    dragon_pose(d, 0);
     if (!sp_dragon_bounds(d, &lo, &hi)) lo = hi = (sp_vec3){0, 0, 0};
     alo = lo, ahi = hi;
     sp_vec3 offset = sp_v3_scale(sp_v3_add(lo, hi), -0.5);
@@ -159,7 +159,7 @@ sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
     if (animated) {
         for (int k = 0; k <= K; ++k) {
             ftimes[k] = (float)times[k];
-            sp_dragon_pose_at(d, times[k], err);
+            dragon_pose(d, times[k]);
             sp_vec3 klo, khi;
             if (sp_dragon_bounds(d, &klo, &khi)) {
                 alo = (sp_vec3){fmin(alo.x, klo.x), fmin(alo.y, klo.y), fmin(alo.z, klo.z)};

@@ -25,8 +25,7 @@ static void outline_box(const sp_dragon* d, const part* p, double b[4])
 
 static cJSON* report_tree(sp_dragon* d)
 {
-    sp_error perr = {0};
-    bool posed = sp_dragon_pose_at(d, 0, &perr) == SP_OK;
+    dragon_pose(d, 0);
     cJSON* o = cJSON_CreateObject();
     double ms = 0, eb = 0, ea = 0, mean = 0, mx = 0;
     int it = 0, rounds = 0, unused = 0;
@@ -90,12 +89,8 @@ static cJSON* report_tree(sp_dragon* d)
         cJSON_AddBoolToObject(pj, "far_side", p->pub.far_side);
         cJSON_AddBoolToObject(pj, "mirrored", p->pub.mirrored);
         double box[4];
-        if (posed) {
-            outline_box(d, p, box);
-            cJSON_AddItemToObject(pj, "outline_bbox_px", box_json(box));
-        } else {
-            cJSON_AddNullToObject(pj, "outline_bbox_px");
-        }
+        outline_box(d, p, box);
+        cJSON_AddItemToObject(pj, "outline_bbox_px", box_json(box));
         cJSON_AddItemToObject(pj, "stroke_bbox_px", box_json(p->stroke_box));
         cJSON_AddStringToObject(pj, "note", p->note ? sp_dragon_note_name(p->note) : "");
         cJSON_AddItemToObject(pj, "report", sp_report_to_json(r, rig, ab, p->p_fit));

@@ -283,7 +283,9 @@ double sp_dragon_period(const sp_dragon* d);
 /// Evaluates every part at time t (seconds, wrapped into the loop): its
 /// animated parameters, its attachment, its skinned vertices and abstraction
 /// in world space, readable with the calls below until the next pose_at,
-/// change, report or export (then NULL). SP_ERR_NO_MEMORY is the only failure.
+/// change, report or export (then NULL). t is also the time the dragon is
+/// shown at (0 before any call): a detail drawn next is bound to its part as
+/// posed then, where the visitor saw it. SP_ERR_NO_MEMORY is the only failure.
 sp_result sp_dragon_pose_at(sp_dragon* d, double t, sp_error* err);
 /// Part i's vertices at the last pose_at, world, rig.vertex_count by 3.
 const double* sp_dragon_part_xyz(const sp_dragon* d, int i);
