@@ -89,6 +89,13 @@ void dragon_pose_parts(sp_dragon* d, double t)
     }
 }
 
+void dragon_pose_shown(sp_dragon* d)
+{
+    // Posed means posed at shown_t with nothing changed since (a change,
+    // the export and the report unpose).
+    if (!d->posed) dragon_pose_parts(d, d->shown_t);
+}
+
 void dragon_pose(sp_dragon* d, double t)
 {
     dragon_pose_parts(d, t);

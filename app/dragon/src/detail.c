@@ -295,7 +295,7 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     // dragon's clock), not at its fit, which a clip's pose moves (a tail's
     // sway starts off rest). The parts only: what the caller posed and
     // reads stays as it was.
-    dragon_pose_parts(d, d->shown_t);
+    dragon_pose_shown(d);
     sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
     for (int v = 0; px && v < rig->vertex_count; ++v)
         px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});

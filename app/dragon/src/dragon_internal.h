@@ -339,6 +339,9 @@ void dragon_pose(sp_dragon* d, double t);
 /// Poses only the parts (their p_t, ev, xyz, outline, world_t), not the
 /// details, and leaves d->posed as it was.
 void dragon_pose_parts(sp_dragon* d, double t);
+/// The parts posed as shown (at d->shown_t), for binding details where
+/// they were drawn; d->posed stays as it was.
+void dragon_pose_shown(sp_dragon* d);
 /// Detail i's points in its part's bind space with their skin (for the
 /// export; rest: n by 3, joints and weights: n by 4 for the detail's n
 /// points): each point's corners and their four influences blended by its

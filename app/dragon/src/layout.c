@@ -551,10 +551,11 @@ void dragon_detail_hit_free(detail_hit* hit)
     hit->xyz = NULL, hit->px = NULL;
 }
 
-// Part k's mesh at its fit as shown (after attachment), in the world and on
-// the canvas (*xyz, *px: malloc'd, vertex_count each), and its box there
-// [a, b], when its stroke's box, grown as below, overlaps the stroke's box
-// [lo, hi]. 0: not near it (or no mesh); -1: out of memory.
+// Part k's mesh as shown (posed by dragon_pose_shown at d->shown_t: a
+// clip's pose there is not the fit), in the world and on the canvas (*xyz,
+// *px: malloc'd, vertex_count each), and its box there [a, b], when its
+// stroke's box, grown as below, overlaps the stroke's box [lo, hi]. 0: not
+// near it (or no mesh); -1: out of memory.
 static int part_near_stroke(sp_dragon* d, int k, sp_vec2 lo, sp_vec2 hi, double** xyz, sp_vec2** px, sp_vec2* a, sp_vec2* b)
 {
     const part* q = d->parts[k];
@@ -574,7 +575,9 @@ static int part_near_stroke(sp_dragon* d, int k, sp_vec2 lo, sp_vec2 hi, double*
         *xyz = NULL, *px = NULL;
         return -1;
     }
-    mesh_on_canvas(d, q, &q->world_fit, *xyz, *px);
+    memcpy(*xyz, q->xyz, sizeof(double) * 3 * (size_t)nv);
+    for (int v = 0; v < nv; ++v)
+        (*px)[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
     px_box(*px, nv, a, b);
     return 1;
 }
@@ -589,6 +592,7 @@ static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
                        detail_hit* hit)
 {
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
+    dragon_pose_shown(d);                      // for part_near_stroke
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
         part* q = d->parts[k];
         double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]);
@@ -667,6 +671,7 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
     for (int k = 0; k < d->part_n; ++k) // the bodies' meshes, for the distances below
         if (k != skip && d->parts[k]->t->is_torso) body_prepare(d, d->parts[k]);
+    dragon_pose_shown(d); // for part_near_stroke
     int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES;
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
         part* q = d->parts[k];
