@@ -684,7 +684,13 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         if (got == 0) continue;
         int nv = q->t->ch.rig.vertex_count;
         double pd = hypot(b.x - a.x, b.y - a.y), touch = FLOURISH_TOUCH * pd, nearest = INFINITY;
-        bool flourish = diag <= FLOURISH_SIZE * pd && isfinite(pd);
+        // Its mesh at its fit too, where its stroke was drawn: a clip's pose
+        // moves it from there, and a stroke drawn out of either is drawn out of it.
+        double* fxyz = malloc(sizeof(double) * 3 * (size_t)nv);
+        sp_vec2* fpx = malloc(sizeof(sp_vec2) * (size_t)nv);
+        if (fxyz && fpx) mesh_on_canvas(d, q, &q->world_fit, fxyz, fpx);
+        free(fxyz);
+        bool flourish = fpx && diag <= FLOURISH_SIZE * pd && isfinite(pd);
         int out = 0;
         // Every point nearer the part than any body: out of the part, not
         // reaching for the body (a part drawn there would attach to it).
@@ -692,7 +698,8 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         // those are a few pixels across, and a head has some 30,000.
         for (int s = 0; flourish && s < m; ++s) {
             sp_vec2 x = pts[(size_t)s * (size_t)(n - 1) / (size_t)(m - 1)];
-            double dm = dragon_vertex_nearest(px, nv, x, INFINITY), dp = fmin(dm, dragon_ink_distance(d, q->pub.id, x));
+            double dm = fmin(dragon_vertex_nearest(px, nv, x, INFINITY), dragon_vertex_nearest(fpx, nv, x, INFINITY));
+            double dp = fmin(dm, dragon_ink_distance(d, q->pub.id, x));
             for (int j = 0; flourish && j < d->part_n; ++j) {
                 const part* o = d->parts[j];
                 if (j != skip && o->t->is_torso && o->body_px)
@@ -703,6 +710,7 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
             nearest = fmin(nearest, fmin(dp, dragon_vertex_nearest(q->stroke, q->stroke_n, x, dp)));
             out += dm > touch;
         }
+        free(fpx);
         if (flourish && nearest <= touch && out >= FLOURISH_OUT * m) {
             if (hit) {
                 // Only points on the mesh are bound to it; the rest ride it in the air.
