@@ -3747,7 +3747,7 @@ static void test_details_on_parts(void)
     }
     ENSURE(isfinite(edge.y));
     for (int above = 0; above < 2; ++above) {
-        small_loop((sp_vec2){edge.x, edge.y - (above ? 40 : 0)}, 8, loop);
+        small_loop((sp_vec2){edge.x, edge.y - (above ? 40 : 3)}, 8, loop); // over the edge, more off the tail than on
         ENSURE(sp_dragon_add_points(d, loop, 40, NULL, &res, &err) == SP_OK);
         fprintf(stderr, "  a spot %s the tail's edge: %s\n", above ? "40 px above" : "over", sp_dragon_reject_name(res.reason));
         if (above) {

@@ -287,8 +287,8 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
 /// The part that a speck is drawn on, or -1: a stroke too small to become a
 /// part (its box's diagonal under SP_DRAGON_PART_MIN of the canvas's) with
 /// half its points on a part's mesh, as dragon_detail_of measures (a spot
-/// at a thin tail's edge), its points off the mesh each carried from the
-/// vertex nearest it. hit as for dragon_detail_of.
+/// at a thin tail's edge), its points off the mesh carried together in the
+/// air, as a flourish's. hit as for dragon_detail_of.
 int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
 /// The part that a stroke is drawn out of, away from the dragon's bodies,
 /// or -1 (fire from a mouth, a spade at a tail's tip, a crown on a head:

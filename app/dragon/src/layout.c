@@ -639,7 +639,11 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
 int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
     if (!(hypot(hi.x - lo.x, hi.y - lo.y) < SP_DRAGON_PART_MIN * hypot(d->desc.canvas_w, d->desc.canvas_h))) return -1;
-    return detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_AIR_EACH, hit);
+    int k = detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_AIR_TOGETHER, hit);
+    // Bound where drawn: its points off the mesh ride in the air rather
+    // than onto the mesh's edge, which would squash a spot drawn half off.
+    if (k >= 0 && hit) hit->near = 0.71;
+    return k;
 }
 
 // A flourish (fire from a mouth, a spade at a tail's tip, a crown on a
@@ -688,9 +692,10 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         // moves it from there, and a stroke drawn out of either is drawn out of it.
         double* fxyz = malloc(sizeof(double) * 3 * (size_t)nv);
         sp_vec2* fpx = malloc(sizeof(sp_vec2) * (size_t)nv);
-        if (fxyz && fpx) mesh_on_canvas(d, q, &q->world_fit, fxyz, fpx);
+        bool fitted = fxyz && fpx;
+        if (fitted) mesh_on_canvas(d, q, &q->world_fit, fxyz, fpx);
         free(fxyz);
-        bool flourish = fpx && diag <= FLOURISH_SIZE * pd && isfinite(pd);
+        bool flourish = fitted && diag <= FLOURISH_SIZE * pd && isfinite(pd);
         int out = 0;
         // Every point nearer the part than any body: out of the part, not
         // reaching for the body (a part drawn there would attach to it).
