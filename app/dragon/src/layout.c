@@ -658,6 +658,10 @@ int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2
 // The share of its points off the part: a stroke mostly over a part is
 // drawn over it, not out of it.
 #define FLOURISH_OUT 0.3
+// Touching only the part's stroke (the part as drawn, where its fit does not
+// reach), a flourish is at most this multiple of the part's size: a crown
+// on a drawn head is; legs drawn against it are not (a part of their own).
+#define FLOURISH_DRAWN_SIZE 0.75
 
 double dragon_vertex_nearest(const sp_vec2* px, int n, sp_vec2 p, double limit)
 {
@@ -687,7 +691,7 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         if (got < 0) return -1; // out of memory: not a flourish, the stroke goes on as a part
         if (got == 0) continue;
         int nv = q->t->ch.rig.vertex_count;
-        double pd = hypot(b.x - a.x, b.y - a.y), touch = FLOURISH_TOUCH * pd, nearest = INFINITY;
+        double pd = hypot(b.x - a.x, b.y - a.y), touch = FLOURISH_TOUCH * pd, nearest = INFINITY, drawn = INFINITY;
         // Its mesh at its fit too, where its stroke was drawn: a clip's pose
         // moves it from there, and a stroke drawn out of either is drawn out of it.
         double* fxyz = malloc(sizeof(double) * 3 * (size_t)nv);
@@ -710,13 +714,16 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
                 if (j != skip && o->t->is_torso && o->body_px)
                     flourish = !(dragon_vertex_nearest(o->body_px, o->t->ch.rig.vertex_count, x, dp) < dp);
             }
-            // Touching counts for the part as drawn too: a visitor draws a
-            // crown on the head they drew, where the fit may not reach.
-            nearest = fmin(nearest, fmin(dp, dragon_vertex_nearest(q->stroke, q->stroke_n, x, dp)));
+            nearest = fmin(nearest, dp);
+            drawn = fmin(drawn, dragon_vertex_nearest(q->stroke, q->stroke_n, x, drawn));
             out += dm > touch;
         }
         free(fpx);
-        if (flourish && nearest <= touch && out >= FLOURISH_OUT * m) {
+        // Touching the part as drawn counts too, for a stroke clearly smaller
+        // than the part: a visitor draws a crown on the head they drew,
+        // where the fit may not reach; one about as large is a part of its own.
+        bool touches = nearest <= touch || (drawn <= touch && diag <= FLOURISH_DRAWN_SIZE * pd);
+        if (flourish && touches && out >= FLOURISH_OUT * m) {
             if (hit) {
                 // Only points on the mesh are bound to it; the rest ride it in the air.
                 *hit = (detail_hit){.part = k, .xyz = xyz, .px = px, .near = 0.71, .air = DETAIL_AIR_TOGETHER};
