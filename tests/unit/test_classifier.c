@@ -1454,7 +1454,7 @@ static int cv_first_call(int k)
 static void test_cv_entry_single_threaded(void)
 {
     for (int k = 0; k < 3; ++k) {
-        char v[8];
+        char v[16];
         snprintf(v, sizeof v, "%d", k);
         pid_t pid = fork();
         if (pid == 0) {
