@@ -31,7 +31,8 @@ static const char* const k_text[SP_KTEXT_COUNT] = {
     [SP_KTEXT_PICK_PART] = "Tap the part you drew",
     [SP_KTEXT_UNRECOGNISED] = "Hmm, what is that? Tap the part you drew",
     [SP_KTEXT_UNRECOGNISED_NO_OFFER] = "Hmm, what is that? Try a body, a head, wings, a tail or legs",
-    [SP_KTEXT_TOO_SMALL] = "A bit bigger please: draw one long line",
+    // The strokes it refuses are specks, spots and dashes alike: no advice on how to draw.
+    [SP_KTEXT_TOO_SMALL] = "A bit bigger please!",
     [SP_KTEXT_DETAIL] = "Drawn on your dragon! Was it a new part? Tap it",
     [SP_KTEXT_TRICKY] = "That one was tricky. Try drawing it again",
     [SP_KTEXT_NOT_READY] = "This kiosk is not ready yet. Please ask a guide",
