@@ -237,16 +237,8 @@ static sp_result build_joints(work* w, sp_derive_info* info, sp_error* err)
 static sp_result convert_clip(work* w, sp_error* err)
 {
     const sp_rig* sr = w->sr;
-    for (int a = 0; a < sr->animation_count && !w->clip; ++a) {
-        const sp_animation* an = &sr->animations[a];
-        double start = INFINITY, end = -INFINITY;
-        for (int k = 0; k < an->channel_count; ++k)
-            if (an->channels[k].key_count > 0) {
-                start = fmin(start, an->channels[k].times[0]);
-                end = fmax(end, an->channels[k].times[an->channels[k].key_count - 1]);
-            }
-        if (end - start > 1e-3 && isfinite(end - start)) w->clip = an;
-    }
+    double start, end;
+    w->clip = sp_rig_first_clip(sr, &start, &end);
     if (!w->clip) return SP_OK;
     const sp_animation* an = w->clip;
     // Key times: every channel's, plus a steady rate where keys are not linear.

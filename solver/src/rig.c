@@ -394,6 +394,24 @@ static int find_key(const float* times, int n, double t)
     return lo;
 }
 
+const sp_animation* sp_rig_first_clip(const sp_rig* rig, double* start, double* end)
+{
+    for (int a = 0; a < rig->animation_count; ++a) {
+        const sp_animation* an = &rig->animations[a];
+        double t0 = INFINITY, t1 = -INFINITY;
+        for (int k = 0; k < an->channel_count; ++k)
+            if (an->channels[k].key_count > 0) {
+                t0 = fmin(t0, an->channels[k].times[0]);
+                t1 = fmax(t1, an->channels[k].times[an->channels[k].key_count - 1]);
+            }
+        if (t1 - t0 > 1e-3 && isfinite(t1 - t0)) {
+            *start = t0, *end = t1;
+            return an;
+        }
+    }
+    return NULL;
+}
+
 void sp_animation_sample(const sp_animation* anim, double t, sp_vec3* trans, sp_quat* rot, sp_vec3* scale)
 {
     for (int c = 0; c < anim->channel_count; ++c) {

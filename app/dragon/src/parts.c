@@ -82,26 +82,6 @@ static void read_part_extras(tpl* t)
     }
 }
 
-// The template's clip: the first animation of its rig with channels.
-static void find_clip(tpl* t)
-{
-    const sp_rig* rig = &t->ch.rig;
-    for (int a = 0; a < rig->animation_count && !t->clip; ++a) {
-        const sp_animation* an = &rig->animations[a];
-        double start = INFINITY, end = -INFINITY;
-        for (int k = 0; k < an->channel_count; ++k)
-            if (an->channels[k].key_count > 0) {
-                start = fmin(start, an->channels[k].times[0]);
-                end = fmax(end, an->channels[k].times[an->channels[k].key_count - 1]);
-            }
-        if (end - start > 1e-3 && isfinite(end - start)) {
-            t->clip = an;
-            t->clip_start = start;
-            t->clip_len = end - start;
-        }
-    }
-}
-
 // Loads part `name` from the database as a template fitted with its
 // abstraction (`outline`); or, with line_of, makes line_of's part fitted
 // with a `line` added to it, from a copy of its character (SP_OK, *out
@@ -188,7 +168,9 @@ static sp_result tpl_load(sp_db* db, const tpl* line_of, const char* name, int c
     sp_vec2 reach = sp_v2_sub(sp_v2_scale(sp_v2_add(t->rest_lo, t->rest_hi), 0.5), at);
     t->lengthwise = !t->is_torso && fabs(reach.x) > fabs(reach.y);
     t->outward = reach.x >= 0 ? 1 : -1;
-    find_clip(t);
+    double start = 0, end = 0; // the clip: the rig's first animation that moves
+    t->clip = sp_rig_first_clip(rig, &start, &end);
+    t->clip_start = start, t->clip_len = end - start;
     if (t->clip) {
         t->clip0 = malloc(sizeof(double) * P);
         if (!t->clip0) {

@@ -207,6 +207,10 @@ void sp_rig_params_from_trs(const sp_rig* rig, int joint, sp_vec3 t, sp_quat r, 
 /// Samples an animation at time t (seconds, clamped to its range) into
 /// per-joint local TRS arrays, which the caller pre-fills (e.g. with rest).
 void sp_animation_sample(const sp_animation* anim, double t, sp_vec3* trans, sp_quat* rot, sp_vec3* scale);
+/// The rig's first animation whose keys span more than a millisecond (a
+/// clip that moves), its first and last key times in *start and *end; NULL
+/// (start and end untouched) when it has none.
+const sp_animation* sp_rig_first_clip(const sp_rig* rig, double* start, double* end);
 /// Whether n key times can be an animation's: finite, at most FLT_MAX in
 /// magnitude and increasing in single precision (glTF stores float times).
 /// SP_ERR_INVALID (one line naming the key) when not.
