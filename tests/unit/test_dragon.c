@@ -3117,7 +3117,8 @@ static double to_fitted_mesh(const sp_dragon* d, int i, sp_vec2 p)
 // from the body), is fitted again with that end where the stroke comes
 // nearest the body: it attaches, its neck meeting the body's surface, its
 // head still where it was drawn. Drawn farther apart it stays free, and a
-// chip's choice reaches too (the README's tree taken for a head).
+// chip's choice reaches too (the README's tree taken for a head). A head
+// drawn first reaches when the body comes; Undo of the body frees it again.
 static void test_reaches_the_body(void)
 {
     const char* path = real_db();
@@ -3163,6 +3164,37 @@ static void test_reaches_the_body(void)
             ENSURE(off < 0.25 * diag);                                            // the part fits its stroke where it was drawn
         }
         ENSURE(sp_dragon_undo(d));
+    }
+    // The head first, 20 or 45 px beyond where the body comes: the body
+    // makes it reach, and Undo of the body gives its own fit back, free.
+    for (int mirrored = 0; mirrored < 2; ++mirrored) { // 20 px facing right, 45 facing left
+        double gap = mirrored ? 45 : 20;
+        sp_dragon_clear(d);
+        sp_dragon_result body = draw_part(d, db, "torso", 640, 440, 420, false, true), res;
+        sp_vec2 blo, bhi;
+        int n;
+        fitted_box(d, body.part, &blo, &bhi);
+        sp_dragon_clear(d);
+        sp_vec2* xy = at_box_end("head/head-blunt-round-ear.json", 230, blo.y - 40, mirrored, blo, bhi, !mirrored, -gap, &n);
+        ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
+               !res.rejected && res.part == 0);
+        free(xy);
+        const sp_dragon_part* p = sp_dragon_part_get(d, 0);
+        int np = p->character->rig.param_count;
+        double own[256];
+        bool was_mirrored = p->mirrored;
+        ENSURE(np <= 256 && p->attached_to < 0);
+        memcpy(own, p->params, sizeof(double) * (size_t)np);
+        body = draw_part(d, db, "torso", 640, 440, 420, false, true);
+        p = sp_dragon_part_get(d, 0);
+        fprintf(stderr,
+                "  round head %.0f px beyond, then the body (facing %s): attached to %d, its end %.0f px from the anchor\n", gap,
+                mirrored ? "left" : "right", p->attached_to, sp_v2_len(sp_v2_sub(p->attach_end, p->anchor)));
+        ENSURE(body.part == 1 && p->attached_to == 1);
+        ENSURE(sp_v2_len(sp_v2_sub(p->attach_end, p->anchor)) < 0.25 * snap);
+        ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == 1);
+        p = sp_dragon_part_get(d, 0);
+        ENSURE(p->attached_to < 0 && p->mirrored == was_mirrored && !memcmp(p->params, own, sizeof(double) * (size_t)np));
     }
     // The README's refused stroke (docs/img/kiosk_refused.json): a tree
     // drawn over the body's front, made a head with a chip (the kiosk adds

@@ -260,6 +260,12 @@ bool dragon_family_member(sp_dragon* d, int i, char out[SP_NAME_MAX]);
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip);
 /// The same test against part k only (false when k is not a body).
 bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k);
+/// Where part i's stroke comes nearest a body it is drawn on or near
+/// (dragon_on_body; only body `only` when it is not -1), within the snap
+/// distance: that body's surface point in *target, and the body's index.
+/// Of the stroke's points about that near (a stroke that overlaps the body
+/// has many), the one nearest the fitted attachment end a2. -1: none.
+int dragon_reach_target(sp_dragon* d, int i, int only, sp_vec2 a2, sp_vec2* target);
 /// What becomes of a detail's points off its part's mesh: left out (a
 /// detail drawn on the part), carried in the air together from the mesh's
 /// point nearest their middle (a flourish: it keeps its shape), or each from

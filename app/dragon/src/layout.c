@@ -911,11 +911,7 @@ static int nearest_body_surface(sp_dragon* d, int i, sp_vec2 a2, double snap, su
 // The stroke's points tried for where it comes nearest a body (evenly by index).
 #define REACH_SAMPLES 48
 
-// Where part i's stroke comes nearest a body it is drawn on or near
-// (dragon_on_body), within the snap distance: that body's surface point.
-// Of the stroke's points about that near (a stroke that overlaps the body
-// has many), the one nearest the fitted attachment end a2. -1: none.
-static int reach_target(sp_dragon* d, int i, sp_vec2 a2, sp_vec2* target)
+int dragon_reach_target(sp_dragon* d, int i, int only, sp_vec2 a2, sp_vec2* target)
 {
     const part* p = d->parts[i];
     sp_vec2 lo = {p->stroke_box[0], p->stroke_box[1]}, hi = {p->stroke_box[2], p->stroke_box[3]};
@@ -925,7 +921,7 @@ static int reach_target(sp_dragon* d, int i, sp_vec2 a2, sp_vec2* target)
     double bd = INFINITY;
     for (int k = 0; k < d->part_n; ++k) {
         part* q = d->parts[k];
-        if (k == i || !dragon_on_body(d, lo, hi, k) || !q->body_has_surface) continue;
+        if (k == i || (only >= 0 && k != only) || !dragon_on_body(d, lo, hi, k) || !q->body_has_surface) continue;
         for (int s = 0; s < REACH_SAMPLES && m < REACH_SAMPLES; ++s) {
             sp_vec2 pt = p->stroke[(int)((long)s * (p->stroke_n - 1) / (REACH_SAMPLES - 1))];
             surface_hit h;
@@ -967,9 +963,10 @@ static void layout_part(sp_dragon* d, int i)
     // The part just drawn near a body, its attachment end fitted farther
     // from it: fitted again with that end held where the stroke comes
     // nearest the body (reach.c). Only the newest part, at its first layout:
-    // an earlier part's fit stays what its own stroke made it.
+    // an earlier part's fit stays what its own stroke made it (a body drawn
+    // after it makes it reach: stroke.c, parts_meet_body).
     sp_vec2 target;
-    if (bk < 0 && p->layout_key == 0 && i == d->part_n - 1 && reach_target(d, i, a2, &target) >= 0 &&
+    if (bk < 0 && p->layout_key == 0 && i == d->part_n - 1 && dragon_reach_target(d, i, -1, a2, &target) >= 0 &&
         dragon_fit_reaching(d, p, target)) {
         a = fitted_point(p, &p->pub.placement, p->t->attach_joint, p->t->attach_local);
         p->pub.attach_end = a2 = sp_camera_project(&d->world, a);

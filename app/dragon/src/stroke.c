@@ -639,6 +639,17 @@ static sp_result take_family_member(sp_dragon* d, sp_dragon_result* out, sp_erro
     return SP_OK;
 }
 
+// q, a new fit of part i, takes its place as the part it was (its id, a
+// chip's choice), keeping it to give back when part `by` goes.
+static void take_place(sp_dragon* d, int i, part* q, uint64_t by)
+{
+    part* old = d->parts[i];
+    q->pub.id = old->pub.id;
+    q->chosen = old->chosen;
+    q->before = old, q->before_by = by;
+    d->parts[i] = q;
+}
+
 // Part i becomes fit f (which it frees), keeping its id (the kiosk keys its
 // chips and its kept stroke by id) and its stroke; the part it was is kept
 // for the body with id `by` to give back (give_back_fits). False when out of
@@ -650,10 +661,7 @@ static bool replace_before_body(sp_dragon* d, int i, fit_choice* f, float confid
     sp_result r = new_part(d, f->t, f->p, &f->rep, &f->view, f->mirrored, old->stroke, old->stroke_n, confidence, &q, &lerr);
     free(f->p);
     if (r != SP_OK) return false;
-    q->pub.id = old->pub.id;
-    q->chosen = old->chosen;
-    q->before = old, q->before_by = by;
-    d->parts[i] = q;
+    take_place(d, i, q, by);
     return true;
 }
 
@@ -759,6 +767,40 @@ static void parts_by_place(sp_dragon* d, int body, uint64_t by)
     if (changed) dragon_relayout(d);
 }
 
+// Parts drawn a little apart before the body came (free, their strokes
+// within the snap distance of its surface) reach it as the part just drawn
+// does (layout.c, layout_part): fitted again with the attachment end where
+// the stroke comes nearest the body. A head drawn first hung beside its
+// dragon where, drawn second, it attached (BENCHMARKS.md, "Thirty-fifth
+// pass"). The former fit is kept for Undo (give_back_fits).
+static bool parts_reach_body(sp_dragon* d, int body, uint64_t by)
+{
+    bool changed = false;
+    for (int i = 0; i < body; ++i) {
+        part *old = d->parts[i], *q = NULL;
+        sp_vec2 target;
+        if (old->t->is_torso || old->pub.attached_to >= 0 ||
+            dragon_reach_target(d, i, body, old->pub.attach_end, &target) != body)
+            continue;
+        bool own = old->before && old->before_by == by; // already this body's (turned): reaches in place
+        if (own) {
+            if (dragon_fit_reaching(d, old, target)) old->layout_key = 0, changed = true;
+            continue;
+        }
+        sp_error lerr = {0};
+        if (new_part(d, old->t, old->p_fit, &old->pub.report, &old->pub.view, old->pub.mirrored, old->stroke, old->stroke_n,
+                     old->pub.confidence, &q, &lerr) != SP_OK)
+            continue;
+        if (!dragon_fit_reaching(d, q, target)) {
+            dragon_part_free(q);
+            continue;
+        }
+        take_place(d, i, q, by);
+        changed = true;
+    }
+    return changed;
+}
+
 // Parts drawn before a body, when the body comes (the last part), as if
 // drawn after it:
 // - a part the classifier took for a body that lies on it is decided again
@@ -767,7 +809,8 @@ static void parts_by_place(sp_dragon* d, int body, uint64_t by)
 //   after the body (fit_variants: the facing the body hints at, kept when
 //   it comes out of the body's end), so that its root rides the body;
 // - legs attached to it become the legs of their end, and legs and wings
-//   face the way its dragon does (parts_by_place).
+//   face the way its dragon does (parts_by_place);
+// - a part drawn a little apart reaches it (parts_reach_body).
 // Each keeps its id and its stroke; its former fit is kept for Undo or a
 // Redraw of the body (give_back_fits).
 static void parts_meet_body(sp_dragon* d)
@@ -800,6 +843,7 @@ static void parts_meet_body(sp_dragon* d)
         changed |= replace_before_body(d, i, &f, old->pub.confidence, by);
     }
     if (changed) dragon_relayout(d);
+    if (parts_reach_body(d, body, by)) dragon_relayout(d);
     parts_by_place(d, body, by);
 }
 
