@@ -702,6 +702,51 @@ static void test_other_chip(void)
     sp_kiosk_session_free(&s);
 }
 
+// Points of a line under any of the chips shown.
+static int under_chips(const sp_kiosk_ui* ui, const sp_kiosk_line* l)
+{
+    int n = 0;
+    for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t) {
+        const sp_kiosk_rect* r = &ui->target[t];
+        for (int i = 0; sp_kiosk_ui_target_visible(ui, (sp_kiosk_target)t) && i < l->count; ++i)
+            n += l->xy[2 * i] >= r->x && l->xy[2 * i] < r->x + r->w && l->xy[2 * i + 1] >= r->y && l->xy[2 * i + 1] < r->y + r->h;
+    }
+    return n;
+}
+
+// The chips stay at the canvas's top-left, unless the stroke they are about
+// was drawn there: then they go to the top-right, in the same order, and
+// cover none of it (a head drawn in the corner lay under "Head", "Wings?").
+static void test_chips_clear_the_stroke(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    float mid = ui->canvas.x + 0.5f * ui->canvas.w;
+    double t = stroke(ui, 1000, 400, 400, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL));
+    ENSURE(ui->target[SP_KT_CHIP_LABEL].x < mid && ui->target[SP_KT_CHIP_MORE].x < mid);
+    // In the corner, under where the chips were.
+    t = stroke(ui, t + 2000, 20, 25, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 2 && ui->flash_stroke.count > 0 && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    ENSURE(under_chips(ui, &ui->flash_stroke) == 0 && under_chips(ui, &ui->flash_outline) == 0);
+    float end = 0; // the stroke's right end
+    for (int i = 0; i < ui->flash_stroke.count; ++i)
+        end = fmaxf(end, ui->flash_stroke.xy[2 * i]);
+    ENSURE(ui->target[SP_KT_CHIP_LABEL].x > end);
+    ENSURE(ui->target[SP_KT_CHIP_LABEL].x < ui->target[SP_KT_CHIP_GUESS1].x &&
+           ui->target[SP_KT_CHIP_GUESS1].x < ui->target[SP_KT_CHIP_MORE].x);
+    check_targets(ui);
+    // A refused stroke there: its guesses keep clear of it as well.
+    t = refused_stroke(ui, t + 2000, 60, 15);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    ENSURE(under_chips(ui, &ui->held_stroke) == 0 && ui->target[SP_KT_CHIP_GUESS1].x > 100);
+    check_targets(ui);
+    sp_kiosk_ui_destroy(ui);
+}
+
 // Issue 16, item 7: Start over returns to the first-draw prompt with the
 // animation stopped (the old kiosk showed a blank canvas and "Pause").
 static void test_start_over(void)
@@ -1942,6 +1987,7 @@ int main(int argc, char** argv)
                                    {"parts_row", test_parts_row},
                                    {"parts_row_twelve", test_parts_row_twelve},
                                    {"other_chip", test_other_chip},
+                                   {"chips_clear_the_stroke", test_chips_clear_the_stroke},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},

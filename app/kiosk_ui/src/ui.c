@@ -210,6 +210,44 @@ static void keep_stroke_in_sight(sp_kiosk_ui* ui, float top, float end, float ma
     ui->hint_box.y = start;
 }
 
+// Points of a line inside rect r.
+static int points_in(const sp_kiosk_line* l, const sp_kiosk_rect* r)
+{
+    int n = 0;
+    for (int i = 0; i < l->count; ++i) {
+        float x = l->xy[2 * i], y = l->xy[2 * i + 1];
+        n += x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
+    }
+    return n;
+}
+
+// Points of the lines the chips are about (the refused stroke offered, or
+// the last part's stroke and fitted outline) under the chips.
+static int chips_cover(const sp_kiosk_ui* ui)
+{
+    int n = 0;
+    for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t)
+        n += offering(ui) ? points_in(&ui->held_stroke, &ui->target[t])
+                          : points_in(&ui->flash_stroke, &ui->target[t]) + points_in(&ui->flash_outline, &ui->target[t]);
+    return n;
+}
+
+// Each row of chips moved to end at `right`, in the same order.
+static void chips_to_right(sp_kiosk_ui* ui, float right)
+{
+    enum { first = SP_KT_CHIP_LABEL, n = SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1 };
+    sp_kiosk_rect* c = &ui->target[first];
+    float shift[n];
+    for (int i = 0; i < n; ++i) {
+        float end = c[i].x + c[i].w; // its row's end
+        for (int j = 0; j < n; ++j)
+            if (c[j].w > 0 && c[j].y == c[i].y) end = fmaxf(end, c[j].x + c[j].w);
+        shift[i] = right - end;
+    }
+    for (int i = 0; i < n; ++i)
+        if (c[i].w > 0) c[i].x += shift[i];
+}
+
 // Chips sit in a row at the canvas's top-left and wrap when the row is full;
 // while a refused stroke is offered, the row of parts goes under them, and
 // the hint under both. Chip widths follow the text: a DejaVu Sans character
@@ -243,6 +281,15 @@ static void layout_chips(sp_kiosk_ui* ui)
         }
         *r = (sp_kiosk_rect){x, y, w, h};
         x += w + gap;
+    }
+    // A stroke drawn at the top-left (the one they are about) would be under
+    // them: they go to the top-right when it covers less there.
+    int covered = chips_cover(ui);
+    if (covered > 0) {
+        sp_kiosk_rect at_left[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
+        memcpy(at_left, &ui->target[SP_KT_CHIP_LABEL], sizeof at_left);
+        chips_to_right(ui, right);
+        if (chips_cover(ui) >= covered) memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left); // no better
     }
     float below = y + h + gap, chips_end = below;
     // The parts row: an outline over its name, 26 x 22 mm, smaller (down to
@@ -1233,10 +1280,6 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
         return;
     }
     ui->part_count = r->part_count;
-    if (last)
-        set_chips(ui, r->category, r->guesses[0], r->guesses[1]);
-    else
-        set_chips(ui, NULL, NULL, NULL);
     ++ui->revision;
     if (r->stroke && r->stroke_count > 0) {
         line_set(&ui->flash_stroke, r->stroke, r->stroke_count, SP_KIOSK_STROKE_MAX);
@@ -1251,6 +1294,11 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
     for (int i = 0; !thinned && r->outline_breaks && i < r->outline_break_count && ui->flash_break_count < 64; ++i)
         if (r->outline_breaks[i] > 0 && r->outline_breaks[i] < ui->flash_outline.count)
             ui->flash_breaks[ui->flash_break_count++] = r->outline_breaks[i];
+    // After the lines: the chips keep clear of them (layout_chips).
+    if (last)
+        set_chips(ui, r->category, r->guesses[0], r->guesses[1]);
+    else
+        set_chips(ui, NULL, NULL, NULL);
     ui->flash_until = ui->now + ui->desc.flash_ms;
     ui->fade_until = -1;
     ui->hint_until = -1;
