@@ -3100,6 +3100,42 @@ static void test_polygon_refusal(void)
     sp_dragon_destroy(d);
 }
 
+// A slow, shaky hand: the visitors' drawings with a point every pixel and
+// 1 px of touch noise (an outside review's child) become the part the
+// steady drawing does. The noise doubled the stroke's length, which the
+// scribble test refused, its first guess right.
+static void test_shaky_hand(void)
+{
+    const char* path = real_db();
+    sp_dragon* d = new_dragon(path);
+    sp_error err = {0};
+    const char* drawings[] = {"head/head-open-jaw-teeth.json", "front_legs/front-legs-boots.json",
+                              "hind_legs/hind-legs-boots.json"};
+    sp_rng rng = {11};
+    for (int k = 0; k < 3; ++k) {
+        int n;
+        sp_vec2* xy = visitor_stroke(drawings[k], k == 0 ? 230 : 175, (sp_vec2){640, 400}, false, &n);
+        sp_dragon_result steady, shaky;
+        ENSURE(sp_dragon_add_points(d, xy, n, NULL, &steady, &err) == SP_OK && !steady.rejected);
+        char category[64];
+        snprintf(category, sizeof category, "%s", sp_dragon_part_get(d, steady.part)->category);
+        sp_dragon_clear(d);
+        int m = (int)sp_curve_length(xy, n, false);
+        sp_vec2* slow = malloc(sizeof(sp_vec2) * (size_t)m);
+        ENSURE(slow && sp_curve_resample(xy, n, false, m, slow) == SP_OK);
+        for (int i = 0; i < m; ++i)
+            slow[i].x += sp_rng_normal(&rng), slow[i].y += sp_rng_normal(&rng);
+        ENSURE(sp_dragon_add_points(d, slow, m, NULL, &shaky, &err) == SP_OK);
+        fprintf(stderr, "  %s: steady %s, shaky (%d points) %s\n", drawings[k], category, m,
+                shaky.rejected ? sp_dragon_reject_name(shaky.reason) : sp_dragon_part_get(d, shaky.part)->category);
+        ENSURE(!shaky.rejected && !strcmp(sp_dragon_part_get(d, shaky.part)->category, category));
+        sp_dragon_clear(d);
+        free(slow);
+        free(xy);
+    }
+    sp_dragon_destroy(d);
+}
+
 // The distance from canvas point p to the nearest of part i's mesh vertices at its fit.
 static double to_fitted_mesh(const sp_dragon* d, int i, sp_vec2 p)
 {
@@ -4368,6 +4404,7 @@ int main(int argc, char** argv)
                                    {"head_first_faces_as_after", test_head_first_faces_as_after},
                                    {"mirror_refusal", test_mirror_refusal},
                                    {"polygon_refusal", test_polygon_refusal},
+                                   {"shaky_hand", test_shaky_hand},
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},

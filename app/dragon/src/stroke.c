@@ -498,15 +498,31 @@ static bool turns_onto_itself(const sp_vec2* pts, int n)
 // and tiny strokes never get here. Constants tuned on the tune half and the
 // fresh set of tests/data/visitors (BENCHMARKS.md, "Visitors' drawings").
 
+// The scribble test's ink is measured over points at least this fraction
+// of the canvas diagonal apart (3.8 px at 1280 x 800): a slow, shaky hand
+// (a point every pixel, 1 px of touch noise) doubled its stroke's length
+// and was refused, its first guess right (BENCHMARKS.md, "Thirty-sixth pass").
+#define INK_STEP 0.0025
+
+// Length of the stroke over points at least `step` apart (sp_curve_clean).
+static double ink_length(const sp_vec2* pts, int n, double step)
+{
+    sp_vec2* k = malloc(sizeof(sp_vec2) * (size_t)n);
+    if (!k) return sp_curve_length(pts, n, false);
+    double len = sp_curve_length(k, sp_curve_clean(pts, n, step, k), false);
+    free(k);
+    return len;
+}
+
 // A scribble (far more ink than its size, or crossing itself over and over)
-// or a shape with a polygon's or a star's symmetry.
-static bool refused_before_fit(const sp_vec2* pts, int n)
+// or a shape with a polygon's or a star's symmetry. `diag`: the canvas's diagonal.
+static bool refused_before_fit(const sp_vec2* pts, int n, double diag)
 {
     enum { M = 64 };
     sp_vec2 r[M], lo = pts[0], hi = pts[0];
     for (int i = 1; i < n; ++i)
         lo.x = fmin(lo.x, pts[i].x), lo.y = fmin(lo.y, pts[i].y), hi.x = fmax(hi.x, pts[i].x), hi.y = fmax(hi.y, pts[i].y);
-    if (sp_curve_length(pts, n, false) > 6.0 * sp_v2_len(sp_v2_sub(hi, lo))) return true;
+    if (ink_length(pts, n, INK_STEP * diag) > 6.0 * sp_v2_len(sp_v2_sub(hi, lo))) return true;
     if (sp_curve_resample(pts, n, false, M, r) != SP_OK) return false;
 #define CROSS(a, b) ((a).x * (b).y - (a).y * (b).x)
     int crossings = 0;
@@ -566,7 +582,7 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     if (forced) return SP_DRAGON_ACCEPTED;
     if (isfinite(a->reject_distance) && a->reject_distance > 0) *near = a->distance / a->reject_distance;
     if (a->count == 0 || a->ranked[0].score < d->desc.min_confidence ||
-        refused_before_fit(sk->strokes[0].points, sk->strokes[0].count))
+        refused_before_fit(sk->strokes[0].points, sk->strokes[0].count, hypot(sk->canvas_w, sk->canvas_h)))
         return SP_DRAGON_UNRECOGNISED;
     dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a->ranked[0].category));
     *confidence = a->ranked[0].score;
