@@ -1196,6 +1196,18 @@ static void test_turn_reminds_draw(void)
     ENSURE(ui->pending_count == 0 && f.parts == 1);
     tap(ui, td + 200, SP_KT_TURN);
     ENSURE(ui->mode == SP_KM_DRAW && !sp_kiosk_ui_hint_visible(ui));
+    // A review's child tapped Redraw (a pencil) in the turn view to draw:
+    // it stayed armed unseen, and the next new part replaced the last. Now
+    // it goes back to drawing, armed and saying so; Turn disarms it.
+    tap(ui, td + 300, SP_KT_TURN);
+    tap(ui, td + 400, SP_KT_REDRAW);
+    ENSURE(ui->mode == SP_KM_DRAW && ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_REDRAW)));
+    tap(ui, td + 500, SP_KT_TURN);
+    ENSURE(ui->mode == SP_KM_TURN && !ui->redraw_armed);
+    tap(ui, td + 600, SP_KT_TURN);
+    double te = stroke(ui, td + 700, 300, 500, 18, 5);
+    frame(ui, &f, te + 10);
+    ENSURE(ui->mode == SP_KM_DRAW && f.parts == 2); // a new part, the last one kept
     sp_kiosk_ui_destroy(ui);
 }
 

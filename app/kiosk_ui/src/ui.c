@@ -938,6 +938,13 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         }
         break;
     case SP_KT_REDRAW:
+        // Tapped in the turn view it means "draw it again": back to drawing,
+        // armed (it stayed armed unseen, and the next part replaced the last).
+        if (ui->mode == SP_KM_TURN) {
+            ui->mode = SP_KM_DRAW;
+            ui->mode_since = ui->now;
+            ui->redraw_armed = false;
+        }
         ui->redraw_armed = !ui->redraw_armed;
         ui->redraw_for_offer = false; // the visitor's own Redraw: it waits for them
         if (ui->redraw_armed)
@@ -968,6 +975,7 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
         ui->mode_since = ui->now;
         end_offer(ui, false);            // its chips only show in the drawing view
         if (ui->row_open) close_row(ui); // and so does the row opened for the last part
+        ui->redraw_armed = ui->redraw_for_offer = false; // a Redraw waits for a stroke in this view only
         if (ui->mode == SP_KM_TURN)
             set_hint(ui, sp_kiosk_text(SP_KTEXT_TURN));
         else
