@@ -386,6 +386,32 @@ static void test_flow(void)
 // guesses as chips; a tap makes it that part; the chips never refer to any
 // stroke but the last (the old kiosk re-fitted the previous part: the body
 // became a head).
+// A curator's category of 63 characters, the most the part database takes:
+// a guess chip and a tile choose it whole (cut to 47, it matched no part
+// and the kiosk said it was not ready).
+static void test_long_category(void)
+{
+    char name[64];
+    memset(name, 'a', 63);
+    name[63] = 0;
+    const char* const row[7] = {"torso", "head", "wings", "tail", "front_legs", "hind_legs", name};
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    sp_kiosk_ui_set_parts(ui, row, 7);
+    sp_kiosk_job j;
+    for (int k = 0; k < 2; ++k) {
+        double t = refused_stroke(ui, 1000 + 20000 * k, 800, 200);
+        ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.offer = true, .offers = {name, "wings", "tail"}});
+        ENSURE(sp_kiosk_ui_offering(ui) && sp_kiosk_ui_target_visible(ui, SP_KT_PART1 + 6));
+        tap(ui, t + 500, k == 0 ? SP_KT_CHIP_GUESS1 : SP_KT_PART1 + 6);
+        ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !strcmp(j.category, name));
+        sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = name, .part_count = k + 1});
+        ENSURE(!strcmp(ui->chip[0], name));
+    }
+    sp_kiosk_ui_destroy(ui);
+}
+
 static void test_refused_stroke(void)
 {
     fake f;
@@ -2000,6 +2026,7 @@ int main(int argc, char** argv)
                                    {"parts_row_twelve", test_parts_row_twelve},
                                    {"other_chip", test_other_chip},
                                    {"chips_clear_the_stroke", test_chips_clear_the_stroke},
+                                   {"long_category", test_long_category},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},

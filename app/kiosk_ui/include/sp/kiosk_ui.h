@@ -83,7 +83,9 @@ enum {
     SP_KIOSK_OUTLINE_MAX = 4096, ///< points of a fitted outline kept for the flash
     SP_KIOSK_PENDING_MAX = 2,    ///< finished strokes waiting for the pipeline; a third drops the oldest
     SP_KIOSK_JOBS_MAX = 32,      ///< queued jobs; more are dropped (tap storms)
-    SP_KIOSK_LABEL_MAX = 48,
+    /// A category's name with its NUL: the part database takes up to 63
+    /// characters (SP_NAME_MAX), and one cut short here matched no part.
+    SP_KIOSK_LABEL_MAX = 64,
     SP_KIOSK_TEXT_MAX = 160,
     /// Start over's second tap comes at least this long after the first: a
     /// double tap (0.1-0.3 s) is one touch, not a confirmation read and given.
