@@ -434,21 +434,22 @@ static const char* note_hint(sp_dragon_note n)
     return n == SP_DRAGON_NOTE_NO_SURFACE ? sp_kiosk_text(SP_KTEXT_NO_SURFACE) : NULL;
 }
 
-// The chips' guesses for a stroke: the classifier's ranked categories but
-// `skip` (the part it became, or the one that did not fit), then, as a sure
+// The chips' guesses for a stroke: the classifier's ranked categories that
+// have a part but `skip` (the part it became, or the one that did not fit), then, as a sure
 // classifier votes for few categories, the model's others in the parts row's
 // order, so that the visitor always has `want` to choose from.
 static int stroke_guesses(const sp_kiosk* k, const sp_dragon_result* res, const char* skip, char out[][SP_NAME_MAX], int want)
 {
     int n = 0;
     for (int i = 0; i < res->guess_count && n < want; ++i)
-        if (!skip || strcmp(res->guesses[i].category, skip) != 0) snprintf(out[n++], SP_NAME_MAX, "%s", res->guesses[i].category);
+        if ((!skip || strcmp(res->guesses[i].category, skip) != 0) && sp_dragon_has_part(k->dragon, res->guesses[i].category))
+            snprintf(out[n++], SP_NAME_MAX, "%s", res->guesses[i].category);
     const sp_clf* clf = sp_dragon_model(k->dragon);
     while (clf && n < want) {
         const char* next = NULL;
         for (int c = 0; c < sp_clf_category_count(clf); ++c) {
             const char* name = sp_clf_category(clf, c);
-            bool used = skip && !strcmp(name, skip);
+            bool used = (skip && !strcmp(name, skip)) || !sp_dragon_has_part(k->dragon, name);
             for (int q = 0; q < n; ++q)
                 used = used || !strcmp(name, out[q]);
             if (!used && (!next || sp_kiosk_part_order(name) < sp_kiosk_part_order(next))) next = name;

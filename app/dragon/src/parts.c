@@ -473,6 +473,11 @@ tpl* dragon_category_first(sp_dragon* d, const char* category)
     return dragon_category_templates(d, category, t, 1, &lerr) == 1 ? t[0] : NULL;
 }
 
+bool sp_dragon_has_part(sp_dragon* d, const char* category)
+{
+    return d && category && dragon_category_first(d, category) != NULL;
+}
+
 sp_result sp_dragon_preload_step(sp_dragon* d, bool* done, sp_error* err)
 {
     *done = true;

@@ -315,6 +315,10 @@ static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2
         for (int g = 0; g < out->guess_count; ++g) {
             fit_choice f;
             if (no_body && category_is_body(d, out->guesses[g].category) != (pass == 1)) continue;
+            // A guess with no part (one removed until the next db train) is
+            // not the first the others' shares count from: it left the stroke
+            // with no part at all, the kiosk saying it was not ready.
+            if (!dragon_category_first(d, out->guesses[g].category)) continue;
             if (first < 0) first = g;
             if (g > first && out->guesses[g].confidence < RERANK_MIN_SHARE * out->guesses[first].confidence) continue;
             if (!fit_category(d, out->guesses[g].category, sk, lo, hi, &f, not_finite, any_part)) continue;

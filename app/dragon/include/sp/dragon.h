@@ -351,6 +351,10 @@ int sp_dragon_loaded_parts(const sp_dragon* d);
 /// whose parts all fail gives SP_DRAGON_NO_PART, and this says why. A part
 /// that does not load is not tried again until the database changes.
 const char* sp_dragon_part_error(const sp_dragon* d);
+/// Whether a part of the category is in the database and loads (what a
+/// guess needs to become a part: the model may still rank a category whose
+/// part a curator removed, until the next `db train`).
+bool sp_dragon_has_part(sp_dragon* d, const char* category);
 /// The categories the current model knows (for hints); NULL when there is no model.
 const sp_clf* sp_dragon_model(const sp_dragon* d);
 /// Why sp_dragon_model is NULL, one line naming the database ("DB: no
