@@ -1179,12 +1179,19 @@ static void test_line_from_overlay(void)
     ENSURE(!sp_kiosk_ui_offering(ui) && ui->chosen == 0 && sp_kiosk_ui_fade(ui) > 0.9);
     frame(ui, &f, t + 900);
     ENSURE(f.forced == forced && f.fits == fits + 1 && f.parts == 3);
-    // A toolbar button pressed and dragged away does nothing at all.
+    // A toolbar button pressed and dragged away within the toolbar does
+    // nothing at all; drawn on into the canvas, it is a line from where it
+    // enters (a review's child began a line on Undo, and it was lost), and
+    // the button is not pressed.
     const sp_kiosk_rect* u = &ui->target[SP_KT_UNDO];
     ENSURE(!in_rect(&ui->canvas, u->x, u->y));
-    line_from(ui, t + 2000, u->x + 0.5f * u->w, u->y + 0.5f * u->h, -15, 0, 30);
+    line_from(ui, t + 2000, u->x + 0.5f * u->w, u->y + 0.5f * u->h, 0, 4, 30);
     frame(ui, &f, t + 2500);
     ENSURE(f.parts == 3 && f.undos == 0 && ui->pending_count == 0 && ui->job_count == 0);
+    line_from(ui, t + 2600, u->x + 0.5f * u->w, u->y + 0.5f * u->h, -15, 0, 30);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->xy[0] < ui->canvas.x + ui->canvas.w &&
+           j.stroke->xy[0] > ui->canvas.x + ui->canvas.w - 25 && j.stroke->count > 20);
+    ENSURE(!sp_kiosk_ui_next_job(ui, &j) && f.undos == 0);
     // From the toolbar's strip (no button there) into the canvas: the line starts where it enters.
     float sx = ui->canvas.x + ui->canvas.w + 4, sy = 3;
     ENSURE(sx < ui->width && sp_kiosk_ui_hit(ui, sx, sy) == SP_KT_NONE);

@@ -1125,6 +1125,12 @@ static void on_move(sp_kiosk_ui* ui, float x, float y)
             sp_kiosk_ui_hit(ui, x, y) != ui->pressed) {
             start_stroke(ui, ui->down_x, ui->down_y, ui->down_t);
             add_point(ui, x, y, false);
+        } else if (ui->mode == SP_KM_DRAW && !inside(&ui->canvas, ui->down_x, ui->down_y) && inside(&ui->canvas, x, y) &&
+                   sp_kiosk_ui_hit(ui, x, y) == SP_KT_NONE) {
+            // One begun on a toolbar button and drawn into the canvas starts
+            // where it enters, as from the toolbar's strip: a review's child
+            // began a right-facing dragon's line on Undo, and it was lost.
+            start_stroke(ui, x, y, ui->now);
         }
         break;
     case SP_KCAP_SWALLOW:
