@@ -3129,6 +3129,41 @@ static void test_guess_without_part(void)
     sp_dragon_destroy(d);
 }
 
+// Colouring in: a zigzag scribble over most of the body (an outside
+// review's child) is kept as ink on it, offered as a detail; it was
+// refused as a scribble and faded. The same scribble beside the dragon is
+// still refused.
+static void test_colouring_in(void)
+{
+    const char* path = real_db();
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    sp_dragon_result body = draw_part(d, db, "torso", 640, 440, 420, false, true), res;
+    sp_vec2 blo, bhi;
+    fitted_box(d, body.part, &blo, &bhi);
+    for (int k = 0; k < 2; ++k) {
+        // 12 strokes up and down across the body's middle, within its outline.
+        sp_vec2 zig[25], xy[400];
+        double x0 = blo.x + 0.2 * (bhi.x - blo.x), w = 0.6 * (bhi.x - blo.x), ym = 0.5 * (blo.y + bhi.y);
+        double dy = k ? 700 - ym : 0; // k = 1: far below the dragon
+        for (int i = 0; i < 25; ++i)
+            zig[i] = (sp_vec2){x0 + w * i / 24, ym + dy + (i % 2 ? 0.18 : -0.18) * (bhi.y - blo.y)};
+        ENSURE(sp_curve_resample(zig, 25, false, 400, xy) == SP_OK);
+        int before = sp_dragon_detail_count(d);
+        ENSURE(sp_dragon_add_points(d, xy, 400, NULL, &res, &err) == SP_OK && res.rejected);
+        fprintf(stderr, "  a zigzag %s: %s, %d details\n", k ? "below the dragon" : "over the body",
+                sp_dragon_reject_name(res.reason), sp_dragon_detail_count(d));
+        if (k == 0)
+            ENSURE(res.reason == SP_DRAGON_DETAIL && res.detail >= 0 && sp_dragon_detail_count(d) == before + 1 &&
+                   res.guess_count > 0);
+        else
+            ENSURE(res.reason == SP_DRAGON_UNRECOGNISED && sp_dragon_detail_count(d) == before);
+    }
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // A slow, shaky hand: the visitors' drawings with a point every pixel and
 // 1 px of touch noise (an outside review's child) become the part the
 // steady drawing does. The noise doubled the stroke's length, which the
@@ -4434,6 +4469,7 @@ int main(int argc, char** argv)
                                    {"mirror_refusal", test_mirror_refusal},
                                    {"polygon_refusal", test_polygon_refusal},
                                    {"shaky_hand", test_shaky_hand},
+                                   {"colouring_in", test_colouring_in},
                                    {"guess_without_part", test_guess_without_part},
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},

@@ -587,16 +587,17 @@ static int part_near_stroke(sp_dragon* d, int k, sp_vec2 lo, sp_vec2 hi, double*
 #define SPECK_ON 0.5
 
 // dragon_detail_of with `on`, the share of points that must lie on the
-// part, and what becomes of the points off it.
-static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, double on, detail_air air,
-                       detail_hit* hit)
+// part, `size`, the stroke's largest size (box diagonals, a fraction of the
+// part's mesh on the canvas), and what becomes of the points off it.
+static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, double on, double size,
+                       detail_air air, detail_hit* hit)
 {
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
     dragon_pose_shown(d);                      // for part_near_stroke
     for (int k = d->part_n - 1; k >= 0; --k) { // the part drawn last lies on top
         part* q = d->parts[k];
         double qd = hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]);
-        if (k == skip || n < 2 || !(diag <= 2 * DETAIL_SIZE * qd)) continue;
+        if (k == skip || n < 2 || !(diag <= 2 * size * qd)) continue;
         const sp_rig* rig = &q->t->ch.rig;
         double* xyz;
         sp_vec2 *px, a, b;
@@ -605,7 +606,7 @@ static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         if (got == 0) continue;
         int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0;
         double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
-        bool detail = diag <= DETAIL_SIZE * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
+        bool detail = diag <= size * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
         // The window: the stroke's box grown by `near` (and a cell); none for
         // a mesh that is not finite or a window beyond reason.
         sp_vec2 o = {floor(lo.x - near - 1), floor(lo.y - near - 1)};
@@ -633,13 +634,24 @@ static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
 
 int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
-    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, DETAIL_AIR_NONE, hit);
+    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, DETAIL_SIZE, DETAIL_AIR_NONE, hit);
+}
+
+// Colouring in is drawn over a part up to its whole size: a stroke refused
+// as a scribble (or not recognised) that lies on one part as a detail does.
+#define COLOURING_SIZE 1.0
+
+int dragon_colouring_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+{
+    // A closed shape drawn on a part is a part drawn there (as for spikes along the back).
+    if (n < 2 || sp_stroke_is_loop(&(sp_stroke){.count = n, .points = (sp_vec2*)pts})) return -1;
+    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, COLOURING_SIZE, DETAIL_AIR_NONE, hit);
 }
 
 int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
     if (!(hypot(hi.x - lo.x, hi.y - lo.y) < SP_DRAGON_PART_MIN * hypot(d->desc.canvas_w, d->desc.canvas_h))) return -1;
-    int k = detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_AIR_TOGETHER, hit);
+    int k = detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_SIZE, DETAIL_AIR_TOGETHER, hit);
     // Bound where drawn: its points off the mesh ride in the air rather
     // than onto the mesh's edge, which would squash a spot drawn half off.
     if (k >= 0 && hit) hit->near = 0.71;

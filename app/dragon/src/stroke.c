@@ -957,13 +957,16 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // A small stroke drawn on a part is a detail of it (an eye, spots,
     // shading), one drawn along a body's edge too (spikes on its back), and
     // a speck half on a part (a spot at a thin tail's edge): a tiny or thin
-    // part there is not what was meant. It is kept as ink on
+    // part there is not what was meant. So is a stroke not recognised that
+    // lies on a part, whatever its size: colouring in (a review's child
+    // coloured the body, and the refused scribble faded). It is kept as ink on
     // the part; its guesses stay, so a chip still makes it a part.
     detail_hit hit = {0};
     int skip = o.replace_last ? d->part_n - 1 : -1;
     if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
         (dragon_detail_of(d, pts, n, lo, hi, skip, &hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, &hit) >= 0 ||
-         dragon_speck_of(d, pts, n, lo, hi, skip, &hit) >= 0))
+         dragon_speck_of(d, pts, n, lo, hi, skip, &hit) >= 0 ||
+         (why == SP_DRAGON_UNRECOGNISED && dragon_colouring_of(d, pts, n, lo, hi, skip, &hit) >= 0)))
         why = SP_DRAGON_DETAIL;
     bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
     if (flourish) why = SP_DRAGON_DETAIL;
