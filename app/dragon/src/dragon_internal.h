@@ -43,6 +43,8 @@ typedef struct tpl {
     bool lengthwise;          // from its attachment end it reaches sideways on the canvas (a head, a tail)
     int outward;              // and which way: +1 right, -1 left, as modelled
     sp_vec2 rest_lo, rest_hi; // the rest abstraction's bounding box in `base`, pixels
+    double own_mirror_gap;    // the rest abstraction's dragon_mirror_gap (a front view of a person: near 0)
+    bool own_polygonal;       // the rest abstraction has a polygon's or a star's symmetry (dragon_turns_onto_itself)
     bool is_torso;
     int socket_count;
     dsocket* sockets;
@@ -72,6 +74,12 @@ typedef struct tpl {
 
 /// Drops one reference (the last frees it). NULL is fine.
 void dragon_tpl_release(tpl* t);
+/// How far a stroke is from being its own mirror image about the upright
+/// line through its centroid, over its RMS radius (0: symmetric; 1 when it
+/// cannot be measured). stroke.c.
+double dragon_mirror_gap(const sp_vec2* pts, int n);
+/// Whether a stroke has the symmetry of a regular polygon or a star. stroke.c.
+bool dragon_turns_onto_itself(const sp_vec2* pts, int n);
 /// The loaded templates of `category` (loaded and cached on first use), at most cap.
 int dragon_category_templates(sp_dragon* d, const char* category, tpl** out, int cap, sp_error* err);
 /// The first of them (what every part of a category shares: a body or not,

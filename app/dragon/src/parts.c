@@ -157,6 +157,10 @@ static sp_result tpl_load(sp_db* db, const tpl* line_of, const char* name, int c
         t->rest_lo.x = fmin(t->rest_lo.x, xy[2 * i]), t->rest_lo.y = fmin(t->rest_lo.y, xy[2 * i + 1]);
         t->rest_hi.x = fmax(t->rest_hi.x, xy[2 * i]), t->rest_hi.y = fmax(t->rest_hi.y, xy[2 * i + 1]);
     }
+    // Its own symmetry: the refusal's symmetry rules are for what no
+    // dragon part is, and a curator's part may be (a star, a person from the front).
+    t->own_mirror_gap = dragon_mirror_gap((const sp_vec2*)xy, n);
+    t->own_polygonal = dragon_turns_onto_itself((const sp_vec2*)xy, n);
     double diag = sp_v2_len(sp_v2_sub(t->rest_hi, t->rest_lo));
     if (!(diag > 1e-6) || !isfinite(diag)) {
         r = sp_fail(err, SP_ERR_INVALID, "part %s: its abstraction is invisible in its sketch view", name);

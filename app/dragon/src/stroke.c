@@ -403,7 +403,7 @@ static sp_result reject(sp_dragon_result* out, sp_dragon_reject why, double t0)
 
 // A stroke turned by a k-th of a turn (k = 3..8) that lands within this of
 // itself, nearer than TURN_GAP_RATIO times where an arbitrary turn lands it,
-// has the symmetry of a regular polygon or a star (turns_onto_itself).
+// has the symmetry of a regular polygon or a star (dragon_turns_onto_itself).
 // TURN_GAP_ROUND keeps circles out: an arbitrary turn lands a round stroke
 // on itself too, and a round body is a part. No training drawing of a part
 // (714 single strokes) and no tune drawing of a part meets all three; every
@@ -456,7 +456,7 @@ static double mapped_gap(const sp_vec2 r[SHAPE_POINTS], const double m[4])
 // through its centroid: the mean distance from each of its points to the
 // mirrored stroke and back, over its RMS radius (0: symmetric). 1 (far from
 // symmetric) when it cannot be measured.
-static double mirror_gap(const sp_vec2* pts, int n)
+double dragon_mirror_gap(const sp_vec2* pts, int n)
 {
     sp_vec2 r[SHAPE_POINTS];
     if (!shape_points(pts, n, r)) return 1.0;
@@ -475,7 +475,7 @@ static double turn_gap(const sp_vec2 r[SHAPE_POINTS], double angle)
 
 // Whether the stroke has the symmetry of a regular polygon or a star (a
 // triangle, a square, a house, a sun): no dragon part a visitor draws does.
-static bool turns_onto_itself(const sp_vec2* pts, int n)
+bool dragon_turns_onto_itself(const sp_vec2* pts, int n)
 {
     sp_vec2 r[SHAPE_POINTS];
     if (!shape_points(pts, n, r)) return false;
@@ -519,8 +519,9 @@ static double ink_length(const sp_vec2* pts, int n, double step)
 }
 
 // A scribble (far more ink than its size, or crossing itself over and over)
-// or a shape with a polygon's or a star's symmetry. `diag`: the canvas's diagonal.
-static bool refused_before_fit(const sp_vec2* pts, int n, double diag)
+// or a shape with a polygon's or a star's symmetry, unless the best guess's
+// part has it too (`polygonal`: a curator's star). `diag`: the canvas's diagonal.
+static bool refused_before_fit(const sp_vec2* pts, int n, double diag, bool polygonal)
 {
     enum { M = 64 };
     sp_vec2 r[M], lo = pts[0], hi = pts[0];
@@ -538,7 +539,15 @@ static bool refused_before_fit(const sp_vec2* pts, int n, double diag)
             crossings += d1 * d2 < 0 && d3 * d4 < 0;
         }
 #undef CROSS
-    return crossings > 12 || turns_onto_itself(pts, n);
+    return crossings > 12 || (!polygonal && dragon_turns_onto_itself(pts, n));
+}
+
+// Whether part t is drawn in profile, where a symmetric drawing is
+// suspect: not a body, not legs, and not its own mirror image (a curator's
+// part seen from the front: a person's outline is symmetric).
+static bool in_profile(const tpl* t)
+{
+    return !t->is_torso && !t->family[0] && t->own_mirror_gap >= MIRROR_GAP_SYMMETRIC;
 }
 
 // How far from every part (refused above SP_DRAGON_FAR_LIMIT): `near`, the
@@ -553,8 +562,16 @@ static double far_score(const sp_vec2* pts, int n, double near, double fit, bool
     // mirror image about an upright line; much else a visitor draws is (a
     // tree, a sun). Bodies and leg pairs are left out: a visitor's
     // oval or humped body and a neat pair of legs are symmetric too.
-    double sym = profile ? fmax(0.0, MIRROR_GAP_SYMMETRIC - mirror_gap(pts, n)) : 0.0;
+    double sym = profile ? fmax(0.0, MIRROR_GAP_SYMMETRIC - dragon_mirror_gap(pts, n)) : 0.0;
     return near + 6.0 * fit + MIRROR_WEIGHT * sym;
+}
+
+// Whether the classifier's best guess is a part with a polygon's or a star's
+// symmetry itself (a curator's star: its own outline was refused).
+static bool top_is_polygonal(sp_dragon* d, const sp_clf_answer* a)
+{
+    const tpl* t = a->count > 0 ? dragon_category_first(d, sp_clf_category(d->clf, a->ranked[0].category)) : NULL;
+    return t && t->own_polygonal;
 }
 
 // The stroke path's decision: the classifier's answer becomes a category
@@ -586,7 +603,8 @@ static sp_dragon_reject classify_and_decide(sp_dragon* d, const sp_sketch* sk, c
     if (forced) return SP_DRAGON_ACCEPTED;
     if (isfinite(a->reject_distance) && a->reject_distance > 0) *near = a->distance / a->reject_distance;
     if (a->count == 0 || a->ranked[0].score < d->desc.min_confidence ||
-        refused_before_fit(sk->strokes[0].points, sk->strokes[0].count, hypot(sk->canvas_w, sk->canvas_h)))
+        refused_before_fit(sk->strokes[0].points, sk->strokes[0].count, hypot(sk->canvas_w, sk->canvas_h),
+                           top_is_polygonal(d, a)))
         return SP_DRAGON_UNRECOGNISED;
     dragon_copy_name(category, SP_NAME_MAX, sp_clf_category(d->clf, a->ranked[0].category));
     *confidence = a->ranked[0].score;
@@ -879,6 +897,18 @@ static void give_back_fits(sp_dragon* d, uint64_t by)
         }
 }
 
+// Whether a classified stroke (accepted or not recognised) is drawn on a
+// part (not part `skip`) as its detail, its spikes, a speck or colouring in
+// (layout.c); *hit says where.
+static bool drawn_on_part(sp_dragon* d, sp_dragon_reject why, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip,
+                          detail_hit* hit)
+{
+    if (why != SP_DRAGON_ACCEPTED && why != SP_DRAGON_UNRECOGNISED) return false;
+    return dragon_detail_of(d, pts, n, lo, hi, skip, hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, hit) >= 0 ||
+           dragon_speck_of(d, pts, n, lo, hi, skip, hit) >= 0 ||
+           (why == SP_DRAGON_UNRECOGNISED && dragon_colouring_of(d, pts, n, lo, hi, skip, hit) >= 0);
+}
+
 // A stroke (classified, not a Redraw) drawn out of a part of the dragon,
 // away from its body, is a flourish of that part (docs/DESIGN.md,
 // "Flourishes ride their part"): kept as ink on it (out->detail, -1 when
@@ -962,12 +992,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // coloured the body, and the refused scribble faded). It is kept as ink on
     // the part; its guesses stay, so a chip still makes it a part.
     detail_hit hit = {0};
-    int skip = o.replace_last ? d->part_n - 1 : -1;
-    if ((why == SP_DRAGON_ACCEPTED || why == SP_DRAGON_UNRECOGNISED) && !o.category &&
-        (dragon_detail_of(d, pts, n, lo, hi, skip, &hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, &hit) >= 0 ||
-         dragon_speck_of(d, pts, n, lo, hi, skip, &hit) >= 0 ||
-         (why == SP_DRAGON_UNRECOGNISED && dragon_colouring_of(d, pts, n, lo, hi, skip, &hit) >= 0)))
-        why = SP_DRAGON_DETAIL;
+    if (!o.category && drawn_on_part(d, why, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit)) why = SP_DRAGON_DETAIL;
     bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
     if (flourish) why = SP_DRAGON_DETAIL;
     if (why != SP_DRAGON_ACCEPTED) {
@@ -1012,7 +1037,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         if (not_finite > 0) out->note = SP_DRAGON_NOTE_NOT_FINITE;
         return reject(out, SP_DRAGON_FIT_FAILED, t0);
     }
-    if (!o.category && d->clf) out->far_score = far_score(pts, n, near, best.score, !best.t->is_torso && !best.t->family[0]);
+    if (!o.category && d->clf) out->far_score = far_score(pts, n, near, best.score, in_profile(best.t));
     if (out->far_score > SP_DRAGON_FAR_LIMIT) {
         bool flourish = kept_as_flourish(d, &o, pts, n, lo, hi, out);
         free(pts);
