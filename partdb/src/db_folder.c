@@ -173,15 +173,20 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
     while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         const char* name = (const char*)sqlite3_column_text(st, 0);
         if ((r = export_part_intact(db, st, err)) != SP_OK) break;
-        snprintf(path, sizeof path, "%s/parts/%s.glb", dir, name);
-        r = db_write_file(path, sqlite3_column_blob(st, 3), (size_t)sqlite3_column_bytes(st, 3), err);
+        // Named for what it holds: a part added as a self-contained .gltf is
+        // stored as that JSON (a .glb name made tools read it as binary).
+        const void* blob = sqlite3_column_blob(st, 3);
+        size_t bytes = (size_t)sqlite3_column_bytes(st, 3);
+        const char* ext = bytes >= 4 && !memcmp(blob, "glTF", 4) ? "glb" : "gltf";
+        snprintf(path, sizeof path, "%s/parts/%s.%s", dir, name, ext);
+        r = db_write_file(path, blob, bytes, err);
         db_str_printf(&m, "%s{\"name\": ", n++ ? ", " : "");
         db_str_json(&m, name);
         db_str_printf(&m, ", \"category\": ");
         db_str_json(&m, (const char*)sqlite3_column_text(st, 1));
         db_str_printf(&m, ", \"abstraction\": ");
         db_str_json(&m, (const char*)sqlite3_column_text(st, 2));
-        db_str_printf(&m, ", \"file\": \"parts/%s.glb\", \"added_by\": ", name);
+        db_str_printf(&m, ", \"file\": \"parts/%s.%s\", \"added_by\": ", name, ext);
         db_str_json(&m, (const char*)sqlite3_column_text(st, 4));
         db_str_printf(&m, ", \"added_at\": ");
         db_str_json(&m, (const char*)sqlite3_column_text(st, 5));

@@ -221,6 +221,61 @@ static void test_sha256(void)
     ENSURE(!strcmp(h, "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"));
 }
 
+// Scratch paths for an export test named `stem`: its database, the one
+// rebuilt from the export, and the export's folder; none of them there.
+static void fresh_export(const char* stem, char p[1024], char p2[1024], char dir[1024])
+{
+    char name[128], cmd[1100];
+    snprintf(name, sizeof name, "%s.db", stem);
+    snprintf(p, 1024, "%s", sp_test_tmp_path(name));
+    snprintf(name, sizeof name, "%s_rebuilt.db", stem);
+    snprintf(p2, 1024, "%s", sp_test_tmp_path(name));
+    snprintf(name, sizeof name, "%s_export", stem);
+    snprintf(dir, 1024, "%s", sp_test_tmp_path(name));
+    sp_fixture_remove_db(p);
+    sp_fixture_remove_db(p2);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ENSURE(system(cmd) == 0);
+}
+
+// A part stored as the self-contained .gltf it was added from is exported
+// under a .gltf name (an outside curator review: parts/NAME.glb held JSON,
+// which tools that go by the name read as binary), and the export rebuilds.
+static void test_export_gltf_named(void)
+{
+    char p[1024], dir[1024], gltf[1024], file[1200], p2[1024];
+    fresh_export("exgltf", p, p2, dir);
+    snprintf(gltf, sizeof gltf, "%s", sp_test_tmp_path("text_part.gltf"));
+    write_part(&k_parts[0], gltf);
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    sp_error err = {0};
+    ENSURE(sp_db_add_part_file(db, gltf, &(sp_db_part_desc){.name = "text_part", .synth_sketches = 5}, NULL, &err) == SP_OK);
+    add_ok(db, 1, 5);
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
+    sp_db_close(db);
+    snprintf(file, sizeof file, "%s/parts/text_part.gltf", dir);
+    FILE* f = fopen(file, "rb");
+    ENSURE(f && fgetc(f) == '{');
+    fclose(f);
+    snprintf(file, sizeof file, "%s/parts/text_part.glb", dir);
+    ENSURE(access(file, F_OK) != 0);
+    snprintf(file, sizeof file, "%s/parts/%s.glb", dir, k_parts[1].name); // a GLB stays one
+    f = fopen(file, "rb");
+    char magic[4] = {0};
+    ENSURE(f && fread(magic, 1, 4, f) == 4 && !memcmp(magic, "glTF", 4));
+    fclose(f);
+    snprintf(file, sizeof file, "%s/manifest.json", dir);
+    static char manifest[1 << 20];
+    f = fopen(file, "rb");
+    ENSURE(f);
+    manifest[fread(manifest, 1, sizeof manifest - 1, f)] = 0;
+    fclose(f);
+    ENSURE(strstr(manifest, "\"parts/text_part.gltf\""));
+    sp_db_train_desc td = quick_train(-1);
+    ENSURE(sp_db_create_from_export(p2, dir, &td, "test", &err) == SP_OK);
+    ENSURE(scalar(p2, "SELECT count(*) FROM parts") == 2);
+}
+
 static void test_round_trip(void)
 {
     const char* path = sp_test_tmp_path("rt.db");
@@ -401,14 +456,8 @@ static void test_sketch_doubles_exact(void)
     same_bits(&sk, &back);
     sp_sketch_free(&back);
     free(text);
-    char p[1024], p2[1024], dir[1024], cmd[1100];
-    snprintf(p, sizeof p, "%s", sp_test_tmp_path("exact.db"));
-    snprintf(p2, sizeof p2, "%s", sp_test_tmp_path("exact_rebuilt.db"));
-    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("exact_export"));
-    sp_fixture_remove_db(p);
-    sp_fixture_remove_db(p2);
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    ENSURE(system(cmd) == 0);
+    char p[1024], p2[1024], dir[1024];
+    fresh_export("exact", p, p2, dir);
     sp_db* db = open_ok(p, SP_DB_CREATE);
     add_ok(db, 0, 0);
     char* cat = strdup(k_parts[0].category);
@@ -3000,6 +3049,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"sha256", test_sha256},
                                    {"round_trip", test_round_trip},
+                                   {"export_gltf_named", test_export_gltf_named},
                                    {"sketch_doubles_exact", test_sketch_doubles_exact},
                                    {"export_whole", test_export_whole},
                                    {"durable", test_durable},
