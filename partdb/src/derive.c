@@ -777,6 +777,14 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         sp_character_warn(out, "only the clip '%s' is kept; %d other animations were left out", w.clip ? w.clip->name : "",
                           sr->animation_count - 1);
     if (!w.clip) sp_character_warn(out, "no animation with keys: the part has no clip (it holds its fitted pose in the kiosk)");
+    // The kiosk fits one stroke per part: a figure of several curves cannot
+    // be drawn there (an outside review's stick figure became six parts).
+    int ka = sp_rig_find_abstraction(&out->rig, abstraction);
+    if (ka >= 0 && out->rig.abstractions[ka].curve_count > 1)
+        sp_character_warn(out,
+                          "its '%s' abstraction has %d curves; the kiosk fits one stroke per part, so visitors cannot draw it "
+                          "there (it suits `sketchpose pose`; the kiosk's parts use `outline`)",
+                          abstraction, out->rig.abstractions[ka].curve_count);
 done:
     sp_part_free(&part);
     free(is_skin);

@@ -259,7 +259,7 @@ static void test_what_is_derived(void)
     ENSURE(sp_part_needs_derivation(&src) && src.mesh_skins == 1);
     sp_derive_info info;
     derive_ok(&src, &(sp_derive_desc){.category = "lizard"}, &part, &info);
-    ENSURE(sp_fixture_has_warning(&part, "lizard_skin.png"));
+    ENSURE(sp_fixture_has_warning(&part, "lizard_skin.png") && !sp_fixture_has_warning(&part, "one stroke per part"));
     ENSURE(info.derived == (SP_DERIVED_OUTLINE | SP_DERIVED_STICK | SP_DERIVED_PARAMETERS | SP_DERIVED_ATTACH | SP_DERIVED_CLIP |
                             SP_DERIVED_VIEW));
     // The Armature node is folded away; every joint moves vertices.
@@ -323,6 +323,8 @@ static void test_options(void)
     derive_ok(&src, &(sp_derive_desc){.abstraction = "stick", .attach_joint = "tail_3"}, &part, &info);
     const sp_part* ex = part_extras(&part);
     ENSURE(!ex->category[0] && !strcmp(ex->abstraction, "stick"));
+    // A stick figure of several curves cannot be drawn in the kiosk's one stroke: said.
+    ENSURE(sp_fixture_has_warning(&part, "the kiosk fits one stroke per part"));
     const sp_part_attach* at = &ex->attach;
     ENSURE(ex->has_attach && !strcmp(at->joint, "tail_3") && !at->socket[0]);
     ENSURE(at->has_position);
