@@ -464,6 +464,11 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
             code = SP_ERR_IO;
         fail(code, "%s: %s", what, explain(cx, data, size, line).c_str());
     }
+    // glTF 2.0 says a loader refuses an asset of another major version: its
+    // meaning may differ in ways no warning could name (one of "3.0" loaded silently).
+    const std::string& ver = model.asset.version;
+    if (ver.compare(0, 2, "2.") != 0)
+        fail(SP_ERR_UNSUPPORTED, "%s: glTF version '%.16s': sketchpose reads glTF 2.x", what, ver.c_str());
     if (!twarn.empty()) sp_character_warn(ch, "glTF: %s", without_data_payloads(first_line(twarn)).c_str());
     // glTF forbids both, and viewers differ in which they use: ours is said.
     for (int n : cx.matrix_and_trs) {

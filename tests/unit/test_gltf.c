@@ -641,6 +641,15 @@ static void test_says_what_is_wrong(void)
     static const char nan_text[] = "{\"asset\": {\"version\": \"2.0\"}, \"x\": [1, NaN]}";
     ENSURE(mini_write(nan_json, nan_text, sizeof nan_text - 1));
     ensure_fails(nan_json, "nan.gltf", "nan.gltf: not valid JSON at line 1, column 40: syntax error");
+    // Another major version is refused, as glTF 2.0 asks (one of 3.0 loaded
+    // silently: an outside curator review); a 2.x minor version loads.
+    ensure_fails(write_edited("v3.gltf", &(mini_desc){0}, "\"version\": \"2.0\"", "\"version\": \"3.0\""), "v3.gltf",
+                 "v3.gltf: glTF version '3.0': sketchpose reads glTF 2.x");
+    sp_character v21 = {0};
+    sp_error v21e = {0};
+    ENSURE(sp_gltf_load(write_edited("v21.gltf", &(mini_desc){0}, "\"version\": \"2.0\"", "\"version\": \"2.1\""), &v21, &v21e) ==
+           SP_OK);
+    sp_character_free(&v21);
     // An image whose uri names a pipe: the file loads, with a warning. Looking
     // for the file used to open it, which waits for a writer forever; in a
     // child, so that such a wait fails the test (SIGALRM) instead of hanging it.
