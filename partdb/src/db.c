@@ -229,6 +229,22 @@ static bool side_file_unwritable(const char* path, const char* doing, sp_error* 
     return false;
 }
 
+// Whether this process may make files in the folder holding `path` (a
+// writable database in a folder it may not write reads as read-only to
+// SQLite, and the file's own permissions were blamed).
+static bool folder_writable(const char* path)
+{
+    char dir[4096];
+    const char* slash = strrchr(path, '/');
+    if (!slash) return access(".", W_OK) == 0;
+    size_t n = (size_t)(slash - path);
+    if (n == 0) n = 1;                // the root folder
+    if (n >= sizeof dir) return true; // cannot tell: the general message
+    memcpy(dir, path, n);
+    dir[n] = 0;
+    return access(dir, W_OK) == 0;
+}
+
 sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
 {
     int prim = rc & 0xff;
@@ -243,6 +259,11 @@ sp_result db_fail(sp_db* db, int rc, const char* doing, sp_error* err)
         return sp_fail(err, SP_ERR_IO, "%s: disk full while %s; %s", p, doing, kept);
     case SQLITE_READONLY:
         if (!db->readonly && side_file_unwritable(p, doing, err)) return SP_ERR_IO;
+        if (!db->readonly && access(p, W_OK) == 0 && !folder_writable(p))
+            return sp_fail(
+                err, SP_ERR_IO,
+                "%s: its folder is not writable (SQLite makes its -wal and -shm files beside the database) while %s; %s", p,
+                doing, kept);
         return sp_fail(err, SP_ERR_IO, "%s: the database is read-only (file permissions or opened read-only) while %s; %s", p,
                        doing, kept);
     case SQLITE_NOMEM: return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory while %s", p, doing);

@@ -858,6 +858,21 @@ static void test_read_only_folder(void)
     }
     int st;
     ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
+    ENSURE(WEXITSTATUS(st) == 0);
+    // The file writable, its folder not: the folder is blamed (an outside
+    // curator review was told of the file's permissions, which were 0666).
+    ENSURE(chmod(p, 0666) == 0);
+    pid = fork_unprivileged();
+    if (pid == 0) {
+        sp_db* d = NULL;
+        sp_error e = {0};
+        sp_result r = sp_db_open(p, 0, &d, &e);
+        if (r == SP_OK) r = sp_db_remove_part(d, "tail_a", "test", &e);
+        fprintf(stderr, "  writable file, read-only folder, writer: %s\n", e.text);
+        sp_db_close(d);
+        _exit(r == SP_ERR_IO && strstr(e.text, "its folder is not writable") ? 0 : 9);
+    }
+    ENSURE(waitpid(pid, &st, 0) == pid && WIFEXITED(st));
     ENSURE(chmod(dir, 0755) == 0);
     ENSURE(WEXITSTATUS(st) == 0);
     struct stat sb;
