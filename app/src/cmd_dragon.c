@@ -198,6 +198,12 @@ int cmd_dragon(int argc, char** argv)
             cJSON_AddNumberToObject(o, "score", res.guesses[k].confidence);
             cJSON_AddItemToArray(g, o);
         }
+        // How far from every part (refused over SP_DRAGON_FAR_LIMIT): a curator can see
+        // how near a refused drawing of their part came (null: not measured).
+        if (isfinite(res.far_score))
+            cJSON_AddNumberToObject(s, "far_score", res.far_score);
+        else
+            cJSON_AddNullToObject(s, "far_score");
         cJSON_AddNumberToObject(s, "ms", res.ms_total);
         say_stroke(&said, d, &res, &sk.strokes[i], strokes, i);
     }

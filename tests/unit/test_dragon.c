@@ -1779,6 +1779,8 @@ static void test_command_stroke_lines(void)
     ENSURE(WEXITSTATUS(system(cmd)) == 1);
     cJSON* j = sp_fixture_json_file(rep);
     ENSURE(j && cJSON_GetArraySize(cJSON_GetObjectItem(j, "strokes")) == 31);
+    ENSURE(
+        cJSON_IsNull(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(j, "strokes"), 0), "far_score"))); // not measured
     cJSON_Delete(j);
     FILE* f = fopen(svg, "w");
     ENSURE(f);
@@ -1844,7 +1846,15 @@ static void test_command(void)
         ENSURE(at->valueint >= 0 ? cJSON_GetArraySize(anchor) == 2 : cJSON_IsNull(anchor));
     }
     const cJSON* sj;
-    cJSON_ArrayForEach(sj, cJSON_GetObjectItem(j, "strokes")) ENSURE(cJSON_IsString(cJSON_GetObjectItem(sj, "note")));
+    cJSON_ArrayForEach(sj, cJSON_GetObjectItem(j, "strokes"))
+    {
+        // Each accepted stroke's distance from every part, within the refusal's limit.
+        const cJSON* far = cJSON_GetObjectItem(sj, "far_score");
+        ENSURE(cJSON_IsString(cJSON_GetObjectItem(sj, "note")));
+        ENSURE(cJSON_IsTrue(cJSON_GetObjectItem(sj, "rejected"))
+                   ? cJSON_IsNull(far) || cJSON_IsNumber(far)
+                   : cJSON_IsNumber(far) && far->valuedouble <= SP_DRAGON_FAR_LIMIT);
+    }
     fprintf(stderr, "  sketchpose dragon: mean error %.2f px over %d parts, %.0f ms of solving\n",
             cJSON_GetObjectItem(j, "mean_error_px")->valuedouble, cJSON_GetArraySize(parts),
             cJSON_GetObjectItem(j, "ms")->valuedouble);
