@@ -435,9 +435,9 @@ static const char* note_hint(sp_dragon_note n)
 }
 
 // The chips' guesses for a stroke: the classifier's ranked categories that
-// have a part but `skip` (the part it became, or the one that did not fit), then, as a sure
-// classifier votes for few categories, the model's others in the parts row's
-// order, so that the visitor always has `want` to choose from.
+// have a part but `skip` (the part it became, or the one that did not fit),
+// then, as a sure classifier votes for few categories, the model's others in
+// the parts row's order, so that the visitor always has `want` to choose from.
 static int stroke_guesses(const sp_kiosk* k, const sp_dragon_result* res, const char* skip, char out[][SP_NAME_MAX], int want)
 {
     int n = 0;
