@@ -1241,6 +1241,15 @@ static void test_turn_reminds_draw(void)
     double te = stroke(ui, td + 700, 300, 500, 18, 5);
     frame(ui, &f, te + 10);
     ENSURE(ui->mode == SP_KM_DRAW && f.parts == 2); // a new part, the last one kept
+    // Nor is it armed again unseen by its stroke's refusal arriving in the
+    // turn view (an outside code review: the refused Redraw re-armed itself).
+    tap(ui, te + 100, SP_KT_REDRAW);
+    te = stroke(ui, te + 200, 300, 500, 18, 5);
+    tap(ui, te + 50, SP_KT_TURN);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.replace);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = false, .part_count = 2});
+    ENSURE(ui->mode == SP_KM_TURN && !ui->redraw_armed);
     sp_kiosk_ui_destroy(ui);
 }
 

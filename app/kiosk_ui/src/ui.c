@@ -1274,7 +1274,8 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
             return;
         }
         // Still waiting for the replacement: a chip for this stroke, or the next stroke, replaces.
-        if (ui->inflight_replace) ui->redraw_armed = ui->redraw_for_offer = true;
+        // (In the drawing view only: one tapped in the turn view meanwhile is not re-armed unseen.)
+        if (ui->inflight_replace && ui->mode == SP_KM_DRAW) ui->redraw_armed = ui->redraw_for_offer = true;
         // The dragon changed all the same: what the stroke's first piece made was
         // taken back, or the stroke stays on it as ink (a save must see either).
         if (ui->inflight_undo || r->kept) {
