@@ -311,7 +311,9 @@ static bool rerank_by_fit(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2
     // Pass 1, only when drawn on a body and no other guess fitted: the body
     // guesses, their shares counted from the first guess as without the rule.
     for (int pass = 0; pass < (no_body ? 2 : 1) && kept < 0; ++pass) {
-        int first = pass == 1 ? 0 : -1;
+        int first = -1; // pass 1: the first guess with a part, body or not
+        for (int g = 0; pass == 1 && first < 0 && g < out->guess_count; ++g)
+            if (dragon_category_first(d, out->guesses[g].category)) first = g;
         for (int g = 0; g < out->guess_count; ++g) {
             fit_choice f;
             if (no_body && category_is_body(d, out->guesses[g].category) != (pass == 1)) continue;
@@ -781,6 +783,42 @@ static bool turn_to_dragon(sp_dragon* d, int i, fit_choice* f)
     return true;
 }
 
+// Free parts whose strokes come within the snap distance of body's surface
+// reach it as the part just drawn does (layout.c, layout_part): fitted
+// again with the attachment end where the stroke comes nearest the body.
+// When the body comes (part `by`), every part drawn before it: a head drawn
+// first hung beside its dragon where, drawn second, it attached
+// (BENCHMARKS.md, "Thirty-fifth pass"); only_refitted: only those part `by`
+// fitted again (parts_by_place: legs made the other kind or turned lost
+// their reach). The former fit is kept for Undo (give_back_fits).
+static bool parts_reach_body(sp_dragon* d, int body, uint64_t by, bool only_refitted)
+{
+    bool changed = false;
+    for (int i = 0; i < d->part_n; ++i) {
+        part *old = d->parts[i], *q = NULL;
+        sp_vec2 target;
+        bool own = old->before && old->before_by == by; // fitted again by part `by` (turned): reaches in place
+        if (i == body || old->pub.id == by || old->t->is_torso || old->pub.attached_to >= 0 || (only_refitted && !own) ||
+            dragon_reach_target(d, i, body, old->pub.attach_end, &target) != body)
+            continue;
+        if (own) {
+            if (dragon_fit_reaching(d, old, target)) old->layout_key = 0, changed = true;
+            continue;
+        }
+        sp_error lerr = {0};
+        if (new_part(d, old->t, old->p_fit, &old->pub.report, &old->pub.view, old->pub.mirrored, old->stroke, old->stroke_n,
+                     old->pub.confidence, &q, &lerr) != SP_OK)
+            continue;
+        if (!dragon_fit_reaching(d, q, target)) {
+            dragon_part_free(q);
+            continue;
+        }
+        take_place(d, i, q, by);
+        changed = true;
+    }
+    return changed;
+}
+
 // Legs and wings attached to body `body` follow its dragon, as when drawn
 // after the part with id `by` (a body just drawn, or a head or tail that
 // just told its facing): legs take their kind from where they are on it
@@ -802,41 +840,10 @@ static void parts_by_place(sp_dragon* d, int body, uint64_t by)
         if ((!p->chosen && fit_family_member(d, i, member, &f)) || turn_to_dragon(d, i, &f))
             changed |= replace_before_body(d, i, &f, p->pub.confidence, by);
     }
-    if (changed) dragon_relayout(d);
-}
-
-// Parts drawn a little apart before the body came (free, their strokes
-// within the snap distance of its surface) reach it as the part just drawn
-// does (layout.c, layout_part): fitted again with the attachment end where
-// the stroke comes nearest the body. A head drawn first hung beside its
-// dragon where, drawn second, it attached (BENCHMARKS.md, "Thirty-fifth
-// pass"). The former fit is kept for Undo (give_back_fits).
-static bool parts_reach_body(sp_dragon* d, int body, uint64_t by)
-{
-    bool changed = false;
-    for (int i = 0; i < body; ++i) {
-        part *old = d->parts[i], *q = NULL;
-        sp_vec2 target;
-        if (old->t->is_torso || old->pub.attached_to >= 0 ||
-            dragon_reach_target(d, i, body, old->pub.attach_end, &target) != body)
-            continue;
-        bool own = old->before && old->before_by == by; // already this body's (turned): reaches in place
-        if (own) {
-            if (dragon_fit_reaching(d, old, target)) old->layout_key = 0, changed = true;
-            continue;
-        }
-        sp_error lerr = {0};
-        if (new_part(d, old->t, old->p_fit, &old->pub.report, &old->pub.view, old->pub.mirrored, old->stroke, old->stroke_n,
-                     old->pub.confidence, &q, &lerr) != SP_OK)
-            continue;
-        if (!dragon_fit_reaching(d, q, target)) {
-            dragon_part_free(q);
-            continue;
-        }
-        take_place(d, i, q, by);
-        changed = true;
-    }
-    return changed;
+    if (!changed) return;
+    dragon_relayout(d);
+    // Fitted again from their strokes alone, parts that had reached the body may hang free.
+    if (parts_reach_body(d, body, by, true)) dragon_relayout(d);
 }
 
 // Parts drawn before a body, when the body comes (the last part), as if
@@ -881,7 +888,7 @@ static void parts_meet_body(sp_dragon* d)
         changed |= replace_before_body(d, i, &f, old->pub.confidence, by);
     }
     if (changed) dragon_relayout(d);
-    if (parts_reach_body(d, body, by)) dragon_relayout(d);
+    if (parts_reach_body(d, body, by, false)) dragon_relayout(d);
     parts_by_place(d, body, by);
 }
 
