@@ -1285,9 +1285,16 @@ struct Importer {
                     continue;
                 }
                 if (!triangles || tag.is_curve) {
-                    if (!warned_lines)
+                    // A curve's extras on a primitive that is not a strip or a
+                    // loop (a re-export's LINES): said as such, not as missing extras.
+                    if (tag.is_curve)
+                        sp_character_warn(ch,
+                                          "ignored mesh %d primitive %zu: an sp_abstraction curve must be a LINE_STRIP or "
+                                          "LINE_LOOP, this one is mode %d (%s)",
+                                          nd.mesh, pi, mode, mode == TINYGLTF_MODE_LINE ? "LINES" : "not lines");
+                    else if (!warned_lines)
                         sp_character_warn(ch, "ignored line primitives without sp_abstraction extras (mesh %d)", nd.mesh);
-                    warned_lines = true;
+                    warned_lines = warned_lines || !tag.is_curve;
                     continue;
                 }
                 if (nd.skin != skin) {

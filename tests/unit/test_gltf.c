@@ -645,6 +645,16 @@ static void test_says_what_is_wrong(void)
     // silently: an outside curator review); a 2.x minor version loads.
     ensure_fails(write_edited("v3.gltf", &(mini_desc){0}, "\"version\": \"2.0\"", "\"version\": \"3.0\""), "v3.gltf",
                  "v3.gltf: glTF version '3.0': sketchpose reads glTF 2.x");
+    // A curve re-exported as LINES (an outside curator review: told the
+    // extras were missing, which they were not) is said as such.
+    sp_character lines = {0};
+    sp_error le = {0};
+    ENSURE(sp_gltf_load(write_edited("curve_lines.gltf", &(mini_desc){.extras = true}, "\"mode\": 2}]}", "\"mode\": 1}]}"),
+                        &lines, &le) == SP_OK);
+    ENSURE(
+        sp_fixture_has_warning(&lines, "an sp_abstraction curve must be a LINE_STRIP or LINE_LOOP, this one is mode 1 (LINES)") &&
+        !sp_fixture_has_warning(&lines, "without sp_abstraction extras"));
+    sp_character_free(&lines);
     sp_character v21 = {0};
     sp_error v21e = {0};
     ENSURE(sp_gltf_load(write_edited("v21.gltf", &(mini_desc){0}, "\"version\": \"2.0\"", "\"version\": \"2.1\""), &v21, &v21e) ==
