@@ -186,13 +186,21 @@ static bool guess_hidden(const sp_kiosk_ui* ui, sp_kiosk_target t)
     return t >= SP_KT_CHIP_GUESS1 && t <= SP_KT_CHIP_GUESS3 && row_for_part(ui);
 }
 
-// Points of a stroke with y in [y0, y1).
-static int points_within(const sp_kiosk_line* l, float y0, float y1)
+// Points of a line inside rect r.
+static int points_in(const sp_kiosk_line* l, const sp_kiosk_rect* r)
 {
     int n = 0;
-    for (int i = 0; i < l->count; ++i)
-        n += l->xy[2 * i + 1] >= y0 && l->xy[2 * i + 1] < y1;
+    for (int i = 0; i < l->count; ++i) {
+        float x = l->xy[2 * i], y = l->xy[2 * i + 1];
+        n += x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
+    }
     return n;
+}
+
+// Points of a line with y in [y0, y1), at any x.
+static int points_within(const sp_kiosk_line* l, float y0, float y1)
+{
+    return points_in(l, &(sp_kiosk_rect){-1e9f, y0, 2e9f, y1 - y0});
 }
 
 // The stroke the row is about stays in sight (the refused one, or the last
@@ -208,17 +216,6 @@ static void keep_stroke_in_sight(sp_kiosk_ui* ui, float top, float end, float ma
     for (int i = 0; i < ui->row_fit; ++i)
         ui->target[SP_KT_PART1 + i].y += dy;
     ui->hint_box.y = start;
-}
-
-// Points of a line inside rect r.
-static int points_in(const sp_kiosk_line* l, const sp_kiosk_rect* r)
-{
-    int n = 0;
-    for (int i = 0; i < l->count; ++i) {
-        float x = l->xy[2 * i], y = l->xy[2 * i + 1];
-        n += x >= r->x && x < r->x + r->w && y >= r->y && y < r->y + r->h;
-    }
-    return n;
 }
 
 // Points of the lines the chips are about (the refused stroke offered, or
