@@ -3275,6 +3275,61 @@ static double to_fitted_mesh(const sp_dragon* d, int i, sp_vec2 p)
     return best;
 }
 
+// The distance from p to the polyline xy (n points, open).
+static double to_polyline(const sp_vec2* xy, int n, sp_vec2 p)
+{
+    double best = n > 0 ? sp_v2_len(sp_v2_sub(xy[0], p)) : INFINITY;
+    for (int k = 1; k < n; ++k) {
+        sp_vec2 ab = sp_v2_sub(xy[k], xy[k - 1]);
+        double l2 = sp_v2_dot(ab, ab), s = l2 > 0 ? fmin(1, fmax(0, sp_v2_dot(sp_v2_sub(p, xy[k - 1]), ab) / l2)) : 0;
+        best = fmin(best, sp_v2_len(sp_v2_sub(p, sp_v2_add(xy[k - 1], sp_v2_scale(ab, s)))));
+    }
+    return best;
+}
+
+// Wings drawn a little above the back, beyond the tips of its spikes (an
+// outside review's child): they go on the back, where the body's outline
+// is, not on a spike's tip, hovering above it. Drawn on either side of the
+// middle, facing either way; a head drawn above the front the same.
+static void test_on_the_back_not_a_spike(void)
+{
+    const char* path = real_db();
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    for (int k = 0; k < 4; ++k) {
+        bool mirrored = k & 1, head = k >= 2;
+        sp_dragon_clear(d);
+        sp_vec2* body_xy;
+        int bn = category_stroke(db, "torso", 640, 440, 420, mirrored, &body_xy), n;
+        sp_dragon_result body, res;
+        ENSURE(sp_dragon_add_points(d, body_xy, bn, &(sp_dragon_stroke_opts){.category = "torso"}, &body, &err) == SP_OK &&
+               !body.rejected);
+        sp_vec2 blo, bhi, slo, shi;
+        fitted_box(d, body.part, &blo, &bhi); // its mesh, the spikes' tips at the top
+        double x = head ? (mirrored ? blo.x + 40 : bhi.x - 40) : 640 + (mirrored ? 30 : -30);
+        sp_vec2* xy = visitor_stroke(head ? "head/head-blunt-round-ear.json" : "wings/wing-3-scallops-raised.json", 200,
+                                     (sp_vec2){x, 0}, mirrored, &n);
+        points_box(xy, n, &slo, &shi);
+        for (int i = 0; i < n; ++i) // its lowest point 12 px above the spikes' tips
+            xy[i].y += blo.y - 12 - shi.y;
+        ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = head ? "head" : "wings"}, &res, &err) ==
+                   SP_OK &&
+               !res.rejected);
+        const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
+        double off = p->attached_to == body.part ? to_polyline(body_xy, bn, p->anchor) : INFINITY;
+        fprintf(stderr, "  %s above the %s (facing %s): attached to %d, the anchor %.1f px from the body's stroke\n",
+                head ? "a head" : "wings", head ? "front" : "back", mirrored ? "left" : "right", p->attached_to, off);
+        // The spikes stand about 25 px above the back at this size; the
+        // fitted outline lies within a few px of the stroke.
+        ENSURE(p->attached_to == body.part && off < 8);
+        free(xy);
+        free(body_xy);
+    }
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // A part drawn a little apart from a body (its stroke within the snap
 // distance of the body's surface), whose fit puts its attachment end
 // farther (a round head's neck fitted inside the drawing, on the side away
@@ -4540,6 +4595,7 @@ int main(int argc, char** argv)
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"root_at_the_body", test_root_at_the_body},
                                    {"reaches_the_body", test_reaches_the_body},
+                                   {"on_the_back_not_a_spike", test_on_the_back_not_a_spike},
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},

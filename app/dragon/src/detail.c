@@ -28,19 +28,10 @@ static bool bary_of(sp_vec2 p, sp_vec2 a, sp_vec2 b, sp_vec2 c, double w[3])
     return isfinite(w[1]) && isfinite(w[2]);
 }
 
-// The point of the segment ab nearest p.
-static sp_vec2 segment_nearest(sp_vec2 p, sp_vec2 a, sp_vec2 b)
-{
-    sp_vec2 ab = sp_v2_sub(b, a);
-    double l2 = sp_v2_dot(ab, ab);
-    double s = l2 > 0 ? fmin(1, fmax(0, sp_v2_dot(sp_v2_sub(p, a), ab) / l2)) : 0;
-    return sp_v2_add(a, sp_v2_scale(ab, s));
-}
-
 // The point of the triangle abc's edges nearest p (p outside it).
 static sp_vec2 edge_nearest(sp_vec2 p, sp_vec2 a, sp_vec2 b, sp_vec2 c)
 {
-    sp_vec2 q[3] = {segment_nearest(p, a, b), segment_nearest(p, b, c), segment_nearest(p, c, a)};
+    sp_vec2 q[3] = {dragon_segment_nearest(p, a, b), dragon_segment_nearest(p, b, c), dragon_segment_nearest(p, c, a)};
     int k = 0;
     for (int i = 1; i < 3; ++i)
         if (sp_v2_len(sp_v2_sub(p, q[i])) < sp_v2_len(sp_v2_sub(p, q[k]))) k = i;
@@ -352,7 +343,7 @@ double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p)
         sp_vec2 a = moved ? moved_px(d, &m, e->drawn[0]) : e->drawn[0];
         for (int j = 0; j + 1 < e->n; ++j) {
             sp_vec2 b = moved ? moved_px(d, &m, e->drawn[j + 1]) : e->drawn[j + 1];
-            best = fmin(best, sp_v2_len(sp_v2_sub(p, segment_nearest(p, a, b))));
+            best = fmin(best, sp_v2_len(sp_v2_sub(p, dragon_segment_nearest(p, a, b))));
             a = b;
         }
     }

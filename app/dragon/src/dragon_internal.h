@@ -14,6 +14,7 @@
 #ifndef SP_DRAGON_INTERNAL_H
 #define SP_DRAGON_INTERNAL_H
 
+#include <math.h>
 #include <stdio.h>
 #include <sys/types.h>
 
@@ -22,6 +23,15 @@
 static inline void dragon_copy_name(char* dst, size_t cap, const char* src)
 {
     snprintf(dst, cap, "%s", src ? src : "");
+}
+
+// The point of the segment ab nearest p.
+static inline sp_vec2 dragon_segment_nearest(sp_vec2 p, sp_vec2 a, sp_vec2 b)
+{
+    sp_vec2 ab = sp_v2_sub(b, a);
+    double l2 = sp_v2_dot(ab, ab);
+    double s = l2 > 0 ? fmin(1, fmax(0, sp_v2_dot(sp_v2_sub(p, a), ab) / l2)) : 0;
+    return sp_v2_add(a, sp_v2_scale(ab, s));
 }
 
 // ---- parts as stored (templates), parts.c ------------------------------------------
@@ -138,6 +148,11 @@ typedef struct part {
     double* body_tri_box;     // per triangle its canvas box: lo.x, lo.y, hi.x, hi.y
     sp_vec2 body_lo, body_hi; // canvas box of its vertices
     bool body_has_surface;
+    // Its outline at the fit on the canvas, when its abstraction is one
+    // closed curve (NULL otherwise): what a drawing of it shows, without the
+    // spikes and crests its mesh carries.
+    sp_vec2* body_ring;
+    int body_ring_n;
     // Its fit before a part drawn later changed it (a body that decided it
     // again or turned it, a body, head or tail that made legs the other
     // legs or turned legs or wings: stroke.c, parts_meet_body,

@@ -85,15 +85,24 @@ sp_mat4 dragon_placement_of(const sp_dragon* d, const tpl* t, const sp_camera* v
 // ---- bodies as seen on the canvas ------------------------------------------------------
 
 // Part q's mesh at its fit moved by m into the world (xyz: vertex_count by
-// 3) and seen on the canvas (px).
-static void mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px)
+// 3) and seen on the canvas (px). With ring_xyz (point_count by 3 of its
+// abstraction), the abstraction too, into ring_xyz and seen in ring.
+static void mesh_on_canvas(const sp_dragon* d, const part* q, const sp_mat4* m, double* xyz, sp_vec2* px, double* ring_xyz,
+                           sp_vec2* ring)
 {
     const sp_rig* rig = &q->t->ch.rig;
+    const sp_abstraction* ab = &rig->abstractions[q->t->abstraction];
     sp_rig_eval_update(q->t->ev, q->p_fit, false);
     sp_rig_eval_points(q->t->ev, sp_rig_mesh_points(rig), xyz);
+    // Before the move: an abstraction embedded in the mesh reads its model-space vertices.
+    if (ring_xyz) sp_rig_eval_abstraction(q->t->ev, ab, xyz, ring_xyz);
     sp_mat4_points(m, xyz, rig->vertex_count);
     for (int v = 0; v < rig->vertex_count; ++v)
         px[v] = sp_camera_project(&d->world, (sp_vec3){xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]});
+    if (!ring_xyz) return;
+    sp_mat4_points(m, ring_xyz, ab->point_count);
+    for (int k = 0; k < ab->point_count; ++k)
+        ring[k] = sp_camera_project(&d->world, (sp_vec3){ring_xyz[3 * k], ring_xyz[3 * k + 1], ring_xyz[3 * k + 2]});
 }
 
 static bool px_box(const sp_vec2* px, int n, sp_vec2* lo, sp_vec2* hi);
@@ -105,15 +114,22 @@ static bool body_prepare(const sp_dragon* d, part* q)
     if (q->body_px) return true;
     const sp_rig* rig = &q->t->ch.rig;
     size_t n = (size_t)rig->vertex_count;
+    const sp_abstraction* ab = &rig->abstractions[q->t->abstraction];
+    bool ring = ab->curve_count == 1 && ab->curves[0].closed && ab->point_count >= 3;
+    size_t nr = ring ? (size_t)ab->point_count : 0;
     q->body_xyz = malloc(sizeof(double) * 3 * (n + 1));
     q->body_px = malloc(sizeof(sp_vec2) * (n + 1));
     q->body_tri_box = malloc(sizeof(double) * 4 * ((size_t)rig->triangle_count + 1));
-    if (!q->body_xyz || !q->body_px || !q->body_tri_box) {
-        free(q->body_xyz), free(q->body_px), free(q->body_tri_box);
-        q->body_xyz = NULL, q->body_px = NULL, q->body_tri_box = NULL;
+    q->body_ring = ring ? malloc(sizeof(sp_vec2) * nr) : NULL;
+    double* ring_xyz = ring ? malloc(sizeof(double) * 3 * nr) : NULL;
+    if (!q->body_xyz || !q->body_px || !q->body_tri_box || (ring && (!q->body_ring || !ring_xyz))) {
+        free(q->body_xyz), free(q->body_px), free(q->body_tri_box), free(q->body_ring), free(ring_xyz);
+        q->body_xyz = NULL, q->body_px = NULL, q->body_tri_box = NULL, q->body_ring = NULL;
         return false;
     }
-    mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px);
+    mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px, ring_xyz, q->body_ring);
+    free(ring_xyz);
+    q->body_ring_n = (int)nr;
     // Boxes kept for nearest_surface, which every part laid out asks of
     // every body near it (a new body lays out them all again).
     for (int f = 0; f < rig->triangle_count; ++f) {
@@ -257,6 +273,47 @@ static bool nearest_surface(const part* q, sp_vec2 p, double within, surface_hit
         }
     }
     return h->tri[0] >= 0;
+}
+
+// The point of body q's outline (body_ring) nearest p; *inside: p lies within it.
+static sp_vec2 ring_nearest(const part* q, sp_vec2 p, bool* inside)
+{
+    const sp_vec2* r = q->body_ring;
+    int n = q->body_ring_n;
+    sp_vec2 best = r[0];
+    double bd = INFINITY;
+    bool in = false;
+    for (int k = 0, j = n - 1; k < n; j = k++) {
+        sp_vec2 c = dragon_segment_nearest(p, r[j], r[k]);
+        double dd = sp_v2_len(sp_v2_sub(c, p));
+        if (dd < bd) bd = dd, best = c;
+        if ((r[k].y > p.y) != (r[j].y > p.y) && p.x < r[j].x + (p.y - r[j].y) * (r[k].x - r[j].x) / (r[k].y - r[j].y)) in = !in;
+    }
+    *inside = in;
+    return best;
+}
+
+// A point of the mesh farther than this fraction of the outline's size
+// outside it is a spike's or a crest's: no drawing of the body shows it.
+#define BEYOND_OUTLINE 0.02
+
+// Where on body q a part goes, given the mesh's point nearest its end (*h):
+// a spike or a crest is not where a drawing shows the body (wings on a
+// spike's tip hover above the back), so such a point becomes the surface
+// at the outline's point nearest it, the spike's foot. h->dist stays the
+// distance to the mesh (what the snap measures).
+static void onto_outline(const part* q, surface_hit* h)
+{
+    if (!q->body_ring) return;
+    sp_vec2 lo, hi;
+    if (!px_box(q->body_ring, q->body_ring_n, &lo, &hi)) return;
+    bool in;
+    sp_vec2 r = ring_nearest(q, h->px, &in);
+    if (in || !(sp_v2_len(sp_v2_sub(r, h->px)) > BEYOND_OUTLINE * sp_v2_len(sp_v2_sub(hi, lo)))) return;
+    surface_hit s;
+    if (!nearest_surface(q, r, INFINITY, &s)) return;
+    s.dist = h->dist;
+    *h = s;
 }
 
 // ---- attaching -------------------------------------------------------------------------
@@ -709,7 +766,7 @@ int dragon_flourish_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         double* fxyz = malloc(sizeof(double) * 3 * (size_t)nv);
         sp_vec2* fpx = malloc(sizeof(sp_vec2) * (size_t)nv);
         bool fitted = fxyz && fpx;
-        if (fitted) mesh_on_canvas(d, q, &q->world_fit, fxyz, fpx);
+        if (fitted) mesh_on_canvas(d, q, &q->world_fit, fxyz, fpx, NULL, NULL);
         free(fxyz);
         bool flourish = fitted && diag <= FLOURISH_SIZE * pd && isfinite(pd);
         int out = 0;
@@ -917,6 +974,7 @@ static int nearest_body_surface(sp_dragon* d, int i, sp_vec2 a2, double snap, su
         surface_hit h;
         if (nearest_surface(q, a2, within, &h) && h.dist < best->dist) *best = h, bk = k;
     }
+    if (bk >= 0) onto_outline(d->parts[bk], best);
     return bk;
 }
 
@@ -938,6 +996,7 @@ int dragon_reach_target(sp_dragon* d, int i, int only, sp_vec2 a2, sp_vec2* targ
             sp_vec2 pt = p->stroke[(int)((long)s * (p->stroke_n - 1) / (REACH_SAMPLES - 1))];
             surface_hit h;
             if (box_distance(pt, q->body_lo, q->body_hi) > snap || !nearest_surface(q, pt, snap, &h)) continue;
+            onto_outline(q, &h);
             dist[m] = h.dist, at[m] = h.px, from[m] = pt, body[m++] = k;
             bd = fmin(bd, h.dist);
         }

@@ -242,6 +242,7 @@ void dragon_part_free(part* p)
     free(p->body_xyz);
     free(p->body_px);
     free(p->body_tri_box);
+    free(p->body_ring);
     sp_rig_eval_destroy(p->ev);
     free(p);
 }
