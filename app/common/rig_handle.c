@@ -139,6 +139,10 @@ const sp_abstraction* sp_rig_handle_abstractions(const sp_rig_handle* h)
 
 int sp_rig_handle_pick_abstraction(const sp_rig_handle* h, const char* name, sp_error* err)
 {
+    // A part says what its sketches show (`derive --abstraction stick`
+    // writes it): that one, where the file lists the outline first.
+    if (!name && !h->bb && h->ch.part.abstraction[0] && sp_rig_find_abstraction(&h->ch.rig, h->ch.part.abstraction) >= 0)
+        name = h->ch.part.abstraction;
     return sp_pick_abstraction(sp_rig_handle_abstractions(h), sp_rig_handle_abstraction_count(h), h->path, name, err);
 }
 

@@ -80,7 +80,8 @@ sp_result sp_rig_handle_read_pose(const sp_rig_handle* h, const char* path, doub
 /// Abstractions: abstraction_count of them in one array.
 int sp_rig_handle_abstraction_count(const sp_rig_handle* h);
 const sp_abstraction* sp_rig_handle_abstractions(const sp_rig_handle* h);
-/// Index of the abstraction called `name` (NULL: the first one); -1 and a
+/// Index of the abstraction called `name` (NULL: the one the part's
+/// `sp_part.abstraction` names, else the first one); -1 and a
 /// message naming the rig and the abstractions it has if there is none.
 int sp_rig_handle_pick_abstraction(const sp_rig_handle* h, const char* name, sp_error* err);
 

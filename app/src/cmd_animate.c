@@ -61,7 +61,8 @@ int cmd_animate(int argc, char** argv)
     sp_str_list keys = {0};
     const sp_opt opts[] = {
         {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb)", true},
-        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
+        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME",
+         "which abstraction the strokes draw (default: the part's own, else the first)", false},
         {"--strokes", SP_OPT_IN_LIST, &keys, "K1.json K2.json ...", "one stroke file (or .svg) per key pose, in time order",
          true},
         {"--times", SP_OPT_STRING, &times_s, "t1,t2,...", "key times in seconds (default 0,1,2,...)", false},

@@ -19,7 +19,8 @@ int cmd_pose(int argc, char** argv)
     double cap_ms = NAN, lambda_pose = NAN, lambda_plane = NAN, lambda_dist = NAN;
     const sp_opt opts[] = {
         {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
-        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction the strokes draw (default: the first)", false},
+        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME",
+         "which abstraction the strokes draw (default: the part's own, else the first)", false},
         {"--strokes", SP_OPT_IN, &strokes, "S.json", "the strokes (sketchpose-strokes JSON, or an SVG drawing: .svg)", true},
         {"--start", SP_OPT_IN, &start, "p.json", "start pose (default: the rig's stored pose)", false},
         {"--out", SP_OPT_OUT, &out, "posed.glb", "write the posed character", false},

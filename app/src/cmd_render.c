@@ -77,8 +77,8 @@ int cmd_render(int argc, char** argv)
     const sp_opt opts[] = {
         {"--rig", SP_OPT_IN, &rig_path, "R.gltf", "the rigged character (.gltf or .glb), or a black-box rig plugin (.so)", true},
         {"--pose", SP_OPT_IN, &pose_path, "p.json", "pose file {\"parameters\": {...}} (default: the rig's stored pose)", false},
-        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "abstraction to overlay (default: the first; 'none': no overlay)",
-         false},
+        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME",
+         "abstraction to overlay (default: the part's own, else the first; 'none': no overlay)", false},
         {"--out", SP_OPT_OUT, &out_path, "X.png", "the PNG to write", true},
         {"--size", SP_OPT_STRING, &size, "WxH", "image size in pixels, sides 16..8192 (default 640x480)", false},
         {"--line-width", SP_OPT_DOUBLE, &line_width, "PX",

@@ -392,7 +392,8 @@ int cmd_synth(int argc, char** argv)
     const sp_opt opts[] = {
         {"--rig", SP_OPT_IN, &rig_path, "R.gltf",
          "the rigged character (.gltf or .glb), or a black-box rig plugin (.so) (required unless --parts)", false},
-        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the first)", false},
+        {"--abstraction", SP_OPT_STRING, &abs_name, "NAME", "which abstraction to draw (default: the part's own, else the first)",
+         false},
         {"--seed", SP_OPT_INT, &seed, "N", "random seed, not negative (required unless --pose)", false},
         {"--pose", SP_OPT_IN, &pose, "p.json", "draw this pose instead of a random one", false},
         {"--amplitude", SP_OPT_DOUBLE, &amplitude, "A",

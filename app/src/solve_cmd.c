@@ -19,7 +19,9 @@
 // not pass here: its visitors' strokes are loose by design.
 static void note_loose_curve(sp_solve_report* rep, const sp_abstraction* ab)
 {
-    if (rep->note[0] || !(rep->bbox_diagonal_px > 0)) return;
+    // After a note that strokes were left unused (which says nothing of
+    // the fit), not after a best-effort one (which says it all).
+    if (strstr(rep->note, "best effort") || !(rep->bbox_diagonal_px > 0)) return;
     int worst = -1;
     for (int i = 0; i < rep->curve_count; ++i)
         if (rep->curves[i].stroke >= 0 && (worst < 0 || rep->curves[i].mean_px > rep->curves[worst].mean_px)) worst = i;
@@ -27,10 +29,11 @@ static void note_loose_curve(sp_solve_report* rep, const sp_abstraction* ab)
     const sp_curve_report* c = &rep->curves[worst];
     double share = c->mean_px / rep->bbox_diagonal_px;
     if (share <= 0.04 || c->curve < 0 || c->curve >= ab->curve_count) return;
-    snprintf(rep->note, sizeof rep->note,
-             "loose fit: curve '%s' lies %.1f px (%.1f%% of the abstraction's size) from stroke %d on average: a stroke "
+    size_t at = strlen(rep->note);
+    snprintf(rep->note + at, sizeof rep->note - at,
+             "%sloose fit: curve '%s' lies %.1f px (%.1f%% of the abstraction's size) from stroke %d on average: a stroke "
              "missing or drawn otherwise?",
-             ab->curves[c->curve].name, c->mean_px, 100.0 * share, c->stroke);
+             at ? "; " : "", ab->curves[c->curve].name, c->mean_px, 100.0 * share, c->stroke);
 }
 
 // Fewer strokes than curves: each stroke goes to the curve it matches best,

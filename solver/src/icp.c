@@ -347,10 +347,12 @@ static sp_result run_plan(sp_solver* s, attempt_run* r, double* p_out)
     if (res != SP_OK) return res;
     rep->after = sp__energy(s, p, &configured);
     sp__fill_errors(s, s->ab->correspondence, rep);
-    if (rep->mean_error_px > 0.05 * s->L && !rep->note[0])
-        snprintf(rep->note, sizeof rep->note,
-                 "best effort: the abstraction cannot reach the strokes (mean error %.1f px, %.1f%% of its size)",
-                 rep->mean_error_px, 100.0 * rep->mean_error_px / s->L);
+    // After the pairing's own note (strokes left unused), if any.
+    size_t at = strlen(rep->note);
+    if (rep->mean_error_px > 0.05 * s->L && !strstr(rep->note, "best effort"))
+        snprintf(rep->note + at, sizeof rep->note - at,
+                 "%sbest effort: the abstraction cannot reach the strokes (mean error %.1f px, %.1f%% of its size)",
+                 at ? "; " : "", rep->mean_error_px, 100.0 * rep->mean_error_px / s->L);
     memcpy(p_out, p, sizeof(double) * (size_t)s->P);
     return SP_OK;
 }

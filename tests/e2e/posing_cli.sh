@@ -54,6 +54,15 @@ grep -q '"note":	""' "$WORK/man.json" || fail "a clean stick figure got a note: 
 expect 0 "$SP" pose --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --report "$WORK/man1.json"
 grep -q '"note":	"loose fit: curve .leg_' "$WORK/man1.json" || fail "legs drawn as one stroke: no note: $(grep '"note"' "$WORK/man1.json")"
 one_line_naming "loose fit: curve 'leg_"
+# Five lines of a stick figure drawn by hand, the spine leaning (an outside
+# review's), and a short stray line in a corner: the stray line is left
+# unused, and the loose spine is still named after that note (it was dropped).
+strokes "$WORK/man_stray.json" '[[320, 246], [321, 200], [322, 160], [322, 122]]' '[[320, 197], [370, 197], [420, 197]]' \
+    '[[320, 197], [290, 160], [275, 110]]' '[[320, 246], [350, 300], [370, 370]]' \
+    '[[320, 246], [300, 300], [330, 340], [300, 380]]' '[[600, 20], [630, 40]]'
+expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/man_stray.json" --report "$WORK/man_stray_r.json"
+grep -q '"note":	"1 stroke(s) more than .* left unused; loose fit: curve ' "$WORK/man_stray_r.json" ||
+    fail "a stray line hid the loose-fit note: $(grep '"note"' "$WORK/man_stray_r.json")"
 expect 0 "$SP" animate --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up.json" "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --out "$WORK/man.glb"
 one_line_naming "man_arm_up_legs_one.json: loose fit: curve 'leg_"
 

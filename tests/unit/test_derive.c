@@ -584,6 +584,26 @@ static void test_cli(void)
     load_ok(out, &part);
     check_conventions(&part);
     sp_character_free(&part);
+    // --abstraction stick: what pose and synth --rig then take without
+    // --abstraction (they took the file's first, the outline).
+    char stick[1024], drawn[1024];
+    snprintf(stick, sizeof stick, "%s", sp_test_tmp_path("cli_lizard_stick.glb"));
+    snprintf(drawn, sizeof drawn, "%s", sp_test_tmp_path("cli_lizard_stick.json"));
+    snprintf(cmd, sizeof cmd, "'%s' derive --rig '%s' --out '%s' --view +z --abstraction stick 2>/dev/null", bin, src, stick);
+    ENSURE(run(cmd, NULL) == 0);
+    snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --seed 2 --out '%s' 2>/dev/null", bin, stick, drawn);
+    ENSURE(run(cmd, NULL) == 0);
+    snprintf(cmd, sizeof cmd, "'%s' pose --rig '%s' --strokes '%s' 2>/dev/null", bin, stick, drawn);
+    ENSURE(run(cmd, &text) == 0);
+    j = cJSON_Parse(text);
+    free(text);
+    const cJSON* curves = cJSON_GetObjectItem(j, "curves");
+    fprintf(stderr, "  derived with --abstraction stick: pose fitted %d curve(s), the first '%s'\n", cJSON_GetArraySize(curves),
+            cJSON_GetStringValue(cJSON_GetObjectItem(cJSON_GetArrayItem(curves, 0), "curve")));
+    ENSURE(cJSON_GetArraySize(curves) >= 1);
+    cJSON* c;
+    cJSON_ArrayForEach(c, curves) ENSURE(strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(c, "curve")), "outline"));
+    cJSON_Delete(j);
     // Bad usage: exit 2.
     snprintf(cmd, sizeof cmd, "'%s' derive --rig '%s' --out '%s' --view sideways 2>/dev/null", bin, src, out);
     ENSURE(run(cmd, NULL) == 2);
