@@ -3434,6 +3434,37 @@ static void test_reaches_the_body(void)
     sp_db_close(db);
 }
 
+// A bigger body drawn round a small dragon (an outside review's "my dragon
+// is too small"): the small body carries a head and legs, so it is not
+// decided again as a part lying on the new body (it became a head smeared
+// over the big body's flank); drawn alone, a body on the new one still is.
+static void test_body_round_a_dragon(void)
+{
+    const char* path = real_db();
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    sp_dragon_result small = draw_part(d, db, "torso", 640, 440, 300, false, false);
+    ENSURE(small.part == 0 && sp_dragon_part_get(d, 0)->is_torso);
+    draw_part(d, db, "head", 820, 340, 160, false, true);
+    draw_part(d, db, "front_legs", 700, 520, 130, false, true);
+    int carried = 0;
+    for (int i = 1; i < sp_dragon_part_count(d); ++i)
+        carried += sp_dragon_part_get(d, i)->attached_to == 0;
+    ENSURE(carried == 2);
+    sp_dragon_result big = draw_part(d, db, "torso", 640, 440, 620, false, false);
+    fprintf(stderr, "  a small dragon, then a body twice its size round it: the small body is a %s, the new one a %s\n",
+            sp_dragon_part_get(d, 0)->category, sp_dragon_part_get(d, big.part)->category);
+    ENSURE(sp_dragon_part_get(d, 0)->is_torso && sp_dragon_part_get(d, big.part)->is_torso);
+    // The small body alone (nothing on it), then the big one: decided again as before.
+    sp_dragon_clear(d);
+    draw_part(d, db, "torso", 640, 440, 300, false, false);
+    draw_part(d, db, "torso", 640, 440, 620, false, false);
+    fprintf(stderr, "  the small body alone, then the big one: the small one is a %s\n", sp_dragon_part_get(d, 0)->category);
+    ENSURE(!sp_dragon_part_get(d, 0)->is_torso);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // Parts drawn before the body end as if drawn after it, keeping their ids:
 // the same tails turn to face away from the body and attach; a round head
 // that alone is a body becomes the head; legs become the legs of their end
@@ -4596,6 +4627,7 @@ int main(int argc, char** argv)
                                    {"root_at_the_body", test_root_at_the_body},
                                    {"reaches_the_body", test_reaches_the_body},
                                    {"on_the_back_not_a_spike", test_on_the_back_not_a_spike},
+                                   {"body_round_a_dragon", test_body_round_a_dragon},
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},

@@ -161,6 +161,7 @@ typedef struct part {
     struct part* before;
     uint64_t before_by;
     bool chosen; // its category was the caller's (a chip's), not the classifier's
+    int carried; // a body: the parts hung on it before the last part came (sp_dragon_add_points)
     // Posed at the last pose_at.
     double *p_t, *xyz, *outline;
     sp_mat4 world_t;

@@ -732,14 +732,18 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
 // on the body just drawn (dragon_on_body): decided again as if drawn after
 // that body (the on-body rule of rerank_by_fit), so the tail a visitor
 // started with becomes a tail of this dragon instead of a second one. A
-// body a chip chose stays. The new part takes the old one's place and id;
-// false (nothing changed) when no other guess has a part that fits.
+// body a chip chose stays, and so does one that carries two parts or more
+// (a small dragon with a bigger body drawn round it: its body became a head
+// smeared over the new one's flank; one part may hang on a wing or tail
+// drawn first and taken for a body). The new part takes the old one's place and
+// id; false (nothing changed) when no other guess has a part that fits.
 static bool decide_again_on_body(sp_dragon* d, int i, int body)
 {
     part* old = d->parts[i];
     sp_vec2 lo, hi;
     stroke_box_of(old, &lo, &hi);
     if (!old->t->is_torso || old->chosen || !d->clf || !dragon_on_body(d, lo, hi, body)) return false;
+    if (old->carried >= 2) return false;
     sp_stroke st;
     sp_sketch sk = part_sketch(d, old, &st);
     sp_dragon_result res = {.part = -1};
@@ -930,6 +934,18 @@ static bool kept_as_flourish(sp_dragon* d, const sp_dragon_stroke_opts* o, const
     return true;
 }
 
+// How many parts each body carries before a part comes (a body laid out
+// with it may take their parts to itself): decide_again_on_body.
+static void count_carried(sp_dragon* d)
+{
+    for (int k = 0; k < d->part_n; ++k)
+        d->parts[k]->carried = 0;
+    for (int k = 0; k < d->part_n; ++k) {
+        int b = d->parts[k]->pub.attached_to;
+        if (b >= 0 && b < d->part_n) ++d->parts[b]->carried;
+    }
+}
+
 // The new part q in the last one's place (replace_last) or after it; q is
 // freed when there is no room.
 static sp_result put_part(sp_dragon* d, part* q, bool replace_last, sp_error* err)
@@ -1060,6 +1076,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
         return r;
     }
     q->chosen = o.category != NULL;
+    count_carried(d);
     if ((r = put_part(d, q, o.replace_last, err)) != SP_OK) {
         free(pts);
         return r;
