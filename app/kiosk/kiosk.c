@@ -372,6 +372,7 @@ static void forget_strokes(sp_kiosk* k)
     for (int i = 0; i < k->guess_count; ++i)
         free(k->guesses[i].xy), free(k->guesses[i].t);
     k->guess_count = 0;
+    k->chip_undo_n = 0;
 }
 
 // Keeps an accepted part's stroke for collection (canvas pixels; ms since
@@ -395,6 +396,13 @@ static void keep_stroke(sp_kiosk* k, int part, const sp_vec2* xy, const double* 
     g->n = n;
 }
 
+static bool has_body(const sp_dragon* d)
+{
+    for (int i = 0; i < sp_dragon_part_count(d); ++i)
+        if (sp_dragon_part_get(d, i)->is_torso) return true;
+    return false;
+}
+
 // The label chip and the next two guesses of the last part, for the UI.
 static void last_label(sp_kiosk* k, sp_kiosk_part_label* l)
 {
@@ -403,6 +411,7 @@ static void last_label(sp_kiosk* k, sp_kiosk_part_label* l)
     if (n == 0) return;
     const sp_dragon_part* p = sp_dragon_part_get(k->dragon, n - 1);
     l->category = p->category;
+    l->waiting = !p->is_torso && !has_body(k->dragon);
     const part_guesses* g = guesses_of(k, p->id, false);
     if (g) l->guesses[0] = g->guess[0], l->guesses[1] = g->guess[1];
 }
@@ -481,13 +490,6 @@ static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* re
     for (int i = 0; i < n; ++i)
         r.offers[i] = offers[i];
     sp_kiosk_ui_fit_done(k->ui, &r);
-}
-
-static bool has_body(const sp_dragon* d)
-{
-    for (int i = 0; i < sp_dragon_part_count(d); ++i)
-        if (sp_dragon_part_get(d, i)->is_torso) return true;
-    return false;
 }
 
 // forced: the category the visitor chose for a refused stroke (NULL: classified).
@@ -587,26 +589,91 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     if (rc == SP_OK && res.reason == SP_DRAGON_DETAIL && res.detail >= 0) ++k->rev; // new ink to pose
 }
 
-static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
+// The last part re-fitted as `category` (NULL: as the classifier takes its
+// stroke, a Redraw of the same stroke), forced or not. The re-fitted part is
+// a new part of the same stroke: the kept stroke moves to it (or back, when
+// the re-fit fails and the part stays). True when the part was replaced;
+// *new_id is the new part's id.
+static bool refit_last(sp_kiosk* k, const char* category, bool answer, sp_dragon_result* res, uint64_t* new_id)
 {
-    // The re-fitted part is a new part of the same stroke: the kept stroke
-    // moves to it (or back, when the re-fit fails and the part stays).
     int n = sp_dragon_part_count(k->dragon);
-    uint64_t old_id = n > 0 ? sp_dragon_part_get(k->dragon, n - 1)->id : 0;
-    part_guesses* old = n > 0 ? guesses_of(k, old_id, false) : NULL;
+    if (n == 0) return false;
+    const sp_dragon_part* last = sp_dragon_part_get(k->dragon, n - 1);
+    uint64_t old_id = last->id;
+    part_guesses* old = guesses_of(k, old_id, false);
     part_guesses kept = {0};
     if (old) kept.xy = old->xy, kept.t = old->t, kept.n = old->n, old->xy = NULL, old->t = NULL, old->n = 0;
-    sp_dragon_result res;
-    memset(&res, 0, sizeof res);
+    memset(res, 0, sizeof *res);
     sp_error err = {0};
-    sp_result rc = sp_dragon_refit_last(k->dragon, j->category, &res, &err);
-    answer_fit(k, rc, &res, &err, true, NULL);
-    bool moved = rc == SP_OK && !res.rejected && res.part >= 0 && res.part < sp_dragon_part_count(k->dragon);
-    part_guesses* to = guesses_of(k, moved ? sp_dragon_part_get(k->dragon, res.part)->id : old_id, false);
+    sp_result rc = SP_ERR_NO_MEMORY;
+    if (category) {
+        rc = sp_dragon_refit_last(k->dragon, category, res, &err);
+    } else {
+        // A copy: the part (and its stroke) is freed when replaced.
+        sp_vec2* xy = malloc(sizeof *xy * (size_t)(last->stroke_points + 1));
+        if (xy) {
+            memcpy(xy, last->stroke_xy, sizeof *xy * (size_t)last->stroke_points);
+            rc = sp_dragon_add_points(k->dragon, xy, last->stroke_points, &(sp_dragon_stroke_opts){.replace_last = true}, res,
+                                      &err);
+            free(xy);
+        }
+    }
+    if (answer) answer_fit(k, rc, res, &err, true, NULL);
+    bool moved = rc == SP_OK && !res->rejected && res->part >= 0 && res->part < sp_dragon_part_count(k->dragon);
+    *new_id = moved ? sp_dragon_part_get(k->dragon, res->part)->id : old_id;
+    part_guesses* to = guesses_of(k, *new_id, !answer && moved);
     if (to && !to->xy)
         to->xy = kept.xy, to->t = kept.t, to->n = kept.n;
     else
         free(kept.xy), free(kept.t);
+    return moved;
+}
+
+static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
+{
+    // What the chip replaces, for Undo.
+    int n = sp_dragon_part_count(k->dragon);
+    chip_undo u = {0};
+    if (n > 0) {
+        const sp_dragon_part* last = sp_dragon_part_get(k->dragon, n - 1);
+        const part_guesses* g = guesses_of(k, last->id, false);
+        u.replaced = last->id;
+        snprintf(u.category, sizeof u.category, "%s", last->category);
+        u.chosen = g && g->chosen;
+        for (int i = 0; g && i < 2; ++i)
+            snprintf(u.guess[i], sizeof u.guess[i], "%s", g->guess[i]);
+    }
+    sp_dragon_result res;
+    if (!refit_last(k, j->category, true, &res, &u.by) || n == 0) return;
+    if (k->chip_undo_n == KIOSK_CHIP_UNDO_MAX) memmove(&k->chip_undo[0], &k->chip_undo[1], sizeof u * --k->chip_undo_n);
+    k->chip_undo[k->chip_undo_n++] = u;
+}
+
+// Undo right after a chip: the part the chip replaced comes back, fitted
+// again from the same stroke as it was (its chip's category, or the
+// classifier's answer), with its chips. A parent who tapped the wrong chip
+// on the body lost the body, and every part came loose (an outside review).
+// False when the last change is not a chip's (a part drawn since, ink on it).
+static bool undo_chip(sp_kiosk* k)
+{
+    int n = sp_dragon_part_count(k->dragon), nd = sp_dragon_detail_count(k->dragon);
+    if (n == 0 || k->chip_undo_n == 0) return false;
+    chip_undo u = k->chip_undo[k->chip_undo_n - 1];
+    uint64_t last = sp_dragon_part_get(k->dragon, n - 1)->id;
+    sp_dragon_detail dd;
+    if (u.by != last || (nd > 0 && sp_dragon_detail_get(k->dragon, nd - 1, &dd) && dd.id > last)) return false;
+    --k->chip_undo_n;
+    sp_dragon_result res;
+    uint64_t id;
+    if (!refit_last(k, u.chosen ? u.category : NULL, false, &res, &id)) return false;
+    part_guesses* g = guesses_of(k, id, true);
+    if (g) {
+        g->chosen = u.chosen;
+        memcpy(g->guess, u.guess, sizeof g->guess);
+    }
+    for (int i = 0; i < k->chip_undo_n; ++i) // a chip before it replaced this part, which has a new id
+        if (k->chip_undo[i].by == u.replaced) k->chip_undo[i].by = id;
+    return true;
 }
 
 // The parts on the canvas leave it (Start over, the idle timeout, the kiosk
@@ -656,7 +723,7 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         run_refit(k, j);
         break;
     case SP_KJOB_UNDO: {
-        if (sp_dragon_undo(k->dragon)) ++k->rev, ++k->stats.undos;
+        if (undo_chip(k) || sp_dragon_undo(k->dragon)) ++k->rev, ++k->stats.undos;
         sp_kiosk_part_label l;
         last_label(k, &l);
         sp_kiosk_ui_parts_changed(k->ui, sp_dragon_part_count(k->dragon), &l);

@@ -42,6 +42,16 @@ typedef struct part_guesses {
     int n;
 } part_guesses;
 
+/// A part a chip replaced (the same stroke fitted as another part), for
+/// Undo to bring back while the part that replaced it is the last change.
+enum { KIOSK_CHIP_UNDO_MAX = 8 };
+typedef struct chip_undo {
+    uint64_t replaced, by; ///< the part's id, and its replacement's
+    char category[SP_NAME_MAX];
+    bool chosen; ///< its category was a chip's (else the classifier's: fitted again as classified)
+    char guess[2][SP_NAME_MAX];
+} chip_undo;
+
 /// The writer of visitors' strokes (kiosk_collect.c): a thread with its own
 /// database handle, so that the frame loop never waits for the database.
 typedef struct kiosk_collector kiosk_collector;
@@ -81,6 +91,8 @@ struct sp_kiosk {
     mesh_cache meshes;
     part_guesses* guesses;
     int guess_count, guess_cap;
+    chip_undo chip_undo[KIOSK_CHIP_UNDO_MAX]; // newest last
+    int chip_undo_n;
     kiosk_collector* collector;          // NULL: collection off (--no-collect) or closed
     int collect_stored, collect_dropped; // the collector's counts when it closed
     uint64_t rev;                        // grows with every change of the dragon

@@ -1130,6 +1130,45 @@ static void test_collect(void)
     }
 }
 
+// A parent taps a wrong chip on the body, twice, and takes both taps back
+// with Undo (an outside review: Undo after a chip removed the body, and
+// every part came loose): the body comes back a body, carrying the head.
+static void test_chip_undo(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const stroke *body = &g_strokes[0], *head = &g_strokes[1];
+    ENSURE(!strcmp(body->category, "torso") && !strcmp(head->category, "head"));
+    const char* sc = sp_test_tmp_path("kiosk_chip_undo.json");
+    for (int undos = 0; undos <= 2; undos += 2) {
+        script s = script_open(sc, 0);
+        script_event(&s, 0, "down", 640, 400);
+        script_event(&s, 60, "up", 640, 400);
+        double t = part_stroke_at(&s, 500, head, 0, 0) + 1500;
+        t = script_stroke(&s, t, body->xy, body->n, 4) + 1500;
+        script_press(&s, t, "guess1");
+        script_press(&s, t + 1500, "guess2");
+        for (int u = 0; u < undos; ++u)
+            script_press(&s, t + 3000 + 1500 * u, "undo");
+        script_end(&s, sc, t + 3000 + 1500 * undos + 1000);
+        char args[2048];
+        snprintf(args, sizeof args, "--script '%s'", sc);
+        cJSON* st = NULL;
+        ENSURE(run_kiosk(args, &st) == 0 && st);
+        const cJSON* att = cJSON_GetObjectItemCaseSensitive(st, "attached_to");
+        int head_on = (int)cJSON_GetNumberValue(cJSON_GetArrayItem(att, 0));
+        fprintf(stderr, "  head, body, two chips, %d undo(s): parts %g (%s, %s), the head attached to %d, undos %g\n", undos,
+                num(st, "parts"), stat_category(st, 0), stat_category(st, 1), head_on, num(st, "undos"));
+        ENSURE(num(st, "parts") == 2 && num(st, "undos") == undos);
+        if (undos == 0) {
+            ENSURE(strcmp(stat_category(st, 1), "torso") != 0 && head_on < 0); // the premise: the chips made it another part
+        } else {
+            ENSURE(!strcmp(stat_category(st, 1), "torso") && head_on == 1);
+        }
+        cJSON_Delete(st);
+    }
+}
+
 // A visitor's finger leaves the glass for a moment: the part drawn in two
 // pieces, 120 ms apart, is one part, collected as one stroke; the same two
 // pieces 700 ms apart are two strokes (a pause, not a slip).
@@ -2422,6 +2461,7 @@ int main(int argc, char** argv)
                                    {"continued_stroke", test_continued_stroke},
                                    {"twenty_strokes", test_twenty_strokes},
                                    {"collect", test_collect},
+                                   {"chip_undo", test_chip_undo},
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
                                    {"collect_mended", test_collect_mended},

@@ -63,7 +63,7 @@ static void fake_label(const fake* f, sp_kiosk_part_label* l)
         return;
     }
     int c = f->cat[f->parts - 1];
-    *l = (sp_kiosk_part_label){k_cats[c], {k_cats[(c + 1) % 6], k_cats[(c + 2) % 6]}};
+    *l = (sp_kiosk_part_label){k_cats[c], {k_cats[(c + 1) % 6], k_cats[(c + 2) % 6]}, false};
 }
 
 static void fake_drain(sp_kiosk_ui* ui, fake* f)
@@ -1337,6 +1337,12 @@ static void test_waiting_part(void)
     ENSURE(f.parts == 3 && sp_kiosk_ui_message(ui) == NULL);
     frame(ui, &f, t + 30);
     ENSURE(f.parts == 4 && !strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_WAITING)));
+    // Undo (of a chip that had made the body a part: the body is back): the
+    // last part no longer waits, and the hint goes; one that still waits keeps it.
+    sp_kiosk_ui_parts_changed(ui, 4, &(sp_kiosk_part_label){"wings", {"head", "tail"}, true});
+    ENSURE(!strcmp(sp_kiosk_ui_message(ui), sp_kiosk_text(SP_KTEXT_WAITING)));
+    sp_kiosk_ui_parts_changed(ui, 4, &(sp_kiosk_part_label){"torso", {"head", "wings"}, false});
+    ENSURE(sp_kiosk_ui_message(ui) == NULL);
     sp_kiosk_ui_destroy(ui);
 }
 

@@ -1331,6 +1331,10 @@ void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_p
         set_chips(ui, label->category, label->guesses[0], label->guesses[1]);
     else
         set_chips(ui, NULL, NULL, NULL);
+    // "Draw a body" holds only while the last part waits for one (Undo of a
+    // chip that had made the body a part gives the body back).
+    bool waiting = label && label->category && label->waiting && ui->part_count > 0;
+    if (!waiting && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_WAITING))) ui->hint_until = -1;
     ++ui->revision;
     if (ui->part_count == 0) { // an empty canvas starts again: the animation too
         ui->redraw_armed = false;

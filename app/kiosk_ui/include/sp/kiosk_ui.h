@@ -180,6 +180,7 @@ typedef struct sp_kiosk_fit_result {
 typedef struct sp_kiosk_part_label {
     const char* category;
     const char* guesses[2];
+    bool waiting; ///< the part waits for a body (no body on the canvas)
 } sp_kiosk_part_label;
 
 /// The state. Read-only outside ui.c (the renderer and tests read it).
