@@ -53,6 +53,32 @@ static void stick_free(stick_buf* b)
     free(b->rest), free(b->joints), free(b->weights);
 }
 
+// How far along the unit direction `dir` from `pivot` the mesh vertices
+// that `joint` moves most reach (xyz: the mesh at the default parameters);
+// 0 when none lies that way. *share (may be NULL): those vertices' share of the mesh.
+static double mesh_reach(const sp_rig* rig, const double* xyz, int joint, sp_vec3 pivot, sp_vec3 dir, double* share)
+{
+    double far = 0;
+    int moved = 0;
+    for (int v = 0; xyz && v < rig->vertex_count; ++v) {
+        int strongest = 0;
+        for (int k = 1; k < 4; ++k)
+            if (rig->weights4[4 * v + k] > rig->weights4[4 * v + strongest]) strongest = k;
+        if (rig->joints4[4 * v + strongest] != joint) continue;
+        sp_vec3 x = {xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]};
+        far = fmax(far, sp_v3_dot(sp_v3_sub(x, pivot), dir));
+        ++moved;
+    }
+    if (share) *share = rig->vertex_count > 0 ? (double)moved / rig->vertex_count : 0;
+    return far;
+}
+
+// A leaf that moves at least this share of the mesh gets a curve of its own
+// past its pivot. Smaller ones (a head, hands, feet) do not: with theirs,
+// CesiumMan's random poses were fitted within 1% 88 times of 100, where the
+// recovery protocol asks 95 (96 without).
+#define STICK_TIP_SHARE 0.25
+
 sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones, sp_error* err)
 {
     int J = rig->joint_count;
@@ -63,6 +89,7 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones
     sp_mat4* inv = malloc(sizeof(sp_mat4) * (size_t)J);
     bool* usable = malloc(sizeof(bool) * (size_t)J);
     sp_vec3* pos = malloc(sizeof(sp_vec3) * (size_t)J);
+    double* xyz = NULL;
     sp_rig_eval* ev;
     sp_rig_eval_create(rig, &ev, NULL);
     stick_buf b = {0};
@@ -75,6 +102,9 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones
     sp_rig_eval_update(ev, p, false);
     const sp_mat4* world = sp_rig_eval_world(ev);
     const sp_mat4* skin = sp_rig_eval_skin(ev);
+    // The mesh, for the tips of chains that end at a leaf (NULL: none).
+    if (rig->vertex_count > 0 && (xyz = malloc(sizeof(double) * 3 * (size_t)rig->vertex_count)))
+        sp_rig_eval_points(ev, sp_rig_mesh_points(rig), xyz);
     sp_vec3 lo = {0, 0, 0}, hi = {0, 0, 0};
     for (int j = 0; j < J; ++j) {
         // A joint whose skin matrix flattens space has no bind-space place
@@ -127,9 +157,21 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones
                 last_u = u, last_v = v;
             }
             if (last_u < 0) continue;
-            if (!stick_push(&b, &inv[last_u], last_u, pos[last_v])) {
-                r = sp_fail(err, SP_ERR_NO_MEMORY, "stick figure: out of memory");
-                goto done;
+            // A chain that ends at a leaf moving much of the mesh goes on
+            // to where that mesh ends: without it that bone had no curve,
+            // and the solve posed it at random (RiggedSimple's upper half,
+            // an outside review).
+            sp_vec3 d = sp_v3_norm(sp_v3_sub(pos[last_v], pos[last_u]));
+            double share = 0,
+                   tip = nchild[last_v] == 0 && usable[last_v] ? mesh_reach(rig, xyz, last_v, pos[last_v], d, &share) : 0;
+            int steps = tip > eps && share >= STICK_TIP_SHARE ? SP_STICK_POINTS_PER_BONE : 0;
+            for (int k = 0; k <= steps; ++k) {
+                int u = k == 0 ? last_u : last_v;
+                sp_vec3 x = sp_v3_add(pos[last_v], sp_v3_scale(d, tip * (double)k / SP_STICK_POINTS_PER_BONE));
+                if (!stick_push(&b, &inv[u], u, x)) {
+                    r = sp_fail(err, SP_ERR_NO_MEMORY, "stick figure: out of memory");
+                    goto done;
+                }
             }
             char name[SP_NAME_MAX];
             snprintf(name, sizeof name, "%.31s-%.31s", rig->joints[chain[0]].name, rig->joints[chain[len - 1]].name);
@@ -138,7 +180,7 @@ sp_result sp_gltf_derive_stick(sp_rig* rig, const bool* is_skin, int* flat_bones
     }
 done:
     sp_rig_eval_destroy(ev);
-    free(nchild), free(chain), free(p), free(inv), free(usable), free(pos);
+    free(nchild), free(chain), free(p), free(inv), free(usable), free(pos), free(xyz);
     stick_free(&b);
     return r;
 }
@@ -218,15 +260,7 @@ static sp_vec3 pushed_end(const sp_rig* rig, const double* xyz, int joint, sp_ve
     double len = sp_v3_len(d), reach = 0.8 * len;
     if (!(len > 0)) return pivot;
     d = sp_v3_scale(d, 1.0 / len);
-    double far = 0;
-    for (int v = 0; xyz && v < rig->vertex_count; ++v) {
-        int strongest = 0;
-        for (int k = 1; k < 4; ++k)
-            if (rig->weights4[4 * v + k] > rig->weights4[4 * v + strongest]) strongest = k;
-        if (rig->joints4[4 * v + strongest] != joint) continue;
-        sp_vec3 x = {xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]};
-        far = fmax(far, sp_v3_dot(sp_v3_sub(x, pivot), d));
-    }
+    double far = mesh_reach(rig, xyz, joint, pivot, d, NULL);
     return sp_v3_add(pivot, sp_v3_scale(d, far > 0 ? far : reach));
 }
 
