@@ -18,6 +18,7 @@
 #include "sp/clock.h"
 
 static void forget_strokes(sp_kiosk* k);
+static void replaced_free(replaced_part* u);
 
 // ------------------------------------------------------------------ mapping
 
@@ -290,6 +291,7 @@ void sp_kiosk_destroy(sp_kiosk* k)
     free(k->guesses);
     free(k->scratch);
     free(k->outline_px);
+    free(k->scene_px);
     free(k);
 }
 
@@ -372,7 +374,9 @@ static void forget_strokes(sp_kiosk* k)
     for (int i = 0; i < k->guess_count; ++i)
         free(k->guesses[i].xy), free(k->guesses[i].t);
     k->guess_count = 0;
-    k->chip_undo_n = 0;
+    for (int i = 0; i < k->replaced_n; ++i)
+        replaced_free(&k->replaced[i]);
+    k->replaced_n = 0;
 }
 
 // Keeps an accepted part's stroke for collection (canvas pixels; ms since
@@ -401,6 +405,29 @@ static bool has_body(const sp_dragon* d)
     for (int i = 0; i < sp_dragon_part_count(d); ++i)
         if (sp_dragon_part_get(d, i)->is_torso) return true;
     return false;
+}
+
+// Where the parts are on the screen (their strokes), for the chips to keep
+// clear of: told to the UI before it lays them out.
+static void tell_scene(sp_kiosk* k)
+{
+    int total = 0, n = sp_dragon_part_count(k->dragon);
+    for (int i = 0; i < n; ++i)
+        total += sp_dragon_part_get(k->dragon, i)->stroke_points;
+    if (total > k->scene_cap) {
+        float* p = realloc(k->scene_px, sizeof *p * 2 * (size_t)total);
+        if (!p) total = 0;
+        if (p) k->scene_px = p, k->scene_cap = total;
+    }
+    int m = 0;
+    for (int i = 0; i < n && m < total; ++i) {
+        const sp_dragon_part* p = sp_dragon_part_get(k->dragon, i);
+        for (int j = 0; j < p->stroke_points && m < total; ++j, ++m) {
+            sp_vec2 q = kiosk_canvas_to_fb(k, p->stroke_xy[j]);
+            k->scene_px[2 * m] = (float)q.x, k->scene_px[2 * m + 1] = (float)q.y;
+        }
+    }
+    sp_kiosk_ui_set_scene(k->ui, k->scene_px, m);
 }
 
 // The label chip and the next two guesses of the last part, for the UI.
@@ -489,6 +516,7 @@ static void answer_refusal(sp_kiosk* k, sp_result rc, const sp_dragon_result* re
     int n = r.offer ? stroke_guesses(k, res, tried, offers, 3) : 0;
     for (int i = 0; i < n; ++i)
         r.offers[i] = offers[i];
+    tell_scene(k);
     sp_kiosk_ui_fit_done(k->ui, &r);
 }
 
@@ -537,6 +565,7 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
     // A part drawn before any body waits where it was drawn; the visitor is told to draw one.
     bool waiting = !p->is_torso && !has_body(k->dragon);
     k->stats.waiting += waiting;
+    tell_scene(k);
     sp_kiosk_ui_fit_done(k->ui, &(sp_kiosk_fit_result){.ok = true,
                                                        .hint = note_hint(res->note),
                                                        .waiting = waiting,
@@ -554,6 +583,46 @@ static void answer_fit(sp_kiosk* k, sp_result rc, const sp_dragon_result* res, c
     else
         ++k->stats.parts_added;
     if (forced) ++k->stats.chosen;
+}
+
+// What the last part is, for Undo of what replaces it: with a Redraw's
+// new stroke, also its own stroke and the stroke kept for its collection
+// (moved out of its chips' record).
+static replaced_part describe_last(sp_kiosk* k, bool redraw)
+{
+    replaced_part u = {0};
+    int n = sp_dragon_part_count(k->dragon);
+    if (n == 0) return u;
+    const sp_dragon_part* last = sp_dragon_part_get(k->dragon, n - 1);
+    part_guesses* g = guesses_of(k, last->id, false);
+    u.replaced = last->id;
+    snprintf(u.category, sizeof u.category, "%s", last->category);
+    u.chosen = g && g->chosen;
+    for (int i = 0; g && i < 2; ++i)
+        snprintf(u.guess[i], sizeof u.guess[i], "%s", g->guess[i]);
+    if (redraw && (u.stroke = malloc(sizeof *u.stroke * (size_t)(last->stroke_points + 1)))) {
+        memcpy(u.stroke, last->stroke_xy, sizeof *u.stroke * (size_t)last->stroke_points);
+        u.stroke_n = last->stroke_points;
+        if (g) u.kept = *g, g->xy = NULL, g->t = NULL, g->n = 0;
+    }
+    return u;
+}
+
+static void replaced_free(replaced_part* u)
+{
+    free(u->stroke), free(u->kept.xy), free(u->kept.t);
+    *u = (replaced_part){0};
+}
+
+// Keeps u (taking its buffers) for Undo; the oldest goes when full.
+static void replaced_push(sp_kiosk* k, replaced_part* u)
+{
+    if (k->replaced_n == KIOSK_REPLACED_MAX) {
+        replaced_free(&k->replaced[0]);
+        memmove(&k->replaced[0], &k->replaced[1], sizeof *u * --k->replaced_n);
+    }
+    k->replaced[k->replaced_n++] = *u;
+    *u = (replaced_part){0};
 }
 
 static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
@@ -577,6 +646,8 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     double t0 = sp_now_ms();
     // The stroke continues the last one: what its first piece made goes first (the UI's join).
     if (j->undo_first && sp_dragon_undo(k->dragon)) ++k->rev;
+    // A Redraw: what the part it replaces was, for Undo.
+    replaced_part u = j->replace && !j->undo_first ? describe_last(k, true) : (replaced_part){0};
     sp_result rc = sp_dragon_add_points(
         k->dragon, k->scratch, s->count,
         &(sp_dragon_stroke_opts){.category = forced, .replace_last = j->replace, .replace_detail = j->replace_detail}, &res,
@@ -586,19 +657,29 @@ static void run_fit(sp_kiosk* k, const sp_kiosk_job* j)
     k->stats.fit_ms[k->stats.fit_count++ % 4096] = ms;
     answer_fit(k, rc, &res, &err, false, forced);
     if (rc == SP_OK && !res.rejected) keep_stroke(k, res.part, k->scratch, s->t, s->count);
+    bool made = rc == SP_OK && !res.rejected && res.part >= 0 && res.part < sp_dragon_part_count(k->dragon);
+    if (u.replaced && made && (u.by = sp_dragon_part_get(k->dragon, res.part)->id) != u.replaced) {
+        replaced_push(k, &u);
+    } else if (u.replaced) { // refused: the part stays, with its kept stroke
+        part_guesses* g = guesses_of(k, u.replaced, false);
+        if (g && !g->xy) g->xy = u.kept.xy, g->t = u.kept.t, g->n = u.kept.n, u.kept = (part_guesses){0};
+        replaced_free(&u);
+    }
     if (rc == SP_OK && res.reason == SP_DRAGON_DETAIL && res.detail >= 0) ++k->rev; // new ink to pose
 }
 
-// The last part re-fitted as `category` (NULL: as the classifier takes its
-// stroke, a Redraw of the same stroke), forced or not. The re-fitted part is
-// a new part of the same stroke: the kept stroke moves to it (or back, when
-// the re-fit fails and the part stays). True when the part was replaced;
-// *new_id is the new part's id.
-static bool refit_last(sp_kiosk* k, const char* category, bool answer, sp_dragon_result* res, uint64_t* new_id)
+// The last part fitted again as `category` (NULL: as the classifier takes
+// the stroke), from its own stroke or from `xy` (n points: the stroke of
+// the part a Redraw replaced), forced or not. From its own stroke the
+// stroke kept for collection moves to the new part (or back, when the fit
+// fails and the part stays); from another, it goes with the part. True
+// when the part was replaced; *new_id is the new part's id.
+static bool refit_last(sp_kiosk* k, const char* category, const sp_vec2* xy, int n, bool answer, sp_dragon_result* res,
+                       uint64_t* new_id)
 {
-    int n = sp_dragon_part_count(k->dragon);
-    if (n == 0) return false;
-    const sp_dragon_part* last = sp_dragon_part_get(k->dragon, n - 1);
+    int count = sp_dragon_part_count(k->dragon);
+    if (count == 0) return false;
+    const sp_dragon_part* last = sp_dragon_part_get(k->dragon, count - 1);
     uint64_t old_id = last->id;
     part_guesses* old = guesses_of(k, old_id, false);
     part_guesses kept = {0};
@@ -606,23 +687,22 @@ static bool refit_last(sp_kiosk* k, const char* category, bool answer, sp_dragon
     memset(res, 0, sizeof *res);
     sp_error err = {0};
     sp_result rc = SP_ERR_NO_MEMORY;
-    if (category) {
+    // A copy: the part (and its stroke) is freed when replaced.
+    sp_vec2* copy = malloc(sizeof *copy * (size_t)((xy ? n : last->stroke_points) + 1));
+    if (category && !xy) {
         rc = sp_dragon_refit_last(k->dragon, category, res, &err);
-    } else {
-        // A copy: the part (and its stroke) is freed when replaced.
-        sp_vec2* xy = malloc(sizeof *xy * (size_t)(last->stroke_points + 1));
-        if (xy) {
-            memcpy(xy, last->stroke_xy, sizeof *xy * (size_t)last->stroke_points);
-            rc = sp_dragon_add_points(k->dragon, xy, last->stroke_points, &(sp_dragon_stroke_opts){.replace_last = true}, res,
-                                      &err);
-            free(xy);
-        }
+    } else if (copy) {
+        int m = xy ? n : last->stroke_points;
+        memcpy(copy, xy ? xy : last->stroke_xy, sizeof *copy * (size_t)m);
+        rc = sp_dragon_add_points(k->dragon, copy, m, &(sp_dragon_stroke_opts){.category = category, .replace_last = true}, res,
+                                  &err);
     }
+    free(copy);
     if (answer) answer_fit(k, rc, res, &err, true, NULL);
     bool moved = rc == SP_OK && !res->rejected && res->part >= 0 && res->part < sp_dragon_part_count(k->dragon);
     *new_id = moved ? sp_dragon_part_get(k->dragon, res->part)->id : old_id;
     part_guesses* to = guesses_of(k, *new_id, !answer && moved);
-    if (to && !to->xy)
+    if (to && !to->xy && !(xy && moved))
         to->xy = kept.xy, to->t = kept.t, to->n = kept.n;
     else
         free(kept.xy), free(kept.t);
@@ -631,48 +711,41 @@ static bool refit_last(sp_kiosk* k, const char* category, bool answer, sp_dragon
 
 static void run_refit(sp_kiosk* k, const sp_kiosk_job* j)
 {
-    // What the chip replaces, for Undo.
-    int n = sp_dragon_part_count(k->dragon);
-    chip_undo u = {0};
-    if (n > 0) {
-        const sp_dragon_part* last = sp_dragon_part_get(k->dragon, n - 1);
-        const part_guesses* g = guesses_of(k, last->id, false);
-        u.replaced = last->id;
-        snprintf(u.category, sizeof u.category, "%s", last->category);
-        u.chosen = g && g->chosen;
-        for (int i = 0; g && i < 2; ++i)
-            snprintf(u.guess[i], sizeof u.guess[i], "%s", g->guess[i]);
-    }
+    replaced_part u = describe_last(k, false); // for Undo
     sp_dragon_result res;
-    if (!refit_last(k, j->category, true, &res, &u.by) || n == 0) return;
-    if (k->chip_undo_n == KIOSK_CHIP_UNDO_MAX) memmove(&k->chip_undo[0], &k->chip_undo[1], sizeof u * --k->chip_undo_n);
-    k->chip_undo[k->chip_undo_n++] = u;
+    if (refit_last(k, j->category, NULL, 0, true, &res, &u.by) && u.replaced) replaced_push(k, &u);
 }
 
-// Undo right after a chip: the part the chip replaced comes back, fitted
-// again from the same stroke as it was (its chip's category, or the
+// Undo right after a chip or a Redraw: the part it replaced comes back,
+// fitted again from its stroke as it was (its chip's category, or the
 // classifier's answer), with its chips. A parent who tapped the wrong chip
-// on the body lost the body, and every part came loose (an outside review).
-// False when the last change is not a chip's (a part drawn since, ink on it).
-static bool undo_chip(sp_kiosk* k)
+// on the body lost the body, and every part came loose (an outside
+// review). False when the last change is not one (a part drawn since, ink).
+static bool undo_replace(sp_kiosk* k)
 {
     int n = sp_dragon_part_count(k->dragon), nd = sp_dragon_detail_count(k->dragon);
-    if (n == 0 || k->chip_undo_n == 0) return false;
-    chip_undo u = k->chip_undo[k->chip_undo_n - 1];
+    if (n == 0 || k->replaced_n == 0) return false;
+    replaced_part* top = &k->replaced[k->replaced_n - 1];
     uint64_t last = sp_dragon_part_get(k->dragon, n - 1)->id;
     sp_dragon_detail dd;
-    if (u.by != last || (nd > 0 && sp_dragon_detail_get(k->dragon, nd - 1, &dd) && dd.id > last)) return false;
-    --k->chip_undo_n;
+    if (top->by != last || (nd > 0 && sp_dragon_detail_get(k->dragon, nd - 1, &dd) && dd.id > last)) return false;
+    replaced_part u = *top;
+    --k->replaced_n;
     sp_dragon_result res;
     uint64_t id;
-    if (!refit_last(k, u.chosen ? u.category : NULL, false, &res, &id)) return false;
+    if (!refit_last(k, u.chosen ? u.category : NULL, u.stroke, u.stroke_n, false, &res, &id)) {
+        replaced_free(&u);
+        return false;
+    }
     part_guesses* g = guesses_of(k, id, true);
     if (g) {
         g->chosen = u.chosen;
         memcpy(g->guess, u.guess, sizeof g->guess);
+        if (u.stroke && !g->xy) g->xy = u.kept.xy, g->t = u.kept.t, g->n = u.kept.n, u.kept = (part_guesses){0};
     }
-    for (int i = 0; i < k->chip_undo_n; ++i) // a chip before it replaced this part, which has a new id
-        if (k->chip_undo[i].by == u.replaced) k->chip_undo[i].by = id;
+    for (int i = 0; i < k->replaced_n; ++i) // one before it replaced this part, which has a new id
+        if (k->replaced[i].by == u.replaced) k->replaced[i].by = id;
+    replaced_free(&u);
     return true;
 }
 
@@ -723,9 +796,10 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         run_refit(k, j);
         break;
     case SP_KJOB_UNDO: {
-        if (undo_chip(k) || sp_dragon_undo(k->dragon)) ++k->rev, ++k->stats.undos;
+        if (undo_replace(k) || sp_dragon_undo(k->dragon)) ++k->rev, ++k->stats.undos;
         sp_kiosk_part_label l;
         last_label(k, &l);
+        tell_scene(k);
         sp_kiosk_ui_parts_changed(k->ui, sp_dragon_part_count(k->dragon), &l);
         break;
     }
@@ -734,6 +808,7 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
         sp_dragon_clear(k->dragon);
         ++k->rev, ++k->stats.clears;
         forget_strokes(k);
+        tell_scene(k);
         sp_kiosk_ui_parts_changed(k->ui, 0, NULL);
         break;
     case SP_KJOB_SAVE:

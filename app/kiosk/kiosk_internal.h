@@ -42,15 +42,20 @@ typedef struct part_guesses {
     int n;
 } part_guesses;
 
-/// A part a chip replaced (the same stroke fitted as another part), for
-/// Undo to bring back while the part that replaced it is the last change.
-enum { KIOSK_CHIP_UNDO_MAX = 8 };
-typedef struct chip_undo {
+/// A part a chip or a Redraw replaced, for Undo to bring back while the
+/// part that replaced it is the last change.
+enum { KIOSK_REPLACED_MAX = 8 };
+typedef struct replaced_part {
     uint64_t replaced, by; ///< the part's id, and its replacement's
     char category[SP_NAME_MAX];
     bool chosen; ///< its category was a chip's (else the classifier's: fitted again as classified)
     char guess[2][SP_NAME_MAX];
-} chip_undo;
+    // A Redraw's: the part's own stroke (canvas pixels, as fitted) and the
+    // one kept for collection (NULL: a chip's, the stroke is the same).
+    sp_vec2* stroke;
+    int stroke_n;
+    part_guesses kept;
+} replaced_part;
 
 /// The writer of visitors' strokes (kiosk_collect.c): a thread with its own
 /// database handle, so that the frame loop never waits for the database.
@@ -91,8 +96,8 @@ struct sp_kiosk {
     mesh_cache meshes;
     part_guesses* guesses;
     int guess_count, guess_cap;
-    chip_undo chip_undo[KIOSK_CHIP_UNDO_MAX]; // newest last
-    int chip_undo_n;
+    replaced_part replaced[KIOSK_REPLACED_MAX]; // newest last
+    int replaced_n;
     kiosk_collector* collector;          // NULL: collection off (--no-collect) or closed
     int collect_stored, collect_dropped; // the collector's counts when it closed
     uint64_t rev;                        // grows with every change of the dragon
@@ -131,6 +136,8 @@ struct sp_kiosk {
     int scratch_cap;
     float* outline_px;
     int outline_cap;
+    float* scene_px; // the parts' strokes for the chips to keep clear of (framebuffer pixels, by 2)
+    int scene_cap;
     int breaks[64];
 };
 

@@ -1130,6 +1130,38 @@ static void test_collect(void)
     }
 }
 
+// Redraw of the head, then Undo: the head comes back, with its chips, and
+// the body still carries it (Undo took the new part away and nothing came back).
+static void test_redraw_undo(void)
+{
+    NEED_XVFB();
+    six_strokes();
+    const stroke *body = &g_strokes[0], *head = &g_strokes[1], *tail = &g_strokes[3];
+    const char* sc = sp_test_tmp_path("kiosk_redraw_undo.json");
+    for (int undo = 0; undo < 2; ++undo) {
+        script s = script_open(sc, 0);
+        script_event(&s, 0, "down", 640, 400);
+        script_event(&s, 60, "up", 640, 400);
+        double t = part_stroke_at(&s, 500, body, 0, 0) + 1500;
+        t = part_stroke_at(&s, t, head, 0, 0) + 1500;
+        script_press(&s, t, "redraw");
+        t = script_stroke(&s, t + 500, tail->xy, tail->n, 4) + 1500;
+        if (undo) script_press(&s, t, "undo");
+        script_end(&s, sc, t + 1500);
+        char args[2048];
+        snprintf(args, sizeof args, "--script '%s'", sc);
+        cJSON* st = NULL;
+        ENSURE(run_kiosk(args, &st) == 0 && st);
+        const cJSON* att = cJSON_GetObjectItemCaseSensitive(st, "attached_to");
+        int on = (int)cJSON_GetNumberValue(cJSON_GetArrayItem(att, 1));
+        fprintf(stderr, "  body, head, Redraw with a tail%s: parts %g (%s, %s), the second attached to %d\n",
+                undo ? ", Undo" : "", num(st, "parts"), stat_category(st, 0), stat_category(st, 1), on);
+        ENSURE(num(st, "parts") == 2 && !strcmp(stat_category(st, 0), "torso") && on == 0);
+        ENSURE(!strcmp(stat_category(st, 1), undo ? "head" : "tail"));
+        cJSON_Delete(st);
+    }
+}
+
 // A parent taps a wrong chip on the body, twice, and takes both taps back
 // with Undo (an outside review: Undo after a chip removed the body, and
 // every part came loose): the body comes back a body, carrying the head.
@@ -2462,6 +2494,7 @@ int main(int argc, char** argv)
                                    {"twenty_strokes", test_twenty_strokes},
                                    {"collect", test_collect},
                                    {"chip_undo", test_chip_undo},
+                                   {"redraw_undo", test_redraw_undo},
                                    {"collect_read_only", test_collect_read_only},
                                    {"collect_reload", test_collect_reload},
                                    {"collect_mended", test_collect_mended},

@@ -773,6 +773,41 @@ static void test_chips_clear_the_stroke(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// A dragon drawn in the top-left corner: the chips of its legs, drawn
+// below them, kept to the top-left and hid its head (an outside review).
+// The parts on the canvas (the scene the kiosk gives) count as the stroke does.
+static void test_chips_clear_the_dragon(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    float mid = ui->canvas.x + 0.5f * ui->canvas.w, corner[2 * 200];
+    for (int i = 0; i < 200; ++i) // a head's stroke across where the chips go
+        corner[2 * i] = ui->canvas.x + 20 + 2.0f * i, corner[2 * i + 1] = ui->canvas.y + 30 + 20 * sinf(0.1f * i);
+    sp_kiosk_ui_set_scene(ui, corner, 200);
+    ENSURE(ui->scene.count == 200);
+    double t = stroke(ui, 1000, 300, 300, 30, 10); // the legs, below the chips
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL));
+    fprintf(stderr, "  the chips' label at x %.0f (the canvas's middle %.0f); scene points under them %d\n",
+            ui->target[SP_KT_CHIP_LABEL].x, mid, under_chips(ui, &ui->scene));
+    ENSURE(under_chips(ui, &ui->scene) == 0 && ui->target[SP_KT_CHIP_LABEL].x > corner[2 * 199]); // right of the head
+    // No parts there (Start over): back at the top-left.
+    sp_kiosk_ui_set_scene(ui, NULL, 0);
+    t = stroke(ui, t + 2000, 300, 300, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->target[SP_KT_CHIP_LABEL].x < ui->canvas.x + 0.1f * ui->canvas.w);
+    // Thinned evenly when there are more points than it keeps.
+    float* many = malloc(sizeof(float) * 2 * 3 * SP_KIOSK_STROKE_MAX);
+    ENSURE(many);
+    for (int i = 0; i < 3 * SP_KIOSK_STROKE_MAX; ++i)
+        many[2 * i] = (float)i, many[2 * i + 1] = 0;
+    sp_kiosk_ui_set_scene(ui, many, 3 * SP_KIOSK_STROKE_MAX);
+    ENSURE(ui->scene.count == SP_KIOSK_STROKE_MAX && ui->scene.xy[2] == 3 &&
+           ui->scene.xy[2 * (SP_KIOSK_STROKE_MAX - 1)] == 3 * (SP_KIOSK_STROKE_MAX - 1));
+    free(many);
+    sp_kiosk_ui_destroy(ui);
+}
+
 // Issue 16, item 7: Start over returns to the first-draw prompt with the
 // animation stopped (the old kiosk showed a blank canvas and "Pause").
 static void test_start_over(void)
@@ -2048,6 +2083,7 @@ int main(int argc, char** argv)
                                    {"parts_row_twelve", test_parts_row_twelve},
                                    {"other_chip", test_other_chip},
                                    {"chips_clear_the_stroke", test_chips_clear_the_stroke},
+                                   {"chips_clear_the_dragon", test_chips_clear_the_dragon},
                                    {"long_category", test_long_category},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},

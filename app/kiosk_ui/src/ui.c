@@ -117,7 +117,7 @@ sp_result sp_kiosk_ui_create(const sp_kiosk_ui_desc* desc, sp_kiosk_ui** out, sp
         line_alloc(&ui->stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->job_stroke, SP_KIOSK_STROKE_MAX, true) &&
         line_alloc(&ui->flash_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->fade_stroke, SP_KIOSK_STROKE_MAX, true) &&
         line_alloc(&ui->held_stroke, SP_KIOSK_STROKE_MAX, true) && line_alloc(&ui->last_stroke, SP_KIOSK_STROKE_MAX, true) &&
-        line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
+        line_alloc(&ui->scene, SP_KIOSK_STROKE_MAX, false) && line_alloc(&ui->flash_outline, SP_KIOSK_OUTLINE_MAX, false);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
         ok = ok && line_alloc(&ui->pending[i], SP_KIOSK_STROKE_MAX, true);
     if (!ok) {
@@ -141,6 +141,7 @@ void sp_kiosk_ui_destroy(sp_kiosk_ui* ui)
     line_free(&ui->flash_stroke);
     line_free(&ui->fade_stroke);
     line_free(&ui->held_stroke);
+    line_free(&ui->scene);
     line_free(&ui->last_stroke);
     line_free(&ui->flash_outline);
     for (int i = 0; i < SP_KIOSK_PENDING_MAX; ++i)
@@ -219,13 +220,15 @@ static void keep_stroke_in_sight(sp_kiosk_ui* ui, float top, float end, float ma
 }
 
 // Points of the lines the chips are about (the refused stroke offered, or
-// the last part's stroke and fitted outline) under the chips.
+// the last part's stroke and fitted outline), and of the parts on the
+// canvas (the scene), under the chips.
 static int chips_cover(const sp_kiosk_ui* ui)
 {
     int n = 0;
     for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t)
-        n += offering(ui) ? points_in(&ui->held_stroke, &ui->target[t])
-                          : points_in(&ui->flash_stroke, &ui->target[t]) + points_in(&ui->flash_outline, &ui->target[t]);
+        n += (offering(ui) ? points_in(&ui->held_stroke, &ui->target[t])
+                           : points_in(&ui->flash_stroke, &ui->target[t]) + points_in(&ui->flash_outline, &ui->target[t])) +
+             points_in(&ui->scene, &ui->target[t]);
     return n;
 }
 
@@ -279,8 +282,9 @@ static void layout_chips(sp_kiosk_ui* ui)
         *r = (sp_kiosk_rect){x, y, w, h};
         x += w + gap;
     }
-    // A stroke drawn at the top-left (the one they are about) would be under
-    // them: they go to the top-right when it covers less there.
+    // A stroke drawn at the top-left (the one they are about, or a part
+    // drawn before: a dragon drawn in the corner had its head under them)
+    // would be under them: they go to the top-right when less is there.
     int covered = chips_cover(ui);
     if (covered > 0) {
         sp_kiosk_rect at_left[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
@@ -1319,6 +1323,17 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
         set_hint(ui, r->hint);
     else if (last && r->waiting)
         set_hint(ui, sp_kiosk_text(SP_KTEXT_WAITING));
+}
+
+void sp_kiosk_ui_set_scene(sp_kiosk_ui* ui, const float* xy, int n)
+{
+    int cap = SP_KIOSK_STROKE_MAX, m = n < cap ? n : cap;
+    ui->scene.count = 0;
+    for (int i = 0; xy && i < m; ++i) {
+        int k = (int)((long long)i * n / m);
+        ui->scene.xy[2 * i] = xy[2 * k], ui->scene.xy[2 * i + 1] = xy[2 * k + 1];
+        ui->scene.count = i + 1;
+    }
 }
 
 void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label)

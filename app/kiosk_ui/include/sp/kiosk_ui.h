@@ -245,6 +245,7 @@ typedef struct sp_kiosk_ui {
     double flash_until;
     sp_kiosk_line fade_stroke; ///< a rejected stroke, fading until fade_until
     double fade_until;
+    sp_kiosk_line scene;       ///< the strokes of the parts on the canvas, thinned (sp_kiosk_ui_set_scene)
     sp_kiosk_line held_stroke; ///< the last stroke, refused, offered until held_until (then it fades)
     double held_until;
     bool held_kept; ///< the held stroke is also kept as a detail: Undo takes it back from the dragon too
@@ -302,6 +303,10 @@ bool sp_kiosk_ui_next_job(sp_kiosk_ui* ui, sp_kiosk_job* job);
 sp_kiosk_job_kind sp_kiosk_ui_peek_job(const sp_kiosk_ui* ui);
 /// Reports a FIT or REFIT job's result.
 void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r);
+/// Where the parts on the canvas are, for the chips to keep clear of them:
+/// their strokes' points (n by 2, framebuffer pixels), thinned evenly to at
+/// most SP_KIOSK_STROKE_MAX. Given before fit_done or parts_changed.
+void sp_kiosk_ui_set_scene(sp_kiosk_ui* ui, const float* xy, int n);
 /// Reports the parts after UNDO or CLEAR (label NULL or label->category NULL: no part left).
 void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label);
 /// Reports a SAVE job: ok with the code to show, or a failure (a friendly message is shown).
