@@ -3434,6 +3434,39 @@ static void test_reaches_the_body(void)
     sp_db_close(db);
 }
 
+// Wings face the way their dragon does unless the other facing fits them
+// twice as well: a child's wing leaning forward, drawn at the shoulders
+// (an outside review), fitted leaning back shrank across the neck and was
+// kept as ink on the head. Here the wings' own outline, mirrored, drawn on
+// the back of a dragon facing right: fitted as drawn, and attached. The
+// visitors' tune-half wings at a dragon keep their dragon's facing
+// (visitors --on-body, line for line).
+static void test_wing_leaning_forward(void)
+{
+    const char* path = real_db();
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    sp_dragon_result body = draw_part(d, db, "torso", 640, 440, 420, false, true);
+    draw_part(d, db, "head", 900, 300, 200, false, true); // the dragon faces right
+    for (int mirror = 0; mirror < 2; ++mirror) {
+        sp_vec2* xy;
+        int n = category_stroke(db, "wings", 620, 250, 200, mirror, &xy);
+        sp_dragon_result res;
+        ENSURE(sp_dragon_add_points(d, xy, n, &(sp_dragon_stroke_opts){.category = "wings"}, &res, &err) == SP_OK &&
+               !res.rejected);
+        free(xy);
+        const sp_dragon_part* w = sp_dragon_part_get(d, res.part);
+        fprintf(stderr, "  wings drawn %s: fitted %s, attached to %d, error %.1f px\n",
+                mirror ? "leaning forward" : "as modelled", w->mirrored ? "mirrored" : "as modelled", w->attached_to,
+                w->report.mean_error_px);
+        ENSURE(w->mirrored == (mirror != 0) && w->attached_to == body.part);
+        ENSURE(sp_dragon_undo(d));
+    }
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // A bigger body drawn round a small dragon (an outside review's "my dragon
 // is too small"): the small body carries a head and legs, so it is not
 // decided again as a part lying on the new body (it became a head smeared
@@ -4628,6 +4661,7 @@ int main(int argc, char** argv)
                                    {"reaches_the_body", test_reaches_the_body},
                                    {"on_the_back_not_a_spike", test_on_the_back_not_a_spike},
                                    {"body_round_a_dragon", test_body_round_a_dragon},
+                                   {"wing_leaning_forward", test_wing_leaning_forward},
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},

@@ -151,6 +151,23 @@ static bool fit_one(sp_dragon* d, tpl* t, const sp_sketch* sk, sp_vec2 lo, sp_ve
 // diagonal; good fits of hand-drawn parts are 0.1-0.3%) also tries the other.
 #define OTHER_FACING_SCORE 0.004
 
+// Wings (a part that neither reaches sideways, nor is a body, nor has kin
+// told apart by place) face the way their dragon does unless the other
+// facing fits clearly better: a child's wing leaning forward, drawn at the
+// shoulders, fitted leaning back shrank across the neck and was kept as ink
+// on the head (an outside review). Legs keep their dragon's facing (toes).
+static bool faces_freely(const tpl* t)
+{
+    return !t->lengthwise && !t->is_torso && !t->family[0];
+}
+
+// How much better the other facing must fit: a head's or a tail's (no
+// facing told, or a poor fit in the told one), and a wing's against its
+// dragon's facing (the review's wing: 0.49; the visitors' tune half's wings
+// at a dragon, 0.59 and more, keep their dragon's facing).
+#define OTHER_FACING_GAIN 0.8
+#define WING_FACING_GAIN 0.55
+
 // Fits every candidate part. A part that reaches sideways (a head, a tail)
 // is fitted in the facing the bodies' sockets hint at and, when there is no
 // hint or that fit is poor, in the other too: the hinted one is kept unless
@@ -168,7 +185,7 @@ static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk,
         int hint = t->lengthwise ? dragon_facing_hint(d, t, lo, hi, &out_of_end) : t->is_torso ? 1 : dragon_facing_at(d, lo, hi);
         fit_choice a, b;
         bool got = fit_one(d, t, sk, lo, hi, hint < 0, &a, not_finite);
-        bool other = t->lengthwise && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
+        bool other = (t->lengthwise || (faces_freely(t) && hint != 0)) && (hint == 0 || !got || a.score > OTHER_FACING_SCORE);
         if (other && fit_one(d, t, sk, lo, hi, !(hint < 0), &b, not_finite)) {
             if (got && out_of_end) {
                 // Drawn out of a body's end, the part's root is at the body
@@ -178,7 +195,7 @@ static bool fit_variants(sp_dragon* d, tpl** cands, int nc, const sp_sketch* sk,
                 // evidence for the ranking and the refusal.
                 a.score = fmin(a.score, b.score);
                 free(b.p);
-            } else if (!got || b.score < 0.8 * a.score) {
+            } else if (!got || b.score < (t->lengthwise ? OTHER_FACING_GAIN : WING_FACING_GAIN) * a.score) {
                 if (got) free(a.p);
                 a = b, got = true;
             } else {
@@ -783,6 +800,11 @@ static bool turn_to_dragon(sp_dragon* d, int i, fit_choice* f)
     sp_sketch sk = part_sketch(d, old, &st);
     int not_finite = 0;
     if (!fit_one(d, old->t, &sk, lo, hi, hint < 0, f, &not_finite)) return false;
+    double own = old->pub.report.mean_error_px / fmax(old->pub.report.bbox_diagonal_px, 1.0);
+    if (faces_freely(old->t) && own < WING_FACING_GAIN * f->score) { // its own facing fits far better
+        free(f->p);
+        return false;
+    }
     prefer_line(d, &sk, lo, hi, f);
     return true;
 }
