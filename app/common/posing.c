@@ -56,7 +56,20 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
             return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d has %d point%s (at least 2 are needed)", path, i, n,
                            n == 1 ? "" : "s");
         }
-    return SP_OK;
+    // Nothing drawn on the canvas is nothing to pose by: such strokes were
+    // solved "best effort", the figure rolled into a ball or flung to a
+    // corner with exit 0 (an outside review; `dragon` refuses them too).
+    if (!(sk->canvas_w > 0 && sk->canvas_h > 0)) return SP_OK;
+    for (int i = 0; i < sk->stroke_count; ++i)
+        for (int k = 0; k < sk->strokes[i].count; ++k) {
+            sp_vec2 q = sk->strokes[i].points[k];
+            if (q.x >= 0 && q.x <= sk->canvas_w && q.y >= 0 && q.y <= sk->canvas_h) return SP_OK;
+        }
+    double w = sk->canvas_w, h = sk->canvas_h;
+    sp_fail(err, SP_ERR_INVALID, "%s: every stroke lies off its %gx%g canvas (the first point is at %g, %g)", path, w, h,
+            sk->strokes[0].points[0].x, sk->strokes[0].points[0].y);
+    sp_sketch_free(sk);
+    return SP_ERR_INVALID;
 }
 
 // The nearest joint that is an ancestor of both (or one of them); -1: none.

@@ -63,6 +63,15 @@ strokes "$WORK/man_stray.json" '[[320, 246], [321, 200], [322, 160], [322, 122]]
 expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/man_stray.json" --report "$WORK/man_stray_r.json"
 grep -q '"note":	"1 stroke(s) more than .* left unused; loose fit: curve ' "$WORK/man_stray_r.json" ||
     fail "a stray line hid the loose-fit note: $(grep '"note"' "$WORK/man_stray_r.json")"
+# Strokes wholly off their canvas: nothing to pose by (they were solved
+# "best effort" with exit 0); one on it is enough.
+strokes "$WORK/off.json" '[[2600, 100], [2700, 300]]' '[[-50, -40], [-10, -90]]'
+expect 1 "$SP" pose --rig "$MAN" --strokes "$WORK/off.json"
+one_line_naming "off.json: every stroke lies off its 640x480 canvas"
+expect 1 "$SP" animate --rig "$MAN" --strokes "$WORK/off.json" --out "$WORK/off.glb"
+one_line_naming "off.json: every stroke lies off"
+strokes "$WORK/half_off.json" '[[2600, 100], [2700, 300]]' '[[300, 200], [340, 260]]'
+expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/half_off.json"
 expect 0 "$SP" animate --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up.json" "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --out "$WORK/man.glb"
 one_line_naming "man_arm_up_legs_one.json: loose fit: curve 'leg_"
 
@@ -230,10 +239,16 @@ one_line_naming missing.json
 expect 1 "$SP" pose --rig "$WORK/missing.glb" --strokes "$WORK/s.json"
 one_line_naming missing.glb
 
-# Hard but valid strokes: a best-effort pose, exit 0, the report says so.
+# Hard but valid strokes (a frame round the whole canvas for two bones): a
+# best-effort pose, exit 0, the report says so. Strokes wholly off the
+# canvas are refused (they were solved best effort too).
+strokes "$WORK/hard.json" '[[5, 5], [635, 5], [635, 475], [5, 475]]'
+expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/hard.json" --report "$WORK/hard_r.json"
+grep -q '"note":	"best effort' "$WORK/hard_r.json" || fail "hard strokes: no best-effort note"
 strokes "$WORK/far.json" '[[100000, 100000], [100040, 100090], [100100, 100100]]'
-expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/far.json" --report "$WORK/far_r.json"
-grep -q '"note":	"best effort' "$WORK/far_r.json" || fail "far strokes: no best-effort note"
+expect 1 "$SP" pose --rig "$RIG" --strokes "$WORK/far.json" --report "$WORK/far_r.json"
+one_line_naming "far.json: every stroke lies off its 640x480 canvas"
+[ -e "$WORK/far_r.json" ] && fail "far strokes: a report was written"
 # two_bone.gltf has no extras: a derived stick figure, ordered correspondences.
 strokes "$WORK/many.json" '[[10, 10], [50, 60]]' '[[300, 300], [320, 310]]' '[[500, 40], [520, 90]]' '[[100, 400], [140, 420]]' '[[600, 460], [610, 470]]'
 expect 0 "$SP" pose --rig "$SRC/tests/e2e/data/two_bone.gltf" --strokes "$WORK/many.json" --report "$WORK/many_r.json"
