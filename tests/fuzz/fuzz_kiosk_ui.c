@@ -111,7 +111,7 @@ static void answer(sp_kiosk_ui* ui, pipeline* pl, reader* r)
         }
         case SP_KJOB_UNDO: {
             if (pl->parts > 0) --pl->parts;
-            sp_kiosk_part_label l = {pl->parts ? cat(r) : NULL, {cat(r), NULL}};
+            sp_kiosk_part_label l = {pl->parts ? cat(r) : NULL, {cat(r), NULL}, pl->parts % 2 == 1};
             sp_kiosk_ui_parts_changed(ui, pl->parts, &l);
             break;
         }
