@@ -61,10 +61,7 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
     // corner with exit 0 (an outside review; `dragon` refuses them too).
     if (!(sk->canvas_w > 0 && sk->canvas_h > 0)) return SP_OK;
     for (int i = 0; i < sk->stroke_count; ++i)
-        for (int k = 0; k < sk->strokes[i].count; ++k) {
-            sp_vec2 q = sk->strokes[i].points[k];
-            if (q.x >= 0 && q.x <= sk->canvas_w && q.y >= 0 && q.y <= sk->canvas_h) return SP_OK;
-        }
+        if (sp_stroke_points_off_canvas(&sk->strokes[i], sk->canvas_w, sk->canvas_h) < sk->strokes[i].count) return SP_OK;
     double w = sk->canvas_w, h = sk->canvas_h;
     sp_fail(err, SP_ERR_INVALID, "%s: every stroke lies off its %gx%g canvas (the first point is at %g, %g)", path, w, h,
             sk->strokes[0].points[0].x, sk->strokes[0].points[0].y);

@@ -686,18 +686,9 @@ static bool refit_last(sp_kiosk* k, const char* category, const sp_vec2* xy, int
     if (old) kept.xy = old->xy, kept.t = old->t, kept.n = old->n, old->xy = NULL, old->t = NULL, old->n = 0;
     memset(res, 0, sizeof *res);
     sp_error err = {0};
-    sp_result rc = SP_ERR_NO_MEMORY;
-    // A copy: the part (and its stroke) is freed when replaced.
-    sp_vec2* copy = malloc(sizeof *copy * (size_t)((xy ? n : last->stroke_points) + 1));
-    if (category && !xy) {
-        rc = sp_dragon_refit_last(k->dragon, category, res, &err);
-    } else if (copy) {
-        int m = xy ? n : last->stroke_points;
-        memcpy(copy, xy ? xy : last->stroke_xy, sizeof *copy * (size_t)m);
-        rc = sp_dragon_add_points(k->dragon, copy, m, &(sp_dragon_stroke_opts){.category = category, .replace_last = true}, res,
-                                  &err);
-    }
-    free(copy);
+    sp_result rc = xy ? sp_dragon_add_points(k->dragon, xy, n,
+                                             &(sp_dragon_stroke_opts){.category = category, .replace_last = true}, res, &err)
+                      : sp_dragon_refit_last(k->dragon, category, res, &err);
     if (answer) answer_fit(k, rc, res, &err, true, NULL);
     bool moved = rc == SP_OK && !res->rejected && res->part >= 0 && res->part < sp_dragon_part_count(k->dragon);
     *new_id = moved ? sp_dragon_part_get(k->dragon, res->part)->id : old_id;

@@ -61,10 +61,7 @@ typedef struct stroke_lines {
 // it too_short: what is left of it on the canvas is nothing).
 static bool off_canvas(const stroke_lines* l, const sp_stroke* st)
 {
-    double w = l->canvas_w, h = l->canvas_h;
-    for (int k = 0; k < st->count; ++k)
-        if (st->points[k].x >= 0 && st->points[k].x <= w && st->points[k].y >= 0 && st->points[k].y <= h) return false;
-    return st->count > 0;
+    return st->count > 0 && sp_stroke_points_off_canvas(st, l->canvas_w, l->canvas_h) == st->count;
 }
 
 static void say_stroke(stroke_lines* l, const sp_dragon* d, const sp_dragon_result* res, const sp_stroke* st, const char* file,

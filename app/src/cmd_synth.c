@@ -284,10 +284,7 @@ static void warn_off_canvas(const sp_sketch* sk, const char* out)
 {
     int outside = 0, total = 0;
     for (int i = 0; i < sk->stroke_count; ++i)
-        for (int k = 0; k < sk->strokes[i].count; ++k, ++total) {
-            sp_vec2 q = sk->strokes[i].points[k];
-            outside += !(q.x >= 0 && q.x <= sk->canvas_w && q.y >= 0 && q.y <= sk->canvas_h);
-        }
+        outside += sp_stroke_points_off_canvas(&sk->strokes[i], sk->canvas_w, sk->canvas_h), total += sk->strokes[i].count;
     if (outside)
         fprintf(stderr, "sketchpose synth: warning: %s: %d of %d points lie outside the %gx%g canvas\n", out, outside, total,
                 sk->canvas_w, sk->canvas_h);

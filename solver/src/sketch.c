@@ -84,6 +84,16 @@ bool sp_sketch_is_valid(const sp_sketch* s)
     return true;
 }
 
+int sp_stroke_points_off_canvas(const sp_stroke* st, double w, double h)
+{
+    int off = 0;
+    for (int k = 0; k < st->count; ++k) {
+        sp_vec2 q = st->points[k];
+        off += !(q.x >= 0 && q.x <= w && q.y >= 0 && q.y <= h);
+    }
+    return off;
+}
+
 // Why a fifth: gaps at closure are common in hand drawing (see the
 // hand-drawing model of the classifier's training data).
 bool sp_stroke_is_loop(const sp_stroke* st)

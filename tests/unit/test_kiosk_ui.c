@@ -796,14 +796,14 @@ static void test_chips_clear_the_dragon(void)
     t = stroke(ui, t + 2000, 300, 300, 30, 10);
     frame(ui, &f, t + 10);
     ENSURE(ui->target[SP_KT_CHIP_LABEL].x < ui->canvas.x + 0.1f * ui->canvas.w);
-    // Thinned evenly when there are more points than it keeps.
+    // Thinned evenly, its ends kept, when there are more points than it keeps.
     float* many = malloc(sizeof(float) * 2 * 3 * SP_KIOSK_STROKE_MAX);
     ENSURE(many);
     for (int i = 0; i < 3 * SP_KIOSK_STROKE_MAX; ++i)
         many[2 * i] = (float)i, many[2 * i + 1] = 0;
     sp_kiosk_ui_set_scene(ui, many, 3 * SP_KIOSK_STROKE_MAX);
-    ENSURE(ui->scene.count == SP_KIOSK_STROKE_MAX && ui->scene.xy[2] == 3 &&
-           ui->scene.xy[2 * (SP_KIOSK_STROKE_MAX - 1)] == 3 * (SP_KIOSK_STROKE_MAX - 1));
+    ENSURE(ui->scene.count == SP_KIOSK_STROKE_MAX && ui->scene.xy[0] == 0 && ui->scene.xy[2] == 3 &&
+           ui->scene.xy[2 * (SP_KIOSK_STROKE_MAX - 1)] == 3 * SP_KIOSK_STROKE_MAX - 1);
     free(many);
     sp_kiosk_ui_destroy(ui);
 }

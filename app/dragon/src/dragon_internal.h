@@ -153,6 +153,7 @@ typedef struct part {
     // spikes and crests its mesh carries.
     sp_vec2* body_ring;
     int body_ring_n;
+    double body_ring_size; // its box's diagonal
     // Its fit before a part drawn later changed it (a body that decided it
     // again or turned it, a body, head or tail that made legs the other
     // legs or turned legs or wings: stroke.c, parts_meet_body,

@@ -130,6 +130,8 @@ static bool body_prepare(const sp_dragon* d, part* q)
     mesh_on_canvas(d, q, &q->pub.placement, q->body_xyz, q->body_px, ring_xyz, q->body_ring);
     free(ring_xyz);
     q->body_ring_n = (int)nr;
+    sp_vec2 rlo, rhi;
+    q->body_ring_size = px_box(q->body_ring, q->body_ring_n, &rlo, &rhi) ? sp_v2_len(sp_v2_sub(rhi, rlo)) : NAN;
     // Boxes kept for nearest_surface, which every part laid out asks of
     // every body near it (a new body lays out them all again).
     for (int f = 0; f < rig->triangle_count; ++f) {
@@ -305,11 +307,9 @@ static sp_vec2 ring_nearest(const part* q, sp_vec2 p, bool* inside)
 static void onto_outline(const part* q, surface_hit* h)
 {
     if (!q->body_ring) return;
-    sp_vec2 lo, hi;
-    if (!px_box(q->body_ring, q->body_ring_n, &lo, &hi)) return;
     bool in;
     sp_vec2 r = ring_nearest(q, h->px, &in);
-    if (in || !(sp_v2_len(sp_v2_sub(r, h->px)) > BEYOND_OUTLINE * sp_v2_len(sp_v2_sub(hi, lo)))) return;
+    if (in || !(sp_v2_len(sp_v2_sub(r, h->px)) > BEYOND_OUTLINE * q->body_ring_size)) return;
     surface_hit s;
     if (!nearest_surface(q, r, INFINITY, &s)) return;
     s.dist = h->dist;

@@ -1150,7 +1150,7 @@ sp_result sp_dragon_add_stroke(sp_dragon* d, const sp_stroke* stroke, const sp_d
 
 sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_result* out, sp_error* err)
 {
-    if (d->part_n == 0 || !category) {
+    if (d->part_n == 0) {
         memset(out, 0, sizeof *out);
         out->detail = -1;
         out->far_score = NAN;

@@ -1327,13 +1327,7 @@ void sp_kiosk_ui_fit_done(sp_kiosk_ui* ui, const sp_kiosk_fit_result* r)
 
 void sp_kiosk_ui_set_scene(sp_kiosk_ui* ui, const float* xy, int n)
 {
-    int cap = SP_KIOSK_STROKE_MAX, m = n < cap ? n : cap;
-    ui->scene.count = 0;
-    for (int i = 0; xy && i < m; ++i) {
-        int k = (int)((long long)i * n / m);
-        ui->scene.xy[2 * i] = xy[2 * k], ui->scene.xy[2 * i + 1] = xy[2 * k + 1];
-        ui->scene.count = i + 1;
-    }
+    line_set(&ui->scene, xy, n, SP_KIOSK_STROKE_MAX);
 }
 
 void sp_kiosk_ui_parts_changed(sp_kiosk_ui* ui, int part_count, const sp_kiosk_part_label* label)

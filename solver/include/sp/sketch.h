@@ -39,6 +39,9 @@ int sp_sketch_point_count(const sp_sketch* s);
 bool sp_sketch_bounds(const sp_sketch* s, sp_vec2* lo, sp_vec2* hi);
 /// True when every coordinate (and time) is finite.
 bool sp_sketch_is_valid(const sp_sketch* s);
+/// Points of the stroke outside the w x h canvas [0, w] x [0, h] (a point
+/// that is not finite counts as outside).
+int sp_stroke_points_off_canvas(const sp_stroke* st, double w, double h);
 /// Whether a stroke is drawn as a loop: at least 8 points, its ends within a
 /// fifth of its bounding box's diagonal (people leave gaps when they close
 /// an outline). The solver matches a loop to a closed outline in order first.

@@ -238,7 +238,9 @@ sp_result sp_dragon_add_stroke(sp_dragon* d, const sp_stroke* stroke, const sp_d
 sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const sp_dragon_stroke_opts* opts,
                                sp_dragon_result* out, sp_error* err);
 /// A chip tap: re-fits the last part's stroke as `category` (replacing that
-/// part). Rejected (nothing changed) when there is no part or no part of that category.
+/// part); NULL: the stroke classified again, as a Redraw of it would be
+/// (Undo of a chip that replaced a classified part). Rejected (nothing
+/// changed) when there is no part or no part of that category.
 sp_result sp_dragon_refit_last(sp_dragon* d, const char* category, sp_dragon_result* out, sp_error* err);
 /// Removes the last change: the last detail when it came after the last
 /// part, else the last part; false when there was neither.
