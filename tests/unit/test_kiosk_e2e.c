@@ -1535,7 +1535,8 @@ static void test_collect_before_pipeline(void)
     live_and_next("kiosk_order", db, next, wal);
     sp_error err = {0};
     sp_dragon* d = NULL;
-    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = db, .canvas_w = 1280, .canvas_h = 800}, &d, &err) == SP_OK);
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = db, .canvas_w = 1280, .canvas_h = 800, .solve = {.time_cap_ms = 1e9}},
+                            &d, &err) == SP_OK);
     int stored = 0, dropped = 0;
     kiosk_collector* c = collector_after_one(db, &stored, &dropped);
     ENSURE(stored == 1);
@@ -2164,7 +2165,8 @@ static void test_body_after_parts(void)
     sp_dragon* d = NULL;
     sp_error err = {0};
     sp_dragon_result res;
-    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = db, .canvas_w = 1280, .canvas_h = 800}, &d, &err) == SP_OK);
+    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = db, .canvas_w = 1280, .canvas_h = 800, .solve = {.time_cap_ms = 1e9}},
+                            &d, &err) == SP_OK);
     ENSURE(sp_dragon_add_points(d, small, body->n, NULL, &res, &err) == SP_OK && !res.rejected);
     ENSURE(sp_dragon_part_get(d, res.part)->is_torso);
     sp_dragon_clear(d);
@@ -2407,7 +2409,9 @@ static void test_parts_loaded_while_idle(void)
     six_strokes();
     sp_error err = {0};
     sp_dragon* all = NULL;
-    ENSURE(sp_dragon_create(&(sp_dragon_desc){.db_path = e2e_db(), .canvas_w = 1280, .canvas_h = 800}, &all, &err) == SP_OK);
+    ENSURE(
+        sp_dragon_create(&(sp_dragon_desc){.db_path = e2e_db(), .canvas_w = 1280, .canvas_h = 800, .solve = {.time_cap_ms = 1e9}},
+                         &all, &err) == SP_OK);
     ENSURE(sp_dragon_preload(all, &err) == SP_OK);
     int want = sp_dragon_loaded_parts(all);
     sp_dragon_destroy(all);
