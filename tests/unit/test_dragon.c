@@ -3475,6 +3475,43 @@ static void test_wing_leaning_forward(void)
     sp_db_close(db);
 }
 
+// A body drawn rising to one end (the visitors' "long rising" body) with a
+// big head drawn at the top corner of its box over the low end, as the
+// visitors bench places heads: its neck hangs on the back 45 px from the
+// body's middle, so the dragon's facing is read from where the head is
+// drawn, not from where it hangs (read from there, nothing was told, and
+// the tune half's legs at such a dragon faced the wrong way).
+static void test_facing_of_a_rising_body(void)
+{
+    const char* path = real_db();
+    sp_error err = {0};
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    for (int left = 0; left < 2; ++left) {
+        sp_dragon_clear(d);
+        int bn, hn;
+        sp_vec2 blo, bhi;
+        sp_vec2* body_xy = visitor_stroke("torso/torso-long-rising.json", 500, (sp_vec2){640, 400}, left, &bn);
+        points_box(body_xy, bn, &blo, &bhi);
+        sp_vec2 at = {640 + (left ? -1 : 1) * (0.5 * (bhi.x - blo.x) - 20), blo.y - 20};
+        sp_vec2* head_xy = visitor_stroke("head/head-brow-ridge.json", 320, at, left, &hn);
+        sp_dragon_result body, head;
+        ENSURE(sp_dragon_add_points(d, body_xy, bn, &(sp_dragon_stroke_opts){.category = "torso"}, &body, &err) == SP_OK &&
+               !body.rejected);
+        ENSURE(sp_dragon_add_points(d, head_xy, hn, &(sp_dragon_stroke_opts){.category = "head"}, &head, &err) == SP_OK &&
+               !head.rejected);
+        const sp_dragon_part* h = sp_dragon_part_get(d, head.part);
+        int facing = dragon_facing_at(d, blo, bhi);
+        fprintf(stderr, "  facing %s: the head hangs on %d at x %.0f (the body %.0f-%.0f); the dragon reads facing %d\n",
+                left ? "left" : "right", h->attached_to, h->anchor.x, blo.x, bhi.x, facing);
+        ENSURE(h->attached_to == body.part && facing == (left ? -1 : 1));
+        free(body_xy);
+        free(head_xy);
+    }
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // A bigger body drawn round a small dragon (an outside review's "my dragon
 // is too small"): the small body carries a head and legs, so it is not
 // decided again as a part lying on the new body (it became a head smeared
@@ -4671,6 +4708,7 @@ int main(int argc, char** argv)
                                    {"on_the_back_not_a_spike", test_on_the_back_not_a_spike},
                                    {"body_round_a_dragon", test_body_round_a_dragon},
                                    {"wing_leaning_forward", test_wing_leaning_forward},
+                                   {"facing_of_a_rising_body", test_facing_of_a_rising_body},
                                    {"parts_before_body", test_parts_before_body},
                                    {"details_on_parts", test_details_on_parts},
                                    {"flourishes_off_parts", test_flourishes_off_parts},

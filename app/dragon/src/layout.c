@@ -472,9 +472,11 @@ static double socket_u(const sp_dragon* d, const part* q, const dsocket* so, dou
 }
 
 // Which way the dragon of body k faces: 1 mirrored, 0 as modelled, -1 not
-// told. A head or tail attached at the end of the body other than its
-// socket's says the dragon is drawn mirrored; one near the middle says
-// nothing, and two that disagree tell nothing.
+// told. A head or tail drawn at the end of the body other than its socket's
+// says the dragon is drawn mirrored; one over the middle says nothing, and
+// two that disagree tell nothing. Where it is drawn is its stroke's box, not
+// where it hangs: a long neck, a body rising to one end or a spike's foot
+// puts the anchor near the middle.
 static int body_facing(sp_dragon* d, int k)
 {
     part* q = d->parts[k];
@@ -487,7 +489,7 @@ static int body_facing(sp_dragon* d, int k)
         if (o->pub.attached_to != k || !o->t->lengthwise) continue;
         const dsocket* so = kind_socket(q, o->pub.category, o->t->prefer);
         if (!so) continue;
-        double su = socket_u(d, q, so, mid), du = o->pub.anchor.x - mid;
+        double su = socket_u(d, q, so, mid), du = 0.5 * (o->stroke_box[0] + o->stroke_box[2]) - mid;
         if (!(fabs(su) > 0.25 * half && fabs(du) > 0.25 * half)) continue;
         int m = (su > 0) != (du > 0);
         if (mirrored >= 0 && m != mirrored) return -1;
