@@ -555,6 +555,18 @@ View dense_view(const tinygltf::Model& m, int index, const char* what)
     const tinygltf::Accessor& a = m.accessors[(size_t)index];
     int ncomp;
     size_t elem = element_bytes(a, index, what, &ncomp);
+    if (a.bufferView < 0) {
+        // Zeros cost the file nothing: a 3 KB file claiming 2^28 of them
+        // had gigabytes made before its counts were compared. No more than
+        // the file's buffers hold (or 16 MiB) is a mesh's worth.
+        size_t held = 0;
+        for (const tinygltf::Buffer& b : m.buffers)
+            held += b.data.size();
+        if (a.count * elem > std::max(held, (size_t)1 << 24))
+            fail(SP_ERR_INVALID,
+                 "%s: accessor %d claims %zu elements without a buffer view (%zu bytes of zeros; the buffers hold %zu)", what,
+                 index, a.count, a.count * elem, held);
+    }
     auto own = std::make_shared<std::vector<unsigned char>>(a.count * elem + 1, 0);
     unsigned char* out = own->data();
     if (a.bufferView >= 0) {

@@ -833,6 +833,12 @@ static void test_says_what_is_wrong(void)
     // view of no size, and synth wrote strokes 1e9 pixels long.
     ensure_fails(write_edited("no_extent.gltf", &(mini_desc){0}, "{\"bufferView\": 0, ", "{"), "no_extent.gltf",
                  "the skinned mesh's 4 vertices are all at one point: no surface to pose");
+    // Zeros claimed by the million cost the file nothing: refused before
+    // they are made (2^28 of them took 3 GB and 27 s to reach "different counts").
+    const char* zeros_from[] = {"{\"bufferView\": 0, ", "\"count\": 4, \"type\": \"VEC3\""};
+    const char* zeros_to[] = {"{", "\"count\": 268435456, \"type\": \"VEC3\""};
+    ensure_fails(write_edits("zeros_huge.gltf", &(mini_desc){0}, 2, zeros_from, zeros_to), "zeros_huge.gltf",
+                 "accessor 0 claims 268435456 elements without a buffer view");
     const char* tops[] = {"[1, 2]", "null", " 0", "\"glTF\""};
     for (size_t i = 0; i < sizeof tops / sizeof tops[0]; ++i) {
         const char* p = sp_test_tmp_path("top.gltf");
