@@ -106,6 +106,27 @@ static void say_strokes_unsaid(const stroke_lines* l, const char* file)
                 details == 1 ? "" : "s");
 }
 
+// The report's curves name the stroke of the file their part came from:
+// the library counts one stroke per part, which a refused stroke or one
+// kept as a detail before it puts off by one (an outside review). `list`:
+// the "strokes" entries, in file order.
+static void curves_name_file_strokes(cJSON* report, const cJSON* list)
+{
+    const cJSON *s, *cv;
+    cJSON_ArrayForEach(cv, cJSON_GetObjectItem(report, "curves"))
+    {
+        cJSON* stroke = cJSON_GetObjectItem(cv, "stroke");
+        const cJSON* part = cJSON_GetObjectItem(cv, "part");
+        if (!cJSON_IsNumber(stroke) || !cJSON_IsNumber(part)) continue;
+        cJSON_ArrayForEach(s, list)
+        {
+            const cJSON* sp = cJSON_GetObjectItem(s, "part");
+            if (cJSON_IsFalse(cJSON_GetObjectItem(s, "rejected")) && cJSON_IsNumber(sp) && sp->valueint == part->valueint)
+                cJSON_SetNumberValue(stroke, cJSON_GetObjectItem(s, "stroke")->valuedouble);
+        }
+    }
+}
+
 int cmd_dragon(int argc, char** argv)
 {
     const char *db_path = NULL, *strokes = NULL, *out = NULL, *render = NULL, *report = NULL, *assets = NULL;
@@ -213,6 +234,7 @@ int cmd_dragon(int argc, char** argv)
         sp_fail(&err, SP_ERR_NO_MEMORY, "out of memory");
         goto fail;
     }
+    curves_name_file_strokes(j, list);
     cJSON_AddItemToObject(j, "strokes", list);
     list = NULL;
     if (sp_dragon_part_count(d) == 0) {

@@ -108,12 +108,6 @@ static uint64_t rest_hash(const double* rest, int n)
     return h;
 }
 
-static int cmp_double(const void* a, const void* b)
-{
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
-
 // How much larger the mesh is in the world, at the default pose, than in
 // its rest (bind-space) coordinates: the median, over the representatives,
 // of the distance to the nearest other one there over here, which a bone's
@@ -157,7 +151,7 @@ static double bind_to_world_scale(sp_solver* s, sp_model* m)
     }
     double f = 1.0;
     if (n > 0) {
-        qsort(ratio, (size_t)n, sizeof *ratio, cmp_double);
+        qsort(ratio, (size_t)n, sizeof *ratio, sp_cmp_double);
         f = ratio[n / 2];
     }
     free(x), free(p), free(ratio);

@@ -1808,6 +1808,8 @@ static void test_command(void)
     sp_error err = {0};
     ENSURE(sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK);
     sp_sketch sk = {.canvas_w = 1280, .canvas_h = 800};
+    // A dot first (refused, too short): the parts' curves name strokes 1, 2, … of the file.
+    ENSURE(sp_sketch_add_stroke(&sk, (sp_vec2[]){{100, 100}, {101, 100}}, NULL, 2) == SP_OK);
     for (int i = 0; i < TEST_PART_COUNT; ++i) {
         sp_vec2* xy;
         int n = part_stroke(db, k_layout[i].name, 400 + (uint64_t)i, 0.3, k_layout[i].cx, k_layout[i].cy, k_layout[i].size, &xy);
@@ -1863,6 +1865,17 @@ static void test_command(void)
                    ? cJSON_IsNull(far) || cJSON_IsNumber(far)
                    : cJSON_IsNumber(far) && far->valuedouble <= SP_DRAGON_FAR_LIMIT);
     }
+    const cJSON* cv;
+    int named = 0;
+    cJSON_ArrayForEach(cv, cJSON_GetObjectItem(j, "curves"))
+    {
+        const cJSON* st = cJSON_GetObjectItem(cv, "stroke");
+        if (!cJSON_IsNumber(st)) continue;
+        const cJSON* from = cJSON_GetArrayItem(cJSON_GetObjectItem(j, "strokes"), st->valueint);
+        ENSURE(st->valueint >= 1 && cJSON_GetObjectItem(from, "part")->valueint == cJSON_GetObjectItem(cv, "part")->valueint);
+        ++named;
+    }
+    ENSURE(named >= TEST_PART_COUNT);
     fprintf(stderr, "  sketchpose dragon: mean error %.2f px over %d parts, %.0f ms of solving\n",
             cJSON_GetObjectItem(j, "mean_error_px")->valuedouble, cJSON_GetArraySize(parts),
             cJSON_GetObjectItem(j, "ms")->valuedouble);

@@ -56,7 +56,8 @@ static cJSON* report_tree(sp_dragon* d)
             cJSON* cv = cJSON_CreateObject();
             cJSON_AddNumberToObject(cv, "part", i);
             cJSON_AddStringToObject(cv, "curve", c < ab->curve_count ? ab->curves[c].name : "");
-            // One stroke per part, in order: the part's stroke is stroke i of the file.
+            // One stroke per part, in order (demo's strokes file); `dragon`
+            // renumbers it by its input's strokes, refused ones included.
             if (r->curves[c].stroke >= 0)
                 cJSON_AddNumberToObject(cv, "stroke", i);
             else
