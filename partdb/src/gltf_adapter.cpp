@@ -1605,7 +1605,10 @@ namespace
 {
 
 // The JSON text of a .gltf, or of a .glb's first chunk: the header and that
-// chunk only, not the binary one (a glb of 2 GiB is not read twice).
+// chunk only, not the binary one (a glb of 2 GiB is not read twice). Empty
+// for a file that is neither: whatever does not open with '{' is no glTF
+// JSON (commands ask this of every input, and a 570 MB database was read
+// whole for it).
 std::string gltf_json_text(const char* path)
 {
     struct stat st;
@@ -1614,10 +1617,12 @@ std::string gltf_json_text(const char* path)
     if (!f) return std::string();
     unsigned char head[20];
     size_t got = fread(head, 1, sizeof head, f.get());
-    size_t len = (size_t)st.st_size;
+    size_t len = (size_t)st.st_size, lead = 0;
+    while (lead < got && strchr(" \t\r\n", head[lead]))
+        ++lead;
     if (got == sizeof head && !memcmp(head, "glTF", 4))
         len = std::min((size_t)le32(head + 12), len - got);
-    else if (fseek(f.get(), 0, SEEK_SET) != 0)
+    else if ((lead < got && head[lead] != '{') || fseek(f.get(), 0, SEEK_SET) != 0)
         return std::string();
     std::string text(len, '\0');
     text.resize(fread(&text[0], 1, len, f.get()));
