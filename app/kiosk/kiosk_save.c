@@ -91,6 +91,14 @@ void kiosk_prune_saves(sp_kiosk* k)
                      k->desc.keep_saves_days);
 }
 
+// Whether the folder lies on the database's disk (or either cannot be
+// looked at: then the reserve holds, as it did).
+static bool on_db_disk(const sp_kiosk* k, const char* folder)
+{
+    struct stat a, b;
+    return stat(folder, &a) != 0 || stat(k->db_path, &b) != 0 || a.st_dev == b.st_dev;
+}
+
 void kiosk_run_save(sp_kiosk* k)
 {
     sp_error err = {0};
@@ -102,9 +110,11 @@ void kiosk_run_save(sp_kiosk* k)
     sp_image img = {0};
     // Each file is written whole (sp_file_write): a visitor's code never names half a file.
     sp_result r = make_dirs(k->export_dir, &err);
-    // The last of the disk is the database's: a visitor's strokes, a curator's training.
+    // The last of the database's disk is the database's: a visitor's strokes,
+    // a curator's training. Saves on a disk of their own (a small USB stick)
+    // keep nothing back for it: they were never made there.
     double reserve = k->desc.save_reserve_mb == 0 ? SP_KIOSK_SAVE_RESERVE_MB : k->desc.save_reserve_mb, left = -1;
-    if (r == SP_OK && reserve > 0 && (left = kiosk_free_mb(k->export_dir)) >= 0 && left < reserve)
+    if (r == SP_OK && reserve > 0 && on_db_disk(k, k->export_dir) && (left = kiosk_free_mb(k->export_dir)) >= 0 && left < reserve)
         r = sp_fail(&err, SP_ERR_IO,
                     "%s: %.0f MB free on its disk, under the %.0f MB kept for the database: not saved (move old saves away, or "
                     "--keep-saves-days)",

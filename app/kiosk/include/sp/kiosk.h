@@ -52,8 +52,8 @@ typedef struct sp_kiosk_desc {
                        ///< meshes
     int max_parts;     ///< parts a dragon may have (sp_dragon_desc.max_parts); 0: the pipeline's (48)
     int keep_saves_days; ///< saves older than this many days are removed, at start and after each save; 0: kept
-    double
-        save_reserve_mb; ///< Save is refused while the export folder's disk has less free; 0: SP_KIOSK_SAVE_RESERVE_MB; < 0: none
+    double save_reserve_mb;    ///< Save is refused while the export folder's disk, when it is the database's, has less free; 0:
+                               ///< SP_KIOSK_SAVE_RESERVE_MB; < 0: none
     double collect_reserve_mb; ///< strokes are not collected while the database's disk has less free; 0:
                                ///< SP_KIOSK_COLLECT_RESERVE_MB; < 0: none
     bool no_collect;   ///< keep no visitors' strokes (default: each part left on the canvas is stored as a pending kiosk
