@@ -12,6 +12,7 @@
 
 #include "clf_cli.h"
 #include "cli.h"
+#include "outputs.h"
 #include "sp/headless.h"
 #include "sp/math.h"
 #include "sp/part_preview.h"
@@ -424,6 +425,18 @@ static bool derive_options_apply(const char* cmd, const char* file, const char* 
     return plain;
 }
 
+// add-part's --preview, drawn from the part as it will be stored (sp_db_part_desc.before_store).
+static sp_result store_preview(void* user, const sp_character* part, int abstraction, sp_error* err)
+{
+    sp_result r = sp_part_preview_png(part, abstraction, (const char*)user, err);
+    if (r != SP_OK) {
+        char why[sizeof err->text];
+        snprintf(why, sizeof why, "%s", err->text);
+        sp_fail(err, r, "%s; the part was not stored", why);
+    }
+    return r;
+}
+
 static int db_add_part(int argc, char** argv)
 {
     const char* cmd = "sketchpose db add-part";
@@ -484,21 +497,26 @@ static int db_add_part(int argc, char** argv)
     bool existed = db_exists(&c);
     sp_db* db = open_db(cmd, &c, SP_DB_CREATE);
     if (!db) return SP_EXIT_INPUT;
+    // The picture is made (staged) before the part is stored: a picture that
+    // fails (a full disk) leaves the database as it was, where the part was
+    // stored, then removed, the log showing both (an outside review).
+    sp_outputs staged = {0};
+    const char* preview_to = NULL;
+    sp_result r = sp_outputs_stage(&staged, preview, &preview_to, &err);
+    d.before_store = preview_to ? store_preview : NULL;
+    d.before_store_user = (void*)preview_to;
     sp_db_part_info info;
-    sp_result r = sp_db_add_part_file(db, pos[0], &d, &info, &err);
-    sp_character part = {0};
-    if (r == SP_OK && preview) {
-        if ((r = sp_db_load_part(db, info.name, &part, &err)) == SP_OK)
-            r = sp_part_preview_png(&part, sp_rig_find_abstraction(&part.rig, info.abstraction), preview, &err);
-        // The picture failed after all (a full disk): the part goes again, so that a refused part leaves none behind.
+    if (r == SP_OK) r = sp_db_add_part_file(db, pos[0], &d, &info, &err);
+    if (r == SP_OK && (r = sp_outputs_commit(&staged, &err)) != SP_OK) {
+        // Put in place it could not be (rare: its folder went): the part goes again.
         sp_error rm = {0};
-        if (r != SP_OK && sp_db_remove_part(db, info.name, c.by, &rm) == SP_OK) {
+        if (sp_db_remove_part(db, info.name, c.by, &rm) == SP_OK) {
             char why[sizeof err.text];
             snprintf(why, sizeof why, "%s", err.text);
             sp_fail(&err, r, "%s; part %s not kept", why, info.name);
         }
     }
-    sp_character_free(&part);
+    if (r != SP_OK) sp_outputs_undo(&staged, &err);
     sp_db_close(db);
     if (r != SP_OK) {
         free(warns.lines);

@@ -308,6 +308,10 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
     // Everything slow happens before the write lock.
     sp_result r = validate(glb, size, d.name, &d, &info, &ch, &a, err);
     if (r != SP_OK) return r;
+    if (d.before_store && (r = d.before_store(d.before_store_user, &ch, a, err)) != SP_OK) {
+        sp_character_free(&ch);
+        return r;
+    }
     copy_name(info.name, sizeof info.name, d.name);
     int nsynth = d.synth_sketches == 0 ? SP_DB_SYNTH_DEFAULT : d.synth_sketches < 0 ? 0 : d.synth_sketches;
     sp_dataset synth = {0};

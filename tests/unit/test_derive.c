@@ -666,15 +666,19 @@ static void test_cli(void)
     cJSON_Delete(j);
     // A preview that cannot be written keeps no part: a folder that is not
     // there, or a link into one, seen before storing; a folder that passes
-    // the check but takes no file (/proc, to root) only when the picture is
-    // written: the part goes again.
+    // the check but takes no file (/proc, to root), or a full disk
+    // (/dev/full), when the picture is made, also before the part is stored:
+    // the database's log shows none of them (the part was stored, then
+    // removed, the log showing both: an outside review).
     char dangling[1024];
     snprintf(dangling, sizeof dangling, "%s", sp_test_tmp_path("dangling.png"));
     unlink(dangling);
     ENSURE(symlink("/nonexistent-sp-folder/p.png", dangling) == 0);
-    const char* previews[3][2] = {
-        {"lizard_nodir", sp_test_tmp_path("nowhere/p.png")}, {"lizard_link", dangling}, {"lizard_proc", "/proc/sp-preview.png"}};
-    int cases = access("/proc", W_OK) == 0 ? 3 : 2;
+    const char* previews[4][2] = {{"lizard_nodir", sp_test_tmp_path("nowhere/p.png")},
+                                  {"lizard_link", dangling},
+                                  {"lizard_full", "/dev/full"},
+                                  {"lizard_proc", "/proc/sp-preview.png"}};
+    int cases = access("/dev/full", W_OK) != 0 ? 2 : access("/proc", W_OK) == 0 ? 4 : 3;
     for (int i = 0; i < cases; ++i) {
         char errf[1024];
         snprintf(errf, sizeof errf, "%s", sp_test_tmp_path("add_part_err.txt"));
@@ -684,12 +688,16 @@ static void test_cli(void)
         snprintf(cmd, sizeof cmd, "cat '%s'", errf);
         ENSURE(run(cmd, &text) == 0);
         fprintf(stderr, "  %s", text);
-        ENSURE(strstr(text, i < 2 ? "cannot write into folder" : "not kept") && strchr(text, '\n') == text + strlen(text) - 1);
+        ENSURE(strstr(text, i < 2 ? "cannot write into folder" : "the part was not stored") &&
+               strchr(text, '\n') == text + strlen(text) - 1);
         free(text);
     }
     snprintf(cmd, sizeof cmd, "'%s' db list --db '%s'", bin, db);
     ENSURE(run(cmd, &text) == 0 && strstr(text, "lizard_again") && !strstr(text, "lizard_nodir") &&
-           !strstr(text, "lizard_link") && !strstr(text, "lizard_proc"));
+           !strstr(text, "lizard_link") && !strstr(text, "lizard_proc") && !strstr(text, "lizard_full"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "'%s' db log --db '%s'", bin, db);
+    ENSURE(run(cmd, &text) == 0 && strstr(text, "lizard_again") && !strstr(text, "lizard_full") && !strstr(text, "lizard_proc"));
     free(text);
     unlink(dangling);
 }

@@ -162,6 +162,13 @@ typedef struct sp_db_part_desc {
     /// validated (a refused part may have warned); NULL: not reported.
     void (*warn)(void* user, const char* line);
     void* warn_user; ///< passed to warn
+    /// Called with the part as it will be stored (validated; derived when it
+    /// was; `abstraction` its sketches' index) before anything is written:
+    /// a failure (err set) refuses the part, nothing written. What a command
+    /// makes of the part (add-part's --preview) fails before the database
+    /// changes, not after. NULL: none.
+    sp_result (*before_store)(void* user, const sp_character* part, int abstraction, sp_error* err);
+    void* before_store_user; ///< passed to before_store
 } sp_db_part_desc;
 
 /// Validates a part without writing anything: the glTF loads, it has a skin
