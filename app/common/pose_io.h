@@ -21,9 +21,10 @@
 /// Reads `path` into p (count values of `params`, pre-filled by the caller).
 /// *clamped (may be NULL) receives the number of clamped values.
 sp_result sp_pose_read(const char* path, const sp_param* params, int count, double* p, int* clamped, sp_error* err);
-/// Same from JSON text; `what` names the source in messages.
-sp_result sp_pose_parse(const char* text, const char* what, const sp_param* params, int count, double* p, int* clamped,
-                        sp_error* err);
+/// Same from JSON text (len bytes: a NUL in it is refused, not an end);
+/// `what` names the source in messages.
+sp_result sp_pose_parse(const char* text, size_t len, const char* what, const sp_param* params, int count, double* p,
+                        int* clamped, sp_error* err);
 /// {"<name>": value, ...} for p (caller deletes it).
 cJSON* sp_pose_params_json(const sp_param* params, int count, const double* p);
 /// The pose object {"parameters": {...}} for p (caller deletes it).

@@ -148,9 +148,11 @@ sp_result db_read_json(const char* path, cJSON** root, sp_error* err)
     *root = NULL;
     sp_result r = db_read_file(path, &text, &size, err);
     if (r != SP_OK) return r;
-    *root = cJSON_ParseWithLength(text, size);
+    // One document, each key once, as every user's JSON (a manifest's
+    // "sketches" given twice kept the first).
+    r = sp_json_parse_document(text, size, 0, path, root, err);
     free(text);
-    return SP_OK;
+    return r;
 }
 
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err)

@@ -70,8 +70,9 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
 sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err);
 /// Reads a whole file (malloc'd, NUL-terminated beyond size).
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err);
-/// Reads and parses a JSON file: *root NULL when its bytes are not JSON (the
-/// caller names what it wanted); errors are the reading's.
+/// Reads and parses a JSON file as one document, each key once
+/// (sp_json_parse_document): malformed JSON, text after it or a key given
+/// twice is an error naming the file; the caller names what else it wanted.
 sp_result db_read_json(const char* path, cJSON** root, sp_error* err);
 /// Writes a whole file in place (for files in a folder put in place whole; else sp_file_write).
 sp_result db_write_file(const char* path, const void* data, size_t size, sp_error* err);

@@ -515,6 +515,42 @@ static sp_result keys_once(const cJSON* root, const char* name, sp_error* err)
     return SP_OK;
 }
 
+// The first key held twice by obj or any object within it (depth-first), else NULL.
+static const char* json_key_twice_within(const cJSON* obj, bool* no_memory)
+{
+    const char* twice = json_key_twice(obj, no_memory);
+    for (const cJSON* it = obj ? obj->child : NULL; it && !twice && !*no_memory; it = it->next)
+        if (cJSON_IsObject(it) || cJSON_IsArray(it)) twice = json_key_twice_within(it, no_memory);
+    return twice;
+}
+
+sp_result sp_json_parse_document(const char* text, size_t len, size_t max_values, const char* name, cJSON** root, sp_error* err)
+{
+    *root = NULL;
+    if (max_values > 0 && sp_json_measure(text, len).values > max_values)
+        return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values", name, max_values);
+    const char* end = NULL;
+    cJSON* doc = cJSON_ParseWithLengthOpts(text, len, &end, false);
+    sp_result r = sp_json_document_end(text, len, doc != NULL, end, name, err);
+    const char* nul = r == SP_OK ? memchr(text, 0, (size_t)(end - text)) : NULL;
+    if (nul)
+        r = sp_fail(err, SP_ERR_PARSE, "%s: a NUL byte in the JSON document, line %d (not a text file?)", name,
+                    line_of(text, len, nul));
+    bool oom = false;
+    const char* twice = r == SP_OK ? json_key_twice_within(doc, &oom) : NULL;
+    char shown[96];
+    if (twice)
+        r = sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", name, sp_text_printable(twice, shown, sizeof shown));
+    else if (oom)
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+    if (r != SP_OK) {
+        cJSON_Delete(doc);
+        return r;
+    }
+    *root = doc;
+    return SP_OK;
+}
+
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);

@@ -1911,7 +1911,13 @@ static void test_session_errors(void)
         const char* text;
         const char* expect;
     } bad[] = {
-        {"{", "not valid JSON"},
+        {"{", "malformed JSON near line 1"},
+        // One document, each key once, as a stroke file (sp_json_parse_document):
+        // "events" twice replayed nothing, and text after it was taken.
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [], \"events\": [{\"t\": 1, \"type\": "
+         "\"frame\"}]}",
+         "key \"events\" given twice"},
+        {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": []} trailing", "text after the JSON document"},
         {"{\"format\": \"x\", \"version\": 1, \"events\": []}", "not a kiosk session"},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 2, \"events\": []}", "version"},
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1}", "\"events\" must be an array"},

@@ -271,7 +271,18 @@ static void test_export_gltf_named(void)
     manifest[fread(manifest, 1, sizeof manifest - 1, f)] = 0;
     fclose(f);
     ENSURE(strstr(manifest, "\"parts/text_part.gltf\""));
+    // A manifest whose "sketches" is given twice (an edit by hand) is refused
+    // naming the key: cJSON kept the first, the second list silently lost.
+    char* open_brace = strchr(manifest, '{');
+    ENSURE(open_brace);
+    f = fopen(file, "wb");
+    ENSURE(f && fprintf(f, "{\"sketches\": [], %s", open_brace + 1) > 0 && fclose(f) == 0);
     sp_db_train_desc td = quick_train(-1);
+    err = (sp_error){0};
+    ENSURE(sp_db_create_from_export(p2, dir, &td, "test", &err) != SP_OK && strstr(err.text, "key \"sketches\" given twice"));
+    fprintf(stderr, "  %s\n", err.text);
+    f = fopen(file, "wb");
+    ENSURE(f && fputs(manifest, f) >= 0 && fclose(f) == 0);
     ENSURE(sp_db_create_from_export(p2, dir, &td, "test", &err) == SP_OK);
     ENSURE(scalar(p2, "SELECT count(*) FROM parts") == 2);
 }

@@ -698,25 +698,30 @@ static void test_pose_file_whole(void)
     unlink(path);
 }
 
-// A pose file is one JSON document naming each parameter once, as a stroke
-// file is: text after it and a parameter given twice were taken (the last
-// value silently won).
+// A pose file is one JSON document naming each key once, as a stroke file
+// is (sp_json_parse_document): text after it and a parameter given twice
+// were taken (the last value silently won); a NUL ended it silently, and
+// "parameters" given twice kept the first (an outside review).
 static void test_pose_file_strict(void)
 {
     sp_param params[2] = {{.name = "head.rx", .min = -1, .max = 1}, {.name = "head.ry", .min = -1, .max = 1}};
     const struct {
         const char* text;
+        size_t len; // 0: strlen
         const char* said;
     } cases[] = {
-        {"{\"parameters\": {\"head.rx\": 0.1}}\n", NULL},
-        {"{\"parameters\": {\"head.rx\": 0.1}} x\n", "pose.json: text after the JSON document, line 1"},
-        {"{\"parameters\": {\"head.rx\": 0.1, \"head.rx\": 0.2}}", "pose.json: parameter 'head.rx' given twice"},
-        {"{\"parameters\": {\"head.rx\": 0.1", "pose.json: malformed JSON near line 1"},
+        {"{\"parameters\": {\"head.rx\": 0.1}}\n", 0, NULL},
+        {"{\"parameters\": {\"head.rx\": 0.1}} x\n", 0, "pose.json: text after the JSON document, line 1"},
+        {"{\"parameters\": {\"head.rx\": 0.1, \"head.rx\": 0.2}}", 0, "pose.json: key \"head.rx\" given twice"},
+        {"{\"parameters\": {\"head.rx\": 0.1}, \"parameters\": {}}", 0, "pose.json: key \"parameters\" given twice"},
+        {"{\"parameters\": {\"head.rx\": 0.1}}\0{\"garbage", 42, "pose.json: text after the JSON document, line 1"},
+        {"{\"parameters\": {\"head.rx\": 0.1", 0, "pose.json: malformed JSON near line 1"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         double p[2] = {0};
         sp_error err = {0};
-        sp_result r = sp_pose_parse(cases[i].text, "pose.json", params, 2, p, NULL, &err);
+        size_t len = cases[i].len ? cases[i].len : strlen(cases[i].text);
+        sp_result r = sp_pose_parse(cases[i].text, len, "pose.json", params, 2, p, NULL, &err);
         fprintf(stderr, "  %s -> %s\n", cases[i].text, r == SP_OK ? "read" : err.text);
         ENSURE(cases[i].said ? r != SP_OK && !strcmp(err.text, cases[i].said) : r == SP_OK && p[0] == 0.1);
     }
