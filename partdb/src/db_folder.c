@@ -319,6 +319,14 @@ static int64_t part_id(sp_db* db, const char* name)
     return id;
 }
 
+// Whether s is one of the n names.
+static bool name_in(const char* s, const char* const* names, int n)
+{
+    for (int k = 0; s && k < n; ++k)
+        if (!strcmp(s, names[k])) return true;
+    return false;
+}
+
 // What a manifest's entries must be before anything is stored: a part's file
 // inside the export folder (said as such: "../outside.glb" was "a part entry
 // without name or file"), and an added_by without control characters, as
@@ -340,12 +348,25 @@ static sp_result manifest_entries_ok(const cJSON* parts, const cJSON* sketches, 
                            sp_text_printable(jstr(it, "added_by"), shown, sizeof shown));
         ++i;
     }
+    // A source or a review status of no known kind: a typo ("sythetic") was
+    // stored as curated, and a status failed the schema's CHECK naming the
+    // output database in SQL (an outside review).
+    static const char *const sources[] = {"synthetic", "curated", "kiosk"}, *const statuses[] = {"pending", "approved",
+                                                                                                 "rejected"};
     i = 0;
     cJSON_ArrayForEach(it, sketches)
     {
         if (sp_text_has_control(jstr(it, "added_by")))
             return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: added_by '%s' holds control characters", path, i,
                            sp_text_printable(jstr(it, "added_by"), shown, sizeof shown));
+        const cJSON* src = cJSON_GetObjectItemCaseSensitive(it, "source");
+        const cJSON* status = cJSON_GetObjectItemCaseSensitive(it, "status");
+        if (src && !name_in(cJSON_GetStringValue(src), sources, 3))
+            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: source '%s' is not synthetic, curated or kiosk", path, i,
+                           sp_text_printable(cJSON_IsString(src) ? src->valuestring : "(not a name)", shown, sizeof shown));
+        if (status && !cJSON_IsNull(status) && !name_in(cJSON_GetStringValue(status), statuses, 3))
+            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: status '%s' is not pending, approved or rejected", path, i,
+                           sp_text_printable(cJSON_IsString(status) ? status->valuestring : "(not a name)", shown, sizeof shown));
         ++i;
     }
     return SP_OK;

@@ -281,6 +281,21 @@ static void test_export_gltf_named(void)
     err = (sp_error){0};
     ENSURE(sp_db_create_from_export(p2, dir, &td, "test", &err) != SP_OK && strstr(err.text, "key \"sketches\" given twice"));
     fprintf(stderr, "  %s\n", err.text);
+    // A sketch's source or review status of no known kind is refused naming
+    // the entry (a typo was stored as curated; a bad status failed in SQL).
+    const char* kinds[2][2] = {{"\"source\": \"", "sythetic"}, {"\"source\": \"", "kiosk\", \"status\": \"bogus"}};
+    for (int k = 0; k < 2; ++k) {
+        char* at = strstr(manifest, kinds[k][0]);
+        ENSURE(at);
+        char* value_end = strchr(at + strlen(kinds[k][0]), '"');
+        f = fopen(file, "wb");
+        ENSURE(f && fprintf(f, "%.*s%s%s", (int)(at - manifest + strlen(kinds[k][0])), manifest, kinds[k][1], value_end) > 0 &&
+               fclose(f) == 0);
+        err = (sp_error){0};
+        ENSURE(sp_db_create_from_export(p2, dir, &td, "test", &err) != SP_OK &&
+               strstr(err.text, k ? "status 'bogus' is not pending" : "source 'sythetic' is not synthetic"));
+        fprintf(stderr, "  %s\n", err.text);
+    }
     f = fopen(file, "wb");
     ENSURE(f && fputs(manifest, f) >= 0 && fclose(f) == 0);
     ENSURE(sp_db_create_from_export(p2, dir, &td, "test", &err) == SP_OK);
