@@ -203,6 +203,16 @@ static void cb_error(int code, const char* text)
     sp_kiosk_log("GLFW error 0x%x: %s", code, text);
 }
 
+// Until the window is open, GLFW's last error is kept for the one line
+// that says why there is none (it was a time-stamped log line above it).
+static char g_glfw_early[256];
+
+static void cb_error_early(int code, const char* text)
+{
+    (void)code;
+    snprintf(g_glfw_early, sizeof g_glfw_early, "%s", text ? text : "");
+}
+
 // One frame: update at t, draw, swap; the pen-up latency of strokes whose fit just landed.
 static void frame(app* a, double t, bool render)
 {
@@ -443,11 +453,11 @@ static bool numbers_ok(int* lod, int* msaa, int* max_parts, int* keep_days, doub
 // opens). Full screen takes the monitor's size into *win_w, *win_h.
 static GLFWwindow* open_window(bool fullscreen, bool scripted, int msaa, int* win_w, int* win_h)
 {
-    glfwSetErrorCallback(cb_error);
+    glfwSetErrorCallback(cb_error_early);
     if (!glfwInit()) {
         fprintf(stderr,
-                "%s: cannot open a window (no display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n",
-                k_cmd);
+                "%s: cannot open a window (%s%sno display? run it under xvfb-run, or use `sketchpose dragon` without a window)\n",
+                k_cmd, g_glfw_early, g_glfw_early[0] ? "; " : "");
         return NULL;
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -476,10 +486,13 @@ static GLFWwindow* open_window(bool fullscreen, bool scripted, int msaa, int* wi
         if (win) glfwMakeContextCurrent(win);
     }
     if (!win) {
-        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (install libgl1-mesa-dri)\n", k_cmd);
+        fprintf(stderr, "%s: cannot create an OpenGL 3.3 core window (%s%sinstall libgl1-mesa-dri)\n", k_cmd, g_glfw_early,
+                g_glfw_early[0] ? "; " : "");
         glfwTerminate();
-    } else if (mon)
-        glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
+        return NULL;
+    }
+    glfwSetErrorCallback(cb_error);                                  // from now on the log's, the window open
+    if (mon) glfwSetInputMode(win, GLFW_CURSOR, GLFW_CURSOR_HIDDEN); // a finger needs no arrow
     return win;
 }
 
