@@ -381,7 +381,7 @@ static double iou(const double a[4], const double b[4])
 }
 
 // The dragon's report (sp_dragon_report_json's text) as a tree.
-static cJSON* report_tree(const sp_dragon* d)
+static cJSON* report_tree(sp_dragon* d)
 {
     char* text = NULL;
     sp_error err = {0};

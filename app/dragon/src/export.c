@@ -100,11 +100,8 @@ static void group_ink(const sp_dragon* d, sp_gltf_scene_part* parts, sp_gltf_sce
     }
 }
 
-sp_result sp_dragon_export(const sp_dragon* dc, const char* path, sp_error* err)
+sp_result sp_dragon_export(sp_dragon* d, const char* path, sp_error* err)
 {
-    // Why the cast: posing at the key times reuses the parts' evaluation
-    // buffers; the visible state is restored at the end (posed = false).
-    sp_dragon* d = (sp_dragon*)dc;
     if (d->part_n == 0) return sp_fail(err, SP_ERR_INVALID, "%s: the dragon has no parts to export", path);
     int n = d->part_n;
     bool animated = d->period > 0;

@@ -125,12 +125,11 @@ static cJSON* report_tree(sp_dragon* d)
     return o;
 }
 
-sp_result sp_dragon_report_json(const sp_dragon* dc, char** json, sp_error* err)
+sp_result sp_dragon_report_json(sp_dragon* d, char** json, sp_error* err)
 {
-    // Why the cast: the outlines' boxes at t = 0 are read from a pose, which
-    // reuses the parts' evaluation buffers (sp/dragon.h says a report ends
-    // the last pose).
-    cJSON* o = report_tree((sp_dragon*)dc);
+    // The outlines' boxes at t = 0 are read from a pose, which reuses the
+    // parts' evaluation buffers (sp/dragon.h says a report ends the last pose).
+    cJSON* o = report_tree(d);
     // cJSON allocates with malloc (the project sets no hooks): free() frees it.
     *json = o ? cJSON_PrintUnformatted(o) : NULL;
     cJSON_Delete(o);

@@ -315,8 +315,9 @@ bool sp_dragon_bounds(const sp_dragon* d, sp_vec3* lo, sp_vec3* hi);
 /// and ONE looped animation of length sp_dragon_period holding
 /// the joints' offsets and the attached parts' placements as their bodies
 /// move (none when no part animates). Fails with SP_ERR_INVALID when there
-/// are no parts.
-sp_result sp_dragon_export(const sp_dragon* d, const char* path, sp_error* err);
+/// are no parts. Poses the dragon at its key times (non-const: the parts'
+/// pose buffers are reused; pose it again before reading poses).
+sp_result sp_dragon_export(sp_dragon* d, const char* path, sp_error* err);
 
 /// Polls the database: when another connection committed a change (or the
 /// file was replaced), reloads the model and forgets the loaded parts that
@@ -372,7 +373,7 @@ const char* sp_dragon_model_error(const sp_dragon* d);
 /// "stroke_bbox_px", "note", "report": {...}}], "details": [{"part", "points"}]).
 /// Poses the dragon at t = 0.
 /// *json: UTF-8 text, malloc'd, free() it; NULL on failure (out of memory).
-sp_result sp_dragon_report_json(const sp_dragon* d, char** json, sp_error* err);
+sp_result sp_dragon_report_json(sp_dragon* d, char** json, sp_error* err);
 
 #ifdef __cplusplus
 }
