@@ -117,8 +117,15 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
                    sp_text_printable(category, shown, sizeof shown));
     }
     int a = pick_abstraction(&ch, d);
-    if (a < 0) add_reason(reasons, sizeof reasons, "no sketch abstraction%s%s", d && d->abstraction ? " named " : "",
-                          d && d->abstraction ? d->abstraction : "");
+    // The loader's word on an abstraction it left out (a curve saved as LINES
+    // by Blender) is the reason: "no sketch abstraction" alone sent a curator
+    // to `inspect` to find it (an outside review).
+    const char* why = NULL;
+    for (int w = 0; w < ch.warning_count && !why; ++w)
+        if (strstr(ch.warnings[w], "sp_abstraction")) why = ch.warnings[w];
+    if (a < 0)
+        add_reason(reasons, sizeof reasons, "no sketch abstraction%s%s%s%s%s", d && d->abstraction ? " named " : "",
+                   d && d->abstraction ? d->abstraction : "", why ? " (" : "", why ? why : "", why ? ")" : "");
     else if (rig->abstractions[a].curve_count == 0 || rig->abstractions[a].point_count < 2)
         add_reason(reasons, sizeof reasons, "abstraction '%s' has no curve", rig->abstractions[a].name);
     if (rig->param_count == 0) add_reason(reasons, sizeof reasons, "no rig parameters");

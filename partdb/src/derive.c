@@ -23,6 +23,8 @@
 #define BONE_SCALE_MIN 0.6
 #define BONE_SCALE_MAX 1.6
 #define FRAME_MARGIN 1.35
+// A clip longer than this (seconds) is likely in another unit: said.
+#define CLIP_LONG_S 60.0
 // A bone shorter than this share of the part's size has no direction of its own.
 #define BONE_EPS 1e-4
 static const double k_pi = 3.14159265358979323846;
@@ -776,7 +778,19 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     if (sr->animation_count > 1)
         sp_character_warn(out, "only the clip '%s' is kept; %d other animations were left out", w.clip ? w.clip->name : "",
                           sr->animation_count - 1);
-    if (!w.clip) sp_character_warn(out, "no animation with keys: the part has no clip (it holds its fitted pose in the kiosk)");
+    // A clip in the wrong unit (ms or frames read as seconds) is said either
+    // way: 0.2 ms of keys was "no animation", 2000 s passed silently and
+    // hardly moved in the kiosk (an outside review).
+    if (!w.clip && sr->animation_count > 0)
+        sp_character_warn(out, "the file's animations have no keys more than 1 ms apart: the part has no clip (are its key "
+                               "times in seconds?)");
+    else if (!w.clip)
+        sp_character_warn(out, "no animation with keys: the part has no clip (it holds its fitted pose in the kiosk)");
+    else if (w.times[w.keys - 1] - w.times[0] > CLIP_LONG_S)
+        sp_character_warn(out,
+                          "clip '%s' lasts %.0f s: the kiosk loops it, so the part hardly moves (are its key times in "
+                          "seconds, not frames or ms?)",
+                          w.clip->name, (double)(w.times[w.keys - 1] - w.times[0]));
     // The kiosk fits one stroke per part: a figure of several curves cannot
     // be drawn there (an outside review's stick figure became six parts).
     int ka = sp_rig_find_abstraction(&out->rig, abstraction);

@@ -445,6 +445,9 @@ void parse_model(tinygltf::Model& model, const unsigned char* data, size_t size,
             ++i;
         if (i == size) fail(SP_ERR_PARSE, "%s: empty file", what);
         if (data[i] != '{') {
+            if (size - i >= 3 && !memcmp(data + i, "\xEF\xBB\xBF", 3))
+                fail(SP_ERR_PARSE, "%s: starts with a UTF-8 byte-order mark, which glTF JSON must not have (save it without one)",
+                     what);
             if (strchr("[\"-0123456789tfn", data[i]))
                 fail(SP_ERR_PARSE, "%s: the top level is not a JSON object (glTF JSON is one)", what);
             fail(SP_ERR_PARSE, "%s: neither glTF JSON nor a .glb", what);
@@ -804,7 +807,9 @@ void read_skinned(const tinygltf::Model& m, const tinygltf::Primitive& prim, int
             for (int b = a + 1; b < 4; ++b)
                 if (j[a] == j[b] && w[b] > 0) w[a] += w[b], w[b] = 0;
         if (!(w[0] + w[1] + w[2] + w[3] > 0))
-            fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: vertex %zu has all skin weights zero", what, mesh, pi, i);
+            fail(SP_ERR_INVALID, "%s: mesh %d primitive %d: vertex %zu has all skin weights zero%s", what, mesh, pi, i,
+                 attr("WEIGHTS_1") >= 0 ? " in WEIGHTS_0 (WEIGHTS_1 is not read: at most 4 joints a vertex; re-export with 4)"
+                                        : "");
         for (int c = 0; c < 4; ++c) {
             out.joints[4 * i + (size_t)c] = (uint16_t)skin_map[j[c]];
             out.weights[4 * i + (size_t)c] = (float)w[c];
@@ -1458,8 +1463,9 @@ struct Importer {
                     expect(ov, 3, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, what, usage);
                 size_t per = interp == SP_INTERP_CUBICSPLINE ? 3 : 1;
                 if (in.count < 1 || ov.count != in.count * per)
-                    fail(SP_ERR_INVALID, "%s: animation %zu sampler %d: %zu outputs for %zu keys", what, ai, c.sampler, ov.count,
-                         in.count);
+                    fail(SP_ERR_INVALID, "%s: animation %zu sampler %d: %zu outputs for %zu keys%s (%zu wanted)", what, ai,
+                         c.sampler, ov.count, in.count,
+                         per == 3 ? " of CUBICSPLINE, 3 a key: in-tangent, value, out-tangent" : "", in.count * per);
                 sp_anim_channel* oc = &out->channels[out->channel_count];
                 oc->joint = node2joint[(size_t)node];
                 oc->path = path;

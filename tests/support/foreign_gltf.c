@@ -412,7 +412,7 @@ int sp_foreign_write(const sp_foreign_desc* d, const char* path)
         enum { KEYS = 21 };
         float times[KEYS];
         for (int k = 0; k < KEYS; ++k)
-            times[k] = (float)k / 10.0f;
+            times[k] = (float)((double)k / 10.0 * (d->clip_scale > 0 ? d->clip_scale : 1));
         cJSON* an = cJSON_CreateObject();
         cJSON_AddStringToObject(an, "name", "sway");
         cJSON* ch = cJSON_AddArrayToObject(an, "channels");

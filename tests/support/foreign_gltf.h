@@ -25,6 +25,7 @@ typedef struct sp_foreign_desc {
     bool two_skins;       ///< the legs' mesh uses a second skin (a file derive must refuse)
     bool no_skin;         ///< meshes without skins or skin attributes (refused too)
     bool no_clip;         ///< no animation
+    double clip_scale;    ///< the clip's key times times this (0: 1; the clip lasts 2 s)
 } sp_foreign_desc;
 
 /// The lizard's joints (index = node order in the file after the Armature).

@@ -834,6 +834,21 @@ static void test_says_what_is_wrong(void)
     // view of no size, and synth wrote strokes 1e9 pixels long.
     ensure_fails(write_edited("no_extent.gltf", &(mini_desc){0}, "{\"bufferView\": 0, ", "{"), "no_extent.gltf",
                  "the skinned mesh's 4 vertices are all at one point: no surface to pose");
+    // A byte-order mark (some Windows tools write one) is named, and a vertex
+    // whose weight is only in WEIGHTS_1 says that set is not read (both were
+    // refused with a reason that misled: an outside curator review).
+    {
+        char* text = mini_gltf(&(mini_desc){0});
+        const char* bom = sp_test_tmp_path("bom.gltf");
+        FILE* f = fopen(bom, "wb");
+        ENSURE(f && fprintf(f, "\xEF\xBB\xBF%s", text) > 0 && fclose(f) == 0);
+        free(text);
+        ensure_fails(bom, "bom.gltf", "starts with a UTF-8 byte-order mark");
+        const char* w1_from[] = {"\"WEIGHTS_0\": 2}"};
+        const char* w1_to[] = {"\"WEIGHTS_0\": 2, \"JOINTS_1\": 1, \"WEIGHTS_1\": 2}"};
+        ensure_fails(write_edits("weights1.gltf", &(mini_desc){.zero_weights = true}, 1, w1_from, w1_to), "weights1.gltf",
+                     "all skin weights zero in WEIGHTS_0 (WEIGHTS_1 is not read");
+    }
     // Zeros claimed by the million cost the file nothing: refused before
     // they are made (2^28 of them took 3 GB and 27 s to reach "different counts").
     const char* zeros_from[] = {"{\"bufferView\": 0, ", "\"count\": 4, \"type\": \"VEC3\""};

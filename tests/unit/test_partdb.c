@@ -302,6 +302,26 @@ static void test_export_gltf_named(void)
     ENSURE(scalar(p2, "SELECT count(*) FROM parts") == 2);
 }
 
+// A part whose only curve the loader left out (saved as LINES, as Blender
+// does) is refused with the loader's reason, where it said only "no sketch
+// abstraction" (an outside curator review).
+static void test_refusal_says_why(void)
+{
+    char* text = mini_gltf(&(mini_desc){.extras = true});
+    char* mode = strstr(text, "\"mode\": 2}]}");
+    ENSURE(mode);
+    mode[8] = '1';
+    sp_error err = {0};
+    ENSURE(sp_db_validate_part(
+               text, strlen(text), "curve_lines",
+               &(sp_db_part_desc){.name = "curve_lines", .abstraction = "outline", .selftest_seeds = -1, .synth_sketches = -1},
+               NULL, &err) != SP_OK);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "no sketch abstraction named outline (ignored mesh") &&
+           strstr(err.text, "this one is mode 1 (LINES)"));
+    free(text);
+}
+
 static void test_round_trip(void)
 {
     const char* path = sp_test_tmp_path("rt.db");
@@ -3089,6 +3109,7 @@ int main(int argc, char** argv)
     }
     return sp_test_run(argc, argv,
                        (sp_test[]){{"sha256", test_sha256},
+                                   {"refusal_says_why", test_refusal_says_why},
                                    {"round_trip", test_round_trip},
                                    {"export_gltf_named", test_export_gltf_named},
                                    {"sketch_doubles_exact", test_sketch_doubles_exact},
