@@ -20,11 +20,12 @@ sp_result sp_pose_parse(const char* text, size_t len, const char* what, const sp
                         int* clamped, sp_error* err)
 {
     if (clamped) *clamped = 0;
-    cJSON* root = NULL;
     // As a stroke file: a NUL ended the file silently, a key given twice was
     // dropped, and 60 MB of small values took 2.4 GB (an outside review).
-    sp_result r = sp_json_parse_document(text, len, SP_SKETCH_MAX_JSON_VALUES, what, &root, err);
+    sp_result r = sp_json_document_check(text, len, SP_SKETCH_MAX_JSON_VALUES, what, err);
     if (r != SP_OK) return r;
+    cJSON* root = cJSON_ParseWithLength(text, len);
+    if (!root) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", what);
     const cJSON* values = cJSON_GetObjectItemCaseSensitive(root, "parameters");
     if (!cJSON_IsObject(values)) {
         r = sp_fail(err, SP_ERR_INVALID, "%s: expected {\"parameters\": {\"<joint>.<channel>\": value, ...}}", what);

@@ -150,7 +150,8 @@ sp_result db_read_json(const char* path, cJSON** root, sp_error* err)
     if (r != SP_OK) return r;
     // One document, each key once, as every user's JSON (a manifest's
     // "sketches" given twice kept the first).
-    r = sp_json_parse_document(text, size, 0, path, root, err);
+    if ((r = sp_json_document_check(text, size, 0, path, err)) == SP_OK && !(*root = cJSON_ParseWithLength(text, size)))
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
     free(text);
     return r;
 }

@@ -71,7 +71,7 @@ sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err);
 /// Reads a whole file (malloc'd, NUL-terminated beyond size).
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err);
 /// Reads and parses a JSON file as one document, each key once
-/// (sp_json_parse_document): malformed JSON, text after it or a key given
+/// (sp_json_document_check): malformed JSON, text after it or a key given
 /// twice is an error naming the file; the caller names what else it wanted.
 sp_result db_read_json(const char* path, cJSON** root, sp_error* err);
 /// Writes a whole file in place (for files in a folder put in place whole; else sp_file_write).

@@ -524,9 +524,8 @@ static const char* json_key_twice_within(const cJSON* obj, bool* no_memory)
     return twice;
 }
 
-sp_result sp_json_parse_document(const char* text, size_t len, size_t max_values, const char* name, cJSON** root, sp_error* err)
+sp_result sp_json_document_check(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
 {
-    *root = NULL;
     if (max_values > 0 && sp_json_measure(text, len).values > max_values)
         return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values", name, max_values);
     const char* end = NULL;
@@ -543,12 +542,8 @@ sp_result sp_json_parse_document(const char* text, size_t len, size_t max_values
         r = sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", name, sp_text_printable(twice, shown, sizeof shown));
     else if (oom)
         r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
-    if (r != SP_OK) {
-        cJSON_Delete(doc);
-        return r;
-    }
-    *root = doc;
-    return SP_OK;
+    cJSON_Delete(doc);
+    return r;
 }
 
 sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, sp_sketch* out, sp_error* err)

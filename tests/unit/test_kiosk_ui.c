@@ -1912,7 +1912,7 @@ static void test_session_errors(void)
         const char* expect;
     } bad[] = {
         {"{", "malformed JSON near line 1"},
-        // One document, each key once, as a stroke file (sp_json_parse_document):
+        // One document, each key once, as a stroke file (sp_json_document_check):
         // "events" twice replayed nothing, and text after it was taken.
         {"{\"format\": \"sketchpose-kiosk-session\", \"version\": 1, \"events\": [], \"events\": [{\"t\": 1, \"type\": "
          "\"frame\"}]}",

@@ -699,7 +699,7 @@ static void test_pose_file_whole(void)
 }
 
 // A pose file is one JSON document naming each key once, as a stroke file
-// is (sp_json_parse_document): text after it and a parameter given twice
+// is (sp_json_document_check): text after it and a parameter given twice
 // were taken (the last value silently won); a NUL ended it silently, and
 // "parameters" given twice kept the first (an outside review).
 static void test_pose_file_strict(void)

@@ -154,11 +154,12 @@ static sp_result parse_event(const cJSON* e, int i, const char* name, double* la
 sp_result sp_kiosk_session_parse(const char* text, size_t len, const char* name, sp_kiosk_session* out, sp_error* err)
 {
     memset(out, 0, sizeof *out);
-    cJSON* root = NULL;
     // As a stroke file (a key given twice replayed nothing; junk values took
     // gigabytes): a session's strokes hold twice a drawing's values.
-    sp_result r = sp_json_parse_document(text, len, 2 * (size_t)SP_SKETCH_MAX_JSON_VALUES, name, &root, err);
+    sp_result r = sp_json_document_check(text, len, 2 * (size_t)SP_SKETCH_MAX_JSON_VALUES, name, err);
     if (r != SP_OK) return r;
+    cJSON* root = cJSON_ParseWithLength(text, len);
+    if (!root) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
     sp_kiosk_session s = {0};
     const cJSON* fmt = cJSON_GetObjectItemCaseSensitive(root, "format");
     if (!cJSON_IsObject(root) || !cJSON_IsString(fmt) || strcmp(fmt->valuestring, "sketchpose-kiosk-session") != 0) {

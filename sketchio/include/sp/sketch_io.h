@@ -28,8 +28,6 @@
 #include "sp/result.h"
 #include "sp/sketch.h"
 
-struct cJSON; // cjson/cJSON.h, for sp_json_parse_document
-
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -137,16 +135,15 @@ sp_json_shape sp_json_measure(const char* text, size_t len);
 /// Whether text holds at most max_values values (sp_json_measure): SP_OK,
 /// else SP_ERR_INVALID with err naming `name`.
 sp_result sp_json_values_within(const char* text, size_t len, size_t max_values, const char* name, sp_error* err);
-/// Parses text (len bytes) as one JSON document, as every reader of a user's
-/// JSON file must (pose files, kiosk sessions, a database folder's manifest;
-/// stroke files add their own messages): at most max_values values (0: no
-/// cap), nothing but white space after it, no NUL byte in it, and no object
-/// anywhere holding a key twice (cJSON keeps both and lookups find the
-/// first: `"events": [], "events": [...]` replayed nothing). *root: the
-/// document (cJSON_Delete it), NULL on failure, err naming `name` (and the
-/// line, where it tells).
-sp_result sp_json_parse_document(const char* text, size_t len, size_t max_values, const char* name, struct cJSON** root,
-                                 sp_error* err);
+/// Whether text (len bytes) is one JSON document as every reader of a user's
+/// JSON file wants it (pose files, kiosk sessions, a database folder's
+/// manifest; stroke files add their own messages): at most max_values values
+/// (0: no cap), nothing but white space after it, no NUL byte in it, and no
+/// object anywhere holding a key twice (cJSON keeps both and lookups find
+/// the first: `"events": [], "events": [...]` replayed nothing). SP_OK, then
+/// parse it; else err names `name` (and the line, where it tells). It parses
+/// the text itself, so that no cJSON type is in this header.
+sp_result sp_json_document_check(const char* text, size_t len, size_t max_values, const char* name, sp_error* err);
 /// Whether s holds a control character (a byte below 0x20, or DEL 0x7f).
 bool sp_text_has_control(const char* s);
 /// `s` for a one-line message (returns buf, cap > 0): a control character
