@@ -1,6 +1,6 @@
 // bench/visitors.c: the visitors' drawings through the kiosk pipeline (issue 16).
 //   visitors [--half tune|report|fresh] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] [--list] [--fit-all]
-//            [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] [--json]
+//            [--on-body [--gap PX] [--part-scale F] [--scenes K]] [--pieces F [--pause MS]] [--json]
 // Every drawing of one half of the visitors' set (drawings made neither by nor
 // for the project's hand-drawing model: tests/data/visitors/README.md; --data
 // defaults to the whole set the build makes from designs.json and the Quick,
@@ -33,6 +33,8 @@
 // --gap PX drawn that far apart instead (their box PX beyond the body's).
 // --part-scale F draws the legs, heads, tails and wings F times their size
 // (a visitor's small parts on a large body; the body stays 500 px).
+// --scenes K draws each at K dragons a facing (the half's bodies and heads
+// in turn): more dragons to measure a placement rule on (default 1).
 // --pieces F [--pause MS] instead draws every part drawing through the
 // kiosk's UI (sp_kiosk_ui, 1280 x 800 at 96 dpi, a point every 8 ms) in two
 // pieces, as a finger that left the glass: broken at F of its points, the
@@ -166,6 +168,9 @@ static bool add_part(sp_dragon* d, const sp_dataset* ds, const scene_set* s, int
 // `alone`: the drawings' single-stroke outcomes (no body, no rule).
 // --part-scale: the on-body parts' size against the bench's own.
 static double part_scale = 1;
+// --scenes K: each on-body drawing at K dragons (the half's bodies and heads
+// in turn) a facing, where one gives few dragons to learn a rule from.
+static int scene_rounds = 1;
 
 static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alone_out, bool json, const char* half,
                          bool parts_first)
@@ -184,16 +189,17 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
         // Once a drawing; n counts each drawing once a facing, so both print it twice.
         alone[kind] += !alone_out[i].refused && !strcmp(alone_out[i].answer, label);
         for (int facing = 0; facing < 2; ++facing, ++m)
-            for (int end = 0; end < 2; ++end) { // 0: the legs' own end, 1: the other
+            for (int e = 0; e < 2 * scene_rounds; ++e) {
+                int end = e % 2, sm = m * scene_rounds + e / 2; // 0: the legs' own end, 1: the other; sm: the dragon
                 // The legs' top at 60% of the body's height, a quarter of its width from the middle.
                 sp_vec2 lo, hi, head_at;
-                bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, true, &lo, &hi, &head_at);
+                bool ok = draw_dragon(d, ds, &scenes, sm, facing != 0, true, &lo, &hi, &head_at);
                 double dir = facing ? -1 : 1, w = hi.x - lo.x; // dir: the side the head is on
                 bool front = (kind == 0) == (end == 0);
                 sp_stroke ls =
                     placed(legs, 260 * part_scale, (sp_vec2){640 + dir * (front ? 0.25 : -0.25) * w, lo.y + 0.6 * (hi.y - lo.y)},
                            true, facing != 0);
-                ok = ok && ls.points && add_part(d, ds, &scenes, m, facing != 0, true, parts_first, &ls, &res);
+                ok = ok && ls.points && add_part(d, ds, &scenes, sm, facing != 0, true, parts_first, &ls, &res);
                 if (ok && !res.rejected) {
                     const sp_dragon_part* p = sp_dragon_part_get(d, res.part);
                     bool right = !strcmp(p->category, label);
@@ -212,8 +218,8 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
         for (int k = 0; k < 2; ++k)
             printf("  {\"case\": \"%s %s on a body%s\", \"n\": %d, \"alone\": %d, \"own_end\": %d, \"other_end\": %d, "
                    "\"as_legs\": %d, \"facing_the_dragon\": %d},\n",
-                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], 2 * alone[k], own[k], other[k], as_legs[k],
-                   faced[k]);
+                   half, kinds[k], parts_first ? ", drawn first" : "", n[k], 2 * scene_rounds * alone[k], own[k], other[k],
+                   as_legs[k], faced[k]);
         return;
     }
     printf("Legs drawn at a dragon (%s; facing right, then left): became their own kind\n",
@@ -221,8 +227,8 @@ static void legs_on_body(sp_dragon* d, const sp_dataset* ds, const outcome* alon
     printf("%-12s %6s %22s %22s %22s %22s\n", "legs", "drawn", "alone (no body)", "at their own end", "at the other end",
            "facing their dragon");
     for (int k = 0; k < 2; ++k)
-        printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * alone[k], n[k], own[k], n[k],
-               other[k], n[k], faced[k], as_legs[k]);
+        printf("%-12s %6d %15d of %4d %15d of %4d %15d of %4d %15d of %4d\n", kinds[k], n[k], 2 * scene_rounds * alone[k], n[k],
+               own[k], n[k], other[k], n[k], faced[k], as_legs[k]);
 }
 
 // The stroke moved by (dx, dy), in place.
@@ -259,10 +265,11 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             if (!strcmp(label, kinds[k])) kind = k;
         if (kind < 0) continue;
         const sp_stroke* part_s = &ds->samples[i].sketch.strokes[0];
-        for (int facing = 0; facing < 2; ++facing, ++m) {
+        for (int fr = 0; fr < 2 * scene_rounds; ++fr) {
+            int facing = fr / scene_rounds, sm = (m + facing) * scene_rounds + fr % scene_rounds; // sm: the dragon
             sp_dragon_result res;
             sp_vec2 lo, hi, head_at, plo, phi;
-            bool ok = draw_dragon(d, ds, &scenes, m, facing != 0, kind != 0, &lo, &hi, &head_at);
+            bool ok = draw_dragon(d, ds, &scenes, sm, facing != 0, kind != 0, &lo, &hi, &head_at);
             double dir = facing ? -1 : 1;
             sp_stroke ps = placed(part_s, (kind == 0 ? 200 : 260) * part_scale, kind == 0 ? head_at : (sp_vec2){640, 400}, false,
                                   facing != 0);
@@ -278,7 +285,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
                             kind == 0 ? 0 : 0.5 * (lo.y + hi.y) - 0.5 * (plo.y + phi.y));
                 }
             }
-            ok = ok && ps.points && add_part(d, ds, &scenes, m, facing != 0, kind != 0, parts_first, &ps, &res);
+            ok = ok && ps.points && add_part(d, ds, &scenes, sm, facing != 0, kind != 0, parts_first, &ps, &res);
             n[kind]++;
             if (!ok || res.rejected) {
                 refused[kind]++;
@@ -295,6 +302,7 @@ static void parts_on_body(sp_dragon* d, const sp_dataset* ds, bool json, const c
             }
             free(ps.points);
         }
+        m += 2;
     }
     sp_dragon_clear(d);
     if (json) {
@@ -526,6 +534,8 @@ int main(int argc, char** argv)
             gap = atof(argv[++i]);
         else if (!strcmp(argv[i], "--part-scale") && i + 1 < argc && atof(argv[i + 1]) > 0)
             part_scale = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--scenes") && i + 1 < argc && atoi(argv[i + 1]) >= 1 && atoi(argv[i + 1]) <= 64)
+            scene_rounds = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--pieces") && i + 1 < argc && atof(argv[i + 1]) > 0)
             pieces = atof(argv[++i]);
         else if (!strcmp(argv[i], "--pause") && i + 1 < argc && atof(argv[i + 1]) >= 0)
@@ -535,7 +545,8 @@ int main(int argc, char** argv)
         else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr,
                     "usage: visitors [--half tune|report|fresh] [--db PATH] [--assets DIR] [--data DIR] [--sheet out.png] "
-                    "[--list] [--fit-all] [--limits L,L...] [--on-body [--gap PX] [--part-scale F]] [--pieces F [--pause MS]] "
+                    "[--list] [--fit-all] [--limits L,L...] [--on-body [--gap PX] [--part-scale F] [--scenes K]] [--pieces F "
+                    "[--pause MS]] "
                     "[--json]\n");
             return 2;
         }
