@@ -308,6 +308,13 @@ bool sp_cli_out_is_stdout(const char* path)
     return stat(path, &sp) == 0 && fstat(1, &so) == 0 && sp.st_dev == so.st_dev && sp.st_ino == so.st_ino;
 }
 
+bool sp_cli_stdout_taken(const char* const* outs, int n)
+{
+    for (int i = 0; i < n; ++i)
+        if (sp_cli_out_is_stdout(outs[i])) return true;
+    return false;
+}
+
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)
 {
     if (!path) return true;

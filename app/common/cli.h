@@ -88,6 +88,10 @@ bool sp_cli_out_is_stream(const char* path);
 /// /dev/stdout and its spellings, or the file stdout is redirected to. A
 /// command that prints its report on stdout does not print it twice there.
 bool sp_cli_out_is_stdout(const char* path);
+/// True when any of the n outputs (NULL: none) is stdout (sp_cli_out_is_stdout):
+/// the command then prints nothing else there, its JSON too (a glTF or a PNG
+/// followed by a summary is a file no reader takes; --report has it).
+bool sp_cli_stdout_taken(const char* const* outs, int n);
 /// True, after one line naming both, when the output `out` would overwrite
 /// the input `in` or a file the input reads (a glTF's external buffers and
 /// images): for inputs that are not options (sp_cli_parse checks those).

@@ -528,8 +528,10 @@ static int db_add_part(int argc, char** argv)
     for (int i = 0; i < warns.count; ++i)
         fprintf(stderr, "%s: %s: warning: %s\n", cmd, pos[0], warns.lines[i]);
     if (warns.dropped) fprintf(stderr, "%s: %s: warning: %d more warnings (out of memory)\n", cmd, pos[0], warns.dropped);
-    print_part(&info, true, &warns);
-    printf("\n");
+    if (!sp_cli_out_is_stdout(preview)) { // a preview on stdout has it to itself
+        print_part(&info, true, &warns);
+        printf("\n");
+    }
     free(warns.lines);
     return SP_EXIT_OK;
 }

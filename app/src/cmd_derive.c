@@ -134,7 +134,8 @@ int cmd_derive(int argc, char** argv)
     cJSON* warnings = cJSON_AddArrayToObject(root, "warnings");
     for (int i = 0; i < part.warning_count; ++i)
         cJSON_AddItemToArray(warnings, cJSON_CreateString(part.warnings[i]));
-    char* text = cJSON_PrintUnformatted(root);
+    // The part or its preview on stdout has it to itself.
+    char* text = sp_cli_stdout_taken((const char* const[]){out_path, preview}, 2) ? NULL : cJSON_PrintUnformatted(root);
     if (text) puts(text);
     free(text);
     cJSON_Delete(root);

@@ -253,7 +253,7 @@ int cmd_dragon(int argc, char** argv)
         if (sp_dragon_snapshot_png(d, &sd, render_to, &err) != SP_OK) goto fail;
     }
     if (sp_outputs_commit(&staged, &err) != SP_OK) goto fail;
-    if (!sp_cli_out_is_stdout(report)) sp_json_print(j);
+    if (!sp_cli_stdout_taken((const char* const[]){report, out, render}, 3)) sp_json_print(j);
     exit_code = SP_EXIT_OK;
     goto done;
 fail:

@@ -42,7 +42,7 @@ int cmd_export(int argc, char** argv)
     cJSON_AddStringToObject(root, "out", out_path);
     cJSON_AddNumberToObject(root, "parameters", sp_rig_handle_param_count(rig));
     cJSON_AddNumberToObject(root, "clamped", clamped);
-    char* text = cJSON_PrintUnformatted(root);
+    char* text = sp_cli_out_is_stdout(out_path) ? NULL : cJSON_PrintUnformatted(root); // the glTF has stdout
     if (text) puts(text);
     free(text);
     cJSON_Delete(root);

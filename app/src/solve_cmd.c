@@ -130,7 +130,7 @@ bool sp_solve_cmd_write(const sp_solve_cmd* s, const cJSON* report, const double
         fprintf(stderr, "%s: %s\n", s->cmd, err.text);
         return false;
     }
-    if (!sp_cli_out_is_stdout(o->report)) sp_json_print(report);
+    if (!sp_cli_stdout_taken((const char* const[]){o->report, o->out, o->render}, 3)) sp_json_print(report);
     if (o->note && o->note[0]) fprintf(stderr, "%s: %s\n", s->cmd, o->note);
     if (o->out) sp_rig_handle_warn_textures(s->cmd, s->rig, o->out);
     return true;

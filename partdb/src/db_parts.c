@@ -244,6 +244,17 @@ static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, c
                            "%s: %s applies to a part derived from a plain rigged glTF; this one already has sketchpose extras",
                            what, d->attach_joint ? "attach_joint" : "view");
         report_warnings(ch, d);
+        // Derived before (`derive --abstraction stick`, then add-part): said
+        // here too, as derive said it (it was stored without a word).
+        int a = pick_abstraction(ch, d);
+        if (d->warn && a >= 0 && ch->rig.abstractions[a].curve_count > 1) {
+            char line[256];
+            snprintf(line, sizeof line,
+                     "its '%s' abstraction has %d curves: visitors cannot draw it in the kiosk, which fits one stroke "
+                     "per part (the kiosk's parts use `outline`)",
+                     ch->rig.abstractions[a].name, ch->rig.abstractions[a].curve_count);
+            d->warn(d->warn_user, line);
+        }
         return SP_OK;
     }
     sp_character part = {0};

@@ -677,6 +677,13 @@ static void test_cli(void)
     cJSON_Delete(j);
     ENSURE(sp_image_read_png(png, &img, &err) == SP_OK);
     sp_image_free(&img);
+    // The stick part derived before (the README's derive, then add-part) is
+    // said not drawable in the kiosk too (it was stored without a word).
+    snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --name lizard_stick2 --category tail --synth 8 2>/dev/null", bin,
+             db, stick);
+    ENSURE(run(cmd, &text) == 0);
+    ENSURE(strstr(text, "visitors cannot draw it in the kiosk"));
+    free(text);
     // A part with its own abstraction (the derived one) is stored as given: nothing derived.
     snprintf(cmd, sizeof cmd, "'%s' db add-part --db '%s' '%s' --name lizard_again --synth 8 2>/dev/null", bin, db, out);
     ENSURE(run(cmd, &text) == 0);

@@ -1049,6 +1049,38 @@ static void test_report_on_stdout_once(void)
     }
 }
 
+// A file written to stdout has it to itself: `export --out /dev/stdout`
+// followed its glTF with the command's summary and `pose --render
+// /dev/stdout` its PNG with the report (an outside review of the README).
+static void test_file_on_stdout_alone(void)
+{
+    char strokes[1100], pose[1100], out[1100], args[4000];
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("alone_strokes.json"));
+    snprintf(pose, sizeof pose, "%s", sp_test_tmp_path("alone_pose.json"));
+    snprintf(out, sizeof out, "%s", sp_test_tmp_path("alone_out"));
+    const char* rig = SP_SOURCE_DIR "/assets/tail.glb";
+    synth_strokes(rig, 2, strokes);
+    FILE* f = fopen(pose, "wb");
+    ENSURE(f && fputs("{\"parameters\": {}}\n", f) >= 0 && fclose(f) == 0);
+    snprintf(args, sizeof args, "'%s' export --rig '%s' --pose '%s' --out /dev/stdout > '%s' 2>/dev/null", SP_SKETCHPOSE, rig,
+             pose, out);
+    ENSURE(run(args) == 0);
+    char* text = sp_fixture_file_text(out, NULL);
+    const char* end = NULL;
+    cJSON* j = cJSON_ParseWithOpts(text, &end, false);
+    ENSURE(j && cJSON_GetObjectItem(j, "asset") && strspn(end, " \n") == strlen(end)); // a glTF, nothing after it
+    cJSON_Delete(j);
+    free(text);
+    snprintf(args, sizeof args, "'%s' pose --rig '%s' --strokes '%s' --render /dev/stdout > '%s' 2>/dev/null", SP_SKETCHPOSE, rig,
+             strokes, out);
+    ENSURE(run(args) == 0);
+    size_t n = 0;
+    unsigned char* png = (unsigned char*)sp_fixture_file_text(out, &n);
+    // A PNG ends with its IEND chunk and its CRC: nothing after it.
+    ENSURE(png && n > 12 && !memcmp(png + 1, "PNG", 3) && !memcmp(png + n - 8, "IEND", 4));
+    free(png);
+}
+
 // A solve out of iterations is reported so, also when the cap falls between
 // two stages of its plan: the next stage ended at once, "converged", with
 // no iteration left (the cartoon man's outline drawn as one loop: its
@@ -1451,6 +1483,7 @@ int main(int argc, char** argv)
                                    {"outputs_kept", test_outputs_kept},
                                    {"outputs_off_gltf_files", test_outputs_off_gltf_files},
                                    {"report_on_stdout_once", test_report_on_stdout_once},
+                                   {"file_on_stdout_alone", test_file_on_stdout_alone},
                                    {"render_size", test_render_size},
                                    {"pose_file_strict", test_pose_file_strict},
                                    {"note_unmatched_curves", test_note_unmatched_curves},
