@@ -578,7 +578,9 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
         }
     }
     if (rc != SQLITE_OK) {
-        r = db_fail(db, rc, "reading the schema version", err);
+        // Opened to write, a read-only file fails here: said as what the caller was doing (a kiosk's
+        // collector logged "while reading the schema version" for each stroke dropped: an outside review).
+        r = db_fail(db, rc, ro ? "reading the schema version" : "opening it to write", err);
         goto fail;
     }
     if (!ro && sqlite3_db_readonly(db->h, "main") == 1) {
