@@ -10,7 +10,11 @@
 #include "commands.h"
 #include "posing.h"
 #include "solve_cmd.h"
+#include "sp/curve.h"
 #include "sp/embed.h"
+
+// The shortest stroke drawn over the character, px.
+#define DRAWOVER_MIN_PX 3.0
 
 // One abstraction with a curve per stroke of `on`, embedded in the mesh.
 static sp_result embed_strokes(const sp_rig* rig, const double* xyz, const sp_camera* cam, const sp_sketch* on, sp_abstraction* out,
@@ -29,6 +33,13 @@ static sp_result embed_strokes(const sp_rig* rig, const double* xyz, const sp_ca
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     }
     for (int i = 0; i < n; ++i) {
+        // A tap or a dot says no part of the character: embedded, it swung
+        // the arm it touched to its bounds, exit 0 (as --to refuses it).
+        double len = sp_curve_length(on->strokes[i].points, on->strokes[i].count, false);
+        if (!(len >= DRAWOVER_MIN_PX)) {
+            sp_abstraction_free(out);
+            return sp_fail(err, SP_ERR_INVALID, "stroke %d is %.1f px long: too short to draw over a part (a tap?)", i, len);
+        }
         sp_abstraction one;
         char name[32];
         snprintf(name, sizeof name, "stroke%d", i);
@@ -123,6 +134,7 @@ int cmd_drawover(int argc, char** argv)
     if (run.abstraction < 0) goto oom;
     if (!(active = sp_drawover_active(&ch->rig, &emb))) goto oom;
     run.desc.active = active;
+    run.desc.ordered_by_ends = true; // a curve redrawn turned about one end keeps its ends
     double scale = sp_drawover_scale_weights(&run.desc, &ch->rig, xyz, &cam, &emb);
     sp_solve_report rep;
     if (!sp_solve_cmd_solve(&run, &cam, &to, to_path, p, p, &rep, &rep_json)) goto done;

@@ -383,6 +383,8 @@ static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_
     rep->bbox_diagonal_px = s->L;
     plan_attempt(s, sk, at, iou, pl);
     s->c2s_valid = false;
+    for (int c = 0; c < SP_REPORT_CURVES; ++c)
+        s->end_stroke[c] = -1;
     if (s->model->failed)
         res = sp_fail(err, SP_ERR_INVALID, "%s", s->model->error.text);
     else

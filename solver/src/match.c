@@ -350,6 +350,16 @@ static sp_result ordered_pairs(sp_solver* s, const sp_sketch* sk, const sp_pairi
         if (how->loop_shift && cv->closed && C == 1) {
             info = *how->loop_shift;
             sp_corr_ordered_match(&info, m, match);
+        } else if (s->d.ordered_by_ends && !cv->closed) {
+            bool held = c < SP_REPORT_CURVES && s->end_stroke[c] == st;
+            sp_vec2 y0 = y[0], y1 = y[m - 1], z0 = z[0], z1 = z[m - 1];
+            bool rev = held ? s->end_rev[c]
+                            : hypot(y0.x - z0.x, y0.y - z0.y) + hypot(y1.x - z1.x, y1.y - z1.y) >
+                                  hypot(y0.x - z1.x, y0.y - z1.y) + hypot(y1.x - z0.x, y1.y - z0.y);
+            if (c < SP_REPORT_CURVES) s->end_stroke[c] = st, s->end_rev[c] = rev;
+            info = (sp_ordered_info){rev, rev ? m - 1 : 0, 0};
+            sp_corr_ordered_match(&info, m, match);
+            info.shift = 0;
         } else {
             res = sp_corr_ordered(y, z, m, cv->closed, match, &info);
         }

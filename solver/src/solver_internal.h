@@ -121,6 +121,11 @@ struct sp_solver {
     double L;                  // abstraction 2D diagonal at the start pose, pixels
     int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke), for sp_pairing.keep_assignment
     bool c2s_valid;
+    // ordered_by_ends: each curve's direction and the stroke it was decided
+    // with, at an attempt's first pairing, held after (an arm folding on its
+    // way up had its ends' sums cross and was paired back); -1: not yet.
+    int end_stroke[SP_REPORT_CURVES];
+    bool end_rev[SP_REPORT_CURVES];
 };
 
 // The energy's weights in one round (the graduated schedule of icp.c):

@@ -69,6 +69,13 @@ typedef struct sp_solve_desc {
     bool no_root_alignment; ///< skip the first stage that moves only the root's parameters
     const bool* active;  ///< param_count flags: which parameters may change; NULL: all
     int threads;         ///< black-box rigs (sp/blackbox.h): finite-difference threads; 0: the online cores (at most 8)
+    /// Ordered pairing of an open curve and its stroke runs the way that puts
+    /// their ends nearer (the sum of the two ends' distances), not the way of
+    /// the least squared distance over all samples: for draw-over, where a
+    /// curve is redrawn turned about one end. An arm redrawn raised 40
+    /// degrees or more was paired reversed, the cheaper pairing of two lines
+    /// meeting at the shoulder, and folded onto itself (an outside review).
+    bool ordered_by_ends;
 } sp_solve_desc;
 
 /// Why a solve stopped: how the last stage of the attempt kept ended. A
