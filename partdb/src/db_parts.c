@@ -312,6 +312,25 @@ static sp_result category_case_clash(sp_db* db, const char* category, sp_error* 
     return r;
 }
 
+// A part stored already from the same bytes (under another name) is said:
+// the classifier then learns two categories from the same shapes, and a
+// curator added one file twice without a word (an outside review).
+static void warn_same_file(sp_db* db, const sp_db_part_info* info, const sp_db_part_desc* d)
+{
+    sqlite3_stmt* st = NULL;
+    sp_error e = {0};
+    if (!d->warn || db_prepare(db, "SELECT name, category FROM parts WHERE sha256 = ? LIMIT 1", &st, &e) != SP_OK) return;
+    sqlite3_bind_text(st, 1, info->sha256, -1, SQLITE_TRANSIENT);
+    if (sqlite3_step(st) == SQLITE_ROW) {
+        char line[320];
+        snprintf(line, sizeof line,
+                 "the same file as part '%s' (category %s): visitors' drawings of the two look alike to the classifier",
+                 (const char*)sqlite3_column_text(st, 0), (const char*)sqlite3_column_text(st, 1));
+        d->warn(d->warn_user, line);
+    }
+    sqlite3_finalize(st);
+}
+
 static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, unsigned derived,
                           sp_db_part_info* info_out, sp_error* err)
 {
@@ -349,6 +368,7 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
     sqlite3_stmt* st = NULL;
     if ((r = db_begin(db, err)) != SP_OK) goto done;
     if ((r = category_case_clash(db, info.category, err)) != SP_OK) goto rollback;
+    warn_same_file(db, &info, &d);
     if ((r = db_prepare(db,
                         "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, parameters,"
                         " abstractions, animations, selftest_error, summary, added_by) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
