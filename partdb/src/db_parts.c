@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "db_internal.h"
+#include "gltf_internal.h"
 #include "sp/handdraw.h"
 #include "sp/part.h"
 #include "sp/sketch_io.h"
@@ -121,7 +122,7 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
     // by Blender) is the reason: "no sketch abstraction" alone sent a curator
     // to `inspect` to find it (an outside review).
     const char* why = NULL;
-    for (int w = 0; w < ch.warning_count && !why; ++w)
+    for (int w = 0; a < 0 && w < ch.warning_count && !why; ++w)
         if (strstr(ch.warnings[w], "sp_abstraction")) why = ch.warnings[w];
     if (a < 0)
         add_reason(reasons, sizeof reasons, "no sketch abstraction%s%s%s%s%s", d && d->abstraction ? " named " : "",
@@ -246,15 +247,8 @@ static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, c
         report_warnings(ch, d);
         // Derived before (`derive --abstraction stick`, then add-part): said
         // here too, as derive said it (it was stored without a word).
-        int a = pick_abstraction(ch, d);
-        if (d->warn && a >= 0 && ch->rig.abstractions[a].curve_count > 1) {
-            char line[256];
-            snprintf(line, sizeof line,
-                     "its '%s' abstraction has %d curves: visitors cannot draw it in the kiosk, which fits one stroke "
-                     "per part (the kiosk's parts use `outline`)",
-                     ch->rig.abstractions[a].name, ch->rig.abstractions[a].curve_count);
-            d->warn(d->warn_user, line);
-        }
+        char line[320];
+        if (d->warn && sp_part_curves_warning(&ch->rig, pick_abstraction(ch, d), line, sizeof line)) d->warn(d->warn_user, line);
         return SP_OK;
     }
     sp_character part = {0};

@@ -658,6 +658,16 @@ static sp_result attach_joint_of(const work* w, const char* name, int* attach, s
     return SP_OK;
 }
 
+bool sp_part_curves_warning(const sp_rig* rig, int a, char* line, size_t cap)
+{
+    if (a < 0 || a >= rig->abstraction_count || rig->abstractions[a].curve_count <= 1) return false;
+    snprintf(line, cap,
+             "its '%s' abstraction has %d curves; the kiosk fits one stroke per part, so visitors cannot draw it in the kiosk "
+             "(it suits `sketchpose pose`; the kiosk's parts use `outline`)",
+             rig->abstractions[a].name, rig->abstractions[a].curve_count);
+    return true;
+}
+
 sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp_character* out, sp_derive_info* info_out,
                          sp_error* err)
 {
@@ -793,12 +803,9 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
                           w.clip->name, (double)(w.times[w.keys - 1] - w.times[0]));
     // The kiosk fits one stroke per part: a figure of several curves cannot
     // be drawn there (an outside review's stick figure became six parts).
-    int ka = sp_rig_find_abstraction(&out->rig, abstraction);
-    if (ka >= 0 && out->rig.abstractions[ka].curve_count > 1)
-        sp_character_warn(out,
-                          "its '%s' abstraction has %d curves; the kiosk fits one stroke per part, so visitors cannot draw it "
-                          "there (it suits `sketchpose pose`; the kiosk's parts use `outline`)",
-                          abstraction, out->rig.abstractions[ka].curve_count);
+    char line[320];
+    if (sp_part_curves_warning(&out->rig, sp_rig_find_abstraction(&out->rig, abstraction), line, sizeof line))
+        sp_character_warn(out, "%s", line);
 done:
     sp_part_free(&part);
     free(is_skin);

@@ -82,6 +82,11 @@ void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s);
 /// unknown names and non-numbers become warnings on ch; values are clamped.
 void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, double* p);
 
+/// The warning a part whose abstraction `a` has several curves gets (the
+/// kiosk fits one stroke per part), written into line; false (nothing
+/// written) for one curve. derive and add-part say it in the same words.
+bool sp_part_curves_warning(const sp_rig* rig, int a, char* line, size_t cap);
+
 /// Appends a warning line to ch->warnings (printf style).
 void sp_character_warn(sp_character* ch, const char* fmt, ...)
 #if defined(__GNUC__)

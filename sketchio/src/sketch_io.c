@@ -524,17 +524,31 @@ static const char* json_key_twice_within(const cJSON* obj, bool* no_memory)
     return twice;
 }
 
-sp_result sp_json_document_check(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+// One JSON document parsed from text: nothing but white space after it,
+// and no NUL byte in it (inside a key, "ca\0nvas", cJSON cut the key short
+// and a stroke file's canvas was dropped silently). *doc: NULL on failure.
+static sp_result parse_document(const char* text, size_t len, const char* name, cJSON** doc, sp_error* err)
 {
-    if (max_values > 0 && sp_json_measure(text, len).values > max_values)
-        return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values", name, max_values);
     const char* end = NULL;
-    cJSON* doc = cJSON_ParseWithLengthOpts(text, len, &end, false);
-    sp_result r = sp_json_document_end(text, len, doc != NULL, end, name, err);
+    *doc = cJSON_ParseWithLengthOpts(text, len, &end, false);
+    sp_result r = sp_json_document_end(text, len, *doc != NULL, end, name, err);
     const char* nul = r == SP_OK ? memchr(text, 0, (size_t)(end - text)) : NULL;
     if (nul)
         r = sp_fail(err, SP_ERR_PARSE, "%s: a NUL byte in the JSON document, line %d (not a text file?)", name,
                     line_of(text, len, nul));
+    if (r != SP_OK) {
+        cJSON_Delete(*doc);
+        *doc = NULL;
+    }
+    return r;
+}
+
+sp_result sp_json_document_check(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+{
+    if (max_values > 0 && sp_json_measure(text, len).values > max_values)
+        return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values", name, max_values);
+    cJSON* doc;
+    sp_result r = parse_document(text, len, name, &doc, err);
     bool oom = false;
     const char* twice = r == SP_OK ? json_key_twice_within(doc, &oom) : NULL;
     char shown[96];
@@ -551,13 +565,9 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
     memset(out, 0, sizeof *out);
     sp_result vr = sp_json_values_within(text, len, SP_SKETCH_MAX_JSON_VALUES, name, err);
     if (vr != SP_OK) return vr;
-    const char* end = NULL;
-    cJSON* root = cJSON_ParseWithLengthOpts(text, len, &end, false);
-    sp_result rc = sp_json_document_end(text, len, root != NULL, end, name, err);
-    if (rc != SP_OK) {
-        cJSON_Delete(root);
-        return rc;
-    }
+    cJSON* root;
+    sp_result rc = parse_document(text, len, name, &root, err);
+    if (rc != SP_OK) return rc;
     sp_sketch s = {0};
     stroke_scratch b = {0};
     const cJSON* fmt = cJSON_GetObjectItemCaseSensitive(root, "format");
@@ -566,13 +576,6 @@ sp_result sp_sketch_parse_json(const char* text, size_t len, const char* name, s
     const cJSON* strokes = cJSON_GetObjectItemCaseSensitive(root, "strokes");
     if (!cJSON_IsObject(root)) {
         rc = sp_fail(err, SP_ERR_PARSE, "%s: a stroke file is a JSON object", name);
-        goto done;
-    }
-    // A NUL byte is no JSON text; inside a key ("ca\0nvas") cJSON cut the key short and the canvas was dropped silently.
-    const char* nul = memchr(text, 0, (size_t)(end - text));
-    if (nul) {
-        rc = sp_fail(err, SP_ERR_PARSE, "%s: a NUL byte in the JSON document, line %d (not a text file?)", name,
-                     line_of(text, len, nul));
         goto done;
     }
     if ((rc = keys_once(root, name, err)) != SP_OK) goto done;

@@ -408,9 +408,7 @@ sp_result sp__gauss_newton_at(sp_solver* s, const sp_sketch* sk, const double* p
     sp_solve_report rep;
     memset(&rep, 0, sizeof rep);
     memcpy(s->p0, p_ref, sizeof(double) * (size_t)s->P);
-    s->c2s_valid = false;
-    for (int c = 0; c < SP_REPORT_CURVES; ++c)
-        s->end_stroke[c] = -1;
+    sp__forget_pairing(s);
     s->ypoly_valid = false;
     s->model->failed = false;
     sp__model_update(s, p_ref, false);

@@ -382,9 +382,7 @@ static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_
     const double iou = start_view(s, sk, r.it.p);
     rep->bbox_diagonal_px = s->L;
     plan_attempt(s, sk, at, iou, pl);
-    s->c2s_valid = false;
-    for (int c = 0; c < SP_REPORT_CURVES; ++c)
-        s->end_stroke[c] = -1;
+    sp__forget_pairing(s);
     if (s->model->failed)
         res = sp_fail(err, SP_ERR_INVALID, "%s", s->model->error.text);
     else

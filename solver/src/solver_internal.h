@@ -128,6 +128,15 @@ struct sp_solver {
     bool end_rev[SP_REPORT_CURVES];
 };
 
+// A new solve or attempt pairs afresh: the kept assignment and the
+// directions decided by the ends are forgotten together.
+static inline void sp__forget_pairing(sp_solver* s)
+{
+    s->c2s_valid = false;
+    for (int c = 0; c < SP_REPORT_CURVES; ++c)
+        s->end_stroke[c] = -1;
+}
+
 // The energy's weights in one round (the graduated schedule of icp.c):
 // W_pose of the parameters from boost_from on times pose_boost (>= 1), the
 // parameters before it (a loop's root placement, placed free) at the
