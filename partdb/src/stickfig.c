@@ -264,11 +264,15 @@ static sp_vec3 pushed_end(const sp_rig* rig, const double* xyz, int joint, sp_ve
     return sp_v3_add(pivot, sp_v3_scale(d, far > 0 ? far : reach));
 }
 
-sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err)
+// Appends abstraction `name` (one open curve of the same name) through the
+// pivots of the joints the rig's line reaches in `order` (n of them, read by
+// joints_of), each end pushed on to the end of the mesh there.
+static sp_result add_path(sp_rig* rig, int (*joints_of)(const sp_rig*, int, int*, int), int arg, const char* name, bool* added,
+                          sp_error* err)
 {
     *added = false;
     int J = rig->joint_count;
-    if (sp_rig_find_abstraction(rig, "line") >= 0) return SP_OK;
+    if (sp_rig_find_abstraction(rig, name) >= 0) return SP_OK;
     int* order = malloc(sizeof(int) * (size_t)(J + 1));
     double* p = malloc(sizeof(double) * (size_t)(rig->param_count + 1));
     sp_vec3* at = malloc(sizeof(sp_vec3) * (size_t)(J + 3)); // the path's points: the two pushed ends added
@@ -279,10 +283,10 @@ sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err)
     stick_buf b = {0};
     sp_result r = SP_OK;
     if (!order || !p || !at || !bone || !ev) {
-        r = sp_fail(err, SP_ERR_NO_MEMORY, "line: out of memory");
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
         goto done;
     }
-    int n = sp_rig_line_joints(rig, order, J);
+    int n = joints_of(rig, arg, order, J);
     if (n < 2) goto done;
     sp_rig_defaults(rig, p);
     sp_rig_eval_update(ev, p, false);
@@ -312,19 +316,57 @@ sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err)
         int k = (int)ceil(LINE_POINTS * sp_v3_len(d) / total);
         sp_mat4 inv;
         if (!sp_mat4_inverse_rel(&skin[bone[i]], SP_MAT4_FLAT, &inv)) {
-            r = sp_fail(err, SP_ERR_INVALID, "line: joint %s has a singular skin matrix", rig->joints[bone[i]].name);
+            r = sp_fail(err, SP_ERR_INVALID, "%s: joint %s has a singular skin matrix", name, rig->joints[bone[i]].name);
             goto done;
         }
         for (int s = 0; s < k || (i == n && s == k); ++s)
             if (!stick_push(&b, &inv, bone[i], sp_v3_add(at[i], sp_v3_scale(d, k > 0 ? (double)s / k : 0.0)))) {
-                r = sp_fail(err, SP_ERR_NO_MEMORY, "line: out of memory");
+                r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
                 goto done;
             }
     }
-    if (b.n >= 2 && (r = stick_append(rig, &b, "line", "line", "line", err)) == SP_OK) *added = true;
+    if (b.n >= 2 && (r = stick_append(rig, &b, name, name, name, err)) == SP_OK) *added = true;
 done:
     sp_rig_eval_destroy(ev);
     free(order), free(p), free(at), free(bone), free(xyz);
     stick_free(&b);
     return r;
+}
+
+static int line_joints(const sp_rig* rig, int unused, int* order, int cap)
+{
+    (void)unused;
+    return sp_rig_line_joints(rig, order, cap);
+}
+
+sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err)
+{
+    return add_path(rig, line_joints, 0, "line", added, err);
+}
+
+// The chain from `leaf` up to the joint the skeleton's two leaves share
+// (that joint last); 0 unless the skeleton is a line of two leaves and
+// `leaf` is one of them.
+static int limb_joints(const sp_rig* rig, int leaf, int* order, int cap)
+{
+    int lv[2];
+    if (leaves(rig, lv, 2) != 2 || (leaf != lv[0] && leaf != lv[1]) || cap < 1) return 0;
+    int n = sp_rig_line_joints(rig, order, cap);
+    if (n < 3 || n > cap) return 0;
+    // The line runs leaf A .. shared .. leaf B: the shared joint is the first
+    // from A whose parent is not the next one on the line.
+    if (order[0] != leaf)
+        for (int i = 0, k = n - 1; i < k; ++i, --k) {
+            int t = order[i];
+            order[i] = order[k], order[k] = t;
+        }
+    int m = 1;
+    while (m < n && rig->joints[order[m - 1]].parent == order[m])
+        ++m;
+    return m >= 2 ? m : 0;
+}
+
+sp_result sp_rig_add_limb(sp_rig* rig, int leaf, bool* added, sp_error* err)
+{
+    return add_path(rig, limb_joints, leaf, "limb", added, err);
 }

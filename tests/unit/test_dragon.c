@@ -2909,6 +2909,56 @@ static void test_line_drawn(void)
     sp_dragon_destroy(d);
 }
 
+// A pair of legs drawn as one straight line (a young child's leg) is
+// fitted with one leg's line (sp_rig_add_limb), the other leg stepping
+// beside it: along the whole stroke, where the outline and the pair's
+// peaked line both shrank to under half of it (an outside review: 40-45%
+// of the line's length, every straight leg). The visitors' legs drawn as a
+// peaked line (both feet on the ground) keep the pair's curves.
+static void test_leg_drawn_as_one_line(void)
+{
+    const char* path = real_db();
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    int as_limb = 0, total = 0;
+    double worst = 1;
+    for (int k = 0; k < 8; ++k) {
+        sp_dragon_clear(d);
+        sp_dragon_result body = draw_part(d, db, "torso", 640, 380, 420, false, true);
+        sp_vec2 blo, bhi;
+        fitted_box(d, body.part, &blo, &bhi);
+        bool front = k & 1;
+        double len = k & 2 ? 240 : 120, slant = k & 4 ? 0.35 : 0.0; // radians from upright
+        // From the belly down, with a little of a hand's wobble.
+        sp_vec2 top = {blo.x + (front ? 0.7 : 0.3) * (bhi.x - blo.x), bhi.y - 0.08 * (bhi.y - blo.y)}, xy[40];
+        for (int i = 0; i < 40; ++i) {
+            double u = i / 39.0, w = 2.0 * sin(9.0 * u + k);
+            xy[i] = (sp_vec2){top.x + u * len * sin(slant) + w, top.y + u * len * cos(slant)};
+        }
+        int i = add_as(d, xy, 40, front ? "front_legs" : "hind_legs");
+        const char* curve = fitted_curve(d, i);
+        double reach = fitted_reach(d, i, xy, 40, fmax(6.0, 0.06 * len));
+        fprintf(stderr, "  %s legs, a line of %.0f px %s: fitted with its %s, %.0f%% of the line within 6%% of its length\n",
+                front ? "front" : "hind", len, slant > 0 ? "slanted" : "upright", curve, 100 * reach);
+        as_limb += !strcmp(curve, "limb");
+        worst = fmin(worst, reach);
+        ++total;
+    }
+    ENSURE(as_limb == total && worst >= 0.8);
+    const char* peaked[] = {"front_legs/front-legs-open-line.json", "hind_legs/hind-legs-zigzag-line.json"};
+    for (int k = 0; k < 2; ++k) {
+        int n;
+        sp_dragon_clear(d);
+        sp_vec2* xy = visitor_stroke(peaked[k], 260, (sp_vec2){640, 400}, false, &n);
+        const char* curve = fitted_curve(d, add_as(d, xy, n, k ? "hind_legs" : "front_legs"));
+        fprintf(stderr, "  %s: fitted with its %s\n", peaked[k], curve);
+        ENSURE(strcmp(curve, "limb"));
+        free(xy);
+    }
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // Legs and wings face the way their dragon does (docs/DESIGN.md, "The kiosk
 // pipeline"): a dragon of visitors' drawings (tune half) drawn facing left
 // (mirrored, its head at the left end of the body) gets its legs and wings
@@ -4706,6 +4756,7 @@ int main(int argc, char** argv)
                                    {"robustness", test_robustness},
                                    {"visitors_policy", test_visitors_policy},
                                    {"line_drawn", test_line_drawn},
+                                   {"leg_drawn_as_one_line", test_leg_drawn_as_one_line},
                                    {"facing_follows_dragon", test_facing_follows_dragon},
                                    {"head_first_faces_as_after", test_head_first_faces_as_after},
                                    {"mirror_refusal", test_mirror_refusal},

@@ -72,9 +72,10 @@ typedef struct tpl {
     sp_camera solver_cam; // the solver reads the camera through this pointer at every solve
     sp_rig_eval* ev;
     // The same part fitted with its `line` abstraction (sp_rig_add_line: a
-    // tail, a pair of legs), for strokes drawn as one open line; NULL for
-    // other parts and for the line template itself.
-    struct tpl* line;
+    // tail, a pair of legs) and, for a pair of legs, its `limb` (one leg:
+    // sp_rig_add_limb), for strokes drawn as one open line; NULL for other
+    // parts and for the line templates themselves.
+    struct tpl *line, *limb;
     bool* active; // the line template's solver moves these (param_count; NULL: all)
     // The same fit with the attachment end held in place (reach.c; made on
     // first use): every parameter of `active` but the root's translation.

@@ -15,6 +15,7 @@ void dragon_tpl_release(tpl* t)
 {
     if (!t || --t->refs > 0) return;
     dragon_tpl_release(t->line);
+    dragon_tpl_release(t->limb);
     sp_solver_destroy(t->solver);
     free(t->active);
     sp_solver_destroy(t->pinned);
@@ -82,12 +83,41 @@ static void read_part_extras(tpl* t)
     }
 }
 
+static sp_result tpl_load(sp_db* db, const tpl* line_of, int limb_leaf, const char* name, int canvas_w, int canvas_h,
+                          const sp_solve_desc* solve, tpl** out, sp_error* err);
+
+// Gives t (an outline template) its line templates, for strokes drawn as one
+// open line: the `line` through its chain (a tail, a pair of legs) and, for
+// a pair of legs, the `limb` of the leg nearer the camera (the leg a child
+// draws as one straight line). A part whose lines cannot be made is still
+// fitted with its outline.
+static void load_lines(sp_db* db, tpl* t, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve)
+{
+    const sp_rig* rig = &t->ch.rig;
+    int* order = malloc(sizeof(int) * ((size_t)rig->joint_count + 1));
+    int n = order ? sp_rig_line_joints(rig, order, rig->joint_count) : 0;
+    sp_error lerr = {0};
+    if (n > 0) tpl_load(db, t, -1, name, canvas_w, canvas_h, solve, &t->line, &lerr);
+    if (t->line && rig->joints[order[n - 1]].parent >= 0) { // two leaves (one chain ends at the root)
+        const sp_mat4* world = sp_rig_eval_world(t->ev);
+        double z0 = sp_mat4_point(&t->base.view, sp_mat4_translation(&world[order[0]])).z,
+               z1 = sp_mat4_point(&t->base.view, sp_mat4_translation(&world[order[n - 1]])).z;
+        tpl_load(db, t, z0 >= z1 ? order[0] : order[n - 1], name, canvas_w, canvas_h, solve, &t->limb, &lerr);
+    }
+    free(order);
+    // Which way the part reaches is the part's, whichever curve is fitted.
+    tpl* lines[2] = {t->line, t->limb};
+    for (int k = 0; k < 2; ++k)
+        if (lines[k]) lines[k]->lengthwise = t->lengthwise, lines[k]->outward = t->outward;
+}
+
 // Loads part `name` from the database as a template fitted with its
 // abstraction (`outline`); or, with line_of, makes line_of's part fitted
-// with a `line` added to it, from a copy of its character (SP_OK, *out
-// NULL and nothing in err when its skeleton has no line).
-static sp_result tpl_load(sp_db* db, const tpl* line_of, const char* name, int canvas_w, int canvas_h, const sp_solve_desc* solve,
-                          tpl** out, sp_error* err)
+// with a `line` added to it (with limb_leaf >= 0: a `limb` from that leaf),
+// from a copy of its character (SP_OK, *out NULL and nothing in err when
+// its skeleton has no such curve).
+static sp_result tpl_load(sp_db* db, const tpl* line_of, int limb_leaf, const char* name, int canvas_w, int canvas_h,
+                          const sp_solve_desc* solve, tpl** out, sp_error* err)
 {
     *out = NULL;
     tpl* t = calloc(1, sizeof *t);
@@ -106,11 +136,12 @@ static sp_result tpl_load(sp_db* db, const tpl* line_of, const char* name, int c
     const sp_rig* rig = &t->ch.rig;
     if (line_of) {
         bool added = false;
-        if ((r = sp_rig_add_line(&t->ch.rig, &added, err)) != SP_OK || !added) {
+        r = limb_leaf >= 0 ? sp_rig_add_limb(&t->ch.rig, limb_leaf, &added, err) : sp_rig_add_line(&t->ch.rig, &added, err);
+        if (r != SP_OK || !added) {
             dragon_tpl_release(t);
             return r;
         }
-        t->abstraction = sp_rig_find_abstraction(rig, "line");
+        t->abstraction = sp_rig_find_abstraction(rig, limb_leaf >= 0 ? "limb" : "line");
     } else {
         t->abstraction = info.abstraction[0] ? sp_rig_find_abstraction(rig, info.abstraction) : -1;
         if (t->abstraction < 0) t->abstraction = rig->abstraction_count > 0 ? 0 : -1;
@@ -210,16 +241,7 @@ static sp_result tpl_load(sp_db* db, const tpl* line_of, const char* name, int c
     }
     free(xyz);
     free(xy);
-    int ends[2];
-    if (!line_of && !t->is_torso && sp_rig_line_joints(rig, ends, 2) > 0) {
-        sp_error lerr = {0}; // a part whose line cannot be made is still fitted with its outline
-        tpl_load(db, t, name, canvas_w, canvas_h, solve, &t->line, &lerr);
-        if (t->line) {
-            // Which way the part reaches is the part's, whichever curve is fitted.
-            t->line->lengthwise = t->lengthwise;
-            t->line->outward = t->outward;
-        }
-    }
+    if (!line_of && !t->is_torso) load_lines(db, t, name, canvas_w, canvas_h, solve);
     *out = t;
     return SP_OK;
 fail:
@@ -423,7 +445,7 @@ static tpl* cache_load(sp_dragon* d, const char* name, sp_error* err)
 {
     sp_error lerr = {0};
     tpl* t = NULL;
-    sp_result r = tpl_load(d->db, NULL, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, &t, &lerr);
+    sp_result r = tpl_load(d->db, NULL, -1, name, d->desc.canvas_w, d->desc.canvas_h, &d->desc.solve, &t, &lerr);
     if (r != SP_OK) {
         fail_part(d, name, r, lerr.text);
         sp_fail(err, r, "%s", lerr.text);

@@ -253,23 +253,29 @@ done:
 // A stroke drawn as one open line (not a loop: sp_stroke_is_loop) may be a
 // tail or a pair of legs drawn as a line, which the part's outline can only
 // take folded or shrunk: the kept fit f is fitted again with the part's
-// line (tpl.line) in the same facing, and the line's fit replaces it when
-// it lies nearer the stroke both ways (two_way_gap). The outline's score
-// stays f's evidence (the ranking and the refusal are measured on outlines).
+// lines (tpl.line, tpl.limb) in the same facing, and the line fit lying
+// nearest the stroke both ways (two_way_gap) replaces it when nearer than
+// f. The outline's score stays f's evidence (the ranking and the refusal
+// are measured on outlines).
 static void prefer_line(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, fit_choice* f)
 {
-    fit_choice l;
-    int not_finite = 0;
-    if (!f->t->line || sp_stroke_is_loop(&sk->strokes[0]) || !fit_one(d, f->t->line, sk, lo, hi, f->mirrored, &l, &not_finite))
-        return;
-    double diag = sp_v2_len(sp_v2_sub(hi, lo)), gf = two_way_gap(f, &sk->strokes[0], diag),
-           gl = two_way_gap(&l, &sk->strokes[0], diag);
-    if (gl < gf) {
-        l.score = f->score;
-        free(f->p);
-        *f = l;
-    } else {
-        free(l.p);
+    if (sp_stroke_is_loop(&sk->strokes[0])) return;
+    double diag = sp_v2_len(sp_v2_sub(hi, lo)), best = INFINITY;
+    tpl* lines[2] = {f->t->line, f->t->limb};
+    for (int k = 0; k < 2; ++k) {
+        fit_choice l;
+        int not_finite = 0;
+        if (!lines[k] || !fit_one(d, lines[k], sk, lo, hi, f->mirrored, &l, &not_finite)) continue;
+        if (best == INFINITY) best = two_way_gap(f, &sk->strokes[0], diag);
+        double gl = two_way_gap(&l, &sk->strokes[0], diag);
+        if (gl < best) {
+            best = gl;
+            l.score = f->score;
+            free(f->p);
+            *f = l;
+        } else {
+            free(l.p);
+        }
     }
 }
 

@@ -126,6 +126,14 @@ int sp_rig_line_joints(const sp_rig* rig, int* order, int cap);
 /// already has a `line`; also on SP_ERR_NO_MEMORY or SP_ERR_INVALID (a
 /// singular skin matrix), when the rig is not to be fitted with a line.
 sp_result sp_rig_add_line(sp_rig* rig, bool* added, sp_error* err);
+/// Appends the `limb` abstraction to a rig of two chains (a pair of legs):
+/// the same kind of curve as `line`, from `leaf` (one of the two leaves)
+/// up to the joint the chains share. A pair of legs drawn as one straight
+/// line is one leg, the other hidden behind it or stepping apart; the
+/// `line` would fold to take it (foot, hip and foot along one stroke).
+/// *added is false, and nothing changes, for another skeleton, a leaf that
+/// is not one of the two, or a rig that already has a `limb`.
+sp_result sp_rig_add_limb(sp_rig* rig, int leaf, bool* added, sp_error* err);
 /// Makes a character of a finalized rig, which it takes over (*rig is zeroed):
 /// default pose, light grey vertices, the default front orthographic camera.
 /// For generators and tests that build rigs in code and want to save them.
