@@ -120,6 +120,10 @@ struct sp_solver {
     int pair_count, pair_cap;
     double L;                  // abstraction 2D diagonal at the start pose, pixels
     int c2s[SP_REPORT_CURVES]; // the last stroke assignment (curve -> stroke), for sp_pairing.keep_assignment
+    // With it, when the topology made it: which way each open curve runs
+    // along its stroke, where one end of each meets others (the stroke's
+    // meeting end pairs with the curve's); -1: not told so.
+    signed char topo_rev[SP_REPORT_CURVES];
     bool c2s_valid;
     // ordered_by_ends: each curve's direction and the stroke it was decided
     // with, at an attempt's first pairing, held after (an arm folding on its
