@@ -394,8 +394,11 @@ static void mark_path(const char* shot, const char* name, char* out, size_t cap)
 
 // A database that is there must have parts to draw: checked before any
 // window opens, one line when not. One not there is built by the default
-// recipe (sp_kiosk_create).
-static bool has_parts(const char* path, const char* assets)
+// recipe (sp_kiosk_create). A kiosk that collects opens it to write when it
+// may, as its collector does, so that an older schema is migrated (the
+// read-only open refuses one, and the kiosk would not start on last
+// season's database after an upgrade: an outside review).
+static bool has_parts(const char* path, const char* assets, bool collect)
 {
     struct stat st;
     // Missing, it is built from the assets: without them the kiosk said
@@ -412,7 +415,9 @@ static bool has_parts(const char* path, const char* assets)
     sp_db* db = NULL;
     char** cats = NULL;
     int n = 0;
-    bool ok = sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK && sp_db_categories(db, &cats, &n, &err) == SP_OK;
+    bool ok = collect && access(path, W_OK) == 0 && sp_db_open(path, 0, &db, &err) == SP_OK;
+    if (!ok) err = (sp_error){0}, ok = sp_db_open(path, SP_DB_READONLY, &db, &err) == SP_OK;
+    ok = ok && sp_db_categories(db, &cats, &n, &err) == SP_OK;
     if (!ok)
         fprintf(stderr, "%s: %s\n", k_cmd, err.text);
     else if (n == 0)
@@ -658,7 +663,7 @@ int main(int argc, char** argv)
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
-    if (!has_parts(db ? db : sp_db_default_path(), assets ? assets : sp_dragon_default_assets())) {
+    if (!has_parts(db ? db : sp_db_default_path(), assets ? assets : sp_dragon_default_assets(), !no_collect)) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }

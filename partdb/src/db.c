@@ -457,6 +457,23 @@ static bool reader_may_write(const char* path)
     return ok;
 }
 
+// A database to be created: its folder must be there and take new files.
+// Said before SQLite tries, whose retry read-only leaves errno at ENOENT (a
+// read-only file system read "cannot open (No such file or directory)").
+static sp_result folder_takes_files(const char* path, sp_error* err)
+{
+    char* dir = sp_path_folder(path);
+    if (!dir) return sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", path);
+    struct stat ds;
+    sp_result r = SP_OK;
+    if (stat(dir, &ds) != 0 || !S_ISDIR(ds.st_mode))
+        r = sp_fail(err, SP_ERR_IO, "%s: cannot create it: the folder %s is not there", path, dir);
+    else if (faccessat(AT_FDCWD, dir, W_OK | X_OK, AT_EACCESS) != 0)
+        r = sp_fail(err, SP_ERR_IO, "%s: cannot create it in the folder %s (%s)", path, dir, strerror(errno));
+    free(dir);
+    return r;
+}
+
 sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err)
 {
     return sp_db_open_wait(path, flags, -1, out, err);
@@ -528,6 +545,7 @@ static bool open_here(const struct stat* st)
 sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db** out, sp_error* err)
 {
     *out = NULL;
+    sp_result r;
     bool ro = (flags & SP_DB_READONLY) != 0;
     struct stat st;
     bool exists = stat(path, &st) == 0;
@@ -540,6 +558,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     if (!exists && (ro || !(flags & SP_DB_CREATE)))
         return sp_fail(err, SP_ERR_IO, "%s: no such database (create one with `sketchpose db init`)", path);
     if (exists && !S_ISREG(st.st_mode)) return sp_fail(err, SP_ERR_IO, "%s: not a regular file", path);
+    if (!exists && (r = folder_takes_files(path, err)) != SP_OK) return r;
     sp_db* db = calloc(1, sizeof *db);
     if (!db || !(db->path = strdup(path))) {
         free(db);
@@ -557,7 +576,7 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     if (exists) db->at_dev = st.st_dev, db->at_ino = st.st_ino, db->at_known = true;
     int rc = sqlite3_open_v2(path, &db->h, oflags | SQLITE_OPEN_FULLMUTEX, NULL);
     DB_HOOK("opened");
-    sp_result r = SP_OK;
+    r = SP_OK;
     if (rc != SQLITE_OK) {
         r = (rc & 0xff) == SQLITE_CANTOPEN ? sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno ? errno : EACCES))
                                           : db_fail(db, rc, "opening", err);
@@ -567,9 +586,11 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     sqlite3_busy_timeout(db->h, db->busy_ms);
     int v = 0;
     rc = pragma_int(db, "PRAGMA user_version", &v);
-    if (ro && (rc & 0xff) == SQLITE_READONLY) {
+    if (ro && ((rc & 0xff) == SQLITE_READONLY || (ro_file && (rc & 0xff) == SQLITE_CANTOPEN))) {
         // A WAL database read where this user may not make its -shm (a folder
-        // of someone else's): read it as a file no one changes meanwhile.
+        // of someone else's; a read-only file system, where SQLite cannot
+        // even open it: an SD card, a squashfs image): read it as a file no
+        // one changes meanwhile.
         sqlite3_close(db->h);
         db->h = NULL;
         if ((rc = open_immutable(path, &db->h)) == SQLITE_OK) {

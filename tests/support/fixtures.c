@@ -403,3 +403,26 @@ bool sp_fixture_store_model_again(const char* path)
     sqlite3_close(h);
     return rc == SQLITE_OK;
 }
+
+bool sp_fixture_db_downgrade(const char* path, int version)
+{
+    sqlite3* h = NULL;
+    int rc = version == 1 || version == 2 ? sqlite3_open(path, &h) : SQLITE_MISUSE;
+    // The version-3 trigger reads the status column: it goes first.
+    if (rc == SQLITE_OK)
+        rc = sqlite3_exec(h,
+                          "DROP TRIGGER gen_sketches_ins; DROP INDEX sketches_review; ALTER TABLE sketches DROP COLUMN status;"
+                          "CREATE TRIGGER gen_sketches_ins AFTER INSERT ON sketches BEGIN UPDATE meta SET value = value + 1 "
+                          "WHERE key = 'generation'; END; PRAGMA user_version = 2",
+                          NULL, NULL, NULL);
+    if (rc == SQLITE_OK && version == 1)
+        rc = sqlite3_exec(
+            h,
+            "DROP TRIGGER gen_parts_ins; DROP TRIGGER gen_parts_del; DROP TRIGGER gen_sketches_ins;"
+            "DROP TRIGGER gen_sketches_del; DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta;"
+            "PRAGMA user_version = 1",
+            NULL, NULL, NULL);
+    if (rc != SQLITE_OK) fprintf(stderr, "  %s: %s\n", path, h ? sqlite3_errmsg(h) : "no such version");
+    sqlite3_close(h);
+    return rc == SQLITE_OK;
+}

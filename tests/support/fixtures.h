@@ -119,6 +119,11 @@ bool sp_fixture_rename_done(void);
 /// reader reads them as it would). False, said on stderr, when it cannot.
 bool sp_fixture_store_model_again(const char* path);
 
+/// Takes the sketchpose database at `path` back to schema version 2 (before
+/// reviews: no status column) or 1 (nor a generation counter either), as
+/// an older release left it; false, with a line on stderr, on failure.
+bool sp_fixture_db_downgrade(const char* path, int version);
+
 /// A JSON file, parsed (fails the running test when it does
 /// not read or parse). Free with cJSON_Delete.
 struct cJSON* sp_fixture_json_file(const char* path);

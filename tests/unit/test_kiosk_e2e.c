@@ -1523,6 +1523,43 @@ static void test_collect_stale_wal(void)
     ENSURE(pending_count(db) == 1);
 }
 
+// Last season's database (schema version 2, before reviews) after an
+// upgrade: a kiosk that collects opens it to write and migrates it, then
+// runs (an outside review: it exited 1 before its window, its check of the
+// parts opening it read-only, which refuses an older schema); one that does
+// not collect never writes it, and says what to run.
+static void test_older_schema(void)
+{
+    NEED_XVFB();
+    for (int collect = 1; collect >= 0; --collect) {
+        char db[1100];
+        e2e_db_copy(collect ? "kiosk_v2.db" : "kiosk_v2_nocollect.db", db, sizeof db);
+        ENSURE(sp_fixture_db_downgrade(db, 2));
+        const char* sc = sp_test_tmp_path("kiosk_v2.json");
+        script s = script_open(sc, 0);
+        script_event(&s, 0, "down", 640, 400);
+        script_event(&s, 60, "up", 640, 400);
+        script_end(&s, sc, 500);
+        char args[2048];
+        snprintf(args, sizeof args, "--script '%s'%s", sc, collect ? "" : " --no-collect");
+        int rc = run_kiosk_on(db, args, NULL);
+        sqlite3* h = NULL;
+        ENSURE(sqlite3_open(db, &h) == SQLITE_OK);
+        sqlite3_stmt* q = NULL;
+        ENSURE(sqlite3_prepare_v2(h, "PRAGMA user_version", -1, &q, NULL) == SQLITE_OK && sqlite3_step(q) == SQLITE_ROW);
+        int version = sqlite3_column_int(q, 0);
+        sqlite3_finalize(q);
+        sqlite3_close(h);
+        char* said = sp_fixture_file_text(sp_test_tmp_path("kiosk_stderr.txt"), NULL);
+        fprintf(stderr, "  %s: exit %d, schema version %d after\n", collect ? "collecting" : "--no-collect", rc, version);
+        if (collect)
+            ENSURE(rc == 0 && version == SP_DB_SCHEMA_VERSION);
+        else
+            ENSURE(rc == 1 && version == 2 && said && strstr(said, "older than") && strstr(said, "sketchpose db check"));
+        free(said);
+    }
+}
+
 // The collector follows a database renamed over the live one before the
 // pipeline does (a stroke left while the next one was being fitted): the
 // pipeline's reopen must not take the collector's new -wal and -shm for the
@@ -2522,6 +2559,7 @@ int main(int argc, char** argv)
                                    {"collect_mended", test_collect_mended},
                                    {"collect_stale_wal", test_collect_stale_wal},
                                    {"collect_before_pipeline", test_collect_before_pipeline},
+                                   {"older_schema", test_older_schema},
                                    {"saves_disk", test_saves_disk},
                                    {"parts_row_follows", test_parts_row_follows},
                                    {"long_category", test_long_category},

@@ -302,6 +302,43 @@ static void test_export_gltf_named(void)
     ENSURE(scalar(p2, "SELECT count(*) FROM parts") == 2);
 }
 
+// A database on a read-only file system (an SD card, a squashfs image, a
+// read-only mount) is read as an immutable file, as one in a folder the user
+// may not write (SQLite cannot open it there at all: every reader, the
+// kiosk too, failed with "unable to open database file"); one to be
+// created there, or in a folder that is not there, says so (it said "cannot
+// open (No such file or directory)": SQLite's retry had set errno). The
+// read-only mount is made in a mount namespace of its own (unshare); where
+// this user may not make one, that part is skipped.
+static void test_read_only_file_system(void)
+{
+    char dir[1024], ro[1100], p[1200], cmd[8192], out[4096];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("rofs_src"));
+    snprintf(ro, sizeof ro, "%s", sp_test_tmp_path("rofs"));
+    mkdir(dir, 0755), mkdir(ro, 0755);
+    snprintf(p, sizeof p, "%s/parts.db", dir);
+    sp_fixture_remove_db(p);
+    sp_db_close(open_ok(p, SP_DB_CREATE));
+    sp_db* db = NULL;
+    sp_error err = {0};
+    snprintf(p, sizeof p, "%s/nowhere/parts.db", dir);
+    ENSURE(sp_db_open(p, SP_DB_CREATE, &db, &err) == SP_ERR_IO && strstr(err.text, "nowhere is not there"));
+    fprintf(stderr, "  %s\n", err.text);
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    snprintf(cmd, sizeof cmd, "unshare -m sh -c \"mount --bind '%s' '%s' && mount -o remount,ro,bind '%s'\" 2>/dev/null", dir, ro,
+             ro);
+    if (system(cmd) != 0) SKIP("no mount namespace for this user (unshare -m)");
+    snprintf(cmd, sizeof cmd,
+             "unshare -m sh -c \"mount --bind '%s' '%s' && mount -o remount,ro,bind '%s' && '%s' db list --db '%s/parts.db' && "
+             "'%s' db init --db '%s/new.db' --folds 0\" 2>&1",
+             dir, ro, ro, bin, ro, bin, ro);
+    int rc = sp_fixture_run(cmd, out, sizeof out);
+    fprintf(stderr, "  exit %d: %s", rc, out);
+    ENSURE(rc == 1 && strstr(out, "\"schema\": 3") && strstr(out, "new.db: cannot create it in the folder") &&
+           strstr(out, "Read-only file system"));
+}
+
 // A part whose only curve the loader left out (saved as LINES, as Blender
 // does) is refused with the loader's reason, where it said only "no sketch
 // abstraction" (an outside curator review).
@@ -1155,13 +1192,7 @@ static void test_schema_versions(void)
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     // Older (version 1: no generation counter, no review status): read-only refuses, writable migrates and keeps the data.
-    ENSURE(sqlite3_open(p, &h) == SQLITE_OK);
-    ENSURE(sqlite3_exec(h,
-                        "DROP TRIGGER gen_parts_ins; DROP TRIGGER gen_parts_del; DROP TRIGGER gen_sketches_ins; DROP TRIGGER gen_sketches_del;"
-                        "DROP TRIGGER gen_models_ins; DROP TRIGGER gen_models_del; DROP TABLE meta;"
-                        "DROP INDEX sketches_review; ALTER TABLE sketches DROP COLUMN status; PRAGMA user_version = 1",
-                        NULL, NULL, NULL) == SQLITE_OK);
-    sqlite3_close(h);
+    ENSURE(sp_fixture_db_downgrade(p, 1));
     ENSURE(sp_db_open(p, SP_DB_READONLY, &db, &err) == SP_ERR_UNSUPPORTED && strstr(err.text, "older") &&
            strstr(err.text, "a user who may write it")); // `db check` alone reads it for one who may not
     db = open_ok(p, 0);
@@ -2365,7 +2396,8 @@ static void test_default_db_cli(void)
     ENSURE(stat(p, &st) != 0);
     // A folder that is not there: the error names the database given, not the file built beside it.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s/nowhere/x.db' --assets '%s' 2>&1", bin, root, assets);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere/x.db: cannot open") && !strstr(out, ".building-"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "nowhere/x.db: cannot create it: the folder") &&
+           strstr(out, "nowhere is not there") && !strstr(out, ".building-"));
     // A concept family that is not one: one line, a usage exit, no database.
     snprintf(cmd, sizeof cmd, "'%s' db init --db '%s' --assets '%s' --concept-family 0 2>&1", bin, p, assets);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "--concept-family must be 1 to 1000000") &&
@@ -3140,6 +3172,7 @@ int main(int argc, char** argv)
     return sp_test_run(argc, argv,
                        (sp_test[]){{"sha256", test_sha256},
                                    {"refusal_says_why", test_refusal_says_why},
+                                   {"read_only_file_system", test_read_only_file_system},
                                    {"same_file_twice", test_same_file_twice},
                                    {"round_trip", test_round_trip},
                                    {"export_gltf_named", test_export_gltf_named},
