@@ -512,17 +512,32 @@ static void test_refused_stroke(void)
     t = stroke(ui, t + ui->desc.offer_ms + 500, 300, 500, 18, 5);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 6});
-    // A Redraw tapped during another refusal's offer is the visitor's own: it
-    // outlives that offer and the next stroke replaces the last part.
+    // A Redraw tapped during a refusal's offer means that stroke drawn
+    // again: the refused stroke goes at once and the next stroke is a new
+    // part (an outside review: armed to replace the last part, the leg
+    // drawn again took the place of the front legs).
     t = refused_stroke(ui, t + 1000, 900, 150);
     frame(ui, &f, t + 10);
     ENSURE(sp_kiosk_ui_offering(ui) && !ui->redraw_armed);
     tap(ui, t + 500, SP_KT_REDRAW);
-    frame(ui, &f, t + ui->desc.offer_ms + 100);
-    ENSURE(!sp_kiosk_ui_offering(ui) && ui->redraw_armed);
-    t = stroke(ui, t + ui->desc.offer_ms + 500, 300, 500, 18, 5);
+    frame(ui, &f, t + 600);
+    ENSURE(!sp_kiosk_ui_offering(ui) && !ui->redraw_armed && sp_kiosk_ui_fade(ui) == 0 && f.undos == 0 &&
+           !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
+    t = stroke(ui, t + 1500, 300, 500, 18, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 7});
+    // The refused stroke was a Redraw's replacement: Redraw again keeps it
+    // armed for that part.
+    tap(ui, t + 1000, SP_KT_REDRAW);
+    t = refused_stroke(ui, t + 1200, 900, 150);
+    frame(ui, &f, t + 10);
+    ENSURE(sp_kiosk_ui_offering(ui) && ui->redraw_armed);
+    tap(ui, t + 500, SP_KT_REDRAW);
+    frame(ui, &f, t + 600);
+    ENSURE(!sp_kiosk_ui_offering(ui) && ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_REDRAW)));
+    t = stroke(ui, t + 1500, 300, 500, 18, 5);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.replace);
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 6});
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 7});
     // A refusal that comes back while a later stroke waits offers nothing:
     // the chips would be for a stroke that is no longer the last.
     t = refused_stroke(ui, t + 2000, 900, 150);

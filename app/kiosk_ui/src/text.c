@@ -24,6 +24,7 @@ static const char* const k_text[SP_KTEXT_COUNT] = {
     [SP_KTEXT_TAP] = "Press, draw one line, then lift your finger",
     [SP_KTEXT_NEED_PART] = "Draw a dragon part first",
     [SP_KTEXT_REDRAW] = "Draw the new part: it replaces the last one",
+    [SP_KTEXT_DRAW_AGAIN] = "Draw it again, in one line",
     [SP_KTEXT_CONFIRM_CLEAR] = "Tap again to start over",
     [SP_KTEXT_TURN] = "Drag to turn your dragon. Tap Draw to draw again",
     [SP_KTEXT_LABEL] = "Not right? Tap another guess",

@@ -945,6 +945,20 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             ui->mode = SP_KM_DRAW;
             ui->mode_since = ui->now;
             ui->redraw_armed = false;
+        } else if (offering(ui)) {
+            // The refused stroke on screen is the last thing drawn, and what a
+            // child means to draw again: it goes, as with Undo, and the next
+            // stroke is a new part, or still the replacement a Redraw before
+            // it was for (an outside review: armed to replace the last part, the
+            // leg drawn again took the place of the front legs drawn right).
+            bool for_part = ui->redraw_for_offer;
+            if (!ui->held_kept)
+                end_offer(ui, false);
+            else if (push_job(ui, SP_KJOB_UNDO))
+                clear_overlays(ui);
+            ui->redraw_armed = ui->redraw_for_offer = for_part;
+            set_hint(ui, sp_kiosk_text(for_part ? SP_KTEXT_REDRAW : SP_KTEXT_DRAW_AGAIN));
+            break;
         }
         ui->redraw_armed = !ui->redraw_armed;
         ui->redraw_for_offer = false; // the visitor's own Redraw: it waits for them

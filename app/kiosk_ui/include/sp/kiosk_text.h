@@ -38,6 +38,7 @@ typedef enum sp_kiosk_text_id {
     SP_KTEXT_TAP,                   ///< a tap on the canvas (not a line)
     SP_KTEXT_NEED_PART,             ///< a button that needs a part, with none
     SP_KTEXT_REDRAW,                ///< Redraw armed
+    SP_KTEXT_DRAW_AGAIN,            ///< Redraw tapped while a refused stroke is offered: it went
     SP_KTEXT_CONFIRM_CLEAR,         ///< Start over, first tap
     SP_KTEXT_TURN,                  ///< Turn mode
     SP_KTEXT_LABEL,                 ///< the label chip tapped
