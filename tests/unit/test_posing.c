@@ -1108,6 +1108,18 @@ static void test_max_iterations_between_stages(void)
         ENSURE(stopped && (!strcmp(stopped, "max_iterations") == (i == 0)) && (i == 1 || its == caps[i]) && its < 1000);
         cJSON_Delete(j);
     }
+    // A fit cut short says the cap stopped it, not that the abstraction cannot
+    // reach the strokes (an outside review: a --max-ms 5 fit was told so, and
+    // the same strokes fit at 1.2 px).
+    snprintf(args, sizeof args, "'%s' synth --rig '%s' --seed 2 --amplitude 0.9 --out '%s' 2>/dev/null", SP_SKETCHPOSE, rig,
+             strokes);
+    ENSURE(run(args) == 0);
+    snprintf(args, sizeof args, "pose --rig '%s' --strokes '%s' --max-iterations 1", rig, strokes);
+    cJSON* j = report_of(args, report);
+    const char* note = cJSON_GetStringValue(cJSON_GetObjectItem(j, "note"));
+    fprintf(stderr, "  --max-iterations 1: %s\n", note ? note : "(no note)");
+    ENSURE(note && strstr(note, "best effort: the iteration cap stopped the solve first") && !strstr(note, "cannot reach"));
+    cJSON_Delete(j);
 }
 
 // --render's picture is the strokes' canvas, at most 4096 px on its longer
