@@ -64,6 +64,14 @@ static int split_args(int argc, char** argv, const sp_opt* opts, int nopts, char
             pos[(*npos)++] = argv[i];
             continue;
         }
+        if (!o && strcmp(argv[i], "--help") != 0 && strcmp(argv[i], "-h") != 0) {
+            // An option not known (a typo): the rest goes to the option parser
+            // as it is, which names it; its value, taken for a positional,
+            // was named instead ("unexpected argument '1'" for --aprove 1).
+            while (i < argc)
+                kept[nk++] = argv[i++];
+            break;
+        }
         kept[nk++] = argv[i];
         bool list = o && (o->kind == SP_OPT_LIST || o->kind == SP_OPT_IN_LIST);
         if (o && o->kind != SP_OPT_FLAG && !list && i + 1 < argc)

@@ -1490,6 +1490,18 @@ static void test_bad_input(void)
         st = pclose(pp);
         ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 2 && strstr(line, "unexpected argument 'extra'"));
     }
+    // A misspelt option with its value names the option, not the value (an
+    // outside review: "--aprove 1" said "unexpected argument '1'").
+    const char* typos[3][2] = {{"review --aprove 1", "--aprove"}, {"list --limt 3", "--limt"}, {"show head --jsn x", "--jsn"}};
+    for (int i = 0; i < 3; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db %s --db '%s' 2>&1 >/dev/null", bin, typos[i][0], p);
+        FILE* pp = popen(cmd, "r");
+        char line[600] = "", want[80];
+        if (!fgets(line, sizeof line, pp)) line[0] = 0;
+        st = pclose(pp);
+        snprintf(want, sizeof want, "unknown option '%s'", typos[i][1]);
+        ENSURE(WIFEXITED(st) && WEXITSTATUS(st) == 2 && strstr(line, want));
+    }
 }
 
 static void test_generation(void)
