@@ -86,7 +86,9 @@ static int common_ancestor(const sp_rig* rig, int a, int b)
 // - Carriers: a joint with at least SP_DRAWOVER_CARRIER_SHARE of the skin
 //   (the triangle's vertices' weights blended by the point's barycentric
 //   coordinates) at a tenth of the curve's points or more: one point on the
-//   chest where a stroke starts did not make the chest twist for an arm.
+//   chest where a stroke starts did not make the chest twist for an arm. A
+//   joint moving more than SP_DRAWOVER_LIMB_SHARE of the mesh (a trunk)
+//   counts only the points where no joint under it has that share.
 // - The limb above: each carrier's ancestors up to, not including, the
 //   first that moves more than SP_DRAWOVER_LIMB_SHARE of the mesh (its skin
 //   and its descendants': a chest carries the head and both arms): a hand,
@@ -97,10 +99,12 @@ static bool curve_carriers(const sp_rig* rig, const sp_abstraction* emb, double 
 {
     int J = rig->joint_count;
     double* w = calloc((size_t)J + 1, sizeof(double));
-    int* hits = calloc((size_t)J + 1, sizeof(int));
+    int* hits = calloc(2 * ((size_t)J + 1), sizeof(int));
+    int* own = hits + J + 1;                               // hits where no joint under it has the share too
+    bool* under = calloc((size_t)J + 1, sizeof(bool));     // at the point: a joint under it has the share
     double* moves = calloc((size_t)J + 1, sizeof(double)); // share of the mesh's skin at or under the joint
-    if (!w || !hits || !moves) {
-        free(w), free(hits), free(moves);
+    if (!w || !hits || !under || !moves) {
+        free(w), free(hits), free(under), free(moves);
         return false;
     }
     for (int i = 0; i < emb->point_count; ++i) {
@@ -109,9 +113,13 @@ static bool curve_carriers(const sp_rig* rig, const sp_abstraction* emb, double 
             for (int k = 0; k < 4 && v < (uint32_t)rig->vertex_count; ++k)
                 w[rig->joints4[4 * (size_t)v + k]] += emb->bary[3 * i + c] * rig->weights4[4 * (size_t)v + k];
         }
+        for (int j = 0; j < J; ++j)
+            for (int a = w[j] >= share ? rig->joints[j].parent : -1; a >= 0 && !under[a]; a = rig->joints[a].parent)
+                under[a] = true;
         for (int j = 0; j < J; ++j) {
             hits[j] += w[j] >= share;
-            w[j] = 0;
+            own[j] += w[j] >= share && !under[j];
+            w[j] = 0, under[j] = false;
         }
     }
     for (size_t v = 0; v < (size_t)rig->vertex_count; ++v)
@@ -120,14 +128,19 @@ static bool curve_carriers(const sp_rig* rig, const sp_abstraction* emb, double 
     for (int j = J - 1; j > 0; --j) // children come after their parents (sp_rig_finalize)
         if (rig->joints[j].parent >= 0) moves[rig->joints[j].parent] += moves[j];
     for (int j = 0; j < J; ++j) {
-        if (10 * hits[j] < emb->point_count || hits[j] == 0) continue;
+        // A trunk joint (moving more than the limb share) counts only where
+        // the curve is on its own skin: RiggedFigure's upper arm is skinned to
+        // its spine at the shoulder, and a draw-over of the arm freed the
+        // chest, the head and the other arm (an outside review).
+        int h = moves[j] > SP_DRAWOVER_LIMB_SHARE ? own[j] : hits[j];
+        if (10 * h < emb->point_count || h == 0) continue;
         free_j[j] = true;
         for (int a = rig->joints[j].parent; a >= 0 && moves[a] <= SP_DRAWOVER_LIMB_SHARE; a = rig->joints[a].parent)
             free_j[a] = true;
     }
     for (int j = 0; j < J; ++j)
         free_j[j] |= rig->joints[j].parent >= 0 && free_j[rig->joints[j].parent];
-    free(w), free(hits), free(moves);
+    free(w), free(hits), free(under), free(moves);
     return true;
 }
 

@@ -29,7 +29,9 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// derived placement) to fit it, and turned and grew the whole cartoon man.
 /// With emb (the curves embedded in the mesh, sp_embed_curve), only the
 /// joints that carry them (SP_DRAWOVER_CARRIER_SHARE of the skin at a tenth
-/// of the curve's points), the limb above them (ancestors moving at most
+/// of the curve's points; a joint moving more than SP_DRAWOVER_LIMB_SHARE of
+/// the mesh counts only points where no joint under it has that share),
+/// the limb above them (ancestors moving at most
 /// SP_DRAWOVER_LIMB_SHARE of the mesh), and
 /// the joints below them move (posing.c, curve_carriers). An arm redrawn
 /// raised past its bounds twisted the cartoon man's spine, chest, neck and

@@ -351,8 +351,12 @@ static void test_drawover_neck_local(void)
             "  a redrawn neck: far vertices moved %.2f%% of the size (error %.2f px) at the paper's weights, %.2f%% (%.2f px) "
             "at %.0f times them\n",
             100 * before, e0, 100 * after, e1, f1);
-    ENSURE(f1 > 10 && e1 < 0.5);
-    ENSURE(after < 0.5 * before);
+    // The chest, skinned onto the neck all along the line, is no carrier
+    // (curve_carriers: a trunk counts only where the neck does not), so
+    // nothing far moves at either weight; with the chest free, at the
+    // paper's weights, an arm swung.
+    ENSURE(f1 > 10 && e1 < 1.0);
+    ENSURE(after < 0.001 && before < 0.001);
 }
 
 // Runs a shell command; returns its exit status.
@@ -1191,6 +1195,58 @@ static void test_note_unmatched_curves(void)
     }
 }
 
+// A draw-over of one arm moves that arm alone: RiggedFigure's upper arm is
+// skinned to its spine at the shoulder, which made the spine a carrier, and
+// the chest, the head and the other arm turned for a 0.46 px fit with no
+// note (an outside review's strokes: the upper arm redrawn bent down).
+static void test_drawover_arm_alone(void)
+{
+    const char* data = sp_test_data_dir();
+    if (!data) SKIP("../shared/data absent");
+    enum { N = 46 };
+    sp_vec2 on[N], to[N];
+    for (int i = 0; i < N; ++i) {
+        double t = (double)i / (N - 1), u = 2 * t;
+        on[i] = (sp_vec2){280 - 83 * t, 153 + 43 * t};
+        to[i] = u < 1 ? (sp_vec2){280 - 5 * u, 153 + 47 * u} : (sp_vec2){275 + 15 * (u - 1), 200 + 50 * (u - 1)};
+    }
+    char on_f[1100], to_f[1100], rep[1100], args[4000];
+    snprintf(on_f, sizeof on_f, "%s", sp_test_tmp_path("rf_arm_on.json"));
+    snprintf(to_f, sizeof to_f, "%s", sp_test_tmp_path("rf_arm_to.json"));
+    snprintf(rep, sizeof rep, "%s", sp_test_tmp_path("rf_arm_report.json"));
+    write_one_stroke(on_f, on, N);
+    cJSON* same = NULL;
+    for (int k = 0; k < 2; ++k) {
+        write_one_stroke(to_f, k ? to : on, N);
+        snprintf(args, sizeof args, "drawover --rig '%s/gltf/RiggedFigure/RiggedFigure.glb' --on '%s' --to '%s'", data, on_f,
+                 to_f);
+        cJSON* j = report_of(args, rep);
+        if (!k) {
+            same = j;
+            continue;
+        }
+        // Against the same draw-over with nothing changed: which joints moved.
+        double arm = 0, rest = 0;
+        const cJSON *it, *p0 = cJSON_GetObjectItem(same, "parameters");
+        cJSON_ArrayForEach(it, cJSON_GetObjectItem(j, "parameters"))
+        {
+            double d = fabs(it->valuedouble - cJSON_GetNumberValue(cJSON_GetObjectItem(p0, it->string)));
+            bool on_arm =
+                !strncmp(it->string, "node13.", 7) || !strncmp(it->string, "node14.", 7) || !strncmp(it->string, "node15.", 7);
+            if (on_arm)
+                arm = fmax(arm, d);
+            else
+                rest = fmax(rest, d);
+        }
+        double err_px = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "mean_error_px"));
+        fprintf(stderr, "  RiggedFigure's arm redrawn bent: %.2f px; the arm's joints moved up to %.2f, the rest %.4f\n", err_px,
+                arm, rest);
+        ENSURE(arm > 0.3 && rest < 1e-6 && err_px < 4);
+        cJSON_Delete(j);
+    }
+    cJSON_Delete(same);
+}
+
 // Only the joints under a draw-over curve, the limb above them and the
 // joints below them move: the cartoon man's left arm redrawn raised past
 // what the arm allows twisted his spine, chest, neck and head to their
@@ -1562,6 +1618,7 @@ int main(int argc, char** argv)
                                    {"animate_cli_times", test_animate_cli_times},
                                    {"drawover_cesiumman", test_drawover_cesiumman},
                                    {"drawover_neck_local", test_drawover_neck_local},
+                                   {"drawover_arm_alone", test_drawover_arm_alone},
                                    {"drawover_scale_is_solvers", test_drawover_scale_is_solvers},
                                    {"synth_jitter", test_synth_jitter},
                                    {"rig_handle", test_rig_handle},
