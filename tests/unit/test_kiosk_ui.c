@@ -986,6 +986,66 @@ static double line_stroke(sp_kiosk_ui* ui, double t, float x, float y, int n, fl
     return t + 8 * (n - 1);
 }
 
+// Half an ellipse of n points from (x0, y) to (x0 + 2 rx, y), over the top
+// (up) or under the bottom, 8 ms apart, drawn from the left; the pen-up time.
+static double arc_stroke(sp_kiosk_ui* ui, double t, float x0, float y, float rx, float ry, bool up, int n)
+{
+    for (int i = 0; i < n; ++i) {
+        double a = M_PI * (1.0 - (double)i / (n - 1));
+        float x = x0 + rx + rx * (float)cos(a), yy = y + (up ? -1.0f : 1.0f) * ry * (float)sin(a);
+        send(ui, i == 0 ? SP_KEV_DOWN : i + 1 < n ? SP_KEV_MOVE : SP_KEV_UP, t + 8 * i, x, yy);
+    }
+    return t + 8 * (n - 1);
+}
+
+// A body drawn as two arcs from the same side, each begun where the other
+// did (an outside review's child, a Quick, Draw! sheep): the second closes
+// the first, and the two are fitted as one outline, the first's part taken
+// back. Not: a stroke that meets the last at one end only (legs under a
+// body), the last already a loop, a second arc after 3 s, or the same arc
+// drawn again over the first.
+static void test_closing_stroke(void)
+{
+    fake f;
+    sp_kiosk_job j;
+    for (int c = 0; c < 5; ++c) {
+        sp_kiosk_ui* ui = started(&f);
+        double t = 1000;
+        if (c == 2) { // a whole ellipse in one stroke, a loop from (400, 400) round to it
+            for (int i = 0; i < 80; ++i) {
+                double a = M_PI * (1.0 - i / 39.5);
+                send(ui,
+                     i == 0       ? SP_KEV_DOWN
+                     : i + 1 < 80 ? SP_KEV_MOVE
+                                  : SP_KEV_UP,
+                     t + 8 * i, 600 + 200 * (float)cos(a), 400 - 120 * (float)sin(a));
+            }
+            t += 8 * 79;
+        } else {
+            t = arc_stroke(ui, t, 400, 400, 200, 120, true, 40);
+        }
+        frame(ui, &f, t + 16);
+        ENSURE(f.parts == 1 && ui->last_outcome == SP_KLAST_PART);
+        double at = t + (c == 3 ? 3500 : 400);
+        if (c == 1) // a leg from the arc's middle down
+            t = line_stroke(ui, at, 600, 280, 20, 0, 10);
+        else
+            t = arc_stroke(ui, at, 400, 400, 200, 120, c == 4, 40);
+        bool job = sp_kiosk_ui_next_job(ui, &j);
+        fprintf(stderr, "  case %d: %s, closed %d\n", c, job ? (j.undo_first ? "one line" : "a stroke of its own") : "no job",
+                ui->closed);
+        if (c == 0) {
+            ENSURE(job && j.kind == SP_KJOB_FIT && j.undo_first && j.stroke->count == 80 && ui->closed == 1);
+            // The second arc runs on from the first's end, back to its start.
+            ENSURE(j.stroke->xy[2 * 39] == 800 && fabsf(j.stroke->xy[2 * 79] - 400) < 0.5f);
+            ENSURE(j.stroke->t[39] <= j.stroke->t[40]);
+        } else {
+            ENSURE(ui->closed == 0);
+        }
+        sp_kiosk_ui_destroy(ui);
+    }
+}
+
 // A finger that leaves the glass for a moment, or draws on after a pause
 // for breath, draws one stroke: the pieces are fitted as one line.
 static void test_continued_stroke(void)
@@ -2100,6 +2160,7 @@ int main(int argc, char** argv)
                                    {"refused_stroke", test_refused_stroke},
                                    {"detail_refused", test_detail_refused},
                                    {"continued_stroke", test_continued_stroke},
+                                   {"closing_stroke", test_closing_stroke},
                                    {"parts_row", test_parts_row},
                                    {"parts_row_twelve", test_parts_row_twelve},
                                    {"other_chip", test_other_chip},

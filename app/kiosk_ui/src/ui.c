@@ -754,6 +754,73 @@ static bool continue_last(sp_kiosk_ui* ui)
     }
 }
 
+// A stroke that closes the last one, an open line drawn just before: its
+// two ends meet that line's two ends (within the join distance), so the
+// two are one outline drawn in two strokes (a child's body drawn as two
+// arcs from the same side: the first became a sliver of a body and the
+// second was refused, an outside review). *reversed: it runs from the last
+// line's start to its end. Parts drawn at a body touch it, not both ends of
+// the stroke drawn before them.
+#define SP_KIOSK_CLOSE_MS 3000.0
+static bool closes_last(const sp_kiosk_ui* ui, const sp_kiosk_line* s, bool* reversed)
+{
+    const sp_kiosk_line* l = &ui->last_stroke;
+    bool after =
+        ui->last_outcome == SP_KLAST_PENDING || ui->last_outcome == SP_KLAST_PART || ui->last_outcome == SP_KLAST_REFUSED;
+    if (!after || l->count < 2 || s->count < 2 || !(ui->desc.join_ms > 0) || !(ui->now - ui->last_up <= SP_KIOSK_CLOSE_MS))
+        return false;
+    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int i = 0; i < l->count; ++i)
+        for (int c = 0; c < 2; ++c)
+            lo[c] = fminf(lo[c], l->xy[2 * i + c]), hi[c] = fmaxf(hi[c], l->xy[2 * i + c]);
+    const float *l0 = l->xy, *l1 = l->xy + 2 * (l->count - 1), *s0 = s->xy, *s1 = s->xy + 2 * (s->count - 1);
+#define SP_GAP(a, b) hypot((a)[0] - (b)[0], (a)[1] - (b)[1])
+    double near = mm(ui, ui->desc.join_mm);
+    bool open = SP_GAP(l0, l1) > fmax(0.2 * hypot(hi[0] - lo[0], hi[1] - lo[1]), 2 * near); // not a loop already
+    bool on = SP_GAP(s0, l1) <= near && SP_GAP(s1, l0) <= near, back = SP_GAP(s0, l0) <= near && SP_GAP(s1, l1) <= near;
+#undef SP_GAP
+    *reversed = back && !on;
+    if (!open || !(on || back)) return false;
+    // Not the same line drawn again over it (a refused leg redrawn): its
+    // middle lies away from the last line, across the shape they close.
+    const float* mid = s->xy + 2 * (s->count / 2);
+    double apart = INFINITY;
+    for (int i = 0; i < l->count; ++i)
+        apart = fmin(apart, hypot(mid[0] - l->xy[2 * i], mid[1] - l->xy[2 * i + 1]));
+    return apart > fmax(2 * near, 0.1 * hypot(hi[0] - lo[0], hi[1] - lo[1]));
+}
+
+// ui->stroke (the piece just drawn) becomes the last line and then it, run
+// on from the last line's end (reversed when it was drawn from its start),
+// thinned evenly to SP_KIOSK_STROKE_MAX points; the times keep the order
+// they were drawn in.
+static bool join_closing(sp_kiosk_ui* ui, bool reversed)
+{
+    sp_kiosk_line* s = &ui->stroke;
+    const sp_kiosk_line* l = &ui->last_stroke;
+    int n = l->count + s->count, step = (n + SP_KIOSK_STROKE_MAX - 1) / SP_KIOSK_STROKE_MAX;
+    float* xy = malloc(sizeof(float) * 2 * (size_t)n);
+    double* t = malloc(sizeof(double) * (size_t)n);
+    if (!xy || !t) { // no room: the piece stays a stroke of its own
+        free(xy), free(t);
+        return false;
+    }
+    for (int i = 0; i < n; ++i) {
+        bool first = i < l->count;
+        int k = first ? i : reversed ? n - 1 - i : i - l->count;
+        const sp_kiosk_line* from = first ? l : s;
+        xy[2 * i] = from->xy[2 * k], xy[2 * i + 1] = from->xy[2 * k + 1];
+        t[i] = first ? l->t[i] : s->t[i - l->count];
+    }
+    s->count = 0;
+    for (int i = 0; i < n; i += step, ++s->count) {
+        int k = i + step >= n ? n - 1 : i; // the end kept
+        s->xy[2 * s->count] = xy[2 * k], s->xy[2 * s->count + 1] = xy[2 * k + 1], s->t[s->count] = t[k];
+    }
+    free(xy), free(t);
+    return true;
+}
+
 static void finish_stroke(sp_kiosk_ui* ui)
 {
     sp_kiosk_line* s = &ui->stroke;
@@ -780,6 +847,11 @@ static void finish_stroke(sp_kiosk_ui* ui)
         return;
     }
     ++ui->strokes_finished;
+    bool reversed = false;
+    if (!cont && closes_last(ui, s, &reversed) && join_closing(ui, reversed)) {
+        cont = true;
+        ++ui->closed;
+    }
     if (cont && continue_last(ui)) {
         s->count = 0;
         return;

@@ -280,6 +280,7 @@ typedef struct sp_kiosk_ui {
     // Counters (tests, logs).
     int strokes_finished, taps, activations[SP_KT_COUNT], resets;
     int joined, merged;        ///< strokes that continued the last one; of them, merged into its waiting FIT job
+    int closed;                ///< of the joined, those that closed the last line (both ends meeting its ends)
     int offered, chosen;       ///< refused strokes held with offers; of them, made a part by a tap
     int others, others_chosen; ///< rows opened by "Other?"; of them, closed by re-fitting the part as another
 } sp_kiosk_ui;
