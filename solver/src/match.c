@@ -111,7 +111,7 @@ static bool grow_pairs(sp_solver* s, int need)
 // point must get two strokes that meet, and the other way round), then by
 // the ordered shape and length cost. Plain optimal assignment on shape cost alone
 // swaps a spine and an arm that happen to overlap; the joints do not.
-enum { TOPO_MAX = 7 };
+enum { TOPO_MAX = SP_TOPO_MAX };
 
 static bool ends_meet(sp_vec2 a0, sp_vec2 a1, sp_vec2 b0, sp_vec2 b1, double eps)
 {
@@ -147,34 +147,81 @@ static void topo_visit(topo_search* t, int s, int breaks, double cost)
     }
 }
 
-// Whether end e of polyline i and an end of polyline j lie within eps (ends[][2]: first, last).
-static bool end_at(sp_vec2 (*ends)[2], int i, int e, int j, double eps)
+// The abstraction's own junctions: which curve ends meet which at the
+// default pose (s->rest_meet, 2% of its diagonal there), for the
+// directions below. The current pose's would do for a pose near it, not for
+// a start with a hand at a foot or on the head (an outside review: chained
+// `pose --start` from a squat paired arms by a hand-knee meeting).
+void sp__rest_junctions(sp_solver* s, double* scratch)
 {
-    return sp_v2_len(sp_v2_sub(ends[i][e], ends[j][0])) < eps || sp_v2_len(sp_v2_sub(ends[i][e], ends[j][1])) < eps;
+    const int C = s->ab->curve_count;
+    s->rest_meet_valid = false;
+    if (C < 2 || C > TOPO_MAX) return;
+    for (int i = 0; i < s->P; ++i)
+        scratch[i] = s->model->params[i].def;
+    sp__model_update(s, scratch, false);
+    sp__project_abstraction(s);
+    double box[4];
+    sp__projected_box(s, box);
+    double eps = 0.02 * hypot(box[2] - box[0], box[3] - box[1]);
+    sp_vec2 ce[TOPO_MAX][2];
+    for (int c = 0; c < C; ++c) {
+        const sp_curve* cv = &s->ab->curves[c];
+        int k0 = cv->first_point, k1 = cv->first_point + cv->point_count - 1;
+        ce[c][0] = (sp_vec2){s->z2[2 * k0], s->z2[2 * k0 + 1]}, ce[c][1] = (sp_vec2){s->z2[2 * k1], s->z2[2 * k1 + 1]};
+    }
+    for (int c = 0; c < C; ++c)
+        for (int f = 0; f < 2; ++f) {
+            s->rest_meet[c][f] = 0;
+            for (int d = 0; d < C; ++d)
+                for (int g = 0; g < 2 && d != c; ++g)
+                    if (sp_v2_len(sp_v2_sub(ce[c][f], ce[d][g])) < eps) s->rest_meet[c][f] |= (uint16_t)(1u << (2 * d + g));
+        }
+    s->rest_meet_valid = !s->model->failed && eps > 0;
 }
 
-// Which way each assigned pair runs when the joints tell it (topo_rev of
-// the solver): stroke i's end e goes with its curve's end f when some other
-// stroke meeting i at e has its curve meeting i's curve at f; the pairing
-// (forward: ends 0-0 and 1-1, reversed: 0-1 and 1-0) with more such ends
-// wins, a tie tells nothing (-1). The direction with the least squared
-// distance at the current pose pairs an arm drawn hanging with one raised
-// from its hand to its shoulder, and a solve that starts there folds it (an
-// outside review: pose --start from raised arms, 11.4 px).
-static void topology_directions(const sp_polyline* lines, int C, sp_vec2 (*se)[2], sp_vec2 (*ce)[2], double seps, double ceps,
+// Which way each assigned stroke runs along its curve when the joints tell
+// it (topo_rev of the solver): of every way to run the open curves' strokes,
+// the ones that keep the most junctions (two stroke ends that meet go to two
+// curve ends that meet at rest, s->rest_meet) win; a stroke whose direction
+// they do not all agree on, or a closed curve's, is not told (-1). The
+// direction with the least squared distance at the current pose pairs an arm
+// drawn hanging with one raised from its hand to its shoulder, and a solve
+// that starts there folds it (an outside review: pose --start from raised
+// arms, 11.4 px); hands drawn touching meet as shoulders do, and only the
+// whole figure's junctions tell them apart.
+static void topology_directions(const sp_solver* s, const sp_polyline* lines, int n, sp_vec2 (*se)[2], double seps,
                                 const int* best, signed char* rev)
 {
-    for (int i = 0; i < C; ++i) {
-        int c = best[i], ways[2] = {0, 0}; // forward, reversed
-        for (int e = 0; e < 2; ++e)
-            for (int f = 0; f < 2; ++f) {
-                bool met = false;
-                for (int j = 0; j < C && !met; ++j)
-                    met = j != i && end_at(se, i, e, j, seps) && end_at(ce, c, f, best[j], ceps);
-                ways[e != f] += met;
-            }
-        rev[c] = lines[c].closed || ways[0] == ways[1] ? -1 : (signed char)(ways[1] > ways[0]);
+    for (int i = 0; i < n; ++i)
+        rev[best[i]] = -1;
+    if (!s->rest_meet_valid) return;
+    int meet[TOPO_MAX * TOPO_MAX * 4][4], m = 0; // stroke i end e meets stroke j end g
+    for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j)
+            for (int e = 0; e < 2; ++e)
+                for (int g = 0; g < 2; ++g)
+                    if (sp_v2_len(sp_v2_sub(se[i][e], se[j][g])) < seps)
+                        meet[m][0] = i, meet[m][1] = e, meet[m][2] = j, meet[m++][3] = g;
+    unsigned closed = 0;
+    for (int i = 0; i < n; ++i)
+        closed |= (unsigned)lines[best[i]].closed << i;
+    int top = 0;
+    unsigned top_mask = 0, agree = 0;
+    for (unsigned mask = 0; mask < 1u << n; ++mask) {
+        if (mask & closed) continue;
+        int kept = 0;
+        for (int k = 0; k < m; ++k) {
+            int i = meet[k][0], j = meet[k][2], f = meet[k][1] ^ (int)(mask >> i & 1), g = meet[k][3] ^ (int)(mask >> j & 1);
+            kept += s->rest_meet[best[i]][f] >> (2 * best[j] + g) & 1;
+        }
+        if (kept > top)
+            top = kept, top_mask = mask, agree = ~0u;
+        else if (kept == top && top > 0)
+            agree &= ~(mask ^ top_mask);
     }
+    for (int i = 0; top > 0 && i < n; ++i)
+        if (!(closed >> i & 1) && (agree >> i & 1)) rev[best[i]] = (signed char)(top_mask >> i & 1);
 }
 
 // Fills c2s (curve -> stroke) and rev (topology_directions) and returns
@@ -232,7 +279,7 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
     topo_visit(&t, 0, 0, 0.0);
     for (int c = 0; c < C; ++c) c2s[c] = -1;
     for (int i = 0; i < n; ++i) c2s[t.best[i]] = i;
-    topology_directions(lines, C, se, ce, seps, ceps, t.best, rev);
+    topology_directions(s, lines, n, se, seps, t.best, rev);
     return true;
 }
 

@@ -58,6 +58,9 @@ typedef struct row_group {
     double* U;       // cap by n, row-major: least-squares rows, H += U^T U
 } row_group;
 
+// Stroke assignment by topology applies to at most this many strokes and curves (match.c).
+enum { SP_TOPO_MAX = 7 };
+
 struct sp_solver {
     sp_model* model; // the rig: LBS (analytic Jacobians) or black box (finite differences)
     const sp_abstraction* ab;
@@ -124,6 +127,11 @@ struct sp_solver {
     // along its stroke, where one end of each meets others (the stroke's
     // meeting end pairs with the curve's); -1: not told so.
     signed char topo_rev[SP_REPORT_CURVES];
+    // The abstraction's junctions at the default pose (match.c,
+    // sp__rest_junctions): bit 2 d + g of rest_meet[c][f] says curve c's end
+    // f meets curve d's end g; for abstractions of 2 to 7 curves.
+    uint16_t rest_meet[SP_TOPO_MAX][2];
+    bool rest_meet_valid;
     bool c2s_valid;
     // ordered_by_ends: each curve's direction and the stroke it was decided
     // with, at an attempt's first pairing, held after (an arm folding on its
@@ -186,6 +194,16 @@ static inline void sp__start_pose(const sp_solver* s, const double* p_start, dou
     sp__model_clamp(s, p);
 }
 
+// The projected abstraction's box (s->z2): lo x, lo y, hi x, hi y.
+static inline void sp__projected_box(const sp_solver* s, double box[4])
+{
+    box[0] = box[1] = INFINITY, box[2] = box[3] = -INFINITY;
+    for (int i = 0; i < s->ab->point_count; ++i) {
+        box[0] = fmin(box[0], s->z2[2 * i]), box[2] = fmax(box[2], s->z2[2 * i]);
+        box[1] = fmin(box[1], s->z2[2 * i + 1]), box[3] = fmax(box[3], s->z2[2 * i + 1]);
+    }
+}
+
 // A sample of the projected abstraction (s->z2).
 static inline sp_vec2 sp__sample_at(const sp_solver* s, sample_ref r)
 {
@@ -194,6 +212,9 @@ static inline sp_vec2 sp__sample_at(const sp_solver* s, sample_ref r)
     return (sp_vec2){a[0] + r.t * (b[0] - a[0]), a[1] + r.t * (b[1] - a[1])};
 }
 
+// match.c: the abstraction's junctions at the default pose (rest_meet),
+// evaluated with scratch (P doubles); leaves the model at the defaults.
+void sp__rest_junctions(sp_solver* s, double* scratch);
 // match.c: resamples the projected curves (s->z2) and the strokes and fills
 // s->pairs; writes which stroke each curve got into rep->curves.
 sp_result sp__build_pairs(sp_solver* s, const sp_sketch* sk, const sp_pairing* how, sp_solve_report* rep, sp_error* err);
