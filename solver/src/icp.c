@@ -350,9 +350,12 @@ static sp_result run_plan(sp_solver* s, attempt_run* r, double* p_out)
     // A solve cut short by a cap says so: blamed on the abstraction, a
     // --max-ms 5 fit sent the user to redraw strokes it fits at 1.2 px (an
     // outside review).
-    const char* why = rep->stopped == SP_STOP_TIME_CAP         ? "the time cap stopped the solve first"
-                      : rep->stopped == SP_STOP_MAX_ITERATIONS ? "the iteration cap stopped the solve first"
-                                                               : "the abstraction cannot reach the strokes";
+    // The iteration cap only when it was reached: the rounds' own limit
+    // stops a fit that no longer gets on (an outside review).
+    bool capped = rep->stopped == SP_STOP_MAX_ITERATIONS && rep->iterations >= s->d.max_iterations;
+    const char* why = rep->stopped == SP_STOP_TIME_CAP ? "the time cap stopped the solve first"
+                      : capped                         ? "the iteration cap stopped the solve first"
+                                                       : "the abstraction cannot reach the strokes";
     if (rep->mean_error_px > 0.05 * s->L && !strstr(rep->note, "best effort"))
         snprintf(rep->note + at, sizeof rep->note - at, "%sbest effort: %s (mean error %.1f px, %.1f%% of its size)",
                  at ? "; " : "", why, rep->mean_error_px, 100.0 * rep->mean_error_px / s->L);
