@@ -320,6 +320,10 @@ static void test_flow(void)
     ENSURE(sp_kiosk_ui_fade(ui) > 0.3 && sp_kiosk_ui_fade(ui) < 0.7);
     frame(ui, &f, t + 1300);
     ENSURE(sp_kiosk_ui_fade(ui) == 0);
+    // Redraw right after a refusal means that stroke drawn again: nothing armed.
+    tap(ui, 5400, SP_KT_REDRAW);
+    ENSURE(!ui->redraw_armed && strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)) == 0);
+    tap(ui, 5600, SP_KT_TURN), tap(ui, 5800, SP_KT_TURN); // another button between
     // Redraw: the next stroke replaces the last part; a second tap disarms.
     tap(ui, 6000, SP_KT_REDRAW);
     ENSURE(ui->redraw_armed);
@@ -523,9 +527,29 @@ static void test_refused_stroke(void)
     frame(ui, &f, t + 600);
     ENSURE(!sp_kiosk_ui_offering(ui) && !ui->redraw_armed && sp_kiosk_ui_fade(ui) == 0 && f.undos == 0 &&
            !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
+    // Tapped again (nothing seemed to happen): the same, not armed for the last part (a review's second tap).
+    tap(ui, t + 1400, SP_KT_REDRAW);
+    frame(ui, &f, t + 1500);
+    ENSURE(!ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
     t = stroke(ui, t + 1500, 300, 500, 18, 5);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 7});
+    // A refusal with nothing offered ("A bit bigger please!"): Redraw means that stroke again too.
+    t = stroke(ui, t + 1000, 300, 500, 18, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_TOO_SMALL});
+    ENSURE(!sp_kiosk_ui_offering(ui));
+    tap(ui, t + 400, SP_KT_REDRAW);
+    frame(ui, &f, t + 500);
+    ENSURE(!ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
+    t = stroke(ui, t + 1500, 300, 500, 18, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 8});
+    // After a part, Redraw arms as before.
+    tap(ui, t + 400, SP_KT_REDRAW);
+    ENSURE(ui->redraw_armed);
+    tap(ui, t + 1400, SP_KT_REDRAW);
+    ENSURE(!ui->redraw_armed);
     // The refused stroke was a Redraw's replacement: Redraw again keeps it
     // armed for that part.
     tap(ui, t + 1000, SP_KT_REDRAW);

@@ -823,6 +823,7 @@ static bool join_closing(sp_kiosk_ui* ui, bool reversed)
 
 static void finish_stroke(sp_kiosk_ui* ui)
 {
+    ui->redraw_spent = false;
     sp_kiosk_line* s = &ui->stroke;
     bool cont = ui->continuing;
     ui->continuing = false;
@@ -980,6 +981,8 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
 {
     ++ui->activations[t];
     ui->target_at = ui->now;
+    bool after_refusal = ui->last_outcome == SP_KLAST_REFUSED;
+    if (t != SP_KT_REDRAW) ui->redraw_spent = false;
     ui->last_outcome = SP_KLAST_NONE; // a button between two strokes: the next one is a stroke of its own
     if (!sp_kiosk_ui_target_enabled(ui, t)) {
         if (ui->part_count == 0 && t < SP_KT_CHIP_LABEL) set_hint(ui, sp_kiosk_text(SP_KTEXT_NEED_PART));
@@ -1017,17 +1020,20 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
             ui->mode = SP_KM_DRAW;
             ui->mode_since = ui->now;
             ui->redraw_armed = false;
-        } else if (offering(ui)) {
-            // The refused stroke on screen is the last thing drawn, and what a
-            // child means to draw again: it goes, as with Undo, and the next
-            // stroke is a new part, or still the replacement a Redraw before
-            // it was for (an outside review: armed to replace the last part, the
-            // leg drawn again took the place of the front legs drawn right).
+        } else if (offering(ui) || after_refusal || ui->redraw_spent) {
+            // The refused stroke (on screen, or just faded: "A bit bigger
+            // please!") is the last thing drawn, and what a child means to
+            // draw again: it goes, as with Undo, and the next stroke is a new
+            // part, or still the replacement a Redraw before it was for; so
+            // do more taps until a stroke is drawn (an outside review: armed
+            // to replace the last part, the leg drawn again took the place of
+            // the front legs drawn right; a second tap did the same).
             bool for_part = ui->redraw_for_offer;
-            if (!ui->held_kept)
+            if (offering(ui) && !ui->held_kept)
                 end_offer(ui, false);
-            else if (push_job(ui, SP_KJOB_UNDO))
+            else if (offering(ui) && push_job(ui, SP_KJOB_UNDO))
                 clear_overlays(ui);
+            ui->redraw_spent = !for_part;
             ui->redraw_armed = ui->redraw_for_offer = for_part;
             set_hint(ui, sp_kiosk_text(for_part ? SP_KTEXT_REDRAW : SP_KTEXT_DRAW_AGAIN));
             break;

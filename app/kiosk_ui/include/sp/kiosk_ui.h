@@ -269,6 +269,7 @@ typedef struct sp_kiosk_ui {
     uint64_t saved_revision;                        ///< revision at the last successful save (0: never)
     bool redraw_armed;
     bool redraw_for_offer; ///< armed again by a refused Redraw: it lapses with the offer
+    bool redraw_spent;     ///< Redraw took a refused stroke back: more taps do the same until a stroke is drawn
     double clear_armed_until;
     double clear_armed_at; ///< when Start over was first tapped
     double undo_at;        ///< when Undo last acted
