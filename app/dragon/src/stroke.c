@@ -600,17 +600,24 @@ static double far_score(const sp_vec2* pts, int n, double near, double fit, bool
 // mirror image accepted (an outside review: Quick, Draw! feet 10 and 17,
 // the classifier 86-94% sure). The tune half's spiral, taken for legs,
 // fits the other facing at 0.65 times and stays refused. Fitted only for a
-// stroke about to be refused.
+// stroke about to be refused; a stroke it keeps takes that fit (*best).
 #define REFUSAL_FACING_GAIN 0.55
-static double other_facing_far(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, const fit_choice* best,
-                               const sp_vec2* pts, int n, double near)
+static double other_facing_far(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 hi, fit_choice* best, const sp_vec2* pts,
+                               int n, double near)
 {
     fit_choice o;
     int not_finite = 0;
     if (!fit_one(d, best->t, sk, lo, hi, !best->mirrored, &o, &not_finite)) return INFINITY;
-    free(o.p);
-    if (!(o.score < REFUSAL_FACING_GAIN * best->score)) return INFINITY;
-    return far_score(pts, n, near, o.score, in_profile(best->t));
+    double far = o.score < REFUSAL_FACING_GAIN * best->score ? far_score(pts, n, near, o.score, in_profile(best->t)) : INFINITY;
+    // Kept for the stroke it keeps: folded into its dragon's facing, a foot
+    // pointing back lay 60 px from the foot drawn (the review again).
+    if (far <= SP_DRAGON_FAR_LIMIT) {
+        free(best->p);
+        *best = o;
+    } else {
+        free(o.p);
+    }
+    return far;
 }
 
 // Whether the classifier's best guess is a part with a polygon's or a star's
