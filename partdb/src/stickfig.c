@@ -353,8 +353,8 @@ static int limb_joints(const sp_rig* rig, int leaf, int* order, int cap)
     if (leaves(rig, lv, 2) != 2 || (leaf != lv[0] && leaf != lv[1]) || cap < 1) return 0;
     int n = sp_rig_line_joints(rig, order, cap);
     if (n < 3 || n > cap) return 0;
-    // The line runs leaf A .. shared .. leaf B: the shared joint is the first
-    // from A whose parent is not the next one on the line.
+    // The line runs leaf A .. shared .. leaf B (turned to start at `leaf`):
+    // up from the leaf while each next joint is the one before's parent.
     if (order[0] != leaf)
         for (int i = 0, k = n - 1; i < k; ++i, --k) {
             int t = order[i];

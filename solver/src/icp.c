@@ -348,10 +348,9 @@ static sp_result run_plan(sp_solver* s, attempt_run* r, double* p_out)
     // After the pairing's own note (strokes left unused), if any.
     size_t at = strlen(rep->note);
     // A solve cut short by a cap says so: blamed on the abstraction, a
-    // --max-ms 5 fit sent the user to redraw strokes it fits at 1.2 px (an
-    // outside review).
-    // The iteration cap only when it was reached: the rounds' own limit
-    // stops a fit that no longer gets on (an outside review).
+    // --max-ms 5 fit sent the user to redraw strokes it fits at 1.2 px; the
+    // iteration cap only when it was reached, as the rounds' own limit stops
+    // a fit that no longer gets on (outside reviews).
     bool capped = rep->stopped == SP_STOP_MAX_ITERATIONS && rep->iterations >= s->d.max_iterations;
     const char* why = rep->stopped == SP_STOP_TIME_CAP ? "the time cap stopped the solve first"
                       : capped                         ? "the iteration cap stopped the solve first"
