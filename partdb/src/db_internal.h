@@ -58,6 +58,11 @@ sp_result db_log_row(sp_db* db, const char* by, const char* action, const char* 
 /// The curator's name: `by` if given, else $USER, else "unknown".
 const char* db_who(const char* by);
 
+/// SQL for the highest sketch id ever given: the table's, or the one kept in
+/// meta ('sketch_id_high') when the newest rows were deleted. New sketches
+/// take it plus one, so an id never names two drawings.
+#define DB_SKETCH_ID_HIGH                                                                                                        \
+    "max(coalesce((SELECT max(id) FROM sketches), 0), coalesce((SELECT value FROM meta WHERE key = 'sketch_id_high'), 0))"
 /// Inserts one sketch (strokes or raster) inside the caller's transaction.
 sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source, int64_t part_id, const sp_sample* smp,
                            const sp_db_png* png, const char* by, sp_error* err);

@@ -77,9 +77,10 @@ sp_result sp_db_collect_kiosk_sketch(sp_db* db, const char* category, const sp_s
     sp_result r = db_begin(db, err);
     if (r == SP_OK && (r = pending_room(db, err)) != SP_OK) db_rollback(db);
     if (r == SP_OK &&
-        (r = db_prepare(
-             db, "INSERT INTO sketches(category, source, strokes, added_by, status) VALUES (?, 'kiosk', ?, 'kiosk', 'pending')",
-             &st, err)) == SP_OK) {
+        (r = db_prepare(db,
+                        "INSERT INTO sketches(id, category, source, strokes, added_by, status) VALUES (" DB_SKETCH_ID_HIGH
+                        " + 1, ?, 'kiosk', ?, 'kiosk', 'pending')",
+                        &st, err)) == SP_OK) {
         sqlite3_bind_text(st, 1, category, -1, SQLITE_STATIC);
         sqlite3_bind_text(st, 2, json, -1, SQLITE_STATIC);
         int rc = sqlite3_step(st);
@@ -341,7 +342,14 @@ sp_result sp_db_kiosk_delete_rejected(sp_db* db, const char* by, int* deleted, s
     if (deleted) *deleted = 0;
     sp_result r = db_begin(db, err);
     if (r != SP_OK) return r;
-    int rc = sqlite3_exec(db->h, "DELETE FROM sketches WHERE source = 'kiosk' AND status = 'rejected'", NULL, NULL, NULL);
+    // The highest id so far is kept (meta 'sketch_id_high', DB_SKETCH_ID_HIGH):
+    // SQLite gives a new row the highest id left plus one, so the newest ones
+    // deleted would be given again, and the log's rejected ids and a review's
+    // --after would name other visitors' strokes (an operations review).
+    int rc = sqlite3_exec(db->h, "INSERT OR REPLACE INTO meta(key, value) VALUES ('sketch_id_high', " DB_SKETCH_ID_HIGH ")", NULL,
+                          NULL, NULL);
+    if (rc == SQLITE_OK)
+        rc = sqlite3_exec(db->h, "DELETE FROM sketches WHERE source = 'kiosk' AND status = 'rejected'", NULL, NULL, NULL);
     int n = rc == SQLITE_OK ? sqlite3_changes(db->h) : 0;
     if (rc != SQLITE_OK) r = db_fail(db, rc, "deleting rejected kiosk sketches", err);
     char details[64];

@@ -50,11 +50,11 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
 {
     sqlite3_stmt* st;
     // A kiosk sketch a curator adds is reviewed by that act: approved.
-    sp_result r =
-        db_prepare(db,
-                   "INSERT INTO sketches(category, source, part_id, strokes, raster_w, raster_h, raster, png, added_by, status)"
-                   " VALUES (?1,?2,?3,?4,?5,?6,?7,?8,?9, CASE WHEN ?2 = 'kiosk' THEN 'approved' END)",
-                   &st, err);
+    sp_result r = db_prepare(
+        db,
+        "INSERT INTO sketches(id, category, source, part_id, strokes, raster_w, raster_h, raster, png, added_by, status)"
+        " VALUES (" DB_SKETCH_ID_HIGH " + 1, ?1,?2,?3,?4,?5,?6,?7,?8,?9, CASE WHEN ?2 = 'kiosk' THEN 'approved' END)",
+        &st, err);
     if (r != SP_OK) return r;
     char* json = NULL;
     sqlite3_bind_text(st, 1, category, -1, SQLITE_TRANSIENT);

@@ -2647,6 +2647,29 @@ static void test_kiosk_pending_cap(void)
     sp_db_close(db);
 }
 
+// A sketch id names one drawing for good: the newest kiosk sketches
+// rejected and deleted, the next one stored takes a new id (SQLite gave it
+// the deleted one's, and the log's "rejected [ids]" and a review's --after
+// then named another visitor's stroke: an operations review).
+static void test_sketch_ids_kept(void)
+{
+    char p[1024];
+    snprintf(p, sizeof p, "%s", base_db("ids.db"));
+    sp_db* db = open_ok(p, 0);
+    sp_error err = {0};
+    int64_t id[3];
+    for (int k = 0; k < 3; ++k)
+        id[k] = collect_ok(db, "tail", k);
+    ENSURE(sp_db_kiosk_set_status(db, &id[1], 2, SP_DB_REJECTED, "curator", &err) == SP_OK);
+    int deleted = 0;
+    ENSURE(sp_db_kiosk_delete_rejected(db, "curator", &deleted, &err) == SP_OK && deleted == 2);
+    int64_t next = collect_ok(db, "head", 3);
+    fprintf(stderr, "  ids %lld %lld %lld, the last two deleted: the next is %lld\n", (long long)id[0], (long long)id[1],
+            (long long)id[2], (long long)next);
+    ENSURE(next > id[2]);
+    sp_db_close(db);
+}
+
 static void test_kiosk_review_cli(void)
 {
     const char* bin = sketchpose_bin();
@@ -3217,6 +3240,7 @@ int main(int argc, char** argv)
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
                                    {"kiosk_review_cli", test_kiosk_review_cli},
+                                   {"sketch_ids_kept", test_sketch_ids_kept},
                                    {"kiosk_review_ranges", test_kiosk_review_ranges},
                                    {"kiosk_pending_cap", test_kiosk_pending_cap},
                                    {"file_check", test_file_check},
