@@ -3637,7 +3637,10 @@ static sp_vec2* quickdraw_stroke(const char* category, int index, sp_vec2 lo, sp
 // far from every part (an outside review: Quick, Draw! feet 10 and 17,
 // far_score 1.26 and 1.31, their mirror images accepted). Each drawn at
 // the hind end of a dragon facing right and one facing left, as drawn and
-// mirrored: the old code refused half of them.
+// mirrored: the old code refused half of them. A Quick, Draw! hammer drawn
+// there stays refused (a guard: in the review's own scene it was kept as
+// legs until the rescue asked the classifier to be sure; here it is refused
+// either way).
 static void test_foot_either_way(void)
 {
     if (!people_strokes_present()) SKIP("../shared/data/quickdraw absent");
@@ -3645,7 +3648,7 @@ static void test_foot_either_way(void)
     sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
-    int accepted = 0, total = 0;
+    int accepted = 0, total = 0, hammers_refused = 0;
     for (int left = 0; left < 2; ++left) {
         sp_dragon_clear(d);
         int bn, hn;
@@ -3660,25 +3663,28 @@ static void test_foot_either_way(void)
         ENSURE(sp_dragon_add_points(d, head_xy, hn, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
                !res.rejected);
         double xc = left ? bhi.x - 0.3 * (bhi.x - blo.x) : blo.x + 0.3 * (bhi.x - blo.x);
-        const int feet[2] = {10, 17};
-        for (int k = 0; k < 4; ++k) {
+        const int drawing[3] = {10, 17, 5};
+        for (int k = 0; k < 6; ++k) {
             int n;
-            sp_vec2* xy =
-                quickdraw_stroke("foot", feet[k / 2], (sp_vec2){xc - 50, bhi.y - 20}, (sp_vec2){xc + 50, bhi.y + 160}, k % 2, &n);
+            const char* what = k < 4 ? "foot" : "hammer"; // a hammer, taken for legs at 0.67: not sure enough
+            sp_vec2* xy = quickdraw_stroke(what, drawing[k / 2], (sp_vec2){xc - 50, bhi.y - 20}, (sp_vec2){xc + 50, bhi.y + 160},
+                                           k % 2, &n);
             ENSURE(xy);
             ENSURE(sp_dragon_add_points(d, xy, n, NULL, &res, &err) == SP_OK);
             const char* cat = res.rejected ? "refused" : sp_dragon_part_get(d, res.part)->category;
-            fprintf(stderr, "  dragon facing %s, foot %d%s: %s (far %.2f)\n", left ? "left" : "right", feet[k / 2],
+            fprintf(stderr, "  dragon facing %s, %s %d%s: %s (far %.2f)\n", left ? "left" : "right", what, drawing[k / 2],
                     k % 2 ? " mirrored" : "", cat, res.far_score);
-            accepted += !res.rejected && strstr(cat, "legs");
-            ++total;
+            hammers_refused += k >= 4 && res.rejected;
+            accepted += k < 4 && !res.rejected && strstr(cat, "legs");
+            total += k < 4;
             if (!res.rejected) sp_dragon_undo(d);
             free(xy);
         }
         free(body_xy);
         free(head_xy);
     }
-    ENSURE(accepted == total);
+    fprintf(stderr, "  hammers refused: %d of 4\n", hammers_refused);
+    ENSURE(accepted == total && hammers_refused == 4);
     sp_dragon_destroy(d);
     sp_db_close(db);
 }
