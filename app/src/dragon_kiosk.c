@@ -300,8 +300,8 @@ static void print_stats(const app* a, double start_ms)
     sp_kiosk_collect_counts(a->k, &stored, &dropped);
     printf(" \"collected\": %d, \"collect_stored\": %d, \"collect_dropped\": %d, \"models_loaded\": %d,\n", st->collected, stored,
            dropped, st->models_loaded);
-    printf(" \"others\": %d, \"others_chosen\": %d, \"joined\": %d, \"merged\": %d,\n", ui->others, ui->others_chosen, ui->joined,
-           ui->merged);
+    printf(" \"others\": %d, \"others_chosen\": %d, \"joined\": %d, \"merged\": %d, \"closed\": %d,\n", ui->others,
+           ui->others_chosen, ui->joined, ui->merged, ui->closed);
     // What a visitor reads on screen now (JSON-escaped): the message box
     // (a hint, or the first-draw prompt) and the save banner.
     char banner[2 * SP_KIOSK_TEXT_MAX + 2] = "";
