@@ -3538,6 +3538,34 @@ static void test_wing_leaning_forward(void)
     sp_db_close(db);
 }
 
+// A dragon of visitors' drawings (tune half), drawn facing right or left:
+// `body` at (640, cy) at diagonal body_diag, then `head` at diagonal
+// head_diag at the top corner of the body's box at its facing end, moved out
+// by dx and down by dy; both forced.
+typedef struct drawn_dragon {
+    sp_dragon_result body, head;
+    sp_vec2 lo, hi; // the body stroke's box
+} drawn_dragon;
+
+static drawn_dragon draw_body_and_head(sp_dragon* d, const char* body, double body_diag, double cy, const char* head,
+                                       double head_diag, double dx, double dy, bool left)
+{
+    drawn_dragon g;
+    sp_error err = {0};
+    int bn, hn;
+    sp_vec2* body_xy = visitor_stroke(body, body_diag, (sp_vec2){640, cy}, left, &bn);
+    points_box(body_xy, bn, &g.lo, &g.hi);
+    sp_vec2 at = {640 + (left ? -1 : 1) * (0.5 * (g.hi.x - g.lo.x) + dx), g.lo.y + dy};
+    sp_vec2* head_xy = visitor_stroke(head, head_diag, at, left, &hn);
+    ENSURE(sp_dragon_add_points(d, body_xy, bn, &(sp_dragon_stroke_opts){.category = "torso"}, &g.body, &err) == SP_OK &&
+           !g.body.rejected);
+    ENSURE(sp_dragon_add_points(d, head_xy, hn, &(sp_dragon_stroke_opts){.category = "head"}, &g.head, &err) == SP_OK &&
+           !g.head.rejected);
+    free(body_xy);
+    free(head_xy);
+    return g;
+}
+
 // A body drawn rising to one end (the visitors' "long rising" body) with a
 // big head drawn at the top corner of its box over the low end, as the
 // visitors bench places heads: its neck hangs on the back 45 px from the
@@ -3547,38 +3575,26 @@ static void test_wing_leaning_forward(void)
 static void test_facing_of_a_rising_body(void)
 {
     const char* path = real_db();
-    sp_error err = {0};
     sp_db* db = NULL;
     sp_dragon* d = dragon_and_db(path, &db);
     for (int left = 0; left < 2; ++left) {
         sp_dragon_clear(d);
-        int bn, hn;
-        sp_vec2 blo, bhi;
-        sp_vec2* body_xy = visitor_stroke("torso/torso-long-rising.json", 500, (sp_vec2){640, 400}, left, &bn);
-        points_box(body_xy, bn, &blo, &bhi);
-        sp_vec2 at = {640 + (left ? -1 : 1) * (0.5 * (bhi.x - blo.x) - 20), blo.y - 20};
-        sp_vec2* head_xy = visitor_stroke("head/head-brow-ridge.json", 320, at, left, &hn);
-        sp_dragon_result body, head;
-        ENSURE(sp_dragon_add_points(d, body_xy, bn, &(sp_dragon_stroke_opts){.category = "torso"}, &body, &err) == SP_OK &&
-               !body.rejected);
-        ENSURE(sp_dragon_add_points(d, head_xy, hn, &(sp_dragon_stroke_opts){.category = "head"}, &head, &err) == SP_OK &&
-               !head.rejected);
-        const sp_dragon_part* h = sp_dragon_part_get(d, head.part);
-        int facing = dragon_facing_at(d, blo, bhi);
+        drawn_dragon g =
+            draw_body_and_head(d, "torso/torso-long-rising.json", 500, 400, "head/head-brow-ridge.json", 320, -20, -20, left);
+        const sp_dragon_part* h = sp_dragon_part_get(d, g.head.part);
+        int facing = dragon_facing_at(d, g.lo, g.hi);
         fprintf(stderr, "  facing %s: the head hangs on %d at x %.0f (the body %.0f-%.0f); the dragon reads facing %d\n",
-                left ? "left" : "right", h->attached_to, h->anchor.x, blo.x, bhi.x, facing);
-        ENSURE(h->attached_to == body.part && facing == (left ? -1 : 1));
-        free(body_xy);
-        free(head_xy);
+                left ? "left" : "right", h->attached_to, h->anchor.x, g.lo.x, g.hi.x, facing);
+        ENSURE(h->attached_to == g.body.part && facing == (left ? -1 : 1));
     }
     sp_dragon_destroy(d);
     sp_db_close(db);
 }
 
 // The longest stroke of drawing `index` of Quick, Draw!'s `category`
-// (../shared/data/quickdraw), fitted into the box [lo, hi] keeping its
-// aspect, centred, mirrored left-right when asked, a point every 4 px at
-// most; NULL when the file or drawing is not there.
+// (../shared/data/quickdraw, read by sketchio's ndjson reader), fitted into
+// the box [lo, hi] keeping its aspect, centred, mirrored left-right when
+// asked, a point every 4 px at most; NULL when the file or drawing is not there.
 static sp_vec2* quickdraw_stroke(const char* category, int index, sp_vec2 lo, sp_vec2 hi, bool mirror, int* n)
 {
     char file[1200];
@@ -3586,39 +3602,33 @@ static sp_vec2* quickdraw_stroke(const char* category, int index, sp_vec2 lo, sp
     FILE* f = fopen(file, "r");
     if (!f) return NULL;
     static char line[1 << 16];
-    cJSON* j = NULL;
+    bool got = false;
     for (int k = 0; k <= index && fgets(line, sizeof line, f); ++k)
-        if (k == index) j = cJSON_Parse(line);
+        got = k == index;
     fclose(f);
-    const cJSON *st, *best = NULL;
-    double best_len = -1, x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    cJSON_ArrayForEach(st, cJSON_GetObjectItem(j, "drawing"))
-    {
-        const cJSON *xs = cJSON_GetArrayItem(st, 0), *ys = cJSON_GetArrayItem(st, 1);
-        double len = 0;
-        for (int i = 1; i < cJSON_GetArraySize(xs); ++i)
-            len += hypot(cJSON_GetArrayItem(xs, i)->valuedouble - cJSON_GetArrayItem(xs, i - 1)->valuedouble,
-                         cJSON_GetArrayItem(ys, i)->valuedouble - cJSON_GetArrayItem(ys, i - 1)->valuedouble);
-        if (len > best_len) best_len = len, best = st;
-    }
-    if (!best) {
-        cJSON_Delete(j);
+    sp_dataset ds = {0};
+    sp_error err = {0};
+    if (!got || sp_dataset_parse_ndjson(&ds, line, strlen(line), file, -1, &err) != SP_OK || ds.count != 1) {
+        sp_dataset_free(&ds);
         return NULL;
     }
-    const cJSON *xs = cJSON_GetArrayItem(best, 0), *ys = cJSON_GetArrayItem(best, 1);
-    int m = cJSON_GetArraySize(xs);
-    for (int i = 0; i < m; ++i) {
-        double x = cJSON_GetArrayItem(xs, i)->valuedouble, y = cJSON_GetArrayItem(ys, i)->valuedouble;
-        x0 = fmin(x0, x), y0 = fmin(y0, y), x1 = fmax(x1, x), y1 = fmax(y1, y);
+    const sp_sketch* sk = &ds.samples[0].sketch;
+    const sp_stroke* st = NULL;
+    double best_len = -1;
+    for (int i = 0; i < sk->stroke_count; ++i) {
+        double len = sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false);
+        if (len > best_len) best_len = len, st = &sk->strokes[i];
     }
-    double s = fmin((hi.x - lo.x) / fmax(x1 - x0, 1), (hi.y - lo.y) / fmax(y1 - y0, 1));
+    sp_vec2 p0, p1;
+    points_box(st->points, st->count, &p0, &p1);
+    double s = fmin((hi.x - lo.x) / fmax(p1.x - p0.x, 1), (hi.y - lo.y) / fmax(p1.y - p0.y, 1));
     sp_vec2 c = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y)};
-    int cap = (int)(best_len * s / 4) + m + 1, k = 0;
+    int cap = (int)(best_len * s / 4) + st->count + 1, k = 0;
     sp_vec2* out = malloc(sizeof(sp_vec2) * (size_t)cap);
     ENSURE(out);
-    for (int i = 0; i < m; ++i) {
-        sp_vec2 p = {c.x + (mirror ? -1 : 1) * (cJSON_GetArrayItem(xs, i)->valuedouble - 0.5 * (x0 + x1)) * s,
-                     c.y + (cJSON_GetArrayItem(ys, i)->valuedouble - 0.5 * (y0 + y1)) * s};
+    for (int i = 0; i < st->count; ++i) {
+        sp_vec2 p = {c.x + (mirror ? -1 : 1) * (st->points[i].x - 0.5 * (p0.x + p1.x)) * s,
+                     c.y + (st->points[i].y - 0.5 * (p0.y + p1.y)) * s};
         if (k > 0) { // a point every 4 px at most, as a finger gives them
             sp_vec2 q = out[k - 1];
             for (int t = 1, steps = (int)(sp_v2_len(sp_v2_sub(p, q)) / 4); t < steps && k < cap; ++t)
@@ -3626,7 +3636,7 @@ static sp_vec2* quickdraw_stroke(const char* category, int index, sp_vec2 lo, sp
         }
         if (k < cap) out[k++] = p;
     }
-    cJSON_Delete(j);
+    sp_dataset_free(&ds);
     *n = k;
     return out;
 }
@@ -3651,17 +3661,10 @@ static void test_foot_either_way(void)
     int accepted = 0, total = 0, hammers_refused = 0;
     for (int left = 0; left < 2; ++left) {
         sp_dragon_clear(d);
-        int bn, hn;
-        sp_vec2 blo, bhi;
-        sp_vec2* body_xy = visitor_stroke("torso/torso-humped.json", 420, (sp_vec2){640, 360}, left, &bn);
-        points_box(body_xy, bn, &blo, &bhi);
-        sp_vec2* head_xy = visitor_stroke("head/head-brow-ridge.json", 220,
-                                          (sp_vec2){640 + (left ? -1 : 1) * (0.5 * (bhi.x - blo.x) + 60), blo.y}, left, &hn);
+        drawn_dragon g =
+            draw_body_and_head(d, "torso/torso-humped.json", 420, 360, "head/head-brow-ridge.json", 220, 60, 0, left);
+        sp_vec2 blo = g.lo, bhi = g.hi;
         sp_dragon_result res;
-        ENSURE(sp_dragon_add_points(d, body_xy, bn, &(sp_dragon_stroke_opts){.category = "torso"}, &res, &err) == SP_OK &&
-               !res.rejected);
-        ENSURE(sp_dragon_add_points(d, head_xy, hn, &(sp_dragon_stroke_opts){.category = "head"}, &res, &err) == SP_OK &&
-               !res.rejected);
         double xc = left ? bhi.x - 0.3 * (bhi.x - blo.x) : blo.x + 0.3 * (bhi.x - blo.x);
         const int drawing[3] = {10, 17, 5};
         for (int k = 0; k < 6; ++k) {
@@ -3680,8 +3683,6 @@ static void test_foot_either_way(void)
             if (!res.rejected) sp_dragon_undo(d);
             free(xy);
         }
-        free(body_xy);
-        free(head_xy);
     }
     fprintf(stderr, "  hammers refused: %d of 4\n", hammers_refused);
     ENSURE(accepted == total && hammers_refused == 4);

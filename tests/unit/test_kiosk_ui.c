@@ -416,6 +416,26 @@ static void test_long_category(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// Redraw tapped at t right after a refusal: that stroke drawn again,
+// nothing armed for the last part.
+static void redraw_draws_again(sp_kiosk_ui* ui, fake* f, double t)
+{
+    tap(ui, t, SP_KT_REDRAW);
+    frame(ui, f, t + 100);
+    ENSURE(!ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
+}
+
+// A stroke at t fitted as a new part (not a replacement), the part count
+// then `parts`; its pen-up time.
+static double new_part_stroke(sp_kiosk_ui* ui, double t, int parts)
+{
+    sp_kiosk_job j;
+    t = stroke(ui, t, 300, 500, 18, 5);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = parts});
+    return t;
+}
+
 static void test_refused_stroke(void)
 {
     fake f;
@@ -513,9 +533,7 @@ static void test_refused_stroke(void)
     ENSURE(sp_kiosk_ui_offering(ui) && ui->redraw_armed);
     frame(ui, &f, t + ui->desc.offer_ms + 100);
     ENSURE(!sp_kiosk_ui_offering(ui) && !ui->redraw_armed);
-    t = stroke(ui, t + ui->desc.offer_ms + 500, 300, 500, 18, 5);
-    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 6});
+    t = new_part_stroke(ui, t + ui->desc.offer_ms + 500, 6);
     // A Redraw tapped during a refusal's offer means that stroke drawn
     // again: the refused stroke goes at once and the next stroke is a new
     // part (an outside review: armed to replace the last part, the leg
@@ -523,33 +541,24 @@ static void test_refused_stroke(void)
     t = refused_stroke(ui, t + 1000, 900, 150);
     frame(ui, &f, t + 10);
     ENSURE(sp_kiosk_ui_offering(ui) && !ui->redraw_armed);
-    tap(ui, t + 500, SP_KT_REDRAW);
-    frame(ui, &f, t + 600);
-    ENSURE(!sp_kiosk_ui_offering(ui) && !ui->redraw_armed && sp_kiosk_ui_fade(ui) == 0 && f.undos == 0 &&
-           !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
+    redraw_draws_again(ui, &f, t + 500);
+    ENSURE(!sp_kiosk_ui_offering(ui) && sp_kiosk_ui_fade(ui) == 0 && f.undos == 0);
     // Tapped again (nothing seemed to happen): the same, not armed for the last part (a review's second tap).
-    tap(ui, t + 1400, SP_KT_REDRAW);
-    frame(ui, &f, t + 1500);
-    ENSURE(!ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
-    t = stroke(ui, t + 1500, 300, 500, 18, 5);
-    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 7});
+    redraw_draws_again(ui, &f, t + 1400);
+    t = new_part_stroke(ui, t + 1500, 7);
     // A refusal with nothing offered ("A bit bigger please!"): Redraw means that stroke again too.
     t = stroke(ui, t + 1000, 300, 500, 18, 5);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.refusal = SP_KREF_TOO_SMALL});
     ENSURE(!sp_kiosk_ui_offering(ui));
-    tap(ui, t + 400, SP_KT_REDRAW);
-    frame(ui, &f, t + 500);
-    ENSURE(!ui->redraw_armed && !strcmp(ui->hint, sp_kiosk_text(SP_KTEXT_DRAW_AGAIN)));
-    t = stroke(ui, t + 1500, 300, 500, 18, 5);
-    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.replace);
-    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .part_count = 8});
+    redraw_draws_again(ui, &f, t + 400);
+    t = new_part_stroke(ui, t + 1500, 8);
     // After a part, Redraw arms as before.
     tap(ui, t + 400, SP_KT_REDRAW);
     ENSURE(ui->redraw_armed);
     tap(ui, t + 1400, SP_KT_REDRAW);
     ENSURE(!ui->redraw_armed);
+    t += 1500;
     // The refused stroke was a Redraw's replacement: Redraw again keeps it
     // armed for that part.
     tap(ui, t + 1000, SP_KT_REDRAW);

@@ -754,6 +754,16 @@ static bool continue_last(sp_kiosk_ui* ui)
     }
 }
 
+// The diagonal of the box of a line's points from index `from` on (0 for none).
+static double line_diag(const sp_kiosk_line* l, int from)
+{
+    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int i = from; i < l->count; ++i)
+        for (int c = 0; c < 2; ++c)
+            lo[c] = fminf(lo[c], l->xy[2 * i + c]), hi[c] = fmaxf(hi[c], l->xy[2 * i + c]);
+    return l->count > from ? hypot(hi[0] - lo[0], hi[1] - lo[1]) : 0;
+}
+
 // A stroke that closes the last one, an open line drawn just before: its
 // two ends meet that line's two ends (within the join distance), so the
 // two are one outline drawn in two strokes (a child's body drawn as two
@@ -769,14 +779,11 @@ static bool closes_last(const sp_kiosk_ui* ui, const sp_kiosk_line* s, bool* rev
         ui->last_outcome == SP_KLAST_PENDING || ui->last_outcome == SP_KLAST_PART || ui->last_outcome == SP_KLAST_REFUSED;
     if (!after || l->count < 2 || s->count < 2 || !(ui->desc.join_ms > 0) || !(ui->now - ui->last_up <= SP_KIOSK_CLOSE_MS))
         return false;
-    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int i = 0; i < l->count; ++i)
-        for (int c = 0; c < 2; ++c)
-            lo[c] = fminf(lo[c], l->xy[2 * i + c]), hi[c] = fmaxf(hi[c], l->xy[2 * i + c]);
+    double diag = line_diag(l, 0);
     const float *l0 = l->xy, *l1 = l->xy + 2 * (l->count - 1), *s0 = s->xy, *s1 = s->xy + 2 * (s->count - 1);
 #define SP_GAP(a, b) hypot((a)[0] - (b)[0], (a)[1] - (b)[1])
     double near = mm(ui, ui->desc.join_mm);
-    bool open = SP_GAP(l0, l1) > fmax(0.2 * hypot(hi[0] - lo[0], hi[1] - lo[1]), 2 * near); // not a loop already
+    bool open = SP_GAP(l0, l1) > fmax(0.2 * diag, 2 * near); // not a loop already
     bool on = SP_GAP(s0, l1) <= near && SP_GAP(s1, l0) <= near, back = SP_GAP(s0, l0) <= near && SP_GAP(s1, l1) <= near;
 #undef SP_GAP
     *reversed = back && !on;
@@ -787,7 +794,7 @@ static bool closes_last(const sp_kiosk_ui* ui, const sp_kiosk_line* s, bool* rev
     double apart = INFINITY;
     for (int i = 0; i < l->count; ++i)
         apart = fmin(apart, hypot(mid[0] - l->xy[2 * i], mid[1] - l->xy[2 * i + 1]));
-    return apart > fmax(2 * near, 0.1 * hypot(hi[0] - lo[0], hi[1] - lo[1]));
+    return apart > fmax(2 * near, 0.1 * diag);
 }
 
 // ui->stroke (the piece just drawn) becomes the last line and then it, run
@@ -829,11 +836,7 @@ static void finish_stroke(sp_kiosk_ui* ui)
     ui->continuing = false;
     // A continuation's own piece decides whether it was a tap.
     int from = cont ? ui->continued_from : 0;
-    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int i = from; i < s->count; ++i)
-        for (int c = 0; c < 2; ++c)
-            lo[c] = fminf(lo[c], s->xy[2 * i + c]), hi[c] = fmaxf(hi[c], s->xy[2 * i + c]);
-    double diag = s->count > from ? hypot(hi[0] - lo[0], hi[1] - lo[1]) : 0;
+    double diag = line_diag(s, from);
     if (s->count - from < 2 || diag < mm(ui, ui->desc.tap_mm)) {
         s->count = 0;
         if (cont) return; // a finger bouncing off the glass at the end: the last stroke stands
