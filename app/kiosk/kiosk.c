@@ -810,6 +810,20 @@ static void run_job(sp_kiosk* k, const sp_kiosk_job* j)
     }
 }
 
+// A lasting database problem (a damaged file renamed over it) fails every
+// poll: the log says it once, again only when it changes, and when it ends.
+static void kiosk_poll_database(sp_kiosk* k)
+{
+    sp_error err = {0};
+    if (sp_dragon_reload_if_changed(k->dragon, NULL, &err) == SP_OK) {
+        if (k->db_problem[0]) sp_kiosk_log("database: %s reads again", k->db_path);
+        k->db_problem[0] = '\0';
+    } else if (strcmp(err.text, k->db_problem) != 0) {
+        sp_kiosk_log("database: %s", err.text);
+        snprintf(k->db_problem, sizeof k->db_problem, "%s", err.text);
+    }
+}
+
 void sp_kiosk_update(sp_kiosk* k, double t_ms)
 {
     ++k->updates;
@@ -834,8 +848,7 @@ void sp_kiosk_update(sp_kiosk* k, double t_ms)
     // strokes; add_stroke polls too, this only keeps idle kiosks current.
     if (!k->heavy_done && k->ui->capture == SP_KCAP_NONE && t_ms - k->last_reload_check >= 2000) {
         k->last_reload_check = t_ms;
-        sp_error err = {0};
-        if (sp_dragon_reload_if_changed(k->dragon, NULL, &err) != SP_OK) sp_kiosk_log("database: %s", err.text);
+        kiosk_poll_database(k);
     }
     // A change either poll took in (a stroke's came first when it was drawn
     // right after the change): a curator may have changed the parts, so the

@@ -129,6 +129,7 @@ struct sp_kiosk {
     uint64_t code_state;
     char last_save[1100];
     double last_reload_check;
+    char db_problem[sizeof(sp_error){0}.text]; // the database problem last logged ("": none), said once until it changes or ends
     uint64_t reloads_seen; // sp_dragon_reload_count when the parts row and parts were last reloaded
     bool heavy_done; // a heavy job ran in this update
     bool save_shown; // a frame was drawn since the Save job was queued (its hint and the Save button's state)

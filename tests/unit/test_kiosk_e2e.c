@@ -1844,6 +1844,56 @@ static void test_attract_follows_damaged(void)
     attract_kiosk_end(k, gl, &t);
 }
 
+// Runs the in-process kiosk from *t to `until` with its stderr in `path`
+// (appended), so that a test can read its log lines.
+static void updates_logged(sp_kiosk* k, double* t, double until, const char* path)
+{
+    fflush(stderr);
+    int keep = dup(2);
+    FILE* f = fopen(path, "a");
+    ENSURE(keep >= 0 && f && dup2(fileno(f), 2) == 2);
+    updates_until(k, t, until);
+    fflush(stderr);
+    ENSURE(dup2(keep, 2) == 2);
+    close(keep);
+    fclose(f);
+}
+
+// A damaged file renamed over the database: the kiosk goes on with what it
+// has and says so once, not at every poll (every 2 s, a season's log of one
+// line); once a good file is back it says that, and a new problem is said again.
+static void test_db_problem_said_once(void)
+{
+    char db[1100], next[1100], wal[1200], junk[1200], log[1100];
+    live_and_next("kiosk_problem", db, next, wal);
+    snprintf(junk, sizeof junk, "%s.junk", db);
+    snprintf(log, sizeof log, "%s", sp_test_tmp_path("kiosk_problem_log.txt"));
+    unlink(log);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = attract_kiosk(db, true, &gl, &t);
+    FILE* f = fopen(junk, "w");
+    ENSURE(f && fputs("not a database, not at all; a page of text in its place\n", f) >= 0 && fclose(f) == 0);
+    ENSURE(rename(junk, db) == 0);
+    updates_logged(k, &t, t + 12000, log);
+    int problems = stamped_lines_with(log, "database: "), back = stamped_lines_with(log, "reads again");
+    fprintf(stderr, "  damaged file for 12 s: %d database lines\n", problems);
+    ENSURE(problems == 1 && back == 0);
+    ENSURE(rename(next, db) == 0);
+    updates_logged(k, &t, t + 4000, log);
+    back = stamped_lines_with(log, "reads again");
+    fprintf(stderr, "  a good file back: %d reload(s), %d 'reads again'\n", sp_kiosk_stats_of(k)->reloads, back);
+    ENSURE(back == 1 && sp_kiosk_stats_of(k)->reloads >= 1);
+    f = fopen(junk, "w");
+    ENSURE(f && fputs("damaged again\n", f) >= 0 && fclose(f) == 0);
+    ENSURE(rename(junk, db) == 0);
+    updates_logged(k, &t, t + 8000, log);
+    problems = stamped_lines_with(log, "database: ") - stamped_lines_with(log, "reads again");
+    fprintf(stderr, "  damaged again: %d problem lines in all\n", problems);
+    ENSURE(problems == 2);
+    attract_kiosk_end(k, gl, &t);
+}
+
 // A database with thirteen part categories (seven a curator added): the
 // refusal's row offers the first twelve, the shipped six first.
 static void test_row_twelve(void)
@@ -2574,6 +2624,7 @@ int main(int argc, char** argv)
                                    {"collect_disk_reserve", test_collect_disk_reserve},
                                    {"attract_follows", test_attract_follows},
                                    {"attract_follows_damaged", test_attract_follows_damaged},
+                                   {"db_problem_said_once", test_db_problem_said_once},
                                    {"row_twelve", test_row_twelve},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},
