@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -393,4 +394,19 @@ void sp_cli_print_shell_word(FILE* f, const char* s)
             fputc(*c, f);
     }
     fputc('\'', f);
+}
+
+static char g_done[512];
+
+void sp_cli_done(const char* fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(g_done, sizeof g_done, fmt, ap);
+    va_end(ap);
+}
+
+const char* sp_cli_done_text(void)
+{
+    return g_done;
 }

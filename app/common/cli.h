@@ -118,6 +118,13 @@ bool sp_cli_check_out_folders(const char* cmd, const sp_opt* opts, int nopts);
 /// three commands say the same range.
 bool sp_cli_check_max_ms(const char* cmd, double ms);
 
+/// Says what a command has done that stays done (a database change
+/// committed), for the error line of a later failure to write stdout: a
+/// script that sees exit 1 must learn that the change is kept all the same.
+void sp_cli_done(const char* fmt, ...);
+/// What sp_cli_done said last ("" when nothing).
+const char* sp_cli_done_text(void);
+
 /// Prints `s` as one word a POSIX shell reads back as `s`: as it is when it
 /// holds only [A-Za-z0-9_./=:,+-], else in single quotes (a quote as '\'').
 /// For command lines printed to be pasted.

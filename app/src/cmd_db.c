@@ -386,6 +386,7 @@ static int db_init(int argc, char** argv)
                                  &err);
     }
     if (r != SP_OK) return fail(cmd, &err);
+    sp_cli_done("%s is built", db_path(&c));
     sp_db* db = open_db(cmd, &c, SP_DB_READONLY);
     if (!db) return SP_EXIT_INPUT;
     sp_db_part_info* parts = NULL;
@@ -532,6 +533,7 @@ static int db_add_part(int argc, char** argv)
         return fail(cmd, &err);
     }
     note_created(cmd, &c, existed);
+    sp_cli_done("part %s is stored in %s", info.name, db_path(&c));
     // As `sketchpose derive` prints them for the same file: stderr for the curator, JSON for a script.
     for (int i = 0; i < warns.count; ++i)
         fprintf(stderr, "%s: %s: warning: %s\n", cmd, pos[0], warns.lines[i]);
@@ -750,6 +752,7 @@ static int db_add_sketch(int argc, char** argv)
     if (r != SP_OK) exit_code = db || err.text[0] ? fail(cmd, &err) : SP_EXIT_INPUT;
     else {
         note_created(cmd, &c, existed);
+        sp_cli_done("%d sketches are stored in %s", added, db_path(&c));
         int* per = calloc((size_t)(s.ds.category_count + 1), sizeof(int));
         for (int i = 0; per && i < s.ds.count; ++i)
             per[s.ds.samples[i].label]++;
@@ -867,6 +870,7 @@ static int db_remove(int argc, char** argv)
     sp_result r = sp_db_remove_part(db, pos[0], c.by, &err);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);
+    sp_cli_done("part %s is removed from %s", pos[0], db_path(&c));
     printf("{\"removed\": ");
     clf_cli_json_str(stdout, pos[0]);
     printf("}\n");
@@ -940,6 +944,7 @@ static int db_train(int argc, char** argv)
     sp_result r = sp_db_train(db, &td, &report, &err);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);
+    sp_cli_done("the new model is stored in %s", db_path(&c));
     cJSON* rj = cJSON_Parse(report);
     const cJSON* left = cJSON_GetObjectItemCaseSensitive(rj, "curated_left_out");
     long n_left = cJSON_IsNumber(left) ? (long)left->valuedouble : 0;
@@ -1079,6 +1084,7 @@ static int review_act(const char* cmd, const db_common* c, const sp_str_list* ap
                                                         c->by, &changed, &m, &err);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);
+    sp_cli_done("the review is stored in %s", db_path(c));
     if (delete_rejected) {
         printf("{\"deleted\": %d}\n", m);
     } else if (relabel->count) {

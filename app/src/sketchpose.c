@@ -32,7 +32,9 @@ static int finish(int rc)
     errno = 0;
     if (fflush(stdout) == 0 && !ferror(stdout)) return rc;
     int e = errno;
-    fprintf(stderr, "sketchpose: stdout: write error (%s)\n", e ? strerror(e) : "an earlier write failed");
+    const char* done = sp_cli_done_text();
+    fprintf(stderr, "sketchpose: stdout: write error (%s)%s%s\n", e ? strerror(e) : "an earlier write failed",
+            done[0] ? "; done all the same: " : "", done);
     return rc == SP_EXIT_OK ? SP_EXIT_INPUT : rc;
 }
 

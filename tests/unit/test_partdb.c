@@ -2753,8 +2753,11 @@ static void test_kiosk_review_cli(void)
     // Approve, reject the other, train: the new model's training set has it.
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --approve %lld", bin, p, (long long)id);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"approved\": ["));
-    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %lld >/dev/null", bin, p, (long long)first);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+    // Its JSON lost to a full disk: exit 1, and the line says the rejection is kept (it is).
+    snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --reject %lld 2>&1 >/dev/full", bin, p, (long long)first);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "done all the same: the review is stored in") &&
+           !strchr(strchr(out, '\n') + 1, '\n'));
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'kiosk' AND status = 'rejected'") == 1);
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --status approved", bin, p);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 && strstr(out, "\"status\": \"approved\"") &&
            strstr(out, "\"category\": \"wings\""));
@@ -2781,6 +2784,11 @@ static void test_kiosk_review_cli(void)
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, no_such));
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
+    // A model trained with its report lost to a full disk is kept, and the line says so.
+    int models = scalar(p, "SELECT count(*) FROM models");
+    snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --words 64 --folds -1 2>&1 >/dev/full", bin, p);
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 1 && strstr(out, "done all the same: the new model is stored in"));
+    ENSURE(scalar(p, "SELECT count(*) FROM models") == models + 1);
     snprintf(cmd, sizeof cmd, "'%s' db train --db '%s' --words 64 --folds -1", bin, p);
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
     fprintf(stderr, "  train: %.160s\n", out);
