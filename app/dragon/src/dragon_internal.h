@@ -77,6 +77,11 @@ typedef struct tpl {
     // parts and for the line templates themselves.
     struct tpl *line, *limb;
     bool* active; // the line template's solver moves these (param_count; NULL: all)
+    // The limb template's two legs, joint by joint from the leaves up to the
+    // joint they share (not included): the drawn leg's joint, then the
+    // other's (twin_count pairs; 0 for other templates; limb_pairs, parts.c).
+    int twin_count;
+    int (*twins)[2];
     // The same fit with the attachment end held in place (reach.c; made on
     // first use): every parameter of `active` but the root's translation.
     sp_solver* pinned;
@@ -85,6 +90,10 @@ typedef struct tpl {
 
 /// Drops one reference (the last frees it). NULL is fine.
 void dragon_tpl_release(tpl* t);
+/// A pair of legs fitted with the limb template (p: its fit): the leg not
+/// drawn takes the drawn leg's pose as seen, bone by bone, within its own
+/// bounds. parts.c.
+void dragon_limb_follow(const tpl* limb, double* p);
 /// How far a stroke is from being its own mirror image about the upright
 /// line through its centroid, over its RMS radius (0: symmetric; 1 when it
 /// cannot be measured). stroke.c.

@@ -18,6 +18,7 @@ void dragon_tpl_release(tpl* t)
     dragon_tpl_release(t->limb);
     sp_solver_destroy(t->solver);
     free(t->active);
+    free(t->twins);
     sp_solver_destroy(t->pinned);
     free(t->pinned_active);
     sp_rig_eval_destroy(t->ev);
@@ -86,6 +87,93 @@ static void read_part_extras(tpl* t)
 static sp_result tpl_load(sp_db* db, const tpl* line_of, int limb_leaf, const char* name, int canvas_w, int canvas_h,
                           const sp_solve_desc* solve, tpl** out, sp_error* err);
 
+// Pairs the two legs' joints from the leaves up to the joint they share
+// (for dragon_limb_follow): t->twins, t->twin_count (none when out of memory).
+static void limb_pairs(tpl* t, int near, int far)
+{
+    const sp_rig* rig = &t->ch.rig;
+    int J = rig->joint_count;
+    int* up = malloc(sizeof(int) * (size_t)(2 * J + 2));
+    if (!up) return;
+    int *a = up, *b = up + J + 1; // each leaf up to the root
+    int na = 0, nb = 0;
+    for (int j = near; j >= 0 && na < J; j = rig->joints[j].parent)
+        a[na++] = j;
+    for (int j = far; j >= 0 && nb < J; j = rig->joints[j].parent)
+        b[nb++] = j;
+    while (na > 0 && nb > 0 && a[na - 1] == b[nb - 1]) // what the two share stays
+        --na, --nb;
+    int n = na < nb ? na : nb;
+    if (n > 0 && (t->twins = malloc(sizeof *t->twins * (size_t)n)))
+        for (int i = 0; i < n; ++i)
+            t->twins[i][0] = a[i], t->twins[i][1] = b[i], t->twin_count = n;
+    free(up);
+}
+
+// The direction, as seen (radians), of joint j's bone: towards joint `to`,
+// or with to < 0 (a leaf) along the joint's own axis (x, or y where x is
+// seen end-on), at the last evaluation of t->ev.
+static double seen_angle(const tpl* t, int j, int to)
+{
+    const sp_mat4* w = sp_rig_eval_world(t->ev);
+    sp_vec3 o = sp_mat4_point(&t->base.view, sp_mat4_translation(&w[j])), e;
+    if (to >= 0) {
+        e = sp_mat4_point(&t->base.view, sp_mat4_translation(&w[to]));
+    } else {
+        sp_vec3 x = sp_mat4_point(&t->base.view, sp_mat4_point(&w[j], (sp_vec3){1, 0, 0}));
+        sp_vec3 y = sp_mat4_point(&t->base.view, sp_mat4_point(&w[j], (sp_vec3){0, 1, 0}));
+        e = hypot(x.x - o.x, x.y - o.y) >= 0.3 * hypot(y.x - o.x, y.y - o.y) ? x : y;
+    }
+    return atan2(e.y - o.y, e.x - o.x);
+}
+
+// How fast parameter k turns joint j's bone as seen (radians per unit), at p.
+static double seen_rate(const tpl* t, double* p, int k, int j, int to)
+{
+    const double h = 1e-3;
+    sp_rig_eval_update(t->ev, p, false);
+    double a0 = seen_angle(t, j, to);
+    double keep = p[k];
+    p[k] += h;
+    sp_rig_eval_update(t->ev, p, false);
+    p[k] = keep;
+    return remainder(seen_angle(t, j, to) - a0, 2 * M_PI) / h;
+}
+
+void dragon_limb_follow(const tpl* limb, double* p)
+{
+    const sp_rig* rig = &limb->ch.rig;
+    // From the hips down: each joint of the other leg turns so that its bone
+    // points as the drawn leg's does (a leaf: turns as much as the drawn
+    // leaf does), and takes its scales.
+    for (int i = limb->twin_count - 1; i >= 0; --i) {
+        int a = limb->twins[i][0], b = limb->twins[i][1];
+        int a_to = i > 0 ? limb->twins[i - 1][0] : -1, b_to = i > 0 ? limb->twins[i - 1][1] : -1;
+        for (int m = 0; m < rig->param_count; ++m) {
+            if (rig->params[m].joint != b) continue;
+            int k = -1;
+            for (int q = 0; q < rig->param_count && k < 0; ++q)
+                if (rig->params[q].joint == a && rig->params[q].channel == rig->params[m].channel) k = q;
+            if (k < 0) continue;
+            double v = p[k];
+            if (sp_channel_is_rotation(rig->params[m].channel)) {
+                double rf = seen_rate(limb, p, m, b, b_to);
+                if (fabs(rf) < 0.1) continue; // a turn this joint cannot show
+                if (i > 0) {
+                    sp_rig_eval_update(limb->ev, p, false);
+                    v = p[m] + remainder(seen_angle(limb, a, a_to) - seen_angle(limb, b, b_to), 2 * M_PI) / rf;
+                } else {
+                    double d[2] = {rig->params[k].def, p[k]};
+                    v = rig->params[m].def + seen_rate(limb, p, k, a, a_to) * (d[1] - d[0]) / rf;
+                }
+            } else if (!sp_channel_is_scale(rig->params[m].channel)) {
+                continue; // the other leg keeps its own offsets
+            }
+            p[m] = fmin(fmax(v, rig->params[m].min), rig->params[m].max);
+        }
+    }
+}
+
 // Gives t (an outline template) its line templates, for strokes drawn as one
 // open line: the `line` through its chain (a tail, a pair of legs) and, for
 // a pair of legs, the `limb` of the leg nearer the camera (the leg a child
@@ -102,7 +190,9 @@ static void load_lines(sp_db* db, tpl* t, const char* name, int canvas_w, int ca
         const sp_mat4* world = sp_rig_eval_world(t->ev);
         double z0 = sp_mat4_point(&t->base.view, sp_mat4_translation(&world[order[0]])).z,
                z1 = sp_mat4_point(&t->base.view, sp_mat4_translation(&world[order[n - 1]])).z;
-        tpl_load(db, t, z0 >= z1 ? order[0] : order[n - 1], name, canvas_w, canvas_h, solve, &t->limb, &lerr);
+        int near = z0 >= z1 ? order[0] : order[n - 1];
+        tpl_load(db, t, near, name, canvas_w, canvas_h, solve, &t->limb, &lerr);
+        if (t->limb) limb_pairs(t->limb, near, near == order[0] ? order[n - 1] : order[0]);
     }
     free(order);
     // Which way the part reaches is the part's, whichever curve is fitted.

@@ -270,6 +270,7 @@ static void prefer_line(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 h
         double gl = two_way_gap(&l, &sk->strokes[0], diag);
         if (gl < best) {
             best = gl;
+            if (k == 1) dragon_limb_follow(lines[k], l.p);
             l.score = f->score;
             free(f->p);
             *f = l;
