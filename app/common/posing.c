@@ -85,7 +85,7 @@ static int common_ancestor(const sp_rig* rig, int a, int b)
 // curves embedded in the mesh, the limb above them and everything below.
 // - Carriers: a joint with at least SP_DRAWOVER_CARRIER_SHARE of the skin
 //   (the triangle's vertices' weights blended by the point's barycentric
-//   coordinates) at a tenth of the curve's points or more: one point on the
+//   coordinates) at a tenth of a curve's points or more: one point on the
 //   chest where a stroke starts did not make the chest twist for an arm. A
 //   joint moving more than SP_DRAWOVER_LIMB_SHARE of the mesh (a trunk)
 //   counts only the points where no joint under it has that share.
@@ -107,41 +107,66 @@ static bool curve_carriers(const sp_rig* rig, const sp_abstraction* emb, double 
         free(w), free(hits), free(under), free(moves);
         return false;
     }
-    for (int i = 0; i < emb->point_count; ++i) {
-        for (int c = 0; c < 3; ++c) {
-            uint32_t v = emb->tri_vertices[3 * i + c];
-            for (int k = 0; k < 4 && v < (uint32_t)rig->vertex_count; ++k)
-                w[rig->joints4[4 * (size_t)v + k]] += emb->bary[3 * i + c] * rig->weights4[4 * (size_t)v + k];
-        }
-        for (int j = 0; j < J; ++j)
-            for (int a = w[j] >= share ? rig->joints[j].parent : -1; a >= 0 && !under[a]; a = rig->joints[a].parent)
-                under[a] = true;
-        for (int j = 0; j < J; ++j) {
-            hits[j] += w[j] >= share;
-            own[j] += w[j] >= share && !under[j];
-            w[j] = 0, under[j] = false;
-        }
-    }
     for (size_t v = 0; v < (size_t)rig->vertex_count; ++v)
         for (int k = 0; k < 4; ++k)
             moves[rig->joints4[4 * v + k]] += rig->weights4[4 * v + k] / rig->vertex_count;
     for (int j = J - 1; j > 0; --j) // children come after their parents (sp_rig_finalize)
         if (rig->joints[j].parent >= 0) moves[rig->joints[j].parent] += moves[j];
-    for (int j = 0; j < J; ++j) {
-        // A trunk joint (moving more than the limb share) counts only where
-        // the curve is on its own skin: RiggedFigure's upper arm is skinned to
-        // its spine at the shoulder, and a draw-over of the arm freed the
-        // chest, the head and the other arm (an outside review).
-        int h = moves[j] > SP_DRAWOVER_LIMB_SHARE ? own[j] : hits[j];
-        if (10 * h < emb->point_count || h == 0) continue;
-        free_j[j] = true;
-        for (int a = rig->joints[j].parent; a >= 0 && moves[a] <= SP_DRAWOVER_LIMB_SHARE; a = rig->joints[a].parent)
-            free_j[a] = true;
+    // Curve by curve: a tenth of each curve's own points (with several
+    // curves drawn over, a tenth of them all left a spine's short curve
+    // without carriers, and the chest bent into an S; an outside review).
+    for (int c = 0; c < emb->curve_count; ++c) {
+        const sp_curve* cv = &emb->curves[c];
+        for (int i = cv->first_point; i < cv->first_point + cv->point_count; ++i) {
+            for (int t = 0; t < 3; ++t) {
+                uint32_t v = emb->tri_vertices[3 * i + t];
+                for (int k = 0; k < 4 && v < (uint32_t)rig->vertex_count; ++k)
+                    w[rig->joints4[4 * (size_t)v + k]] += emb->bary[3 * i + t] * rig->weights4[4 * (size_t)v + k];
+            }
+            for (int j = 0; j < J; ++j)
+                for (int a = w[j] >= share ? rig->joints[j].parent : -1; a >= 0 && !under[a]; a = rig->joints[a].parent)
+                    under[a] = true;
+            for (int j = 0; j < J; ++j) {
+                hits[j] += w[j] >= share;
+                own[j] += w[j] >= share && !under[j];
+                w[j] = 0, under[j] = false;
+            }
+        }
+        for (int j = 0; j < J; ++j) {
+            // A trunk joint (moving more than the limb share) counts only where
+            // the curve is on its own skin: RiggedFigure's upper arm is skinned to
+            // its spine at the shoulder, and a draw-over of the arm freed the
+            // chest, the head and the other arm (an outside review).
+            int h = moves[j] > SP_DRAWOVER_LIMB_SHARE ? own[j] : hits[j];
+            hits[j] = own[j] = 0;
+            if (10 * h < cv->point_count || h == 0) continue;
+            free_j[j] = true;
+            for (int a = rig->joints[j].parent; a >= 0 && moves[a] <= SP_DRAWOVER_LIMB_SHARE; a = rig->joints[a].parent)
+                free_j[a] = true;
+        }
     }
     for (int j = 0; j < J; ++j)
         free_j[j] |= rig->joints[j].parent >= 0 && free_j[rig->joints[j].parent];
     free(w), free(hits), free(under), free(moves);
     return true;
+}
+
+// How many of joint j's children have parameters at or under them.
+static int branches_with_params(const sp_rig* rig, int j)
+{
+    int n = 0;
+    for (int c = 0; c < rig->joint_count; ++c) {
+        if (rig->joints[c].parent != j) continue;
+        bool any = false;
+        for (int k = c; k < rig->joint_count && !any; ++k) { // children come after their parents
+            int a = k;
+            while (a > c)
+                a = rig->joints[a].parent;
+            any = a == c && rig->joints[k].param_count > 0;
+        }
+        n += any;
+    }
+    return n;
 }
 
 bool* sp_drawover_active(const sp_rig* rig, const sp_abstraction* emb)
@@ -163,6 +188,10 @@ bool* sp_drawover_active(const sp_rig* rig, const sp_abstraction* emb)
     int place = rig->param_count > 0 ? rig->params[0].joint : -1, body = -2;
     for (int j = 0; placement && j < rig->joint_count; ++j)
         if (j != place && rig->joints[j].param_count > 0) body = body == -2 ? j : common_ancestor(rig, body, j);
+    // Only a body's root where limbs branch (hips: legs and spine) is held;
+    // on a single chain (SimpleSkin, RiggedSimple) it is the chain's first
+    // bend, and holding it left SimpleSkin nothing to move (an outside review).
+    if (body >= 0 && branches_with_params(rig, body) < 2) body = -2;
     for (int q = 0; q < rig->param_count; ++q)
         on[q] = !(placement && (rig->params[q].joint == place || rig->params[q].joint == body)) &&
                 (!emb || !emb->tri_vertices || carrier[rig->params[q].joint]);
