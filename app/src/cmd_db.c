@@ -854,6 +854,42 @@ static int db_show(int argc, char** argv)
     return SP_EXIT_OK;
 }
 
+// What a removal leaves the kiosk, said on stderr: a category no part has
+// now that the newest model still knows (its strokes became another part,
+// with nothing offered, until a retrain), and a dragon without a body to
+// hang its parts on (an outside curator review).
+static void note_after_remove(const char* cmd, sp_db* db, const char* category)
+{
+    char** cats = NULL;
+    int n = 0;
+    char* models = NULL;
+    sp_error e = {0};
+    if (sp_db_categories(db, &cats, &n, &e) != SP_OK) return;
+    bool left = false;
+    for (int i = 0; i < n; ++i)
+        left = left || !strcmp(cats[i], category);
+    sp_db_free_strings(cats, n);
+    if (left) return;
+    if (sp_db_models_json(db, &models, &e) == SP_OK) {
+        cJSON* m = cJSON_Parse(models);
+        const cJSON* known = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(m, 0), "categories");
+        const cJSON* it;
+        bool knows = false;
+        cJSON_ArrayForEach(it, known) knows = knows || (cJSON_IsString(it) && !strcmp(it->valuestring, category));
+        if (knows)
+            fprintf(stderr,
+                    "%s: no part of category %s is left, and the newest model still knows it: run `sketchpose db train`\n", cmd,
+                    category);
+        cJSON_Delete(m);
+        free(models);
+    }
+    if (!strcmp(category, "torso"))
+        fprintf(stderr,
+                "%s: no body (category torso) is left: the kiosk's parts will hang free, and no stroke can make the body it asks "
+                "for\n",
+                cmd);
+}
+
 static int db_remove(int argc, char** argv)
 {
     const char* cmd = "sketchpose db remove";
@@ -867,7 +903,10 @@ static int db_remove(int argc, char** argv)
     sp_db* db = open_db(cmd, &c, 0);
     if (!db) return SP_EXIT_INPUT;
     sp_error err = {0};
-    sp_result r = sp_db_remove_part(db, pos[0], c.by, &err);
+    sp_db_part_info gone;
+    sp_result r = sp_db_part(db, pos[0], &gone, &err);
+    if (r == SP_OK) r = sp_db_remove_part(db, pos[0], c.by, &err);
+    if (r == SP_OK) note_after_remove(cmd, db, gone.category);
     sp_db_close(db);
     if (r != SP_OK) return fail(cmd, &err);
     sp_cli_done("part %s is removed from %s", pos[0], db_path(&c));

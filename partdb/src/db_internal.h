@@ -73,6 +73,14 @@ sp_result db_insert_sketch(sp_db* db, const char* category, sp_db_source source,
 #define DB_SKETCH_DIGITS 9
 /// Checks a sample is storable (strokes with finite points, or a raster).
 sp_result db_sample_ok(const sp_sample* smp, const char* what, sp_error* err);
+/// A name that differs from one the database has only in case is a slip
+/// (the kiosk showed "Front legs" twice, one tile a part each; an export's
+/// files collide on a FAT stick): `sql` selects such a name for ?1 (the
+/// value); found, SP_ERR_INVALID "DB: KIND 'value' differs from its 'other'
+/// only in case (WHY)".
+sp_result db_case_clash(sp_db* db, const char* sql, const char* kind, const char* value, const char* why, sp_error* err);
+/// db_case_clash for a category against the parts' and the sketches' categories.
+sp_result db_category_case_clash(sp_db* db, const char* category, sp_error* err);
 /// Reads a whole file (malloc'd, NUL-terminated beyond size).
 sp_result db_read_file(const char* path, void** data, size_t* size, sp_error* err);
 /// Reads and parses a JSON file as one document, each key once

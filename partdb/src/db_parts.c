@@ -287,22 +287,29 @@ sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_pa
     return r;
 }
 
-// A category that differs from one the database has only in case is a
-// slip: the kiosk showed "Front legs" twice, one tile a part each.
-static sp_result category_case_clash(sp_db* db, const char* category, sp_error* err)
+sp_result db_case_clash(sp_db* db, const char* sql, const char* kind, const char* value, const char* why, sp_error* err)
 {
     sqlite3_stmt* st = NULL;
-    sp_result r =
-        db_prepare(db, "SELECT category FROM parts WHERE category = ?1 COLLATE NOCASE AND category <> ?1 LIMIT 1", &st, err);
+    sp_result r = db_prepare(db, sql, &st, err);
     if (r != SP_OK) return r;
-    sqlite3_bind_text(st, 1, category, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 1, value, -1, SQLITE_TRANSIENT);
     int rc = sqlite3_step(st);
     if (rc == SQLITE_ROW)
-        r = sp_fail(err, SP_ERR_INVALID, "%s: category '%s' differs from its '%s' only in case (use that one)", db->path,
-                    category, (const char*)sqlite3_column_text(st, 0));
+        r = sp_fail(err, SP_ERR_INVALID, "%s: %s '%s' differs from its '%s' only in case (%s)", db->path, kind, value,
+                    (const char*)sqlite3_column_text(st, 0), why);
     else if (rc != SQLITE_DONE)
-        r = db_fail(db, rc, "reading the categories", err);
+        r = db_fail(db, rc, "reading the names", err);
     sqlite3_finalize(st);
+    return r;
+}
+
+sp_result db_category_case_clash(sp_db* db, const char* category, sp_error* err)
+{
+    sp_result r = db_case_clash(db, "SELECT category FROM parts WHERE category = ?1 COLLATE NOCASE AND category <> ?1 LIMIT 1",
+                                "category", category, "use that one", err);
+    if (r == SP_OK)
+        r = db_case_clash(db, "SELECT category FROM sketches WHERE category = ?1 COLLATE NOCASE AND category <> ?1 LIMIT 1",
+                          "category", category, "use that one", err);
     return r;
 }
 
@@ -361,7 +368,10 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
     const char* by = db_who(d.added_by);
     sqlite3_stmt* st = NULL;
     if ((r = db_begin(db, err)) != SP_OK) goto done;
-    if ((r = category_case_clash(db, info.category, err)) != SP_OK) goto rollback;
+    if ((r = db_category_case_clash(db, info.category, err)) != SP_OK ||
+        (r = db_case_clash(db, "SELECT name FROM parts WHERE name = ?1 COLLATE NOCASE AND name <> ?1 LIMIT 1", "part name",
+                           info.name, "an export's files of the two would be one on a case-blind file system", err)) != SP_OK)
+        goto rollback;
     warn_same_file(db, &info, &d);
     if ((r = db_prepare(db,
                         "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, parameters,"

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "db_internal.h"
 #include "sp/part.h"
@@ -116,8 +117,21 @@ sp_result sp_db_add_sketches(sp_db* db, const sp_dataset* data, const sp_db_png*
                            SP_DB_KIOSK_POINTS_MAX, why);
     }
     if (data->count == 0) return sp_fail(err, SP_ERR_INVALID, "no drawings to add");
+    // Categories differing only in case (a folder `Head` beside the parts'
+    // `head`) were stored apart and never trained on, with a warning that
+    // asked for a part of that category (an outside review).
+    for (int a = 0; a < data->category_count; ++a)
+        for (int b = a + 1; b < data->category_count; ++b)
+            if (!strcasecmp(data->categories[a], data->categories[b]))
+                return sp_fail(err, SP_ERR_INVALID, "categories '%s' and '%s' differ only in case (use one)", data->categories[a],
+                               data->categories[b]);
     sp_result r = db_begin(db, err);
     if (r != SP_OK) return r;
+    for (int c = 0; c < data->category_count; ++c)
+        if ((r = db_category_case_clash(db, data->categories[c], err)) != SP_OK) {
+            db_rollback(db);
+            return r;
+        }
     for (int i = 0; i < data->count; ++i) {
         const sp_sample* s = &data->samples[i];
         if ((r = db_insert_sketch(db, data->categories[s->label], source, 0, s, png ? &png[i] : NULL, by, err)) != SP_OK) {

@@ -2306,7 +2306,8 @@ static void test_add_part_derive_options(void)
 
 // A part whose category differs from one the database has only in case is
 // refused naming both (the kiosk showed two "Front legs" tiles); the same
-// category, and another one, are stored.
+// category, and another one, are stored. So are part names, and sketches'
+// categories.
 static void test_category_case(void)
 {
     const char* p = sp_test_tmp_path("category_case.db");
@@ -2325,6 +2326,33 @@ static void test_category_case(void)
     d.name = "tail_y", d.category = "tails";
     ENSURE(sp_db_add_part_file(db, part_file(3), &d, NULL, &err) == SP_OK);
     ENSURE(scalar(p, "SELECT count(*) FROM parts") == 3);
+    // A part name differing only in case: two files of one name in an
+    // export on a case-blind stick (an outside curator review).
+    d.name = "TAIL_Y", d.category = "tails";
+    ENSURE(sp_db_add_part_file(db, part_file(3), &d, NULL, &err) == SP_ERR_INVALID);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "part name 'TAIL_Y' differs from its 'tail_y' only in case"));
+    // Sketches of a category differing only in case from a part's, or from
+    // another of the same set, were stored apart and never trained on.
+    sp_dataset ds = {0};
+    sp_character ch = {0};
+    ENSURE(sp_db_load_part(db, "tail_x", &ch, &err) == SP_OK);
+    ENSURE(db_synth_sketches(&ch, 0, 2, 77, 0, &ds, &err) == SP_OK);
+    free(ds.categories[0]);
+    ds.categories[0] = strdup("TAIL");
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err) == SP_ERR_INVALID);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "category 'TAIL' differs from its 'tail' only in case"));
+    free(ds.categories[0]);
+    ds.categories[0] = strdup("rider");
+    ENSURE(sp_dataset_add_category(&ds, "Rider") == 1);
+    ds.samples[1].label = 1;
+    ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err) == SP_ERR_INVALID);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "categories 'rider' and 'Rider' differ only in case"));
+    ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 0);
+    sp_dataset_free(&ds);
+    sp_character_free(&ch);
     sp_db_close(db);
 }
 
@@ -2478,6 +2506,36 @@ static void test_default_db_cli(void)
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0 &&
            strstr(out, "sketches/picks.json: the Quick, Draw! data is not where it says"));
     ENSURE(stat(p, &st) == 0);
+}
+
+// `db remove` says what the removal leaves the kiosk: a category the
+// newest model still knows that no part has now (its strokes became
+// another part, with nothing offered, until a retrain) and a dragon with no
+// body. Another part of the category left: nothing said.
+static void test_remove_notes(void)
+{
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    char p[1024], cmd[4096], out[8192];
+    snprintf(p, sizeof p, "%s", base_db("remove_notes.db"));
+    sp_db* db = open_ok(p, 0);
+    sp_error err = {0};
+    const sp_db_part_desc quick = {.synth_sketches = -1, .selftest_seeds = -1};
+    sp_db_part_desc d = quick;
+    d.name = "tail_b", d.category = "tail";
+    ENSURE(sp_db_add_part_file(db, part_file(0), &d, NULL, &err) == SP_OK);
+    d.name = "blob", d.category = "torso";
+    ENSURE(sp_db_add_part_file(db, part_file(3), &d, NULL, &err) == SP_OK);
+    sp_db_close(db);
+    const char* cases[][2] = {{"tail_b", ""}, // tail_a stays
+                              {"wings_a", "no part of category wings is left, and the newest model still knows it"},
+                              {"blob", "no body (category torso) is left"}};
+    for (int i = 0; i < 3; ++i) {
+        snprintf(cmd, sizeof cmd, "'%s' db remove %s --db '%s' 2>&1 >/dev/null", bin, cases[i][0], p);
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 0);
+        fprintf(stderr, "  remove %s: %s", cases[i][0], out[0] ? out : "(nothing said)\n");
+        ENSURE(cases[i][1][0] ? strstr(out, cases[i][1]) && !strchr(strchr(out, '\n') + 1, '\n') : !out[0]);
+    }
 }
 
 // The review through the command line, end to end: a stroke the visitor
@@ -3244,6 +3302,7 @@ int main(int argc, char** argv)
                                    {"curated_cap", test_curated_cap},
                                    {"default_db", test_default_db},
                                    {"default_db_cli", test_default_db_cli},
+                                   {"remove_notes", test_remove_notes},
                                    {"db_help_lists_all", test_db_help_lists_all},
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
