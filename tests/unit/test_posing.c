@@ -424,6 +424,52 @@ static void test_animate_cli_cesiumman(void)
     sp_character_free(&ch);
 }
 
+// An animation is one character: after the first key the shape parameters
+// (bone and body scales) stay the first key's. A jump of the cartoon man
+// drawn by an outside review (stand, crouch, in the air, land, stand):
+// started from each other, the keys' proportions drifted (the figure 0.97
+// -> 1.22 in size, the head 0.82), and the last stand fitted otherwise
+// than the first.
+static void test_animate_holds_proportions(void)
+{
+    const char* names[5] = {"k0_stand", "k1_crouch", "k2_air", "k3_land", "k0_stand"};
+    char cmd[8192], list[4096] = "";
+    for (int k = 0; k < 5; ++k) {
+        size_t at = strlen(list);
+        snprintf(list + at, sizeof list - at, " '%s/tests/data/posing/cartoon_man_jump_%s.json'", SP_SOURCE_DIR, names[k]);
+    }
+    const char* rig = SP_SOURCE_DIR "/assets/cartoon_man.glb";
+    const char* rep = sp_test_tmp_path("jump_report.json");
+    snprintf(cmd, sizeof cmd, "'%s' animate --rig '%s' --strokes%s --out '%s' --report '%s' > /dev/null 2>&1", SP_SKETCHPOSE, rig,
+             list, sp_test_tmp_path("jump.glb"), rep);
+    ENSURE(run(cmd) == 0);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(rig, &ch, &err) == SP_OK);
+    cJSON* reports = sp_fixture_json_file(rep);
+    ENSURE(reports && cJSON_GetArraySize(reports) == 5);
+    double drift = 0, worst = 0, diag = 0;
+    int shapes = 0;
+    const cJSON* first = cJSON_GetObjectItem(cJSON_GetArrayItem(reports, 0), "parameters");
+    for (int k = 0; k < 5; ++k) {
+        const cJSON* key = cJSON_GetArrayItem(reports, k);
+        const cJSON* params = cJSON_GetObjectItem(key, "parameters");
+        for (int i = 0; i < ch.rig.param_count; ++i) {
+            if (ch.rig.params[i].group != SP_GROUP_SHAPE) continue;
+            shapes += k == 0;
+            double a = cJSON_GetNumberValue(cJSON_GetObjectItem(first, ch.rig.params[i].name));
+            drift = fmax(drift, fabs(cJSON_GetNumberValue(cJSON_GetObjectItem(params, ch.rig.params[i].name)) - a));
+        }
+        worst = fmax(worst, cJSON_GetNumberValue(cJSON_GetObjectItem(key, "mean_error_px")));
+        diag = cJSON_GetNumberValue(cJSON_GetObjectItem(key, "bbox_diagonal_px"));
+    }
+    fprintf(stderr, "  a jump in 5 keys: %d shape parameters, drifting at most %.3g; keys fitted within %.2f px\n", shapes, drift,
+            worst);
+    ENSURE(shapes > 5 && drift == 0 && worst < 0.01 * diag);
+    cJSON_Delete(reports);
+    sp_character_free(&ch);
+}
+
 // `animate --times` refuses times the .glb cannot store as floats (it used to
 // write a file that would not load again); fine times still load back.
 static void test_animate_cli_times(void)
@@ -1686,6 +1732,7 @@ int main(int argc, char** argv)
                                    {"drawover_neck_local", test_drawover_neck_local},
                                    {"drawover_arm_alone", test_drawover_arm_alone},
                                    {"drawover_several_curves", test_drawover_several_curves},
+                                   {"animate_holds_proportions", test_animate_holds_proportions},
                                    {"drawover_single_chain", test_drawover_single_chain},
                                    {"drawover_scale_is_solvers", test_drawover_scale_is_solvers},
                                    {"synth_jitter", test_synth_jitter},
