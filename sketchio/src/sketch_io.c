@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -387,7 +388,24 @@ static sp_result add_stroke(sp_sketch* s, const sp_vec2* pts, const double* ts, 
 
 sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const char* end, const char* name, sp_error* err)
 {
-    if (!parsed) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d", name, line_of(text, len, end));
+    if (!parsed) {
+        // A stroke file is often one line: the column and what stands there
+        // say where (a NaN that Python's json wrote was only "line 1").
+        if (!end || end < text || end > text + len) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON", name);
+        const char* bol = end;
+        while (bol > text && bol[-1] != '\n')
+            --bol;
+        char near[24] = "", shown[100];
+        size_t n = 0;
+        for (const char* q = end; q < text + len && n < 16 && *q != '\n' && *q != '\r'; ++q)
+            near[n++] = *q;
+        near[n] = 0;
+        bool not_number = (n >= 3 && (!strncasecmp(near, "nan", 3) || !strncasecmp(near, "inf", 3))) ||
+                          (n >= 4 && !strncasecmp(near, "-inf", 4));
+        return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d, column %d%s%s%s%s", name, line_of(text, len, end),
+                       (int)(end - bol) + 1, n ? ", at '" : "", n ? sp_text_printable(near, shown, sizeof shown) : "",
+                       n ? "'" : "", not_number ? " (NaN and infinity are not JSON numbers)" : "");
+    }
     // Anything but white space after the document means the file is not what it seems (two files joined, a bad edit).
     while (end && end < text + len && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r' || *end == 0))
         ++end;
