@@ -130,6 +130,17 @@ static sp_result validate(const void* glb, size_t size, const char* what, const 
     else if (rig->abstractions[a].curve_count == 0 || rig->abstractions[a].point_count < 2)
         add_reason(reasons, sizeof reasons, "abstraction '%s' has no curve", rig->abstractions[a].name);
     if (rig->param_count == 0) add_reason(reasons, sizeof reasons, "no rig parameters");
+    // Joints sp_part names that the skeleton lacks (a bone renamed in an
+    // editor): the kiosk attached such a part by its root, without a word.
+    if (ch.has_part && ch.part.has_attach && ch.part.attach.joint[0] && sp_rig_find_joint(rig, ch.part.attach.joint) < 0)
+        add_reason(reasons, sizeof reasons,
+                   "sp_part.attach names joint '%s', which the part does not have (renamed in an editor? fix it, or derive the "
+                   "file without sp_part again, --attach-joint)",
+                   ch.part.attach.joint);
+    for (int i = 0; ch.has_part && i < ch.part.socket_count; ++i)
+        if (ch.part.sockets[i].joint[0] && sp_rig_find_joint(rig, ch.part.sockets[i].joint) < 0)
+            add_reason(reasons, sizeof reasons, "sp_part socket '%s' names joint '%s', which the part does not have",
+                       ch.part.sockets[i].name, ch.part.sockets[i].joint);
     for (int i = 0; i < rig->param_count; ++i) {
         const sp_param* pm = &rig->params[i];
         if (!isfinite(pm->min) || !isfinite(pm->max) || pm->min > pm->max ||

@@ -2356,6 +2356,31 @@ static void test_category_case(void)
     sp_db_close(db);
 }
 
+// A part whose sp_part names a joint its skeleton lacks (a bone renamed in
+// an editor after deriving) is refused naming the joint; the kiosk attached
+// it by its root without a word (an outside curator review).
+static void test_attach_joint_missing(void)
+{
+    const char* p = sp_test_tmp_path("attach_missing.db");
+    sp_fixture_remove_db(p);
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(part_file(0), &ch, &err) == SP_OK);
+    ch.has_part = true, ch.part.has_attach = true;
+    snprintf(ch.part.attach.joint, sizeof ch.part.attach.joint, "Hips");
+    if (!ch.part.category[0]) snprintf(ch.part.category, sizeof ch.part.category, "tail");
+    const char* renamed = sp_test_tmp_path("renamed.glb");
+    ENSURE(sp_gltf_save(&ch, ch.pose, renamed, &err) == SP_OK);
+    sp_character_free(&ch);
+    const sp_db_part_desc quick = {.synth_sketches = -1, .selftest_seeds = -1};
+    ENSURE(sp_db_add_part_file(db, renamed, &quick, NULL, &err) == SP_ERR_INVALID);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "sp_part.attach names joint 'Hips', which the part does not have"));
+    ENSURE(scalar(p, "SELECT count(*) FROM parts") == 0);
+    sp_db_close(db);
+}
+
 // add-part and add-sketch create the database at a --db path where no file
 // is (documented), and now say so on stderr, one line naming it, so that a
 // mistyped path or a wrong folder is noticed; into an existing one, not a word.
@@ -3303,6 +3328,7 @@ int main(int argc, char** argv)
                                    {"default_db", test_default_db},
                                    {"default_db_cli", test_default_db_cli},
                                    {"remove_notes", test_remove_notes},
+                                   {"attach_joint_missing", test_attach_joint_missing},
                                    {"db_help_lists_all", test_db_help_lists_all},
                                    {"kiosk_collect", test_kiosk_collect},
                                    {"kiosk_migration", test_kiosk_migration},
