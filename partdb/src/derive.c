@@ -647,6 +647,27 @@ static sp_result source_at_rest(work* w, sp_vec3* tr, sp_quat* rot, sp_vec3* sc,
     return SP_OK;
 }
 
+// A part attached by a root its limbs branch from (a figure's hips) hangs
+// from the body there: a figure drawn standing on a dragon's back sank into
+// it to the waist (an outside curator review). Said, naming the lowest
+// joint, which such a figure stands on; the attach point is the curator's
+// choice (a pair of legs hangs by its hips). ev holds the rest pose.
+static void warn_attach_between_limbs(const sp_rig* R, const sp_rig_eval* ev, const bool* is_skin, sp_character* notes)
+{
+    int limbs = 0, lowest = -1;
+    const sp_mat4* world = sp_rig_eval_world(ev);
+    for (int c = 1; c < R->joint_count; ++c) {
+        if (!is_skin[c]) continue;
+        if (R->joints[c].parent == 0) ++limbs;
+        if (lowest < 0 || sp_mat4_translation(&world[c]).y < sp_mat4_translation(&world[lowest]).y) lowest = c;
+    }
+    if (limbs >= 2 && lowest > 0)
+        sp_character_warn(notes,
+                          "it attaches by its root '%s', where %d limbs branch: on a body it hangs from there (a figure standing "
+                          "on a dragon sinks in to the waist); to stand on its lowest joint give --attach-joint %s",
+                          R->joints[0].name, limbs, R->joints[lowest].name);
+}
+
 // The derived joint a part attaches by, named by its source joint.
 static sp_result attach_joint_of(const work* w, const char* name, int* attach, sp_error* err)
 {
@@ -755,6 +776,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
         sp_character_warn(&notes,
                           "the stick figure leaves out %d bone%s whose skin flattens the mesh (a singular inverse bind matrix)",
                           flat, flat == 1 ? "" : "s");
+    if (!d.attach_joint) warn_attach_between_limbs(&R, ev, is_skin, &notes);
     bool stick = sp_rig_find_abstraction(&R, "stick") >= 0;
     if (!strcmp(abstraction, "stick") && !stick) {
         sp_character_free(&notes);

@@ -341,7 +341,17 @@ static void test_options(void)
     sp_character src = {0}, part = {0};
     load_ok(lizard("lizard_opt.glb", (sp_foreign_desc){0}), &src);
     sp_derive_info info;
+    // By default it attaches by its root, where its neck, tail and legs
+    // branch: said, naming the lowest joint (a figure there sank into the
+    // dragon to the waist, an outside curator review); not when chosen.
+    derive_ok(&src, NULL, &part, &info);
+    for (int w = 0; w < part.warning_count; ++w)
+        fprintf(stderr, "  default attach: %s\n", part.warnings[w]);
+    ENSURE(sp_fixture_has_warning(&part, "it attaches by its root 'root', where") &&
+           sp_fixture_has_warning(&part, "give --attach-joint"));
+    sp_character_free(&part);
     derive_ok(&src, &(sp_derive_desc){.abstraction = "stick", .attach_joint = "tail_3"}, &part, &info);
+    ENSURE(!sp_fixture_has_warning(&part, "it attaches by its root"));
     const sp_part* ex = part_extras(&part);
     ENSURE(!ex->category[0] && !strcmp(ex->abstraction, "stick"));
     // A stick figure of several curves cannot be drawn in the kiosk's one stroke: said.
