@@ -60,13 +60,30 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
     // solved "best effort", the figure rolled into a ball or flung to a
     // corner with exit 0 (an outside review; `dragon` refuses them too).
     if (!(sk->canvas_w > 0 && sk->canvas_h > 0)) return SP_OK;
-    for (int i = 0; i < sk->stroke_count; ++i)
-        if (sp_stroke_points_off_canvas(&sk->strokes[i], sk->canvas_w, sk->canvas_h) < sk->strokes[i].count) return SP_OK;
     double w = sk->canvas_w, h = sk->canvas_h;
-    sp_fail(err, SP_ERR_INVALID, "%s: every stroke lies off its %gx%g canvas (the first point is at %g, %g)", path, w, h,
-            sk->strokes[0].points[0].x, sk->strokes[0].points[0].y);
-    sp_sketch_free(sk);
-    return SP_ERR_INVALID;
+    bool on = false;
+    for (int i = 0; i < sk->stroke_count && !on; ++i)
+        on = sp_stroke_points_off_canvas(&sk->strokes[i], sk->canvas_w, sk->canvas_h) < sk->strokes[i].count;
+    if (!on) {
+        sp_fail(err, SP_ERR_INVALID, "%s: every stroke lies off its %gx%g canvas (the first point is at %g, %g)", path, w, h,
+                sk->strokes[0].points[0].x, sk->strokes[0].points[0].y);
+        sp_sketch_free(sk);
+        return SP_ERR_INVALID;
+    }
+    // A point more than a whole canvas beyond its edge is a pen's glitch or
+    // a coordinate slip, not a drawing: one such point flung a crouching
+    // figure's leg out, exit 0 (an outside review). Named, refused.
+    for (int i = 0; i < sk->stroke_count; ++i)
+        for (int k = 0; k < sk->strokes[i].count; ++k) {
+            sp_vec2 q = sk->strokes[i].points[k];
+            if (q.x >= -w && q.x <= 2 * w && q.y >= -h && q.y <= 2 * h) continue;
+            sp_fail(err, SP_ERR_INVALID,
+                    "%s: stroke %d, point %d (%g, %g) lies more than a canvas beyond its %gx%g canvas (a glitch of the pen?)",
+                    path, i, k, q.x, q.y, w, h);
+            sp_sketch_free(sk);
+            return SP_ERR_INVALID;
+        }
+    return SP_OK;
 }
 
 // The nearest joint that is an ancestor of both (or one of them); -1: none.

@@ -70,8 +70,13 @@ expect 1 "$SP" pose --rig "$MAN" --strokes "$WORK/off.json"
 one_line_naming "off.json: every stroke lies off its 640x480 canvas"
 expect 1 "$SP" animate --rig "$MAN" --strokes "$WORK/off.json" --out "$WORK/off.glb"
 one_line_naming "off.json: every stroke lies off"
-strokes "$WORK/half_off.json" '[[2600, 100], [2700, 300]]' '[[300, 200], [340, 260]]'
+strokes "$WORK/half_off.json" '[[700, 100], [760, 300]]' '[[300, 200], [340, 260]]'
 expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/half_off.json"
+# A point more than a canvas beyond it (a pen's glitch, a slipped
+# coordinate) is refused, naming it: it flung a leg out, exit 0.
+strokes "$WORK/glitch.json" '[[320, 246], [321, 200], [322, 160]]' '[[300, 200], [340, 260], [2600, 100]]'
+expect 1 "$SP" pose --rig "$MAN" --strokes "$WORK/glitch.json"
+one_line_naming "glitch.json: stroke 1, point 2 (2600, 100) lies more than a canvas beyond its 640x480 canvas"
 expect 0 "$SP" animate --rig "$MAN" --strokes "$SRC/tests/e2e/data/man_arm_up.json" "$SRC/tests/e2e/data/man_arm_up_legs_one.json" --out "$WORK/man.glb"
 one_line_naming "man_arm_up_legs_one.json: loose fit: curve 'leg_"
 
