@@ -484,18 +484,25 @@ static void further_attempts(sp_solver* s, const sp_sketch* sk, const double* p_
 // the pose it was drawn over.
 static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep)
 {
+    // Rest for what the solve moves; what it holds (sp_solve_desc.active)
+    // keeps the start's values: `animate` holds the first key's proportions,
+    // which a rest start set back to 1 mid-clip (an outside review).
     bool at_rest = true;
     for (int i = 0; i < s->P && at_rest; ++i)
-        at_rest = p_start[i] == s->model->params[i].def;
+        at_rest = (s->d.active && !s->d.active[i]) || p_start[i] == s->model->params[i].def;
     if (at_rest || s->ab->curve_count < 2 || s->d.ordered_by_ends || !(s->d.time_cap_ms - rep->ms > 0)) return;
-    double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
+    double* p2 = malloc(sizeof(double) * (size_t)(2 * s->P + 1));
     sp_solve_report* r2 = malloc(sizeof *r2);
     sp_error e2 = {0};
     plan pl;
-    if (p2 && r2 &&
-        run_attempt(s, sk, NULL, &(attempt){.allow_loop = true, .place_free = true}, s->d.time_cap_ms - rep->ms, p2, r2, &pl,
-                    &e2) == SP_OK)
-        keep_better(s, rep, p_out, r2, p2);
+    if (p2 && r2) {
+        double* rest = p2 + s->P;
+        for (int i = 0; i < s->P; ++i)
+            rest[i] = s->d.active && !s->d.active[i] ? p_start[i] : s->model->params[i].def;
+        if (run_attempt(s, sk, rest, &(attempt){.allow_loop = true, .place_free = true}, s->d.time_cap_ms - rep->ms, p2, r2, &pl,
+                        &e2) == SP_OK)
+            keep_better(s, rep, p_out, r2, p2);
+    }
     free(p2), free(r2);
 }
 
