@@ -2978,6 +2978,22 @@ static void test_leg_drawn_as_one_line(void)
     }
     // The hind legs' thighs reach their bounds (the other's feet were
     // 0.44-0.52 of the line apart, now 0.43-0.44); the front legs stand as one (0.31-0.45, now 0.01-0.07).
+    // Drawn before the head that says the dragon faces left, the legs are
+    // fitted again, turned: they still stand side by side (the second fit
+    // crossed them again: an outside review).
+    sp_dragon_clear(d);
+    sp_dragon_result body = draw_part(d, db, "torso", 640, 380, 420, true, true);
+    sp_vec2 blo, bhi, turned[40];
+    fitted_box(d, body.part, &blo, &bhi);
+    for (int i = 0; i < 40; ++i)
+        turned[i] = (sp_vec2){blo.x + 0.3 * (bhi.x - blo.x), bhi.y - 0.08 * (bhi.y - blo.y) + 200.0 * i / 39};
+    int legs = add_as(d, turned, 40, "front_legs");
+    draw_part(d, db, "head", blo.x - 40, blo.y + 10, 220, true, true);
+    const sp_dragon_part* lp = sp_dragon_part_get(d, legs);
+    double turned_apart = feet_apart(d, legs) / 200;
+    fprintf(stderr, "  front legs drawn before a head facing left: %s, %s, feet %.2f of the line apart\n",
+            lp->mirrored ? "turned" : "not turned", fitted_curve(d, legs), turned_apart);
+    widest[1] = fmax(widest[1], lp->mirrored ? turned_apart : INFINITY);
     fprintf(stderr, "  feet at most %.2f (hind legs), %.2f (front legs) of the line apart\n", widest[0], widest[1]);
     ENSURE(as_limb == total && worst >= 0.8 && widest[0] <= 0.47 && widest[1] <= 0.15);
     const char* peaked[] = {"front_legs/front-legs-open-line.json", "hind_legs/hind-legs-zigzag-line.json"};

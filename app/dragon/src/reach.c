@@ -108,6 +108,7 @@ bool dragon_fit_reaching(sp_dragon* d, part* p, sp_vec2 target)
     sp_solve_report rep;
     sp_error err = {0};
     if (sp_solver_solve(t->pinned, &sk, q, q, &rep, &err) != SP_OK) goto done;
+    if (t->twins) dragon_limb_follow(t, q); // as every fit of legs by one leg's line
     for (int k = 0; k < rig->param_count; ++k)
         if (!isfinite(q[k])) goto done;
     double before = p->pub.report.mean_error_px / fmax(p->pub.report.bbox_diagonal_px, 1.0);

@@ -135,6 +135,9 @@ static bool fit_one(sp_dragon* d, tpl* t, const sp_sketch* sk, sp_vec2 lo, sp_ve
     sp_error serr = {0};
     bool ok = sp_solver_solve(t->solver, &msk, p, p, &rep, &serr) == SP_OK;
     free(flipped);
+    // Legs fitted by one leg's line: the other leg stands beside it, on
+    // every fit (a part turned or re-fitted later, too: an outside review).
+    if (ok && t->twins) dragon_limb_follow(t, p);
     if (ok && d->fit_hook) d->fit_hook(p, rig->param_count);
     sp_camera view = mirrored ? dragon_mirrored_view(&t->solver_cam, u) : t->solver_cam;
     if (ok && !fit_is_finite(d, t, p, &rep, &view)) ok = false, ++*not_finite;
@@ -270,7 +273,6 @@ static void prefer_line(sp_dragon* d, const sp_sketch* sk, sp_vec2 lo, sp_vec2 h
         double gl = two_way_gap(&l, &sk->strokes[0], diag);
         if (gl < best) {
             best = gl;
-            if (k == 1) dragon_limb_follow(lines[k], l.p);
             l.score = f->score;
             free(f->p);
             *f = l;
