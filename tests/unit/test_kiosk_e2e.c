@@ -1864,7 +1864,8 @@ static void updates_logged(sp_kiosk* k, double* t, double until, const char* pat
 
 // A damaged file renamed over the database: the kiosk goes on with what it
 // has and says so once, not at every poll (every 2 s, a season's log of one
-// line); once a good file is back it says that, and a new problem is said again.
+// line); once a good file is back it says that, and a new problem is said
+// again, so is the file deleted.
 static void test_db_problem_said_once(void)
 {
     char db[1100], next[1100], wal[1200], junk[1200], log[1100];
@@ -1887,13 +1888,19 @@ static void test_db_problem_said_once(void)
     back = stamped_lines_with(log, "reads again");
     fprintf(stderr, "  a good file back: %d reload(s), %d 'reads again'\n", sp_kiosk_stats_of(k)->reloads, back);
     ENSURE(back == 1 && sp_kiosk_stats_of(k)->reloads >= 1);
+    // Deleted: still read through the open handles, and said once (nothing was).
+    ENSURE(unlink(db) == 0);
+    updates_logged(k, &t, t + 8000, log);
+    int gone = stamped_lines_with(log, "the database file is gone");
+    fprintf(stderr, "  deleted for 8 s: %d line(s) saying so\n", gone);
+    ENSURE(gone == 1);
     f = fopen(junk, "w");
     ENSURE(f && fputs("damaged again\n", f) >= 0 && fclose(f) == 0);
     ENSURE(rename(junk, db) == 0);
     updates_logged(k, &t, t + 8000, log);
     problems = stamped_lines_with(log, "database: ") - stamped_lines_with(log, "reads again");
     fprintf(stderr, "  damaged again: %d problem lines in all\n", problems);
-    ENSURE(problems == 2);
+    ENSURE(problems == 3);
     attract_kiosk_end(k, gl, &t);
 }
 
