@@ -386,26 +386,51 @@ static sp_result add_stroke(sp_sketch* s, const sp_vec2* pts, const double* ts, 
     return SP_OK;
 }
 
+// Where a JSON file does not parse, said so that a one-line file (a stroke
+// file written by a script) can be mended: the line, the column and up to
+// 16 bytes from there, anything but printable ASCII as \xNN (a UTF-8
+// character cut at the 16th byte, or a UTF-16 file, printed raw bytes), and
+// why when the cause is common: a NaN or infinity as Python's json writes
+// them, a file that is empty or ends before the document does.
+static sp_result json_error_at(const char* text, size_t len, const char* end, const char* name, sp_error* err)
+{
+    const char* stop = text + len;
+    const char* q = text;
+    while (q < stop && (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r'))
+        ++q;
+    if (q == stop) return sp_fail(err, SP_ERR_PARSE, "%s: the file is empty (no JSON document)", name);
+    if (!end || end < text || end > stop) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON", name);
+    const char* bol = end;
+    while (bol > text && bol[-1] != '\n')
+        --bol;
+    char near[16 * 4 + 1];
+    size_t n = 0, taken = 0;
+    for (q = end; q < stop && taken < 16 && *q != '\n' && *q != '\r'; ++q, ++taken) {
+        unsigned char c = (unsigned char)*q;
+        n += (size_t)(c >= 0x20 && c < 0x7f ? snprintf(near + n, sizeof near - n, "%c", c)
+                                            : snprintf(near + n, sizeof near - n, "\\x%02X", c));
+    }
+    size_t word = 0; // the bare word there: nan, inf, infinity (any case, a sign before)
+    while (end + word < stop && (isalpha((unsigned char)end[word]) || (word == 0 && (end[0] == '-' || end[0] == '+'))))
+        ++word;
+    const char* w = end + (word && (end[0] == '-' || end[0] == '+'));
+    size_t wl = word - (size_t)(w - end);
+    bool not_number =
+        (wl == 3 && (!strncasecmp(w, "nan", 3) || !strncasecmp(w, "inf", 3))) || (wl == 8 && !strncasecmp(w, "infinity", 8));
+    const char* rest = end;
+    while (rest < stop && (*rest == ' ' || *rest == '\t' || *rest == '\n' || *rest == '\r'))
+        ++rest;
+    bool cut = rest >= stop || end + 1 >= stop;
+    return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d, column %d%s%s%s%s", name, line_of(text, len, end),
+                   (int)(end - bol) + 1, n ? ", at '" : "", n ? near : "", n ? "'" : "",
+                   not_number ? " (NaN and infinity are not JSON numbers)"
+                   : cut      ? " (the file ends before the document does: cut short?)"
+                              : "");
+}
+
 sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const char* end, const char* name, sp_error* err)
 {
-    if (!parsed) {
-        // A stroke file is often one line: the column and what stands there
-        // say where (a NaN that Python's json wrote was only "line 1").
-        if (!end || end < text || end > text + len) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON", name);
-        const char* bol = end;
-        while (bol > text && bol[-1] != '\n')
-            --bol;
-        char near[24] = "", shown[100];
-        size_t n = 0;
-        for (const char* q = end; q < text + len && n < 16 && *q != '\n' && *q != '\r'; ++q)
-            near[n++] = *q;
-        near[n] = 0;
-        bool not_number = (n >= 3 && (!strncasecmp(near, "nan", 3) || !strncasecmp(near, "inf", 3))) ||
-                          (n >= 4 && !strncasecmp(near, "-inf", 4));
-        return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d, column %d%s%s%s%s", name, line_of(text, len, end),
-                       (int)(end - bol) + 1, n ? ", at '" : "", n ? sp_text_printable(near, shown, sizeof shown) : "",
-                       n ? "'" : "", not_number ? " (NaN and infinity are not JSON numbers)" : "");
-    }
+    if (!parsed) return json_error_at(text, len, end, name, err);
     // Anything but white space after the document means the file is not what it seems (two files joined, a bad edit).
     while (end && end < text + len && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r' || *end == 0))
         ++end;

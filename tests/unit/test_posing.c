@@ -777,10 +777,15 @@ static void test_pose_file_strict(void)
         {"{\"parameters\": {\"head.rx\": 0.1, \"head.rx\": 0.2}}", 0, "pose.json: key \"head.rx\" given twice"},
         {"{\"parameters\": {\"head.rx\": 0.1}, \"parameters\": {}}", 0, "pose.json: key \"parameters\" given twice"},
         {"{\"parameters\": {\"head.rx\": 0.1}}\0{\"garbage", 42, "pose.json: text after the JSON document, line 1"},
-        {"{\"parameters\": {\"head.rx\": 0.1", 0, "pose.json: malformed JSON near line 1, column 30, at '1'"},
+        {"{\"parameters\": {\"head.rx\": 0.1", 0,
+         "pose.json: malformed JSON near line 1, column 30, at '1' (the file ends before the document does: cut short?)"},
         // One line as Python's json writes it: where, what stands there, and why.
         {"{\"parameters\": {\"head.rx\": NaN, \"head.ry\": 0.2}}", 0,
          "pose.json: malformed JSON near line 1, column 28, at 'NaN, \"head.ry\": ' (NaN and infinity are not JSON numbers)"},
+        // Not a NaN, only a word that begins like one; bytes past ASCII escaped (a UTF-16 file's BOM).
+        {"{\"parameters\": nancy}", 0, "pose.json: malformed JSON near line 1, column 16, at 'nancy}'"},
+        {"\xff\xfe{\"parameters\"", 0, "pose.json: malformed JSON near line 1, column 1, at '\\xFF\\xFE{\"parameters\"'"},
+        {" \n ", 0, "pose.json: the file is empty (no JSON document)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         double p[2] = {0};
