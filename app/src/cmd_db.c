@@ -752,7 +752,7 @@ static int db_add_sketch(int argc, char** argv)
     if (r != SP_OK) exit_code = db || err.text[0] ? fail(cmd, &err) : SP_EXIT_INPUT;
     else {
         note_created(cmd, &c, existed);
-        sp_cli_done("%d sketches are stored in %s", added, db_path(&c));
+        sp_cli_done("%d sketch%s stored in %s", added, added == 1 ? " is" : "es are", db_path(&c));
         int* per = calloc((size_t)(s.ds.category_count + 1), sizeof(int));
         for (int i = 0; per && i < s.ds.count; ++i)
             per[s.ds.samples[i].label]++;

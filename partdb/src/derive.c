@@ -647,11 +647,12 @@ static sp_result source_at_rest(work* w, sp_vec3* tr, sp_quat* rot, sp_vec3* sc,
     return SP_OK;
 }
 
-// A part attached by a root its limbs branch from (a figure's hips) hangs
-// from the body there: a figure drawn standing on a dragon's back sank into
-// it to the waist (an outside curator review). Said, naming the lowest
-// joint, which such a figure stands on; the attach point is the curator's
-// choice (a pair of legs hangs by its hips). ev holds the rest pose.
+// A part attached by a root three or more limbs branch from (a figure's
+// hips: legs and spine) hangs from the body there: a figure drawn standing
+// on a dragon's back sank into it to the waist (an outside curator review).
+// Said, naming the lowest joint, which such a figure stands on; the attach
+// point is the curator's choice (a pair of legs hangs by its hips). ev
+// holds the rest pose.
 static void warn_attach_between_limbs(const sp_rig* R, const sp_rig_eval* ev, const bool* is_skin, sp_character* notes)
 {
     int limbs = 0, lowest = -1;
@@ -661,7 +662,7 @@ static void warn_attach_between_limbs(const sp_rig* R, const sp_rig_eval* ev, co
         if (R->joints[c].parent == 0) ++limbs;
         if (lowest < 0 || sp_mat4_translation(&world[c]).y < sp_mat4_translation(&world[lowest]).y) lowest = c;
     }
-    if (limbs >= 2 && lowest > 0)
+    if (limbs >= 3 && lowest > 0) // a pair of legs (two) rightly hangs by its hips
         sp_character_warn(notes,
                           "it attaches by its root '%s', where %d limbs branch: on a body it hangs from there (a figure standing "
                           "on a dragon sinks in to the waist); to stand on its lowest joint give --attach-joint %s",
