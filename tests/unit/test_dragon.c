@@ -3010,6 +3010,44 @@ static void test_leg_drawn_as_one_line(void)
     sp_db_close(db);
 }
 
+// A shape drawn on a body is measured against the body as drawn, not only
+// as fitted: a child's body with a fin the fit left out (an outside
+// review's dolphin, its fit 0.56 of the drawing) made a wing drawn on its
+// back "about as large" as the body, and a second body. Here the body's
+// drawing is made 1.6 times its fit (the stroke box, as such a drawing
+// leaves it), and a smaller body drawing goes on its back: 0.85 of the
+// fit's size, 0.53 of the drawing's.
+static void test_on_body_as_drawn(void)
+{
+    const char* path = real_db();
+    sp_dragon* d = new_dragon(path);
+    int n, m;
+    sp_vec2* body = visitor_stroke("torso/torso-pear.json", 360, (sp_vec2){560, 420}, false, &n);
+    int b = add_as(d, body, n, "torso");
+    sp_vec2 flo, fhi;
+    fitted_box(d, b, &flo, &fhi);
+    double fit_diag = sp_v2_len(sp_v2_sub(fhi, flo));
+    sp_vec2* small =
+        visitor_stroke("torso/torso-humped.json", 0.85 * fit_diag, (sp_vec2){0.5 * (flo.x + fhi.x), flo.y + 10}, false, &m);
+    sp_error err = {0};
+    sp_dragon_result res;
+    const char* became[2];
+    for (int drawn = 0; drawn < 2; ++drawn) {
+        double* box = d->parts[b]->stroke_box;
+        double cx = 0.5 * (flo.x + fhi.x), cy = 0.5 * (flo.y + fhi.y), k = drawn ? 0.8 : 0.5;
+        box[0] = cx - k * (fhi.x - flo.x), box[1] = cy - k * (fhi.y - flo.y);
+        box[2] = cx + k * (fhi.x - flo.x), box[3] = cy + k * (fhi.y - flo.y);
+        ENSURE(sp_dragon_add_points(d, small, m, NULL, &res, &err) == SP_OK);
+        became[drawn] = res.rejected ? "refused" : sp_dragon_part_get(d, res.part)->category;
+        fprintf(stderr, "  a body drawing %.0f px on the back of a body fitted %.0f px, drawn %.0f: %s\n", 0.85 * fit_diag,
+                fit_diag, 2 * k * fit_diag, became[drawn]);
+        if (!res.rejected) ENSURE(sp_dragon_undo(d));
+    }
+    ENSURE(!strcmp(became[0], "torso") && strcmp(became[1], "torso") != 0);
+    free(body), free(small);
+    sp_dragon_destroy(d);
+}
+
 // Legs and wings face the way their dragon does (docs/DESIGN.md, "The kiosk
 // pipeline"): a dragon of visitors' drawings (tune half) drawn facing left
 // (mirrored, its head at the left end of the body) gets its legs and wings
@@ -4923,6 +4961,7 @@ int main(int argc, char** argv)
                                    {"visitors_policy", test_visitors_policy},
                                    {"line_drawn", test_line_drawn},
                                    {"leg_drawn_as_one_line", test_leg_drawn_as_one_line},
+                                   {"on_body_as_drawn", test_on_body_as_drawn},
                                    {"facing_follows_dragon", test_facing_follows_dragon},
                                    {"head_first_faces_as_after", test_head_first_faces_as_after},
                                    {"mirror_refusal", test_mirror_refusal},

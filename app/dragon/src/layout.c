@@ -549,7 +549,13 @@ bool dragon_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int k)
     if (!q->t->is_torso || !body_prepare(d, q) || !body_box(q, &a, &b)) return false;
     // Near counts as on: a part drawn within the snap distance of a body
     // attaches to it, so a small shape drawn there is meant for that dragon.
-    return near_body_box(d, lo, hi, a, b) && hypot(hi.x - lo.x, hi.y - lo.y) <= ON_BODY_SIZE * hypot(b.x - a.x, b.y - a.y);
+    // Its size against the body as drawn too: a fit that took only part of a
+    // child's body (a dolphin's outline without its fin) made a wing drawn
+    // on its back as large as the fit, and that wing a second body (an
+    // outside review).
+    double body =
+        fmax(hypot(b.x - a.x, b.y - a.y), hypot(q->stroke_box[2] - q->stroke_box[0], q->stroke_box[3] - q->stroke_box[1]));
+    return near_body_box(d, lo, hi, a, b) && hypot(hi.x - lo.x, hi.y - lo.y) <= ON_BODY_SIZE * body;
 }
 
 bool dragon_drawn_on_body(sp_dragon* d, sp_vec2 lo, sp_vec2 hi, int skip)
