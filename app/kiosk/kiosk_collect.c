@@ -33,6 +33,8 @@ struct kiosk_collector {
                // sketch)
     bool idle; // db was closed after a visit's sketches were written, not by a failure: reopened without a word
     uint64_t dev, ino; // the file db had open when it was last closed (idle_close; 0, 0: none)
+    char last_drop[sizeof(sp_error){0}.text]; // the last reason a sketch was dropped, said ("": none)
+    int same_drops;                           // sketches dropped since for that reason, not said yet
     char path[1024];
     double canvas_w, canvas_h;
     double reserve_mb; // free space on the database's disk kept for saves and training (<= 0: none)
@@ -61,6 +63,23 @@ static void count_result(kiosk_collector* c, bool stored)
     else
         ++c->dropped;
     pthread_mutex_unlock(&c->lock);
+}
+
+// A dropped sketch's reason, said once while it repeats (a visit's twenty
+// parts on a damaged database were twenty identical lines): the next
+// different reason, a stored sketch or the close (why NULL) says how many
+// more went the same way.
+static void say_dropped(kiosk_collector* c, const char* why)
+{
+    if (why && !strcmp(why, c->last_drop)) {
+        ++c->same_drops;
+        return;
+    }
+    if (c->same_drops > 0)
+        sp_kiosk_log("%s: %d more sketch%s dropped for the same reason", c->path, c->same_drops, c->same_drops == 1 ? "" : "es");
+    c->same_drops = 0;
+    snprintf(c->last_drop, sizeof c->last_drop, "%s", why ? why : "");
+    if (why) sp_kiosk_log("%s", why);
 }
 
 // Closes the writer's handle between visits (or to read a file rewritten
@@ -196,7 +215,8 @@ static void* collector_main(void* arg)
             sp_kiosk_log("%s: another writer held the database for %.1f s%s; sketch dropped", c->path,
                          (sp_now_ms() - s.busy_since) / 1000.0, closing ? " when the kiosk closed" : "");
         else if (r != SP_OK)
-            sp_kiosk_log("%s", err.text);
+            say_dropped(c, err.text);
+        if (r == SP_OK) say_dropped(c, NULL);
         queued_free(&s);
         count_result(c, r == SP_OK);
         pthread_mutex_lock(&c->lock);
@@ -309,6 +329,7 @@ void kiosk_collector_close(kiosk_collector* c, int* stored, int* dropped)
         pthread_join(c->thread, NULL);
     }
     kiosk_collector_counts(c, stored, dropped);
+    say_dropped(c, NULL);
     sp_db_close(c->db);
     pthread_cond_destroy(&c->wake);
     pthread_mutex_destroy(&c->lock);
