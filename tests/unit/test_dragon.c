@@ -3031,14 +3031,14 @@ static void test_on_body_as_drawn(void)
         visitor_stroke("torso/torso-humped.json", 0.85 * fit_diag, (sp_vec2){0.5 * (flo.x + fhi.x), flo.y + 10}, false, &m);
     sp_error err = {0};
     sp_dragon_result res;
-    const char* became[2];
+    char became[2][SP_NAME_MAX];
     for (int drawn = 0; drawn < 2; ++drawn) {
         double* box = d->parts[b]->stroke_box;
         double cx = 0.5 * (flo.x + fhi.x), cy = 0.5 * (flo.y + fhi.y), k = drawn ? 0.8 : 0.5;
         box[0] = cx - k * (fhi.x - flo.x), box[1] = cy - k * (fhi.y - flo.y);
         box[2] = cx + k * (fhi.x - flo.x), box[3] = cy + k * (fhi.y - flo.y);
         ENSURE(sp_dragon_add_points(d, small, m, NULL, &res, &err) == SP_OK);
-        became[drawn] = res.rejected ? "refused" : sp_dragon_part_get(d, res.part)->category;
+        snprintf(became[drawn], sizeof became[drawn], "%s", res.rejected ? "refused" : sp_dragon_part_get(d, res.part)->category);
         fprintf(stderr, "  a body drawing %.0f px on the back of a body fitted %.0f px, drawn %.0f: %s\n", 0.85 * fit_diag,
                 fit_diag, 2 * k * fit_diag, became[drawn]);
         if (!res.rejected) ENSURE(sp_dragon_undo(d));
