@@ -83,26 +83,69 @@ static bool is_proportion(const sp_param* params, int P, const sp_rig* rig, int 
     return false;
 }
 
-// One character through the clip: from the first key that fits well (its
-// mean error within 1% of its size) on, its proportions are held at that
-// key's, and the later keys move only the pose and the overall size (the
-// solver made again with them held). Each key started from the last one's
-// fit and nothing drew the proportions back: a jump's head shrank to 0.82,
-// the same drawing at the clip's end fitted otherwise than at its start; a
-// key drawn 1.25 times larger must still grow the figure, and a poor first
-// key must not set the clip's proportions (outside reviews). False when out
-// of memory.
+// One character through the clip. From the first key that is not a best
+// effort (its mean error within 5% of its size: a sketchy key of 1-2% is a
+// good key), its proportions are held for the later keys, and so is its
+// overall size (the topmost scale) unless a key is drawn at another size
+// (size_ratio). Each key started from the last one's fit and nothing drew
+// the shape back: a jump's head shrank to 0.82, the figure grew to 1.22 and
+// leaned back, and the same drawing at the clip's end fitted otherwise than
+// at its start (outside reviews). held[0..P): what a key drawn at the held
+// key's size moves; held[P..2P): what a key drawn at another size moves
+// (its overall size too). False when out of memory.
 static bool hold_shape(sp_solve_cmd* run, const sp_rig* rig, bool** held, int P)
 {
     const sp_param* params = sp_rig_handle_params(run->rig);
-    *held = malloc(sizeof(bool) * (size_t)(P + 1));
+    *held = malloc(sizeof(bool) * (size_t)(2 * P + 1));
     if (!*held) return false;
-    for (int q = 0; q < P; ++q)
-        (*held)[q] = !is_proportion(params, P, rig, q) && (!run->desc.active || run->desc.active[q]);
-    run->desc.active = *held;
+    for (int q = 0; q < P; ++q) {
+        bool moves = !run->desc.active || run->desc.active[q];
+        (*held)[q] = moves && params[q].group != SP_GROUP_SHAPE;
+        (*held)[P + q] = moves && !is_proportion(params, P, rig, q);
+    }
+    return true;
+}
+
+// The drawn length of all the strokes: as a stick figure's bones are drawn
+// whatever the pose, it says the figure's size on the canvas.
+static double drawn_length(const sp_sketch* sk)
+{
+    double len = 0;
+    for (int i = 0; i < sk->stroke_count; ++i)
+        for (int k = 1; k < sk->strokes[i].count; ++k)
+            len += sp_v2_len(sp_v2_sub(sk->strokes[i].points[k], sk->strokes[i].points[k - 1]));
+    return len;
+}
+
+// How much larger key sk is drawn than the held key (1: the same size):
+// its drawn length over the held key's when both have as many strokes
+// (a key of fewer strokes, a spine alone, says nothing of the size); within
+// 15% it is the same size (a hand's wobble, a pose that hides a limb).
+static double size_ratio(const sp_sketch* sk, int held_strokes, double held_length)
+{
+    if (sk->stroke_count != held_strokes || !(held_length > 0)) return 1.0;
+    double r = drawn_length(sk) / held_length;
+    return r > 0.85 && r < 1.0 / 0.85 ? 1.0 : r;
+}
+
+// Sets the solver to move what `moves` says (made again when it changes).
+static void set_moves(sp_solve_cmd* run, const bool* moves)
+{
+    if (run->desc.active == moves) return;
+    run->desc.active = moves;
     sp_solver_destroy(run->solver);
     run->solver = NULL;
-    return true;
+}
+
+// `from` with the overall size (shape parameters that are not proportions)
+// set to the held key's times `ratio`, within bounds, into out.
+static void sized_start(const sp_param* params, const bool* held, int P, const double* from, const double* held_pose,
+                        double ratio, double* out)
+{
+    memcpy(out, from, sizeof(double) * (size_t)P);
+    for (int q = 0; q < P; ++q)
+        if (params[q].group == SP_GROUP_SHAPE && held[P + q])
+            out[q] = fmin(fmax(held_pose[q] * ratio, params[q].min), params[q].max);
 }
 
 int cmd_animate(int argc, char** argv)
@@ -143,7 +186,10 @@ int cmd_animate(int argc, char** argv)
     double *kp = NULL, *p0 = NULL;
     bool* held = NULL; // the parameters the keys after held_key move (hold_shape)
     int held_key = 0;
-    double* start_p = NULL;                                 // scratch for other_starts
+    double *start_p = NULL, *held_p = NULL, *scratch = NULL; // a later key's starts; other_starts' scratch
+    int held_strokes = 0;
+    double held_length = 0;
+    const sp_param* params = NULL;
     char(*notes)[sizeof((sp_solve_report){0}.note)] = NULL; // each key's report note
     cJSON* all = cJSON_CreateArray();
     int exit_code = SP_EXIT_INPUT;
@@ -157,28 +203,41 @@ int cmd_animate(int argc, char** argv)
     if (sp_rig_handle_read_pose(rig, NULL, &p0, NULL, &err) != SP_OK) goto fail;
     kp = malloc(sizeof(double) * (size_t)(P + 1) * (size_t)n);
     notes = calloc((size_t)n, sizeof *notes);
-    start_p = malloc(sizeof(double) * (size_t)(P + 1));
+    start_p = malloc(sizeof(double) * (size_t)(3 * P + 1));
     if (!kp || !notes || !start_p) goto oom;
+    held_p = start_p + P, scratch = start_p + 2 * P;
+    params = sp_rig_handle_params(rig);
     for (int k = 0; k < n; ++k) {
         sp_sketch sk = {0};
         if (sp_read_strokes(keys.items[k], &sk, &err) != SP_OK) goto fail;
         sp_camera cam = sp_rig_handle_camera(rig, sk.canvas_w, sk.canvas_h);
         const double* start = k == 0 ? p0 : kp + (size_t)(k - 1) * P;
+        const bool* moves = NULL;
+        if (held) {
+            double ratio = size_ratio(&sk, held_strokes, held_length);
+            moves = ratio == 1.0 ? held : held + P;
+            set_moves(&run, moves);
+            sized_start(params, held, P, start, kp + (size_t)held_key * P, ratio, start_p);
+            sized_start(params, held, P, kp + (size_t)held_key * P, kp + (size_t)held_key * P, ratio, held_p);
+            start = start_p;
+        }
         sp_solve_report rep;
         cJSON* j = NULL;
         bool solved = sp_solve_cmd_solve(&run, &cam, &sk, keys.items[k], start, kp + (size_t)k * P, &rep, &j);
         if (solved && k > 0 &&
-            !other_starts(&run, &cam, &sk, keys.items[k], p0, held, kp + (size_t)held_key * P, start_p, kp + (size_t)k * P, P,
-                          &rep, &j)) {
+            !other_starts(&run, &cam, &sk, keys.items[k], p0, moves, held_p, scratch, kp + (size_t)k * P, P, &rep, &j)) {
             sp_sketch_free(&sk);
             goto oom;
         }
+        if (solved && !held && rep.mean_error_px <= 0.05 * rep.bbox_diagonal_px) {
+            if (!hold_shape(&run, &ch->rig, &held, P)) {
+                sp_sketch_free(&sk);
+                goto oom;
+            }
+            held_key = k, held_strokes = sk.stroke_count, held_length = drawn_length(&sk);
+        }
         sp_sketch_free(&sk);
         if (!solved) goto done;
-        if (!held && rep.mean_error_px <= 0.01 * rep.bbox_diagonal_px) {
-            if (!hold_shape(&run, &ch->rig, &held, P)) goto oom;
-            held_key = k;
-        }
         snprintf(notes[k], sizeof notes[k], "%s", rep.note);
         cJSON_AddStringToObject(j, "strokes", keys.items[k]);
         cJSON_AddNumberToObject(j, "time_s", times[k]);
