@@ -424,10 +424,10 @@ static void test_animate_cli_cesiumman(void)
     sp_character_free(&ch);
 }
 
-// An animation is one character: from the first key that fits well on, the
-// proportions (the shape parameters under another one's joint: bone
-// lengths, the head's size) stay that key's, while the overall size (the
-// root's scale) follows the drawing. A jump of the cartoon man drawn by an
+// An animation is one character: from the first key that is not a best
+// effort on, the proportions (the shape parameters under another one's
+// joint: bone lengths, the head's size) stay that key's, and so does the
+// overall size (the root's scale) but for a key drawn at another size. A jump of the cartoon man drawn by an
 // outside review (stand, crouch, in the air, land, stand, then the stand
 // drawn 1.25 times larger): started from each other, the keys' proportions
 // drifted (the head to 0.82) and the last stand fitted the figure 1.22 times
@@ -476,7 +476,9 @@ static void test_animate_holds_proportions(void)
         "(size %.3f), last %.2f px (%.3f), 1.25x larger %.2f px (%.3f)\n",
         proportions, drift, 100 * worst, e[0], size[0], e[4], size[4], e[5], size[5]);
     ENSURE(proportions > 5 && drift == 0 && worst < 0.01);
-    ENSURE(fabs(size[4] - size[0]) < 0.03 && e[4] < e[0] + 0.3); // the same drawing, the same figure
+    for (int k = 1; k < 5; ++k) // drawn at one size: the figure's size held (it crept to 1.22, leaning back)
+        ENSURE(fabs(size[k] - size[0]) < 0.03);
+    ENSURE(e[4] < e[0] + 0.3); // the same drawing, the same figure
     ENSURE(size[5] > 1.15 * size[0]);                            // a larger drawing, a larger figure
     cJSON_Delete(reports);
     sp_character_free(&ch);
