@@ -29,10 +29,7 @@ typedef struct queued {
 } queued;
 
 struct kiosk_collector {
-    sp_db* db; // the writer's own handle; NULL: closed between visits (idle), or it could not be opened (tried again for each
-               // sketch)
-    bool idle; // db was closed after a visit's sketches were written, not by a failure: reopened without a word
-    uint64_t dev, ino; // the file db had open when it was last closed (idle_close; 0, 0: none)
+    sp_db* db; // the writer's own handle; NULL: it could not be opened (tried again for each sketch)
     char last_drop[sizeof(sp_error){0}.text]; // the last reason a sketch was dropped, said ("": none)
     int same_drops;                           // sketches dropped since for that reason, not said yet
     char path[1024];
@@ -82,16 +79,6 @@ static void say_dropped(kiosk_collector* c, const char* why)
     if (why) sp_kiosk_log("%s", why);
 }
 
-// Closes the writer's handle between visits (or to read a file rewritten
-// in place anew), remembering which file it had open.
-static void idle_close(kiosk_collector* c)
-{
-    sp_db_file_id(c->db, &c->dev, &c->ino);
-    sp_db_close(c->db);
-    c->db = NULL;
-    c->idle = true;
-}
-
 // A database that could not be written (read-only, damaged, not there) is
 // tried again for each sketch, in this thread: a technician who mends the
 // file expects collecting to resume without a restart. Once open, it says
@@ -101,24 +88,17 @@ static sp_result open_writer(kiosk_collector* c, const char* said, sp_error* err
     if (c->db) return SP_OK;
     struct stat st;
     if (stat(c->path, &st) != 0) return sp_fail(err, SP_ERR_IO, "%s: no database there; sketch dropped", c->path);
-    // Another file renamed over the one last written: as follow_file, the
-    // old file's WAL beside the path goes first.
-    if ((c->dev || c->ino) && ((uint64_t)st.st_dev != c->dev || (uint64_t)st.st_ino != c->ino))
-        sp_db_drop_stale_sidecars(c->path);
     // Waiting no longer than a store does: closing the kiosk waits for this thread.
     sp_db* db = NULL;
     sp_result r = sp_db_open_wait(c->path, 0, SP_DB_COLLECT_BUSY_MS, &db, err);
     if (r != SP_OK) {
-        c->idle = false; // said when it opens again
         char why[sizeof err->text];
         snprintf(why, sizeof why, "%s", err->text);
         return sp_fail(err, r, "%s; sketch dropped", why);
     }
     sp_db_set_busy_timeout(db, SP_DB_COLLECT_BUSY_MS);
     c->db = db;
-    c->dev = c->ino = 0;
-    if (!c->idle) sp_kiosk_log("%s: %s", c->path, said);
-    c->idle = false;
+    sp_kiosk_log("%s: %s", c->path, said);
     return SP_OK;
 }
 
@@ -203,12 +183,6 @@ static void* collector_main(void* arg)
         if (r == SP_OK) r = follow_file(c, &err);
         if (r == SP_OK) r = room_left(c, &err);
         if (r == SP_OK) r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
-        if (r == SP_ERR_PARSE && c->db) { // "malformed" through this handle: a file rewritten in place is read anew, once
-            idle_close(c);
-            err = (sp_error){0};
-            r = open_writer(c, "", &err);
-            if (r == SP_OK) r = sp_db_collect_kiosk_sketch(c->db, s.category, &st, c->canvas_w, c->canvas_h, NULL, &err);
-        }
         bool closing = false;
         if (r == SP_ERR_BUSY && wait_busy(c, &s, &closing)) continue; // the lock is held again
         if (r == SP_ERR_BUSY && s.busy_since > 0)
@@ -225,13 +199,8 @@ static void* collector_main(void* arg)
             // into the file itself: a curator's copy of the file has them,
             // and a file renamed over it (follow_file) never meets this
             // file's WAL. A reader in the way only postpones it.
-            // The handle closes until the next visit's sketches: a file
-            // rewritten in place meanwhile (a backup copied over it with
-            // cp) is then read afresh, where the handle's cached pages of
-            // the old file, written back, damaged the copy (an outside
-            // review). The checkpoint emptied the WAL first.
             pthread_mutex_unlock(&c->lock);
-            if (sp_db_checkpoint(c->db, NULL) == SP_OK) idle_close(c);
+            sp_db_checkpoint(c->db, NULL);
             pthread_mutex_lock(&c->lock);
         }
     }
@@ -264,13 +233,14 @@ kiosk_collector* kiosk_collector_open(const char* db_path, double canvas_w, doub
         sp_kiosk_log("visitors' strokes cannot be collected for now (tried again for each): %s", err.text);
         c->db = NULL;
     }
-    // Opened once to migrate an older schema and to say now whether it can
-    // be written; then closed until the first visit's sketches (open_writer),
-    // so that no handle with pages of an older file waits meanwhile.
-    if (c->db) idle_close(c);
+    // Every wait of the writer's (a store, a checkpoint) is short: closing the
+    // kiosk waits for the writer.
+    if (c->db) sp_db_set_busy_timeout(c->db, SP_DB_COLLECT_BUSY_MS);
     c->threaded = pthread_create(&c->thread, NULL, collector_main, c) == 0;
     if (!c->threaded) {
         sp_kiosk_log("%s: visitors' strokes cannot be collected: no thread to write them", db_path);
+        sp_db_close(c->db);
+        c->db = NULL;
     }
     return c;
 }

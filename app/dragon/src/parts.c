@@ -474,11 +474,7 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
         // inode: the open connection still reads the old one. A deleted file
         // keeps being read through the open connection until a new one appears.
         bool replaced = d->db && sp_db_file_check(d->db) == SP_DB_FILE_REPLACED;
-        // A file rewritten in place (a backup copied over it with cp) reads
-        // as damaged through this handle's cached pages, and whole through a
-        // new one: an unreadable generation opens it anew.
-        bool unreadable = d->db && !replaced && sp_db_generation(d->db) == 0;
-        if (replaced || unreadable || !d->db) {
+        if (replaced || !d->db) {
             // First: then nothing of ours holds the old file's sidecars (a
             // model being read ends, and what it read is not taken).
             (void)dragon_model_load_take(d, true);
@@ -486,10 +482,8 @@ sp_result sp_dragon_reload_if_changed(sp_dragon* d, bool* reloaded, sp_error* er
             if (replaced) sp_db_drop_stale_sidecars(d->db_path);
             d->db = NULL;
             if (open_own(d, err) != SP_OK) return SP_ERR_IO; // parts already loaded and the model stay usable
-            uint64_t g = sp_db_generation(d->db);
-            if (g == 0) return sp_fail(err, SP_ERR_IO, "%s: the database cannot be read", d->db_path);
             dragon_reload_model(d, false);
-            d->gen = g;
+            d->gen = sp_db_generation(d->db);
             cache_prune(d);
             ++d->reloads;
             if (reloaded) *reloaded = true;
