@@ -342,6 +342,20 @@ bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path
                       : !S_ISDIR(st.st_mode)          ? "not a folder"
                       : access(dir, W_OK | X_OK) != 0 ? "this user may not write there"
                                                       : NULL;
+    // A folder that lets root write but takes no new file (/proc) failed only
+    // after the work, with ENOENT from the temporary file (an outside
+    // review): a file is made there and removed, before the work.
+    size_t dn = strlen(dir) + 3;
+    char* in_dir = why ? NULL : malloc(dn); // a name in the folder written (links followed)
+    if (in_dir) snprintf(in_dir, dn, "%s/x", dir);
+    char* probe = in_dir ? sp_path_temp_beside(in_dir, ".probe") : NULL;
+    free(in_dir);
+    int pfd = probe ? open(probe, O_WRONLY | O_CREAT | O_EXCL, 0600) : 0;
+    if (pfd < 0)
+        why = strerror(errno);
+    else if (probe)
+        close(pfd), unlink(probe);
+    free(probe);
     if (why) fprintf(stderr, "%s: %s %s: cannot write into folder '%s' (%s)\n", cmd, name, path, dir, why);
     free(dir);
     if (!why && stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {

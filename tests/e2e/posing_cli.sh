@@ -107,6 +107,13 @@ one_line_naming nowhere/x.png
 [ -e "$WORK/left.glb" ] && fail "pose left its .glb after --render failed"
 [ -e "$WORK/left.json" ] && fail "pose left its report after --render failed"
 ls -A "$WORK" | grep -q -e 'tmp' -e '^[.]sp-' && fail "pose left a temporary file: $(ls -A "$WORK" | grep -e tmp -e '^[.]sp-')"
+# A folder that lets root write but takes no new file (/proc): said before
+# the work, naming the folder (it came after every key was solved, as
+# "No such file or directory" of the temporary file).
+if [ -d /proc ]; then
+    expect 1 "$SP" animate --rig "$RIG" --strokes "$WORK/s.json" "$WORK/s.json" --out /proc/a.glb
+    one_line_naming "/proc/a.glb: cannot write into folder '/proc'"
+fi
 
 # Streams are not files: one stream named as two outputs overwrites nothing.
 expect 0 "$SP" pose --rig "$RIG" --strokes "$WORK/s.json" --out /dev/null --report /dev/null

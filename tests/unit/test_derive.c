@@ -703,9 +703,9 @@ static void test_cli(void)
     ENSURE(!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(j, "abstraction")), "outline"));
     cJSON_Delete(j);
     // A preview that cannot be written keeps no part: a folder that is not
-    // there, or a link into one, seen before storing; a folder that passes
-    // the check but takes no file (/proc, to root), or a full disk
-    // (/dev/full), when the picture is made, also before the part is stored:
+    // there, a link into one, or one that takes no file (/proc, which lets
+    // root write: a file is tried there), seen before storing; a full disk
+    // (/dev/full) when the picture is made, also before the part is stored:
     // the database's log shows none of them (the part was stored, then
     // removed, the log showing both: an outside review).
     char dangling[1024];
@@ -726,7 +726,7 @@ static void test_cli(void)
         snprintf(cmd, sizeof cmd, "cat '%s'", errf);
         ENSURE(run(cmd, &text) == 0);
         fprintf(stderr, "  %s", text);
-        ENSURE(strstr(text, i < 2 ? "cannot write into folder" : "the part was not stored") &&
+        ENSURE(strstr(text, i != 2 ? "cannot write into folder" : "the part was not stored") &&
                strchr(text, '\n') == text + strlen(text) - 1);
         free(text);
     }
