@@ -178,8 +178,10 @@ int cmd_animate(int argc, char** argv)
         free(times);
         return SP_EXIT_USAGE;
     }
-    if (!sp_cli_check_out_folders("sketchpose animate", opts, (int)(sizeof opts / sizeof opts[0])))
+    if (!sp_cli_check_out_folders("sketchpose animate", opts, (int)(sizeof opts / sizeof opts[0]))) {
+        free(times);
         return SP_EXIT_INPUT; // before the work
+    }
     sp_rig_handle* rig = NULL;
     sp_error err = {0};
     sp_solve_cmd run = {.cmd = "sketchpose animate"};
