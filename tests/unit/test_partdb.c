@@ -81,6 +81,20 @@ static const char* part_file(int i)
     return paths[i];
 }
 
+// n synthetic sketches of stored part `part` (seed 77), labelled `category`.
+static sp_dataset synth_as(sp_db* db, const char* part, int n, const char* category)
+{
+    sp_dataset ds = {0};
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_db_load_part(db, part, &ch, &err) == SP_OK);
+    ENSURE(db_synth_sketches(&ch, 0, n, 77, 0, &ds, &err) == SP_OK);
+    sp_character_free(&ch);
+    free(ds.categories[0]);
+    ds.categories[0] = strdup(category);
+    return ds;
+}
+
 static sp_db* open_ok(const char* path, unsigned flags)
 {
     sp_db* db = NULL;
@@ -424,15 +438,9 @@ static void test_round_trip(void)
     ENSURE(parts[0].vertices > 0 && parts[0].parameters > 0 && parts[0].selftest_error >= 0 && parts[0].selftest_error <= 0.02);
     free(parts);
     // Curated sketches: strokes of a wings pose, stored and read back.
-    sp_dataset ds = {0};
-    sp_character ch = {0};
-    ENSURE(sp_db_load_part(db, "wings_a", &ch, &err) == SP_OK);
-    ENSURE(db_synth_sketches(&ch, 0, 5, 77, 0, &ds, &err) == SP_OK);
-    free(ds.categories[0]);
-    ds.categories[0] = strdup("wings");
+    sp_dataset ds = synth_as(db, "wings_a", 5, "wings");
     ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", &n, &err) == SP_OK && n == 5);
     sp_dataset_free(&ds);
-    sp_character_free(&ch);
     ENSURE(sp_db_load_dataset(db, &ds, NULL, &err) == SP_OK);
     ENSURE(ds.count == 45 && ds.category_count == 2 && !strcmp(ds.categories[1], "wings"));
     sp_dataset_free(&ds);
@@ -2334,12 +2342,7 @@ static void test_category_case(void)
     ENSURE(strstr(err.text, "part name 'TAIL_Y' differs from its 'tail_y' only in case"));
     // Sketches of a category differing only in case from a part's, or from
     // another of the same set, were stored apart and never trained on.
-    sp_dataset ds = {0};
-    sp_character ch = {0};
-    ENSURE(sp_db_load_part(db, "tail_x", &ch, &err) == SP_OK);
-    ENSURE(db_synth_sketches(&ch, 0, 2, 77, 0, &ds, &err) == SP_OK);
-    free(ds.categories[0]);
-    ds.categories[0] = strdup("TAIL");
+    sp_dataset ds = synth_as(db, "tail_x", 2, "TAIL");
     ENSURE(sp_db_add_sketches(db, &ds, NULL, SP_DB_SOURCE_CURATED, "test", NULL, &err) == SP_ERR_INVALID);
     fprintf(stderr, "  %s\n", err.text);
     ENSURE(strstr(err.text, "category 'TAIL' differs from its 'tail' only in case"));
@@ -2352,7 +2355,6 @@ static void test_category_case(void)
     ENSURE(strstr(err.text, "categories 'rider' and 'Rider' differ only in case"));
     ENSURE(scalar(p, "SELECT count(*) FROM sketches WHERE source = 'curated'") == 0);
     sp_dataset_free(&ds);
-    sp_character_free(&ch);
     sp_db_close(db);
 }
 

@@ -104,9 +104,11 @@ static void limb_pairs(tpl* t, int near, int far)
     while (na > 0 && nb > 0 && a[na - 1] == b[nb - 1]) // what the two share stays
         --na, --nb;
     int n = na < nb ? na : nb;
-    if (n > 0 && (t->twins = malloc(sizeof *t->twins * (size_t)n)))
+    if (n > 0 && (t->twins = malloc(sizeof *t->twins * (size_t)n))) {
         for (int i = 0; i < n; ++i)
-            t->twins[i][0] = a[i], t->twins[i][1] = b[i], t->twin_count = n;
+            t->twins[i][0] = a[i], t->twins[i][1] = b[i];
+        t->twin_count = n;
+    }
     free(up);
 }
 
