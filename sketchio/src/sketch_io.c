@@ -386,6 +386,15 @@ static sp_result add_stroke(sp_sketch* s, const sp_vec2* pts, const double* ts, 
     return SP_OK;
 }
 
+// The first byte at or after p that is not JSON white space (nor a NUL, when
+// nul counts as space: some editors pad the end of a file with them).
+static const char* skip_space(const char* p, const char* stop, bool nul)
+{
+    while (p < stop && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || (nul && *p == 0)))
+        ++p;
+    return p;
+}
+
 // Where a JSON file does not parse, said so that a one-line file (a stroke
 // file written by a script) can be mended: the line, the column and up to
 // 16 bytes from there, anything but printable ASCII as \xNN (a UTF-8
@@ -395,17 +404,15 @@ static sp_result add_stroke(sp_sketch* s, const sp_vec2* pts, const double* ts, 
 static sp_result json_error_at(const char* text, size_t len, const char* end, const char* name, sp_error* err)
 {
     const char* stop = text + len;
-    const char* q = text;
-    while (q < stop && (*q == ' ' || *q == '\t' || *q == '\n' || *q == '\r'))
-        ++q;
-    if (q == stop) return sp_fail(err, SP_ERR_PARSE, "%s: the file is empty (no JSON document)", name);
+    if (skip_space(text, stop, false) == stop)
+        return sp_fail(err, SP_ERR_PARSE, "%s: the file is empty (no JSON document)", name);
     if (!end || end < text || end > stop) return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON", name);
     const char* bol = end;
     while (bol > text && bol[-1] != '\n')
         --bol;
     char near[16 * 4 + 1];
     size_t n = 0, taken = 0;
-    for (q = end; q < stop && taken < 16 && *q != '\n' && *q != '\r'; ++q, ++taken) {
+    for (const char* q = end; q < stop && taken < 16 && *q != '\n' && *q != '\r'; ++q, ++taken) {
         unsigned char c = (unsigned char)*q;
         n += (size_t)(c >= 0x20 && c < 0x7f ? snprintf(near + n, sizeof near - n, "%c", c)
                                             : snprintf(near + n, sizeof near - n, "\\x%02X", c));
@@ -417,10 +424,7 @@ static sp_result json_error_at(const char* text, size_t len, const char* end, co
     size_t wl = word - (size_t)(w - end);
     bool not_number =
         (wl == 3 && (!strncasecmp(w, "nan", 3) || !strncasecmp(w, "inf", 3))) || (wl == 8 && !strncasecmp(w, "infinity", 8));
-    const char* rest = end;
-    while (rest < stop && (*rest == ' ' || *rest == '\t' || *rest == '\n' || *rest == '\r'))
-        ++rest;
-    bool cut = rest >= stop || end + 1 >= stop;
+    bool cut = skip_space(end, stop, false) >= stop || end + 1 >= stop;
     return sp_fail(err, SP_ERR_PARSE, "%s: malformed JSON near line %d, column %d%s%s%s%s", name, line_of(text, len, end),
                    (int)(end - bol) + 1, n ? ", at '" : "", n ? near : "", n ? "'" : "",
                    not_number ? " (NaN and infinity are not JSON numbers)"
@@ -432,8 +436,7 @@ sp_result sp_json_document_end(const char* text, size_t len, bool parsed, const 
 {
     if (!parsed) return json_error_at(text, len, end, name, err);
     // Anything but white space after the document means the file is not what it seems (two files joined, a bad edit).
-    while (end && end < text + len && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r' || *end == 0))
-        ++end;
+    if (end) end = skip_space(end, text + len, true);
     if (end && end < text + len)
         return sp_fail(err, SP_ERR_PARSE, "%s: text after the JSON document, line %d", name, line_of(text, len, end));
     return SP_OK;
