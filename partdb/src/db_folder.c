@@ -69,6 +69,32 @@ static bool dir_is_empty(const char* dir)
     return empty;
 }
 
+// Removes the temporary folders an export to `final` left when its process
+// was killed: "<final>.partial-<pid>-<k>" whose pid runs no more on this
+// machine. They hold copies only, and a folder of a running export (this
+// machine's) is left alone.
+static void remove_stopped_exports(const char* final)
+{
+    char* folder = sp_path_folder(final);
+    const char* base = strrchr(final, '/');
+    base = base ? base + 1 : final;
+    DIR* d = folder ? opendir(folder) : NULL;
+    size_t bl = strlen(base);
+    struct dirent* e;
+    while (d && (e = readdir(d))) {
+        const char* tail = e->d_name + bl;
+        if (strncmp(e->d_name, base, bl) || strncmp(tail, ".partial-", 9)) continue;
+        char* end;
+        long pid = strtol(tail + 9, &end, 10);
+        if (pid <= 0 || end == tail + 9 || *end != '-' || !end[1] || strspn(end + 1, "0123456789") != strlen(end + 1)) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+        char path[1200];
+        if (snprintf(path, sizeof path, "%s/%s", folder, e->d_name) < (int)sizeof path) sp_dir_remove_tree(path);
+    }
+    if (d) closedir(d);
+    free(folder);
+}
+
 // Checks DIR (absent, or an empty folder) and makes the temporary folder beside it.
 static sp_result export_begin(const char* dir, export_dir* ex, sp_error* err)
 {
@@ -92,6 +118,7 @@ static sp_result export_begin(const char* dir, export_dir* ex, sp_error* err)
         snprintf(ex->final, sizeof ex->final, "%s", real);
         free(real);
     }
+    remove_stopped_exports(ex->final);
     if (stat(ex->final, &ex->had) == 0) {
         if (!S_ISDIR(ex->had.st_mode)) return sp_fail(err, SP_ERR_INVALID, "%s: exists and is not a folder", dir);
         if (!dir_is_empty(ex->final)) return not_empty(dir, err);

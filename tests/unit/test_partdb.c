@@ -252,6 +252,40 @@ static void fresh_export(const char* stem, char p[1024], char p2[1024], char dir
     ENSURE(system(cmd) == 0);
 }
 
+// An export killed midway leaves "<DIR>.partial-<pid>-<k>" beside DIR (a
+// full copy of the database, seen by an outside curator review): the next
+// export to DIR removes those of a process that runs no more, and leaves a
+// running one's (this process's) and anything else named like it.
+static void test_export_clears_stopped(void)
+{
+    char p[1024], p2[1024], dir[1024], left[1200], live[1200], other[1200], file[1300];
+    fresh_export("exstop", p, p2, dir);
+    pid_t child = fork();
+    if (child == 0) _exit(0);
+    ENSURE(child > 0 && waitpid(child, NULL, 0) == child); // a pid that runs no more
+    snprintf(left, sizeof left, "%s.partial-%ld-0", dir, (long)child);
+    snprintf(live, sizeof live, "%s.partial-%ld-7", dir, (long)getpid());
+    snprintf(other, sizeof other, "%s.partial-%ld-0x", dir, (long)child);
+    const char* made[] = {left, live, other};
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(mkdir(made[i], 0777) == 0);
+        snprintf(file, sizeof file, "%s/manifest.json", made[i]);
+        FILE* f = fopen(file, "wb");
+        ENSURE(f && fputs("{}", f) >= 0 && fclose(f) == 0);
+    }
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    add_ok(db, 1, 5);
+    sp_error err = {0};
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
+    sp_db_close(db);
+    ENSURE(access(left, F_OK) != 0);
+    ENSURE(access(live, F_OK) == 0 && access(other, F_OK) == 0);
+    for (int i = 1; i < 3; ++i)
+        sp_dir_remove_tree(made[i]);
+    sp_dir_remove_tree(dir);
+    sp_fixture_remove_db(p);
+}
+
 // A part stored as the self-contained .gltf it was added from is exported
 // under a .gltf name (an outside curator review: parts/NAME.glb held JSON,
 // which tools that go by the name read as binary), and the export rebuilds.
@@ -3304,6 +3338,7 @@ int main(int argc, char** argv)
                                    {"same_file_twice", test_same_file_twice},
                                    {"round_trip", test_round_trip},
                                    {"export_gltf_named", test_export_gltf_named},
+                                   {"export_clears_stopped", test_export_clears_stopped},
                                    {"sketch_doubles_exact", test_sketch_doubles_exact},
                                    {"export_whole", test_export_whole},
                                    {"durable", test_durable},
