@@ -63,6 +63,12 @@ static const stage k_place = {.pairing = SP_CORR_CLOSEST, .placement_only = true
 // pairs place the root in a few iterations where fresh closest points crawl,
 // and did as well as ordered pairs (BENCHMARKS.md, "Measurements behind the
 // solver's constants and stages").
+// ... or, for a figure matched in order whose closest-point placement
+// ended short (further_attempts), with the abstraction's own ordered pairs:
+// a stick figure's vertical lines give closest points almost no vertical
+// pull, so a figure drawn 80 px above where it stands stayed put.
+static const stage k_place_ordered = {
+    .pairing = SP_CORR_ORDERED, .placement_only = true, .its_fresh = 3, .its_frozen = 2, .tol = 1e-2};
 static const stage k_place_held = {
     .pairing = SP_CORR_CLOSEST, .placement_only = true, .hold_pairs = true, .its_fresh = 3, .its_frozen = 2, .tol = 1e-2};
 // Everything moves, with the abstraction's own pairing. Graduated
@@ -107,6 +113,8 @@ typedef struct plan {
     bool graduate_vertex; // W_plane and W_dist follow W_pose's schedule (draw-over curves: local edits)
     bool loop;            // an outline drawn as a loop, matched in order first
     bool placed_free;     // that loop's root is placed by its ordered rounds (no placement stage)
+    bool placed_closest;  // a figure matched in order, placed by closest points first
+    bool placed_ordered;  // ... or by its ordered pairs
 } plan;
 
 // One attempt at a fit: sp_solver_solve makes the first, and more for a
@@ -114,6 +122,7 @@ typedef struct plan {
 typedef struct attempt {
     bool allow_loop;                   // a loop may be matched in order first
     bool place_free;                   // a loop drawn away from the part may be placed by its ordered rounds
+    bool place_ordered;                // a placement stage pairs as the abstraction does (ordered), not closest
     const sp_ordered_info* loop_shift; // hold this shift and direction through the ordered rounds (NULL: the best each round)
 } attempt;
 
@@ -142,8 +151,11 @@ static void plan_attempt(const sp_solver* s, const sp_sketch* sk, const attempt*
     *pl = (plan){.loop = loop, .placed_free = placing && loop && at->place_free, .graduate_vertex = m->embedded};
     pl->boost_from = pl->placed_free ? m->placement_count : 0;
     const bool place_stage = placing && !pl->placed_free;
-    pl->start_pairing = place_stage ? SP_CORR_CLOSEST : s->ab->correspondence;
-    if (place_stage) pl->stages[pl->count++] = loop ? k_place_held : k_place;
+    const bool ordered_place = place_stage && !loop && at->place_ordered && s->ab->correspondence == SP_CORR_ORDERED;
+    pl->start_pairing = place_stage && !ordered_place ? SP_CORR_CLOSEST : s->ab->correspondence;
+    if (place_stage) pl->stages[pl->count++] = ordered_place ? k_place_ordered : loop ? k_place_held : k_place;
+    pl->placed_ordered = ordered_place;
+    pl->placed_closest = place_stage && !ordered_place && !loop && s->ab->correspondence == SP_CORR_ORDERED;
     if (loop) {
         pl->stages[pl->count++] = k_loop_in_order;
         pl->stages[pl->count++] = k_loop_closest;
@@ -506,6 +518,22 @@ static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p
     free(p2), free(r2);
 }
 
+// A figure matched in order whose fit from a closest-point placement ends
+// above 1% is placed again by its ordered pairs, and the better fit kept.
+static void attempt_placed_ordered(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep)
+{
+    if (!(s->d.time_cap_ms - rep->ms > 0)) return;
+    double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
+    sp_solve_report* r2 = malloc(sizeof *r2);
+    sp_error e2 = {0};
+    plan pl;
+    if (p2 && r2 &&
+        run_attempt(s, sk, p_start, &(attempt){.allow_loop = true, .place_free = true, .place_ordered = true},
+                    s->d.time_cap_ms - rep->ms, p2, r2, &pl, &e2) == SP_OK)
+        keep_better(s, rep, p_out, r2, p2);
+    free(p2), free(r2);
+}
+
 sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep,
                           sp_error* err)
 {
@@ -513,7 +541,7 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     sp_result res =
         run_attempt(s, sk, p_start, &(attempt){.allow_loop = true, .place_free = true}, s->d.time_cap_ms, p_out, rep, &pl, err);
     if (res == SP_OK && !fit_ok(rep) && pl.loop) further_attempts(s, sk, p_start, &pl, p_out, rep);
-    else if (res == SP_OK && !fit_ok(rep) && p_start)
-        attempt_from_rest(s, sk, p_start, p_out, rep);
+    if (res == SP_OK && !fit_ok(rep) && pl.placed_closest) attempt_placed_ordered(s, sk, p_start, p_out, rep);
+    if (res == SP_OK && !fit_ok(rep) && !pl.loop && p_start) attempt_from_rest(s, sk, p_start, p_out, rep);
     return res;
 }
