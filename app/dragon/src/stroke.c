@@ -788,6 +788,10 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
         d->parts[k]->pub.attached_to = saved[k];
 }
 
+// How much surer of the new body than of an earlier one that carries a part
+// the classifier has to be for the earlier one to be decided again.
+#define SURE_BODY_MARGIN 0.05
+
 // Part i, taken by the classifier for a body when it was drawn alone, lies
 // on the body just drawn (dragon_on_body): decided again as if drawn after
 // that body (the on-body rule of rerank_by_fit), so the tail a visitor
@@ -795,15 +799,21 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
 // body a chip chose stays, and so does one that carries two parts or more
 // (a small dragon with a bigger body drawn round it: its body became a head
 // smeared over the new one's flank; one part may hang on a wing or tail
-// drawn first and taken for a body). The new part takes the old one's place and
-// id; false (nothing changed) when no other guess has a part that fits.
+// drawn first and taken for a body), or one part and is as surely a body.
+// The new part takes the old one's place and id; false (nothing changed) when no other guess has a part that fits.
 static bool decide_again_on_body(sp_dragon* d, int i, int body)
 {
     part* old = d->parts[i];
     sp_vec2 lo, hi;
     stroke_box_of(old, &lo, &hi);
     if (!old->t->is_torso || old->chosen || !d->clf || !dragon_on_body(d, lo, hi, body)) return false;
-    if (old->carried >= 2) return false;
+    // A body that carries a part and that the classifier took for one at
+    // least as surely as the new one is a body: an arch drawn over a
+    // dragon's back (0.49 a body) made the dragon's body (1.00) a pair of
+    // legs and dropped its head, and a body drawn again round the first made
+    // that one a head as large as the body (an outside review).
+    if (old->carried >= 2 || (old->carried >= 1 && old->pub.confidence >= d->parts[body]->pub.confidence - SURE_BODY_MARGIN))
+        return false;
     sp_stroke st;
     sp_sketch sk = part_sketch(d, old, &st);
     sp_dragon_result res = {.part = -1};
