@@ -2,10 +2,12 @@
 // built from assets/.
 #define _XOPEN_SOURCE 700 // nftw
 #include <cjson/cJSON.h>
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <ftw.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -224,11 +226,11 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
     db_str_printf(&m, "], \"sketches\": [");
-    if ((r = db_prepare(
-             db,
-             "SELECT s.id, s.category, s.source, p.name, s.strokes, s.png, s.raster_w, s.added_by, s.status FROM sketches s"
-             " LEFT JOIN parts p ON p.id = s.part_id ORDER BY s.category, s.id",
-             &st, err)) != SP_OK)
+    if ((r = db_prepare(db,
+                        "SELECT s.id, s.category, s.source, p.name, s.strokes, s.png, s.raster_w, s.added_by, s.status, "
+                        "s.added_at FROM sketches s"
+                        " LEFT JOIN parts p ON p.id = s.part_id ORDER BY s.category, s.id",
+                        &st, err)) != SP_OK)
         goto out;
     n = 0;
     char last_cat[SP_NAME_MAX] = "";
@@ -265,13 +267,16 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
         } else {
             continue; // a raster without its PNG (none are stored that way today)
         }
-        db_str_printf(&m, "%s{\"file\": \"sketches/%s/%s-%06lld.%s\", \"category\": ", n++ ? ", " : "", cat, src, id, ext);
+        db_str_printf(&m, "%s{\"id\": %lld, \"file\": \"sketches/%s/%s-%06lld.%s\", \"category\": ", n++ ? ", " : "", id, cat,
+                      src, id, ext);
         db_str_json(&m, cat);
         db_str_printf(&m, ", \"source\": \"%s\", \"part\": ", src);
         if (sqlite3_column_type(st, 3) != SQLITE_NULL) db_str_json(&m, (const char*)sqlite3_column_text(st, 3));
         else db_str_printf(&m, "null");
         db_str_printf(&m, ", \"added_by\": ");
         db_str_json(&m, (const char*)sqlite3_column_text(st, 7));
+        db_str_printf(&m, ", \"added_at\": ");
+        db_str_json(&m, (const char*)sqlite3_column_text(st, 9));
         if (sqlite3_column_type(st, 8) != SQLITE_NULL) {
             db_str_printf(&m, ", \"status\": ");
             db_str_json(&m, (const char*)sqlite3_column_text(st, 8));
@@ -281,7 +286,12 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
     if (r == SP_OK && rc != SQLITE_DONE) r = db_fail(db, rc, "reading the sketches", err);
     sqlite3_finalize(st);
     if (r != SP_OK) goto out;
-    db_str_printf(&m, "]}\n");
+    // The highest id ever given, so that the ids of sketches deleted before
+    // the export are not given again after it.
+    if ((r = db_prepare(db, "SELECT " DB_SKETCH_ID_HIGH, &st, err)) != SP_OK) goto out;
+    db_str_printf(&m, "], \"sketch_id_high\": %lld}\n",
+                  sqlite3_step(st) == SQLITE_ROW ? (long long)sqlite3_column_int64(st, 0) : 0);
+    sqlite3_finalize(st);
     if (m.oom) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         goto out;
@@ -354,6 +364,43 @@ static bool name_in(const char* s, const char* const* names, int n)
     return false;
 }
 
+// A time as the database writes one (strftime '%Y-%m-%dT%H:%M:%fZ').
+static bool timestamp_ok(const char* t)
+{
+    static const char form[] = "dddd-dd-ddTdd:dd:dd.dddZ";
+    if (!t || strlen(t) != sizeof form - 1) return false;
+    for (size_t k = 0; k < sizeof form - 1; ++k)
+        if (form[k] == 'd' ? !isdigit((unsigned char)t[k]) : t[k] != form[k]) return false;
+    return true;
+}
+
+static int compare_ids(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+// No sketch id given twice in the manifest: each names one drawing.
+static sp_result ids_unique(const cJSON* sketches, const char* path, sp_error* err)
+{
+    int n = cJSON_GetArraySize(sketches), m = 0;
+    double* ids = malloc(sizeof(double) * (size_t)(n + 1));
+    if (!ids) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    const cJSON* it;
+    cJSON_ArrayForEach(it, sketches)
+    {
+        const cJSON* id = cJSON_GetObjectItemCaseSensitive(it, "id");
+        if (id) ids[m++] = id->valuedouble;
+    }
+    qsort(ids, (size_t)m, sizeof *ids, compare_ids);
+    int k = 1;
+    while (k < m && ids[k] != ids[k - 1])
+        ++k;
+    sp_result r = k < m ? sp_fail(err, SP_ERR_INVALID, "%s: sketch id %.0f given twice", path, ids[k]) : SP_OK;
+    free(ids);
+    return r;
+}
+
 // What a manifest's entries must be before anything is stored: a part's file
 // inside the export folder (said as such: "../outside.glb" was "a part entry
 // without name or file"), and an added_by without control characters, as
@@ -383,6 +430,14 @@ static sp_result manifest_entries_ok(const cJSON* parts, const cJSON* sketches, 
     i = 0;
     cJSON_ArrayForEach(it, sketches)
     {
+        const cJSON* id = cJSON_GetObjectItemCaseSensitive(it, "id");
+        const cJSON* at = cJSON_GetObjectItemCaseSensitive(it, "added_at");
+        if (id && !(cJSON_IsNumber(id) && id->valuedouble >= 1 && id->valuedouble <= 9007199254740992.0 &&
+                    id->valuedouble == floor(id->valuedouble)))
+            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: id is not a whole number from 1 up", path, i);
+        if (at && !timestamp_ok(cJSON_GetStringValue(at)))
+            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: added_at '%s' is not a time as YYYY-MM-DDTHH:MM:SS.sssZ", path, i,
+                           sp_text_printable(cJSON_IsString(at) ? at->valuestring : "(not text)", shown, sizeof shown));
         if (sp_text_has_control(jstr(it, "added_by")))
             return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: added_by '%s' holds control characters", path, i,
                            sp_text_printable(jstr(it, "added_by"), shown, sizeof shown));
@@ -396,7 +451,55 @@ static sp_result manifest_entries_ok(const cJSON* parts, const cJSON* sketches, 
                            sp_text_printable(cJSON_IsString(status) ? status->valuestring : "(not a name)", shown, sizeof shown));
         ++i;
     }
-    return SP_OK;
+    return ids_unique(sketches, path, err);
+}
+
+// Before an import's sketches are stored: the highest id ever given made at
+// least the export's and every id the manifest gives, so that a sketch given
+// a new id never takes one the manifest keeps for another.
+static sp_result hold_ids_back(sp_db* db, const cJSON* man, const cJSON* sketches, sp_error* err)
+{
+    double high = 0;
+    const cJSON* h = cJSON_GetObjectItemCaseSensitive(man, "sketch_id_high");
+    if (cJSON_IsNumber(h) && h->valuedouble >= 1 && h->valuedouble <= 9007199254740992.0) high = floor(h->valuedouble);
+    const cJSON* it;
+    cJSON_ArrayForEach(it, sketches)
+    {
+        const cJSON* id = cJSON_GetObjectItemCaseSensitive(it, "id");
+        if (id) high = fmax(high, id->valuedouble);
+    }
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(
+        db, "INSERT OR REPLACE INTO meta(key, value) VALUES ('sketch_id_high', max(?1, " DB_SKETCH_ID_HIGH "))", &st, err);
+    if (r != SP_OK) return r;
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)high);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    return rc == SQLITE_DONE ? SP_OK : db_fail(db, rc, "importing the sketches' ids", err);
+}
+
+// The sketch just stored (the last row) takes the id and the time its
+// manifest entry gives, where the id is free: a moved database keeps what
+// its review ids and `--after` name (they named other drawings after an
+// export and `init --from`, the visits regrouped by category; an outside
+// curator review).
+static sp_result keep_id_and_time(sp_db* db, const cJSON* entry, sp_error* err)
+{
+    const cJSON* id = cJSON_GetObjectItemCaseSensitive(entry, "id");
+    const char* at = jstr(entry, "added_at");
+    if (!id && !at) return SP_OK;
+    sqlite3_stmt* st;
+    sp_result r = db_prepare(db,
+                             "UPDATE sketches SET id = CASE WHEN ?1 IS NULL OR EXISTS (SELECT 1 FROM sketches WHERE id = ?1)"
+                             " THEN id ELSE ?1 END, added_at = coalesce(?2, added_at) WHERE id = ?3",
+                             &st, err);
+    if (r != SP_OK) return r;
+    if (id) sqlite3_bind_int64(st, 1, (sqlite3_int64)id->valuedouble);
+    if (at) sqlite3_bind_text(st, 2, at, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int64(st, 3, sqlite3_last_insert_rowid(db->h));
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    return rc == SQLITE_DONE ? SP_OK : db_fail(db, rc, "importing a sketch's id", err);
 }
 
 sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err)
@@ -412,6 +515,24 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
         strcmp(jstr(man, "format"), "sketchpose-db-export") != 0) {
         cJSON_Delete(man);
         return sp_fail(err, SP_ERR_PARSE, "%s: not a sketchpose-db-export manifest", path);
+    }
+    const cJSON* version = cJSON_GetObjectItemCaseSensitive(man, "version");
+    const cJSON* schema = cJSON_GetObjectItemCaseSensitive(man, "schema");
+    if ((version && !(cJSON_IsNumber(version) && version->valuedouble == 1)) ||
+        (schema && !(cJSON_IsNumber(schema) && schema->valuedouble >= 1 && schema->valuedouble <= SP_DB_SCHEMA_VERSION))) {
+        char v[32] = "none", sc[32] = "none";
+        const cJSON* said[2] = {version, schema};
+        char* text[2] = {v, sc};
+        for (int k = 0; k < 2; ++k)
+            if (said[k] && cJSON_IsNumber(said[k]))
+                snprintf(text[k], sizeof v, "%g", said[k]->valuedouble);
+            else if (said[k])
+                snprintf(text[k], sizeof v, "not a number");
+        cJSON_Delete(man);
+        return sp_fail(err, SP_ERR_INVALID,
+                       "%s: an export of version %s, schema %s; this sketchpose reads version 1, schemas 1 to %d (a newer "
+                       "sketchpose's export?)",
+                       path, v, sc, SP_DB_SCHEMA_VERSION);
     }
     if ((r = manifest_entries_ok(parts, sketches, path, err)) != SP_OK) {
         cJSON_Delete(man);
@@ -456,9 +577,11 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
         }
     }
     if (r == SP_OK && read > 0 && (r = db_begin(db, err)) == SP_OK) {
+        r = hold_ids_back(db, man, sketches, err);
         int i = 0;
         cJSON_ArrayForEach(it, sketches)
         {
+            if (r != SP_OK) break;
             const char* pname = jstr(it, "part");
             const char* src = jstr(it, "source");
             sp_db_source s = parse_source(src);
@@ -479,6 +602,7 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
                     break;
                 }
             }
+            if ((r = keep_id_and_time(db, it, err)) != SP_OK) break; // last: it may change the row's id
             ++i;
         }
         char details[128];
