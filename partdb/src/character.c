@@ -56,6 +56,7 @@ void sp_character_warn(sp_character* ch, const char* fmt, ...)
     va_start(ap, fmt);
     vsnprintf(ch->warnings[ch->warning_count], SP_WARNING_MAX, fmt, ap);
     va_end(ap);
+    sp_text_escape_controls(ch->warnings[ch->warning_count], SP_WARNING_MAX); // one line, as sp_fail's
     ++ch->warning_count;
 }
 

@@ -350,6 +350,23 @@ static void test_options(void)
     ENSURE(sp_fixture_has_warning(&part, "it attaches by its root 'root', where") &&
            sp_fixture_has_warning(&part, "give --attach-joint"));
     sp_character_free(&part);
+    // A joint's name from a file, with a newline and an escape code, is said
+    // on one line, the codes escaped (the terminal was cleared, the warning
+    // split in two; an outside curator review); errors too.
+    int root = 0;
+    while (root < src.rig.joint_count && strcmp(src.rig.joints[root].name, "root"))
+        ++root;
+    ENSURE(root < src.rig.joint_count);
+    snprintf(src.rig.joints[root].name, sizeof src.rig.joints[root].name, "ro\x1b[2Jot\nFAKE LINE");
+    derive_ok(&src, NULL, &part, &info);
+    ENSURE(sp_fixture_has_warning(&part, "it attaches by its root 'ro\\x1b[2Jot\\nFAKE LINE', where"));
+    for (int w = 0; w < part.warning_count; ++w)
+        ENSURE(!strpbrk(part.warnings[w], "\n\x1b"));
+    sp_character_free(&part);
+    sp_error jerr = {0};
+    sp_fail(&jerr, SP_ERR_INVALID, "joint '%s' is odd", src.rig.joints[root].name);
+    ENSURE(!strcmp(jerr.text, "joint 'ro\\x1b[2Jot\\nFAKE LINE' is odd"));
+    snprintf(src.rig.joints[root].name, sizeof src.rig.joints[root].name, "root");
     derive_ok(&src, &(sp_derive_desc){.abstraction = "stick", .attach_joint = "tail_3"}, &part, &info);
     ENSURE(!sp_fixture_has_warning(&part, "it attaches by its root"));
     const sp_part* ex = part_extras(&part);

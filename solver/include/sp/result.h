@@ -40,6 +40,11 @@ sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)
 #endif
     ;
 
+/// Rewrites text s (a buffer of cap bytes) on one line: a newline as \n, a
+/// tab as \t, any other control character as \xNN (a name from a file may
+/// hold any), cut to fit (at most 1023 bytes). sp_fail does it to every message.
+void sp_text_escape_controls(char* s, size_t cap);
+
 /// Short stable name of a result code, e.g. "parse error".
 const char* sp_result_name(sp_result r);
 
