@@ -814,7 +814,15 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     // A clip in the wrong unit (ms or frames read as seconds) is said either
     // way: 0.2 ms of keys was "no animation", 2000 s passed silently and
     // hardly moved in the kiosk (an outside review).
-    if (!w.clip && sr->animation_count > 0)
+    int channels = 0;
+    for (int a = 0; a < sr->animation_count; ++a)
+        channels += sr->animations[a].channel_count;
+    // Channels on nodes outside the skeleton were dropped at the load (said
+    // then): a clip of those alone was sent to look at its key times.
+    if (!w.clip && sr->animation_count > 0 && channels == 0)
+        sp_character_warn(out, "the file's animations move no joint of the skin (their channels are on other nodes): the "
+                               "part has no clip");
+    else if (!w.clip && sr->animation_count > 0)
         sp_character_warn(out, "the file's animations have no keys more than 1 ms apart: the part has no clip (are its key "
                                "times in seconds?)");
     else if (!w.clip)

@@ -270,6 +270,22 @@ static void test_clip_units(void)
         sp_character_free(&src);
         sp_character_free(&part);
     }
+    // A clip whose channels were all on nodes outside the skeleton (dropped
+    // at the load) is said as such, not as keys in another unit (an outside
+    // curator review).
+    sp_character src = {0}, part = {0};
+    load_ok(lizard("lizard_units.glb", (sp_foreign_desc){0}), &src);
+    int kept[8] = {0};
+    for (int a = 0; a < src.rig.animation_count && a < 8; ++a)
+        kept[a] = src.rig.animations[a].channel_count, src.rig.animations[a].channel_count = 0;
+    sp_derive_info info;
+    derive_ok(&src, &(sp_derive_desc){.category = "lizard"}, &part, &info);
+    ENSURE(sp_fixture_has_warning(&part, "the file's animations move no joint of the skin") &&
+           !sp_fixture_has_warning(&part, "1 ms apart"));
+    for (int a = 0; a < src.rig.animation_count && a < 8; ++a)
+        src.rig.animations[a].channel_count = kept[a];
+    sp_character_free(&src);
+    sp_character_free(&part);
 }
 
 static void test_what_is_derived(void)
