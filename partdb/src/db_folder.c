@@ -124,6 +124,19 @@ static sp_result export_begin(const char* dir, export_dir* ex, sp_error* err)
     if (stat(ex->final, &ex->had) == 0) {
         if (!S_ISDIR(ex->had.st_mode)) return sp_fail(err, SP_ERR_INVALID, "%s: exists and is not a folder", dir);
         if (!dir_is_empty(ex->final)) return not_empty(dir, err);
+        // The export is written beside DIR and renamed onto it, which a
+        // mount point refuses: said before the work (an empty USB stick's
+        // folder failed after the whole export was written on the disk it
+        // is mounted on; an outside curator review).
+        char* parent = sp_path_folder(ex->final);
+        struct stat up;
+        bool mounted = parent && stat(parent, &up) == 0 && up.st_dev != ex->had.st_dev;
+        free(parent);
+        if (mounted)
+            return sp_fail(err, SP_ERR_INVALID,
+                           "%s: a mount point (a USB stick?), which the finished export cannot be renamed onto: export into a "
+                           "new folder on it, e.g. %s/sketchpose-export",
+                           dir, ex->final);
         ex->exists = true;
     } else if (errno != ENOENT) {
         return sp_fail(err, SP_ERR_IO, "%s: cannot reach the folder (%s)", dir, strerror(errno));

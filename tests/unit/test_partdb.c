@@ -387,6 +387,38 @@ static void test_read_only_file_system(void)
            strstr(out, "Read-only file system"));
 }
 
+// An export onto an empty mount point (a freshly mounted USB stick) is
+// refused before the work, saying to export into a folder on it: it was
+// written beside the mount point, on the disk that holds it, and then could
+// not be renamed onto it (an outside curator review). Where this user may
+// not mount, skipped.
+static void test_export_onto_mount_point(void)
+{
+    char p[1024], usb[1024], cmd[8192], out[4096];
+    snprintf(p, sizeof p, "%s", sp_test_tmp_path("usb_src.db"));
+    snprintf(usb, sizeof usb, "%s", sp_test_tmp_path("usb"));
+    sp_fixture_remove_db(p);
+    mkdir(usb, 0755);
+    sp_db* db = open_ok(p, SP_DB_CREATE);
+    add_ok(db, 1, 5);
+    sp_db_close(db);
+    const char* bin = sketchpose_bin();
+    if (!bin) SKIP("sketchpose not built");
+    snprintf(cmd, sizeof cmd, "unshare -m sh -c \"mount -t tmpfs tmpfs '%s'\" 2>/dev/null", usb);
+    if (system(cmd) != 0) SKIP("no mount namespace for this user (unshare -m)");
+    snprintf(
+        cmd, sizeof cmd,
+        "unshare -m sh -c \"mount -t tmpfs tmpfs '%s' && '%s' db export '%s' --db '%s'; echo exit \\$?\" 2>&1; echo partials "
+        "$(ls -d '%s'.partial-* 2>/dev/null | wc -l)",
+        usb, bin, usb, p, usb);
+    int rc = sp_fixture_run(cmd, out, sizeof out);
+    fprintf(stderr, "  %s", out);
+    ENSURE(rc == 0 && strstr(out, "a mount point (a USB stick?)") && strstr(out, "export into a new folder on it") &&
+           strstr(out, "exit 1") && strstr(out, "partials 0")); // nothing written beside it
+    rmdir(usb);
+    sp_fixture_remove_db(p);
+}
+
 // A part whose only curve the loader left out (saved as LINES, as Blender
 // does) is refused with the loader's reason, where it said only "no sketch
 // abstraction" (an outside curator review).
@@ -3379,6 +3411,7 @@ int main(int argc, char** argv)
                                    {"round_trip", test_round_trip},
                                    {"export_gltf_named", test_export_gltf_named},
                                    {"export_clears_stopped", test_export_clears_stopped},
+                                   {"export_onto_mount_point", test_export_onto_mount_point},
                                    {"sketch_doubles_exact", test_sketch_doubles_exact},
                                    {"export_whole", test_export_whole},
                                    {"durable", test_durable},
