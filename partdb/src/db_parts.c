@@ -209,10 +209,12 @@ sp_result sp_db_validate_part(const void* glb, size_t size, const char* what, co
     return validate(glb, size, what, desc, info, NULL, NULL, err);
 }
 
-static char* summary_json(const sp_rig* rig)
+// The part's parameters and abstractions, and the sha256 of the file it
+// was added from (before any derivation: warn_same_file).
+static char* summary_json(const sp_rig* rig, const char* source_sha)
 {
     db_str b = {0};
-    db_str_printf(&b, "{\"parameters\": [");
+    db_str_printf(&b, "{\"source_sha256\": \"%s\", \"parameters\": [", source_sha);
     for (int i = 0; i < rig->param_count; ++i) {
         const sp_param* p = &rig->params[i];
         db_str_printf(&b, "%s{\"name\": ", i ? ", " : "");
@@ -277,7 +279,7 @@ static sp_result derive_part(const sp_character* ch, const sp_db_part_desc* d, c
 }
 
 static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, unsigned derived,
-                          sp_db_part_info* info_out, sp_error* err);
+                          const char* source_sha, sp_db_part_info* info_out, sp_error* err);
 
 sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, sp_db_part_info* info_out, sp_error* err)
 {
@@ -291,9 +293,11 @@ sp_result sp_db_add_part(sp_db* db, const void* glb, size_t size, const sp_db_pa
     unsigned derived = 0;
     r = derive_part(&ch, &d, what, &derived_glb, &derived_size, &derived, err);
     sp_character_free(&ch);
+    char source[65];
+    if (r == SP_OK && !sp_sha256_hex(glb, size, source)) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     if (r == SP_OK)
-        r = derived_glb ? add_part(db, derived_glb, derived_size, &d, derived, info_out, err)
-                        : add_part(db, glb, size, &d, 0, info_out, err);
+        r = derived_glb ? add_part(db, derived_glb, derived_size, &d, derived, source, info_out, err)
+                        : add_part(db, glb, size, &d, 0, source, info_out, err);
     free(derived_glb);
     return r;
 }
@@ -324,15 +328,24 @@ sp_result db_category_case_clash(sp_db* db, const char* category, sp_error* err)
     return r;
 }
 
-// A part stored already from the same bytes (under another name) is said:
-// the classifier then learns two categories from the same shapes, and a
-// curator added one file twice without a word (an outside review).
-static void warn_same_file(sp_db* db, const sp_db_part_info* info, const sp_db_part_desc* d)
+// A part stored already from the same bytes (under another name), or
+// derived from the same file, is said: the classifier then learns two
+// categories from the same shapes, and a curator added one file twice
+// without a word (an outside review). The file's own hash: a plain glTF
+// derived under two categories is stored as two files (the category is in
+// them), so the case this is for went unsaid (a second review).
+static void warn_same_file(sp_db* db, const sp_db_part_info* info, const char* source_sha, const sp_db_part_desc* d)
 {
     sqlite3_stmt* st = NULL;
     sp_error e = {0};
-    if (!d->warn || db_prepare(db, "SELECT name, category FROM parts WHERE sha256 = ? LIMIT 1", &st, &e) != SP_OK) return;
+    if (!d->warn ||
+        db_prepare(db,
+                   "SELECT name, category FROM parts WHERE sha256 = ?1 OR json_extract(summary, '$.source_sha256') = ?2"
+                   " ORDER BY sha256 = ?1 DESC LIMIT 1",
+                   &st, &e) != SP_OK)
+        return;
     sqlite3_bind_text(st, 1, info->sha256, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(st, 2, source_sha, -1, SQLITE_TRANSIENT);
     if (sqlite3_step(st) == SQLITE_ROW) {
         char line[320];
         snprintf(line, sizeof line,
@@ -344,7 +357,7 @@ static void warn_same_file(sp_db* db, const sp_db_part_info* info, const sp_db_p
 }
 
 static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_part_desc* desc, unsigned derived,
-                          sp_db_part_info* info_out, sp_error* err)
+                          const char* source_sha, sp_db_part_info* info_out, sp_error* err)
 {
     sp_db_part_desc d = desc ? *desc : (sp_db_part_desc){0};
     char shown[128];
@@ -370,7 +383,7 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
         sp_character_free(&ch);
         return r;
     }
-    char* summary = summary_json(&ch.rig);
+    char* summary = summary_json(&ch.rig, source_sha);
     sp_character_free(&ch);
     if (!summary) {
         sp_dataset_free(&synth);
@@ -383,7 +396,7 @@ static sp_result add_part(sp_db* db, const void* glb, size_t size, const sp_db_p
         (r = db_case_clash(db, "SELECT name FROM parts WHERE name = ?1 COLLATE NOCASE AND name <> ?1 LIMIT 1", "part name",
                            info.name, "an export's files of the two would be one on a case-blind file system", err)) != SP_OK)
         goto rollback;
-    warn_same_file(db, &info, &d);
+    warn_same_file(db, &info, source_sha, &d);
     if ((r = db_prepare(db,
                         "INSERT INTO parts(name, category, abstraction, gltf, bytes, sha256, vertices, triangles, joints, parameters,"
                         " abstractions, animations, selftest_error, summary, added_by) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
@@ -493,7 +506,17 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
                            path, sp_text_printable(name, shown, sizeof shown));
         }
     }
-    r = add_part(db, bytes, size, &d, derived, info, err);
+    // The file as given, for warn_same_file (bytes may be derived from it).
+    char source[65];
+    void* raw = NULL;
+    size_t raw_size = 0;
+    if (!derived) {
+        r = sp_sha256_hex(bytes, size, source) ? SP_OK : sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    } else if ((r = db_read_file(path, &raw, &raw_size, err)) == SP_OK && !sp_sha256_hex(raw, raw_size, source)) {
+        r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    }
+    free(raw);
+    if (r == SP_OK) r = add_part(db, bytes, size, &d, derived, source, info, err);
     free(bytes);
     return r;
 }

@@ -466,6 +466,24 @@ static void test_same_file_twice(void)
     ENSURE(sp_db_add_part_file(db, part_file(0), &d, NULL, &err) == SP_OK);
     fprintf(stderr, "  %s", said);
     ENSURE(strstr(said, "the same file as part 'first' (category "));
+    // A plain glTF (derived as it is added) under two categories: stored as
+    // two files (the category is in them), it was not said (a second
+    // curator review).
+    char plain[1100];
+    snprintf(plain, sizeof plain, "%s", sp_test_tmp_path("plain_twice.gltf"));
+    char* text = mini_gltf(&(mini_desc){0});
+    FILE* f = fopen(plain, "wb");
+    ENSURE(text && f && fputs(text, f) >= 0 && fclose(f) == 0);
+    free(text);
+    said[0] = 0;
+    d.name = "plain_fin", d.category = "fin";
+    sp_result r = sp_db_add_part_file(db, plain, &d, NULL, &err);
+    if (r != SP_OK) fprintf(stderr, "  plain: %s\n", err.text);
+    ENSURE(r == SP_OK && !strstr(said, "the same file"));
+    d.name = "plain_rider", d.category = "rider";
+    ENSURE(sp_db_add_part_file(db, plain, &d, NULL, &err) == SP_OK);
+    fprintf(stderr, "  %s", said);
+    ENSURE(strstr(said, "the same file as part 'plain_fin' (category fin)"));
     sp_db_close(db);
 }
 
