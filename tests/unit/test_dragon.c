@@ -4639,6 +4639,39 @@ static void test_flourishes_off_parts(void)
     sp_dragon_destroy(d);
 }
 
+// Decorations drawn inside a body (an outside review's: stripes, a spiral,
+// a zigzag, a wavy line along the belly) are ink on it, whatever the
+// classifier took them for: they became legs and a tail stuck to the flank,
+// and the wavy line, refused after its fit, faded.
+static void test_decorations_on_the_body(void)
+{
+    const char* path = real_db();
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    char file[1200];
+    snprintf(file, sizeof file, "%s/tests/e2e/data/kiosk_decorations.json", SP_SOURCE_DIR);
+    sp_sketch sk = {0};
+    sp_error err = {0};
+    ENSURE(sp_sketch_read_json(file, &sk, &err) == SP_OK && sk.stroke_count == 9);
+    const char* kinds[5] = {"torso", "head", "front_legs", "hind_legs", "tail"};
+    for (int k = 0; k < 5; ++k)
+        add_as(d, sk.strokes[k].points, sk.strokes[k].count, kinds[k]);
+    const char* names[4] = {"stripes", "a spiral", "a zigzag", "a wavy line along the belly"};
+    for (int k = 5; k < 9; ++k) {
+        sp_dragon_result res;
+        ENSURE(sp_dragon_add_points(d, sk.strokes[k].points, sk.strokes[k].count, NULL, &res, &err) == SP_OK);
+        sp_dragon_detail e;
+        bool on_body = res.reason == SP_DRAGON_DETAIL && sp_dragon_detail_get(d, res.detail, &e) && e.part == 0;
+        fprintf(stderr, "  %s on the body: %s%s\n", names[k - 5], sp_dragon_reject_name(res.reason),
+                on_body ? ", ink on it" : "");
+        ENSURE(on_body && sp_dragon_part_count(d) == 5);
+        ENSURE(sp_dragon_undo(d));
+    }
+    sp_sketch_free(&sk);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // A flame drawn out of the tip of a tail drawn as one line (fitted with its
 // `line`) is ink on the tail, and at t = 0 it lies where it was drawn: the
 // tail is taken as shown, posed at the dragon's clock, whether the flame
@@ -5008,6 +5041,7 @@ int main(int argc, char** argv)
                                    {"family_by_place", test_family_by_place},
                                    {"drawn_on_body", test_drawn_on_body},
                                    {"body_with_a_part_stays", test_body_with_a_part_stays},
+                                   {"decorations_on_the_body", test_decorations_on_the_body},
                                    {"root_at_the_body", test_root_at_the_body},
                                    {"reaches_the_body", test_reaches_the_body},
                                    {"on_the_back_not_a_spike", test_on_the_back_not_a_spike},

@@ -331,11 +331,13 @@ int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec
 /// at a thin tail's edge), its points off the mesh carried together in the
 /// air, as a flourish's. hit as for dragon_detail_of.
 int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
-/// A stroke refused before the fit (a scribble, or not recognised) lying on
-/// a part as a detail does, at any size up to the part's, and is not a loop
-/// (sp_stroke_is_loop): colouring in (DETAIL_ON of its points on the
-/// part). Returns the part's index or -1.
-int dragon_colouring_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit);
+/// A stroke lying on a part as a detail does, at any size up to the
+/// part's, and not a loop (sp_stroke_is_loop): colouring in (DETAIL_ON of
+/// its points on the part; `recognised`, a stroke the classifier took for a
+/// part: within the part's mesh, not only near it). Returns the part's
+/// index or -1.
+int dragon_colouring_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, bool recognised,
+                        detail_hit* hit);
 /// The part that a stroke is drawn out of, away from the dragon's bodies,
 /// or -1 (fire from a mouth, a spade at a tail's tip, a crown on a head:
 /// docs/DESIGN.md, "Flourishes ride their part"): a part attached to a

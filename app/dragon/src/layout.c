@@ -655,7 +655,7 @@ static int part_near_stroke(sp_dragon* d, int k, sp_vec2 lo, sp_vec2 hi, double*
 // part, `size`, the stroke's largest size (box diagonals, a fraction of the
 // part's mesh on the canvas), and what becomes of the points off it.
 static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, double on, double size,
-                       detail_air air, detail_hit* hit)
+                       double near_part, detail_air air, detail_hit* hit)
 {
     double diag = hypot(hi.x - lo.x, hi.y - lo.y);
     dragon_pose_shown(d);                      // for part_near_stroke
@@ -670,7 +670,7 @@ static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
         if (got < 0) return -1; // out of memory: not a detail, the stroke goes on as a part
         if (got == 0) continue;
         int m = n < DETAIL_SAMPLES ? n : DETAIL_SAMPLES, off = 0;
-        double near = fmin(DETAIL_NEAR * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
+        double near = fmin(near_part * hypot(b.x - a.x, b.y - a.y), DETAIL_NEAR_OWN * diag);
         bool detail = diag <= size * hypot(b.x - a.x, b.y - a.y) && boxes_overlap(lo, hi, a, b);
         // The window: the stroke's box grown by `near` (and a cell); none for
         // a mesh that is not finite or a window beyond reason.
@@ -699,24 +699,30 @@ static int detail_with(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_v
 
 int dragon_detail_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
-    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, DETAIL_SIZE, DETAIL_AIR_NONE, hit);
+    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, DETAIL_SIZE, DETAIL_NEAR, DETAIL_AIR_NONE, hit);
 }
 
 // Colouring in is drawn over a part up to its whole size: a stroke refused
 // as a scribble (or not recognised) that lies on one part as a detail does.
 #define COLOURING_SIZE 1.0
+// A stroke the classifier took for a part is colouring in only when it lies
+// within the part's mesh, a point off it by at most this fraction of the
+// part's size: short legs drawn as teeth under a belly reach over its edge.
+#define COLOURING_NEAR_RECOGNISED 0.01
 
-int dragon_colouring_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
+int dragon_colouring_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, bool recognised,
+                        detail_hit* hit)
 {
     // A closed shape drawn on a part is a part drawn there (as for spikes along the back).
     if (n < 2 || sp_stroke_is_loop(&(sp_stroke){.count = n, .points = (sp_vec2*)pts})) return -1;
-    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, COLOURING_SIZE, DETAIL_AIR_NONE, hit);
+    return detail_with(d, pts, n, lo, hi, skip, DETAIL_ON, COLOURING_SIZE, recognised ? COLOURING_NEAR_RECOGNISED : DETAIL_NEAR,
+                       DETAIL_AIR_NONE, hit);
 }
 
 int dragon_speck_of(sp_dragon* d, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip, detail_hit* hit)
 {
     if (!(hypot(hi.x - lo.x, hi.y - lo.y) < SP_DRAGON_PART_MIN * hypot(d->desc.canvas_w, d->desc.canvas_h))) return -1;
-    int k = detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_SIZE, DETAIL_AIR_TOGETHER, hit);
+    int k = detail_with(d, pts, n, lo, hi, skip, SPECK_ON, DETAIL_SIZE, DETAIL_NEAR, DETAIL_AIR_TOGETHER, hit);
     // Bound where drawn: its points off the mesh ride in the air rather
     // than onto the mesh's edge, which would squash a spot drawn half off.
     if (k >= 0 && hit) hit->near = 0.71;

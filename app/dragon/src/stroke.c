@@ -992,7 +992,7 @@ static bool drawn_on_part(sp_dragon* d, sp_dragon_reject why, const sp_vec2* pts
     if (why != SP_DRAGON_ACCEPTED && why != SP_DRAGON_UNRECOGNISED) return false;
     return dragon_detail_of(d, pts, n, lo, hi, skip, hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, hit) >= 0 ||
            dragon_speck_of(d, pts, n, lo, hi, skip, hit) >= 0 ||
-           (why == SP_DRAGON_UNRECOGNISED && dragon_colouring_of(d, pts, n, lo, hi, skip, hit) >= 0);
+           dragon_colouring_of(d, pts, n, lo, hi, skip, why == SP_DRAGON_ACCEPTED, hit) >= 0;
 }
 
 // A stroke (classified, not a Redraw) drawn out of a part of the dragon,
@@ -1085,10 +1085,12 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // A small stroke drawn on a part is a detail of it (an eye, spots,
     // shading), one drawn along a body's edge too (spikes on its back), and
     // a speck half on a part (a spot at a thin tail's edge): a tiny or thin
-    // part there is not what was meant. So is a stroke not recognised that
-    // lies on a part, whatever its size: colouring in (a review's child
-    // coloured the body, and the refused scribble faded). It is kept as ink on
-    // the part; its guesses stay, so a chip still makes it a part.
+    // part there is not what was meant. So is an open stroke that lies on a
+    // part, whatever its size: colouring in (a review's child coloured the
+    // body, and the refused scribble faded; another's stripes, spiral and
+    // zigzag on the body became legs and a tail stuck to its flank). It is
+    // kept as ink on the part; its guesses stay, so a chip still makes it a
+    // part.
     detail_hit hit = {0};
     if (!o.category && drawn_on_part(d, why, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit)) why = SP_DRAGON_DETAIL;
     bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
@@ -1139,7 +1141,14 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     if (out->far_score > SP_DRAGON_FAR_LIMIT && a.count > 0 && a.ranked[0].score >= REFUSAL_FACING_SURE)
         out->far_score = fmin(out->far_score, other_facing_far(d, &sk, lo, hi, &best, pts, n, near));
     if (out->far_score > SP_DRAGON_FAR_LIMIT) {
-        bool flourish = kept_as_flourish(d, &o, pts, n, lo, hi, out);
+        // Refused by its fit: colouring in or a flourish all the same (a
+        // wavy line along a belly faded; an outside review).
+        detail_hit ink = {0};
+        bool coloured =
+            !o.category && dragon_colouring_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, true, &ink) >= 0;
+        if (coloured) out->detail = dragon_detail_keep(d, &ink, pts, n);
+        dragon_detail_hit_free(&ink);
+        bool flourish = coloured || kept_as_flourish(d, &o, pts, n, lo, hi, out);
         free(pts);
         free(best.p);
         return reject(out, flourish ? SP_DRAGON_DETAIL : SP_DRAGON_UNRECOGNISED, t0);
