@@ -690,6 +690,32 @@ bool sp_part_curves_warning(const sp_rig* rig, int a, char* line, size_t cap)
     return true;
 }
 
+// What the part's clip (w->clip, or none) says of the file's animations.
+static void warn_clip(sp_character* out, const sp_rig* sr, const work* w)
+{
+    // A clip in the wrong unit (ms or frames read as seconds) is said either
+    // way: 0.2 ms of keys was "no animation", 2000 s passed silently and
+    // hardly moved in the kiosk (an outside review).
+    int channels = 0;
+    for (int a = 0; a < sr->animation_count; ++a)
+        channels += sr->animations[a].channel_count;
+    // Channels on nodes outside the skeleton were dropped at the load (said
+    // then): a clip of those alone was sent to look at its key times.
+    if (!w->clip && sr->animation_count > 0 && channels == 0)
+        sp_character_warn(out, "the file's animations move no joint of the skin (their channels are on other nodes): the "
+                               "part has no clip");
+    else if (!w->clip && sr->animation_count > 0)
+        sp_character_warn(out, "the file's animations have no keys more than 1 ms apart: the part has no clip (are its key "
+                               "times in seconds?)");
+    else if (!w->clip)
+        sp_character_warn(out, "no animation with keys: the part has no clip (it holds its fitted pose in the kiosk)");
+    else if (w->times[w->keys - 1] - w->times[0] > CLIP_LONG_S)
+        sp_character_warn(out,
+                          "clip '%s' lasts %.0f s: the kiosk loops it, so the part hardly moves (are its key times in "
+                          "seconds, not frames or ms?)",
+                          w->clip->name, (double)(w->times[w->keys - 1] - w->times[0]));
+}
+
 sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp_character* out, sp_derive_info* info_out,
                          sp_error* err)
 {
@@ -811,27 +837,7 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     if (sr->animation_count > 1)
         sp_character_warn(out, "only the clip '%s' is kept; %d other animations were left out", w.clip ? w.clip->name : "",
                           sr->animation_count - 1);
-    // A clip in the wrong unit (ms or frames read as seconds) is said either
-    // way: 0.2 ms of keys was "no animation", 2000 s passed silently and
-    // hardly moved in the kiosk (an outside review).
-    int channels = 0;
-    for (int a = 0; a < sr->animation_count; ++a)
-        channels += sr->animations[a].channel_count;
-    // Channels on nodes outside the skeleton were dropped at the load (said
-    // then): a clip of those alone was sent to look at its key times.
-    if (!w.clip && sr->animation_count > 0 && channels == 0)
-        sp_character_warn(out, "the file's animations move no joint of the skin (their channels are on other nodes): the "
-                               "part has no clip");
-    else if (!w.clip && sr->animation_count > 0)
-        sp_character_warn(out, "the file's animations have no keys more than 1 ms apart: the part has no clip (are its key "
-                               "times in seconds?)");
-    else if (!w.clip)
-        sp_character_warn(out, "no animation with keys: the part has no clip (it holds its fitted pose in the kiosk)");
-    else if (w.times[w.keys - 1] - w.times[0] > CLIP_LONG_S)
-        sp_character_warn(out,
-                          "clip '%s' lasts %.0f s: the kiosk loops it, so the part hardly moves (are its key times in "
-                          "seconds, not frames or ms?)",
-                          w.clip->name, (double)(w.times[w.keys - 1] - w.times[0]));
+    warn_clip(out, sr, &w);
     // The kiosk fits one stroke per part: a figure of several curves cannot
     // be drawn there (an outside review's stick figure became six parts).
     char line[320];

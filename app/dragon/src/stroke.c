@@ -1009,6 +1009,19 @@ static bool kept_as_flourish(sp_dragon* d, const sp_dragon_stroke_opts* o, const
     return true;
 }
 
+// A stroke its fit refused, kept as ink all the same when it is colouring
+// in on a part or a flourish of one (a wavy line along a belly faded; an
+// outside review): out->detail.
+static bool kept_as_ink_after_fit(sp_dragon* d, const sp_dragon_stroke_opts* o, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi,
+                                  sp_dragon_result* out)
+{
+    detail_hit ink = {0};
+    bool coloured = !o->category && dragon_colouring_of(d, pts, n, lo, hi, o->replace_last ? d->part_n - 1 : -1, true, &ink) >= 0;
+    if (coloured) out->detail = dragon_detail_keep(d, &ink, pts, n);
+    dragon_detail_hit_free(&ink);
+    return coloured || kept_as_flourish(d, o, pts, n, lo, hi, out);
+}
+
 // How many parts each body carries before a part comes (a body laid out
 // with it may take their parts to itself): decide_again_on_body.
 static void count_carried(sp_dragon* d)
@@ -1085,12 +1098,9 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // A small stroke drawn on a part is a detail of it (an eye, spots,
     // shading), one drawn along a body's edge too (spikes on its back), and
     // a speck half on a part (a spot at a thin tail's edge): a tiny or thin
-    // part there is not what was meant. So is an open stroke that lies on a
-    // part, whatever its size: colouring in (a review's child coloured the
-    // body, and the refused scribble faded; another's stripes, spiral and
-    // zigzag on the body became legs and a tail stuck to its flank). It is
-    // kept as ink on the part; its guesses stay, so a chip still makes it a
-    // part.
+    // part there is not what was meant. So is an open stroke on a part, at
+    // any size: colouring in (reviews: a scribble faded, stripes became legs).
+    // It is kept as ink on the part; its guesses stay (a chip makes it a part).
     detail_hit hit = {0};
     if (!o.category && drawn_on_part(d, why, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit)) why = SP_DRAGON_DETAIL;
     bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
@@ -1141,17 +1151,10 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     if (out->far_score > SP_DRAGON_FAR_LIMIT && a.count > 0 && a.ranked[0].score >= REFUSAL_FACING_SURE)
         out->far_score = fmin(out->far_score, other_facing_far(d, &sk, lo, hi, &best, pts, n, near));
     if (out->far_score > SP_DRAGON_FAR_LIMIT) {
-        // Refused by its fit: colouring in or a flourish all the same (a
-        // wavy line along a belly faded; an outside review).
-        detail_hit ink = {0};
-        bool coloured =
-            !o.category && dragon_colouring_of(d, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, true, &ink) >= 0;
-        if (coloured) out->detail = dragon_detail_keep(d, &ink, pts, n);
-        dragon_detail_hit_free(&ink);
-        bool flourish = coloured || kept_as_flourish(d, &o, pts, n, lo, hi, out);
+        bool ink = kept_as_ink_after_fit(d, &o, pts, n, lo, hi, out);
         free(pts);
         free(best.p);
-        return reject(out, flourish ? SP_DRAGON_DETAIL : SP_DRAGON_UNRECOGNISED, t0);
+        return reject(out, ink ? SP_DRAGON_DETAIL : SP_DRAGON_UNRECOGNISED, t0);
     }
     prefer_line(d, &sk, lo, hi, &best);
     part* q = NULL;
