@@ -788,9 +788,9 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
         d->parts[k]->pub.attached_to = saved[k];
 }
 
-// How much surer of the new body than of an earlier one that carries a part
-// the classifier has to be for the earlier one to be decided again.
-#define SURE_BODY_MARGIN 0.05
+// An earlier body that carries a part, at least this fraction of the new
+// body's size (stroke box diagonals), stays a body.
+#define SAME_SIZE_BODY 0.65
 
 // Part i, taken by the classifier for a body when it was drawn alone, lies
 // on the body just drawn (dragon_on_body): decided again as if drawn after
@@ -799,7 +799,7 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
 // body a chip chose stays, and so does one that carries two parts or more
 // (a small dragon with a bigger body drawn round it: its body became a head
 // smeared over the new one's flank; one part may hang on a wing or tail
-// drawn first and taken for a body), or one part and is as surely a body.
+// drawn first and taken for a body), or one part and is about as large.
 // The new part takes the old one's place and id; false (nothing changed) when no other guess has a part that fits.
 static bool decide_again_on_body(sp_dragon* d, int i, int body)
 {
@@ -807,13 +807,16 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
     sp_vec2 lo, hi;
     stroke_box_of(old, &lo, &hi);
     if (!old->t->is_torso || old->chosen || !d->clf || !dragon_on_body(d, lo, hi, body)) return false;
-    // A body that carries a part and that the classifier took for one at
-    // least as surely as the new one is a body: an arch drawn over a
-    // dragon's back (0.49 a body) made the dragon's body (1.00) a pair of
-    // legs and dropped its head, and a body drawn again round the first made
-    // that one a head as large as the body (an outside review).
-    if (old->carried >= 2 || (old->carried >= 1 && old->pub.confidence >= d->parts[body]->pub.confidence - SURE_BODY_MARGIN))
-        return false;
+    // A body that carries a part and is about as large as the new one, as
+    // drawn, is a body: an arch drawn over a dragon's back made its body a
+    // pair of legs and dropped its head, and a body drawn again round the
+    // first made that one a head as large as the body (an outside review).
+    // A tail or head drawn first and taken for a body is clearly smaller
+    // (confidence does not tell: misread ones score 0.99 too, a second review).
+    const part* nb = d->parts[body];
+    double old_size = hypot(hi.x - lo.x, hi.y - lo.y),
+           new_size = hypot(nb->stroke_box[2] - nb->stroke_box[0], nb->stroke_box[3] - nb->stroke_box[1]);
+    if (old->carried >= 2 || (old->carried >= 1 && old_size >= SAME_SIZE_BODY * new_size)) return false;
     sp_stroke st;
     sp_sketch sk = part_sketch(d, old, &st);
     sp_dragon_result res = {.part = -1};
