@@ -49,12 +49,18 @@ sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err)
         sp_sketch_free(sk);
         return sp_fail(err, SP_ERR_INVALID, "%s: the file has no strokes", path);
     }
+    // A one-point stroke is a tap (dot eyes: tablets record one point), left
+    // unused by the solve (solve_cmd.c) and said there; a drawing of taps
+    // alone has nothing to pose by.
+    int lines = 0;
     for (int i = 0; i < sk->stroke_count; ++i)
-        if (sk->strokes[i].count < 2) {
+        lines += sk->strokes[i].count >= 2;
+    for (int i = 0; i < sk->stroke_count; ++i)
+        if (sk->strokes[i].count < 1 || lines == 0) {
             int n = sk->strokes[i].count;
             sp_sketch_free(sk);
-            return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d has %d point%s (at least 2 are needed)", path, i, n,
-                           n == 1 ? "" : "s");
+            return sp_fail(err, SP_ERR_INVALID, "%s: stroke %d has %d point%s (%s)", path, i, n, n == 1 ? "" : "s",
+                           n < 1 ? "an empty stroke" : "no stroke has 2 or more points");
         }
     // Nothing drawn on the canvas is nothing to pose by: such strokes were
     // solved "best effort", the figure rolled into a ball or flung to a

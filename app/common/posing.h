@@ -17,7 +17,7 @@ int sp_pick_abstraction(const sp_abstraction* abs, int count, const char* rig_pa
 /// refused: its canvas is unknown); err names the file.
 sp_result sp_read_drawing(const char* path, sp_sketch* sk, sp_error* err);
 /// Reads a stroke file (sp_read_drawing) and checks that it has at least one stroke of two
-/// or more points; err names the file.
+/// or more points and no empty stroke (one-point taps are kept); err names the file.
 sp_result sp_read_strokes(const char* path, sp_sketch* sk, sp_error* err);
 /// The parameters a draw-over solve may move (sp_solve_desc.active;
 /// malloc'd, param_count of them; NULL when out of memory): all but the

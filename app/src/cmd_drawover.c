@@ -108,6 +108,12 @@ int cmd_drawover(int argc, char** argv)
     sp_character* ch = sp_rig_handle_character(rig);
     run.rig = rig;
     if (sp_read_strokes(on_path, &on, &err) != SP_OK || sp_read_strokes(to_path, &to, &err) != SP_OK) goto fail;
+    for (int i = 0; i < on.stroke_count; ++i) // each becomes a curve on the character (a tap in --to is left unused)
+        if (on.strokes[i].count < 2) {
+            sp_fail(&err, SP_ERR_INVALID, "%s: stroke %d is a tap (one point): a curve drawn over the character needs 2", on_path,
+                    i);
+            goto fail;
+        }
     // Both drawings are on one screen: --to's points are read in --on's
     // canvas (its camera), so another canvas gave a wrong fit with exit 0.
     if (to.canvas_w > 0 && on.canvas_w > 0 && (to.canvas_w != on.canvas_w || to.canvas_h != on.canvas_h)) {

@@ -149,52 +149,62 @@ static bool traces_over(const sp_stroke* b, const sp_stroke* a, double tol)
     return near >= 29;
 }
 
-// Which strokes a solve of sk leaves out (why[i]: STROKE_KEPT, STROKE_DOT,
-// or the stroke it traces over), the number kept returned. A dot (a pen tap:
-// dot eyes) is no curve; with more strokes than the abstraction's `curves`,
-// a stroke that traces over a longer one (a line gone over twice, as sketchy
-// drawing does) is left out first, shortest first, while strokes are over:
-// the strokes were assigned against the start pose, so a retraced line that
-// did not move beat the limb the animator posed, which was left unused (an
-// outside review). Drawn within 2.5% of the drawing's size (at least 2 px): a wobbly retrace strays 6 px.
-static int pick_strokes(const sp_sketch* sk, int curves, int* why)
+// The dots (pen taps: dot eyes) of sk, which are no curve: why[i]
+// STROKE_DOT, else STROKE_KEPT; the number kept returned.
+static int mark_dots(const sp_sketch* sk, int* why)
 {
-    int n = sk->stroke_count, kept = 0;
-    double* len = malloc(sizeof(double) * (size_t)(5 * n + 1));
-    if (!len) {
-        for (int i = 0; i < n; ++i)
-            why[i] = STROKE_KEPT;
-        return n;
+    int kept = 0;
+    for (int i = 0; i < sk->stroke_count; ++i) {
+        why[i] = sk->strokes[i].count >= 2 && stroke_length(&sk->strokes[i]) > 0 ? STROKE_KEPT : STROKE_DOT;
+        kept += why[i] == STROKE_KEPT;
     }
-    double* box = len + n;
+    return kept;
+}
+
+// With more kept strokes than the abstraction's `curves`, the strokes that
+// trace over a longer kept one (a line gone over twice, as sketchy drawing
+// does), shortest first, while strokes are over: why[j] = the stroke it
+// traces over. The number kept returned. Drawn within 2.5% of the
+// drawing's size (at least 2 px): a wobbly retrace strays 6 px. Only up to
+// RETRACE_MAX_STROKES strokes (more is hatching, and the pairs' test grows
+// with their square).
+#define RETRACE_MAX_STROKES 64
+static int mark_retraces(const sp_sketch* sk, int curves, int kept, int* why)
+{
+    int n = sk->stroke_count;
+    if (kept <= curves || n > RETRACE_MAX_STROKES) return kept;
+    double len[RETRACE_MAX_STROKES], box[4 * RETRACE_MAX_STROKES];
     double all[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < n; ++i) {
-        len[i] = sk->strokes[i].count < 2 ? 0 : stroke_length(&sk->strokes[i]);
-        why[i] = len[i] > 0 ? STROKE_KEPT : STROKE_DOT;
-        kept += len[i] > 0;
+        len[i] = why[i] == STROKE_KEPT ? stroke_length(&sk->strokes[i]) : 0;
         stroke_box(&sk->strokes[i], box + 4 * i);
         for (int c = 0; c < 2; ++c)
             all[c] = fmin(all[c], box[4 * i + c]), all[2 + c] = fmax(all[2 + c], box[4 * i + 2 + c]);
     }
     const double tol = fmax(2.0, 0.025 * hypot(all[2] - all[0], all[3] - all[1]));
-    for (bool more = kept > curves; more && kept > curves;) {
-        int drop = -1, over = -1;
-        for (int j = 0; j < n; ++j) { // the shortest stroke that traces over a kept one at least as long
-            if (why[j] != STROKE_KEPT || (drop >= 0 && len[j] >= len[drop])) continue;
-            const double* bj = box + 4 * j;
-            for (int i = 0; i < n; ++i) {
-                const double* bi = box + 4 * i;
-                if (i == j || why[i] != STROKE_KEPT || len[i] < len[j] || bj[0] < bi[0] - tol || bj[1] < bi[1] - tol ||
-                    bj[2] > bi[2] + tol || bj[3] > bi[3] + tol || !traces_over(&sk->strokes[j], &sk->strokes[i], tol))
-                    continue;
-                drop = j, over = i;
-                break;
-            }
+    bool over[RETRACE_MAX_STROKES][RETRACE_MAX_STROKES]; // [j][i]: j traces over i
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const double *bj = box + 4 * j, *bi = box + 4 * i;
+            over[j][i] = i != j && why[i] == STROKE_KEPT && why[j] == STROKE_KEPT && len[i] >= len[j] && bj[0] >= bi[0] - tol &&
+                         bj[1] >= bi[1] - tol && bj[2] <= bi[2] + tol && bj[3] <= bi[3] + tol &&
+                         traces_over(&sk->strokes[j], &sk->strokes[i], tol);
         }
-        more = drop >= 0;
-        if (more) why[drop] = over, --kept;
+    while (kept > curves) {
+        int drop = -1, onto = -1;
+        for (int j = 0; j < n; ++j) {
+            if (why[j] != STROKE_KEPT || (drop >= 0 && len[j] >= len[drop])) continue;
+            for (int i = 0; i < n; ++i)
+                if (over[j][i] && why[i] == STROKE_KEPT) {
+                    drop = j;
+                    break;
+                }
+        }
+        if (drop < 0) break;
+        for (int i = 0; i < n; ++i) // named: the longest kept stroke it traces over
+            if (over[drop][i] && why[i] == STROKE_KEPT && (onto < 0 || len[i] > len[onto])) onto = i;
+        why[drop] = onto, --kept;
     }
-    free(len);
     return kept;
 }
 
@@ -209,27 +219,65 @@ static void note_unused_strokes(sp_solve_report* rep, const int* why, const int*
         const char* end = strchr(at, ';');
         memmove(rep->note, end ? end + 2 : at + strlen(at), strlen(end ? end + 2 : at + strlen(at)) + 1);
     }
-    char list[300] = "";
-    int count = 0;
+    char list[160] = "";
+    int count = 0, cut = 0;
     size_t w = 0;
     for (int i = 0; i < n; ++i) {
         if (why[i] == STROKE_KEPT && used[i]) continue;
         ++count;
-        if (w + 48 >= sizeof list) continue;
-        w += (size_t)snprintf(list + w, sizeof list - w, "%s%d", w ? ", " : "", i);
-        if (why[i] == STROKE_DOT)
-            w += (size_t)snprintf(list + w, sizeof list - w, " (a dot)");
-        else if (why[i] >= 0)
-            w += (size_t)snprintf(list + w, sizeof list - w, " (traced over stroke %d)", why[i]);
+        char one[48];
+        int k = snprintf(one, sizeof one, "%s%d%s", w ? ", " : "", i, why[i] == STROKE_DOT ? " (a dot)" : "");
+        if (why[i] >= 0) k = snprintf(one, sizeof one, "%s%d (traced over stroke %d)", w ? ", " : "", i, why[i]);
+        if (cut || w + (size_t)k + 6 >= sizeof list) { // room for ", ..."
+            ++cut;
+            continue;
+        }
+        memcpy(list + w, one, (size_t)k + 1);
+        w += (size_t)k;
     }
+    if (cut) snprintf(list + w, sizeof list - w, ", ...");
     rep->unused_strokes = count;
     if (count == 0) return;
-    if (w + 48 >= sizeof list) snprintf(list + w, sizeof list - w, ", ...");
     char rest[sizeof rep->note];
     snprintf(rest, sizeof rest, "%s", rep->note);
     int said = snprintf(rep->note, sizeof rep->note, "%d stroke%s left unused: %s%s%s", count, count == 1 ? "" : "s", list,
                         rest[0] ? "; " : "", rest);
     if (said >= (int)sizeof rep->note) memcpy(rep->note + sizeof rep->note - 4, "...", 4); // a long note says it was cut
+}
+
+// The solve of sk's strokes that why[] keeps (all of them when it keeps
+// none: the solver says why), its report's strokes numbered as in sk;
+// used[i]: stroke i took a curve (closest pairs: every stroke kept does).
+static bool solve_kept(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const int* why,
+                       const double* start, double* p, sp_solve_report* rep, int* used, sp_error* err)
+{
+    int n = sk->stroke_count, kept = 0;
+    for (int i = 0; i < n; ++i)
+        kept += why[i] == STROKE_KEPT;
+    sp_sketch picked = *sk;
+    sp_stroke* some = kept > 0 && kept < n ? malloc(sizeof *some * (size_t)kept) : NULL;
+    int* orig = malloc(sizeof(int) * (size_t)(n + 1));
+    if (!orig || (kept > 0 && kept < n && !some)) {
+        free(some), free(orig);
+        sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        fprintf(stderr, "%s: %s: %s\n", s->cmd, strokes, err->text);
+        return false;
+    }
+    for (int i = 0, k = 0; i < n; ++i)
+        if (!some || why[i] == STROKE_KEPT) {
+            if (some) some[k] = sk->strokes[i];
+            orig[k++] = i;
+        }
+    if (some) picked.strokes = some, picked.stroke_count = kept;
+    bool ok = solve_picked(s, cam, &picked, strokes, start, p, rep, err);
+    const sp_abstraction* ab = &sp_rig_handle_abstractions(s->rig)[s->abstraction];
+    for (int i = 0; i < n; ++i)
+        used[i] = ab->correspondence == SP_CORR_CLOSEST && why[i] == STROKE_KEPT;
+    for (int i = 0; ok && i < rep->curve_count; ++i)
+        if (rep->curves[i].stroke >= 0 && rep->curves[i].stroke < picked.stroke_count)
+            used[rep->curves[i].stroke = orig[rep->curves[i].stroke]] = 1;
+    free(some), free(orig);
+    return ok;
 }
 
 bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
@@ -238,38 +286,42 @@ bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
     *report = NULL;
     sp_error err = {0};
     const sp_abstraction* ab = &sp_rig_handle_abstractions(s->rig)[s->abstraction];
-    int n = sk->stroke_count;
-    int* why = malloc(sizeof(int) * (size_t)(3 * n + 1));
-    if (!why) {
+    int n = sk->stroke_count, P = sp_rig_handle_param_count(s->rig);
+    int* why = malloc(sizeof(int) * (size_t)(4 * n + 1));
+    double* alt = malloc(sizeof(double) * (size_t)(2 * P + 1));
+    sp_solve_report* rep2 = malloc(sizeof *rep2);
+    if (!why || !alt || !rep2) {
+        free(why), free(alt), free(rep2);
         fprintf(stderr, "%s: %s: out of memory\n", s->cmd, strokes);
         return false;
     }
-    int *used = why + n, *orig = why + 2 * n;
-    int kept = pick_strokes(sk, ab->curve_count, why);
-    sp_sketch picked = *sk;
-    sp_stroke* some = NULL;
-    if (kept > 0 && kept < n && (some = malloc(sizeof *some * (size_t)kept))) {
-        for (int i = 0, k = 0; i < n; ++i)
-            if (why[i] == STROKE_KEPT) some[k] = sk->strokes[i], orig[k++] = i;
-        picked.strokes = some, picked.stroke_count = kept;
-    } else { // none left (the solver says why), or out of memory: every stroke
-        for (int i = 0; i < n; ++i)
-            why[i] = STROKE_KEPT, orig[i] = i;
+    int *why2 = why + n, *used = why + 2 * n, *used2 = why + 3 * n;
+    double* start0 = alt + P; // p may be start
+    if (start) memcpy(start0, start, sizeof(double) * (size_t)P);
+    int kept = mark_dots(sk, why);
+    memcpy(why2, why, sizeof(int) * (size_t)n);
+    bool retraces = mark_retraces(sk, ab->curve_count, kept, why2) < kept;
+    bool ok = solve_kept(s, cam, sk, strokes, why, start, p, rep, used, &err);
+    // Without the retraces, kept when that fits better: two legs drawn
+    // together, or a line of action beside the spine, look like a retrace
+    // too, and left out broke a figure that fitted (a second review).
+    if (ok && retraces && solve_kept(s, cam, sk, strokes, why2, start ? start0 : NULL, alt, rep2, used2, &err) &&
+        rep2->mean_error_px < rep->mean_error_px) {
+        memcpy(p, alt, sizeof(double) * (size_t)P);
+        *rep = *rep2;
+        memcpy(why, why2, sizeof(int) * (size_t)n);
+        memcpy(used, used2, sizeof(int) * (size_t)n);
     }
-    bool ok = solve_picked(s, cam, &picked, strokes, start, p, rep, &err);
     if (ok) {
-        memset(used, 0, sizeof(int) * (size_t)n);
-        for (int i = 0; i < rep->curve_count; ++i)
-            if (rep->curves[i].stroke >= 0 && rep->curves[i].stroke < picked.stroke_count)
-                used[rep->curves[i].stroke = orig[rep->curves[i].stroke]] = 1;
-        if (ab->correspondence == SP_CORR_ORDERED || picked.stroke_count < n) note_unused_strokes(rep, why, used, n);
+        note_unused_strokes(rep, why, used, n);
         note_loose_curve(rep, ab);
-        note_placement_bound(rep, sp_rig_handle_params(s->rig), sp_rig_handle_param_count(s->rig), p);
+        note_placement_bound(rep, sp_rig_handle_params(s->rig), P, p);
         note_unmatched_curves(rep, ab);
-        *report = sp_report_json(rep, ab, sp_rig_handle_params(s->rig), sp_rig_handle_param_count(s->rig), p);
+        size_t len = strlen(rep->note);
+        if (len + 1 >= sizeof rep->note) memcpy(rep->note + sizeof rep->note - 4, "...", 4); // a note cut says so
+        *report = sp_report_json(rep, ab, sp_rig_handle_params(s->rig), P, p);
     }
-    free(some);
-    free(why);
+    free(why), free(alt), free(rep2);
     return ok;
 }
 

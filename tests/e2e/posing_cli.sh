@@ -72,6 +72,14 @@ expect 1 "$SP" animate --rig "$MAN" --strokes "$WORK/off.json" --out "$WORK/off.
 one_line_naming "off.json: every stroke lies off"
 strokes "$WORK/half_off.json" '[[700, 100], [760, 300]]' '[[300, 200], [340, 260]]'
 expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/half_off.json"
+# A tap (one point: dot eyes as a tablet records them) is left unused and
+# named (it refused the drawing); taps alone are nothing to pose by.
+strokes "$WORK/tap.json" '[[320, 246], [321, 200], [322, 160], [322, 122]]' '[[310, 110]]'
+expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/tap.json" --report "$WORK/tap_r.json"
+grep -q '"note":	"1 stroke left unused: 1 (a dot)' "$WORK/tap_r.json" || fail "a tap: $(grep '"note"' "$WORK/tap_r.json")"
+strokes "$WORK/taps.json" '[[310, 110]]' '[[330, 110]]'
+expect 1 "$SP" pose --rig "$MAN" --strokes "$WORK/taps.json"
+one_line_naming "taps.json: stroke 0 has 1 point (no stroke has 2 or more points)"
 # A point more than a canvas beyond it (a pen's glitch, a slipped
 # coordinate) is refused, naming it: it flung a leg out, exit 0.
 strokes "$WORK/glitch.json" '[[320, 246], [321, 200], [322, 160]]' '[[300, 200], [340, 260], [2600, 100]]'

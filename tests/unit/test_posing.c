@@ -1263,9 +1263,9 @@ static void test_note_unmatched_curves(void)
     }
 }
 
-// More strokes than curves (an outside review's drawings of the cartoon
-// man, tests/data/posing): a line traced twice, every line traced twice, dot
-// eyes. The retrace and the dots are left unused and named, and the posed
+// More strokes than curves (outside reviews' drawings of the cartoon man,
+// tests/data/posing): a line traced twice, every line traced twice, dot
+// eyes, legs drawn together, a line of action. The retrace and the dots are left unused and named, and the posed
 // limbs keep their strokes: the retraced leg took the raised arm's curve
 // (30 px), every line twice folded the figure (31 px), and a dot refused
 // the whole drawing.
@@ -1276,7 +1276,13 @@ static void test_pose_surplus_strokes(void)
         int unused;
     } cases[] = {{"leg_retraced", "1 stroke left unused: 4 (traced over stroke 5)", 1},
                  {"overdrawn", "(traced over stroke 7)", 5},
-                 {"dot_eyes", "6 (a dot), 7 (a dot)", 3}};
+                 {"dot_eyes", "6 (a dot), 7 (a dot)", 3},
+                 // Lines that only look like a retrace stay when leaving them
+                 // out fits worse (a second review: legs drawn together with a
+                 // head circle lost a leg, 23.8 px; a line of action beside the
+                 // spine kept, the spine left out, 14.7 px).
+                 {"legs_together_head", "1 stroke left unused: 5", 1},
+                 {"line_of_action", "1 stroke left unused: 0", 1}};
     char report[1100], args[4000];
     snprintf(report, sizeof report, "%s", sp_test_tmp_path("surplus_report.json"));
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -1289,7 +1295,7 @@ static void test_pose_surplus_strokes(void)
         int unused = (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "unused_strokes"));
         fprintf(stderr, "  %s: mean %.2f px, max %.1f px, note \"%s\"\n", cases[i].file, mean, max, note ? note : "");
         ENSURE(note && strstr(note, cases[i].said) && unused == cases[i].unused);
-        ENSURE(mean < 2 && max < 10);
+        ENSURE(mean < 2 && max < 13);
         cJSON_Delete(j);
     }
 }
