@@ -97,13 +97,55 @@ static void remove_stopped_exports(const char* final)
     free(folder);
 }
 
+// Whether folder `path` (stat st) is a mount point: listed as one in
+// /proc/self/mountinfo (a bind mount from the same file system has its
+// parent's device), else on another device than its parent ("X/." and
+// links resolved first).
+static bool is_mount_point(const char* path, const struct stat* st)
+{
+    char* real = realpath(path, NULL);
+    if (!real) return false;
+    bool found = false;
+    FILE* f = fopen("/proc/self/mountinfo", "re");
+    char line[4096], field[4096];
+    while (f && !found && fgets(line, sizeof line, f)) {
+        // The fifth field is the mount point, with ' ', '\t', '\n' and '\\' as \ooo.
+        char* at = line;
+        for (int k = 0; k < 4 && at; ++k)
+            at = strchr(at, ' '), at = at ? at + 1 : NULL;
+        size_t w = 0;
+        for (; at && *at && *at != ' ' && w + 1 < sizeof field; ++at)
+            if (at[0] == '\\' && isdigit((unsigned char)at[1]) && isdigit((unsigned char)at[2]) &&
+                isdigit((unsigned char)at[3])) {
+                field[w++] = (char)((at[1] - '0') * 64 + (at[2] - '0') * 8 + (at[3] - '0'));
+                at += 3;
+            } else {
+                field[w++] = *at;
+            }
+        field[w] = 0;
+        found = at && !strcmp(field, real);
+    }
+    if (f) fclose(f);
+    if (!f) {
+        char* parent = sp_path_folder(real);
+        struct stat up;
+        found = parent && stat(parent, &up) == 0 && up.st_dev != st->st_dev;
+        free(parent);
+    }
+    free(real);
+    return found;
+}
+
 // Checks DIR (absent, or an empty folder) and makes the temporary folder beside it.
 static sp_result export_begin(const char* dir, export_dir* ex, sp_error* err)
 {
     memset(ex, 0, sizeof *ex);
     size_t n = strlen(dir);
-    while (n > 1 && dir[n - 1] == '/') // "out/" names out, whose sibling is out.partial-...
-        --n;
+    // "out/" and "out/." name out, whose sibling is out.partial-... (with
+    // "out/." the temporary folder was made inside out, and the export failed
+    // after the work; a second curator review).
+    while (n > 1 && (dir[n - 1] == '/' || (n > 2 && dir[n - 1] == '.' && dir[n - 2] == '/')))
+        n -= dir[n - 1] == '/' ? 1 : 2;
     // Room for sketches/<category>/<source>-<id>.json below the temporary folder's name.
     if (n == 0 || n > 800)
         return sp_fail(err, SP_ERR_INVALID, "%s: not a usable folder name (empty or over 800 characters)", dir);
@@ -128,11 +170,7 @@ static sp_result export_begin(const char* dir, export_dir* ex, sp_error* err)
         // mount point refuses: said before the work (an empty USB stick's
         // folder failed after the whole export was written on the disk it
         // is mounted on; an outside curator review).
-        char* parent = sp_path_folder(ex->final);
-        struct stat up;
-        bool mounted = parent && stat(parent, &up) == 0 && up.st_dev != ex->had.st_dev;
-        free(parent);
-        if (mounted)
+        if (is_mount_point(ex->final, &ex->had))
             return sp_fail(err, SP_ERR_INVALID,
                            "%s: a mount point (a USB stick?), which the finished export cannot be renamed onto: export into a "
                            "new folder on it, e.g. %s/sketchpose-export",

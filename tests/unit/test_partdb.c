@@ -394,9 +394,11 @@ static void test_read_only_file_system(void)
 // not mount, skipped.
 static void test_export_onto_mount_point(void)
 {
-    char p[1024], usb[1024], cmd[8192], out[4096];
+    char p[1024], usb[1024], other[1024], cmd[16384], out[4096];
     snprintf(p, sizeof p, "%s", sp_test_tmp_path("usb_src.db"));
     snprintf(usb, sizeof usb, "%s", sp_test_tmp_path("usb"));
+    snprintf(other, sizeof other, "%s", sp_test_tmp_path("usb_bound"));
+    mkdir(other, 0755);
     sp_fixture_remove_db(p);
     mkdir(usb, 0755);
     sp_db* db = open_ok(p, SP_DB_CREATE);
@@ -406,15 +408,22 @@ static void test_export_onto_mount_point(void)
     if (!bin) SKIP("sketchpose not built");
     snprintf(cmd, sizeof cmd, "unshare -m sh -c \"mount -t tmpfs tmpfs '%s'\" 2>/dev/null", usb);
     if (system(cmd) != 0) SKIP("no mount namespace for this user (unshare -m)");
+    // The folder itself, named "usb/." too, and a bind mount over it of a
+    // folder on the same file system: each refused, nothing written beside it.
     snprintf(
         cmd, sizeof cmd,
-        "unshare -m sh -c \"mount -t tmpfs tmpfs '%s' && '%s' db export '%s' --db '%s'; echo exit \\$?\" 2>&1; echo partials "
-        "$(ls -d '%s'.partial-* 2>/dev/null | wc -l)",
-        usb, bin, usb, p, usb);
+        "unshare -m sh -c \"mount -t tmpfs tmpfs '%s' && '%s' db export '%s' --db '%s'; echo exit \\$?; '%s' db export '%s/.' "
+        "--db '%s'; echo exit \\$?; mount --bind '%s' '%s' && '%s' db export '%s' --db '%s'; echo exit \\$?\" 2>&1; "
+        "echo partials $(ls -d '%s'.partial-* 2>/dev/null | wc -l)",
+        usb, bin, usb, p, bin, usb, p, other, usb, bin, usb, p, usb);
     int rc = sp_fixture_run(cmd, out, sizeof out);
     fprintf(stderr, "  %s", out);
-    ENSURE(rc == 0 && strstr(out, "a mount point (a USB stick?)") && strstr(out, "export into a new folder on it") &&
-           strstr(out, "exit 1") && strstr(out, "partials 0")); // nothing written beside it
+    int said = 0;
+    for (const char* at = out; (at = strstr(at, "a mount point (a USB stick?)")); ++at)
+        ++said;
+    ENSURE(rc == 0 && said == 3 && strstr(out, "export into a new folder on it") && !strstr(out, "exit 0") &&
+           strstr(out, "partials 0"));
+    rmdir(other);
     rmdir(usb);
     sp_fixture_remove_db(p);
 }
