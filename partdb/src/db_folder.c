@@ -422,7 +422,8 @@ static bool timestamp_ok(const char* t)
     if (!t || strlen(t) != sizeof form - 1) return false;
     for (size_t k = 0; k < sizeof form - 1; ++k)
         if (form[k] == 'd' ? !isdigit((unsigned char)t[k]) : t[k] != form[k]) return false;
-    return true;
+    int mo = atoi(t + 5), dd = atoi(t + 8), hh = atoi(t + 11), mi = atoi(t + 14), ss = atoi(t + 17);
+    return mo >= 1 && mo <= 12 && dd >= 1 && dd <= 31 && hh <= 23 && mi <= 59 && ss <= 60; // a time that can be
 }
 
 static int compare_ids(const void* a, const void* b)
@@ -483,7 +484,7 @@ static sp_result manifest_entries_ok(const cJSON* parts, const cJSON* sketches, 
     {
         const cJSON* id = cJSON_GetObjectItemCaseSensitive(it, "id");
         const cJSON* at = cJSON_GetObjectItemCaseSensitive(it, "added_at");
-        if (id && !(cJSON_IsNumber(id) && id->valuedouble >= 1 && id->valuedouble <= 9007199254740992.0 &&
+        if (id && !(cJSON_IsNumber(id) && id->valuedouble >= 1 && id->valuedouble < 9007199254740992.0 &&
                     id->valuedouble == floor(id->valuedouble)))
             return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: id is not a whole number from 1 up", path, i);
         if (at && !timestamp_ok(cJSON_GetStringValue(at)))
@@ -512,7 +513,7 @@ static sp_result hold_ids_back(sp_db* db, const cJSON* man, const cJSON* sketche
 {
     double high = 0;
     const cJSON* h = cJSON_GetObjectItemCaseSensitive(man, "sketch_id_high");
-    if (cJSON_IsNumber(h) && h->valuedouble >= 1 && h->valuedouble <= 9007199254740992.0) high = floor(h->valuedouble);
+    if (cJSON_IsNumber(h) && h->valuedouble >= 1 && h->valuedouble < 9007199254740992.0) high = floor(h->valuedouble);
     const cJSON* it;
     cJSON_ArrayForEach(it, sketches)
     {
@@ -627,7 +628,9 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
             ++read;
         }
     }
-    if (r == SP_OK && read > 0 && (r = db_begin(db, err)) == SP_OK) {
+    // With no sketches, the highest id ever given is still kept.
+    bool high = cJSON_GetObjectItemCaseSensitive(man, "sketch_id_high") != NULL;
+    if (r == SP_OK && (read > 0 || high) && (r = db_begin(db, err)) == SP_OK) {
         r = hold_ids_back(db, man, sketches, err);
         int i = 0;
         cJSON_ArrayForEach(it, sketches)

@@ -1377,6 +1377,9 @@ static void test_names_escaped(void)
          "sketch 0: id is not a whole number from 1 up"},
         {"\"parts\": [], \"sketches\": [{\"file\": \"s.json\", \"category\": \"tail\", \"added_at\": \"yesterday\"}]",
          "sketch 0: added_at 'yesterday' is not a time as YYYY-MM-DDTHH:MM:SS.sssZ"},
+        {"\"parts\": [], \"sketches\": [{\"file\": \"s.json\", \"category\": \"tail\", \"added_at\": "
+         "\"2026-99-99T99:99:99.999Z\"}]",
+         "sketch 0: added_at '2026-99-99T99:99:99.999Z' is not a time"},
         // A newer release's export is not read as this one's.
         {"\"version\": 2, \"parts\": [], \"sketches\": []", "an export of version 2, schema 3; this sketchpose reads version 1"},
         {"\"schema\": 9, \"parts\": [], \"sketches\": []", "an export of version 1, schema 9;"},
