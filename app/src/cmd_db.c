@@ -535,9 +535,11 @@ static int db_add_part(int argc, char** argv)
     note_created(cmd, &c, existed);
     sp_cli_done("part %s is stored in %s", info.name, db_path(&c));
     // As `sketchpose derive` prints them for the same file: stderr for the curator, JSON for a script.
+    char shown[300]; // the path as typed, on one line (warnings are one line each)
+    sp_text_printable(pos[0], shown, sizeof shown);
     for (int i = 0; i < warns.count; ++i)
-        fprintf(stderr, "%s: %s: warning: %s\n", cmd, pos[0], warns.lines[i]);
-    if (warns.dropped) fprintf(stderr, "%s: %s: warning: %d more warnings (out of memory)\n", cmd, pos[0], warns.dropped);
+        fprintf(stderr, "%s: %s: warning: %s\n", cmd, shown, warns.lines[i]);
+    if (warns.dropped) fprintf(stderr, "%s: %s: warning: %d more warnings (out of memory)\n", cmd, shown, warns.dropped);
     if (!sp_cli_out_is_stdout(preview)) { // a preview on stdout has it to itself
         print_part(&info, true, &warns);
         printf("\n");

@@ -89,8 +89,10 @@ int cmd_derive(int argc, char** argv)
         fprintf(stderr, "%s: %s\n", k_cmd, err.text);
         goto done;
     }
+    char shown[300]; // the path as typed, on one line (warnings are one line each)
+    sp_text_printable(rig_path, shown, sizeof shown);
     for (int i = 0; i < part.warning_count; ++i)
-        fprintf(stderr, "%s: warning: %s: %s\n", k_cmd, rig_path, part.warnings[i]);
+        fprintf(stderr, "%s: warning: %s: %s\n", k_cmd, shown, part.warnings[i]);
 
     cJSON* root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "out", out_path);
