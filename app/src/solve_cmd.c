@@ -57,8 +57,9 @@ static void note_loose_curve(sp_solve_report* rep, const sp_abstraction* ab)
 }
 
 // A fit left loose with the root's translation at a bound: the drawing lies
-// farther than the character may be moved, which the loose-fit note would blame on the strokes (a figure drawn
-// 150 px left of where it stands: "a stroke missing?"; an outside review).
+// farther than the character may be moved, which the loose-fit note blamed
+// on the strokes (a figure drawn 150 px aside: "a stroke missing?"; an
+// outside review).
 static void note_placement_bound(sp_solve_report* rep, const sp_param* params, int n, const double* p)
 {
     if (!strstr(rep->note, "best effort") && !strstr(rep->note, "loose fit")) return;

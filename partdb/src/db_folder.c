@@ -423,7 +423,7 @@ static bool timestamp_ok(const char* t)
     for (size_t k = 0; k < sizeof form - 1; ++k)
         if (form[k] == 'd' ? !isdigit((unsigned char)t[k]) : t[k] != form[k]) return false;
     int mo = atoi(t + 5), dd = atoi(t + 8), hh = atoi(t + 11), mi = atoi(t + 14), ss = atoi(t + 17);
-    return mo >= 1 && mo <= 12 && dd >= 1 && dd <= 31 && hh <= 23 && mi <= 59 && ss <= 60; // a time that can be
+    return mo >= 1 && mo <= 12 && dd >= 1 && dd <= 31 && hh <= 23 && mi <= 59 && ss <= 60; // a real time of day
 }
 
 static int compare_ids(const void* a, const void* b)
@@ -486,7 +486,7 @@ static sp_result manifest_entries_ok(const cJSON* parts, const cJSON* sketches, 
         const cJSON* at = cJSON_GetObjectItemCaseSensitive(it, "added_at");
         if (id && !(cJSON_IsNumber(id) && id->valuedouble >= 1 && id->valuedouble < 9007199254740992.0 &&
                     id->valuedouble == floor(id->valuedouble)))
-            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: id is not a whole number from 1 up", path, i);
+            return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: id is not a whole number from 1 to 2^53 - 1", path, i);
         if (at && !timestamp_ok(cJSON_GetStringValue(at)))
             return sp_fail(err, SP_ERR_INVALID, "%s: sketch %d: added_at '%s' is not a time as YYYY-MM-DDTHH:MM:SS.sssZ", path, i,
                            sp_text_printable(cJSON_IsString(at) ? at->valuestring : "(not text)", shown, sizeof shown));

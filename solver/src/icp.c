@@ -63,8 +63,9 @@ static const stage k_place = {.pairing = SP_CORR_CLOSEST, .placement_only = true
 // pairs place the root in a few iterations where fresh closest points crawl,
 // and did as well as ordered pairs (BENCHMARKS.md, "Measurements behind the
 // solver's constants and stages").
-// ... or, for a figure matched in order whose closest-point placement
-// ended short (further_attempts), with the abstraction's own ordered pairs:
+// ... or, for a figure matched in order whose fit after a closest-point
+// placement ends above 1% (attempt_placed_ordered), with the abstraction's
+// own ordered pairs:
 // a stick figure's vertical lines give closest points almost no vertical
 // pull, so a figure drawn 80 px above where it stands stayed put.
 static const stage k_place_ordered = {
@@ -114,7 +115,6 @@ typedef struct plan {
     bool loop;            // an outline drawn as a loop, matched in order first
     bool placed_free;     // that loop's root is placed by its ordered rounds (no placement stage)
     bool placed_closest;  // a figure matched in order, placed by closest points first
-    bool placed_ordered;  // ... or by its ordered pairs
 } plan;
 
 // One attempt at a fit: sp_solver_solve makes the first, and more for a
@@ -154,7 +154,6 @@ static void plan_attempt(const sp_solver* s, const sp_sketch* sk, const attempt*
     const bool ordered_place = place_stage && !loop && at->place_ordered && s->ab->correspondence == SP_CORR_ORDERED;
     pl->start_pairing = place_stage && !ordered_place ? SP_CORR_CLOSEST : s->ab->correspondence;
     if (place_stage) pl->stages[pl->count++] = ordered_place ? k_place_ordered : loop ? k_place_held : k_place;
-    pl->placed_ordered = ordered_place;
     pl->placed_closest = place_stage && !ordered_place && !loop && s->ab->correspondence == SP_CORR_ORDERED;
     if (loop) {
         pl->stages[pl->count++] = k_loop_in_order;

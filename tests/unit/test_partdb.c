@@ -1374,7 +1374,7 @@ static void test_names_escaped(void)
          "\"s.json\", \"category\": \"tail\"}]",
          "sketch id 7 given twice"},
         {"\"parts\": [], \"sketches\": [{\"id\": 2.5, \"file\": \"s.json\", \"category\": \"tail\"}]",
-         "sketch 0: id is not a whole number from 1 up"},
+         "sketch 0: id is not a whole number from 1 to 2^53 - 1"},
         {"\"parts\": [], \"sketches\": [{\"file\": \"s.json\", \"category\": \"tail\", \"added_at\": \"yesterday\"}]",
          "sketch 0: added_at 'yesterday' is not a time as YYYY-MM-DDTHH:MM:SS.sssZ"},
         {"\"parts\": [], \"sketches\": [{\"file\": \"s.json\", \"category\": \"tail\", \"added_at\": "

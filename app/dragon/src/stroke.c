@@ -800,7 +800,8 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
 // (a small dragon with a bigger body drawn round it: its body became a head
 // smeared over the new one's flank; one part may hang on a wing or tail
 // drawn first and taken for a body), or one part and is about as large.
-// The new part takes the old one's place and id; false (nothing changed) when no other guess has a part that fits.
+// The new part takes the old one's place and id; false (nothing changed)
+// when no other guess has a part that fits.
 static bool decide_again_on_body(sp_dragon* d, int i, int body)
 {
     part* old = d->parts[i];
