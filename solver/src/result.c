@@ -5,13 +5,27 @@
 
 void sp_text_escape_controls(char* s, size_t cap)
 {
+    const unsigned char* p = (const unsigned char*)s;
+    while (*p && *p >= 0x20 && *p != 0x7f)
+        ++p;
+    if (!*p) return; // nothing to escape: the text as it is
     char out[1024];
     size_t w = 0, room = cap < sizeof out ? cap : sizeof out;
-    for (const unsigned char* p = (const unsigned char*)s; *p && w + 5 < room; ++p)
-        w += (size_t)(*p == '\n'                ? snprintf(out + w, room - w, "\\n")
-                      : *p == '\t'              ? snprintf(out + w, room - w, "\\t")
-                      : *p < 0x20 || *p == 0x7f ? snprintf(out + w, room - w, "\\x%02x", *p)
-                                                : snprintf(out + w, room - w, "%c", *p));
+    for (p = (const unsigned char*)s; *p; ++p) {
+        char one[8];
+        int k = *p == '\n'                ? snprintf(one, sizeof one, "\\n")
+                : *p == '\t'              ? snprintf(one, sizeof one, "\\t")
+                : *p < 0x20 || *p == 0x7f ? snprintf(one, sizeof one, "\\x%02x", *p)
+                                          : snprintf(one, sizeof one, "%c", *p);
+        if (w + (size_t)k + 1 > room) { // cut, and not inside a UTF-8 character
+            while (w > 0 && ((unsigned char)out[w - 1] & 0xC0) == 0x80)
+                --w;
+            if (w > 0 && (unsigned char)out[w - 1] >= 0xC0) --w;
+            break;
+        }
+        memcpy(out + w, one, (size_t)k);
+        w += (size_t)k;
+    }
     memcpy(s, out, w);
     s[w] = 0;
 }
