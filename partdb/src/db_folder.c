@@ -246,8 +246,10 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
     db_str m = {0};
     db_str_printf(&m, "{\"format\": \"sketchpose-db-export\", \"version\": 1, \"schema\": %d, \"parts\": [", SP_DB_SCHEMA_VERSION);
     sqlite3_stmt* st;
-    if ((r = db_prepare(db, "SELECT name, category, abstraction, gltf, added_by, added_at, sha256 FROM parts ORDER BY name", &st,
-                        err)) != SP_OK)
+    if ((r = db_prepare(db,
+                        "SELECT name, category, abstraction, gltf, added_by, added_at, sha256,"
+                        " json_extract(summary, '$.source_sha256') FROM parts ORDER BY name",
+                        &st, err)) != SP_OK)
         goto out;
     int rc, n = 0;
     while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
@@ -270,6 +272,10 @@ static sp_result export_rows(sp_db* db, const char* dir, sp_error* err)
         db_str_json(&m, (const char*)sqlite3_column_text(st, 4));
         db_str_printf(&m, ", \"added_at\": ");
         db_str_json(&m, (const char*)sqlite3_column_text(st, 5));
+        if (sqlite3_column_type(st, 7) == SQLITE_TEXT) { // the file it was added from, for the same-file warning
+            db_str_printf(&m, ", \"source_sha256\": ");
+            db_str_json(&m, (const char*)sqlite3_column_text(st, 7));
+        }
         db_str_printf(&m, "}");
     }
     // A read error ends the loop as the last row does: an export without the rows after it is no export.
@@ -603,7 +609,8 @@ sp_result sp_db_import(sp_db* db, const char* dir, const char* by, sp_error* err
                              .category = jstr(it, "category"),
                              .abstraction = jstr(it, "abstraction"),
                              .added_by = jstr(it, "added_by") ? jstr(it, "added_by") : by,
-                             .synth_sketches = -1};
+                             .synth_sketches = -1,
+                             .source_sha256 = jstr(it, "source_sha256")};
         if ((r = sp_db_add_part_file(db, path, &d, NULL, err)) != SP_OK) break;
     }
     // Sketches: all of them in one transaction, after reading and checking every file.

@@ -510,7 +510,9 @@ sp_result sp_db_add_part_file(sp_db* db, const char* path, const sp_db_part_desc
     char source[65];
     void* raw = NULL;
     size_t raw_size = 0;
-    if (!derived) {
+    if (d.source_sha256 && strlen(d.source_sha256) == 64 && strspn(d.source_sha256, "0123456789abcdef") == 64) {
+        memcpy(source, d.source_sha256, 65);
+    } else if (!derived) {
         r = sp_sha256_hex(bytes, size, source) ? SP_OK : sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     } else if ((r = db_read_file(path, &raw, &raw_size, err)) == SP_OK && !sp_sha256_hex(raw, raw_size, source)) {
         r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");

@@ -493,7 +493,24 @@ static void test_same_file_twice(void)
     ENSURE(sp_db_add_part_file(db, plain, &d, NULL, &err) == SP_OK);
     fprintf(stderr, "  %s", said);
     ENSURE(strstr(said, "the same file as part 'plain_fin' (category fin)"));
+    // And after a move (export, init --from): the exported part file is the
+    // derived one, so the original's hash goes with it in the manifest.
+    char dir[1100], moved[1100];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("twice_export"));
+    snprintf(moved, sizeof moved, "%s", sp_test_tmp_path("twice_moved.db"));
+    sp_dir_remove_tree(dir);
+    sp_fixture_remove_db(moved);
+    ENSURE(sp_db_export(db, dir, &err) == SP_OK);
     sp_db_close(db);
+    ENSURE(sp_db_create_from_export(moved, dir, NULL, "test", &err) == SP_OK);
+    db = open_ok(moved, 0);
+    said[0] = 0;
+    d.name = "plain_wing", d.category = "wing";
+    ENSURE(sp_db_add_part_file(db, plain, &d, NULL, &err) == SP_OK);
+    fprintf(stderr, "  after a move: %s", said);
+    ENSURE(strstr(said, "the same file as part 'plain_"));
+    sp_db_close(db);
+    sp_dir_remove_tree(dir);
 }
 
 static void test_round_trip(void)

@@ -169,6 +169,10 @@ typedef struct sp_db_part_desc {
     /// changes, not after. NULL: none.
     sp_result (*before_store)(void* user, const sp_character* part, int abstraction, sp_error* err);
     void* before_store_user; ///< passed to before_store
+    /// The sha256 (64 hex digits) of the file the part was first added from,
+    /// kept for the same-file warning: an export's part file is that file
+    /// derived (`db init --from` passes the manifest's); NULL: the file's own.
+    const char* source_sha256;
 } sp_db_part_desc;
 
 /// Validates a part without writing anything: the glTF loads, it has a skin
