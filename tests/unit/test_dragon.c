@@ -4676,16 +4676,43 @@ static void test_decorations_on_the_body(void)
     for (int k = 0; k < 5; ++k)
         add_as(d, sk.strokes[k].points, sk.strokes[k].count, kinds[k]);
     const char* names[4] = {"stripes", "a spiral", "a zigzag", "a wavy line along the belly"};
+    int inked = 0;
     for (int k = 5; k < 9; ++k) {
         sp_dragon_result res;
         ENSURE(sp_dragon_add_points(d, sk.strokes[k].points, sk.strokes[k].count, NULL, &res, &err) == SP_OK);
         sp_dragon_detail e;
         bool on_body = res.reason == SP_DRAGON_DETAIL && sp_dragon_detail_get(d, res.detail, &e) && e.part == 0;
-        fprintf(stderr, "  %s on the body: %s%s\n", names[k - 5], sp_dragon_reject_name(res.reason),
-                on_body ? ", ink on it" : "");
-        ENSURE(on_body && sp_dragon_part_count(d) == 5);
-        ENSURE(sp_dragon_undo(d));
+        float sure = 0; // the classifier's best score (the guesses are ranked by their fits)
+        for (int g = 0; g < res.guess_count; ++g)
+            sure = fmaxf(sure, res.guesses[g].confidence);
+        fprintf(stderr, "  %s on the body: %s%s (%s %.2f)\n", names[k - 5], sp_dragon_reject_name(res.reason),
+                on_body ? ", ink on it" : "", res.guess_count ? res.guesses[0].category : "-", sure);
+        // Unsure, it is ink; a part the classifier is sure of stays one
+        // unless its fit refuses it (a wing drawn on the flank; this test's
+        // quickly trained model is sure of some of these).
+        ENSURE(sure >= 0.85f || (on_body && sp_dragon_part_count(d) == 5));
+        inked += sure < 0.85f;
+        if (!res.rejected || res.reason == SP_DRAGON_DETAIL) ENSURE(sp_dragon_undo(d));
     }
+    ENSURE(inked >= 2); // the premise: most are not surely parts
+    // Wings drawn flat on the flank stay wings where the classifier is sure
+    // (a third review: 10 of 30 visitors' wings there became ink).
+    const char* wings[3] = {"wings/wing-feathered.json", "wings/wing-3-scallops-raised.json", "wings/wing-fan-4-ribs.json"};
+    int sure_wings = 0;
+    for (int w = 0; w < 3; ++w) {
+        int m;
+        sp_vec2* xy = visitor_stroke(wings[w], 200, (sp_vec2){650, 412}, false, &m);
+        sp_dragon_result res;
+        ENSURE(sp_dragon_add_points(d, xy, m, NULL, &res, &err) == SP_OK);
+        free(xy);
+        float sure = 0;
+        for (int g = 0; g < res.guess_count; ++g)
+            if (!strcmp(res.guesses[g].category, "wings")) sure = res.guesses[g].confidence;
+        fprintf(stderr, "  %s on the flank: %s (wings %.2f)\n", wings[w], sp_dragon_reject_name(res.reason), sure);
+        if (sure >= 0.85f) ENSURE(res.reason == SP_DRAGON_ACCEPTED && ++sure_wings);
+        if (!res.rejected || res.reason == SP_DRAGON_DETAIL) ENSURE(sp_dragon_undo(d));
+    }
+    ENSURE(sure_wings >= 1);
     sp_sketch_free(&sk);
     sp_dragon_destroy(d);
     sp_db_close(db);

@@ -790,7 +790,7 @@ static void part_return(sp_dragon* d, int i, part* p, const int* saved)
 
 // An earlier body that carries a part, at least this fraction of the new
 // body's size (stroke box diagonals), stays a body.
-#define SAME_SIZE_BODY 0.65
+#define SAME_SIZE_BODY 0.75
 
 // Part i, taken by the classifier for a body when it was drawn alone, lies
 // on the body just drawn (dragon_on_body): decided again as if drawn after
@@ -810,13 +810,14 @@ static bool decide_again_on_body(sp_dragon* d, int i, int body)
     if (!old->t->is_torso || old->chosen || !d->clf || !dragon_on_body(d, lo, hi, body)) return false;
     // A body that carries a part and is about as large as the new one, as
     // drawn, is a body: an arch drawn over a dragon's back made its body a
-    // pair of legs and dropped its head, and a body drawn again round the
-    // first made that one a head as large as the body (an outside review).
-    // A tail or head drawn first and taken for a body is clearly smaller
-    // (confidence does not tell: misread ones score 0.99 too, a second review).
-    const part* nb = d->parts[body];
-    double old_size = hypot(hi.x - lo.x, hi.y - lo.y),
-           new_size = hypot(nb->stroke_box[2] - nb->stroke_box[0], nb->stroke_box[3] - nb->stroke_box[1]);
+    // pair of legs and dropped its head, and a body drawn again a little
+    // larger round the first made that one a head as large as the body (an
+    // outside review). A tail or head drawn first and taken for a body is
+    // clearly smaller (confidence does not tell: misread ones score 0.99
+    // too; nor does lying inside the new body's box: such a tail may; second
+    // and third reviews).
+    const double* nbox = d->parts[body]->stroke_box;
+    double old_size = hypot(hi.x - lo.x, hi.y - lo.y), new_size = hypot(nbox[2] - nbox[0], nbox[3] - nbox[1]);
     if (old->carried >= 2 || (old->carried >= 1 && old_size >= SAME_SIZE_BODY * new_size)) return false;
     sp_stroke st;
     sp_sketch sk = part_sketch(d, old, &st);
@@ -987,16 +988,24 @@ static void give_back_fits(sp_dragon* d, uint64_t by)
         }
 }
 
+// Below this confidence, a stroke taken for a part may be colouring in.
+#define COLOURING_UNSURE 0.85
+
 // Whether a classified stroke (accepted or not recognised) is drawn on a
 // part (not part `skip`) as its detail, its spikes, a speck or colouring in
 // (layout.c); *hit says where.
-static bool drawn_on_part(sp_dragon* d, sp_dragon_reject why, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi, int skip,
-                          detail_hit* hit)
+static bool drawn_on_part(sp_dragon* d, sp_dragon_reject why, float confidence, const sp_vec2* pts, int n, sp_vec2 lo, sp_vec2 hi,
+                          int skip, detail_hit* hit)
 {
     if (why != SP_DRAGON_ACCEPTED && why != SP_DRAGON_UNRECOGNISED) return false;
+    // Colouring in of a stroke taken for a part only when the classifier is
+    // unsure: a wing drawn flat on the flank (0.9-1.0 wings) is a wing (a
+    // third review: 10 of 30 visitors' wings became ink); stripes, a spiral
+    // and a zigzag scored 0.42-0.8.
+    bool colouring = why == SP_DRAGON_UNRECOGNISED || confidence < COLOURING_UNSURE;
     return dragon_detail_of(d, pts, n, lo, hi, skip, hit) >= 0 || dragon_edge_of(d, pts, n, lo, hi, skip, hit) >= 0 ||
            dragon_speck_of(d, pts, n, lo, hi, skip, hit) >= 0 ||
-           dragon_colouring_of(d, pts, n, lo, hi, skip, why == SP_DRAGON_ACCEPTED, hit) >= 0;
+           (colouring && dragon_colouring_of(d, pts, n, lo, hi, skip, why == SP_DRAGON_ACCEPTED, hit) >= 0);
 }
 
 // A stroke (classified, not a Redraw) drawn out of a part of the dragon,
@@ -1106,7 +1115,8 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // any size: colouring in (reviews: a scribble faded, stripes became legs).
     // It is kept as ink on the part; its guesses stay (a chip makes it a part).
     detail_hit hit = {0};
-    if (!o.category && drawn_on_part(d, why, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit)) why = SP_DRAGON_DETAIL;
+    if (!o.category && drawn_on_part(d, why, confidence, pts, n, lo, hi, o.replace_last ? d->part_n - 1 : -1, &hit))
+        why = SP_DRAGON_DETAIL;
     bool flourish = why == SP_DRAGON_UNRECOGNISED && kept_as_flourish(d, &o, pts, n, lo, hi, out);
     if (flourish) why = SP_DRAGON_DETAIL;
     if (why != SP_DRAGON_ACCEPTED) {
