@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "outputs.h"
 #include "report.h"
+#include "sp/curve.h"
 #include "sp/snapshot.h"
 
 // A fit whose mean error is small can still leave one curve far from its
@@ -110,14 +111,6 @@ static bool solve_picked(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch*
 
 enum { STROKE_KEPT = -1, STROKE_DOT = -2 }; // else: the stroke it traces over
 
-static double stroke_length(const sp_stroke* st)
-{
-    double len = 0;
-    for (int j = 1; j < st->count; ++j)
-        len += sp_v2_len(sp_v2_sub(st->points[j], st->points[j - 1]));
-    return len;
-}
-
 static void stroke_box(const sp_stroke* st, double box[4])
 {
     box[0] = box[1] = INFINITY, box[2] = box[3] = -INFINITY;
@@ -156,7 +149,9 @@ static int mark_dots(const sp_sketch* sk, int* why)
 {
     int kept = 0;
     for (int i = 0; i < sk->stroke_count; ++i) {
-        why[i] = sk->strokes[i].count >= 2 && stroke_length(&sk->strokes[i]) > 0 ? STROKE_KEPT : STROKE_DOT;
+        why[i] = sk->strokes[i].count >= 2 && sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false) > 0
+                     ? STROKE_KEPT
+                     : STROKE_DOT;
         kept += why[i] == STROKE_KEPT;
     }
     return kept;
@@ -177,7 +172,7 @@ static int mark_retraces(const sp_sketch* sk, int curves, int kept, int* why)
     double len[RETRACE_MAX_STROKES], box[4 * RETRACE_MAX_STROKES];
     double all[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < n; ++i) {
-        len[i] = why[i] == STROKE_KEPT ? stroke_length(&sk->strokes[i]) : 0;
+        len[i] = why[i] == STROKE_KEPT ? sp_curve_length(sk->strokes[i].points, sk->strokes[i].count, false) : 0;
         stroke_box(&sk->strokes[i], box + 4 * i);
         for (int c = 0; c < 2; ++c)
             all[c] = fmin(all[c], box[4 * i + c]), all[2 + c] = fmax(all[2 + c], box[4 * i + 2 + c]);

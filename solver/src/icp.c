@@ -64,7 +64,7 @@ static const stage k_place = {.pairing = SP_CORR_CLOSEST, .placement_only = true
 // and did as well as ordered pairs (BENCHMARKS.md, "Measurements behind the
 // solver's constants and stages").
 // ... or, for a figure matched in order whose fit after a closest-point
-// placement ends above 1% (attempt_placed_ordered), with the abstraction's
+// placement ends above 1% (sp_solver_solve), with the abstraction's
 // own ordered pairs:
 // a stick figure's vertical lines give closest points almost no vertical
 // pull, so a figure drawn 80 px above where it stands stayed put.
@@ -486,6 +486,21 @@ static void further_attempts(sp_solver* s, const sp_sketch* sk, const double* p_
     free(p2), free(r2);
 }
 
+// One more attempt `at` from p_start in the time left, kept when it fits
+// better (keep_better).
+static void attempt_again(sp_solver* s, const sp_sketch* sk, const double* p_start, const attempt* at, double* p_out,
+                          sp_solve_report* rep)
+{
+    if (!(s->d.time_cap_ms - rep->ms > 0)) return;
+    double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
+    sp_solve_report* r2 = malloc(sizeof *r2);
+    sp_error e2 = {0};
+    plan pl;
+    if (p2 && r2 && run_attempt(s, sk, p_start, at, s->d.time_cap_ms - rep->ms, p2, r2, &pl, &e2) == SP_OK)
+        keep_better(s, rep, p_out, r2, p2);
+    free(p2), free(r2);
+}
+
 // A figure of several curves started from a pose of its own (`pose
 // --start`, an animation's previous key) whose fit ends above 1% is solved
 // again from the default pose, and the better fit kept: from a squat on the
@@ -502,35 +517,12 @@ static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p
     for (int i = 0; i < s->P && at_rest; ++i)
         at_rest = (s->d.active && !s->d.active[i]) || p_start[i] == s->model->params[i].def;
     if (at_rest || s->ab->curve_count < 2 || s->d.ordered_by_ends || !(s->d.time_cap_ms - rep->ms > 0)) return;
-    double* p2 = malloc(sizeof(double) * (size_t)(2 * s->P + 1));
-    sp_solve_report* r2 = malloc(sizeof *r2);
-    sp_error e2 = {0};
-    plan pl;
-    if (p2 && r2) {
-        double* rest = p2 + s->P;
-        for (int i = 0; i < s->P; ++i)
-            rest[i] = s->d.active && !s->d.active[i] ? p_start[i] : s->model->params[i].def;
-        if (run_attempt(s, sk, rest, &(attempt){.allow_loop = true, .place_free = true}, s->d.time_cap_ms - rep->ms, p2, r2, &pl,
-                        &e2) == SP_OK)
-            keep_better(s, rep, p_out, r2, p2);
-    }
-    free(p2), free(r2);
-}
-
-// A figure matched in order whose fit from a closest-point placement ends
-// above 1% is placed again by its ordered pairs, and the better fit kept.
-static void attempt_placed_ordered(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep)
-{
-    if (!(s->d.time_cap_ms - rep->ms > 0)) return;
-    double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
-    sp_solve_report* r2 = malloc(sizeof *r2);
-    sp_error e2 = {0};
-    plan pl;
-    if (p2 && r2 &&
-        run_attempt(s, sk, p_start, &(attempt){.allow_loop = true, .place_free = true, .place_ordered = true},
-                    s->d.time_cap_ms - rep->ms, p2, r2, &pl, &e2) == SP_OK)
-        keep_better(s, rep, p_out, r2, p2);
-    free(p2), free(r2);
+    double* rest = malloc(sizeof(double) * (size_t)(s->P + 1));
+    if (!rest) return;
+    for (int i = 0; i < s->P; ++i)
+        rest[i] = s->d.active && !s->d.active[i] ? p_start[i] : s->model->params[i].def;
+    attempt_again(s, sk, rest, &(attempt){.allow_loop = true, .place_free = true}, p_out, rep);
+    free(rest);
 }
 
 sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_start, double* p_out, sp_solve_report* rep,
@@ -540,7 +532,10 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     sp_result res =
         run_attempt(s, sk, p_start, &(attempt){.allow_loop = true, .place_free = true}, s->d.time_cap_ms, p_out, rep, &pl, err);
     if (res == SP_OK && !fit_ok(rep) && pl.loop) further_attempts(s, sk, p_start, &pl, p_out, rep);
-    if (res == SP_OK && !fit_ok(rep) && pl.placed_closest) attempt_placed_ordered(s, sk, p_start, p_out, rep);
+    // A figure matched in order whose fit from a closest-point placement ends
+    // above 1% is placed again by its ordered pairs (k_place_ordered).
+    if (res == SP_OK && !fit_ok(rep) && pl.placed_closest)
+        attempt_again(s, sk, p_start, &(attempt){.allow_loop = true, .place_free = true, .place_ordered = true}, p_out, rep);
     if (res == SP_OK && !fit_ok(rep) && !pl.loop && p_start) attempt_from_rest(s, sk, p_start, p_out, rep);
     return res;
 }
