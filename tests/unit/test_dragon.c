@@ -1616,15 +1616,21 @@ static void test_background_replaced(void)
     sp_result polled = sp_dragon_reload_if_changed(d, &reloaded, &err); // a stroke's poll: the file is reopened
     if (polled != SP_OK) fprintf(stderr, "  poll: %s\n", err.text);
     ENSURE(polled == SP_OK);
-    bool mid_read = sp_dragon_model_loading(d);
     for (int i = 0; i < 3; ++i)
         settle(d);
+    if (d->model_retry_at > 0) {
+        // A read that failed for a reason that may pass (the new file busy
+        // for its 100 ms under a loaded machine) is tried again later: now.
+        fprintf(stderr, "  a read failed and waits to be tried again\n");
+        d->model_retry_at = 1;
+        settle(d), settle(d);
+    }
     sp_db* r = NULL;
     sp_clf* want = NULL;
     ENSURE(sp_db_open(p, SP_DB_READONLY, &r, &err) == SP_OK && sp_db_load_model(r, &want, NULL, &err) == SP_OK);
     sp_db_close(r);
-    fprintf(stderr, "  replaced %s; words in use %d, the file's model %d\n", mid_read ? "mid-read" : "after the read",
-            sp_clf_get_desc(sp_dragon_model(d)).words, sp_clf_get_desc(want).words);
+    fprintf(stderr, "  replaced: words in use %d, the file's model %d\n", sp_clf_get_desc(sp_dragon_model(d)).words,
+            sp_clf_get_desc(want).words);
     ENSURE(sp_clf_get_desc(sp_dragon_model(d)).words == 64 && sp_clf_get_desc(want).words == 64);
     sp_clf_destroy(want);
     sp_dragon_destroy(d);
