@@ -570,14 +570,12 @@ static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size,
     if (why)
         return sp_fail(err, SP_ERR_INVALID, "%s: a kiosk sketch is one stroke of 2..%d points; this is %s (add it as curated)",
                        what, SP_DB_KIOSK_POINTS_MAX, why);
-    if (s->ds.count == s->cap) {
-        int cap = s->cap ? 2 * s->cap : 64;
-        sp_sample* g = realloc(s->ds.samples, sizeof *g * (size_t)cap);
-        if (g) s->ds.samples = g;
-        sp_db_png* h = realloc(s->png, sizeof *h * (size_t)cap);
-        if (h) s->png = h;
-        if (!g || !h) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-        s->cap = cap;
+    if (sp_dataset_reserve(&s->ds, 1) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+    if (s->ds.capacity > s->cap) { // the drawings' PNGs, one a sample
+        sp_db_png* h = realloc(s->png, sizeof *h * (size_t)s->ds.capacity);
+        if (!h) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+        s->png = h;
+        s->cap = s->ds.capacity;
     }
     s->png[s->ds.count] = (sp_db_png){png, png_size};
     s->ds.samples[s->ds.count++] = *smp;

@@ -47,6 +47,7 @@ sp_result db_dataset_one(sp_dataset* out, const char* category, int n, sp_error*
         sp_dataset_free(out);
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     }
+    out->capacity = n;
     return SP_OK;
 }
 

@@ -293,7 +293,7 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, int curated_max, sp_dat
     }
     sqlite3_bind_int(st, 1, kiosk_cap);
     sqlite3_bind_int(st, 2, curated_max);
-    int rc, cap = 0;
+    int rc;
     int* per_cat = calloc((size_t)(ncat > 0 ? ncat : 1), sizeof(int));
     if (!per_cat) r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     while (r == SP_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
@@ -302,14 +302,9 @@ sp_result db_load_training_set(sp_db* db, int kiosk_cap, int curated_max, sp_dat
             ++n.unused;
             continue;
         }
-        if (out->count == cap) {
-            cap = cap ? 2 * cap : 64;
-            sp_sample* g = realloc(out->samples, sizeof(sp_sample) * (size_t)cap);
-            if (!g) {
-                r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-                break;
-            }
-            out->samples = g;
+        if (sp_dataset_reserve(out, 1) != SP_OK) {
+            r = sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
+            break;
         }
         sp_sample* s = &out->samples[out->count];
         memset(s, 0, sizeof *s);

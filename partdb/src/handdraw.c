@@ -577,9 +577,7 @@ sp_result sp_handdraw_dataset(const sp_rig* rig, int abstraction, const sp_camer
     sp_handdraw_desc clean = desc ? *desc : (sp_handdraw_desc){0};
     clean.params = NULL;
     clean.style = SP_HANDDRAW_CLEAN;
-    sp_sample* g = realloc(ds->samples, sizeof *g * (size_t)(ds->count + n));
-    if (!g) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
-    ds->samples = g;
+    if (sp_dataset_reserve(ds, n) != SP_OK) return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
     for (int i = 0; i < n; ++i) {
         sp_sample* s = &ds->samples[ds->count + i];
         memset(s, 0, sizeof *s);

@@ -10,6 +10,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <ftw.h>
+#include <limits.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -798,16 +799,26 @@ int sp_dataset_add_category(sp_dataset* ds, const char* name)
     return ds->category_count++;
 }
 
+sp_result sp_dataset_reserve(sp_dataset* ds, int n)
+{
+    if (n < 0 || ds->count < 0 || n > INT_MAX - ds->count) return SP_ERR_NO_MEMORY;
+    // A set built before `capacity` was kept (0) holds exactly `count`.
+    if (ds->count + n <= ds->capacity) return SP_OK;
+    long long cap = ds->capacity > 0 ? ds->capacity : 8;
+    while (cap < (long long)ds->count + n)
+        cap *= 2;
+    if (cap > INT_MAX) cap = (long long)ds->count + n;
+    sp_sample* grown = realloc(ds->samples, sizeof(sp_sample) * (size_t)cap);
+    if (!grown) return SP_ERR_NO_MEMORY;
+    ds->samples = grown;
+    ds->capacity = (int)cap;
+    return SP_OK;
+}
+
 sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp)
 {
-    // Grow geometrically; the capacity is implied by count (powers of two).
+    if (sp_dataset_reserve(ds, 1) != SP_OK) return SP_ERR_NO_MEMORY;
     int n = ds->count;
-    if ((n & (n - 1)) == 0) {
-        size_t cap = n ? (size_t)n * 2 : 1;
-        sp_sample* grown = realloc(ds->samples, sizeof(sp_sample) * cap);
-        if (!grown) return SP_ERR_NO_MEMORY;
-        ds->samples = grown;
-    }
     int idx = 0;
     for (int i = 0; i < n; ++i)
         if (ds->samples[i].label == smp->label) ++idx;
@@ -944,8 +955,24 @@ sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, 
         while (b < e && isspace((unsigned char)text[b]))
             ++b;
         if (b == e) continue; // blank line
-        cJSON* root = cJSON_ParseWithLength(text + b, e - b);
-        if (!root) return sp_fail(err, SP_ERR_PARSE, "%s:%d: malformed JSON", name, line);
+        // Each line is a JSON document as the stroke file is: its values
+        // counted before it is parsed (a 60 MB line of small values took
+        // 2.4 GB), one document, no NUL, each key once (an outside review).
+        char lname[1100];
+        snprintf(lname, sizeof lname, "%s:%d", name, line);
+        cJSON* root = NULL;
+        sp_result vr = sp_json_values_within(text + b, e - b, SP_SKETCH_MAX_JSON_VALUES, lname, err);
+        if (vr != SP_OK || (vr = parse_document(text + b, e - b, lname, &root, err)) != SP_OK) return vr;
+        bool oom = false;
+        const char* twice = json_key_twice_within(root, &oom);
+        char shown[96];
+        if (twice || oom) {
+            vr = twice ? sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", lname,
+                                 sp_text_printable(twice, shown, sizeof shown))
+                       : sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", lname);
+            cJSON_Delete(root);
+            return vr;
+        }
         const cJSON* drawing = cJSON_GetObjectItemCaseSensitive(root, "drawing");
         if (!cJSON_IsObject(root) || !cJSON_IsArray(drawing)) {
             cJSON_Delete(root);
@@ -1044,14 +1071,21 @@ static bool svg_number(const char** p, const char* end, double* v)
     const char* q = s;
     if (q < end && (*q == '+' || *q == '-')) buf[k++] = *q++;
     bool digits = false, dot = false;
-    while (q < end && k < sizeof buf - 8) {
+    while (q < end) {
         if (isdigit((unsigned char)*q))
             digits = true;
         else if (*q == '.' && !dot)
             dot = true;
         else
             break;
-        buf[k++] = *q++;
+        // A number longer than the buffer: digits past the point only lose
+        // precision and are read over; any other is refused (it was cut in
+        // two, and the rest read as the next number).
+        if (k < sizeof buf - 8)
+            buf[k++] = *q;
+        else if (!dot || *q == '.')
+            return false;
+        ++q;
     }
     if (!digits) return false;
     if (q < end && (*q == 'e' || *q == 'E')) {
@@ -1065,6 +1099,7 @@ static bool svg_number(const char** p, const char* end, double* v)
             eb[ek++] = *r++;
             ed = true;
         }
+        if (ed && r < end && isdigit((unsigned char)*r)) return false; // an exponent of more digits than it holds
         if (ed) {
             memcpy(buf + k, eb, ek);
             k += ek;

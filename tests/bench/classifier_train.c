@@ -62,12 +62,10 @@ int main(int argc, char** argv)
     sp_error err = {0};
     // Hand-drawn variants of every drawing.
     int orig = ds.count;
-    sp_sample* g = realloc(ds.samples, sizeof *g * (size_t)orig * (size_t)(1 + copies));
-    if (!g) {
+    if (sp_dataset_reserve(&ds, orig * copies) != SP_OK) {
         fprintf(stderr, "bench_classifier_train: out of memory\n");
         return 1;
     }
-    ds.samples = g;
     sp_handdraw_params hp = sp_handdraw_preset(SP_HANDDRAW_NORMAL);
     for (int k = 0; k < copies; ++k)
         for (int i = 0; i < orig; ++i) {

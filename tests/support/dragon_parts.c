@@ -237,13 +237,11 @@ sp_result dragon_scribbles(const char* data_dir, int per_category, sp_dataset* d
             return r;
         }
         int n = one.count < per_category ? one.count : per_category;
-        sp_sample* g = realloc(ds->samples, sizeof *g * (size_t)(ds->count + n));
-        if (!g) {
+        if (sp_dataset_reserve(ds, n) != SP_OK) {
             sp_dataset_free(&one);
             sp_dataset_free(ds);
             return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory");
         }
-        ds->samples = g;
         for (int i = 0; i < n; ++i) {
             ds->samples[ds->count++] = one.samples[i];
             memset(&one.samples[i], 0, sizeof one.samples[i]); // moved

@@ -259,6 +259,34 @@ static void test_ndjson(void)
         if (!contains(e.text, want[i])) fprintf(stderr, "  '%s'\n", e.text);
         ENSURE(contains(e.text, "b.ndjson") && contains(e.text, want[i]));
     }
+    // Each line is checked as a stroke file is (an outside review): a key
+    // given twice (the first was read), a NUL with text after it (read up
+    // to the NUL), and a line of more values than a stroke file may hold
+    // (parsed first: gigabytes).
+    const char twice[] = "{\"drawing\": [[[0, 1], [0, 1]]], \"drawing\": [[[5, 9], [5, 9]]]}\n";
+    const char nul[] = "{\"drawing\": [[[0, 1], [0, 1]]]}\0 garbage\n";
+    size_t big_n = 2 * (size_t)SP_SKETCH_MAX_JSON_VALUES + 64;
+    char* big = malloc(big_n + 64);
+    ENSURE(big);
+    size_t at = (size_t)sprintf(big, "{\"drawing\": [[[");
+    while (at + 16 < big_n)
+        big[at++] = '0', big[at++] = ',';
+    at += (size_t)sprintf(big + at, "0], [0]]]}\n");
+    const struct {
+        const char* text;
+        size_t len;
+        const char* want;
+    } checked[] = {{twice, sizeof twice - 1, "b.ndjson:1: key \"drawing\" given twice"},
+                   {nul, sizeof nul - 1, "b.ndjson:1: text after the JSON document"},
+                   {big, at, "b.ndjson:1: more than"}};
+    for (size_t i = 0; i < sizeof checked / sizeof checked[0]; ++i) {
+        sp_error e = {0};
+        int before = ds.count;
+        ENSURE(sp_dataset_parse_ndjson(&ds, checked[i].text, checked[i].len, "b.ndjson", l, &e) != SP_OK);
+        fprintf(stderr, "  %.120s\n", e.text);
+        ENSURE(contains(e.text, checked[i].want) && ds.count == before);
+    }
+    free(big);
     sp_dataset_free(&ds);
 }
 
@@ -341,15 +369,13 @@ static void test_svg(void)
     ENSURE(s.strokes[3].count == 2 && s.strokes[4].count == 3);
     sp_sketch_free(&s);
 
-    const char* bad[] = {"<svg><path d=\"M 0 0 L 1\"/></svg>",
-                         "<svg><path d=\"X 0 0\"/></svg>",
-                         "<svg><path d=\"0 0\"/></svg>",
-                         "<svg></g></svg>",
-                         "<path d=\"M0 0 L1 1\"/>",
-                         "<svg><path d=\"M 0 0 L nan 1\"/></svg>",
-                         "<svg><path d=\"M 0 0 L 1e999 1\"/></svg>",
-                         "<svg><g transform=\"scale(\"><path d=\"M0 0\"/></g></svg>",
-                         "<svg><path d=\"M0 0"};
+    const char* bad[] = {"<svg><path d=\"M 0 0 L 1\"/></svg>", "<svg><path d=\"X 0 0\"/></svg>", "<svg><path d=\"0 0\"/></svg>",
+                         "<svg></g></svg>", "<path d=\"M0 0 L1 1\"/>", "<svg><path d=\"M 0 0 L nan 1\"/></svg>",
+                         "<svg><path d=\"M 0 0 L 1e999 1\"/></svg>", "<svg><g transform=\"scale(\"><path d=\"M0 0\"/></g></svg>",
+                         "<svg><path d=\"M0 0",
+                         // 60 integer digits: cut in two, the rest was read as the next number
+                         "<svg><path d=\"M 0 0 L 100000000000000000000000000000000000000000000000000000000000 5\"/></svg>",
+                         "<svg><path d=\"M 0 0 L 1e000000001 5\"/></svg>"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         sp_error e = {0};
         sp_result rc = sp_sketch_parse_svg(bad[i], strlen(bad[i]), "b.svg", &s, &e);
@@ -357,6 +383,15 @@ static void test_svg(void)
         ENSURE(rc != SP_OK && contains(e.text, "b.svg"));
         ENSURE(s.stroke_count == 0);
     }
+    // Digits past the point beyond what a double holds only lose precision:
+    // one line to (100, 50), where 60 zeros made it three points (an outside review).
+    char zeros[61];
+    memset(zeros, '0', 60), zeros[60] = 0;
+    char longnum[512];
+    snprintf(longnum, sizeof longnum, "<svg><path d=\"M 0 0 L 100.%s 50.%s\"/></svg>", zeros, zeros);
+    ENSURE(sp_sketch_parse_svg(longnum, strlen(longnum), "t.svg", &s, &err) == SP_OK);
+    ENSURE(s.stroke_count == 1 && s.strokes[0].count == 2 && s.strokes[0].points[1].x == 100 && s.strokes[0].points[1].y == 50);
+    sp_sketch_free(&s);
 }
 
 // Parses an SVG text that must be accepted; the caller frees s.

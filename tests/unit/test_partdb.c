@@ -2536,6 +2536,36 @@ static void test_attach_joint_missing(void)
     sp_db_close(db);
 }
 
+// A set built by one public call and then appended to by another: the
+// builders sized the samples exactly while sp_dataset_add_sample took its
+// room from the count, and wrote past the end (an outside code review;
+// ASan saw it).
+static void test_dataset_appends_after_builders(void)
+{
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(part_file(0), &ch, &err) == SP_OK);
+    sp_dataset ds = {0};
+    ENSURE(sp_dataset_add_category(&ds, "tail") == 0);
+    ENSURE(sp_handdraw_dataset(&ch.rig, 0, &ch.camera, &(sp_handdraw_desc){0}, 1, 3, 0, 0, &ds, &err) == SP_OK);
+    ENSURE(ds.count == 3 && ds.capacity >= 3);
+    for (int k = 0; k < 20; ++k) {
+        sp_sample smp = {.label = 0};
+        ENSURE(sp_sketch_add_stroke(&smp.sketch, (const sp_vec2[2]){{0, 0}, {10, 10 + k}}, NULL, 2) == SP_OK);
+        ENSURE(sp_dataset_add_sample(&ds, &smp) == SP_OK);
+        ENSURE(ds.capacity >= ds.count && ds.samples[ds.count - 1].index == 3 + k);
+    }
+    ENSURE(sp_handdraw_dataset(&ch.rig, 0, &ch.camera, &(sp_handdraw_desc){0}, 2, 5, 0, 23, &ds, &err) == SP_OK);
+    ENSURE(ds.count == 28 && ds.capacity >= 28 && ds.samples[27].sketch.stroke_count > 0);
+    // A set made by hand (no capacity kept) holds exactly its count.
+    sp_dataset exact = {.count = 1, .samples = calloc(1, sizeof(sp_sample)), .category_count = 0};
+    ENSURE(exact.samples && sp_dataset_reserve(&exact, 1) == SP_OK && exact.capacity >= 2);
+    ENSURE(sp_dataset_reserve(&exact, -1) == SP_ERR_NO_MEMORY && sp_dataset_reserve(&exact, INT_MAX) == SP_ERR_NO_MEMORY);
+    sp_dataset_free(&exact);
+    sp_dataset_free(&ds);
+    sp_character_free(&ch);
+}
+
 // add-part and add-sketch create the database at a --db path where no file
 // is (documented), and now say so on stderr, one line naming it, so that a
 // mistyped path or a wrong folder is noticed; into an existing one, not a word.
@@ -3499,5 +3529,6 @@ int main(int argc, char** argv)
                                    {"new_db_said_cli", test_new_db_said_cli},
                                    {"add_part_derive_options", test_add_part_derive_options},
                                    {"category_case", test_category_case},
+                                   {"dataset_appends_after_builders", test_dataset_appends_after_builders},
                                    {0}});
 }

@@ -61,6 +61,7 @@ typedef struct sp_sample {
 typedef struct sp_dataset {
     int count;
     sp_sample* samples;
+    int capacity; // samples allocated; grow them only with sp_dataset_reserve
     int category_count;
     char** categories;
 } sp_dataset;
@@ -108,6 +109,9 @@ void sp_dataset_free(sp_dataset* ds);
 /// sets its `index` (its position within its category). SP_ERR_NO_MEMORY
 /// leaves `smp` with the caller.
 sp_result sp_dataset_add_sample(sp_dataset* ds, sp_sample* smp);
+/// Makes room for n more samples past `count` (geometric growth); the
+/// samples in the set stay. SP_ERR_NO_MEMORY changes nothing.
+sp_result sp_dataset_reserve(sp_dataset* ds, int n);
 
 /// Reads a whole file into *data (malloc'd, NUL-terminated, *size bytes
 /// without the NUL): regular files only (a device or a pipe is refused, never
