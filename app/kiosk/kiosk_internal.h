@@ -189,6 +189,10 @@ sp_result kiosk_postcard(sp_kiosk* k, const char* code, sp_image* img, sp_error*
 /// kiosk_save.c: Save now (the export, the postcard, the banner; refused when
 /// the export folder's disk is under its reserve).
 void kiosk_run_save(sp_kiosk* k);
+/// The next free save code of k's sequence, claimed by making <code>.glb
+/// (empty, O_EXCL) in the export folder; refused, never reused, when
+/// none of 1000 is free.
+sp_result kiosk_claim_code(sp_kiosk* k, char code[8], sp_error* err);
 /// Removes the saves older than desc.keep_saves_days (0: none), with one line.
 void kiosk_prune_saves(sp_kiosk* k);
 

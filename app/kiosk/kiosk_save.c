@@ -1,6 +1,7 @@
 // kiosk_save.c: Save (a visitor's dragon as <code>.glb and <code>.png in the
 // export folder), the disk it fills, and the old saves a museum lets go.
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,9 +20,12 @@ static const char k_code_alphabet[] = "ACEFHJKLMNPRTUVWXY3479";
 // 300 saves of a six-part dragon (6 MB each) before saves stop.
 enum { SAVE_WARN_MB = 2048 };
 
-static void next_code(sp_kiosk* k, char code[8])
+// Codes tried before a save gives up: the folder nearly full of saves.
+enum { CODE_TRIES = 1000 };
+
+sp_result kiosk_claim_code(sp_kiosk* k, char code[8], sp_error* err)
 {
-    for (int attempt = 0; attempt < 1000; ++attempt) {
+    for (int attempt = 0; attempt < CODE_TRIES; ++attempt) {
         uint64_t z = (k->code_state += 0x9E3779B97F4A7C15ull);
         z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
         z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
@@ -31,8 +35,21 @@ static void next_code(sp_kiosk* k, char code[8])
         code[4] = 0;
         char path[1200];
         snprintf(path, sizeof path, "%s/%s.glb", k->export_dir, code);
-        if (access(path, F_OK) != 0) return;
+        // Made, not looked for: another kiosk saving into this folder (or a
+        // code that was taken) gets EEXIST and the next code, never this one.
+        int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+        if (fd >= 0) {
+            close(fd);
+            return SP_OK;
+        }
+        if (errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", path, strerror(errno));
     }
+    // A code already given to a visitor is never given again (it named
+    // their dragon): refused, not reused.
+    return sp_fail(err, SP_ERR_IO,
+                   "%s: no free save code in %d tries (the folder is nearly full of saves: move old ones away, or "
+                   "--keep-saves-days)",
+                   k->export_dir, CODE_TRIES);
 }
 
 static sp_result make_dirs(const char* dir, sp_error* err)
@@ -102,11 +119,7 @@ static bool on_db_disk(const sp_kiosk* k, const char* folder)
 void kiosk_run_save(sp_kiosk* k)
 {
     sp_error err = {0};
-    char code[8];
-    next_code(k, code);
-    char glb[1200], png[1200];
-    snprintf(glb, sizeof glb, "%s/%s.glb", k->export_dir, code);
-    snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
+    char code[8] = "", glb[1200] = "", png[1200] = "";
     sp_image img = {0};
     // Each file is written whole (sp_file_write): a visitor's code never names half a file.
     sp_result r = make_dirs(k->export_dir, &err);
@@ -119,6 +132,9 @@ void kiosk_run_save(sp_kiosk* k)
                     "%s: %.0f MB free on its disk, under the %.0f MB kept for the database: not saved (move old saves away, or "
                     "--keep-saves-days)",
                     k->export_dir, left, reserve);
+    bool claimed = r == SP_OK && (r = kiosk_claim_code(k, code, &err)) == SP_OK;
+    snprintf(glb, sizeof glb, "%s/%s.glb", k->export_dir, code);
+    snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
     if (r == SP_OK) r = sp_dragon_export(k->dragon, glb, &err);
     if (r == SP_OK) {
         // The export evaluates poses of its own: pose the dragon again for the picture.
@@ -126,8 +142,8 @@ void kiosk_run_save(sp_kiosk* k)
         k->posed = false;
         if (r == SP_OK) r = kiosk_postcard(k, code, &img, &err);
         if (r == SP_OK) r = sp_image_write_png(&img, png, &err);
-        if (r != SP_OK) unlink(glb); // the visitor gets no code, so no file may carry it
     }
+    if (r != SP_OK && claimed) unlink(glb); // the visitor gets no code, so no file may carry it
     sp_image_free(&img);
     if (r == SP_OK) {
         ++k->stats.saves;

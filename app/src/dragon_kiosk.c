@@ -255,6 +255,18 @@ static void frame(app* a, double t, bool render)
     }
 }
 
+// Where the save codes start: two kiosks started in the same second (one
+// export folder on a share) start apart; a code is claimed on the disk anyway.
+static uint64_t code_seed(void)
+{
+    char host[256] = "";
+    uint64_t h = 1469598103934665603ull; // FNV-1a
+    if (gethostname(host, sizeof host - 1) == 0)
+        for (const char* c = host; *c; ++c)
+            h = (h ^ (unsigned char)*c) * 1099511628211ull;
+    return (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32) ^ h;
+}
+
 static double quantile(const double* v, int n, double q)
 {
     if (n <= 0) return 0;
@@ -691,7 +703,7 @@ int main(int argc, char** argv)
                                .join_ms = isnan(join_ms) ? 0
                                           : join_ms > 0  ? join_ms
                                                          : -1},
-                        .code_seed = script ? 1 : (uint64_t)time(NULL),
+                        .code_seed = script ? 1 : code_seed(),
                         .lod_triangles = lod,
                         .max_parts = max_parts,
                         .keep_saves_days = keep_days,

@@ -2013,6 +2013,50 @@ static void test_saves_disk(void)
     }
 }
 
+// A save code names one visitor's dragon for good: each is claimed on the
+// disk (another kiosk saving into the folder skips it), and a folder whose
+// next 1000 codes are all taken refuses the save, where the last code
+// tried, one already given out, was written over (an outside review).
+static void test_save_codes_never_reused(void)
+{
+    six_strokes();
+    char db[1100], cmd[2400];
+    e2e_db_copy("kiosk_codes.db", db, sizeof db);
+    const char* ex = sp_test_tmp_path("kiosk_codes_ex");
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir '%s'", ex, ex);
+    ENSURE(system(cmd) == 0);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k =
+        inproc_kiosk_desc((sp_kiosk_desc){.db_path = db, .export_dir = ex, .code_seed = 77, .no_collect = true}, &gl, &t);
+    uint64_t start = k->code_state;
+    sp_error err = {0};
+    char code[8], first[8] = "";
+    for (int i = 0; i < 1000; ++i) {
+        ENSURE(kiosk_claim_code(k, code, &err) == SP_OK);
+        if (i == 0) snprintf(first, sizeof first, "%s", code);
+    }
+    snprintf(cmd, sizeof cmd, "test $(ls -A '%s' | wc -l) -eq 1000 && test -z \"$(find '%s' -type f -size +0)\"", ex, ex);
+    ENSURE(system(cmd) == 0); // 1000 codes, each an empty claim
+    k->code_state = start;    // the same codes again: each taken
+    ENSURE(kiosk_claim_code(k, code, &err) == SP_ERR_IO);
+    fprintf(stderr, "  %s\n", err.text);
+    ENSURE(strstr(err.text, "no free save code in 1000 tries"));
+    k->code_state = start;
+    ENSURE(!draw_and_save(k, &t) && sp_kiosk_stats_of(k)->save_failures == 1);
+    ENSURE(system(cmd) == 0); // nothing written over, nothing added
+    // One code freed: the save takes it, as the visitor's own.
+    char path[1300];
+    snprintf(path, sizeof path, "%s/%s.glb", ex, first);
+    ENSURE(unlink(path) == 0);
+    k->code_state = start;
+    ENSURE(draw_and_save(k, &t));
+    snprintf(path, sizeof path, "%s/%s", ex, first);
+    ENSURE(!strcmp(sp_kiosk_last_save(k), path));
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 // A curator's tool holds the database's write lock while a visitor leaves
 // (a `db train` committing its model): the kiosk goes on, its writer tries
 // the sketch again until the lock is gone, and stores it; a sketch still
@@ -2623,6 +2667,7 @@ int main(int argc, char** argv)
                                    {"collect_before_pipeline", test_collect_before_pipeline},
                                    {"older_schema", test_older_schema},
                                    {"saves_disk", test_saves_disk},
+                                   {"save_codes_never_reused", test_save_codes_never_reused},
                                    {"parts_row_follows", test_parts_row_follows},
                                    {"long_category", test_long_category},
                                    {"parts_loaded_while_idle", test_parts_loaded_while_idle},
