@@ -126,6 +126,42 @@ void sp_curve_smooth(const sp_vec2* pts, int n, bool closed, int iterations, sp_
     }
 }
 
+static double seg_dist2(sp_vec2 x, sp_vec2 a, sp_vec2 b);
+
+int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_share)
+{
+    enum { M = 64 }; // samples along the stroke: a stretch's share is counted in 64ths
+    if (n < 4 || !(tol > 0) || !sp_curve_is_valid(pts, n)) return n;
+    double len = sp_curve_length(pts, n, false);
+    sp_vec2 r[M];
+    if (!(len > 0) || sp_curve_resample(pts, n, false, M, r) != SP_OK) return n;
+    double step = len / (M - 1);
+    // A sample's own neighbourhood along the stroke does not count (a turn
+    // back comes within tol of itself there without going over anything).
+    int w = (int)fmin(M, ceil(2.0 * tol / step));
+    if (w < 1) w = 1;
+    bool on[M] = {false};
+    for (int i = w + 1; i < M; ++i)
+        for (int j = 0; j + 1 <= i - w && !on[i]; ++j)
+            on[i] = seg_dist2(r[i], r[j], r[j + 1]) < tol * tol;
+    int last = M - (int)ceil(fmax(0.0, min_share) * (M - 1)); // the stretch's earliest start
+    for (int c = w + 1; c <= last && c < M; ++c) {
+        if (!on[c]) continue;
+        int count = 0;
+        for (int i = c; i < M; ++i)
+            count += on[i];
+        if (count < 0.9 * (M - c)) continue;
+        // The first input point at or past the sample's arc length.
+        double at = c * step, s = 0.0;
+        for (int k = 1; k < n; ++k) {
+            s += sp_v2_len(sp_v2_sub(pts[k], pts[k - 1]));
+            if (s >= at - 1e-9 * len) return k + 1;
+        }
+        return n;
+    }
+    return n;
+}
+
 // Cost of one ordered candidate; stops early once it cannot beat `best`
 // (a tie keeps the earlier candidate, so stopping at equality is exact).
 static double ordered_cost(const sp_vec2* y, const sp_vec2* z, int m, bool reversed, int shift, double best)

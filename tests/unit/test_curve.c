@@ -186,6 +186,57 @@ static void test_clean_smooth(void)
     ENSURE_NEAR(sq[0].y, 0.5, 1e-12);
 }
 
+// Strokes that go over themselves (a loop gone round twice, a line out and
+// back) and strokes that only come near themselves (a closing overlap, a
+// spiral, stick legs drawn down, up and down again).
+static void test_retrace_start(void)
+{
+    enum { N = 400 };
+    static sp_vec2 p[N];
+    // An oval gone round twice, its second turn 3 px outside the first: cut after one turn.
+    for (int i = 0; i < N; ++i) {
+        double a = 4 * M_PI * i / (N - 1), grow = 3.0 * i / (N - 1);
+        p[i] = (sp_vec2){500 + (200 + grow) * cos(a), 400 + (85 + grow) * sin(a)};
+    }
+    int r = sp_curve_retrace_start(p, N, 10, 0.25);
+    fprintf(stderr, "  oval twice: keep %d of %d\n", r, N);
+    ENSURE(r >= N / 2 - 4 && r <= N / 2 + 8);
+    // 1.2 turns: the overlap of a closed outline stays.
+    for (int i = 0; i < N; ++i) {
+        double a = 2.4 * M_PI * i / (N - 1);
+        p[i] = (sp_vec2){500 + 200 * cos(a), 400 + 85 * sin(a)};
+    }
+    ENSURE(sp_curve_retrace_start(p, N, 10, 0.25) == N);
+    // A wavy line out and back along itself (2 px beside it): cut at the turn.
+    for (int i = 0; i < N; ++i) {
+        double u = i < N / 2 ? i / (N / 2.0 - 1) : 1 - (i - N / 2) / (N / 2.0 - 1);
+        p[i] = (sp_vec2){100 + 600 * u, 300 + 40 * sin(6 * u) + (i >= N / 2 ? 2 : 0)};
+    }
+    r = sp_curve_retrace_start(p, N, 10, 0.25);
+    fprintf(stderr, "  out and back: keep %d of %d\n", r, N);
+    ENSURE(r >= N / 2 - 4 && r <= N / 2 + 12);
+    // Stick legs: down, up the same line, down another 60 px away: not a retrace.
+    for (int i = 0; i < N; ++i) {
+        int leg = i * 3 / N;
+        double u = (i - leg * N / 3.0) / (N / 3.0);
+        p[i] = leg == 0   ? (sp_vec2){300, 200 + 200 * u}
+               : leg == 1 ? (sp_vec2){300, 400 - 200 * u}
+                          : (sp_vec2){300 + 60 * u, 200 + 200 * u};
+    }
+    ENSURE(sp_curve_retrace_start(p, N, 10, 0.25) == N);
+    // A spiral of three rings 20 px apart.
+    for (int i = 0; i < N; ++i) {
+        double a = 6 * M_PI * i / (N - 1);
+        p[i] = (sp_vec2){500 + (20 + 20 * a / (2 * M_PI)) * cos(a), 400 + (20 + 20 * a / (2 * M_PI)) * sin(a)};
+    }
+    ENSURE(sp_curve_retrace_start(p, N, 10, 0.25) == N);
+    // Too few points, no tolerance, no length.
+    ENSURE(sp_curve_retrace_start(p, 3, 10, 0.25) == 3 && sp_curve_retrace_start(p, N, 0, 0.25) == N);
+    for (int i = 0; i < 8; ++i)
+        p[i] = (sp_vec2){7, 7};
+    ENSURE(sp_curve_retrace_start(p, 8, 10, 0.25) == 8);
+}
+
 static void circle(sp_vec2* p, int m, double cx, double cy, double r, double phase)
 {
     for (int i = 0; i < m; ++i) {
@@ -788,6 +839,7 @@ int main(int argc, char** argv)
                                    {"resample_degenerate", test_resample_degenerate},
                                    {"resample_million", test_resample_million},
                                    {"clean_smooth", test_clean_smooth},
+                                   {"retrace_start", test_retrace_start},
                                    {"ordered_direction", test_ordered_direction},
                                    {"ordered_cyclic_shift", test_ordered_cyclic_shift},
                                    {"closest_both_ways", test_closest_both_ways},

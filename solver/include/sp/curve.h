@@ -75,6 +75,15 @@ sp_result sp_curve_resample(const sp_vec2* pts, int n, bool closed, int m, sp_ve
 /// first). out: up to n points; may equal pts (in place). Returns the number of points written (0 when n <= 0).
 int sp_curve_clean(const sp_vec2* pts, int n, double min_step, sp_vec2* out);
 
+/// Where a stroke starts going over itself again: the first point of the
+/// last stretch (at least `min_share` of its length) that lies, all but a
+/// tenth of it, within `tol` pixels of the stroke before it: a loop gone
+/// round twice, a line drawn out and back along itself. Returns how many
+/// points to keep, the stretch cut off (pts[0 .. r-1], r >= 2), or n when
+/// the stroke does not go over itself (n < 4, tol <= 0 or a length of 0
+/// included). O(n + 64^2).
+int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_share);
+
 /// Light Laplacian smoothing: `iterations` passes of (1/4, 1/2, 1/4) over
 /// neighbours. Open polylines keep their end points; closed ones wrap.
 /// out: n points; may equal pts (in place). n < 3 copies the input.
