@@ -2853,6 +2853,48 @@ static void test_gone_over_twice(void)
     sp_db_close(db);
 }
 
+// The canvas box of detail i's points as posed (after sp_dragon_pose_at);
+// false when it is not shown.
+static bool detail_box(const sp_dragon* d, int i, sp_vec2* lo, sp_vec2* hi)
+{
+    sp_dragon_detail e;
+    if (!sp_dragon_detail_get(d, i, &e) || !e.xyz) return false;
+    *lo = (sp_vec2){INFINITY, INFINITY}, *hi = (sp_vec2){-INFINITY, -INFINITY};
+    const sp_camera cam = sp_dragon_camera(d);
+    for (int j = 0; j < e.point_count; ++j) {
+        sp_vec2 p = sp_camera_project(&cam, (sp_vec3){e.xyz[3 * j], e.xyz[3 * j + 1], e.xyz[3 * j + 2]});
+        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y);
+    }
+    return true;
+}
+
+// An eye drawn in a head drawn first, which the classifier took for a
+// body, then the body: the head is decided again and its eye goes with it
+// (it was hidden for good: bound to the body fit the head no longer had).
+// Undo of the body gives the first fit back, and the eye as it was bound.
+static void test_ink_follows_its_part(void)
+{
+    const char* path = real_db();
+    sp_db* db = NULL;
+    sp_dragon* d = dragon_and_db(path, &db);
+    sp_error err = {0};
+    draw_data_strokes(d, "kiosk_head_first_eye", 3, 1);
+    ENSURE(sp_dragon_part_count(d) == 2 && sp_dragon_detail_count(d) == 1);
+    const sp_dragon_part *head = sp_dragon_part_get(d, 0), *body = sp_dragon_part_get(d, 1);
+    fprintf(stderr, "  first stroke: %s, then %s\n", head->category, body->category);
+    ENSURE(!strcmp(head->category, "head") && body->is_torso && head->attached_to == 1);
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK);
+    sp_vec2 lo, hi;
+    ENSURE(detail_box(d, 0, &lo, &hi));
+    fprintf(stderr, "  the eye shown at [%.0f %.0f %.0f %.0f] (drawn at about [768 309 782 321])\n", lo.x, lo.y, hi.x, hi.y);
+    ENSURE(fabs(0.5 * (lo.x + hi.x) - 775) < 12 && fabs(0.5 * (lo.y + hi.y) - 315) < 12 && hi.x - lo.x > 8 && hi.x - lo.x < 30);
+    ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == 1 && sp_dragon_part_get(d, 0)->is_torso);
+    ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK && detail_box(d, 0, &lo, &hi));
+    ENSURE(fabs(0.5 * (lo.x + hi.x) - 775) < 12 && fabs(0.5 * (lo.y + hi.y) - 315) < 12);
+    sp_dragon_destroy(d);
+    sp_db_close(db);
+}
+
 // The visitors' tails these tests draw out of a body's end.
 static const char* const k_end_tails[4] = {"tail/tail-outline-spade.json", "tail/tail-outline-flame.json",
                                            "tail/tail-line-curl.json", "tail/tail-wavy-line.json"};
@@ -5117,6 +5159,7 @@ int main(int argc, char** argv)
                                    {"body_with_a_part_stays", test_body_with_a_part_stays},
                                    {"decorations_on_the_body", test_decorations_on_the_body},
                                    {"gone_over_twice", test_gone_over_twice},
+                                   {"ink_follows_its_part", test_ink_follows_its_part},
                                    {"root_at_the_body", test_root_at_the_body},
                                    {"reaches_the_body", test_reaches_the_body},
                                    {"on_the_back_not_a_spike", test_on_the_back_not_a_spike},

@@ -12,9 +12,12 @@
 
 static void detail_free(detail* e)
 {
-    if (!e) return;
-    free(e->tri);
-    free(e);
+    while (e) {
+        detail* alt = e->alt;
+        free(e->tri);
+        free(e);
+        e = alt;
+    }
 }
 
 // Barycentric coordinates of p in the canvas triangle abc (false when it has no area).
@@ -257,14 +260,13 @@ static int bind_points(const sp_dragon* d, const part* q, const detail_hit* hit,
     return k;
 }
 
-int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n)
+// The points (n canvas points) bound to part q's mesh as shown (hit: its
+// tolerance and what becomes of points off it): a detail without an id, or
+// NULL when fewer than two points bind or memory runs out.
+static detail* bind_detail(sp_dragon* d, const part* q, const detail_hit* hit, const sp_vec2* pts, int n)
 {
-    int k = hit->part;
-    if (k < 0 || k >= d->part_n || !hit->xyz || !hit->px || n < 2 || d->detail_n >= SP_DRAGON_MAX_DETAILS) return -1;
-    const part* q = d->parts[k];
     const sp_rig* rig = &q->t->ch.rig;
-    if (rig->vertex_count <= 0 || rig->triangle_count <= 0) return -1;
-    if (!d->details && !(d->details = calloc(SP_DRAGON_MAX_DETAILS, sizeof(detail*)))) return -1;
+    if (rig->vertex_count <= 0 || rig->triangle_count <= 0 || n < 2) return NULL;
     // A long stroke is resampled along its length: the ink's shape, not every pen sample.
     int m = n <= SP_DRAGON_DETAIL_POINTS ? n : SP_DRAGON_DETAIL_POINTS;
     detail* e = calloc(1, sizeof *e);
@@ -275,37 +277,125 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     uint32_t* block = malloc(sizeof(uint32_t) * 8 * mm + sizeof(double) * 16 * mm);
     if (!e || (m < n && !rs) || !block || (rs && sp_curve_resample(pts, n, false, m, rs) != SP_OK)) {
         free(e), free(rs), free(block);
-        return -1;
+        return NULL;
     }
     e->tri = block, e->joint = block + 4 * mm;
     e->bary = (double*)(void*)(block + 8 * mm); // 8m uint32s keep the doubles aligned
     e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
     e->drawn = (sp_vec2*)(void*)(e->normal + 3 * mm);
     e->weight = (double*)(void*)(e->drawn + mm);
-    // Bound to the part as the visitor saw it while drawing (posed at the
-    // dragon's clock), not at its fit, which a clip's pose moves (a tail's
-    // sway starts off rest). The parts only: what the caller posed and
-    // reads stays as it was.
+    // Bound to the part as the visitor sees it (posed at the dragon's
+    // clock), not at its fit, which a clip's pose moves (a tail's sway
+    // starts off rest). The parts only: what the caller posed and reads
+    // stays as it was.
     dragon_pose_shown(d);
     sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
     for (int v = 0; px && v < rig->vertex_count; ++v)
         px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
     detail_hit shown = *hit;
     shown.xyz = q->xyz, shown.px = px;
-    // Within the tolerance the detail test used.
+    // Within the tolerance the caller's test used.
     e->n = px ? bind_points(d, q, &shown, rs ? rs : pts, m, e) : 0;
     free(rs), free(px);
     if (e->n < 2) {
         detail_free(e);
-        return -1;
+        return NULL;
     }
-    e->id = d->next_id++;
     e->host = q->pub.id;
     e->t = q->t;
     e->fit0 = q->world_fit;
     e->mirrored = q->pub.mirrored;
+    return e;
+}
+
+int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n)
+{
+    int k = hit->part;
+    if (k < 0 || k >= d->part_n || !hit->xyz || !hit->px || n < 2 || d->detail_n >= SP_DRAGON_MAX_DETAILS) return -1;
+    if (!d->details && !(d->details = calloc(SP_DRAGON_MAX_DETAILS, sizeof(detail*)))) return -1;
+    detail* e = bind_detail(d, d->parts[k], hit, pts, n);
+    if (!e) return -1;
+    e->id = d->next_id++;
     d->details[d->detail_n] = e;
     return d->detail_n++;
+}
+
+// Canvas point x moved by the world transform m (the canvas is the world's front view).
+static sp_vec2 moved_px(const sp_dragon* d, const sp_mat4* m, sp_vec2 x)
+{
+    sp_vec3 o, dir;
+    sp_camera_ray(&d->world, x, &o, &dir);
+    return sp_camera_project(&d->world, sp_mat4_point(m, o));
+}
+
+// The transform from where detail e was drawn to where part q (which shows
+// it) is laid out now; false when q has not moved since.
+static bool ink_moved(const detail* e, const part* q, sp_mat4* m)
+{
+    sp_mat4 inv;
+    if (!memcmp(&q->world_fit, &e->fit0, sizeof *m) || !sp_mat4_inverse(&e->fit0, &inv)) return false;
+    *m = sp_mat4_mul(&q->world_fit, &inv);
+    return true;
+}
+
+static bool binds(const detail* e, const part* q)
+{
+    return e->t == q->t && e->mirrored == q->pub.mirrored;
+}
+
+// Ink bound anew to another fit of its part snaps onto that mesh within
+// this share of its own size (the detail test's own-size tolerance).
+#define DETAIL_FOLLOW_NEAR 0.3
+
+// Bindings kept of one detail: the part decided again, then turned, then
+// given back; a longer chain loses its oldest.
+enum { DETAIL_BINDINGS = 4 };
+
+static void details_follow(sp_dragon* d, int k, const part* was)
+{
+    const part* q = d->parts[k];
+    for (int i = 0; i < d->detail_n; ++i) {
+        detail* e = d->details[i];
+        if (e->host != q->pub.id || binds(e, q)) continue;
+        // A binding to this fit kept from before (the part given back): first again.
+        detail *prev = e, *b = e->alt;
+        while (b && !binds(b, q))
+            prev = b, b = b->alt;
+        if (b) {
+            prev->alt = b->alt, b->alt = e;
+            d->details[i] = b;
+            continue;
+        }
+        // Else bound anew where it shows on the part it was bound to, as if
+        // drawn there now (an eye drawn in a head taken for a body, which
+        // the body drawn next made a head, was hidden for good).
+        if (!was || !binds(e, was)) continue;
+        sp_vec2* at = malloc(sizeof(sp_vec2) * (size_t)e->n);
+        if (!at) continue;
+        sp_mat4 m;
+        bool moved = ink_moved(e, was, &m);
+        for (int j = 0; j < e->n; ++j)
+            at[j] = moved ? moved_px(d, &m, e->drawn[j]) : e->drawn[j];
+        sp_vec2 lo = at[0], hi = at[0];
+        for (int j = 1; j < e->n; ++j)
+            lo.x = fmin(lo.x, at[j].x), lo.y = fmin(lo.y, at[j].y), hi.x = fmax(hi.x, at[j].x), hi.y = fmax(hi.y, at[j].y);
+        // Its points off the new mesh go with it in the air (a flourish's
+        // way): ink the visitor drew is not dropped.
+        detail_hit hit = {
+            .part = k, .near = DETAIL_FOLLOW_NEAR * hypot(hi.x - lo.x, hi.y - lo.y) + 1.0, .air = DETAIL_AIR_TOGETHER};
+        detail* nb = bind_detail(d, q, &hit, at, e->n);
+        free(at);
+        if (!nb) continue;
+        nb->id = e->id;
+        nb->alt = e;
+        d->details[i] = nb;
+        int depth = 0;
+        for (detail* c = nb; c; c = c->alt)
+            if (++depth == DETAIL_BINDINGS && c->alt) {
+                detail_free(c->alt);
+                c->alt = NULL;
+            }
+    }
 }
 
 static const part* host_of(const sp_dragon* d, const detail* e, int* index)
@@ -319,14 +409,6 @@ static const part* host_of(const sp_dragon* d, const detail* e, int* index)
     return NULL;
 }
 
-// Canvas point x moved by the world transform m (the canvas is the world's front view).
-static sp_vec2 moved_px(const sp_dragon* d, const sp_mat4* m, sp_vec2 x)
-{
-    sp_vec3 o, dir;
-    sp_camera_ray(&d->world, x, &o, &dir);
-    return sp_camera_project(&d->world, sp_mat4_point(m, o));
-}
-
 double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p)
 {
     double best = INFINITY;
@@ -334,12 +416,11 @@ double dragon_ink_distance(const sp_dragon* d, uint64_t host, sp_vec2 p)
         const detail* e = d->details[i];
         int k;
         const part* q = e->host == host ? host_of(d, e, &k) : NULL;
-        if (!q || q->t != e->t || q->pub.mirrored != e->mirrored) continue; // not shown
+        if (!q || !binds(e, q)) continue; // not shown
         // Its part laid out again since (attached elsewhere, or freed): the
         // ink is shown where the part's move takes it, not where it was drawn.
-        sp_mat4 inv, m = {{0}};
-        bool moved = memcmp(&q->world_fit, &e->fit0, sizeof m) != 0 && sp_mat4_inverse(&e->fit0, &inv);
-        if (moved) m = sp_mat4_mul(&q->world_fit, &inv);
+        sp_mat4 m = {{0}};
+        bool moved = ink_moved(e, q, &m);
         sp_vec2 a = moved ? moved_px(d, &m, e->drawn[0]) : e->drawn[0];
         for (int j = 0; j + 1 < e->n; ++j) {
             sp_vec2 b = moved ? moved_px(d, &m, e->drawn[j + 1]) : e->drawn[j + 1];
@@ -375,6 +456,12 @@ void dragon_details_pose(sp_dragon* d)
             memcpy(e->normal + 3 * j, &(double[3]){nrm.x, nrm.y, nrm.z}, sizeof(double) * 3);
         }
     }
+}
+
+void dragon_details_follow_parts(sp_dragon* d)
+{
+    for (int k = 0; k < d->part_n; ++k)
+        details_follow(d, k, d->parts[k]->before);
 }
 
 int dragon_detail_skinned(const sp_dragon* d, int i, double* rest, uint16_t* joints, float* weights)

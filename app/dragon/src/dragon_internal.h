@@ -199,6 +199,9 @@ typedef struct detail {
     sp_vec2* drawn;       // n: where each point was drawn on the canvas
     sp_mat4 fit0;         // the part's world_fit when drawn (a part laid out again since moves its ink with it)
     bool shown;           // posed and its part as bound
+    // The same ink bound to another fit of its part (before the part was
+    // decided again or turned; dragon_details_follow), newest first.
+    struct detail* alt;
 } detail;
 
 struct sp_dragon {
@@ -375,6 +378,13 @@ bool dragon_fit_reaching(sp_dragon* d, part* p, sp_vec2 target);
 /// dragon_detail_of found it on: its index, or -1 when the dragon holds
 /// SP_DRAGON_MAX_DETAILS, fewer than two points can be bound, or memory runs out.
 int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, int n);
+/// The ink on each part follows it when the part is another fit of its
+/// stroke than the ink was bound to (decided again, turned, or given back
+/// by an Undo; the same id): a binding to its fit kept from before comes
+/// first again, else the ink is bound anew to it where it shows on the fit
+/// it replaced (part.before), laid out as it was. After a stroke's
+/// changes, when the parts are where they end.
+void dragon_details_follow_parts(sp_dragon* d);
 /// The distance on the canvas from p to the ink kept on the part with this
 /// id, as drawn, moved with the part when it was laid out again since
 /// (INFINITY when it has none shown).

@@ -1229,6 +1229,7 @@ sp_result sp_dragon_add_points(sp_dragon* d, const sp_vec2* xy, int count, const
     // wings turn to face the way it does.
     const part* last = d->parts[d->part_n - 1];
     if (last->t->lengthwise && last->pub.attached_to >= 0) parts_by_place(d, last->pub.attached_to, last->pub.id);
+    dragon_details_follow_parts(d); // parts fitted again, laid out where they end
     if (drop_detail) dragon_detail_remove(d, drop_detail);
     out->part = d->part_n - 1;
     out->rejected = false;
@@ -1275,6 +1276,7 @@ bool sp_dragon_undo(sp_dragon* d)
     give_back_fits(d, last->pub.id);
     dragon_part_free(last);
     dragon_relayout(d);
+    dragon_details_follow_parts(d);
     return true;
 }
 
