@@ -128,6 +128,10 @@ void sp_curve_smooth(const sp_vec2* pts, int n, bool closed, int iterations, sp_
 
 static double seg_dist2(sp_vec2 x, sp_vec2 a, sp_vec2 b);
 
+// A stretch that goes over the stroke before it is at least this share of
+// the length it goes over.
+#define RETRACE_MIN_LENGTH 0.7
+
 int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_share)
 {
     enum { M = 64 }; // samples along the stroke: a stretch's share is counted in 64ths
@@ -140,17 +144,34 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
     // back comes within tol of itself there without going over anything).
     int w = (int)fmin(M, ceil(2.0 * tol / step));
     if (w < 1) w = 1;
-    bool on[M] = {false};
-    for (int i = w + 1; i < M; ++i)
-        for (int j = 0; j + 1 <= i - w && !on[i]; ++j)
-            on[i] = seg_dist2(r[i], r[j], r[j + 1]) < tol * tol;
+    // first[i]: the first segment (r[j], r[j+1]) of the stroke before sample
+    // i that it lies within tol of; M when none.
+    int first[M];
+    for (int i = 0; i < M; ++i) {
+        first[i] = M;
+        for (int j = 0; j + 1 <= i - w && first[i] == M; ++j)
+            if (seg_dist2(r[i], r[j], r[j + 1]) < tol * tol) first[i] = j;
+    }
     int last = M - (int)ceil(fmax(0.0, min_share) * (M - 1)); // the stretch's earliest start
     for (int c = w + 1; c <= last && c < M; ++c) {
-        if (!on[c]) continue;
+        // Over the stroke up to c, not over itself: shading drawn back and
+        // forth goes over its last pass only, and is not drawn once.
+        if (first[c] + 1 > c) continue;
         int count = 0;
         for (int i = c; i < M; ++i)
-            count += on[i];
+            count += first[i] + 1 <= c;
         if (count < 0.9 * (M - c)) continue;
+        // Going over a stretch follows it about its length: a line drawn
+        // straight back through a zigzag (closing it into a shape) comes
+        // within tol of all of it in half its length.
+        int covered = 0;
+        for (int j = 0; j < c; ++j) {
+            bool near = false;
+            for (int i = c; i < M && !near; ++i)
+                near = seg_dist2(r[i], r[j], r[j + 1]) < tol * tol;
+            covered += near;
+        }
+        if (M - 1 - c < RETRACE_MIN_LENGTH * covered) continue;
         // The first input point at or past the sample's arc length.
         double at = c * step, s = 0.0;
         for (int k = 1; k < n; ++k) {

@@ -230,6 +230,19 @@ static void test_retrace_start(void)
         p[i] = (sp_vec2){500 + (20 + 20 * a / (2 * M_PI)) * cos(a), 400 + (20 + 20 * a / (2 * M_PI)) * sin(a)};
     }
     ENSURE(sp_curve_retrace_start(p, N, 10, 0.25) == N);
+    // Shading drawn back and forth, each pass a little lower (as a child
+    // colours in): each pass goes over the last one only.
+    for (int i = 0; i < 200; ++i)
+        p[i] = (sp_vec2){500 - 15 + 30 * fabs(fmod(i * 0.37, 2.0) - 1), 400 - 12 + 0.12 * i};
+    ENSURE(sp_curve_retrace_start(p, 200, 3, 0.25) == 200);
+    // Teeth 22 px tall, closed by a straight line back through their middle:
+    // within tol of every tooth, in half their length.
+    int m = 0;
+    for (double x = 0; x <= 280; x += 4, ++m)
+        p[m] = (sp_vec2){300 + x, 300 - (2 + 22 * (1 - fabs(2 * fmod(x, 28) / 28 - 1)))};
+    for (double x = 280; x >= 0; x -= 4)
+        p[m++] = (sp_vec2){300 + x, 300 - 12};
+    ENSURE(sp_curve_retrace_start(p, m, 7.3, 0.25) == m);
     // Too few points, no tolerance, no length.
     ENSURE(sp_curve_retrace_start(p, 3, 10, 0.25) == 3 && sp_curve_retrace_start(p, N, 0, 0.25) == N);
     for (int i = 0; i < 8; ++i)
