@@ -81,12 +81,12 @@ static bool out_overwrites(const char* cmd, const char* out_name, const char* ou
 {
     for (int k = 0; k < f->count; ++k)
         if (same_file(out, f->files[k])) {
-            fprintf(stderr, "%s: %s %s is a file that %s %s reads (%s): it would be overwritten\n", cmd, out_name, out, in_name,
-                    in, f->files[k]);
+            sp_cli_say("%s: %s %s is a file that %s %s reads (%s): it would be overwritten", cmd, out_name, out, in_name, in,
+                       f->files[k]);
             return true;
         }
     if (!same_file(out, in)) return false;
-    fprintf(stderr, "%s: %s %s is the same file as %s: it would be overwritten\n", cmd, out_name, out, in_name);
+    sp_cli_say("%s: %s %s is the same file as %s: it would be overwritten", cmd, out_name, out, in_name);
     return true;
 }
 
@@ -103,7 +103,7 @@ bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out,
 static bool outs_clash(const char* cmd, const sp_opt* opts, int i, int j, const char* out, const char* other)
 {
     if (j > i || !same_file(out, other)) return false;
-    fprintf(stderr, "%s: %s %s is the same file as %s: one would overwrite the other\n", cmd, opts[i].name, out, opts[j].name);
+    sp_cli_say("%s: %s %s is the same file as %s: one would overwrite the other", cmd, opts[i].name, out, opts[j].name);
     return true;
 }
 
@@ -327,7 +327,7 @@ bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path
         // (`>&-`) would be whatever it opens next, a database, say.
         free(real);
         if (fcntl(fd, F_GETFD) != -1) return true;
-        fprintf(stderr, "%s: %s %s: descriptor %d is not open (nothing to write into)\n", cmd, name, path, fd);
+        sp_cli_say("%s: %s %s: descriptor %d is not open (nothing to write into)", cmd, name, path, fd);
         return false;
     }
     if (sp_cli_out_is_stream(path)) {
@@ -356,10 +356,10 @@ bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path
     else if (probe)
         close(pfd), unlink(probe);
     free(probe);
-    if (why) fprintf(stderr, "%s: %s %s: cannot write into folder '%s' (%s)\n", cmd, name, path, dir, why);
+    if (why) sp_cli_say("%s: %s %s: cannot write into folder '%s' (%s)", cmd, name, path, dir, why);
     free(dir);
     if (!why && stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        fprintf(stderr, "%s: %s %s: is a folder, not a file\n", cmd, name, path);
+        sp_cli_say("%s: %s %s: is a folder, not a file", cmd, name, path);
         return false;
     }
     return why == NULL;
@@ -373,15 +373,15 @@ bool sp_cli_check_out(const char* cmd, const char* name, const char* path, sp_cl
     if (sp_cli_out_is_stream(path)) return true;
     if (kind == SP_CLI_OUT_GLTF) {
         if (sp_path_ext_is(path, "glb") || sp_path_ext_is(path, "gltf")) return true;
-        fprintf(stderr, "%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'\n", cmd, name, path);
+        sp_cli_say("%s: %s writes glTF: the file name must end in .glb or .gltf, got '%s'", cmd, name, path);
     } else if (kind == SP_CLI_OUT_PNG) {
         if (sp_path_ext_is(path, "png")) return true;
-        fprintf(stderr, "%s: %s writes a PNG: the file name must end in .png, got '%s'\n", cmd, name, path);
+        sp_cli_say("%s: %s writes a PNG: the file name must end in .png, got '%s'", cmd, name, path);
     } else {
         // The drawing readers (classify, db add-sketch, labelled folders) tell
         // a stroke file from SVG, PNG and ndjson by this name.
         if (sp_path_ext_is(path, "json")) return true;
-        fprintf(stderr, "%s: %s writes a stroke file (JSON): the file name must end in .json, got '%s'\n", cmd, name, path);
+        sp_cli_say("%s: %s writes a stroke file (JSON): the file name must end in .json, got '%s'", cmd, name, path);
     }
     return false;
 }
@@ -408,6 +408,16 @@ void sp_cli_print_shell_word(FILE* f, const char* s)
             fputc(*c, f);
     }
     fputc('\'', f);
+}
+
+void sp_cli_say(const char* fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    sp_text_vline(line, sizeof line, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "%s\n", line);
 }
 
 static char g_done[512];

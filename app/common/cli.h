@@ -97,6 +97,16 @@ bool sp_cli_stdout_taken(const char* const* outs, int n);
 /// images): for inputs that are not options (sp_cli_parse checks those).
 bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out, const char* in_name, const char* in);
 
+/// One line on stderr, printf-style, its control characters escaped
+/// (sp_text_escape_controls): for messages that quote a path or a name
+/// someone typed (a newline in it split the line, an escape code drove the
+/// terminal: an outside review). At most 1023 bytes.
+void sp_cli_say(const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
 /// For outputs written at the end of work (a solve, a kiosk session): NULL
 /// and streams pass; otherwise the file's folder must exist and be writable
 /// by this user, else "<cmd>: <name> <path>: cannot write into folder 'dir'

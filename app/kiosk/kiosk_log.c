@@ -7,10 +7,10 @@
 
 void sp_kiosk_log(const char* fmt, ...)
 {
-    char msg[2048];
+    char msg[1024]; // sp_text_escape_controls's most
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sp_text_vline(msg, sizeof msg, fmt, ap); // one line, whatever a path in it holds
     va_end(ap);
     // UTC: a kiosk's log outlives daylight saving changes and is read next to other machines'.
     char when[32] = "";

@@ -145,11 +145,13 @@ static inline bool clf_cli_drop_no_extent(const char* cmd, const char* dir, sp_d
 {
     int n = sp_dataset_drop_no_extent(ds);
     if (n > 0)
-        fprintf(stderr, "%s: warning: %s: %d drawing%s left out: no extent (no points, or all at one place)\n", cmd, dir, n,
-                n == 1 ? "" : "s");
+        fprintf(stderr,
+                "%s: warning: %s: %d drawing%s left out: no extent (no points, or all at one place; a picture with no dark "
+                "lines)\n",
+                cmd, dir, n, n == 1 ? "" : "s");
     if (ds->count > 0) return true;
     sp_dataset_free(ds);
-    sp_fail(err, SP_ERR_INVALID, "%s: no drawing with an extent (all points at one place, or none)", dir);
+    sp_fail(err, SP_ERR_INVALID, "%s: no drawing with an extent (all points at one place, or none; pictures all blank)", dir);
     return false;
 }
 

@@ -586,7 +586,7 @@ static sp_result push(sketch_set* s, sp_sample* smp, void* png, size_t png_size,
 // nothing to train on or show: refused, as classify and pose refuse it.
 static sp_result extent_ok(const sp_sample* smp, const char* what, sp_error* err)
 {
-    const char* why = smp->raster.pixels ? NULL : sp_sketch_extent_problem(&smp->sketch);
+    const char* why = smp->raster.pixels ? sp_raster_ink_problem(&smp->raster) : sp_sketch_extent_problem(&smp->sketch);
     return why ? sp_fail(err, SP_ERR_INVALID, "%s: %s", what, why) : SP_OK;
 }
 

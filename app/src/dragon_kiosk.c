@@ -2,6 +2,7 @@
 // sp_kiosk_events; kiosk.h does the rest. With --script the session file is
 // replayed on a virtual clock (its own timestamps, 60 updates a second, every
 // tenth one drawn), so a run is deterministic whatever the machine's speed.
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -267,6 +268,38 @@ static uint64_t code_seed(void)
     return (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32) ^ h;
 }
 
+// The folder Save writes into is made at the first Save, parents and all,
+// so it may be missing; a file in its place, or a nearest existing folder
+// on its way this user may not write into, failed every visitor's Save
+// with one log line (an outside review): said before the window opens.
+static bool export_folder_ok(const char* dir)
+{
+    char* at = strdup(dir);
+    struct stat st;
+    const char* why = NULL;
+    while (at && !why) {
+        if (stat(at, &st) == 0) {
+            why = !S_ISDIR(st.st_mode) ? "not a folder" : access(at, W_OK | X_OK) != 0 ? "this user may not write there" : NULL;
+            break;
+        }
+        if (errno != ENOENT && errno != ENOTDIR) {
+            why = strerror(errno);
+            break;
+        }
+        char* up = sp_path_folder(at); // missing (or under a file): its folder tells
+        bool top = up && !strcmp(up, at);
+        free(at);
+        at = top ? NULL : up;
+    }
+    if (why && !strcmp(at, dir))
+        sp_cli_say("%s: --export-dir %s: %s (Save writes the visitors' dragons there)", k_cmd, dir, why);
+    else if (why)
+        sp_cli_say("%s: --export-dir %s: '%s' on its way is %s (Save makes the folder and writes the visitors' dragons there)",
+                   k_cmd, dir, at, why);
+    free(at);
+    return why == NULL;
+}
+
 static double quantile(const double* v, int n, double q)
 {
     if (n <= 0) return 0;
@@ -416,10 +449,9 @@ static bool has_parts(const char* path, const char* assets, bool collect)
     // Missing, it is built from the assets: without them the kiosk said
     // only "assets: cannot open the folder", after opening its window.
     if (access(path, F_OK) != 0 && (stat(assets, &st) != 0 || !S_ISDIR(st.st_mode))) {
-        fprintf(stderr,
-                "%s: no part database at %s, and no folder '%s' of parts to build one from (give --db DB, or --assets DIR: "
-                "the source tree's assets/)\n",
-                k_cmd, path, assets);
+        sp_cli_say("%s: no part database at %s, and no folder '%s' of parts to build one from (give --db DB, or --assets DIR: "
+                   "the source tree's assets/)",
+                   k_cmd, path, assets);
         return false;
     }
     if (access(path, F_OK) != 0) return true;
@@ -671,7 +703,8 @@ int main(int argc, char** argv)
         return SP_EXIT_USAGE;
     }
     // Written when the session ends: a folder that cannot take them is said now.
-    if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0]))) {
+    if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0])) ||
+        !export_folder_ok(export_dir ? export_dir : "dragon-exports")) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }

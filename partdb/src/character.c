@@ -154,6 +154,12 @@ void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s)
 
 // ---- extras -------------------------------------------------------------
 
+// The largest bounds a channel may have: a move (in the rig's units), a
+// turn (radians; a few turns is plenty) and a scale.
+#define DOF_MOVE_MAX 1e6
+#define DOF_TURN_MAX 100.0
+#define DOF_SCALE_MAX 1e3
+
 static bool json_number(const cJSON* o, const char* key, double* v)
 {
     const cJSON* it = cJSON_GetObjectItemCaseSensitive(o, key);
@@ -218,6 +224,15 @@ sp_result sp_gltf_joint_extras(sp_rig* rig, int joint, const char* json, bool* h
             }
             if (sp_channel_is_scale(c) && !(lo > 0.0)) {
                 r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': scale channel %s needs min > 0 (got %g)", what, jn, cn, lo);
+                goto done;
+            }
+            // Bounds past any pose a part takes: synth and export wrote
+            // strokes and node transforms near 1e300 that our own readers
+            // refuse (an outside curator review).
+            double most = sp_channel_is_scale(c) ? DOF_SCALE_MAX : sp_channel_is_rotation(c) ? DOF_TURN_MAX : DOF_MOVE_MAX;
+            if (fabs(lo) > most || fabs(hi) > most) {
+                r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s has bounds [%g, %g] beyond +-%g", what, jn,
+                            cn, lo, hi, most);
                 goto done;
             }
             sp_group g = sp_channel_is_scale(c) ? SP_GROUP_SHAPE : SP_GROUP_POSE;

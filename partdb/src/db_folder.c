@@ -813,8 +813,14 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
         return sp_fail(err, SP_ERR_INVALID, "%s: exists already (remove it, or use another --db)", path);
     ino_t was = st.st_ino;
     // The empty file itself is replaced: through a link, the file it names
-    // (the link stays), and built beside that one, on its file system.
-    char* real = empty ? realpath(path, NULL) : NULL;
+    // (the link stays), and built beside that one, on its file system. A
+    // link to no file yet (data/sketchpose.db not made) is followed too, as
+    // for every output: the build was linked onto the link's own name,
+    // which link() refuses ("File exists"), after a minute's work (an
+    // outside review).
+    struct stat lst;
+    bool dangling = !empty && lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode);
+    char* real = empty ? realpath(path, NULL) : dangling ? sp_path_follow_links(path) : NULL;
     const char* where = real ? real : path;
     // `<where>.building-<pid>`, or with two more digits when another build
     // holds that name (the first process of two containers is pid 1 in each).
@@ -843,7 +849,7 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     // It keeps the empty file's permissions (mktemp makes it 0600: a
     // database built into it is as private).
     if (r == SP_OK && replace) chmod(tmp, st.st_mode & 07777);
-    if (r == SP_OK && (replace ? rename(tmp, where) : link(tmp, path)) != 0)
+    if (r == SP_OK && (replace ? rename(tmp, where) : link(tmp, where)) != 0)
         r = sp_fail(err, errno == EEXIST ? SP_ERR_BUSY : SP_ERR_IO, "%s: %s", path, strerror(errno));
     else if (r == SP_OK)
         sp_path_sync_folder(where); // SQLite synced the file; its new name too

@@ -847,13 +847,22 @@ const char* sp_sketch_extent_problem(const sp_sketch* s)
     return any ? "the drawing has no extent: all its points are at one place" : "the drawing has no points";
 }
 
+const char* sp_raster_ink_problem(const sp_raster* r)
+{
+    size_t n = r->pixels && r->w > 0 && r->h > 0 ? (size_t)r->w * (size_t)r->h : 0;
+    for (size_t i = 0; i < n; ++i)
+        if (r->pixels[i] < SP_RASTER_INK_BELOW) return NULL;
+    return "the picture has no dark lines (a blank page?)";
+}
+
 int sp_dataset_drop_no_extent(sp_dataset* ds)
 {
     int kept = 0, dropped = 0;
     for (int i = 0; i < ds->count; ++i) {
         sp_sample* smp = &ds->samples[i];
-        if (!smp->raster.pixels && sp_sketch_extent_problem(&smp->sketch)) {
+        if (smp->raster.pixels ? sp_raster_ink_problem(&smp->raster) != NULL : sp_sketch_extent_problem(&smp->sketch) != NULL) {
             sp_sketch_free(&smp->sketch);
+            sp_raster_free(&smp->raster);
             ++dropped;
             continue;
         }

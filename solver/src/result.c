@@ -30,16 +30,21 @@ void sp_text_escape_controls(char* s, size_t cap)
     s[w] = 0;
 }
 
+void sp_text_vline(char* buf, size_t cap, const char* fmt, va_list ap)
+{
+    vsnprintf(buf, cap, fmt, ap);
+    // One line, whatever a file's names hold: a joint named with a newline
+    // and an escape code split a message and cleared the terminal.
+    sp_text_escape_controls(buf, cap);
+}
+
 sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)
 {
     if (err) {
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err->text, sizeof err->text, fmt, ap);
+        sp_text_vline(err->text, sizeof err->text, fmt, ap);
         va_end(ap);
-        // One line, whatever a file's names hold: a joint named with a newline
-        // and an escape code split a message and cleared the terminal.
-        sp_text_escape_controls(err->text, sizeof err->text);
     }
     return code;
 }

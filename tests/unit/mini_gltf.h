@@ -24,6 +24,7 @@ typedef struct mini_desc {
     bool armature;     ///< a non-joint "Armature" node above the root joint
     bool extras;       ///< sp_dofs, an "outline" curve, sp_part and a camera
     bool bad_dofs;     ///< sp_dofs with min > max
+    const char* dofs;  ///< the root's sp_dofs list (JSON) instead, e.g. bounds past reason
     float w1;          ///< weight of vertex 1 (0: 1); e.g. 0.5 needs renormalising
     bool strip;        ///< TRIANGLE_STRIP instead of indexed TRIANGLES
     bool byte_joints;  ///< JOINTS_0 as UNSIGNED_BYTE (in a separate view)
@@ -88,9 +89,11 @@ static char* mini_gltf(const mini_desc* d)
                     : ", \"extras\": {\"sp_dofs\": [{\"channel\": \"rz\", \"min\": -1, \"max\": 1, \"group\": \"pose\"},"
                       " {\"channel\": \"s\", \"min\": 0.5, \"max\": 2, \"group\": \"shape\"},"
                       " {\"channel\": \"tx\", \"min\": -0.25, \"max\": 0.25}]}";
+    char own_dofs[512];
+    if (d->dofs) snprintf(own_dofs, sizeof own_dofs, ", \"extras\": {\"sp_dofs\": %s}", d->dofs), dofs_root = own_dofs;
     const char* dofs_tip = ", \"extras\": {\"sp_dofs\": [{\"channel\": \"rx\", \"min\": -1.5, \"max\": 1.5}, "
                            "{\"channel\": \"rz\", \"min\": -1.5, \"max\": 1.5}]}";
-    bool ex = d->extras || d->bad_dofs;
+    bool ex = d->extras || d->bad_dofs || d->dofs;
     char scene_extras[2048];
     snprintf(scene_extras, sizeof scene_extras, ", \"extras\": {\"sp_part\": %s}",
              d->part ? d->part : "{\"category\": \"tail\", \"attach\": \"back\"}");

@@ -305,6 +305,20 @@ static void test_drop_no_extent(void)
     ENSURE(sp_sketch_extent_problem(&ds.samples[3].sketch) == NULL);
     ENSURE(sp_dataset_drop_no_extent(&ds) == 2 && ds.count == 2);
     ENSURE(ds.samples[0].index == 0 && ds.samples[1].index == 1 && ds.samples[1].sketch.strokes[0].points[1].x == 2);
+    // A blank picture (all white, or grey lighter than the classifier's ink)
+    // goes too; one dark pixel is a drawing (an outside review: a blank PNG
+    // was stored by `db add-sketch` and trained on, which classify refused).
+    for (int k = 0; k < 2; ++k) {
+        sp_sample smp = {.label = l, .raster = {8, 8, malloc(64)}};
+        ENSURE(smp.raster.pixels);
+        memset(smp.raster.pixels, k == 0 ? 255 : SP_RASTER_INK_BELOW, 64);
+        ENSURE(sp_raster_ink_problem(&smp.raster) && sp_dataset_add_sample(&ds, &smp) == SP_OK);
+    }
+    sp_sample inked = {.label = l, .raster = {8, 8, calloc(64, 1)}};
+    ENSURE(inked.raster.pixels);
+    memset(inked.raster.pixels, 255, 63); // one black pixel
+    ENSURE(!sp_raster_ink_problem(&inked.raster) && sp_dataset_add_sample(&ds, &inked) == SP_OK);
+    ENSURE(sp_dataset_drop_no_extent(&ds) == 2 && ds.count == 3 && ds.samples[2].raster.pixels == inked.raster.pixels);
     sp_dataset_free(&ds);
 }
 

@@ -632,6 +632,11 @@ static void test_bad_input(void)
     bad_mini("zero_weights.gltf", (mini_desc){.zero_weights = true}, "weight");
     bad_mini("bad_joint.gltf", (mini_desc){.bad_joint = 5}, "joint 5");
     bad_mini("bad_dofs.gltf", (mini_desc){.bad_dofs = true}, "bounds");
+    // Bounds past any pose: synth and export wrote numbers near 1e300 that
+    // our own readers refuse (an outside curator review).
+    bad_mini("huge_move.gltf", (mini_desc){.dofs = "[{\"channel\": \"tx\", \"min\": -1e300, \"max\": 1e300}]"},
+             "sp_dofs channel tx has bounds [-1e+300, 1e+300] beyond +-1e+06");
+    bad_mini("huge_scale.gltf", (mini_desc){.dofs = "[{\"channel\": \"s\", \"min\": 0.5, \"max\": 1e300}]"}, "beyond +-1000");
 
     char* text = mini_gltf(&(mini_desc){0});
     const char* p = sp_test_tmp_path("invalid_json.gltf");

@@ -2468,6 +2468,16 @@ static void test_screenshot_unwritable(void)
         if (rc != cases[i].code || !one_line || !strstr(out, cases[i].says)) fprintf(stderr, "  %s: %d %s", args, rc, out);
         ENSURE(rc == cases[i].code && one_line && strstr(out, cases[i].says) && strstr(out, cases[i].opt));
     }
+    // Save's folder: made at the first Save when missing, but a file in its
+    // place, or on its way, failed every visitor's Save (an outside review).
+    const char* on_way[2] = {"", "/saves"};
+    for (int i = 0; i < 2; ++i) {
+        snprintf(args, sizeof args, "--script '%s' --export-dir '%s%s'", script, file_dir, on_way[i]);
+        int rc = kiosk_no_display(args, out, sizeof out);
+        fprintf(stderr, "  %s", out);
+        ENSURE(rc == 1 && strstr(out, "--export-dir") && strstr(out, i ? "on its way is not a folder" : ": not a folder") &&
+               strchr(out, '\n') == out + strlen(out) - 1);
+    }
     // Without marks a stream takes the last frame, as before: past these
     // checks (a missing database is built later, by the kiosk, from the
     // assets given), the missing display stops it.

@@ -967,6 +967,9 @@ static void test_outputs_kept(void)
         {"synth --drawings --sheet '%3$s/none/s.png'", 1, "--sheet %3$s/none/s.png: cannot write into folder '%3$s/none'"},
         {"synth --concepts --sheet '%3$s/none/s.png'", 1, "--sheet %3$s/none/s.png: cannot write into folder '%3$s/none'"},
         {"db review --db '%3$s/no.db' --sheet '%3$s/none/s.png'", 1, "--sheet %3$s/none/s.png: cannot write into folder"},
+        // A name with a newline and an escape code in it: one line, both written out (an outside review).
+        {"pose --rig '%1$s' --strokes '%2$s' --out '%3$s/none/a\nb\x1b[2J.glb'", 1,
+         "--out %3$s/none/a\\nb\\x1b[2J.glb: cannot write into folder"},
     };
     struct stat before;
     ENSURE(stat(strokes, &before) == 0);
@@ -1805,6 +1808,26 @@ static void test_no_extent_cli(void)
     snprintf(args, sizeof args, "db add-sketch --db '%s/x.db' --category a '%s'", dir, dot);
     text = run_said(args, &rc);
     ENSURE(rc == 1 && strstr(text, "sketchpose db add-sketch: ") && strstr(text, want));
+    free(text);
+    // A blank picture is no drawing either (an outside review: `db
+    // add-sketch` stored an all-white PNG, and `db train` trained on it,
+    // which classify refused): an 8 x 8 white PNG.
+    static const unsigned char white[71] = {
+        0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00,
+        0x00, 0x08, 0x00, 0x00, 0x00, 0x08, 0x08, 0x00, 0x00, 0x00, 0x00, 0xe1, 0x64, 0xe1, 0x57, 0x00, 0x00, 0x00,
+        0x0e, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0xf8, 0x0f, 0x05, 0x0c, 0x94, 0x31, 0x00, 0xf7, 0xc0, 0x3f,
+        0xc1, 0xb2, 0x34, 0x41, 0xbb, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+    char blank[1200];
+    snprintf(blank, sizeof blank, "%s/b/white.png", dir);
+    FILE* f = fopen(blank, "wb");
+    ENSURE(f && fwrite(white, sizeof white, 1, f) == 1 && fclose(f) == 0);
+    snprintf(args, sizeof args, "db add-sketch --db '%s/x.db' --category a '%s'", dir, blank);
+    text = run_said(args, &rc);
+    ENSURE(rc == 1 && strstr(text, "white.png: the picture has no dark lines"));
+    free(text);
+    snprintf(args, sizeof args, "train --data '%s' --model '%s' --words 20", dir, model);
+    text = run_said(args, &rc);
+    ENSURE(rc == 0 && strstr(text, "2 drawings left out: no extent"));
     free(text);
     snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", dir, model);
     ENSURE(run(cmd) == 0);

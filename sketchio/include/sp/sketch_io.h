@@ -98,9 +98,14 @@ int sp_dataset_add_category(sp_dataset* ds, const char* name);
 /// drawing has no points", or "the drawing has no extent: all its points
 /// are at one place" (a dot, or strokes scaled to nothing).
 const char* sp_sketch_extent_problem(const sp_sketch* s);
+/// A grey level under this is ink in a picture (the classifier's threshold).
+#define SP_RASTER_INK_BELOW 191
+/// Why a picture (a PNG drawing) cannot be classified, else NULL: "the
+/// picture has no dark lines" (blank: no pixel under SP_RASTER_INK_BELOW).
+const char* sp_raster_ink_problem(const sp_raster* r);
 /// Takes out of `ds` the stroke drawings that sp_sketch_extent_problem
-/// refuses (a raster sample stays), renumbering `index` within each
-/// category; returns how many were taken out.
+/// refuses and the pictures sp_raster_ink_problem refuses, renumbering
+/// `index` within each category; returns how many were taken out.
 int sp_dataset_drop_no_extent(sp_dataset* ds);
 /// Frees everything and zeroes the set.
 void sp_dataset_free(sp_dataset* ds);

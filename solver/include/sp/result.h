@@ -45,6 +45,11 @@ sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)
 /// hold any), cut to fit (at most 1023 bytes). sp_fail does it to every message.
 void sp_text_escape_controls(char* s, size_t cap);
 
+/// vsnprintf into buf (cap bytes), then sp_text_escape_controls: a message
+/// on one line whatever it quotes (sp_fail's, the commands' and the kiosk
+/// log's own lines).
+void sp_text_vline(char* buf, size_t cap, const char* fmt, va_list ap);
+
 /// Short stable name of a result code, e.g. "parse error".
 const char* sp_result_name(sp_result r);
 
