@@ -351,10 +351,11 @@ static bool binds(const detail* e, const part* q)
 // given back; a longer chain loses its oldest.
 enum { DETAIL_BINDINGS = 4 };
 
-static void details_follow(sp_dragon* d, int k, const part* was)
+static void details_follow(sp_dragon* d, int k, const part* before)
 {
     const part* q = d->parts[k];
     for (int i = 0; i < d->detail_n; ++i) {
+        const part* was = before;
         detail* e = d->details[i];
         if (e->host != q->pub.id || binds(e, q)) continue;
         // A binding to this fit kept from before (the part given back): first again.
@@ -366,10 +367,13 @@ static void details_follow(sp_dragon* d, int k, const part* was)
             d->details[i] = b;
             continue;
         }
-        // Else bound anew where it shows on the part it was bound to, as if
+        // Else bound anew where it shows on the fit it was bound to, as if
         // drawn there now (an eye drawn in a head taken for a body, which
-        // the body drawn next made a head, was hidden for good).
-        if (!was || !binds(e, was)) continue;
+        // the body drawn next made a head, was hidden for good); that fit
+        // may lie further back (decided again, then turned, in one stroke).
+        while (was && !binds(e, was))
+            was = was->before;
+        if (!was) continue;
         sp_vec2* at = malloc(sizeof(sp_vec2) * (size_t)e->n);
         if (!at) continue;
         sp_mat4 m;
