@@ -122,7 +122,11 @@ void kiosk_run_save(sp_kiosk* k)
     char code[8] = "", glb[1200] = "", png[1200] = "";
     sp_image img = {0};
     // Each file is written whole (sp_file_write): a visitor's code never names half a file.
-    sp_result r = make_dirs(k->export_dir, &err);
+    // Through a link to a folder not made yet, its target is made (the
+    // link's own name exists, and its files could not be made).
+    char* real = sp_path_follow_links(k->export_dir);
+    sp_result r = make_dirs(real ? real : k->export_dir, &err);
+    free(real);
     // The last of the database's disk is the database's: a visitor's strokes,
     // a curator's training. Saves on a disk of their own (a small USB stick)
     // keep nothing back for it: they were never made there.

@@ -149,10 +149,25 @@ static inline bool clf_cli_drop_no_extent(const char* cmd, const char* dir, sp_d
                 "%s: warning: %s: %d drawing%s left out: no extent (no points, or all at one place; a picture with no dark "
                 "lines)\n",
                 cmd, dir, n, n == 1 ? "" : "s");
-    if (ds->count > 0) return true;
-    sp_dataset_free(ds);
-    sp_fail(err, SP_ERR_INVALID, "%s: no drawing with an extent (all points at one place, or none; pictures all blank)", dir);
-    return false;
+    if (ds->count == 0) {
+        sp_dataset_free(ds);
+        sp_fail(err, SP_ERR_INVALID, "%s: no drawing with an extent (all points at one place, or none; pictures all blank)", dir);
+        return false;
+    }
+    // A category with no drawing left (its folder empty, or only blank
+    // pictures) would be in the model with nothing to learn it from: every
+    // drawing of it taken for another (a second review).
+    for (int c = 0; c < ds->category_count; ++c) {
+        int k = 0;
+        while (k < ds->count && ds->samples[k].label != c)
+            ++k;
+        if (k < ds->count) continue;
+        sp_fail(err, SP_ERR_INVALID, "%s: category '%s' has no drawing%s (nothing to learn it from)", dir, ds->categories[c],
+                n > 0 ? " left" : "");
+        sp_dataset_free(ds);
+        return false;
+    }
+    return true;
 }
 
 static inline bool clf_cli_tty(void) { return isatty(fileno(stderr)) != 0; }

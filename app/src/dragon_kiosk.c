@@ -274,7 +274,9 @@ static uint64_t code_seed(void)
 // with one log line (an outside review): said before the window opens.
 static bool export_folder_ok(const char* dir)
 {
-    char* at = strdup(dir);
+    // Through a link, the folder it names (one not made yet: Save makes it).
+    char* real = sp_path_follow_links(dir);
+    char* at = real ? strdup(real) : NULL;
     struct stat st;
     const char* why = NULL;
     while (at && !why) {
@@ -291,12 +293,12 @@ static bool export_folder_ok(const char* dir)
         free(at);
         at = top ? NULL : up;
     }
-    if (why && !strcmp(at, dir))
+    if (why && !strcmp(at, real))
         sp_cli_say("%s: --export-dir %s: %s (Save writes the visitors' dragons there)", k_cmd, dir, why);
     else if (why)
         sp_cli_say("%s: --export-dir %s: '%s' on its way is %s (Save makes the folder and writes the visitors' dragons there)",
                    k_cmd, dir, at, why);
-    free(at);
+    free(at), free(real);
     return why == NULL;
 }
 

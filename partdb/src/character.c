@@ -230,9 +230,10 @@ sp_result sp_gltf_joint_extras(sp_rig* rig, int joint, const char* json, bool* h
             // strokes and node transforms near 1e300 that our own readers
             // refuse (an outside curator review).
             double most = sp_channel_is_scale(c) ? DOF_SCALE_MAX : sp_channel_is_rotation(c) ? DOF_TURN_MAX : DOF_MOVE_MAX;
-            if (fabs(lo) > most || fabs(hi) > most) {
-                r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s has bounds [%g, %g] beyond +-%g", what, jn,
-                            cn, lo, hi, most);
+            double least = sp_channel_is_scale(c) ? 1.0 / DOF_SCALE_MAX : -most;
+            if (lo < least || hi > most) {
+                r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s has bounds [%g, %g] outside [%g, %g]", what,
+                            jn, cn, lo, hi, least, most);
                 goto done;
             }
             sp_group g = sp_channel_is_scale(c) ? SP_GROUP_SHAPE : SP_GROUP_POSE;

@@ -635,8 +635,11 @@ static void test_bad_input(void)
     // Bounds past any pose: synth and export wrote numbers near 1e300 that
     // our own readers refuse (an outside curator review).
     bad_mini("huge_move.gltf", (mini_desc){.dofs = "[{\"channel\": \"tx\", \"min\": -1e300, \"max\": 1e300}]"},
-             "sp_dofs channel tx has bounds [-1e+300, 1e+300] beyond +-1e+06");
-    bad_mini("huge_scale.gltf", (mini_desc){.dofs = "[{\"channel\": \"s\", \"min\": 0.5, \"max\": 1e300}]"}, "beyond +-1000");
+             "sp_dofs channel tx has bounds [-1e+300, 1e+300] outside [-1e+06, 1e+06]");
+    bad_mini("huge_scale.gltf", (mini_desc){.dofs = "[{\"channel\": \"s\", \"min\": 0.5, \"max\": 1e300}]"},
+             "outside [0.001, 1000]");
+    bad_mini("tiny_scale.gltf", (mini_desc){.dofs = "[{\"channel\": \"s\", \"min\": 1e-300, \"max\": 2}]"},
+             "outside [0.001, 1000]");
 
     char* text = mini_gltf(&(mini_desc){0});
     const char* p = sp_test_tmp_path("invalid_json.gltf");

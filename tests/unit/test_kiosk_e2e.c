@@ -1996,6 +1996,18 @@ static void test_saves_disk(void)
     ENSURE(access(path, F_OK) == 0);
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
+    // A link to a folder not made yet: Save makes the folder it names (the
+    // link's own name exists, and every Save failed; a second review).
+    char target[1100], link[1300];
+    snprintf(target, sizeof target, "%s/made/here", ex);
+    snprintf(link, sizeof link, "%s/link", ex);
+    ENSURE(symlink("made/here", link) == 0);
+    k = inproc_kiosk_desc((sp_kiosk_desc){.db_path = db, .export_dir = link, .no_collect = true}, &gl, &t);
+    ENSURE(draw_and_save(k, &t));
+    snprintf(path, sizeof path, "%s/%.4s.glb", target, strrchr(sp_kiosk_last_save(k), '/') + 1);
+    ENSURE(access(path, F_OK) == 0);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
     // An export folder on a disk other than the database's (/dev/shm, where
     // it is one) keeps nothing back for the database: saved however little
     // is free (a USB stick of 200 MB could never save).

@@ -1837,6 +1837,13 @@ static void test_no_extent_cli(void)
     text = run_said(args, &rc);
     ENSURE(rc == 0 && strstr(text, "2 drawings left out: no extent"));
     free(text);
+    // A category whose only drawing is blank: nothing to learn it from (it
+    // was in the model, every drawing of it taken for another).
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s/c' && cp '%s' '%s/c/'", dir, blank, dir);
+    ENSURE(run(cmd) == 0);
+    text = run_said(args, &rc);
+    ENSURE(rc == 1 && strstr(text, "category 'c' has no drawing left (nothing to learn it from)"));
+    free(text);
     snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", dir, model);
     ENSURE(run(cmd) == 0);
 }
