@@ -38,11 +38,16 @@ sp_result kiosk_claim_code(sp_kiosk* k, char code[8], sp_error* err)
         // Made, not looked for: another kiosk saving into this folder (or a
         // code that was taken) gets EEXIST and the next code, never this one.
         int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-        if (fd >= 0) {
-            close(fd);
-            return SP_OK;
-        }
-        if (errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", path, strerror(errno));
+        if (fd < 0 && errno != EEXIST) return sp_fail(err, SP_ERR_IO, "%s: cannot create (%s)", path, strerror(errno));
+        if (fd < 0) continue;
+        close(fd);
+        // A postcard kept without its .glb (staff moved the large files off
+        // a full disk) still names an earlier visitor's dragon (a second
+        // review: it was written over).
+        char png[1200];
+        snprintf(png, sizeof png, "%s/%s.png", k->export_dir, code);
+        if (access(png, F_OK) != 0) return SP_OK;
+        unlink(path);
     }
     // A code already given to a visitor is never given again (it named
     // their dragon): refused, not reused.

@@ -296,7 +296,7 @@ static bool export_folder_ok(const char* dir)
     if (why && !strcmp(at, real))
         sp_cli_say("%s: --export-dir %s: %s (Save writes the visitors' dragons there)", k_cmd, dir, why);
     else if (why)
-        sp_cli_say("%s: --export-dir %s: '%s' on its way is %s (Save makes the folder and writes the visitors' dragons there)",
+        sp_cli_say("%s: --export-dir %s: '%s' on its way: %s (Save makes the folder and writes the visitors' dragons there)",
                    k_cmd, dir, at, why);
     free(at), free(real);
     return why == NULL;
@@ -685,6 +685,10 @@ int main(int argc, char** argv)
         !sp_cli_check_out(k_cmd, "--export", out_glb, SP_CLI_OUT_GLTF))
         return SP_EXIT_USAGE;
     if (!numbers_ok(&lod, &msaa, &max_parts, &keep_days, idle_s)) return SP_EXIT_USAGE;
+    if (export_dir && !export_dir[0]) { // an unset variable's name: every Save failed
+        fprintf(stderr, "%s: --export-dir needs a folder name, got an empty value\n", k_cmd);
+        return SP_EXIT_USAGE;
+    }
     int win_w = 1280, win_h = 800;
     if (!window_size(size, &win_w, &win_h)) return SP_EXIT_USAGE;
     sp_kiosk_session session = {0};

@@ -2057,10 +2057,16 @@ static void test_save_codes_never_reused(void)
     k->code_state = start;
     ENSURE(!draw_and_save(k, &t) && sp_kiosk_stats_of(k)->save_failures == 1);
     ENSURE(system(cmd) == 0); // nothing written over, nothing added
-    // One code freed: the save takes it, as the visitor's own.
-    char path[1300];
+    // One code freed: the save takes it, as the visitor's own; but not while
+    // its postcard is kept without its .glb (staff moved the large files
+    // away): that code still names an earlier visitor's dragon.
+    char path[1300], png[1300];
     snprintf(path, sizeof path, "%s/%s.glb", ex, first);
-    ENSURE(unlink(path) == 0);
+    snprintf(png, sizeof png, "%s/%s.png", ex, first);
+    ENSURE(rename(path, png) == 0);
+    k->code_state = start;
+    ENSURE(!draw_and_save(k, &t) && access(path, F_OK) != 0);
+    ENSURE(unlink(png) == 0);
     k->code_state = start;
     ENSURE(draw_and_save(k, &t));
     snprintf(path, sizeof path, "%s/%s", ex, first);
@@ -2487,7 +2493,7 @@ static void test_screenshot_unwritable(void)
         snprintf(args, sizeof args, "--script '%s' --export-dir '%s%s'", script, file_dir, on_way[i]);
         int rc = kiosk_no_display(args, out, sizeof out);
         fprintf(stderr, "  %s", out);
-        ENSURE(rc == 1 && strstr(out, "--export-dir") && strstr(out, i ? "on its way is not a folder" : ": not a folder") &&
+        ENSURE(rc == 1 && strstr(out, "--export-dir") && strstr(out, i ? "on its way: not a folder" : ": not a folder") &&
                strchr(out, '\n') == out + strlen(out) - 1);
     }
     // Without marks a stream takes the last frame, as before: past these
