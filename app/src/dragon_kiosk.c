@@ -268,6 +268,14 @@ static uint64_t code_seed(void)
     return (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 32) ^ h;
 }
 
+// An empty --export-dir (an unset variable's name): every Save failed.
+static bool export_named(const char* dir)
+{
+    if (!dir || dir[0]) return true;
+    fprintf(stderr, "%s: --export-dir needs a folder name, got an empty value\n", k_cmd);
+    return false;
+}
+
 // The folder Save writes into is made at the first Save, parents and all,
 // so it may be missing; a file in its place, or a nearest existing folder
 // on its way this user may not write into, failed every visitor's Save
@@ -684,11 +692,7 @@ int main(int argc, char** argv)
     if (!sp_cli_check_out(k_cmd, "--screenshot", shot, SP_CLI_OUT_PNG) ||
         !sp_cli_check_out(k_cmd, "--export", out_glb, SP_CLI_OUT_GLTF))
         return SP_EXIT_USAGE;
-    if (!numbers_ok(&lod, &msaa, &max_parts, &keep_days, idle_s)) return SP_EXIT_USAGE;
-    if (export_dir && !export_dir[0]) { // an unset variable's name: every Save failed
-        fprintf(stderr, "%s: --export-dir needs a folder name, got an empty value\n", k_cmd);
-        return SP_EXIT_USAGE;
-    }
+    if (!numbers_ok(&lod, &msaa, &max_parts, &keep_days, idle_s) || !export_named(export_dir)) return SP_EXIT_USAGE;
     int win_w = 1280, win_h = 800;
     if (!window_size(size, &win_w, &win_h)) return SP_EXIT_USAGE;
     sp_kiosk_session session = {0};
