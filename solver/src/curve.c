@@ -138,45 +138,73 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
     if (n < 4 || !(tol > 0) || !sp_curve_is_valid(pts, n)) return n;
     double len = sp_curve_length(pts, n, false);
     sp_vec2 r[M];
-    if (!(len > 0) || sp_curve_resample(pts, n, false, M, r) != SP_OK) return n;
-    double step = len / (M - 1);
-    // A sample's own neighbourhood along the stroke does not count (a turn
-    // back comes within tol of itself there without going over anything).
-    int w = (int)fmin(M, ceil(2.0 * tol / step));
-    if (w < 1) w = 1;
-    // first[i]: the first segment (r[j], r[j+1]) of the stroke before sample
-    // i that it lies within tol of; M when none.
-    int first[M];
-    for (int i = 0; i < M; ++i) {
-        first[i] = M;
-        for (int j = 0; j + 1 <= i - w && first[i] == M; ++j)
-            if (seg_dist2(r[i], r[j], r[j + 1]) < tol * tol) first[i] = j;
+    double* arc = malloc(sizeof(double) * (size_t)n); // the stroke's length up to each point
+    if (!arc || !(len > 0) || sp_curve_resample(pts, n, false, M, r) != SP_OK) {
+        free(arc);
+        return n;
     }
+    arc[0] = 0;
+    for (int k = 1; k < n; ++k)
+        arc[k] = arc[k - 1] + sp_v2_len(sp_v2_sub(pts[k], pts[k - 1]));
+    double step = len / (M - 1), own = fmax(2.0 * tol, step);
+    // first[i]: where along the stroke the first of its segments within tol
+    // of sample i ends (INFINITY: none), against the stroke as drawn, not
+    // its samples (a claw's tip lies off a 64th's chord of an outline); a
+    // sample's own stretch of the stroke does not count (a turn back comes
+    // within tol of itself there without going over anything).
+    double first[M];
+    for (int i = 0; i < M; ++i) {
+        first[i] = INFINITY;
+        for (int k = 0; k + 1 < n && arc[k + 1] <= i * step - own; ++k)
+            if (seg_dist2(r[i], pts[k], pts[k + 1]) < tol * tol) {
+                first[i] = arc[k + 1];
+                break;
+            }
+    }
+    free(arc);
     int last = M - (int)ceil(fmax(0.0, min_share) * (M - 1)); // the stretch's earliest start
-    for (int c = w + 1; c <= last && c < M; ++c) {
+    for (int c = 1; c <= last && c < M; ++c) {
         // Over the stroke up to c, not over itself: shading drawn back and
         // forth goes over its last pass only, and is not drawn once.
-        if (first[c] + 1 > c) continue;
+        double at = c * step;
+        if (!(first[c] <= at)) continue;
         int count = 0;
         for (int i = c; i < M; ++i)
-            count += first[i] + 1 <= c;
+            count += first[i] <= at;
         if (count < 0.9 * (M - c)) continue;
         // Going over a stretch follows it about its length: a line drawn
         // straight back through a zigzag (closing it into a shape) comes
         // within tol of all of it in half its length.
-        int covered = 0;
+        bool covered[M] = {false};
+        int n_covered = 0;
         for (int j = 0; j < c; ++j) {
-            bool near = false;
-            for (int i = c; i < M && !near; ++i)
-                near = seg_dist2(r[i], r[j], r[j + 1]) < tol * tol;
-            covered += near;
+            for (int i = c; i < M && !covered[j]; ++i)
+                covered[j] = seg_dist2(r[i], r[j], r[j + 1]) < tol * tol;
+            n_covered += covered[j];
         }
-        if (M - 1 - c < RETRACE_MIN_LENGTH * covered) continue;
-        // The first input point at or past the sample's arc length.
-        double at = c * step, s = 0.0;
+        if (M - 1 - c < RETRACE_MIN_LENGTH * n_covered) continue;
+        // What leads from the first pass to the second without being gone
+        // over (a line back to where the first began, then the doodle
+        // again) is cut too: kept, it closed the doodle into a part. Told
+        // by the samples before the second pass's own neighbourhood that
+        // it does not go near.
+        bool near[M] = {false};
+        for (int j = 0; j < c; ++j)
+            for (int i = c; i + 1 < M && !near[j]; ++i)
+                near[j] = seg_dist2(r[j], r[i], r[i + 1]) < tol * tol;
+        int keep = c, j = c - (int)ceil(own / step) - 1;
+        if (j > 0 && !near[j]) {
+            keep = j;
+            while (keep > c / 2 && keep > 1 && !near[keep - 1])
+                --keep;
+        }
+        // The input points up to that length (a long segment that crosses
+        // it, a jump back to where the stroke began, is left out whole).
+        at = keep * step;
+        double s = 0.0;
         for (int k = 1; k < n; ++k) {
             s += sp_v2_len(sp_v2_sub(pts[k], pts[k - 1]));
-            if (s >= at - 1e-9 * len) return k + 1;
+            if (s > at + 1e-9 * len) return k >= 2 ? k : 2;
         }
         return n;
     }

@@ -243,6 +243,25 @@ static void test_retrace_start(void)
     for (double x = 280; x >= 0; x -= 4)
         p[m++] = (sp_vec2){300 + x, 300 - 12};
     ENSURE(sp_curve_retrace_start(p, m, 7.3, 0.25) == m);
+    // A doodle drawn again from where it began, the pen jumping back (one
+    // long segment): cut where the first pass ends, the jump left out (kept,
+    // it closed the doodle into a shape a part).
+    m = 0;
+    for (int i = 0; i < 60; ++i)
+        p[m++] = (sp_vec2){300 + 4 * i, 300 + (i < 30 ? 2 * i : 120 - 2 * i)};
+    for (int i = 1; i < 60; ++i)
+        p[m++] = p[i];
+    ENSURE(sp_curve_retrace_start(p, m, 7.5, 0.25) == 60);
+    // An outline with 40 teeth 12 px tall gone round twice exactly: the teeth
+    // lie off the chords of a 64-sample resampling, not off the stroke.
+    enum { LAP = 190 };
+    for (int i = 0; i < 2 * LAP; ++i) {
+        double a = 2 * M_PI * (i % LAP) / LAP, rad = 200 + ((i % LAP) % 5 == 2 ? 12 : 0);
+        p[i] = (sp_vec2){500 + rad * cos(a), 400 + rad * sin(a)};
+    }
+    r = sp_curve_retrace_start(p, 2 * LAP, 7.5, 0.25);
+    fprintf(stderr, "  toothed outline twice: keep %d of %d\n", r, 2 * LAP);
+    ENSURE(r >= LAP - 4 && r <= LAP + 8);
     // Too few points, no tolerance, no length.
     ENSURE(sp_curve_retrace_start(p, 3, 10, 0.25) == 3 && sp_curve_retrace_start(p, N, 0, 0.25) == N);
     for (int i = 0; i < 8; ++i)

@@ -2891,6 +2891,25 @@ static void test_ink_follows_its_part(void)
     ENSURE(sp_dragon_undo(d) && sp_dragon_part_count(d) == 1 && sp_dragon_part_get(d, 0)->is_torso);
     ENSURE(sp_dragon_pose_at(d, 0, &err) == SP_OK && detail_box(d, 0, &lo, &hi));
     ENSURE(fabs(0.5 * (lo.x + hi.x) - 775) < 12 && fabs(0.5 * (lo.y + hi.y) - 315) < 12);
+    // Spots on legs that the head drawn next makes the other kind (a second
+    // review): they stay on the legs, where they hung 50 px beside them in
+    // the air, bound where the old fit had the leg.
+    draw_data_strokes(d, "kiosk_ink_legs_change_kind", 5, 2);
+    ENSURE(sp_dragon_detail_count(d) == 2 && sp_dragon_pose_at(d, 0, &err) == SP_OK);
+    const sp_camera cam = sp_dragon_camera(d);
+    for (int i = 0; i < 2; ++i) {
+        sp_dragon_detail e;
+        ENSURE(sp_dragon_detail_get(d, i, &e) && e.xyz && detail_box(d, i, &lo, &hi));
+        sp_vec2 mid = {0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y)};
+        const double* v = sp_dragon_part_xyz(d, e.part);
+        double nearest = INFINITY;
+        for (int k = 0; k < sp_dragon_part_get(d, e.part)->character->rig.vertex_count; ++k)
+            nearest = fmin(nearest,
+                           sp_v2_len(sp_v2_sub(sp_camera_project(&cam, (sp_vec3){v[3 * k], v[3 * k + 1], v[3 * k + 2]}), mid)));
+        fprintf(stderr, "  spot %d on %s: %.1f px from its nearest vertex\n", i, sp_dragon_part_get(d, e.part)->category,
+                nearest);
+        ENSURE(nearest < 8);
+    }
     sp_dragon_destroy(d);
     sp_db_close(db);
 }

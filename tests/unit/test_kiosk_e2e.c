@@ -2496,6 +2496,8 @@ static void test_screenshot_unwritable(void)
         ENSURE(rc == 1 && strstr(out, "--export-dir") && strstr(out, i ? "on its way: not a folder" : ": not a folder") &&
                strchr(out, '\n') == out + strlen(out) - 1);
     }
+    snprintf(args, sizeof args, "--script '%s' --export-dir ''", script);
+    ENSURE(kiosk_no_display(args, out, sizeof out) == 2 && strstr(out, "--export-dir needs a folder name"));
     // Without marks a stream takes the last frame, as before: past these
     // checks (a missing database is built later, by the kiosk, from the
     // assets given), the missing display stops it.

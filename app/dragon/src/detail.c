@@ -343,6 +343,37 @@ static bool binds(const detail* e, const part* q)
     return e->t == q->t && e->mirrored == q->pub.mirrored;
 }
 
+// Ink (n canvas points) whose middle the part's mesh as shown does not
+// cover is moved, whole, until it does, at the mesh's point nearest it: a
+// spot drawn on a leg's foot, whose new fit put the foot elsewhere, hung in
+// the air 50 px beside it (a second review).
+static void onto_mesh(sp_dragon* d, const part* q, sp_vec2* at, int n)
+{
+    const sp_rig* rig = &q->t->ch.rig;
+    dragon_pose_shown(d);
+    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
+    if (!px) return;
+    for (int v = 0; v < rig->vertex_count; ++v)
+        px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
+    sp_vec2 mid = {0, 0};
+    for (int j = 0; j < n; ++j)
+        mid = sp_v2_add(mid, at[j]);
+    mid = sp_v2_scale(mid, 1.0 / n);
+    double w[3];
+    int f = mesh_point_at(rig, q->xyz, px, mid, w);
+    if (f >= 0) {
+        const uint32_t* tr = rig->triangles + 3 * (size_t)f;
+        sp_vec2 m = {0, 0};
+        for (int c = 0; c < 3; ++c)
+            m = sp_v2_add(m, sp_v2_scale(px[tr[c]], w[c]));
+        sp_vec2 by = sp_v2_sub(m, mid);
+        if (sp_v2_len(by) > 0.5)
+            for (int j = 0; j < n; ++j)
+                at[j] = sp_v2_add(at[j], by);
+    }
+    free(px);
+}
+
 // Ink bound anew to another fit of its part snaps onto that mesh within
 // this share of its own size (the detail test's own-size tolerance).
 #define DETAIL_FOLLOW_NEAR 0.3
@@ -380,6 +411,7 @@ static void details_follow(sp_dragon* d, int k, const part* before)
         bool moved = ink_moved(e, was, &m);
         for (int j = 0; j < e->n; ++j)
             at[j] = moved ? moved_px(d, &m, e->drawn[j]) : e->drawn[j];
+        onto_mesh(d, q, at, e->n);
         sp_vec2 lo = at[0], hi = at[0];
         for (int j = 1; j < e->n; ++j)
             lo.x = fmin(lo.x, at[j].x), lo.y = fmin(lo.y, at[j].y), hi.x = fmax(hi.x, at[j].x), hi.y = fmax(hi.y, at[j].y);

@@ -12,13 +12,16 @@
 #include "sp/synth.h"
 
 // A stroke that goes over itself for at least this share of its length,
-// within this share of its box's diagonal (RETRACE_MIN_PX at least), is
-// taken as drawn once: a child goes round a body twice, or back along a
-// head's line, and no drawing the classifier knows does (an outside review:
-// such strokes were refused with the right part first at 0.97-1.00).
+// within this share of its box's diagonal, is taken as drawn once: a child
+// goes round a body twice, or back along a head's line, and no drawing the
+// classifier knows does (an outside review: such strokes were refused with
+// the right part first at 0.97-1.00).
 #define RETRACE_SHARE 0.25
 #define RETRACE_TOL 0.025
-#define RETRACE_MIN_PX 3.0
+// ... and at least this share of the canvas's diagonal: a finger goes back
+// along a small part's line a few pixels off (2 mm on 1280 x 800 at 96
+// dpi; legs 4 px off were refused: a second review).
+#define RETRACE_MIN_CANVAS 0.005
 
 // Cleans a stroke: clamps onto the canvas, drops repeated points, cuts off
 // a stretch drawn over the stroke again, resamples very long strokes.
@@ -35,7 +38,8 @@ static int clean_stroke(const sp_dragon* d, const sp_vec2* xy, int n, sp_vec2** 
     }
     int m = sp_curve_clean(tmp, n, 0.0, tmp);
     if (m >= 4)
-        m = sp_curve_retrace_start(tmp, m, fmax(RETRACE_MIN_PX, RETRACE_TOL * sp_v2_len(sp_v2_sub(hi, lo))), RETRACE_SHARE);
+        m = sp_curve_retrace_start(tmp, m, fmax(RETRACE_MIN_CANVAS * hypot(W, H), RETRACE_TOL * sp_v2_len(sp_v2_sub(hi, lo))),
+                                   RETRACE_SHARE);
     if (m > SP_DRAGON_MAX_STROKE_POINTS) {
         sp_vec2* r = malloc(sizeof(sp_vec2) * SP_DRAGON_MAX_STROKE_POINTS);
         if (!r || sp_curve_resample(tmp, m, false, SP_DRAGON_MAX_STROKE_POINTS, r) != SP_OK) {
