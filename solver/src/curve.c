@@ -172,6 +172,13 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
         for (int i = c; i < M; ++i)
             count += first[i] <= at;
         if (count < 0.9 * (M - c)) continue;
+        // Going over the stroke follows it along, in order: a scribble's
+        // points each lie near some of the scribble before them too, here
+        // and there (it was cut, and the rest of it taken for a part).
+        int jumps = 0, pairs = 0;
+        for (int i = c; i + 1 < M; ++i)
+            if (first[i] <= at && first[i + 1] <= at) ++pairs, jumps += fabs(first[i + 1] - first[i]) > 3.0 * step + 2.0 * tol;
+        if (jumps > 1 + 0.1 * pairs) continue;
         // Going over a stretch follows it about its length: a line drawn
         // straight back through a zigzag (closing it into a shape) comes
         // within tol of all of it in half its length.

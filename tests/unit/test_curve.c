@@ -262,6 +262,17 @@ static void test_retrace_start(void)
     r = sp_curve_retrace_start(p, 2 * LAP, 7.5, 0.25);
     fprintf(stderr, "  toothed outline twice: keep %d of %d\n", r, 2 * LAP);
     ENSURE(r >= LAP - 4 && r <= LAP + 8);
+    // A scribble: its points lie near the scribble before them, but here
+    // and there, not along it.
+    uint64_t z = 42;
+    for (int i = 0; i < 400; ++i) {
+        z = z * 6364136223846793005ull + 1442695040888963407ull;
+        double u = (double)(z >> 11) / 9007199254740992.0;
+        z = z * 6364136223846793005ull + 1442695040888963407ull;
+        double v = (double)(z >> 11) / 9007199254740992.0;
+        p[i] = (sp_vec2){500 + 300 * u, 300 + 200 * v};
+    }
+    ENSURE(sp_curve_retrace_start(p, 400, 9, 0.25) == 400);
     // Too few points, no tolerance, no length.
     ENSURE(sp_curve_retrace_start(p, 3, 10, 0.25) == 3 && sp_curve_retrace_start(p, N, 0, 0.25) == N);
     for (int i = 0; i < 8; ++i)

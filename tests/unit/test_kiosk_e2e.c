@@ -2540,11 +2540,13 @@ static void test_save_fails_whole(void)
         ENSURE(pass == 1 ? sp_kiosk_ui_hint_visible(ui) : !sp_kiosk_ui_hint_visible(ui) && sp_kiosk_ui_banner_visible(ui));
         updates_until(k, &t, t + 1500);
         if (pass == 0) {
-            // The same kiosk start gives the same first free code: make its postcard's name a folder.
+            // The same kiosk start gives the same first free code: make its
+            // postcard's name a link into a folder that is not there (a
+            // postcard already there keeps its code from the next save).
             ENSURE(st->saves == 1 && st->save_failures == 0);
             snprintf(glb, sizeof glb, "%s.glb", sp_kiosk_last_save(k));
             snprintf(png, sizeof png, "%s.png", sp_kiosk_last_save(k));
-            ENSURE(access(glb, F_OK) == 0 && unlink(glb) == 0 && unlink(png) == 0 && mkdir(png, 0755) == 0);
+            ENSURE(access(glb, F_OK) == 0 && unlink(glb) == 0 && unlink(png) == 0 && symlink("nowhere/x.png", png) == 0);
         } else {
             fprintf(stderr, "  saves %d, failures %d; %s %s\n", st->saves, st->save_failures, glb,
                     access(glb, F_OK) == 0 ? "left behind" : "taken back");

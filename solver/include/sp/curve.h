@@ -78,8 +78,9 @@ int sp_curve_clean(const sp_vec2* pts, int n, double min_step, sp_vec2* out);
 /// Where a stroke starts going over itself again: the first point of the
 /// last stretch (at least `min_share` of its length) that lies, all but a
 /// tenth of it, within `tol` pixels of the stroke before that point: a loop
-/// gone round twice, a line drawn out and back along itself (not shading
-/// drawn back and forth, each pass over the last one only). Returns how many
+/// gone round twice, a line drawn out and back along itself, following it
+/// in order (not shading drawn back and forth, each pass over the last one
+/// only, nor a scribble here and there over itself). Returns how many
 /// points to keep, the stretch cut off (pts[0 .. r-1], r >= 2), or n when
 /// the stroke does not go over itself (n < 4, tol <= 0 or a length of 0
 /// included). O(n + 64^2).
