@@ -590,19 +590,30 @@ static sp_result parse_document(const char* text, size_t len, const char* name, 
     return r;
 }
 
-sp_result sp_json_document_check(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+// parse_document, and no object anywhere holding a key twice. *doc: NULL on failure.
+static sp_result parse_keys_once(const char* text, size_t len, const char* name, cJSON** doc, sp_error* err)
 {
-    if (max_values > 0 && sp_json_measure(text, len).values > max_values)
-        return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values", name, max_values);
-    cJSON* doc;
-    sp_result r = parse_document(text, len, name, &doc, err);
+    sp_result r = parse_document(text, len, name, doc, err);
     bool oom = false;
-    const char* twice = r == SP_OK ? json_key_twice_within(doc, &oom) : NULL;
+    const char* twice = r == SP_OK ? json_key_twice_within(*doc, &oom) : NULL;
     char shown[96];
     if (twice)
         r = sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", name, sp_text_printable(twice, shown, sizeof shown));
     else if (oom)
         r = sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", name);
+    if (r != SP_OK) {
+        cJSON_Delete(*doc);
+        *doc = NULL;
+    }
+    return r;
+}
+
+sp_result sp_json_document_check(const char* text, size_t len, size_t max_values, const char* name, sp_error* err)
+{
+    if (max_values > 0 && sp_json_measure(text, len).values > max_values)
+        return sp_fail(err, SP_ERR_INVALID, "%s: more than %zu JSON values", name, max_values);
+    cJSON* doc;
+    sp_result r = parse_keys_once(text, len, name, &doc, err);
     cJSON_Delete(doc);
     return r;
 }
@@ -971,17 +982,7 @@ sp_result sp_dataset_parse_ndjson(sp_dataset* ds, const char* text, size_t len, 
         snprintf(lname, sizeof lname, "%s:%d", name, line);
         cJSON* root = NULL;
         sp_result vr = sp_json_values_within(text + b, e - b, SP_SKETCH_MAX_JSON_VALUES, lname, err);
-        if (vr != SP_OK || (vr = parse_document(text + b, e - b, lname, &root, err)) != SP_OK) return vr;
-        bool oom = false;
-        const char* twice = json_key_twice_within(root, &oom);
-        char shown[96];
-        if (twice || oom) {
-            vr = twice ? sp_fail(err, SP_ERR_INVALID, "%s: key \"%s\" given twice", lname,
-                                 sp_text_printable(twice, shown, sizeof shown))
-                       : sp_fail(err, SP_ERR_NO_MEMORY, "%s: out of memory", lname);
-            cJSON_Delete(root);
-            return vr;
-        }
+        if (vr != SP_OK || (vr = parse_keys_once(text + b, e - b, lname, &root, err)) != SP_OK) return vr;
         const cJSON* drawing = cJSON_GetObjectItemCaseSensitive(root, "drawing");
         if (!cJSON_IsObject(root) || !cJSON_IsArray(drawing)) {
             cJSON_Delete(root);

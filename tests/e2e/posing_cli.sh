@@ -58,9 +58,9 @@ one_line_naming "loose fit: curve 'leg_"
 # review's), and a short stray line in a corner: the stray line is left
 # out, and the figure fits (the stray line pulled the pose while the strokes
 # were assigned: the spine took an arm's stroke, 9.9 px mean; a later review).
-strokes "$WORK/man_stray.json" '[[320, 246], [321, 200], [322, 160], [322, 122]]' '[[320, 197], [370, 197], [420, 197]]' \
-    '[[320, 197], [290, 160], [275, 110]]' '[[320, 246], [350, 300], [370, 370]]' \
-    '[[320, 246], [300, 300], [330, 340], [300, 380]]' '[[600, 20], [630, 40]]'
+SPINE='[[320, 246], [321, 200], [322, 160], [322, 122]]' ARM_R='[[320, 197], [370, 197], [420, 197]]'
+ARM_L='[[320, 197], [290, 160], [275, 110]]' LEG_R='[[320, 246], [350, 300], [370, 370]]' STRAY='[[600, 20], [630, 40]]'
+strokes "$WORK/man_stray.json" "$SPINE" "$ARM_R" "$ARM_L" "$LEG_R" '[[320, 246], [300, 300], [330, 340], [300, 380]]' "$STRAY"
 expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/man_stray.json" --report "$WORK/man_stray_r.json"
 grep -q '"note":	"1 stroke left unused: 5 (the rest fit better without it)"' "$WORK/man_stray_r.json" ||
     fail "a stray line: $(grep '"note"' "$WORK/man_stray_r.json")"
@@ -68,9 +68,7 @@ grep -q '"curve":	"spine",$' "$WORK/man_stray_r.json" && grep -A1 '"curve":	"spi
     fail "a stray line: the spine did not take the spine's stroke"
 # The same with a leg that starts short of the hips: still loose, which is
 # named after the note of the stray line (it was dropped).
-strokes "$WORK/man_stray2.json" '[[320, 246], [321, 200], [322, 160], [322, 122]]' '[[320, 197], [370, 197], [420, 197]]' \
-    '[[320, 197], [290, 160], [275, 110]]' '[[320, 246], [350, 300], [370, 370]]' \
-    '[[300, 300], [330, 340], [300, 380]]' '[[600, 20], [630, 40]]'
+strokes "$WORK/man_stray2.json" "$SPINE" "$ARM_R" "$ARM_L" "$LEG_R" '[[300, 300], [330, 340], [300, 380]]' "$STRAY"
 expect 0 "$SP" pose --rig "$MAN" --strokes "$WORK/man_stray2.json" --report "$WORK/man_stray2_r.json"
 grep -q '"note":	"1 stroke left unused: 5 (the rest fit better without it); loose fit: curve ' "$WORK/man_stray2_r.json" ||
     fail "a stray line hid the loose-fit note: $(grep '"note"' "$WORK/man_stray2_r.json")"

@@ -260,10 +260,24 @@ static int bind_points(const sp_dragon* d, const part* q, const detail_hit* hit,
     return k;
 }
 
+// Part q's vertices on the canvas as the visitor sees it (posed at the
+// dragon's clock, not at its fit, which a clip's pose moves: a tail's sway
+// starts off rest; the parts only, what the caller posed and reads stays as
+// it was); malloc'd, NULL when out of memory.
+static sp_vec2* shown_px(sp_dragon* d, const part* q)
+{
+    int nv = q->t->ch.rig.vertex_count;
+    dragon_pose_shown(d);
+    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)(nv > 0 ? nv : 1));
+    for (int v = 0; px && v < nv; ++v)
+        px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
+    return px;
+}
+
 // The points (n canvas points) bound to part q's mesh as shown (hit: its
-// tolerance and what becomes of points off it): a detail without an id, or
-// NULL when fewer than two points bind or memory runs out.
-static detail* bind_detail(sp_dragon* d, const part* q, const detail_hit* hit, const sp_vec2* pts, int n)
+// tolerance and what becomes of points off it; px: shown_px of q): a detail
+// without an id, or NULL when fewer than two points bind or memory runs out.
+static detail* bind_detail(sp_dragon* d, const part* q, const detail_hit* hit, const sp_vec2* px, const sp_vec2* pts, int n)
 {
     const sp_rig* rig = &q->t->ch.rig;
     if (rig->vertex_count <= 0 || rig->triangle_count <= 0 || n < 2) return NULL;
@@ -284,19 +298,11 @@ static detail* bind_detail(sp_dragon* d, const part* q, const detail_hit* hit, c
     e->flip = e->bary + 3 * mm, e->xyz = e->flip + mm, e->normal = e->xyz + 3 * mm;
     e->drawn = (sp_vec2*)(void*)(e->normal + 3 * mm);
     e->weight = (double*)(void*)(e->drawn + mm);
-    // Bound to the part as the visitor sees it (posed at the dragon's
-    // clock), not at its fit, which a clip's pose moves (a tail's sway
-    // starts off rest). The parts only: what the caller posed and reads
-    // stays as it was.
-    dragon_pose_shown(d);
-    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
-    for (int v = 0; px && v < rig->vertex_count; ++v)
-        px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
+    // Bound to the part as the visitor sees it, within the tolerance the caller's test used.
     detail_hit shown = *hit;
-    shown.xyz = q->xyz, shown.px = px;
-    // Within the tolerance the caller's test used.
-    e->n = px ? bind_points(d, q, &shown, rs ? rs : pts, m, e) : 0;
-    free(rs), free(px);
+    shown.xyz = q->xyz, shown.px = (sp_vec2*)px;
+    e->n = bind_points(d, q, &shown, rs ? rs : pts, m, e);
+    free(rs);
     if (e->n < 2) {
         detail_free(e);
         return NULL;
@@ -313,7 +319,9 @@ int dragon_detail_keep(sp_dragon* d, const detail_hit* hit, const sp_vec2* pts, 
     int k = hit->part;
     if (k < 0 || k >= d->part_n || !hit->xyz || !hit->px || n < 2 || d->detail_n >= SP_DRAGON_MAX_DETAILS) return -1;
     if (!d->details && !(d->details = calloc(SP_DRAGON_MAX_DETAILS, sizeof(detail*)))) return -1;
-    detail* e = bind_detail(d, d->parts[k], hit, pts, n);
+    sp_vec2* px = shown_px(d, d->parts[k]);
+    detail* e = px ? bind_detail(d, d->parts[k], hit, px, pts, n) : NULL;
+    free(px);
     if (!e) return -1;
     e->id = d->next_id++;
     d->details[d->detail_n] = e;
@@ -347,14 +355,9 @@ static bool binds(const detail* e, const part* q)
 // cover is moved, whole, until it does, at the mesh's point nearest it: a
 // spot drawn on a leg's foot, whose new fit put the foot elsewhere, hung in
 // the air 50 px beside it (a second review).
-static void onto_mesh(sp_dragon* d, const part* q, sp_vec2* at, int n)
+static void onto_mesh(const part* q, const sp_vec2* px, sp_vec2* at, int n)
 {
     const sp_rig* rig = &q->t->ch.rig;
-    dragon_pose_shown(d);
-    sp_vec2* px = malloc(sizeof(sp_vec2) * (size_t)rig->vertex_count);
-    if (!px) return;
-    for (int v = 0; v < rig->vertex_count; ++v)
-        px[v] = sp_camera_project(&d->world, (sp_vec3){q->xyz[3 * v], q->xyz[3 * v + 1], q->xyz[3 * v + 2]});
     sp_vec2 mid = {0, 0};
     for (int j = 0; j < n; ++j)
         mid = sp_v2_add(mid, at[j]);
@@ -371,7 +374,6 @@ static void onto_mesh(sp_dragon* d, const part* q, sp_vec2* at, int n)
             for (int j = 0; j < n; ++j)
                 at[j] = sp_v2_add(at[j], by);
     }
-    free(px);
 }
 
 // Ink bound anew to another fit of its part snaps onto that mesh within
@@ -385,6 +387,7 @@ enum { DETAIL_BINDINGS = 4 };
 static void details_follow(sp_dragon* d, int k, const part* before)
 {
     const part* q = d->parts[k];
+    sp_vec2* px = NULL; // shown_px of q, once a detail is bound anew
     for (int i = 0; i < d->detail_n; ++i) {
         const part* was = before;
         detail* e = d->details[i];
@@ -406,12 +409,16 @@ static void details_follow(sp_dragon* d, int k, const part* before)
             was = was->before;
         if (!was) continue;
         sp_vec2* at = malloc(sizeof(sp_vec2) * (size_t)e->n);
-        if (!at) continue;
+        if (!px) px = shown_px(d, q);
+        if (!at || !px) {
+            free(at);
+            continue;
+        }
         sp_mat4 m;
         bool moved = ink_moved(e, was, &m);
         for (int j = 0; j < e->n; ++j)
             at[j] = moved ? moved_px(d, &m, e->drawn[j]) : e->drawn[j];
-        onto_mesh(d, q, at, e->n);
+        onto_mesh(q, px, at, e->n);
         sp_vec2 lo = at[0], hi = at[0];
         for (int j = 1; j < e->n; ++j)
             lo.x = fmin(lo.x, at[j].x), lo.y = fmin(lo.y, at[j].y), hi.x = fmax(hi.x, at[j].x), hi.y = fmax(hi.y, at[j].y);
@@ -419,7 +426,7 @@ static void details_follow(sp_dragon* d, int k, const part* before)
         // way): ink the visitor drew is not dropped.
         detail_hit hit = {
             .part = k, .near = DETAIL_FOLLOW_NEAR * hypot(hi.x - lo.x, hi.y - lo.y) + 1.0, .air = DETAIL_AIR_TOGETHER};
-        detail* nb = bind_detail(d, q, &hit, at, e->n);
+        detail* nb = bind_detail(d, q, &hit, px, at, e->n);
         free(at);
         if (!nb) continue;
         nb->id = e->id;
@@ -432,6 +439,7 @@ static void details_follow(sp_dragon* d, int k, const part* before)
                 c->alt = NULL;
             }
     }
+    free(px);
 }
 
 static const part* host_of(const sp_dragon* d, const detail* e, int* index)
