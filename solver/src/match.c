@@ -106,11 +106,14 @@ static bool grow_pairs(sp_solver* s, int need)
 }
 
 // Drawing-order independence for small stick figures, topology first: when
-// strokes and curves are as many and at most 7, every one-to-one assignment
-// is scored by how many joints it breaks (two curves that meet at an end
-// point must get two strokes that meet, and the other way round), then by
-// the ordered shape and length cost. Plain optimal assignment on shape cost alone
-// swaps a spine and an arm that happen to overlap; the joints do not.
+// there are at most 7 curves and no more strokes (at least 2), every
+// one-to-one assignment of the strokes to curves is scored by how many
+// joints it breaks (two curves that meet at an end point must get two
+// strokes that meet, and the other way round, among the curves that get a
+// stroke), then by the ordered shape and length cost. Plain optimal
+// assignment on shape cost alone swaps a spine and an arm that happen to
+// overlap, and with a limb left undrawn it gave the spine a raised arm; the
+// joints do not.
 enum { TOPO_MAX = SP_TOPO_MAX };
 
 static bool ends_meet(sp_vec2 a0, sp_vec2 a1, sp_vec2 b0, sp_vec2 b1, double eps)
@@ -120,7 +123,7 @@ static bool ends_meet(sp_vec2 a0, sp_vec2 a1, sp_vec2 b0, sp_vec2 b1, double eps
 }
 
 typedef struct topo_search {
-    int n;
+    int n, C;                        // strokes, curves (n <= C)
     double cost[TOPO_MAX][TOPO_MAX]; // stroke x curve
     bool sadj[TOPO_MAX][TOPO_MAX], cadj[TOPO_MAX][TOPO_MAX];
     int perm[TOPO_MAX], best[TOPO_MAX];
@@ -137,7 +140,7 @@ static void topo_visit(topo_search* t, int s, int breaks, double cost)
         memcpy(t->best, t->perm, sizeof t->perm);
         return;
     }
-    for (int c = 0; c < t->n; ++c) {
+    for (int c = 0; c < t->C; ++c) {
         if (t->used[c]) continue;
         int b = 0;
         for (int q = 0; q < s; ++q) b += t->sadj[s][q] != t->cadj[c][t->perm[q]];
@@ -230,9 +233,9 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
                                signed char* rev)
 {
     int n = sk->stroke_count;
-    if (n != C || n < 2 || n > TOPO_MAX) return false;
+    if (n > C || n < 2 || C > TOPO_MAX) return false;
     enum { M = 48 };
-    topo_search t = {.n = n, .best_breaks = 1 << 30, .best_cost = INFINITY};
+    topo_search t = {.n = n, .C = C, .best_breaks = 1 << 30, .best_cost = INFINITY};
     sp_vec2 y[M], z[M], se[TOPO_MAX][2], ce[TOPO_MAX][2];
     double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
     for (int i = 0; i < n; ++i) {
@@ -246,9 +249,9 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
     for (int c = 0; c < C; ++c) ce[c][0] = lines[c].points[0], ce[c][1] = lines[c].points[lines[c].count - 1];
     double seps = 0.05 * hypot(hi_x - lo_x, hi_y - lo_y), ceps = 0.02 * s->L;
     bool any = false;
-    for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) {
-            t.sadj[a][b] = a != b && ends_meet(se[a][0], se[a][1], se[b][0], se[b][1], seps);
+    for (int a = 0; a < C; ++a)
+        for (int b = 0; b < C; ++b) {
+            t.sadj[a][b] = a != b && a < n && b < n && ends_meet(se[a][0], se[a][1], se[b][0], se[b][1], seps);
             t.cadj[a][b] = a != b && ends_meet(ce[a][0], ce[a][1], ce[b][0], ce[b][1], ceps);
             any |= t.cadj[a][b];
         }
@@ -277,7 +280,8 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
         free(tmp);
     }
     topo_visit(&t, 0, 0, 0.0);
-    for (int c = 0; c < C; ++c) c2s[c] = -1;
+    for (int c = 0; c < C; ++c)
+        c2s[c] = -1, rev[c] = -1;
     for (int i = 0; i < n; ++i) c2s[t.best[i]] = i;
     topology_directions(s, lines, n, se, seps, t.best, rev);
     return true;

@@ -1317,6 +1317,50 @@ static void test_pose_surplus_strokes(void)
     }
 }
 
+// Fewer strokes than curves: a figure drawn with a limb or the spine left
+// out (the outside reviews' drawings, strokes removed). The strokes go to
+// the curves the joints tell, as when every curve is drawn: assigned on
+// shape alone against the rest pose, a raised arm took the spine and the
+// spine an arm (8-20 px mean, the figure bent double).
+static void test_pose_fewer_strokes(void)
+{
+    const struct {
+        const char* file;
+        int drop[2];
+        const char* missing; // the curve said to have no stroke
+    } cases[] = {{"arms_up_head_circle", {1, 3}, "('arm_r')"},
+                 {"arms_up_head_circle", {1, 2}, "('arm_l')"},
+                 {"arms_up_head_circle", {1, 4}, "('leg_r')"},
+                 {"arms_up_head_circle", {1, 5}, "('leg_l')"},
+                 {"stand_up85", {0, -1}, "('spine')"}};
+    char strokes[1100], report[1100], args[4000];
+    snprintf(strokes, sizeof strokes, "%s", sp_test_tmp_path("fewer_strokes.json"));
+    snprintf(report, sizeof report, "%s", sp_test_tmp_path("fewer_report.json"));
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char src[1100];
+        snprintf(src, sizeof src, "%s/tests/data/posing/cartoon_man_%s.json", SP_SOURCE_DIR, cases[i].file);
+        sp_sketch all, some = {0};
+        sp_error err = {0};
+        ENSURE(sp_sketch_read_json(src, &all, &err) == SP_OK);
+        some.canvas_w = all.canvas_w, some.canvas_h = all.canvas_h;
+        for (int k = 0; k < all.stroke_count; ++k)
+            if (k != cases[i].drop[0] && k != cases[i].drop[1])
+                ENSURE(sp_sketch_add_stroke(&some, all.strokes[k].points, NULL, all.strokes[k].count) == SP_OK);
+        ENSURE(sp_sketch_write_json(strokes, &some, &err) == SP_OK);
+        sp_sketch_free(&all), sp_sketch_free(&some);
+        snprintf(args, sizeof args, "pose --rig '%s/assets/cartoon_man.glb' --strokes '%s'", SP_SOURCE_DIR, strokes);
+        cJSON* j = report_of(args, report);
+        const char* note = cJSON_GetStringValue(cJSON_GetObjectItem(j, "note"));
+        double mean = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "mean_error_px"));
+        double max = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "max_error_px"));
+        fprintf(stderr, "  %s without %d, %d: mean %.2f px, max %.1f px, note \"%s\"\n", cases[i].file, cases[i].drop[0],
+                cases[i].drop[1], mean, max, note ? note : "");
+        ENSURE(note && strstr(note, "1 curve without a stroke") && strstr(note, cases[i].missing));
+        ENSURE(mean < 2 && max < 10);
+        cJSON_Delete(j);
+    }
+}
+
 // A figure drawn 85 px above where it stands (a jump; an outside review's
 // drawings): closest points give a figure of vertical lines no pull upwards,
 // and it stayed where it stood, "best effort" at 86 px; placed by its ordered
@@ -1957,6 +2001,7 @@ int main(int argc, char** argv)
                                    {"pose_file_strict", test_pose_file_strict},
                                    {"note_unmatched_curves", test_note_unmatched_curves},
                                    {"pose_surplus_strokes", test_pose_surplus_strokes},
+                                   {"pose_fewer_strokes", test_pose_fewer_strokes},
                                    {"pose_drawn_higher", test_pose_drawn_higher},
                                    {"pose_notes_say_why", test_pose_notes_say_why},
                                    {"drawover_only_carriers", test_drawover_only_carriers},
