@@ -51,11 +51,13 @@ int cmd_classify(int argc, char** argv)
         sp_clf_destroy(clf);
         return SP_EXIT_INPUT;
     }
-    // A dot has nothing to classify (pose refuses it too): it was ranked, exit 0.
-    const char* why = r.pixels ? NULL : sp_sketch_extent_problem(&s);
+    // A dot has nothing to classify (pose refuses it too): it was ranked,
+    // exit 0. A blank picture is said as db add-sketch says it.
+    const char* why = r.pixels ? sp_raster_ink_problem(&r) : sp_sketch_extent_problem(&s);
     if (why) {
         fprintf(stderr, "sketchpose classify: %s: %s\n", strokes, why);
         sp_sketch_free(&s);
+        sp_raster_free(&r);
         sp_clf_destroy(clf);
         return SP_EXIT_INPUT;
     }

@@ -1887,6 +1887,12 @@ static void test_no_extent_cli(void)
     text = run_said(args, &rc);
     ENSURE(rc == 0 && strstr(text, "2 drawings left out: no extent"));
     free(text);
+    // classify says it in the same words (it said "raster has no dark lines").
+    char said_by[3000];
+    snprintf(said_by, sizeof said_by, "classify --model '%s' --strokes '%s'", model, blank);
+    text = run_said(said_by, &rc);
+    ENSURE(rc == 1 && strstr(text, "white.png: the picture has no dark lines (a blank page?)"));
+    free(text);
     // A category whose only drawing is blank: nothing to learn it from (it
     // was in the model, every drawing of it taken for another).
     snprintf(cmd, sizeof cmd, "mkdir -p '%s/c' && cp '%s' '%s/c/'", dir, blank, dir);
