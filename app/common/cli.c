@@ -412,7 +412,7 @@ void sp_cli_print_shell_word(FILE* f, const char* s)
 
 void sp_cli_say(const char* fmt, ...)
 {
-    char line[1024];
+    char line[SP_TEXT_LINE_MAX];
     va_list ap;
     va_start(ap, fmt);
     sp_text_vline(line, sizeof line, fmt, ap);

@@ -7,7 +7,7 @@
 
 void sp_kiosk_log(const char* fmt, ...)
 {
-    char msg[1024]; // sp_text_escape_controls's most
+    char msg[SP_TEXT_LINE_MAX];
     va_list ap;
     va_start(ap, fmt);
     sp_text_vline(msg, sizeof msg, fmt, ap); // one line, whatever a path in it holds

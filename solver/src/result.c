@@ -1,7 +1,20 @@
 #include "sp/result.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
+
+// A text cut to fit its buffer says so: "..." at its end, not inside a
+// UTF-8 character (a path cut short hid the part an error was about).
+static void mark_cut(char* s, size_t cap)
+{
+    if (cap < 4) return;
+    size_t w = strlen(s);
+    if (w + 4 > cap) w = cap - 4;
+    while (w > 0 && ((unsigned char)s[w] & 0xC0) == 0x80)
+        --w;
+    memcpy(s + w, "...", 4);
+}
 
 void sp_text_escape_controls(char* s, size_t cap)
 {
@@ -9,18 +22,17 @@ void sp_text_escape_controls(char* s, size_t cap)
     while (*p && *p >= 0x20 && *p != 0x7f)
         ++p;
     if (!*p) return; // nothing to escape: the text as it is
-    char out[1024];
+    char out[SP_TEXT_LINE_MAX];
     size_t w = 0, room = cap < sizeof out ? cap : sizeof out;
+    bool cut = false;
     for (p = (const unsigned char*)s; *p; ++p) {
         char one[8];
         int k = *p == '\n'                ? snprintf(one, sizeof one, "\\n")
                 : *p == '\t'              ? snprintf(one, sizeof one, "\\t")
                 : *p < 0x20 || *p == 0x7f ? snprintf(one, sizeof one, "\\x%02x", *p)
                                           : snprintf(one, sizeof one, "%c", *p);
-        if (w + (size_t)k + 1 > room) { // cut, and not inside a UTF-8 character
-            while (w > 0 && ((unsigned char)out[w - 1] & 0xC0) == 0x80)
-                --w;
-            if (w > 0 && (unsigned char)out[w - 1] >= 0xC0) --w;
+        if (w + (size_t)k + 1 > room) {
+            cut = true;
             break;
         }
         memcpy(out + w, one, (size_t)k);
@@ -28,11 +40,13 @@ void sp_text_escape_controls(char* s, size_t cap)
     }
     memcpy(s, out, w);
     s[w] = 0;
+    if (cut) mark_cut(s, room);
 }
 
 void sp_text_vline(char* buf, size_t cap, const char* fmt, va_list ap)
 {
-    vsnprintf(buf, cap, fmt, ap);
+    int n = vsnprintf(buf, cap, fmt, ap);
+    if (n >= 0 && (size_t)n >= cap) mark_cut(buf, cap);
     // One line, whatever a file's names hold: a joint named with a newline
     // and an escape code split a message and cleared the terminal.
     sp_text_escape_controls(buf, cap);

@@ -382,6 +382,20 @@ static void test_options(void)
     sp_error jerr = {0};
     sp_fail(&jerr, SP_ERR_INVALID, "joint '%s' is odd", src.rig.joints[root].name);
     ENSURE(!strcmp(jerr.text, "joint 'ro\\x1b[2Jot\\nFAKE LINE' is odd"));
+    // A message cut to fit ends in "...", with or without codes to escape (a
+    // long path's end, which named the problem, was cut without a sign; an
+    // outside review), and not inside a UTF-8 character.
+    char longname[1200];
+    memset(longname, 'a', sizeof longname - 1), longname[sizeof longname - 1] = 0;
+    for (int esc = 0; esc < 2; ++esc) {
+        if (esc) longname[3] = '\n';
+        sp_fail(&jerr, SP_ERR_INVALID, "%s/out.jpg: not an image", longname);
+        size_t len = strlen(jerr.text);
+        ENSURE(len == sizeof jerr.text - 1 && !strcmp(jerr.text + len - 3, "...") && !strchr(jerr.text, '\n'));
+    }
+    char line[6]; // "a", e acute, tab, "zz": "a\xc3\xa9\\t" fills it, "..." goes before the e acute
+    sp_text_escape_controls(strcpy(line, "a\xc3\xa9\tz"), sizeof line);
+    ENSURE(!strcmp(line, "a..."));
     snprintf(src.rig.joints[root].name, sizeof src.rig.joints[root].name, "root");
     derive_ok(&src, &(sp_derive_desc){.abstraction = "stick", .attach_joint = "tail_3"}, &part, &info);
     ENSURE(!sp_fixture_has_warning(&part, "it attaches by its root"));

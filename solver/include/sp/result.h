@@ -40,14 +40,19 @@ sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)
 #endif
     ;
 
+/// The longest line sp_text_escape_controls writes, its end included: room
+/// for two paths of PATH_MAX's 4096 bytes is not needed, one is.
+#define SP_TEXT_LINE_MAX 4096
+
 /// Rewrites text s (a buffer of cap bytes) on one line: a newline as \n, a
 /// tab as \t, any other control character as \xNN (a name from a file may
-/// hold any), cut to fit (at most 1023 bytes). sp_fail does it to every message.
+/// hold any), cut to fit (at most SP_TEXT_LINE_MAX - 1 bytes), a cut text
+/// ending in "...". sp_fail does it to every message.
 void sp_text_escape_controls(char* s, size_t cap);
 
 /// vsnprintf into buf (cap bytes), then sp_text_escape_controls: a message
 /// on one line whatever it quotes (sp_fail's, the commands' and the kiosk
-/// log's own lines).
+/// log's own lines), ending in "..." when cut to fit.
 void sp_text_vline(char* buf, size_t cap, const char* fmt, va_list ap);
 
 /// Short stable name of a result code, e.g. "parse error".
