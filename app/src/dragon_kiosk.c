@@ -286,7 +286,8 @@ static bool export_folder_ok(const char* dir)
     char* real = sp_path_follow_links(dir);
     char* at = real ? strdup(real) : NULL;
     struct stat st;
-    const char* why = NULL;
+    // No folder at the end of its links (a loop): every Save would fail.
+    const char* why = real ? NULL : "its links go round in a loop";
     while (at && !why) {
         if (stat(at, &st) == 0) {
             why = !S_ISDIR(st.st_mode) ? "not a folder" : access(at, W_OK | X_OK) != 0 ? "this user may not write there" : NULL;
@@ -301,7 +302,7 @@ static bool export_folder_ok(const char* dir)
         free(at);
         at = top ? NULL : up;
     }
-    if (why && !strcmp(at, real))
+    if (why && (!at || !strcmp(at, real)))
         sp_cli_say("%s: --export-dir %s: %s (Save writes the visitors' dragons there)", k_cmd, dir, why);
     else if (why)
         sp_cli_say("%s: --export-dir %s: '%s' on its way: %s (Save makes the folder and writes the visitors' dragons there)",
