@@ -100,7 +100,8 @@ bool sp_cli_out_is_input(const char* cmd, const char* out_name, const char* out,
 /// One line on stderr, printf-style, its control characters escaped
 /// (sp_text_escape_controls): for messages that quote a path or a name
 /// someone typed (a newline in it split the line, an escape code drove the
-/// terminal: an outside review). At most 1023 bytes.
+/// terminal: an outside review). At most SP_TEXT_LINE_MAX - 1 bytes, ending
+/// in "..." when cut.
 void sp_cli_say(const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 1, 2)))

@@ -311,6 +311,15 @@ static bool export_folder_ok(const char* dir)
     return why == NULL;
 }
 
+// The database is read and written, named or not: a recording over it
+// replaced it with the session, every visitor's sketch then dropped.
+static bool outs_spare_database(const char* db, const char* record, const char* shot, const char* out_glb)
+{
+    return !sp_cli_out_is_input(k_cmd, "--record", record, "the database", db) &&
+           !sp_cli_out_is_input(k_cmd, "--screenshot", shot, "the database", db) &&
+           !sp_cli_out_is_input(k_cmd, "--export", out_glb, "the database", db);
+}
+
 static double quantile(const double* v, int n, double q)
 {
     if (n <= 0) return 0;
@@ -694,6 +703,7 @@ int main(int argc, char** argv)
         !sp_cli_check_out(k_cmd, "--export", out_glb, SP_CLI_OUT_GLTF))
         return SP_EXIT_USAGE;
     if (!numbers_ok(&lod, &msaa, &max_parts, &keep_days, idle_s) || !export_named(export_dir)) return SP_EXIT_USAGE;
+    if (!outs_spare_database(db ? db : sp_db_default_path(), record, shot, out_glb)) return SP_EXIT_USAGE;
     int win_w = 1280, win_h = 800;
     if (!window_size(size, &win_w, &win_h)) return SP_EXIT_USAGE;
     sp_kiosk_session session = {0};

@@ -2458,7 +2458,7 @@ static int kiosk_no_display(const char* args, char* out, size_t cap)
 // (it was one line at the end of the replay); a script with marks and a
 // screenshot to a stream, which has no "beside" for the marks' PNGs, is bad
 // usage (it wrote /dev/stdout-<mark>.png), and so is a recording over the
-// script it replays (which it replaced).
+// script it replays (which it replaced) or an output over the database.
 static void test_screenshot_unwritable(void)
 {
     char file_dir[1100], args[3000], out[1024];
@@ -2485,6 +2485,26 @@ static void test_screenshot_unwritable(void)
         bool one_line = nl && nl[1] == 0;
         if (rc != cases[i].code || !one_line || !strstr(out, cases[i].says)) fprintf(stderr, "  %s: %d %s", args, rc, out);
         ENSURE(rc == cases[i].code && one_line && strstr(out, cases[i].says) && strstr(out, cases[i].opt));
+    }
+    // The database, named or the default one, is no output's: a recording
+    // over it replaced it with the session (an outside review).
+    for (int named = 0; named < 2; ++named) {
+        for (int o = 0; o < 3; ++o) {
+            const char* opt[3] = {"--record", "--screenshot", "--export"};
+            char in[1200], run_it[6000];
+            snprintf(in, sizeof in, "%s%s", file_dir, o == 1 ? ".png" : o == 2 ? ".glb" : "");
+            FILE* g = fopen(in, "a");
+            ENSURE(g && fclose(g) == 0);
+            snprintf(run_it, sizeof run_it,
+                     "env -u DISPLAY -u WAYLAND_DISPLAY SP_DB='%s' '%s' %s%s%s --script '%s' %s '%s' 2>&1 >/dev/null",
+                     named ? "/nonexistent/k.db" : in, SP_DRAGON_KIOSK, named ? "--db '" : "", named ? in : "", named ? "'" : "",
+                     script, opt[o], in);
+            int rc = sp_fixture_run(run_it, out, sizeof out);
+            fprintf(stderr, "  %s", out);
+            ENSURE(rc == 2 && strstr(out, opt[o]) && strstr(out, "is the same file as the database: it would be overwritten") &&
+                   strchr(out, '\n') == out + strlen(out) - 1);
+            if (o) unlink(in);
+        }
     }
     // Save's folder: made at the first Save when missing, but a file in its
     // place, or on its way, failed every visitor's Save (an outside review).
