@@ -1,10 +1,26 @@
 // cmd_train.c: sketchpose train --data DIR --model M
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "clf_cli.h"
 #include "sp/classifier.h"
 #include "sp/clock.h"
 #include "sp/sketch_io.h"
+
+// Whether the model would be written where the labelled folder's reader
+// looks (DIR/<category>/*.json|svg|png, DIR/*.ndjson): it replaced a
+// drawing, and the next train failed on it (an outside review).
+static bool model_among_drawings(const char* model, const char* dir)
+{
+    char* folder = sp_path_folder(model);
+    char* up = folder ? sp_path_folder(folder) : NULL;
+    char *rd = realpath(dir, NULL), *rf = folder ? realpath(folder, NULL) : NULL, *ru = up ? realpath(up, NULL) : NULL;
+    bool drawing = sp_path_ext_is(model, "json") || sp_path_ext_is(model, "svg") || sp_path_ext_is(model, "png");
+    bool among = rd && ((rf && !strcmp(rf, rd) && sp_path_ext_is(model, "ndjson")) || (ru && !strcmp(ru, rd) && drawing));
+    free(folder), free(up), free(rd), free(rf), free(ru);
+    return among;
+}
 
 int cmd_train(int argc, char** argv)
 {
@@ -32,6 +48,13 @@ int cmd_train(int argc, char** argv)
         fprintf(stderr, "sketchpose train: --calibrate-quantile applies only with --calibrate DIR\n");
         return SP_EXIT_USAGE;
     }
+    for (int i = 0; i < 2; ++i)
+        if ((i ? calibrate : data) && model_among_drawings(model, i ? calibrate : data)) {
+            sp_cli_say("sketchpose train: --model %s lies among the drawings of %s %s: it would replace or join them; write it "
+                       "elsewhere",
+                       model, i ? "--calibrate" : "--data", i ? calibrate : data);
+            return SP_EXIT_USAGE;
+        }
     if (isnan(cal_q)) cal_q = 0.96;
     if (!sp_cli_check_double("sketchpose train", "--calibrate-quantile", cal_q, 0, true, 1)) return SP_EXIT_USAGE;
     if (!sp_cli_check_out_folders("sketchpose train", opts, (int)(sizeof opts / sizeof opts[0])))

@@ -1893,6 +1893,23 @@ static void test_no_extent_cli(void)
     text = run_said(said_by, &rc);
     ENSURE(rc == 1 && strstr(text, "white.png: the picture has no dark lines (a blank page?)"));
     free(text);
+    // A model written among the drawings replaced one (and the next train
+    // failed on it): bad usage, the drawing kept (an outside review).
+    const char* among[2] = {"b/0.json", "more.ndjson"};
+    for (int i = 0; i < 2; ++i) {
+        char over[1200], before[1200];
+        snprintf(over, sizeof over, "%s/%s", dir, among[i]);
+        snprintf(before, sizeof before, "%s", sp_test_tmp_path("extent_before"));
+        snprintf(cmd, sizeof cmd, "touch '%s' && cp '%s' '%s'", over, over, before);
+        ENSURE(run(cmd) == 0);
+        snprintf(said_by, sizeof said_by, "train --data '%s' --model '%s' --words 20", dir, over);
+        text = run_said(said_by, &rc);
+        ENSURE(rc == 2 && strstr(text, "lies among the drawings of --data") && strchr(text, '\n') == text + strlen(text) - 1);
+        free(text);
+        snprintf(cmd, sizeof cmd, "cmp -s '%s' '%s' && rm '%s'%s%s%s", over, before, before, i ? " '" : "", i ? over : "",
+                 i ? "'" : "");
+        ENSURE(run(cmd) == 0);
+    }
     // A category whose only drawing is blank: nothing to learn it from (it
     // was in the model, every drawing of it taken for another).
     snprintf(cmd, sizeof cmd, "mkdir -p '%s/c' && cp '%s' '%s/c/'", dir, blank, dir);
