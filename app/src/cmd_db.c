@@ -1187,10 +1187,18 @@ static int db_review(int argc, char** argv)
                 limit < 0 ? limit : after);
         return SP_EXIT_USAGE;
     }
-    if (actions > 1 || (actions && sheet) || (relabel.count && relabel.count != 2)) {
+    // Said for what was given (one message for all three read as if no
+    // action had been given; an outside review).
+    if (relabel.count && relabel.count != 2) {
+        fprintf(stderr, "%s: --relabel takes one id and its new category (--relabel ID CATEGORY), got %d value%s\n", cmd,
+                relabel.count, relabel.count == 1 ? "" : "s");
+        return SP_EXIT_USAGE;
+    }
+    if (actions > 1 || (actions && sheet)) {
         fprintf(stderr,
-                "%s: give one of --approve ID..., --reject ID..., --relabel ID CATEGORY, --delete-rejected (not with --sheet)\n",
-                cmd);
+                "%s: %s: one action at a time, --approve ID..., --reject ID..., --relabel ID CATEGORY or --delete-rejected, "
+                "and not with --sheet (which draws the listing)\n",
+                cmd, actions > 1 ? "more than one action given" : "an action with --sheet");
         return SP_EXIT_USAGE;
     }
     unsigned mask = 0;

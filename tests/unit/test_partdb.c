@@ -3045,12 +3045,20 @@ static void test_kiosk_review_cli(void)
     // One action at a time, and --relabel takes one id and one category:
     // anything else is bad usage (exit 2), and nothing changes.
     file_sha(p, before);
-    const char* usage[] = {"--approve %1$lld --reject %2$lld", "--relabel %1$lld wings %2$lld"};
-    for (int u = 0; u < 2; ++u) {
+    // Each said for what was given (one message read as if no action had
+    // been given; an outside review).
+    const struct {
+        const char *args, *says;
+    } usage[] = {{"--approve %1$lld --reject %2$lld", "more than one action given"},
+                 {"--relabel %1$lld wings %2$lld", "--relabel takes one id and its new category (--relabel ID CATEGORY), got 3"},
+                 {"--relabel %1$lld", "got 1 value\n"},
+                 {"--approve %1$lld --sheet s.png", "an action with --sheet"}};
+    for (size_t u = 0; u < sizeof usage / sizeof usage[0]; ++u) {
         char args[200];
-        snprintf(args, sizeof args, usage[u], (long long)id, (long long)first);
+        snprintf(args, sizeof args, usage[u].args, (long long)id, (long long)first);
         snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' %s 2>&1 >/dev/null", bin, p, args);
-        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "give one of --approve ID..., --reject ID..."));
+        ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, usage[u].says) &&
+               strchr(out, '\n') == out + strlen(out) - 1);
     }
     // --relabel acts on kiosk sketches only: a curated or generated one is
     // "no kiosk sketch", exit 1.
