@@ -30,7 +30,8 @@ int cmd_pose(int argc, char** argv)
         {"--lambda-plane", SP_OPT_DOUBLE, &lambda_plane, "L", "weight of W_plane (default 0.01; 0 or negative: off)", false},
         {"--lambda-dist", SP_OPT_DOUBLE, &lambda_dist, "L", "weight of W_dist (default 0.001; 0 or negative: off)", false},
         {"--representatives", SP_OPT_INT, &reps, "K", "coarsening: representative vertices, 1..100000 (default 200)", false},
-        {"--max-iterations", SP_OPT_INT, &iters, "N", "Gauss-Newton iterations at most, 1..1000000 (default 300)", false},
+        {"--max-iterations", SP_OPT_INT, &iters, "N", "Gauss-Newton iterations at most, each attempt, 1..1000000 (default 300)",
+         false},
         {"--max-ms", SP_OPT_DOUBLE, &cap_ms, "MS", "time cap of the solve, " SP_CLI_MAX_MS_RANGE " (default 3000)", false},
     };
     int rc = sp_cli_parse(argc, argv, "sketchpose pose", "Redraw posing: fits the rig's abstraction to the strokes.", opts,

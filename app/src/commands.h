@@ -8,7 +8,7 @@
 #define SP_COMMANDS(X)                                                                                                           \
     X(inspect, "print a rig's joints, parameters, abstractions and warnings as JSON")                                            \
     X(render, "render a rig (posed) with an abstraction overlaid to PNG")                                                        \
-    X(export, "write a rig posed by a pose file as .glb")                                                                        \
+    X(export, "write a rig posed by a pose file as .glb or .gltf")                                                               \
     X(train, "train a sketch classifier on a labelled folder")                                                                   \
     X(eval, "classifier accuracy (top-1/top-3, recall, confusion), cross-validation")                                            \
     X(classify, "classify one drawing with a trained model; ranked JSON")                                                        \

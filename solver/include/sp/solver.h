@@ -63,7 +63,7 @@ typedef struct sp_solve_desc {
     double lambda_dist;  ///< 0: SP_LAMBDA_DIST; < 0: term off
     int representatives; ///< k for the coarsening (eq. 12); 0: 200
     int samples;         ///< samples per curve after resampling; 0: by length, 16..160
-    int max_iterations;  ///< Gauss-Newton iterations in all; 0: 300
+    int max_iterations;  ///< Gauss-Newton iterations of each attempt (a loose fit gets more attempts); 0: 300
     int max_icp_rounds;  ///< correspondence updates; 0: 40
     double time_cap_ms;  ///< wall-clock cap; 0: 3000
     bool no_root_alignment; ///< skip the first stage that moves only the root's parameters
