@@ -154,9 +154,9 @@ void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s)
 
 // ---- extras -------------------------------------------------------------
 
-// The largest bounds a channel may have: a move (in the rig's units), a
+// The largest bounds a channel may have: a move (SP_GLTF_MOVE_MAX), a
 // turn (radians; a few turns is plenty) and a scale.
-#define DOF_MOVE_MAX 1e6
+#define DOF_MOVE_MAX SP_GLTF_MOVE_MAX
 #define DOF_TURN_MAX 100.0
 #define DOF_SCALE_MAX 1e3
 

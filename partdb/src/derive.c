@@ -781,6 +781,15 @@ sp_result sp_part_derive(const sp_character* src, const sp_derive_desc* desc, sp
     sp_bounds(w.xyz, R.vertex_count, &lo, &hi);
     sp_camera cam = sp_part_side_camera(lo, hi, FRAME_MARGIN);
     double reach = 0.5 * fmax(cam.width, cam.height) / cam.scale;
+    // A part whose moves our own readers refuse is no part (a model in
+    // micrometres was written, then refused by inspect: an outside review).
+    if (!(reach <= SP_GLTF_MOVE_MAX)) {
+        r = sp_fail(err, SP_ERR_INVALID,
+                    "the model is %.3g units across: its placement would move it by up to %.3g, over the %.0e a part's moves may "
+                    "span; scale it down (a model in micrometres to metres)",
+                    fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z)), reach, SP_GLTF_MOVE_MAX);
+        goto done;
+    }
     for (int q = 0; q < R.param_count; ++q)
         if (R.joints[R.params[q].joint].parent < 0 && (R.params[q].channel == SP_CH_TX || R.params[q].channel == SP_CH_TY))
             R.params[q].min = -reach, R.params[q].max = reach;

@@ -87,6 +87,11 @@ void sp_gltf_apply_pose_json(sp_character* ch, const char* parameters_json, doub
 /// written) for one curve. derive and add-part say it in the same words.
 bool sp_part_curves_warning(const sp_rig* rig, int a, char* line, size_t cap);
 
+/// The largest bound an `sp_dofs` move may have, in the rig's units: the
+/// readers refuse more, and derive refuses a model whose placement would
+/// need more (half its framed size).
+#define SP_GLTF_MOVE_MAX 1e6
+
 /// Appends a warning line to ch->warnings (printf style).
 void sp_character_warn(sp_character* ch, const char* fmt, ...)
 #if defined(__GNUC__)

@@ -517,6 +517,22 @@ static void test_refusals(void)
     fprintf(stderr, "  flat: %s\n", err.text);
     ENSURE(strstr(err.text, "all have no area") && !strchr(err.text, '\n'));
     sp_character_free(&flat);
+    // A model whose placement would need moves past the readers' bound (a
+    // model in micrometres): refused, where the part written was then
+    // refused by inspect and the kiosk (an outside review); 1e4 times
+    // larger is still a part.
+    for (int big = 0; big < 2; ++big) {
+        sp_character huge = {0};
+        load_ok(lizard("lizard_huge.glb", (sp_foreign_desc){0}), &huge);
+        double k = big ? 1e8 : 1e4;
+        for (int j = 0; j < huge.rig.joint_count; ++j) // the whole skin scaled from its top, as a file's root matrix would
+            if (huge.rig.joints[j].parent < 0) huge.rig.joints[j].rest_s = sp_v3_scale(huge.rig.joints[j].rest_s, k);
+        sp_result hr = sp_part_derive(&huge, NULL, &part, NULL, &err);
+        fprintf(stderr, "  scaled %g: %s\n", k, hr == SP_OK ? "derived" : err.text);
+        ENSURE(big ? hr == SP_ERR_INVALID && strstr(err.text, "units across") && strstr(err.text, "scale it down") : hr == SP_OK);
+        if (hr == SP_OK) sp_character_free(&part);
+        sp_character_free(&huge);
+    }
     const char* bin = sketchpose_bin();
     if (!bin) return;
     const char* none = lizard("lizard_no_skin.glb", (sp_foreign_desc){.no_skin = true});
