@@ -1,6 +1,7 @@
 // kiosk_collect.c: the visitors' strokes the kiosk keeps for review (issue
 // 16, item 5), written by a thread of their own so that the frame loop never
 // waits for the database (docs/DESIGN.md, "Collecting visitors' strokes").
+#include <ctype.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -66,9 +67,25 @@ static void count_result(kiosk_collector* c, bool stored)
 // parts on a damaged database were twenty identical lines): the next
 // different reason, a stored sketch or the close (why NULL) says how many
 // more went the same way.
+bool kiosk_same_reason(const char* a, const char* b)
+{
+    while (*a && *b) {
+        bool na = isdigit((unsigned char)*a), nb = isdigit((unsigned char)*b);
+        if (na != nb) return false;
+        if (na) {
+            while (isdigit((unsigned char)*a) || *a == '.')
+                ++a;
+            while (isdigit((unsigned char)*b) || *b == '.')
+                ++b;
+        } else if (*a++ != *b++)
+            return false;
+    }
+    return *a == *b;
+}
+
 static void say_dropped(kiosk_collector* c, const char* why)
 {
-    if (why && !strcmp(why, c->last_drop)) {
+    if (why && kiosk_same_reason(why, c->last_drop)) {
         ++c->same_drops;
         return;
     }

@@ -176,6 +176,10 @@ void kiosk_collector_counts(kiosk_collector* c, int* stored, int* dropped);
 /// Writes what is still queued, stops the writer, closes the handle (NULL is
 /// fine); *stored and *dropped get the final counts.
 void kiosk_collector_close(kiosk_collector* c, int* stored, int* dropped);
+/// Whether two reasons for dropping a sketch are alike but for their numbers
+/// (said once with a count): the free space a full disk's reason names
+/// changed with every sketch, and each was said anew (an outside review).
+bool kiosk_same_reason(const char* a, const char* b);
 /// Brings the cached meshes in step with d's parts at its last pose_at.
 void mesh_cache_sync(mesh_cache* c, sp_renderer* r, const sp_dragon* d, bool update_positions);
 void mesh_cache_free(mesh_cache* c);

@@ -95,17 +95,25 @@ void kiosk_prune_saves(sp_kiosk* k)
 {
     if (k->desc.keep_saves_days <= 0) return;
     char** names = NULL;
-    int count = 0;
+    int count = 0, removed = 0;
     sp_error err = {0};
     if (sp_dir_list(k->export_dir, &names, &count, &err) != SP_OK) return; // no folder yet: nothing saved
-    time_t before = time(NULL) - (time_t)k->desc.keep_saves_days * 86400;
-    int removed = 0;
-    for (int i = 0; i < count; ++i) {
-        if (!is_save_name(names[i])) continue; // anything else in the folder is staff's
-        char path[1200];
-        snprintf(path, sizeof path, "%s/%s", k->export_dir, names[i]);
-        struct stat st;
-        if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && st.st_mtime < before && unlink(path) == 0) ++removed;
+    // Days counted back from the newest save when the clock is past it: a
+    // kiosk that boots with its clock a year ahead (a flat RTC battery, no
+    // network time yet) removed every save, the last minute's too (an
+    // outside review). A museum closed for a month keeps a month more.
+    time_t now = time(NULL), newest = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        time_t before = (newest < now ? newest : now) - (time_t)k->desc.keep_saves_days * 86400;
+        for (int i = 0; i < count; ++i) {
+            if (!is_save_name(names[i])) continue; // anything else in the folder is staff's
+            char path[1200];
+            snprintf(path, sizeof path, "%s/%s", k->export_dir, names[i]);
+            struct stat st;
+            if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode)) continue;
+            if (pass == 0 && st.st_mtime > newest) newest = st.st_mtime;
+            if (pass == 1 && st.st_mtime < before && unlink(path) == 0) ++removed;
+        }
     }
     sp_dir_list_free(names, count);
     if (removed > 0)

@@ -1447,6 +1447,13 @@ static kiosk_collector* collector_after_one(const char* db, int* stored, int* dr
 // good one is renamed over it, collecting resumes without a restart.
 static void test_collect_mended(void)
 {
+    // Reasons alike but for their numbers are one reason, said once with a
+    // count (a disk under the reserve named its free space, new each time,
+    // and every sketch was said anew; an outside review).
+    const char* full = "k.db: 512 MB free on its disk, under the 1000 MB kept; sketch dropped";
+    ENSURE(kiosk_same_reason(full, "k.db: 498.5 MB free on its disk, under the 1000 MB kept; sketch dropped"));
+    ENSURE(!kiosk_same_reason(full, "k.db: not a valid sketchpose database; sketch dropped"));
+    ENSURE(!kiosk_same_reason("k.db: 5 free", "k.db: free") && !kiosk_same_reason(full, "") && kiosk_same_reason("", ""));
     six_strokes();
     char db[1100], good[1100];
     snprintf(db, sizeof db, "%s", sp_test_tmp_path("kiosk_mended.db"));
@@ -1994,6 +2001,28 @@ static void test_saves_disk(void)
     ENSURE(draw_and_save(k, &t));
     snprintf(path, sizeof path, "%s.glb", sp_kiosk_last_save(k));
     ENSURE(access(path, F_OK) == 0);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+    // The clock a year ahead of the saves (a kiosk booted with a flat RTC
+    // battery): days are counted back from the newest save, not from the
+    // clock, which removed every save, the last minute's too (an outside
+    // review).
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir '%s'", ex, ex);
+    ENSURE(system(cmd) == 0);
+    const char* ahead[4] = {"CEFH.glb", "CEFH.png", "JKLM.glb", "NPRT.glb"};
+    const int age_days[4] = {400, 400, 420, 440};
+    for (int i = 0; i < 4; ++i) {
+        snprintf(path, sizeof path, "%s/%s", ex, ahead[i]);
+        FILE* f = fopen(path, "wb");
+        ENSURE(f && fputs("x", f) >= 0 && fclose(f) == 0);
+        struct timespec when[2] = {{time(NULL) - age_days[i] * 86400, 0}, {time(NULL) - age_days[i] * 86400, 0}};
+        ENSURE(utimensat(AT_FDCWD, path, when, 0) == 0);
+    }
+    k = inproc_kiosk_desc((sp_kiosk_desc){.db_path = db, .export_dir = ex, .keep_saves_days = 30, .no_collect = true}, &gl, &t);
+    for (int i = 0; i < 4; ++i) {
+        snprintf(path, sizeof path, "%s/%s", ex, ahead[i]);
+        ENSURE((access(path, F_OK) == 0) == (age_days[i] < 430));
+    }
     sp_kiosk_destroy(k);
     sp_headless_destroy(gl);
     // A link to a folder not made yet: Save makes the folder it names (the
