@@ -2827,7 +2827,7 @@ static void test_kiosk_review_ranges(void)
     ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "--status chooses what is listed"));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --delete-rejected --approve %lld 2>&1 >/dev/null", bin, p,
              (long long)id[0]);
-    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "give one of"));
+    ENSURE(sp_fixture_run(cmd, out, sizeof out) == 2 && strstr(out, "more than one action given"));
     file_sha(p, after);
     ENSURE(!strcmp(before, after));
     snprintf(cmd, sizeof cmd, "'%s' db review --db '%s' --delete-rejected", bin, p);
