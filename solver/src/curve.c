@@ -204,6 +204,14 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
             keep = j;
             while (keep > c / 2 && keep > 1 && !near[keep - 1])
                 --keep;
+        } else {
+            // A loop comes within tol of where it began a tol short of
+            // closing: cut where it comes nearest (an eye 6 px across gone
+            // round three times was kept as four fifths of a ring; an
+            // outside review).
+            int at0 = (int)fmin(M - 1, floor(first[c] / step + 0.5));
+            while (keep + 1 < M && sp_v2_len(sp_v2_sub(r[keep + 1], r[at0])) < sp_v2_len(sp_v2_sub(r[keep], r[at0])))
+                ++keep;
         }
         // The input points up to that length (a long segment that crosses
         // it, a jump back to where the stroke began, is left out whole).

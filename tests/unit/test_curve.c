@@ -201,6 +201,16 @@ static void test_retrace_start(void)
     int r = sp_curve_retrace_start(p, N, 10, 0.25);
     fprintf(stderr, "  oval twice: keep %d of %d\n", r, N);
     ENSURE(r >= N / 2 - 4 && r <= N / 2 + 8);
+    // An eye 12 px across gone round three times, at the kiosk's tolerance
+    // (7.5 px, more than its radius): cut after one whole turn, where it was
+    // cut a tol short of closing, four fifths of a ring (an outside review).
+    for (int i = 0; i < 90; ++i) {
+        double a = 6 * M_PI * i / 89;
+        p[i] = (sp_vec2){600 + 6 * cos(a), 400 + 6 * sin(a)};
+    }
+    r = sp_curve_retrace_start(p, 90, 7.5, 0.25);
+    fprintf(stderr, "  eye three times: keep %d of 90 (a turn is 30)\n", r);
+    ENSURE(r >= 29 && r <= 34);
     // 1.2 turns: the overlap of a closed outline stays.
     for (int i = 0; i < N; ++i) {
         double a = 2.4 * M_PI * i / (N - 1);

@@ -83,7 +83,7 @@ int sp_curve_clean(const sp_vec2* pts, int n, double min_step, sp_vec2* out);
 /// only, nor a scribble here and there over itself). Returns how many
 /// points to keep, the stretch cut off with what leads into it without
 /// being gone over (the pen's jump back to the start; pts[0 .. r-1],
-/// r >= 2), or n when
+/// r >= 2; a loop after the point nearest where it began), or n when
 /// the stroke does not go over itself (n < 4, tol <= 0 or a length of 0
 /// included). O(64 n + 64^3).
 int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_share);
