@@ -821,6 +821,34 @@ static void test_chips_clear_the_stroke(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// Wings reaching the top edge along its whole width lay under the chips
+// left or right (an outside review): they go to the canvas's bottom, the
+// hint above them.
+static void test_chips_clear_the_top_edge(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    float top[2 * 300];
+    for (int i = 0; i < 300; ++i) // a part drawn along the canvas's top, edge to edge
+        top[2 * i] = ui->canvas.x + 10 + (ui->canvas.w - 20) * i / 299.0f,
+                top[2 * i + 1] = ui->canvas.y + 25 + 15 * sinf(0.2f * i);
+    sp_kiosk_ui_set_scene(ui, top, 300);
+    double t = stroke(ui, 1000, 300, 400, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_LABEL));
+    fprintf(stderr, "  the chips' label at y %.0f (the canvas %.0f..%.0f); scene points under them %d\n",
+            ui->target[SP_KT_CHIP_LABEL].y, ui->canvas.y, ui->canvas.y + ui->canvas.h, under_chips(ui, &ui->scene));
+    ENSURE(under_chips(ui, &ui->scene) == 0 && ui->target[SP_KT_CHIP_LABEL].y > ui->canvas.y + 0.5f * ui->canvas.h);
+    ENSURE(ui->hint_box.y + ui->hint_box.h <= ui->target[SP_KT_CHIP_LABEL].y);
+    check_targets(ui);
+    // Nothing at the top: back there.
+    sp_kiosk_ui_set_scene(ui, NULL, 0);
+    t = stroke(ui, t + 2000, 300, 400, 30, 10);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->target[SP_KT_CHIP_LABEL].y < ui->canvas.y + 0.1f * ui->canvas.h);
+    sp_kiosk_ui_destroy(ui);
+}
+
 // A dragon drawn in the top-left corner: the chips of its legs, drawn
 // below them, kept to the top-left and hid its head (an outside review).
 // The parts on the canvas (the scene the kiosk gives) count as the stroke does.
@@ -1528,9 +1556,10 @@ static void check_targets(const sp_kiosk_ui* ui)
             const sp_kiosk_rect* c = &ui->canvas;
             bool apart = r->y >= c->y + c->h || r->x >= c->x + c->w;
             ENSURE(apart);
-        } else { // chips lie above the hint, the parts row above or below it
+        } else { // chips lie above the hint (below it at the canvas's bottom, with no parts row), the parts row above or below it
             const sp_kiosk_rect* h = &ui->hint_box;
-            ENSURE(r->y + r->h <= h->y + 1e-3 || (t >= SP_KT_PART1 && r->y >= h->y + h->h - 1e-3));
+            bool chips_low = r->y > ui->canvas.y + 0.5f * ui->canvas.h && !sp_kiosk_ui_target_visible(ui, SP_KT_PART1);
+            ENSURE(r->y + r->h <= h->y + 1e-3 || ((t >= SP_KT_PART1 || chips_low) && r->y >= h->y + h->h - 1e-3));
             ENSURE(r->y >= ui->canvas.y && r->y + r->h <= ui->canvas.y + ui->canvas.h + 1e-3);
         }
     }
@@ -2199,6 +2228,7 @@ int main(int argc, char** argv)
                                    {"other_chip", test_other_chip},
                                    {"chips_clear_the_stroke", test_chips_clear_the_stroke},
                                    {"chips_clear_the_dragon", test_chips_clear_the_dragon},
+                                   {"chips_clear_the_top_edge", test_chips_clear_the_top_edge},
                                    {"long_category", test_long_category},
                                    {"start_over", test_start_over},
                                    {"part_names", test_part_names},

@@ -286,11 +286,31 @@ static void layout_chips(sp_kiosk_ui* ui)
     // drawn before: a dragon drawn in the corner had its head under them)
     // would be under them: they go to the top-right when less is there.
     int covered = chips_cover(ui);
+    float up = 0; // how far the chips went down to the canvas's bottom
     if (covered > 0) {
         sp_kiosk_rect at_left[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
         memcpy(at_left, &ui->target[SP_KT_CHIP_LABEL], sizeof at_left);
         chips_to_right(ui, right);
         if (chips_cover(ui) >= covered) memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left); // no better
+        covered = chips_cover(ui);
+        // A stroke along the whole top (wings reaching the top edge) lay
+        // under them either way: they go to the bottom when less is there,
+        // left or right. Not with the parts row, which goes under them, nor
+        // where they fill a quarter of the canvas (a phone's).
+        if (covered > 0 && !row_shown(ui) && y + h - ui->canvas.y < 0.25f * ui->canvas.h) {
+            sp_kiosk_rect kept[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
+            memcpy(kept, &ui->target[SP_KT_CHIP_LABEL], sizeof kept);
+            float dy = ui->canvas.y + ui->canvas.h - margin - (y + h);
+            for (int side = 0; side < 2 && covered > 0; ++side) {
+                memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left);
+                for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t)
+                    if (ui->target[t].w > 0) ui->target[t].y += dy;
+                if (side) chips_to_right(ui, right);
+                int c = chips_cover(ui);
+                if (c < covered) covered = c, up = dy, memcpy(kept, &ui->target[SP_KT_CHIP_LABEL], sizeof kept);
+            }
+            memcpy(&ui->target[SP_KT_CHIP_LABEL], kept, sizeof kept);
+        }
     }
     float below = y + h + gap, chips_end = below;
     // The parts row: an outline over its name, 26 x 22 mm, smaller (down to
@@ -335,6 +355,8 @@ static void layout_chips(sp_kiosk_ui* ui)
     // A canvas too small for the hint under the parts row (a phone held
     // upright) shows none: the chips and the row say enough.
     if (below + hh > ui->canvas.y + ui->canvas.h && row) hh = 0;
+    // Chips at the bottom: the hint above them.
+    if (up > 0) below = ui->canvas.y + margin + up - gap - hh;
     ui->hint_box = (sp_kiosk_rect){ui->canvas.x + 0.5f * (ui->canvas.w - hw), below, hw, hh};
     if (row) keep_stroke_in_sight(ui, chips_end, below + hh, margin, gap);
 }
