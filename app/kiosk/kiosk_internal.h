@@ -84,6 +84,7 @@ typedef struct part_icon {
 struct sp_kiosk {
     sp_kiosk_desc desc;
     char db_path[1024], export_dir[1024];
+    bool prune_checked, prune_held; // kiosk_prune_saves: the clock looked at its first call; saves kept this run
     sp_kiosk_ui* ui;
     sp_dragon* dragon;
     sp_renderer* r;

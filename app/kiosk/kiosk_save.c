@@ -93,18 +93,13 @@ static bool is_save_name(const char* name)
 
 void kiosk_prune_saves(sp_kiosk* k)
 {
-    if (k->desc.keep_saves_days <= 0) return;
+    if (k->desc.keep_saves_days <= 0 || k->prune_held) return;
     char** names = NULL;
     int count = 0, removed = 0;
     sp_error err = {0};
     if (sp_dir_list(k->export_dir, &names, &count, &err) != SP_OK) return; // no folder yet: nothing saved
-    // Days counted back from the newest save when the clock is past it: a
-    // kiosk that boots with its clock a year ahead (a flat RTC battery, no
-    // network time yet) removed every save, the last minute's too (an
-    // outside review). A museum closed for a month keeps a month more.
-    time_t now = time(NULL), newest = 0;
+    time_t now = time(NULL), newest = 0, keep = (time_t)k->desc.keep_saves_days * 86400;
     for (int pass = 0; pass < 2; ++pass) {
-        time_t before = (newest < now ? newest : now) - (time_t)k->desc.keep_saves_days * 86400;
         for (int i = 0; i < count; ++i) {
             if (!is_save_name(names[i])) continue; // anything else in the folder is staff's
             char path[1200];
@@ -112,7 +107,21 @@ void kiosk_prune_saves(sp_kiosk* k)
             struct stat st;
             if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode)) continue;
             if (pass == 0 && st.st_mtime > newest) newest = st.st_mtime;
-            if (pass == 1 && st.st_mtime < before && unlink(path) == 0) ++removed;
+            if (pass == 1 && st.st_mtime < now - keep && unlink(path) == 0) ++removed;
+        }
+        // A clock past every save by more than the days kept, when the kiosk
+        // starts, may be a clock set wrong (a flat RTC battery, no network
+        // time yet), which removed every save, and the next Save's date the
+        // rest (an outside review); a museum closed that long loses a day.
+        if (pass == 0 && !k->prune_checked) {
+            k->prune_checked = true;
+            k->prune_held = newest > 0 && now - newest > keep;
+            if (k->prune_held) {
+                sp_kiosk_log("%s: the clock is %.0f days past the newest save: no save is removed until the kiosk restarts "
+                             "(--keep-saves-days %d; is the clock right?)",
+                             k->export_dir, (double)(now - newest) / 86400.0, k->desc.keep_saves_days);
+                break;
+            }
         }
     }
     sp_dir_list_free(names, count);
