@@ -106,7 +106,8 @@ static bool grow_pairs(sp_solver* s, int need)
 }
 
 // Drawing-order independence for small stick figures, topology first: when
-// there are at most 7 curves and no more strokes (at least 2), every
+// there are at most 7 curves and as many strokes (or, in the attempt that
+// asks for it, s->partial_topology, fewer but at least 2), every
 // one-to-one assignment of the strokes to curves is scored by how many
 // joints it breaks (two curves that meet at an end point must get two
 // strokes that meet, and the other way round, among the curves that get a
@@ -233,7 +234,7 @@ static bool assign_by_topology(const sp_solver* s, const sp_sketch* sk, const sp
                                signed char* rev)
 {
     int n = sk->stroke_count;
-    if (n > C || n < 2 || C > TOPO_MAX) return false;
+    if (n > C || n < 2 || C > TOPO_MAX || (n < C && !s->partial_topology)) return false;
     enum { M = 48 };
     topo_search t = {.n = n, .C = C, .best_breaks = 1 << 30, .best_cost = INFINITY};
     sp_vec2 y[M], z[M], se[TOPO_MAX][2], ce[TOPO_MAX][2];

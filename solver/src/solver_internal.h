@@ -133,6 +133,7 @@ struct sp_solver {
     uint16_t rest_meet[SP_TOPO_MAX][2];
     bool rest_meet_valid;
     bool c2s_valid;
+    bool partial_topology; // this attempt assigns fewer strokes than curves by the junctions (icp.c's attempt)
     // ordered_by_ends: each curve's direction and the stroke it was decided
     // with, at an attempt's first pairing, held after (an arm folding on its
     // way up had its ends' sums cross and was paired back); -1: not yet.

@@ -1359,6 +1359,36 @@ static void test_pose_fewer_strokes(void)
         ENSURE(mean < 2 && max < 10);
         cJSON_Delete(j);
     }
+    // An animator's drawings: the junctions tell an arm and a leg with no
+    // spine apart (by shape the raised arm took the spine: 10.2 px), but
+    // legs begun 14 px below the spine meet nothing there, and by the
+    // junctions alone a leg took an arm's curve (7.7 px): the better fit of
+    // the two assignments is kept.
+    const struct {
+        const char* file;
+        const char* curves[5]; // the curve of each stroke
+        double mean;
+    } drawn[] = {{"arm_leg", {"arm_r", "leg_l"}, 2.0}, {"spine_legs_gap", {"spine", "leg_l", "leg_r"}, 5.0}};
+    for (size_t i = 0; i < sizeof drawn / sizeof drawn[0]; ++i) {
+        snprintf(args, sizeof args, "pose --rig '%s/assets/cartoon_man.glb' --strokes '%s/tests/data/posing/cartoon_man_%s.json'",
+                 SP_SOURCE_DIR, SP_SOURCE_DIR, drawn[i].file);
+        cJSON* j = report_of(args, report);
+        double mean = cJSON_GetNumberValue(cJSON_GetObjectItem(j, "mean_error_px"));
+        const cJSON* c;
+        int right = 0, strokes = 0;
+        cJSON_ArrayForEach(c, cJSON_GetObjectItem(j, "curves"))
+        {
+            const cJSON* st = cJSON_GetObjectItem(c, "stroke");
+            if (!cJSON_IsNumber(st)) continue;
+            int k = (int)cJSON_GetNumberValue(st);
+            ++strokes;
+            right += k >= 0 && k < 5 && drawn[i].curves[k] &&
+                     !strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(c, "curve")), drawn[i].curves[k]);
+        }
+        fprintf(stderr, "  %s: mean %.2f px, %d of %d strokes on their curves\n", drawn[i].file, mean, right, strokes);
+        ENSURE(mean < drawn[i].mean && right == strokes && strokes > 0);
+        cJSON_Delete(j);
+    }
 }
 
 // A figure drawn 85 px above where it stands (a jump; an outside review's
