@@ -131,6 +131,10 @@ static double seg_dist2(sp_vec2 x, sp_vec2 a, sp_vec2 b);
 // A stretch that goes over the stroke before it is at least this share of
 // the length it goes over.
 #define RETRACE_MIN_LENGTH 0.7
+// What leads to the second pass is cut as a line back when it lies within
+// this share of the distance it spans from the straight line between its
+// ends (half an ellipse twice as wide as tall: 0.25).
+#define CONNECTOR_BENT 0.15
 
 int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_share)
 {
@@ -153,11 +157,12 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
     // sample's own stretch of the stroke does not count (a turn back comes
     // within tol of itself there without going over anything).
     double first[M];
+    int first_seg[M]; // that segment's index
     for (int i = 0; i < M; ++i) {
-        first[i] = INFINITY;
+        first[i] = INFINITY, first_seg[i] = -1;
         for (int k = 0; k + 1 < n && arc[k + 1] <= i * step - own; ++k)
             if (seg_dist2(r[i], pts[k], pts[k + 1]) < tol * tol) {
-                first[i] = arc[k + 1];
+                first[i] = arc[k + 1], first_seg[i] = k;
                 break;
             }
     }
@@ -204,13 +209,25 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
             keep = j;
             while (keep > c / 2 && keep > 1 && !near[keep - 1])
                 --keep;
-        } else {
+            // A line back is about straight (the pen's jump); the rest of a
+            // loop gone round one and a half times bends away from it, and
+            // was cut to half a ring (a second review).
+            double off = 0.0, span = sp_v2_len(sp_v2_sub(r[c], r[keep]));
+            for (int q = keep + 1; q < c; ++q)
+                off = fmax(off, sqrt(seg_dist2(r[q], r[keep], r[c])));
+            if (off > CONNECTOR_BENT * span) keep = c;
+        }
+        if (keep == c && first_seg[c] >= 0) {
             // A loop comes within tol of where it began a tol short of
-            // closing: cut where it comes nearest (an eye 6 px across gone
-            // round three times was kept as four fifths of a ring; an
-            // outside review).
-            int at0 = (int)fmin(M - 1, floor(first[c] / step + 0.5));
-            while (keep + 1 < M && sp_v2_len(sp_v2_sub(r[keep + 1], r[at0])) < sp_v2_len(sp_v2_sub(r[keep], r[at0])))
+            // closing: cut where it comes nearest to the point it passes
+            // (an eye 6 px across gone round three times was kept as four
+            // fifths of a ring; an outside review), on the segment it
+            // passes, not at its end (one long straight side drawn twice
+            // was kept whole; a second review).
+            sp_vec2 a = pts[first_seg[c]], b = pts[first_seg[c] + 1], ab = sp_v2_sub(b, a);
+            double t = sp_v2_dot(ab, ab) > 0 ? fmin(1.0, fmax(0.0, sp_v2_dot(sp_v2_sub(r[c], a), ab) / sp_v2_dot(ab, ab))) : 0.0;
+            sp_vec2 at0 = sp_v2_add(a, sp_v2_scale(ab, t));
+            while (keep + 1 < M && sp_v2_len(sp_v2_sub(r[keep + 1], at0)) < sp_v2_len(sp_v2_sub(r[keep], at0)))
                 ++keep;
         }
         // The input points up to that length (a long segment that crosses

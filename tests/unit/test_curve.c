@@ -211,6 +211,27 @@ static void test_retrace_start(void)
     r = sp_curve_retrace_start(p, 90, 7.5, 0.25);
     fprintf(stderr, "  eye three times: keep %d of 90 (a turn is 30)\n", r);
     ENSURE(r >= 29 && r <= 34);
+    // A body gone round one and a half times: cut after one turn (the rest
+    // of the first turn, not gone over again, was cut as a line back to the
+    // start: half a ring; a second review).
+    for (int i = 0; i < 120; ++i) {
+        double a = 3 * M_PI * i / 119;
+        p[i] = (sp_vec2){640 + 220 * cos(a), 420 + 110 * sin(a)};
+    }
+    r = sp_curve_retrace_start(p, 120, 7.5, 0.25);
+    fprintf(stderr, "  body one and a half times: keep %d of 120 (a turn is 80)\n", r);
+    ENSURE(r >= 76 && r <= 86);
+    // A D whose straight side is one segment, gone round twice: one D (the
+    // cut went on along the whole segment; a second review).
+    int nd = 0;
+    for (int lap = 0; lap < 2; ++lap) {
+        for (int i = lap ? 1 : 0; i <= 40; ++i)
+            p[nd++] = (sp_vec2){500 + 150 * cos(-M_PI / 2 + M_PI * i / 40), 400 + 150 * sin(-M_PI / 2 + M_PI * i / 40)};
+        p[nd++] = (sp_vec2){500, 250};
+    }
+    r = sp_curve_retrace_start(p, nd, 7.5, 0.25);
+    fprintf(stderr, "  a D twice: keep %d of %d (a D is 42)\n", r, nd);
+    ENSURE(r >= 41 && r <= 45);
     // 1.2 turns: the overlap of a closed outline stays.
     for (int i = 0; i < N; ++i) {
         double a = 2.4 * M_PI * i / (N - 1);
