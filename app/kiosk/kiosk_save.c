@@ -112,7 +112,8 @@ void kiosk_prune_saves(sp_kiosk* k)
         // A clock past every save by more than the days kept, when the kiosk
         // starts, may be a clock set wrong (a flat RTC battery, no network
         // time yet), which removed every save, and the next Save's date the
-        // rest (an outside review); a museum closed that long loses a day.
+        // rest (two outside reviews); a museum closed that long keeps its
+        // saves one run more.
         if (pass == 0 && !k->prune_checked) {
             k->prune_checked = true;
             k->prune_held = newest > 0 && now - newest > keep;
