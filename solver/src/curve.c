@@ -131,10 +131,28 @@ static double seg_dist2(sp_vec2 x, sp_vec2 a, sp_vec2 b);
 // A stretch that goes over the stroke before it is at least this share of
 // the length it goes over.
 #define RETRACE_MIN_LENGTH 0.7
-// What leads to the second pass is cut as a line back when it lies within
-// this share of the distance it spans from the straight line between its
-// ends (half an ellipse twice as wide as tall: 0.25).
-#define CONNECTOR_BENT 0.15
+// What leads to the second pass is the pen's way back when the stroke
+// turns where it ends by more than about 60 degrees (the cosine): a loop's
+// next turn runs on.
+#define CONNECTOR_TURN 0.5
+
+static double turn_sign(sp_vec2 a, sp_vec2 b, sp_vec2 c)
+{
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+// Whether the polyline p[0..n-1] crosses itself (two segments that are not
+// neighbours cross properly). O(n^2).
+static bool crosses_itself(const sp_vec2* p, int n)
+{
+    for (int i = 0; i + 1 < n; ++i)
+        for (int j = i + 2; j + 1 < n; ++j) {
+            double d1 = turn_sign(p[i], p[i + 1], p[j]), d2 = turn_sign(p[i], p[i + 1], p[j + 1]);
+            double d3 = turn_sign(p[j], p[j + 1], p[i]), d4 = turn_sign(p[j], p[j + 1], p[i + 1]);
+            if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+        }
+    return false;
+}
 
 int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_share)
 {
@@ -209,13 +227,17 @@ int sp_curve_retrace_start(const sp_vec2* pts, int n, double tol, double min_sha
             keep = j;
             while (keep > c / 2 && keep > 1 && !near[keep - 1])
                 --keep;
-            // A line back is about straight (the pen's jump); the rest of a
-            // loop gone round one and a half times bends away from it, and
-            // was cut to half a ring (a second review).
-            double off = 0.0, span = sp_v2_len(sp_v2_sub(r[c], r[keep]));
-            for (int q = keep + 1; q < c; ++q)
-                off = fmax(off, sqrt(seg_dist2(r[q], r[keep], r[c])));
-            if (off > CONNECTOR_BENT * span) keep = c;
+            // The pen back to where the stroke began turns there to go over
+            // it again; the rest of a loop gone round one and a half times
+            // runs on into its second turn, one simple ring up to there (its
+            // ends aside: they meet), and was cut to half a ring (a second
+            // review). A test of straightness instead kept a curved way
+            // back, and a tail or a spring drawn twice became wings (a
+            // third); the spring's coils cross.
+            int k = c + 2 < M ? 2 : M - 1 - c;
+            sp_vec2 in = sp_v2_sub(r[c], r[c - 2 < keep ? keep : c - 2]), out = sp_v2_sub(r[c + k], r[c]);
+            if (k > 0 && sp_v2_dot(in, out) > CONNECTOR_TURN * sp_v2_len(in) * sp_v2_len(out) && !crosses_itself(r + 1, c - 1))
+                keep = c;
         }
         if (keep == c && first_seg[c] >= 0) {
             // A loop comes within tol of where it began a tol short of

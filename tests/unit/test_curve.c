@@ -232,6 +232,26 @@ static void test_retrace_start(void)
     r = sp_curve_retrace_start(p, nd, 7.5, 0.25);
     fprintf(stderr, "  a D twice: keep %d of %d (a D is 42)\n", r, nd);
     ENSURE(r >= 41 && r <= 45);
+    // A coiled spring drawn, the pen back to its start in a wide arc, and the
+    // spring again: cut before the arc (a test of straightness kept it and
+    // closed the spring into wings; a third review). Its coils cross, as no
+    // loop's one turn does.
+    nd = 0;
+    for (int i = 0; i < 60; ++i) {
+        double u = i / 59.0;
+        p[nd++] = (sp_vec2){480 + 300 * u - 25 * sin(8 * M_PI * u), 150 + 50 * cos(8 * M_PI * u)};
+    }
+    for (int i = 1; i < 12; ++i) { // a quadratic arc over the top, back to (455, 200)
+        double u = i / 12.0;
+        sp_vec2 a = p[59], b = {630, -120}, e = p[0];
+        p[nd++] = (sp_vec2){(1 - u) * (1 - u) * a.x + 2 * u * (1 - u) * b.x + u * u * e.x,
+                            (1 - u) * (1 - u) * a.y + 2 * u * (1 - u) * b.y + u * u * e.y};
+    }
+    for (int i = 0; i < 60; ++i)
+        p[nd++] = p[i];
+    r = sp_curve_retrace_start(p, nd, 9.5, 0.25);
+    fprintf(stderr, "  a spring, a wide arc back, the spring: keep %d of %d (the spring is 60)\n", r, nd);
+    ENSURE(r >= 56 && r <= 64);
     // 1.2 turns: the overlap of a closed outline stays.
     for (int i = 0; i < N; ++i) {
         double a = 2.4 * M_PI * i / (N - 1);
