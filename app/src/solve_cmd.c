@@ -99,9 +99,8 @@ static void note_unmatched_curves(sp_solve_report* rep, const sp_abstraction* ab
     }
     if (n_left == 0) return;
     size_t at = strlen(rep->note);
-    snprintf(rep->note + at, sizeof rep->note - at,
-             "%s%d curve%s without a stroke (%s%s); each stroke took the curve it fits best: %s%s", at ? "; " : "", n_left,
-             n_left == 1 ? "" : "s", left, n_left > 3 ? ", ..." : "", took, n_took > 3 ? ", ..." : "");
+    snprintf(rep->note + at, sizeof rep->note - at, "%s%d curve%s without a stroke (%s%s); the strokes took: %s%s",
+             at ? "; " : "", n_left, n_left == 1 ? "" : "s", left, n_left > 3 ? ", ..." : "", took, n_took > 3 ? ", ..." : "");
 }
 
 static bool solve_picked(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
