@@ -125,6 +125,7 @@ typedef struct attempt {
     bool place_ordered;                // a placement stage pairs as the abstraction does (ordered), not closest
     const sp_ordered_info* loop_shift; // hold this shift and direction through the ordered rounds (NULL: the best each round)
     bool partial_topology;             // fewer strokes than curves assigned by the junctions (match.c), not by shape
+    int one_stroke_curve;              // a single stroke's curve, plus one (0: by shape)
 } attempt;
 
 // The stages of attempt `at`. The placement stage is skipped when the
@@ -402,6 +403,7 @@ static sp_result run_attempt(sp_solver* s, const sp_sketch* sk, const double* p_
     plan_attempt(s, sk, at, iou, pl);
     sp__forget_pairing(s);
     s->partial_topology = at->partial_topology;
+    s->one_stroke_curve = at->one_stroke_curve - 1;
     if (s->model->failed)
         res = sp_fail(err, SP_ERR_INVALID, "%s", s->model->error.text);
     else
@@ -510,7 +512,7 @@ static void attempt_again(sp_solver* s, const sp_sketch* sk, const double* p_sta
 // ended upside down at 42 px, where from rest the same strokes fit at 1.1
 // (an outside review). Not for a draw-over (ordered_by_ends), which keeps
 // the pose it was drawn over.
-static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p_start, bool partial_topology, double* p_out,
+static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p_start, const attempt* how, double* p_out,
                               sp_solve_report* rep)
 {
     // Rest for what the solve moves; what it holds (sp_solve_desc.active)
@@ -524,30 +526,55 @@ static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p
     if (!rest) return;
     for (int i = 0; i < s->P; ++i)
         rest[i] = s->d.active && !s->d.active[i] ? p_start[i] : s->model->params[i].def;
-    attempt_again(s, sk, rest, &(attempt){.allow_loop = true, .place_free = true, .partial_topology = partial_topology}, p_out,
-                  rep);
+    attempt_again(s, sk, rest,
+                  &(attempt){.allow_loop = true,
+                             .place_free = true,
+                             .partial_topology = how->partial_topology,
+                             .one_stroke_curve = how->one_stroke_curve},
+                  p_out, rep);
     free(rest);
 }
 
-// The attempts of a solve, fewer strokes than curves assigned by the
-// junctions when `partial_topology`, by shape when not.
-static sp_result solve_attempts(sp_solver* s, const sp_sketch* sk, const double* p_start, bool partial_topology, double* p_out,
+// The attempts of a solve, the strokes assigned to curves as `how` says
+// (its partial_topology and one_stroke_curve; the rest of it unused).
+static sp_result solve_attempts(sp_solver* s, const sp_sketch* sk, const double* p_start, const attempt* how, double* p_out,
                                 sp_solve_report* rep, sp_error* err)
 {
     plan pl;
-    sp_result res =
-        run_attempt(s, sk, p_start, &(attempt){.allow_loop = true, .place_free = true, .partial_topology = partial_topology},
-                    s->d.time_cap_ms, p_out, rep, &pl, err);
+    attempt at = {.allow_loop = true,
+                  .place_free = true,
+                  .partial_topology = how->partial_topology,
+                  .one_stroke_curve = how->one_stroke_curve};
+    sp_result res = run_attempt(s, sk, p_start, &at, s->d.time_cap_ms, p_out, rep, &pl, err);
     if (res == SP_OK && !fit_ok(rep) && pl.loop) further_attempts(s, sk, p_start, &pl, p_out, rep);
     // A figure matched in order whose fit from a closest-point placement ends
     // above 1% is placed again by its ordered pairs (k_place_ordered).
-    if (res == SP_OK && !fit_ok(rep) && pl.placed_closest)
-        attempt_again(
-            s, sk, p_start,
-            &(attempt){.allow_loop = true, .place_free = true, .place_ordered = true, .partial_topology = partial_topology},
-            p_out, rep);
-    if (res == SP_OK && !fit_ok(rep) && !pl.loop && p_start) attempt_from_rest(s, sk, p_start, partial_topology, p_out, rep);
+    at.place_ordered = true;
+    if (res == SP_OK && !fit_ok(rep) && pl.placed_closest) attempt_again(s, sk, p_start, &at, p_out, rep);
+    if (res == SP_OK && !fit_ok(rep) && !pl.loop && p_start) attempt_from_rest(s, sk, p_start, how, p_out, rep);
     return res;
+}
+
+// Solves again as `how` says, from the caller's start as the first solve
+// was (start0: its copy; in p2 itself when the caller's start was its p_out:
+// the later attempts then start from the first one's result, which
+// CesiumMan's arms raised 40 degrees need, 5.4 px, 9.3 from the start
+// itself), in the time left; kept when it fits better.
+static void solve_again(sp_solver* s, const sp_sketch* sk, const double* p_start, const double* start0, const attempt* how,
+                        double* p_out, sp_solve_report* rep)
+{
+    if (!(s->d.time_cap_ms - rep->ms > 0) || (p_start && !start0)) return;
+    double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
+    sp_solve_report* r2 = malloc(sizeof *r2);
+    sp_error e2 = {0};
+    double cap = s->d.time_cap_ms;
+    s->d.time_cap_ms = cap - rep->ms;
+    bool aliased = p_start && p_start == p_out;
+    if (p2 && aliased) memcpy(p2, start0, sizeof(double) * (size_t)s->P);
+    if (p2 && r2 && solve_attempts(s, sk, aliased ? p2 : start0, how, p2, r2, &e2) == SP_OK) keep_better(s, rep, p_out, r2, p2);
+    s->d.time_cap_ms = cap;
+    s->partial_topology = false, s->one_stroke_curve = -1;
+    free(p2), free(r2);
 }
 
 // The second solve of fewer strokes than curves is made when the first
@@ -564,32 +591,18 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     // arm (9 px, the figure bent double); assigned by the junctions, 0.8.
     // But drawn not quite touching, or with two curves undrawn, the
     // junctions mislead as often as the shapes (two outside reviews): the
-    // better fit of the two solves is kept, the second in the time left and
-    // from the caller's start (which may be p_out, as `pose` gives it).
-    bool both = s->ab->correspondence == SP_CORR_ORDERED && sk->stroke_count >= 2 && sk->stroke_count < s->ab->curve_count &&
-                s->ab->curve_count <= SP_TOPO_MAX;
-    double* start0 = both && p_start ? malloc(sizeof(double) * (size_t)s->P) : NULL;
+    // better fit of the two solves is kept. A stroke alone has no
+    // junctions: it is tried on each curve (a raised arm drawn alone took
+    // the spine, 16.6 px).
+    const int C = s->ab->curve_count, n = sk->stroke_count;
+    bool fewer = s->ab->correspondence == SP_CORR_ORDERED && n >= 1 && n < C && C <= SP_TOPO_MAX;
+    double* start0 = fewer && p_start ? malloc(sizeof(double) * (size_t)s->P) : NULL;
     if (start0) memcpy(start0, p_start, sizeof(double) * (size_t)s->P);
-    sp_result res = solve_attempts(s, sk, p_start, false, p_out, rep, err);
-    if (res == SP_OK && both && (start0 || !p_start) && rep->mean_error_px > BOTH_ABOVE * rep->bbox_diagonal_px &&
-        s->d.time_cap_ms - rep->ms > 0) {
-        double* p2 = malloc(sizeof(double) * (size_t)(s->P + 1));
-        sp_solve_report* r2 = malloc(sizeof *r2);
-        sp_error e2 = {0};
-        double cap = s->d.time_cap_ms;
-        s->d.time_cap_ms = cap - rep->ms;
-        // As the first was solved: from a start in p2 itself when the
-        // caller's start was its p_out (the later attempts then start from
-        // the first one's result, which CesiumMan's arms raised 40 degrees
-        // need: 5.4 px, 9.3 from the start itself).
-        bool aliased = p_start == p_out;
-        if (p2 && aliased) memcpy(p2, start0, sizeof(double) * (size_t)s->P);
-        if (p2 && r2 && solve_attempts(s, sk, aliased ? p2 : start0, true, p2, r2, &e2) == SP_OK)
-            keep_better(s, rep, p_out, r2, p2);
-        s->d.time_cap_ms = cap;
-        s->partial_topology = false;
-        free(p2), free(r2);
-    }
+    sp_result res = solve_attempts(s, sk, p_start, &(attempt){0}, p_out, rep, err);
+    for (int c = n == 1 ? 0 : C - 1; c < C && res == SP_OK && fewer; ++c)
+        if (rep->mean_error_px > BOTH_ABOVE * rep->bbox_diagonal_px)
+            solve_again(s, sk, p_start, start0, &(attempt){.partial_topology = n >= 2, .one_stroke_curve = n == 1 ? c + 1 : 0},
+                        p_out, rep);
     free(start0);
     return res;
 }

@@ -374,6 +374,9 @@ static sp_result assign_curves(sp_solver* s, const sp_sketch* sk, const sp_polyl
         for (int c = 0; c < C; ++c)
             rep->unused_strokes -= c2s[c] >= 0;
         rep->unused_strokes += sk->stroke_count;
+    } else if (sk->stroke_count == 1 && s->one_stroke_curve >= 0 && s->one_stroke_curve < C) { // icp.c tries each
+        for (int c = 0; c < C && c < SP_REPORT_CURVES; ++c)
+            c2s[c] = c == s->one_stroke_curve ? 0 : -1, s->topo_rev[c] = -1;
     } else if (!assign_by_topology(s, sk, lines, C, c2s, s->topo_rev)) { // C <= TOPO_MAX when it applies
         for (int c = 0; c < C && c < SP_REPORT_CURVES; ++c)
             s->topo_rev[c] = -1;

@@ -285,6 +285,7 @@ sp_result sp__solver_create_model(sp_model* m, const sp_camera* cam, const sp_so
         return sp_fail(err, SP_ERR_NO_MEMORY, "out of memory making a solver");
     }
     s->model = m;
+    s->one_stroke_curve = -1; // by shape (icp.c's attempts say otherwise)
     m->deadline_ms = INFINITY;
     s->ab = m->ab;
     s->cam = cam;

@@ -1368,7 +1368,11 @@ static void test_pose_fewer_strokes(void)
         const char* file;
         const char* curves[5]; // the curve of each stroke
         double mean;
-    } drawn[] = {{"arm_leg", {"arm_r", "leg_l"}, 2.0}, {"spine_legs_gap", {"spine", "leg_l", "leg_r"}, 5.0}};
+    } drawn[] = {{"arm_leg", {"arm_r", "leg_l"}, 2.0},
+                 {"spine_legs_gap", {"spine", "leg_l", "leg_r"}, 5.0},
+                 // A stroke alone has no junctions: tried on each curve (by
+                 // shape the raised arm took the spine, 16.6 px).
+                 {"arm_alone", {"arm_l"}, 2.0}};
     for (size_t i = 0; i < sizeof drawn / sizeof drawn[0]; ++i) {
         snprintf(args, sizeof args, "pose --rig '%s/assets/cartoon_man.glb' --strokes '%s/tests/data/posing/cartoon_man_%s.json'",
                  SP_SOURCE_DIR, SP_SOURCE_DIR, drawn[i].file);
