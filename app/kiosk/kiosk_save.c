@@ -99,32 +99,34 @@ void kiosk_prune_saves(sp_kiosk* k)
     sp_error err = {0};
     if (sp_dir_list(k->export_dir, &names, &count, &err) != SP_OK) return; // no folder yet: nothing saved
     time_t now = time(NULL), newest = 0, keep = (time_t)k->desc.keep_saves_days * 86400;
-    for (int pass = 0; pass < 2; ++pass) {
-        for (int i = 0; i < count; ++i) {
-            if (!is_save_name(names[i])) continue; // anything else in the folder is staff's
-            char path[1200];
-            snprintf(path, sizeof path, "%s/%s", k->export_dir, names[i]);
-            struct stat st;
-            if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode)) continue;
-            if (pass == 0 && st.st_mtime > newest) newest = st.st_mtime;
-            if (pass == 1 && st.st_mtime < now - keep && unlink(path) == 0) ++removed;
-        }
-        // A clock past every save by more than the days kept, when the kiosk
-        // starts, may be a clock set wrong (a flat RTC battery, no network
-        // time yet), which removed every save, and the next Save's date the
-        // rest (two outside reviews); a museum closed that long keeps its
-        // saves one run more.
-        if (pass == 0 && !k->prune_checked) {
-            k->prune_checked = true;
-            k->prune_held = newest > 0 && now - newest > keep;
-            if (k->prune_held) {
-                sp_kiosk_log("%s: the clock is %.0f days past the newest save: no save is removed until the kiosk restarts "
-                             "(--keep-saves-days %d; is the clock right?)",
-                             k->export_dir, (double)(now - newest) / 86400.0, k->desc.keep_saves_days);
-                break;
-            }
-        }
+    time_t* when = malloc(sizeof(time_t) * (size_t)(count > 0 ? count : 1)); // a save's time, 0: not a save
+    for (int i = 0; when && i < count; ++i) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s", k->export_dir, names[i]);
+        struct stat st;
+        // Anything else in the folder is staff's.
+        when[i] = is_save_name(names[i]) && lstat(path, &st) == 0 && S_ISREG(st.st_mode) ? st.st_mtime : 0;
+        if (when[i] > newest) newest = when[i];
     }
+    // A clock past every save by more than the days kept, when the kiosk
+    // starts, may be a clock set wrong (a flat RTC battery, no network time
+    // yet), which removed every save, and the next Save's date the rest
+    // (two outside reviews); a museum closed that long keeps its saves one
+    // run more.
+    if (when && !k->prune_checked) {
+        k->prune_checked = true;
+        k->prune_held = newest > 0 && now - newest > keep;
+        if (k->prune_held)
+            sp_kiosk_log("%s: the clock is %.0f days past the newest save: no save is removed until the kiosk restarts "
+                         "(--keep-saves-days %d; is the clock right?)",
+                         k->export_dir, (double)(now - newest) / 86400.0, k->desc.keep_saves_days);
+    }
+    for (int i = 0; when && !k->prune_held && i < count; ++i) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s", k->export_dir, names[i]);
+        if (when[i] > 0 && when[i] < now - keep && unlink(path) == 0) ++removed;
+    }
+    free(when);
     sp_dir_list_free(names, count);
     if (removed > 0)
         sp_kiosk_log("%s: %d files of saves older than %d days removed (--keep-saves-days)", k->export_dir, removed,

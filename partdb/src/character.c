@@ -154,9 +154,8 @@ void sp_gltf_decompose(const sp_mat4* a, sp_vec3* t, sp_quat* r, sp_vec3* s)
 
 // ---- extras -------------------------------------------------------------
 
-// The largest bounds a channel may have: a move (SP_GLTF_MOVE_MAX), a
-// turn (radians; a few turns is plenty) and a scale.
-#define DOF_MOVE_MAX SP_GLTF_MOVE_MAX
+// The largest bounds a channel may have besides a move's
+// (SP_GLTF_MOVE_MAX): a turn (radians; a few turns is plenty) and a scale.
 #define DOF_TURN_MAX 100.0
 #define DOF_SCALE_MAX 1e3
 
@@ -229,7 +228,7 @@ sp_result sp_gltf_joint_extras(sp_rig* rig, int joint, const char* json, bool* h
             // Bounds past any pose a part takes: synth and export wrote
             // strokes and node transforms near 1e300 that our own readers
             // refuse (an outside curator review).
-            double most = sp_channel_is_scale(c) ? DOF_SCALE_MAX : sp_channel_is_rotation(c) ? DOF_TURN_MAX : DOF_MOVE_MAX;
+            double most = sp_channel_is_scale(c) ? DOF_SCALE_MAX : sp_channel_is_rotation(c) ? DOF_TURN_MAX : SP_GLTF_MOVE_MAX;
             double least = sp_channel_is_scale(c) ? 1.0 / DOF_SCALE_MAX : -most;
             if (lo < least || hi > most) {
                 r = sp_fail(err, SP_ERR_INVALID, "%s: joint '%s': sp_dofs channel %s has bounds [%g, %g] outside [%g, %g]", what,

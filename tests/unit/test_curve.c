@@ -186,6 +186,15 @@ static void test_clean_smooth(void)
     ENSURE_NEAR(sq[0].y, 0.5, 1e-12);
 }
 
+// n points along an ellipse about c (radii rx, ry) gone round `turns` times.
+static void ring(sp_vec2* p, int n, sp_vec2 c, double rx, double ry, double turns)
+{
+    for (int i = 0; i < n; ++i) {
+        double a = 2 * M_PI * turns * i / (n - 1);
+        p[i] = (sp_vec2){c.x + rx * cos(a), c.y + ry * sin(a)};
+    }
+}
+
 // Strokes that go over themselves (a loop gone round twice, a line out and
 // back) and strokes that only come near themselves (a closing overlap, a
 // spiral, stick legs drawn down, up and down again).
@@ -204,20 +213,14 @@ static void test_retrace_start(void)
     // An eye 12 px across gone round three times, at the kiosk's tolerance
     // (7.5 px, more than its radius): cut after one whole turn, where it was
     // cut a tol short of closing, four fifths of a ring (an outside review).
-    for (int i = 0; i < 90; ++i) {
-        double a = 6 * M_PI * i / 89;
-        p[i] = (sp_vec2){600 + 6 * cos(a), 400 + 6 * sin(a)};
-    }
+    ring(p, 90, (sp_vec2){600, 400}, 6, 6, 3.0);
     r = sp_curve_retrace_start(p, 90, 7.5, 0.25);
     fprintf(stderr, "  eye three times: keep %d of 90 (a turn is 30)\n", r);
     ENSURE(r >= 29 && r <= 34);
     // A body gone round one and a half times: cut after one turn (the rest
     // of the first turn, not gone over again, was cut as a line back to the
     // start: half a ring; a second review).
-    for (int i = 0; i < 120; ++i) {
-        double a = 3 * M_PI * i / 119;
-        p[i] = (sp_vec2){640 + 220 * cos(a), 420 + 110 * sin(a)};
-    }
+    ring(p, 120, (sp_vec2){640, 420}, 220, 110, 1.5);
     r = sp_curve_retrace_start(p, 120, 7.5, 0.25);
     fprintf(stderr, "  body one and a half times: keep %d of 120 (a turn is 80)\n", r);
     ENSURE(r >= 76 && r <= 86);
@@ -253,10 +256,7 @@ static void test_retrace_start(void)
     fprintf(stderr, "  a spring, a wide arc back, the spring: keep %d of %d (the spring is 60)\n", r, nd);
     ENSURE(r >= 56 && r <= 64);
     // 1.2 turns: the overlap of a closed outline stays.
-    for (int i = 0; i < N; ++i) {
-        double a = 2.4 * M_PI * i / (N - 1);
-        p[i] = (sp_vec2){500 + 200 * cos(a), 400 + 85 * sin(a)};
-    }
+    ring(p, N, (sp_vec2){500, 400}, 200, 85, 1.2);
     ENSURE(sp_curve_retrace_start(p, N, 10, 0.25) == N);
     // A wavy line out and back along itself (2 px beside it): cut at the turn.
     for (int i = 0; i < N; ++i) {
