@@ -316,6 +316,28 @@ bool sp_cli_stdout_taken(const char* const* outs, int n)
     return false;
 }
 
+// Why the existing folder dir takes no new file, or NULL. A folder that
+// lets root write but takes no new file (/proc) failed only after the work,
+// with ENOENT from the temporary file (an outside review): a file is made
+// there and removed.
+static const char* folder_takes_no_file(const char* dir)
+{
+    struct stat st;
+    if (stat(dir, &st) != 0) return strerror(errno);
+    if (!S_ISDIR(st.st_mode)) return "not a folder";
+    if (access(dir, W_OK | X_OK) != 0) return "this user may not write there";
+    size_t dn = strlen(dir) + 3;
+    char* in_dir = malloc(dn); // a name in the folder written (links followed)
+    if (in_dir) snprintf(in_dir, dn, "%s/x", dir);
+    char* probe = in_dir ? sp_path_temp_beside(in_dir, ".probe") : NULL;
+    free(in_dir);
+    int pfd = probe ? open(probe, O_WRONLY | O_CREAT | O_EXCL, 0600) : 0;
+    const char* why = pfd < 0 ? strerror(errno) : NULL;
+    if (probe && pfd >= 0) close(pfd), unlink(probe);
+    free(probe);
+    return why;
+}
+
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path)
 {
     if (!path) return true;
@@ -337,31 +359,44 @@ bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path
     char* dir = real ? sp_path_folder(real) : NULL;
     free(real);
     if (!dir) return true; // out of memory or a loop of links: the writer will say so
-    struct stat st;
-    const char* why = stat(dir, &st) != 0             ? strerror(errno)
-                      : !S_ISDIR(st.st_mode)          ? "not a folder"
-                      : access(dir, W_OK | X_OK) != 0 ? "this user may not write there"
-                                                      : NULL;
-    // A folder that lets root write but takes no new file (/proc) failed only
-    // after the work, with ENOENT from the temporary file (an outside
-    // review): a file is made there and removed, before the work.
-    size_t dn = strlen(dir) + 3;
-    char* in_dir = why ? NULL : malloc(dn); // a name in the folder written (links followed)
-    if (in_dir) snprintf(in_dir, dn, "%s/x", dir);
-    char* probe = in_dir ? sp_path_temp_beside(in_dir, ".probe") : NULL;
-    free(in_dir);
-    int pfd = probe ? open(probe, O_WRONLY | O_CREAT | O_EXCL, 0600) : 0;
-    if (pfd < 0)
-        why = strerror(errno);
-    else if (probe)
-        close(pfd), unlink(probe);
-    free(probe);
+    const char* why = folder_takes_no_file(dir);
     if (why) sp_cli_say("%s: %s %s: cannot write into folder '%s' (%s)", cmd, name, path, dir, why);
     free(dir);
+    struct stat st;
     if (!why && stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
         sp_cli_say("%s: %s %s: is a folder, not a file", cmd, name, path);
         return false;
     }
+    return why == NULL;
+}
+
+bool sp_cli_check_folder_to_make(const char* cmd, const char* name, const char* dir, const char* purpose)
+{
+    // Through a link, the folder it names (one not made yet: the writer makes it).
+    char* real = sp_path_follow_links(dir);
+    char* at = real ? strdup(real) : NULL;
+    // No folder at the end of its links (a loop): every write would fail.
+    const char* why = real ? NULL : "its links go round in a loop";
+    while (at && !why) {
+        struct stat st;
+        if (stat(at, &st) == 0) {
+            why = folder_takes_no_file(at);
+            break;
+        }
+        if (errno != ENOENT && errno != ENOTDIR) {
+            why = strerror(errno);
+            break;
+        }
+        char* up = sp_path_folder(at); // missing (or under a file): its folder tells
+        bool top = up && !strcmp(up, at);
+        free(at);
+        at = top ? NULL : up;
+    }
+    if (why && (!at || !strcmp(at, real)))
+        sp_cli_say("%s: %s %s: %s (%s there)", cmd, name, dir, why, purpose);
+    else if (why)
+        sp_cli_say("%s: %s %s: '%s' on its way: %s (the folder is made and %s there)", cmd, name, dir, at, why, purpose);
+    free(at), free(real);
     return why == NULL;
 }
 

@@ -115,6 +115,14 @@ void sp_cli_say(const char* fmt, ...)
 /// folder, not a file"); false (exit 1), said before the work, not after it.
 bool sp_cli_check_out_folder(const char* cmd, const char* name, const char* path);
 
+/// For a folder written into at the end of work and made then, parents and
+/// all (the kiosk's --export-dir): it may be missing, but a file in its place
+/// or on its way, links that go round in a loop, or a nearest existing
+/// folder this user cannot make files in fail every write: "<cmd>: <name>
+/// <dir>: <reason> (<purpose> there)", or "...: '<folder>' on its way:
+/// <reason> (the folder is made and <purpose> there)"; false (exit 1).
+bool sp_cli_check_folder_to_make(const char* cmd, const char* name, const char* dir, const char* purpose);
+
 /// sp_cli_check_out_folder of every SP_OPT_OUT option given ("-" aside): a
 /// command calls it after its usage checks (bad usage is said first, exit
 /// 2) and before its work; false after saying why (exit 1).

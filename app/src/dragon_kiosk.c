@@ -276,41 +276,6 @@ static bool export_named(const char* dir)
     return false;
 }
 
-// The folder Save writes into is made at the first Save, parents and all,
-// so it may be missing; a file in its place, or a nearest existing folder
-// on its way this user may not write into, failed every visitor's Save
-// with one log line (an outside review): said before the window opens.
-static bool export_folder_ok(const char* dir)
-{
-    // Through a link, the folder it names (one not made yet: Save makes it).
-    char* real = sp_path_follow_links(dir);
-    char* at = real ? strdup(real) : NULL;
-    struct stat st;
-    // No folder at the end of its links (a loop): every Save would fail.
-    const char* why = real ? NULL : "its links go round in a loop";
-    while (at && !why) {
-        if (stat(at, &st) == 0) {
-            why = !S_ISDIR(st.st_mode) ? "not a folder" : access(at, W_OK | X_OK) != 0 ? "this user may not write there" : NULL;
-            break;
-        }
-        if (errno != ENOENT && errno != ENOTDIR) {
-            why = strerror(errno);
-            break;
-        }
-        char* up = sp_path_folder(at); // missing (or under a file): its folder tells
-        bool top = up && !strcmp(up, at);
-        free(at);
-        at = top ? NULL : up;
-    }
-    if (why && (!at || !strcmp(at, real)))
-        sp_cli_say("%s: --export-dir %s: %s (Save writes the visitors' dragons there)", k_cmd, dir, why);
-    else if (why)
-        sp_cli_say("%s: --export-dir %s: '%s' on its way: %s (Save makes the folder and writes the visitors' dragons there)",
-                   k_cmd, dir, at, why);
-    free(at), free(real);
-    return why == NULL;
-}
-
 // The database is read and written, named or not: a recording over it
 // replaced it with the session, every visitor's sketch then dropped.
 static bool outs_spare_database(const char* db, const char* record, const char* shot, const char* out_glb)
@@ -725,7 +690,11 @@ int main(int argc, char** argv)
     }
     // Written when the session ends: a folder that cannot take them is said now.
     if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0])) ||
-        !export_folder_ok(export_dir ? export_dir : "dragon-exports")) {
+        // Save makes its folder at the first Save; a file in its place, or a
+        // nearest folder this user cannot write into, failed every Save
+        // with one log line (an outside review): said before the window.
+        !sp_cli_check_folder_to_make(k_cmd, "--export-dir", export_dir ? export_dir : "dragon-exports",
+                                     "Save writes the visitors' dragons")) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }

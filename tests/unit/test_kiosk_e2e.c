@@ -2554,6 +2554,16 @@ static void test_screenshot_unwritable(void)
         ENSURE(rc == 1 && strstr(out, "--export-dir") && strstr(out, i ? "on its way: not a folder" : ": not a folder") &&
                strchr(out, '\n') == out + strlen(out) - 1);
     }
+    // A folder that lets root write but takes no file (/proc): every Save
+    // failed, after the window opened.
+    struct stat proc_st;
+    if (stat("/proc/self", &proc_st) == 0) {
+        snprintf(args, sizeof args, "--script '%s' --export-dir /proc/sp-kiosk-saves", script);
+        int rc = kiosk_no_display(args, out, sizeof out);
+        fprintf(stderr, "  %s", out);
+        ENSURE(rc == 1 && strstr(out, "--export-dir /proc/sp-kiosk-saves: '/proc' on its way") &&
+               strchr(out, '\n') == out + strlen(out) - 1);
+    }
     // Links that go round in a loop name no folder: every Save failed
     // (an outside review).
     char loop1[1100], loop2[1100];
