@@ -276,6 +276,15 @@ static bool export_named(const char* dir)
     return false;
 }
 
+// Save makes its folder at the first Save; a file in its place, or a
+// nearest folder this user cannot write into, failed every Save with one log
+// line (an outside review): said before the window opens.
+static bool saves_folder_ok(const char* export_dir)
+{
+    return sp_cli_check_folder_to_make(k_cmd, "--export-dir", export_dir ? export_dir : "dragon-exports",
+                                       "Save writes the visitors' dragons");
+}
+
 // The database is read and written, named or not: a recording over it
 // replaced it with the session, every visitor's sketch then dropped.
 static bool outs_spare_database(const char* db, const char* record, const char* shot, const char* out_glb)
@@ -689,12 +698,7 @@ int main(int argc, char** argv)
         return SP_EXIT_USAGE;
     }
     // Written when the session ends: a folder that cannot take them is said now.
-    if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0])) ||
-        // Save makes its folder at the first Save; a file in its place, or a
-        // nearest folder this user cannot write into, failed every Save
-        // with one log line (an outside review): said before the window.
-        !sp_cli_check_folder_to_make(k_cmd, "--export-dir", export_dir ? export_dir : "dragon-exports",
-                                     "Save writes the visitors' dragons")) {
+    if (!sp_cli_check_out_folders(k_cmd, opts, (int)(sizeof opts / sizeof opts[0])) || !saves_folder_ok(export_dir)) {
         sp_kiosk_session_free(&session);
         return SP_EXIT_INPUT;
     }
