@@ -518,9 +518,13 @@ static void attempt_from_rest(sp_solver* s, const sp_sketch* sk, const double* p
     // Rest for what the solve moves; what it holds (sp_solve_desc.active)
     // keeps the start's values: `animate` holds the first key's proportions,
     // which a rest start set back to 1 mid-clip (an outside review).
+    // Judged on the caller's start: an aliased p_start holds the first
+    // attempt's fit by now, and a solve begun at rest ran this same attempt
+    // again.
+    const double* given = s->caller_start;
     bool at_rest = true;
-    for (int i = 0; i < s->P && at_rest; ++i)
-        at_rest = (s->d.active && !s->d.active[i]) || p_start[i] == s->model->params[i].def;
+    for (int i = 0; i < s->P && at_rest && given; ++i)
+        at_rest = (s->d.active && !s->d.active[i]) || given[i] == s->model->params[i].def;
     if (at_rest || s->ab->curve_count < 2 || s->d.ordered_by_ends || !(s->d.time_cap_ms - rep->ms > 0)) return;
     double* rest = malloc(sizeof(double) * (size_t)(s->P + 1));
     if (!rest) return;
@@ -596,13 +600,15 @@ sp_result sp_solver_solve(sp_solver* s, const sp_sketch* sk, const double* p_sta
     // the spine, 16.6 px).
     const int C = s->ab->curve_count, n = sk->stroke_count;
     bool fewer = s->ab->correspondence == SP_CORR_ORDERED && n >= 1 && n < C && C <= SP_TOPO_MAX;
-    double* start0 = fewer && p_start ? malloc(sizeof(double) * (size_t)s->P) : NULL;
+    double* start0 = p_start ? malloc(sizeof(double) * (size_t)s->P) : NULL;
     if (start0) memcpy(start0, p_start, sizeof(double) * (size_t)s->P);
+    s->caller_start = start0;
     sp_result res = solve_attempts(s, sk, p_start, &(attempt){0}, p_out, rep, err);
     for (int c = n == 1 ? 0 : C - 1; c < C && res == SP_OK && fewer; ++c)
         if (rep->mean_error_px > BOTH_ABOVE * rep->bbox_diagonal_px)
             solve_again(s, sk, p_start, start0, &(attempt){.partial_topology = n >= 2, .one_stroke_curve = n == 1 ? c + 1 : 0},
                         p_out, rep);
+    s->caller_start = NULL;
     free(start0);
     return res;
 }

@@ -135,6 +135,7 @@ struct sp_solver {
     bool c2s_valid;
     bool partial_topology; // this attempt assigns fewer strokes than curves by the junctions (icp.c's attempt)
     int one_stroke_curve;  // this attempt's curve for a single stroke (-1: by shape; icp.c's attempt)
+    const double* caller_start; // the solve's start as the caller gave it (a copy; NULL: defaults), during sp_solver_solve
     // ordered_by_ends: each curve's direction and the stroke it was decided
     // with, at an attempt's first pairing, held after (an arm folding on its
     // way up had its ends' sums cross and was paired back); -1: not yet.

@@ -1699,6 +1699,50 @@ static void test_held_through_rest_attempt(void)
     sp_rig_handle_free(h);
 }
 
+// A solve from the default pose is the solve from no start; started in the
+// result's own buffer it ran the attempt from rest a second time (the
+// aliased start held the first fit by then, so it did not look like rest):
+// the same fit, the work paid again (arm_alone: 180 iterations, 128 now).
+static void test_start_held_anywhere(void)
+{
+    sp_rig_handle* h = NULL;
+    sp_error err = {0};
+    ENSURE(sp_rig_handle_load(SP_SOURCE_DIR "/assets/cartoon_man.glb", &h, &err) == SP_OK);
+    int P = sp_rig_handle_param_count(h), a = sp_rig_handle_pick_abstraction(h, NULL, &err);
+    ENSURE(a >= 0);
+    const char* drawings[2] = {"arm_alone", "spine_legs_gap"};
+    for (int d = 0; d < 2; ++d) {
+        char strokes[1100];
+        snprintf(strokes, sizeof strokes, "%s/tests/data/posing/cartoon_man_%s.json", SP_SOURCE_DIR, drawings[d]);
+        sp_sketch sk = {0};
+        ENSURE(sp_read_strokes(strokes, &sk, &err) == SP_OK);
+        sp_camera cam = sp_rig_handle_camera(h, sk.canvas_w, sk.canvas_h);
+        sp_solver* solver = NULL;
+        ENSURE(sp_rig_handle_solver(h, a, &cam, &(sp_solve_desc){0}, &solver, &err) == SP_OK);
+        double* p = malloc(sizeof(double) * (size_t)(3 * P));
+        ENSURE(p);
+        for (int q = 0; q < P; ++q)
+            p[P + q] = p[2 * P + q] = sp_rig_handle_params(h)[q].def;
+        sp_solve_report rep[3];
+        ENSURE(sp_solver_solve(solver, &sk, NULL, p, &rep[0], &err) == SP_OK);
+        ENSURE(sp_solver_solve(solver, &sk, p + 2 * P, p + P, &rep[1], &err) == SP_OK);
+        ENSURE(sp_solver_solve(solver, &sk, p + 2 * P, p + 2 * P, &rep[2], &err) == SP_OK);
+        fprintf(stderr, "  %s: %.3f px in %d iterations; from defaults %.3f in %d; aliased %.3f in %d\n", drawings[d],
+                rep[0].mean_error_px, rep[0].iterations, rep[1].mean_error_px, rep[1].iterations, rep[2].mean_error_px,
+                rep[2].iterations);
+        ENSURE(rep[1].mean_error_px == rep[0].mean_error_px && rep[1].iterations == rep[0].iterations);
+        ENSURE(!memcmp(p + P, p, sizeof(double) * (size_t)P));
+        // Aliased, the later attempts start from the best fit so far (as
+        // documented), so a few iterations may differ; the attempt from rest
+        // run twice cost 40% more.
+        ENSURE(fabs(rep[2].mean_error_px - rep[0].mean_error_px) < 0.01 && rep[2].iterations <= rep[0].iterations * 1.1);
+        free(p);
+        sp_solver_destroy(solver);
+        sp_sketch_free(&sk);
+    }
+    sp_rig_handle_free(h);
+}
+
 // An arm redrawn raised, turned about the shoulder by 100 to 160 degrees
 // (an outside review: at 40 degrees above the horizontal and more, the
 // line was paired reversed, the hand sent to the shoulder, the arm folded
@@ -2041,6 +2085,7 @@ int main(int argc, char** argv)
                                    {"drawover_several_curves", test_drawover_several_curves},
                                    {"animate_holds_proportions", test_animate_holds_proportions},
                                    {"held_through_rest_attempt", test_held_through_rest_attempt},
+                                   {"start_held_anywhere", test_start_held_anywhere},
                                    {"drawover_single_chain", test_drawover_single_chain},
                                    {"drawover_scale_is_solvers", test_drawover_scale_is_solvers},
                                    {"synth_jitter", test_synth_jitter},

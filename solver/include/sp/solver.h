@@ -149,7 +149,9 @@ void sp_solver_destroy(sp_solver* s);
 const int* sp_solver_representatives(const sp_solver* s, int* count);
 
 /// Fits the rig to the strokes from p_start (param_count, NULL: defaults);
-/// writes the result into p_out (may alias p_start). Bad strokes (NaN,
+/// writes the result into p_out (may alias p_start: then the attempts after
+/// the first, when it ends above 1%, start from the best fit so far rather
+/// than from p_start, which is what the kiosk and `pose` do). Bad strokes (NaN,
 /// empty, one point) are refused with SP_ERR_INVALID; a target that cannot
 /// be reached gives SP_OK with a best-effort pose and a note in the report.
 sp_result sp_solver_solve(sp_solver* s, const sp_sketch* strokes, const double* p_start, double* p_out, sp_solve_report* rep,
