@@ -43,13 +43,40 @@ void sp_text_escape_controls(char* s, size_t cap)
     if (cut) mark_cut(s, room);
 }
 
+// Text s (w bytes) into buf (cap bytes) with its middle left out, "..." in
+// its place, neither end inside a UTF-8 character.
+static void cut_middle(const char* s, size_t w, char* buf, size_t cap)
+{
+    size_t head = (cap - 4) / 3, tail = cap - 4 - head;
+    while (head > 0 && ((unsigned char)s[head] & 0xC0) == 0x80)
+        --head;
+    size_t from = w - tail;
+    while (from < w && ((unsigned char)s[from] & 0xC0) == 0x80)
+        ++from;
+    memcpy(buf, s, head);
+    memcpy(buf + head, "...", 3);
+    memcpy(buf + head + 3, s + from, w - from + 1);
+}
+
 void sp_text_vline(char* buf, size_t cap, const char* fmt, va_list ap)
 {
-    int n = vsnprintf(buf, cap, fmt, ap);
-    if (n >= 0 && (size_t)n >= cap) mark_cut(buf, cap);
+    if (cap == 0) return;
+    char whole[SP_TEXT_LINE_MAX];
+    int n = vsnprintf(whole, sizeof whole, fmt, ap);
+    if (n < 0) whole[0] = 0;
+    if (n >= 0 && (size_t)n >= sizeof whole) mark_cut(whole, sizeof whole);
     // One line, whatever a file's names hold: a joint named with a newline
     // and an escape code split a message and cleared the terminal.
-    sp_text_escape_controls(buf, cap);
+    sp_text_escape_controls(whole, sizeof whole);
+    size_t w = strlen(whole);
+    // Too long, the middle goes: a path's end and the reason after it name
+    // the problem ("<a long path>: cannot open (...)" kept only the path).
+    if (w < cap)
+        memcpy(buf, whole, w + 1);
+    else if (cap >= 16)
+        cut_middle(whole, w, buf, cap);
+    else
+        memcpy(buf, whole, cap - 1), buf[cap - 1] = 0, mark_cut(buf, cap);
 }
 
 sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)

@@ -382,16 +382,29 @@ static void test_options(void)
     sp_error jerr = {0};
     sp_fail(&jerr, SP_ERR_INVALID, "joint '%s' is odd", src.rig.joints[root].name);
     ENSURE(!strcmp(jerr.text, "joint 'ro\\x1b[2Jot\\nFAKE LINE' is odd"));
-    // A message cut to fit ends in "...", with or without codes to escape (a
-    // long path's end, which named the problem, was cut without a sign; an
-    // outside review), and not inside a UTF-8 character.
+    // A message cut to fit says so with "...", with or without codes to
+    // escape (a long path's end, which named the problem, was cut without a
+    // sign; an outside review), and not inside a UTF-8 character; its
+    // middle goes, so that the reason at its end stays (a database path of
+    // 600 bytes left "<path>..." and no reason; a second review).
     char longname[1200];
-    memset(longname, 'a', sizeof longname - 1), longname[sizeof longname - 1] = 0;
-    for (int esc = 0; esc < 2; ++esc) {
-        if (esc) longname[3] = '\n';
+    for (int esc = 0; esc < 3; ++esc) {
+        memset(longname, 'a', sizeof longname - 1), longname[sizeof longname - 1] = 0;
+        if (esc == 1) longname[3] = '\n';
+        for (int i = 0; esc == 2 && i + 3 < (int)sizeof longname; i += 3) // euro signs, three bytes each
+            memcpy(longname + i, "\xe2\x82\xac", 3);
         sp_fail(&jerr, SP_ERR_INVALID, "%s/out.jpg: not an image", longname);
         size_t len = strlen(jerr.text);
-        ENSURE(len == sizeof jerr.text - 1 && !strcmp(jerr.text + len - 3, "...") && !strchr(jerr.text, '\n'));
+        ENSURE(len >= sizeof jerr.text - 4 && strstr(jerr.text, "...") && !strchr(jerr.text, '\n'));
+        ENSURE(!strcmp(jerr.text + len - 22, "/out.jpg: not an image"));
+        ENSURE(!strncmp(jerr.text, esc == 0 ? "aaaaaa" : esc == 1 ? "aaa\\naa" : "\xe2\x82\xac\xe2\x82\xac", 6));
+        for (const unsigned char* c = (const unsigned char*)jerr.text; *c;) { // whole UTF-8 characters only
+            int k = *c < 0x80 ? 1 : (*c & 0xE0) == 0xC0 ? 2 : (*c & 0xF0) == 0xE0 ? 3 : 0;
+            ENSURE(k > 0);
+            for (int j = 1; j < k; ++j)
+                ENSURE((c[j] & 0xC0) == 0x80);
+            c += k;
+        }
     }
     char line[6]; // "a", e acute, tab, "zz": "a\xc3\xa9\\t" fills it, "..." goes before the e acute
     sp_text_escape_controls(strcpy(line, "a\xc3\xa9\tz"), sizeof line);

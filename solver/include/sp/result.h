@@ -50,9 +50,10 @@ sp_result sp_fail(sp_error* err, sp_result code, const char* fmt, ...)
 /// ending in "...". sp_fail does it to every message.
 void sp_text_escape_controls(char* s, size_t cap);
 
-/// vsnprintf into buf (cap bytes), then sp_text_escape_controls: a message
+/// vsnprintf, then sp_text_escape_controls, into buf (cap bytes): a message
 /// on one line whatever it quotes (sp_fail's, the commands' and the kiosk
-/// log's own lines), ending in "..." when cut to fit.
+/// log's own lines); one too long for buf keeps its start and its end, "..."
+/// for the middle left out (the end says what is wrong).
 void sp_text_vline(char* buf, size_t cap, const char* fmt, va_list ap);
 
 /// Short stable name of a result code, e.g. "parse error".
