@@ -474,6 +474,19 @@ static sp_result folder_takes_files(const char* path, sp_error* err)
     return r;
 }
 
+// SQLite's open refused (SQLITE_CANTOPEN): why, as far as it can be told.
+// Its unix files take a path of at most 512 bytes from /, a relative name
+// made absolute first: a short --db in a deep folder fails too.
+static sp_result cannot_open(const char* path, int error, sp_error* err)
+{
+    size_t n = strlen(path);
+    char cwd[4096];
+    if (path[0] != '/' && getcwd(cwd, sizeof cwd)) n += strlen(cwd) + 1;
+    if (n >= 512)
+        return sp_fail(err, SP_ERR_IO, "%s: cannot open: its path is %zu bytes from /, longer than SQLite takes (511)", path, n);
+    return sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, error ? strerror(error) : "SQLite gave no reason");
+}
+
 sp_result sp_db_open(const char* path, unsigned flags, sp_db** out, sp_error* err)
 {
     return sp_db_open_wait(path, flags, -1, out, err);
@@ -574,12 +587,12 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
     // path during the open then reads as replaced (noted after the open, the
     // new file could be taken for the one the handle has, and never followed).
     if (exists) db->at_dev = st.st_dev, db->at_ino = st.st_ino, db->at_known = true;
+    errno = 0; // SQLite's own refusals set none: a leftover ENOENT said an existing file was missing
     int rc = sqlite3_open_v2(path, &db->h, oflags | SQLITE_OPEN_FULLMUTEX, NULL);
     DB_HOOK("opened");
     r = SP_OK;
     if (rc != SQLITE_OK) {
-        r = (rc & 0xff) == SQLITE_CANTOPEN ? sp_fail(err, SP_ERR_IO, "%s: cannot open (%s)", path, strerror(errno ? errno : EACCES))
-                                          : db_fail(db, rc, "opening", err);
+        r = (rc & 0xff) == SQLITE_CANTOPEN ? cannot_open(path, errno, err) : db_fail(db, rc, "opening", err);
         goto fail;
     }
     sqlite3_extended_result_codes(db->h, 1);
@@ -659,8 +672,9 @@ sp_result sp_db_open_wait(const char* path, unsigned flags, int busy_ms, sp_db**
                         path, v, SP_DB_SCHEMA_VERSION);
             goto fail;
         }
-        if (ro) {
-            r = sp_fail(err, SP_ERR_INVALID, "%s: not a sketchpose database (no schema)", path);
+        if (ro) { // an empty file said as a writer says it (the reader's "no schema" said nothing of what to do)
+            r = sp_fail(err, SP_ERR_INVALID, "%s: not a sketchpose database (%s)", path,
+                        counted && tables == 0 ? "an empty file; `sketchpose db init` makes one" : "no schema");
             goto fail;
         }
         if ((r = db_migrate(db, SP_DB_SCHEMA_VERSION, err)) != SP_OK) goto fail;

@@ -825,6 +825,12 @@ static sp_result build_then_link(const char* path, sp_result (*fill)(sp_db*, con
     // `<where>.building-<pid>`, or with two more digits when another build
     // holds that name (the first process of two containers is pid 1 in each).
     char tmp[1024];
+    if (strlen(where) + 40 > sizeof tmp) { // cut, the temporary name was the target's own, removed after
+        sp_result r =
+            sp_fail(err, SP_ERR_INVALID, "%s: path too long (%zu bytes) to build a database beside it", path, strlen(where));
+        free(real);
+        return r;
+    }
     int lock = -1;
     bool busy = true;
     for (int k = 0; busy && k < 100; ++k) {

@@ -2668,7 +2668,7 @@ static void test_nothing_to_draw(void)
         snprintf(cmd, sizeof cmd, "env -u DISPLAY -u WAYLAND_DISPLAY '%s' --db '%s' %s 2> '%s'", SP_DRAGON_KIOSK, db, args, errf);
         int rc = system(cmd);
         ENSURE(WIFEXITED(rc) && WEXITSTATUS(rc) == 1);
-        ENSURE(lines_with(errf, v == 0 ? "no schema" : "no parts to draw") == 1 && lines_with(errf, "") == 1);
+        ENSURE(lines_with(errf, v == 0 ? "an empty file" : "no parts to draw") == 1 && lines_with(errf, "") == 1);
         ENSURE(stat(db, &after) == 0 && after.st_size == before.st_size);
     }
     unlink(db);
