@@ -139,8 +139,8 @@ int cmd_eval(int argc, char** argv)
     qsort(ms, (size_t)nms, sizeof(double), sp_cmp_double);
     printf("{\"top1\": %.4f, \"top3\": %.4f, \"n\": %d, \"ms_median\": %.3f, \"ms_p90\": %.3f, \"rejected\": %d, "
            "\"failed\": %d, \"folds\": %d,\n",
-           n ? (double)top1 / n : 0.0, n ? (double)top3 / n : 0.0, n, nms ? ms[nms / 2] : 0.0,
-           nms ? ms[(int)(0.9 * (nms - 1))] : 0.0, rejected, failed, folds);
+           n ? (double)top1 / n : 0.0, n ? (double)top3 / n : 0.0, n, sp_sorted_quantile(ms, nms, 0.5),
+           sp_sorted_quantile(ms, nms, 0.9), rejected, failed, folds);
     if (folds > 0) {
         printf(" \"per_fold\": [");
         for (int f = 0; f < folds; ++f)

@@ -301,7 +301,7 @@ static double quantile(const double* v, int n, double q)
     if (!s) return 0;
     memcpy(s, v, sizeof *s * (size_t)n);
     qsort(s, (size_t)n, sizeof *s, sp_cmp_double);
-    double r = s[(int)fmin(n - 1, floor(q * (n - 1) + 0.5))];
+    double r = sp_sorted_quantile(s, n, q);
     free(s);
     return r;
 }

@@ -264,6 +264,17 @@ static inline int sp_cmp_double(const void* a, const void* b)
     return (x > y) - (x < y);
 }
 
+/// Quantile q (0..1) of n values sorted ascending, the nearest rank rounded
+/// up at a half: one rule for the median and the p90, so that the p90 is
+/// never below the median (eval rounded the two ways: 15 ms median, 3 ms
+/// p90). 0 for none.
+static inline double sp_sorted_quantile(const double* sorted, int n, double q)
+{
+    if (n <= 0) return 0;
+    int i = (int)floor(q * (n - 1) + 0.5);
+    return sorted[i < 0 ? 0 : i >= n ? n - 1 : i];
+}
+
 /// The same for ints (no subtraction, so no overflow).
 static inline int sp_cmp_int(const void* a, const void* b)
 {
