@@ -1484,6 +1484,15 @@ struct Importer {
         }
     }
 
+    // Two finite numbers within [lo, hi] in a JSON list of two.
+    static bool two_numbers(const cJSON* a, double* x, double* y, double lo, double hi)
+    {
+        const cJSON *p = cJSON_GetArrayItem(a, 0), *q = cJSON_GetArrayItem(a, 1);
+        if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != 2 || !cJSON_IsNumber(p) || !cJSON_IsNumber(q)) return false;
+        *x = p->valuedouble, *y = q->valuedouble;
+        return *x >= lo && *x <= hi && *y >= lo && *y <= hi;
+    }
+
     void read_camera()
     {
         for (int n : order) {
@@ -1503,35 +1512,38 @@ struct Importer {
             double cx = -1, cy = -1;
             if (!c.extras_json_string.empty()) {
                 cJSON* ex = cJSON_Parse(c.extras_json_string.c_str());
+                // Malformed, they are refused as a malformed sp_dofs is: a
+                // principal point of 1e308 put inf into every fit, exit 0, and
+                // a canvas of [0, 0] became 640x480 without a word (an outside review).
                 const cJSON* cv = cJSON_GetObjectItemCaseSensitive(ex, "sp_canvas");
-                if (cJSON_GetArraySize(cv) == 2 && cJSON_IsNumber(cJSON_GetArrayItem(cv, 0)) &&
-                    cJSON_IsNumber(cJSON_GetArrayItem(cv, 1))) {
-                    double a = cJSON_GetArrayItem(cv, 0)->valuedouble, b = cJSON_GetArrayItem(cv, 1)->valuedouble;
-                    if (a >= 16 && a <= 16384 && b >= 16 && b <= 16384) w = (int)a, h = (int)b;
-                }
                 const cJSON* pp = cJSON_GetObjectItemCaseSensitive(ex, "sp_principal");
-                if (cJSON_GetArraySize(pp) == 2 && cJSON_IsNumber(cJSON_GetArrayItem(pp, 0)) &&
-                    cJSON_IsNumber(cJSON_GetArrayItem(pp, 1))) {
-                    cx = cJSON_GetArrayItem(pp, 0)->valuedouble, cy = cJSON_GetArrayItem(pp, 1)->valuedouble;
-                    if (!std::isfinite(cx) || !std::isfinite(cy)) cx = cy = -1;
-                }
+                double a = 0, b = 0;
+                const char* bad = NULL;
+                if (cv && !two_numbers(cv, &a, &b, 16, 16384))
+                    bad = "sp_canvas must be [width, height], each 16 to 16384 pixels";
+                else if (cv)
+                    w = (int)a, h = (int)b;
+                if (pp && !bad && !two_numbers(pp, &cx, &cy, -1e6, 1e6))
+                    bad = "sp_principal must be [x, y], each within +-1e6 pixels";
                 cJSON_Delete(ex);
+                if (bad) fail(SP_ERR_INVALID, "%s: camera %d: %s", what, nd.camera, bad);
             }
             cam.width = w, cam.height = h;
             cam.cx = cx >= 0 ? cx : 0.5 * w;
             cam.cy = cy >= 0 ? cy : 0.5 * h;
             if (c.type == "orthographic") {
                 double xm = std::fabs(c.orthographic.xmag), ym = std::fabs(c.orthographic.ymag);
-                if (!(xm > 0) || !(ym > 0) || !std::isfinite(xm) || !std::isfinite(ym))
-                    fail(SP_ERR_INVALID, "%s: camera %d: xmag and ymag must be non-zero", what, nd.camera);
+                // Within 1e-6..1e6 units: xmag 1e-300 gave a scale of 1e302 px a unit.
+                if (!(xm >= 1e-6 && xm <= 1e6) || !(ym >= 1e-6 && ym <= 1e6))
+                    fail(SP_ERR_INVALID, "%s: camera %d: xmag and ymag must be within 1e-6..1e6 (not zero)", what, nd.camera);
                 cam.kind = SP_CAMERA_ORTHOGRAPHIC;
                 cam.scale = std::min(0.5 * w / xm, 0.5 * h / ym);
                 cam.zfar = c.orthographic.zfar;
                 cam.znear = c.orthographic.znear > 0 ? c.orthographic.znear : 1e-4 * cam.zfar;
             } else if (c.type == "perspective") {
                 double f = c.perspective.yfov;
-                if (!(f > 0 && f < 3.14159) || !std::isfinite(f))
-                    fail(SP_ERR_INVALID, "%s: camera %d: yfov must be in (0, pi)", what, nd.camera);
+                if (!(f >= 1e-6 && f < 3.14159))
+                    fail(SP_ERR_INVALID, "%s: camera %d: yfov must be in (0, pi), at least 1e-6", what, nd.camera);
                 cam.kind = SP_CAMERA_PERSPECTIVE;
                 cam.scale = 0.5 * h / std::tan(0.5 * f);
                 cam.znear = c.perspective.znear;

@@ -31,6 +31,7 @@ typedef struct mini_desc {
     const char* part;  ///< with extras: the scene's sp_part JSON (NULL: a tail attached by the short form)
     const float* ibm1; ///< 16 floats, column-major: the tip's inverse bind matrix (NULL: translate by -1 in y)
     const float* ibm0; ///< the root's likewise (NULL: identity)
+    const char* camera; ///< the camera's JSON object instead (NULL: a perspective one)
 } mini_desc;
 
 static void mini_base64(const unsigned char* d, size_t n, char* out)
@@ -112,7 +113,7 @@ static char* mini_gltf(const mini_desc* d)
              " \"sp_correspondence\": \"closest\"}},\n"
              "  {\"name\": \"view\", \"camera\": 0, \"translation\": [0, 1, 5]}\n"
              " ],\n"
-             " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, \"zfar\": 100}}],\n"
+             " \"cameras\": [%s],\n"
              " \"meshes\": [\n"
              "  {\"primitives\": [{\"attributes\": {\"POSITION\": %d, \"JOINTS_0\": %d, \"WEIGHTS_0\": 2}%s, \"mode\": %d,"
              " \"material\": 0}]},\n"
@@ -141,6 +142,8 @@ static char* mini_gltf(const mini_desc* d)
              "}\n",
              d->armature ? "3" : "0", ex ? ", 4, 5" : "", ex ? scene_extras : "", ex ? dofs_root : "",
              d->cycle ? ", \"children\": [0]" : "", ex ? dofs_tip : "", d->armature ? ", \"children\": [0]" : "",
+             d->camera ? d->camera
+                       : "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, \"zfar\": 100}}",
              d->pos_accessor ? d->pos_accessor : 0, d->byte_joints ? 5 : 1, d->strip ? "" : ", \"indices\": 3", d->strip ? 5 : 4,
              d->empty_skin ? "" : "0, 1", d->pos_count ? d->pos_count : 4, uri);
     return out;

@@ -515,6 +515,52 @@ static void bad_mini(const char* name, mini_desc d, const char* expect)
     ensure_fails(write_mini(name, &d), name, expect);
 }
 
+// A camera whose numbers no picture could come from is refused in one line
+// naming it (xmag 1e-300 and a principal point of 1e308 put inf into every
+// fit, exit 0, and a canvas of [0, 0] became 640x480 without a word; an
+// outside review).
+static void test_camera_bad(void)
+{
+    static const struct {
+        const char* file;
+        const char* camera;
+        const char* expect;
+    } k_bad[] = {
+        {"cam_xmag.gltf",
+         "{\"type\": \"orthographic\", \"orthographic\": {\"xmag\": 1e-300, \"ymag\": 1e-300, \"znear\": 0.1, \"zfar\": 100}}",
+         "camera 0: xmag and ymag must be within 1e-6..1e6"},
+        {"cam_xmag0.gltf",
+         "{\"type\": \"orthographic\", \"orthographic\": {\"xmag\": 0, \"ymag\": 1, \"znear\": 0.1, \"zfar\": 100}}",
+         "xmag and ymag must be"},
+        {"cam_yfov.gltf", "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1e-300, \"znear\": 0.1, \"zfar\": 100}}",
+         "camera 0: yfov must be in (0, pi)"},
+        {"cam_principal.gltf",
+         "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, \"zfar\": 100}, \"extras\": "
+         "{\"sp_principal\": [1e308, 1e308]}}",
+         "camera 0: sp_principal must be [x, y]"},
+        {"cam_canvas0.gltf",
+         "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, \"zfar\": 100}, \"extras\": "
+         "{\"sp_canvas\": [0, 0]}}",
+         "camera 0: sp_canvas must be [width, height], each 16 to 16384 pixels"},
+        {"cam_canvas1.gltf",
+         "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, \"zfar\": 100}, \"extras\": "
+         "{\"sp_canvas\": [640]}}",
+         "sp_canvas must be"},
+    };
+    for (size_t i = 0; i < sizeof k_bad / sizeof k_bad[0]; ++i)
+        bad_mini(k_bad[i].file, (mini_desc){.extras = true, .camera = k_bad[i].camera}, k_bad[i].expect);
+    // In range, they are the camera's.
+    mini_desc ok = {.extras = true,
+                    .camera = "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, \"zfar\": 100}, "
+                              "\"extras\": {\"sp_canvas\": [800, 600], \"sp_principal\": [300, 200]}}"};
+    const char* path = write_mini("cam_ok.gltf", &ok);
+    sp_character ch = {0};
+    sp_error err = {0};
+    ENSURE(sp_gltf_load(path, &ch, &err) == SP_OK && ch.has_camera);
+    ENSURE(ch.camera.width == 800 && ch.camera.height == 600 && ch.camera.cx == 300 && ch.camera.cy == 200);
+    sp_character_free(&ch);
+}
+
 // ---- sp_part -----------------------------------------------------------------
 
 // Every key the struct knows, in every form, and keys it does not know at
@@ -1081,6 +1127,7 @@ int main(int argc, char** argv)
                                    {"fixture_round_trip", test_fixture_round_trip},
                                    {"part_round_trip", test_part_round_trip},
                                    {"part_bad", test_part_bad},
+                                   {"camera_bad", test_camera_bad},
                                    {"bad_input", test_bad_input},
                                    {"says_what_is_wrong", test_says_what_is_wrong},
                                    {"inverse_bind", test_inverse_bind},
