@@ -302,6 +302,14 @@ void sp_kiosk_resize(sp_kiosk* k, int fb_w, int fb_h, double px_per_mm)
     if (px_per_mm > 0) k->ppm = px_per_mm;
     sp_kiosk_ui_resize(k->ui, k->fb_w, k->fb_h, k->ppm);
     k->ppm = k->ui->px_per_mm;
+    // The drawing area in canvas pixels: a window turned or resized after the
+    // start shows the canvas scaled into it, and the area then reaches
+    // beyond the canvas (strokes there were clamped onto its edge and their
+    // parts fitted flat; an outside review).
+    const sp_kiosk_rect* c = &k->ui->canvas;
+    sp_vec2 lo = kiosk_fb_to_canvas(k, (sp_vec2){c->x, c->y}), hi = kiosk_fb_to_canvas(k, (sp_vec2){c->x + c->w, c->y + c->h});
+    if (k->dragon)
+        sp_dragon_set_stroke_area(k->dragon, fmin(lo.x, 0), fmin(lo.y, 0), fmax(hi.x, k->canvas_w), fmax(hi.y, k->canvas_h));
 }
 
 void sp_kiosk_input(sp_kiosk* k, const sp_kiosk_event* ev)

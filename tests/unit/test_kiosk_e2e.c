@@ -1673,6 +1673,47 @@ static void test_collect_reload(void)
     sp_headless_destroy(gl);
 }
 
+// A window turned upright after the start (1280x800 to 800x1280): the
+// canvas is shown scaled into the band across its middle, and a part drawn
+// above the band was clamped onto the canvas's edge and fitted flat there
+// (an outside review). Drawn there now, it keeps its shape.
+static void test_resized_window(void)
+{
+    six_strokes();
+    char db[1100];
+    e2e_db_copy("kiosk_resized.db", db, sizeof db);
+    sp_headless* gl = NULL;
+    double t = 0;
+    sp_kiosk* k = inproc_kiosk(db, "kiosk_resized_ex", &gl, &t);
+    draw_part(k, &t, &g_strokes[0]); // the body, before the turn
+    sp_kiosk_resize(k, 800, 1280, 0);
+    updates_until(k, &t, t + 100);
+    // The wings as the visitor sees the canvas now (0.625 of it, centred),
+    // drawn 400 px higher, above the band.
+    const stroke* w = &g_strokes[2];
+    stroke up = {.xy = malloc(sizeof(sp_vec2) * (size_t)w->n), .n = w->n};
+    ENSURE(up.xy);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < w->n; ++i) {
+        up.xy[i] = (sp_vec2){400 + (w->xy[i].x - 640) * 0.625, 640 + (w->xy[i].y - 400) * 0.625 - 400};
+        lo = fmin(lo, w->xy[i].y), hi = fmax(hi, w->xy[i].y);
+    }
+    draw_part(k, &t, &up);
+    const sp_dragon* d = sp_kiosk_dragon(k);
+    const sp_dragon_part* p = sp_dragon_part_get(d, sp_dragon_part_count(d) - 1);
+    double plo = INFINITY, phi = -INFINITY;
+    for (int i = 0; i < p->stroke_points; ++i)
+        plo = fmin(plo, p->stroke_xy[i].y), phi = fmax(phi, p->stroke_xy[i].y);
+    fprintf(stderr, "  wings drawn above the band: canvas y %.0f..%.0f (drawn %.0f..%.0f, 640 px higher)\n", plo, phi, lo - 640,
+            hi - 640);
+    ENSURE(fabs(plo - (lo - 640)) < 2 && fabs(phi - (hi - 640)) < 2);
+    sp_error err = {0};
+    ENSURE(sp_kiosk_screenshot(k, sp_test_tmp_path("kiosk_resized.png"), &err) == SP_OK); // to look at
+    free(up.xy);
+    sp_kiosk_destroy(k);
+    sp_headless_destroy(gl);
+}
+
 // The refusal's parts row follows the curators' parts: a new model alone
 // keeps it (reading six parts again held a frame), a part removed leaves it,
 // whichever poll (the kiosk's or a stroke's) takes the change in.
@@ -2792,6 +2833,7 @@ int main(int argc, char** argv)
                                    {"attract_follows_damaged", test_attract_follows_damaged},
                                    {"db_problem_said_once", test_db_problem_said_once},
                                    {"row_twelve", test_row_twelve},
+                                   {"resized_window", test_resized_window},
                                    {"hangup", test_hangup},
                                    {"no_database_here", test_no_database_here},
                                    {"body_after_parts", test_body_after_parts},

@@ -234,6 +234,7 @@ struct sp_dragon {
     detail** details; // SP_DRAGON_MAX_DETAILS slots, allocated with the first
     int detail_n;
     sp_camera world;
+    double area[4]; // where strokes may lie (sp_dragon_set_stroke_area); x1 <= x0: the canvas
     double period;
     bool posed;
     // The time of the last sp_dragon_pose_at (0 before one): the dragon as

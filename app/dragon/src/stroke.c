@@ -23,17 +23,25 @@
 // dpi; legs 4 px off were refused: a second review).
 #define RETRACE_MIN_CANVAS 0.005
 
-// Cleans a stroke: clamps onto the canvas, drops repeated points, cuts off
-// a stretch drawn over the stroke again, resamples very long strokes.
+void sp_dragon_set_stroke_area(sp_dragon* d, double x0, double y0, double x1, double y1)
+{
+    bool ok = isfinite(x0) && isfinite(y0) && isfinite(x1) && isfinite(y1) && x1 > x0 && y1 > y0;
+    d->area[0] = ok ? x0 : 0, d->area[1] = ok ? y0 : 0, d->area[2] = ok ? x1 : 0, d->area[3] = ok ? y1 : 0;
+}
+
+// Cleans a stroke: clamps onto the stroke area, drops repeated points, cuts
+// off a stretch drawn over the stroke again, resamples very long strokes.
 // *out malloc'd. Returns the point count (0 on no memory).
 static int clean_stroke(const sp_dragon* d, const sp_vec2* xy, int n, sp_vec2** out)
 {
     double W = d->desc.canvas_w, H = d->desc.canvas_h;
+    bool area = d->area[2] > d->area[0];
+    double x0 = area ? d->area[0] : 0, y0 = area ? d->area[1] : 0, x1 = area ? d->area[2] : W, y1 = area ? d->area[3] : H;
     sp_vec2* tmp = malloc(sizeof(sp_vec2) * (size_t)(n > 0 ? n : 1));
     if (!tmp) return 0;
     sp_vec2 lo = {INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY};
     for (int i = 0; i < n; ++i) {
-        tmp[i] = (sp_vec2){fmin(fmax(xy[i].x, 0.0), W), fmin(fmax(xy[i].y, 0.0), H)};
+        tmp[i] = (sp_vec2){fmin(fmax(xy[i].x, x0), x1), fmin(fmax(xy[i].y, y0), y1)};
         lo.x = fmin(lo.x, tmp[i].x), lo.y = fmin(lo.y, tmp[i].y), hi.x = fmax(hi.x, tmp[i].x), hi.y = fmax(hi.y, tmp[i].y);
     }
     int m = sp_curve_clean(tmp, n, 0.0, tmp);

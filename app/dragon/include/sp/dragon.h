@@ -227,9 +227,16 @@ const char* sp_dragon_default_assets(void);
 /// Frees everything (NULL is fine). Does not close a caller's database.
 void sp_dragon_destroy(sp_dragon* d);
 
+/// Where strokes may lie, canvas pixels (x0, y0 to x1, y1; default, and for
+/// an empty or non-finite box: the canvas). A kiosk window resized after the
+/// start shows the canvas scaled into it, and its drawing area then reaches
+/// beyond the canvas: clamped onto the canvas, a wing drawn there was fitted
+/// flat on its edge (an outside review).
+void sp_dragon_set_stroke_area(sp_dragon* d, double x0, double y0, double x1, double y1);
+
 /// Classifies one stroke (pixels on the canvas), instantiates the part of
 /// that category and fits it (shape and pose), attaches it. Points outside
-/// the canvas are clamped onto its edge; more than SP_DRAGON_MAX_STROKE_POINTS
+/// the stroke area (the canvas by default) are clamped onto its edge; more than SP_DRAGON_MAX_STROKE_POINTS
 /// are resampled. Returns SP_ERR_INVALID (nothing changed) for non-finite
 /// coordinates; every other unusable stroke is SP_OK with out->rejected.
 sp_result sp_dragon_add_stroke(sp_dragon* d, const sp_stroke* stroke, const sp_dragon_stroke_opts* opts, sp_dragon_result* out,
