@@ -49,6 +49,10 @@ int sp_cli_parse(int argc, char** argv, const char* cmd, const char* summary, co
 int sp_cli_parse_pos(int argc, char** argv, const char* cmd, const char* positional, const char* summary, const sp_opt* opts,
                      int nopts);
 
+/// strtod of a decimal number only ([+-]digits[.digits][e[+-]digits]):
+/// hexadecimal, inf and nan read nothing (*end = s). errno as strtod sets it.
+double sp_cli_strtod(const char* s, char** end);
+
 /// Parses "WxH" into two ints of 16..8192; false if malformed or out of range.
 bool sp_cli_parse_size(const char* s, int* w, int* h);
 

@@ -19,7 +19,7 @@ static bool parse_times(const char* s, double* t, int n)
     const char* at = s;
     for (int i = 0; i < n; ++i) {
         char* end = NULL;
-        t[i] = strtod(at, &end);
+        t[i] = sp_cli_strtod(at, &end);
         if (end == at || !(t[i] >= 0)) return false;
         at = end;
         if (i + 1 < n) {

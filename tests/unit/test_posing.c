@@ -498,7 +498,8 @@ static void test_animate_cli_times(void)
         snprintf(cmd, sizeof cmd, "'%s' synth --rig '%s' --seed %d --out '%s' > /dev/null", SP_SKETCHPOSE, rig, 1 + k, k ? b : a);
         ENSURE(run(cmd) == 0);
     }
-    const char* bad[] = {"0,1e300", "0,1e-300", "1e39,1e40", "0,inf"};
+    // Decimal numbers only: strtod's hexadecimal was taken (0x1 as 1; an outside review).
+    const char* bad[] = {"0,1e300", "0,1e-300", "1e39,1e40", "0,inf", "0x1,2", "0,nan"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         remove(out);
         snprintf(cmd, sizeof cmd, "'%s' animate --rig '%s' --strokes '%s' '%s' --times '%s' --out '%s' > /dev/null 2> '%s'",
@@ -706,8 +707,8 @@ static void test_cli_missing_value(void)
 static void test_pose_option_ranges(void)
 {
     char cmd[2048];
-    const char* bad[] = {"--max-iterations 0", "--max-iterations -1",  "--max-ms 0",
-                         "--max-ms -1",        "--representatives -5", "--representatives 0"};
+    const char* bad[] = {"--max-iterations 0",   "--max-iterations -1", "--max-ms 0",    "--max-ms -1",
+                         "--representatives -5", "--representatives 0", "--max-ms 0x10", "--lambda-pose 0x1p-2"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         snprintf(cmd, sizeof cmd, "'%s' pose --rig r.glb --strokes s.json %s 2>/dev/null", SP_SKETCHPOSE, bad[i]);
         ENSURE(run(cmd) == 2);
