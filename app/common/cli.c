@@ -349,7 +349,8 @@ static const char* folder_takes_no_file(const char* dir)
     char* probe = in_dir ? sp_path_temp_beside(in_dir, ".probe") : NULL;
     free(in_dir);
     int pfd = probe ? open(probe, O_WRONLY | O_CREAT | O_EXCL, 0600) : 0;
-    const char* why = pfd < 0 ? strerror(errno) : NULL;
+    // ENOENT from an existing folder (/proc) named the probe, not the folder.
+    const char* why = pfd >= 0 ? NULL : errno == ENOENT ? "it takes no new file" : strerror(errno);
     if (probe && pfd >= 0) close(pfd), unlink(probe);
     free(probe);
     return why;
