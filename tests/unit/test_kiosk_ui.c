@@ -1379,6 +1379,59 @@ static void test_line_from_overlay(void)
     sp_kiosk_ui_destroy(ui);
 }
 
+// An outside review: on a phone (1080 x 2340 at 400 dpi) a chip is 16 mm
+// tall and most of the canvas wide, so a whole head or wing fits inside
+// one; such a line was a tap on the chip, the last part was re-fitted and
+// the drawing lost. A press that draws past the tap size (4 mm) is a line
+// from its touch, on a chip or a tile, whether or not it leaves it.
+static void test_line_inside_chip(void)
+{
+    fake f;
+    sp_kiosk_ui* ui = started(&f);
+    sp_kiosk_ui_resize(ui, 1080, 2340, 400 / 25.4);
+    double t = stroke(ui, 1000, 200, 1500, 30, 20);
+    frame(ui, &f, t + 10);
+    ENSURE(ui->part_count == 1 && sp_kiosk_ui_target_visible(ui, SP_KT_CHIP_GUESS1));
+    const sp_kiosk_rect* g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    float mm = (float)ui->px_per_mm, x = g1->x + 4 * mm, y = g1->y + 0.5f * g1->h;
+    // A 12 mm zig-zag, every point on the chip.
+    send(ui, SP_KEV_DOWN, t + 1000, x, y);
+    for (int i = 1; i < 12; ++i)
+        send(ui, SP_KEV_MOVE, t + 1000 + 8 * i, x + mm * (float)i, y + (i & 1 ? 3 * mm : -3 * mm));
+    ENSURE(ui->capture == SP_KCAP_STROKE && in_rect(g1, x + 11 * mm, y - 3 * mm));
+    send(ui, SP_KEV_UP, t + 1100, x + 11 * mm, y - 3 * mm);
+    sp_kiosk_job j;
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.category[0]);
+    ENSURE(j.stroke->xy[0] == x && j.stroke->xy[1] == y && j.stroke->count >= 12);
+    ENSURE(ui->activations[SP_KT_CHIP_GUESS1] == 0 && !sp_kiosk_ui_next_job(ui, &j));
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "tail", .guesses = {"head"}, .part_count = 2});
+    f.parts = 2, f.cat[1] = 2;
+    // Touched and lifted 6 mm away on the chip, with no move between: a line too.
+    g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    x = g1->x + 4 * mm, y = g1->y + 0.5f * g1->h;
+    send(ui, SP_KEV_DOWN, t + 3000, x, y);
+    send(ui, SP_KEV_UP, t + 3100, x + 6 * mm, y);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->count == 2);
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "tail", .guesses = {"head"}, .part_count = 3});
+    f.parts = 3, f.cat[2] = 2;
+    // A tap that slides 3 mm is still a tap.
+    g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    x = g1->x + 4 * mm, y = g1->y + 0.5f * g1->h;
+    line_from(ui, t + 5000, x, y, mm, 0, 4);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT && !strcmp(j.category, "head"));
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"tail"}, .part_count = 3});
+    // A line inside a tile of the parts row (at least 15 mm): a new stroke, not that part.
+    tap(ui, t + 7000, SP_KT_CHIP_MORE);
+    ENSURE(sp_kiosk_ui_target_visible(ui, SP_KT_PART1 + 1));
+    const sp_kiosk_rect* p = &ui->target[SP_KT_PART1 + 1];
+    x = p->x + 2 * mm, y = p->y + 2 * mm;
+    ENSURE(in_rect(p, x + 9 * mm, y + 9 * mm));
+    line_from(ui, t + 8000, x, y, mm, mm, 10);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && !j.category[0] && j.stroke->xy[0] == x);
+    ENSURE(ui->activations[SP_KT_PART1 + 1] == 0 && ui->others_chosen == 0);
+    sp_kiosk_ui_destroy(ui);
+}
+
 // A kiosk review: a child trying to draw in Turn mode only spun the
 // dragon, and nothing said how to draw again once the first hint went. Each
 // turn says it again.
@@ -2234,6 +2287,7 @@ int main(int argc, char** argv)
                                    {"part_names", test_part_names},
                                    {"save_code", test_save_code},
                                    {"line_from_overlay", test_line_from_overlay},
+                                   {"line_inside_chip", test_line_inside_chip},
                                    {"banner_over_row", test_banner_over_row},
                                    {"turn_reminds_draw", test_turn_reminds_draw},
                                    {"undo_double_tap", test_undo_double_tap},

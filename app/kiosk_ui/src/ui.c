@@ -1143,6 +1143,21 @@ static void activate(sp_kiosk_ui* ui, sp_kiosk_target t)
     }
 }
 
+// A press on a chip or tile (drawn over the canvas) whose path, with (x, y),
+// reaches the canvas's tap size ("strokes under 4 mm are taps") is a line
+// begun there, even if it never leaves the chip: on a phone a whole head
+// fits inside one, and was taken as a tap that re-fitted the last part (an
+// outside review).
+static bool press_drew(sp_kiosk_ui* ui, float x, float y)
+{
+    if (ui->mode != SP_KM_DRAW || ui->pressed < SP_KT_CHIP_LABEL || !inside(&ui->canvas, ui->down_x, ui->down_y)) return false;
+    float* b = ui->press_box;
+    b[0] = fminf(b[0], x), b[1] = fminf(b[1], y), b[2] = fmaxf(b[2], x), b[3] = fmaxf(b[3], y);
+    return hypot(b[2] - b[0], b[3] - b[1]) >= mm(ui, ui->desc.tap_mm);
+}
+
+static void start_stroke(sp_kiosk_ui* ui, float x, float y, double t);
+
 static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
 {
     switch (ui->capture) {
@@ -1151,7 +1166,13 @@ static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
         finish_stroke(ui);
         break;
     case SP_KCAP_TARGET:
-        if (up && ui->pressed != SP_KT_NONE && sp_kiosk_ui_hit(ui, x, y) == ui->pressed) activate(ui, ui->pressed);
+        if (up && press_drew(ui, x, y)) { // a line drawn with no move between touch and lift
+            start_stroke(ui, ui->down_x, ui->down_y, ui->down_t);
+            add_point(ui, x, y, true);
+            finish_stroke(ui);
+        } else if (up && ui->pressed != SP_KT_NONE && sp_kiosk_ui_hit(ui, x, y) == ui->pressed) {
+            activate(ui, ui->pressed);
+        }
         break;
     case SP_KCAP_ORBIT:
         // A child who tries to draw while turning only spins the dragon: each
@@ -1195,6 +1216,7 @@ static void on_down(sp_kiosk_ui* ui, float x, float y)
     ui->last_input = ui->now;
     ui->last_x = x, ui->last_y = y;
     ui->down_x = x, ui->down_y = y, ui->down_t = ui->now;
+    ui->press_box[0] = ui->press_box[2] = x, ui->press_box[1] = ui->press_box[3] = y;
     ui->down_on_banner = sp_kiosk_ui_banner_visible(ui) && inside(&ui->banner_box, x, y);
     // The attract screen invites drawing, so a child often starts with a
     // stroke: it leaves the screen and is already the visit's first stroke.
@@ -1237,10 +1259,11 @@ static void on_move(sp_kiosk_ui* ui, float x, float y)
         break;
     case SP_KCAP_TARGET:
         // A finger that leaves the chip or tile it touched (drawn over the
-        // canvas) is drawing a line that happened to start there, as
-        // children start lines anywhere: the line is kept from its touch.
-        if (ui->mode == SP_KM_DRAW && ui->pressed >= SP_KT_CHIP_LABEL && inside(&ui->canvas, ui->down_x, ui->down_y) &&
-            sp_kiosk_ui_hit(ui, x, y) != ui->pressed) {
+        // canvas), or draws past the tap size on it, is drawing a line that
+        // happened to start there, as children start lines anywhere: the
+        // line is kept from its touch.
+        if (press_drew(ui, x, y) || (ui->mode == SP_KM_DRAW && ui->pressed >= SP_KT_CHIP_LABEL &&
+                                     inside(&ui->canvas, ui->down_x, ui->down_y) && sp_kiosk_ui_hit(ui, x, y) != ui->pressed)) {
             start_stroke(ui, ui->down_x, ui->down_y, ui->down_t);
             add_point(ui, x, y, false);
         } else if (ui->mode == SP_KM_DRAW && !inside(&ui->canvas, ui->down_x, ui->down_y) && inside(&ui->canvas, x, y) &&
