@@ -248,25 +248,39 @@ static void chips_to_right(sp_kiosk_ui* ui, float right)
         if (c[i].w > 0) c[i].x += shift[i];
 }
 
-// Chips sit in a row at the canvas's top-left and wrap when the row is full;
-// while a refused stroke is offered, the row of parts goes under them, and
-// the hint under both. Chip widths follow the text: a DejaVu Sans character
-// averages ~0.6 of the text height, and the renderer shrinks text that would
-// not fit anyway.
-static void layout_chips(sp_kiosk_ui* ui)
+// The chips a screen too small for all of them leaves out, least useful
+// first: the guesses from the last (the parts row offers every part), then
+// the label (the row draws the part's own tile as chosen), "Other?" last.
+static const sp_kiosk_target k_drop_order[] = {SP_KT_CHIP_GUESS3, SP_KT_CHIP_GUESS2, SP_KT_CHIP_GUESS1, SP_KT_CHIP_LABEL,
+                                               SP_KT_CHIP_MORE};
+enum { DROP_MAX = sizeof k_drop_order / sizeof k_drop_order[0] };
+
+static bool dropped(sp_kiosk_target t, int drop)
 {
-    float h = (float)mm(ui, ui->desc.min_target_mm + 1.0);
+    for (int i = 0; i < drop; ++i)
+        if (k_drop_order[i] == t) return true;
+    return false;
+}
+
+// Chips sit in a row at the canvas's top-left and wrap when the row is
+// full, all but the `drop` least useful. Chip widths follow the text: a
+// DejaVu Sans character averages ~0.6 of the text height, and the renderer
+// shrinks text that would not fit anyway. Returns where what goes under
+// them starts (the canvas's top margin when none is shown).
+static float line_up_chips(sp_kiosk_ui* ui, int drop, float h)
+{
     float pad = (float)mm(ui, 4.0), gap = (float)mm(ui, 3.0), margin = (float)mm(ui, 3.0);
     float min = (float)mm(ui, ui->desc.min_target_mm);
     float chip_text = 0.42f * h;
     float left = ui->canvas.x + margin, right = ui->canvas.x + ui->canvas.w - margin;
     float x = left, y = ui->canvas.y + margin;
+    bool any = false;
     for (int i = 0; i < 5; ++i) {
         sp_kiosk_target t = (sp_kiosk_target)(SP_KT_CHIP_LABEL + i);
         sp_kiosk_rect* r = &ui->target[t];
         char text[SP_KIOSK_TEXT_MAX];
         size_t n = strlen(sp_kiosk_ui_target_text(ui, t, text, sizeof text));
-        if (n == 0 || (t == SP_KT_CHIP_MORE && !more_shown(ui)) || guess_hidden(ui, t)) {
+        if (n == 0 || (t == SP_KT_CHIP_MORE && !more_shown(ui)) || guess_hidden(ui, t) || dropped(t, drop)) {
             *r = (sp_kiosk_rect){0};
             continue;
         }
@@ -281,46 +295,61 @@ static void layout_chips(sp_kiosk_ui* ui)
         }
         *r = (sp_kiosk_rect){x, y, w, h};
         x += w + gap;
+        any = true;
     }
-    // A stroke drawn at the top-left (the one they are about, or a part
-    // drawn before: a dragon drawn in the corner had its head under them)
-    // would be under them: they go to the top-right when less is there.
+    return any ? y + h + gap : y;
+}
+
+// A stroke drawn at the top-left (the one the chips are about, or a part
+// drawn before: a dragon drawn in the corner had its head under them)
+// would be under them: they go to the top-right when less is there, or to
+// the bottom (below); `end` is where they end. Returns how far they went down.
+static float chips_out_of_the_way(sp_kiosk_ui* ui, float end)
+{
+    float margin = (float)mm(ui, 3.0), right = ui->canvas.x + ui->canvas.w - margin;
     int covered = chips_cover(ui);
     float up = 0; // how far the chips went down to the canvas's bottom
-    if (covered > 0) {
-        sp_kiosk_rect at_left[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
-        memcpy(at_left, &ui->target[SP_KT_CHIP_LABEL], sizeof at_left);
-        chips_to_right(ui, right);
-        if (chips_cover(ui) >= covered) memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left); // no better
-        covered = chips_cover(ui);
-        // A stroke along the whole top (wings reaching the top edge) lay
-        // under them either way: they go to the bottom when less is there,
-        // left or right. Not with the parts row, which goes under them, nor
-        // where they fill a quarter of the canvas (a phone's).
-        if (covered > 0 && !row_shown(ui) && y + h - ui->canvas.y < 0.25f * ui->canvas.h) {
-            sp_kiosk_rect kept[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
-            memcpy(kept, &ui->target[SP_KT_CHIP_LABEL], sizeof kept);
-            float dy = ui->canvas.y + ui->canvas.h - margin - (y + h);
-            for (int side = 0; side < 2 && covered > 0; ++side) {
-                memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left);
-                for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t)
-                    if (ui->target[t].w > 0) ui->target[t].y += dy;
-                if (side) chips_to_right(ui, right);
-                int c = chips_cover(ui);
-                if (c < covered) covered = c, up = dy, memcpy(kept, &ui->target[SP_KT_CHIP_LABEL], sizeof kept);
-            }
-            memcpy(&ui->target[SP_KT_CHIP_LABEL], kept, sizeof kept);
+    if (covered == 0) return 0;
+    sp_kiosk_rect at_left[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
+    memcpy(at_left, &ui->target[SP_KT_CHIP_LABEL], sizeof at_left);
+    chips_to_right(ui, right);
+    if (chips_cover(ui) >= covered) memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left); // no better
+    covered = chips_cover(ui);
+    // A stroke along the whole top (wings reaching the top edge) lay
+    // under them either way: they go to the bottom when less is there,
+    // left or right. Not with the parts row, which goes under them, nor
+    // where they fill a quarter of the canvas (a phone's).
+    if (covered > 0 && !row_shown(ui) && end - ui->canvas.y < 0.25f * ui->canvas.h) {
+        sp_kiosk_rect kept[SP_KT_CHIP_MORE - SP_KT_CHIP_LABEL + 1];
+        memcpy(kept, &ui->target[SP_KT_CHIP_LABEL], sizeof kept);
+        float dy = ui->canvas.y + ui->canvas.h - margin - end;
+        for (int side = 0; side < 2 && covered > 0; ++side) {
+            memcpy(&ui->target[SP_KT_CHIP_LABEL], at_left, sizeof at_left);
+            for (int t = SP_KT_CHIP_LABEL; t <= SP_KT_CHIP_MORE; ++t)
+                if (ui->target[t].w > 0) ui->target[t].y += dy;
+            if (side) chips_to_right(ui, right);
+            int c = chips_cover(ui);
+            if (c < covered) covered = c, up = dy, memcpy(kept, &ui->target[SP_KT_CHIP_LABEL], sizeof kept);
         }
+        memcpy(&ui->target[SP_KT_CHIP_LABEL], kept, sizeof kept);
     }
-    float below = y + h + gap, chips_end = below;
-    // The parts row: an outline over its name, 26 x 22 mm, smaller (down to
-    // the smallest target) where the rows and the hint would not fit on the canvas.
+    return up;
+}
+
+// The parts row from `below` down: an outline over its name, 26 x 22 mm,
+// smaller (down to the smallest target) where the rows and the hint would
+// not fit on the canvas. Sets row_fit; returns where the hint goes.
+static float layout_row(sp_kiosk_ui* ui, float below)
+{
+    float gap = (float)mm(ui, 3.0), margin = (float)mm(ui, 3.0), min = (float)mm(ui, ui->desc.min_target_mm);
+    float left = ui->canvas.x + margin, right = ui->canvas.x + ui->canvas.w - margin;
+    float chips_end = below;
     bool row = row_shown(ui);
     float bottom = ui->canvas.y + ui->canvas.h - 2.2f * ui->text_px;
     for (float scale = 1.0f; row; scale -= 0.1f) {
         float bw = fmaxf((float)mm(ui, 26.0) * scale, min), bh = fmaxf((float)mm(ui, 22.0) * scale, min);
         if (bw > right - left) bw = fmaxf(right - left, min);
-        x = left, y = below;
+        float x = left, y = below;
         for (int i = 0; i < ui->row_count; ++i) {
             if (x + bw > right && x > left) {
                 x = left;
@@ -345,11 +374,40 @@ static void layout_chips(sp_kiosk_ui* ui)
     }
     if (row && ui->row_fit < ui->row_count) {
         // The hint goes under the tiles shown (under the chips when none is).
-        below = ui->row_fit > 0 ? ui->target[SP_KT_PART1 + ui->row_fit - 1].y + ui->target[SP_KT_PART1 + ui->row_fit - 1].h + gap
-                                : chips_end;
+        const sp_kiosk_rect* last = &ui->target[SP_KT_PART1 + ui->row_fit - 1];
+        below = ui->row_fit > 0 ? last->y + last->h + gap : chips_end;
     }
     for (int i = ui->row_fit; i < SP_KIOSK_ROW_MAX; ++i)
         ui->target[SP_KT_PART1 + i] = (sp_kiosk_rect){0};
+    return below;
+}
+
+// The chips, while a refused stroke is offered or "Other?" is open the row
+// of parts under them, and the hint under both.
+static void layout_chips(sp_kiosk_ui* ui)
+{
+    float h = (float)mm(ui, ui->desc.min_target_mm + 1.0), gap = (float)mm(ui, 3.0), margin = (float)mm(ui, 3.0);
+    float end = ui->canvas.y + ui->canvas.h - margin;
+    // Chips run past the canvas lay over the toolbar and took its taps (an
+    // outside review: on a small phone a tap on Undo opened the parts row):
+    // the least useful go until the chips fit on the canvas, and the parts
+    // row when shown offers every part, or as many as it can.
+    int best = DROP_MAX, best_fit = -1;
+    for (int drop = 0; drop <= DROP_MAX; ++drop) {
+        float below = line_up_chips(ui, drop, h);
+        if (below - gap > end && drop < DROP_MAX) continue;
+        if (!row_shown(ui)) {
+            best = drop;
+            break;
+        }
+        layout_row(ui, below);
+        if (ui->row_fit > best_fit) best = drop, best_fit = ui->row_fit;
+        if (ui->row_fit == ui->row_count) break;
+    }
+    float chips_end = line_up_chips(ui, best, h);
+    float up = chips_out_of_the_way(ui, chips_end - gap);
+    float below = layout_row(ui, chips_end);
+    bool row = row_shown(ui);
     float hw = ui->canvas.w - 2 * margin, hh = 2.2f * ui->text_px;
     if (hw > (float)mm(ui, 220)) hw = (float)mm(ui, 220);
     // A canvas too small for the hint under the parts row (a phone held
@@ -379,62 +437,91 @@ static void layout_banner(sp_kiosk_ui* ui)
         (sp_kiosk_rect){ui->canvas.x + 0.5f * (ui->canvas.w - w), ui->canvas.y + ui->canvas.h - h - (float)mm(ui, 3.0), w, h};
 }
 
+// The toolbar: below the canvas in rows or beside it in columns, whichever
+// leaves the canvas larger, for buttons bh tall (and bw_side wide beside it).
+typedef struct toolbar {
+    bool bottom;
+    int k, rows;   // below: buttons a row, rows
+    int kc, cols;  // beside: buttons a column, columns
+    double bw, bh; // a button's size
+    double strip;  // the strip's height (below) or width (beside)
+    double canvas_area;
+} toolbar;
+
+static toolbar plan_toolbar(const sp_kiosk_ui* ui, double bw_side, double bh)
+{
+    const double W = ui->width, H = ui->height, min = mm(ui, ui->desc.min_target_mm);
+    const double bw_pref = mm(ui, ui->desc.button_mm) * 1.4; // room for an icon over a short word
+    const double gap = mm(ui, 3.0), margin = mm(ui, 3.0);
+    const int n = SP_KT_SAVE - SP_KT_UNDO + 1;
+    toolbar a = {.bh = bh}, b = {.bh = bh, .bw = bw_side};
+    // Below: as many buttons a row as fit at their minimum width.
+    a.k = (int)floor((W - 2 * margin + gap) / (min + gap));
+    a.k = a.k < 1 ? 1 : a.k > n ? n : a.k;
+    a.rows = (n + a.k - 1) / a.k;
+    a.bw = fmin(bw_pref * 1.15, fmax(min, (W - 2 * margin - (a.k - 1) * gap) / a.k));
+    a.strip = a.rows * bh + (a.rows - 1) * gap + 2 * margin;
+    a.canvas_area = W * fmax(0.0, H - a.strip);
+    a.bottom = true;
+    // Beside: as many buttons a column as fit.
+    b.kc = (int)floor((H - 2 * margin + gap) / (bh + gap));
+    b.kc = b.kc < 1 ? 1 : b.kc > n ? n : b.kc;
+    b.cols = (n + b.kc - 1) / b.kc;
+    b.strip = b.cols * bw_side + (b.cols - 1) * gap + 2 * margin;
+    b.canvas_area = H * fmax(0.0, W - b.strip);
+    return a.canvas_area >= b.canvas_area ? a : b;
+}
+
+static void place_toolbar(sp_kiosk_ui* ui, const toolbar* tb)
+{
+    const double W = ui->width, H = ui->height, gap = mm(ui, 3.0), margin = mm(ui, 3.0);
+    const int n = SP_KT_SAVE - SP_KT_UNDO + 1;
+    for (int i = 0; i < n; ++i) {
+        sp_kiosk_rect* r = &ui->target[SP_KT_UNDO + i];
+        if (tb->bottom) {
+            int row = i / tb->k, col = i % tb->k;
+            int in_row = row == tb->rows - 1 ? n - row * tb->k : tb->k;
+            double row_w = in_row * tb->bw + (in_row - 1) * gap;
+            double x0 = 0.5 * (W - row_w);
+            if (x0 < margin && W >= row_w + 2 * margin) x0 = margin;
+            if (x0 < 0) x0 = 0;
+            double y0 = H - tb->strip + margin + row * (tb->bh + gap);
+            *r = (sp_kiosk_rect){(float)(x0 + col * (tb->bw + gap)), (float)y0, (float)tb->bw, (float)tb->bh};
+        } else {
+            int col = i / tb->kc, row = i % tb->kc;
+            int in_col = col == tb->cols - 1 ? n - col * tb->kc : tb->kc;
+            double col_h = in_col * tb->bh + (in_col - 1) * gap;
+            double y0 = 0.5 * (H - col_h);
+            if (y0 < 0) y0 = 0;
+            double x0 = W - tb->strip + margin + col * (tb->bw + gap);
+            *r = (sp_kiosk_rect){(float)x0, (float)(y0 + row * (tb->bh + gap)), (float)tb->bw, (float)tb->bh};
+        }
+    }
+    if (tb->bottom)
+        ui->canvas = (sp_kiosk_rect){0, 0, (float)W, (float)fmax(0.0, H - tb->strip)};
+    else
+        ui->canvas = (sp_kiosk_rect){0, 0, (float)fmax(0.0, W - tb->strip), (float)H};
+}
+
 void sp_kiosk_ui_resize(sp_kiosk_ui* ui, int width, int height, double px_per_mm)
 {
     if (width < 1) width = 1;
     if (height < 1) height = 1;
     if (!(px_per_mm > 0) || !isfinite(px_per_mm)) px_per_mm = 96.0 / 25.4;
     ui->width = width, ui->height = height, ui->px_per_mm = px_per_mm;
-    const double W = width, H = height;
-    const double min = mm(ui, ui->desc.min_target_mm);
-    const double bh = mm(ui, ui->desc.button_mm);
-    const double bw_pref = bh * 1.4; // room for an icon over a short word
-    const double gap = mm(ui, 3.0), margin = mm(ui, 3.0);
-    const int n = SP_KT_SAVE - SP_KT_UNDO + 1;
     ui->text_px = (float)fmax(10.0, mm(ui, 6.0));
     ui->big_text_px = (float)fmax(16.0, mm(ui, 13.0));
     ui->line_px = (float)fmax(3.0, mm(ui, 1.8));
-
-    // Bottom strip: as many buttons per row as fit at their minimum width.
-    int k = (int)floor((W - 2 * margin + gap) / (min + gap));
-    k = k < 1 ? 1 : k > n ? n : k;
-    int rows = (n + k - 1) / k;
-    double bw_a = fmin(bw_pref * 1.15, fmax(min, (W - 2 * margin - (k - 1) * gap) / k));
-    double strip_a = rows * bh + (rows - 1) * gap + 2 * margin;
-    double area_a = W * fmax(0.0, H - strip_a);
-    // Right strip: as many buttons per column as fit.
-    int kc = (int)floor((H - 2 * margin + gap) / (bh + gap));
-    kc = kc < 1 ? 1 : kc > n ? n : kc;
-    int cols = (n + kc - 1) / kc;
-    double strip_b = cols * bw_pref + (cols - 1) * gap + 2 * margin;
-    double area_b = H * fmax(0.0, W - strip_b);
-    bool bottom = area_a >= area_b;
-
-    for (int i = 0; i < n; ++i) {
-        sp_kiosk_rect* r = &ui->target[SP_KT_UNDO + i];
-        if (bottom) {
-            int row = i / k, col = i % k;
-            int in_row = row == rows - 1 ? n - row * k : k;
-            double row_w = in_row * bw_a + (in_row - 1) * gap;
-            double x0 = 0.5 * (W - row_w);
-            if (x0 < margin && W >= row_w + 2 * margin) x0 = margin;
-            if (x0 < 0) x0 = 0;
-            double y0 = H - strip_a + margin + row * (bh + gap);
-            *r = (sp_kiosk_rect){(float)(x0 + col * (bw_a + gap)), (float)y0, (float)bw_a, (float)bh};
-        } else {
-            int col = i / kc, row = i % kc;
-            int in_col = col == cols - 1 ? n - col * kc : kc;
-            double col_h = in_col * bh + (in_col - 1) * gap;
-            double y0 = 0.5 * (H - col_h);
-            if (y0 < 0) y0 = 0;
-            double x0 = W - strip_b + margin + col * (bw_pref + gap);
-            *r = (sp_kiosk_rect){(float)x0, (float)(y0 + row * (bh + gap)), (float)bw_pref, (float)bh};
-        }
+    const double min = mm(ui, ui->desc.min_target_mm), bh = mm(ui, ui->desc.button_mm);
+    toolbar tb = plan_toolbar(ui, bh * 1.4, bh);
+    // Buttons of the preferred size that leave the canvas under half the
+    // window shrink to the smallest target, below or beside: on a phone held
+    // sideways two rows of them left a canvas 17 mm tall (an outside review).
+    if (tb.canvas_area < 0.5 * (double)width * height) {
+        toolbar small = plan_toolbar(ui, min, min);
+        if (small.canvas_area > tb.canvas_area) tb = small;
     }
-    if (bottom)
-        ui->canvas = (sp_kiosk_rect){0, 0, (float)W, (float)fmax(0.0, H - strip_a)};
-    else
-        ui->canvas = (sp_kiosk_rect){0, 0, (float)fmax(0.0, W - strip_b), (float)H};
+    place_toolbar(ui, &tb);
     layout_chips(ui);
     layout_banner(ui);
 }
@@ -481,18 +568,26 @@ bool sp_kiosk_ui_target_enabled(const sp_kiosk_ui* ui, sp_kiosk_target t)
     }
 }
 
+// Whether (x, y) is in a visible target's touch area: it reaches half the
+// 3 mm gap beyond the drawn rectangle, so a finger that lands on the rim
+// still counts and neighbours never overlap.
+static bool hits(const sp_kiosk_ui* ui, int t, float x, float y)
+{
+    float slop = (float)mm(ui, 1.4);
+    const sp_kiosk_rect* r = &ui->target[t];
+    return visible(ui, (sp_kiosk_target)t) && x >= r->x - slop && x < r->x + r->w + slop && y >= r->y - slop &&
+           y < r->y + r->h + slop;
+}
+
 sp_kiosk_target sp_kiosk_ui_hit(const sp_kiosk_ui* ui, float x, float y)
 {
     if (!isfinite(x) || !isfinite(y)) return SP_KT_NONE;
-    // Touch areas reach half the 3 mm gap beyond the drawn rectangle, so a
-    // finger that lands on the rim still counts and neighbours never overlap.
-    float slop = (float)mm(ui, 1.4);
-    // Chips are drawn over the canvas: test them first.
-    for (int t = SP_KT_COUNT - 1; t > SP_KT_NONE; --t) {
-        if (!visible(ui, (sp_kiosk_target)t)) continue;
-        const sp_kiosk_rect* r = &ui->target[t];
-        if (x >= r->x - slop && x < r->x + r->w + slop && y >= r->y - slop && y < r->y + r->h + slop) return (sp_kiosk_target)t;
-    }
+    // The toolbar's buttons first: a chip that reached one took its taps (an
+    // outside review: on a small phone a tap on Undo opened the parts row).
+    for (int t = SP_KT_UNDO; t <= SP_KT_SAVE; ++t)
+        if (hits(ui, t, x, y)) return (sp_kiosk_target)t;
+    for (int t = SP_KT_COUNT - 1; t > SP_KT_SAVE; --t)
+        if (hits(ui, t, x, y)) return (sp_kiosk_target)t;
     return SP_KT_NONE;
 }
 
