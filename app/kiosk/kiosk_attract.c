@@ -14,8 +14,12 @@
 
 #include "sp/synth.h"
 
-// Where each category goes on the canvas (fractions of its width and height)
-// and its size (box diagonal, fraction of the canvas height), in drawing order.
+// Where each category goes in the demo's frame (fractions of its width and
+// height) and its size (box diagonal, fraction of its height), in drawing
+// order. The frame keeps the layout's own aspect (it was made on 1280 x 800),
+// so the parts stay together on any screen: placed by the canvas's width and
+// sized by its height, head and tail floated off the body on an ultrawide
+// screen (an outside review).
 static const struct {
     const char* category;
     double cx, cy, size;
@@ -24,11 +28,27 @@ static const struct {
     {"front_legs", 0.60, 0.74, 0.22}, {"hind_legs", 0.40, 0.74, 0.24}, {"legs", 0.50, 0.74, 0.22},
 };
 enum { LAYOUT_N = sizeof k_layout / sizeof k_layout[0] };
+static const double k_frame_aspect = 1.6;
+// The dragon's top and bottom in its frame (fractions of its height): the
+// wings' tips and the feet.
+static const double k_dragon_top = 0.18, k_dragon_bottom = 0.87;
+
+// The demo's frame (canvas pixels): as large as the canvas's width allows
+// with the dragon between top and bottom (under the title, above "Touch to
+// start", which covered half of it on a phone held sideways), centred there.
+static sp_kiosk_rect attract_frame(double canvas_w, double canvas_h, double top, double bottom)
+{
+    double span = k_dragon_bottom - k_dragon_top;
+    if (!(bottom - top > 0.1 * canvas_h)) top = 0, bottom = canvas_h; // no room between them: the whole canvas
+    double h = fmin(canvas_w / k_frame_aspect, (bottom - top) / span), w = h * k_frame_aspect;
+    double y = 0.5 * (top + bottom) - h * 0.5 * (k_dragon_top + k_dragon_bottom);
+    return (sp_kiosk_rect){(float)(0.5 * (canvas_w - w)), (float)y, (float)w, (float)h};
+}
 
 // Timeline (ms): each part is drawn, then flashes; then the dragon lives.
 static const double k_draw_ms = 1100, k_flash_ms = 600, k_alive_ms = 6000;
 
-static void demo_stroke(sp_kiosk* k, sp_db* db, int li)
+static void demo_stroke(sp_kiosk* k, sp_db* db, int li, const sp_kiosk_rect* frame)
 {
     sp_error err = {0};
     sp_character ch = {0};
@@ -45,13 +65,13 @@ static void demo_stroke(sp_kiosk* k, sp_db* db, int li)
     demo_part* d = &k->demo_parts[k->demo_count];
     if (!(d->xy = malloc(sizeof(sp_vec2) * (size_t)n))) goto done;
     // Several curves become one stroke, as a visitor would draw them.
-    double f = k_layout[li].size * k->canvas_h / fmax(1e-9, sp_v2_len(sp_v2_sub(hi, lo)));
+    double f = k_layout[li].size * frame->h / fmax(1e-9, sp_v2_len(sp_v2_sub(hi, lo)));
     sp_vec2 c = sp_v2_scale(sp_v2_add(lo, hi), 0.5);
+    double x0 = frame->x + k_layout[li].cx * frame->w, y0 = frame->y + k_layout[li].cy * frame->h;
     int m = 0;
     for (int s = 0; s < sk.stroke_count; ++s)
         for (int i = 0; i < sk.strokes[s].count; ++i, ++m)
-            d->xy[m] = (sp_vec2){k_layout[li].cx * k->canvas_w + f * (sk.strokes[s].points[i].x - c.x),
-                                 k_layout[li].cy * k->canvas_h + f * (sk.strokes[s].points[i].y - c.y)};
+            d->xy[m] = (sp_vec2){x0 + f * (sk.strokes[s].points[i].x - c.x), y0 + f * (sk.strokes[s].points[i].y - c.y)};
     d->n = n;
     d->part = -1;
     snprintf(d->category, sizeof d->category, "%s", k_layout[li].category);
@@ -79,8 +99,12 @@ static void prepare(sp_kiosk* k)
     int n = 0;
     if (sp_db_categories(db, &cats, &n, &err) == SP_OK) k->demo_source = kiosk_row_source(db, cats, n);
     sp_db_free_strings(cats, n);
+    float top, bottom;
+    kiosk_attract_band(k->ui, (float)k->fb_h, &top, &bottom);
+    sp_kiosk_rect frame = attract_frame(k->canvas_w, k->canvas_h, kiosk_fb_to_canvas(k, (sp_vec2){0, top}).y,
+                                        kiosk_fb_to_canvas(k, (sp_vec2){0, bottom}).y);
     for (int li = 0; li < LAYOUT_N && k->demo_count < DEMO_MAX; ++li)
-        demo_stroke(k, db, li);
+        demo_stroke(k, db, li, &frame);
     sp_db_close(db);
     if (k->demo_count == 0) return;
     if (sp_dragon_create(&(sp_dragon_desc){.db_path = k->db_path,

@@ -259,11 +259,24 @@ static void draw_countdown(sp_kiosk* k, double left_s)
     draw_message(k, &box, sp_kiosk_text(SP_KTEXT_COUNTDOWN), ui->text_px, k_panel, k_white);
 }
 
+static float attract_title_px(const sp_kiosk_ui* ui, float H)
+{
+    return fminf(ui->big_text_px * 1.25f, 0.09f * H);
+}
+
+void kiosk_attract_band(const sp_kiosk_ui* ui, float H, float* top, float* bottom)
+{
+    *top = 0.09f * H + 0.9f * attract_title_px(ui, H) + 0.8f * ui->text_px;  // under the line under the title
+    *bottom = H - (float)(ui->px_per_mm * (ui->desc.min_target_mm + 3 + 8)); // "Touch to start"'s top
+}
+
 static void draw_attract_ui(sp_kiosk* k)
 {
     const sp_kiosk_ui* ui = k->ui;
     float W = (float)k->fb_w, H = (float)k->fb_h;
-    float big = fminf(ui->big_text_px * 1.25f, 0.09f * H);
+    float big = attract_title_px(ui, H), top, by;
+    kiosk_attract_band(ui, H, &top, &by);
+    (void)top; // the demo dragon's
     sp_draw2d_text_fit(k->d2, sp_kiosk_text(SP_KTEXT_TITLE), 0.5f * W, 0.09f * H, big, 0.92f * W, SP_ALIGN_CENTER, k_ink);
     sp_draw2d_text_fit(k->d2, sp_kiosk_text(SP_KTEXT_ATTRACT), 0.5f * W, 0.09f * H + 0.9f * big, ui->text_px, 0.92f * W,
                        SP_ALIGN_CENTER, (const float[4]){0.15f, 0.18f, 0.25f, 1});
@@ -272,7 +285,7 @@ static void draw_attract_ui(sp_kiosk* k)
     const char* start = sp_kiosk_text(SP_KTEXT_TOUCH_TO_START);
     float bh = (float)(ui->px_per_mm * (ui->desc.min_target_mm + 3)),
           bw = fminf(0.9f * W, sp_font_width(k->font, start, ui->text_px * 1.3f) + 3 * bh);
-    float bx = 0.5f * (W - bw), by = H - bh - (float)(ui->px_per_mm * 8);
+    float bx = 0.5f * (W - bw);
     sp_draw2d_rect(k->d2, bx, by, bw, bh, 0.5f * bh, 0, (const float[4]){k_navy[0], k_navy[1], k_navy[2], (float)a});
     icon(k->d2, SP_KT_REDRAW, false, bx + 0.6f * bh, by + 0.5f * bh, 0.55f * bh, k_yellow);
     sp_draw2d_text_fit(k->d2, start, bx + 0.5f * bw + 0.3f * bh, by + 0.5f * bh, ui->text_px * 1.3f, bw - 1.6f * bh,

@@ -187,6 +187,9 @@ void mesh_cache_free(mesh_cache* c);
 sp_render_mesh* mesh_cache_get(const mesh_cache* c, uint64_t id);
 
 // kiosk_draw.c
+/// The attract screen's room for its demo dragon on a framebuffer H pixels
+/// tall (y down): from under its title (top) to above "Touch to start" (bottom).
+void kiosk_attract_band(const sp_kiosk_ui* ui, float H, float* top, float* bottom);
 /// Draws the frame into the bound framebuffer of w x h pixels.
 void kiosk_draw_frame(sp_kiosk* k, int w, int h);
 /// Renders the postcard (the dragon framed, a title and the code) into img.

@@ -1803,23 +1803,31 @@ static int fds_on(const struct stat* was)
 
 // An in-process kiosk on db that stays on the attract screen (its demo
 // dragon built, unless no_demo), collecting nothing.
-static sp_kiosk* attract_kiosk(const char* db, bool no_demo, sp_headless** gl, double* t)
+// The same on a w x h screen of ppm pixels a millimetre, updated until `until` ms.
+static sp_kiosk* attract_kiosk_at(const char* db, bool no_demo, int w, int h, double ppm, double until, sp_headless** gl,
+                                  double* t)
 {
     sp_error err = {0};
     if (sp_headless_create(gl, &err) != SP_OK) SKIP("no headless OpenGL");
     sp_kiosk* k = sp_kiosk_create(&(sp_kiosk_desc){.db_path = db,
                                                    .export_dir = sp_test_tmp_path("kiosk_attract_ex"),
-                                                   .canvas_w = 1280,
-                                                   .canvas_h = 800,
+                                                   .canvas_w = w,
+                                                   .canvas_h = h,
                                                    .no_collect = true,
                                                    .no_attract_demo = no_demo,
                                                    .fit_time_cap_ms = 60000},
                                   &err);
     if (!k) fprintf(stderr, "  %s\n", err.text);
     ENSURE(k);
+    sp_kiosk_resize(k, w, h, ppm);
     *t = 0;
-    updates_until(k, t, 3000);
+    updates_until(k, t, until);
     return k;
+}
+
+static sp_kiosk* attract_kiosk(const char* db, bool no_demo, sp_headless** gl, double* t)
+{
+    return attract_kiosk_at(db, no_demo, 1280, 800, 0, 3000, gl, t);
 }
 
 static void attract_kiosk_end(sp_kiosk* k, sp_headless* gl, double* t)
@@ -1836,6 +1844,54 @@ static void remove_part(const char* db, const char* name)
     sp_error err = {0};
     ENSURE(sp_db_open(db, 0, &w, &err) == SP_OK && sp_db_remove_part(w, name, "test", &err) == SP_OK);
     sp_db_close(w);
+}
+
+// An outside review: on a 21:9 screen the attract screen's demo dragon had
+// its head and tail floating off its body (parts placed by the canvas's
+// width but sized by its height), and on a phone held sideways "Touch to
+// start" covered half of it. On every screen each demo stroke's box lies
+// as near the body's as at 1280 x 800 (in the body's size), and every
+// stroke between the title and that button.
+static void test_attract_whole(void)
+{
+    const char* db = e2e_db();
+    const struct {
+        int w, h;
+        double ppm;
+    } screens[] = {{1280, 800, 96 / 25.4}, {3440, 1440, 4.33}, {2340, 1080, 3.7795}, {640, 360, 5.8}};
+    double ref[DEMO_MAX] = {0}; // each part's distance from the body at 1280 x 800, in the body's size
+    for (int s = 0; s < 4; ++s) {
+        sp_headless* gl;
+        double t;
+        sp_kiosk* k = attract_kiosk_at(db, false, screens[s].w, screens[s].h, screens[s].ppm, 50, &gl, &t);
+        ENSURE(k->demo_count == 6);
+        float top, bottom;
+        kiosk_attract_band(sp_kiosk_ui_of(k), (float)screens[s].h, &top, &bottom);
+        double box[DEMO_MAX][4], body_diag = 0; // x0, y0, x1, y1
+        int body = -1;
+        for (int i = 0; i < k->demo_count; ++i) {
+            const demo_part* d = &k->demo_parts[i];
+            double* b = box[i];
+            b[0] = b[1] = 1e30, b[2] = b[3] = -1e30;
+            for (int j = 0; j < d->n; ++j) {
+                b[0] = fmin(b[0], d->xy[j].x), b[1] = fmin(b[1], d->xy[j].y);
+                b[2] = fmax(b[2], d->xy[j].x), b[3] = fmax(b[3], d->xy[j].y);
+            }
+            if (!strcmp(d->category, "torso")) body = i, body_diag = hypot(b[2] - b[0], b[3] - b[1]);
+            ENSURE(b[1] >= top - 1 && b[3] <= bottom + 1);
+        }
+        ENSURE(body >= 0);
+        for (int i = 0; i < k->demo_count; ++i) {
+            const double *a = box[i], *b = box[body];
+            double gap = fmax(fmax(a[0] - b[2], b[0] - a[2]), fmax(a[1] - b[3], b[1] - a[3]));
+            fprintf(stderr, "  %dx%d: %s %.0f..%.0f x %.0f..%.0f, %.2f of the body's size from it (band %.0f..%.0f)\n",
+                    screens[s].w, screens[s].h, k->demo_parts[i].category, a[0], a[2], a[1], a[3], gap / body_diag, top, bottom);
+            // As near as on the 1280 x 800 screen the layout was made on, where the pipeline attaches each.
+            if (s == 0) ref[i] = gap / body_diag;
+            ENSURE(gap <= 0.15 * body_diag && fabs(gap / body_diag - ref[i]) < 0.01);
+        }
+        attract_kiosk_end(k, gl, &t);
+    }
 }
 
 // The attract screen's demo dragon follows the curators: a part they remove
@@ -2823,6 +2879,7 @@ int main(int argc, char** argv)
                                    {"saves_disk", test_saves_disk},
                                    {"save_codes_never_reused", test_save_codes_never_reused},
                                    {"parts_row_follows", test_parts_row_follows},
+                                   {"attract_whole", test_attract_whole},
                                    {"long_category", test_long_category},
                                    {"parts_loaded_while_idle", test_parts_loaded_while_idle},
                                    {"collect_busy", test_collect_busy},
