@@ -325,7 +325,7 @@ static void solve_if_better(sp_solve_cmd* s, const sp_camera* cam, const sp_sket
 // was made; grass tufts drawn under the feet are the shortest strokes.
 #define LEAVE_OUT_MAX 36
 static void try_leaving_out(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
-                            bool aliased, const kept_fit* cand, kept_fit* best)
+                            bool aliased, bool every_way, const kept_fit* cand, kept_fit* best)
 {
     const sp_abstraction* ab = &sp_rig_handle_abstractions(s->rig)[s->abstraction];
     int n = sk->stroke_count, kept = 0;
@@ -360,7 +360,7 @@ static void try_leaving_out(sp_solve_cmd* s, const sp_camera* cam, const sp_sket
     // curve at 2.2 px, 0.5% of the drawing's size, under any threshold that
     // good fits pass (a second review).
     long ways = surplus == 1 ? kept : (long)kept * (kept - 1) / 2;
-    for (int a = 0; surplus <= 2 && ways <= LEAVE_OUT_MAX && a < n; ++a)
+    for (int a = 0; every_way && surplus <= 2 && ways <= LEAVE_OUT_MAX && a < n; ++a)
         for (int b = surplus == 2 ? a + 1 : a; b < (surplus == 2 ? n : a + 1); ++b) {
             if (was[a] != STROKE_KEPT || was[b] != STROKE_KEPT) continue;
             memcpy(cand->why, was, sizeof(int) * (size_t)n);
@@ -372,9 +372,10 @@ static void try_leaving_out(sp_solve_cmd* s, const sp_camera* cam, const sp_sket
 
 // The fit of sk's strokes as they are drawn, into *best (why, used, p,
 // rep: sized for sk): the dots and retraces left out, then strokes left out
-// when the rest fits better (start0: the caller's start copied, or NULL).
+// when the rest fits better (start0: the caller's start copied, or NULL;
+// every_way: try_leaving_out's search of every way too).
 static bool fit_strokes(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
-                        const double* start0, kept_fit* best)
+                        const double* start0, bool every_way, kept_fit* best)
 {
     const sp_abstraction* ab = &sp_rig_handle_abstractions(s->rig)[s->abstraction];
     int n = sk->stroke_count, P = sp_rig_handle_param_count(s->rig);
@@ -396,7 +397,7 @@ static bool fit_strokes(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
     // together, or a line of action beside the spine, look like a retrace
     // too, and left out broke a figure that fitted (a second review).
     if (ok && retraces) solve_if_better(s, cam, sk, strokes, start0, start == best->p, &cand, best);
-    if (ok) try_leaving_out(s, cam, sk, strokes, start0, start == best->p, &cand, best);
+    if (ok) try_leaving_out(s, cam, sk, strokes, start0, start == best->p, every_way, &cand, best);
     free(why2), free(alt), free(rep2);
     return ok;
 }
@@ -441,22 +442,54 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
         if (best->rep->curves[c].stroke >= 0 && best->rep->curves[c].stroke < m)
             best->rep->curves[c].stroke = first[best->rep->curves[c].stroke];
     memcpy(best->p, j->p, sizeof(double) * (size_t)P);
+    // The lines a curve took (one left out is named among the unused).
     char said[160] = "";
     size_t w = 0;
-    int groups = 0;
+    int groups = 0, cut = 0;
     for (int k = 0; k < m; ++k) {
         int members = 0;
         for (int i = first[k]; i < n; ++i)
             members += line_of[i] == k;
-        if (members < 2 || w + 16 * (size_t)members + 8 >= sizeof said) continue; // a long list is cut short
+        if (members < 2 || j->why[k] != STROKE_KEPT || !j->used[k]) continue;
         ++groups;
+        if (cut || w + 12 * (size_t)members + 8 >= sizeof said) { // room for ", ..."
+            ++cut;
+            continue;
+        }
         for (int i = first[k]; i < n; ++i)
             if (line_of[i] == k)
                 w += (size_t)snprintf(said + w, sizeof said - w, "%s%d", i == first[k] ? (w ? ", " : "") : "+", i);
     }
+    if (cut) snprintf(said + w, sizeof said - w, ", ...");
     size_t at = strlen(best->rep->note);
-    snprintf(best->rep->note + at, sizeof best->rep->note - at, "%sstrokes %s taken as one line%s (drawn in pieces)",
-             at ? "; " : "", said, groups > 1 ? " each" : "");
+    if (groups > 0)
+        snprintf(best->rep->note + at, sizeof best->rep->note - at, "%sstrokes %s taken as one line%s (drawn in pieces)",
+                 at ? "; " : "", said, groups > 1 ? " each" : "");
+}
+
+// The fit of `lines` (sk's strokes joined, line_of: sp_pieces_join) in the
+// buffers given (why: 4 n ints, pj: P), taken into *best by JOINED_WORSE.
+// Without the search of every way to leave strokes out, which the drawing
+// as drawn had (an animation's keys in pieces took 2-2.6 s, 0.3-0.5 before).
+static bool fit_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const sp_sketch* lines,
+                       const int* line_of, const double* start0, bool aliased, bool after_joined, int* why, double* pj,
+                       sp_solve_report* rj, kept_fit* best)
+{
+    int n = sk->stroke_count, m = lines->stroke_count, P = sp_rig_handle_param_count(s->rig);
+    if (start0) memcpy(pj, start0, sizeof(double) * (size_t)P);
+    kept_fit j = {why, why + m, pj, rj};
+    if (!fit_strokes(s, cam, lines, strokes, start0 && aliased ? pj : start0, start0, false, &j)) return false;
+    int *why_n = why + 2 * n, *used_n = why_n + n; // j's in sk's strokes, to count the ink left out
+    for (int i = 0; i < n; ++i)
+        why_n[i] = j.why[line_of[i]] == STROKE_KEPT ? STROKE_KEPT : STROKE_LEFT_OUT, used_n[i] = j.used[line_of[i]];
+    double was = best->rep->mean_error_px, ink = ink_left_out(sk, why_n, used_n),
+           ink_was = ink_left_out(sk, best->why, best->used);
+    // After a fit of other joins was taken, only a better one (as solve_if_better).
+    bool better = after_joined ? ink <= ink_was && rj->mean_error_px < BETTER_FIT * was
+                               : ink < ink_was && rj->mean_error_px <= fmax(JOINED_WORSE * was, was + JOINED_WORSE_PX);
+    if (!better) return false;
+    take_joined(sk, lines, line_of, &j, P, best);
+    return true;
 }
 
 // More strokes than curves, some left out: lines drawn in pieces, end to
@@ -471,33 +504,28 @@ static void try_pieces_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sk
 {
     const sp_abstraction* ab = &sp_rig_handle_abstractions(s->rig)[s->abstraction];
     int n = sk->stroke_count, P = sp_rig_handle_param_count(s->rig), kept = 0;
-    double out_before = ink_left_out(sk, best->why, best->used);
-    if (ab->correspondence != SP_CORR_ORDERED || n > 64 || !(out_before > 0)) return;
+    if (ab->correspondence != SP_CORR_ORDERED || n > 64 || !(ink_left_out(sk, best->why, best->used) > 0)) return;
     bool keep[64];
-    int next[64], line_of[64];
-    bool flip[64];
     for (int i = 0; i < n; ++i)
         kept += keep[i] = best->why[i] != STROKE_DOT;
-    if (sp_pieces_find(sk, keep, kept - ab->curve_count, next, flip) == 0) return;
-    sp_sketch lines;
-    if (!sp_pieces_join(sk, next, flip, &lines, line_of)) return;
-    int m = lines.stroke_count;
-    int* why = malloc(sizeof(int) * (size_t)(2 * m + 2 * n + 1));
+    int* why = malloc(sizeof(int) * (size_t)(4 * n + 1));
     double* pj = malloc(sizeof(double) * (size_t)(P + 1));
     sp_solve_report* rj = malloc(sizeof *rj);
-    if (why && pj && rj) {
-        if (start0) memcpy(pj, start0, sizeof(double) * (size_t)P);
-        kept_fit j = {why, why + m, pj, rj};
-        bool ok = fit_strokes(s, cam, &lines, strokes, start0 && aliased ? pj : start0, start0, &j);
-        int *why_n = why + 2 * m, *used_n = why_n + n; // j's in sk's strokes, to count the ink left out
-        for (int i = 0; ok && i < n; ++i)
-            why_n[i] = j.why[line_of[i]] == STROKE_KEPT ? STROKE_KEPT : STROKE_LEFT_OUT, used_n[i] = j.used[line_of[i]];
-        if (ok && ink_left_out(sk, why_n, used_n) < out_before &&
-            rj->mean_error_px <= fmax(JOINED_WORSE * best->rep->mean_error_px, best->rep->mean_error_px + JOINED_WORSE_PX))
-            take_joined(sk, &lines, line_of, &j, P, best);
+    // The joins closest first, and again without the first or the second
+    // candidate, the best fit kept (with one stroke over, the spine going
+    // straight on into a leg took the only join, and the leg's own two
+    // pieces were never tried; a second review).
+    bool taken = false;
+    for (int skip = -1; why && pj && rj && skip < 2; ++skip) {
+        int next[64], line_of[64];
+        bool flip[64];
+        sp_sketch lines;
+        if (sp_pieces_find(sk, keep, kept - ab->curve_count, skip, next, flip) == 0) break;
+        if (!sp_pieces_join(sk, next, flip, &lines, line_of)) break;
+        taken |= fit_joined(s, cam, sk, strokes, &lines, line_of, start0, aliased, taken, why, pj, rj, best);
+        sp_sketch_free(&lines);
     }
     free(why), free(pj), free(rj);
-    sp_sketch_free(&lines);
 }
 
 bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const double* start,
@@ -515,7 +543,7 @@ bool sp_solve_cmd_solve(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* 
     }
     if (start) memcpy(start0, start, sizeof(double) * (size_t)P);
     kept_fit best = {why, why + n, p, rep};
-    bool ok = fit_strokes(s, cam, sk, strokes, start, start ? start0 : NULL, &best);
+    bool ok = fit_strokes(s, cam, sk, strokes, start, start ? start0 : NULL, true, &best);
     if (ok) try_pieces_joined(s, cam, sk, strokes, start ? start0 : NULL, start == p, &best);
     if (ok) {
         note_unused_strokes(rep, why, best.used, n);

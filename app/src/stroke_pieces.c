@@ -65,6 +65,14 @@ static double point_segment(sp_vec2 p, sp_vec2 a, sp_vec2 b)
     return sp_v2_len(sp_v2_sub(ap, sp_v2_scale(ab, t)));
 }
 
+// Whether q lies within r of stroke st's line.
+static bool near_line(const sp_stroke* st, sp_vec2 q, double r)
+{
+    for (int j = 0; j + 1 < st->count; ++j)
+        if (point_segment(q, st->points[j], st->points[j + 1]) <= r) return true;
+    return st->count == 1 && sp_v2_len(sp_v2_sub(q, st->points[0])) <= r;
+}
+
 // Whether a kept stroke other than a and b comes within r of q: a junction
 // of the figure (two arms drawn out from the spine), not a pen lifted.
 static bool at_junction(const sp_sketch* sk, const bool* keep, int a, int b, sp_vec2 q, double r)
@@ -99,8 +107,13 @@ static int candidate_joins(const sp_sketch* sk, const bool* keep, double tol, jo
                     sp_vec2 in_b = way_at(sb, eb, fmin(0.2 * lb, 2 * tol), false);
                     double turn = angle_between(out_a, in_b);
                     // Across a gap the pen goes on the way it went (a gap
-                    // beside the line is another stroke's start).
-                    if (turn > JOIN_TURN_MAX || (g > 0.25 * tol && angle_between(out_a, gap) > 1.5 * JOIN_TURN_MAX)) continue;
+                    // beside the line is another stroke's start); put down
+                    // back on the line, it goes on over it (the usual way
+                    // of lifting the pen: refused, the pieces of a leg
+                    // overlapping 5 px were left apart; an outside review).
+                    bool on = g <= 0.25 * tol || angle_between(out_a, gap) <= 1.5 * JOIN_TURN_MAX ||
+                              near_line(sa, pb, fmax(2.0, 0.25 * tol));
+                    if (turn > JOIN_TURN_MAX || !on) continue;
                     // Two arms drawn out from the spine's side meet in a
                     // straight line there, as a line's pieces do.
                     if (at_junction(sk, keep, a, b, sp_v2_scale(sp_v2_add(pa, pb), 0.5), fmax(3.0, tol / 3))) continue;
@@ -111,7 +124,7 @@ static int candidate_joins(const sp_sketch* sk, const bool* keep, double tol, jo
     return m;
 }
 
-int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int* next, bool* flip)
+int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int skip, int* next, bool* flip)
 {
     int n = sk->stroke_count;
     for (int i = 0; i < n; ++i)
@@ -133,8 +146,10 @@ int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int* next, b
     for (int i = 0; i < n; ++i)
         link[i][0] = link[i][1] = -1, up[i] = i;
     int m = candidate_joins(sk, keep, tol, cand), joins = 0;
+    if (skip >= m) m = 0; // nothing else to try
     for (int k = 0; k < m && joins < most; ++k) {
         const join* j = &cand[k];
+        if (k == skip) continue;
         int ra = root_of(up, j->a), rb = root_of(up, j->b);
         if (link[j->a][j->ea] >= 0 || link[j->b][j->eb] >= 0 || ra == rb) continue; // an end taken, or a loop
         link[j->a][j->ea] = j->b, link[j->b][j->eb] = j->a, up[ra] = rb, ++joins;
@@ -175,9 +190,18 @@ bool sp_pieces_join(const sp_sketch* sk, const int* next, const bool* flip, sp_s
         int count = 0;
         for (int at = i; at >= 0; at = next[at]) {
             const sp_stroke* st = &sk->strokes[at];
-            for (int j = 0; j < st->count; ++j)
-                pts[count + j] = st->points[flip[at] ? st->count - 1 - j : j];
-            count += st->count;
+            // A piece put down back over the last one: the points behind
+            // where the line got to go (the line doubled back there).
+            int from = 0;
+            if (count >= 2) {
+                sp_vec2 end = pts[count - 1], way = sp_v2_sub(end, pts[count > 4 ? count - 4 : 0]);
+                while (from < st->count - 2 &&
+                       sp_v2_dot(sp_v2_sub(st->points[flip[at] ? st->count - 1 - from : from], end), way) < 0)
+                    ++from;
+            }
+            for (int j = from; j < st->count; ++j)
+                pts[count + j - from] = st->points[flip[at] ? st->count - 1 - j : j];
+            count += st->count - from;
             line_of[at] = lines->stroke_count;
         }
         ok = sp_sketch_add_stroke(lines, pts, NULL, count) == SP_OK;

@@ -1278,37 +1278,45 @@ static void test_pose_surplus_strokes(void)
     const struct {
         const char *file, *said;
         int unused;
-    } cases[] = {{"leg_retraced", "1 stroke left unused: 4 (traced over stroke 5)", 1},
-                 {"overdrawn", "(traced over stroke 7)", 5},
-                 {"dot_eyes", "6 (a dot), 7 (a dot)", 3},
+        double mean_below; // 0: 2 px
+    } cases[] = {{"leg_retraced", "1 stroke left unused: 4 (traced over stroke 5)", 1, 0},
+                 {"overdrawn", "(traced over stroke 7)", 5, 0},
+                 {"dot_eyes", "6 (a dot), 7 (a dot)", 3, 0},
                  // Lines that only look like a retrace stay when leaving them
                  // out fits worse (a second review: legs drawn together with a
                  // head circle lost a leg, 23.8 px; a line of action beside the
                  // spine kept, the spine left out, 14.7 px).
-                 {"legs_together_head", "1 stroke left unused: 5", 1},
-                 {"line_of_action", "1 stroke left unused: 0", 1},
+                 {"legs_together_head", "1 stroke left unused: 5", 1, 0},
+                 {"line_of_action", "1 stroke left unused: 0", 1, 0},
                  // One stroke over the curves, the arms raised (a third
                  // review): assigned against the rest pose, the head circle,
                  // a ground line or an arm's second piece took the spine's or
                  // an arm's curve and the figure folded (8-30 px mean).
-                 {"arms_up_head_circle", "1 stroke left unused: 1 (the rest fit better without it)", 1},
-                 {"arms_up_ground", "1 stroke left unused: 5 (the rest fit better without it)", 1},
+                 {"arms_up_head_circle", "1 stroke left unused: 1 (the rest fit better without it)", 1, 0},
+                 {"arms_up_ground", "1 stroke left unused: 5 (the rest fit better without it)", 1, 0},
                  // A line drawn in pieces, end to end, is one curve's line
                  // (a review against the paper: one piece was left out as a
                  // stray and the limb fitted short, the arm ending at the
                  // head, a foot at knee height at 0.96 px, a head folded
                  // into the chest at 0.58; five lines in ten pieces 18 px).
-                 {"arms_up_arm_in_two", "strokes 1+2 taken as one line (drawn in pieces)", 0},
-                 {"leg_in_two", "strokes 3+4 taken as one line (drawn in pieces)", 0},
-                 {"spine_in_two", "strokes 0+1 taken as one line (drawn in pieces)", 0},
-                 {"star_in_pieces", "strokes 0+1, 2+3, 4+5, 6+7, 8+9 taken as one line each", 0},
-                 {"crouch_head_circle", "1 stroke left unused: 1 (the rest fit better without it)", 1},
+                 {"arms_up_arm_in_two", "strokes 1+2 taken as one line (drawn in pieces)", 0, 0},
+                 {"leg_in_two", "strokes 3+4 taken as one line (drawn in pieces)", 0, 0},
+                 {"spine_in_two", "strokes 0+1 taken as one line (drawn in pieces)", 0, 0},
+                 {"star_in_pieces", "strokes 0+1, 2+3, 4+5, 6+7, 8+9 taken as one line each", 0, 0},
+                 // A second review: pieces put down back over the last (the
+                 // usual way) were never joined; with one stroke over, the
+                 // spine going on into a leg took the only join.
+                 {"leg_overlap", "strokes 3+4 taken as one line (drawn in pieces)", 0, 0},
+                 // (Drawn whole, this figure fits at 2.8 px.)
+                 {"leg_in_two_spine_on", "strokes 4+5 taken as one line (drawn in pieces)", 0, 3},
+                 {"hatched", "taken as one line each (drawn in pieces)", 2, 0},
+                 {"crouch_head_circle", "1 stroke left unused: 1 (the rest fit better without it)", 1, 0},
                  // A fourth review: the fit without the ground line, solved
                  // from another start buffer than `pose` gives, stayed at
                  // 21.8 px (14.1 kept); two strays took an arm's curve at a
                  // 2.2 px fit, under the loose-fit thresholds.
-                 {"arms_straight_up_ground", "1 stroke left unused: 5 (the rest fit better without it)", 1},
-                 {"arms_up_two_strays", "2 strokes left unused: 5 (the rest fit better without it), 6 (the rest", 2}};
+                 {"arms_straight_up_ground", "1 stroke left unused: 5 (the rest fit better without it)", 1, 0},
+                 {"arms_up_two_strays", "2 strokes left unused: 5 (the rest fit better without it), 6 (the rest", 2, 0}};
     char report[1100], args[4000];
     snprintf(report, sizeof report, "%s", sp_test_tmp_path("surplus_report.json"));
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -1321,7 +1329,7 @@ static void test_pose_surplus_strokes(void)
         int unused = (int)cJSON_GetNumberValue(cJSON_GetObjectItem(j, "unused_strokes"));
         fprintf(stderr, "  %s: mean %.2f px, max %.1f px, note \"%s\"\n", cases[i].file, mean, max, note ? note : "");
         ENSURE(note && strstr(note, cases[i].said) && unused == cases[i].unused);
-        ENSURE(mean < 2 && max < 13);
+        ENSURE(mean < (cases[i].mean_below > 0 ? cases[i].mean_below : 2) && max < 13);
         cJSON_Delete(j);
     }
 }
