@@ -443,7 +443,7 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
             best->rep->curves[c].stroke = first[best->rep->curves[c].stroke];
     memcpy(best->p, j->p, sizeof(double) * (size_t)P);
     // The lines a curve took (one left out is named among the unused).
-    char said[160] = "";
+    char said[200] = "";
     size_t w = 0;
     int groups = 0, cut = 0;
     for (int k = 0; k < m; ++k) {
@@ -452,7 +452,7 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
             members += line_of[i] == k;
         if (members < 2 || j->why[k] != STROKE_KEPT || !j->used[k]) continue;
         ++groups;
-        if (cut || w + 12 * (size_t)members + 8 >= sizeof said) { // room for ", ..."
+        if (cut || w + 4 * (size_t)members + 8 >= sizeof said) { // room for ", ..."
             ++cut;
             continue;
         }
@@ -460,7 +460,7 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
             if (line_of[i] == k)
                 w += (size_t)snprintf(said + w, sizeof said - w, "%s%d", i == first[k] ? (w ? ", " : "") : "+", i);
     }
-    if (cut) snprintf(said + w, sizeof said - w, ", ...");
+    if (cut) snprintf(said + w, sizeof said - w, "%s...", w ? ", " : "");
     size_t at = strlen(best->rep->note);
     if (groups > 0)
         snprintf(best->rep->note + at, sizeof best->rep->note - at, "%sstrokes %s taken as one line%s (drawn in pieces)",

@@ -73,13 +73,18 @@ static bool near_line(const sp_stroke* st, sp_vec2 q, double r)
     return st->count == 1 && sp_v2_len(sp_v2_sub(q, st->points[0])) <= r;
 }
 
-// Whether a kept stroke other than a and b comes within r of q: a junction
-// of the figure (two arms drawn out from the spine), not a pen lifted.
+// Whether a kept stroke other than a and b passes within r of q: a junction
+// of the figure (two arms drawn out from the spine), not a pen lifted. A
+// stroke that ends there does not pass: arms drawn from where the spine
+// was lifted (the usual place, the chest) left its pieces apart, the head
+// folded into the chest (a second review).
 static bool at_junction(const sp_sketch* sk, const bool* keep, int a, int b, sp_vec2 q, double r)
 {
     for (int i = 0; i < sk->stroke_count; ++i) {
         const sp_stroke* st = &sk->strokes[i];
-        if (i == a || i == b || !keep[i]) continue;
+        if (i == a || i == b || !keep[i] || sp_v2_len(sp_v2_sub(q, st->points[0])) <= 2 * r ||
+            sp_v2_len(sp_v2_sub(q, st->points[st->count - 1])) <= 2 * r)
+            continue;
         for (int j = 0; j < st->count; ++j)
             if (point_segment(q, st->points[j], st->points[j + (j + 1 < st->count)]) <= r) return true;
     }
@@ -117,11 +122,39 @@ static int candidate_joins(const sp_sketch* sk, const bool* keep, double tol, jo
                     // Two arms drawn out from the spine's side meet in a
                     // straight line there, as a line's pieces do.
                     if (at_junction(sk, keep, a, b, sp_v2_scale(sp_v2_add(pa, pb), 0.5), fmax(3.0, tol / 3))) continue;
-                    out[m++] = (join){a, ea, b, eb, g / tol + turn / JOIN_TURN_MAX};
+                    // Ranked by the way the two pieces go over more of
+                    // their length: where three or more ends meet (the
+                    // spine lifted where the arms start), the arms' first
+                    // few pixels ran straight across the chest as the
+                    // spine's pieces did, and took the join.
+                    double turn_far = angle_between(way_at(sa, ea, fmin(0.4 * la, 2 * tol), true),
+                                                    way_at(sb, eb, fmin(0.4 * lb, 2 * tol), false));
+                    out[m++] = (join){a, ea, b, eb, g / tol + fmax(turn, turn_far) / JOIN_TURN_MAX};
                 }
         }
     qsort(out, (size_t)m, sizeof *out, by_score);
     return m;
+}
+
+// After join j: where it meets, three or more kept strokes' ends within a
+// third of the gap limit make a junction of ends, which takes no other join
+// (link -2).
+static void close_junction(const sp_sketch* sk, const bool* keep, const join* j, double tol, int (*link)[2])
+{
+    const sp_stroke *sa = &sk->strokes[j->a], *sb = &sk->strokes[j->b];
+    sp_vec2 q = sp_v2_scale(sp_v2_add(sa->points[j->ea ? sa->count - 1 : 0], sb->points[j->eb ? sb->count - 1 : 0]), 0.5);
+    double r = fmax(3.0, tol / 3);
+    int ends = 0;
+    for (int pass = 0; pass < 2; ++pass)
+        for (int i = 0; i < sk->stroke_count; ++i)
+            for (int e = 0; keep[i] && e < 2; ++e) {
+                const sp_stroke* st = &sk->strokes[i];
+                if (sp_v2_len(sp_v2_sub(st->points[e ? st->count - 1 : 0], q)) > r) continue;
+                if (pass == 0)
+                    ++ends;
+                else if (ends >= 3 && link[i][e] == -1)
+                    link[i][e] = -2;
+            }
 }
 
 int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int skip, int* next, bool* flip)
@@ -138,7 +171,7 @@ int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int skip, in
         }
     double tol = fmax(3.0, JOIN_GAP_SHARE * hypot(hi[0] - lo[0], hi[1] - lo[1]));
     join* cand = malloc(sizeof *cand * (size_t)(2 * n * n + 1));
-    int link[PIECES_MAX][2], up[PIECES_MAX]; // link[i][e]: the stroke joined at end e of i (-1: none)
+    int link[PIECES_MAX][2], up[PIECES_MAX]; // link[i][e]: the stroke joined at end e of i (-1: none, -2: none allowed)
     if (!cand || !(tol < INFINITY)) {
         free(cand);
         return 0;
@@ -151,8 +184,12 @@ int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int skip, in
         const join* j = &cand[k];
         if (k == skip) continue;
         int ra = root_of(up, j->a), rb = root_of(up, j->b);
-        if (link[j->a][j->ea] >= 0 || link[j->b][j->eb] >= 0 || ra == rb) continue; // an end taken, or a loop
+        if (link[j->a][j->ea] != -1 || link[j->b][j->eb] != -1 || ra == rb) continue; // an end taken, or a loop
         link[j->a][j->ea] = j->b, link[j->b][j->eb] = j->a, up[ra] = rb, ++joins;
+        // Where three or more ends meet (the spine lifted where the arms
+        // start) one join is made: the arms' pieces were joined across the
+        // chest too, and every line in three pieces fell apart (15.7 px).
+        close_junction(sk, keep, j, tol, link);
     }
     free(cand);
     // Each line walked from a stroke with one end free, which it starts from.
@@ -163,7 +200,7 @@ int sp_pieces_find(const sp_sketch* sk, const bool* keep, int most, int skip, in
         while (at >= 0) {
             seen[at] = true;
             flip[at] = in_end == 1; // it starts where its end 1 is: reversed
-            int to = link[at][1 - in_end];
+            int to = link[at][1 - in_end] >= 0 ? link[at][1 - in_end] : -1; // -2: an end left free at a junction
             next[at] = to;
             if (to >= 0) in_end = link[to][0] == at ? 0 : 1; // two strokes share one join at most
             at = to;

@@ -1310,6 +1310,14 @@ static void test_pose_surplus_strokes(void)
                  // (Drawn whole, this figure fits at 2.8 px.)
                  {"leg_in_two_spine_on", "strokes 4+5 taken as one line (drawn in pieces)", 0, 3},
                  {"hatched", "taken as one line each (drawn in pieces)", 2, 0},
+                 // The spine lifted where the arms start: its pieces were
+                 // never joined (a stroke passing there is a junction, one
+                 // ending there is not); every line in three pieces, the
+                 // arms' pieces joined across the chest (one join where
+                 // three or more ends meet, ranked by the way the pieces go
+                 // over more of their length).
+                 {"spine_lifted_at_chest", "strokes 0+1 taken as one line (drawn in pieces)", 0, 0},
+                 {"lines_in_three", "strokes 0+1+2, 3+4+5, 6+7+8, 9+10+11, 12+13+14 taken as one line each", 0, 0},
                  {"crouch_head_circle", "1 stroke left unused: 1 (the rest fit better without it)", 1, 0},
                  // A fourth review: the fit without the ground line, solved
                  // from another start buffer than `pose` gives, stayed at
