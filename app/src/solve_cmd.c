@@ -419,12 +419,19 @@ static double ink_left_out(const sp_sketch* sk, const int* why, const int* used)
 // with its forearm left out and the arm ending at the head, at 0.84 whole.
 #define JOINED_WORSE 1.3
 #define JOINED_WORSE_PX 0.3
+// ... or, in a draw-over (its strokes redraw the curves drawn over, no
+// strays), when it fits within this share of its size all the same: half a
+// line left out fits at nearly nothing (an arm redrawn in two pieces kept
+// half, 0.19 px, where whole it fits at 0.63; a third review). Not in a
+// redraw: a ground line drawn on from a kicking foot was joined to the leg.
+#define JOINED_GOOD 0.005
 
-// The fit of the lines joined (lines, line_of: sp_pieces_join) into
+// The fit of the lines joined (lines, line_of, flip: sp_pieces_join) into
 // *best's terms (sk's strokes): a stroke joined takes its line's why and
 // used, a line traced over is its first stroke, and the report's curves
 // name a line's first stroke; said in the note.
-static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* line_of, const kept_fit* j, int P, kept_fit* best)
+static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* line_of, const bool* flip, const kept_fit* j,
+                        int P, kept_fit* best)
 {
     int n = sk->stroke_count, m = lines->stroke_count;
     int first[64 + 1];
@@ -438,9 +445,12 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
         best->used[i] = j->used[line_of[i]];
     }
     *best->rep = *j->rep;
-    for (int c = 0; c < best->rep->curve_count; ++c)
-        if (best->rep->curves[c].stroke >= 0 && best->rep->curves[c].stroke < m)
-            best->rep->curves[c].stroke = first[best->rep->curves[c].stroke];
+    for (int c = 0; c < best->rep->curve_count; ++c) {
+        sp_curve_report* cr = &best->rep->curves[c];
+        if (cr->stroke < 0 || cr->stroke >= m) continue;
+        cr->stroke = first[cr->stroke];
+        cr->reversed ^= flip[cr->stroke]; // the stroke named, not its line (a third review)
+    }
     memcpy(best->p, j->p, sizeof(double) * (size_t)P);
     // The lines a curve took (one left out is named among the unused).
     char said[200] = "";
@@ -472,23 +482,25 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
 // Without the search of every way to leave strokes out, which the drawing
 // as drawn had (an animation's keys in pieces took 2-2.6 s, 0.3-0.5 before).
 static bool fit_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const sp_sketch* lines,
-                       const int* line_of, const double* start0, bool aliased, bool after_joined, int* why, double* pj,
-                       sp_solve_report* rj, kept_fit* best)
+                       const int* line_of, const bool* flip, const double* start0, bool aliased, bool after_joined,
+                       bool every_way, int* why, double* pj, sp_solve_report* rj, kept_fit* best)
 {
     int n = sk->stroke_count, m = lines->stroke_count, P = sp_rig_handle_param_count(s->rig);
     if (start0) memcpy(pj, start0, sizeof(double) * (size_t)P);
     kept_fit j = {why, why + m, pj, rj};
-    if (!fit_strokes(s, cam, lines, strokes, start0 && aliased ? pj : start0, start0, false, &j)) return false;
+    if (!fit_strokes(s, cam, lines, strokes, start0 && aliased ? pj : start0, start0, every_way, &j)) return false;
     int *why_n = why + 2 * n, *used_n = why_n + n; // j's in sk's strokes, to count the ink left out
-    for (int i = 0; i < n; ++i)
-        why_n[i] = j.why[line_of[i]] == STROKE_KEPT ? STROKE_KEPT : STROKE_LEFT_OUT, used_n[i] = j.used[line_of[i]];
+    for (int i = 0; i < n; ++i) // (a retrace is not ink left out: counted so, it kept an arm's pieces apart; a third review)
+        why_n[i] = j.why[line_of[i]], used_n[i] = j.used[line_of[i]];
     double was = best->rep->mean_error_px, ink = ink_left_out(sk, why_n, used_n),
            ink_was = ink_left_out(sk, best->why, best->used);
     // After a fit of other joins was taken, only a better one (as solve_if_better).
-    bool better = after_joined ? ink <= ink_was && rj->mean_error_px < BETTER_FIT * was
-                               : ink < ink_was && rj->mean_error_px <= fmax(JOINED_WORSE * was, was + JOINED_WORSE_PX);
+    bool better = after_joined
+                      ? ink <= ink_was && rj->mean_error_px < BETTER_FIT * was
+                      : ink < ink_was && (rj->mean_error_px <= fmax(JOINED_WORSE * was, was + JOINED_WORSE_PX) ||
+                                          (s->desc.ordered_by_ends && rj->mean_error_px <= JOINED_GOOD * rj->bbox_diagonal_px));
     if (!better) return false;
-    take_joined(sk, lines, line_of, &j, P, best);
+    take_joined(sk, lines, line_of, flip, &j, P, best);
     return true;
 }
 
@@ -522,7 +534,11 @@ static void try_pieces_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sk
         sp_sketch lines;
         if (sp_pieces_find(sk, keep, kept - ab->curve_count, skip, next, flip) == 0) break;
         if (!sp_pieces_join(sk, next, flip, &lines, line_of)) break;
-        taken |= fit_joined(s, cam, sk, strokes, &lines, line_of, start0, aliased, taken, why, pj, rj, best);
+        // The first with the search of every way to leave strokes out
+        // (without it, a spine lifted at the chest and a leg in pieces kept
+        // the foot at knee height; a third review), the others without (an
+        // animation's keys in pieces took 2-2.6 s).
+        taken |= fit_joined(s, cam, sk, strokes, &lines, line_of, flip, start0, aliased, taken, skip < 0, why, pj, rj, best);
         sp_sketch_free(&lines);
     }
     free(why), free(pj), free(rj);

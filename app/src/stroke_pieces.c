@@ -118,7 +118,12 @@ static int candidate_joins(const sp_sketch* sk, const bool* keep, double tol, jo
                     // overlapping 5 px were left apart; an outside review).
                     bool on = g <= 0.25 * tol || angle_between(out_a, gap) <= 1.5 * JOIN_TURN_MAX ||
                               near_line(sa, pb, fmax(2.0, 0.25 * tol));
-                    if (turn > JOIN_TURN_MAX || !on) continue;
+                    double turn_far = angle_between(way_at(sa, ea, fmin(0.4 * la, 2 * tol), true),
+                                                    way_at(sb, eb, fmin(0.4 * lb, 2 * tol), false));
+                    // Either way of measuring within the limit: a drag of
+                    // 1.5 px back at the lift of a 20 px piece read as 40.3
+                    // degrees, and the arm was left out (a third review).
+                    if (fmin(turn, turn_far) > JOIN_TURN_MAX || !on) continue;
                     // Two arms drawn out from the spine's side meet in a
                     // straight line there, as a line's pieces do.
                     if (at_junction(sk, keep, a, b, sp_v2_scale(sp_v2_add(pa, pb), 0.5), fmax(3.0, tol / 3))) continue;
@@ -127,8 +132,6 @@ static int candidate_joins(const sp_sketch* sk, const bool* keep, double tol, jo
                     // spine lifted where the arms start), the arms' first
                     // few pixels ran straight across the chest as the
                     // spine's pieces did, and took the join.
-                    double turn_far = angle_between(way_at(sa, ea, fmin(0.4 * la, 2 * tol), true),
-                                                    way_at(sb, eb, fmin(0.4 * lb, 2 * tol), false));
                     out[m++] = (join){a, ea, b, eb, g / tol + fmax(turn, turn_far) / JOIN_TURN_MAX};
                 }
         }
