@@ -1406,19 +1406,29 @@ static void test_line_inside_chip(void)
     ENSURE(ui->activations[SP_KT_CHIP_GUESS1] == 0 && !sp_kiosk_ui_next_job(ui, &j));
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "tail", .guesses = {"head"}, .part_count = 2});
     f.parts = 2, f.cat[1] = 2;
-    // Touched and lifted 6 mm away on the chip, with no move between: a line too.
+    // Touched and lifted 9 mm away on the chip, with no move between: a line too.
     g1 = &ui->target[SP_KT_CHIP_GUESS1];
     x = g1->x + 4 * mm, y = g1->y + 0.5f * g1->h;
+    ENSURE(in_rect(g1, x + 9 * mm, y));
     send(ui, SP_KEV_DOWN, t + 3000, x, y);
-    send(ui, SP_KEV_UP, t + 3100, x + 6 * mm, y);
+    send(ui, SP_KEV_UP, t + 3100, x + 9 * mm, y);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_FIT && j.stroke->count == 2);
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "tail", .guesses = {"head"}, .part_count = 3});
     f.parts = 3, f.cat[2] = 2;
-    // A tap that slides 3 mm is still a tap.
+    // A tap that slides 5 mm, or rolls 2.5 mm either way, is still a tap (a
+    // second review: taken as a line, the refused drawing was lost).
     g1 = &ui->target[SP_KT_CHIP_GUESS1];
     x = g1->x + 4 * mm, y = g1->y + 0.5f * g1->h;
-    line_from(ui, t + 5000, x, y, mm, 0, 4);
+    line_from(ui, t + 5000, x, y, mm, 0, 6);
     ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT && !strcmp(j.category, "head"));
+    sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"tail"}, .part_count = 3});
+    g1 = &ui->target[SP_KT_CHIP_GUESS1];
+    x = g1->x + 6 * mm, y = g1->y + 0.5f * g1->h;
+    send(ui, SP_KEV_DOWN, t + 6000, x, y);
+    for (int i = 1; i < 8; ++i)
+        send(ui, SP_KEV_MOVE, t + 6000 + 10 * i, x + (i & 1 ? 2.5f : -2.5f) * mm, y + (i & 2 ? 2.5f : -2.5f) * mm);
+    send(ui, SP_KEV_UP, t + 6090, x, y);
+    ENSURE(sp_kiosk_ui_next_job(ui, &j) && j.kind == SP_KJOB_REFIT && !strcmp(j.category, "tail"));
     sp_kiosk_ui_fit_done(ui, &(sp_kiosk_fit_result){.ok = true, .category = "head", .guesses = {"tail"}, .part_count = 3});
     // A line inside a tile of the parts row (at least 15 mm): a new stroke, not that part.
     tap(ui, t + 7000, SP_KT_CHIP_MORE);

@@ -1251,17 +1251,33 @@ static bool press_drew(sp_kiosk_ui* ui, float x, float y)
     return hypot(b[2] - b[0], b[3] - b[1]) >= mm(ui, ui->desc.tap_mm);
 }
 
+// A line begun on a chip or tile that ends on it less than twice the tap
+// size across is a tap on it: a child's tap slides and rolls 4-5 mm, and
+// taken as a line it lost the refused drawing the chip was to fix (a second
+// review); a part drawn inside a phone's chip is 10 mm or more.
+static bool stroke_was_tap(const sp_kiosk_ui* ui, float x, float y)
+{
+    return ui->stroke_target != SP_KT_NONE && !ui->continuing && line_diag(&ui->stroke, 0) < 2 * mm(ui, ui->desc.tap_mm) &&
+           sp_kiosk_ui_hit(ui, x, y) == ui->stroke_target;
+}
+
 static void start_stroke(sp_kiosk_ui* ui, float x, float y, double t);
 
 static void end_capture(sp_kiosk_ui* ui, float x, float y, bool up)
 {
     switch (ui->capture) {
     case SP_KCAP_STROKE:
+        if (up && stroke_was_tap(ui, x, y)) {
+            ui->stroke.count = 0;
+            activate(ui, ui->stroke_target);
+            break;
+        }
         if (up) add_point(ui, x, y, true);
         finish_stroke(ui);
         break;
     case SP_KCAP_TARGET:
-        if (up && press_drew(ui, x, y)) { // a line drawn with no move between touch and lift
+        if (up && press_drew(ui, x, y) && hypot(x - ui->down_x, y - ui->down_y) >= 2 * mm(ui, ui->desc.tap_mm)) {
+            // A line drawn with no move between touch and lift.
             start_stroke(ui, ui->down_x, ui->down_y, ui->down_t);
             add_point(ui, x, y, true);
             finish_stroke(ui);
@@ -1288,6 +1304,7 @@ static void start_stroke(sp_kiosk_ui* ui, float x, float y, double t)
     if (sp_kiosk_ui_flashing(ui)) ui->flash_until = ui->now;
     ui->capture = SP_KCAP_STROKE;
     ui->pressed = SP_KT_NONE;
+    ui->stroke_target = SP_KT_NONE;
     ui->stroke.count = 0;
     ui->stroke_spacing = fmax(0.5, mm(ui, 0.3));
     // Drawn on from where the last stroke ended: one line, shown as one while it is drawn.
@@ -1359,7 +1376,9 @@ static void on_move(sp_kiosk_ui* ui, float x, float y)
         // line is kept from its touch.
         if (press_drew(ui, x, y) || (ui->mode == SP_KM_DRAW && ui->pressed >= SP_KT_CHIP_LABEL &&
                                      inside(&ui->canvas, ui->down_x, ui->down_y) && sp_kiosk_ui_hit(ui, x, y) != ui->pressed)) {
+            sp_kiosk_target on = ui->pressed;
             start_stroke(ui, ui->down_x, ui->down_y, ui->down_t);
+            ui->stroke_target = on; // a tap yet, if it ends small on it (stroke_was_tap)
             add_point(ui, x, y, false);
         } else if (ui->mode == SP_KM_DRAW && !inside(&ui->canvas, ui->down_x, ui->down_y) && inside(&ui->canvas, x, y) &&
                    sp_kiosk_ui_hit(ui, x, y) == SP_KT_NONE) {

@@ -208,6 +208,7 @@ typedef struct sp_kiosk_ui {
     float down_x, down_y; ///< where the finger now down touched, and when
     double down_t;
     float press_box[4];    ///< a press on a chip or tile: its path's box so far (x0, y0, x1, y1)
+    sp_kiosk_target stroke_target; ///< the chip or tile the stroke being drawn began on (SP_KT_NONE: none)
     bool down_on_banner;   ///< it touched the save banner
     sp_kiosk_line stroke;  ///< the stroke being drawn (blue)
     double stroke_spacing; ///< current thinning distance, pixels
