@@ -305,11 +305,16 @@ void sp_kiosk_resize(sp_kiosk* k, int fb_w, int fb_h, double px_per_mm)
     // The drawing area in canvas pixels: a window turned or resized after the
     // start shows the canvas scaled into it, and the area then reaches
     // beyond the canvas (strokes there were clamped onto its edge and their
-    // parts fitted flat; an outside review).
+    // parts fitted flat; an outside review). Every area of the run: a part
+    // drawn beyond the canvas is fitted again from its stroke (a chip, Undo)
+    // after the window has turned back (a second review).
     const sp_kiosk_rect* c = &k->ui->canvas;
     sp_vec2 lo = kiosk_fb_to_canvas(k, (sp_vec2){c->x, c->y}), hi = kiosk_fb_to_canvas(k, (sp_vec2){c->x + c->w, c->y + c->h});
-    if (k->dragon)
-        sp_dragon_set_stroke_area(k->dragon, fmin(lo.x, 0), fmin(lo.y, 0), fmax(hi.x, k->canvas_w), fmax(hi.y, k->canvas_h));
+    double* a = k->area;
+    bool first = !(a[2] > a[0]);
+    a[0] = fmin(first ? 0 : a[0], lo.x), a[1] = fmin(first ? 0 : a[1], lo.y);
+    a[2] = fmax(first ? k->canvas_w : a[2], hi.x), a[3] = fmax(first ? k->canvas_h : a[3], hi.y);
+    if (k->dragon) sp_dragon_set_stroke_area(k->dragon, a[0], a[1], a[2], a[3]);
 }
 
 void sp_kiosk_input(sp_kiosk* k, const sp_kiosk_event* ev)

@@ -91,6 +91,7 @@ struct sp_kiosk {
     sp_font* font;
     sp_draw2d* d2;
     int fb_w, fb_h;
+    double area[4]; // where the pipeline takes strokes, canvas pixels: every drawing area of the run so far
     double ppm;
     int canvas_w, canvas_h;
     sp_camera canvas_cam; // the pipeline's world camera on its canvas

@@ -1707,6 +1707,18 @@ static void test_resized_window(void)
     fprintf(stderr, "  wings drawn above the band: canvas y %.0f..%.0f (drawn %.0f..%.0f, 640 px higher)\n", plo, phi, lo - 640,
             hi - 640);
     ENSURE(fabs(plo - (lo - 640)) < 2 && fabs(phi - (hi - 640)) < 2);
+    // Turned back, a chip fits the wings again from their stroke: not
+    // clamped onto the first canvas (a second review).
+    sp_kiosk_resize(k, 1280, 800, 0);
+    updates_until(k, &t, t + 100);
+    sp_kiosk_input(k, &(sp_kiosk_event){SP_KEV_PRESS, t, 0, 0, SP_KT_CHIP_GUESS1});
+    updates_until(k, &t, t + 1500);
+    p = sp_dragon_part_get(d, sp_dragon_part_count(d) - 1);
+    double rlo = INFINITY;
+    for (int i = 0; i < p->stroke_points; ++i)
+        rlo = fmin(rlo, p->stroke_xy[i].y);
+    fprintf(stderr, "  fitted again as %s after the window turned back: top at canvas y %.0f\n", p->category, rlo);
+    ENSURE(fabs(rlo - (lo - 640)) < 2);
     sp_error err = {0};
     ENSURE(sp_kiosk_screenshot(k, sp_test_tmp_path("kiosk_resized.png"), &err) == SP_OK); // to look at
     free(up.xy);
