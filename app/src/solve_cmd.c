@@ -478,9 +478,9 @@ static void take_joined(const sp_sketch* sk, const sp_sketch* lines, const int* 
 }
 
 // The fit of `lines` (sk's strokes joined, line_of: sp_pieces_join) in the
-// buffers given (why: 4 n ints, pj: P), taken into *best by JOINED_WORSE.
-// Without the search of every way to leave strokes out, which the drawing
-// as drawn had (an animation's keys in pieces took 2-2.6 s, 0.3-0.5 before).
+// buffers given (why: 4 n ints, pj: P), with or without the search of every
+// way to leave strokes out (every_way), taken into *best by JOINED_WORSE
+// (after_joined: best is another joined fit, which only a better one beats).
 static bool fit_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes, const sp_sketch* lines,
                        const int* line_of, const bool* flip, const double* start0, bool aliased, bool after_joined,
                        bool every_way, int* why, double* pj, sp_solve_report* rj, kept_fit* best)
@@ -505,12 +505,10 @@ static bool fit_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* s
 }
 
 // More strokes than curves, some left out: lines drawn in pieces, end to
-// end (stroke_pieces.h), joined and the drawing fitted again; taken by
-// JOINED_WORSE. Why: the solver gives a curve one stroke, so a limb drawn
-// in two pieces kept one and fitted short, the other left out as a stray
-// at a good-looking error (a foot at knee height, 0.96 px; a head folded
-// into the chest, 0.58 px; an outside review), and a drawing of five lines
-// in ten pieces fell apart (18 px).
+// end (stroke_pieces.h), joined and the drawing fitted again (fit_joined). Why: the solver gives a curve one stroke, so a limb
+// drawn in two pieces kept one and fitted short, the other left out as a stray at a good-looking error (a foot at knee height,
+// 0.96 px; a head folded into the chest, 0.58 px; an outside review), and a drawing of five lines in ten pieces fell apart (18
+// px).
 static void try_pieces_joined(sp_solve_cmd* s, const sp_camera* cam, const sp_sketch* sk, const char* strokes,
                               const double* start0, bool aliased, kept_fit* best)
 {
