@@ -120,13 +120,6 @@ static void stroke_box(const sp_stroke* st, double box[4])
     }
 }
 
-static double point_segment(sp_vec2 p, sp_vec2 a, sp_vec2 b)
-{
-    sp_vec2 ab = sp_v2_sub(b, a), ap = sp_v2_sub(p, a);
-    double l2 = sp_v2_dot(ab, ab), t = l2 > 0 ? fmin(fmax(sp_v2_dot(ap, ab) / l2, 0), 1) : 0;
-    return sp_v2_len(sp_v2_sub(ap, sp_v2_scale(ab, t)));
-}
-
 // Whether stroke b traces over stroke a: 90% of 32 points along b lie within
 // tol of a (a's polyline at up to 256 of its points).
 static bool traces_over(const sp_stroke* b, const sp_stroke* a, double tol)
@@ -136,8 +129,8 @@ static bool traces_over(const sp_stroke* b, const sp_stroke* a, double tol)
         sp_vec2 q = b->points[(int)((long)k * (b->count - 1) / 31)];
         double d = INFINITY;
         for (int i = 1; i < na && d > tol; ++i)
-            d = fmin(d, point_segment(q, a->points[(int)((long)(i - 1) * (a->count - 1) / (na - 1))],
-                                      a->points[(int)((long)i * (a->count - 1) / (na - 1))]));
+            d = fmin(d, sp_v2_segment_dist(q, a->points[(int)((long)(i - 1) * (a->count - 1) / (na - 1))],
+                                           a->points[(int)((long)i * (a->count - 1) / (na - 1))]));
         near += d <= tol;
     }
     return near >= 29;

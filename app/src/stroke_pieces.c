@@ -58,18 +58,11 @@ static int root_of(int* up, int i)
     return i;
 }
 
-static double point_segment(sp_vec2 p, sp_vec2 a, sp_vec2 b)
-{
-    sp_vec2 ab = sp_v2_sub(b, a), ap = sp_v2_sub(p, a);
-    double l2 = sp_v2_dot(ab, ab), t = l2 > 0 ? fmin(fmax(sp_v2_dot(ap, ab) / l2, 0), 1) : 0;
-    return sp_v2_len(sp_v2_sub(ap, sp_v2_scale(ab, t)));
-}
-
 // Whether q lies within r of stroke st's line.
 static bool near_line(const sp_stroke* st, sp_vec2 q, double r)
 {
     for (int j = 0; j + 1 < st->count; ++j)
-        if (point_segment(q, st->points[j], st->points[j + 1]) <= r) return true;
+        if (sp_v2_segment_dist(q, st->points[j], st->points[j + 1]) <= r) return true;
     return st->count == 1 && sp_v2_len(sp_v2_sub(q, st->points[0])) <= r;
 }
 
@@ -85,8 +78,7 @@ static bool at_junction(const sp_sketch* sk, const bool* keep, int a, int b, sp_
         if (i == a || i == b || !keep[i] || sp_v2_len(sp_v2_sub(q, st->points[0])) <= 2 * r ||
             sp_v2_len(sp_v2_sub(q, st->points[st->count - 1])) <= 2 * r)
             continue;
-        for (int j = 0; j < st->count; ++j)
-            if (point_segment(q, st->points[j], st->points[j + (j + 1 < st->count)]) <= r) return true;
+        if (near_line(st, q, r)) return true;
     }
     return false;
 }

@@ -1217,26 +1217,35 @@ static void test_own_readonly_leftovers(void)
     ENSURE(rmdir(dir) == 0);
 }
 
-// A database whose path fills the 1,100 bytes the -wal and -shm names were
-// built in: the cut name was the database's own, and it was removed as a
-// stale sidecar.
-static void test_drop_sidecars_long_path(void)
+// path: a file name `len` bytes long under tmp/<name>, in folders of 150
+// bytes made on the way, ending in `suffix`.
+static void long_path(const char* name, size_t len, const char* suffix, char path[2048])
 {
-    char dir[2048], path[2048];
-    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("long"));
+    char dir[2048];
+    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path(name));
     mkdir(dir, 0777);
-    while (strlen(dir) < 1099 - 200) {
+    while (strlen(dir) < len - 200) {
         size_t n = strlen(dir);
         dir[n] = '/';
         memset(dir + n + 1, 'd', 150);
         dir[n + 151] = 0;
         ENSURE(mkdir(dir, 0777) == 0 || errno == EEXIST);
     }
-    size_t n = strlen(dir);
+    size_t n = strlen(dir), k = strlen(suffix);
     memcpy(path, dir, n);
     path[n] = '/';
-    memset(path + n + 1, 'f', 1099 - n - 1);
-    path[1099] = 0;
+    memset(path + n + 1, 'f', len - n - 1 - k);
+    memcpy(path + len - k, suffix, k + 1);
+    ENSURE(strlen(path) == len);
+}
+
+// A database whose path fills the 1,100 bytes the -wal and -shm names were
+// built in: the cut name was the database's own, and it was removed as a
+// stale sidecar.
+static void test_drop_sidecars_long_path(void)
+{
+    char path[2048];
+    long_path("long", 1099, "", path);
     FILE* f = fopen(path, "wb");
     ENSURE(f && fputs("a database", f) >= 0 && fclose(f) == 0);
     sp_db_drop_stale_sidecars(path);
@@ -1252,23 +1261,9 @@ static void test_drop_sidecars_long_path(void)
 // and the user's empty file was removed after the failed build).
 static void test_long_paths(void)
 {
-    char dir[2048], path[2048];
-    snprintf(dir, sizeof dir, "%s", sp_test_tmp_path("longdb"));
-    if (strlen(dir) > 500) SKIP("the build folder's own path is longer than 500 bytes");
-    mkdir(dir, 0777);
-    while (strlen(dir) < 1023 - 200) {
-        size_t n = strlen(dir);
-        dir[n] = '/';
-        memset(dir + n + 1, 'd', 150);
-        dir[n + 151] = 0;
-        ENSURE(mkdir(dir, 0777) == 0 || errno == EEXIST);
-    }
-    size_t n = strlen(dir);
-    memcpy(path, dir, n);
-    path[n] = '/';
-    memset(path + n + 1, 'f', 1023 - n - 1 - 3);
-    memcpy(path + 1023 - 3, ".db", 4);
-    ENSURE(strlen(path) == 1023);
+    char path[2048];
+    if (strlen(sp_test_tmp_path("longdb")) > 500) SKIP("the build folder's own path is longer than 500 bytes");
+    long_path("longdb", 1023, ".db", path);
     FILE* f = fopen(path, "wb"); // empty, as mktemp makes it
     ENSURE(f && fclose(f) == 0);
     sp_error err = {0};

@@ -44,6 +44,13 @@ static inline sp_vec2 sp_v2_scale(sp_vec2 a, double s) { return (sp_vec2){a.x * 
 static inline double sp_v2_dot(sp_vec2 a, sp_vec2 b) { return a.x * b.x + a.y * b.y; }
 static inline double sp_v2_len(sp_vec2 a) { return sqrt(a.x * a.x + a.y * a.y); }
 static inline bool sp_v2_is_valid(sp_vec2 a) { return isfinite(a.x) && isfinite(a.y); }
+/// Distance from p to the segment a-b (a point when a == b).
+static inline double sp_v2_segment_dist(sp_vec2 p, sp_vec2 a, sp_vec2 b)
+{
+    sp_vec2 ab = sp_v2_sub(b, a), ap = sp_v2_sub(p, a);
+    double l2 = sp_v2_dot(ab, ab), t = l2 > 0 ? fmin(fmax(sp_v2_dot(ap, ab) / l2, 0), 1) : 0;
+    return sp_v2_len(sp_v2_sub(ap, sp_v2_scale(ab, t)));
+}
 
 static inline sp_quat sp_quat_identity(void) { return (sp_quat){0, 0, 0, 1}; }
 static inline sp_quat sp_quat_mul(sp_quat a, sp_quat b)
